@@ -1,0 +1,113 @@
+# wetdem — build, test, demo, validation, benchmarks.
+#   make          library (static + shared) and the wetdem CLI in build/
+#   make test     build and run every unit test (installs missing Debian packages first)
+#   make check    everything CI checks: tests under ASan+UBSan, symbol prefixes, docs freshness
+#   make demo     the built-in default scenario
+#   make validate long validation sweeps and figures (docs/validation.md)
+#   make bench    benchmarks with ratios against baselines measured in the same run
+#   make figures  figures from CSV in build/validate
+
+CC      ?= gcc
+BUILD   ?= build
+PYTHON  ?= /usr/bin/python3
+CSTD     = -std=c11 -D_DEFAULT_SOURCE
+WARN     = -Wall -Wextra -Wpedantic -Wshadow -Werror
+OPT     ?= -O2
+CFLAGS_ALL = $(CSTD) $(WARN) $(OPT) -g -fPIC -fvisibility=hidden -ffp-contract=off -fopenmp \
+             -Iinclude -Isrc $(EXTRA_CFLAGS)
+LDLIBS   = -lsundials_cvode -lsundials_nvecserial -lgsl -lgslcblas -linih -lm -fopenmp
+VERSION := $(shell sed -n 's/^\#define WETDEM_VERSION "\(.*\)"/\1/p' include/wetdem.h)
+GIT_HASH := $(shell git rev-parse --short HEAD 2>/dev/null || echo unknown)
+
+LIB_SRC  = $(sort $(wildcard src/*.c))
+LIB_OBJ  = $(patsubst src/%.c,$(BUILD)/obj/%.o,$(LIB_SRC))
+CLI_SRC  = $(sort $(wildcard cli/*.c))
+CLI_OBJ  = $(patsubst cli/%.c,$(BUILD)/cli/%.o,$(CLI_SRC))
+TEST_SRC = $(sort $(wildcard tests/test_*.c))
+TEST_BIN = $(patsubst tests/%.c,$(BUILD)/tests/%,$(TEST_SRC))
+EX_SRC   = $(sort $(wildcard examples/*/main.c))
+EX_BIN   = $(patsubst examples/%/main.c,$(BUILD)/examples/%,$(EX_SRC))
+
+.PHONY: all deps test check san test-san demo validate bench figures docs clean format \
+        check-format check-prefix check-docs examples
+
+all: deps $(BUILD)/libwetdem.a $(BUILD)/libwetdem.so $(BUILD)/wetdem
+
+deps:
+	@scripts/install-deps build
+
+$(BUILD)/obj/%.o: src/%.c include/wetdem.h $(wildcard src/*.h)
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS_ALL) -c $< -o $@
+
+$(BUILD)/cli/%.o: cli/%.c include/wetdem.h $(wildcard cli/*.h)
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS_ALL) -DWETDEM_GIT_HASH='"$(GIT_HASH)"' -c $< -o $@
+
+$(BUILD)/libwetdem.a: $(LIB_OBJ)
+	@rm -f $@
+	ar rcs $@ $^
+
+$(BUILD)/libwetdem.so: $(LIB_OBJ)
+	$(CC) -shared -o $@ $^ $(LDLIBS)
+
+$(BUILD)/wetdem: $(CLI_OBJ) $(BUILD)/libwetdem.a
+	$(CC) -o $@ $(CLI_OBJ) $(BUILD)/libwetdem.a $(LDLIBS)
+
+$(BUILD)/tests/%: tests/%.c tests/harness.h $(BUILD)/libwetdem.a
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS_ALL) -Itests -o $@ $< $(BUILD)/libwetdem.a $(LDLIBS) -lcmocka
+
+$(BUILD)/examples/%: examples/%/main.c $(BUILD)/libwetdem.a
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS_ALL) -o $@ $< $(BUILD)/libwetdem.a $(LDLIBS)
+
+examples: $(EX_BIN)
+
+test: all $(TEST_BIN) $(EX_BIN)
+	@WETDEM_CLI=$(abspath $(BUILD)/wetdem) tests/run-tests $(TEST_BIN) $(EX_BIN)
+
+# Tests again under AddressSanitizer + UndefinedBehaviorSanitizer, in a separate build tree.
+test-san:
+	$(MAKE) test BUILD=build-san OPT=-O1 \
+	  EXTRA_CFLAGS="-fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer" \
+	  LDLIBS="$(LDLIBS) -fsanitize=address,undefined"
+
+check-prefix: all
+	@tools/check-prefix $(BUILD)
+
+check-docs: all
+	@$(BUILD)/wetdem docs-models > $(BUILD)/models.md && diff -u docs/models.md $(BUILD)/models.md \
+	  || { echo "docs/models.md is stale: run 'make docs'"; exit 1; }
+
+check-format:
+	@if command -v clang-format >/dev/null; then \
+	  clang-format --dry-run -Werror src/*.c src/*.h include/*.h cli/*.c cli/*.h tests/*.c tests/*.h; \
+	else echo "clang-format not installed: format check skipped"; fi
+
+check: test test-san check-prefix check-docs
+
+docs: all
+	$(BUILD)/wetdem docs-models > docs/models.md
+
+demo: all
+	@scripts/install-deps figures
+	@scripts/demo $(BUILD)/wetdem
+
+validate: all
+	@scripts/install-deps figures
+	@scripts/validate $(BUILD)/wetdem
+
+figures:
+	@scripts/install-deps figures
+	@for f in figures/*.py; do $(PYTHON) $$f || exit 1; done
+
+bench: all
+	@scripts/install-deps bench
+	@scripts/bench $(BUILD)/wetdem
+
+format:
+	clang-format -i src/*.c src/*.h include/*.h cli/*.c cli/*.h tests/*.c tests/*.h
+
+clean:
+	rm -rf build build-san

@@ -1,0 +1,396 @@
+/*
+ * wetdem.h — the one public header of libwetdem.
+ *
+ * wetdem simulates collisions of wet and immersed spheres with the discrete element method:
+ * lubrication, thin-film viscous and capillary forces combined with soft (Hertz–Mindlin) or
+ * hard-sphere (impulse) contact.
+ *
+ * Conventions (docs/concepts.md): SI units everywhere. For a pair i–j the unit normal points
+ * from j to i, the gap h = |x_i - x_j| - R_i - R_j is negative when the solids overlap, the
+ * normal approach speed v_n is positive when the surfaces approach, R* = R_i R_j/(R_i + R_j),
+ * m* = m_i m_j/(m_i + m_j). A force reported for a pair acts on i; j receives the opposite.
+ *
+ * Status codes: 0 success, > 0 success with information, < 0 error (enum wetdem_status). The
+ * library never exits or aborts; a failing call on a simulation stores a message that
+ * wetdem_sim_errmsg() returns.
+ *
+ * Sections, in the order a user needs them: value types; status; parameters; materials;
+ * models; simulation; pair forces; hard-sphere impulses; soft engine; analysis;
+ * pairwise engine; tracking and fitting.
+ */
+#ifndef WETDEM_H
+#define WETDEM_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#if defined(__GNUC__)
+#define WETDEM_API __attribute__((visibility("default")))
+#else
+#define WETDEM_API
+#endif
+
+#define WETDEM_VERSION "0.1.0"
+
+/* ======================================================================================== */
+/* Value types                                                                              */
+/* ======================================================================================== */
+
+struct wetdem_vec3 {
+    double x, y, z;
+};
+
+/* One sphere. Plain data: safe to copy. */
+struct wetdem_particle {
+    struct wetdem_vec3 pos;   /* centre position [m] */
+    struct wetdem_vec3 vel;   /* velocity [m/s] */
+    struct wetdem_vec3 omega; /* angular velocity [rad/s] */
+    double radius;            /* [m], > 0 */
+    double mass;              /* [kg], > 0; 0 means "from the material density" when added */
+    int material;             /* index into the simulation's material table */
+    bool is_fixed;            /* held in place (infinite mass), e.g. a target on a support */
+};
+
+/* Solid and film properties of one material. All per particle; pairs mix them
+ * (wetdem_contact: harmonic for moduli, mean for the others, sum for films). */
+struct wetdem_material {
+    double density;        /* [kg/m^3] > 0 */
+    double youngs_modulus; /* E [Pa] > 0 */
+    double poisson_ratio;  /* nu [-], in [-1, 0.5) */
+    double restitution;    /* dry coefficient of restitution e_dry [-], in (0, 1] */
+    double friction_dry;   /* Coulomb coefficient of dry contact [-] >= 0 */
+    double friction_lub;   /* Coulomb coefficient of lubricated contact [-] >= 0 */
+    double roughness;      /* mean asperity height sigma [m] >= 0 (Nijssen Eq. 3) */
+    double film;           /* liquid film thickness delta_i on this sphere [m] >= 0 */
+};
+
+/* The liquid between or around the spheres. */
+struct wetdem_fluid {
+    double viscosity;       /* mu [Pa s] >= 0 */
+    double surface_tension; /* sigma [N/m] >= 0 */
+    double density;         /* [kg/m^3] >= 0 (for Reynolds-number checks only) */
+};
+
+/* ======================================================================================== */
+/* Status and errors                                                                        */
+/* ======================================================================================== */
+
+enum wetdem_status {
+    WETDEM_OK = 0,
+    WETDEM_EVENT = 1,          /* stopped at a terminal event: information, not an error */
+    WETDEM_RETRY = 2,          /* internal: the step was too large */
+    WETDEM_ERR_NOMEM = -1,     /* out of memory */
+    WETDEM_ERR_INVALID = -2,   /* bad argument or parameter value */
+    WETDEM_ERR_NOT_FOUND = -3, /* unknown model, integrator, material or parameter name */
+    WETDEM_ERR_STEP = -4,      /* the integrator could not reach its tolerance */
+    WETDEM_ERR_MAX_STEPS = -5, /* step budget exhausted */
+    WETDEM_ERR_CALLBACK = -6,  /* a user callback returned an error */
+    WETDEM_ERR_IO = -7,        /* a file could not be read or written */
+    WETDEM_ERR_PARSE = -8,     /* a scenario or data file is malformed */
+    WETDEM_ERR_NUMERIC = -9,   /* NaN or infinity appeared in the state */
+};
+
+/* Name of a status code, e.g. "WETDEM_ERR_INVALID"; "WETDEM_UNKNOWN" for other values. */
+WETDEM_API const char* wetdem_status_name(int status);
+
+/* ======================================================================================== */
+/* Parameters: named, documented, range-checked                                             */
+/* ======================================================================================== */
+
+/* Descriptor of one parameter stored as a double at `offset` in a parameter struct.
+ * A parameter with `choices` is an enumeration: the stored double is the index of the
+ * chosen word (set it by word with wetdem_sim_set_param_str()). Tables end with {0}. */
+struct wetdem_param_desc {
+    const char* name;            /* "cutoff_ratio" */
+    const char* unit;            /* "m", "Pa s", "-" */
+    const char* doc;             /* one sentence */
+    size_t offset;               /* offsetof(params struct, field) */
+    double default_value;        /* also the index of the default choice */
+    double min, max;             /* valid closed range [min, max]; see *_open flags */
+    bool min_open, max_open;     /* exclude the bound itself */
+    const char* const* choices;  /* NULL-terminated words, or NULL for a number */
+};
+
+/* Number of descriptors in a {0}-terminated table. */
+WETDEM_API size_t wetdem_param_count(const struct wetdem_param_desc* table);
+/* Finds a descriptor by name in a table; NULL if absent. */
+WETDEM_API const struct wetdem_param_desc* wetdem_param_find(const struct wetdem_param_desc* table,
+                                                             const char* name);
+/* Fills a parameter struct with the defaults of its table. */
+WETDEM_API void wetdem_param_init_defaults(const struct wetdem_param_desc* table, void* params);
+/* Checks `value` against a descriptor. Returns WETDEM_OK or WETDEM_ERR_INVALID and writes a
+ * message naming the parameter, the value and the valid range into msg (may be NULL). */
+WETDEM_API int wetdem_param_validate(const struct wetdem_param_desc* d, double value, char* msg,
+                                     size_t msg_size);
+/* Writes the valid range of d as text, e.g. "(0, 1]" or "one of: c, nc". */
+WETDEM_API void wetdem_param_range_text(const struct wetdem_param_desc* d, char* buf, size_t n);
+/* Index of `word` among d->choices, or -1. */
+WETDEM_API int wetdem_param_choice_index(const struct wetdem_param_desc* d, const char* word);
+/* The closest of `candidates` (NULL-terminated) to `word` by edit distance, or NULL when
+ * nothing is close enough to be a plausible typo. */
+WETDEM_API const char* wetdem_param_suggest(const char* word, const char* const* candidates);
+
+/* ======================================================================================== */
+/* Materials                                                                                */
+/* ======================================================================================== */
+
+/* Fills *m with a built-in preset: "steel1", "steel2", "glass", "delrin" (Nijssen 2023
+ * Table 1, the immersed spheres of Yang & Hunt), "punch_steel" (Punch Table 1, dry striker)
+ * or "punch_steel_coated" (the same sphere with the 270 um silicone-oil film).
+ * Returns WETDEM_OK or WETDEM_ERR_NOT_FOUND. */
+WETDEM_API int wetdem_material_preset(const char* name, struct wetdem_material* m);
+/* Fills *f with the fluid that goes with a preset: "water" (1e-3 Pa s), "glycerol80"
+ * (Yang & Hunt 80 w% glycerol, 0.057 Pa s), "silicone10" (Punch: 10 Pa s, 0.0205 N/m). */
+WETDEM_API int wetdem_fluid_preset(const char* name, struct wetdem_fluid* f);
+/* NULL-terminated list of material preset names. */
+WETDEM_API const char* const* wetdem_material_preset_names(void);
+/* Descriptors of struct wetdem_material and struct wetdem_fluid, for docs and validation. */
+WETDEM_API const struct wetdem_param_desc* wetdem_material_params(void);
+WETDEM_API const struct wetdem_param_desc* wetdem_fluid_params(void);
+/* Checks every field of a material; message into msg. WETDEM_OK or WETDEM_ERR_INVALID. */
+WETDEM_API int wetdem_material_validate(const struct wetdem_material* m, char* msg, size_t n);
+/* Checks every field of a fluid; message into msg. WETDEM_OK or WETDEM_ERR_INVALID. */
+WETDEM_API int wetdem_fluid_validate(const struct wetdem_fluid* f, char* msg, size_t n);
+
+/* ======================================================================================== */
+/* Pair geometry, pair forces and the model interface                                       */
+/* ======================================================================================== */
+
+/* Geometry, kinematics and mixed properties of one interacting pair, computed once per pair
+ * (wetdem_contact_from_particles) and read by every model. For a plane wall j, radius_j is
+ * INFINITY, m_eff = m_i and r_eff = R_i. */
+struct wetdem_contact {
+    size_t i, j;               /* particle indices (j: wall index for walls) */
+    bool is_wall;              /* j is a plane wall */
+    struct wetdem_vec3 normal; /* unit vector from j to i */
+    double gap;                /* surface separation h [m]; < 0 overlap */
+    double radius_i, radius_j; /* [m] */
+    double r_eff;              /* R* [m] */
+    double m_eff;              /* m* [kg] */
+    double v_n;                /* normal approach speed [m/s], > 0 approaching */
+    struct wetdem_vec3 v_t;    /* tangential velocity of i's surface relative to j's at the
+                                  contact point [m/s] */
+    double dt;                 /* time since the pair's history was last committed [s] */
+    /* mixed pair properties */
+    double e_star;             /* 1/E* = (1-nu_i^2)/E_i + (1-nu_j^2)/E_j [Pa] */
+    double g_star;             /* 1/G* = (2-nu_i)/G_i + (2-nu_j)/G_j [Pa] */
+    double restitution;        /* e_dry, mean of the two [-] */
+    double friction_dry;       /* mean of the two [-] */
+    double friction_lub;       /* mean of the two [-] */
+    double roughness;          /* h_sigma = (sigma_i + sigma_j)/2 [m] (Nijssen Eq. 3) */
+    double film;               /* delta_ij = delta_i + delta_j [m] */
+    double viscosity;          /* fluid mu [Pa s] */
+    double surface_tension;    /* fluid sigma [N/m] */
+    double h_min;              /* minimum separation from the min-separation model [m] */
+};
+
+/* What one model adds for one pair. Forces act on i; j receives the opposite. */
+struct wetdem_pair_force {
+    double f_normal;             /* along the normal, > 0 repulsive [N] */
+    struct wetdem_vec3 f_tan;    /* tangential force on i [N] */
+    struct wetdem_vec3 torque_i; /* torque on i about its centre [N m] */
+    struct wetdem_vec3 torque_j; /* torque on j about its centre [N m] */
+};
+
+enum wetdem_model_kind {
+    WETDEM_MODEL_CONTACT = 1,        /* solid contact force (soft) */
+    WETDEM_MODEL_FLUID = 2,          /* lubrication, thin-film viscous or capillary force */
+    WETDEM_MODEL_MIN_SEPARATION = 3, /* gives h_min for a pair */
+    WETDEM_MODEL_IMPULSE = 4,        /* hard-sphere impulse contact */
+};
+
+#define WETDEM_MAX_THRESHOLDS 4
+
+/* A named, documented, parameter-checked model (force, minimum separation or impulse). */
+struct wetdem_model {
+    const char* name;                       /* keyword used by the CLI, scenarios and docs */
+    enum wetdem_model_kind kind;
+    const char* summary;                    /* one line */
+    const char* doc;                        /* a paragraph: physics, validity, units */
+    const char* equations;                  /* equation references in the seed papers */
+    const struct wetdem_param_desc* params; /* terminated by {0} */
+    size_t params_size;                     /* sizeof the model's params struct */
+    size_t history_len;                     /* doubles of per-pair state (0 if none) */
+    /* Largest gap at which the model acts [m] (force models). */
+    double (*range)(const void* params, const struct wetdem_contact* c);
+    /* Adds the model's force to *out. history (history_len doubles) holds the committed state
+     * on entry and receives the state advanced by c->dt; the caller decides whether to keep
+     * it. Returns WETDEM_OK or a negative status. */
+    int (*pair)(const void* params, const struct wetdem_contact* c, double* history,
+                struct wetdem_pair_force* out);
+    /* Minimum separation h_min [m] (min-separation models); may update history. */
+    double (*min_separation)(const void* params, const struct wetdem_contact* c,
+                             double* history);
+    /* Gaps [m] at which the force law changes branch, for event location; returns the count
+     * written (<= WETDEM_MAX_THRESHOLDS). Optional. */
+    size_t (*thresholds)(const void* params, const struct wetdem_contact* c,
+                         const double* history, double* gaps);
+};
+
+/* NULL-terminated table of every built-in model. */
+WETDEM_API const struct wetdem_model* const* wetdem_model_registry(void);
+/* Built-in model by name, or NULL. */
+WETDEM_API const struct wetdem_model* wetdem_model_find(const char* name);
+/* "contact", "fluid", "min-separation", "impulse". */
+WETDEM_API const char* wetdem_model_kind_name(enum wetdem_model_kind kind);
+
+/* Builds the contact of particles a (as i) and b (as j) with their materials and the fluid.
+ * h_min and dt are left 0 for the caller to fill. */
+WETDEM_API void wetdem_contact_from_particles(struct wetdem_contact* c,
+                                              const struct wetdem_particle* a,
+                                              const struct wetdem_material* ma,
+                                              const struct wetdem_particle* b,
+                                              const struct wetdem_material* mb,
+                                              const struct wetdem_fluid* fluid);
+/* Builds the contact of particle a (as i) with a plane wall through `point` with unit normal
+ * `normal` pointing into the domain; mw is the wall's material. */
+WETDEM_API void wetdem_contact_with_wall(struct wetdem_contact* c, const struct wetdem_particle* a,
+                                         const struct wetdem_material* ma,
+                                         struct wetdem_vec3 point, struct wetdem_vec3 normal,
+                                         const struct wetdem_material* mw,
+                                         const struct wetdem_fluid* fluid);
+/* The same contact seen from j: normal, v_t reversed, i and j swapped. */
+WETDEM_API struct wetdem_contact wetdem_contact_swapped(const struct wetdem_contact* c);
+/* Adds a tangential force on i acting at the contact point: f_tan += ft and the torques
+ * torque_i += (-R_i n) x ft, torque_j += (-R_j n) x ft (j receives -ft at +R_j n). */
+WETDEM_API void wetdem_pair_force_add_tangential(struct wetdem_pair_force* out,
+                                                 const struct wetdem_contact* c,
+                                                 struct wetdem_vec3 ft);
+
+/* ======================================================================================== */
+/* Hard-sphere impulse contact (Davis 2023 Appendix A, Eqs. A1-A36, in 3-D vector form)      */
+/* ======================================================================================== */
+
+/* One body of an impulsive collision. For a wall, mass = INFINITY, radius = INFINITY. */
+struct wetdem_impulse_body {
+    struct wetdem_vec3 vel;   /* [m/s] */
+    struct wetdem_vec3 omega; /* [rad/s] */
+    double mass;              /* [kg] */
+    double radius;            /* lever arm from centre to contact point [m] */
+    double inertia;           /* moment of inertia [kg m^2]; 2/5 m R^2 for a solid sphere */
+};
+
+/* Result of wetdem_hard_impulse(). */
+struct wetdem_impulse_result {
+    double impulse_normal;          /* J_n >= 0 along the normal, on i [N s] */
+    struct wetdem_vec3 impulse_tan; /* tangential impulse on i [N s] */
+    bool is_sticking;               /* slip arrested (A30-A35) rather than sliding (A8-A11) */
+};
+
+/* Applies a hard-sphere collision to bodies i and j in place. normal: unit, from j to i.
+ * The normal relative velocity is reversed with e_dry (A1-A3); friction gives a tangential
+ * impulse mu_f J_n opposing slip (sliding, A8-A11) unless that exceeds what arrests the slip
+ * (A36), in which case slip stops (A33). Returns WETDEM_OK, or WETDEM_ERR_INVALID for
+ * non-positive masses/radii, e_dry outside (0, 1] or mu_f < 0. Separating pairs
+ * (v_n <= 0) are left unchanged and WETDEM_OK is returned. */
+WETDEM_API int wetdem_hard_impulse(struct wetdem_impulse_body* bi, struct wetdem_impulse_body* bj,
+                                   struct wetdem_vec3 normal, double restitution, double friction,
+                                   struct wetdem_impulse_result* result);
+
+/* ======================================================================================== */
+/* Simulation object                                                                        */
+/* ======================================================================================== */
+
+struct wetdem_sim;
+
+/* Allocates an empty simulation with default settings. NULL only if out of memory. */
+WETDEM_API struct wetdem_sim* wetdem_sim_create(void);
+/* Frees the simulation and everything it owns. NULL does nothing. */
+WETDEM_API void wetdem_sim_free(struct wetdem_sim* sim);
+/* Last detailed error message of this simulation, "" if none. */
+WETDEM_API const char* wetdem_sim_errmsg(const struct wetdem_sim* sim);
+
+/* Appends a material (copied, validated). Returns its index >= 0, or a negative status. */
+WETDEM_API int wetdem_sim_add_material(struct wetdem_sim* sim, const struct wetdem_material* m);
+/* Appends a material preset by name; returns its index or a negative status. */
+WETDEM_API int wetdem_sim_add_material_preset(struct wetdem_sim* sim, const char* name);
+/* Borrowed pointer to material k, NULL if out of range. */
+WETDEM_API const struct wetdem_material* wetdem_sim_material(const struct wetdem_sim* sim, int k);
+/* Number of materials. */
+WETDEM_API int wetdem_sim_n_materials(const struct wetdem_sim* sim);
+/* Sets the fluid (validated). */
+WETDEM_API int wetdem_sim_set_fluid(struct wetdem_sim* sim, const struct wetdem_fluid* f);
+/* The fluid. */
+WETDEM_API struct wetdem_fluid wetdem_sim_fluid(const struct wetdem_sim* sim);
+
+/* Appends a copy of p (validated: finite, radius > 0, known material). A mass of 0 is filled
+ * from the material density. Returns WETDEM_OK or a negative status. */
+WETDEM_API int wetdem_sim_add_particle(struct wetdem_sim* sim, struct wetdem_particle p);
+/* Borrowed view of the particles, valid until the next add. *n receives the count. */
+WETDEM_API struct wetdem_particle* wetdem_sim_particles(struct wetdem_sim* sim, size_t* n);
+/* Number of particles. */
+WETDEM_API size_t wetdem_sim_n_particles(const struct wetdem_sim* sim);
+/* Adds a plane wall through `point` with unit `normal` into the domain, of material k. */
+WETDEM_API int wetdem_sim_add_wall(struct wetdem_sim* sim, struct wetdem_vec3 point,
+                                   struct wetdem_vec3 normal, int material);
+/* Number of walls. */
+WETDEM_API size_t wetdem_sim_n_walls(const struct wetdem_sim* sim);
+
+/* Enables a built-in model by name for every pair (force models add up; one min-separation
+ * model; one impulse model). Enabling a min-separation model replaces the previous one.
+ * Returns WETDEM_OK, WETDEM_ERR_NOT_FOUND (message with a suggestion) or WETDEM_ERR_INVALID. */
+WETDEM_API int wetdem_sim_enable_model(struct wetdem_sim* sim, const char* name);
+/* Attaches a custom force model to this simulation only; params (model->params_size bytes)
+ * are copied. */
+WETDEM_API int wetdem_sim_add_model(struct wetdem_sim* sim, const struct wetdem_model* model,
+                                    const void* params);
+/* Disables every force model and resets the min-separation model to "fixed". */
+WETDEM_API void wetdem_sim_clear_models(struct wetdem_sim* sim);
+/* Number of enabled force models, and the k-th. */
+WETDEM_API size_t wetdem_sim_n_models(const struct wetdem_sim* sim);
+WETDEM_API const struct wetdem_model* wetdem_sim_model(const struct wetdem_sim* sim, size_t k);
+/* The min-separation model in use. */
+WETDEM_API const struct wetdem_model* wetdem_sim_min_separation_model(const struct wetdem_sim* s);
+
+/* Sets a parameter by dotted name: "<model>.<param>" for an enabled model or the
+ * min-separation model, "fluid.<field>", "sim.<setting>". Checks range and finiteness.
+ * Returns WETDEM_OK, WETDEM_ERR_NOT_FOUND ("did you mean ...") or WETDEM_ERR_INVALID. */
+WETDEM_API int wetdem_sim_set_param(struct wetdem_sim* sim, const char* name, double value);
+/* Sets an enumerated parameter by word, e.g. ("db.below_hmin", "nc"); numbers are accepted
+ * as text too. */
+WETDEM_API int wetdem_sim_set_param_str(struct wetdem_sim* sim, const char* name,
+                                        const char* value);
+/* Reads a parameter by dotted name into *value. */
+WETDEM_API int wetdem_sim_param(const struct wetdem_sim* sim, const char* name, double* value);
+
+/* Evaluates the sum of the enabled force models for particles i and j (j may equal
+ * (size_t)-1 - w to address wall w) with the given per-pair history (may be NULL: fresh
+ * history), at the current state. Writes the contact used into *c if non-NULL. */
+WETDEM_API int wetdem_sim_pair_force(struct wetdem_sim* sim, size_t i, size_t j,
+                                     struct wetdem_contact* c, struct wetdem_pair_force* out);
+
+/* ======================================================================================== */
+/* Soft engine: integration, events, analysis (see docs/engines.md)                         */
+/* ======================================================================================== */
+
+/* ---- soft engine section: filled by the engine files ---- */
+
+/* ======================================================================================== */
+/* Pairwise engine (Davis 2023)                                                             */
+/* ======================================================================================== */
+
+/* ---- pairwise engine section ---- */
+
+/* ======================================================================================== */
+/* Experiment tracking and fitting (Punch 2023 Sec. 3.2)                                    */
+/* ======================================================================================== */
+
+/* ---- tracking section ---- */
+
+/* ======================================================================================== */
+/* ABI checks for bindings                                                                  */
+/* ======================================================================================== */
+
+/* sizeof of the public value types, for bindings that mirror them. */
+WETDEM_API size_t wetdem_abi_sizeof(const char* type_name);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* WETDEM_H */

@@ -1,0 +1,122 @@
+/*
+ * contact.c — builds struct wetdem_contact for a particle pair or a particle–wall pair:
+ * geometry once per pair (SPEC §2), read-only for every model.
+ * Prefix override: wetdem_contact_* and wetdem_pair_force_*.
+ *
+ *   n    = (x_i - x_j)/|x_i - x_j|           unit normal from j to i
+ *   h    = |x_i - x_j| - R_i - R_j           gap [m], < 0 overlap
+ *   v_n  = -(v_i - v_j) . n                  approach speed [m/s], > 0 approaching
+ *   v_s  = (v_i + w_i x (-R_i n)) - (v_j + w_j x (R_j n))   surface velocity of i rel. to j
+ *   v_t  = v_s - (v_s . n) n                 tangential part [m/s]
+ * Mixed properties: 1/E* = (1-nu_i^2)/E_i + (1-nu_j^2)/E_j; 1/G* = (2-nu_i)/G_i +
+ * (2-nu_j)/G_j with G = E/(2(1+nu)) (Di Renzo & Di Maio 2004); e_dry, mu and sigma are the
+ * means of the two materials (Nijssen Eq. 3 for sigma); delta_ij = delta_i + delta_j.
+ * A plane wall is a sphere of infinite radius and mass: R* = R_i, m* = m_i.
+ * A fixed particle has infinite mass: m* = m of the other.
+ */
+#include <math.h>
+
+#include "vec3.h"
+#include "wetdem.h"
+
+static double reduced(double a, double b)
+{
+    if (isinf(a))
+        return b;
+    if (isinf(b))
+        return a;
+    return a * b / (a + b);
+}
+
+static double effective_mass(const struct wetdem_particle* p)
+{
+    return p->is_fixed ? INFINITY : p->mass;
+}
+
+static void mix_properties(struct wetdem_contact* c, const struct wetdem_material* a,
+                           const struct wetdem_material* b, const struct wetdem_fluid* fluid)
+{
+    double ga = a->youngs_modulus / (2.0 * (1.0 + a->poisson_ratio));
+    double gb = b->youngs_modulus / (2.0 * (1.0 + b->poisson_ratio));
+    c->e_star = 1.0 / ((1.0 - a->poisson_ratio * a->poisson_ratio) / a->youngs_modulus +
+                       (1.0 - b->poisson_ratio * b->poisson_ratio) / b->youngs_modulus);
+    c->g_star = 1.0 / ((2.0 - a->poisson_ratio) / ga + (2.0 - b->poisson_ratio) / gb);
+    c->restitution = 0.5 * (a->restitution + b->restitution);
+    c->friction_dry = 0.5 * (a->friction_dry + b->friction_dry);
+    c->friction_lub = 0.5 * (a->friction_lub + b->friction_lub);
+    c->roughness = 0.5 * (a->roughness + b->roughness);
+    c->film = a->film + b->film;
+    c->viscosity = fluid ? fluid->viscosity : 0.0;
+    c->surface_tension = fluid ? fluid->surface_tension : 0.0;
+    c->h_min = 0.0;
+    c->dt = 0.0;
+}
+
+static void set_kinematics(struct wetdem_contact* c, struct wetdem_vec3 dv,
+                           struct wetdem_vec3 surface_rel)
+{
+    c->v_n = -vec3_dot(dv, c->normal);
+    c->v_t = vec3_reject(surface_rel, c->normal);
+}
+
+void wetdem_contact_from_particles(struct wetdem_contact* c, const struct wetdem_particle* a,
+                                   const struct wetdem_material* ma,
+                                   const struct wetdem_particle* b,
+                                   const struct wetdem_material* mb,
+                                   const struct wetdem_fluid* fluid)
+{
+    struct wetdem_vec3 d = vec3_sub(a->pos, b->pos);
+    double dist = vec3_norm(d);
+    c->is_wall = false;
+    c->normal = dist > 0 ? vec3_scale(d, 1.0 / dist) : vec3(1, 0, 0);
+    c->gap = dist - a->radius - b->radius;
+    c->radius_i = a->radius;
+    c->radius_j = b->radius;
+    c->r_eff = reduced(a->radius, b->radius);
+    c->m_eff = reduced(effective_mass(a), effective_mass(b));
+    struct wetdem_vec3 n = c->normal;
+    struct wetdem_vec3 va = vec3_add(a->vel, vec3_cross(a->omega, vec3_scale(n, -a->radius)));
+    struct wetdem_vec3 vb = vec3_add(b->vel, vec3_cross(b->omega, vec3_scale(n, b->radius)));
+    mix_properties(c, ma, mb, fluid);
+    set_kinematics(c, vec3_sub(a->vel, b->vel), vec3_sub(va, vb));
+}
+
+void wetdem_contact_with_wall(struct wetdem_contact* c, const struct wetdem_particle* a,
+                              const struct wetdem_material* ma, struct wetdem_vec3 point,
+                              struct wetdem_vec3 normal, const struct wetdem_material* mw,
+                              const struct wetdem_fluid* fluid)
+{
+    double dist = vec3_dot(vec3_sub(a->pos, point), normal);
+    c->is_wall = true;
+    c->normal = normal;
+    c->gap = dist - a->radius;
+    c->radius_i = a->radius;
+    c->radius_j = INFINITY;
+    c->r_eff = a->radius;
+    c->m_eff = effective_mass(a);
+    struct wetdem_vec3 va = vec3_add(a->vel, vec3_cross(a->omega, vec3_scale(normal, -a->radius)));
+    mix_properties(c, ma, mw, fluid);
+    set_kinematics(c, a->vel, va);
+}
+
+struct wetdem_contact wetdem_contact_swapped(const struct wetdem_contact* c)
+{
+    struct wetdem_contact s = *c;
+    s.i = c->j;
+    s.j = c->i;
+    s.normal = vec3_neg(c->normal);
+    s.v_t = vec3_neg(c->v_t);
+    s.radius_i = c->radius_j;
+    s.radius_j = c->radius_i;
+    return s;
+}
+
+void wetdem_pair_force_add_tangential(struct wetdem_pair_force* out, const struct wetdem_contact* c,
+                                      struct wetdem_vec3 ft)
+{
+    out->f_tan = vec3_add(out->f_tan, ft);
+    struct wetdem_vec3 nxf = vec3_cross(c->normal, ft);
+    out->torque_i = vec3_axpy(out->torque_i, -c->radius_i, nxf);
+    if (!c->is_wall)
+        out->torque_j = vec3_axpy(out->torque_j, -c->radius_j, nxf);
+}

@@ -1,0 +1,128 @@
+/*
+ * param.c — parameter descriptors: defaults, validation with a message naming the parameter,
+ * its value and valid range, enumerated choices, and "did you mean" suggestions by edit
+ * distance (Levenshtein, with a threshold of one third of the word length, at least 2).
+ */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "wetdem.h"
+
+size_t wetdem_param_count(const struct wetdem_param_desc* table)
+{
+    size_t n = 0;
+    while (table && table[n].name)
+        n++;
+    return n;
+}
+
+const struct wetdem_param_desc* wetdem_param_find(const struct wetdem_param_desc* table,
+                                                  const char* name)
+{
+    for (size_t k = 0; table && table[k].name; k++)
+        if (strcmp(table[k].name, name) == 0)
+            return &table[k];
+    return NULL;
+}
+
+void wetdem_param_init_defaults(const struct wetdem_param_desc* table, void* params)
+{
+    for (size_t k = 0; table && table[k].name; k++)
+        *(double*)((char*)params + table[k].offset) = table[k].default_value;
+}
+
+static size_t count_choices(const char* const* choices)
+{
+    size_t n = 0;
+    while (choices[n])
+        n++;
+    return n;
+}
+
+void wetdem_param_range_text(const struct wetdem_param_desc* d, char* buf, size_t n)
+{
+    if (d->choices) {
+        size_t used = (size_t)snprintf(buf, n, "one of:");
+        for (size_t k = 0; d->choices[k] && used < n; k++)
+            used += (size_t)snprintf(buf + used, n - used, "%s %s", k ? "," : "", d->choices[k]);
+        return;
+    }
+    snprintf(buf, n, "%c%.6g, %.6g%c", d->min_open ? '(' : '[', d->min, d->max,
+             d->max_open ? ')' : ']');
+}
+
+int wetdem_param_validate(const struct wetdem_param_desc* d, double value, char* msg,
+                          size_t msg_size)
+{
+    char range[160];
+    wetdem_param_range_text(d, range, sizeof range);
+    bool ok = isfinite(value);
+    if (ok && d->choices) {
+        double idx = floor(value);
+        ok = idx == value && idx >= 0 && idx < (double)count_choices(d->choices);
+    } else if (ok) {
+        ok = (d->min_open ? value > d->min : value >= d->min) &&
+             (d->max_open ? value < d->max : value <= d->max);
+    }
+    if (ok)
+        return WETDEM_OK;
+    if (msg && msg_size)
+        snprintf(msg, msg_size, "%s = %g [%s] is out of range: valid %s", d->name, value, d->unit,
+                 range);
+    return WETDEM_ERR_INVALID;
+}
+
+int wetdem_param_choice_index(const struct wetdem_param_desc* d, const char* word)
+{
+    for (int k = 0; d->choices && d->choices[k]; k++)
+        if (strcmp(d->choices[k], word) == 0)
+            return k;
+    return -1;
+}
+
+/* Levenshtein distance of two short strings (truncated to 63 characters). */
+static size_t edit_distance(const char* a, const char* b)
+{
+    size_t la = strlen(a), lb = strlen(b);
+    if (la > 63)
+        la = 63;
+    if (lb > 63)
+        lb = 63;
+    size_t row[64];
+    for (size_t j = 0; j <= lb; j++)
+        row[j] = j;
+    for (size_t i = 1; i <= la; i++) {
+        size_t diag = row[0];
+        row[0] = i;
+        for (size_t j = 1; j <= lb; j++) {
+            size_t up = row[j];
+            size_t cost = a[i - 1] == b[j - 1] ? 0 : 1;
+            size_t best = diag + cost;
+            if (up + 1 < best)
+                best = up + 1;
+            if (row[j - 1] + 1 < best)
+                best = row[j - 1] + 1;
+            row[j] = best;
+            diag = up;
+        }
+    }
+    return row[lb];
+}
+
+const char* wetdem_param_suggest(const char* word, const char* const* candidates)
+{
+    const char* best = NULL;
+    size_t best_d = (size_t)-1;
+    for (size_t k = 0; candidates && candidates[k]; k++) {
+        size_t d = edit_distance(word, candidates[k]);
+        if (d < best_d) {
+            best_d = d;
+            best = candidates[k];
+        }
+    }
+    size_t limit = strlen(word) / 3;
+    if (limit < 2)
+        limit = 2;
+    return best_d <= limit ? best : NULL;
+}

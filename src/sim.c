@@ -1,0 +1,203 @@
+/*
+ * sim.c — lifecycle of struct wetdem_sim, materials, fluid, particles and walls, and the
+ * per-simulation error message. Prefix: wetdem_sim_.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "models.h"
+#include "sim.h"
+#include "vec3.h"
+
+int wetdem_sim_fail(struct wetdem_sim* sim, int status, const char* fmt, ...)
+{
+    if (!sim)
+        return status;
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(sim->errmsg, sizeof sim->errmsg, fmt, ap);
+    va_end(ap);
+    return status;
+}
+
+const char* wetdem_sim_errmsg(const struct wetdem_sim* sim)
+{
+    return sim ? sim->errmsg : "";
+}
+
+struct wetdem_sim* wetdem_sim_create(void)
+{
+    struct wetdem_sim* sim = calloc(1, sizeof *sim);
+    if (!sim)
+        return NULL;
+    wetdem_fluid_preset("water", &sim->fluid);
+    sim->minsep.model = &wetdem_minsep_fixed;
+    sim->minsep.params = calloc(1, wetdem_minsep_fixed.params_size ? wetdem_minsep_fixed.params_size : 1);
+    if (!sim->minsep.params) {
+        free(sim);
+        return NULL;
+    }
+    wetdem_param_init_defaults(wetdem_minsep_fixed.params, sim->minsep.params);
+    sim->history_len = wetdem_minsep_fixed.history_len;
+    return sim;
+}
+
+void wetdem_sim_free(struct wetdem_sim* sim)
+{
+    if (!sim)
+        return;
+    wetdem_sim_clear_models(sim);
+    free(sim->minsep.params);
+    free(sim->particles);
+    free(sim->materials);
+    free(sim->walls);
+    free(sim);
+}
+
+/* Grows *array (element size `size`) to hold at least `need` elements. */
+static int grow(void** array, size_t* cap, size_t need, size_t size)
+{
+    if (need <= *cap)
+        return WETDEM_OK;
+    size_t new_cap = *cap ? 2 * *cap : 8;
+    while (new_cap < need)
+        new_cap *= 2;
+    void* p = realloc(*array, new_cap * size);
+    if (!p)
+        return WETDEM_ERR_NOMEM;
+    *array = p;
+    *cap = new_cap;
+    return WETDEM_OK;
+}
+
+int wetdem_sim_add_material(struct wetdem_sim* sim, const struct wetdem_material* m)
+{
+    char msg[512];
+    if (wetdem_material_validate(m, msg, sizeof msg) != WETDEM_OK)
+        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID, "%s", msg);
+    size_t cap = (size_t)sim->materials_cap;
+    if (grow((void**)&sim->materials, &cap, (size_t)sim->n_materials + 1, sizeof *m) != WETDEM_OK)
+        return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory adding a material");
+    sim->materials_cap = (int)cap;
+    sim->materials[sim->n_materials] = *m;
+    return sim->n_materials++;
+}
+
+int wetdem_sim_add_material_preset(struct wetdem_sim* sim, const char* name)
+{
+    struct wetdem_material m;
+    if (wetdem_material_preset(name, &m) != WETDEM_OK) {
+        const char* hint = wetdem_param_suggest(name, wetdem_material_preset_names());
+        return wetdem_sim_fail(sim, WETDEM_ERR_NOT_FOUND, "unknown material preset '%s'%s%s%s",
+                               name, hint ? " (did you mean '" : "", hint ? hint : "",
+                               hint ? "'?)" : "");
+    }
+    return wetdem_sim_add_material(sim, &m);
+}
+
+const struct wetdem_material* wetdem_sim_material(const struct wetdem_sim* sim, int k)
+{
+    return (k >= 0 && k < sim->n_materials) ? &sim->materials[k] : NULL;
+}
+
+int wetdem_sim_n_materials(const struct wetdem_sim* sim)
+{
+    return sim->n_materials;
+}
+
+int wetdem_sim_set_fluid(struct wetdem_sim* sim, const struct wetdem_fluid* f)
+{
+    char msg[512];
+    if (wetdem_fluid_validate(f, msg, sizeof msg) != WETDEM_OK)
+        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID, "%s", msg);
+    sim->fluid = *f;
+    return WETDEM_OK;
+}
+
+struct wetdem_fluid wetdem_sim_fluid(const struct wetdem_sim* sim)
+{
+    return sim->fluid;
+}
+
+int wetdem_sim_add_particle(struct wetdem_sim* sim, struct wetdem_particle p)
+{
+    size_t k = sim->n_particles;
+    if (!vec3_is_finite(p.pos) || !vec3_is_finite(p.vel) || !vec3_is_finite(p.omega))
+        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
+                               "particle %zu: position, velocity and spin must be finite", k);
+    if (!(isfinite(p.radius) && p.radius > 0))
+        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
+                               "particle %zu: radius must be > 0 and finite, got %g m", k,
+                               p.radius);
+    if (p.material < 0 || p.material >= sim->n_materials)
+        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
+                               "particle %zu: material %d does not exist (valid 0..%d)", k,
+                               p.material, sim->n_materials - 1);
+    if (p.mass == 0)
+        p.mass = sim->materials[p.material].density * 4.0 / 3.0 * M_PI * p.radius * p.radius *
+                 p.radius;
+    if (!(isfinite(p.mass) && p.mass > 0))
+        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
+                               "particle %zu: mass must be > 0 and finite, got %g kg", k, p.mass);
+    if (grow((void**)&sim->particles, &sim->particles_cap, k + 1, sizeof p) != WETDEM_OK)
+        return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory adding particle %zu", k);
+    sim->particles[k] = p;
+    sim->n_particles++;
+    return WETDEM_OK;
+}
+
+struct wetdem_particle* wetdem_sim_particles(struct wetdem_sim* sim, size_t* n)
+{
+    if (n)
+        *n = sim->n_particles;
+    return sim->particles;
+}
+
+size_t wetdem_sim_n_particles(const struct wetdem_sim* sim)
+{
+    return sim->n_particles;
+}
+
+int wetdem_sim_add_wall(struct wetdem_sim* sim, struct wetdem_vec3 point,
+                        struct wetdem_vec3 normal, int material)
+{
+    double len = vec3_norm(normal);
+    if (!vec3_is_finite(point) || !(isfinite(len) && len > 0))
+        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
+                               "wall %zu: point must be finite and normal non-zero", sim->n_walls);
+    if (material < 0 || material >= sim->n_materials)
+        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
+                               "wall %zu: material %d does not exist (valid 0..%d)", sim->n_walls,
+                               material, sim->n_materials - 1);
+    if (grow((void**)&sim->walls, &sim->walls_cap, sim->n_walls + 1, sizeof *sim->walls) !=
+        WETDEM_OK)
+        return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory adding a wall");
+    sim->walls[sim->n_walls++] =
+        (struct wetdem_wall){.point = point, .normal = vec3_scale(normal, 1.0 / len),
+                             .material = material};
+    return WETDEM_OK;
+}
+
+size_t wetdem_sim_n_walls(const struct wetdem_sim* sim)
+{
+    return sim->n_walls;
+}
+
+void wetdem_sim_build_contact(const struct wetdem_sim* sim, size_t i, size_t j, bool is_wall,
+                              struct wetdem_contact* c)
+{
+    const struct wetdem_particle* a = &sim->particles[i];
+    if (is_wall) {
+        const struct wetdem_wall* w = &sim->walls[j];
+        wetdem_contact_with_wall(c, a, &sim->materials[a->material], w->point, w->normal,
+                                 &sim->materials[w->material], &sim->fluid);
+    } else {
+        const struct wetdem_particle* b = &sim->particles[j];
+        wetdem_contact_from_particles(c, a, &sim->materials[a->material], b,
+                                      &sim->materials[b->material], &sim->fluid);
+    }
+    c->i = i;
+    c->j = j;
+}

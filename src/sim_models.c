@@ -1,0 +1,345 @@
+/*
+ * sim_models.c — enabling models on a simulation, dotted-name parameters with validation and
+ * "did you mean" hints, and the evaluation of all enabled force models for one pair.
+ * Prefix: wetdem_sim_.
+ *
+ * Per-pair history layout: [min-separation model | force model 0 | force model 1 | ...].
+ * Forces of enabled models add up (STYLE §6.4); the min-separation model runs first and
+ * writes c->h_min, which thin-film models read.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "models.h"
+#include "sim.h"
+#include "vec3.h"
+
+#define SET(field) offsetof(struct wetdem_sim_settings, field)
+static const struct wetdem_param_desc settings_params[] = {
+    {"gravity_x", "m/s^2", "Gravitational acceleration, x component.", SET(gravity_x), 0, -1e4,
+     1e4, false, false, NULL},
+    {"gravity_y", "m/s^2", "Gravitational acceleration, y component.", SET(gravity_y), 0, -1e4,
+     1e4, false, false, NULL},
+    {"gravity_z", "m/s^2", "Gravitational acceleration, z component.", SET(gravity_z), 0, -1e4,
+     1e4, false, false, NULL},
+    {0},
+};
+#undef SET
+
+static void recompute_history_layout(struct wetdem_sim* sim)
+{
+    size_t off = sim->minsep.model->history_len;
+    for (size_t k = 0; k < sim->n_models; k++) {
+        sim->models[k].history_offset = off;
+        off += sim->models[k].model->history_len;
+    }
+    sim->history_len = off;
+}
+
+static int make_slot(struct wetdem_sim* sim, struct wetdem_model_slot* slot,
+                     const struct wetdem_model* model, const void* params)
+{
+    void* p = calloc(1, model->params_size ? model->params_size : 1);
+    if (!p)
+        return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory enabling %s", model->name);
+    if (params)
+        memcpy(p, params, model->params_size);
+    else
+        wetdem_param_init_defaults(model->params, p);
+    slot->model = model;
+    slot->params = p;
+    slot->history_offset = 0;
+    return WETDEM_OK;
+}
+
+int wetdem_sim_add_model(struct wetdem_sim* sim, const struct wetdem_model* model,
+                         const void* params)
+{
+    if (model->kind == WETDEM_MODEL_MIN_SEPARATION) {
+        struct wetdem_model_slot slot;
+        int st = make_slot(sim, &slot, model, params);
+        if (st != WETDEM_OK)
+            return st;
+        free(sim->minsep.params);
+        sim->minsep = slot;
+        recompute_history_layout(sim);
+        return WETDEM_OK;
+    }
+    if (model->kind == WETDEM_MODEL_IMPULSE || !model->pair)
+        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
+                               "model '%s' is an impulse model: it is used by the pairwise "
+                               "engine, not summed as a force",
+                               model->name);
+    for (size_t k = 0; k < sim->n_models; k++)
+        if (strcmp(sim->models[k].model->name, model->name) == 0)
+            return wetdem_sim_fail(sim, WETDEM_ERR_INVALID, "model '%s' is already enabled",
+                                   model->name);
+    if (sim->n_models >= WETDEM_MAX_MODELS)
+        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID, "at most %d force models",
+                               WETDEM_MAX_MODELS);
+    int st = make_slot(sim, &sim->models[sim->n_models], model, params);
+    if (st != WETDEM_OK)
+        return st;
+    sim->n_models++;
+    recompute_history_layout(sim);
+    return WETDEM_OK;
+}
+
+/* NULL-terminated list of every built-in model name, for suggestions. */
+static void model_names(const char** names, size_t cap)
+{
+    const struct wetdem_model* const* reg = wetdem_model_registry();
+    size_t n = 0;
+    for (; reg[n] && n + 1 < cap; n++)
+        names[n] = reg[n]->name;
+    names[n] = NULL;
+}
+
+int wetdem_sim_enable_model(struct wetdem_sim* sim, const char* name)
+{
+    const struct wetdem_model* m = wetdem_model_find(name);
+    if (!m) {
+        const char* names[64];
+        model_names(names, 64);
+        const char* hint = wetdem_param_suggest(name, names);
+        return wetdem_sim_fail(sim, WETDEM_ERR_NOT_FOUND,
+                               "unknown model '%s'%s%s%s (see 'wetdem models')", name,
+                               hint ? " (did you mean '" : "", hint ? hint : "",
+                               hint ? "'?)" : "");
+    }
+    return wetdem_sim_add_model(sim, m, NULL);
+}
+
+void wetdem_sim_clear_models(struct wetdem_sim* sim)
+{
+    for (size_t k = 0; k < sim->n_models; k++)
+        free(sim->models[k].params);
+    sim->n_models = 0;
+    if (sim->minsep.model != &wetdem_minsep_fixed) {
+        struct wetdem_model_slot slot;
+        if (make_slot(sim, &slot, &wetdem_minsep_fixed, NULL) == WETDEM_OK) {
+            free(sim->minsep.params);
+            sim->minsep = slot;
+        }
+    }
+    recompute_history_layout(sim);
+}
+
+size_t wetdem_sim_n_models(const struct wetdem_sim* sim)
+{
+    return sim->n_models;
+}
+
+const struct wetdem_model* wetdem_sim_model(const struct wetdem_sim* sim, size_t k)
+{
+    return k < sim->n_models ? sim->models[k].model : NULL;
+}
+
+const struct wetdem_model* wetdem_sim_min_separation_model(const struct wetdem_sim* sim)
+{
+    return sim->minsep.model;
+}
+
+/* ---- dotted parameter names ---- */
+
+struct param_target {
+    const struct wetdem_param_desc* desc;
+    double* field;
+};
+
+/* Collects every settable dotted name into names (for suggestions). */
+static size_t all_param_names(const struct wetdem_sim* sim, char (*buf)[96], const char** names,
+                              size_t cap)
+{
+    size_t n = 0;
+    const struct {
+        const char* prefix;
+        const struct wetdem_param_desc* table;
+    } groups[] = {{"fluid", wetdem_fluid_params()}, {"sim", settings_params}};
+    for (size_t g = 0; g < 2; g++)
+        for (size_t k = 0; groups[g].table[k].name && n + 1 < cap; k++, n++)
+            snprintf(buf[n], 96, "%s.%s", groups[g].prefix, groups[g].table[k].name);
+    for (size_t m = 0; m <= sim->n_models; m++) {
+        const struct wetdem_model* model = m < sim->n_models ? sim->models[m].model
+                                                             : sim->minsep.model;
+        for (size_t k = 0; model->params[k].name && n + 1 < cap; k++, n++)
+            snprintf(buf[n], 96, "%s.%s", model->name, model->params[k].name);
+    }
+    for (size_t k = 0; k < n; k++)
+        names[k] = buf[k];
+    names[n] = NULL;
+    return n;
+}
+
+static int not_found(const struct wetdem_sim* sim_c, const char* name)
+{
+    struct wetdem_sim* sim = (struct wetdem_sim*)sim_c;
+    static const size_t cap = 256;
+    char (*buf)[96] = malloc(cap * sizeof *buf);
+    const char** names = malloc(cap * sizeof *names);
+    const char* hint = NULL;
+    char hint_copy[96] = "";
+    if (buf && names) {
+        all_param_names(sim, buf, names, cap);
+        hint = wetdem_param_suggest(name, names);
+        if (hint)
+            snprintf(hint_copy, sizeof hint_copy, "%s", hint);
+    }
+    free(buf);
+    free(names);
+    if (hint_copy[0])
+        return wetdem_sim_fail(sim, WETDEM_ERR_NOT_FOUND,
+                               "unknown parameter '%s' (did you mean '%s'?)", name, hint_copy);
+    return wetdem_sim_fail(sim, WETDEM_ERR_NOT_FOUND,
+                           "unknown parameter '%s': names are <model>.<param> for an enabled "
+                           "model, fluid.<field> or sim.<setting>",
+                           name);
+}
+
+static int find_target(const struct wetdem_sim* sim, const char* name, struct param_target* t)
+{
+    const char* dot = strchr(name, '.');
+    if (!dot)
+        return not_found(sim, name);
+    size_t plen = (size_t)(dot - name);
+    const char* key = dot + 1;
+    const struct wetdem_param_desc* table = NULL;
+    void* base = NULL;
+    if (plen == 5 && strncmp(name, "fluid", 5) == 0) {
+        table = wetdem_fluid_params();
+        base = (void*)&sim->fluid;
+    } else if (plen == 3 && strncmp(name, "sim", 3) == 0) {
+        table = settings_params;
+        base = (void*)&sim->settings;
+    } else {
+        for (size_t m = 0; m <= sim->n_models; m++) {
+            const struct wetdem_model_slot* s = m < sim->n_models ? &sim->models[m] : &sim->minsep;
+            if (strlen(s->model->name) == plen && strncmp(s->model->name, name, plen) == 0) {
+                table = s->model->params;
+                base = s->params;
+            }
+        }
+    }
+    const struct wetdem_param_desc* d = table ? wetdem_param_find(table, key) : NULL;
+    if (!d)
+        return not_found(sim, name);
+    t->desc = d;
+    t->field = (double*)((char*)base + d->offset);
+    return WETDEM_OK;
+}
+
+int wetdem_sim_set_param(struct wetdem_sim* sim, const char* name, double value)
+{
+    struct param_target t;
+    int st = find_target(sim, name, &t);
+    if (st != WETDEM_OK)
+        return st;
+    char msg[512];
+    if (wetdem_param_validate(t.desc, value, msg, sizeof msg) != WETDEM_OK)
+        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID, "%.*s.%s", (int)(strchr(name, '.') - name),
+                               name, msg);
+    *t.field = value;
+    return WETDEM_OK;
+}
+
+int wetdem_sim_set_param_str(struct wetdem_sim* sim, const char* name, const char* value)
+{
+    struct param_target t;
+    int st = find_target(sim, name, &t);
+    if (st != WETDEM_OK)
+        return st;
+    if (t.desc->choices) {
+        int idx = wetdem_param_choice_index(t.desc, value);
+        if (idx < 0) {
+            char range[160];
+            wetdem_param_range_text(t.desc, range, sizeof range);
+            const char* hint = wetdem_param_suggest(value, t.desc->choices);
+            return wetdem_sim_fail(sim, WETDEM_ERR_INVALID, "%s = '%s' is not valid: %s%s%s%s",
+                                   name, value, range, hint ? " (did you mean '" : "",
+                                   hint ? hint : "", hint ? "'?)" : "");
+        }
+        *t.field = idx;
+        return WETDEM_OK;
+    }
+    char* end = NULL;
+    double v = strtod(value, &end);
+    if (end == value || *end != '\0')
+        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID, "%s = '%s' is not a number [%s]", name,
+                               value, t.desc->unit);
+    return wetdem_sim_set_param(sim, name, v);
+}
+
+int wetdem_sim_param(const struct wetdem_sim* sim, const char* name, double* value)
+{
+    struct param_target t;
+    int st = find_target(sim, name, &t);
+    if (st == WETDEM_OK)
+        *value = *t.field;
+    return st;
+}
+
+/* ---- evaluation ---- */
+
+void wetdem_sim_history_init(const struct wetdem_sim* sim, double* history)
+{
+    for (size_t k = 0; k < sim->history_len; k++)
+        history[k] = 0.0;
+}
+
+double wetdem_sim_contact_range(const struct wetdem_sim* sim, const struct wetdem_contact* c)
+{
+    double r = 0.0;
+    for (size_t k = 0; k < sim->n_models; k++) {
+        const struct wetdem_model_slot* s = &sim->models[k];
+        double rk = s->model->range ? s->model->range(s->params, c) : 0.0;
+        if (rk > r)
+            r = rk;
+    }
+    return r;
+}
+
+int wetdem_sim_eval_contact(const struct wetdem_sim* sim, struct wetdem_contact* c,
+                            double* history, struct wetdem_pair_force* out,
+                            struct wetdem_pair_force* per_model)
+{
+    double scratch[64];
+    if (!history) {
+        if (sim->history_len > 64)
+            return WETDEM_ERR_INVALID;
+        wetdem_sim_history_init(sim, scratch);
+        history = scratch;
+    }
+    *out = (struct wetdem_pair_force){0};
+    c->h_min = sim->minsep.model->min_separation(sim->minsep.params, c, history);
+    for (size_t k = 0; k < sim->n_models; k++) {
+        const struct wetdem_model_slot* s = &sim->models[k];
+        struct wetdem_pair_force f = {0};
+        int st = s->model->pair(s->params, c, history + s->history_offset, &f);
+        if (st < 0)
+            return st;
+        out->f_normal += f.f_normal;
+        out->f_tan = vec3_add(out->f_tan, f.f_tan);
+        out->torque_i = vec3_add(out->torque_i, f.torque_i);
+        out->torque_j = vec3_add(out->torque_j, f.torque_j);
+        if (per_model)
+            per_model[k] = f;
+    }
+    return WETDEM_OK;
+}
+
+int wetdem_sim_pair_force(struct wetdem_sim* sim, size_t i, size_t j, struct wetdem_contact* c,
+                          struct wetdem_pair_force* out)
+{
+    bool is_wall = j >= sim->n_particles && j != i && (size_t)-1 - j < sim->n_walls;
+    if (i >= sim->n_particles || (!is_wall && (j >= sim->n_particles || j == i)))
+        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
+                               "pair (%zu, %zu): indices must address two different particles "
+                               "(0..%zu) or a wall",
+                               i, j, sim->n_particles);
+    struct wetdem_contact local;
+    struct wetdem_contact* cc = c ? c : &local;
+    wetdem_sim_build_contact(sim, i, is_wall ? (size_t)-1 - j : j, is_wall, cc);
+    return wetdem_sim_eval_contact(sim, cc, NULL, out, NULL);
+}
