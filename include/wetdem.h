@@ -368,7 +368,128 @@ WETDEM_API int wetdem_sim_pair_force(struct wetdem_sim* sim, size_t i, size_t j,
 /* Soft engine: integration, events, analysis (see docs/engines.md)                         */
 /* ======================================================================================== */
 
-/* ---- soft engine section: filled by the engine files ---- */
+/* Integrators are chosen by name: "verlet" (velocity Verlet, fixed step dt = dt_fraction x
+ * the Hertz contact time of the fastest pair, Nijssen 2023 Sec. 3) or "cvode" (SUNDIALS CVODE,
+ * adaptive, with every branch boundary of the force laws located as an event). Their
+ * parameters are set by dotted name: "verlet.dt_fraction", "verlet.dt", "cvode.rtol", ... */
+WETDEM_API int wetdem_sim_set_integrator(struct wetdem_sim* sim, const char* name);
+/* Name of the integrator in use ("verlet" by default). */
+WETDEM_API const char* wetdem_sim_integrator_name(const struct wetdem_sim* sim);
+/* NULL-terminated list of integrator names. */
+WETDEM_API const char* const* wetdem_integrator_names(void);
+
+/* Advances the simulation to time t_end [s]. Returns WETDEM_OK at t_end, WETDEM_EVENT when a
+ * stop condition fired (sim.stop_on_separation), or a negative status (message in errmsg). */
+WETDEM_API int wetdem_sim_integrate(struct wetdem_sim* sim, double t_end);
+/* Current simulated time [s]. */
+WETDEM_API double wetdem_sim_time(const struct wetdem_sim* sim);
+
+/* Work counters since the simulation was created or reset (CVODE GetNum* style). */
+struct wetdem_stats {
+    unsigned long long steps;          /* accepted steps */
+    unsigned long long rejected_steps; /* failed or rejected step attempts */
+    unsigned long long force_evals;    /* evaluations of all forces on all particles (RHS) */
+    unsigned long long pair_evals;     /* evaluations of one pair's models */
+    unsigned long long root_evals;     /* evaluations of the event functions */
+    unsigned long long events;         /* events located */
+};
+WETDEM_API struct wetdem_stats wetdem_sim_stats(const struct wetdem_sim* sim);
+
+/* Located crossings of a pair's gap through a branch boundary of the force law. */
+enum wetdem_event_kind {
+    WETDEM_EVENT_INTERACTION_START = 1, /* gap fell below the largest model range */
+    WETDEM_EVENT_HMIN_REACHED = 2,      /* gap fell below h_min */
+    WETDEM_EVENT_CONTACT_START = 3,     /* gap fell below 0: solid overlap begins */
+    WETDEM_EVENT_CONTACT_END = 4,       /* gap rose above 0 */
+    WETDEM_EVENT_HMIN_LEFT = 5,         /* gap rose above h_min */
+    WETDEM_EVENT_INTERACTION_END = 6,   /* gap rose above the largest model range */
+    WETDEM_EVENT_HARD_CONTACT = 7,      /* hard-sphere impulse (pairwise engine) */
+    WETDEM_EVENT_PARTNER_CHANGE = 8,    /* tracked pairs changed (pairwise engine) */
+};
+struct wetdem_event_record {
+    double time;                /* [s] */
+    enum wetdem_event_kind kind;
+    size_t i, j;                /* pair (j: wall index when is_wall) */
+    bool is_wall;
+    double gap;                 /* gap at the event [m] */
+    double v_n;                 /* normal approach speed at the event [m/s] */
+};
+/* Name of an event kind, e.g. "contact_start". */
+WETDEM_API const char* wetdem_event_kind_name(enum wetdem_event_kind kind);
+/* Borrowed view of the event log, valid until the next integrate/reset. */
+WETDEM_API const struct wetdem_event_record* wetdem_sim_events(const struct wetdem_sim* sim,
+                                                               size_t* n);
+
+/* Called every `interval` seconds of simulated time (and at t = 0 and at the end) with the
+ * current state; a non-zero return stops the integration with WETDEM_ERR_CALLBACK. */
+typedef int (*wetdem_observer_fn)(const struct wetdem_sim* sim, void* ctx);
+WETDEM_API void wetdem_sim_set_observer(struct wetdem_sim* sim, double interval,
+                                        wetdem_observer_fn fn, void* ctx);
+/* Read-only particle view for observers. */
+WETDEM_API const struct wetdem_particle* wetdem_sim_particles_const(const struct wetdem_sim* sim,
+                                                                    size_t* n);
+
+/* ---- two-body collision analysis (SPEC §4) ---- */
+
+enum wetdem_outcome {
+    WETDEM_OUTCOME_STICK = 0,                 /* no separation by t_end */
+    WETDEM_OUTCOME_STICK_ROTATE_SEPARATE = 1, /* separated after rotating as a doublet */
+    WETDEM_OUTCOME_BOUNCE = 2,                /* separated promptly (contact-bounce) */
+};
+/* "stick", "stick-rotate-separate", "bounce". */
+WETDEM_API const char* wetdem_outcome_name(enum wetdem_outcome outcome);
+
+/* A binary collision: sphere i (the striker) moves towards a target j at rest (a sphere, or a
+ * plane wall). Materials, fluid, models and integrator come from the simulation. */
+struct wetdem_collision_spec {
+    int material_i, material_j; /* material indices (j: the target's or the wall's) */
+    double radius_i, radius_j;  /* [m]; radius_j ignored for a wall */
+    bool target_is_wall;        /* j is a plane wall */
+    bool target_is_fixed;       /* target sphere held in place */
+    double speed;               /* impact speed of i [m/s]; 0: derived from stokes */
+    double stokes;              /* normal Stokes number St_n = m* v_n0/(6 pi mu R*^2), used
+                                   when speed == 0 */
+    double angle;               /* impact angle [rad]: between the velocity of i and the line
+                                   of centres at first interaction; 0 = head-on */
+    struct wetdem_vec3 omega_i; /* initial spin of i [rad/s] */
+    double initial_gap;         /* gap at t = 0 [m]; <= 0: just outside the interaction range */
+    double t_end;               /* longest simulated time [s] */
+    double observe_time;        /* > 0: also report e_n at this time (Punch Fig. 9 window) */
+    double rebound_gap_factor;  /* separation is declared when the gap exceeds this multiple
+                                   of the interaction range (>= 1; 0 means 1) */
+};
+
+struct wetdem_collision_result {
+    double stokes_n;            /* normal Stokes number of the impact [-] */
+    double speed_n0;            /* normal approach speed at first interaction [m/s] */
+    double e;                   /* Nijssen: |dv_1|/|dv_0| of the relative velocity [-] */
+    double e_n;                 /* normal restitution -v_f.n_f / v_0.n_0 (Punch Eq. 3) [-] */
+    double e_t;                 /* tangential restitution of the contact-point velocity [-] */
+    double e_n_observed;        /* e_n evaluated at observe_time (NAN if not requested) */
+    double angle_in, angle_out; /* impact and rebound angles to the normal [rad] */
+    struct wetdem_vec3 omega_i, omega_j; /* final spins [rad/s] */
+    double contact_duration;    /* total time with gap < 0 [s] */
+    double interaction_duration;/* time from first interaction to separation [s] */
+    double min_gap;             /* smallest gap reached [m] */
+    bool solid_contact;         /* gap reached 0 */
+    bool hmin_reached;          /* gap reached h_min */
+    bool separated;             /* left the interaction range by t_end */
+    double rotation_angle;      /* angle the line of centres turned during interaction [rad] */
+    enum wetdem_outcome outcome;
+    struct wetdem_stats stats;
+};
+
+/* Sets up and runs one binary collision on `sim` (its particles are replaced; its materials,
+ * fluid, models, integrator and parameters are used). Returns WETDEM_OK or a negative status.
+ * The event log of the run stays available through wetdem_sim_events(). */
+WETDEM_API int wetdem_collision_run(struct wetdem_sim* sim, const struct wetdem_collision_spec* spec,
+                                    struct wetdem_collision_result* result);
+/* Removes all particles and walls, the event log, pair histories and statistics, and sets
+ * the time to 0; materials, fluid, models and parameters are kept. */
+WETDEM_API void wetdem_sim_reset(struct wetdem_sim* sim);
+/* Deep copy (materials, fluid, models, parameters, integrator, particles; not the observer).
+ * NULL if out of memory. For running independent collisions in parallel. */
+WETDEM_API struct wetdem_sim* wetdem_sim_clone(const struct wetdem_sim* sim);
 
 /* ======================================================================================== */
 /* Pairwise engine (Davis 2023)                                                             */
