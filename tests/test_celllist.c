@@ -1,0 +1,249 @@
+/*
+ * test_celllist.c — cell-list neighbour search (src/celllist.c) against brute force on random
+ * polydisperse configurations, with and without periodic axes (including boxes of only 2 and
+ * 3 cells, where neighbouring cells coincide), thread-count independence, the rebuild
+ * guarantee for beyond-contact pairs (LAMMPS PR #4685), and history remapping.
+ */
+#include <gsl/gsl_rng.h>
+#include <omp.h>
+#include <stdlib.h>
+
+#include "celllist.h"
+#include "harness.h"
+#include "vec3.h"
+
+/* n spheres with radii uniform in [r_lo, r_hi] and centres uniform in [0, len]^3 (overlaps
+ * allowed: the search must not care). */
+static struct wetdem_particle* random_spheres(size_t n, double len, double r_lo, double r_hi,
+                                              unsigned long seed)
+{
+    gsl_rng* rng = gsl_rng_alloc(gsl_rng_mt19937);
+    gsl_rng_set(rng, seed);
+    struct wetdem_particle* p = calloc(n, sizeof *p);
+    for (size_t i = 0; i < n; i++) {
+        p[i].pos = vec3(len * gsl_rng_uniform(rng), len * gsl_rng_uniform(rng),
+                        len * gsl_rng_uniform(rng));
+        p[i].radius = r_lo + (r_hi - r_lo) * gsl_rng_uniform(rng);
+    }
+    gsl_rng_free(rng);
+    return p;
+}
+
+static bool within(const struct wetdem_celllist_box* box, const struct wetdem_particle* p,
+                   size_t i, size_t j, double gap_max)
+{
+    struct wetdem_vec3 d = celllist_delta(box, p[i].pos, p[j].pos);
+    double lim = p[i].radius + p[j].radius + gap_max;
+    return vec3_dot(d, d) < lim * lim;
+}
+
+/* Every brute-force pair with gap < reach + skin is listed, in (i, j) order, and nothing else. */
+static void check_against_brute_force(const struct wetdem_celllist* cl,
+                                      const struct wetdem_particle* p, size_t n)
+{
+    size_t k = 0;
+    for (size_t i = 0; i < n; i++)
+        for (size_t j = i + 1; j < n; j++) {
+            if (!within(&cl->box, p, i, j, cl->reach + cl->skin))
+                continue;
+            if (k >= cl->n_pairs || cl->pairs[k].i != i || cl->pairs[k].j != j)
+                fail_msg("pair (%zu, %zu) missing or out of order at list position %zu", i, j,
+                         k);
+            k++;
+        }
+    assert_int_equal(k, cl->n_pairs);
+    for (size_t i = 0; i < n; i++)
+        for (size_t q = cl->first_pair[i]; q < cl->first_pair[i + 1]; q++)
+            assert_int_equal(cl->pairs[q].i, i);
+}
+
+static void run_case(const bool periodic[3], double len, size_t n, unsigned long seed)
+{
+    struct wetdem_particle* p = random_spheres(n, len, 0.5e-3, 1.5e-3, seed);
+    struct wetdem_celllist_box box = {{0, 0, 0}, {len, len, len}, {0}};
+    memcpy(box.periodic, periodic, sizeof box.periodic);
+    struct wetdem_celllist cl;
+    char msg[256];
+    CHECK_OK(wetdem_celllist_init(&cl, &box, 0.4e-3, 0.2e-3, msg, sizeof msg));
+    CHECK_OK(wetdem_celllist_build(&cl, p, n, msg, sizeof msg));
+    check_against_brute_force(&cl, p, n);
+    assert_true(cl.n_pairs > 0);
+    wetdem_celllist_clear(&cl);
+    free(p);
+}
+
+/* d_cut = 2 x 1.5 mm + 0.4 mm + 0.2 mm = 3.6 mm. A 30 mm box has 8 cells per axis; 600
+ * spheres of mean radius 1 mm fill 8.4 % of it, so there are many pairs and empty cells. */
+static void test_celllist_matches_brute_force_open_box(void** state)
+{
+    (void)state;
+    run_case((bool[3]){false, false, false}, 30e-3, 600, 1);
+}
+
+static void test_celllist_matches_brute_force_periodic(void** state)
+{
+    (void)state;
+    run_case((bool[3]){true, false, true}, 30e-3, 600, 2);
+    run_case((bool[3]){true, true, true}, 30e-3, 600, 3);
+}
+
+/* 7.5 mm / 3.6 mm -> 2 cells per axis: the -1 and +1 neighbours are the same cell and must
+ * not yield the pair twice; 11 mm -> 3 cells, where -1 and +1 differ but wrap. */
+static void test_celllist_small_periodic_boxes_have_no_duplicates(void** state)
+{
+    (void)state;
+    run_case((bool[3]){true, true, true}, 7.5e-3, 40, 4);
+    run_case((bool[3]){true, true, true}, 11e-3, 90, 5);
+}
+
+static void test_celllist_rejects_too_small_periodic_box(void** state)
+{
+    (void)state;
+    /* 7.0 mm < 2 d_cut = 7.2 mm: a pair could interact through two images. */
+    struct wetdem_particle* p = random_spheres(10, 7e-3, 1.5e-3, 1.5e-3, 6);
+    struct wetdem_celllist_box box = {{0, 0, 0}, {7e-3, 7e-3, 7e-3}, {true, false, false}};
+    struct wetdem_celllist cl;
+    char msg[256] = "";
+    CHECK_OK(wetdem_celllist_init(&cl, &box, 0.4e-3, 0.2e-3, msg, sizeof msg));
+    CHECK_STATUS(wetdem_celllist_build(&cl, p, 10, msg, sizeof msg), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(msg, "periodic box length");
+    CHECK_STATUS(wetdem_celllist_init(&cl, &box, 0.4e-3, 0.0, msg, sizeof msg),
+                 WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(msg, "skin");
+    CHECK_STATUS(wetdem_celllist_init(&cl, &box, NAN, 1e-4, msg, sizeof msg), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(msg, "reach");
+    wetdem_celllist_clear(&cl);
+    free(p);
+}
+
+static void test_celllist_same_list_for_any_thread_count(void** state)
+{
+    (void)state;
+    size_t n = 3000;
+    struct wetdem_particle* p = random_spheres(n, 60e-3, 0.5e-3, 1.5e-3, 7);
+    struct wetdem_celllist_box box = {{0, 0, 0}, {60e-3, 60e-3, 60e-3}, {true, false, false}};
+    struct wetdem_celllist a, b;
+    CHECK_OK(wetdem_celllist_init(&a, &box, 0.4e-3, 0.2e-3, NULL, 0));
+    CHECK_OK(wetdem_celllist_init(&b, &box, 0.4e-3, 0.2e-3, NULL, 0));
+    int saved = omp_get_max_threads();
+    omp_set_num_threads(1);
+    CHECK_OK(wetdem_celllist_build(&a, p, n, NULL, 0));
+    omp_set_num_threads(4);
+    CHECK_OK(wetdem_celllist_build(&b, p, n, NULL, 0));
+    omp_set_num_threads(saved);
+    assert_int_equal(a.n_pairs, b.n_pairs);
+    assert_memory_equal(a.pairs, b.pairs, a.n_pairs * sizeof *a.pairs);
+    wetdem_celllist_clear(&a);
+    wetdem_celllist_clear(&b);
+    free(p);
+}
+
+/* Moves particles with random velocities for `steps` steps of at most step_max each, wrapping
+ * periodic coordinates into the box as an engine does, rebuilding only when the criterion
+ * (or, for the negative control, a lax displacement `lax` > skin/2) asks for it. Returns the
+ * number of (step, pair) occurrences with gap < reach that were absent from the list. */
+static size_t count_missed_pairs(double reach, double lax, size_t* builds)
+{
+    size_t n = 400, missed = 0;
+    double len = 24e-3, skin = 0.2e-3, step_max = 0.01e-3;
+    struct wetdem_particle* p = random_spheres(n, len, 0.5e-3, 1.0e-3, 8);
+    gsl_rng* rng = gsl_rng_alloc(gsl_rng_mt19937);
+    gsl_rng_set(rng, 9);
+    struct wetdem_vec3* v = calloc(n, sizeof *v);
+    for (size_t i = 0; i < n; i++)
+        v[i] = vec3(gsl_rng_uniform(rng) - 0.5, gsl_rng_uniform(rng) - 0.5,
+                    gsl_rng_uniform(rng) - 0.5);
+    struct wetdem_celllist_box box = {{0, 0, 0}, {len, len, len}, {true, true, false}};
+    struct wetdem_celllist cl;
+    CHECK_OK(wetdem_celllist_init(&cl, &box, reach, skin, NULL, 0));
+    char* listed = calloc(n * n, 1);
+    for (int s = 0; s < 300; s++) {
+        bool rebuild = lax > 0 ? wetdem_celllist_max_displacement(&cl, p, n) > lax
+                               : wetdem_celllist_needs_rebuild(&cl, p, n);
+        if (rebuild) {
+            CHECK_OK(wetdem_celllist_build(&cl, p, n, NULL, 0));
+            memset(listed, 0, n * n);
+            for (size_t q = 0; q < cl.n_pairs; q++)
+                listed[cl.pairs[q].i * n + cl.pairs[q].j] = 1;
+        }
+        for (size_t i = 0; i < n; i++)
+            for (size_t j = i + 1; j < n; j++)
+                missed += within(&box, p, i, j, 0.4e-3) && !listed[i * n + j];
+        for (size_t i = 0; i < n; i++) {
+            /* |v| <= sqrt(3)/2, so one step moves a particle by <= 0.87 step_max */
+            p[i].pos = vec3_axpy(p[i].pos, step_max, v[i]);
+            p[i].pos.x -= len * floor(p[i].pos.x / len);
+            p[i].pos.y -= len * floor(p[i].pos.y / len);
+        }
+    }
+    *builds = (size_t)cl.n_builds;
+    wetdem_celllist_clear(&cl);
+    free(listed);
+    free(v);
+    free(p);
+    gsl_rng_free(rng);
+    return missed;
+}
+
+/* The interaction range is a 0.4 mm film beyond contact. With reach = 0.4 mm and the skin/2
+ * criterion nothing is ever missed although the list is rebuilt only every ~12 steps
+ * (0.1 mm / 0.0087 mm). Negative controls that must fail: a list built for contact only
+ * (reach 0, the LAMMPS #4685 failure mode) and a lax criterion (rebuild after > skin). */
+static void test_celllist_never_misses_beyond_contact_pairs(void** state)
+{
+    (void)state;
+    size_t builds;
+    assert_int_equal(count_missed_pairs(0.4e-3, 0, &builds), 0);
+    assert_true(builds > 5 && builds < 100);
+    assert_true(count_missed_pairs(0.0, 0, &builds) > 0);
+    assert_true(count_missed_pairs(0.4e-3, 0.3e-3, &builds) > 0);
+}
+
+static void test_celllist_remap_history_keeps_common_pairs(void** state)
+{
+    (void)state;
+    struct wetdem_celllist_pair old_pairs[] = {{0, 1}, {0, 5}, {2, 3}, {4, 7}};
+    double old_hist[] = {1, 10, 2, 20, 3, 30, 4, 40};
+    struct wetdem_celllist_pair new_pairs[] = {{0, 1}, {0, 2}, {2, 3}, {3, 4}, {4, 7}};
+    double new_hist[10], fresh[2] = {-1, -2};
+    assert_int_equal(wetdem_celllist_remap_history(old_pairs, old_hist, 4, new_pairs, new_hist,
+                                                   5, 2, fresh),
+                     3);
+    double want[] = {1, 10, -1, -2, 3, 30, -1, -2, 4, 40};
+    for (int k = 0; k < 10; k++)
+        CHECK_ABS(new_hist[k], want[k], 0); /* copies: exact */
+}
+
+static void test_celllist_rebuild_criterion_is_half_skin(void** state)
+{
+    (void)state;
+    struct wetdem_particle p[2] = {{.pos = {0, 0, 0}, .radius = 1e-3},
+                                   {.pos = {5e-3, 0, 0}, .radius = 1e-3}};
+    struct wetdem_celllist cl;
+    CHECK_OK(wetdem_celllist_init(&cl, NULL, 0, 0.2e-3, NULL, 0));
+    assert_true(wetdem_celllist_needs_rebuild(&cl, p, 2)); /* never built */
+    CHECK_OK(wetdem_celllist_build(&cl, p, 2, NULL, 0));
+    assert_int_equal(cl.n_pairs, 0); /* gap 3 mm > 0.2 mm */
+    p[0].pos.y = 0.099e-3;             /* 0.099 mm < skin/2 = 0.1 mm */
+    assert_false(wetdem_celllist_needs_rebuild(&cl, p, 2));
+    CHECK_REL(wetdem_celllist_max_displacement(&cl, p, 2), 0.099e-3, 1e-12);
+    p[0].pos.y = 0.101e-3;
+    assert_true(wetdem_celllist_needs_rebuild(&cl, p, 2));
+    assert_true(wetdem_celllist_needs_rebuild(&cl, p, 1)); /* count changed */
+    wetdem_celllist_clear(&cl);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_celllist_matches_brute_force_open_box),
+        cmocka_unit_test(test_celllist_matches_brute_force_periodic),
+        cmocka_unit_test(test_celllist_small_periodic_boxes_have_no_duplicates),
+        cmocka_unit_test(test_celllist_rejects_too_small_periodic_box),
+        cmocka_unit_test(test_celllist_same_list_for_any_thread_count),
+        cmocka_unit_test(test_celllist_never_misses_beyond_contact_pairs),
+        cmocka_unit_test(test_celllist_remap_history_keeps_common_pairs),
+        cmocka_unit_test(test_celllist_rebuild_criterion_is_half_skin),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
