@@ -1,0 +1,222 @@
+/*
+ * test_insert.c — initial configurations (src/insert.c): reproducibility from the seed, no
+ * overlap (brute force, minimum image on periodic axes), spheres inside the region, lattice
+ * capacity by hand arithmetic, radius and velocity statistics, clear errors.
+ */
+#include <stdlib.h>
+
+#include "harness.h"
+#include "insert.h"
+#include "vec3.h"
+
+static struct wetdem_insert_spec base_spec(enum wetdem_insert_layout layout, size_t n)
+{
+    return (struct wetdem_insert_spec){
+        .layout = layout,
+        .n = n,
+        .lo = {0, 0, 0},
+        .hi = {20e-3, 20e-3, 20e-3},
+        .radius_min = 0.5e-3,
+        .radius_max = 1.0e-3,
+        .gap = 0.05e-3,
+        .velocity_sigma = 0.1,
+        .seed = 42,
+    };
+}
+
+/* Smallest gap over all pairs minus the required gap (>= 0 when nothing overlaps) [m]. */
+static double worst_gap_excess(const struct wetdem_insert_spec* s, const struct wetdem_particle* p)
+{
+    double worst = INFINITY, len[3] = {s->hi.x - s->lo.x, s->hi.y - s->lo.y, s->hi.z - s->lo.z};
+    for (size_t i = 0; i < s->n; i++)
+        for (size_t j = i + 1; j < s->n; j++) {
+            double d[3] = {p[i].pos.x - p[j].pos.x, p[i].pos.y - p[j].pos.y,
+                           p[i].pos.z - p[j].pos.z};
+            for (int k = 0; k < 3; k++)
+                if (s->periodic[k])
+                    d[k] -= len[k] * round(d[k] / len[k]);
+            double gap = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) - p[i].radius -
+                         p[j].radius;
+            worst = fmin(worst, gap - s->gap);
+        }
+    return worst;
+}
+
+static void check_inside(const struct wetdem_insert_spec* s, const struct wetdem_particle* p)
+{
+    for (size_t i = 0; i < s->n; i++) {
+        double x[3] = {p[i].pos.x, p[i].pos.y, p[i].pos.z};
+        double lo[3] = {s->lo.x, s->lo.y, s->lo.z}, hi[3] = {s->hi.x, s->hi.y, s->hi.z};
+        for (int k = 0; k < 3; k++) {
+            double margin = s->periodic[k] ? 0 : p[i].radius + s->gap;
+            /* 1e-15 m: rounding of lo + k a on a 20 mm region */
+            assert_true(x[k] >= lo[k] + margin - 1e-15 && x[k] <= hi[k] - margin + 1e-15);
+        }
+        assert_true(p[i].radius >= s->radius_min && p[i].radius <= s->radius_max);
+    }
+}
+
+static void test_insert_same_seed_gives_identical_particles(void** state)
+{
+    (void)state;
+    struct wetdem_insert_spec s = base_spec(WETDEM_INSERT_RANDOM, 300);
+    struct wetdem_particle a[300], b[300], c[300];
+    CHECK_OK(wetdem_insert_particles(&s, a, NULL, 0));
+    CHECK_OK(wetdem_insert_particles(&s, b, NULL, 0));
+    assert_memory_equal(a, b, sizeof a);
+    s.seed = 43;
+    CHECK_OK(wetdem_insert_particles(&s, c, NULL, 0));
+    assert_memory_not_equal(a, c, sizeof a);
+}
+
+static void test_insert_random_has_no_overlap(void** state)
+{
+    (void)state;
+    /* 1500 spheres of mean volume 4/3 pi (0.75 mm)^3 ~ 1.9e-9 m^3 (mean of r^3 over [0.5, 1]
+     * mm is 0.47e-9 m^3, so 1.97e-9 m^3) in 8e-6 m^3: volume fraction 0.37, close to the
+     * jamming limit of random sequential addition, a hard case for the grid search. */
+    struct wetdem_insert_spec s = base_spec(WETDEM_INSERT_RANDOM, 1500);
+    struct wetdem_particle* p = calloc(s.n, sizeof *p);
+    char msg[512] = "";
+    s.gap = 0;
+    int st = wetdem_insert_particles(&s, p, msg, sizeof msg);
+    if (st != WETDEM_OK)
+        fail_msg("%s", msg);
+    assert_true(worst_gap_excess(&s, p) >= 0);
+    check_inside(&s, p);
+    free(p);
+}
+
+static void test_insert_random_periodic_respects_images(void** state)
+{
+    (void)state;
+    struct wetdem_insert_spec s = base_spec(WETDEM_INSERT_RANDOM, 800);
+    s.periodic[0] = s.periodic[2] = true;
+    struct wetdem_particle* p = calloc(s.n, sizeof *p);
+    CHECK_OK(wetdem_insert_particles(&s, p, NULL, 0));
+    assert_true(worst_gap_excess(&s, p) >= 0);
+    check_inside(&s, p);
+    free(p);
+}
+
+/* Lattice, 10 mm cube, R = 1 mm, gap 0: spacing a = 2 mm; sites per axis
+ * floor((10 - 0 - 2)/2) + 1 = 5, so 125 sites at 1, 3, 5, 7, 9 mm. With gap 0.1 mm:
+ * a = 2.1 mm, floor((10 - 0.2 - 2)/2.1) + 1 = 3 + 1 = 4 per axis, 64 sites. */
+static void test_insert_lattice_capacity_by_hand(void** state)
+{
+    (void)state;
+    struct wetdem_insert_spec s = base_spec(WETDEM_INSERT_LATTICE, 125);
+    s.hi = vec3(10e-3, 10e-3, 10e-3);
+    s.radius_min = s.radius_max = 1e-3;
+    s.gap = 0;
+    struct wetdem_particle p[126];
+    char msg[512] = "";
+    CHECK_OK(wetdem_insert_particles(&s, p, msg, sizeof msg));
+    CHECK_REL(p[0].pos.x, 1e-3, 1e-15);   /* first site lo + gap + R */
+    CHECK_REL(p[124].pos.z, 9e-3, 1e-15); /* last site 1 + 4 x 2 mm */
+    CHECK_REL(p[1].pos.x - p[0].pos.x, 2e-3, 1e-12);
+    assert_true(worst_gap_excess(&s, p) >= -1e-15); /* touching: gap 0 up to rounding */
+    s.n = 126;
+    CHECK_STATUS(wetdem_insert_particles(&s, p, msg, sizeof msg), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(msg, "at most 125 spheres (5 x 5 x 5)");
+    s.gap = 0.1e-3;
+    s.n = 65;
+    CHECK_STATUS(wetdem_insert_particles(&s, p, msg, sizeof msg), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(msg, "at most 64 spheres");
+    s.n = 64;
+    CHECK_OK(wetdem_insert_particles(&s, p, msg, sizeof msg));
+    check_inside(&s, p);
+}
+
+static void test_insert_lattice_polydisperse_no_overlap(void** state)
+{
+    (void)state;
+    struct wetdem_insert_spec s = base_spec(WETDEM_INSERT_LATTICE, 700);
+    s.periodic[1] = true;
+    struct wetdem_particle* p = calloc(s.n, sizeof *p);
+    CHECK_OK(wetdem_insert_particles(&s, p, NULL, 0));
+    assert_true(worst_gap_excess(&s, p) >= 0);
+    check_inside(&s, p);
+    free(p);
+}
+
+static void test_insert_random_reports_jamming(void** state)
+{
+    (void)state;
+    /* 2000 spheres of R = 1 mm in a 20 mm cube: 8.4e-6 m^3 of spheres in 8e-6 m^3 (> 1). */
+    struct wetdem_insert_spec s = base_spec(WETDEM_INSERT_RANDOM, 2000);
+    s.radius_min = s.radius_max = 1e-3;
+    s.max_attempts = 200;
+    struct wetdem_particle* p = calloc(s.n, sizeof *p);
+    char msg[512] = "";
+    CHECK_STATUS(wetdem_insert_particles(&s, p, msg, sizeof msg), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(msg, "random-insertion limit");
+    CHECK_CONTAINS(msg, "lattice");
+    free(p);
+}
+
+static void test_insert_given_radii_and_velocity_statistics(void** state)
+{
+    (void)state;
+    size_t n = 4000;
+    struct wetdem_insert_spec s = base_spec(WETDEM_INSERT_LATTICE, n);
+    s.hi = vec3(0.2, 0.2, 0.2);
+    s.velocity = vec3(0, 0, -1);
+    double* radii = malloc(n * sizeof *radii);
+    for (size_t i = 0; i < n; i++)
+        radii[i] = (i % 2) ? 1e-3 : 0.6e-3;
+    s.radii = radii;
+    struct wetdem_particle* p = calloc(n, sizeof *p);
+    CHECK_OK(wetdem_insert_particles(&s, p, NULL, 0));
+    double mean = 0, var = 0;
+    for (size_t i = 0; i < n; i++) {
+        assert_true(p[i].radius == radii[i]);
+        mean += p[i].vel.z / n;
+    }
+    for (size_t i = 0; i < n; i++)
+        var += (p[i].vel.z - mean) * (p[i].vel.z - mean) / (n - 1);
+    /* sample mean ~ N(-1, 0.1/sqrt(4000) = 1.6e-3): 5 standard errors is 7.9e-3 */
+    CHECK_ABS(mean, -1.0, 7.9e-3);
+    /* sample sd of 4000 Gaussians: relative standard error 1/sqrt(2 x 3999) = 1.1 %; 5 % */
+    CHECK_REL(sqrt(var), 0.1, 0.05);
+    free(p);
+    free(radii);
+}
+
+static void test_insert_rejects_bad_spec(void** state)
+{
+    (void)state;
+    struct wetdem_particle p[4];
+    char msg[512] = "";
+    struct wetdem_insert_spec s = base_spec(WETDEM_INSERT_RANDOM, 4);
+    s.radius_min = 2e-3;
+    CHECK_STATUS(wetdem_insert_particles(&s, p, msg, sizeof msg), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(msg, "radius_min <= radius_max");
+    s = base_spec(WETDEM_INSERT_RANDOM, 4);
+    s.hi.y = -1;
+    CHECK_STATUS(wetdem_insert_particles(&s, p, msg, sizeof msg), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(msg, "y range");
+    s = base_spec(WETDEM_INSERT_RANDOM, 4);
+    s.gap = NAN;
+    CHECK_STATUS(wetdem_insert_particles(&s, p, msg, sizeof msg), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(msg, "insert.gap");
+    s = base_spec(WETDEM_INSERT_RANDOM, 4);
+    s.hi.x = 1.5e-3; /* thinner than one sphere */
+    CHECK_STATUS(wetdem_insert_particles(&s, p, msg, sizeof msg), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(msg, "does not fit");
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_insert_same_seed_gives_identical_particles),
+        cmocka_unit_test(test_insert_random_has_no_overlap),
+        cmocka_unit_test(test_insert_random_periodic_respects_images),
+        cmocka_unit_test(test_insert_lattice_capacity_by_hand),
+        cmocka_unit_test(test_insert_lattice_polydisperse_no_overlap),
+        cmocka_unit_test(test_insert_random_reports_jamming),
+        cmocka_unit_test(test_insert_given_radii_and_velocity_statistics),
+        cmocka_unit_test(test_insert_rejects_bad_spec),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
