@@ -1,0 +1,700 @@
+/*
+ * test_contact_models.c — the soft solid-contact models hertz, mindlin and hooke: closed forms
+ * at hand-computed points, sign conventions, i<->j symmetry, the exact Hertz damping table
+ * against a fresh integration of the dimensionless collision and against its closed form
+ * (docs/derivations/contact.md), the Hertz contact-time constant, and isolated collisions
+ * integrated through pair() that must rebound with e_dry.
+ *
+ * `test_contact_models --regen-hertz-table` prints the table of src/force_hertz.c.
+ */
+#include <stdbool.h>
+#include <stdlib.h>
+
+#include "harness.h"
+#include "models.h"
+
+static double vec3_norm_test(struct wetdem_vec3 a)
+{
+    return sqrt(a.x * a.x + a.y * a.y + a.z * a.z);
+}
+
+static struct wetdem_vec3 cross(struct wetdem_vec3 a, struct wetdem_vec3 b)
+{
+    return (struct wetdem_vec3){a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z,
+                                a.x * b.y - a.y * b.x};
+}
+
+/* ======================================================================================== */
+/* The dimensionless Hertz collision x'' = -x^(3/2) - c x^(1/4) x', x(0) = 0, x'(0) = 1,      */
+/* with the total force clipped at zero (contact.md Sec. 1).                                 */
+/* ======================================================================================== */
+
+/* With s = x^(1/4) and d tau = 4 s^3 d sigma the system is polynomial and smooth at x = 0:
+ * ds/dsigma = v, dv/dsigma = -4 s^9 - 4 c s^4 v, dtau/dsigma = 4 s^3. */
+struct sigma_state {
+    double s, v, tau;
+};
+
+static struct sigma_state sigma_rhs(struct sigma_state y, double c)
+{
+    double s4 = y.s * y.s * y.s * y.s;
+    return (struct sigma_state){y.v, -4.0 * s4 * (s4 * y.s + c * y.v), 4.0 * y.s * y.s * y.s};
+}
+
+static struct sigma_state sigma_axpy(struct sigma_state a, double h, struct sigma_state b)
+{
+    return (struct sigma_state){a.s + h * b.s, a.v + h * b.v, a.tau + h * b.tau};
+}
+
+static struct sigma_state sigma_rk4(struct sigma_state y, double c, double h)
+{
+    struct sigma_state k1 = sigma_rhs(y, c);
+    struct sigma_state k2 = sigma_rhs(sigma_axpy(y, h / 2, k1), c);
+    struct sigma_state k3 = sigma_rhs(sigma_axpy(y, h / 2, k2), c);
+    struct sigma_state k4 = sigma_rhs(sigma_axpy(y, h, k3), c);
+    struct sigma_state k = {k1.s + 2 * k2.s + 2 * k3.s + k4.s, k1.v + 2 * k2.v + 2 * k3.v + k4.v,
+                            k1.tau + 2 * k2.tau + 2 * k3.tau + k4.tau};
+    return sigma_axpy(y, h / 6, k);
+}
+
+/* Contact ends while unloading when the force x^(3/2)(1 + c w), w = x'/x^(5/4), reaches zero
+ * (clipped) or, unclipped, when x reaches zero. */
+static bool sigma_ended(struct sigma_state y, double c, bool clipped)
+{
+    double g = clipped ? y.s * y.s * y.s * y.s * y.s + c * y.v : y.s;
+    return y.v < 0 && g <= 0;
+}
+
+/* Rebound speed (= e) of the dimensionless collision by RK4 with sigma step h; the last step
+ * is shortened by bisection to end on the event. *tau_c: contact duration (the ballistic
+ * remainder x/|x'| after the force vanished is included). NAN if it never ends. */
+static double hertz_restitution_by_integration(double c, double h, bool clipped, double* tau_c)
+{
+    struct sigma_state y = {0.0, 1.0, 0.0};
+    for (long n = 0; n < 10000000; n++) {
+        struct sigma_state y1 = sigma_rk4(y, c, h);
+        if (!sigma_ended(y1, c, clipped)) {
+            y = y1;
+            continue;
+        }
+        double lo = 0.0, hi = h;
+        for (int k = 0; k < 200 && lo < hi; k++) {
+            double mid = 0.5 * (lo + hi);
+            if (mid == lo || mid == hi)
+                break;
+            if (sigma_ended(sigma_rk4(y, c, mid), c, clipped))
+                hi = mid;
+            else
+                lo = mid;
+        }
+        struct sigma_state z = sigma_rk4(y, c, hi);
+        double x = z.s > 0 ? z.s * z.s * z.s * z.s : 0.0;
+        *tau_c = z.tau + x / -z.v;
+        return -z.v;
+    }
+    return NAN;
+}
+
+/* Closed form ln e(c) of the clipped collision (contact.md Sec. 1.3):
+ * ln e = -(c/2) J, J = int_{-1/c}^inf dw / (5/4 w^2 + c w + 1). */
+static double hertz_log_restitution(double c)
+{
+    if (c == 0.0)
+        return 0.0;
+    double d2 = 5.0 - c * c;
+    double j;
+    if (d2 > 0.0)
+        j = 2.0 / sqrt(d2) * atan2(c * sqrt(d2), c * c - 2.5);
+    else if (d2 < 0.0)
+        j = 2.0 / sqrt(-d2) * log1p((c * c - 5.0 + c * sqrt(-d2)) / 2.5);
+    else
+        j = 2.0 * c / (c * c - 2.5);
+    return -0.5 * c * j;
+}
+
+/* The exact dimensionless damping c(e) by bisection on the closed form (machine precision). */
+static double hertz_damping_of_restitution(double e)
+{
+    if (e >= 1.0)
+        return 0.0;
+    double target = log(e), lo = 0.0, hi = 1.0;
+    while (hertz_log_restitution(hi) > target)
+        hi *= 2.0;
+    for (int k = 0; k < 400; k++) {
+        double mid = 0.5 * (lo + hi);
+        if (mid == lo || mid == hi)
+            break;
+        if (hertz_log_restitution(mid) > target)
+            lo = mid;
+        else
+            hi = mid;
+    }
+    return 0.5 * (lo + hi);
+}
+
+static double tsuji_c(double e)
+{
+    double l = log(e);
+    return -sqrt(5.0) * l / sqrt(l * l + M_PI * M_PI);
+}
+
+/* y(u) = ln(c_exact/c_tsuji) at u = ln e < 0, the tabulated function. */
+static double table_function(double u)
+{
+    double e = exp(u);
+    return log(hertz_damping_of_restitution(e) / tsuji_c(e));
+}
+
+static double table_slope(double u)
+{
+    const double d = 1e-3;
+    if (u > -2 * d) { /* one-sided, fourth order; y(0) = 0 */
+        double f[5];
+        for (int k = 0; k < 5; k++)
+            f[k] = k == 0 && u == 0.0 ? 0.0 : table_function(u - k * d);
+        return (25 * f[0] - 48 * f[1] + 36 * f[2] - 16 * f[3] + 3 * f[4]) / (12 * d);
+    }
+    return (table_function(u - 2 * d) - 8 * table_function(u - d) + 8 * table_function(u + d) -
+            table_function(u + 2 * d)) /
+           (12 * d);
+}
+
+static void print_hertz_table(void)
+{
+    const int n = 201;
+    const double u_min = log(1e-6);
+    for (int k = 0; k < n; k++) {
+        double u = k == n - 1 ? 0.0 : u_min * (1.0 - (double)k / (n - 1));
+        double y = k == n - 1 ? 0.0 : table_function(u);
+        printf("    {%.17g, %.17g}, /* e = %.6g */\n", y, table_slope(u), exp(u));
+    }
+}
+
+/* The dimensionless damping c that the library uses: F_d / (delta^(1/4) v_n sqrt(m* k)). */
+static double library_damping_coefficient(double e, int form)
+{
+    const double e_star = 1.0, r_eff = 1.0, m_eff = 1.0, delta = 1.0, v_n = 1.0;
+    double k = 4.0 / 3.0;
+    return wetdem_force_hertz_damping(e_star, r_eff, m_eff, delta, v_n, e, form) / sqrt(k);
+}
+
+/* ======================================================================================== */
+/* A one-dimensional head-on collision integrated through a model's pair()                   */
+/* ======================================================================================== */
+
+struct collision {
+    const struct wetdem_model* model;
+    const void* params;
+    struct wetdem_contact c; /* geometry and materials; gap and v_n are overwritten */
+};
+
+/* Relative acceleration d^2 h/dt^2 = F_n / m* (a repulsive force opens the gap). */
+static double gap_acceleration(const struct collision* col, double h, double dhdt)
+{
+    struct wetdem_contact c = col->c;
+    struct wetdem_pair_force f = {0};
+    c.gap = h;
+    c.v_n = -dhdt;
+    int st = col->model->pair(col->params, &c, NULL, &f);
+    return st == WETDEM_OK ? f.f_normal / c.m_eff : NAN;
+}
+
+static void rk4_gap(const struct collision* col, double dt, double* h, double* v)
+{
+    double h1 = *h, v1 = *v, a1 = gap_acceleration(col, h1, v1);
+    double h2 = h1 + 0.5 * dt * v1, v2 = v1 + 0.5 * dt * a1, a2 = gap_acceleration(col, h2, v2);
+    double h3 = h1 + 0.5 * dt * v2, v3 = v1 + 0.5 * dt * a2, a3 = gap_acceleration(col, h3, v3);
+    double h4 = h1 + dt * v3, v4 = v1 + dt * a3, a4 = gap_acceleration(col, h4, v4);
+    *h = h1 + dt / 6 * (v1 + 2 * v2 + 2 * v3 + v4);
+    *v = v1 + dt / 6 * (a1 + 2 * a2 + 2 * a3 + a4);
+}
+
+/* Collision from h = 0- at approach speed v0 until h returns to 0 (last step by bisection).
+ * Returns the rebound ratio e; *t_c the contact duration. */
+static double collide(const struct collision* col, double v0, double dt, double* t_c)
+{
+    double h = -1e-300, v = -v0, t = 0.0; /* just inside, so a dashpot acts from the start */
+    for (long n = 0; n < 100000000; n++) {
+        double h1 = h, v1 = v;
+        rk4_gap(col, dt, &h1, &v1);
+        if (!(h1 >= 0.0 && v1 > 0.0)) {
+            h = h1;
+            v = v1;
+            t += dt;
+            continue;
+        }
+        double lo = 0.0, hi = dt;
+        for (int k = 0; k < 200; k++) {
+            double mid = 0.5 * (lo + hi), hm = h, vm = v;
+            if (mid == lo || mid == hi)
+                break;
+            rk4_gap(col, mid, &hm, &vm);
+            if (hm >= 0.0 && vm > 0.0)
+                hi = mid;
+            else
+                lo = mid;
+        }
+        rk4_gap(col, hi, &h, &v);
+        *t_c = t + hi;
+        return v / v0;
+    }
+    return NAN;
+}
+
+/* Two steel-like spheres of radius 2 mm and mass 2e-4 kg: R* = 1 mm, m* = 1e-4 kg,
+ * E* = 100 GPa, G* = 40 GPa (harness defaults). */
+static struct wetdem_contact steel_pair(double gap, double v_n)
+{
+    return test_contact(2e-3, 2e-3, 2e-4, 2e-4, gap, v_n);
+}
+
+/* ======================================================================================== */
+/* hertz                                                                                     */
+/* ======================================================================================== */
+
+static void test_hertz_elastic_force_at_hand_point(void** state)
+{
+    (void)state;
+    /* (4/3) E* sqrt(R*) delta^(3/2) = (4/3) 1e11 sqrt(1e-3) (1e-6)^(3/2)
+     *   = (4/3) 1e11 * 0.0316227766 * 1e-9 = 4.216370213557839 N. */
+    CHECK_REL(wetdem_force_hertz_elastic(100e9, 1e-3, 1e-6), 4.216370213557839, 1e-14);
+    double p[1];
+    wetdem_param_init_defaults(wetdem_force_hertz.params, p);
+    struct wetdem_contact c = steel_pair(-1e-6, 0.0); /* no damping at v_n = 0 */
+    struct wetdem_pair_force f = {0};
+    CHECK_OK(wetdem_force_hertz.pair(p, &c, NULL, &f));
+    /* 1e-14: a handful of roundings in a product of five factors. */
+    CHECK_REL(f.f_normal, 4.216370213557839, 1e-14);
+    CHECK_ABS(vec3_norm_test(f.f_tan), 0.0, 0.0);
+}
+
+static void test_hertz_zero_without_overlap(void** state)
+{
+    (void)state;
+    double p[1];
+    wetdem_param_init_defaults(wetdem_force_hertz.params, p);
+    const double gaps[] = {1e-6, 0.0};
+    for (int k = 0; k < 2; k++) {
+        struct wetdem_contact c = steel_pair(gaps[k], 1.0);
+        struct wetdem_pair_force f = {0};
+        CHECK_OK(wetdem_force_hertz.pair(p, &c, NULL, &f));
+        CHECK_ABS(f.f_normal, 0.0, 0.0);
+    }
+    CHECK_ABS(wetdem_force_hertz_elastic(100e9, 1e-3, -1e-6), 0.0, 0.0);
+    CHECK_ABS(wetdem_force_hertz_damping(100e9, 1e-3, 1e-4, -1e-6, 1.0, 0.5, 0), 0.0, 0.0);
+    CHECK_ABS(wetdem_force_hertz.range(p, &(struct wetdem_contact){0}), 0.0, 0.0);
+}
+
+static void test_hertz_damping_sign_and_clipping(void** state)
+{
+    (void)state;
+    double p[1];
+    wetdem_param_init_defaults(wetdem_force_hertz.params, p);
+    double f_el = wetdem_force_hertz_elastic(100e9, 1e-3, 1e-6);
+    struct wetdem_contact c = steel_pair(-1e-6, 0.1);
+    c.restitution = 0.5;
+    struct wetdem_pair_force in = {0}, out = {0}, fast = {0};
+    CHECK_OK(wetdem_force_hertz.pair(p, &c, NULL, &in));
+    assert_true(in.f_normal > f_el); /* approaching: the dashpot resists, repulsive */
+    c.v_n = -0.1;
+    CHECK_OK(wetdem_force_hertz.pair(p, &c, NULL, &out));
+    assert_true(out.f_normal < f_el && out.f_normal > 0.0);
+    /* damping is linear in v_n: the two differ from F_el by the same amount; 1e-12 covers
+     * the cancellation in F - F_el (F_d / F_el ~ 0.3). */
+    CHECK_REL(in.f_normal - f_el, f_el - out.f_normal, 1e-12);
+    c.v_n = -1000.0; /* separating so fast that elastic + damping < 0: clipped to zero */
+    CHECK_OK(wetdem_force_hertz.pair(p, &c, NULL, &fast));
+    CHECK_ABS(fast.f_normal, 0.0, 0.0);
+}
+
+static void test_hertz_swap_is_equal_and_opposite(void** state)
+{
+    (void)state;
+    double p[1];
+    wetdem_param_init_defaults(wetdem_force_hertz.params, p);
+    struct wetdem_contact c = test_contact(1e-3, 3e-3, 1e-5, 4e-4, -2e-7, 0.3);
+    struct wetdem_contact s = wetdem_contact_swapped(&c);
+    struct wetdem_pair_force f = {0}, g = {0};
+    CHECK_OK(wetdem_force_hertz.pair(p, &c, NULL, &f));
+    CHECK_OK(wetdem_force_hertz.pair(p, &s, NULL, &g));
+    /* f_normal is along each side's own normal: the same scalar means equal and opposite
+     * vectors f n and g (-n). Identical arithmetic: exact. */
+    assert_true(f.f_normal > 0.0);
+    CHECK_REL(f.f_normal, g.f_normal, 0.0);
+}
+
+static void test_hertz_closed_form_matches_integration(void** state)
+{
+    (void)state;
+    /* Covers both branches of J and the borderline c^2 = 5 (e = exp(-2)). RK4 in sigma with
+     * step 1e-3 is accurate to ~1e-13 (halving the step changes e by < 1e-13). */
+    const double cs[] = {1e-3, 0.1, 0.7, 1.0, 2.0, sqrt(5.0), 3.0, 10.0, 100.0};
+    for (size_t k = 0; k < sizeof cs / sizeof cs[0]; k++) {
+        double tau;
+        double e = hertz_restitution_by_integration(cs[k], 1e-3, true, &tau);
+        CHECK_REL(e, exp(hertz_log_restitution(cs[k])), 1e-10);
+    }
+    /* c = 3: J = ln 5, ln e = -(3/2) ln 5, e = 5^(-3/2) = 0.08944271909999159. */
+    CHECK_REL(exp(hertz_log_restitution(3.0)), 0.08944271909999159, 1e-14);
+}
+
+static void test_hertz_exact_table_matches_integration(void** state)
+{
+    (void)state;
+    /* The library's c(e) fed into a fresh integration of the dimensionless ODE rebounds with
+     * e. Table interpolation error < 4e-9 relative in c, |d ln e / d ln c| < 2.3 over this
+     * range, integration ~1e-13: 2e-8 relative in e. */
+    const double es[] = {1e-5, 0.01, 0.05, 0.1, 0.3, 0.5, 0.7, 0.9, 0.99, 0.999};
+    for (size_t k = 0; k < sizeof es / sizeof es[0]; k++) {
+        double tau;
+        double c = library_damping_coefficient(es[k], 0);
+        CHECK_REL(hertz_restitution_by_integration(c, 1e-3, true, &tau), es[k], 2e-8);
+    }
+    CHECK_ABS(library_damping_coefficient(1.0, 0), 0.0, 0.0);
+}
+
+static void test_hertz_exact_table_matches_closed_form(void** state)
+{
+    (void)state;
+    /* 400 log-spaced e in [1e-12, 1): relative error of c < 1e-8 in the table range
+     * (Hermite interpolation, measured 4e-9); below e = 1e-6 the library inverts the closed
+     * form by fixed-point iteration, to ~1e-14. */
+    for (int k = 0; k < 400; k++) {
+        double e = exp(log(1e-12) * (1.0 - (k + 0.5) / 400.0));
+        double want = hertz_damping_of_restitution(e);
+        CHECK_REL(library_damping_coefficient(e, 0), want, e >= 1e-6 ? 1e-8 : 1e-13);
+    }
+    /* the smallest doubles stay finite: c ~ sqrt(5/(4 e)) */
+    CHECK_REL(library_damping_coefficient(1e-300, 0), sqrt(1.25e300), 1e-12);
+    CHECK_REL(library_damping_coefficient(5e-324, 0), sqrt(1.25) / sqrt(5e-324), 1e-12);
+}
+
+static void test_hertz_tsuji_coefficient_at_hand_point(void** state)
+{
+    (void)state;
+    /* e = 0.9: ln e = -0.10536051565782628, beta = ln e / sqrt(ln^2 e + pi^2)
+     *   = -0.10536051565782628 / 3.1433589103615005 = -0.03351844910567637.
+     * S_n = 2 E* sqrt(R* delta) = 2e11 sqrt(1e-9) = 6.324555320336759e6 N/m, m* = 1e-4 kg,
+     * sqrt(S_n m*) = 25.14866859365871; gamma_n = -2 sqrt(5/6) beta sqrt(S_n m*)
+     *   = 2 * 0.9128709291752769 * 0.03351844910567637 * 25.14866859365871 = 1.538998817524729
+     * kg/s; at v_n = 0.5 m/s F_d = 0.7694994087623646 N. */
+    double fd = wetdem_force_hertz_damping(100e9, 1e-3, 1e-4, 1e-6, 0.5, 0.9, 1);
+    CHECK_REL(fd, 0.7694994087623646, 1e-13); /* 1e-13: logs, roots and ~15 roundings */
+    double p[1] = {1.0};                      /* damping = tsuji */
+    assert_int_equal(wetdem_param_choice_index(&wetdem_force_hertz.params[0], "tsuji"), 1);
+    struct wetdem_contact c = steel_pair(-1e-6, 0.5);
+    struct wetdem_pair_force f = {0};
+    CHECK_OK(wetdem_force_hertz.pair(p, &c, NULL, &f));
+    CHECK_REL(f.f_normal, 4.216370213557839 + 0.7694994087623646, 1e-13);
+}
+
+static void test_hertz_tsuji_is_exact_only_without_clipping(void** state)
+{
+    (void)state;
+    /* contact.md Sec. 1.3: unclipped, ln e = -pi c / sqrt(5 - c^2), inverted by c_tsuji. */
+    const double es[] = {0.3, 0.6, 0.9};
+    for (int k = 0; k < 3; k++) {
+        double tau;
+        double c = library_damping_coefficient(es[k], 1);
+        CHECK_REL(hertz_restitution_by_integration(c, 1e-3, false, &tau), es[k], 1e-10);
+    }
+    /* With clipping the Tsuji coefficient rebounds faster: e = 0.3 -> 0.40 (> 0.05 off). */
+    double tau;
+    double e_clip =
+        hertz_restitution_by_integration(library_damping_coefficient(0.3, 1), 1e-3, true, &tau);
+    assert_true(e_clip > 0.35 && e_clip < 0.45);
+}
+
+static void test_hertz_contact_time_constant(void** state)
+{
+    (void)state;
+    /* Undamped: tau_c = 2 int_0^{x_m} dx / sqrt(1 - 4/5 x^(5/2)) = (4/5)(5/4)^(2/5) B(2/5,1/2)
+     * in the units T = (m*^2/(k^2 v))^(1/5), k = (4/3) E* sqrt(R*), so
+     * t_c = (9/16)^(1/5) tau_c (m*^2/(E*^2 R* v))^(1/5) = 2.8682656991953315 (...)^(1/5). */
+    double tau;
+    double e = hertz_restitution_by_integration(0.0, 1e-3, true, &tau);
+    CHECK_REL(e, 1.0, 1e-12); /* energy conserved: RK4 error ~1e-14 */
+    double beta = tgamma(0.4) * tgamma(0.5) / tgamma(0.9);
+    CHECK_REL(tau, 0.8 * pow(1.25, 0.4) * beta, 1e-11);
+    double constant = pow(9.0 / 16.0, 0.2) * tau;
+    /* m* = E* = R* = v = 1: t_c is the constant itself. 1e-11: the integration error. */
+    CHECK_REL(wetdem_force_hertz_contact_time(1.0, 1.0, 1.0, 1.0), constant, 1e-11);
+    CHECK_REL(wetdem_force_hertz_contact_time(1.0, 1.0, 1.0, 1.0), 2.8682656991953315, 1e-15);
+    /* scaling: m* x 32 -> t_c x 32^(2/5) = 4. */
+    CHECK_REL(wetdem_force_hertz_contact_time(1.0, 1.0, 32.0, 1.0), 4 * 2.8682656991953315, 1e-14);
+}
+
+static void test_hertz_collision_through_pair_rebounds_with_e(void** state)
+{
+    (void)state;
+    double p[1];
+    wetdem_param_init_defaults(wetdem_force_hertz.params, p);
+    struct collision col = {&wetdem_force_hertz, p, steel_pair(0.0, 0.0)};
+    col.c.restitution = 0.3;
+    double v0 = 0.5;
+    double tc0 = wetdem_force_hertz_contact_time(col.c.e_star, col.c.r_eff, col.c.m_eff, v0);
+    double tc;
+    /* dt = t_c/20000: the delta^(1/4) start limits RK4 to O(dt^(5/4)), ~1e-6 in e. */
+    double e = collide(&col, v0, tc0 / 20000, &tc);
+    CHECK_REL(e, 0.3, 1e-5);
+    assert_true(tc > tc0); /* damping lengthens the contact (tau 3.22 -> ~3.9, Sec. 1.3) */
+    p[0] = 1.0;            /* tsuji: e = 0.40, clearly not 0.3 */
+    e = collide(&col, v0, tc0 / 20000, &tc);
+    assert_true(e > 0.35);
+    /* e = 1: elastic, speed-independent contact time matches the closed form. 1e-6: the
+     * RK4 error at dt = t_c/20000 near the x^(3/2) start. */
+    p[0] = 0.0;
+    col.c.restitution = 1.0;
+    e = collide(&col, v0, tc0 / 20000, &tc);
+    CHECK_REL(e, 1.0, 1e-8);
+    CHECK_REL(tc, tc0, 1e-6);
+}
+
+static void test_hertz_rejects_invalid_restitution(void** state)
+{
+    (void)state;
+    double p[1];
+    wetdem_param_init_defaults(wetdem_force_hertz.params, p);
+    const double bad[] = {0.0, -0.5, 1.5, NAN};
+    for (int k = 0; k < 4; k++) {
+        struct wetdem_contact c = steel_pair(-1e-6, 0.5);
+        c.restitution = bad[k];
+        struct wetdem_pair_force f = {0};
+        CHECK_STATUS(wetdem_force_hertz.pair(p, &c, NULL, &f), WETDEM_ERR_INVALID);
+        assert_true(isnan(wetdem_force_hertz_damping(1e11, 1e-3, 1e-4, 1e-6, 1, bad[k], 0)));
+    }
+    char msg[200];
+    CHECK_STATUS(wetdem_param_validate(&wetdem_force_hertz.params[0], 2.0, msg, sizeof msg),
+                 WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(msg, "damping");
+}
+
+/* ======================================================================================== */
+/* mindlin                                                                                   */
+/* ======================================================================================== */
+
+static void test_mindlin_sticking_step_from_zero(void** state)
+{
+    (void)state;
+    double p[1] = {0.0};
+    /* k_t = 8 G* sqrt(R* delta) = 8 * 4e10 * sqrt(1e-9) = 1.0119288512538815e7 N/m.
+     * One step from s = 0 with v_t = 0.01 m/s (y), dt = 1e-7 s: s = 1e-9 m,
+     * F_t = -k_t s = -1.0119288512538816e-2 N (y) with e = 1 (no damping). The Coulomb
+     * limit 0.1 * 4.216 N is far away: sticking. */
+    struct wetdem_contact c = steel_pair(-1e-6, 0.0);
+    c.restitution = 1.0;
+    c.v_t = (struct wetdem_vec3){0, 0.01, 0};
+    double hist[3] = {0, 0, 0};
+    struct wetdem_pair_force f = {0};
+    CHECK_OK(wetdem_force_mindlin.pair(p, &c, hist, &f));
+    CHECK_REL(f.f_tan.y, -1.0119288512538816e-2, 1e-14); /* few roundings */
+    CHECK_ABS(f.f_tan.x, 0.0, 0.0);
+    CHECK_ABS(f.f_tan.z, 0.0, 0.0);
+    CHECK_REL(hist[1], 1e-9, 1e-15);
+    CHECK_ABS(f.f_normal, 0.0, 0.0); /* mindlin adds no normal force */
+    /* With e = 0.9 the damping -gamma_t v_t adds: gamma_t = -2 sqrt(5/6) beta sqrt(m* k_t)
+     * = 2 * 0.9128709291752769 * 0.03351844910567637 * sqrt(1e-4 * 1.0119288512538815e7)
+     * = 1.9466966318736014 kg/s; F_t = -0.010119288512538816 - 0.019466966318736014
+     * = -0.02958625483127483 N. */
+    c.restitution = 0.9;
+    hist[0] = hist[1] = hist[2] = 0.0;
+    struct wetdem_pair_force g = {0};
+    CHECK_OK(wetdem_force_mindlin.pair(p, &c, hist, &g));
+    CHECK_REL(g.f_tan.y, -0.02958625483127483, 1e-13);
+}
+
+static void test_mindlin_sliding_caps_at_coulomb_limit(void** state)
+{
+    (void)state;
+    struct wetdem_contact c = steel_pair(-1e-6, 0.0);
+    c.v_t = (struct wetdem_vec3){0, 0.5, 0};
+    double f_el = 4.216370213557839;   /* Hertz elastic at delta = 1e-6 m, hand value above */
+    const double mus[2] = {0.1, 0.02}; /* friction_dry, friction_lub of the harness */
+    for (int k = 0; k < 2; k++) {
+        double p[1] = {(double)k};
+        double hist[3] = {0, 1e-6, 0}; /* k_t |s| = 10.1 N >> mu F_el */
+        struct wetdem_pair_force f = {0};
+        CHECK_OK(wetdem_force_mindlin.pair(p, &c, hist, &f));
+        /* exact up to the rescaling roundings */
+        CHECK_REL(vec3_norm_test(f.f_tan), mus[k] * f_el, 1e-14);
+        assert_true(f.f_tan.y < 0.0); /* opposes the spring, which points along +y */
+        /* spring truncated to the limit: k_t |s| = mu F_el */
+        CHECK_REL(1.0119288512538815e7 * hist[1], mus[k] * f_el, 1e-14);
+    }
+}
+
+static void test_mindlin_spring_rotates_into_tangent_plane(void** state)
+{
+    (void)state;
+    double p[1] = {0.0};
+    struct wetdem_contact c = steel_pair(-1e-6, 0.0);
+    c.friction_dry = 10.0; /* keep it sticking */
+    c.restitution = 1.0;
+    /* normal now tilted in the x-y plane; the stored spring has a component along it */
+    double a = 0.3;
+    c.normal = (struct wetdem_vec3){cos(a), sin(a), 0};
+    double hist[3] = {2e-9, 1e-9, 3e-9};
+    double len0 = sqrt(4e-18 + 1e-18 + 9e-18);
+    struct wetdem_pair_force f = {0};
+    CHECK_OK(wetdem_force_mindlin.pair(p, &c, hist, &f));
+    struct wetdem_vec3 s = {hist[0], hist[1], hist[2]};
+    double sn = s.x * c.normal.x + s.y * c.normal.y + s.z * c.normal.z;
+    CHECK_ABS(sn, 0.0, 1e-24);                 /* perpendicular: 1e-15 |s| */
+    CHECK_REL(vec3_norm_test(s), len0, 1e-15); /* rigid rotation keeps the length */
+    double fn = f.f_tan.x * c.normal.x + f.f_tan.y * c.normal.y + f.f_tan.z * c.normal.z;
+    CHECK_ABS(fn, 0.0, 1e-15 * vec3_norm_test(f.f_tan));
+}
+
+static void test_mindlin_swap_symmetry_and_torques(void** state)
+{
+    (void)state;
+    double p[1] = {0.0};
+    struct wetdem_contact c = test_contact(1e-3, 3e-3, 1e-5, 4e-4, -2e-7, 0.1);
+    c.v_t = (struct wetdem_vec3){0, 0.02, -0.01};
+    c.restitution = 0.7;
+    double h1[3] = {0, 2e-10, 1e-10}, h2[3] = {0, -2e-10, -1e-10};
+    struct wetdem_contact s = wetdem_contact_swapped(&c);
+    struct wetdem_pair_force f = {0}, g = {0};
+    CHECK_OK(wetdem_force_mindlin.pair(p, &c, h1, &f));
+    CHECK_OK(wetdem_force_mindlin.pair(p, &s, h2, &g));
+    /* identical arithmetic with every sign flipped: exact */
+    CHECK_ABS(f.f_tan.y + g.f_tan.y, 0.0, 0.0);
+    CHECK_ABS(f.f_tan.z + g.f_tan.z, 0.0, 0.0);
+    CHECK_ABS(h1[1] + h2[1], 0.0, 0.0);
+    CHECK_ABS(f.torque_i.z - g.torque_j.z, 0.0, 1e-30);
+    CHECK_ABS(f.torque_j.y - g.torque_i.y, 0.0, 1e-30);
+    /* torques: i is pushed at -R_i n, j at +R_j n by -F: tau_i = -R_i n x F, tau_j = -R_j n x F */
+    struct wetdem_vec3 nf = cross(c.normal, f.f_tan);
+    CHECK_REL(f.torque_i.y, -c.radius_i * nf.y, 1e-15);
+    CHECK_REL(f.torque_i.z, -c.radius_i * nf.z, 1e-15);
+    CHECK_REL(f.torque_j.y, -c.radius_j * nf.y, 1e-15);
+    CHECK_REL(f.torque_j.z, -c.radius_j * nf.z, 1e-15);
+    /* total angular momentum about the contact point is conserved: (x_i - x_c) x F + tau_i
+     * = R_i n x F - R_i n x F = 0, likewise for j. */
+    assert_true(fabs(nf.y) + fabs(nf.z) > 0.0);
+}
+
+static void test_mindlin_resets_when_separated(void** state)
+{
+    (void)state;
+    double p[1] = {0.0};
+    struct wetdem_contact c = steel_pair(1e-9, 0.0);
+    c.v_t = (struct wetdem_vec3){0, 0.5, 0};
+    double hist[3] = {0, 1e-8, 2e-8};
+    struct wetdem_pair_force f = {0};
+    CHECK_OK(wetdem_force_mindlin.pair(p, &c, hist, &f));
+    CHECK_ABS(hist[1], 0.0, 0.0);
+    CHECK_ABS(hist[2], 0.0, 0.0);
+    CHECK_ABS(vec3_norm_test(f.f_tan) + vec3_norm_test(f.torque_i), 0.0, 0.0);
+    /* The shared kernel, as nijssen calls it with its shifted overlap and own mu. */
+    double spring[3] = {0, 1e-8, 0};
+    struct wetdem_vec3 ft = wetdem_force_mindlin_update(&c, 0.0, 1.0, 0.1, spring);
+    CHECK_ABS(vec3_norm_test(ft) + fabs(spring[1]), 0.0, 0.0);
+    /* from zero: k_t v_t dt = 1.0119e7 * 0.5 * 1e-7 = 0.506 N > mu f_limit = 0.1 N: slides */
+    ft = wetdem_force_mindlin_update(&c, 1e-6, 1.0, 0.1, spring);
+    CHECK_REL(ft.y, -0.1, 1e-15);
+}
+
+/* ======================================================================================== */
+/* hooke                                                                                     */
+/* ======================================================================================== */
+
+static void test_hooke_force_closed_form(void** state)
+{
+    (void)state;
+    double p[1] = {2e6};
+    struct wetdem_contact c = steel_pair(-1e-6, 0.5);
+    c.restitution = 0.5;
+    /* gamma = -2 ln e sqrt(m* k)/sqrt(ln^2 e + pi^2): ln 0.5 = -0.6931471805599453,
+     * sqrt(1e-4 * 2e6) = 14.142135623730951, sqrt(0.4804530139182014 + 9.869604401089358)
+     * = 3.2171505117118095; gamma = 2 * 0.6931471805599453 * 14.142135623730951 /
+     * 3.2171505117118095 = 6.093952644739415 kg/s.
+     * F = k delta + gamma v_n = 2 + 3.0469763223697075 = 5.046976322369707 N. */
+    struct wetdem_pair_force f = {0};
+    CHECK_OK(wetdem_force_hooke.pair(p, &c, NULL, &f));
+    CHECK_REL(f.f_normal, 5.046976322369707, 1e-14);
+    c.gap = 0.0;
+    struct wetdem_pair_force g = {0};
+    CHECK_OK(wetdem_force_hooke.pair(p, &c, NULL, &g));
+    CHECK_ABS(g.f_normal, 0.0, 0.0);
+    c.gap = -1e-6;
+    c.restitution = 0.0;
+    CHECK_STATUS(wetdem_force_hooke.pair(p, &c, NULL, &g), WETDEM_ERR_INVALID);
+}
+
+static void test_hooke_collision_recovers_e_and_contact_time(void** state)
+{
+    (void)state;
+    double p[1];
+    wetdem_param_init_defaults(wetdem_force_hooke.params, p);
+    struct collision col = {&wetdem_force_hooke, p, steel_pair(0.0, 0.0)};
+    const double es[] = {0.2, 0.6, 1.0};
+    for (int k = 0; k < 3; k++) {
+        col.c.restitution = es[k];
+        double m = col.c.m_eff, kk = p[0], l = log(es[k]);
+        double gamma = -2 * l * sqrt(m * kk) / sqrt(l * l + M_PI * M_PI);
+        double tc0 = M_PI / sqrt(kk / m - gamma * gamma / (4 * m * m));
+        double tc;
+        /* dt = t_c/2000: RK4 global error ~ (2 pi/2000)^4 ~ 1e-10 on a smooth solution */
+        double e = collide(&col, 0.3, tc0 / 2000, &tc);
+        CHECK_REL(e, es[k], 1e-9);
+        CHECK_REL(tc, tc0, 1e-9);
+    }
+}
+
+/* ======================================================================================== */
+/* model objects                                                                             */
+/* ======================================================================================== */
+
+static void test_contact_model_objects_are_documented(void** state)
+{
+    (void)state;
+    const struct wetdem_model* ms[] = {&wetdem_force_hertz, &wetdem_force_mindlin,
+                                       &wetdem_force_hooke};
+    const char* names[] = {"hertz", "mindlin", "hooke"};
+    const size_t hist[] = {0, 3, 0};
+    for (int k = 0; k < 3; k++) {
+        assert_string_equal(ms[k]->name, names[k]);
+        assert_int_equal(ms[k]->kind, WETDEM_MODEL_CONTACT);
+        assert_true(strlen(ms[k]->summary) > 20 && strlen(ms[k]->doc) > 200);
+        assert_true(strlen(ms[k]->equations) > 20);
+        assert_int_equal(ms[k]->history_len, hist[k]);
+        assert_int_equal(wetdem_param_count(ms[k]->params), 1);
+        assert_int_equal(ms[k]->params_size, sizeof(double));
+        double gaps[WETDEM_MAX_THRESHOLDS];
+        struct wetdem_contact c = steel_pair(0.0, 0.0);
+        assert_int_equal(ms[k]->thresholds(NULL, &c, NULL, gaps), 1);
+        CHECK_ABS(gaps[0], 0.0, 0.0);
+    }
+}
+
+int main(int argc, char** argv)
+{
+    if (argc > 1 && strcmp(argv[1], "--regen-hertz-table") == 0) {
+        print_hertz_table();
+        return 0;
+    }
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_hertz_elastic_force_at_hand_point),
+        cmocka_unit_test(test_hertz_zero_without_overlap),
+        cmocka_unit_test(test_hertz_damping_sign_and_clipping),
+        cmocka_unit_test(test_hertz_swap_is_equal_and_opposite),
+        cmocka_unit_test(test_hertz_closed_form_matches_integration),
+        cmocka_unit_test(test_hertz_exact_table_matches_integration),
+        cmocka_unit_test(test_hertz_exact_table_matches_closed_form),
+        cmocka_unit_test(test_hertz_tsuji_coefficient_at_hand_point),
+        cmocka_unit_test(test_hertz_tsuji_is_exact_only_without_clipping),
+        cmocka_unit_test(test_hertz_contact_time_constant),
+        cmocka_unit_test(test_hertz_collision_through_pair_rebounds_with_e),
+        cmocka_unit_test(test_hertz_rejects_invalid_restitution),
+        cmocka_unit_test(test_mindlin_sticking_step_from_zero),
+        cmocka_unit_test(test_mindlin_sliding_caps_at_coulomb_limit),
+        cmocka_unit_test(test_mindlin_spring_rotates_into_tangent_plane),
+        cmocka_unit_test(test_mindlin_swap_symmetry_and_torques),
+        cmocka_unit_test(test_mindlin_resets_when_separated),
+        cmocka_unit_test(test_hooke_force_closed_form),
+        cmocka_unit_test(test_hooke_collision_recovers_e_and_contact_time),
+        cmocka_unit_test(test_contact_model_objects_are_documented),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
