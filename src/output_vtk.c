@@ -1,0 +1,222 @@
+/*
+ * output_vtk.c — legacy VTK (version 3.0) POLYDATA files of the particles, ASCII or binary,
+ * and ParaView ".vtk.series" time-series files. Prefix: wetdem_output_vtk.
+ *
+ * Layout (VTK User's Guide, "VTK File Formats", legacy format):
+ *   # vtk DataFile Version 3.0 / title / ASCII|BINARY / DATASET POLYDATA
+ *   FIELD FieldData 1, TIME 1 1 double      simulated time [s] (ParaView shows it)
+ *   POINTS n double                         centres [m]
+ *   VERTICES n 2n                           one vertex cell per sphere ("1 i")
+ *   POINT_DATA n, FIELD FieldData 6: radius [m], velocity [m/s], spin [rad/s], contacts,
+ *                                    material, id
+ * The point arrays form a FIELD rather than SCALARS/VECTORS attributes because VTK's legacy
+ * reader loads only the first SCALARS and VECTORS unless told otherwise; field arrays are all
+ * read.
+ * Binary arrays are big-endian (the legacy format's byte order); 32-bit ints and 64-bit
+ * doubles. Render spheres in ParaView with the Glyph filter (sphere, scale by "radius", factor 2).
+ * Files are written to "<path>.tmp" and renamed into place (atomic on POSIX file systems).
+ */
+#include <errno.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "output_vtk.h"
+
+static int io_fail(char* msg, size_t n, const char* fmt, ...) __attribute__((format(printf, 3, 4)));
+static int io_fail(char* msg, size_t n, const char* fmt, ...)
+{
+    if (msg && n) {
+        va_list ap;
+        va_start(ap, fmt);
+        vsnprintf(msg, n, fmt, ap);
+        va_end(ap);
+    }
+    return WETDEM_ERR_IO;
+}
+
+static bool host_is_little_endian(void)
+{
+    const uint16_t probe = 1;
+    unsigned char b;
+    memcpy(&b, &probe, 1);
+    return b == 1;
+}
+
+/* Writes `count` elements of `size` bytes in big-endian order. */
+static void put_be(FILE* f, const void* data, size_t size, size_t count)
+{
+    const unsigned char* s = data;
+    if (!host_is_little_endian()) {
+        fwrite(s, size, count, f);
+        return;
+    }
+    unsigned char buf[8];
+    for (size_t e = 0; e < count; e++) {
+        for (size_t b = 0; b < size; b++)
+            buf[b] = s[e * size + size - 1 - b];
+        fwrite(buf, size, 1, f);
+    }
+}
+
+static void put_double(FILE* f, double x, bool binary)
+{
+    if (binary)
+        put_be(f, &x, sizeof x, 1);
+    else
+        fprintf(f, "%.17g\n", x);
+}
+
+static void put_vec(FILE* f, struct wetdem_vec3 v, bool binary)
+{
+    if (binary) {
+        double a[3] = {v.x, v.y, v.z};
+        put_be(f, a, sizeof a[0], 3);
+    } else {
+        fprintf(f, "%.17g %.17g %.17g\n", v.x, v.y, v.z);
+    }
+}
+
+static void put_int(FILE* f, int32_t x, bool binary)
+{
+    if (binary)
+        put_be(f, &x, sizeof x, 1);
+    else
+        fprintf(f, "%d\n", (int)x);
+}
+
+/* The vec3 member of particle k selected by `which`: 0 position, 1 velocity, 2 spin. */
+static struct wetdem_vec3 member(const struct wetdem_particle* p, int which)
+{
+    return which == 0 ? p->pos : (which == 1 ? p->vel : p->omega);
+}
+
+static void write_vectors(FILE* f, const char* head, const struct wetdem_particle* p, size_t n,
+                          int which, bool binary)
+{
+    fprintf(f, head, n);
+    for (size_t k = 0; k < n; k++)
+        put_vec(f, member(&p[k], which), binary);
+    if (binary)
+        fputc('\n', f);
+}
+
+/* Integer point data: 0 contacts, 1 material, 2 id. */
+static void write_ints(FILE* f, const char* name, const struct wetdem_particle* p, size_t n,
+                       const uint32_t* contacts, int which, bool binary)
+{
+    fprintf(f, "%s 1 %zu int\n", name, n);
+    for (size_t k = 0; k < n; k++) {
+        int32_t v = which == 0 ? (contacts ? (int32_t)contacts[k] : 0)
+                               : (which == 1 ? (int32_t)p[k].material : (int32_t)k);
+        put_int(f, v, binary);
+    }
+    if (binary)
+        fputc('\n', f);
+}
+
+static void write_body(FILE* f, const struct wetdem_particle* p, size_t n,
+                       const uint32_t* contacts, double time, bool binary)
+{
+    fprintf(f, "# vtk DataFile Version 3.0\nwetdem particles t = %.17g s\n%s\n"
+               "DATASET POLYDATA\nFIELD FieldData 1\nTIME 1 1 double\n",
+            time, binary ? "BINARY" : "ASCII");
+    put_double(f, time, binary);
+    if (binary)
+        fputc('\n', f);
+    write_vectors(f, "POINTS %zu double\n", p, n, 0, binary);
+    fprintf(f, "VERTICES %zu %zu\n", n, 2 * n);
+    for (size_t k = 0; k < n; k++) {
+        int32_t cell[2] = {1, (int32_t)k};
+        if (binary)
+            put_be(f, cell, sizeof cell[0], 2);
+        else
+            fprintf(f, "1 %zu\n", k);
+    }
+    if (binary)
+        fputc('\n', f);
+    fprintf(f, "POINT_DATA %zu\nFIELD FieldData 6\nradius 1 %zu double\n", n, n);
+    for (size_t k = 0; k < n; k++)
+        put_double(f, p[k].radius, binary);
+    if (binary)
+        fputc('\n', f);
+    write_vectors(f, "velocity 3 %zu double\n", p, n, 1, binary);
+    write_vectors(f, "spin 3 %zu double\n", p, n, 2, binary);
+    write_ints(f, "contacts", p, n, contacts, 0, binary);
+    write_ints(f, "material", p, n, contacts, 1, binary);
+    write_ints(f, "id", p, n, contacts, 2, binary);
+}
+
+/* Closes f (opened on tmp) and renames tmp to path; cleans up on failure. */
+static int finish_atomic(FILE* f, const char* tmp, const char* path, char* msg, size_t n)
+{
+    bool ok = !ferror(f);
+    ok = (fclose(f) == 0) && ok;
+    if (!ok || rename(tmp, path) != 0) {
+        int err = errno;
+        remove(tmp);
+        return io_fail(msg, n, "cannot write '%s': %s", path, strerror(err));
+    }
+    return WETDEM_OK;
+}
+
+static FILE* open_tmp(const char* path, char* tmp, size_t tmp_size, char* msg, size_t n)
+{
+    if ((size_t)snprintf(tmp, tmp_size, "%s.tmp", path) >= tmp_size) {
+        io_fail(msg, n, "output path too long: '%s'", path);
+        return NULL;
+    }
+    FILE* f = fopen(tmp, "wb");
+    if (!f)
+        io_fail(msg, n, "cannot open '%s' for writing: %s", tmp, strerror(errno));
+    return f;
+}
+
+int wetdem_output_vtk_write(const char* path, const struct wetdem_particle* p, size_t n,
+                            const uint32_t* contacts, double time, bool binary, char* msg,
+                            size_t msg_size)
+{
+    if (n > INT32_MAX)
+        return io_fail(msg, msg_size, "too many particles for a legacy VTK file: %zu", n);
+    char tmp[4096];
+    FILE* f = open_tmp(path, tmp, sizeof tmp, msg, msg_size);
+    if (!f)
+        return WETDEM_ERR_IO;
+    write_body(f, p, n, contacts, time, binary);
+    return finish_atomic(f, tmp, path, msg, msg_size);
+}
+
+int wetdem_output_vtk_path(char* buf, size_t size, const char* prefix, uint64_t index)
+{
+    return snprintf(buf, size, "%s_%06llu.vtk", prefix, (unsigned long long)index);
+}
+
+/* Writes s as a JSON string literal (quotes and backslashes escaped). */
+static void put_json_string(FILE* f, const char* s)
+{
+    fputc('"', f);
+    for (; *s; s++) {
+        if (*s == '"' || *s == '\\')
+            fputc('\\', f);
+        fputc(*s, f);
+    }
+    fputc('"', f);
+}
+
+int wetdem_output_vtk_series_write(const char* path, const char* const* files,
+                                   const double* times, size_t n, char* msg, size_t msg_size)
+{
+    char tmp[4096];
+    FILE* f = open_tmp(path, tmp, sizeof tmp, msg, msg_size);
+    if (!f)
+        return WETDEM_ERR_IO;
+    fputs("{\n  \"file-series-version\" : \"1.0\",\n  \"files\" : [\n", f);
+    for (size_t k = 0; k < n; k++) {
+        fputs("    { \"name\" : ", f);
+        put_json_string(f, files[k]);
+        fprintf(f, ", \"time\" : %.17g }%s\n", times[k], k + 1 < n ? "," : "");
+    }
+    fputs("  ]\n}\n", f);
+    return finish_atomic(f, tmp, path, msg, msg_size);
+}

@@ -1,0 +1,32 @@
+/*
+ * output_vtk.h — VTK files of particles for ParaView (internal). Prefix: wetdem_output_vtk.
+ */
+#ifndef WETDEM_OUTPUT_VTK_H
+#define WETDEM_OUTPUT_VTK_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "wetdem.h"
+
+/* Writes n particles as a legacy VTK POLYDATA file (one vertex per sphere) with the point
+ * data radius [m], velocity [m/s], spin [rad/s], contacts (count per particle; contacts may be
+ * NULL for zeros), material and id, and the simulated time [s] as field data TIME. binary:
+ * big-endian binary arrays as the legacy format requires, else ASCII with 17 significant
+ * digits (exact round trip). The file is written to a temporary name and renamed, so a
+ * reader never sees half a file. Returns WETDEM_OK or WETDEM_ERR_IO (message in msg). */
+int wetdem_output_vtk_write(const char* path, const struct wetdem_particle* p, size_t n,
+                            const uint32_t* contacts, double time, bool binary, char* msg,
+                            size_t msg_size);
+
+/* Formats "<prefix>_<index, 6 digits>.vtk" into buf. Returns the length snprintf would write. */
+int wetdem_output_vtk_path(char* buf, size_t size, const char* prefix, uint64_t index);
+
+/* Writes a ParaView time-series file (path ends in ".vtk.series": JSON listing the files,
+ * given relative to the series file's directory, with their times [s]). Atomic like the
+ * above. Returns WETDEM_OK or WETDEM_ERR_IO. */
+int wetdem_output_vtk_series_write(const char* path, const char* const* files,
+                                   const double* times, size_t n, char* msg, size_t msg_size);
+
+#endif
