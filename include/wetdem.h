@@ -405,6 +405,8 @@ enum wetdem_event_kind {
     WETDEM_EVENT_INTERACTION_END = 6,   /* gap rose above the largest model range */
     WETDEM_EVENT_HARD_CONTACT = 7,      /* hard-sphere impulse (pairwise engine) */
     WETDEM_EVENT_PARTNER_CHANGE = 8,    /* tracked pairs changed (pairwise engine) */
+    WETDEM_EVENT_BRANCH = 9,            /* gap crossed another branch boundary that a model
+                                           lists in thresholds() (either direction) */
 };
 struct wetdem_event_record {
     double time;                /* [s] */

@@ -41,6 +41,8 @@ struct wetdem_sim* wetdem_sim_create(void)
     }
     wetdem_param_init_defaults(wetdem_minsep_fixed.params, sim->minsep.params);
     sim->history_len = wetdem_minsep_fixed.history_len;
+    wetdem_param_init_defaults(wetdem_sim_settings_params(), &sim->settings);
+    wetdem_sim_engine_init(sim);
     return sim;
 }
 
@@ -49,6 +51,7 @@ void wetdem_sim_free(struct wetdem_sim* sim)
     if (!sim)
         return;
     wetdem_sim_clear_models(sim);
+    wetdem_sim_engine_free(sim);
     free(sim->minsep.params);
     free(sim->particles);
     free(sim->materials);
@@ -200,4 +203,82 @@ void wetdem_sim_build_contact(const struct wetdem_sim* sim, size_t i, size_t j, 
     }
     c->i = i;
     c->j = j;
+}
+
+void wetdem_sim_reset(struct wetdem_sim* sim)
+{
+    sim->n_particles = 0;
+    sim->n_walls = 0;
+    sim->errmsg[0] = '\0';
+    wetdem_sim_engine_clear(sim);
+}
+
+/* Copies n elements of size `size` into a fresh allocation (*dst); NULL source gives NULL. */
+static int copy_array(void** dst, const void* src, size_t n, size_t size)
+{
+    *dst = NULL;
+    if (!src || n == 0)
+        return WETDEM_OK;
+    *dst = malloc(n * size);
+    if (!*dst)
+        return WETDEM_ERR_NOMEM;
+    memcpy(*dst, src, n * size);
+    return WETDEM_OK;
+}
+
+/* Deep copy of a model slot's parameter block. */
+static int copy_slot(struct wetdem_model_slot* dst, const struct wetdem_model_slot* src)
+{
+    *dst = *src;
+    size_t size = src->model->params_size ? src->model->params_size : 1;
+    dst->params = malloc(size);
+    if (!dst->params)
+        return WETDEM_ERR_NOMEM;
+    memcpy(dst->params, src->params, size);
+    return WETDEM_OK;
+}
+
+/* Copies everything but the engine from src into the zeroed sim. */
+static int copy_setup(struct wetdem_sim* sim, const struct wetdem_sim* src)
+{
+    sim->fluid = src->fluid;
+    sim->settings = src->settings;
+    sim->history_len = src->history_len;
+    int st = copy_array((void**)&sim->particles, src->particles, src->n_particles,
+                        sizeof *src->particles);
+    if (st != WETDEM_OK)
+        return st;
+    sim->n_particles = sim->particles_cap = src->n_particles;
+    st = copy_array((void**)&sim->materials, src->materials, (size_t)src->n_materials,
+                    sizeof *src->materials);
+    if (st != WETDEM_OK)
+        return st;
+    sim->n_materials = sim->materials_cap = src->n_materials;
+    st = copy_array((void**)&sim->walls, src->walls, src->n_walls, sizeof *src->walls);
+    if (st != WETDEM_OK)
+        return st;
+    sim->n_walls = sim->walls_cap = src->n_walls;
+    st = copy_slot(&sim->minsep, &src->minsep);
+    for (size_t k = 0; k < src->n_models && st == WETDEM_OK; k++) {
+        st = copy_slot(&sim->models[k], &src->models[k]);
+        if (st == WETDEM_OK)
+            sim->n_models = k + 1;
+    }
+    return st;
+}
+
+struct wetdem_sim* wetdem_sim_clone(const struct wetdem_sim* src)
+{
+    struct wetdem_sim* sim = calloc(1, sizeof *sim);
+    if (!sim)
+        return NULL;
+    wetdem_sim_engine_init(sim);
+    int st = copy_setup(sim, src);
+    if (st == WETDEM_OK)
+        st = wetdem_sim_engine_copy(sim, src);
+    if (st != WETDEM_OK) {
+        wetdem_sim_free(sim);
+        return NULL;
+    }
+    return sim;
 }

@@ -7,10 +7,13 @@
 
 #include <stdarg.h>
 
+#include "pairs.h"
 #include "wetdem.h"
 
 #define WETDEM_MAX_MODELS 16
 #define WETDEM_ERRMSG_SIZE 1024
+#define WETDEM_MAX_INTEGRATORS 4         /* registered integrators (integrator.c) */
+#define WETDEM_INTEGRATOR_PARAMS_MAX 16  /* doubles of one integrator's parameter block */
 
 /* A model enabled on this simulation with its own parameter block. */
 struct wetdem_model_slot {
@@ -28,6 +31,50 @@ struct wetdem_wall {
 /* Simulation-wide settings addressed as "sim.<name>" (descriptor table in sim_params.c). */
 struct wetdem_sim_settings {
     double gravity_x, gravity_y, gravity_z; /* [m/s^2] */
+    double stop_on_separation; /* 0/1: stop once every pair that interacted has separated */
+    double separation_factor;  /* separated: gap > factor x interaction range [-], >= 1 */
+    double speed_floor;        /* smallest relative speed used for step and tolerance
+                                  scales [m/s] > 0 (sim_integrate.c) */
+};
+
+struct wetdem_event_slot; /* integrator.h */
+struct wetdem_sim;
+
+/* Run-time state of the soft engine (sim_integrate.c, integrator_*.c, event.c). */
+struct wetdem_engine {
+    double time;        /* simulated time [s] */
+    double t_committed; /* time at which the pair histories hold the committed state [s] */
+    size_t integrator;  /* index into the integrator registry (integrator.c) */
+    /* parameter blocks of every registered integrator, addressed as "<name>.<param>" */
+    double integrator_params[WETDEM_MAX_INTEGRATORS][WETDEM_INTEGRATOR_PARAMS_MAX];
+
+    struct wetdem_pairs pairs;
+    /* per pair, at the latest event-function evaluation: gap [m], approach speed [m/s] */
+    double *pair_gap, *pair_vn, *pair_gap_prev, *pair_vn_prev;
+    double* pair_range; /* per pair: largest model range at the latest evaluation [m] */
+    size_t pair_scratch_cap;
+    /* event functions g = gap - threshold, grouped by pair (event.c) */
+    struct wetdem_event_slot* slots;
+    double *g_prev, *g_new;
+    size_t n_slots, slots_cap;
+
+    struct wetdem_event_record* events; /* the event log */
+    size_t n_events, events_cap;
+    struct wetdem_stats stats;
+
+    struct wetdem_vec3 *force, *torque; /* per particle, from the latest force evaluation */
+    size_t force_cap;
+
+    wetdem_observer_fn observer;
+    void* observer_ctx;
+    double observer_interval; /* [s], 0: only at the start and the end of a run */
+    double next_observe;      /* next observer time [s] */
+    double last_observed;     /* time of the latest observer call [s], NAN if none */
+
+    /* internal per-step hook (collision analysis): called after every accepted step with
+     * the state at engine.time; a negative return stops the run with that status */
+    int (*monitor)(struct wetdem_sim* sim, void* ctx);
+    void* monitor_ctx;
 };
 
 struct wetdem_sim {
@@ -46,6 +93,8 @@ struct wetdem_sim {
     size_t n_models;
     struct wetdem_model_slot minsep;                    /* gives h_min; history at offset 0 */
     size_t history_len;                                 /* doubles per pair, all slices */
+
+    struct wetdem_engine engine; /* soft engine: time, pairs, events, integrator */
 };
 
 /* Formats a message into sim->errmsg and returns status (printf-style). */
@@ -69,5 +118,19 @@ void wetdem_sim_history_init(const struct wetdem_sim* sim, double* history);
 /* Builds the contact of particle i with particle j, or with wall w when is_wall. */
 void wetdem_sim_build_contact(const struct wetdem_sim* sim, size_t i, size_t j, bool is_wall,
                               struct wetdem_contact* c);
+
+/* sim_models.c: descriptor table of struct wetdem_sim_settings ("sim.<name>"). */
+const struct wetdem_param_desc* wetdem_sim_settings_params(void);
+
+/* sim_integrate.c: sets the engine defaults (integrator "verlet" and every integrator's
+ * default parameters); called by wetdem_sim_create(). */
+void wetdem_sim_engine_init(struct wetdem_sim* sim);
+/* sim_integrate.c: frees the engine's storage (not the sim). */
+void wetdem_sim_engine_free(struct wetdem_sim* sim);
+/* sim_integrate.c: empties pairs, event log, statistics, time (reset). */
+void wetdem_sim_engine_clear(struct wetdem_sim* sim);
+/* sim_integrate.c: deep copy of src's engine into dst (observer and monitor not copied).
+ * WETDEM_OK or WETDEM_ERR_NOMEM. */
+int wetdem_sim_engine_copy(struct wetdem_sim* dst, const struct wetdem_sim* src);
 
 #endif

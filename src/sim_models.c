@@ -12,9 +12,12 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "integrator.h"
 #include "models.h"
 #include "sim.h"
 #include "vec3.h"
+
+static const char* const yes_no[] = {"no", "yes", NULL};
 
 #define SET(field) offsetof(struct wetdem_sim_settings, field)
 static const struct wetdem_param_desc settings_params[] = {
@@ -24,9 +27,24 @@ static const struct wetdem_param_desc settings_params[] = {
      1e4, false, false, NULL},
     {"gravity_z", "m/s^2", "Gravitational acceleration, z component.", SET(gravity_z), 0, -1e4,
      1e4, false, false, NULL},
+    {"stop_on_separation", "-",
+     "Stop integrating (status WETDEM_EVENT) once every pair that interacted has left its "
+     "interaction range and recedes.",
+     SET(stop_on_separation), 0, 0, 1, false, false, yes_no},
+    {"separation_factor", "-",
+     "A pair counts as separated when its gap exceeds this multiple of its interaction range.",
+     SET(separation_factor), 1, 1, 1e3, false, false, NULL},
+    {"speed_floor", "m/s",
+     "Smallest relative speed used to derive the Verlet step and the CVODE tolerance scales.",
+     SET(speed_floor), 1e-3, 0, 1e3, true, false, NULL},
     {0},
 };
 #undef SET
+
+const struct wetdem_param_desc* wetdem_sim_settings_params(void)
+{
+    return settings_params;
+}
 
 static void recompute_history_layout(struct wetdem_sim* sim)
 {
@@ -161,6 +179,10 @@ static size_t all_param_names(const struct wetdem_sim* sim, char (*buf)[96], con
     for (size_t g = 0; g < 2; g++)
         for (size_t k = 0; groups[g].table[k].name && n + 1 < cap; k++, n++)
             snprintf(buf[n], 96, "%s.%s", groups[g].prefix, groups[g].table[k].name);
+    const struct wetdem_integrator* const* integ = wetdem_integrator_registry();
+    for (size_t m = 0; integ[m]; m++)
+        for (size_t k = 0; integ[m]->params[k].name && n + 1 < cap; k++, n++)
+            snprintf(buf[n], 96, "%s.%s", integ[m]->name, integ[m]->params[k].name);
     for (size_t m = 0; m <= sim->n_models; m++) {
         const struct wetdem_model* model = m < sim->n_models ? sim->models[m].model
                                                              : sim->minsep.model;
@@ -194,7 +216,8 @@ static int not_found(const struct wetdem_sim* sim_c, const char* name)
                                "unknown parameter '%s' (did you mean '%s'?)", name, hint_copy);
     return wetdem_sim_fail(sim, WETDEM_ERR_NOT_FOUND,
                            "unknown parameter '%s': names are <model>.<param> for an enabled "
-                           "model, fluid.<field> or sim.<setting>",
+                           "model, fluid.<field>, sim.<setting>, verlet.<param> or "
+                           "cvode.<param>",
                            name);
 }
 
@@ -213,6 +236,10 @@ static int find_target(const struct wetdem_sim* sim, const char* name, struct pa
     } else if (plen == 3 && strncmp(name, "sim", 3) == 0) {
         table = settings_params;
         base = (void*)&sim->settings;
+    } else if (wetdem_integrator_index(name, plen) >= 0) {
+        int k = wetdem_integrator_index(name, plen);
+        table = wetdem_integrator_registry()[k]->params;
+        base = (void*)sim->engine.integrator_params[k];
     } else {
         for (size_t m = 0; m <= sim->n_models; m++) {
             const struct wetdem_model_slot* s = m < sim->n_models ? &sim->models[m] : &sim->minsep;

@@ -1,0 +1,280 @@
+/*
+ * event.c — event functions of the soft engine: for every pair, g = h - h_k with h the gap
+ * and h_k each branch boundary of the force laws (docs/engines.md, "Events"):
+ *   - the interaction range (largest model range(), e.g. h_co = R* for nijssen),
+ *   - h_min of the min-separation model, when a model lists it among its thresholds(),
+ *   - 0 (solid contact),
+ *   - any other threshold a model lists below its range (kind "branch"),
+ *   - separation_factor x range when the stop on separation needs it (not logged).
+ * g falling through 0 starts a phase (interaction, h_min, contact), rising ends it.
+ * The adaptive integrator hands these functions to its root finder; fixed-step integrators
+ * compare them between steps and interpolate the crossing linearly (wetdem_event_detect).
+ * Prefix: wetdem_event_.
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "integrator.h"
+
+const char* wetdem_event_kind_name(enum wetdem_event_kind kind)
+{
+    switch (kind) {
+    case WETDEM_EVENT_INTERACTION_START: return "interaction_start";
+    case WETDEM_EVENT_HMIN_REACHED: return "hmin_reached";
+    case WETDEM_EVENT_CONTACT_START: return "contact_start";
+    case WETDEM_EVENT_CONTACT_END: return "contact_end";
+    case WETDEM_EVENT_HMIN_LEFT: return "hmin_left";
+    case WETDEM_EVENT_INTERACTION_END: return "interaction_end";
+    case WETDEM_EVENT_HARD_CONTACT: return "hard_contact";
+    case WETDEM_EVENT_PARTNER_CHANGE: return "partner_change";
+    case WETDEM_EVENT_BRANCH: return "branch";
+    }
+    return "unknown";
+}
+
+/* Geometry of pair k at the current state: contact (with h_min from the min-separation model
+ * evaluated on a scratch copy of the committed history) and range [m]. */
+static void pair_state(const struct wetdem_sim* sim, size_t k, struct wetdem_contact* c,
+                       double* range, double* scratch)
+{
+    const struct wetdem_pair* p = &sim->engine.pairs.items[k];
+    const double* history = wetdem_pairs_history(&sim->engine.pairs, k);
+    wetdem_sim_build_contact(sim, p->i, p->j, p->is_wall, c);
+    *range = wetdem_sim_contact_range(sim, c);
+    if (history)
+        memcpy(scratch, history, sim->history_len * sizeof *scratch);
+    else
+        wetdem_sim_history_init(sim, scratch);
+    c->h_min = sim->minsep.model->min_separation(sim->minsep.params, c, scratch);
+}
+
+static int append_slot(struct wetdem_engine* e, struct wetdem_event_slot slot)
+{
+    if (e->n_slots == e->slots_cap) {
+        size_t cap = e->slots_cap ? 2 * e->slots_cap : 16;
+        struct wetdem_event_slot* s = realloc(e->slots, cap * sizeof *s);
+        if (!s)
+            return WETDEM_ERR_NOMEM;
+        e->slots = s;
+        e->slots_cap = cap;
+    }
+    e->slots[e->n_slots++] = slot;
+    return WETDEM_OK;
+}
+
+/* Appends the event functions of pair k: range, h_min (if listed), 0, other model
+ * thresholds, separation. Marks the pair as interacting when it starts within range. */
+static int build_pair_slots(struct wetdem_sim* sim, size_t k)
+{
+    struct wetdem_engine* e = &sim->engine;
+    struct wetdem_contact c;
+    double range, scratch[64], gaps[WETDEM_MAX_THRESHOLDS];
+    pair_state(sim, k, &c, &range, scratch);
+    if (c.gap <= range)
+        e->pairs.items[k].has_interacted = true;
+    struct wetdem_event_slot extra[WETDEM_MAX_MODELS * WETDEM_MAX_THRESHOLDS];
+    size_t n_extra = 0;
+    bool has_hmin = false;
+    for (size_t m = 0; m < sim->n_models; m++) {
+        const struct wetdem_model_slot* s = &sim->models[m];
+        if (!s->model->thresholds)
+            continue;
+        size_t n = s->model->thresholds(s->params, &c, scratch + s->history_offset, gaps);
+        for (size_t q = 0; q < n && q < WETDEM_MAX_THRESHOLDS; q++) {
+            if (gaps[q] == range || gaps[q] == 0.0 || !(gaps[q] < range))
+                continue;
+            if (gaps[q] == c.h_min)
+                has_hmin = true;
+            else
+                extra[n_extra++] = (struct wetdem_event_slot){k, WETDEM_EVENT_SOURCE_MODEL, m, q};
+        }
+    }
+    int st = append_slot(e, (struct wetdem_event_slot){k, WETDEM_EVENT_SOURCE_RANGE, 0, 0});
+    if (st == WETDEM_OK && has_hmin)
+        st = append_slot(e, (struct wetdem_event_slot){k, WETDEM_EVENT_SOURCE_HMIN, 0, 0});
+    if (st == WETDEM_OK)
+        st = append_slot(e, (struct wetdem_event_slot){k, WETDEM_EVENT_SOURCE_ZERO, 0, 0});
+    for (size_t q = 0; q < n_extra && st == WETDEM_OK; q++)
+        st = append_slot(e, extra[q]);
+    if (st == WETDEM_OK && sim->settings.stop_on_separation != 0 &&
+        sim->settings.separation_factor > 1)
+        st = append_slot(e, (struct wetdem_event_slot){k, WETDEM_EVENT_SOURCE_SEPARATION, 0, 0});
+    return st;
+}
+
+/* Grows a double array to n entries. */
+static int grow_doubles(double** a, size_t n)
+{
+    double* p = realloc(*a, (n ? n : 1) * sizeof *p);
+    if (!p)
+        return WETDEM_ERR_NOMEM;
+    *a = p;
+    return WETDEM_OK;
+}
+
+int wetdem_event_slots_build(struct wetdem_sim* sim)
+{
+    struct wetdem_engine* e = &sim->engine;
+    e->n_slots = 0;
+    int st = WETDEM_OK;
+    for (size_t k = 0; k < e->pairs.n && st == WETDEM_OK; k++)
+        st = build_pair_slots(sim, k);
+    size_t np = e->pairs.n;
+    if (st == WETDEM_OK && np > e->pair_scratch_cap) {
+        double** arrays[] = {&e->pair_gap, &e->pair_vn, &e->pair_gap_prev, &e->pair_vn_prev,
+                             &e->pair_range};
+        for (size_t q = 0; q < 5 && st == WETDEM_OK; q++)
+            st = grow_doubles(arrays[q], np);
+        if (st == WETDEM_OK)
+            e->pair_scratch_cap = np;
+    }
+    if (st == WETDEM_OK)
+        st = grow_doubles(&e->g_prev, e->slots_cap);
+    if (st == WETDEM_OK)
+        st = grow_doubles(&e->g_new, e->slots_cap);
+    if (st != WETDEM_OK)
+        return wetdem_sim_fail(sim, st, "out of memory building the event functions");
+    return WETDEM_OK;
+}
+
+/* Threshold [m] of slot s for a pair in state c (h_min filled) with history scratch. */
+static double slot_threshold(const struct wetdem_sim* sim, const struct wetdem_event_slot* s,
+                             const struct wetdem_contact* c, double range, const double* scratch)
+{
+    switch (s->source) {
+    case WETDEM_EVENT_SOURCE_RANGE: return range;
+    case WETDEM_EVENT_SOURCE_HMIN: return c->h_min;
+    case WETDEM_EVENT_SOURCE_ZERO: return 0.0;
+    case WETDEM_EVENT_SOURCE_SEPARATION: return sim->settings.separation_factor * range;
+    case WETDEM_EVENT_SOURCE_MODEL: break;
+    }
+    const struct wetdem_model_slot* m = &sim->models[s->model];
+    double gaps[WETDEM_MAX_THRESHOLDS];
+    size_t n = m->model->thresholds(m->params, c, scratch + m->history_offset, gaps);
+    return s->index < n ? gaps[s->index] : range;
+}
+
+void wetdem_event_values(struct wetdem_sim* sim, double* g)
+{
+    struct wetdem_engine* e = &sim->engine;
+    struct wetdem_contact c;
+    double range = 0.0, scratch[64];
+    size_t current = (size_t)-1;
+    e->stats.root_evals++;
+    for (size_t q = 0; q < e->n_slots; q++) {
+        const struct wetdem_event_slot* s = &e->slots[q];
+        if (s->pair != current) {
+            current = s->pair;
+            pair_state(sim, current, &c, &range, scratch);
+            e->pair_gap[current] = c.gap;
+            e->pair_vn[current] = c.v_n;
+            e->pair_range[current] = range;
+        }
+        g[q] = c.gap - slot_threshold(sim, s, &c, range, scratch);
+    }
+}
+
+/* Kind logged when slot source src is crossed in direction dir; 0 for none. */
+static int kind_of(enum wetdem_event_source src, int dir)
+{
+    switch (src) {
+    case WETDEM_EVENT_SOURCE_RANGE:
+        return dir < 0 ? WETDEM_EVENT_INTERACTION_START : WETDEM_EVENT_INTERACTION_END;
+    case WETDEM_EVENT_SOURCE_HMIN:
+        return dir < 0 ? WETDEM_EVENT_HMIN_REACHED : WETDEM_EVENT_HMIN_LEFT;
+    case WETDEM_EVENT_SOURCE_ZERO:
+        return dir < 0 ? WETDEM_EVENT_CONTACT_START : WETDEM_EVENT_CONTACT_END;
+    case WETDEM_EVENT_SOURCE_MODEL: return WETDEM_EVENT_BRANCH;
+    case WETDEM_EVENT_SOURCE_SEPARATION: break;
+    }
+    return 0;
+}
+
+int wetdem_event_record(struct wetdem_sim* sim, size_t k, int dir, double t, double gap,
+                        double v_n)
+{
+    struct wetdem_engine* e = &sim->engine;
+    const struct wetdem_event_slot* s = &e->slots[k];
+    struct wetdem_pair* p = &e->pairs.items[s->pair];
+    if (s->source == WETDEM_EVENT_SOURCE_RANGE && dir < 0)
+        p->has_interacted = true;
+    int kind = kind_of(s->source, dir);
+    if (!kind)
+        return WETDEM_OK;
+    if (e->n_events == e->events_cap) {
+        size_t cap = e->events_cap ? 2 * e->events_cap : 32;
+        struct wetdem_event_record* r = realloc(e->events, cap * sizeof *r);
+        if (!r)
+            return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory logging events");
+        e->events = r;
+        e->events_cap = cap;
+    }
+    e->events[e->n_events++] = (struct wetdem_event_record){
+        .time = t, .kind = (enum wetdem_event_kind)kind, .i = p->i, .j = p->j,
+        .is_wall = p->is_wall, .gap = gap, .v_n = v_n};
+    e->stats.events++;
+    return WETDEM_OK;
+}
+
+/* A crossing found between two steps. */
+struct crossing {
+    double t;     /* interpolated time [s] */
+    double theta; /* fraction of the step [-] */
+    size_t slot;
+    int dir;
+};
+
+/* Time order; at equal times starts (falling) before ends, starts in slot order (range,
+ * h_min, contact) and ends in reverse slot order (contact, h_min, range). */
+static bool crossing_before(const struct crossing* a, const struct crossing* b)
+{
+    if (a->t != b->t)
+        return a->t < b->t;
+    if (a->dir != b->dir)
+        return a->dir < b->dir;
+    return a->dir < 0 ? a->slot < b->slot : a->slot > b->slot;
+}
+
+static void sort_crossings(struct crossing* x, size_t n)
+{
+    for (size_t a = 1; a < n; a++) {
+        struct crossing key = x[a];
+        size_t b = a;
+        for (; b > 0 && crossing_before(&key, &x[b - 1]); b--)
+            x[b] = x[b - 1];
+        x[b] = key;
+    }
+}
+
+int wetdem_event_detect(struct wetdem_sim* sim, double t0, double h)
+{
+    struct wetdem_engine* e = &sim->engine;
+    size_t n = 0;
+    for (size_t q = 0; q < e->n_slots; q++)
+        n += (e->g_prev[q] > 0) != (e->g_new[q] > 0);
+    if (n == 0)
+        return WETDEM_OK;
+    struct crossing* x = malloc(n * sizeof *x);
+    if (!x)
+        return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory locating events");
+    n = 0;
+    for (size_t q = 0; q < e->n_slots; q++) {
+        double a = e->g_prev[q], b = e->g_new[q];
+        if ((a > 0) == (b > 0))
+            continue;
+        double theta = a / (a - b);
+        x[n++] = (struct crossing){t0 + theta * h, theta, q, b > 0 ? 1 : -1};
+    }
+    sort_crossings(x, n);
+    int st = WETDEM_OK;
+    for (size_t k = 0; k < n && st == WETDEM_OK; k++) {
+        size_t p = e->slots[x[k].slot].pair;
+        double th = x[k].theta;
+        double gap = e->pair_gap_prev[p] + th * (e->pair_gap[p] - e->pair_gap_prev[p]);
+        double v_n = e->pair_vn_prev[p] + th * (e->pair_vn[p] - e->pair_vn_prev[p]);
+        st = wetdem_event_record(sim, x[k].slot, x[k].dir, x[k].t, gap, v_n);
+    }
+    free(x);
+    return st;
+}

@@ -1,0 +1,109 @@
+/*
+ * integrator.h — internal interface between the soft engine's run loop (sim_integrate.c),
+ * its integrators (integrator_verlet.c, integrator_cvode.c), event location (event.c) and the
+ * collision analysis (collision.c). docs/engines.md describes the semantics.
+ *
+ * The "system" every integrator advances is the state of all free particles: positions x_k,
+ * velocities v_k and angular velocities w_k, with
+ *     dx/dt = v,   dv/dt = F/m + g,   dw/dt = T/I,   I = (2/5) m R^2,
+ * F and T summed over the pairs of the pair list (wetdem_sim_compute_forces). Fixed
+ * particles and walls do not move.
+ */
+#ifndef WETDEM_INTEGRATOR_H
+#define WETDEM_INTEGRATOR_H
+
+#include <stdbool.h>
+
+#include "sim.h"
+
+/* One integrator: a named, documented parameter table and a run function. */
+struct wetdem_integrator {
+    const char* name;                       /* "verlet", "cvode" */
+    const char* summary;                    /* one line */
+    const struct wetdem_param_desc* params; /* terminated by {0}; doubles only */
+    size_t params_size;                     /* <= WETDEM_INTEGRATOR_PARAMS_MAX doubles */
+    /* Advances sim from engine.time to t_end. Called by wetdem_sim_integrate() after the pair
+     * list, the event slots and the forces at the start state are ready. Returns WETDEM_OK,
+     * WETDEM_EVENT (stop condition) or a negative status with the message in sim. */
+    int (*integrate)(struct wetdem_sim* sim, const void* params, double t_end);
+};
+
+extern const struct wetdem_integrator wetdem_integrator_verlet;
+extern const struct wetdem_integrator wetdem_integrator_cvode;
+
+/* ---- integrator.c ---- */
+
+/* NULL-terminated table of the integrators (index = engine.integrator). */
+const struct wetdem_integrator* const* wetdem_integrator_registry(void);
+/* Index of the integrator whose name is the first len characters of name, or -1. */
+int wetdem_integrator_index(const char* name, size_t len);
+
+/* ---- event.c ---- */
+
+/* What an event function's threshold is. */
+enum wetdem_event_source {
+    WETDEM_EVENT_SOURCE_RANGE = 0,      /* largest model range: interaction start/end */
+    WETDEM_EVENT_SOURCE_HMIN = 1,       /* h_min of the min-separation model */
+    WETDEM_EVENT_SOURCE_ZERO = 2,       /* gap 0: solid contact start/end */
+    WETDEM_EVENT_SOURCE_MODEL = 3,      /* another threshold listed by a model */
+    WETDEM_EVENT_SOURCE_SEPARATION = 4, /* separation_factor x range: stop check only */
+};
+
+/* One event function g = gap - threshold of one pair. */
+struct wetdem_event_slot {
+    size_t pair;                      /* index in engine.pairs */
+    enum wetdem_event_source source;
+    size_t model, index;              /* SOURCE_MODEL: force model slot, threshold index */
+};
+
+/* Builds the event functions of every pair of engine.pairs at the current state. Returns
+ * WETDEM_OK or WETDEM_ERR_NOMEM. */
+int wetdem_event_slots_build(struct wetdem_sim* sim);
+/* Evaluates every event function at the current particle state with the committed pair
+ * histories (not modified) into g[n_slots]; writes engine.pair_gap and engine.pair_vn.
+ * Counts one root evaluation. */
+void wetdem_event_values(struct wetdem_sim* sim, double* g);
+/* Records the events of slot k crossing in direction dir (-1: gap fell below the threshold,
+ * +1: rose above it) at time t [s] with gap [m] and approach speed v_n [m/s]; marks the pair
+ * as having interacted when its range is entered. Returns WETDEM_OK or WETDEM_ERR_NOMEM. */
+int wetdem_event_record(struct wetdem_sim* sim, size_t k, int dir, double t, double gap,
+                        double v_n);
+/* Verlet-style detection between two evaluated states: for every sign change of g from
+ * g_prev to g_new over the step [t0, t0 + h], interpolates the crossing time and the pair's
+ * gap and v_n linearly and records the events in time order. */
+int wetdem_event_detect(struct wetdem_sim* sim, double t0, double h);
+
+/* ---- sim_integrate.c: engine services ---- */
+
+/* Sums the pair forces and torques on every particle at the current particle state and
+ * time t into engine.force/torque. Pair histories are advanced by t - engine.t_committed on
+ * scratch copies; with commit, the advanced histories are kept and t_committed = t. Pairs
+ * out of range get a fresh history on commit. Returns WETDEM_OK or a negative status. */
+int wetdem_sim_compute_forces(struct wetdem_sim* sim, double t, bool commit);
+/* Commits the pair histories at the current state and time t without summing forces (for
+ * integrators whose RHS evaluations are trials). */
+int wetdem_sim_commit_histories(struct wetdem_sim* sim, double t);
+/* Linear acceleration of free particle k from engine.force plus gravity [m/s^2]. */
+struct wetdem_vec3 wetdem_sim_acceleration(const struct wetdem_sim* sim, size_t k);
+/* Angular acceleration of free particle k from engine.torque [rad/s^2]. */
+struct wetdem_vec3 wetdem_sim_angular_acceleration(const struct wetdem_sim* sim, size_t k);
+/* Largest relative speed of any pair, including the speed gravity can add over the pair's gap,
+ * floored by sim.speed_floor [m/s]; *t_hertz (if non-NULL) receives the smallest Hertz
+ * contact time of any pair at that speed [s] (INFINITY without pairs). */
+double wetdem_sim_speed_scale(const struct wetdem_sim* sim, double* t_hertz);
+/* Smallest radius of a free particle [m] (1 if none). */
+double wetdem_sim_length_scale(const struct wetdem_sim* sim);
+/* Checks sim.stop_on_separation at the current state (engine.pair_gap/pair_vn must be
+ * current): true when some pair has interacted and every such pair is beyond
+ * separation_factor x range and receding; their flags are then cleared. */
+bool wetdem_sim_separation_reached(struct wetdem_sim* sim);
+/* After an accepted step at engine.time: calls the monitor. Returns its status. */
+int wetdem_sim_step_done(struct wetdem_sim* sim);
+/* Calls the observer, if any, with the current state at engine.time; maps a non-zero return
+ * to WETDEM_ERR_CALLBACK (message stored). */
+int wetdem_sim_observe(struct wetdem_sim* sim);
+/* Calls the observer once at the current state if engine.time has reached the next observer
+ * time, and advances that time past engine.time (fixed-step integrators). */
+int wetdem_sim_observe_due(struct wetdem_sim* sim);
+
+#endif

@@ -1,0 +1,342 @@
+/*
+ * test_integrators.c — conformance matrix of the soft engine's integrators (STYLE §6.9.2):
+ * every integrator on free flight, constant force (gravity and a constant torque), the
+ * harmonic oscillator and the damped oscillator against their closed forms; the convergence
+ * order of Verlet; its time reversibility; CVODE meeting its tolerance; parameter names.
+ *
+ * The oscillators use a test-local force model between a sphere and a plane wall:
+ *     f_normal = -k h + c v_n,   h = gap, v_n = -dh/dt,
+ * so that m h'' = -k h - c h': omega_0 = sqrt(k/m), zeta = c/(2 sqrt(k m)).
+ */
+#include "harness.h"
+
+struct spring_params {
+    double k;      /* [N/m] */
+    double c;      /* [N s/m] */
+    double torque; /* constant torque on i about z [N m] */
+};
+
+static const struct wetdem_param_desc spring_desc[] = {
+    {"k", "N/m", "stiffness", offsetof(struct spring_params, k), 0, 0, 1e12, false, false, NULL},
+    {"c", "N s/m", "damping", offsetof(struct spring_params, c), 0, 0, 1e12, false, false, NULL},
+    {"torque", "N m", "torque", offsetof(struct spring_params, torque), 0, -1, 1, false, false,
+     NULL},
+    {0},
+};
+
+static double spring_range(const void* params, const struct wetdem_contact* c)
+{
+    (void)params;
+    (void)c;
+    return 10.0; /* acts everywhere in these tests [m] */
+}
+
+static int spring_pair(const void* params, const struct wetdem_contact* c, double* history,
+                       struct wetdem_pair_force* out)
+{
+    (void)history;
+    const struct spring_params* p = params;
+    out->f_normal += -p->k * c->gap + p->c * c->v_n;
+    out->torque_i.z += p->torque;
+    return WETDEM_OK;
+}
+
+static const struct wetdem_model spring_model = {
+    .name = "test_spring",
+    .kind = WETDEM_MODEL_FLUID,
+    .summary = "linear spring-dashpot for tests",
+    .doc = "",
+    .equations = "",
+    .params = spring_desc,
+    .params_size = sizeof(struct spring_params),
+    .range = spring_range,
+    .pair = spring_pair,
+};
+
+static const char* const integrators[] = {"verlet", "cvode"};
+
+#define MASS 2e-3   /* [kg] */
+#define RADIUS 1e-3 /* [m] */
+
+/* A sphere of MASS and RADIUS at x = RADIUS + gap0 moving with v0 along x, a wall x = 0
+ * with normal +x when with_wall, the given integrator. */
+static struct wetdem_sim* make_sim(const char* integrator, double gap0, double v0, bool with_wall,
+                                   const struct spring_params* sp)
+{
+    struct wetdem_sim* sim = wetdem_sim_create();
+    assert_non_null(sim);
+    int mat = wetdem_sim_add_material_preset(sim, "steel1");
+    assert_true(mat >= 0);
+    struct wetdem_particle p = {.pos = {RADIUS + gap0, 0, 0}, .vel = {v0, 0, 0},
+                                .radius = RADIUS, .mass = MASS, .material = mat};
+    CHECK_OK(wetdem_sim_add_particle(sim, p));
+    if (with_wall)
+        CHECK_OK(wetdem_sim_add_wall(sim, (struct wetdem_vec3){0, 0, 0},
+                                     (struct wetdem_vec3){1, 0, 0}, mat));
+    if (sp)
+        CHECK_OK(wetdem_sim_add_model(sim, &spring_model, sp));
+    CHECK_OK(wetdem_sim_set_integrator(sim, integrator));
+    CHECK_OK(wetdem_sim_set_param(sim, "cvode.rtol", 1e-10));
+    CHECK_OK(wetdem_sim_set_param(sim, "cvode.atol", 1e-12));
+    return sim;
+}
+
+static struct wetdem_particle particle0(struct wetdem_sim* sim)
+{
+    size_t n;
+    return wetdem_sim_particles(sim, &n)[0];
+}
+
+/* Free flight: x = x0 + v t. Verlet is exact (zero force); CVODE's error test sees zero
+ * derivatives of the acceleration, so it is exact to round-off as well: 1e-12 relative. */
+static void test_integrators_free_flight(void** state)
+{
+    (void)state;
+    for (int q = 0; q < 2; q++) {
+        struct wetdem_sim* sim = make_sim(integrators[q], 0.5, 0.3, false, NULL);
+        CHECK_OK(wetdem_sim_set_param(sim, "verlet.dt", 1e-3));
+        CHECK_OK(wetdem_sim_integrate(sim, 0.25));
+        struct wetdem_particle p = particle0(sim);
+        CHECK_REL(wetdem_sim_time(sim), 0.25, 1e-15);
+        CHECK_REL(p.pos.x, RADIUS + 0.5 + 0.3 * 0.25, 1e-12);
+        CHECK_REL(p.vel.x, 0.3, 1e-14);
+        wetdem_sim_free(sim);
+    }
+}
+
+/* Constant force: gravity g = -9.81 z: z = v0 t + g t^2/2, v = g t; constant torque tau on a
+ * sphere of I = 2/5 m R^2 = 8e-10 kg m^2: w = tau t / I. Both integrators are exact for a
+ * constant acceleration up to round-off (Verlet: the Taylor series ends at t^2; CVODE: the
+ * second derivative is constant, the error estimate vanishes): 1e-10 relative. */
+static void test_integrators_constant_force(void** state)
+{
+    (void)state;
+    struct spring_params sp = {.k = 0, .c = 0, .torque = 1e-6};
+    for (int q = 0; q < 2; q++) {
+        struct wetdem_sim* sim = make_sim(integrators[q], 0.5, 0.0, true, &sp);
+        CHECK_OK(wetdem_sim_set_param(sim, "sim.gravity_z", -9.81));
+        CHECK_OK(wetdem_sim_set_param(sim, "verlet.dt", 1e-3));
+        size_t n;
+        wetdem_sim_particles(sim, &n)[0].vel.z = 2.0;
+        CHECK_OK(wetdem_sim_integrate(sim, 0.4));
+        struct wetdem_particle p = particle0(sim);
+        CHECK_REL(p.pos.z, 2.0 * 0.4 - 0.5 * 9.81 * 0.4 * 0.4, 1e-10);
+        CHECK_REL(p.vel.z, 2.0 - 9.81 * 0.4, 1e-10);
+        double inertia = 0.4 * MASS * RADIUS * RADIUS;
+        CHECK_REL(p.omega.z, 1e-6 * 0.4 / inertia, 1e-10);
+        wetdem_sim_free(sim);
+    }
+}
+
+/* Closed form of m h'' + c h' + k h = 0 with h(0) = h0, h'(0) = u0 (underdamped). */
+static void oscillator(double k, double c, double h0, double u0, double t, double* h, double* u)
+{
+    double w0 = sqrt(k / MASS), zeta = c / (2.0 * sqrt(k * MASS));
+    double wd = w0 * sqrt(1.0 - zeta * zeta), s = zeta * w0;
+    double a = h0, b = (u0 + s * h0) / wd;
+    double e = exp(-s * t), cs = cos(wd * t), sn = sin(wd * t);
+    *h = e * (a * cs + b * sn);
+    *u = e * ((-s * a + wd * b) * cs + (-s * b - wd * a) * sn);
+}
+
+/* Error of one integrator on the oscillator over 1.3 periods: max(|dh|/A, |du|/(A w0)). */
+static double oscillator_error(const char* integrator, double c, double dt, double rtol)
+{
+    struct spring_params sp = {.k = 50.0, .c = c};
+    double h0 = 2e-4, u0 = -0.05, w0 = sqrt(sp.k / MASS), t_end = 1.3 * 2 * M_PI / w0;
+    struct wetdem_sim* sim = make_sim(integrator, h0, u0, true, &sp);
+    CHECK_OK(wetdem_sim_set_param(sim, "verlet.dt", dt));
+    CHECK_OK(wetdem_sim_set_param(sim, "cvode.rtol", rtol));
+    CHECK_OK(wetdem_sim_set_param(sim, "cvode.atol", rtol * 0.1));
+    CHECK_OK(wetdem_sim_integrate(sim, t_end));
+    struct wetdem_particle p = particle0(sim);
+    double h, u, amp = sqrt(h0 * h0 + u0 * u0 / (w0 * w0));
+    oscillator(sp.k, c, h0, u0, t_end, &h, &u);
+    wetdem_sim_free(sim);
+    return fmax(fabs(p.pos.x - RADIUS - h) / amp, fabs(p.vel.x - u) / (amp * w0));
+}
+
+/* Harmonic and damped oscillators: both integrators within 1e-4 of the amplitude at
+ * omega_0 dt = 0.005 (Verlet's global error ~ (omega dt)^2 omega t / 24 ~ 1e-5 here) and
+ * rtol = 1e-8 (a global error of ~100 local tolerances is allowed for the accumulation over
+ * the ~100s of steps of 1.3 periods). */
+static void test_integrators_oscillators(void** state)
+{
+    (void)state;
+    double w0 = sqrt(50.0 / MASS), dt = 0.005 / w0;
+    double cs[] = {0.0, 0.2 * 2 * sqrt(50.0 * MASS)}; /* zeta = 0 and 0.2 */
+    for (int q = 0; q < 2; q++)
+        for (int d = 0; d < 2; d++) {
+            double err = oscillator_error(integrators[q], cs[d], dt, 1e-8);
+            if (!(err < 1e-4))
+                fail_msg("%s, zeta = %g: error %g >= 1e-4", integrators[q], d ? 0.2 : 0.0, err);
+        }
+}
+
+/* Verlet is second order, also with damping (velocity-dependent forces on the predicted
+ * velocity): halving dt divides the error by 4; accepted within [3.6, 4.4], which the O(dt^3)
+ * remainder at omega dt <= 0.04 stays well inside. */
+static void test_integrators_verlet_order_two(void** state)
+{
+    (void)state;
+    double w0 = sqrt(50.0 / MASS);
+    for (int d = 0; d < 2; d++) {
+        double c = d ? 0.2 * 2 * sqrt(50.0 * MASS) : 0.0;
+        double e1 = oscillator_error("verlet", c, 0.04 / w0, 1e-8);
+        double e2 = oscillator_error("verlet", c, 0.02 / w0, 1e-8);
+        double ratio = e1 / e2;
+        if (!(ratio > 3.6 && ratio < 4.4))
+            fail_msg("zeta = %g: error ratio %g (errors %g, %g), expected ~4", d ? 0.2 : 0.0,
+                     ratio, e1, e2);
+    }
+}
+
+/* Velocity Verlet is time-reversible: N steps forward, velocities reversed, N steps forward
+ * again return to the start position with the reversed velocity, up to round-off (1e-12
+ * relative after 2 x 1000 steps of O(1e-16) errors each). */
+static void test_integrators_verlet_reversible(void** state)
+{
+    (void)state;
+    struct spring_params sp = {.k = 50.0};
+    struct wetdem_sim* sim = make_sim("verlet", 2e-4, -0.05, true, &sp);
+    double dt = 0.05 / sqrt(50.0 / MASS);
+    CHECK_OK(wetdem_sim_set_param(sim, "verlet.dt", dt));
+    CHECK_OK(wetdem_sim_integrate(sim, 1000 * dt));
+    size_t n;
+    struct wetdem_particle* p = wetdem_sim_particles(sim, &n);
+    p[0].vel.x = -p[0].vel.x;
+    CHECK_OK(wetdem_sim_integrate(sim, 2000 * dt));
+    CHECK_REL(p[0].pos.x, RADIUS + 2e-4, 1e-12);
+    CHECK_REL(p[0].vel.x, 0.05, 1e-11);
+    wetdem_sim_free(sim);
+}
+
+/* CVODE meets its tolerance: the global error of the oscillator falls with rtol, stays
+ * within 200 rtol (local control, accumulated over ~100 steps), and tightening rtol by 100
+ * reduces it by more than 10. */
+static void test_integrators_cvode_tolerance(void** state)
+{
+    (void)state;
+    double c = 0.1 * 2 * sqrt(50.0 * MASS);
+    double e6 = oscillator_error("cvode", c, 0, 1e-6);
+    double e8 = oscillator_error("cvode", c, 0, 1e-8);
+    if (!(e6 < 200 * 1e-6 && e8 < 200 * 1e-8 && e6 / e8 > 10))
+        fail_msg("cvode errors %g (rtol 1e-6), %g (rtol 1e-8)", e6, e8);
+}
+
+/* Work counters: Verlet takes exactly ceil(t/dt) steps with one force evaluation each (plus
+ * one at the start); CVODE counts its steps and far fewer evaluations on a smooth problem. */
+static void test_integrators_stats(void** state)
+{
+    (void)state;
+    struct spring_params sp = {.k = 50.0};
+    struct wetdem_sim* sim = make_sim("verlet", 2e-4, -0.05, true, &sp);
+    CHECK_OK(wetdem_sim_set_param(sim, "verlet.dt", 1e-4));
+    CHECK_OK(wetdem_sim_integrate(sim, 0.05));
+    struct wetdem_stats s = wetdem_sim_stats(sim);
+    assert_int_equal(s.steps, 500);
+    assert_int_equal(s.force_evals, 501);
+    assert_int_equal(s.pair_evals, 501);
+    wetdem_sim_free(sim);
+    sim = make_sim("cvode", 2e-4, -0.05, true, &sp);
+    CHECK_OK(wetdem_sim_integrate(sim, 0.05));
+    s = wetdem_sim_stats(sim);
+    assert_true(s.steps > 10 && s.steps < 2000);
+    assert_true(s.force_evals >= s.steps && s.force_evals < 501);
+    wetdem_sim_free(sim);
+}
+
+/* Parameter names reach the integrators, with range checks and suggestions. */
+static void test_integrators_params(void** state)
+{
+    (void)state;
+    struct wetdem_sim* sim = wetdem_sim_create();
+    double v;
+    CHECK_OK(wetdem_sim_param(sim, "verlet.dt_fraction", &v));
+    CHECK_REL(v, 0.02, 0);
+    CHECK_OK(wetdem_sim_set_param(sim, "cvode.rtol", 1e-6));
+    CHECK_OK(wetdem_sim_param(sim, "cvode.rtol", &v));
+    CHECK_REL(v, 1e-6, 0);
+    CHECK_OK(wetdem_sim_set_param_str(sim, "cvode.method", "bdf"));
+    CHECK_STATUS(wetdem_sim_set_param(sim, "cvode.rtol", -1), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(wetdem_sim_errmsg(sim), "rtol");
+    CHECK_STATUS(wetdem_sim_set_param(sim, "verlet.dt_fractoin", 0.01), WETDEM_ERR_NOT_FOUND);
+    CHECK_CONTAINS(wetdem_sim_errmsg(sim), "verlet.dt_fraction");
+    CHECK_STATUS(wetdem_sim_set_integrator(sim, "cvod"), WETDEM_ERR_NOT_FOUND);
+    CHECK_CONTAINS(wetdem_sim_errmsg(sim), "cvode");
+    assert_string_equal(wetdem_sim_integrator_name(sim), "verlet");
+    CHECK_OK(wetdem_sim_set_integrator(sim, "cvode"));
+    assert_string_equal(wetdem_sim_integrator_name(sim), "cvode");
+    CHECK_STATUS(wetdem_sim_integrate(sim, -1.0), WETDEM_ERR_INVALID);
+    CHECK_STATUS(wetdem_sim_integrate(sim, NAN), WETDEM_ERR_INVALID);
+    wetdem_sim_free(sim);
+}
+
+/* The BDF variant agrees with the closed form too (damped oscillator, 1e-4). */
+static void test_integrators_cvode_bdf(void** state)
+{
+    (void)state;
+    struct spring_params sp = {.k = 50.0, .c = 0.2 * 2 * sqrt(50.0 * MASS)};
+    double h0 = 2e-4, u0 = -0.05, w0 = sqrt(sp.k / MASS), t_end = 1.3 * 2 * M_PI / w0;
+    struct wetdem_sim* sim = make_sim("cvode", h0, u0, true, &sp);
+    CHECK_OK(wetdem_sim_set_param_str(sim, "cvode.method", "bdf"));
+    CHECK_OK(wetdem_sim_set_param(sim, "cvode.rtol", 1e-9));
+    CHECK_OK(wetdem_sim_integrate(sim, t_end));
+    double h, u;
+    oscillator(sp.k, sp.c, h0, u0, t_end, &h, &u);
+    struct wetdem_particle p = particle0(sim);
+    CHECK_ABS(p.pos.x - RADIUS, h, 1e-4 * h0);
+    wetdem_sim_free(sim);
+}
+
+/* Observer: called at t = 0, every interval and at the end; a non-zero return stops the run
+ * with WETDEM_ERR_CALLBACK. */
+struct obs {
+    int calls;
+    double last_t;
+    int stop_after;
+};
+
+static int observer(const struct wetdem_sim* sim, void* ctx)
+{
+    struct obs* o = ctx;
+    o->calls++;
+    o->last_t = wetdem_sim_time(sim);
+    return o->stop_after && o->calls >= o->stop_after;
+}
+
+static void test_integrators_observer(void** state)
+{
+    (void)state;
+    for (int q = 0; q < 2; q++) {
+        struct spring_params sp = {.k = 50.0};
+        struct wetdem_sim* sim = make_sim(integrators[q], 2e-4, -0.05, true, &sp);
+        CHECK_OK(wetdem_sim_set_param(sim, "verlet.dt", 1e-5));
+        struct obs o = {0};
+        wetdem_sim_set_observer(sim, 0.01, observer, &o);
+        CHECK_OK(wetdem_sim_integrate(sim, 0.1));
+        /* t = 0, 0.01, ..., 0.1: 11 calls (the last one is the end) */
+        assert_int_equal(o.calls, 11);
+        CHECK_REL(o.last_t, 0.1, 1e-12);
+        o = (struct obs){.stop_after = 3};
+        CHECK_STATUS(wetdem_sim_integrate(sim, 0.2), WETDEM_ERR_CALLBACK);
+        wetdem_sim_free(sim);
+    }
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_integrators_free_flight),
+        cmocka_unit_test(test_integrators_constant_force),
+        cmocka_unit_test(test_integrators_oscillators),
+        cmocka_unit_test(test_integrators_verlet_order_two),
+        cmocka_unit_test(test_integrators_verlet_reversible),
+        cmocka_unit_test(test_integrators_cvode_tolerance),
+        cmocka_unit_test(test_integrators_stats),
+        cmocka_unit_test(test_integrators_params),
+        cmocka_unit_test(test_integrators_cvode_bdf),
+        cmocka_unit_test(test_integrators_observer),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
