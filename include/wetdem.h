@@ -505,6 +505,98 @@ WETDEM_API struct wetdem_sim* wetdem_sim_clone(const struct wetdem_sim* sim);
 
 /* ---- tracking section ---- */
 
+/* Tracked dots of the spheres of one Stokes-cradle video (opaque). Each sphere carries three
+ * painted dots: dot 1 on the vertical axis through the centre (in line with the suspension
+ * string), dots 2 and 3 beside it (Punch 2023 Sec. 3.1-3.2). docs/tracking.md. */
+struct wetdem_track;
+
+/* Settings of wetdem_track_analyse(); wetdem_track_options_init() gives the defaults. */
+struct wetdem_track_options {
+    double fps;          /* frame rate [1/s] > 0 (Punch: 5000) */
+    double pixel_size;   /* image resolution [m/pixel] > 0 (Punch: 175e-6) */
+    bool y_down;         /* the y pixel axis points down (image rows): y is negated on input so
+                            that (x, y) is right-handed and omega > 0 is counter-clockwise on
+                            screen (default false) */
+    int window;          /* Savitzky-Golay window [frames], odd, > order (7); 1: no smoothing */
+    int order;           /* Savitzky-Golay polynomial order, >= 0, < window (2) */
+    double threshold;    /* collision: striker velocity change [m/s] > 0 (0.05) */
+    int offset;          /* frames before/after the collision frame where the velocities are
+                            taken (5), >= 1 */
+    int fit_frames;      /* frame intervals in each straight-line fit, >= 3; 0: all (0) */
+    int striker;         /* sphere id of the striker; -1: the faster sphere at the start (-1) */
+    double radius;       /* sphere radius [m] for St_n; 0: not given (no St_n) */
+    double mass;         /* sphere mass [kg] for St_n; 0: not given */
+    double viscosity;    /* film viscosity [Pa s] for St_n; 0: not given */
+};
+
+/* Velocity of one sphere over the frame interval frame -> frame + 1 (Punch Eq. 23). */
+struct wetdem_track_sample {
+    long frame;                        /* first frame of the interval */
+    double time;                       /* interval midpoint (frame + 1/2)/fps [s] */
+    double vx_raw, vy_raw, omega_raw;  /* from the unsmoothed dots [m/s], [rad/s] */
+    double vx, vy, omega;              /* from the Savitzky-Golay smoothed dots */
+    double residual;                   /* rms residual of Eq. 23 on the smoothed dots [m] */
+};
+
+/* Velocities and dot-1 position of one sphere at one frame (straight-line fit values). */
+struct wetdem_track_state {
+    double vx, vy;  /* [m/s] */
+    double omega;   /* spin about the camera axis, counter-clockwise in (x, y) [rad/s] */
+    double x, y;    /* smoothed position of dot 1 (the centre) [m] */
+};
+
+/* The collision found in a two-sphere track. */
+struct wetdem_track_summary {
+    size_t n_spheres;                /* 1 or 2; the fields below need 2 */
+    bool has_collision;
+    int striker_id, target_id;       /* sphere ids as in the input */
+    long collision_frame;            /* last frame before the striker's velocity changes */
+    double collision_time;           /* collision_frame / fps [s] */
+    struct wetdem_track_state striker_before, striker_after; /* at collision_frame -/+ offset */
+    struct wetdem_track_state target_before, target_after;
+    double angle_centres;            /* Eq. 16: atan of dy/dx of the centres at the collision
+                                        frame [rad], in (-pi/2, pi/2] */
+    double impact_angle;             /* angle between the relative velocity before and the
+                                        line of centres at the collision frame [rad] */
+    double speed_n0, speed_nf;       /* normal relative speed before (approach > 0) and after
+                                        (separation > 0) [m/s] */
+    double e_n;                      /* Eq. 3: speed_nf / speed_n0 [-] */
+    double stokes_n;                 /* Eq. 2 with m* = m/2, R* = R/2; NAN without options */
+};
+
+/* Allocates an empty track. NULL only if out of memory. */
+WETDEM_API struct wetdem_track* wetdem_track_create(void);
+/* Frees a track and its results. NULL does nothing. */
+WETDEM_API void wetdem_track_free(struct wetdem_track* track);
+/* Last detailed error message of this track ("" if none). */
+WETDEM_API const char* wetdem_track_errmsg(const struct wetdem_track* track);
+/* Appends one frame of sphere `sphere_id` (>= 0; at most two spheres): xy = x1,y1,x2,y2,x3,y3
+ * [pixel]. Frames of a sphere must follow one another without gaps. Returns WETDEM_OK,
+ * WETDEM_ERR_INVALID (NaN, gap, non-increasing frame, third sphere) or WETDEM_ERR_NOMEM. */
+WETDEM_API int wetdem_track_add_frame(struct wetdem_track* track, int sphere_id, long frame,
+                                      const double xy[6]);
+/* Reads a CSV of rows frame,sphere,x1,y1,x2,y2,x3,y3 (optional header, '#' comments) and
+ * appends them. Returns WETDEM_OK, WETDEM_ERR_IO, WETDEM_ERR_PARSE (message "FILE:LINE: ...")
+ * or WETDEM_ERR_NOMEM. */
+WETDEM_API int wetdem_track_read_csv(struct wetdem_track* track, const char* path);
+/* Fills *opt with the defaults (fps and pixel_size 0: the caller must set them). */
+WETDEM_API void wetdem_track_options_init(struct wetdem_track_options* opt);
+/* Computes the per-frame velocities of every sphere and, with two spheres, the collision
+ * summary (Punch Sec. 3.2). Returns WETDEM_OK, WETDEM_ERR_INVALID (bad options, too few
+ * frames, spheres over different frames, no collision found; message in errmsg) or
+ * WETDEM_ERR_NOMEM. */
+WETDEM_API int wetdem_track_analyse(struct wetdem_track* track,
+                                    const struct wetdem_track_options* opt,
+                                    struct wetdem_track_summary* summary);
+/* Number of spheres, and the id of the k-th (in order of first appearance; -1 if k is out of
+ * range). */
+WETDEM_API size_t wetdem_track_n_spheres(const struct wetdem_track* track);
+WETDEM_API int wetdem_track_sphere_id(const struct wetdem_track* track, size_t k);
+/* Borrowed per-interval velocities of the k-th sphere after wetdem_track_analyse(); *n gets
+ * the count (frames - 1). Valid until the track is changed or freed; NULL before analysis. */
+WETDEM_API const struct wetdem_track_sample* wetdem_track_samples(const struct wetdem_track* t,
+                                                                  size_t k, size_t* n);
+
 /* ======================================================================================== */
 /* ABI checks for bindings                                                                  */
 /* ======================================================================================== */

@@ -1,0 +1,217 @@
+/*
+ * cmd_track.c — `wetdem track DOTS.csv --fps F --pixel-size S [options]`: translational and
+ * rotational velocities, collision frame, impact angle (Eq. 16), St_n (Eq. 2) and e_n (Eq. 3)
+ * from the tracked positions of three painted dots per sphere (Punch 2023 Sec. 3.2, Eq. 23;
+ * library: wetdem_track_*). The summary goes to stdout as "key = value" lines (or JSON with
+ * --json); --frames FILE writes the per-frame velocities as CSV. docs/tracking.md.
+ * Exit codes: 0 ok, 1 out of memory or unwritable output, 2 bad options or malformed track.
+ */
+#include <errno.h>
+#include <limits.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cli_util.h"
+
+static const char usage[] =
+    "usage: wetdem track DOTS.csv --fps F --pixel-size S [--window 7] [--order 2]\n"
+    "                    [--threshold 0.05] [--offset 5] [--fit-frames N] [--striker ID]\n"
+    "                    [--y-down] [--radius R --mass M --viscosity MU] [--frames FILE]\n"
+    "                    [--json]\n"
+    "  DOTS.csv      rows frame,sphere,x1,y1,x2,y2,x3,y3 (pixels); dot 1 = centre dot\n"
+    "  --fps         frame rate [1/s];  --pixel-size  image resolution [m/pixel]\n"
+    "  --window/--order  Savitzky-Golay smoothing (odd frames > order; 1 = none)\n"
+    "  --threshold   striker velocity change marking the collision [m/s]\n"
+    "  --offset      frames before/after the collision where velocities are taken\n"
+    "  --fit-frames  frame intervals in each straight-line fit (default all)\n"
+    "  --striker     sphere id of the striker (default: the faster one at the start)\n"
+    "  --y-down      the y pixel axis points down (image rows)\n"
+    "  --radius, --mass, --viscosity  sphere radius [m], mass [kg], film viscosity [Pa s]\n"
+    "                for the normal Stokes number (two equal spheres)\n"
+    "  --frames FILE per-frame velocities as CSV;  --json  summary as JSON\n";
+
+struct track_cli {
+    const char* input;
+    const char* frames_path;
+    bool json;
+    struct wetdem_track_options opt;
+};
+
+static int parse_int(const char* text, const char* what, int* out)
+{
+    char* end = NULL;
+    errno = 0;
+    long v = strtol(text, &end, 10);
+    if (end == text || *end != '\0' || errno == ERANGE || v < INT_MIN || v > INT_MAX) {
+        cli_error("%s: '%s' is not an integer", what, text);
+        return CLI_EXIT_USAGE;
+    }
+    *out = (int)v;
+    return CLI_EXIT_OK;
+}
+
+/* Options that take a number: name, where it goes (double or int). */
+static int parse_option(struct track_cli* c, const char* name, const char* value)
+{
+    struct wetdem_track_options* o = &c->opt;
+    static const char* const dnames[] = {"--fps", "--pixel-size", "--threshold", "--radius",
+                                         "--mass", "--viscosity"};
+    double* dvals[] = {&o->fps, &o->pixel_size, &o->threshold, &o->radius, &o->mass,
+                       &o->viscosity};
+    for (size_t k = 0; k < sizeof dnames / sizeof dnames[0]; k++)
+        if (strcmp(name, dnames[k]) == 0)
+            return cli_parse_double(value, name, dvals[k]);
+    static const char* const inames[] = {"--window", "--order", "--offset", "--fit-frames",
+                                         "--striker"};
+    int* ivals[] = {&o->window, &o->order, &o->offset, &o->fit_frames, &o->striker};
+    for (size_t k = 0; k < sizeof inames / sizeof inames[0]; k++)
+        if (strcmp(name, inames[k]) == 0)
+            return parse_int(value, name, ivals[k]);
+    if (strcmp(name, "--frames") == 0) {
+        c->frames_path = value;
+        return CLI_EXIT_OK;
+    }
+    cli_error("track: unknown option '%s'\n%s", name, usage);
+    return CLI_EXIT_USAGE;
+}
+
+static int parse_args(int argc, char** argv, struct track_cli* c)
+{
+    memset(c, 0, sizeof *c);
+    wetdem_track_options_init(&c->opt);
+    for (int k = 1; k < argc; k++) {
+        const char* a = argv[k];
+        if (strcmp(a, "--json") == 0) {
+            c->json = true;
+        } else if (strcmp(a, "--y-down") == 0) {
+            c->opt.y_down = true;
+        } else if (strncmp(a, "--", 2) == 0) {
+            if (k + 1 >= argc) {
+                cli_error("track: option %s needs a value", a);
+                return CLI_EXIT_USAGE;
+            }
+            int rc = parse_option(c, a, argv[++k]);
+            if (rc != CLI_EXIT_OK)
+                return rc;
+        } else if (!c->input) {
+            c->input = a;
+        } else {
+            cli_error("track: more than one input file ('%s' and '%s')", c->input, a);
+            return CLI_EXIT_USAGE;
+        }
+    }
+    if (!c->input || c->opt.fps == 0 || c->opt.pixel_size == 0) {
+        cli_error("track: DOTS.csv, --fps and --pixel-size are required\n%s", usage);
+        return CLI_EXIT_USAGE;
+    }
+    return CLI_EXIT_OK;
+}
+
+static int write_frames(const struct wetdem_track* t, const char* path, int argc, char** argv)
+{
+    FILE* f = fopen(path, "w");
+    if (!f) {
+        cli_error("track: cannot write '%s': %s", path, strerror(errno));
+        return CLI_EXIT_RUNTIME;
+    }
+    cli_print_provenance(f, argc, argv);
+    fprintf(f, "sphere,frame,time_s,vx_raw_m_s,vy_raw_m_s,omega_raw_rad_s,vx_m_s,vy_m_s,"
+               "omega_rad_s,residual_m\n");
+    for (size_t k = 0; k < wetdem_track_n_spheres(t); k++) {
+        size_t n;
+        const struct wetdem_track_sample* q = wetdem_track_samples(t, k, &n);
+        for (size_t i = 0; i < n; i++)
+            fprintf(f, "%d,%ld,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.6g\n",
+                    wetdem_track_sphere_id(t, k), q[i].frame, q[i].time, q[i].vx_raw,
+                    q[i].vy_raw, q[i].omega_raw, q[i].vx, q[i].vy, q[i].omega, q[i].residual);
+    }
+    int bad = ferror(f);
+    if (fclose(f) != 0 || bad) {
+        cli_error("track: error writing '%s'", path);
+        return CLI_EXIT_RUNTIME;
+    }
+    return CLI_EXIT_OK;
+}
+
+struct kv {
+    const char* key;
+    double value;
+};
+
+static void print_summary(const struct wetdem_track_summary* s, bool json)
+{
+    const double deg = 180.0 / M_PI;
+    const struct kv rows[] = {
+        {"collision_frame", (double)s->collision_frame},
+        {"collision_time_s", s->collision_time},
+        {"striker", s->striker_id},
+        {"target", s->target_id},
+        {"striker_before_vx_m_s", s->striker_before.vx},
+        {"striker_before_vy_m_s", s->striker_before.vy},
+        {"striker_before_omega_rad_s", s->striker_before.omega},
+        {"target_before_vx_m_s", s->target_before.vx},
+        {"target_before_vy_m_s", s->target_before.vy},
+        {"target_before_omega_rad_s", s->target_before.omega},
+        {"striker_after_vx_m_s", s->striker_after.vx},
+        {"striker_after_vy_m_s", s->striker_after.vy},
+        {"striker_after_omega_rad_s", s->striker_after.omega},
+        {"target_after_vx_m_s", s->target_after.vx},
+        {"target_after_vy_m_s", s->target_after.vy},
+        {"target_after_omega_rad_s", s->target_after.omega},
+        {"angle_centres_deg", s->angle_centres * deg},
+        {"impact_angle_deg", s->impact_angle * deg},
+        {"speed_n0_m_s", s->speed_n0},
+        {"speed_nf_m_s", s->speed_nf},
+        {"e_n", s->e_n},
+        {"stokes_n", s->stokes_n},
+    };
+    size_t n = s->has_collision ? sizeof rows / sizeof rows[0] : 0;
+    if (json)
+        printf("{\n  \"spheres\": %zu,\n  \"has_collision\": %s%s\n", s->n_spheres,
+               s->has_collision ? "true" : "false", n ? "," : "");
+    else
+        printf("spheres = %zu\nhas_collision = %s\n", s->n_spheres,
+               s->has_collision ? "true" : "false");
+    for (size_t k = 0; k < n; k++) {
+        const char* sep = k + 1 < n ? "," : "";
+        if (json && !isfinite(rows[k].value))
+            printf("  \"%s\": null%s\n", rows[k].key, sep);
+        else if (json)
+            printf("  \"%s\": %.9g%s\n", rows[k].key, rows[k].value, sep);
+        else
+            printf("%s = %.9g\n", rows[k].key, rows[k].value);
+    }
+    if (json)
+        printf("}\n");
+}
+
+int cmd_track(int argc, char** argv)
+{
+    struct track_cli c;
+    int rc = parse_args(argc, argv, &c);
+    if (rc != CLI_EXIT_OK)
+        return rc;
+    struct wetdem_track* t = wetdem_track_create();
+    if (!t) {
+        cli_error("track: out of memory");
+        return CLI_EXIT_RUNTIME;
+    }
+    struct wetdem_track_summary s;
+    int st = wetdem_track_read_csv(t, c.input);
+    if (st == WETDEM_OK)
+        st = wetdem_track_analyse(t, &c.opt, &s);
+    if (st != WETDEM_OK) {
+        cli_error("track: %s", wetdem_track_errmsg(t));
+        wetdem_track_free(t);
+        return st == WETDEM_ERR_NOMEM ? CLI_EXIT_RUNTIME : CLI_EXIT_USAGE;
+    }
+    rc = c.frames_path ? write_frames(t, c.frames_path, argc, argv) : CLI_EXIT_OK;
+    if (rc == CLI_EXIT_OK) {
+        if (!c.json)
+            cli_print_provenance(stdout, argc, argv);
+        print_summary(&s, c.json);
+    }
+    wetdem_track_free(t);
+    return rc;
+}

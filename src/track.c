@@ -1,0 +1,756 @@
+/*
+ * track.c — velocities, spin, impact angle, Stokes number and restitution of a Stokes-cradle
+ * collision from the tracked positions of three painted dots per sphere (Punch et al. 2023,
+ * Sec. 3.2, Eqs. 2, 3, 16-23 and Appendix A). docs/tracking.md describes the input and output.
+ *
+ * Pipeline (all lengths in m after multiplying pixels by the pixel size, times in s):
+ *  1. Savitzky-Golay smoothing of every dot coordinate (order 2, 7 frames by default); the
+ *     weights are the rows of the least-squares hat matrix H = V (V^T V)^-1 V^T of the window's
+ *     Vandermonde matrix V, obtained by a QR factorisation (GSL), not from a table.
+ *  2. For every frame interval i -> i+1 the rigid-motion equations of the three dots
+ *         p1^{i+1} - p1^i = v dt                                   (Eqs. 17-18)
+ *         pk^{i+1} - pk^i = v dt + omega dt J (pk^i - p1^i),  k = 2, 3
+ *     with J (a, b) = (-b, a), solved by linear least squares (Eq. 23; GSL QR). Sign: omega is
+ *     counter-clockwise in (x, y), as in Appendix A Eqs. 27-29; Eqs. 19-23 as printed carry
+ *     the opposite sign of omega (they agree with App. A when the image y axis points down,
+ *     which the y_down option handles). Eq. 21 as printed has p_y,2 - p_y,3 where the matrix
+ *     of Eq. 23 (and the derivation) has p_y,1 - p_y,3.
+ *     Small-angle bias: for an exact rotation by a = omega dt the solution is exactly
+ *     omega_est = sin(a)/dt (the cos(a) - 1 part of the rotation is orthogonal to the omega
+ *     column) and v_est = v + (cos(a) - 1)(D2 + D3)/(3 dt), Dk = pk - p1; i.e. a relative
+ *     spin bias -a^2/6 (6e-6 at 30 rad/s and 5000 frames/s).
+ *  3. Collision frame: the first interval from which the striker's smoothed velocity differs
+ *     from its mean over the first `window` intervals by more than `threshold` (0.05 m/s) for
+ *     window/2 + 1 consecutive intervals (a single noisy interval is not a collision).
+ *  4. Straight lines fitted to vx, vy and omega of each sphere before (intervals ending
+ *     window/2 + 1 before the collision frame) and after (from window + 1 after it, clear of
+ *     the smoothing's spread of the jump), evaluated `offset` frames before/after.
+ *  5. Impact angle of the centres (Eq. 16), normal relative speeds with the line of centres at
+ *     the collision frame (n_0) and at `offset` frames after (n_f), e_n (Eq. 3) and
+ *     St_n = m* v_n0 / (6 pi mu R*^2) (Eq. 2) for two equal spheres (m* = m/2, R* = R/2).
+ *
+ * Validity: dot 1 on the spin axis (the painted centre dot), rotation about the camera axis,
+ * orthographic imaging; at most two spheres; frames consecutive without gaps.
+ */
+#include <errno.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+
+#include <gsl/gsl_linalg.h>
+#include <gsl/gsl_matrix.h>
+#include <gsl/gsl_vector.h>
+
+#include "track.h"
+
+#define TRACK_MAX_SPHERES 2
+#define TRACK_ERRMSG_SIZE 512
+#define TRACK_LINE_MAX 4096
+#define TRACK_MIN_FIT 3 /* points of a straight-line fit: 2 parameters + 1 degree of freedom */
+
+struct sphere_track {
+    int id;
+    long first_frame;
+    size_t n, cap;                      /* frames stored */
+    double* xy;                         /* 6 per frame: dots in pixels as given */
+    double* raw;                        /* 6 per frame [m], y negated when y_down */
+    double* smooth;                     /* 6 per frame [m], Savitzky-Golay smoothed */
+    struct wetdem_track_sample* samples; /* n - 1 intervals, after analysis */
+};
+
+struct wetdem_track {
+    char errmsg[TRACK_ERRMSG_SIZE];
+    struct sphere_track s[TRACK_MAX_SPHERES];
+    size_t n_spheres;
+};
+
+static int fail(struct wetdem_track* t, int status, const char* fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+
+static int fail(struct wetdem_track* t, int status, const char* fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(t->errmsg, sizeof t->errmsg, fmt, ap);
+    va_end(ap);
+    return status;
+}
+
+struct wetdem_track* wetdem_track_create(void)
+{
+    return calloc(1, sizeof(struct wetdem_track));
+}
+
+static void free_results(struct sphere_track* s)
+{
+    free(s->raw);
+    free(s->smooth);
+    free(s->samples);
+    s->raw = s->smooth = NULL;
+    s->samples = NULL;
+}
+
+void wetdem_track_free(struct wetdem_track* track)
+{
+    if (!track)
+        return;
+    for (size_t k = 0; k < track->n_spheres; k++) {
+        free_results(&track->s[k]);
+        free(track->s[k].xy);
+    }
+    free(track);
+}
+
+const char* wetdem_track_errmsg(const struct wetdem_track* track)
+{
+    return track ? track->errmsg : "";
+}
+
+size_t wetdem_track_n_spheres(const struct wetdem_track* track)
+{
+    return track->n_spheres;
+}
+
+int wetdem_track_sphere_id(const struct wetdem_track* track, size_t k)
+{
+    return k < track->n_spheres ? track->s[k].id : -1;
+}
+
+const struct wetdem_track_sample* wetdem_track_samples(const struct wetdem_track* t, size_t k,
+                                                       size_t* n)
+{
+    if (k >= t->n_spheres || !t->s[k].samples) {
+        *n = 0;
+        return NULL;
+    }
+    *n = t->s[k].n - 1;
+    return t->s[k].samples;
+}
+
+/* ---- input ------------------------------------------------------------------------------ */
+
+static const char* const coord_names[6] = {"x1", "y1", "x2", "y2", "x3", "y3"};
+
+/* The stored sphere with this id, a new one, or NULL when two spheres exist already. */
+static struct sphere_track* sphere_slot(struct wetdem_track* t, int id)
+{
+    for (size_t k = 0; k < t->n_spheres; k++)
+        if (t->s[k].id == id)
+            return &t->s[k];
+    if (t->n_spheres == TRACK_MAX_SPHERES)
+        return NULL;
+    struct sphere_track* s = &t->s[t->n_spheres++];
+    memset(s, 0, sizeof *s);
+    s->id = id;
+    return s;
+}
+
+int wetdem_track_add_frame(struct wetdem_track* track, int sphere_id, long frame,
+                           const double xy[6])
+{
+    if (sphere_id < 0)
+        return fail(track, WETDEM_ERR_INVALID, "sphere id %d must be >= 0", sphere_id);
+    for (int c = 0; c < 6; c++)
+        if (!isfinite(xy[c]))
+            return fail(track, WETDEM_ERR_INVALID, "sphere %d frame %ld: %s is not finite (%g)",
+                        sphere_id, frame, coord_names[c], xy[c]);
+    struct sphere_track* s = sphere_slot(track, sphere_id);
+    if (!s)
+        return fail(track, WETDEM_ERR_INVALID,
+                    "sphere %d: at most %d spheres per track (found %d and %d already)",
+                    sphere_id, TRACK_MAX_SPHERES, track->s[0].id, track->s[1].id);
+    if (s->n > 0) {
+        long last = s->first_frame + (long)s->n - 1;
+        if (frame <= last)
+            return fail(track, WETDEM_ERR_INVALID,
+                        "sphere %d: frame %ld follows frame %ld; frames must increase",
+                        sphere_id, frame, last);
+        if (frame > last + 1)
+            return fail(track, WETDEM_ERR_INVALID,
+                        "sphere %d: frame %ld follows frame %ld; frames %ld to %ld are missing",
+                        sphere_id, frame, last, last + 1, frame - 1);
+    } else {
+        s->first_frame = frame;
+    }
+    if (s->n == s->cap) {
+        size_t cap = s->cap ? 2 * s->cap : 256;
+        double* p = realloc(s->xy, cap * 6 * sizeof *p);
+        if (!p)
+            return fail(track, WETDEM_ERR_NOMEM, "out of memory storing frame %ld", frame);
+        s->xy = p;
+        s->cap = cap;
+    }
+    memcpy(s->xy + 6 * s->n, xy, 6 * sizeof *xy);
+    s->n++;
+    free_results(s);
+    return WETDEM_OK;
+}
+
+/* Strips leading/trailing blanks in place; returns the start. */
+static char* trim(char* f)
+{
+    while (*f == ' ' || *f == '\t')
+        f++;
+    size_t len = strlen(f);
+    while (len > 0 && (f[len - 1] == ' ' || f[len - 1] == '\t' || f[len - 1] == '\r' ||
+                       f[len - 1] == '\n'))
+        f[--len] = '\0';
+    return f;
+}
+
+/* Splits a line at commas into at most `max` trimmed fields; returns the field count (max + 1
+ * when there are more). */
+static int split_fields(char* line, char** fields, int max)
+{
+    int n = 0;
+    char* p = line;
+    for (;;) {
+        char* comma = strchr(p, ',');
+        if (comma)
+            *comma = '\0';
+        if (n <= max - 1)
+            fields[n] = trim(p);
+        n++;
+        if (!comma || n > max)
+            return n;
+        p = comma + 1;
+    }
+}
+
+static bool parse_long(const char* text, long* out)
+{
+    char* end = NULL;
+    errno = 0;
+    long v = strtol(text, &end, 10);
+    if (end == text || *end != '\0' || errno == ERANGE)
+        return false;
+    *out = v;
+    return true;
+}
+
+static bool parse_number(const char* text, double* out)
+{
+    char* end = NULL;
+    errno = 0;
+    double v = strtod(text, &end);
+    if (end == text || *end != '\0' || errno == ERANGE)
+        return false;
+    *out = v;
+    return true;
+}
+
+/* True when fields are the expected header words frame,sphere,x1,...,y3 (any case). */
+static bool is_expected_header(char** f)
+{
+    if (strcasecmp(f[0], "frame") != 0 || strcasecmp(f[1], "sphere") != 0)
+        return false;
+    for (int c = 0; c < 6; c++)
+        if (strcasecmp(f[2 + c], coord_names[c]) != 0)
+            return false;
+    return true;
+}
+
+/* Parses and appends one data row; messages are prefixed by the caller. */
+static int parse_row(struct wetdem_track* t, char** f)
+{
+    long frame, sphere;
+    double xy[6];
+    if (!parse_long(f[0], &frame))
+        return fail(t, WETDEM_ERR_PARSE, "column frame: '%s' is not an integer", f[0]);
+    if (!parse_long(f[1], &sphere) || sphere < 0 || sphere > 1000000)
+        return fail(t, WETDEM_ERR_PARSE,
+                    "column sphere: '%s' is not an integer id in [0, 1000000]", f[1]);
+    for (int c = 0; c < 6; c++)
+        if (!parse_number(f[2 + c], &xy[c]) || !isfinite(xy[c]))
+            return fail(t, WETDEM_ERR_PARSE, "column %s: '%s' is not a finite number",
+                        coord_names[c], f[2 + c]);
+    int st = wetdem_track_add_frame(t, (int)sphere, frame, xy);
+    return st == WETDEM_ERR_INVALID ? WETDEM_ERR_PARSE : st;
+}
+
+/* Prefixes the current message with "path:line: ". */
+static int located(struct wetdem_track* t, int status, const char* path, long line)
+{
+    char msg[TRACK_ERRMSG_SIZE];
+    snprintf(msg, sizeof msg, "%s", t->errmsg);
+    return fail(t, status, "%s:%ld: %s", path, line, msg);
+}
+
+/* Handles one non-blank, non-comment line; *seen_data tells whether a row came before. */
+static int read_line(struct wetdem_track* t, char* text, bool* seen_data)
+{
+    char* f[9];
+    int n = split_fields(text, f, 9);
+    if (n != 8)
+        return fail(t, WETDEM_ERR_PARSE,
+                    "expected 8 columns (frame,sphere,x1,y1,x2,y2,x3,y3), found %s%d",
+                    n > 8 ? "more than " : "", n > 8 ? 8 : n);
+    long dummy;
+    if (!*seen_data && !parse_long(f[0], &dummy)) {
+        *seen_data = true;
+        if (!is_expected_header(f))
+            return fail(t, WETDEM_ERR_PARSE,
+                        "header must be frame,sphere,x1,y1,x2,y2,x3,y3 (got '%s,%s,...')", f[0],
+                        f[1]);
+        return WETDEM_OK;
+    }
+    *seen_data = true;
+    return parse_row(t, f);
+}
+
+int wetdem_track_read_csv(struct wetdem_track* track, const char* path)
+{
+    FILE* fp = fopen(path, "r");
+    if (!fp)
+        return fail(track, WETDEM_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
+    char buf[TRACK_LINE_MAX];
+    long line = 0;
+    bool seen_data = false;
+    int st = WETDEM_OK;
+    while (st == WETDEM_OK && fgets(buf, sizeof buf, fp)) {
+        line++;
+        if (!strchr(buf, '\n') && !feof(fp)) {
+            st = located(track, fail(track, WETDEM_ERR_PARSE, "line longer than %d characters",
+                                     TRACK_LINE_MAX - 2), path, line);
+            break;
+        }
+        char* text = trim(buf);
+        if (*text == '\0' || *text == '#')
+            continue;
+        st = read_line(track, text, &seen_data);
+        if (st != WETDEM_OK)
+            st = located(track, st, path, line);
+    }
+    fclose(fp);
+    if (st == WETDEM_OK && track->n_spheres == 0)
+        st = fail(track, WETDEM_ERR_PARSE, "%s: no data rows", path);
+    return st;
+}
+
+/* ---- kernels ---------------------------------------------------------------------------- */
+
+int wetdem_track_savgol_hat(int window, int order, double* hat)
+{
+    if (window < 1 || window % 2 == 0 || order < 0 || order >= window)
+        return WETDEM_ERR_INVALID;
+    size_t w = (size_t)window, p = (size_t)order + 1;
+    gsl_matrix* v = gsl_matrix_alloc(w, p);
+    gsl_vector* tau = gsl_vector_alloc(p);
+    gsl_matrix* q = gsl_matrix_alloc(w, w);
+    gsl_matrix* r = gsl_matrix_alloc(w, p);
+    int st = (v && tau && q && r) ? WETDEM_OK : WETDEM_ERR_NOMEM;
+    if (st == WETDEM_OK) {
+        /* Vandermonde matrix on the centred abscissa u = k - window/2 (better conditioned). */
+        for (size_t k = 0; k < w; k++)
+            for (size_t j = 0; j < p; j++)
+                gsl_matrix_set(v, k, j, pow((double)k - (double)(w / 2), (double)j));
+        gsl_linalg_QR_decomp(v, tau);
+        gsl_linalg_QR_unpack(v, tau, q, r);
+        /* V has full column rank, so H = Q1 Q1^T with Q1 the first p columns of Q. */
+        for (size_t a = 0; a < w; a++)
+            for (size_t b = 0; b < w; b++) {
+                double sum = 0;
+                for (size_t j = 0; j < p; j++)
+                    sum += gsl_matrix_get(q, a, j) * gsl_matrix_get(q, b, j);
+                hat[a * w + b] = sum;
+            }
+    }
+    gsl_matrix_free(v);
+    gsl_vector_free(tau);
+    gsl_matrix_free(q);
+    gsl_matrix_free(r);
+    return st;
+}
+
+void wetdem_track_savgol_apply(const double* hat, int window, const double* x, size_t n,
+                               double* out)
+{
+    size_t w = (size_t)window, h = w / 2;
+    for (size_t j = 0; j < n; j++) {
+        size_t start = j < h ? 0 : j - h;
+        if (start + w > n)
+            start = n - w;
+        const double* row = hat + (j - start) * w;
+        double sum = 0;
+        for (size_t m = 0; m < w; m++)
+            sum += row[m] * x[start + m];
+        out[j] = sum;
+    }
+}
+
+int wetdem_track_solve_interval(const double p0[6], const double p1[6], double dt, double out[3],
+                                double* rms)
+{
+    /* Unknowns scaled as (vx dt, vy dt, omega dt) so that the columns are comparable. */
+    double a[18] = {0}, b[6], tau[3], x[3], res[6];
+    for (int k = 0; k < 3; k++) {
+        double dx = p0[2 * k] - p0[0], dy = p0[2 * k + 1] - p0[1];
+        double* rx = a + 6 * k;
+        double* ry = rx + 3;
+        rx[0] = 1.0;
+        rx[2] = -dy;
+        ry[1] = 1.0;
+        ry[2] = dx;
+        b[2 * k] = p1[2 * k] - p0[2 * k];
+        b[2 * k + 1] = p1[2 * k + 1] - p0[2 * k + 1];
+    }
+    gsl_matrix_view av = gsl_matrix_view_array(a, 6, 3);
+    gsl_vector_view bv = gsl_vector_view_array(b, 6), tv = gsl_vector_view_array(tau, 3);
+    gsl_vector_view xv = gsl_vector_view_array(x, 3), rv = gsl_vector_view_array(res, 6);
+    gsl_linalg_QR_decomp(&av.matrix, &tv.vector);
+    /* Degenerate when the outer dots coincide with the centre dot (R[2][2] = 0). */
+    if (!(fabs(gsl_matrix_get(&av.matrix, 2, 2)) > 0))
+        return WETDEM_ERR_NUMERIC;
+    gsl_linalg_QR_lssolve(&av.matrix, &tv.vector, &bv.vector, &xv.vector, &rv.vector);
+    for (int k = 0; k < 3; k++)
+        out[k] = x[k] / dt;
+    if (rms) {
+        double s = 0;
+        for (int k = 0; k < 6; k++)
+            s += res[k] * res[k];
+        *rms = sqrt(s / 6.0);
+    }
+    return isfinite(out[0] + out[1] + out[2]) ? WETDEM_OK : WETDEM_ERR_NUMERIC;
+}
+
+/* ---- analysis --------------------------------------------------------------------------- */
+
+void wetdem_track_options_init(struct wetdem_track_options* opt)
+{
+    *opt = (struct wetdem_track_options){
+        .fps = 0,
+        .pixel_size = 0,
+        .y_down = false,
+        .window = 7,
+        .order = 2,
+        .threshold = 0.05,
+        .offset = 5,
+        .fit_frames = 0,
+        .striker = -1,
+        .radius = 0,
+        .mass = 0,
+        .viscosity = 0,
+    };
+}
+
+static int check_options(struct wetdem_track* t, const struct wetdem_track_options* o)
+{
+    if (!(isfinite(o->fps) && o->fps > 0))
+        return fail(t, WETDEM_ERR_INVALID, "fps = %g: must be a frame rate > 0 [1/s]", o->fps);
+    if (!(isfinite(o->pixel_size) && o->pixel_size > 0))
+        return fail(t, WETDEM_ERR_INVALID, "pixel_size = %g: must be > 0 [m/pixel]",
+                    o->pixel_size);
+    if (o->window < 1 || o->window % 2 == 0 || o->window > 1001)
+        return fail(t, WETDEM_ERR_INVALID, "window = %d: must be odd, in [1, 1001] frames",
+                    o->window);
+    if (o->order < 0 || o->order >= o->window)
+        return fail(t, WETDEM_ERR_INVALID, "order = %d: must be in [0, window - 1 = %d]",
+                    o->order, o->window - 1);
+    if (!(isfinite(o->threshold) && o->threshold > 0))
+        return fail(t, WETDEM_ERR_INVALID, "threshold = %g: must be > 0 [m/s]", o->threshold);
+    if (o->offset < 1 || o->offset > 100000)
+        return fail(t, WETDEM_ERR_INVALID, "offset = %d: must be in [1, 100000] frames",
+                    o->offset);
+    if (o->fit_frames != 0 && (o->fit_frames < TRACK_MIN_FIT || o->fit_frames > 1000000))
+        return fail(t, WETDEM_ERR_INVALID, "fit_frames = %d: must be 0 (all) or in [%d, 1000000]",
+                    o->fit_frames, TRACK_MIN_FIT);
+    const double phys[3] = {o->radius, o->mass, o->viscosity};
+    const char* names[3] = {"radius", "mass", "viscosity"};
+    for (int k = 0; k < 3; k++)
+        if (!(isfinite(phys[k]) && phys[k] >= 0))
+            return fail(t, WETDEM_ERR_INVALID, "%s = %g: must be >= 0 (0: not given)", names[k],
+                        phys[k]);
+    return WETDEM_OK;
+}
+
+/* Positions in m (raw and smoothed) and the per-interval velocities of one sphere. */
+static int sphere_velocities(struct wetdem_track* t, struct sphere_track* s,
+                             const struct wetdem_track_options* o, const double* hat)
+{
+    size_t n = s->n;
+    free_results(s);
+    s->raw = malloc(6 * n * sizeof *s->raw);
+    s->smooth = malloc(6 * n * sizeof *s->smooth);
+    s->samples = malloc((n - 1) * sizeof *s->samples);
+    double* col = malloc(2 * n * sizeof *col);
+    if (!s->raw || !s->smooth || !s->samples || !col) {
+        free(col);
+        free_results(s);
+        return fail(t, WETDEM_ERR_NOMEM, "out of memory analysing sphere %d", s->id);
+    }
+    for (size_t i = 0; i < 6 * n; i++)
+        s->raw[i] = s->xy[i] * o->pixel_size * ((o->y_down && i % 2 == 1) ? -1.0 : 1.0);
+    for (int c = 0; c < 6; c++) {
+        for (size_t i = 0; i < n; i++)
+            col[i] = s->raw[6 * i + (size_t)c];
+        wetdem_track_savgol_apply(hat, o->window, col, n, col + n);
+        for (size_t i = 0; i < n; i++)
+            s->smooth[6 * i + (size_t)c] = col[n + i];
+    }
+    free(col);
+    double dt = 1.0 / o->fps, v[3];
+    for (size_t i = 0; i + 1 < n; i++) {
+        struct wetdem_track_sample* q = &s->samples[i];
+        q->frame = s->first_frame + (long)i;
+        q->time = ((double)q->frame + 0.5) * dt;
+        int st = wetdem_track_solve_interval(s->raw + 6 * i, s->raw + 6 * (i + 1), dt, v, NULL);
+        q->vx_raw = v[0], q->vy_raw = v[1], q->omega_raw = v[2];
+        if (st == WETDEM_OK)
+            st = wetdem_track_solve_interval(s->smooth + 6 * i, s->smooth + 6 * (i + 1), dt, v,
+                                             &q->residual);
+        q->vx = v[0], q->vy = v[1], q->omega = v[2];
+        if (st != WETDEM_OK)
+            return fail(t, WETDEM_ERR_INVALID,
+                        "sphere %d frame %ld: dots 2 and 3 coincide with dot 1 (or are not "
+                        "finite); spin cannot be resolved", s->id, q->frame);
+    }
+    return WETDEM_OK;
+}
+
+static double sample_component(const struct wetdem_track_sample* q, int c)
+{
+    return c == 0 ? q->vx : (c == 1 ? q->vy : q->omega);
+}
+
+/* Index of the striker among the two spheres. */
+static int pick_striker(struct wetdem_track* t, const struct wetdem_track_options* o,
+                        size_t n_ref, size_t* striker)
+{
+    if (o->striker >= 0) {
+        for (size_t k = 0; k < t->n_spheres; k++)
+            if (t->s[k].id == o->striker) {
+                *striker = k;
+                return WETDEM_OK;
+            }
+        return fail(t, WETDEM_ERR_INVALID, "striker = %d: no sphere with that id (found %d, %d)",
+                    o->striker, t->s[0].id, t->s[1].id);
+    }
+    double speed[2];
+    for (size_t k = 0; k < 2; k++) {
+        double vx = 0, vy = 0;
+        for (size_t i = 0; i < n_ref; i++)
+            vx += t->s[k].samples[i].vx, vy += t->s[k].samples[i].vy;
+        speed[k] = hypot(vx, vy) / (double)n_ref;
+    }
+    *striker = speed[1] > speed[0] ? 1 : 0;
+    return WETDEM_OK;
+}
+
+/* First interval from which the striker's velocity differs from its initial mean by more
+ * than the threshold for `persist` consecutive intervals; n_int on failure. */
+static size_t find_collision(const struct sphere_track* s, size_t n_ref, size_t persist,
+                             double threshold)
+{
+    size_t n_int = s->n - 1;
+    double vx0 = 0, vy0 = 0;
+    for (size_t i = 0; i < n_ref; i++)
+        vx0 += s->samples[i].vx, vy0 += s->samples[i].vy;
+    vx0 /= (double)n_ref, vy0 /= (double)n_ref;
+    size_t run = 0;
+    for (size_t i = 0; i < n_int; i++) {
+        double dv = hypot(s->samples[i].vx - vx0, s->samples[i].vy - vy0);
+        run = dv > threshold ? run + 1 : 0;
+        if (run == persist)
+            return i + 1 - persist;
+    }
+    return n_int;
+}
+
+/* Least-squares straight line through component c of samples [first, first + count)
+ * against time, evaluated at t_eval (centred sums; count >= 2 distinct times). */
+static double line_value(const struct wetdem_track_sample* q, size_t first, size_t count, int c,
+                         double t_eval)
+{
+    double tm = 0, ym = 0;
+    for (size_t i = first; i < first + count; i++)
+        tm += q[i].time, ym += sample_component(&q[i], c);
+    tm /= (double)count, ym /= (double)count;
+    double sxx = 0, sxy = 0;
+    for (size_t i = first; i < first + count; i++) {
+        double dt = q[i].time - tm;
+        sxx += dt * dt;
+        sxy += dt * (sample_component(&q[i], c) - ym);
+    }
+    return ym + (sxy / sxx) * (t_eval - tm);
+}
+
+/* The fitted state of a sphere at frame index `at` (0-based) from intervals [first, +count). */
+static struct wetdem_track_state fitted_state(const struct sphere_track* s, size_t first,
+                                              size_t count, size_t at, double dt)
+{
+    double t_eval = (double)(s->first_frame + (long)at) * dt;
+    struct wetdem_track_state st = {
+        .vx = line_value(s->samples, first, count, 0, t_eval),
+        .vy = line_value(s->samples, first, count, 1, t_eval),
+        .omega = line_value(s->samples, first, count, 2, t_eval),
+        .x = s->smooth[6 * at],
+        .y = s->smooth[6 * at + 1],
+    };
+    return st;
+}
+
+/* Fitting windows of the collision at interval k (see the header comment, step 4). */
+struct fit_windows {
+    size_t before_first, before_count, after_first, after_count;
+};
+
+static int fit_windows(struct wetdem_track* t, const struct wetdem_track_options* o,
+                       size_t n_int, size_t k, struct fit_windows* w)
+{
+    size_t h = (size_t)o->window / 2, fit = (size_t)o->fit_frames;
+    size_t b_end = k > h ? k - h : 0, a_first = k + 2 * h + 1;
+    w->before_first = (fit && b_end > fit) ? b_end - fit : 0;
+    w->before_count = b_end - w->before_first;
+    w->after_first = a_first;
+    w->after_count = a_first < n_int ? n_int - a_first : 0;
+    if (fit && w->after_count > fit)
+        w->after_count = fit;
+    long frame = t->s[0].first_frame + (long)k;
+    if (w->before_count < TRACK_MIN_FIT)
+        return fail(t, WETDEM_ERR_INVALID,
+                    "collision at frame %ld leaves %zu frame intervals for the fit before it; "
+                    "at least %d are needed (the track must start %zu frames earlier or more)",
+                    frame, w->before_count, TRACK_MIN_FIT, (size_t)TRACK_MIN_FIT + h);
+    if (w->after_count < TRACK_MIN_FIT)
+        return fail(t, WETDEM_ERR_INVALID,
+                    "collision at frame %ld leaves %zu frame intervals for the fit after it; "
+                    "at least %d are needed (the track must go on %zu frames later or more)",
+                    frame, w->after_count, TRACK_MIN_FIT, (size_t)TRACK_MIN_FIT + 2 * h + 1);
+    if (k < (size_t)o->offset || k + (size_t)o->offset > n_int)
+        return fail(t, WETDEM_ERR_INVALID,
+                    "collision at frame %ld: frames %ld and %ld (offset %d) must both be tracked",
+                    frame, frame - o->offset, frame + o->offset, o->offset);
+    return WETDEM_OK;
+}
+
+/* Unit vector from the target's centre to the striker's at frame index `at`. */
+static void centre_normal(const struct sphere_track* striker, const struct sphere_track* target,
+                          size_t at, double n[2])
+{
+    double dx = striker->smooth[6 * at] - target->smooth[6 * at];
+    double dy = striker->smooth[6 * at + 1] - target->smooth[6 * at + 1];
+    double len = hypot(dx, dy);
+    n[0] = dx / len;
+    n[1] = dy / len;
+}
+
+/* Angles, normal speeds, e_n (Eq. 3) and St_n (Eq. 2) from the fitted states. */
+static int restitution(struct wetdem_track* t, const struct wetdem_track_options* o,
+                       const struct sphere_track* s, const struct sphere_track* g, size_t k,
+                       struct wetdem_track_summary* sum)
+{
+    double n0[2], nf[2];
+    centre_normal(s, g, k, n0);
+    centre_normal(s, g, k + (size_t)o->offset, nf);
+    if (!isfinite(n0[0] + n0[1] + nf[0] + nf[1]))
+        return fail(t, WETDEM_ERR_INVALID, "the two spheres' centre dots coincide");
+    double v0x = sum->striker_before.vx - sum->target_before.vx;
+    double v0y = sum->striker_before.vy - sum->target_before.vy;
+    double vfx = sum->striker_after.vx - sum->target_after.vx;
+    double vfy = sum->striker_after.vy - sum->target_after.vy;
+    sum->speed_n0 = -(v0x * n0[0] + v0y * n0[1]);
+    sum->speed_nf = vfx * nf[0] + vfy * nf[1];
+    if (!(sum->speed_n0 > 0))
+        return fail(t, WETDEM_ERR_INVALID,
+                    "the spheres are not approaching before the collision at frame %ld "
+                    "(normal relative speed %g m/s)", sum->collision_frame, -sum->speed_n0);
+    sum->e_n = sum->speed_nf / sum->speed_n0;
+    double cosine = sum->speed_n0 / hypot(v0x, v0y);
+    sum->impact_angle = acos(cosine > 1 ? 1 : cosine);
+    double dx = g->smooth[6 * k] - s->smooth[6 * k], dy = g->smooth[6 * k + 1] - s->smooth[6 * k + 1];
+    sum->angle_centres = dx != 0 ? atan(dy / dx) : M_PI / 2;
+    sum->stokes_n = NAN;
+    if (o->radius > 0 && o->mass > 0 && o->viscosity > 0) {
+        double m_eff = 0.5 * o->mass, r_eff = 0.5 * o->radius;
+        sum->stokes_n = m_eff * sum->speed_n0 / (6 * M_PI * o->viscosity * r_eff * r_eff);
+    }
+    return WETDEM_OK;
+}
+
+/* Largest velocity change of the striker from its initial mean, for error messages. */
+static double largest_change(const struct sphere_track* s, size_t n_ref)
+{
+    double vx0 = 0, vy0 = 0, best = 0;
+    for (size_t i = 0; i < n_ref; i++)
+        vx0 += s->samples[i].vx / (double)n_ref, vy0 += s->samples[i].vy / (double)n_ref;
+    for (size_t i = 0; i + 1 < s->n; i++)
+        best = fmax(best, hypot(s->samples[i].vx - vx0, s->samples[i].vy - vy0));
+    return best;
+}
+
+static int collision_summary(struct wetdem_track* t, const struct wetdem_track_options* o,
+                             struct wetdem_track_summary* sum)
+{
+    size_t n_int = t->s[0].n - 1, h = (size_t)o->window / 2;
+    size_t n_ref = o->window > TRACK_MIN_FIT ? (size_t)o->window : TRACK_MIN_FIT, si = 0;
+    int st = pick_striker(t, o, n_ref, &si);
+    if (st != WETDEM_OK)
+        return st;
+    const struct sphere_track *s = &t->s[si], *g = &t->s[1 - si];
+    size_t k = find_collision(s, n_ref, h + 1, o->threshold);
+    if (k == n_int)
+        return fail(t, WETDEM_ERR_INVALID,
+                    "no collision found: the velocity of the striker (sphere %d) never differs "
+                    "from its initial value by more than threshold = %g m/s for %zu frames in a "
+                    "row (largest change %.3g m/s)", s->id, o->threshold, h + 1,
+                    largest_change(s, n_ref));
+    if (k < n_ref)
+        return fail(t, WETDEM_ERR_INVALID,
+                    "collision at frame %ld is within the first %zu frames, which set the "
+                    "reference velocity; the track must start earlier", s->first_frame + (long)k,
+                    n_ref);
+    struct fit_windows w;
+    if ((st = fit_windows(t, o, n_int, k, &w)) != WETDEM_OK)
+        return st;
+    double dt = 1.0 / o->fps;
+    size_t off = (size_t)o->offset;
+    sum->has_collision = true;
+    sum->striker_id = s->id;
+    sum->target_id = g->id;
+    sum->collision_frame = s->first_frame + (long)k;
+    sum->collision_time = (double)sum->collision_frame * dt;
+    sum->striker_before = fitted_state(s, w.before_first, w.before_count, k - off, dt);
+    sum->striker_after = fitted_state(s, w.after_first, w.after_count, k + off, dt);
+    sum->target_before = fitted_state(g, w.before_first, w.before_count, k - off, dt);
+    sum->target_after = fitted_state(g, w.after_first, w.after_count, k + off, dt);
+    return restitution(t, o, s, g, k, sum);
+}
+
+int wetdem_track_analyse(struct wetdem_track* track, const struct wetdem_track_options* opt,
+                         struct wetdem_track_summary* summary)
+{
+    memset(summary, 0, sizeof *summary);
+    summary->e_n = summary->stokes_n = NAN;
+    int st = check_options(track, opt);
+    if (st != WETDEM_OK)
+        return st;
+    if (track->n_spheres == 0)
+        return fail(track, WETDEM_ERR_INVALID, "the track has no frames");
+    const struct sphere_track* a = &track->s[0];
+    if (track->n_spheres == 2 &&
+        (track->s[1].first_frame != a->first_frame || track->s[1].n != a->n))
+        return fail(track, WETDEM_ERR_INVALID,
+                    "sphere %d covers frames %ld to %ld but sphere %d covers %ld to %ld; both "
+                    "spheres must be tracked over the same frames", a->id, a->first_frame,
+                    a->first_frame + (long)a->n - 1, track->s[1].id, track->s[1].first_frame,
+                    track->s[1].first_frame + (long)track->s[1].n - 1);
+    size_t need = (size_t)(opt->window > 2 ? opt->window : 2);
+    if (a->n < need)
+        return fail(track, WETDEM_ERR_INVALID,
+                    "sphere %d has %zu frames; at least %zu are needed (window = %d)", a->id,
+                    a->n, need, opt->window);
+    double* hat = malloc((size_t)opt->window * (size_t)opt->window * sizeof *hat);
+    if (!hat)
+        return fail(track, WETDEM_ERR_NOMEM, "out of memory");
+    st = wetdem_track_savgol_hat(opt->window, opt->order, hat);
+    for (size_t k = 0; st == WETDEM_OK && k < track->n_spheres; k++)
+        st = sphere_velocities(track, &track->s[k], opt, hat);
+    free(hat);
+    if (st != WETDEM_OK)
+        return st;
+    summary->n_spheres = track->n_spheres;
+    return track->n_spheres == 2 ? collision_summary(track, opt, summary) : WETDEM_OK;
+}
