@@ -166,6 +166,25 @@ static void test_glass_speed_choices(void** state)
     }
 }
 
+/* h_min is a property of the pair: swapping i and j (unequal radii and masses) gives the
+ * same value and the same history, bit for bit (only n and v_t change sign). */
+static void test_minsep_swap_invariant(void** state)
+{
+    (void)state;
+    const struct wetdem_model* models[] = {&wetdem_minsep_fixed, &wetdem_minsep_roughness,
+                                           &wetdem_minsep_ehd,   &wetdem_minsep_max,
+                                           &wetdem_minsep_glass, NULL};
+    for (size_t k = 0; models[k]; k++) {
+        struct wetdem_contact c = test_contact(3e-3, 9e-3, 0.02, 0.5, 40e-6, 0.8);
+        c.v_t = (struct wetdem_vec3){0, 0.3, -0.1};
+        struct wetdem_contact s = wetdem_contact_swapped(&c);
+        double params[4], ha[3] = {0.2, 0, 0}, hb[3] = {0.2, 0, 0};
+        wetdem_param_init_defaults(models[k]->params, params);
+        CHECK_REL(minsep(models[k], params, &s, hb), minsep(models[k], params, &c, ha), 0);
+        CHECK_REL(hb[0], ha[0], 0);
+    }
+}
+
 /* Parameters through the simulation: out-of-range and NaN rejected with a message naming the
  * parameter and its range; choices by word. */
 static void test_minsep_params_validated(void** state)
@@ -215,6 +234,7 @@ int main(void)
         cmocka_unit_test(test_max_takes_larger_mechanism),
         cmocka_unit_test(test_glass_hand_value_and_cap),
         cmocka_unit_test(test_glass_speed_choices),
+        cmocka_unit_test(test_minsep_swap_invariant),
         cmocka_unit_test(test_minsep_params_validated),
         cmocka_unit_test(test_minsep_models_documented),
     };
