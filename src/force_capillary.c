@@ -8,12 +8,13 @@
  * a = R* [m], sigma the surface tension [N/m], delta = delta_i + delta_j [m]. It is the
  * Laplace suction of the thin bridge between the near-touching coated surfaces, independent of
  * the gap while the bridge exists (Davis & Sitison 2020); the value is the seeds' (twice the
- * classic pendular-ring limit 4 pi a sigma for a small bridge of a wetting liquid, see
- * docs/derivations/fluid.md). The bridge forms when
- * the films overlap (h = delta) and breaks when they separate: zero for h > delta (Davis: the
- * bridge breaks or has negligible influence there). At solid overlap (h <= 0) the bridge
- * stays: the liquid surrounds the contact and the suction keeps acting, as in Davis, where
- * contact is an instant inside a continuing bridge. A film of zero thickness gives no force.
+ * classic pendular-ring limit 4 pi a sigma of a small bridge of wetting liquid; see
+ * docs/derivations/fluid.md Sec. 4). The bridge forms when the films overlap (h = delta) and
+ * breaks when they separate: zero for h > delta (Davis: the bridge breaks or has negligible
+ * influence there). At solid overlap (h <= 0) the bridge stays: the liquid surrounds the
+ * contact and the suction keeps acting, as in Davis, where contact is an instant inside a
+ * continuing bridge (dropping it would add a jump of 8 pi a sigma at contact). A film of zero
+ * thickness gives no force.
  * Validity: delta << a, contact angle zero, bridge volume from the films.
  */
 #include <math.h>
