@@ -71,7 +71,7 @@ static int build_pair_slots(struct wetdem_sim* sim, size_t k)
     struct wetdem_contact c;
     double range, scratch[64], gaps[WETDEM_MAX_THRESHOLDS];
     pair_state(sim, k, &c, &range, scratch);
-    if (c.gap <= range)
+    if (c.gap < range) /* strictly inside: a run stopped exactly at separation stays done */
         e->pairs.items[k].has_interacted = true;
     struct wetdem_event_slot extra[WETDEM_MAX_MODELS * WETDEM_MAX_THRESHOLDS];
     size_t n_extra = 0;

@@ -94,8 +94,8 @@ double wetdem_sim_speed_scale(const struct wetdem_sim* sim, double* t_hertz);
 /* Smallest radius of a free particle [m] (1 if none). */
 double wetdem_sim_length_scale(const struct wetdem_sim* sim);
 /* Checks sim.stop_on_separation at the current state (engine.pair_gap/pair_vn must be
- * current): true when some pair has interacted and every such pair is beyond
- * separation_factor x range and receding; their flags are then cleared. */
+ * current): true when some pair has interacted and every such pair is at or beyond
+ * separation_factor x range and receding (v_n < 0); their flags are then cleared. */
 bool wetdem_sim_separation_reached(struct wetdem_sim* sim);
 /* After an accepted step at engine.time: calls the monitor. Returns its status. */
 int wetdem_sim_step_done(struct wetdem_sim* sim);

@@ -298,7 +298,7 @@ bool wetdem_sim_separation_reached(struct wetdem_sim* sim)
         if (!e->pairs.items[k].has_interacted)
             continue;
         any = true;
-        if (!(e->pair_gap[k] > factor * e->pair_range[k] && e->pair_vn[k] < 0))
+        if (!(e->pair_gap[k] >= factor * e->pair_range[k] && e->pair_vn[k] < 0))
             return false;
     }
     if (!any)
