@@ -50,8 +50,8 @@ static const struct wetdem_param_desc hertz_params_desc[] = {
  * closed form ln e(c) above by bisection to machine precision, slopes by fourth-order
  * finite differences (step 1e-3 in u; one-sided at u = 0): run
  *   build/tests/test_contact_models --regen-hertz-table
- * and paste its output here (then `make format`). test_contact_models checks the table against the closed form
- * and against a fresh integration of the dimensionless collision.
+ * and paste its output here (then `make format`). test_contact_models checks the table
+ * against the closed form and against a fresh integration of the dimensionless collision.
  */
 #define HERTZ_TABLE_N 201
 #define HERTZ_TABLE_U_MIN -13.815510557964274 /* ln(1e-6) */
