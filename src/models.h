@@ -33,19 +33,22 @@ extern const struct wetdem_model wetdem_minsep_glass;
 double wetdem_force_hertz_elastic(double e_star, double r_eff, double overlap);
 /* force_hertz.c: normal viscous damping force of the Hertz contact [N], > 0 (repulsive) for
  * v_n > 0 (approaching), proportional to delta^(1/4) v_n so that the restitution is
- * independent of speed. form 0 "exact": coefficient chosen so that an isolated undamped-
- * spring + dashpot collision rebounds with exactly `restitution`; form 1 "tsuji": the
- * LIGGGHTS/Tsuji coefficient 2 sqrt(5/6) beta sqrt(S_n m*). */
+ * independent of speed. form 0 "exact": coefficient chosen so that an isolated Hertz
+ * spring + dashpot collision, with elastic + damping clipped at >= 0, rebounds with exactly
+ * `restitution`; form 1 "tsuji": the LIGGGHTS/Tsuji coefficient -2 sqrt(5/6) beta
+ * sqrt(S_n m*) (exact only without clipping). NAN for restitution outside (0, 1] or another
+ * form. Callers that want e_dry exactly must clip the sum at zero as the hertz model does. */
 double wetdem_force_hertz_damping(double e_star, double r_eff, double m_eff, double overlap,
                                   double v_n, double restitution, int form);
 /* force_hertz.c: duration of an undamped head-on Hertz collision at impact speed v [s]:
- * 2.86815... (m*^2 / (E*^2 R* v))^(1/5) (Hertz theory; Johnson 1985 Sec. 11.4). */
+ * 2.868266... (m*^2 / (E*^2 R* v))^(1/5) (Hertz theory; Johnson 1985 Sec. 11.4). */
 double wetdem_force_hertz_contact_time(double e_star, double r_eff, double m_eff, double v);
 /* force_mindlin.c: Mindlin tangential spring with Coulomb limit. spring (3 doubles of history:
  * the elastic tangential displacement [m]) is rotated into the current tangent plane and
- * advanced by v_t dt; stiffness k_t = 8 G* sqrt(R* delta); damping from `restitution` as for
- * the normal direction; when |F_t| > mu f_limit the spring is truncated to the Coulomb
- * limit (sliding). Returns the tangential force on i [N]. overlap <= 0 resets the spring. */
+ * advanced by v_t dt; stiffness k_t = 8 G* sqrt(R* delta); Tsuji damping from `restitution`
+ * with k_t; when the spring force k_t |s| > mu |f_limit| the spring is truncated to the
+ * Coulomb limit and |F_t| = mu |f_limit| (sliding, LIGGGHTS semantics). Returns the
+ * tangential force on i [N]. overlap <= 0 resets the spring. */
 struct wetdem_vec3 wetdem_force_mindlin_update(const struct wetdem_contact* c, double overlap,
                                                double f_limit, double mu, double* spring);
 
