@@ -597,6 +597,64 @@ WETDEM_API int wetdem_track_sphere_id(const struct wetdem_track* track, size_t k
 WETDEM_API const struct wetdem_track_sample* wetdem_track_samples(const struct wetdem_track* t,
                                                                   size_t k, size_t* n);
 
+/* ---- model calibration: nonlinear least squares (src/fit.c, docs/calibration.md) ---- */
+
+#define WETDEM_FIT_MAX_PARAMS 8
+
+/* Predictions of a model: fills predicted[0..n_data) for parameter values params[0..n_params)
+ * (in their own units). Returns WETDEM_OK, or a negative status with a message in msg. */
+typedef int (*wetdem_fit_model_fn)(const double* params, double* predicted, char* msg,
+                                   size_t msg_size, void* ctx);
+
+/* A least-squares problem: minimise sum_i ((predicted_i - observed_i)/scale_i)^2. */
+struct wetdem_fit_problem {
+    size_t n_params;           /* 1..WETDEM_FIT_MAX_PARAMS */
+    const char* const* names;  /* parameter names for messages (may be NULL) */
+    const double* initial;     /* initial values [n_params] */
+    const bool* is_log;        /* fit ln(p) (p stays > 0) per parameter; NULL: when initial > 0 */
+    size_t n_data;             /* > n_params (the residual variance needs a degree of freedom) */
+    const double* observed;    /* [n_data] */
+    const double* scale;       /* [n_data] divisor of each residual (> 0), NULL: all 1 */
+    wetdem_fit_model_fn model;
+    void* ctx;
+};
+
+struct wetdem_fit_options {
+    int max_iter;    /* trust-region iterations (50) */
+    double xtol;     /* step tolerance, relative in the fitted variables (1e-6) */
+    double gtol;     /* gradient tolerance (1e-8) */
+    double ftol;     /* cost-reduction tolerance (1e-10) */
+    double fd_step;  /* central-difference step of the Jacobian in the fitted variable:
+                        relative change for log parameters, absolute x max(|p|, 1) otherwise
+                        (1e-2: larger than the integration noise of simulated predictions) */
+};
+
+struct wetdem_fit_result {
+    double values[WETDEM_FIT_MAX_PARAMS];     /* best-fit parameters */
+    double std_errors[WETDEM_FIT_MAX_PARAMS]; /* standard errors: sqrt(diag((J^T J)^-1)) s in
+                                                 the fitted variable, s^2 = cost/dof, mapped to
+                                                 p by dp = p d(ln p) for log parameters */
+    double correlation[WETDEM_FIT_MAX_PARAMS][WETDEM_FIT_MAX_PARAMS]; /* of the estimates */
+    double cost;          /* sum of squared scaled residuals at the solution */
+    double residual_std;  /* s = sqrt(cost/dof), in units of the scale */
+    size_t dof;           /* n_data - n_params */
+    size_t iterations;
+    size_t model_evals;   /* calls of the model function */
+    int converged_by;     /* 1 small step (xtol), 2 small gradient (gtol), 3 small cost change */
+};
+
+/* Fills *opt with the defaults above. */
+WETDEM_API void wetdem_fit_options_init(struct wetdem_fit_options* opt);
+/* Solves the problem with the GSL trust-region (Levenberg-Marquardt) solver and a
+ * central-difference Jacobian. predicted (may be NULL) receives the predictions at the
+ * solution [n_data]. Returns WETDEM_OK, WETDEM_ERR_INVALID (bad problem or options),
+ * WETDEM_ERR_CALLBACK (the model failed), WETDEM_ERR_MAX_STEPS (not converged; *result holds
+ * the last iterate) or WETDEM_ERR_NOMEM; msg (may be NULL) receives a message. */
+WETDEM_API int wetdem_fit_run(const struct wetdem_fit_problem* problem,
+                              const struct wetdem_fit_options* opt,
+                              struct wetdem_fit_result* result, double* predicted, char* msg,
+                              size_t msg_size);
+
 /* ======================================================================================== */
 /* ABI checks for bindings                                                                  */
 /* ======================================================================================== */
