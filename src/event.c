@@ -2,9 +2,10 @@
  * event.c — event functions of the soft engine: for every pair, g = h - h_k with h the gap
  * and h_k each branch boundary of the force laws (docs/engines.md, "Events"):
  *   - the interaction range (largest model range(), e.g. h_co = R* for nijssen),
- *   - h_min of the min-separation model, when a model lists it among its thresholds(),
+ *   - every threshold a model lists in thresholds() strictly between 0 and the range, logged
+ *     as h_min when it equals the min-separation model's h_min or is the only such threshold
+ *     of its model (nijssen's own h_min), otherwise as "branch",
  *   - 0 (solid contact),
- *   - any other threshold a model lists below its range (kind "branch"),
  *   - separation_factor x range when the stop on separation needs it (not logged).
  * g falling through 0 starts a phase (interaction, h_min, contact), rising ends it.
  * The adaptive integrator hands these functions to its root finder; fixed-step integrators
@@ -63,43 +64,76 @@ static int append_slot(struct wetdem_engine* e, struct wetdem_event_slot slot)
     return WETDEM_OK;
 }
 
-/* Appends the event functions of pair k: range, h_min (if listed), 0, other model
- * thresholds, separation. Marks the pair as interacting when it starts within range. */
-static int build_pair_slots(struct wetdem_sim* sim, size_t k)
+/* Appends slot to the interior thresholds of a pair unless an equal value is there; keeps
+ * them in decreasing order of value. */
+static void add_interior(struct wetdem_event_slot* list, double* values, size_t* n,
+                         struct wetdem_event_slot slot, double value)
 {
-    struct wetdem_engine* e = &sim->engine;
-    struct wetdem_contact c;
-    double range, scratch[64], gaps[WETDEM_MAX_THRESHOLDS];
-    pair_state(sim, k, &c, &range, scratch);
-    if (c.gap < range) /* strictly inside: a run stopped exactly at separation stays done */
-        e->pairs.items[k].has_interacted = true;
-    struct wetdem_event_slot extra[WETDEM_MAX_MODELS * WETDEM_MAX_THRESHOLDS];
-    size_t n_extra = 0;
-    bool has_hmin = false;
+    size_t k = 0;
+    while (k < *n && values[k] > value)
+        k++;
+    if (k < *n && values[k] == value) {
+        list[k].as_hmin = list[k].as_hmin || slot.as_hmin;
+        return;
+    }
+    for (size_t q = *n; q > k; q--) {
+        list[q] = list[q - 1];
+        values[q] = values[q - 1];
+    }
+    list[k] = slot;
+    values[k] = value;
+    (*n)++;
+}
+
+/* Collects the interior thresholds (0 < h_k < range) the models of pair k list. A threshold
+ * is logged as h_min when it equals the min-separation model's h_min or is the only interior
+ * threshold of its model (e.g. nijssen's own h_min = max(h_sigma, h_eps)); else as a branch. */
+static size_t interior_thresholds(const struct wetdem_sim* sim, size_t k,
+                                  const struct wetdem_contact* c, double range,
+                                  const double* scratch, struct wetdem_event_slot* list)
+{
+    double values[WETDEM_MAX_MODELS * WETDEM_MAX_THRESHOLDS], gaps[WETDEM_MAX_THRESHOLDS];
+    size_t n = 0;
     for (size_t m = 0; m < sim->n_models; m++) {
         const struct wetdem_model_slot* s = &sim->models[m];
         if (!s->model->thresholds)
             continue;
-        size_t n = s->model->thresholds(s->params, &c, scratch + s->history_offset, gaps);
-        for (size_t q = 0; q < n && q < WETDEM_MAX_THRESHOLDS; q++) {
-            if (gaps[q] == range || gaps[q] == 0.0 || !(gaps[q] < range))
+        size_t ng = s->model->thresholds(s->params, c, scratch + s->history_offset, gaps);
+        size_t n_inner = 0;
+        for (size_t q = 0; q < ng && q < WETDEM_MAX_THRESHOLDS; q++)
+            n_inner += gaps[q] > 0.0 && gaps[q] < range;
+        for (size_t q = 0; q < ng && q < WETDEM_MAX_THRESHOLDS; q++) {
+            if (!(gaps[q] > 0.0 && gaps[q] < range))
                 continue;
-            if (gaps[q] == c.h_min)
-                has_hmin = true;
-            else
-                extra[n_extra++] = (struct wetdem_event_slot){k, WETDEM_EVENT_SOURCE_MODEL, m, q};
+            bool as_hmin = gaps[q] == c->h_min || n_inner == 1;
+            struct wetdem_event_slot slot = {k, WETDEM_EVENT_SOURCE_MODEL, m, q, as_hmin};
+            add_interior(list, values, &n, slot, gaps[q]);
         }
     }
-    int st = append_slot(e, (struct wetdem_event_slot){k, WETDEM_EVENT_SOURCE_RANGE, 0, 0});
-    if (st == WETDEM_OK && has_hmin)
-        st = append_slot(e, (struct wetdem_event_slot){k, WETDEM_EVENT_SOURCE_HMIN, 0, 0});
+    return n;
+}
+
+/* Appends the event functions of pair k in decreasing threshold order: range, interior
+ * thresholds, 0, then separation. Marks the pair as interacting when it starts within range. */
+static int build_pair_slots(struct wetdem_sim* sim, size_t k)
+{
+    struct wetdem_engine* e = &sim->engine;
+    struct wetdem_contact c;
+    double range, scratch[64];
+    pair_state(sim, k, &c, &range, scratch);
+    if (c.gap < range) /* strictly inside: a run stopped exactly at separation stays done */
+        e->pairs.items[k].has_interacted = true;
+    struct wetdem_event_slot inner[WETDEM_MAX_MODELS * WETDEM_MAX_THRESHOLDS];
+    size_t n_inner = interior_thresholds(sim, k, &c, range, scratch, inner);
+    int st = append_slot(e, (struct wetdem_event_slot){k, WETDEM_EVENT_SOURCE_RANGE, 0, 0, 0});
+    for (size_t q = 0; q < n_inner && st == WETDEM_OK; q++)
+        st = append_slot(e, inner[q]);
     if (st == WETDEM_OK)
-        st = append_slot(e, (struct wetdem_event_slot){k, WETDEM_EVENT_SOURCE_ZERO, 0, 0});
-    for (size_t q = 0; q < n_extra && st == WETDEM_OK; q++)
-        st = append_slot(e, extra[q]);
+        st = append_slot(e, (struct wetdem_event_slot){k, WETDEM_EVENT_SOURCE_ZERO, 0, 0, 0});
     if (st == WETDEM_OK && sim->settings.stop_on_separation != 0 &&
         sim->settings.separation_factor > 1)
-        st = append_slot(e, (struct wetdem_event_slot){k, WETDEM_EVENT_SOURCE_SEPARATION, 0, 0});
+        st = append_slot(e,
+                         (struct wetdem_event_slot){k, WETDEM_EVENT_SOURCE_SEPARATION, 0, 0, 0});
     return st;
 }
 
@@ -144,7 +178,6 @@ static double slot_threshold(const struct wetdem_sim* sim, const struct wetdem_e
 {
     switch (s->source) {
     case WETDEM_EVENT_SOURCE_RANGE: return range;
-    case WETDEM_EVENT_SOURCE_HMIN: return c->h_min;
     case WETDEM_EVENT_SOURCE_ZERO: return 0.0;
     case WETDEM_EVENT_SOURCE_SEPARATION: return sim->settings.separation_factor * range;
     case WETDEM_EVENT_SOURCE_MODEL: break;
@@ -175,17 +208,18 @@ void wetdem_event_values(struct wetdem_sim* sim, double* g)
     }
 }
 
-/* Kind logged when slot source src is crossed in direction dir; 0 for none. */
-static int kind_of(enum wetdem_event_source src, int dir)
+/* Kind logged when slot s is crossed in direction dir; 0 for none. */
+static int kind_of(const struct wetdem_event_slot* s, int dir)
 {
-    switch (src) {
+    switch (s->source) {
     case WETDEM_EVENT_SOURCE_RANGE:
         return dir < 0 ? WETDEM_EVENT_INTERACTION_START : WETDEM_EVENT_INTERACTION_END;
-    case WETDEM_EVENT_SOURCE_HMIN:
-        return dir < 0 ? WETDEM_EVENT_HMIN_REACHED : WETDEM_EVENT_HMIN_LEFT;
     case WETDEM_EVENT_SOURCE_ZERO:
         return dir < 0 ? WETDEM_EVENT_CONTACT_START : WETDEM_EVENT_CONTACT_END;
-    case WETDEM_EVENT_SOURCE_MODEL: return WETDEM_EVENT_BRANCH;
+    case WETDEM_EVENT_SOURCE_MODEL:
+        if (!s->as_hmin)
+            return WETDEM_EVENT_BRANCH;
+        return dir < 0 ? WETDEM_EVENT_HMIN_REACHED : WETDEM_EVENT_HMIN_LEFT;
     case WETDEM_EVENT_SOURCE_SEPARATION: break;
     }
     return 0;
@@ -199,7 +233,7 @@ int wetdem_event_record(struct wetdem_sim* sim, size_t k, int dir, double t, dou
     struct wetdem_pair* p = &e->pairs.items[s->pair];
     if (s->source == WETDEM_EVENT_SOURCE_RANGE && dir < 0)
         p->has_interacted = true;
-    int kind = kind_of(s->source, dir);
+    int kind = kind_of(s, dir);
     if (!kind)
         return WETDEM_OK;
     if (e->n_events == e->events_cap) {

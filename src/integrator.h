@@ -43,10 +43,9 @@ int wetdem_integrator_index(const char* name, size_t len);
 /* What an event function's threshold is. */
 enum wetdem_event_source {
     WETDEM_EVENT_SOURCE_RANGE = 0,      /* largest model range: interaction start/end */
-    WETDEM_EVENT_SOURCE_HMIN = 1,       /* h_min of the min-separation model */
+    WETDEM_EVENT_SOURCE_MODEL = 1,      /* a threshold a model lists inside its range */
     WETDEM_EVENT_SOURCE_ZERO = 2,       /* gap 0: solid contact start/end */
-    WETDEM_EVENT_SOURCE_MODEL = 3,      /* another threshold listed by a model */
-    WETDEM_EVENT_SOURCE_SEPARATION = 4, /* separation_factor x range: stop check only */
+    WETDEM_EVENT_SOURCE_SEPARATION = 3, /* separation_factor x range: stop check only */
 };
 
 /* One event function g = gap - threshold of one pair. */
@@ -54,6 +53,7 @@ struct wetdem_event_slot {
     size_t pair;                      /* index in engine.pairs */
     enum wetdem_event_source source;
     size_t model, index;              /* SOURCE_MODEL: force model slot, threshold index */
+    bool as_hmin;                     /* SOURCE_MODEL: logged as h_min reached/left */
 };
 
 /* Builds the event functions of every pair of engine.pairs at the current state. Returns
