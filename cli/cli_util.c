@@ -1,0 +1,161 @@
+/*
+ * cli_util.c — helpers shared by the CLI subcommands (see cli_util.h): messages, strict
+ * parsing of numbers and "A:B:N" ranges, "--set KEY=VALUE", CSV provenance lines.
+ *
+ * Range values: linear x_k = A + (B - A) k/(N - 1); geometric x_k = A (B/A)^(k/(N - 1)),
+ * k = 0..N-1, with x_0 = A and x_{N-1} = B returned exactly.
+ */
+#include <errno.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cli_util.h"
+
+void cli_error(const char* fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    fputs("wetdem: ", stderr);
+    vfprintf(stderr, fmt, ap);
+    fputc('\n', stderr);
+    va_end(ap);
+}
+
+int cli_parse_double(const char* text, const char* what, double* out)
+{
+    char* end = NULL;
+    errno = 0;
+    double v = strtod(text, &end);
+    if (end == text || *end != '\0' || !isfinite(v) || errno == ERANGE) {
+        cli_error("%s: '%s' is not a finite number", what, text);
+        return CLI_EXIT_USAGE;
+    }
+    *out = v;
+    return CLI_EXIT_OK;
+}
+
+/* Parses the count field of a range: a decimal integer in [1, 10^7]. */
+static int parse_count(const char* text, const char* what, size_t* n)
+{
+    char* end = NULL;
+    errno = 0;
+    long long v = strtoll(text, &end, 10);
+    if (end == text || *end != '\0' || errno == ERANGE || v < 1 || v > 10000000) {
+        cli_error("%s: count N = '%s' must be an integer in [1, 10000000]", what, text);
+        return CLI_EXIT_USAGE;
+    }
+    *n = (size_t)v;
+    return CLI_EXIT_OK;
+}
+
+int cli_parse_range(const char* text, bool is_log, const char* what, struct cli_range* r)
+{
+    char buf[256];
+    if (strlen(text) >= sizeof buf) {
+        cli_error("%s: '%.40s...' is too long for A:B:N", what, text);
+        return CLI_EXIT_USAGE;
+    }
+    strcpy(buf, text);
+    char* c1 = strchr(buf, ':');
+    char* c2 = c1 ? strchr(c1 + 1, ':') : NULL;
+    if (!c1 || !c2 || strchr(c2 + 1, ':')) {
+        cli_error("%s: '%s' is not of the form A:B:N (first:last:count)", what, text);
+        return CLI_EXIT_USAGE;
+    }
+    *c1 = '\0';
+    *c2 = '\0';
+    int rc;
+    if ((rc = cli_parse_double(buf, what, &r->first)) != CLI_EXIT_OK ||
+        (rc = cli_parse_double(c1 + 1, what, &r->last)) != CLI_EXIT_OK ||
+        (rc = parse_count(c2 + 1, what, &r->n)) != CLI_EXIT_OK)
+        return rc;
+    r->is_log = is_log;
+    if (r->n == 1 && r->first != r->last) {
+        cli_error("%s: '%s' has N = 1 but A != B; use A:A:1 for a single value", what, text);
+        return CLI_EXIT_USAGE;
+    }
+    if (is_log && !(r->first > 0 && r->last > 0)) {
+        cli_error("%s: '%s' with --log needs A > 0 and B > 0", what, text);
+        return CLI_EXIT_USAGE;
+    }
+    return CLI_EXIT_OK;
+}
+
+double cli_range_value(const struct cli_range* r, size_t k)
+{
+    if (k == 0 || r->n < 2)
+        return r->first;
+    if (k + 1 >= r->n)
+        return r->last;
+    double s = (double)k / (double)(r->n - 1);
+    if (r->is_log)
+        return r->first * pow(r->last / r->first, s);
+    return r->first + (r->last - r->first) * s;
+}
+
+int cli_apply_set(struct wetdem_sim* sim, const char* key_value)
+{
+    const char* eq = strchr(key_value, '=');
+    if (!eq || eq == key_value || eq[1] == '\0') {
+        cli_error("--set '%s': expected KEY=VALUE, e.g. --set fluid.viscosity=0.01", key_value);
+        return CLI_EXIT_USAGE;
+    }
+    char key[256];
+    size_t len = (size_t)(eq - key_value);
+    if (len >= sizeof key) {
+        cli_error("--set: key '%.40s...' is too long", key_value);
+        return CLI_EXIT_USAGE;
+    }
+    memcpy(key, key_value, len);
+    key[len] = '\0';
+    if (wetdem_sim_set_param_str(sim, key, eq + 1) != WETDEM_OK) {
+        cli_error("--set %s: %s", key_value, wetdem_sim_errmsg(sim));
+        return CLI_EXIT_USAGE;
+    }
+    return CLI_EXIT_OK;
+}
+
+void cli_print_provenance(FILE* f, int argc, char** argv)
+{
+    fprintf(f, "# wetdem %s (git %s)\n# command: wetdem", WETDEM_VERSION, WETDEM_GIT_HASH);
+    for (int k = 0; k < argc; k++)
+        fprintf(f, " %s", argv[k]);
+    fputc('\n', f);
+}
+
+void cli_print_double(FILE* f, double v)
+{
+    char buf[40];
+    for (int digits = 15; digits <= 17; digits++) {
+        snprintf(buf, sizeof buf, "%.*g", digits, v);
+        if (strtod(buf, NULL) == v || digits == 17)
+            break;
+    }
+    fputs(buf, f);
+}
+
+void cli_param_default_text(const struct wetdem_param_desc* d, char* buf, size_t n)
+{
+    if (d->choices) {
+        size_t idx = (size_t)d->default_value;
+        size_t count = 0;
+        while (d->choices[count])
+            count++;
+        snprintf(buf, n, "%s", idx < count ? d->choices[idx] : "?");
+        return;
+    }
+    snprintf(buf, n, "%g", d->default_value);
+}
+
+/* The settings table is declared in the library's internal header (src/sim.h), not in
+ * wetdem.h: a weak reference keeps the CLI a client of the public header only, and lets it
+ * say "not available" against a library that lacks the function. */
+#pragma weak wetdem_sim_settings_params
+const struct wetdem_param_desc* wetdem_sim_settings_params(void);
+
+const struct wetdem_param_desc* cli_sim_settings_params(void)
+{
+    return wetdem_sim_settings_params ? wetdem_sim_settings_params() : NULL;
+}

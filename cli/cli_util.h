@@ -1,0 +1,66 @@
+/*
+ * cli_util.h — small helpers shared by the CLI subcommands: error messages, strict number
+ * parsing, "A:B:N" value ranges, "--set KEY=VALUE" parameters, the provenance header of CSV
+ * output and the text of a parameter's default. Uses only the public header wetdem.h.
+ *
+ * Conventions: every function that can reject user input prints one line
+ * "wetdem: <what>: <why>" to stderr and returns an exit code (CLI_EXIT_USAGE, i.e. 2, for bad
+ * input; CLI_EXIT_OK, i.e. 0, on success), so callers can write
+ *     if ((rc = cli_parse_range(...)) != CLI_EXIT_OK) return rc;
+ */
+#ifndef WETDEM_CLI_UTIL_H
+#define WETDEM_CLI_UTIL_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdio.h>
+
+#include "cli.h"
+
+/* A sequence of n values from first to last, evenly spaced (or geometrically when is_log). */
+struct cli_range {
+    double first, last; /* end points, both included */
+    size_t n;           /* number of values, >= 1 */
+    bool is_log;        /* geometric spacing: first and last must be > 0 */
+};
+
+/* Prints "wetdem: " followed by the printf-style message and a newline to stderr. */
+void cli_error(const char* fmt, ...) __attribute__((format(printf, 1, 2)));
+
+/* Parses `text` as one finite number (the whole string, no trailing characters). `what`
+ * names the option in the error message, e.g. "--speed". Returns CLI_EXIT_OK and sets *out,
+ * or prints an error and returns CLI_EXIT_USAGE. */
+int cli_parse_double(const char* text, const char* what, double* out);
+
+/* Parses "A:B:N" (N an integer >= 1; N = 1 requires A == B) into *r with r->is_log = is_log.
+ * With is_log, A and B must be > 0. `what` names the option in the error message.
+ * Returns CLI_EXIT_OK, or prints an error and returns CLI_EXIT_USAGE. */
+int cli_parse_range(const char* text, bool is_log, const char* what, struct cli_range* r);
+
+/* The k-th value (0 <= k < r->n) of a parsed range; the end points are returned exactly. */
+double cli_range_value(const struct cli_range* r, size_t k);
+
+/* Applies "KEY=VALUE" to sim through wetdem_sim_set_param_str (so enumerated parameters may
+ * be given by word). Returns CLI_EXIT_OK, or prints "wetdem: --set KEY=VALUE: <library
+ * message>" and returns CLI_EXIT_USAGE. */
+int cli_apply_set(struct wetdem_sim* sim, const char* key_value);
+
+/* Writes the '#' provenance lines that start every CSV the CLI prints:
+ *     # wetdem <version> (git <hash>)
+ *     # command: wetdem <argv[0]> <argv[1]> ...
+ * argv is the subcommand's argument vector (argv[0] = subcommand name). */
+void cli_print_provenance(FILE* f, int argc, char** argv);
+
+/* Writes v to f with the fewest significant digits (15, 16 or 17) that read back as exactly
+ * v, so CSV output is both exact and readable ("1e-05", not "1.0000000000000001e-05"). */
+void cli_print_double(FILE* f, double v);
+
+/* Writes the default of a parameter as text: the chosen word for an enumeration, otherwise
+ * the number in %g format. */
+void cli_param_default_text(const struct wetdem_param_desc* d, char* buf, size_t n);
+
+/* Descriptor table of the simulation settings addressed as "sim.NAME", or NULL when the
+ * library in use does not export it (wetdem_sim_settings_params). */
+const struct wetdem_param_desc* cli_sim_settings_params(void);
+
+#endif
