@@ -1,0 +1,228 @@
+/*
+ * test_cli.c — the wetdem command-line tool end to end: --version, --help, `models` (every
+ * registry model listed), `describe` (parameters with units and ranges; unknown names give a
+ * hint and exit 2), `forces` (CSV provenance and columns; one value checked against the closed
+ * form of the reynolds model, F = 6 pi mu R*^2 v_n / h), and bad input (exit 2, message).
+ *
+ * The CLI path comes from the environment variable WETDEM_CLI (set by `make test`), falling
+ * back to build/wetdem relative to the working directory (the repository root).
+ */
+#include <stdlib.h>
+#include <sys/wait.h>
+
+#include "harness.h"
+
+/* Output of one CLI run (heap buffer) and its exit code. */
+struct run {
+    char* out;
+    int code;
+};
+
+static const char* cli_path(void)
+{
+    const char* p = getenv("WETDEM_CLI");
+    return p && *p ? p : "build/wetdem";
+}
+
+/* Runs "$WETDEM_CLI args" through the shell; stderr is merged into out when with_stderr,
+ * discarded otherwise. */
+static struct run run_cli(const char* args, bool with_stderr)
+{
+    char cmd[2048];
+    snprintf(cmd, sizeof cmd, "'%s' %s %s", cli_path(), args, with_stderr ? "2>&1" : "2>/dev/null");
+    FILE* p = popen(cmd, "r");
+    if (!p)
+        fail_msg("popen failed for: %s", cmd);
+    size_t cap = 4096, len = 0;
+    char* out = malloc(cap);
+    assert_non_null(out);
+    size_t got;
+    while ((got = fread(out + len, 1, cap - len - 1, p)) > 0) {
+        len += got;
+        if (cap - len - 1 == 0) {
+            cap *= 2;
+            out = realloc(out, cap);
+            assert_non_null(out);
+        }
+    }
+    out[len] = '\0';
+    int status = pclose(p);
+    struct run r = {out, WIFEXITED(status) ? WEXITSTATUS(status) : -1};
+    return r;
+}
+
+/* True if some line of text starts with `word` followed by a space. */
+static bool has_line_starting_with(const char* text, const char* word)
+{
+    size_t n = strlen(word);
+    const char* line = text;
+    while (line) {
+        if (strncmp(line, word, n) == 0 && line[n] == ' ')
+            return true;
+        line = strchr(line, '\n');
+        if (line)
+            line++;
+    }
+    return false;
+}
+
+static void test_cli_version_and_help(void** state)
+{
+    (void)state;
+    struct run r = run_cli("--version", true);
+    assert_int_equal(r.code, 0);
+    CHECK_CONTAINS(r.out, "wetdem " WETDEM_VERSION " (git ");
+    free(r.out);
+    r = run_cli("--help", true);
+    assert_int_equal(r.code, 0);
+    CHECK_CONTAINS(r.out, "wetdem models");
+    CHECK_CONTAINS(r.out, "wetdem describe NAME");
+    CHECK_CONTAINS(r.out, "wetdem forces");
+    CHECK_CONTAINS(r.out, "exit codes");
+    free(r.out);
+    r = run_cli("modles", true);
+    assert_int_equal(r.code, 2);
+    CHECK_CONTAINS(r.out, "did you mean 'models'");
+    free(r.out);
+}
+
+static void test_cli_models_lists_every_model(void** state)
+{
+    (void)state;
+    struct run r = run_cli("models", false);
+    assert_int_equal(r.code, 0);
+    const struct wetdem_model* const* reg = wetdem_model_registry();
+    size_t n = 0;
+    for (; reg[n]; n++)
+        if (!has_line_starting_with(r.out, reg[n]->name))
+            fail_msg("'wetdem models' has no line for '%s':\n%s", reg[n]->name, r.out);
+    assert_true(n >= 2); /* the registry is never empty: at least reynolds and fixed */
+    CHECK_CONTAINS(r.out, "min-separation");
+    free(r.out);
+}
+
+static void test_cli_describe_lists_parameters_with_units(void** state)
+{
+    (void)state;
+    struct run r = run_cli("describe reynolds", false);
+    assert_int_equal(r.code, 0);
+    CHECK_CONTAINS(r.out, "cutoff_ratio [-]  default 1, valid (0, 100]");
+    CHECK_CONTAINS(r.out, "Nijssen 2023 Eq. 1");
+    free(r.out);
+    /* Every parameter of every model appears as "name [unit]". */
+    const struct wetdem_model* const* reg = wetdem_model_registry();
+    for (size_t k = 0; reg[k]; k++) {
+        char args[128], want[160];
+        snprintf(args, sizeof args, "describe %s", reg[k]->name);
+        r = run_cli(args, false);
+        assert_int_equal(r.code, 0);
+        for (size_t q = 0; reg[k]->params[q].name; q++) {
+            snprintf(want, sizeof want, "  %s [%s]", reg[k]->params[q].name,
+                     reg[k]->params[q].unit);
+            CHECK_CONTAINS(r.out, want);
+        }
+        free(r.out);
+    }
+    r = run_cli("describe fluid", false);
+    assert_int_equal(r.code, 0);
+    CHECK_CONTAINS(r.out, "viscosity [Pa s]  default 0.001, valid [0, 1e+06]");
+    free(r.out);
+    r = run_cli("describe presets", false);
+    assert_int_equal(r.code, 0);
+    CHECK_CONTAINS(r.out, "delrin:");
+    CHECK_CONTAINS(r.out, "7.96e-07"); /* delrin roughness 796 nm, Nijssen Table 1 */
+    free(r.out);
+}
+
+static void test_cli_describe_unknown_name(void** state)
+{
+    (void)state;
+    struct run r = run_cli("describe nijsen", true);
+    assert_int_equal(r.code, 2);
+    CHECK_CONTAINS(r.out, "unknown name 'nijsen'");
+    CHECK_CONTAINS(r.out, "did you mean 'nijssen'");
+    free(r.out);
+    r = run_cli("describe", true);
+    assert_int_equal(r.code, 2);
+    CHECK_CONTAINS(r.out, "usage: wetdem describe NAME");
+    free(r.out);
+}
+
+/* Parses the first data row of a forces CSV into cols[4]; checks the provenance lines and the
+ * column header on the way. */
+static void parse_forces_csv(const char* csv, double cols[4])
+{
+    CHECK_CONTAINS(csv, "# wetdem " WETDEM_VERSION " (git ");
+    CHECK_CONTAINS(csv, "# command: wetdem forces");
+    const char* header = strstr(csv, "\ngap_m,f_normal_N,f_tangential_N,h_min_m\n");
+    if (!header)
+        fail_msg("no column header line in:\n%s", csv);
+    const char* row = strchr(header + 1, '\n') + 1;
+    if (sscanf(row, "%lf,%lf,%lf,%lf", &cols[0], &cols[1], &cols[2], &cols[3]) != 4)
+        fail_msg("cannot parse the row '%.80s'", row);
+}
+
+static void test_cli_forces_matches_reynolds_closed_form(void** state)
+{
+    (void)state;
+    struct run r = run_cli("forces --model reynolds --preset steel1 --radius 6.35e-3 "
+                           "--speed 0.1 --gaps 1e-5:1e-5:1 --set fluid.viscosity=0.5",
+                           false);
+    assert_int_equal(r.code, 0);
+    double c[4];
+    parse_forces_csv(r.out, c);
+    free(r.out);
+    /* F = 6 pi mu R*^2 v_n / h with mu = 0.5 Pa s, R* = 6.35e-3/2 = 3.175e-3 m,
+     * v_n = 0.1 m/s, h = 1e-5 m: R*^2 = 1.00806e-5 m^2, F = 18.8496 * 0.5 * 1.00806e-5
+     * * 0.1 / 1e-5 = 0.950077 N (h > h_min = 1e-6 m of the default fixed model). */
+    double r_eff = 6.35e-3 / 2, want = 6 * M_PI * 0.5 * r_eff * r_eff * 0.1 / 1e-5;
+    CHECK_REL(want, 0.950077, 1e-6); /* the hand value above has 6 significant digits */
+    CHECK_REL(c[0], 1e-5, 0.0);      /* the gap column is the requested gap */
+    /* 1e-10: the library recovers h = |x_i - x_j| - 2R from centres ~1e-2 m apart, which
+     * costs ~1e-18 m of rounding, i.e. ~1e-13 relative on h = 1e-5 m. */
+    CHECK_REL(c[1], want, 1e-10);
+    CHECK_REL(c[2], 0.0, 0.0);  /* reynolds has no tangential part */
+    CHECK_REL(c[3], 1e-6, 0.0); /* h_min of the default "fixed" model */
+}
+
+static void test_cli_forces_bad_input(void** state)
+{
+    (void)state;
+    const struct {
+        const char* args;
+        const char* message;
+    } cases[] = {
+        {"forces --model reynolds --gaps 1:2", "A:B:N"},
+        {"forces --model reynolds --gaps 1e-6:1e-3:0", "count N"},
+        {"forces --model reynolds --gaps -1e-6:1e-3:3 --log", "--log needs A > 0"},
+        {"forces --model reynolds --set fluid.viscosty=1", "did you mean 'fluid.viscosity'"},
+        {"forces --model reynolds --set reynolds.cutoff_ratio=-1", "valid (0, 100]"},
+        {"forces --model reynolds --speed nan", "--speed: 'nan' is not a finite number"},
+        {"forces --model reynolds --radius 0", "--radius = 0 m is out of range"},
+        {"forces --model reynolds --preset steal1", "did you mean 'steel1'"},
+        {"forces --model reynols", "did you mean 'reynolds'"},
+        {"forces --model reynolds --bogus", "unknown option '--bogus'"},
+        {"forces", "no model given"},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        struct run r = run_cli(cases[k].args, true);
+        if (r.code != 2)
+            fail_msg("'%s' exited %d, expected 2:\n%s", cases[k].args, r.code, r.out);
+        CHECK_CONTAINS(r.out, "wetdem: ");
+        CHECK_CONTAINS(r.out, cases[k].message);
+        free(r.out);
+    }
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_cli_version_and_help),
+        cmocka_unit_test(test_cli_models_lists_every_model),
+        cmocka_unit_test(test_cli_describe_lists_parameters_with_units),
+        cmocka_unit_test(test_cli_describe_unknown_name),
+        cmocka_unit_test(test_cli_forces_matches_reynolds_closed_form),
+        cmocka_unit_test(test_cli_forces_bad_input),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
