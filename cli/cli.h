@@ -19,6 +19,7 @@
 int cmd_models(int argc, char** argv);
 int cmd_describe(int argc, char** argv);
 int cmd_docs_models(int argc, char** argv);
+int cmd_docs_scenarios(int argc, char** argv);
 int cmd_forces(int argc, char** argv);
 int cmd_run(int argc, char** argv);
 int cmd_sweep(int argc, char** argv);

@@ -16,6 +16,7 @@
 #pragma weak cmd_map
 #pragma weak cmd_fit
 #pragma weak cmd_track
+#pragma weak cmd_docs_scenarios
 
 struct command {
     const char* name;
@@ -42,6 +43,8 @@ static const struct command commands[] = {
      "velocities, spin and restitution from tracked dots (Punch Sec. 3.2)"},
     {"docs-models", cmd_docs_models, "wetdem docs-models",
      "write docs/models.md (Markdown) to stdout"},
+    {"docs-scenarios", cmd_docs_scenarios, "wetdem docs-scenarios",
+     "write the key tables of docs/scenarios.md (Markdown) to stdout"},
 };
 
 static void print_help(FILE* f)

@@ -1,0 +1,601 @@
+/*
+ * scenario.c — reading and checking scenario files (INI via inih), --set overrides and typed
+ * accessors. Building a simulation from a scenario is in scenario_build.c; the key tables and
+ * the generated documentation in scenario_keys.c.
+ *
+ * Syntax (inih): "[section]" headers, "key = value" lines, comments on lines starting with
+ * ';' or '#', inline comments after " ;" or " #". Lines are at most 196 characters. Every
+ * error is reported as "FILE:LINE: ..." and all of them are listed before giving up, so one
+ * run shows every mistake in a file.
+ *
+ * Line numbers: the installed inih does not pass them to the handler, so the reader below
+ * counts the lines it hands to inih (one call per line; an over-long line is reported and the
+ * rest of it skipped, so the count stays right).
+ */
+#include <ctype.h>
+#include <errno.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <ini.h>
+
+#include "cli_util.h"
+#include "scenario.h"
+
+#define LINE_MAX_CHARS 200 /* inih's INI_MAX_LINE: 196 characters + "\r\n\0" + 1 */
+
+/* ---- small string helpers ---- */
+
+static void copy_text(char* dst, size_t n, const char* src)
+{
+    snprintf(dst, n, "%s", src);
+}
+
+static void trim(char* s)
+{
+    size_t len = strlen(s);
+    while (len > 0 && isspace((unsigned char)s[len - 1]))
+        s[--len] = '\0';
+    size_t start = 0;
+    while (s[start] && isspace((unsigned char)s[start]))
+        start++;
+    if (start)
+        memmove(s, s + start, len - start + 1);
+}
+
+/* Removes an inline "#" comment (a '#' preceded by white space). */
+static void strip_hash_comment(char* s)
+{
+    for (char* p = s; *p; p++)
+        if (*p == '#' && p > s && isspace((unsigned char)p[-1])) {
+            *p = '\0';
+            break;
+        }
+    trim(s);
+}
+
+bool cli_is_name(const char* s)
+{
+    if (!*s)
+        return false;
+    for (const char* p = s; *p; p++)
+        if (!isalnum((unsigned char)*p) && *p != '_' && *p != '-')
+            return false;
+    return true;
+}
+
+/* ---- growing arrays ---- */
+
+static int push_entry(struct cli_scenario* sc, const char* section, const char* key,
+                      const char* value, int line)
+{
+    if (sc->n_entries == sc->entries_cap) {
+        size_t cap = sc->entries_cap ? 2 * sc->entries_cap : 32;
+        struct cli_entry* e = realloc(sc->entries, cap * sizeof *e);
+        if (!e)
+            return -1;
+        sc->entries = e;
+        sc->entries_cap = cap;
+    }
+    struct cli_entry* e = &sc->entries[sc->n_entries++];
+    copy_text(e->section, sizeof e->section, section);
+    copy_text(e->key, sizeof e->key, key);
+    copy_text(e->value, sizeof e->value, value);
+    e->line = line;
+    return 0;
+}
+
+static int push_section(struct cli_scenario* sc, const char* name, int line)
+{
+    if (sc->n_sections == sc->sections_cap) {
+        size_t cap = sc->sections_cap ? 2 * sc->sections_cap : 16;
+        struct cli_section_mark* s = realloc(sc->sections, cap * sizeof *s);
+        if (!s)
+            return -1;
+        sc->sections = s;
+        sc->sections_cap = cap;
+    }
+    struct cli_section_mark* s = &sc->sections[sc->n_sections++];
+    copy_text(s->name, sizeof s->name, name);
+    s->line = line;
+    return 0;
+}
+
+void cli_scenario_free(struct cli_scenario* sc)
+{
+    free(sc->entries);
+    free(sc->sections);
+    memset(sc, 0, sizeof *sc);
+}
+
+int cli_scenario_copy(const struct cli_scenario* src, struct cli_scenario* dst)
+{
+    memset(dst, 0, sizeof *dst);
+    copy_text(dst->file, sizeof dst->file, src->file);
+    for (size_t k = 0; k < src->n_entries; k++) {
+        const struct cli_entry* e = &src->entries[k];
+        if (push_entry(dst, e->section, e->key, e->value, e->line) != 0)
+            goto fail;
+    }
+    for (size_t k = 0; k < src->n_sections; k++)
+        if (push_section(dst, src->sections[k].name, src->sections[k].line) != 0)
+            goto fail;
+    return CLI_EXIT_OK;
+fail:
+    cli_scenario_free(dst);
+    cli_error("out of memory copying a scenario");
+    return CLI_EXIT_RUNTIME;
+}
+
+/* ---- messages ---- */
+
+static void vreport(const struct cli_scenario* sc, const struct cli_entry* e, const char* fmt,
+                    va_list ap)
+{
+    if (e->line > 0)
+        fprintf(stderr, "%s:%d: [%s] %s = %s: ", sc->file, e->line, e->section, e->key,
+                e->value);
+    else
+        fprintf(stderr, "%s: --set %s.%s=%s: ", sc->file, e->section, e->key, e->value);
+    vfprintf(stderr, fmt, ap);
+    fputc('\n', stderr);
+}
+
+void cli_scenario_error(const struct cli_scenario* sc, const struct cli_entry* e,
+                        const char* fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vreport(sc, e, fmt, ap);
+    va_end(ap);
+}
+
+static int section_line(const struct cli_scenario* sc, const char* section)
+{
+    for (size_t k = 0; k < sc->n_sections; k++)
+        if (strcmp(sc->sections[k].name, section) == 0)
+            return sc->sections[k].line;
+    for (size_t k = 0; k < sc->n_entries; k++)
+        if (strcmp(sc->entries[k].section, section) == 0 && sc->entries[k].line > 0)
+            return sc->entries[k].line;
+    return 1;
+}
+
+void cli_scenario_section_error(const struct cli_scenario* sc, const char* section,
+                                const char* fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    fprintf(stderr, "%s:%d: [%s]: ", sc->file, section_line(sc, section), section);
+    vfprintf(stderr, fmt, ap);
+    fputc('\n', stderr);
+    va_end(ap);
+}
+
+/* ---- accessors ---- */
+
+const struct cli_entry* cli_scenario_find(const struct cli_scenario* sc, const char* section,
+                                          const char* key)
+{
+    for (size_t k = 0; k < sc->n_entries; k++)
+        if (strcmp(sc->entries[k].section, section) == 0 && strcmp(sc->entries[k].key, key) == 0)
+            return &sc->entries[k];
+    return NULL;
+}
+
+bool cli_scenario_has_section(const struct cli_scenario* sc, const char* section)
+{
+    for (size_t k = 0; k < sc->n_sections; k++)
+        if (strcmp(sc->sections[k].name, section) == 0)
+            return true;
+    for (size_t k = 0; k < sc->n_entries; k++)
+        if (strcmp(sc->entries[k].section, section) == 0)
+            return true;
+    return false;
+}
+
+double cli_scenario_number(const struct cli_scenario* sc, const char* section, const char* key,
+                           double def)
+{
+    const struct cli_entry* e = cli_scenario_find(sc, section, key);
+    return e ? strtod(e->value, NULL) : def;
+}
+
+const char* cli_scenario_text(const struct cli_scenario* sc, const char* section,
+                              const char* key, const char* def)
+{
+    const struct cli_entry* e = cli_scenario_find(sc, section, key);
+    return e ? e->value : def;
+}
+
+/* ---- value checks ---- */
+
+int cli_parse_number_text(const char* text, double* out)
+{
+    char* end = NULL;
+    errno = 0;
+    double v = strtod(text, &end);
+    if (end == text || *end != '\0' || errno == ERANGE || !isfinite(v))
+        return -1;
+    *out = v;
+    return 0;
+}
+
+/* Checks a number against a descriptor; on failure prints the message and returns 2. */
+static int check_number(const struct cli_scenario* sc, const struct cli_entry* e,
+                        const struct wetdem_param_desc* d)
+{
+    double v;
+    if (cli_parse_number_text(e->value, &v) != 0) {
+        cli_scenario_error(sc, e, "not a finite number%s%s%s", d->unit[0] ? " [" : "", d->unit,
+                           d->unit[0] ? "]" : "");
+        return CLI_EXIT_USAGE;
+    }
+    char msg[512];
+    if (wetdem_param_validate(d, v, msg, sizeof msg) != WETDEM_OK) {
+        cli_scenario_error(sc, e, "%s", msg);
+        return CLI_EXIT_USAGE;
+    }
+    return CLI_EXIT_OK;
+}
+
+static int check_choice(const struct cli_scenario* sc, const struct cli_entry* e,
+                        const char* const* choices)
+{
+    for (size_t k = 0; choices[k]; k++)
+        if (strcmp(choices[k], e->value) == 0)
+            return CLI_EXIT_OK;
+    const char* hint = wetdem_param_suggest(e->value, choices);
+    char list[256] = "";
+    for (size_t k = 0; choices[k]; k++) {
+        size_t len = strlen(list);
+        snprintf(list + len, sizeof list - len, "%s%s", k ? ", " : "", choices[k]);
+    }
+    cli_scenario_error(sc, e, "must be one of: %s%s%s%s", list, hint ? " (did you mean '" : "",
+                       hint ? hint : "", hint ? "'?)" : "");
+    return CLI_EXIT_USAGE;
+}
+
+static int check_names(const struct cli_scenario* sc, const struct cli_entry* e, bool list)
+{
+    char buf[CLI_VALUE_MAX];
+    copy_text(buf, sizeof buf, e->value);
+    int count = 0;
+    for (char* tok = strtok(buf, " ,\t"); tok; tok = strtok(NULL, " ,\t")) {
+        if (!cli_is_name(tok)) {
+            cli_scenario_error(sc, e, "'%s' is not a name (letters, digits, '_' and '-')", tok);
+            return CLI_EXIT_USAGE;
+        }
+        count++;
+    }
+    if (count == 0 || (!list && count > 1)) {
+        cli_scenario_error(sc, e, list ? "expected one or more names" : "expected one name");
+        return CLI_EXIT_USAGE;
+    }
+    return CLI_EXIT_OK;
+}
+
+/* A cli_key_desc number as a library descriptor, for validation and range text. */
+struct wetdem_param_desc cli_key_as_param(const struct cli_key_desc* k)
+{
+    struct wetdem_param_desc d = {0};
+    d.name = k->key;
+    d.unit = k->unit;
+    d.doc = k->doc;
+    d.min = k->min;
+    d.max = k->max;
+    d.min_open = k->min_open;
+    d.max_open = k->max_open;
+    d.choices = k->kind == CLI_VALUE_CHOICE ? k->choices : NULL;
+    return d;
+}
+
+static int check_key_value(const struct cli_scenario* sc, const struct cli_entry* e,
+                           const struct cli_key_desc* k)
+{
+    switch (k->kind) {
+    case CLI_VALUE_NUMBER: {
+        struct wetdem_param_desc d = cli_key_as_param(k);
+        return check_number(sc, e, &d);
+    }
+    case CLI_VALUE_CHOICE: return check_choice(sc, e, k->choices);
+    case CLI_VALUE_NAME: return check_names(sc, e, false);
+    case CLI_VALUE_NAME_LIST: return check_names(sc, e, true);
+    case CLI_VALUE_TEXT: return CLI_EXIT_OK;
+    }
+    return CLI_EXIT_OK;
+}
+
+static int check_lib_value(const struct cli_scenario* sc, const struct cli_entry* e,
+                           const struct wetdem_param_desc* d)
+{
+    if (d->choices)
+        return check_choice(sc, e, d->choices);
+    return check_number(sc, e, d);
+}
+
+/* ---- keys of a section ---- */
+
+/* Collects every key name a section accepts into names (NULL-terminated), for suggestions. */
+static size_t section_key_names(const struct cli_section_info* info, const char** names,
+                                size_t cap)
+{
+    size_t n = 0;
+    for (size_t k = 0; info->desc && info->desc->keys && info->desc->keys[k].key && n + 1 < cap;
+         k++)
+        names[n++] = info->desc->keys[k].key;
+    for (size_t k = 0; info->lib_keys && info->lib_keys[k].name && n + 1 < cap; k++)
+        names[n++] = info->lib_keys[k].name;
+    names[n] = NULL;
+    return n;
+}
+
+static void unknown_key(const struct cli_scenario* sc, const struct cli_entry* e,
+                        const struct cli_section_info* info)
+{
+    const char* names[128];
+    section_key_names(info, names, 128);
+    const char* hint = wetdem_param_suggest(e->key, names);
+    if (hint) {
+        cli_scenario_error(sc, e, "unknown key '%s' in [%s] (did you mean '%s'?)", e->key,
+                           e->section, hint);
+        return;
+    }
+    char list[512] = "";
+    for (size_t k = 0; names[k]; k++) {
+        size_t len = strlen(list);
+        snprintf(list + len, sizeof list - len, "%s%s", k ? ", " : "", names[k]);
+    }
+    cli_scenario_error(sc, e, "unknown key '%s' in [%s]; valid keys: %s", e->key, e->section,
+                       list);
+}
+
+/* Checks one entry against its section. Returns an exit code; prints the error. */
+static int check_entry(const struct cli_scenario* sc, const struct cli_entry* e)
+{
+    struct cli_section_info info;
+    if (cli_section_lookup(e->section, &info) != 0)
+        return CLI_EXIT_USAGE; /* reported once per section by the caller */
+    if (info.desc && info.desc->keys)
+        for (size_t k = 0; info.desc->keys[k].key; k++)
+            if (strcmp(info.desc->keys[k].key, e->key) == 0)
+                return check_key_value(sc, e, &info.desc->keys[k]);
+    const struct wetdem_param_desc* d = wetdem_param_find(info.lib_keys, e->key);
+    if (d)
+        return check_lib_value(sc, e, d);
+    if (info.open_keys) {
+        if (!cli_is_name(e->key)) {
+            cli_scenario_error(sc, e, "'%s' is not a key name", e->key);
+            return CLI_EXIT_USAGE;
+        }
+        return CLI_EXIT_OK; /* checked by the library when the scenario is built */
+    }
+    unknown_key(sc, e, &info);
+    return CLI_EXIT_USAGE;
+}
+
+static void unknown_section(const struct cli_scenario* sc, const char* name, int line)
+{
+    char msg[256];
+    cli_section_suggestion(name, msg, sizeof msg);
+    fprintf(stderr, "%s:%d: unknown section [%s]%s\n", sc->file, line, name, msg);
+}
+
+/* Checks every section header and entry; reports all errors. Returns an exit code. */
+static int check_all(const struct cli_scenario* sc)
+{
+    int rc = CLI_EXIT_OK;
+    for (size_t k = 0; k < sc->n_sections; k++) {
+        struct cli_section_info info;
+        if (cli_section_lookup(sc->sections[k].name, &info) != 0) {
+            unknown_section(sc, sc->sections[k].name, sc->sections[k].line);
+            rc = CLI_EXIT_USAGE;
+        }
+        for (size_t m = 0; m < k; m++)
+            if (strcmp(sc->sections[m].name, sc->sections[k].name) == 0) {
+                fprintf(stderr, "%s:%d: section [%s] appears twice (first at line %d)\n",
+                        sc->file, sc->sections[k].line, sc->sections[k].name,
+                        sc->sections[m].line);
+                rc = CLI_EXIT_USAGE;
+            }
+    }
+    for (size_t k = 0; k < sc->n_entries; k++) {
+        const struct cli_entry* e = &sc->entries[k];
+        struct cli_section_info info;
+        if (cli_section_lookup(e->section, &info) != 0)
+            continue;
+        if (check_entry(sc, e) != CLI_EXIT_OK)
+            rc = CLI_EXIT_USAGE;
+        for (size_t m = 0; m < k; m++)
+            if (strcmp(sc->entries[m].section, e->section) == 0 &&
+                strcmp(sc->entries[m].key, e->key) == 0) {
+                cli_scenario_error(sc, e,
+                                   "key given twice (first at line %d; a value cannot continue "
+                                   "on an indented line)",
+                                   sc->entries[m].line);
+                rc = CLI_EXIT_USAGE;
+            }
+    }
+    return rc;
+}
+
+/* ---- reading ---- */
+
+struct reader {
+    FILE* f;
+    struct cli_scenario* sc;
+    int line;
+    int n_errors;
+    bool out_of_memory;
+};
+
+/* Records a "[name]" header line (inih reports malformed ones itself). */
+static void note_section(struct reader* r, const char* text)
+{
+    const char* p = text;
+    while (isspace((unsigned char)*p))
+        p++;
+    if (*p != '[')
+        return;
+    const char* close = strchr(p, ']');
+    if (!close)
+        return;
+    char name[CLI_NAME_MAX];
+    size_t len = (size_t)(close - p - 1);
+    if (len >= sizeof name)
+        len = sizeof name - 1;
+    memcpy(name, p + 1, len);
+    name[len] = '\0';
+    trim(name);
+    if (push_section(r->sc, name, r->line) != 0)
+        r->out_of_memory = true;
+}
+
+/* inih reader: one line per call, counted; an over-long line is reported and skipped. */
+static char* read_line(char* str, int num, void* stream)
+{
+    struct reader* r = stream;
+    if (!fgets(str, num, r->f))
+        return NULL;
+    r->line++;
+    size_t len = strlen(str);
+    if (len > 0 && str[len - 1] != '\n' && !feof(r->f)) {
+        int c;
+        while ((c = fgetc(r->f)) != EOF && c != '\n')
+            ;
+        fprintf(stderr, "%s:%d: line longer than %d characters\n", r->sc->file, r->line,
+                LINE_MAX_CHARS - 4);
+        r->n_errors++;
+        str[0] = '\0';
+        return str;
+    }
+    note_section(r, str);
+    return str;
+}
+
+static int on_pair(void* user, const char* section, const char* key, const char* value)
+{
+    struct reader* r = user;
+    char v[CLI_VALUE_MAX];
+    copy_text(v, sizeof v, value);
+    strip_hash_comment(v);
+    if (section[0] == '\0') {
+        fprintf(stderr, "%s:%d: key '%s' comes before any [section]\n", r->sc->file, r->line, key);
+        r->n_errors++;
+        return 1;
+    }
+    if (strlen(section) >= CLI_NAME_MAX || strlen(key) >= CLI_NAME_MAX) {
+        fprintf(stderr, "%s:%d: section or key name longer than %d characters\n", r->sc->file,
+                r->line, CLI_NAME_MAX - 1);
+        r->n_errors++;
+        return 1;
+    }
+    if (push_entry(r->sc, section, key, v, r->line) != 0)
+        r->out_of_memory = true;
+    return 1;
+}
+
+int cli_scenario_load(const char* path, struct cli_scenario* sc)
+{
+    memset(sc, 0, sizeof *sc);
+    copy_text(sc->file, sizeof sc->file, path);
+    struct reader r = {.f = fopen(path, "r"), .sc = sc};
+    if (!r.f) {
+        cli_error("%s: cannot open scenario file: %s", path, strerror(errno));
+        return CLI_EXIT_USAGE;
+    }
+    int bad_line = ini_parse_stream(read_line, &r, on_pair, &r);
+    fclose(r.f);
+    if (r.out_of_memory || bad_line == -2) {
+        cli_error("%s: out of memory reading the scenario", path);
+        return CLI_EXIT_RUNTIME;
+    }
+    int rc = r.n_errors ? CLI_EXIT_USAGE : CLI_EXIT_OK;
+    if (bad_line > 0) {
+        fprintf(stderr, "%s:%d: malformed line: expected '[section]', 'key = value' or a "
+                        "comment\n",
+                path, bad_line);
+        rc = CLI_EXIT_USAGE;
+    }
+    if (check_all(sc) != CLI_EXIT_OK)
+        rc = CLI_EXIT_USAGE;
+    return rc;
+}
+
+/* ---- overrides ---- */
+
+/* Splits "a.b.c=value" into section "a.b", key "c" and value; a leading model name
+ * "nijssen.x" becomes section "model.nijssen". Returns 0 or -1 (message printed). */
+int cli_override_split(const char* text, char* section, char* key, char* value)
+{
+    const char* eq = strchr(text, '=');
+    const char* dot = NULL;
+    for (const char* p = text; eq && p < eq; p++)
+        if (*p == '.')
+            dot = p;
+    if (!eq || !dot || dot == text || dot + 1 == eq) {
+        cli_error("--set '%s': expected section.key=value, e.g. --set collision.stokes=50",
+                  text);
+        return -1;
+    }
+    size_t slen = (size_t)(dot - text), klen = (size_t)(eq - dot - 1);
+    if (slen >= CLI_NAME_MAX - 6 || klen >= CLI_NAME_MAX || strlen(eq + 1) >= CLI_VALUE_MAX - 1) {
+        cli_error("--set '%.60s...': section, key or value too long", text);
+        return -1;
+    }
+    memcpy(section, text, slen);
+    section[slen] = '\0';
+    memcpy(key, dot + 1, klen);
+    key[klen] = '\0';
+    if (value) {
+        copy_text(value, CLI_VALUE_MAX, eq + 1);
+        trim(value);
+    }
+    struct cli_section_info info;
+    if (cli_section_lookup(section, &info) != 0 && wetdem_model_find(section)) {
+        memmove(section + 6, section, slen + 1); /* slen < CLI_NAME_MAX - 6 checked above */
+        memcpy(section, "model.", 6);
+    }
+    return 0;
+}
+
+int cli_scenario_override(struct cli_scenario* sc, const char* key_value)
+{
+    char section[CLI_NAME_MAX], key[CLI_NAME_MAX], value[CLI_VALUE_MAX];
+    if (cli_override_split(key_value, section, key, value) != 0)
+        return CLI_EXIT_USAGE;
+    struct cli_section_info info;
+    if (cli_section_lookup(section, &info) != 0) {
+        char msg[256];
+        cli_section_suggestion(section, msg, sizeof msg);
+        cli_error("--set %s: unknown section [%s]%s", key_value, section, msg);
+        return CLI_EXIT_USAGE;
+    }
+    struct cli_entry probe = {.line = 0};
+    copy_text(probe.section, sizeof probe.section, section);
+    copy_text(probe.key, sizeof probe.key, key);
+    copy_text(probe.value, sizeof probe.value, value);
+    if (check_entry(sc, &probe) != CLI_EXIT_OK)
+        return CLI_EXIT_USAGE;
+    /* speed and stokes exclude each other: overriding one replaces the other */
+    bool is_speed = strcmp(section, "collision") == 0 &&
+                    (strcmp(key, "speed") == 0 || strcmp(key, "stokes") == 0);
+    bool found = false;
+    for (size_t k = 0; k < sc->n_entries; k++) {
+        struct cli_entry* e = &sc->entries[k];
+        if (strcmp(e->section, section) != 0)
+            continue;
+        if (strcmp(e->key, key) == 0) {
+            *e = probe;
+            found = true;
+        } else if (is_speed && (strcmp(e->key, "speed") == 0 || strcmp(e->key, "stokes") == 0))
+            copy_text(e->value, sizeof e->value, "0");
+    }
+    if (!found && push_entry(sc, section, key, value, 0) != 0) {
+        cli_error("out of memory applying --set");
+        return CLI_EXIT_RUNTIME;
+    }
+    return CLI_EXIT_OK;
+}

@@ -1,0 +1,217 @@
+/*
+ * scenario.h — scenario files (INI, read with inih) for `wetdem run` and `wetdem sweep`.
+ *
+ * A scenario is kept as a generic list of (section, key, value, file, line) entries, so that
+ * every engine or command can read its own sections with the typed accessors below, and so
+ * that `--set section.key=value` overrides work for every key. The keys a section accepts are
+ * described by descriptor tables (unit, default, range, doc); docs/scenarios.md is generated
+ * from them by `wetdem docs-scenarios`, and tests/test_scenario.c checks it is current.
+ *
+ * Error convention (as cli_util.h): functions that reject input print one message to stderr,
+ * "FILE:LINE: [section] key = value: why" (or "--set section.key=value: why" for overrides),
+ * and return CLI_EXIT_USAGE (2); CLI_EXIT_OK (0) on success.
+ */
+#ifndef WETDEM_CLI_SCENARIO_H
+#define WETDEM_CLI_SCENARIO_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdio.h>
+
+#include "cli.h"
+
+#define CLI_NAME_MAX 64   /* longest section or key name + 1 */
+#define CLI_VALUE_MAX 256 /* longest value + 1 */
+
+/* One "key = value" line of a scenario, or one --set override (line 0). */
+struct cli_entry {
+    char section[CLI_NAME_MAX]; /* "collision", "material.delrin", "model.nijssen" */
+    char key[CLI_NAME_MAX];
+    char value[CLI_VALUE_MAX];
+    int line;                   /* 1-based line in the file; 0 for a --set override */
+};
+
+/* A "[section]" header line. */
+struct cli_section_mark {
+    char name[CLI_NAME_MAX];
+    int line;
+};
+
+struct cli_scenario {
+    char file[1024]; /* the path as given, for messages */
+    struct cli_entry* entries;
+    size_t n_entries, entries_cap;
+    struct cli_section_mark* sections;
+    size_t n_sections, sections_cap;
+};
+
+/* Kinds of values a key accepts. */
+enum cli_value_kind {
+    CLI_VALUE_NUMBER = 0, /* a finite number in [min, max] */
+    CLI_VALUE_CHOICE,     /* one word of `choices` */
+    CLI_VALUE_NAME,       /* a name checked when the scenario is built (material, model) */
+    CLI_VALUE_NAME_LIST,  /* space- or comma-separated names, checked when built */
+    CLI_VALUE_TEXT,       /* free text, e.g. a file name */
+};
+
+/* Descriptor of one scenario key (tables end with {0}). */
+struct cli_key_desc {
+    const char* key;
+    enum cli_value_kind kind;
+    const char* unit;         /* "m", "-", ... ("" for words) */
+    const char* default_text; /* as documented, e.g. "0 (derive from stokes)"; NULL: read
+                                 from the library ([integrator], [sim] parameters) */
+    double min, max;          /* numbers: valid range */
+    bool min_open, max_open;  /* exclude the bound */
+    const char* const* choices; /* CLI_VALUE_CHOICE: NULL-terminated words */
+    const char* doc;          /* one or two sentences */
+};
+
+/* Descriptor of one section. A name ending in ".*" (e.g. "material.*") is a family of
+ * sections "material.NAME". keys == NULL means the keys are checked when the scenario is
+ * built (e.g. [model.NAME] keys are the parameters of model NAME). */
+struct cli_section_desc {
+    const char* name;
+    const char* doc;
+    const struct cli_key_desc* keys;
+};
+
+/* Optional (weak): sections another engine reads, e.g. the pairwise engine's, as a
+ * {0}-terminated table; they are accepted, validated and documented like the built-in ones. */
+extern const struct cli_section_desc cli_pairwise_sections[] __attribute__((weak));
+
+/* ---- loading and overriding ---- */
+
+/* Reads and checks a scenario file: syntax, known sections and keys ("did you mean"),
+ * duplicates, numbers finite and in range, words among their choices. Returns CLI_EXIT_OK or
+ * prints every error found and returns CLI_EXIT_USAGE. sc is left valid for free() either way. */
+int cli_scenario_load(const char* path, struct cli_scenario* sc);
+/* Applies "section.key=value" (e.g. "collision.stokes=50", "material.delrin.roughness=1e-7",
+ * "model.nijssen.cutoff_ratio=2"; a dotted model parameter "nijssen.cutoff_ratio" is taken as
+ * [model.nijssen]). The key must be one the section accepts. Returns an exit code. */
+int cli_scenario_override(struct cli_scenario* sc, const char* key_value);
+/* Deep copy of src into dst (dst is overwritten). CLI_EXIT_OK or CLI_EXIT_RUNTIME (memory). */
+int cli_scenario_copy(const struct cli_scenario* src, struct cli_scenario* dst);
+/* Frees what sc owns; sc may then be loaded again. */
+void cli_scenario_free(struct cli_scenario* sc);
+
+/* ---- typed accessors ---- */
+
+/* The entry for section.key, or NULL when absent. */
+const struct cli_entry* cli_scenario_find(const struct cli_scenario* sc, const char* section,
+                                          const char* key);
+/* Whether the scenario has a [section] header or any key in it. */
+bool cli_scenario_has_section(const struct cli_scenario* sc, const char* section);
+/* Reads a number (default `def` when absent). The value was checked when loaded; this only
+ * converts. */
+double cli_scenario_number(const struct cli_scenario* sc, const char* section, const char* key,
+                           double def);
+/* Reads a word or text (default `def` when absent). Borrowed pointer. */
+const char* cli_scenario_text(const struct cli_scenario* sc, const char* section,
+                              const char* key, const char* def);
+/* Prints "FILE:LINE: [section] key = value: <message>" (or the --set form) to stderr. */
+void cli_scenario_error(const struct cli_scenario* sc, const struct cli_entry* e,
+                        const char* fmt, ...) __attribute__((format(printf, 3, 4)));
+/* Prints "FILE:LINE: <message>" for a whole section (its header line, or line 1 if absent). */
+void cli_scenario_section_error(const struct cli_scenario* sc, const char* section,
+                                const char* fmt, ...) __attribute__((format(printf, 3, 4)));
+
+/* ---- building a soft-engine collision ---- */
+
+enum cli_engine { CLI_ENGINE_SOFT = 0, CLI_ENGINE_PAIRWISE = 1 };
+
+/* Everything a soft-engine run needs, resolved from a scenario. */
+struct cli_setup {
+    struct wetdem_sim* sim;             /* owned; materials, fluid, models, integrator set */
+    struct wetdem_collision_spec spec;  /* speed always explicit (derived from stokes) */
+    enum cli_engine engine;
+    double impact_speed;                /* |v_i| at t = 0 [m/s] */
+    double stokes_n;                    /* normal Stokes number of the impact [-] */
+    double m_eff, r_eff;                /* m* [kg], R* [m] used for the Stokes number */
+    double trajectory_interval;         /* [s], resolved from auto */
+    char trajectory_file[CLI_VALUE_MAX]; /* "" = not written */
+    char events_file[CLI_VALUE_MAX];
+    char summary_file[CLI_VALUE_MAX];
+    /* filled by cli_setup_capture() after the run: */
+    double striker_speed_out;          /* |v_i| at the end [m/s] */
+    double striker_angle_out;          /* angle of v_i to the final line of centres [rad] */
+};
+
+/* Reads [engine] type only. CLI_EXIT_OK or CLI_EXIT_USAGE. */
+int cli_scenario_engine(const struct cli_scenario* sc, enum cli_engine* engine);
+/* Builds the simulation and the collision spec. Every library check runs here, so a
+ * scenario that builds runs without input errors. Returns CLI_EXIT_OK, CLI_EXIT_USAGE
+ * (message printed, nothing allocated) or CLI_EXIT_RUNTIME (out of memory). */
+int cli_scenario_build(const struct cli_scenario* sc, struct cli_setup* setup);
+/* Frees the simulation of a setup. */
+void cli_setup_free(struct cli_setup* setup);
+
+/* Impact speed [m/s] that gives the normal Stokes number St_n = m* v cos(angle) /
+ * (6 pi mu R*^2): v = St_n 6 pi mu R*^2 / (m* cos(angle)). */
+double cli_stokes_speed(double stokes_n, double viscosity, double m_eff, double r_eff,
+                        double angle);
+
+/* ---- internal: section lookup (scenario_keys.c), shared by scenario*.c ---- */
+
+/* What a section accepts: its descriptor, keys from a library table, or any key. */
+struct cli_section_info {
+    const struct cli_section_desc* desc;      /* never NULL on success */
+    const struct wetdem_param_desc* lib_keys; /* e.g. wetdem_material_params(), or NULL */
+    const struct wetdem_model* model;         /* [model.NAME]: the model */
+    bool open_keys;                           /* keys checked when built ([integrator], [sim]) */
+};
+/* Looks a section name up ("collision", "material.delrin", "model.nijssen"). 0 or -1. */
+int cli_section_lookup(const char* name, struct cli_section_info* info);
+/* Writes " (did you mean [x]?)" or a list of valid sections for an unknown name into msg. */
+void cli_section_suggestion(const char* name, char* msg, size_t n);
+/* Whether s is a non-empty name of letters, digits, '_' and '-'. */
+bool cli_is_name(const char* s);
+/* Parses a whole string as one finite number. 0 or -1. */
+int cli_parse_number_text(const char* text, double* out);
+/* A numeric or choice key descriptor as a library parameter descriptor (for range text). */
+struct wetdem_param_desc cli_key_as_param(const struct cli_key_desc* k);
+
+/* Unit of a key as documented ("" if unknown or a word). */
+const char* cli_scenario_key_unit(const char* section, const char* key);
+/* Splits an override "a.b.key=value" into section and key (a model name "nijssen" becomes
+ * "model.nijssen"). 0, or -1 with a message printed. value may be NULL. */
+int cli_override_split(const char* text, char* section, char* key, char* value);
+
+/* ---- shared by run and sweep (cmd_run.c) ---- */
+
+/* cli_scenario_load() then cli_scenario_override() for each of sets. Returns an exit code. */
+int cli_load_with_overrides(const char* file, const char* const* sets, int n_sets,
+                            struct cli_scenario* sc);
+/* mkdir -p. 0 or -1 (errno set). */
+int cli_make_dirs(const char* dir);
+
+/* ---- documentation ---- */
+
+/* Built-in section table ({0}-terminated). */
+const struct cli_section_desc* cli_scenario_sections(void);
+/* Writes the Markdown key tables of every section (the generated part of docs/scenarios.md).
+ * Returns 0, or -1 if a documented integrator or sim key is unknown to the library. */
+int cli_scenario_print_docs(FILE* f);
+/* `wetdem docs-scenarios`: the key tables to stdout. */
+int cmd_docs_scenarios(int argc, char** argv);
+
+/* ---- other engines ---- */
+
+/* Options of `wetdem run` handed to an engine. */
+struct cli_run_options {
+    const char* out_dir; /* NULL: no files */
+    bool json;           /* summary as JSON on stdout */
+    int argc;            /* the subcommand's arguments, for provenance lines */
+    char** argv;
+    FILE* sweep_row;     /* non-NULL (sweep): write only one CSV row of results (no newline
+                            handling by the caller: end it with '\n'), or the header */
+    bool sweep_header;   /* with sweep_row: write the CSV column header line instead */
+};
+
+/* Runs a scenario whose [engine] type is "pairwise" (cli/run_pairwise.c). Weak: when the
+ * build has no pairwise engine, run and sweep report "engine 'pairwise' is not in this
+ * build" and exit 1. Returns an exit code. */
+int cli_run_pairwise(const struct cli_scenario* sc, const struct cli_run_options* opt)
+    __attribute__((weak));
+
+#endif

@@ -1,0 +1,320 @@
+/*
+ * scenario_build.c — turns a checked scenario into a simulation and a collision spec:
+ * fluid, materials, models and their parameters, integrator, settings, and the derived
+ * quantities of the collision. Every library check runs here, so a scenario that builds
+ * runs without input errors; each failure names the file, the line and the key.
+ *
+ * Derived quantities (SPEC §2, Nijssen 2023 Eq. 2 with the normal speed):
+ *   m_i = rho_i (4/3) pi R_i^3;  m* = m_i m_j / (m_i + m_j) for a free target sphere, m* = m_i
+ *   for a fixed sphere or a wall;  R* = R_i R_j / (R_i + R_j), R* = R_i for a wall;
+ *   St_n = m* v cos(angle) / (6 pi mu R*^2)  =>  v = St_n 6 pi mu R*^2 / (m* cos(angle)).
+ *   Automatic end time: t_end = 20 max(R*, initial_gap) / v_n (Nijssen's cut-off h_co = R*
+ *   crossed twenty times over); trajectory interval max(R*, initial_gap) / (500 v_n).
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cli_util.h"
+#include "scenario.h"
+
+#define PI 3.14159265358979323846
+
+double cli_stokes_speed(double stokes_n, double viscosity, double m_eff, double r_eff,
+                        double angle)
+{
+    return stokes_n * 6.0 * PI * viscosity * r_eff * r_eff / (m_eff * cos(angle));
+}
+
+/* Reports a library failure of `sim` against entry e (or the section when e is NULL). */
+static int lib_error(const struct cli_scenario* sc, const struct cli_entry* e,
+                     const char* section, const struct wetdem_sim* sim)
+{
+    if (e)
+        cli_scenario_error(sc, e, "%s", wetdem_sim_errmsg(sim));
+    else
+        cli_scenario_section_error(sc, section, "%s", wetdem_sim_errmsg(sim));
+    return CLI_EXIT_USAGE;
+}
+
+static int build_fluid(const struct cli_scenario* sc, struct wetdem_sim* sim)
+{
+    struct wetdem_fluid f;
+    const char* preset = cli_scenario_text(sc, "fluid", "preset", "water");
+    if (wetdem_fluid_preset(preset, &f) != WETDEM_OK) {
+        cli_scenario_error(sc, cli_scenario_find(sc, "fluid", "preset"), "unknown fluid preset");
+        return CLI_EXIT_USAGE;
+    }
+    const struct wetdem_param_desc* d = wetdem_fluid_params();
+    for (size_t k = 0; d[k].name; k++) {
+        const struct cli_entry* e = cli_scenario_find(sc, "fluid", d[k].name);
+        if (e)
+            *(double*)((char*)&f + d[k].offset) = strtod(e->value, NULL);
+    }
+    if (wetdem_sim_set_fluid(sim, &f) != WETDEM_OK)
+        return lib_error(sc, NULL, "fluid", sim);
+    return CLI_EXIT_OK;
+}
+
+/* Names a material can have: presets and [material.NAME] sections (for suggestions). */
+static void material_names(const struct cli_scenario* sc, const char** names, size_t cap)
+{
+    size_t n = 0;
+    const char* const* presets = wetdem_material_preset_names();
+    for (size_t k = 0; presets[k] && n + 1 < cap; k++)
+        names[n++] = presets[k];
+    for (size_t k = 0; k < sc->n_sections && n + 1 < cap; k++)
+        if (strncmp(sc->sections[k].name, "material.", 9) == 0)
+            names[n++] = sc->sections[k].name + 9;
+    names[n] = NULL;
+}
+
+/* Resolves a material name (section first, then preset) into *m. */
+static int resolve_material(const struct cli_scenario* sc, const struct cli_entry* use,
+                            const char* name, struct wetdem_material* m)
+{
+    char section[CLI_NAME_MAX];
+    snprintf(section, sizeof section, "material.%s", name);
+    if (!cli_scenario_has_section(sc, section)) {
+        if (wetdem_material_preset(name, m) == WETDEM_OK)
+            return CLI_EXIT_OK;
+        const char* names[64];
+        material_names(sc, names, 64);
+        const char* hint = wetdem_param_suggest(name, names);
+        cli_scenario_error(sc, use,
+                           "unknown material '%s'%s%s%s: use a preset (wetdem docs-models lists "
+                           "them) or define a [material.%s] section",
+                           name, hint ? " (did you mean '" : "", hint ? hint : "",
+                           hint ? "'?)" : "", name);
+        return CLI_EXIT_USAGE;
+    }
+    const struct cli_entry* p = cli_scenario_find(sc, section, "preset");
+    wetdem_param_init_defaults(wetdem_material_params(), m);
+    if (p && wetdem_material_preset(p->value, m) != WETDEM_OK) {
+        const char* hint = wetdem_param_suggest(p->value, wetdem_material_preset_names());
+        cli_scenario_error(sc, p, "unknown material preset%s%s%s", hint ? " (did you mean '" : "",
+                           hint ? hint : "", hint ? "'?)" : "");
+        return CLI_EXIT_USAGE;
+    }
+    const struct wetdem_param_desc* d = wetdem_material_params();
+    for (size_t k = 0; d[k].name; k++) {
+        const struct cli_entry* e = cli_scenario_find(sc, section, d[k].name);
+        if (e)
+            *(double*)((char*)m + d[k].offset) = strtod(e->value, NULL);
+    }
+    char msg[512];
+    if (wetdem_material_validate(m, msg, sizeof msg) != WETDEM_OK) {
+        cli_scenario_section_error(sc, section, "%s", msg);
+        return CLI_EXIT_USAGE;
+    }
+    return CLI_EXIT_OK;
+}
+
+/* Adds striker and target materials; sets spec material indices. */
+static int build_materials(const struct cli_scenario* sc, struct cli_setup* su,
+                           struct wetdem_material* mi, struct wetdem_material* mj)
+{
+    const char* si = cli_scenario_text(sc, "collision", "striker", "steel1");
+    const char* sj = cli_scenario_text(sc, "collision", "target_material", si);
+    const struct cli_entry* ei = cli_scenario_find(sc, "collision", "striker");
+    const struct cli_entry* ej = cli_scenario_find(sc, "collision", "target_material");
+    struct cli_entry dflt = {.section = "collision", .key = "striker", .value = "steel1", .line = 1};
+    int rc;
+    if ((rc = resolve_material(sc, ei ? ei : &dflt, si, mi)) != CLI_EXIT_OK ||
+        (rc = resolve_material(sc, ej ? ej : (ei ? ei : &dflt), sj, mj)) != CLI_EXIT_OK)
+        return rc;
+    int ki = wetdem_sim_add_material(su->sim, mi);
+    if (ki < 0)
+        return lib_error(sc, ei, "collision", su->sim);
+    int kj = ki;
+    if (strcmp(si, sj) != 0 && (kj = wetdem_sim_add_material(su->sim, mj)) < 0)
+        return lib_error(sc, ej, "collision", su->sim);
+    su->spec.material_i = ki;
+    su->spec.material_j = kj;
+    return CLI_EXIT_OK;
+}
+
+static int enable_forces(const struct cli_scenario* sc, struct wetdem_sim* sim)
+{
+    const struct cli_entry* e = cli_scenario_find(sc, "models", "force");
+    char buf[CLI_VALUE_MAX];
+    snprintf(buf, sizeof buf, "%s", e ? e->value : "hertz");
+    for (char* tok = strtok(buf, " ,\t"); tok; tok = strtok(NULL, " ,\t")) {
+        const struct wetdem_model* m = wetdem_model_find(tok);
+        if (m && m->kind == WETDEM_MODEL_MIN_SEPARATION) {
+            cli_scenario_error(sc, e, "'%s' is a minimum-separation model: write "
+                                      "'min_separation = %s'", tok, tok);
+            return CLI_EXIT_USAGE;
+        }
+        if (wetdem_sim_enable_model(sim, tok) != WETDEM_OK)
+            return lib_error(sc, e, "models", sim);
+    }
+    return CLI_EXIT_OK;
+}
+
+static int build_models(const struct cli_scenario* sc, struct wetdem_sim* sim)
+{
+    wetdem_sim_clear_models(sim);
+    int rc = enable_forces(sc, sim);
+    if (rc != CLI_EXIT_OK)
+        return rc;
+    const struct cli_entry* e = cli_scenario_find(sc, "models", "min_separation");
+    if (e) {
+        const struct wetdem_model* m = wetdem_model_find(e->value);
+        if (m && m->kind != WETDEM_MODEL_MIN_SEPARATION) {
+            cli_scenario_error(sc, e, "'%s' is a %s model, not a minimum-separation model",
+                               e->value, wetdem_model_kind_name(m->kind));
+            return CLI_EXIT_USAGE;
+        }
+        if (wetdem_sim_enable_model(sim, e->value) != WETDEM_OK)
+            return lib_error(sc, e, "models", sim);
+    }
+    for (size_t k = 0; k < sc->n_entries; k++) {
+        const struct cli_entry* p = &sc->entries[k];
+        if (strncmp(p->section, "model.", 6) != 0)
+            continue;
+        char name[2 * CLI_NAME_MAX];
+        snprintf(name, sizeof name, "%s.%s", p->section + 6, p->key);
+        if (wetdem_sim_set_param_str(sim, name, p->value) == WETDEM_OK)
+            continue;
+        double dummy;
+        bool enabled = wetdem_sim_param(sim, name, &dummy) == WETDEM_OK;
+        if (!enabled)
+            cli_scenario_error(sc, p, "model '%s' is not enabled by [models] force or "
+                                      "min_separation, so it has no parameters to set",
+                               p->section + 6);
+        else
+            cli_scenario_error(sc, p, "%s", wetdem_sim_errmsg(sim));
+        return CLI_EXIT_USAGE;
+    }
+    return CLI_EXIT_OK;
+}
+
+/* [integrator] name and parameters ("<name>.<key>"), [sim] settings ("sim.<key>"). */
+static int build_integrator(const struct cli_scenario* sc, struct wetdem_sim* sim)
+{
+    const struct cli_entry* e = cli_scenario_find(sc, "integrator", "name");
+    const char* name = e ? e->value : "verlet";
+    if (wetdem_sim_set_integrator(sim, name) != WETDEM_OK) {
+        struct cli_entry d = {.section = "integrator", .key = "name", .line = 1};
+        snprintf(d.value, sizeof d.value, "%s", name);
+        cli_scenario_error(sc, e ? e : &d, "%s", wetdem_sim_errmsg(sim));
+        return CLI_EXIT_USAGE;
+    }
+    for (size_t k = 0; k < sc->n_entries; k++) {
+        const struct cli_entry* p = &sc->entries[k];
+        bool is_integrator = strcmp(p->section, "integrator") == 0 && strcmp(p->key, "name");
+        if (!is_integrator && strcmp(p->section, "sim") != 0)
+            continue;
+        char full[CLI_VALUE_MAX + CLI_NAME_MAX + 2];
+        snprintf(full, sizeof full, "%s.%s", is_integrator ? name : "sim", p->key);
+        if (wetdem_sim_set_param_str(sim, full, p->value) != WETDEM_OK)
+            return lib_error(sc, p, p->section, sim);
+    }
+    return CLI_EXIT_OK;
+}
+
+/* Radii, masses, R*, m*, the impact speed and the times of the collision. */
+static int build_kinematics(const struct cli_scenario* sc, struct cli_setup* su,
+                            const struct wetdem_material* mi, const struct wetdem_material* mj)
+{
+    struct wetdem_collision_spec* s = &su->spec;
+    const char* target = cli_scenario_text(sc, "collision", "target", "sphere");
+    s->target_is_wall = strcmp(target, "wall") == 0;
+    s->target_is_fixed = strcmp(target, "fixed") == 0;
+    s->radius_i = cli_scenario_number(sc, "collision", "striker_radius", 6.35e-3);
+    s->radius_j = cli_scenario_number(sc, "collision", "target_radius", s->radius_i);
+    double m_i = mi->density * 4.0 / 3.0 * PI * pow(s->radius_i, 3);
+    double m_j = mj->density * 4.0 / 3.0 * PI * pow(s->radius_j, 3);
+    bool free_target = !s->target_is_wall && !s->target_is_fixed;
+    su->m_eff = free_target ? m_i * m_j / (m_i + m_j) : m_i;
+    su->r_eff = s->target_is_wall ? s->radius_i : s->radius_i * s->radius_j / (s->radius_i + s->radius_j);
+    s->angle = cli_scenario_number(sc, "collision", "angle_deg", 0) * PI / 180.0;
+    const struct cli_entry* ev = cli_scenario_find(sc, "collision", "speed");
+    const struct cli_entry* es = cli_scenario_find(sc, "collision", "stokes");
+    double speed = ev ? strtod(ev->value, NULL) : 0, stokes = es ? strtod(es->value, NULL) : 0;
+    double mu = wetdem_sim_fluid(su->sim).viscosity;
+    if (speed > 0 && stokes > 0) {
+        cli_scenario_error(sc, (ev->line == 0 || (es->line != 0 && ev->line > es->line)) ? ev : es,
+                           "give either speed or stokes, not both (speed is derived from stokes)");
+        return CLI_EXIT_USAGE;
+    }
+    if (!(speed > 0) && !(stokes > 0)) {
+        cli_scenario_section_error(sc, "collision", "needs speed > 0 [m/s] or stokes > 0 [-]");
+        return CLI_EXIT_USAGE;
+    }
+    if (stokes > 0 && !(mu > 0)) {
+        cli_scenario_error(sc, es, "a Stokes number needs a fluid viscosity > 0, got %g Pa s", mu);
+        return CLI_EXIT_USAGE;
+    }
+    if (stokes > 0)
+        speed = cli_stokes_speed(stokes, mu, su->m_eff, su->r_eff, s->angle);
+    if (!(speed <= 1e3)) {
+        cli_scenario_error(sc, es, "the derived impact speed %g m/s exceeds 1e3 m/s", speed);
+        return CLI_EXIT_USAGE;
+    }
+    su->impact_speed = speed;
+    s->speed = speed;
+    double v_n = speed * cos(s->angle);
+    su->stokes_n = mu > 0 ? su->m_eff * v_n / (6.0 * PI * mu * su->r_eff * su->r_eff) : INFINITY;
+    s->stokes = mu > 0 ? su->stokes_n : 0;
+    s->omega_i = (struct wetdem_vec3){cli_scenario_number(sc, "collision", "spin_x", 0),
+                                      cli_scenario_number(sc, "collision", "spin_y", 0),
+                                      cli_scenario_number(sc, "collision", "spin_z", 0)};
+    s->initial_gap = cli_scenario_number(sc, "collision", "initial_gap", 0);
+    double t_cross = fmax(su->r_eff, s->initial_gap) / v_n;
+    s->t_end = cli_scenario_number(sc, "collision", "t_end", 0);
+    if (s->t_end == 0)
+        s->t_end = 20.0 * t_cross;
+    s->observe_time = cli_scenario_number(sc, "collision", "observe_time", 0);
+    s->rebound_gap_factor = cli_scenario_number(sc, "collision", "rebound_gap_factor", 1);
+    su->trajectory_interval = cli_scenario_number(sc, "output", "trajectory_interval", 0);
+    if (su->trajectory_interval == 0)
+        su->trajectory_interval = t_cross / 500.0;
+    return CLI_EXIT_OK;
+}
+
+static void output_name(const struct cli_scenario* sc, const char* key, const char* def,
+                        char* out)
+{
+    const char* v = cli_scenario_text(sc, "output", key, def);
+    snprintf(out, CLI_VALUE_MAX, "%s", strcmp(v, "none") == 0 ? "" : v);
+}
+
+int cli_scenario_engine(const struct cli_scenario* sc, enum cli_engine* engine)
+{
+    const char* t = cli_scenario_text(sc, "engine", "type", "soft");
+    *engine = strcmp(t, "pairwise") == 0 ? CLI_ENGINE_PAIRWISE : CLI_ENGINE_SOFT;
+    return CLI_EXIT_OK;
+}
+
+int cli_scenario_build(const struct cli_scenario* sc, struct cli_setup* su)
+{
+    memset(su, 0, sizeof *su);
+    cli_scenario_engine(sc, &su->engine);
+    su->sim = wetdem_sim_create();
+    if (!su->sim) {
+        cli_error("out of memory creating a simulation");
+        return CLI_EXIT_RUNTIME;
+    }
+    struct wetdem_material mi, mj;
+    int rc;
+    if ((rc = build_fluid(sc, su->sim)) != CLI_EXIT_OK ||
+        (rc = build_materials(sc, su, &mi, &mj)) != CLI_EXIT_OK ||
+        (rc = build_models(sc, su->sim)) != CLI_EXIT_OK ||
+        (rc = build_integrator(sc, su->sim)) != CLI_EXIT_OK ||
+        (rc = build_kinematics(sc, su, &mi, &mj)) != CLI_EXIT_OK) {
+        cli_setup_free(su);
+        return rc;
+    }
+    output_name(sc, "trajectory", "trajectory.csv", su->trajectory_file);
+    output_name(sc, "events", "events.csv", su->events_file);
+    output_name(sc, "summary", "summary.json", su->summary_file);
+    return CLI_EXIT_OK;
+}
+
+void cli_setup_free(struct cli_setup* su)
+{
+    wetdem_sim_free(su->sim);
+    su->sim = NULL;
+}

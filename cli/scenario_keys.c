@@ -1,0 +1,400 @@
+/*
+ * scenario_keys.c — the one table of scenario sections and keys (unit, default, range, doc),
+ * section lookup with "did you mean" hints, and `wetdem docs-scenarios`, which writes the
+ * key tables of docs/scenarios.md from this table and from the library's descriptor tables
+ * (materials, fluid, every model's parameters), so the documentation cannot drift.
+ *
+ * Ranges of collision keys: radii in (0, 1] m and speeds up to 1e3 m/s cover every seed
+ * set-up with margin (spheres of 12.7 mm diameter, impact speeds below 1 m/s); the angle is
+ * measured from the line of centres, so a grazing 90 deg would never collide.
+ */
+#include <stdio.h>
+#include <string.h>
+
+#include "cli_util.h"
+#include "scenario.h"
+
+static const char* const target_choices[] = {"sphere", "wall", "fixed", NULL};
+static const char* const fluid_choices[] = {"water", "glycerol80", "silicone10", NULL};
+static const char* const engine_choices[] = {"soft", "pairwise", NULL};
+
+#define NUM(k, u, dflt, lo, hi, lo_open, hi_open, doc)                                            \
+    {k, CLI_VALUE_NUMBER, u, dflt, lo, hi, lo_open, hi_open, NULL, doc}
+#define WORD(k, kind, dflt, choices, doc) {k, kind, "", dflt, 0, 0, false, false, choices, doc}
+
+static const struct cli_key_desc collision_keys[] = {
+    WORD("striker", CLI_VALUE_NAME, "steel1", NULL,
+         "Material of the moving sphere i: a preset (steel1, steel2, glass, delrin, "
+         "punch_steel, punch_steel_coated) or NAME of a [material.NAME] section."),
+    WORD("target_material", CLI_VALUE_NAME, "same as striker", NULL,
+         "Material of the target j (sphere or wall), as for striker."),
+    NUM("striker_radius", "m", "6.35e-3", 0, 1, true, false, "Radius R_i of the striker."),
+    NUM("target_radius", "m", "same as striker_radius", 0, 1, true, false,
+        "Radius R_j of a target sphere; ignored for a wall."),
+    WORD("target", CLI_VALUE_CHOICE, "sphere", target_choices,
+         "sphere: free target at rest; fixed: target sphere held in place (infinite mass); "
+         "wall: plane wall."),
+    NUM("speed", "m/s", "0 (derive from stokes)", 0, 1e3, false, false,
+        "Impact speed |v_i| of the striker. Give speed or stokes, not both."),
+    NUM("stokes", "-", "0", 0, 1e9, false, false,
+        "Normal Stokes number St_n = m* v cos(angle) / (6 pi mu R*^2); the speed is derived "
+        "as v = St_n 6 pi mu R*^2 / (m* cos(angle)). Needs fluid viscosity > 0."),
+    NUM("angle_deg", "deg", "0", 0, 90, false, true,
+        "Impact angle between the striker's velocity and the line of centres at first "
+        "interaction (Nijssen Fig. 1c); 0 = head-on."),
+    NUM("spin_x", "rad/s", "0", -1e6, 1e6, false, false, "Initial spin of the striker, x."),
+    NUM("spin_y", "rad/s", "0", -1e6, 1e6, false, false, "Initial spin of the striker, y."),
+    NUM("spin_z", "rad/s", "0", -1e6, 1e6, false, false, "Initial spin of the striker, z."),
+    NUM("t_end", "s", "0 (auto)", 0, 1e6, false, false,
+        "Longest simulated time. 0: 20 max(R*, initial_gap) / v_n, i.e. twenty times the time "
+        "to cross the lubrication cut-off h_co = R* at the impact speed."),
+    NUM("initial_gap", "m", "0 (auto)", 0, 1, false, false,
+        "Gap at t = 0; 0: just outside the interaction range of the enabled models."),
+    NUM("observe_time", "s", "0 (off)", 0, 1e6, false, false,
+        "Also report e_n at this time after the start (Punch Fig. 9 window)."),
+    NUM("rebound_gap_factor", "-", "1", 1, 1e3, false, false,
+        "Separation is declared when the gap exceeds this multiple of the interaction range."),
+    {0},
+};
+
+static const struct cli_key_desc material_keys[] = {
+    WORD("preset", CLI_VALUE_NAME, "none (the field defaults below)", NULL,
+         "Preset the other keys start from: steel1, steel2, glass, delrin, punch_steel, "
+         "punch_steel_coated."),
+    {0},
+};
+
+static const struct cli_key_desc fluid_keys[] = {
+    WORD("preset", CLI_VALUE_CHOICE, "water", fluid_choices,
+         "Fluid the other keys start from: water (1e-3 Pa s), glycerol80 (80 w% glycerol), "
+         "silicone10 (10 Pa s silicone oil of Punch)."),
+    {0},
+};
+
+static const struct cli_key_desc models_keys[] = {
+    WORD("force", CLI_VALUE_NAME_LIST, "hertz", NULL,
+         "Force models summed for every pair, separated by spaces or commas, e.g. "
+         "'hertz mindlin nijssen' or 'hertz mindlin db davis capillary' (wetdem models)."),
+    WORD("min_separation", CLI_VALUE_NAME, "fixed", NULL,
+         "Minimum-separation model giving h_min: fixed, roughness, ehd, max or glass."),
+    {0},
+};
+
+static const char* const cvode_methods[] = {"adams", "bdf", NULL};
+static const char* const yes_no[] = {"no", "yes", NULL};
+
+/* Keys after "name" are the integrators' parameters ("<name>.<key>" in the library); their
+ * defaults are read from the library when the docs are generated (default_text NULL), and
+ * generation fails if the library does not know a key listed here. */
+static const struct cli_key_desc integrator_keys[] = {
+    WORD("name", CLI_VALUE_NAME, "verlet", NULL,
+         "verlet (fixed step, a fraction of the Hertz contact time) or cvode (adaptive, "
+         "with located events). The other keys are parameters of the chosen integrator, "
+         "checked by the library when the scenario is built."),
+    NUM("dt_fraction", "-", NULL, 0, 1, true, false,
+        "verlet: time step as a fraction of the Hertz contact time (Nijssen: 0.02)."),
+    NUM("dt", "s", NULL, 0, 1, false, false,
+        "verlet: fixed time step; 0 derives it from dt_fraction."),
+    NUM("max_steps", "-", NULL, 1, 1e12, false, false,
+        "verlet and cvode: most steps one integration may take."),
+    NUM("rtol", "-", NULL, 1e-14, 1e-2, false, false, "cvode: relative tolerance."),
+    NUM("atol", "-", NULL, 1e-16, 1e-2, false, false,
+        "cvode: absolute tolerance in units of the length, speed and spin scales."),
+    WORD("method", CLI_VALUE_CHOICE, NULL, cvode_methods,
+         "cvode: adams (non-stiff) or bdf (stiff, dense Newton)."),
+    NUM("max_step", "s", NULL, 0, 1e6, false, false,
+        "cvode: largest step; 0 uses 0.1 x smallest radius / speed scale."),
+    {0},
+};
+
+static const struct cli_key_desc sim_keys[] = {
+    NUM("gravity_x", "m/s^2", NULL, -1e4, 1e4, false, false, "Gravity, x component."),
+    NUM("gravity_y", "m/s^2", NULL, -1e4, 1e4, false, false, "Gravity, y component."),
+    NUM("gravity_z", "m/s^2", NULL, -1e4, 1e4, false, false, "Gravity, z component."),
+    WORD("stop_on_separation", CLI_VALUE_CHOICE, NULL, yes_no,
+         "Stop once every pair that interacted has left its range and recedes (a collision "
+         "run sets this itself)."),
+    NUM("separation_factor", "-", NULL, 1, 1e3, false, false,
+        "A pair counts as separated beyond this multiple of its interaction range."),
+    NUM("speed_floor", "m/s", NULL, 0, 1e3, true, false,
+        "Smallest relative speed used for the Verlet step and the CVODE tolerance scales."),
+    {0},
+};
+
+static const struct cli_key_desc output_keys[] = {
+    WORD("trajectory", CLI_VALUE_TEXT, "trajectory.csv", NULL,
+         "Trajectory file in the --out directory; 'none' disables it."),
+    WORD("events", CLI_VALUE_TEXT, "events.csv", NULL,
+         "Event log file in the --out directory; 'none' disables it."),
+    WORD("summary", CLI_VALUE_TEXT, "summary.json", NULL,
+         "Summary file (JSON) in the --out directory; 'none' disables it."),
+    NUM("trajectory_interval", "s", "0 (auto)", 0, 1e6, false, false,
+        "Time between trajectory rows; 0: max(R*, initial_gap) / (500 v_n)."),
+    {0},
+};
+
+static const struct cli_key_desc engine_keys[] = {
+    WORD("type", CLI_VALUE_CHOICE, "soft", engine_choices,
+         "soft: Cartesian soft-sphere DEM; pairwise: Davis relative-motion engine with hard "
+         "contact (when the build has it)."),
+    {0},
+};
+
+static const struct cli_section_desc sections[] = {
+    {"collision", "The binary collision: striker i moving towards target j at rest.",
+     collision_keys},
+    {"material.*",
+     "A material NAME usable as striker or target_material: a preset and/or every field of "
+     "struct wetdem_material.",
+     material_keys},
+    {"fluid", "The liquid: a preset and/or every field of struct wetdem_fluid.", fluid_keys},
+    {"models", "Which models act on every pair.", models_keys},
+    {"model.*",
+     "Parameters of model NAME, which [models] must enable; each key is set as 'NAME.key'. "
+     "The keys are the model's parameters, listed with unit, default and range in "
+     "docs/models.md (generated from the same descriptor tables the library checks values "
+     "against), e.g. [model.nijssen] cutoff_ratio = 1, [model.glass] p_gt = 11.6e6.",
+     NULL},
+    {"integrator", "Time integrator and its parameters.", integrator_keys},
+    {"sim", "Simulation settings, set as 'sim.<key>'; other keys are checked by the library.",
+     sim_keys},
+    {"output", "Files `wetdem run --out DIR` writes.", output_keys},
+    {"engine", "Which engine runs the scenario.", engine_keys},
+    {0},
+};
+
+const struct cli_section_desc* cli_scenario_sections(void)
+{
+    return sections;
+}
+
+/* Finds name in a section table: exact, or as a "family.*" with a valid NAME. */
+static const struct cli_section_desc* find_in(const struct cli_section_desc* table,
+                                              const char* name, const char** member)
+{
+    for (size_t k = 0; table && table[k].name; k++) {
+        const char* star = strstr(table[k].name, ".*");
+        if (!star) {
+            if (strcmp(table[k].name, name) == 0)
+                return &table[k];
+            continue;
+        }
+        size_t plen = (size_t)(star - table[k].name) + 1; /* "material." */
+        if (strncmp(table[k].name, name, plen) == 0 && cli_is_name(name + plen)) {
+            *member = name + plen;
+            return &table[k];
+        }
+    }
+    return NULL;
+}
+
+int cli_section_lookup(const char* name, struct cli_section_info* info)
+{
+    memset(info, 0, sizeof *info);
+    const char* member = NULL;
+    const struct cli_section_desc* d = find_in(sections, name, &member);
+    if (!d && cli_pairwise_sections)
+        d = find_in(cli_pairwise_sections, name, &member);
+    if (!d)
+        return -1;
+    info->desc = d;
+    if (strcmp(d->name, "material.*") == 0)
+        info->lib_keys = wetdem_material_params();
+    else if (strcmp(d->name, "fluid") == 0)
+        info->lib_keys = wetdem_fluid_params();
+    else if (strcmp(d->name, "model.*") == 0) {
+        info->model = wetdem_model_find(member);
+        if (!info->model)
+            return -1;
+        info->lib_keys = info->model->params;
+    } else if (strcmp(d->name, "integrator") == 0 || strcmp(d->name, "sim") == 0)
+        info->open_keys = true;
+    return 0;
+}
+
+void cli_section_suggestion(const char* name, char* msg, size_t n)
+{
+    if (strncmp(name, "model.", 6) == 0) {
+        const struct wetdem_model* const* reg = wetdem_model_registry();
+        const char* names[64];
+        size_t k = 0;
+        for (; reg[k] && k + 1 < 64; k++)
+            names[k] = reg[k]->name;
+        names[k] = NULL;
+        const char* hint = wetdem_param_suggest(name + 6, names);
+        snprintf(msg, n, ": '%s' is not a model%s%s%s (see 'wetdem models')", name + 6,
+                 hint ? "; did you mean [model." : "", hint ? hint : "", hint ? "]?" : "");
+        return;
+    }
+    const char* names[32];
+    size_t m = 0;
+    for (size_t k = 0; sections[k].name && m + 1 < 32; k++)
+        if (!strstr(sections[k].name, ".*"))
+            names[m++] = sections[k].name;
+    for (size_t k = 0; cli_pairwise_sections && cli_pairwise_sections[k].name && m + 1 < 32; k++)
+        names[m++] = cli_pairwise_sections[k].name;
+    names[m] = NULL;
+    const char* hint = wetdem_param_suggest(name, names);
+    if (hint) {
+        snprintf(msg, n, " (did you mean [%s]?)", hint);
+        return;
+    }
+    size_t used = (size_t)snprintf(msg, n, "; valid sections:");
+    for (size_t k = 0; names[k] && used < n; k++)
+        used += (size_t)snprintf(msg + used, n - used, " [%s]", names[k]);
+    if (used < n)
+        snprintf(msg + used, n - used, " [material.NAME] [model.NAME]");
+}
+
+const char* cli_scenario_key_unit(const char* section, const char* key)
+{
+    struct cli_section_info info;
+    if (cli_section_lookup(section, &info) != 0)
+        return "";
+    for (size_t k = 0; info.desc->keys && info.desc->keys[k].key; k++)
+        if (strcmp(info.desc->keys[k].key, key) == 0)
+            return info.desc->keys[k].unit;
+    const struct wetdem_param_desc* d = wetdem_param_find(info.lib_keys, key);
+    return d ? d->unit : "";
+}
+
+/* ---- documentation ---- */
+
+/* Writes a Markdown table cell, '|' escaped. */
+static void cell(FILE* f, const char* text)
+{
+    for (const char* p = text; *p; p++) {
+        if (*p == '|')
+            fputc('\\', f);
+        fputc(*p, f);
+    }
+}
+
+/* Default of an integrator or sim key read from the library: "<value>" or, for integrator
+ * keys, "<value> (<integrator>)" per integrator that has it. Returns 0, or -1 if the library
+ * knows the key for none. */
+static int library_default(const char* section, const struct cli_key_desc* k, char* out,
+                           size_t n)
+{
+    struct wetdem_sim* sim = wetdem_sim_create();
+    const char* const* names = wetdem_integrator_names();
+    bool is_sim = strcmp(section, "sim") == 0;
+    size_t used = 0;
+    out[0] = '\0';
+    for (size_t m = 0; sim && (is_sim ? m < 1 : names[m] != NULL); m++) {
+        char full[2 * CLI_NAME_MAX];
+        snprintf(full, sizeof full, "%s.%s", is_sim ? "sim" : names[m], k->key);
+        double v;
+        if (!is_sim && wetdem_sim_set_integrator(sim, names[m]) != WETDEM_OK)
+            continue;
+        if (wetdem_sim_param(sim, full, &v) != WETDEM_OK)
+            continue;
+        char value[64];
+        if (k->kind == CLI_VALUE_CHOICE && k->choices && v >= 0 && v < 8)
+            snprintf(value, sizeof value, "%s", k->choices[(size_t)v]);
+        else
+            snprintf(value, sizeof value, "%g", v);
+        used += (size_t)snprintf(out + used, used < n ? n - used : 0, "%s%s%s%s%s",
+                                 used ? ", " : "", value, is_sim ? "" : " (", is_sim ? "" : names[m],
+                                 is_sim ? "" : ")");
+    }
+    wetdem_sim_free(sim);
+    return out[0] ? 0 : -1;
+}
+
+static int key_row(FILE* f, const char* section, const struct cli_key_desc* k)
+{
+    char dflt[256];
+    if (k->default_text)
+        snprintf(dflt, sizeof dflt, "%s", k->default_text);
+    else if (library_default(section, k, dflt, sizeof dflt) != 0) {
+        fprintf(stderr, "wetdem: docs-scenarios: the library has no parameter '%s' for [%s]\n",
+                k->key, section);
+        return -1;
+    }
+    char range[256] = "name";
+    if (k->kind == CLI_VALUE_NUMBER || k->kind == CLI_VALUE_CHOICE) {
+        struct wetdem_param_desc d = cli_key_as_param(k);
+        wetdem_param_range_text(&d, range, sizeof range);
+    } else if (k->kind == CLI_VALUE_NAME_LIST)
+        snprintf(range, sizeof range, "list of names");
+    else if (k->kind == CLI_VALUE_TEXT)
+        snprintf(range, sizeof range, "text");
+    fprintf(f, "| `%s` | %s | ", k->key, k->unit[0] ? k->unit : "");
+    cell(f, dflt);
+    fputs(" | ", f);
+    cell(f, range);
+    fputs(" | ", f);
+    cell(f, k->doc);
+    fputs(" |\n", f);
+    return 0;
+}
+
+static void lib_row(FILE* f, const struct wetdem_param_desc* d)
+{
+    char range[256], dflt[64];
+    wetdem_param_range_text(d, range, sizeof range);
+    cli_param_default_text(d, dflt, sizeof dflt);
+    fprintf(f, "| `%s` | %s | %s | ", d->name, d->unit, dflt);
+    cell(f, range);
+    fputs(" | ", f);
+    cell(f, d->doc);
+    fputs(" |\n", f);
+}
+
+static void table_head(FILE* f)
+{
+    fputs("| key | unit | default | range | meaning |\n|---|---|---|---|---|\n", f);
+}
+
+static int section_doc(FILE* f, const struct cli_section_desc* s)
+{
+    struct cli_section_info info;
+    char probe[CLI_NAME_MAX];
+    snprintf(probe, sizeof probe, "%s", s->name);
+    char* star = strstr(probe, "*");
+    if (star)
+        snprintf(star, sizeof probe - (size_t)(star - probe), "%s",
+                 strcmp(s->name, "model.*") == 0 ? "hertz" : "NAME");
+    cli_section_lookup(probe, &info);
+    fprintf(f, "\n### `[%s]`\n\n", star ? (strcmp(s->name, "model.*") == 0 ? "model.NAME"
+                                                                               : "material.NAME")
+                                         : s->name);
+    cell(f, s->doc);
+    fputs("\n", f);
+    if (strcmp(s->name, "model.*") == 0)
+        return 0; /* the models' parameter tables are docs/models.md (wetdem docs-models) */
+    fputs("\n", f);
+    table_head(f);
+    int rc = 0;
+    for (size_t k = 0; s->keys && s->keys[k].key; k++)
+        if (key_row(f, s->name, &s->keys[k]) != 0)
+            rc = -1;
+    for (size_t k = 0; info.lib_keys && info.lib_keys[k].name; k++)
+        lib_row(f, &info.lib_keys[k]);
+    return rc;
+}
+
+int cli_scenario_print_docs(FILE* f)
+{
+    int rc = 0;
+    fputs("<!-- generated by `wetdem docs-scenarios` from cli/scenario_keys.c and the "
+          "library's descriptor tables; do not edit by hand -->\n",
+          f);
+    for (size_t k = 0; sections[k].name; k++)
+        rc |= section_doc(f, &sections[k]);
+    for (size_t k = 0; cli_pairwise_sections && cli_pairwise_sections[k].name; k++)
+        rc |= section_doc(f, &cli_pairwise_sections[k]);
+    fputs("\n<!-- end of generated tables -->\n", f);
+    return rc;
+}
+
+int cmd_docs_scenarios(int argc, char** argv)
+{
+    (void)argv;
+    if (argc > 1) {
+        cli_error("docs-scenarios: takes no arguments");
+        return CLI_EXIT_USAGE;
+    }
+    return cli_scenario_print_docs(stdout) == 0 ? CLI_EXIT_OK : CLI_EXIT_RUNTIME;
+}
