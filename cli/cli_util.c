@@ -3,7 +3,8 @@
  * parsing of numbers and "A:B:N" ranges, "--set KEY=VALUE", CSV provenance lines.
  *
  * Range values: linear x_k = A + (B - A) k/(N - 1); geometric x_k = A (B/A)^(k/(N - 1)),
- * k = 0..N-1, with x_0 = A and x_{N-1} = B returned exactly.
+ * computed as 10^(log10 A + (log10 B - log10 A) k/(N - 1)) so that decades come out as the
+ * round numbers they are; k = 0..N-1, with x_0 = A and x_{N-1} = B returned exactly.
  */
 #include <errno.h>
 #include <math.h>
@@ -90,8 +91,8 @@ double cli_range_value(const struct cli_range* r, size_t k)
     if (k + 1 >= r->n)
         return r->last;
     double s = (double)k / (double)(r->n - 1);
-    if (r->is_log)
-        return r->first * pow(r->last / r->first, s);
+    if (r->is_log) /* in decades, so that 1e-7:1e-3:5 gives exactly 1e-7, 1e-6, ... */
+        return pow(10.0, log10(r->first) + s * (log10(r->last) - log10(r->first)));
     return r->first + (r->last - r->first) * s;
 }
 

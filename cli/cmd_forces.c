@@ -10,7 +10,8 @@
  * row is a fresh pair (no history), so history-dependent models see their initial state.
  *
  * Columns: gap_m (h [m]; < 0 overlap), f_normal_N (on i along the normal, > 0 repulsive),
- * f_tangential_N (on i along +y, the slip direction), h_min_m (from the min-separation model).
+ * f_tangential_N (on i along +y, the slip direction), h_min_m (from the min-separation model;
+ * composite models with their own minimum approach, e.g. nijssen, do not read it).
  */
 #include <math.h>
 #include <stdio.h>
@@ -199,7 +200,8 @@ static void print_header(struct wetdem_sim* sim, const struct forces_opts* o, in
         printf(" %s", wetdem_sim_model(sim, k)->name);
     printf("; min-separation: %s\n", wetdem_sim_min_separation_model(sim)->name);
     printf("# f_normal_N: on i along the normal from j to i, > 0 repulsive; f_tangential_N: on i "
-           "along the slip direction\n");
+           "along the slip direction; h_min_m: from the min-separation model (models with their "
+           "own h_min, e.g. nijssen, do not read it)\n");
     printf("gap_m,f_normal_N,f_tangential_N,h_min_m\n");
 }
 

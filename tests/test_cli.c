@@ -185,6 +185,24 @@ static void test_cli_forces_matches_reynolds_closed_form(void** state)
     CHECK_REL(c[3], 1e-6, 0.0); /* h_min of the default "fixed" model */
 }
 
+static void test_cli_forces_log_gaps_are_decades(void** state)
+{
+    (void)state;
+    struct run r = run_cli("forces --model reynolds --gaps 1e-7:1e-3:5 --log", false);
+    assert_int_equal(r.code, 0);
+    const char* row = strstr(r.out, "h_min_m\n");
+    assert_non_null(row);
+    /* Five geometric points from 1e-7 to 1e-3 m are the decades 1e-7 ... 1e-3, printed as
+     * such (the text must read back as the double nearest the decimal). */
+    const char* want[] = {"1e-07,", "1e-06,", "1e-05,", "0.0001,", "0.001,"};
+    for (size_t k = 0; k < 5; k++) {
+        row = strchr(row, '\n') + 1;
+        if (strncmp(row, want[k], strlen(want[k])) != 0)
+            fail_msg("row %zu is '%.40s', expected it to start with '%s'", k, row, want[k]);
+    }
+    free(r.out);
+}
+
 static void test_cli_forces_bad_input(void** state)
 {
     (void)state;
@@ -222,6 +240,7 @@ int main(void)
         cmocka_unit_test(test_cli_describe_lists_parameters_with_units),
         cmocka_unit_test(test_cli_describe_unknown_name),
         cmocka_unit_test(test_cli_forces_matches_reynolds_closed_form),
+        cmocka_unit_test(test_cli_forces_log_gaps_are_decades),
         cmocka_unit_test(test_cli_forces_bad_input),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
