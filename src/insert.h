@@ -9,28 +9,7 @@
 
 #include "wetdem.h"
 
-enum wetdem_insert_layout {
-    WETDEM_INSERT_LATTICE = 0, /* simple cubic lattice of spacing 2 R_max + gap, x fastest */
-    WETDEM_INSERT_RANDOM = 1,  /* random sequential addition, largest spheres first */
-};
-
-/* What to insert and where. Seeded: the same spec gives bit-identical particles. */
-struct wetdem_insert_spec {
-    enum wetdem_insert_layout layout;
-    size_t n;                    /* number of spheres, >= 1 */
-    struct wetdem_vec3 lo, hi;   /* region [m]; spheres lie inside it on non-periodic axes */
-    bool periodic[3];            /* axes on which the region wraps (overlaps through images) */
-    double radius_min;           /* radii uniform in [radius_min, radius_max] [m], > 0 */
-    double radius_max;           /* [m], >= radius_min */
-    const double* radii;         /* optional: n radii [m] used instead of the uniform draw */
-    double gap;                  /* least surface gap between spheres and to the region's
-                                    faces on non-periodic axes [m], >= 0 */
-    struct wetdem_vec3 velocity; /* mean velocity [m/s] */
-    double velocity_sigma;       /* standard deviation of each velocity component [m/s] >= 0 */
-    int material;                /* material index given to every sphere */
-    unsigned long seed;          /* seed of the gsl_rng mt19937 generator */
-    size_t max_attempts;         /* random layout: trials per sphere; 0 means 10000 */
-};
+/* struct wetdem_insert_spec and enum wetdem_insert_layout are public (wetdem.h). */
 
 /* Fills out[0 .. spec->n-1] (caller memory): positions, radii, velocities (spins 0, mass 0 so
  * that the simulation fills it from the material density, material). Returns WETDEM_OK,

@@ -52,6 +52,7 @@ void wetdem_sim_free(struct wetdem_sim* sim)
         return;
     wetdem_sim_clear_models(sim);
     wetdem_sim_engine_free(sim);
+    wetdem_sim_many_free(sim);
     free(sim->minsep.params);
     free(sim->particles);
     free(sim->materials);

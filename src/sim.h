@@ -95,6 +95,7 @@ struct wetdem_sim {
     size_t history_len;                                 /* doubles per pair, all slices */
 
     struct wetdem_engine engine; /* soft engine: time, pairs, events, integrator */
+    struct wetdem_many* many;    /* many-particle mode (many.h, sim_many.c), NULL if off */
 };
 
 /* Formats a message into sim->errmsg and returns status (printf-style). */
@@ -121,6 +122,11 @@ void wetdem_sim_build_contact(const struct wetdem_sim* sim, size_t i, size_t j, 
 
 /* sim_models.c: descriptor table of struct wetdem_sim_settings ("sim.<name>"). */
 const struct wetdem_param_desc* wetdem_sim_settings_params(void);
+
+/* sim_many.c: frees the many-particle state (wetdem_sim_free calls it). */
+void wetdem_sim_many_free(struct wetdem_sim* sim);
+/* sim_many.c: runs the many-particle engine to t_end (wetdem_sim_integrate dispatches). */
+int wetdem_sim_many_integrate(struct wetdem_sim* sim, double t_end);
 
 /* sim_integrate.c: sets the engine defaults (integrator "verlet" and every integrator's
  * default parameters); called by wetdem_sim_create(). */

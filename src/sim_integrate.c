@@ -394,6 +394,8 @@ int wetdem_sim_integrate(struct wetdem_sim* sim, double t_end)
 {
     struct wetdem_engine* e = &sim->engine;
     int st = check_run(sim, t_end);
+    if (st == WETDEM_OK && sim->many) /* many-particle mode: cell lists, no events */
+        return wetdem_sim_many_integrate(sim, t_end);
     if (st == WETDEM_OK)
         st = begin_run(sim);
     bool due = e->observer_interval > 0 ? e->time >= e->next_observe : true;

@@ -11,9 +11,6 @@
 
 #include "harness.h"
 
-/* The soft engine may be absent from a partial build; the simulated-data test then skips. */
-#pragma weak wetdem_collision_run
-
 /* ---- a closed-form model --------------------------------------------------------------------
  * Thin-film restitution shape e(St) = e_dry exp(-St_c/St): two positive parameters (e_dry,
  * St_c), fitted in log form, nonlinear in St_c. */
@@ -185,8 +182,6 @@ static int punch_model(const double* p, double* out, char* msg, size_t n, void* 
 static void test_fit_recovers_glass_pressure_from_simulated_data(void** state)
 {
     (void)state;
-    if (!wetdem_collision_run)
-        skip();
     /* Data: e_n simulated at P_gt = 11.6 MPa (Punch Fig. 8d) at 5 Stokes numbers in the
      * contact-bounce range, plus Gaussian noise 0.01 (the scatter of Punch Fig. 6 at high
      * St_n is a few hundredths). */

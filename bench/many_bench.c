@@ -1,0 +1,158 @@
+/*
+ * many_bench.c — the many-particle benchmark system of bench/20-many.sh, run in wetdem, and
+ * the same initial state written as a LIGGGHTS data file (the decks in bench/liggghts read it).
+ *
+ * System: n polydisperse spheres (R uniform in [0.9, 1.0] mm, 2500 kg/m^3, E = 10 MPa,
+ * nu = 0.3, e = 0.5, mu = 0.5) on a 20 x 20 x (n/400) lattice of spacing 2.05 mm with Gaussian
+ * velocities (sigma 0.1 m/s, seed 1), settling in a closed box under gravity.
+ *   dry: hertz + mindlin;  wet: hertz + mindlin + sb (thin-film viscous, 20 um films,
+ *   mu_f = 0.01 Pa s) + capillary (sigma = 0.02 N/m).
+ * dt = 1e-5 s (as the LIGGGHTS decks). The first `settle` steps are not timed.
+ *
+ * Usage: many_bench [--wet] [--n N] [--settle S] [--steps S] [--data FILE] [--budget]
+ * Prints one line: "wetdem <dry|wet> n=.. threads=.. steps=.. seconds=.. psteps_per_s=..
+ * maxrss_kb=.. contacts=.. bridges=.. pairs=.. builds=..". Uses only the public API.
+ */
+#include <omp.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "wetdem.h"
+
+#define SPACING 2.05e-3
+#define GAP 0.05e-3
+
+static long max_rss_kb(void)
+{
+    FILE* f = fopen("/proc/self/status", "r");
+    char line[256];
+    long kb = -1;
+    while (f && fgets(line, sizeof line, f))
+        if (sscanf(line, "VmHWM: %ld", &kb) == 1)
+            break;
+    if (f)
+        fclose(f);
+    return kb;
+}
+
+static void die(struct wetdem_sim* sim, int st, const char* what)
+{
+    fprintf(stderr, "many_bench: %s failed (%s): %s\n", what, wetdem_status_name(st),
+            sim ? wetdem_sim_errmsg(sim) : "");
+    exit(1);
+}
+
+static void write_data(const char* path, struct wetdem_sim* sim, const double hi[3])
+{
+    size_t n;
+    const struct wetdem_particle* p = wetdem_sim_particles_const(sim, &n);
+    FILE* f = fopen(path, "w");
+    if (!f) {
+        fprintf(stderr, "many_bench: cannot write %s\n", path);
+        exit(1);
+    }
+    fprintf(f, "wetdem benchmark system (bench/many_bench.c)\n\n%zu atoms\n1 atom types\n\n"
+               "0 %.17g xlo xhi\n0 %.17g ylo yhi\n0 %.17g zlo zhi\n\nAtoms\n\n",
+            n, hi[0], hi[1], hi[2]);
+    for (size_t k = 0; k < n; k++)
+        fprintf(f, "%zu 1 %.17g 2500 %.17g %.17g %.17g\n", k + 1, 2 * p[k].radius, p[k].pos.x,
+                p[k].pos.y, p[k].pos.z);
+    fputs("\nVelocities\n\n", f);
+    for (size_t k = 0; k < n; k++)
+        fprintf(f, "%zu %.17g %.17g %.17g 0 0 0\n", k + 1, p[k].vel.x, p[k].vel.y, p[k].vel.z);
+    fclose(f);
+}
+
+static void setup(struct wetdem_sim* sim, bool wet, size_t n, double hi[3])
+{
+    struct wetdem_material m = {.density = 2500, .youngs_modulus = 1e7, .poisson_ratio = 0.3,
+                                .restitution = 0.5, .friction_dry = 0.5, .friction_lub = 0.5,
+                                .roughness = 0, .film = wet ? 20e-6 : 0};
+    int st = wetdem_sim_add_material(sim, &m);
+    if (st < 0)
+        die(sim, st, "material");
+    struct wetdem_fluid fl = {.viscosity = 0.01, .surface_tension = 0.02, .density = 1000};
+    if ((st = wetdem_sim_set_fluid(sim, &fl)) != WETDEM_OK)
+        die(sim, st, "fluid");
+    const char* models[] = {"hertz", "mindlin", wet ? "sb" : NULL, wet ? "capillary" : NULL};
+    for (int k = 0; k < 4 && models[k]; k++)
+        if ((st = wetdem_sim_enable_model(sim, models[k])) != WETDEM_OK)
+            die(sim, st, models[k]);
+    size_t layers = (n + 399) / 400;
+    hi[0] = hi[1] = 20 * SPACING + 2 * GAP;
+    hi[2] = 1.3 * layers * SPACING + 2 * GAP;
+    struct wetdem_insert_spec spec = {
+        .layout = WETDEM_INSERT_LATTICE, .n = n, .lo = {0, 0, 0}, .hi = {hi[0], hi[1], hi[2]},
+        .radius_min = 0.9e-3, .radius_max = 1.0e-3, .gap = GAP, .velocity_sigma = 0.1,
+        .seed = 1};
+    if ((st = wetdem_sim_insert(sim, &spec)) != WETDEM_OK)
+        die(sim, st, "insert");
+    struct wetdem_vec3 normals[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0},
+                                     {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+    for (int w = 0; w < 6; w++) {
+        struct wetdem_vec3 point = {w == 1 ? hi[0] : 0, w == 3 ? hi[1] : 0, w == 5 ? hi[2] : 0};
+        if ((st = wetdem_sim_add_wall(sim, point, normals[w], 0)) != WETDEM_OK)
+            die(sim, st, "wall");
+    }
+    wetdem_sim_set_param(sim, "sim.gravity_z", -9.81);
+}
+
+int main(int argc, char** argv)
+{
+    bool wet = false, budget = false;
+    size_t n = 20000;
+    unsigned long settle = 1000, steps = 2000;
+    const char* data = NULL;
+    for (int k = 1; k < argc; k++) {
+        if (!strcmp(argv[k], "--wet"))
+            wet = true;
+        else if (!strcmp(argv[k], "--budget"))
+            budget = true;
+        else if (!strcmp(argv[k], "--n") && k + 1 < argc)
+            n = strtoul(argv[++k], NULL, 10);
+        else if (!strcmp(argv[k], "--settle") && k + 1 < argc)
+            settle = strtoul(argv[++k], NULL, 10);
+        else if (!strcmp(argv[k], "--steps") && k + 1 < argc)
+            steps = strtoul(argv[++k], NULL, 10);
+        else if (!strcmp(argv[k], "--data") && k + 1 < argc)
+            data = argv[++k];
+        else {
+            fprintf(stderr, "usage: many_bench [--wet] [--budget] [--n N] [--settle S] "
+                            "[--steps S] [--data FILE]\n");
+            return 2;
+        }
+    }
+    struct wetdem_sim* sim = wetdem_sim_create();
+    double hi[3];
+    setup(sim, wet, n, hi);
+    if (data) {
+        write_data(data, sim, hi);
+        return 0;
+    }
+    const double dt = 1e-5;
+    struct wetdem_many_settings ms = {.dt = dt, .skin = 0.2e-3, .energy_budget = budget};
+    int st = wetdem_sim_set_many(sim, &ms);
+    if (st != WETDEM_OK || (st = wetdem_sim_integrate(sim, settle * dt)) != WETDEM_OK)
+        die(sim, st, "settling run");
+    double t0 = omp_get_wtime();
+    if ((st = wetdem_sim_integrate(sim, (settle + steps) * dt)) != WETDEM_OK)
+        die(sim, st, "timed run");
+    double secs = omp_get_wtime() - t0;
+    struct wetdem_many_stats s;
+    wetdem_sim_many_stats(sim, &s);
+    printf("wetdem %s n=%zu threads=%d steps=%lu seconds=%.3f psteps_per_s=%.4g maxrss_kb=%ld "
+           "contacts=%zu bridges=%zu pairs=%zu builds=%llu\n",
+           wet ? "wet" : "dry", n, omp_get_max_threads(), steps, secs,
+           (double)n * (double)steps / secs, max_rss_kb(), s.contacts, s.bridges,
+           s.candidate_pairs, s.list_builds);
+    if (budget) {
+        struct wetdem_energy_budget b;
+        wetdem_sim_energy_budget(sim, &b);
+        printf("energy: input %.6g J, kinetic %.6g, potential %.6g, elastic %.6g, dissipated "
+               "%.6g, balance error %.3g\n",
+               b.input, b.kinetic, b.potential, b.elastic, b.dissipated, b.balance_error);
+    }
+    wetdem_sim_free(sim);
+    return 0;
+}

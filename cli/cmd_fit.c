@@ -1,0 +1,654 @@
+/*
+ * cmd_fit.c — `wetdem fit FILE --data CSV --fit KEY[,KEY...] [--init V,...]`: calibrates
+ * scenario parameters (any scenario key or model parameter, e.g. glass.p_gt,
+ * model.fixed.h_min, material.NAME.roughness, material.NAME.friction_dry,
+ * material.NAME.restitution) against measured restitution, and optionally spin, by nonlinear
+ * least squares (library: wetdem_fit_run; docs/calibration.md).
+ *
+ * Data CSV: a header naming the columns, then one row per measurement. Columns (a trailing
+ * " [unit]" in a name is ignored, other columns are ignored): stokes_n (required), e_n
+ * (required), angle_deg (optional, else the scenario's angle), omega_rad_s (optional; used
+ * with --omega-scale S). Every measurement is simulated as `wetdem run FILE --set
+ * collision.stokes=St --set collision.angle_deg=angle --set KEY=value ...` would; the predicted
+ * e_n is the result's e_n_observed when the scenario sets collision.observe_time (Punch
+ * Fig. 9 window), its e_n otherwise, and the predicted spin is |omega_i| of the striker.
+ * Residuals: e_n,sim - e_n,data, and (omega_sim - omega_data)/S.
+ *
+ * The runs of one evaluation are independent and run in parallel (OpenMP) on simulations
+ * built serially beforehand, so results do not depend on the thread count.
+ * Exit codes: 0 ok, 1 runtime error or no convergence, 2 bad options, data or scenario.
+ */
+#include <errno.h>
+#include <math.h>
+#include <omp.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cli_util.h"
+#include "scenario.h"
+
+#define MAX_SETS 256
+#define MAX_POINTS 10000
+
+static void usage(FILE* f)
+{
+    fprintf(f,
+            "usage: wetdem fit FILE --data CSV --fit KEY[,KEY...] [--init V,...]\n"
+            "                  [--set section.key=value ...] [--out FIT.csv] [--curve CURVE.csv]\n"
+            "                  [--curve-points N] [--omega-scale S] [--max-iter N] [--fd-step H]\n"
+            "Fits scenario parameters to measured (stokes_n, e_n[, angle_deg, omega_rad_s]).\n"
+            "  --fit KEYS     scenario keys or model parameters, e.g. glass.p_gt\n"
+            "  --init VALUES  initial values (default: the scenario's values)\n"
+            "  --out FILE     data vs fit, one row per measurement (CSV)\n"
+            "  --curve FILE   the fitted model on N Stokes numbers per angle (CSV)\n"
+            "  --omega-scale S  also fit the spin; an error of S [rad/s] weighs as 1 in e_n\n"
+            "  --max-iter N   trust-region iterations (50); --fd-step H Jacobian step (0.01)\n"
+            "Positive parameters are fitted as ln(value); standard errors from the Jacobian\n"
+            "scaled by the residual variance. See docs/calibration.md.\n");
+}
+
+struct fit_args {
+    const char *file, *data, *fit, *init, *out, *curve;
+    const char* sets[MAX_SETS];
+    int n_sets;
+    int curve_points, max_iter;
+    double omega_scale, fd_step;
+};
+
+/* One measurement (or curve point). */
+struct point {
+    double stokes, angle_deg, e_n, omega; /* omega: NAN when not measured */
+    bool has_angle;
+};
+
+/* Everything the model function needs. */
+struct fit_ctx {
+    const struct cli_scenario* base;
+    char keys[WETDEM_FIT_MAX_PARAMS][2 * CLI_NAME_MAX];
+    size_t n_keys;
+    const struct point* pts;
+    size_t n_pts;
+    bool use_omega;
+};
+
+static int parse_args(int argc, char** argv, struct fit_args* a)
+{
+    memset(a, 0, sizeof *a);
+    a->curve_points = 40;
+    a->max_iter = 50;
+    a->fd_step = 1e-2;
+    for (int k = 1; k < argc; k++) {
+        const char* s = argv[k];
+        const char* v = k + 1 < argc ? argv[k + 1] : NULL;
+        int rc = CLI_EXIT_OK;
+        double x;
+        if (s[0] != '-') {
+            if (a->file) {
+                cli_error("fit: more than one scenario file ('%s' and '%s')", a->file, s);
+                return CLI_EXIT_USAGE;
+            }
+            a->file = s;
+            continue;
+        }
+        if (!v) {
+            cli_error("fit: option '%s' needs a value", s);
+            usage(stderr);
+            return CLI_EXIT_USAGE;
+        }
+        k++;
+        if (strcmp(s, "--data") == 0)
+            a->data = v;
+        else if (strcmp(s, "--fit") == 0)
+            a->fit = v;
+        else if (strcmp(s, "--init") == 0)
+            a->init = v;
+        else if (strcmp(s, "--out") == 0)
+            a->out = v;
+        else if (strcmp(s, "--curve") == 0)
+            a->curve = v;
+        else if (strcmp(s, "--set") == 0 && a->n_sets < MAX_SETS)
+            a->sets[a->n_sets++] = v;
+        else if (strcmp(s, "--omega-scale") == 0) {
+            if ((rc = cli_parse_double(v, s, &a->omega_scale)) == CLI_EXIT_OK &&
+                !(a->omega_scale > 0)) {
+                cli_error("fit: --omega-scale %s: must be > 0 [rad/s]", v);
+                rc = CLI_EXIT_USAGE;
+            }
+        } else if (strcmp(s, "--fd-step") == 0)
+            rc = cli_parse_double(v, s, &a->fd_step);
+        else if (strcmp(s, "--max-iter") == 0 || strcmp(s, "--curve-points") == 0) {
+            if ((rc = cli_parse_double(v, s, &x)) == CLI_EXIT_OK &&
+                (x != floor(x) || x < 1 || x > 100000)) {
+                cli_error("fit: %s %s: must be an integer in [1, 100000]", s, v);
+                rc = CLI_EXIT_USAGE;
+            }
+            if (rc == CLI_EXIT_OK)
+                *(s[2] == 'm' ? &a->max_iter : &a->curve_points) = (int)x;
+        } else {
+            cli_error("fit: unknown option '%s'", s);
+            usage(stderr);
+            return CLI_EXIT_USAGE;
+        }
+        if (rc != CLI_EXIT_OK)
+            return rc;
+    }
+    if (!a->file || !a->data || !a->fit) {
+        cli_error("fit: FILE, --data CSV and --fit KEY[,KEY...] are required");
+        usage(stderr);
+        return CLI_EXIT_USAGE;
+    }
+    return CLI_EXIT_OK;
+}
+
+/* ---- data file ---------------------------------------------------------------------------- */
+
+/* Splits a CSV line in place at commas; trims blanks and a trailing " [unit]" when is_header.
+ * Returns the number of fields (at most max). */
+static int split_csv(char* line, char** f, int max, bool is_header)
+{
+    int n = 0;
+    for (char* p = line; p && n < max; n++) {
+        char* comma = strchr(p, ',');
+        if (comma)
+            *comma = '\0';
+        while (*p == ' ' || *p == '\t')
+            p++;
+        char* end = p + strcspn(p, is_header ? "[\r\n" : "\r\n");
+        while (end > p && (end[-1] == ' ' || end[-1] == '\t'))
+            end--;
+        *end = '\0';
+        f[n] = p;
+        p = comma ? comma + 1 : NULL;
+    }
+    return n;
+}
+
+enum { COL_STOKES, COL_EN, COL_ANGLE, COL_OMEGA, N_COLS };
+static const char* const col_names[N_COLS] = {"stokes_n", "e_n", "angle_deg", "omega_rad_s"};
+
+static int read_header(const char* path, long line, char** f, int n, int col[N_COLS])
+{
+    for (int c = 0; c < N_COLS; c++) {
+        col[c] = -1;
+        for (int k = 0; k < n; k++)
+            if (strcmp(f[k], col_names[c]) == 0)
+                col[c] = k;
+    }
+    if (col[COL_STOKES] < 0 || col[COL_EN] < 0) {
+        cli_error("%s:%ld: the header must name columns stokes_n and e_n (optional: angle_deg, "
+                  "omega_rad_s)", path, line);
+        return CLI_EXIT_USAGE;
+    }
+    return CLI_EXIT_OK;
+}
+
+/* Reads column c of a row into *v with its range check. */
+static int read_value(const char* path, long line, char** f, int n, const int col[N_COLS],
+                      int c, double* v)
+{
+    if (col[c] >= n) {
+        cli_error("%s:%ld: %d columns, but column %s is number %d", path, line, n, col_names[c],
+                  col[c] + 1);
+        return CLI_EXIT_USAGE;
+    }
+    const char* t = f[col[c]];
+    char* end;
+    errno = 0;
+    *v = strtod(t, &end);
+    bool ok = end != t && *end == '\0' && isfinite(*v) && errno != ERANGE;
+    const char* why = "a finite number";
+    if (ok && c == COL_STOKES && !(*v > 0))
+        ok = false, why = "a Stokes number > 0";
+    if (ok && c == COL_ANGLE && !(*v >= 0 && *v < 90))
+        ok = false, why = "an angle in [0, 90) deg";
+    if (!ok) {
+        cli_error("%s:%ld: column %s: '%s' is not %s", path, line, col_names[c], t, why);
+        return CLI_EXIT_USAGE;
+    }
+    return CLI_EXIT_OK;
+}
+
+static int read_row(const char* path, long line, char** f, int n, const int col[N_COLS],
+                    struct point* p)
+{
+    int rc = read_value(path, line, f, n, col, COL_STOKES, &p->stokes);
+    if (rc == CLI_EXIT_OK)
+        rc = read_value(path, line, f, n, col, COL_EN, &p->e_n);
+    p->has_angle = col[COL_ANGLE] >= 0;
+    p->omega = NAN;
+    if (rc == CLI_EXIT_OK && p->has_angle)
+        rc = read_value(path, line, f, n, col, COL_ANGLE, &p->angle_deg);
+    if (rc == CLI_EXIT_OK && col[COL_OMEGA] >= 0)
+        rc = read_value(path, line, f, n, col, COL_OMEGA, &p->omega);
+    return rc;
+}
+
+static int read_data(const char* path, struct point** out, size_t* n_out)
+{
+    FILE* fp = fopen(path, "r");
+    if (!fp) {
+        cli_error("fit: cannot open data file %s: %s", path, strerror(errno));
+        return CLI_EXIT_USAGE;
+    }
+    struct point* pts = calloc(MAX_POINTS, sizeof *pts);
+    char buf[4096], *f[64];
+    int col[N_COLS], rc = pts ? CLI_EXIT_OK : CLI_EXIT_RUNTIME;
+    bool have_header = false;
+    size_t n = 0;
+    for (long line = 1; rc == CLI_EXIT_OK && fgets(buf, sizeof buf, fp); line++) {
+        char* s = buf + strspn(buf, " \t");
+        if (*s == '#' || *s == '\n' || *s == '\r' || *s == '\0')
+            continue;
+        int nf = split_csv(s, f, 64, !have_header);
+        if (!have_header) {
+            rc = read_header(path, line, f, nf, col);
+            have_header = true;
+        } else if (n == MAX_POINTS) {
+            cli_error("%s:%ld: more than %d data rows", path, line, MAX_POINTS);
+            rc = CLI_EXIT_USAGE;
+        } else {
+            rc = read_row(path, line, f, nf, col, &pts[n++]);
+        }
+    }
+    fclose(fp);
+    if (rc == CLI_EXIT_OK && n == 0) {
+        cli_error("%s: no data rows", path);
+        rc = CLI_EXIT_USAGE;
+    }
+    if (rc != CLI_EXIT_OK) {
+        free(pts);
+        return rc;
+    }
+    *out = pts;
+    *n_out = n;
+    return CLI_EXIT_OK;
+}
+
+/* ---- simulation of the measurements ------------------------------------------------------- */
+
+/* Builds the set-up of one point: the base scenario with the point's Stokes number and angle
+ * and the parameter values. Returns an exit code (the builder prints its errors). */
+static int build_point(const struct fit_ctx* c, const double* params, const struct point* p,
+                       struct cli_setup* su)
+{
+    struct cli_scenario sc;
+    int rc = cli_scenario_copy(c->base, &sc);
+    if (rc != CLI_EXIT_OK)
+        return rc;
+    char set[2 * CLI_NAME_MAX + 64];
+    snprintf(set, sizeof set, "collision.stokes=%.17g", p->stokes);
+    rc = cli_scenario_override(&sc, set);
+    if (rc == CLI_EXIT_OK && p->has_angle) {
+        snprintf(set, sizeof set, "collision.angle_deg=%.17g", p->angle_deg);
+        rc = cli_scenario_override(&sc, set);
+    }
+    for (size_t j = 0; rc == CLI_EXIT_OK && j < c->n_keys; j++) {
+        snprintf(set, sizeof set, "%s=%.17g", c->keys[j], params[j]);
+        rc = cli_scenario_override(&sc, set);
+    }
+    if (rc == CLI_EXIT_OK)
+        rc = cli_scenario_build(&sc, su);
+    cli_scenario_free(&sc);
+    return rc;
+}
+
+/* e_n as Punch reports it: at observe_time when set (Fig. 9); 0 for a stick that never
+ * separated (no outgoing normal velocity). */
+static double reported_e_n(const struct cli_setup* su, const struct wetdem_collision_result* r)
+{
+    double e = su->spec.observe_time > 0 ? r->e_n_observed : r->e_n;
+    return (!isfinite(e) && !r->separated) ? 0.0 : e;
+}
+
+/* Simulates n points with the given parameters into e_n[] and omega[] (|omega_i|). */
+static int simulate(const struct fit_ctx* c, const double* params, const struct point* pts,
+                    size_t n, double* e_n, double* omega, char* msg, size_t msg_size)
+{
+    struct cli_setup* su = calloc(n, sizeof *su);
+    int* status = calloc(n, sizeof *status);
+    int st = (su && status) ? WETDEM_OK : WETDEM_ERR_NOMEM;
+    size_t built = 0;
+    for (; st == WETDEM_OK && built < n; built++)
+        if (build_point(c, params, &pts[built], &su[built]) != CLI_EXIT_OK) {
+            st = WETDEM_ERR_INVALID;
+            snprintf(msg, msg_size, "the scenario was rejected at St_n = %g with %s = %g%s",
+                     pts[built].stokes, c->keys[0], params[0],
+                     c->n_keys > 1 ? ", ..." : "");
+        }
+    if (st == WETDEM_OK) {
+#pragma omp parallel for schedule(dynamic, 1)
+        for (size_t k = 0; k < n; k++) {
+            struct wetdem_collision_result r;
+            status[k] = wetdem_collision_run(su[k].sim, &su[k].spec, &r);
+            e_n[k] = reported_e_n(&su[k], &r);
+            omega[k] = sqrt(r.omega_i.x * r.omega_i.x + r.omega_i.y * r.omega_i.y +
+                            r.omega_i.z * r.omega_i.z);
+        }
+        for (size_t k = 0; k < n && st == WETDEM_OK; k++)
+            if (status[k] < 0) {
+                st = WETDEM_ERR_CALLBACK;
+                snprintf(msg, msg_size, "collision at St_n = %g failed: %s", pts[k].stokes,
+                         wetdem_sim_errmsg(su[k].sim));
+            }
+    }
+    for (size_t k = 0; su && k < built; k++)
+        cli_setup_free(&su[k]);
+    free(su);
+    free(status);
+    return st;
+}
+
+/* wetdem_fit_model_fn: e_n of every point, then (with omega) |omega_i| of every point. */
+static int fit_model(const double* params, double* predicted, char* msg, size_t msg_size,
+                     void* ctx)
+{
+    const struct fit_ctx* c = ctx;
+    double* omega = malloc(c->n_pts * sizeof *omega);
+    if (!omega)
+        return WETDEM_ERR_NOMEM;
+    int st = simulate(c, params, c->pts, c->n_pts, predicted, omega, msg, msg_size);
+    if (st == WETDEM_OK && c->use_omega)
+        memcpy(predicted + c->n_pts, omega, c->n_pts * sizeof *omega);
+    free(omega);
+    return st;
+}
+
+/* ---- parameters --------------------------------------------------------------------------- */
+
+/* Splits --fit into full "section.key" names. */
+static int parse_keys(const char* list, struct fit_ctx* c)
+{
+    char buf[1024];
+    snprintf(buf, sizeof buf, "%s", list);
+    c->n_keys = 0;
+    for (char* tok = strtok(buf, ","); tok; tok = strtok(NULL, ",")) {
+        if (c->n_keys == WETDEM_FIT_MAX_PARAMS) {
+            cli_error("fit: --fit: at most %d parameters", WETDEM_FIT_MAX_PARAMS);
+            return CLI_EXIT_USAGE;
+        }
+        char probe[CLI_NAME_MAX * 2 + 4], section[CLI_NAME_MAX], key[CLI_NAME_MAX];
+        snprintf(probe, sizeof probe, "%s=0", tok);
+        if (cli_override_split(probe, section, key, NULL) != 0)
+            return CLI_EXIT_USAGE;
+        snprintf(c->keys[c->n_keys++], sizeof c->keys[0], "%s.%s", section, key);
+    }
+    if (c->n_keys == 0) {
+        cli_error("fit: --fit: no parameter given");
+        return CLI_EXIT_USAGE;
+    }
+    return CLI_EXIT_OK;
+}
+
+/* Value of a material or fluid field from the section's preset (material.NAME.KEY with
+ * "preset = P", or fluid.KEY with the fluid preset, default water). */
+static bool preset_value(const struct cli_scenario* sc, const char* section, const char* key,
+                         double* v)
+{
+    bool is_fluid = strcmp(section, "fluid") == 0;
+    if (!is_fluid && strncmp(section, "material.", 9) != 0)
+        return false;
+    const char* preset = cli_scenario_text(sc, section, "preset", is_fluid ? "water" : NULL);
+    struct wetdem_material m;
+    struct wetdem_fluid f;
+    const void* base = is_fluid ? (const void*)&f : (const void*)&m;
+    if (!preset || (is_fluid ? wetdem_fluid_preset(preset, &f) : wetdem_material_preset(preset, &m)))
+        return false;
+    const struct wetdem_param_desc* d =
+        wetdem_param_find(is_fluid ? wetdem_fluid_params() : wetdem_material_params(), key);
+    if (!d)
+        return false;
+    memcpy(v, (const char*)base + d->offset, sizeof *v);
+    return true;
+}
+
+/* The current value of a model parameter [model.NAME] KEY in the built simulation. */
+static bool model_value(const struct cli_scenario* sc, const char* section, const char* key,
+                        double* v)
+{
+    if (strncmp(section, "model.", 6) != 0)
+        return false;
+    struct cli_setup su;
+    if (cli_scenario_build(sc, &su) != CLI_EXIT_OK)
+        return false;
+    char name[2 * CLI_NAME_MAX];
+    snprintf(name, sizeof name, "%s.%s", section + 6, key);
+    int st = wetdem_sim_param(su.sim, name, v);
+    cli_setup_free(&su);
+    return st == WETDEM_OK;
+}
+
+/* Initial value of key j: the scenario's value, its preset's, or the model's current value.
+ * An unknown key gets the scenario checker's message (with a suggestion). */
+static int initial_value(const struct fit_ctx* c, size_t j, double* v)
+{
+    const char* full = c->keys[j];
+    const char* dot = strrchr(full, '.');
+    char section[CLI_NAME_MAX];
+    snprintf(section, sizeof section, "%.*s", (int)(dot - full), full);
+    const struct cli_entry* e = cli_scenario_find(c->base, section, dot + 1);
+    if (e && cli_parse_number_text(e->value, v) == 0)
+        return CLI_EXIT_OK;
+    if (preset_value(c->base, section, dot + 1, v) || model_value(c->base, section, dot + 1, v))
+        return CLI_EXIT_OK;
+    struct cli_scenario probe;
+    char set[2 * CLI_NAME_MAX + 8];
+    snprintf(set, sizeof set, "%s=1", full);
+    if (cli_scenario_copy(c->base, &probe) != CLI_EXIT_OK)
+        return CLI_EXIT_RUNTIME;
+    int rc = cli_scenario_override(&probe, set);
+    cli_scenario_free(&probe);
+    if (rc == CLI_EXIT_OK)
+        cli_error("fit: %s has no numeric value in %s; give it with --init", full,
+                  c->base->file);
+    return CLI_EXIT_USAGE;
+}
+
+static int initial_values(const struct fit_args* a, const struct fit_ctx* c, double* init)
+{
+    if (!a->init) {
+        for (size_t j = 0; j < c->n_keys; j++)
+            if (initial_value(c, j, &init[j]) != CLI_EXIT_OK)
+                return CLI_EXIT_USAGE;
+        return CLI_EXIT_OK;
+    }
+    char buf[1024];
+    snprintf(buf, sizeof buf, "%s", a->init);
+    size_t n = 0;
+    for (char* tok = strtok(buf, ","); tok; tok = strtok(NULL, ",")) {
+        if (n == c->n_keys) {
+            cli_error("fit: --init has more values than --fit has keys (%zu)", c->n_keys);
+            return CLI_EXIT_USAGE;
+        }
+        if (cli_parse_double(tok, "--init", &init[n++]) != CLI_EXIT_OK)
+            return CLI_EXIT_USAGE;
+    }
+    if (n != c->n_keys) {
+        cli_error("fit: --init has %zu values for %zu keys", n, c->n_keys);
+        return CLI_EXIT_USAGE;
+    }
+    return CLI_EXIT_OK;
+}
+
+/* ---- output ------------------------------------------------------------------------------- */
+
+static const char* const converged_words[] = {"no", "small step", "small gradient",
+                                              "small cost change"};
+
+static void print_result(const struct fit_ctx* c, const double* init,
+                         const struct wetdem_fit_result* r, int argc, char** argv)
+{
+    cli_print_provenance(stdout, argc, argv);
+    printf("parameter,value,std_error,initial,fitted_as\n");
+    for (size_t j = 0; j < c->n_keys; j++)
+        printf("%s,%.9g,%.3g,%.9g,%s\n", c->keys[j], r->values[j], r->std_errors[j], init[j],
+               init[j] > 0 ? "log" : "linear");
+    int by = (r->converged_by >= 0 && r->converged_by <= 3) ? r->converged_by : 0;
+    printf("# cost %.6g, residual std %.4g (%zu dof), %zu iterations, %zu model evaluations "
+           "(x %zu collisions), converged: %s\n", r->cost, r->residual_std, r->dof,
+           r->iterations, r->model_evals, c->n_pts, converged_words[by]);
+    for (size_t j = 0; j < c->n_keys && c->n_keys > 1; j++) {
+        printf("# correlation %s:", c->keys[j]);
+        for (size_t k = 0; k < c->n_keys; k++)
+            printf(" %.3f", r->correlation[j][k]);
+        printf("\n");
+    }
+}
+
+static double point_angle(const struct fit_ctx* c, const struct point* p)
+{
+    return p->has_angle ? p->angle_deg : cli_scenario_number(c->base, "collision", "angle_deg", 0);
+}
+
+static int write_fit_csv(const char* path, const struct fit_ctx* c, const double* pred,
+                         int argc, char** argv)
+{
+    FILE* f = fopen(path, "w");
+    if (!f) {
+        cli_error("fit: cannot write %s: %s", path, strerror(errno));
+        return CLI_EXIT_RUNTIME;
+    }
+    cli_print_provenance(f, argc, argv);
+    fprintf(f, "stokes_n [-],angle_deg [deg],e_n_data [-],e_n_fit [-],e_n_residual [-]%s\n",
+            c->use_omega ? ",omega_data [rad/s],omega_fit [rad/s]" : "");
+    for (size_t i = 0; i < c->n_pts; i++) {
+        const struct point* p = &c->pts[i];
+        fprintf(f, "%.9g,%.9g,%.9g,%.9g,%.6g", p->stokes, point_angle(c, p), p->e_n, pred[i],
+                pred[i] - p->e_n);
+        if (c->use_omega)
+            fprintf(f, ",%.9g,%.9g", p->omega, pred[c->n_pts + i]);
+        fputc('\n', f);
+    }
+    return fclose(f) == 0 ? CLI_EXIT_OK : CLI_EXIT_RUNTIME;
+}
+
+/* The fitted model on `m` log-spaced Stokes numbers over the data range, per distinct angle. */
+static int write_curve_csv(const char* path, const struct fit_ctx* c, const double* values,
+                           int m, int argc, char** argv)
+{
+    double lo = INFINITY, hi = 0, angles[64];
+    size_t n_ang = 0;
+    for (size_t i = 0; i < c->n_pts; i++) {
+        lo = fmin(lo, c->pts[i].stokes), hi = fmax(hi, c->pts[i].stokes);
+        double a = point_angle(c, &c->pts[i]);
+        size_t k = 0;
+        while (k < n_ang && angles[k] != a)
+            k++;
+        if (k == n_ang && n_ang < 64)
+            angles[n_ang++] = a;
+    }
+    size_t n = n_ang * (size_t)m;
+    struct point* pts = calloc(n, sizeof *pts);
+    double* e = calloc(2 * n, sizeof *e);
+    char msg[512] = "out of memory";
+    int st = (pts && e) ? WETDEM_OK : WETDEM_ERR_NOMEM;
+    for (size_t k = 0; st == WETDEM_OK && k < n; k++) {
+        double u = m > 1 ? (double)(k % (size_t)m) / (m - 1) : 0;
+        pts[k] = (struct point){.stokes = lo * pow(hi / lo, u), .angle_deg = angles[k / (size_t)m],
+                                .has_angle = true};
+    }
+    if (st == WETDEM_OK)
+        st = simulate(c, values, pts, n, e, e + n, msg, sizeof msg);
+    FILE* f = st == WETDEM_OK ? fopen(path, "w") : NULL;
+    if (f) {
+        cli_print_provenance(f, argc, argv);
+        fprintf(f, "angle_deg [deg],stokes_n [-],e_n_fit [-],omega_fit [rad/s]\n");
+        for (size_t k = 0; k < n; k++)
+            fprintf(f, "%.9g,%.9g,%.9g,%.9g\n", pts[k].angle_deg, pts[k].stokes, e[k], e[n + k]);
+        st = fclose(f) == 0 ? WETDEM_OK : WETDEM_ERR_IO;
+    } else if (st == WETDEM_OK) {
+        snprintf(msg, sizeof msg, "cannot write %s: %s", path, strerror(errno));
+        st = WETDEM_ERR_IO;
+    }
+    if (st != WETDEM_OK)
+        cli_error("fit: curve: %s", msg);
+    free(pts);
+    free(e);
+    return st == WETDEM_OK ? CLI_EXIT_OK : CLI_EXIT_RUNTIME;
+}
+
+/* ---- command ------------------------------------------------------------------------------ */
+
+/* Problem set-up after the inputs are read: observations and scales. */
+static int run_fit(const struct fit_args* a, struct fit_ctx* c, const double* init, int argc,
+                   char** argv)
+{
+    size_t n = c->n_pts * (c->use_omega ? 2 : 1);
+    double* obs = malloc(n * sizeof *obs);
+    double* scale = malloc(n * sizeof *scale);
+    double* pred = calloc(n, sizeof *pred);
+    if (!obs || !scale || !pred) {
+        free(obs), free(scale), free(pred);
+        cli_error("fit: out of memory");
+        return CLI_EXIT_RUNTIME;
+    }
+    for (size_t i = 0; i < c->n_pts; i++) {
+        obs[i] = c->pts[i].e_n, scale[i] = 1.0;
+        if (c->use_omega)
+            obs[c->n_pts + i] = c->pts[i].omega, scale[c->n_pts + i] = a->omega_scale;
+    }
+    const char* names[WETDEM_FIT_MAX_PARAMS];
+    for (size_t j = 0; j < c->n_keys; j++)
+        names[j] = c->keys[j];
+    struct wetdem_fit_problem pb = {.n_params = c->n_keys, .names = names, .initial = init,
+                                    .n_data = n, .observed = obs, .scale = scale,
+                                    .model = fit_model, .ctx = c};
+    struct wetdem_fit_options o;
+    wetdem_fit_options_init(&o);
+    o.max_iter = a->max_iter;
+    o.fd_step = a->fd_step;
+    struct wetdem_fit_result r;
+    char msg[512] = "";
+    int st = wetdem_fit_run(&pb, &o, &r, pred, msg, sizeof msg);
+    int rc = CLI_EXIT_OK;
+    if (st == WETDEM_OK || st == WETDEM_ERR_MAX_STEPS) {
+        print_result(c, init, &r, argc, argv);
+        if (a->out)
+            rc = write_fit_csv(a->out, c, pred, argc, argv);
+        if (rc == CLI_EXIT_OK && a->curve)
+            rc = write_curve_csv(a->curve, c, r.values, a->curve_points, argc, argv);
+    }
+    if (st != WETDEM_OK) {
+        cli_error("fit: %s", msg);
+        rc = st == WETDEM_ERR_INVALID ? CLI_EXIT_USAGE : CLI_EXIT_RUNTIME;
+    }
+    free(obs), free(scale), free(pred);
+    return rc;
+}
+
+int cmd_fit(int argc, char** argv)
+{
+    struct fit_args a;
+    int rc = parse_args(argc, argv, &a);
+    if (rc != CLI_EXIT_OK)
+        return rc;
+    struct cli_scenario sc;
+    memset(&sc, 0, sizeof sc);
+    enum cli_engine engine = CLI_ENGINE_SOFT;
+    struct fit_ctx c = {.base = &sc};
+    struct point* pts = NULL;
+    double init[WETDEM_FIT_MAX_PARAMS];
+    rc = cli_load_with_overrides(a.file, a.sets, a.n_sets, &sc);
+    if (rc == CLI_EXIT_OK && (rc = cli_scenario_engine(&sc, &engine)) == CLI_EXIT_OK &&
+        engine != CLI_ENGINE_SOFT) {
+        cli_error("fit: %s: only the soft engine can be fitted ([engine] type = soft)", a.file);
+        rc = CLI_EXIT_USAGE;
+    }
+    if (rc == CLI_EXIT_OK)
+        rc = read_data(a.data, &pts, &c.n_pts);
+    c.pts = pts;
+    c.use_omega = a.omega_scale > 0;
+    for (size_t i = 0; rc == CLI_EXIT_OK && c.use_omega && i < c.n_pts; i++)
+        if (isnan(pts[i].omega)) {
+            cli_error("fit: --omega-scale needs an omega_rad_s column in %s", a.data);
+            rc = CLI_EXIT_USAGE;
+        }
+    if (rc == CLI_EXIT_OK)
+        rc = parse_keys(a.fit, &c);
+    if (rc == CLI_EXIT_OK)
+        rc = initial_values(&a, &c, init);
+    if (rc == CLI_EXIT_OK)
+        rc = run_fit(&a, &c, init, argc, argv);
+    free(pts);
+    cli_scenario_free(&sc);
+    return rc;
+}

@@ -1,0 +1,64 @@
+"""Plot of a `wetdem fit` result: measured e_n (markers) and the fitted model (line, from
+--curve, or the fitted values at the data points), per impact angle, with the residuals.
+
+Usage: /usr/bin/python3 figures/fit_plot.py FIT.csv [--curve CURVE.csv] [--png OUT.png]
+       [--title TEXT]
+FIT.csv is the --out file of `wetdem fit` (stokes_n, angle_deg, e_n_data, e_n_fit,
+e_n_residual[, omega_data, omega_fit]); CURVE.csv its --curve file. docs/calibration.md.
+"""
+import argparse
+import os
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from common import plt, read_csv  # noqa: E402
+
+import numpy as np  # noqa: E402
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("fit")
+    ap.add_argument("--curve")
+    ap.add_argument("--png")
+    ap.add_argument("--title", default="wetdem fit")
+    a = ap.parse_args()
+    d = read_csv(a.fit)
+    c = read_csv(a.curve) if a.curve else None
+    png = a.png or os.path.splitext(a.fit)[0] + ".png"
+    has_omega = "omega_data" in d
+    fig, axes = plt.subplots(2 + has_omega, 1, figsize=(6, 6.5 + 2.5 * has_omega), sharex=True,
+                             gridspec_kw={"height_ratios": [3, 1] + [3] * has_omega})
+    ax, axr = axes[0], axes[1]
+    angles = sorted(set(d["angle_deg"]))
+    for k, ang in enumerate(angles):
+        col = f"C{k}"
+        m = d["angle_deg"] == ang
+        ax.plot(d["stokes_n"][m], d["e_n_data"][m], "o", color=col, label=f"data {ang:g} deg")
+        axr.plot(d["stokes_n"][m], d["e_n_residual"][m], "o", color=col)
+        if c is not None:
+            mc = c["angle_deg"] == ang
+            ax.plot(c["stokes_n"][mc], c["e_n_fit"][mc], "-", color=col, label=f"fit {ang:g} deg")
+            if has_omega:
+                axes[2].plot(c["stokes_n"][mc], c["omega_fit"][mc], "-", color=col)
+        else:
+            order = np.argsort(d["stokes_n"][m])
+            ax.plot(d["stokes_n"][m][order], d["e_n_fit"][m][order], "-", color=col)
+        if has_omega:
+            axes[2].plot(d["stokes_n"][m], d["omega_data"][m], "o", color=col)
+    ax.set_ylabel("e_n [-]")
+    ax.set_title(a.title)
+    ax.legend(fontsize=8)
+    axr.axhline(0, color="k", lw=0.5)
+    axr.set_ylabel("fit - data")
+    if has_omega:
+        axes[2].set_ylabel("|omega| striker [rad/s]")
+    axes[-1].set_xlabel("St_n [-]")
+    fig.tight_layout()
+    os.makedirs(os.path.dirname(os.path.abspath(png)), exist_ok=True)
+    fig.savefig(png, dpi=120)
+    print(f"wrote {png}")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,743 @@
+/*
+ * sim_many.c — the many-particle mode of the soft engine (docs/many.md): velocity Verlet over
+ * cell lists with a Verlet skin, plane walls, periodic boundaries, an OpenMP force loop whose
+ * result does not depend on the thread count, and the energy budget. Prefix: wetdem_sim_.
+ *
+ * Step (the scheme of integrator_verlet.c, Nijssen 2023 Sec. 3, so both engines agree):
+ *     v' = v + a(t) dt/2,  w' = w + alpha(t) dt/2,  x(t + dt) = x + v' dt
+ *     F, T at x(t + dt) with the predicted velocities v* = v' + a(t) dt/2 (and w*)
+ *     v(t + dt) = v' + a(t + dt) dt/2,  w(t + dt) = w' + alpha(t + dt) dt/2
+ * with a = F/m + g, alpha = T/I, I = (2/5) m R^2. Steps are whole: a run to t_end takes
+ * ceil((t_end - t)/dt) steps, so runs split into pieces (checkpoint and restart) follow the
+ * same time grid t0 + k dt as one run and give bit-identical states.
+ *
+ * Pairs: the cell list (celllist.h, Eq. 1 there) lists every pair with gap < reach + skin,
+ * where reach is the largest model range of any pair, bounded at start-up from the largest
+ * radius and every material combination; a pair whose actual range exceeds the bound stops
+ * the run with an error rather than being missed. Pair histories follow the pairs (i, j)
+ * across rebuilds; pairs beyond their range get a fresh history (each encounter starts
+ * afresh, as in sim_integrate.c). Particle-wall pairs are all n x n_walls pairs.
+ *
+ * Determinism: each candidate pair is evaluated independently (in parallel) into its own
+ * slot; the forces are then added to the particles serially in pair order, so positions and
+ * velocities are bit-identical for any number of threads. The energy accumulators are summed
+ * per thread and are reproducible for a given thread count.
+ *
+ * Energy budget: the work of model k on a pair over one step is W = dt P(t + dt) with the
+ * power P = F_i.(v*_i - v*_j) + T_i.w*_i + T_j.w*_j of that model's force at the evaluated
+ * state. In velocity Verlet the force F(t + dt) changes the kinetic energy through two half
+ * kicks by exactly dt F.v(t + dt); v* differs from v(t + dt) by O(dt^2), so the sum of the
+ * work of all models and of gravity equals the change of kinetic energy to second order.
+ */
+#include <omp.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "integrator.h"
+#include "many.h"
+#include "models.h"
+#include "vec3.h"
+
+#define HISTORY_MAX 64 /* doubles of per-pair history (as sim_integrate.c) */
+
+/* ---- settings ---- */
+
+static char* dup_string(const char* s)
+{
+    if (!s)
+        return NULL;
+    char* d = malloc(strlen(s) + 1);
+    if (d)
+        strcpy(d, s);
+    return d;
+}
+
+static int check_settings(struct wetdem_sim* sim, const struct wetdem_many_settings* s)
+{
+    if (!(isfinite(s->skin) && s->skin >= 0))
+        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID, "many.skin = %g m must be finite and >= 0",
+                               s->skin);
+    if (!(isfinite(s->dt) && s->dt >= 0))
+        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID, "many.dt = %g s must be finite and >= 0",
+                               s->dt);
+    double lo[3] = {s->box_lo.x, s->box_lo.y, s->box_lo.z};
+    double hi[3] = {s->box_hi.x, s->box_hi.y, s->box_hi.z};
+    for (int k = 0; k < 3; k++)
+        if (s->periodic[k] && !(isfinite(lo[k]) && isfinite(hi[k]) && hi[k] > lo[k]))
+            return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
+                                   "many box: periodic axis %c needs finite box_lo < box_hi, got "
+                                   "[%g, %g] m",
+                                   "xyz"[k], lo[k], hi[k]);
+    return WETDEM_OK;
+}
+
+void wetdem_sim_many_free(struct wetdem_sim* sim)
+{
+    struct wetdem_many* m = sim->many;
+    if (!m)
+        return;
+    wetdem_celllist_clear(&m->cl);
+    free(m->output_prefix);
+    free(m->checkpoint_path);
+    free(m->history);
+    free(m->wall_history);
+    free(m->old_pairs);
+    free(m->old_history);
+    free(m->out);
+    free(m->force);
+    free(m->torque);
+    free(m->vh);
+    free(m->wh);
+    free(m->contacts);
+    free(m->thread_work);
+    for (size_t k = 0; k < m->vtk_files && m->vtk_names; k++)
+        free(m->vtk_names[k]);
+    free(m->vtk_names);
+    free(m->vtk_times);
+    free(m);
+    sim->many = NULL;
+}
+
+int wetdem_sim_set_many(struct wetdem_sim* sim, const struct wetdem_many_settings* s)
+{
+    if (!s) {
+        wetdem_sim_many_free(sim);
+        return WETDEM_OK;
+    }
+    int st = check_settings(sim, s);
+    if (st != WETDEM_OK)
+        return st;
+    wetdem_sim_many_free(sim);
+    struct wetdem_many* m = calloc(1, sizeof *m);
+    if (!m)
+        return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory");
+    m->set = *s;
+    m->output_prefix = dup_string(s->output_prefix);
+    m->checkpoint_path = dup_string(s->checkpoint_path);
+    m->set.output_prefix = m->output_prefix;
+    m->set.checkpoint_path = m->checkpoint_path;
+    sim->many = m;
+    if ((s->output_prefix && !m->output_prefix) || (s->checkpoint_path && !m->checkpoint_path))
+        return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory");
+    return WETDEM_OK;
+}
+
+/* ---- start-up bounds ---- */
+
+/* Contact of two copies of particle p (materials a, b) at gap `gap`, or of p with a wall. */
+static void probe_contact(const struct wetdem_sim* sim, struct wetdem_particle p, int a, int b,
+                          bool wall, double gap, struct wetdem_contact* c)
+{
+    const struct wetdem_material* mat = sim->materials;
+    p.pos = vec3(0, 0, p.radius + gap);
+    if (wall) {
+        wetdem_contact_with_wall(c, &p, &mat[a], vec3(0, 0, 0), vec3(0, 0, 1), &mat[b],
+                                 &sim->fluid);
+        return;
+    }
+    struct wetdem_particle q = p;
+    p.pos = vec3(0, 0, 0);
+    q.pos = vec3(0, 0, 2 * p.radius + gap);
+    wetdem_contact_from_particles(c, &q, &mat[a], &p, &mat[b], &sim->fluid);
+}
+
+/* Largest range of the enabled models over every material combination, for the pair of the
+ * largest spheres and for a largest sphere and a wall [m]. */
+static double reach_bound(const struct wetdem_sim* sim)
+{
+    struct wetdem_particle big = {.radius = 0, .mass = 1};
+    for (size_t k = 0; k < sim->n_particles; k++)
+        if (sim->particles[k].radius > big.radius)
+            big = sim->particles[k];
+    double reach = 0;
+    for (int a = 0; a < sim->n_materials; a++)
+        for (int b = 0; b < sim->n_materials; b++)
+            for (int wall = 0; wall < 2; wall++) {
+                struct wetdem_contact c;
+                probe_contact(sim, big, a, b, wall, 0.0, &c);
+                reach = fmax(reach, wetdem_sim_contact_range(sim, &c));
+            }
+    return reach;
+}
+
+/* Step [s]: many.dt, else verlet.dt, else verlet.dt_fraction x the shortest Hertz contact
+ * time of two smallest spheres (or one and a wall) at the speed scale. */
+static int choose_dt(struct wetdem_sim* sim, double* dt)
+{
+    struct wetdem_many* m = sim->many;
+    double fixed = 0, fraction = 0.02;
+    wetdem_sim_param(sim, "verlet.dt", &fixed);
+    wetdem_sim_param(sim, "verlet.dt_fraction", &fraction);
+    *dt = m->set.dt > 0 ? m->set.dt : fixed;
+    if (*dt > 0)
+        return WETDEM_OK;
+    struct wetdem_particle small = sim->particles[0];
+    double v = 0, lo = INFINITY, hi = -INFINITY;
+    for (size_t k = 0; k < sim->n_particles; k++) {
+        const struct wetdem_particle* p = &sim->particles[k];
+        small = p->radius < small.radius ? *p : small;
+        v = fmax(v, 2 * vec3_norm(p->vel));
+        lo = fmin(lo, fmin(p->pos.z, fmin(p->pos.x, p->pos.y)));
+        hi = fmax(hi, fmax(p->pos.z, fmax(p->pos.x, p->pos.y)));
+    }
+    const struct wetdem_sim_settings* s = &sim->settings;
+    double g = sqrt(s->gravity_x * s->gravity_x + s->gravity_y * s->gravity_y +
+                    s->gravity_z * s->gravity_z);
+    v = fmax(s->speed_floor, v + sqrt(2 * g * fmax(hi - lo, 0.0)));
+    double t_min = INFINITY;
+    for (int a = 0; a < sim->n_materials; a++)
+        for (int b = 0; b < sim->n_materials; b++)
+            for (int wall = 0; wall < 2; wall++) {
+                struct wetdem_contact c;
+                probe_contact(sim, small, a, b, wall, 0.0, &c);
+                t_min = fmin(t_min, wetdem_force_hertz_contact_time(c.e_star, c.r_eff, c.m_eff,
+                                                                    fmax(v, 1e-12)));
+            }
+    *dt = fraction * t_min;
+    if (!(isfinite(*dt) && *dt > 0))
+        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
+                               "many: cannot derive a time step (%g s); set many.dt or verlet.dt",
+                               *dt);
+    return WETDEM_OK;
+}
+
+/* ---- storage ---- */
+
+static int grow(void** a, size_t* cap, size_t need, size_t size)
+{
+    if (need <= *cap && *a)
+        return WETDEM_OK;
+    size_t c = need > 16 ? need + need / 2 : 16;
+    void* p = realloc(*a, c * size);
+    if (!p)
+        return WETDEM_ERR_NOMEM;
+    *a = p;
+    *cap = c;
+    return WETDEM_OK;
+}
+
+static int size_particle_arrays(struct wetdem_sim* sim)
+{
+    struct wetdem_many* m = sim->many;
+    size_t n = sim->n_particles ? sim->n_particles : 1, cap = m->particle_cap;
+    if (n <= cap && m->force)
+        return WETDEM_OK;
+    struct wetdem_vec3** arrays[4] = {&m->force, &m->torque, &m->vh, &m->wh};
+    for (int k = 0; k < 4; k++) {
+        size_t c = cap;
+        if (grow((void**)arrays[k], &c, n, sizeof(struct wetdem_vec3)))
+            return WETDEM_ERR_NOMEM;
+    }
+    size_t c = cap;
+    if (grow((void**)&m->contacts, &c, n, sizeof *m->contacts))
+        return WETDEM_ERR_NOMEM;
+    m->particle_cap = c;
+    size_t len = sim->history_len, nw = sim->n_walls * n * len;
+    size_t old = m->wall_history_cap;
+    if (grow((void**)&m->wall_history, &m->wall_history_cap, nw ? nw : 1, sizeof(double)))
+        return WETDEM_ERR_NOMEM;
+    for (size_t k = old / (len ? len : 1); len && k < nw / len; k++)
+        wetdem_sim_history_init(sim, m->wall_history + k * len);
+    return WETDEM_OK;
+}
+
+/* Rebuilds the cell list and carries the histories of surviving pairs over. */
+static int rebuild(struct wetdem_sim* sim)
+{
+    struct wetdem_many* m = sim->many;
+    size_t len = sim->history_len, n_old = m->cl.n_pairs;
+    if (grow((void**)&m->old_pairs, &m->old_cap, n_old ? n_old : 1, sizeof *m->old_pairs) ||
+        grow((void**)&m->old_history, &m->old_history_cap, n_old * len + 1, sizeof(double)))
+        return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory for the pair list");
+    if (n_old)
+        memcpy(m->old_pairs, m->cl.pairs, n_old * sizeof *m->old_pairs);
+    if (n_old * len > 0)
+        memcpy(m->old_history, m->history, n_old * len * sizeof(double));
+    char msg[512];
+    int st = wetdem_celllist_build(&m->cl, sim->particles, sim->n_particles, msg, sizeof msg);
+    if (st != WETDEM_OK)
+        return wetdem_sim_fail(sim, st, "%s", msg);
+    size_t n_new = m->cl.n_pairs;
+    if (grow((void**)&m->history, &m->history_cap, n_new * len + 1, sizeof(double)) ||
+        grow((void**)&m->out, &m->out_cap, n_new ? n_new : 1, sizeof *m->out))
+        return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory for %zu pairs", n_new);
+    double fresh[HISTORY_MAX];
+    if (len)
+        wetdem_sim_history_init(sim, fresh);
+    wetdem_celllist_remap_history(m->old_pairs, m->old_history, n_old, m->cl.pairs, m->history,
+                                  n_new, len, fresh);
+    return WETDEM_OK;
+}
+
+int wetdem_sim_many_prepare(struct wetdem_sim* sim)
+{
+    struct wetdem_many* m = sim->many;
+    if (sim->history_len > HISTORY_MAX)
+        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
+                               "the enabled models keep %zu doubles of pair history; at most %d",
+                               sim->history_len, HISTORY_MAX);
+    double r_min = INFINITY;
+    for (size_t k = 0; k < sim->n_particles; k++)
+        r_min = fmin(r_min, sim->particles[k].radius);
+    double reach = reach_bound(sim);
+    double skin = m->set.skin > 0 ? m->set.skin : 0.1 * (isfinite(r_min) ? r_min : 1.0);
+    if (!m->started || reach != m->reach || skin != m->cl.skin) {
+        struct wetdem_celllist_box box = {{m->set.box_lo.x, m->set.box_lo.y, m->set.box_lo.z},
+                                          {m->set.box_hi.x, m->set.box_hi.y, m->set.box_hi.z},
+                                          {m->set.periodic[0], m->set.periodic[1],
+                                           m->set.periodic[2]}};
+        struct wetdem_celllist_pair* pairs = m->cl.pairs; /* keep the list for remapping */
+        size_t n_pairs = m->cl.n_pairs, pairs_cap = m->cl.pairs_cap;
+        m->cl.pairs = NULL;
+        wetdem_celllist_clear(&m->cl);
+        char msg[256];
+        int st = wetdem_celllist_init(&m->cl, &box, reach, skin, msg, sizeof msg);
+        m->cl.pairs = pairs;
+        m->cl.n_pairs = n_pairs;
+        m->cl.pairs_cap = pairs_cap;
+        if (st != WETDEM_OK)
+            return wetdem_sim_fail(sim, st, "%s", msg);
+        m->reach = reach;
+    }
+    if (size_particle_arrays(sim) != WETDEM_OK)
+        return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory for %zu particles",
+                               sim->n_particles);
+    if (wetdem_celllist_needs_rebuild(&m->cl, sim->particles, sim->n_particles))
+        return rebuild(sim);
+    return WETDEM_OK;
+}
+
+/* ---- forces ---- */
+
+/* Contact of pair (i, j) with j moved to its nearest periodic image; false if the pair is
+ * certainly beyond reach (gap estimate from the centre distance). */
+static bool pair_contact(const struct wetdem_sim* sim, size_t i, size_t j,
+                         struct wetdem_contact* c)
+{
+    const struct wetdem_many* m = sim->many;
+    const struct wetdem_particle* a = &sim->particles[i];
+    struct wetdem_particle b = sim->particles[j];
+    struct wetdem_vec3 d = celllist_delta(&m->cl.box, a->pos, b.pos);
+    double reach = m->reach + a->radius + b.radius;
+    if (vec3_dot(d, d) > reach * reach)
+        return false;
+    b.pos = vec3_sub(a->pos, d);
+    wetdem_contact_from_particles(c, a, &sim->materials[a->material], &b,
+                                  &sim->materials[b.material], &sim->fluid);
+    c->i = i;
+    c->j = j;
+    return true;
+}
+
+/* Adds dt x the power of each model's force on the pair to work[model]. */
+static void add_work(const struct wetdem_sim* sim, const struct wetdem_contact* c,
+                     const struct wetdem_pair_force* per_model, double* work)
+{
+    const struct wetdem_particle* a = &sim->particles[c->i];
+    struct wetdem_vec3 dv = a->vel, wj = vec3(0, 0, 0);
+    if (!c->is_wall) {
+        dv = vec3_sub(dv, sim->particles[c->j].vel);
+        wj = sim->particles[c->j].omega;
+    }
+    for (size_t k = 0; k < sim->n_models; k++) {
+        const struct wetdem_pair_force* f = &per_model[k];
+        struct wetdem_vec3 fi = vec3_axpy(f->f_tan, f->f_normal, c->normal);
+        double p = vec3_dot(fi, dv) + vec3_dot(f->torque_i, a->omega) +
+                   (c->is_wall ? 0.0 : vec3_dot(f->torque_j, wj));
+        work[k] += sim->many->dt * p;
+    }
+}
+
+/* Evaluates contact c with history hist (advanced in place: committed every step). Returns
+ * the status; *out gets force, torques and flags. */
+static int eval_pair(const struct wetdem_sim* sim, struct wetdem_contact* c, double* hist,
+                     struct wetdem_many_pair_out* out, double* work)
+{
+    const struct wetdem_many* m = sim->many;
+    double range = wetdem_sim_contact_range(sim, c);
+    if (range > m->reach)
+        return WETDEM_ERR_INVALID; /* reported by the caller: the start-up bound failed */
+    out->flags = 0;
+    if (c->gap > range) {
+        if (hist)
+            wetdem_sim_history_init(sim, hist);
+        return WETDEM_OK;
+    }
+    c->dt = m->dt;
+    struct wetdem_pair_force f, per_model[WETDEM_MAX_MODELS];
+    int st = wetdem_sim_eval_contact(sim, c, hist, &f, m->set.energy_budget ? per_model : NULL);
+    if (st < 0)
+        return st;
+    out->force = vec3_axpy(f.f_tan, f.f_normal, c->normal);
+    out->torque_i = f.torque_i;
+    out->torque_j = f.torque_j;
+    out->flags = WETDEM_MANY_ACTIVE | (c->gap < 0 ? WETDEM_MANY_CONTACT : 0) |
+                 (c->film > 0 && c->gap < c->film ? WETDEM_MANY_BRIDGE : 0);
+    if (!(isfinite(f.f_normal) && vec3_is_finite(out->force) && vec3_is_finite(f.torque_i) &&
+          vec3_is_finite(f.torque_j)))
+        return WETDEM_ERR_NUMERIC;
+    if (m->set.energy_budget)
+        add_work(sim, c, per_model, work);
+    return WETDEM_OK;
+}
+
+/* First failing pair (lowest index) of a parallel loop, for a deterministic message. */
+struct failure {
+    size_t index;
+    int status;
+    bool is_wall;
+    double gap, range;
+};
+
+static void note_failure(struct failure* fail, size_t index, int st, bool is_wall,
+                         const struct wetdem_contact* c, const struct wetdem_sim* sim)
+{
+#pragma omp critical(wetdem_many_failure)
+    if (fail->status == WETDEM_OK || index < fail->index)
+        *fail = (struct failure){index, st, is_wall, c->gap, wetdem_sim_contact_range(sim, c)};
+}
+
+static int report_failure(struct wetdem_sim* sim, const struct failure* f)
+{
+    struct wetdem_many* m = sim->many;
+    size_t i = f->is_wall ? f->index / sim->n_walls : m->cl.pairs[f->index].i;
+    size_t j = f->is_wall ? f->index % sim->n_walls : m->cl.pairs[f->index].j;
+    const char* what = f->is_wall ? "wall " : "";
+    if (f->status == WETDEM_ERR_INVALID && f->range > m->reach)
+        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
+                               "pair (%zu, %s%zu): interaction range %.6g m exceeds the "
+                               "neighbour reach %.6g m bounded at start-up",
+                               i, what, j, f->range, m->reach);
+    return wetdem_sim_fail(sim, f->status, "pair (%zu, %s%zu) at t = %.9g s, gap %.6g m: %s", i,
+                           what, j, sim->engine.time, f->gap,
+                           f->status == WETDEM_ERR_NUMERIC ? "non-finite force"
+                                                           : wetdem_status_name(f->status));
+}
+
+static double* thread_work(struct wetdem_many* m, int wall)
+{
+    return m->thread_work + (size_t)omp_get_thread_num() * 2 * WETDEM_MAX_MODELS +
+           (size_t)wall * WETDEM_MAX_MODELS;
+}
+
+static void eval_all_pairs(struct wetdem_sim* sim, struct failure* fail)
+{
+    struct wetdem_many* m = sim->many;
+    size_t len = sim->history_len, n = m->cl.n_pairs;
+#pragma omp parallel for schedule(dynamic, 256)
+    for (size_t q = 0; q < n; q++) {
+        struct wetdem_contact c;
+        double* hist = len ? m->history + q * len : NULL;
+        m->out[q].flags = 0;
+        if (!pair_contact(sim, m->cl.pairs[q].i, m->cl.pairs[q].j, &c)) {
+            if (hist)
+                wetdem_sim_history_init(sim, hist);
+            continue;
+        }
+        int st = eval_pair(sim, &c, hist, &m->out[q], thread_work(m, 0));
+        if (st != WETDEM_OK)
+            note_failure(fail, q, st, false, &c, sim);
+    }
+}
+
+/* Wall forces go straight into the particle's own force (one iteration owns particle i). */
+static void eval_walls(struct wetdem_sim* sim, struct failure* fail)
+{
+    struct wetdem_many* m = sim->many;
+    size_t len = sim->history_len, nw = sim->n_walls;
+#pragma omp parallel for schedule(static)
+    for (size_t i = 0; i < sim->n_particles; i++) {
+        m->force[i] = m->torque[i] = vec3(0, 0, 0);
+        m->contacts[i] = 0;
+        for (size_t w = 0; w < nw; w++) {
+            const struct wetdem_particle* a = &sim->particles[i];
+            const struct wetdem_wall* wall = &sim->walls[w];
+            double gap = vec3_dot(vec3_sub(a->pos, wall->point), wall->normal) - a->radius;
+            double* hist = len ? m->wall_history + (i * nw + w) * len : NULL;
+            if (gap > m->reach) {
+                if (hist)
+                    wetdem_sim_history_init(sim, hist);
+                continue;
+            }
+            struct wetdem_contact c;
+            wetdem_sim_build_contact(sim, i, w, true, &c);
+            struct wetdem_many_pair_out o;
+            int st = eval_pair(sim, &c, hist, &o, thread_work(m, 1));
+            if (st != WETDEM_OK)
+                note_failure(fail, i * nw + w, st, true, &c, sim);
+            if (!(o.flags & WETDEM_MANY_ACTIVE))
+                continue;
+            m->force[i] = vec3_add(m->force[i], o.force);
+            m->torque[i] = vec3_add(m->torque[i], o.torque_i);
+            m->contacts[i] += (o.flags & WETDEM_MANY_CONTACT) ? 1 : 0;
+        }
+    }
+}
+
+/* Serial scatter of the pair results in pair order (fixed summation order). */
+static void scatter_pairs(struct wetdem_sim* sim)
+{
+    struct wetdem_many* m = sim->many;
+    for (size_t q = 0; q < m->cl.n_pairs; q++) {
+        const struct wetdem_many_pair_out* o = &m->out[q];
+        if (!(o->flags & WETDEM_MANY_ACTIVE))
+            continue;
+        size_t i = m->cl.pairs[q].i, j = m->cl.pairs[q].j;
+        m->force[i] = vec3_add(m->force[i], o->force);
+        m->force[j] = vec3_sub(m->force[j], o->force);
+        m->torque[i] = vec3_add(m->torque[i], o->torque_i);
+        m->torque[j] = vec3_add(m->torque[j], o->torque_j);
+        if (o->flags & WETDEM_MANY_CONTACT) {
+            m->contacts[i]++;
+            m->contacts[j]++;
+        }
+    }
+}
+
+/* Forces and torques on every particle at the current state; histories committed. */
+static int compute_forces(struct wetdem_sim* sim)
+{
+    struct wetdem_many* m = sim->many;
+    int st = wetdem_sim_many_prepare(sim);
+    if (st != WETDEM_OK)
+        return st;
+    struct failure fail = {0};
+    eval_walls(sim, &fail);
+    eval_all_pairs(sim, &fail);
+    if (fail.status != WETDEM_OK)
+        return report_failure(sim, &fail);
+    scatter_pairs(sim);
+    sim->engine.stats.force_evals++;
+    sim->engine.stats.pair_evals += m->cl.n_pairs + sim->n_particles * sim->n_walls;
+    return WETDEM_OK;
+}
+
+/* Sums the per-thread work accumulators into the budget in thread order and clears them. */
+static void collect_work(struct wetdem_many* m, int n_threads)
+{
+    for (int t = 0; t < n_threads; t++)
+        for (int k = 0; k < WETDEM_MAX_MODELS; k++) {
+            double* w = m->thread_work + (size_t)t * 2 * WETDEM_MAX_MODELS;
+            m->energy.work_pair[k] += w[k];
+            m->energy.work_wall[k] += w[WETDEM_MAX_MODELS + k];
+            w[k] = w[WETDEM_MAX_MODELS + k] = 0;
+        }
+}
+
+/* ---- integration ---- */
+
+static struct wetdem_vec3 gravity(const struct wetdem_sim* sim)
+{
+    return vec3(sim->settings.gravity_x, sim->settings.gravity_y, sim->settings.gravity_z);
+}
+
+/* Wraps x into [lo, hi) on the periodic axes. */
+static struct wetdem_vec3 wrap(const struct wetdem_celllist_box* b, struct wetdem_vec3 x)
+{
+    double c[3] = {x.x, x.y, x.z};
+    for (int k = 0; k < 3; k++)
+        if (b->periodic[k]) {
+            double len = b->hi[k] - b->lo[k];
+            c[k] -= len * floor((c[k] - b->lo[k]) / len);
+        }
+    return vec3(c[0], c[1], c[2]);
+}
+
+/* Half kick and drift; velocities become the predicted ones v' + a dt/2. */
+static void kick_drift(struct wetdem_sim* sim, double h)
+{
+    struct wetdem_many* m = sim->many;
+    struct wetdem_vec3 g = gravity(sim);
+#pragma omp parallel for schedule(static)
+    for (size_t k = 0; k < sim->n_particles; k++) {
+        struct wetdem_particle* p = &sim->particles[k];
+        if (p->is_fixed)
+            continue;
+        struct wetdem_vec3 a = vec3_axpy(g, 1.0 / p->mass, m->force[k]);
+        struct wetdem_vec3 alpha =
+            vec3_scale(m->torque[k], 1.0 / (0.4 * p->mass * p->radius * p->radius));
+        m->vh[k] = vec3_axpy(p->vel, 0.5 * h, a);
+        m->wh[k] = vec3_axpy(p->omega, 0.5 * h, alpha);
+        p->pos = wrap(&m->cl.box, vec3_axpy(p->pos, h, m->vh[k]));
+        p->vel = vec3_axpy(m->vh[k], 0.5 * h, a);
+        p->omega = vec3_axpy(m->wh[k], 0.5 * h, alpha);
+    }
+}
+
+static void kick(struct wetdem_sim* sim, double h)
+{
+    struct wetdem_many* m = sim->many;
+    struct wetdem_vec3 g = gravity(sim);
+#pragma omp parallel for schedule(static)
+    for (size_t k = 0; k < sim->n_particles; k++) {
+        struct wetdem_particle* p = &sim->particles[k];
+        if (p->is_fixed)
+            continue;
+        p->vel = vec3_axpy(m->vh[k], 0.5 * h, vec3_axpy(g, 1.0 / p->mass, m->force[k]));
+        p->omega = vec3_axpy(m->wh[k], 0.5 * h,
+                             vec3_scale(m->torque[k],
+                                        1.0 / (0.4 * p->mass * p->radius * p->radius)));
+    }
+}
+
+static int forces_and_work(struct wetdem_sim* sim)
+{
+    struct wetdem_many* m = sim->many;
+    int n_threads = omp_get_max_threads();
+    size_t need = (size_t)n_threads * 2 * WETDEM_MAX_MODELS;
+    if (need > m->thread_work_cap) {
+        free(m->thread_work);
+        m->thread_work = calloc(need, sizeof(double));
+        if (!m->thread_work)
+            return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory");
+        m->thread_work_cap = need;
+    }
+    int st = compute_forces(sim);
+    collect_work(m, n_threads);
+    return st;
+}
+
+void wetdem_sim_many_energies(const struct wetdem_sim* sim, double* kinetic, double* potential,
+                              double* elastic)
+{
+    const struct wetdem_many* m = sim->many;
+    struct wetdem_vec3 g = gravity(sim);
+    double k = 0, u = 0, el = 0;
+    for (size_t i = 0; i < sim->n_particles; i++) {
+        const struct wetdem_particle* p = &sim->particles[i];
+        if (p->is_fixed)
+            continue;
+        k += 0.5 * p->mass * vec3_dot(p->vel, p->vel) +
+             0.2 * p->mass * p->radius * p->radius * vec3_dot(p->omega, p->omega);
+        u -= p->mass * vec3_dot(g, p->pos);
+    }
+    /* Hertz elastic energy (8/15) E* sqrt(R*) delta^(5/2) of every overlapping pair: the
+     * integral of (4/3) E* sqrt(R*) delta^(3/2) over delta (Johnson 1985 Eq. 4.23). */
+    for (size_t q = 0; m && q < m->cl.n_pairs; q++) {
+        struct wetdem_contact c;
+        if (!pair_contact(sim, m->cl.pairs[q].i, m->cl.pairs[q].j, &c) || c.gap >= 0)
+            continue;
+        double d = -c.gap;
+        el += 8.0 / 15.0 * c.e_star * sqrt(c.r_eff) * d * d * sqrt(d);
+    }
+    for (size_t i = 0; m && i < sim->n_particles; i++)
+        for (size_t w = 0; w < sim->n_walls; w++) {
+            struct wetdem_contact c;
+            wetdem_sim_build_contact(sim, i, w, true, &c);
+            double d = -c.gap;
+            if (d > 0)
+                el += 8.0 / 15.0 * c.e_star * sqrt(c.r_eff) * d * d * sqrt(d);
+        }
+    *kinetic = k;
+    *potential = u;
+    *elastic = el;
+}
+
+/* First call of a many run: step size, pair list, forces and the energy at t0. */
+static int start(struct wetdem_sim* sim)
+{
+    struct wetdem_many* m = sim->many;
+    int st = choose_dt(sim, &m->dt);
+    if (st != WETDEM_OK)
+        return st;
+    m->t0 = sim->engine.time;
+    m->step = 0;
+    st = forces_and_work(sim);
+    if (st != WETDEM_OK)
+        return st;
+    m->started = true;
+    memset(&m->energy, 0, sizeof m->energy);
+    wetdem_sim_many_energies(sim, &m->energy.k0, &m->energy.u0, &m->energy.el0);
+    return wetdem_sim_many_outputs(sim, false);
+}
+
+static double wall_seconds(void)
+{
+    return omp_get_wtime();
+}
+
+/* Stop flag, progress callback. Returns WETDEM_EVENT to stop (checkpoint written). */
+static int poll_stop(struct wetdem_sim* sim, unsigned long long done, unsigned long long total,
+                     double t_start)
+{
+    struct wetdem_many* m = sim->many;
+    bool stop = m->set.stop_flag && *m->set.stop_flag;
+    unsigned long long every = m->set.progress_every ? m->set.progress_every : 1000;
+    if (!stop && m->set.progress && (done % every == 0 || done == total))
+        stop = m->set.progress(done, total, wall_seconds() - t_start, m->set.progress_ctx) != 0;
+    if (!stop)
+        return WETDEM_OK;
+    if (m->checkpoint_path) {
+        int st = wetdem_sim_write_checkpoint(sim, m->checkpoint_path);
+        if (st != WETDEM_OK)
+            return st;
+    }
+    wetdem_sim_fail(sim, WETDEM_EVENT, "stopped at t = %.9g s (step %llu)%s%s", sim->engine.time,
+                    (unsigned long long)m->step, m->checkpoint_path ? "; checkpoint " : "",
+                    m->checkpoint_path ? m->checkpoint_path : "");
+    return WETDEM_EVENT;
+}
+
+static int one_step(struct wetdem_sim* sim)
+{
+    struct wetdem_many* m = sim->many;
+    kick_drift(sim, m->dt);
+    m->step++;
+    sim->engine.time = m->t0 + (double)m->step * m->dt; /* no accumulated round-off */
+    sim->engine.t_committed = sim->engine.time;
+    int st = forces_and_work(sim);
+    if (st != WETDEM_OK)
+        return st;
+    kick(sim, m->dt);
+    sim->engine.stats.steps++;
+    st = wetdem_sim_many_outputs(sim, false);
+    if (st == WETDEM_OK)
+        st = wetdem_sim_observe_due(sim);
+    return st;
+}
+
+int wetdem_sim_many_integrate(struct wetdem_sim* sim, double t_end)
+{
+    struct wetdem_many* m = sim->many;
+    int st = m->started ? wetdem_sim_many_prepare(sim) : start(sim);
+    if (st != WETDEM_OK)
+        return st;
+    if (sim->engine.observer && !(sim->engine.last_observed == sim->engine.time))
+        st = wetdem_sim_observe(sim);
+    double span = (t_end - sim->engine.time) / m->dt;
+    unsigned long long total = span > 1e-9 ? (unsigned long long)ceil(span - 1e-9) : 0;
+    double t_start = wall_seconds();
+    for (unsigned long long k = 1; st == WETDEM_OK && k <= total; k++) {
+        st = one_step(sim);
+        if (st == WETDEM_OK)
+            st = poll_stop(sim, k, total, t_start);
+    }
+    if (st == WETDEM_OK)
+        st = wetdem_sim_many_outputs(sim, true);
+    if (st >= 0 && sim->engine.observer && !(sim->engine.last_observed == sim->engine.time)) {
+        int so = wetdem_sim_observe(sim);
+        st = so != WETDEM_OK ? so : st;
+    }
+    return st;
+}
+
+int wetdem_sim_energy_budget(const struct wetdem_sim* sim, struct wetdem_energy_budget* b)
+{
+    memset(b, 0, sizeof *b);
+    const struct wetdem_many* m = sim->many;
+    if (!m || !m->started)
+        return WETDEM_ERR_INVALID;
+    wetdem_sim_many_energies(sim, &b->kinetic, &b->potential, &b->elastic);
+    b->input = m->energy.k0 + m->energy.u0 + m->energy.el0;
+    double work = 0;
+    for (size_t k = 0; k < sim->n_models && k < WETDEM_ENERGY_MAX_MODELS; k++) {
+        b->work_pair[k] = m->energy.work_pair[k];
+        b->work_wall[k] = m->energy.work_wall[k];
+        work += b->work_pair[k] + b->work_wall[k];
+    }
+    b->n_models = sim->n_models;
+    b->work_total = work;
+    b->dissipated = b->input - (b->kinetic + b->potential + b->elastic);
+    b->balance_error = (b->kinetic + b->potential) - (m->energy.k0 + m->energy.u0) - work;
+    return WETDEM_OK;
+}

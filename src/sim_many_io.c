@@ -1,0 +1,471 @@
+/*
+ * sim_many_io.c — outputs and persistence of the many-particle mode (docs/many.md): VTK files
+ * every N steps with a ParaView .vtk.series index, a CSV of global quantities (energies,
+ * contacts, liquid bridges, agglomerates found by union-find over bridged pairs), checkpoints
+ * and restart, insertion into a simulation, and the global statistics. Prefix: wetdem_sim_.
+ *
+ * Restart is bit-identical because the checkpoint holds every input of the next step: the
+ * particle state, the time grid (t0, dt, step), the per-pair histories keyed by (i, j) and
+ * (i, wall), and the forces and torques of the latest evaluation (recomputing them would
+ * advance the histories a second time). The neighbour list itself is rebuilt: every pair
+ * within its interaction range is in any valid list, and forces are added in (i, j) order, so
+ * the result does not depend on when the list was built.
+ */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "checkpoint.h"
+#include "insert.h"
+#include "many.h"
+#include "output_vtk.h"
+#include "vec3.h"
+
+#define CSV_SUFFIX ".csv"
+#define SERIES_SUFFIX ".vtk.series"
+
+/* ---- agglomerates ---- */
+
+static size_t find_root(size_t* parent, size_t k)
+{
+    while (parent[k] != k) {
+        parent[k] = parent[parent[k]]; /* path halving */
+        k = parent[k];
+    }
+    return k;
+}
+
+void wetdem_sim_many_agglomerates(const struct wetdem_sim* sim, size_t* count, double* mean)
+{
+    const struct wetdem_many* m = sim->many;
+    size_t n = sim->n_particles;
+    *count = 0;
+    *mean = 0;
+    size_t* parent = malloc((n ? n : 1) * 2 * sizeof *parent);
+    if (!parent || !m)
+        goto done;
+    size_t* size = parent + n;
+    for (size_t k = 0; k < n; k++) {
+        parent[k] = k;
+        size[k] = 1;
+    }
+    for (size_t q = 0; q < m->cl.n_pairs && m->out; q++) {
+        if (!(m->out[q].flags & WETDEM_MANY_BRIDGE))
+            continue;
+        size_t a = find_root(parent, m->cl.pairs[q].i), b = find_root(parent, m->cl.pairs[q].j);
+        if (a == b)
+            continue;
+        if (size[a] < size[b] || (size[a] == size[b] && b < a)) {
+            size_t t = a;
+            a = b;
+            b = t;
+        }
+        parent[b] = a;
+        size[a] += size[b];
+    }
+    size_t members = 0;
+    for (size_t k = 0; k < n; k++)
+        if (parent[k] == k && size[k] >= 2) {
+            (*count)++;
+            members += size[k];
+        }
+    *mean = *count ? (double)members / (double)*count : 0.0;
+done:
+    free(parent);
+}
+
+int wetdem_sim_many_stats(const struct wetdem_sim* sim, struct wetdem_many_stats* s)
+{
+    memset(s, 0, sizeof *s);
+    const struct wetdem_many* m = sim->many;
+    if (!m || !m->started)
+        return WETDEM_ERR_INVALID;
+    for (size_t q = 0; q < m->cl.n_pairs; q++) {
+        s->contacts += (m->out[q].flags & WETDEM_MANY_CONTACT) ? 1 : 0;
+        s->bridges += (m->out[q].flags & WETDEM_MANY_BRIDGE) ? 1 : 0;
+    }
+    size_t touching = 0; /* contact counts per particle hold pairs twice, walls once */
+    for (size_t k = 0; k < sim->n_particles; k++)
+        touching += m->contacts[k];
+    s->contacts += touching - 2 * s->contacts;
+    wetdem_sim_many_agglomerates(sim, &s->agglomerates, &s->mean_agglomerate);
+    s->candidate_pairs = m->cl.n_pairs;
+    s->list_builds = m->cl.n_builds;
+    s->dt = m->dt;
+    s->step = m->step;
+    return WETDEM_OK;
+}
+
+/* ---- VTK and CSV ---- */
+
+int wetdem_sim_write_vtk(struct wetdem_sim* sim, const char* path, bool binary)
+{
+    const uint32_t* contacts = sim->many && sim->many->started ? sim->many->contacts : NULL;
+    char msg[512];
+    int st = wetdem_output_vtk_write(path, sim->particles, sim->n_particles, contacts,
+                                     sim->engine.time, binary, msg, sizeof msg);
+    return st == WETDEM_OK ? st : wetdem_sim_fail(sim, st, "%s", msg);
+}
+
+/* "<prefix><suffix>" into buf. */
+static int prefixed(struct wetdem_sim* sim, char* buf, size_t n, const char* suffix)
+{
+    if ((size_t)snprintf(buf, n, "%s%s", sim->many->output_prefix, suffix) >= n)
+        return wetdem_sim_fail(sim, WETDEM_ERR_IO, "output prefix too long");
+    return WETDEM_OK;
+}
+
+/* File name without its directory, for the series index (relative to the series file). */
+static const char* base_name(const char* path)
+{
+    const char* s = strrchr(path, '/');
+    return s ? s + 1 : path;
+}
+
+static int write_vtk_frame(struct wetdem_sim* sim)
+{
+    struct wetdem_many* m = sim->many;
+    char path[4096], series[4096];
+    wetdem_output_vtk_path(path, sizeof path, m->output_prefix, m->vtk_files);
+    int st = wetdem_sim_write_vtk(sim, path, m->set.vtk_binary);
+    if (st != WETDEM_OK)
+        return st;
+    size_t cap = m->vtk_names_cap;
+    if (m->vtk_files + 1 > cap) {
+        cap = cap ? 2 * cap : 64;
+        char** names = realloc(m->vtk_names, cap * sizeof *names);
+        if (names)
+            m->vtk_names = names;
+        double* times = realloc(m->vtk_times, cap * sizeof *times);
+        if (times)
+            m->vtk_times = times;
+        if (!names || !times)
+            return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory");
+        m->vtk_names_cap = cap;
+    }
+    size_t k = m->vtk_files;
+    m->vtk_names[k] = malloc(strlen(base_name(path)) + 1);
+    if (!m->vtk_names[k])
+        return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory");
+    strcpy(m->vtk_names[k], base_name(path));
+    m->vtk_times[k] = sim->engine.time;
+    m->vtk_files++;
+    st = prefixed(sim, series, sizeof series, SERIES_SUFFIX);
+    char msg[512];
+    if (st == WETDEM_OK &&
+        wetdem_output_vtk_series_write(series, (const char* const*)m->vtk_names, m->vtk_times,
+                                       m->vtk_files, msg, sizeof msg) != WETDEM_OK)
+        st = wetdem_sim_fail(sim, WETDEM_ERR_IO, "%s", msg);
+    return st;
+}
+
+static void csv_header(const struct wetdem_sim* sim, FILE* f)
+{
+    fprintf(f, "# wetdem %s many-particle run: global quantities\n", WETDEM_VERSION);
+    fputs("time_s,step,kinetic_J,potential_J,elastic_J,contacts,bridges,agglomerates,"
+          "mean_agglomerate_size,candidate_pairs",
+          f);
+    for (size_t k = 0; sim->many->set.energy_budget && k < sim->n_models; k++)
+        fprintf(f, ",work_%s_J", sim->models[k].model->name);
+    if (sim->many->set.energy_budget)
+        fputs(",dissipated_J,balance_error_J", f);
+    fputc('\n', f);
+}
+
+static int write_csv_row(struct wetdem_sim* sim)
+{
+    struct wetdem_many* m = sim->many;
+    char path[4096];
+    int st = prefixed(sim, path, sizeof path, CSV_SUFFIX);
+    FILE* f = st == WETDEM_OK ? fopen(path, m->csv_rows ? "a" : "w") : NULL;
+    if (!f)
+        return st != WETDEM_OK ? st
+                               : wetdem_sim_fail(sim, WETDEM_ERR_IO, "cannot open '%s'", path);
+    if (m->csv_rows == 0)
+        csv_header(sim, f);
+    struct wetdem_many_stats s;
+    wetdem_sim_many_stats(sim, &s);
+    double k, u, el;
+    wetdem_sim_many_energies(sim, &k, &u, &el);
+    fprintf(f, "%.9g,%llu,%.9g,%.9g,%.9g,%zu,%zu,%zu,%.6g,%zu", sim->engine.time,
+            (unsigned long long)m->step, k, u, el, s.contacts, s.bridges, s.agglomerates,
+            s.mean_agglomerate, s.candidate_pairs);
+    struct wetdem_energy_budget b;
+    if (m->set.energy_budget && wetdem_sim_energy_budget(sim, &b) == WETDEM_OK) {
+        for (size_t q = 0; q < sim->n_models && q < WETDEM_ENERGY_MAX_MODELS; q++)
+            fprintf(f, ",%.9g", b.work_pair[q] + b.work_wall[q]);
+        fprintf(f, ",%.9g,%.3g", b.dissipated, b.balance_error);
+    }
+    fputc('\n', f);
+    bool ok = !ferror(f);
+    ok = fclose(f) == 0 && ok;
+    m->csv_rows++;
+    return ok ? WETDEM_OK : wetdem_sim_fail(sim, WETDEM_ERR_IO, "cannot write '%s'", path);
+}
+
+/* Output k is due at multiples of `every` steps, once per step. */
+static bool due(uint64_t step, unsigned long long every, uint64_t* next)
+{
+    if (!every || step < *next)
+        return false;
+    *next = (step / every + 1) * every;
+    return true;
+}
+
+int wetdem_sim_many_outputs(struct wetdem_sim* sim, bool final)
+{
+    struct wetdem_many* m = sim->many;
+    int st = WETDEM_OK;
+    (void)final;
+    if (m->output_prefix && due(m->step, m->set.vtk_every, &m->next_vtk_step))
+        st = write_vtk_frame(sim);
+    if (st == WETDEM_OK && m->output_prefix && due(m->step, m->set.csv_every, &m->next_csv_step))
+        st = write_csv_row(sim);
+    if (st == WETDEM_OK && m->checkpoint_path && m->step > 0 &&
+        due(m->step, m->set.checkpoint_every, &m->next_checkpoint_step))
+        st = wetdem_sim_write_checkpoint(sim, m->checkpoint_path);
+    return st;
+}
+
+/* ---- checkpoints ---- */
+
+/* Fingerprint of everything a checkpoint must be restored into unchanged. */
+static uint64_t config_hash(const struct wetdem_sim* sim)
+{
+    uint64_t h = wetdem_checkpoint_hash(0, "wetdem-many-1", 13);
+    h = wetdem_checkpoint_hash(h, sim->materials, (size_t)sim->n_materials * sizeof(*sim->materials));
+    h = wetdem_checkpoint_hash(h, &sim->fluid, sizeof sim->fluid);
+    h = wetdem_checkpoint_hash(h, &sim->settings, sizeof sim->settings);
+    const struct wetdem_model_slot* slots[WETDEM_MAX_MODELS + 1];
+    size_t n = 0;
+    for (size_t k = 0; k < sim->n_models; k++)
+        slots[n++] = &sim->models[k];
+    slots[n++] = &sim->minsep;
+    for (size_t k = 0; k < n; k++) {
+        h = wetdem_checkpoint_hash(h, slots[k]->model->name, strlen(slots[k]->model->name));
+        h = wetdem_checkpoint_hash(h, slots[k]->params, slots[k]->model->params_size);
+    }
+    for (size_t w = 0; w < sim->n_walls; w++) {
+        h = wetdem_checkpoint_hash(h, &sim->walls[w].point, sizeof(struct wetdem_vec3));
+        h = wetdem_checkpoint_hash(h, &sim->walls[w].normal, sizeof(struct wetdem_vec3));
+        h = wetdem_checkpoint_hash(h, &sim->walls[w].material, sizeof(int));
+    }
+    const struct wetdem_many_settings* s = &sim->many->set;
+    double geo[8] = {s->skin,     s->dt,       s->box_lo.x, s->box_lo.y,
+                     s->box_lo.z, s->box_hi.x, s->box_hi.y, s->box_hi.z};
+    unsigned char per[3] = {s->periodic[0], s->periodic[1], s->periodic[2]};
+    h = wetdem_checkpoint_hash(h, geo, sizeof geo);
+    return wetdem_checkpoint_hash(h, per, sizeof per);
+}
+
+/* USER blob: dt, t0, then force and torque of every particle, then its contact count. */
+static size_t blob_size(size_t n)
+{
+    return 2 * sizeof(double) + n * (6 * sizeof(double) + sizeof(uint32_t));
+}
+
+static int fill_checkpoint(struct wetdem_sim* sim, struct wetdem_checkpoint* ck)
+{
+    struct wetdem_many* m = sim->many;
+    size_t n = sim->n_particles, nw = sim->n_walls, np = m->cl.n_pairs, len = sim->history_len;
+    size_t total = np + n * nw;
+    ck->pairs = malloc((total ? total : 1) * sizeof *ck->pairs);
+    ck->history = malloc((total * len > 0 ? total * len : 1) * sizeof(double));
+    ck->walls = malloc((nw ? nw : 1) * sizeof *ck->walls);
+    ck->extra = malloc(blob_size(n));
+    ck->energy = malloc((3 + 2 * WETDEM_MAX_MODELS) * sizeof(double));
+    if (!ck->pairs || !ck->history || !ck->walls || !ck->extra || !ck->energy)
+        return WETDEM_ERR_NOMEM;
+    for (size_t q = 0; q < np; q++)
+        ck->pairs[q] = (struct wetdem_checkpoint_pair){m->cl.pairs[q].i, m->cl.pairs[q].j, false};
+    for (size_t k = 0; k < n * nw; k++)
+        ck->pairs[np + k] = (struct wetdem_checkpoint_pair){k / nw, k % nw, true};
+    if (len) {
+        memcpy(ck->history, m->history, np * len * sizeof(double));
+        memcpy(ck->history + np * len, m->wall_history, n * nw * len * sizeof(double));
+    }
+    for (size_t w = 0; w < nw; w++)
+        ck->walls[w] = (struct wetdem_checkpoint_wall){sim->walls[w].point, sim->walls[w].normal,
+                                                      sim->walls[w].material};
+    unsigned char* b = ck->extra;
+    memcpy(b, &m->dt, 8);
+    memcpy(b + 8, &m->t0, 8);
+    for (size_t k = 0; k < n; k++) {
+        double ft[6] = {m->force[k].x,  m->force[k].y,  m->force[k].z,
+                        m->torque[k].x, m->torque[k].y, m->torque[k].z};
+        memcpy(b + 16 + k * 48, ft, 48);
+    }
+    if (n)
+        memcpy(b + 16 + n * 48, m->contacts, n * sizeof(uint32_t));
+    double* e = ck->energy;
+    e[0] = m->energy.k0;
+    e[1] = m->energy.u0;
+    e[2] = m->energy.el0;
+    memcpy(e + 3, m->energy.work_pair, sizeof m->energy.work_pair);
+    memcpy(e + 3 + WETDEM_MAX_MODELS, m->energy.work_wall, sizeof m->energy.work_wall);
+    *ck = (struct wetdem_checkpoint){
+        .time = sim->engine.time, .step = m->step, .config_hash = config_hash(sim),
+        .particles = sim->particles, .n_particles = n, .walls = ck->walls, .n_walls = nw,
+        .pairs = ck->pairs, .history = ck->history, .n_pairs = total, .history_len = len,
+        .stats = sim->engine.stats, .energy = ck->energy, .n_energy = 3 + 2 * WETDEM_MAX_MODELS,
+        .extra = ck->extra, .extra_size = blob_size(n),
+        .output = {m->vtk_files, m->csv_rows, m->next_vtk_step, m->next_csv_step}};
+    return WETDEM_OK;
+}
+
+int wetdem_sim_write_checkpoint(struct wetdem_sim* sim, const char* path)
+{
+    if (!sim->many || !sim->many->started)
+        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
+                               "checkpoints need a started many-particle run (wetdem_sim_set_many "
+                               "and wetdem_sim_integrate)");
+    struct wetdem_checkpoint ck = {0};
+    int st = fill_checkpoint(sim, &ck);
+    char msg[512] = "out of memory writing a checkpoint";
+    if (st == WETDEM_OK)
+        st = wetdem_checkpoint_write(path, &ck, msg, sizeof msg);
+    free(ck.pairs);
+    free(ck.history);
+    free(ck.walls);
+    free(ck.extra);
+    free(ck.energy);
+    return st == WETDEM_OK ? st : wetdem_sim_fail(sim, st, "%s", msg);
+}
+
+/* Checks that checkpoint ck fits this sim's set-up. */
+static int check_restorable(struct wetdem_sim* sim, const struct wetdem_checkpoint* ck,
+                            const char* path)
+{
+    size_t n = ck->n_particles, nw = sim->n_walls;
+    if (ck->config_hash != config_hash(sim))
+        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
+                               "checkpoint '%s' was written with different materials, fluid, "
+                               "models, parameters, walls or many settings",
+                               path);
+    if (ck->n_walls != nw || ck->history_len != sim->history_len ||
+        ck->extra_size != blob_size(n) || ck->n_energy != 3 + 2 * WETDEM_MAX_MODELS ||
+        ck->n_pairs < n * nw)
+        return wetdem_sim_fail(sim, WETDEM_ERR_PARSE, "checkpoint '%s': inconsistent contents",
+                               path);
+    for (size_t k = 0; k < n; k++)
+        if (ck->particles[k].material < 0 || ck->particles[k].material >= sim->n_materials)
+            return wetdem_sim_fail(sim, WETDEM_ERR_PARSE,
+                                   "checkpoint '%s': particle %zu has material %d", path, k,
+                                   ck->particles[k].material);
+    return WETDEM_OK;
+}
+
+/* Particles, engine time and counters from ck. */
+static int restore_state(struct wetdem_sim* sim, const struct wetdem_checkpoint* ck)
+{
+    struct wetdem_many* m = sim->many;
+    size_t n = ck->n_particles;
+    if (n > sim->particles_cap) {
+        struct wetdem_particle* p = realloc(sim->particles, n * sizeof *p);
+        if (!p)
+            return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory");
+        sim->particles = p;
+        sim->particles_cap = n;
+    }
+    if (n)
+        memcpy(sim->particles, ck->particles, n * sizeof *sim->particles);
+    sim->n_particles = n;
+    sim->engine.time = sim->engine.t_committed = ck->time;
+    sim->engine.stats = ck->stats;
+    m->step = ck->step;
+    memcpy(&m->dt, ck->extra, 8);
+    memcpy(&m->t0, ck->extra + 8, 8);
+    m->energy.k0 = ck->energy[0];
+    m->energy.u0 = ck->energy[1];
+    m->energy.el0 = ck->energy[2];
+    memcpy(m->energy.work_pair, ck->energy + 3, sizeof m->energy.work_pair);
+    memcpy(m->energy.work_wall, ck->energy + 3 + WETDEM_MAX_MODELS, sizeof m->energy.work_wall);
+    m->vtk_files = 0; /* the series index restarts with the files written from now on */
+    m->csv_rows = ck->output.csv_rows;
+    m->next_vtk_step = ck->output.next_vtk_step;
+    m->next_csv_step = ck->output.next_csv_step;
+    unsigned long long every = m->set.checkpoint_every;
+    m->next_checkpoint_step = every ? (m->step / every + 1) * every : 0;
+    return WETDEM_OK;
+}
+
+/* Pair histories: the checkpoint's pair list becomes the "previous" list of a forced rebuild,
+ * which carries the histories over by key; wall histories are copied. Then the forces and
+ * torques of the latest evaluation are restored. */
+static int restore_pairs(struct wetdem_sim* sim, const struct wetdem_checkpoint* ck)
+{
+    struct wetdem_many* m = sim->many;
+    size_t n = ck->n_particles, nw = sim->n_walls, len = sim->history_len;
+    size_t np = ck->n_pairs - n * nw;
+    m->started = false; /* prepare() re-initialises the cell list */
+    m->cl.n_pairs = 0;
+    int st = wetdem_sim_many_prepare(sim);
+    if (st != WETDEM_OK)
+        return st;
+    struct wetdem_celllist_pair* pairs = malloc((np ? np : 1) * sizeof *pairs);
+    if (!pairs)
+        return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory");
+    for (size_t q = 0; q < np; q++)
+        pairs[q] = (struct wetdem_celllist_pair){(uint32_t)ck->pairs[q].i,
+                                                 (uint32_t)ck->pairs[q].j};
+    double fresh[64];
+    if (len)
+        wetdem_sim_history_init(sim, fresh);
+    wetdem_celllist_remap_history(pairs, ck->history, np, m->cl.pairs, m->history,
+                                  m->cl.n_pairs, len, fresh);
+    free(pairs);
+    if (len && n * nw > 0)
+        memcpy(m->wall_history, ck->history + np * len, n * nw * len * sizeof(double));
+    for (size_t k = 0; k < n; k++) {
+        double ft[6];
+        memcpy(ft, ck->extra + 16 + k * 48, 48);
+        m->force[k] = vec3(ft[0], ft[1], ft[2]);
+        m->torque[k] = vec3(ft[3], ft[4], ft[5]);
+    }
+    if (n)
+        memcpy(m->contacts, ck->extra + 16 + n * 48, n * sizeof(uint32_t));
+    memset(m->out, 0, m->cl.n_pairs * sizeof *m->out);
+    m->started = true;
+    return WETDEM_OK;
+}
+
+int wetdem_sim_read_checkpoint(struct wetdem_sim* sim, const char* path)
+{
+    if (!sim->many)
+        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
+                               "reading a checkpoint needs the many-particle mode "
+                               "(wetdem_sim_set_many) set up as when it was written");
+    struct wetdem_checkpoint ck;
+    char msg[512];
+    int st = wetdem_checkpoint_read(path, &ck, msg, sizeof msg);
+    if (st != WETDEM_OK)
+        return wetdem_sim_fail(sim, st, "%s", msg);
+    st = check_restorable(sim, &ck, path);
+    if (st == WETDEM_OK)
+        st = restore_state(sim, &ck);
+    if (st == WETDEM_OK)
+        st = restore_pairs(sim, &ck);
+    wetdem_checkpoint_clear(&ck);
+    return st;
+}
+
+/* ---- insertion ---- */
+
+int wetdem_sim_insert(struct wetdem_sim* sim, const struct wetdem_insert_spec* spec)
+{
+    if (spec->material < 0 || spec->material >= sim->n_materials)
+        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
+                               "insert.material %d does not exist (valid 0..%d)", spec->material,
+                               sim->n_materials - 1);
+    struct wetdem_particle* p = malloc((spec->n ? spec->n : 1) * sizeof *p);
+    if (!p)
+        return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory for %zu particles", spec->n);
+    char msg[768];
+    int st = wetdem_insert_particles(spec, p, msg, sizeof msg);
+    if (st != WETDEM_OK)
+        st = wetdem_sim_fail(sim, st, "%s", msg);
+    for (size_t k = 0; st == WETDEM_OK && k < spec->n; k++)
+        st = wetdem_sim_add_particle(sim, p[k]);
+    free(p);
+    return st;
+}
