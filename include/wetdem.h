@@ -451,8 +451,8 @@ struct wetdem_collision_spec {
     double speed;               /* impact speed of i [m/s]; 0: derived from stokes */
     double stokes;              /* normal Stokes number St_n = m* v_n0/(6 pi mu R*^2), used
                                    when speed == 0 */
-    double angle;               /* impact angle [rad]: between the velocity of i and the line
-                                   of centres at first interaction; 0 = head-on */
+    double angle;               /* impact angle [rad] in [0, pi/2): between the velocity of i
+                                   and the line of centres at first interaction; 0 = head-on */
     struct wetdem_vec3 omega_i; /* initial spin of i [rad/s] */
     double initial_gap;         /* gap at t = 0 [m]; <= 0: just outside the interaction range */
     double t_end;               /* longest simulated time [s] */
@@ -466,7 +466,8 @@ struct wetdem_collision_result {
     double speed_n0;            /* normal approach speed at first interaction [m/s] */
     double e;                   /* Nijssen: |dv_1|/|dv_0| of the relative velocity [-] */
     double e_n;                 /* normal restitution -v_f.n_f / v_0.n_0 (Punch Eq. 3) [-] */
-    double e_t;                 /* tangential restitution of the contact-point velocity [-] */
+    double e_t;                 /* tangential restitution of the contact-point velocity [-]
+                                   (-1 smooth, +1 reversed; NAN without initial slip) */
     double e_n_observed;        /* e_n evaluated at observe_time (NAN if not requested) */
     double angle_in, angle_out; /* impact and rebound angles to the normal [rad] */
     struct wetdem_vec3 omega_i, omega_j; /* final spins [rad/s] */
@@ -477,6 +478,11 @@ struct wetdem_collision_result {
     bool hmin_reached;          /* gap reached h_min */
     bool separated;             /* left the interaction range by t_end */
     double rotation_angle;      /* angle the line of centres turned during interaction [rad] */
+    double rotation_close;      /* the part of rotation_angle turned while the gap was below
+                                   h_close = 0.01 R* (stick-rotate-separate criterion) [rad] */
+    double t_first_interaction; /* time the gap first reached the interaction range [s]
+                                   (0 when starting inside it) */
+    double t_final;             /* time of the final state: separation or t_end [s] */
     enum wetdem_outcome outcome;
     struct wetdem_stats stats;
 };
@@ -494,10 +500,310 @@ WETDEM_API void wetdem_sim_reset(struct wetdem_sim* sim);
 WETDEM_API struct wetdem_sim* wetdem_sim_clone(const struct wetdem_sim* sim);
 
 /* ======================================================================================== */
+/* Many particles: cell lists, boxes, insertion, outputs, energy budget, checkpoints         */
+/* (docs/many.md)                                                                           */
+/* ======================================================================================== */
+
+/* Called every progress_every steps of a many-particle run with the steps done and the total
+ * of this integrate call and the wall-clock time since its start [s]. A non-zero return stops
+ * the run like the stop flag. */
+typedef int (*wetdem_progress_fn)(unsigned long long done, unsigned long long total,
+                                  double elapsed, void* ctx);
+
+/* Settings of the many-particle mode. Zero-initialise, then set what you need. */
+struct wetdem_many_settings {
+    double skin;                         /* Verlet skin of the cell lists [m] >= 0; 0: 0.1 x
+                                            the smallest radius */
+    bool periodic[3];                    /* periodic axes x, y, z */
+    struct wetdem_vec3 box_lo, box_hi;   /* periodic box [m] (read on periodic axes only) */
+    double dt;                           /* step [s] >= 0; 0: verlet.dt, or verlet.dt_fraction
+                                            x the Hertz contact time of the smallest spheres */
+    bool energy_budget;                  /* accumulate the work of every model (costs ~10 %) */
+    const char* output_prefix;           /* <prefix>_NNNNNN.vtk, <prefix>.vtk.series and
+                                            <prefix>.csv; NULL: no files (copied) */
+    unsigned long long vtk_every;        /* steps between VTK files; 0: none */
+    bool vtk_binary;                     /* binary instead of ASCII VTK */
+    unsigned long long csv_every;        /* steps between rows of global quantities; 0: none */
+    const char* checkpoint_path;         /* NULL: no checkpoints (copied) */
+    unsigned long long checkpoint_every; /* steps between checkpoints; 0: only when stopped */
+    volatile int* stop_flag;             /* read every step; non-zero: write the checkpoint and
+                                            return WETDEM_EVENT (e.g. set by a SIGINT handler) */
+    wetdem_progress_fn progress;         /* optional progress callback */
+    void* progress_ctx;
+    unsigned long long progress_every;   /* steps between progress calls; 0: 1000 */
+};
+
+/* Switches sim to the many-particle mode: wetdem_sim_integrate() then runs velocity Verlet
+ * over cell lists (no event location), with walls, gravity, periodic axes, OpenMP, outputs and
+ * checkpoints as set. NULL switches back. Returns WETDEM_OK or WETDEM_ERR_INVALID. */
+WETDEM_API int wetdem_sim_set_many(struct wetdem_sim* sim, const struct wetdem_many_settings* s);
+
+#define WETDEM_ENERGY_MAX_MODELS 16
+
+/* Energy budget of a many-particle run since its start [J]. work_* > 0 means energy given to
+ * the particles, < 0 taken from them (dissipated, or stored as by the Hertz spring). */
+struct wetdem_energy_budget {
+    double kinetic;   /* translational + rotational kinetic energy now */
+    double potential; /* gravitational potential energy now, -sum m g.x */
+    double elastic;   /* Hertz elastic energy (8/15) E* sqrt(R*) delta^(5/2) stored now */
+    double input;     /* kinetic + potential + elastic at the start */
+    double dissipated; /* input - (kinetic + potential + elastic): lost to damping, friction,
+                          viscous forces, plus what capillary bridges and tangential springs
+                          hold */
+    size_t n_models;  /* enabled force models (wetdem_sim_model(sim, k) names them) */
+    double work_pair[WETDEM_ENERGY_MAX_MODELS]; /* work of model k in particle pairs */
+    double work_wall[WETDEM_ENERGY_MAX_MODELS]; /* work of model k in particle-wall pairs */
+    double work_total;    /* sum of all work */
+    double balance_error; /* (kinetic + potential) - (their start values) - work_total: zero
+                             up to the O(dt^2) integration error */
+};
+/* Fills *b (many.energy_budget must be on). WETDEM_OK, or WETDEM_ERR_INVALID before a run. */
+WETDEM_API int wetdem_sim_energy_budget(const struct wetdem_sim* sim,
+                                        struct wetdem_energy_budget* b);
+
+/* Global quantities at the latest force evaluation of a many-particle run. */
+struct wetdem_many_stats {
+    size_t contacts;             /* pairs (and particle-wall pairs) with gap < 0 */
+    size_t bridges;              /* particle pairs with a liquid bridge (gap < film) */
+    size_t agglomerates;         /* clusters of >= 2 particles joined by bridges */
+    double mean_agglomerate;     /* their mean number of particles (0 if none) */
+    size_t candidate_pairs;      /* pairs in the neighbour list */
+    unsigned long long list_builds; /* neighbour-list builds so far */
+    double dt;                   /* step [s] */
+    unsigned long long step;     /* steps since the start of the many run */
+};
+WETDEM_API int wetdem_sim_many_stats(const struct wetdem_sim* sim, struct wetdem_many_stats* s);
+
+/* Writes the particles as a legacy VTK file (radius, velocity, spin, contact count). */
+WETDEM_API int wetdem_sim_write_vtk(struct wetdem_sim* sim, const char* path, bool binary);
+/* Writes a checkpoint of a many-particle run (atomic: temporary file, then rename).
+ * Returns WETDEM_OK, WETDEM_ERR_INVALID (not in many mode) or WETDEM_ERR_IO. */
+WETDEM_API int wetdem_sim_write_checkpoint(struct wetdem_sim* sim, const char* path);
+/* Restores a checkpoint into a sim set up exactly as the one that wrote it (materials, fluid,
+ * models, parameters, walls, many settings): particles, time, step, pair histories, energy
+ * budget and output counters are replaced; continuing gives bit-identical results to the
+ * uninterrupted run. WETDEM_ERR_INVALID if the set-up differs, WETDEM_ERR_PARSE/IO if the
+ * file is bad. */
+WETDEM_API int wetdem_sim_read_checkpoint(struct wetdem_sim* sim, const char* path);
+
+enum wetdem_insert_layout {
+    WETDEM_INSERT_LATTICE = 0, /* simple cubic lattice of spacing 2 R_max + gap, x fastest */
+    WETDEM_INSERT_RANDOM = 1,  /* random sequential addition, largest spheres first */
+};
+
+/* What to insert and where. Seeded: the same spec gives bit-identical particles. */
+struct wetdem_insert_spec {
+    enum wetdem_insert_layout layout;
+    size_t n;                    /* number of spheres, >= 1 */
+    struct wetdem_vec3 lo, hi;   /* region [m]; spheres lie inside it on non-periodic axes */
+    bool periodic[3];            /* axes on which the region wraps (overlaps through images) */
+    double radius_min;           /* radii uniform in [radius_min, radius_max] [m], > 0 */
+    double radius_max;           /* [m], >= radius_min */
+    const double* radii;         /* optional: n radii [m] used instead of the uniform draw */
+    double gap;                  /* least surface gap between spheres and to the region's
+                                    faces on non-periodic axes [m], >= 0 */
+    struct wetdem_vec3 velocity; /* mean velocity [m/s] */
+    double velocity_sigma;       /* standard deviation of each velocity component [m/s] >= 0 */
+    int material;                /* material index given to every sphere */
+    unsigned long seed;          /* seed of the gsl_rng mt19937 generator */
+    size_t max_attempts;         /* random layout: trials per sphere; 0 means 10000 */
+};
+/* Inserts spec->n spheres into sim (mass from the material density). Returns WETDEM_OK,
+ * WETDEM_ERR_INVALID (bad spec, or the region cannot hold them: the message says how many
+ * fit and what to change) or WETDEM_ERR_NOMEM. */
+WETDEM_API int wetdem_sim_insert(struct wetdem_sim* sim, const struct wetdem_insert_spec* spec);
+
+/* ======================================================================================== */
 /* Pairwise engine (Davis 2023)                                                             */
 /* ======================================================================================== */
 
 /* ---- pairwise engine section ---- */
+
+/* Davis's relative-motion formulation (Sec. II) for a few film-coated spheres moving in the
+ * x-y plane: per tracked pair the gap h, line-of-centres angle theta, normal approach speed
+ * v_n, rotation rate Omega of the line of centres and spin sum v_omega = a_i w_i + a_j w_j
+ * (Eqs. 9, 14, 17, 18); sphere 0 in fixed coordinates (Eqs. 34-36, 39); the other pairs from
+ * geometry (Appendix B). Film forces (Eqs. 3-4) act while a pair's films overlap
+ * (h <= delta_i + delta_j); at h = h_min a hard-sphere impulse (Appendix A) reverses the
+ * approach. Adaptive integration (CVODE BDF) with located events. docs/derivations/pairwise.md.
+ * Sign conventions follow Davis: theta_ij is the angle of x_j - x_i from the x axis, v_n > 0
+ * approaching, spins counter-clockwise positive. */
+
+#define WETDEM_PAIRWISE_MAX_SPHERES 8
+#define WETDEM_PAIRWISE_MAX_PAIRS 28 /* MAX_SPHERES (MAX_SPHERES - 1) / 2 */
+
+/* One sphere of a pairwise run, in the x-y plane. */
+struct wetdem_pairwise_sphere {
+    double radius; /* a_i [m] > 0 */
+    double mass;   /* m_i [kg] > 0 */
+    double film;   /* liquid film thickness delta_i [m] >= 0 */
+    double x, y;   /* centre [m] */
+    double vx, vy; /* velocity [m/s] */
+    double omega;  /* spin about +z, counter-clockwise positive [rad/s] */
+};
+
+/* Input of a pairwise run (plain data; fill with wetdem_pairwise_config_init first). */
+struct wetdem_pairwise_config {
+    size_t n_spheres; /* 2..WETDEM_PAIRWISE_MAX_SPHERES */
+    struct wetdem_pairwise_sphere spheres[WETDEM_PAIRWISE_MAX_SPHERES];
+    double viscosity;         /* mu [Pa s] >= 0 */
+    double surface_tension;   /* sigma [N/m] >= 0 (capillary suction 8 pi a_ij sigma) */
+    double h_min;             /* minimum separation where solid-like contact occurs [m] > 0 */
+    double restitution;       /* e_dry (0, 1] */
+    double friction;          /* mu_f of the contact impulse [-] >= 0 */
+    double gravity_x, gravity_y; /* [m/s^2] */
+    double t_end;             /* longest simulated time [s] > 0 */
+    double rtol;              /* relative tolerance of the integrator, (0, 1e-3]; 1e-9 */
+    double rest_speed_ratio;  /* contacts slower than this x v_n0 become resting [-]; 1e-3 */
+    bool stop_when_separated; /* stop once every pair is apart and receding (default true) */
+    size_t ref_i, ref_j;      /* reference pair for v_n0, delta_12, t-hat, t* (default 0, 1) */
+    size_t max_events;        /* event budget (default 100000) */
+};
+
+/* What happened, in the event log of a pairwise run. */
+enum wetdem_pairwise_event_kind {
+    WETDEM_PAIRWISE_FILM_START = 1,     /* films of pair (i, j) begin to overlap: h = delta_ij */
+    WETDEM_PAIRWISE_CONTACT = 2,        /* h = h_min approaching: hard-sphere impulse */
+    WETDEM_PAIRWISE_REST_START = 3,     /* contact slower than the rest speed: pair held at h_min */
+    WETDEM_PAIRWISE_REST_END = 4,       /* the held pair's contact force fell to zero */
+    WETDEM_PAIRWISE_FILM_END = 5,       /* films separate: h = delta_ij receding */
+    WETDEM_PAIRWISE_PARTNER_CHANGE = 6, /* tracked pair (i, j) replaced tracked pair (k, l) */
+};
+
+/* One entry of the event log. */
+struct wetdem_pairwise_event {
+    enum wetdem_pairwise_event_kind kind;
+    double time;   /* [s] */
+    double t_hat;  /* v_n0 t / delta_12 [-] (Davis Eq. 19) */
+    double t_star; /* v_10 t / 4a [-] */
+    size_t i, j;   /* pair */
+    size_t k, l;   /* partner change: the pair that left the tracked set; else = i, j */
+    double gap;    /* h at the event [m] */
+    double v_n;    /* normal approach speed just before the event [m/s] */
+};
+
+/* Outcome of a run of three or more spheres (two: FA = stick, FS = separated). */
+enum wetdem_pairwise_outcome {
+    WETDEM_PAIRWISE_FA = 0, /* full agglomeration: one cluster of overlapping films */
+    WETDEM_PAIRWISE_PA = 1, /* partial agglomeration: some spheres left, some stay together */
+    WETDEM_PAIRWISE_FS = 2, /* full separation: every pair apart */
+};
+
+/* Per-pair summary of a run. */
+struct wetdem_pairwise_pair_result {
+    size_t i, j;
+    bool films_met;     /* the films overlapped at some time */
+    bool bound;         /* films still overlapping (or held at h_min) at the end */
+    unsigned n_contacts;/* hard-sphere impulses */
+    double v_n_in;      /* normal approach speed when the films first overlapped [m/s] */
+    double v_n_out;     /* normal separation speed at the last film separation [m/s] */
+    double e_wet;       /* Eq. 40: v_n_out / v_n0 (0 if bound, NAN if films never met) [-] */
+    double e_wet_own;   /* v_n_out / v_n_in (NAN if v_n_in <= 0 or films never met) [-] */
+    double t_start;     /* first film overlap [s] (NAN if none) */
+    double t_end;       /* last film separation [s] (NAN if none) */
+    double min_gap;     /* smallest gap seen at step ends and events [m] */
+    int mechanism;      /* enum wetdem_outcome: stick, stick-rotate-separate (reversed by the
+                           film and centrifugal forces) or bounce (reversed by an impulse);
+                           -1 if the films never met */
+};
+
+/* Summary of a pairwise run. */
+struct wetdem_pairwise_result {
+    size_t n_spheres, n_pairs;
+    struct wetdem_pairwise_pair_result pairs[WETDEM_PAIRWISE_MAX_PAIRS]; /* order of
+                                          wetdem_pairwise_pair_index() */
+    enum wetdem_pairwise_outcome outcome;
+    int separated_sphere;  /* PA with one sphere alone: its index; else -1 */
+    struct wetdem_pairwise_sphere final[WETDEM_PAIRWISE_MAX_SPHERES]; /* state at the end */
+    double time;           /* time reached [s] */
+    double v_n0;           /* normal approach speed of the reference pair at t = 0 [m/s] */
+    double delta_ref;      /* delta_12 of the reference pair [m] */
+    double v_10;           /* speed of sphere ref_i at t = 0 [m/s] */
+    double a_ref;          /* reduced radius a of the reference pair [m] */
+    size_t n_events;
+    unsigned long long steps, rhs_evals, guard_evals;
+};
+
+/* State of every sphere at one output time, handed to the observer. */
+struct wetdem_pairwise_frame {
+    double time, t_hat, t_star; /* [s], [-], [-] */
+    size_t n_spheres, n_pairs;
+    struct wetdem_pairwise_sphere spheres[WETDEM_PAIRWISE_MAX_SPHERES];
+    double gap[WETDEM_PAIRWISE_MAX_PAIRS];  /* h of every pair [m] */
+    double v_n[WETDEM_PAIRWISE_MAX_PAIRS];  /* normal approach speed of every pair [m/s] */
+};
+/* Observer: called at t = 0, every `interval` seconds and at the end; non-zero stops the run
+ * with WETDEM_ERR_CALLBACK. */
+typedef int (*wetdem_pairwise_observer_fn)(const struct wetdem_pairwise_frame* frame, void* ctx);
+
+/* Dimensionless inputs of Davis Table I for equal spheres (radius 2a, reduced radius a). */
+struct wetdem_pairwise_davis {
+    double n_spheres;   /* 2 (striker and target only) or 3 [-] */
+    double stokes;      /* St_n = m v_n0 / (6 pi mu a^2) > 0 */
+    double capillary;   /* Ca = 3 mu a v_n0 / (sigma delta_12) > 0; 0 or INFINITY: none */
+    double film_ratio;  /* h_a = delta_12 / 4a, (0, 0.5) */
+    double hmin_ratio;  /* h_m = h_min / delta_12, (0, 1) */
+    double angle_deg;   /* impact angle beta = alpha - theta_12,0 [deg], [0, 90) */
+    double d23, d13;    /* delta_23 / delta_12 and delta_13 / delta_12 (> 0, triangle rule) */
+    double h23;         /* h_23,0 / delta_12 >= hmin_ratio */
+    double theta23_deg; /* theta_23,0, angle of x_3 - x_2 from the x axis [deg], [-180, 180] */
+    double restitution; /* e_dry (0, 1] */
+    double friction;    /* mu_f >= 0 */
+    double t_star_end;  /* run length in t* = v_10 t / 4a, > 0 */
+    double a;           /* reduced radius [m] (scale only; results depend on the groups) */
+    double viscosity;   /* mu [Pa s] (scale only) */
+    double speed_n0;    /* v_n0 [m/s] (scale only) */
+};
+
+/* A pairwise run object (opaque): integrator workspace, event log, last error message. */
+struct wetdem_pairwise;
+
+/* Allocates a run object (holds the integrator, event log and messages). NULL if out of
+ * memory. */
+WETDEM_API struct wetdem_pairwise* wetdem_pairwise_create(void);
+/* Frees a run object; NULL does nothing. */
+WETDEM_API void wetdem_pairwise_free(struct wetdem_pairwise* pw);
+/* Last error message of the run object, "" if none. */
+WETDEM_API const char* wetdem_pairwise_errmsg(const struct wetdem_pairwise* pw);
+/* Fills *cfg with defaults (no spheres, e_dry 1, mu_f 0, rtol 1e-9, ...). */
+WETDEM_API void wetdem_pairwise_config_init(struct wetdem_pairwise_config* cfg);
+/* Checks a configuration; a message naming the parameter, value and valid range goes to
+ * msg. Returns WETDEM_OK or WETDEM_ERR_INVALID. */
+WETDEM_API int wetdem_pairwise_config_validate(const struct wetdem_pairwise_config* cfg, char* msg,
+                                               size_t msg_size);
+/* Sets the observer called every `interval` seconds [s] (> 0) of a run; fn NULL removes it. */
+WETDEM_API void wetdem_pairwise_set_observer(struct wetdem_pairwise* pw, double interval,
+                                             wetdem_pairwise_observer_fn fn, void* ctx);
+/* Runs one collision from cfg (copied) and fills *res. Returns WETDEM_OK, or a negative
+ * status with the message in wetdem_pairwise_errmsg(). The event log stays readable until
+ * the next run. */
+WETDEM_API int wetdem_pairwise_run(struct wetdem_pairwise* pw,
+                                   const struct wetdem_pairwise_config* cfg,
+                                   struct wetdem_pairwise_result* res);
+/* Borrowed view of the last run's event log; *n receives the count. */
+WETDEM_API const struct wetdem_pairwise_event* wetdem_pairwise_events(const struct wetdem_pairwise* pw,
+                                                                      size_t* n);
+/* Index of pair (i, j), i != j < n, in the per-pair arrays: (0,1), (0,2), ..., (1,2), ... */
+WETDEM_API size_t wetdem_pairwise_pair_index(size_t n, size_t i, size_t j);
+/* "film_start", "contact", "rest_start", "rest_end", "film_end", "partner_change". */
+WETDEM_API const char* wetdem_pairwise_event_name(enum wetdem_pairwise_event_kind kind);
+/* "FA", "PA", "FS". */
+WETDEM_API const char* wetdem_pairwise_outcome_name(enum wetdem_pairwise_outcome outcome);
+
+/* Fills *d with Davis's defaults (St_n 2, Ca 1000, h_a 0.01, h_m 0.01, beta 30 deg,
+ * d_23 = d_13 = 1, h_23,0 = 1, theta_23,0 = 0, e_dry 1, mu_f 0, t* 20). */
+WETDEM_API void wetdem_pairwise_davis_init(struct wetdem_pairwise_davis* d);
+/* Descriptors of struct wetdem_pairwise_davis ("stokes", "capillary", "film_ratio",
+ * "hmin_ratio", "angle_deg", "d23", "d13", "h23", "theta23_deg", "restitution", "friction",
+ * ...), {0}-terminated, for scenario files and sweeps. */
+WETDEM_API const struct wetdem_param_desc* wetdem_pairwise_davis_params(void);
+/* Builds the Table-I configuration (Fig. 3): sphere 0 (Davis's 1) strikes sphere 1 (2) at
+ * angle beta with films just touching; sphere 2 (3) rests at gap h_23,0 and angle
+ * theta_23,0 from sphere 1. Returns WETDEM_OK or WETDEM_ERR_INVALID (message in msg). */
+WETDEM_API int wetdem_pairwise_davis_config(const struct wetdem_pairwise_davis* d,
+                                            struct wetdem_pairwise_config* cfg, char* msg,
+                                            size_t msg_size);
+
 
 /* ======================================================================================== */
 /* Experiment tracking and fitting (Punch 2023 Sec. 3.2)                                    */
