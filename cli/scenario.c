@@ -18,6 +18,7 @@
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include <ini.h>
 
@@ -598,4 +599,32 @@ int cli_scenario_override(struct cli_scenario* sc, const char* key_value)
         return CLI_EXIT_RUNTIME;
     }
     return CLI_EXIT_OK;
+}
+
+/* ---- shared by run, sweep and fit ---- */
+
+/* Loads the file and applies the overrides. */
+int cli_load_with_overrides(const char* file, const char* const* sets, int n_sets,
+                            struct cli_scenario* sc)
+{
+    int rc = cli_scenario_load(file, sc);
+    for (int k = 0; rc == CLI_EXIT_OK && k < n_sets; k++)
+        rc = cli_scenario_override(sc, sets[k]);
+    return rc;
+}
+
+/* Creates dir and its parents (mkdir -p). */
+int cli_make_dirs(const char* dir)
+{
+    char path[1024];
+    if (snprintf(path, sizeof path, "%s", dir) >= (int)sizeof path)
+        return -1;
+    for (char* p = path + 1; *p; p++)
+        if (*p == '/') {
+            *p = '\0';
+            if (mkdir(path, 0777) != 0 && errno != EEXIST)
+                return -1;
+            *p = '/';
+        }
+    return (mkdir(path, 0777) == 0 || errno == EEXIST) ? 0 : -1;
 }

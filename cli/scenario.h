@@ -177,7 +177,7 @@ const char* cli_scenario_key_unit(const char* section, const char* key);
  * "model.nijssen"). 0, or -1 with a message printed. value may be NULL. */
 int cli_override_split(const char* text, char* section, char* key, char* value);
 
-/* ---- shared by run and sweep (cmd_run.c) ---- */
+/* ---- shared by run, sweep and fit ---- */
 
 /* cli_scenario_load() then cli_scenario_override() for each of sets. Returns an exit code. */
 int cli_load_with_overrides(const char* file, const char* const* sets, int n_sets,

@@ -8,8 +8,9 @@
  *   m_i = rho_i (4/3) pi R_i^3;  m* = m_i m_j / (m_i + m_j) for a free target sphere, m* = m_i
  *   for a fixed sphere or a wall;  R* = R_i R_j / (R_i + R_j), R* = R_i for a wall;
  *   St_n = m* v cos(angle) / (6 pi mu R*^2)  =>  v = St_n 6 pi mu R*^2 / (m* cos(angle)).
- *   Automatic end time: t_end = 20 max(R*, initial_gap) / v_n (Nijssen's cut-off h_co = R*
- *   crossed twenty times over); trajectory interval max(R*, initial_gap) / (500 v_n).
+ *   Automatic end time: t_end = N max(R*, initial_gap) / v_n, N = t_end_crossings (20: the
+ *   cut-off h_co = R* of Nijssen crossed twenty times over); trajectory interval
+ *   max(R*, initial_gap) / (500 v_n).
  */
 #include <math.h>
 #include <stdlib.h>
@@ -265,7 +266,7 @@ static int build_kinematics(const struct cli_scenario* sc, struct cli_setup* su,
     double t_cross = fmax(su->r_eff, s->initial_gap) / v_n;
     s->t_end = cli_scenario_number(sc, "collision", "t_end", 0);
     if (s->t_end == 0)
-        s->t_end = 20.0 * t_cross;
+        s->t_end = cli_scenario_number(sc, "collision", "t_end_crossings", 20) * t_cross;
     s->observe_time = cli_scenario_number(sc, "collision", "observe_time", 0);
     s->rebound_gap_factor = cli_scenario_number(sc, "collision", "rebound_gap_factor", 1);
     su->trajectory_interval = cli_scenario_number(sc, "output", "trajectory_interval", 0);

@@ -46,8 +46,10 @@ static const struct cli_key_desc collision_keys[] = {
     NUM("spin_y", "rad/s", "0", -1e6, 1e6, false, false, "Initial spin of the striker, y."),
     NUM("spin_z", "rad/s", "0", -1e6, 1e6, false, false, "Initial spin of the striker, z."),
     NUM("t_end", "s", "0 (auto)", 0, 1e6, false, false,
-        "Longest simulated time. 0: 20 max(R*, initial_gap) / v_n, i.e. twenty times the time "
-        "to cross the lubrication cut-off h_co = R* at the impact speed."),
+        "Longest simulated time. 0: t_end_crossings x max(R*, initial_gap) / v_n, i.e. that "
+        "many times the time to cross the lubrication cut-off h_co = R* at the impact speed."),
+    NUM("t_end_crossings", "-", "20", 1, 1e6, false, false,
+        "Automatic t_end in units of the crossing time max(R*, initial_gap) / v_n."),
     NUM("initial_gap", "m", "0 (auto)", 0, 1, false, false,
         "Gap at t = 0; 0: just outside the interaction range of the enabled models."),
     NUM("observe_time", "s", "0 (off)", 0, 1e6, false, false,

@@ -1,0 +1,222 @@
+/*
+ * cmd_run.c — `wetdem run FILE [--set section.key=value ...] [--out DIR] [--json] [--check]`:
+ * runs the binary collision of a scenario file (docs/scenarios.md) and prints its summary
+ * (every field of struct wetdem_collision_result with units; JSON with --json). With --out,
+ * writes DIR/trajectory.csv, DIR/events.csv and DIR/summary.json (names from [output]).
+ * --check only reads, checks and resolves the scenario (derived speed, times) and prints that.
+ *
+ * Nothing half-written: the scenario is checked and the simulation built (every input check)
+ * before any file is opened; files are written under temporary names and renamed only when
+ * the run succeeded. Exit codes: 0 ok, 1 runtime error, 2 usage or input error.
+ */
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "cli_util.h"
+#include "output_csv.h"
+#include "scenario.h"
+
+#define MAX_SETS 256
+
+struct run_args {
+    const char* file;
+    const char* sets[MAX_SETS];
+    int n_sets;
+    const char* out_dir;
+    bool json, check;
+};
+
+static void usage(FILE* f)
+{
+    fprintf(f, "usage: wetdem run FILE [--set section.key=value ...] [--out DIR] [--json] "
+               "[--check]\n"
+               "Runs the binary collision of a scenario file (docs/scenarios.md).\n"
+               "  --set K=V   override a scenario key, e.g. --set collision.stokes=50\n"
+               "  --out DIR   write DIR/trajectory.csv, DIR/events.csv, DIR/summary.json\n"
+               "  --json      print the summary as JSON\n"
+               "  --check     check the scenario and print the resolved set-up; do not run\n");
+}
+
+static int parse_args(int argc, char** argv, struct run_args* a)
+{
+    memset(a, 0, sizeof *a);
+    for (int k = 1; k < argc; k++) {
+        const char* s = argv[k];
+        bool has_next = k + 1 < argc;
+        if (strcmp(s, "--set") == 0 && has_next && a->n_sets < MAX_SETS)
+            a->sets[a->n_sets++] = argv[++k];
+        else if (strcmp(s, "--out") == 0 && has_next)
+            a->out_dir = argv[++k];
+        else if (strcmp(s, "--json") == 0)
+            a->json = true;
+        else if (strcmp(s, "--check") == 0)
+            a->check = true;
+        else if (s[0] != '-' && !a->file)
+            a->file = s;
+        else {
+            cli_error("run: unexpected argument '%s'%s", s,
+                      (strcmp(s, "--set") == 0 || strcmp(s, "--out") == 0) ? " (needs a value)"
+                                                                            : "");
+            usage(stderr);
+            return CLI_EXIT_USAGE;
+        }
+    }
+    if (!a->file) {
+        usage(stderr);
+        return CLI_EXIT_USAGE;
+    }
+    return CLI_EXIT_OK;
+}
+
+/* One output file: final name and the temporary name it is written under. */
+struct out_file {
+    char final[1400], tmp[1400];
+    FILE* f;
+};
+
+static int open_out(struct out_file* o, const char* dir, const char* name)
+{
+    o->f = NULL;
+    o->final[0] = '\0';
+    if (!dir || !name[0])
+        return 0;
+    snprintf(o->final, sizeof o->final, "%s/%s", dir, name);
+    snprintf(o->tmp, sizeof o->tmp, "%s/.%s.tmp%ld", dir, name, (long)getpid());
+    o->f = fopen(o->tmp, "w");
+    if (!o->f) {
+        cli_error("run: cannot write %s: %s", o->tmp, strerror(errno));
+        return -1;
+    }
+    return 0;
+}
+
+/* Closes; renames on success (keep), removes the temporary file otherwise. */
+static int close_out(struct out_file* o, bool keep)
+{
+    if (!o->f)
+        return 0;
+    bool bad = ferror(o->f) != 0;
+    bad = (fclose(o->f) != 0) || bad;
+    o->f = NULL;
+    if (keep && !bad && rename(o->tmp, o->final) == 0)
+        return 0;
+    remove(o->tmp);
+    if (keep) {
+        cli_error("run: cannot write %s", o->final);
+        return -1;
+    }
+    return 0;
+}
+
+static void print_check(const struct cli_scenario* sc, const struct cli_setup* su, bool json)
+{
+    const struct wetdem_collision_spec* s = &su->spec;
+    if (json) {
+        printf("{\"scenario\": ");
+        cli_json_string(stdout, sc->file);
+        printf(", \"integrator\": \"%s\", \"impact_speed\": ", wetdem_sim_integrator_name(su->sim));
+        cli_json_number(stdout, su->impact_speed);
+        printf(", \"stokes_n\": ");
+        cli_json_number(stdout, su->stokes_n);
+        printf(", \"m_eff\": %.17g, \"r_eff\": %.17g, \"t_end\": %.17g, \"angle\": %.17g, "
+               "\"trajectory_interval\": %.17g, \"n_models\": %zu}\n",
+               su->m_eff, su->r_eff, s->t_end, s->angle * 180.0 / 3.14159265358979323846,
+               su->trajectory_interval, wetdem_sim_n_models(su->sim));
+        return;
+    }
+    printf("scenario %s is valid\n", sc->file);
+    printf("  impact_speed  %.10g m/s\n  stokes_n      %.10g -\n  m_eff         %.10g kg\n"
+           "  r_eff         %.10g m\n  t_end         %.10g s\n  integrator    %s\n  models       ",
+           su->impact_speed, su->stokes_n, su->m_eff, su->r_eff, s->t_end,
+           wetdem_sim_integrator_name(su->sim));
+    for (size_t k = 0; k < wetdem_sim_n_models(su->sim); k++)
+        printf(" %s", wetdem_sim_model(su->sim, k)->name);
+    printf(" (h_min: %s)\n", wetdem_sim_min_separation_model(su->sim)->name);
+}
+
+/* Runs the collision with the files open; returns an exit code. */
+static int run_soft(const struct cli_scenario* sc, struct cli_setup* su, const struct run_args* a,
+                    int argc, char** argv)
+{
+    struct out_file traj, events, summary;
+    int rc = CLI_EXIT_OK;
+    if (a->out_dir && cli_make_dirs(a->out_dir) != 0) {
+        cli_error("run: cannot create directory %s: %s", a->out_dir, strerror(errno));
+        return CLI_EXIT_RUNTIME;
+    }
+    if (open_out(&traj, a->out_dir, su->trajectory_file) != 0)
+        return CLI_EXIT_RUNTIME;
+    struct cli_trajectory t = {.f = traj.f, .target_is_wall = su->spec.target_is_wall,
+                               .argc = argc, .argv = argv};
+    if (traj.f)
+        wetdem_sim_set_observer(su->sim, su->trajectory_interval, cli_trajectory_observe, &t);
+    struct wetdem_collision_result res;
+    int st = wetdem_collision_run(su->sim, &su->spec, &res);
+    if (st < 0) {
+        cli_error("run %s: %s (%s)", sc->file, wetdem_sim_errmsg(su->sim), wetdem_status_name(st));
+        close_out(&traj, false);
+        return CLI_EXIT_RUNTIME;
+    }
+    cli_setup_capture(su);
+    if (open_out(&events, a->out_dir, su->events_file) != 0 ||
+        open_out(&summary, a->out_dir, su->summary_file) != 0) {
+        close_out(&traj, false);
+        close_out(&events, false);
+        return CLI_EXIT_RUNTIME;
+    }
+    if (events.f)
+        cli_events_csv(events.f, su->sim, argc, argv);
+    if (summary.f)
+        cli_summary_json(summary.f, sc, su, &res);
+    if (close_out(&traj, true) || close_out(&events, true) || close_out(&summary, true))
+        rc = CLI_EXIT_RUNTIME;
+    if (a->json)
+        cli_summary_json(stdout, sc, su, &res);
+    else
+        cli_summary_text(stdout, sc, su, &res);
+    if (a->out_dir && rc == CLI_EXIT_OK && !a->json)
+        printf("files in %s/\n", a->out_dir);
+    return rc;
+}
+
+int cmd_run(int argc, char** argv)
+{
+    if (argc > 1 && (strcmp(argv[1], "--help") == 0 || strcmp(argv[1], "-h") == 0)) {
+        usage(stdout);
+        return CLI_EXIT_OK;
+    }
+    struct run_args a;
+    int rc = parse_args(argc, argv, &a);
+    if (rc != CLI_EXIT_OK)
+        return rc;
+    struct cli_scenario sc;
+    rc = cli_load_with_overrides(a.file, a.sets, a.n_sets, &sc);
+    enum cli_engine engine = CLI_ENGINE_SOFT;
+    if (rc == CLI_EXIT_OK)
+        cli_scenario_engine(&sc, &engine);
+    if (rc == CLI_EXIT_OK && engine == CLI_ENGINE_PAIRWISE) {
+        if (!cli_run_pairwise) {
+            cli_error("run %s: engine 'pairwise' is not in this build", a.file);
+            rc = CLI_EXIT_RUNTIME;
+        } else {
+            struct cli_run_options opt = {.out_dir = a.out_dir, .json = a.json, .argc = argc,
+                                          .argv = argv};
+            rc = cli_run_pairwise(&sc, &opt);
+        }
+        cli_scenario_free(&sc);
+        return rc;
+    }
+    struct cli_setup su = {0};
+    if (rc == CLI_EXIT_OK)
+        rc = cli_scenario_build(&sc, &su);
+    if (rc == CLI_EXIT_OK && a.check)
+        print_check(&sc, &su, a.json);
+    else if (rc == CLI_EXIT_OK)
+        rc = run_soft(&sc, &su, &a, argc, argv);
+    cli_setup_free(&su);
+    cli_scenario_free(&sc);
+    return rc;
+}

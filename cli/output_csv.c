@@ -1,0 +1,308 @@
+/*
+ * output_csv.c — CSV and JSON writers for `wetdem run` and `wetdem sweep` (see output_csv.h):
+ * collision summary, trajectory rows from the observer, event log.
+ *
+ * Trajectory gap: for two spheres h = |x_i - x_j| - R_i - R_j from the positions; for a wall
+ * the library's contact geometry (wetdem_sim_pair_force) gives it. Forces are not written:
+ * the models' forces depend on per-pair history (tangential spring, largest approach speed
+ * for h_eps) that an observer cannot see, so a recomputed force would be wrong.
+ */
+#include <math.h>
+#include <string.h>
+
+#include "cli_util.h"
+#include "output_csv.h"
+
+#define RAD2DEG (180.0 / 3.14159265358979323846)
+
+static struct cli_field num(const char* name, const char* unit, const char* doc, double v)
+{
+    return (struct cli_field){.name = name, .unit = unit, .doc = doc, .kind = CLI_FIELD_NUMBER,
+                              .number = v};
+}
+
+static struct cli_field flag(const char* name, const char* doc, bool v)
+{
+    return (struct cli_field){.name = name, .unit = "", .doc = doc, .kind = CLI_FIELD_BOOL,
+                              .flag = v};
+}
+
+static struct cli_field count(const char* name, const char* doc, unsigned long long v)
+{
+    return (struct cli_field){.name = name, .unit = "", .doc = doc, .kind = CLI_FIELD_COUNT,
+                              .count = v};
+}
+
+size_t cli_result_fields(const struct cli_setup* su, const struct wetdem_collision_result* r,
+                         struct cli_field* out)
+{
+    size_t n = 0;
+    out[n++] = num("impact_speed", "m/s", "speed of the striker at t = 0", su->impact_speed);
+    out[n++] = num("stokes_n", "-", "normal Stokes number m* v_n0 / (6 pi mu R*^2)", r->stokes_n);
+    out[n++] = num("speed_n0", "m/s", "normal approach speed at first interaction", r->speed_n0);
+    out[n++] = num("e", "-", "Nijssen restitution |dv_1|/|dv_0|", r->e);
+    out[n++] = num("e_n", "-", "normal restitution (Punch Eq. 3)", r->e_n);
+    out[n++] = num("e_t", "-", "tangential restitution of the contact point", r->e_t);
+    out[n++] = num("e_n_observed", "-", "e_n at observe_time", r->e_n_observed);
+    out[n++] = num("angle_in", "deg", "impact angle to the normal", r->angle_in * RAD2DEG);
+    out[n++] = num("angle_out", "deg", "rebound angle of the relative velocity to the normal",
+                   r->angle_out * RAD2DEG);
+    out[n++] = num("striker_angle_out", "deg",
+                   "rebound angle of the striker's own velocity to the line of centres",
+                   su->striker_angle_out * RAD2DEG);
+    out[n++] = num("striker_speed_out", "m/s", "final speed of the striker",
+                   su->striker_speed_out);
+    out[n++] = num("omega_i_x", "rad/s", "final spin of the striker, x", r->omega_i.x);
+    out[n++] = num("omega_i_y", "rad/s", "final spin of the striker, y", r->omega_i.y);
+    out[n++] = num("omega_i_z", "rad/s", "final spin of the striker, z", r->omega_i.z);
+    out[n++] = num("omega_j_x", "rad/s", "final spin of the target, x", r->omega_j.x);
+    out[n++] = num("omega_j_y", "rad/s", "final spin of the target, y", r->omega_j.y);
+    out[n++] = num("omega_j_z", "rad/s", "final spin of the target, z", r->omega_j.z);
+    out[n++] = num("contact_duration", "s", "total time with gap < 0", r->contact_duration);
+    out[n++] = num("interaction_duration", "s", "first interaction to separation",
+                   r->interaction_duration);
+    out[n++] = num("min_gap", "m", "smallest gap reached", r->min_gap);
+    out[n++] = flag("solid_contact", "the gap reached 0", r->solid_contact);
+    out[n++] = flag("hmin_reached", "the gap reached h_min", r->hmin_reached);
+    out[n++] = flag("separated", "left the interaction range by t_end", r->separated);
+    out[n++] = num("rotation_angle", "deg", "turn of the line of centres during interaction",
+                   r->rotation_angle * RAD2DEG);
+    out[n] = (struct cli_field){.name = "outcome", .unit = "", .kind = CLI_FIELD_TEXT,
+                                .doc = "stick, stick-rotate-separate or bounce",
+                                .text = wetdem_outcome_name(r->outcome)};
+    n++;
+    out[n++] = count("steps", "accepted integrator steps", r->stats.steps);
+    out[n++] = count("rejected_steps", "rejected step attempts", r->stats.rejected_steps);
+    out[n++] = count("force_evals", "evaluations of all forces (RHS)", r->stats.force_evals);
+    out[n++] = count("pair_evals", "evaluations of one pair's models", r->stats.pair_evals);
+    out[n++] = count("root_evals", "evaluations of the event functions", r->stats.root_evals);
+    out[n++] = count("events", "events located", r->stats.events);
+    return n;
+}
+
+void cli_setup_capture(struct cli_setup* su)
+{
+    size_t n = 0;
+    const struct wetdem_particle* p = wetdem_sim_particles_const(su->sim, &n);
+    su->striker_speed_out = NAN;
+    su->striker_angle_out = NAN;
+    if (n < 1 || (!su->spec.target_is_wall && n < 2))
+        return;
+    double nx = 1, ny = 0, nz = 0; /* the wall x = 0 has normal +x (wetdem_collision_run) */
+    if (!su->spec.target_is_wall) {
+        nx = p[0].pos.x - p[1].pos.x;
+        ny = p[0].pos.y - p[1].pos.y;
+        nz = p[0].pos.z - p[1].pos.z;
+        double d = sqrt(nx * nx + ny * ny + nz * nz);
+        nx /= d;
+        ny /= d;
+        nz /= d;
+    }
+    const struct wetdem_vec3 v = p[0].vel;
+    double vn = v.x * nx + v.y * ny + v.z * nz;
+    double tx = v.x - vn * nx, ty = v.y - vn * ny, tz = v.z - vn * nz;
+    su->striker_speed_out = sqrt(v.x * v.x + v.y * v.y + v.z * v.z);
+    su->striker_angle_out = atan2(sqrt(tx * tx + ty * ty + tz * tz), fabs(vn));
+}
+
+void cli_csv_result_header(FILE* f)
+{
+    struct cli_setup su = {0};
+    struct wetdem_collision_result r = {0};
+    struct cli_field fields[CLI_MAX_FIELDS];
+    size_t n = cli_result_fields(&su, &r, fields);
+    for (size_t k = 0; k < n; k++) {
+        const char* unit = fields[k].kind == CLI_FIELD_BOOL   ? "0/1"
+                           : fields[k].kind == CLI_FIELD_TEXT  ? "word"
+                           : fields[k].kind == CLI_FIELD_COUNT ? "count"
+                                                               : fields[k].unit;
+        fprintf(f, "%s%s [%s]", k ? "," : "", fields[k].name, unit);
+    }
+}
+
+static void csv_value(FILE* f, const struct cli_field* x)
+{
+    switch (x->kind) {
+    case CLI_FIELD_NUMBER: fprintf(f, "%.12g", x->number); break;
+    case CLI_FIELD_BOOL: fputc(x->flag ? '1' : '0', f); break;
+    case CLI_FIELD_TEXT: fputs(x->text, f); break;
+    case CLI_FIELD_COUNT: fprintf(f, "%llu", x->count); break;
+    }
+}
+
+void cli_csv_result_row(FILE* f, const struct cli_setup* su,
+                        const struct wetdem_collision_result* r)
+{
+    struct cli_field fields[CLI_MAX_FIELDS];
+    size_t n = cli_result_fields(su, r, fields);
+    for (size_t k = 0; k < n; k++) {
+        if (k)
+            fputc(',', f);
+        csv_value(f, &fields[k]);
+    }
+}
+
+void cli_summary_text(FILE* f, const struct cli_scenario* sc, const struct cli_setup* su,
+                      const struct wetdem_collision_result* r)
+{
+    fprintf(f, "scenario %s: %s integrator, St_n = %.6g, impact speed %.6g m/s\n", sc->file,
+            wetdem_sim_integrator_name(su->sim), su->stokes_n, su->impact_speed);
+    struct cli_field fields[CLI_MAX_FIELDS];
+    size_t n = cli_result_fields(su, r, fields);
+    for (size_t k = 0; k < n; k++) {
+        fprintf(f, "  %-22s ", fields[k].name);
+        if (fields[k].kind == CLI_FIELD_NUMBER)
+            fprintf(f, "%-14.8g", fields[k].number);
+        else if (fields[k].kind == CLI_FIELD_BOOL)
+            fprintf(f, "%-14s", fields[k].flag ? "yes" : "no");
+        else if (fields[k].kind == CLI_FIELD_TEXT)
+            fprintf(f, "%-14s", fields[k].text);
+        else
+            fprintf(f, "%-14llu", fields[k].count);
+        fprintf(f, " %-6s %s\n", fields[k].unit, fields[k].doc);
+    }
+}
+
+void cli_json_number(FILE* f, double v)
+{
+    if (isfinite(v))
+        fprintf(f, "%.17g", v);
+    else
+        fputs("null", f);
+}
+
+void cli_json_string(FILE* f, const char* s)
+{
+    fputc('"', f);
+    for (const char* p = s; *p; p++) {
+        if (*p == '"' || *p == '\\')
+            fputc('\\', f);
+        if ((unsigned char)*p < 0x20)
+            fprintf(f, "\\u%04x", (unsigned)(unsigned char)*p);
+        else
+            fputc(*p, f);
+    }
+    fputc('"', f);
+}
+
+static void json_fields(FILE* f, const struct cli_field* fields, size_t n, bool units)
+{
+    for (size_t k = 0; k < n; k++) {
+        fprintf(f, "%s\n    \"%s\": ", k ? "," : "", fields[k].name);
+        if (units)
+            cli_json_string(f, fields[k].unit);
+        else if (fields[k].kind == CLI_FIELD_NUMBER)
+            cli_json_number(f, fields[k].number);
+        else if (fields[k].kind == CLI_FIELD_BOOL)
+            fputs(fields[k].flag ? "true" : "false", f);
+        else if (fields[k].kind == CLI_FIELD_TEXT)
+            cli_json_string(f, fields[k].text);
+        else
+            fprintf(f, "%llu", fields[k].count);
+    }
+}
+
+void cli_summary_json(FILE* f, const struct cli_scenario* sc, const struct cli_setup* su,
+                      const struct wetdem_collision_result* r)
+{
+    fprintf(f, "{\n  \"wetdem\": \"%s\",\n  \"git\": \"%s\",\n  \"scenario\": ", WETDEM_VERSION,
+            WETDEM_GIT_HASH);
+    cli_json_string(f, sc->file);
+    fputs(",\n  \"integrator\": ", f);
+    cli_json_string(f, wetdem_sim_integrator_name(su->sim));
+    fputs(",\n  \"setup\": {\n    \"m_eff\": ", f);
+    cli_json_number(f, su->m_eff);
+    fputs(",\n    \"r_eff\": ", f);
+    cli_json_number(f, su->r_eff);
+    fputs(",\n    \"t_end\": ", f);
+    cli_json_number(f, su->spec.t_end);
+    fputs(",\n    \"angle\": ", f);
+    cli_json_number(f, su->spec.angle * RAD2DEG);
+    fputs("\n  },\n  \"setup_units\": {\"m_eff\": \"kg\", \"r_eff\": \"m\", \"t_end\": \"s\", "
+          "\"angle\": \"deg\"},\n  \"result\": {",
+          f);
+    struct cli_field fields[CLI_MAX_FIELDS];
+    size_t n = cli_result_fields(su, r, fields);
+    json_fields(f, fields, n, false);
+    fputs("\n  },\n  \"units\": {", f);
+    json_fields(f, fields, n, true);
+    fputs("\n  }\n}\n", f);
+}
+
+void cli_events_csv(FILE* f, const struct wetdem_sim* sim, int argc, char** argv)
+{
+    cli_print_provenance(f, argc, argv);
+    fputs("time [s],event [word],i [index],j [index],is_wall [0/1],gap [m],v_n [m/s]\n", f);
+    size_t n = 0;
+    const struct wetdem_event_record* ev = wetdem_sim_events(sim, &n);
+    for (size_t k = 0; k < n; k++)
+        fprintf(f, "%.12g,%s,%zu,%zu,%d,%.12g,%.12g\n", ev[k].time,
+                wetdem_event_kind_name(ev[k].kind), ev[k].i, ev[k].j, ev[k].is_wall ? 1 : 0,
+                ev[k].gap, ev[k].v_n);
+}
+
+static void trajectory_header(struct cli_trajectory* t, size_t n)
+{
+    cli_print_provenance(t->f, t->argc, t->argv);
+    fputs("time [s]", t->f);
+    static const char* const names[] = {"x", "y", "z", "vx", "vy", "vz", "wx", "wy", "wz"};
+    static const char* const units[] = {"m", "m", "m", "m/s", "m/s", "m/s", "rad/s", "rad/s",
+                                        "rad/s"};
+    for (size_t p = 0; p < n; p++)
+        for (size_t k = 0; k < 9; k++)
+            fprintf(t->f, ",%s_%c [%s]", names[k], p == 0 ? 'i' : 'j', units[k]);
+    fputs(",gap [m],v_n [m/s]\n", t->f);
+    t->header_done = true;
+}
+
+/* Gap [m] and normal approach speed [m/s] of the striker and the target. */
+static void pair_gap(const struct wetdem_sim* sim, const struct cli_trajectory* t, double* gap,
+                     double* v_n)
+{
+    size_t n = 0;
+    const struct wetdem_particle* p = wetdem_sim_particles_const(sim, &n);
+    *gap = NAN;
+    *v_n = NAN;
+    if (t->target_is_wall) {
+        /* wetdem_sim_pair_force writes to sim only on failure (its message buffer). */
+        struct wetdem_contact c;
+        struct wetdem_pair_force f;
+        if (n >= 1 && wetdem_sim_pair_force((struct wetdem_sim*)sim, 0, (size_t)-1, &c, &f) ==
+                          WETDEM_OK) {
+            *gap = c.gap;
+            *v_n = c.v_n;
+        }
+        return;
+    }
+    if (n < 2)
+        return;
+    double dx = p[0].pos.x - p[1].pos.x, dy = p[0].pos.y - p[1].pos.y,
+           dz = p[0].pos.z - p[1].pos.z;
+    double d = sqrt(dx * dx + dy * dy + dz * dz);
+    *gap = d - p[0].radius - p[1].radius;
+    double dvx = p[0].vel.x - p[1].vel.x, dvy = p[0].vel.y - p[1].vel.y,
+           dvz = p[0].vel.z - p[1].vel.z;
+    *v_n = -(dx * dvx + dy * dvy + dz * dvz) / d;
+}
+
+int cli_trajectory_observe(const struct wetdem_sim* sim, void* ctx)
+{
+    struct cli_trajectory* t = ctx;
+    size_t n = 0;
+    const struct wetdem_particle* p = wetdem_sim_particles_const(sim, &n);
+    if (n > 2)
+        n = 2;
+    if (!t->header_done)
+        trajectory_header(t, n);
+    fprintf(t->f, "%.12g", wetdem_sim_time(sim));
+    for (size_t k = 0; k < n; k++) {
+        const double v[9] = {p[k].pos.x, p[k].pos.y, p[k].pos.z, p[k].vel.x, p[k].vel.y,
+                             p[k].vel.z, p[k].omega.x, p[k].omega.y, p[k].omega.z};
+        for (size_t m = 0; m < 9; m++)
+            fprintf(t->f, ",%.12g", v[m]);
+    }
+    double gap, v_n;
+    pair_gap(sim, t, &gap, &v_n);
+    fprintf(t->f, ",%.12g,%.12g\n", gap, v_n);
+    return ferror(t->f) ? 1 : 0;
+}

@@ -1,0 +1,74 @@
+/*
+ * output_csv.h — writers of what `wetdem run` and `wetdem sweep` report: the collision summary
+ * (text, JSON, or one CSV row), the trajectory CSV (an observer) and the event-log CSV.
+ *
+ * Every CSV starts with '#' provenance lines (version, git hash, command) and a header whose
+ * columns name the quantity and its unit, "name [unit]". Numbers are printed with %.12g (12
+ * significant digits: well below every tolerance the validation uses, and the same bits
+ * for the same input); NaN is "nan" in CSV and null in JSON; booleans are 0/1 in CSV.
+ */
+#ifndef WETDEM_CLI_OUTPUT_CSV_H
+#define WETDEM_CLI_OUTPUT_CSV_H
+
+#include <stdio.h>
+
+#include "scenario.h"
+
+enum cli_field_kind { CLI_FIELD_NUMBER, CLI_FIELD_BOOL, CLI_FIELD_TEXT, CLI_FIELD_COUNT };
+
+/* One reported quantity. */
+struct cli_field {
+    const char* name;
+    const char* unit; /* "-" for dimensionless, "" for words, flags and counts */
+    const char* doc;
+    enum cli_field_kind kind;
+    double number;
+    bool flag;
+    const char* text;
+    unsigned long long count;
+};
+
+#define CLI_MAX_FIELDS 48
+
+/* Fills out (CLI_MAX_FIELDS entries) with every field of a collision result, in a fixed
+ * order, plus the impact speed of the setup; returns the count. Angles are in degrees. */
+size_t cli_result_fields(const struct cli_setup* su, const struct wetdem_collision_result* r,
+                         struct cli_field* out);
+
+/* Records what the result struct lacks from the final state of su->sim: the striker's own
+ * speed and the angle of its velocity to the line of centres, theta_i,1 of Nijssen Fig. 1c,
+ * atan2(|v_t|, |v . n|) in [0, pi/2] (n: the final line of centres, or the wall normal). */
+void cli_setup_capture(struct cli_setup* su);
+
+/* CSV header "name [unit],..." of the result fields (no newline). */
+void cli_csv_result_header(FILE* f);
+/* CSV row of the result fields (no newline). */
+void cli_csv_result_row(FILE* f, const struct cli_setup* su,
+                        const struct wetdem_collision_result* r);
+/* The result as aligned "name  value  unit  meaning" lines. */
+void cli_summary_text(FILE* f, const struct cli_scenario* sc, const struct cli_setup* su,
+                      const struct wetdem_collision_result* r);
+/* The result as one JSON object (version, scenario, integrator, result, units). */
+void cli_summary_json(FILE* f, const struct cli_scenario* sc, const struct cli_setup* su,
+                      const struct wetdem_collision_result* r);
+/* The event log of sim as CSV, with provenance lines. */
+void cli_events_csv(FILE* f, const struct wetdem_sim* sim, int argc, char** argv);
+
+/* Trajectory writer: pass as the observer context of wetdem_sim_set_observer(). */
+struct cli_trajectory {
+    FILE* f;
+    bool header_done;
+    bool target_is_wall;
+    int argc;
+    char** argv;
+};
+/* Observer writing one row: time, position, velocity and spin of each particle, the gap and
+ * the normal approach speed of the pair. Returns 0, or 1 if the file cannot be written. */
+int cli_trajectory_observe(const struct wetdem_sim* sim, void* ctx);
+
+/* A number as JSON (null for NaN or infinity). */
+void cli_json_number(FILE* f, double v);
+/* A string as JSON (quotes and backslashes escaped). */
+void cli_json_string(FILE* f, const char* s);
+
+#endif

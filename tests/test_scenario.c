@@ -1,0 +1,378 @@
+/*
+ * test_scenario.c — scenario files, `wetdem run` and `wetdem sweep` end to end through the CLI
+ * ($WETDEM_CLI, set by `make test`; the working directory is the repository root):
+ *   - every example scenario checks (`run --check`) and resolves the Stokes number to the
+ *     speed of the hand calculation v = St_n 6 pi mu R*^2 / (m* cos angle);
+ *   - each kind of bad file (missing, malformed line, unknown section or key with a "did you
+ *     mean" hint, NaN, inf, negative radius, out of range, duplicate key, speed and stokes
+ *     both given, unknown material) exits 2 with "FILE:LINE:" naming the right line;
+ *   - --set overrides change the resolved set-up and are checked like file keys;
+ *   - docs/scenarios.md contains the key tables `wetdem docs-scenarios` generates;
+ *   - `run --out` writes trajectory, events and summary with unit headers, and nothing at all
+ *     when the input is bad or the run fails;
+ *   - `sweep` rows come in input order and are bit-identical with 1 and 2 threads.
+ */
+#include <stdlib.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "harness.h"
+
+struct run {
+    char* out;
+    int code;
+};
+
+static char tmpdir[256];
+
+static const char* cli_path(void)
+{
+    const char* p = getenv("WETDEM_CLI");
+    return p && *p ? p : "build/wetdem";
+}
+
+/* Runs a shell command line "ENV '$WETDEM_CLI' args"; stdout (and stderr if with_stderr). */
+static struct run run_env(const char* env, const char* args, bool with_stderr)
+{
+    char cmd[4096];
+    snprintf(cmd, sizeof cmd, "%s '%s' %s %s", env, cli_path(), args,
+             with_stderr ? "2>&1" : "2>/dev/null");
+    FILE* p = popen(cmd, "r");
+    if (!p)
+        fail_msg("popen failed for: %s", cmd);
+    size_t cap = 1 << 16, len = 0, got;
+    char* out = malloc(cap);
+    assert_non_null(out);
+    while ((got = fread(out + len, 1, cap - len - 1, p)) > 0) {
+        len += got;
+        if (cap - len - 1 == 0) {
+            cap *= 2;
+            out = realloc(out, cap);
+            assert_non_null(out);
+        }
+    }
+    out[len] = '\0';
+    int status = pclose(p);
+    return (struct run){out, WIFEXITED(status) ? WEXITSTATUS(status) : -1};
+}
+
+static struct run run_cli(const char* args)
+{
+    return run_env("", args, true);
+}
+
+/* Writes text to tmpdir/name; returns the path (static buffer rotation of 4). */
+static const char* write_file(const char* name, const char* text)
+{
+    static char paths[4][512];
+    static int next = 0;
+    char* path = paths[next++ % 4];
+    snprintf(path, 512, "%s/%s", tmpdir, name);
+    FILE* f = fopen(path, "w");
+    assert_non_null(f);
+    fputs(text, f);
+    fclose(f);
+    return path;
+}
+
+/* Value of "key  <number>" in `run --check` output. */
+static double check_value(const char* out, const char* key)
+{
+    const char* p = strstr(out, key);
+    if (!p)
+        fail_msg("'%s' not in output:\n%s", key, out);
+    return strtod(p + strlen(key), NULL);
+}
+
+static int setup(void** state)
+{
+    (void)state;
+    snprintf(tmpdir, sizeof tmpdir, "/tmp/wetdem_test_scenario_XXXXXX");
+    if (!mkdtemp(tmpdir))
+        return -1;
+    return 0;
+}
+
+static int teardown(void** state)
+{
+    (void)state;
+    char cmd[600];
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", tmpdir);
+    return system(cmd) == 0 ? 0 : -1;
+}
+
+static void test_scenario_examples_check(void** state)
+{
+    (void)state;
+    const char* files[] = {"nijssen_head_on", "nijssen_oblique", "wall_collision", "dry_hertz",
+                           "punch_oblique"};
+    for (size_t k = 0; k < sizeof files / sizeof files[0]; k++) {
+        char args[256];
+        snprintf(args, sizeof args, "run examples/scenarios/%s.ini --check", files[k]);
+        struct run r = run_cli(args);
+        if (r.code != 0)
+            fail_msg("%s: exit %d\n%s", files[k], r.code, r.out);
+        CHECK_CONTAINS(r.out, "is valid");
+        free(r.out);
+    }
+}
+
+/* Delrin spheres (R = 6.35 mm, rho = 1400 kg/m^3) head-on in water (mu = 1e-3 Pa s), St = 100:
+ *   m = 1400 (4/3) pi 0.00635^3 = 1.50154e-3 kg, m* = m/2 = 7.50772e-4 kg, R* = 3.175e-3 m,
+ *   6 pi mu R*^2 = 1.900153e-7 kg/s, v = 100 x 1.900153e-7 / 7.50772e-4 = 0.0253093 m/s.
+ * Wall, Steel I (7780 kg/m^3), St = 50: m* = m = 8.34429e-3 kg, R* = R = 6.35e-3 m,
+ *   v = 50 x 6 pi 1e-3 0.00635^2 / 8.34429e-3 = 4.55438e-3 m/s.
+ * Oblique at 30 deg with St_n = 100: v = 0.0253093 / cos(30 deg) = 0.0292247 m/s.
+ * Tolerance 1e-6: the hand values carry 6-7 digits; the CLI prints 10. */
+static void test_scenario_stokes_gives_speed(void** state)
+{
+    (void)state;
+    struct run r = run_cli("run examples/scenarios/nijssen_head_on.ini --check");
+    assert_int_equal(r.code, 0);
+    CHECK_REL(check_value(r.out, "impact_speed"), 0.0253093363, 1e-6);
+    CHECK_REL(check_value(r.out, "m_eff"), 7.50771582e-4, 1e-6);
+    CHECK_REL(check_value(r.out, "stokes_n"), 100.0, 1e-9);
+    free(r.out);
+    r = run_cli("run examples/scenarios/wall_collision.ini --check");
+    assert_int_equal(r.code, 0);
+    CHECK_REL(check_value(r.out, "impact_speed"), 4.55437929e-3, 1e-6);
+    CHECK_REL(check_value(r.out, "r_eff"), 6.35e-3, 1e-12);
+    free(r.out);
+    r = run_cli("run examples/scenarios/nijssen_oblique.ini --check");
+    assert_int_equal(r.code, 0);
+    CHECK_REL(check_value(r.out, "impact_speed"), 0.0253093363 / cos(M_PI / 6), 1e-6);
+    free(r.out);
+}
+
+static void test_scenario_set_overrides(void** state)
+{
+    (void)state;
+    /* St is linear in v: St = 50 halves the St = 100 speed exactly (to print precision). */
+    struct run r = run_cli("run examples/scenarios/nijssen_head_on.ini --check "
+                           "--set collision.stokes=50");
+    assert_int_equal(r.code, 0);
+    CHECK_REL(check_value(r.out, "impact_speed"), 0.0253093363 / 2, 1e-6);
+    free(r.out);
+    /* a speed given on the command line replaces the file's Stokes number */
+    r = run_cli("run examples/scenarios/nijssen_head_on.ini --check --set collision.speed=0.1");
+    assert_int_equal(r.code, 0);
+    CHECK_REL(check_value(r.out, "impact_speed"), 0.1, 1e-12);
+    free(r.out);
+    /* model parameter by its library name, and a material field */
+    r = run_cli("run examples/scenarios/nijssen_head_on.ini --check --set nijssen.cutoff_ratio=2 "
+                "--set fluid.viscosity=2e-3");
+    assert_int_equal(r.code, 0);
+    CHECK_REL(check_value(r.out, "impact_speed"), 2 * 0.0253093363, 1e-6);
+    free(r.out);
+    r = run_cli("run examples/scenarios/nijssen_head_on.ini --check --set collision.stoke=5");
+    assert_int_equal(r.code, 2);
+    CHECK_CONTAINS(r.out, "did you mean 'stokes'");
+    free(r.out);
+    r = run_cli("run examples/scenarios/nijssen_head_on.ini --check "
+                "--set nijssen.cutoff_ratio=-1");
+    assert_int_equal(r.code, 2);
+    CHECK_CONTAINS(r.out, "cutoff_ratio");
+    CHECK_CONTAINS(r.out, "out of range");
+    free(r.out);
+    r = run_cli("run examples/scenarios/nijssen_head_on.ini --check --set integrator.rtoll=1");
+    assert_int_equal(r.code, 2);
+    CHECK_CONTAINS(r.out, "rtol");
+    free(r.out);
+}
+
+struct bad_case {
+    const char* name;
+    const char* text;
+    const char* where;   /* expected "FILE:LINE:" suffix, e.g. ":3:" */
+    const char* message; /* expected part of the message */
+};
+
+static void test_scenario_bad_files_exit_2_with_line(void** state)
+{
+    (void)state;
+    static const struct bad_case cases[] = {
+        {"malformed", "[collision]\nstokes = 5\nstriker delrin\n", ":3:", "malformed line"},
+        {"section", "[collision]\nstokes = 5\n[fluids]\nviscosity = 1\n", ":3:",
+         "did you mean [fluid]"},
+        {"key", "[collision]\nstokse = 5\n", ":2:", "did you mean 'stokes'"},
+        {"nan", "[collision]\n\nstokes = nan\n", ":3:", "not a finite number"},
+        {"inf", "[collision]\nspeed = inf\n", ":2:", "not a finite number"},
+        {"radius", "[collision]\nstokes = 5\nstriker_radius = -0.01\n", ":3:", "out of range"},
+        {"angle", "[collision]\nstokes = 5\nangle_deg = 90\n", ":3:", "valid [0, 90)"},
+        {"duplicate", "[collision]\nstokes = 5\nstokes = 6\n", ":3:", "given twice"},
+        {"both", "[collision]\nstokes = 5\nspeed = 0.1\n", ":3:", "not both"},
+        {"material", "[collision]\nstriker = delrn\nstokes = 5\n", ":2:", "did you mean 'delrin'"},
+        {"matfield", "[collision]\nstokes = 5\n[material.m]\npreset = delrin\nroughness = -1\n",
+         ":5:", "roughness"},
+        {"model", "[collision]\nstokes = 5\n[models]\nforce = nijsen\n", ":4:",
+         "did you mean 'nijssen'"},
+        {"notenabled", "[collision]\nstokes = 5\n[model.nijssen]\ncutoff_ratio = 2\n", ":4:",
+         "not enabled"},
+        {"nospeed", "[collision]\nstriker = delrin\n", ":1:", "speed > 0"},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        char name[64], args[700], where[600];
+        snprintf(name, sizeof name, "bad_%s.ini", cases[k].name);
+        const char* path = write_file(name, cases[k].text);
+        snprintf(args, sizeof args, "run '%s' --check", path);
+        struct run r = run_cli(args);
+        if (r.code != 2)
+            fail_msg("%s: exit %d, expected 2\n%s", cases[k].name, r.code, r.out);
+        snprintf(where, sizeof where, "%s%s", path, cases[k].where);
+        CHECK_CONTAINS(r.out, where);
+        CHECK_CONTAINS(r.out, cases[k].message);
+        free(r.out);
+    }
+    struct run r = run_cli("run /nonexistent/scenario.ini");
+    assert_int_equal(r.code, 2);
+    CHECK_CONTAINS(r.out, "cannot open scenario file");
+    free(r.out);
+}
+
+/* docs/scenarios.md must contain exactly what `wetdem docs-scenarios` generates. */
+static void test_scenario_docs_list_every_key(void** state)
+{
+    (void)state;
+    struct run r = run_env("", "docs-scenarios", false);
+    assert_int_equal(r.code, 0);
+    FILE* f = fopen("docs/scenarios.md", "r");
+    if (!f)
+        fail_msg("docs/scenarios.md missing");
+    static char doc[1 << 18];
+    size_t n = fread(doc, 1, sizeof doc - 1, f);
+    doc[n] = '\0';
+    fclose(f);
+    if (!strstr(doc, r.out))
+        fail_msg("docs/scenarios.md is stale: regenerate its tables with "
+                 "'build/wetdem docs-scenarios' (see the top of the file)");
+    CHECK_CONTAINS(r.out, "`stokes`");
+    CHECK_CONTAINS(r.out, "`[model.NAME]`");
+    free(r.out);
+}
+
+static bool exists(const char* dir, const char* name)
+{
+    char path[700];
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    struct stat st;
+    return stat(path, &st) == 0;
+}
+
+static void test_scenario_run_writes_files_or_nothing(void** state)
+{
+    (void)state;
+    char out[400], args[900];
+    /* a bad --set: nothing written, not even the directory */
+    snprintf(out, sizeof out, "%s/bad_run", tmpdir);
+    snprintf(args, sizeof args,
+             "run examples/scenarios/dry_hertz.ini --out '%s' --set collision.speed=-1", out);
+    struct run r = run_cli(args);
+    assert_int_equal(r.code, 2);
+    free(r.out);
+    assert_false(exists(out, "."));
+    /* a run that fails (step budget of 10 Verlet steps): exit 1 and no file left behind */
+    snprintf(out, sizeof out, "%s/failed_run", tmpdir);
+    snprintf(args, sizeof args,
+             "run examples/scenarios/dry_hertz.ini --out '%s' --set integrator.max_steps=10", out);
+    r = run_cli(args);
+    assert_int_equal(r.code, 1);
+    free(r.out);
+    char cmd[1200];
+    snprintf(cmd, sizeof cmd, "ls -A '%s' 2>/dev/null | wc -l", out);
+    FILE* p = popen(cmd, "r");
+    int count = -1;
+    assert_int_equal(fscanf(p, "%d", &count), 1);
+    pclose(p);
+    assert_int_equal(count, 0);
+    /* a good run: three files with unit headers; the dry Hertz run rebounds with e_dry */
+    snprintf(out, sizeof out, "%s/good_run", tmpdir);
+    snprintf(args, sizeof args, "run examples/scenarios/dry_hertz.ini --out '%s' --json", out);
+    r = run_cli(args);
+    if (r.code != 0)
+        fail_msg("exit %d\n%s", r.code, r.out);
+    CHECK_CONTAINS(r.out, "\"e\": 0.97");
+    free(r.out);
+    assert_true(exists(out, "trajectory.csv"));
+    assert_true(exists(out, "events.csv"));
+    assert_true(exists(out, "summary.json"));
+    snprintf(cmd, sizeof cmd, "head -3 '%s/trajectory.csv'; head -3 '%s/events.csv'", out, out);
+    p = popen(cmd, "r");
+    static char head[8192];
+    size_t n = fread(head, 1, sizeof head - 1, p);
+    head[n] = '\0';
+    pclose(p);
+    CHECK_CONTAINS(head, "# wetdem " WETDEM_VERSION);
+    CHECK_CONTAINS(head, "time [s],x_i [m]");
+    CHECK_CONTAINS(head, "gap [m]");
+    CHECK_CONTAINS(head, "time [s],event [word]");
+}
+
+/* Data lines (not starting with '#') of a sweep. */
+static char* data_lines(const char* text)
+{
+    char* out = calloc(strlen(text) + 1, 1);
+    const char* line = text;
+    while (*line) {
+        const char* end = strchr(line, '\n');
+        size_t len = end ? (size_t)(end - line + 1) : strlen(line);
+        if (line[0] != '#')
+            strncat(out, line, len);
+        line += len;
+    }
+    return out;
+}
+
+static void test_scenario_sweep_order_and_threads(void** state)
+{
+    (void)state;
+    const char* args = "sweep examples/scenarios/nijssen_head_on.ini --param collision.stokes "
+                       "--values 5:500:12 --log";
+    struct run r1 = run_env("OMP_NUM_THREADS=1", args, false);
+    struct run r2 = run_env("OMP_NUM_THREADS=2", args, false);
+    assert_int_equal(r1.code, 0);
+    assert_int_equal(r2.code, 0);
+    char* d1 = data_lines(r1.out);
+    char* d2 = data_lines(r2.out);
+    if (strcmp(d1, d2) != 0)
+        fail_msg("sweep differs between 1 and 2 threads:\n%s\n---\n%s", d1, d2);
+    CHECK_CONTAINS(d1, "collision.stokes [-],status [word],impact_speed [m/s]");
+    /* rows in input order: first column 5, 5 x 100^(1/11), ..., 500 (geometric) */
+    const char* line = strchr(d1, '\n') + 1;
+    for (int k = 0; k < 12; k++) {
+        double want = 5.0 * pow(100.0, k / 11.0);
+        CHECK_REL(strtod(line, NULL), want, 1e-11); /* printed with 12 digits */
+        line = strchr(line, '\n') + 1;
+    }
+    assert_int_equal(*line, '\0');
+    CHECK_CONTAINS(r1.out, "# totals: runs=12");
+    free(d1);
+    free(d2);
+    free(r1.out);
+    free(r2.out);
+    /* a bad value range writes nothing */
+    char cmd[900];
+    snprintf(cmd, sizeof cmd,
+             "sweep examples/scenarios/nijssen_head_on.ini --param collision.angle_deg "
+             "--values 0:120:3 --out '%s/sweep.csv'",
+             tmpdir);
+    struct run r = run_cli(cmd);
+    assert_int_equal(r.code, 2);
+    CHECK_CONTAINS(r.out, "angle_deg");
+    free(r.out);
+    assert_false(exists(tmpdir, "sweep.csv"));
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_scenario_examples_check),
+        cmocka_unit_test(test_scenario_stokes_gives_speed),
+        cmocka_unit_test(test_scenario_set_overrides),
+        cmocka_unit_test(test_scenario_bad_files_exit_2_with_line),
+        cmocka_unit_test(test_scenario_docs_list_every_key),
+        cmocka_unit_test(test_scenario_run_writes_files_or_nothing),
+        cmocka_unit_test(test_scenario_sweep_order_and_threads),
+    };
+    return cmocka_run_group_tests(tests, setup, teardown);
+}
