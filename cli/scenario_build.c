@@ -191,7 +191,27 @@ static int build_models(const struct cli_scenario* sc, struct wetdem_sim* sim)
     return CLI_EXIT_OK;
 }
 
-/* [integrator] name and parameters ("<name>.<key>"), [sim] settings ("sim.<key>"). */
+/* Whether an integrator other than `chosen` has the parameter `key`. */
+static bool other_integrator_has(const char* chosen, const char* key)
+{
+    struct wetdem_sim* probe = wetdem_sim_create();
+    const char* const* names = wetdem_integrator_names();
+    bool found = false;
+    for (size_t k = 0; probe && names[k] && !found; k++) {
+        char full[CLI_VALUE_MAX + CLI_NAME_MAX + 2];
+        snprintf(full, sizeof full, "%s.%s", names[k], key);
+        double v;
+        found = strcmp(names[k], chosen) != 0 &&
+                wetdem_sim_set_integrator(probe, names[k]) == WETDEM_OK &&
+                wetdem_sim_param(probe, full, &v) == WETDEM_OK;
+    }
+    wetdem_sim_free(probe);
+    return found;
+}
+
+/* [integrator] name and parameters ("<name>.<key>"), [sim] settings ("sim.<key>").
+ * Parameters of an integrator other than the chosen one are skipped, so a file tuned for
+ * cvode also runs with --set integrator.name=verlet; a key no integrator has is an error. */
 static int build_integrator(const struct cli_scenario* sc, struct wetdem_sim* sim)
 {
     const struct cli_entry* e = cli_scenario_find(sc, "integrator", "name");
@@ -209,6 +229,10 @@ static int build_integrator(const struct cli_scenario* sc, struct wetdem_sim* si
             continue;
         char full[CLI_VALUE_MAX + CLI_NAME_MAX + 2];
         snprintf(full, sizeof full, "%s.%s", is_integrator ? name : "sim", p->key);
+        double current;
+        if (is_integrator && wetdem_sim_param(sim, full, &current) == WETDEM_ERR_NOT_FOUND &&
+            other_integrator_has(name, p->key))
+            continue; /* a parameter of the integrator not chosen (e.g. --set name=verlet) */
         if (wetdem_sim_set_param_str(sim, full, p->value) != WETDEM_OK)
             return lib_error(sc, p, p->section, sim);
     }

@@ -91,8 +91,8 @@ static const char* const yes_no[] = {"no", "yes", NULL};
 static const struct cli_key_desc integrator_keys[] = {
     WORD("name", CLI_VALUE_NAME, "verlet", NULL,
          "verlet (fixed step, a fraction of the Hertz contact time) or cvode (adaptive, "
-         "with located events). The other keys are parameters of the chosen integrator, "
-         "checked by the library when the scenario is built."),
+         "with located events). The other keys are integrator parameters, checked by the library "
+         "when the scenario is built; those of an integrator not chosen are ignored."),
     NUM("dt_fraction", "-", NULL, 0, 1, true, false,
         "verlet: time step as a fraction of the Hertz contact time (Nijssen: 0.02)."),
     NUM("dt", "s", NULL, 0, 1, false, false,
