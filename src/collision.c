@@ -1,0 +1,417 @@
+/*
+ * collision.c — one binary collision on the soft engine and its analysis (SPEC §4,
+ * docs/engines.md "Collision analysis"). Prefix override: wetdem_collision_* and
+ * wetdem_outcome_*.
+ *
+ * Set-up: target j at rest at the origin (a sphere, or the wall x = 0 with normal +x); the
+ * striker i moves with speed U at the impact angle theta to the line of centres, placed so
+ * that the line of centres is +x when the gap first reaches the interaction range (free
+ * flight before). U from the normal Stokes number when U = 0 (SPEC §2; Nijssen Eq. 2 with the
+ * normal speed, Punch Eq. 2):  St_n = m* U cos(theta) / (6 pi mu R*^2).
+ * Runs to separation (gap >= rebound_gap_factor x range, receding) or t_end.
+ * With the relative velocity of centres dv = v_i - v_j, n0 = +x (first interaction) and n_f
+ * the normal at the final state:
+ *   e   = |dv_f| / |dv_0|                                   (Nijssen; Yang & Hunt)
+ *   e_n = -(dv_f . n_f) / (dv_0 . n0)                        (Punch Eq. 3)
+ *   e_t = -(u_f . t_f) / |u_0|,  u = tangential part of the contact-point velocity
+ *         (v_i + w_i x (-R_i n)) - (v_j + w_j x (R_j n)), t_f = u_0/|u_0| projected on the
+ *         final tangent plane; -1 smooth sliding, +1 full reversal (Walton's beta)
+ *   angle_in = atan2(|dv_0,t|, -dv_0 . n0),  angle_out = atan2(|dv_f,t|, dv_f . n_f).
+ * Outcome: stick if not separated by t_end; stick-rotate-separate if separated after the
+ * line of centres turned by more than 5 degrees after the closest approach while the gap
+ * stayed below h_close = 0.01 R* (a doublet rotating in near contact: a prompt bounce turns
+ * it by well under a degree); else bounce.
+ */
+#include <math.h>
+#include <string.h>
+
+#include "integrator.h"
+#include "vec3.h"
+
+#define SRS_ANGLE (5.0 * M_PI / 180.0) /* rotation that marks stick-rotate-separate [rad] */
+#define CLOSE_GAP_RATIO 0.01           /* h_close / R* [-] */
+#define START_MARGIN_RATIO 0.01        /* start gap beyond the range, / R* [-] */
+
+const char* wetdem_outcome_name(enum wetdem_outcome outcome)
+{
+    switch (outcome) {
+    case WETDEM_OUTCOME_STICK: return "stick";
+    case WETDEM_OUTCOME_STICK_ROTATE_SEPARATE: return "stick-rotate-separate";
+    case WETDEM_OUTCOME_BOUNCE: return "bounce";
+    }
+    return "unknown";
+}
+
+/* Per-step record of the pair (0, 1) or (0, wall 0), kept by the monitor. */
+struct tracker {
+    double r_eff;                  /* R* [m] */
+    double t_prev, gap_prev, vn_prev;
+    struct wetdem_vec3 n_prev, dv_prev;
+    double min_gap;
+    bool interacting;              /* after the first interaction */
+    double t_first;                /* time of the first interaction [s] */
+    double rotation, rotation_close;
+    size_t events_seen;
+    double t_observe;              /* absolute observation time [s], INFINITY if none yet */
+    double observe_span;           /* spec->observe_time [s] */
+    bool observed;
+    struct wetdem_vec3 n_obs, dv_obs;
+};
+
+static struct wetdem_vec3 relative_velocity(const struct wetdem_sim* sim)
+{
+    struct wetdem_vec3 v = sim->particles[0].vel;
+    return sim->n_walls ? v : vec3_sub(v, sim->particles[1].vel);
+}
+
+static void pair_contact(const struct wetdem_sim* sim, struct wetdem_contact* c)
+{
+    wetdem_sim_build_contact(sim, 0, 0 + (sim->n_walls ? 0 : 1), sim->n_walls > 0, c);
+}
+
+/* Smallest value of the cubic Hermite interpolant of the gap over a step in which the
+ * approach speed changed sign (h' = -v_n at both ends) [m]. */
+static double hermite_min(double dt, double h0, double vn0, double h1, double vn1)
+{
+    double m0 = -vn0 * dt, m1 = -vn1 * dt;
+    double a = 6 * h0 + 3 * m0 - 6 * h1 + 3 * m1, b = -6 * h0 - 4 * m0 + 6 * h1 - 2 * m1;
+    double roots[2] = {-1, -1}, best = fmin(h0, h1);
+    if (fabs(a) > 1e-300) {
+        double disc = b * b - 4 * a * m0;
+        if (disc >= 0) {
+            roots[0] = (-b + sqrt(disc)) / (2 * a);
+            roots[1] = (-b - sqrt(disc)) / (2 * a);
+        }
+    } else if (fabs(b) > 1e-300) {
+        roots[0] = -m0 / b;
+    }
+    for (int k = 0; k < 2; k++) {
+        double s = roots[k];
+        if (!(s > 0 && s < 1))
+            continue;
+        double p = (2 * s * s * s - 3 * s * s + 1) * h0 + (s * s * s - 2 * s * s + s) * m0 +
+                   (-2 * s * s * s + 3 * s * s) * h1 + (s * s * s - s * s) * m1;
+        best = fmin(best, p);
+    }
+    return best;
+}
+
+/* Scans new log entries for the first interaction start. */
+static void scan_events(const struct wetdem_sim* sim, struct tracker* tr)
+{
+    for (; tr->events_seen < sim->engine.n_events; tr->events_seen++) {
+        const struct wetdem_event_record* ev = &sim->engine.events[tr->events_seen];
+        if (ev->kind == WETDEM_EVENT_INTERACTION_START && !tr->interacting) {
+            tr->interacting = true;
+            tr->t_first = ev->time;
+            tr->t_observe = tr->observe_span > 0 ? ev->time + tr->observe_span : INFINITY;
+        }
+    }
+}
+
+/* Linear interpolation of the normal and relative velocity at t_observe inside the step. */
+static void observe_in_step(struct tracker* tr, double t, struct wetdem_vec3 n,
+                            struct wetdem_vec3 dv)
+{
+    if (tr->observed || !(t >= tr->t_observe))
+        return;
+    double s = t > tr->t_prev ? (tr->t_observe - tr->t_prev) / (t - tr->t_prev) : 1.0;
+    s = fmin(fmax(s, 0.0), 1.0);
+    tr->n_obs = vec3_add(vec3_scale(tr->n_prev, 1 - s), vec3_scale(n, s));
+    tr->dv_obs = vec3_add(vec3_scale(tr->dv_prev, 1 - s), vec3_scale(dv, s));
+    tr->observed = true;
+}
+
+static int monitor(struct wetdem_sim* sim, void* ctx)
+{
+    struct tracker* tr = ctx;
+    struct wetdem_contact c;
+    pair_contact(sim, &c);
+    double t = sim->engine.time;
+    struct wetdem_vec3 dv = relative_velocity(sim);
+    scan_events(sim, tr);
+    double low = c.gap;
+    if (tr->vn_prev > 0 && c.v_n <= 0)
+        low = fmin(low, hermite_min(t - tr->t_prev, tr->gap_prev, tr->vn_prev, c.gap, c.v_n));
+    if (low < tr->min_gap) {
+        tr->min_gap = low;
+        tr->rotation_close = 0.0; /* count the rotation after the closest approach only */
+    }
+    if (tr->interacting) {
+        double turn = atan2(vec3_norm(vec3_cross(tr->n_prev, c.normal)),
+                            vec3_dot(tr->n_prev, c.normal));
+        tr->rotation += turn;
+        double h_close = CLOSE_GAP_RATIO * tr->r_eff;
+        if (tr->gap_prev < h_close && c.gap < h_close)
+            tr->rotation_close += turn;
+    }
+    observe_in_step(tr, t, c.normal, dv);
+    tr->t_prev = t;
+    tr->gap_prev = c.gap;
+    tr->vn_prev = c.v_n;
+    tr->n_prev = c.normal;
+    tr->dv_prev = dv;
+    return WETDEM_OK;
+}
+
+/* Checks every field of the spec; the message names the field, its value and the range. */
+static int check_spec(struct wetdem_sim* sim, const struct wetdem_collision_spec* s)
+{
+    int nm = sim->n_materials;
+    if (s->material_i < 0 || s->material_i >= nm || s->material_j < 0 || s->material_j >= nm)
+        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
+                               "collision: material_i = %d, material_j = %d: valid 0..%d",
+                               s->material_i, s->material_j, nm - 1);
+    if (!(isfinite(s->radius_i) && s->radius_i > 0) ||
+        (!s->target_is_wall && !(isfinite(s->radius_j) && s->radius_j > 0)))
+        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
+                               "collision: radius_i = %g m, radius_j = %g m: must be finite "
+                               "and > 0",
+                               s->radius_i, s->radius_j);
+    if (!(isfinite(s->angle) && s->angle >= 0 && s->angle < M_PI / 2))
+        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
+                               "collision: angle = %g rad: valid [0, pi/2)", s->angle);
+    if (!(isfinite(s->speed) && s->speed >= 0))
+        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
+                               "collision: speed = %g m/s: valid [0, inf), 0 = from stokes",
+                               s->speed);
+    if (s->speed == 0 && !(isfinite(s->stokes) && s->stokes > 0 && s->angle < M_PI / 2 &&
+                           sim->fluid.viscosity > 0))
+        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
+                               "collision: speed 0 asks for it from stokes = %g (valid > 0), "
+                               "which needs angle < pi/2 (%g rad) and fluid.viscosity > 0 "
+                               "(%g Pa s)",
+                               s->stokes, s->angle, sim->fluid.viscosity);
+    if (!vec3_is_finite(s->omega_i) || !isfinite(s->initial_gap))
+        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
+                               "collision: omega_i and initial_gap must be finite");
+    if (!(isfinite(s->t_end) && s->t_end > 0) ||
+        !(isfinite(s->observe_time) && s->observe_time >= 0))
+        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
+                               "collision: t_end = %g s (valid > 0), observe_time = %g s "
+                               "(valid >= 0)",
+                               s->t_end, s->observe_time);
+    if (!(s->rebound_gap_factor == 0 || (isfinite(s->rebound_gap_factor) &&
+                                         s->rebound_gap_factor >= 1)))
+        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
+                               "collision: rebound_gap_factor = %g: valid 0 (= 1) or >= 1",
+                               s->rebound_gap_factor);
+    return WETDEM_OK;
+}
+
+/* Geometry of the pair, known once both bodies exist. */
+struct setup {
+    double range, r_eff, m_eff; /* [m], [m], [kg] */
+    double speed, speed_n0;     /* [m/s] */
+};
+
+/* Distance back along the approach line from the first-interaction point at which the centre
+ * distance is s, for first-interaction distance d and angle theta (|D x - v d| = s) [m]. */
+static double back_distance(double d, double s, double theta)
+{
+    double c = cos(theta), sn = sin(theta);
+    return -d * c + sqrt(fmax(s * s - d * d * sn * sn, 0.0));
+}
+
+/* Replaces the particles and walls by striker and target and sets the initial state. */
+static int place_bodies(struct wetdem_sim* sim, const struct wetdem_collision_spec* s,
+                        struct setup* out)
+{
+    wetdem_sim_reset(sim);
+    struct wetdem_particle pi = {.radius = s->radius_i, .material = s->material_i,
+                                 .omega = s->omega_i};
+    int st = wetdem_sim_add_particle(sim, pi);
+    if (st == WETDEM_OK && s->target_is_wall)
+        st = wetdem_sim_add_wall(sim, vec3(0, 0, 0), vec3(1, 0, 0), s->material_j);
+    struct wetdem_particle pj = {.radius = s->radius_j, .material = s->material_j,
+                                 .is_fixed = s->target_is_fixed};
+    if (st == WETDEM_OK && !s->target_is_wall)
+        st = wetdem_sim_add_particle(sim, pj);
+    if (st != WETDEM_OK)
+        return st;
+    double reach = s->radius_i + (s->target_is_wall ? 0.0 : s->radius_j);
+    sim->particles[0].pos = vec3(reach + 1.0, 0, 0); /* provisional, for the pair geometry */
+    struct wetdem_contact c;
+    pair_contact(sim, &c);
+    out->range = wetdem_sim_contact_range(sim, &c);
+    out->r_eff = c.r_eff;
+    out->m_eff = c.m_eff;
+    double cos_a = cos(s->angle);
+    out->speed = s->speed > 0 ? s->speed
+                              : s->stokes * 6 * M_PI * sim->fluid.viscosity * c.r_eff *
+                                    c.r_eff / (c.m_eff * cos_a);
+    out->speed_n0 = out->speed * cos_a;
+    double gap0 = s->initial_gap > 0 ? s->initial_gap
+                                     : out->range + START_MARGIN_RATIO * c.r_eff;
+    struct wetdem_vec3 dir = vec3(-cos_a, -sin(s->angle), 0); /* direction of motion of i */
+    double first = reach + out->range, back = 0.0;
+    if (s->target_is_wall)
+        back = cos_a > 0 ? fmax(gap0 - out->range, 0.0) / cos_a : 0.0;
+    else if (gap0 > out->range)
+        back = back_distance(first, reach + gap0, s->angle);
+    else
+        first = reach + gap0;
+    sim->particles[0].pos = vec3_axpy(vec3(first, 0, 0), -back, dir);
+    sim->particles[0].vel = vec3_scale(dir, out->speed);
+    return WETDEM_OK;
+}
+
+/* Runs with the separation stop and the monitor, restoring the caller's settings. */
+static int run(struct wetdem_sim* sim, const struct wetdem_collision_spec* s,
+               struct tracker* tr)
+{
+    struct wetdem_sim_settings saved = sim->settings;
+    sim->settings.stop_on_separation = 1;
+    sim->settings.separation_factor = s->rebound_gap_factor > 1 ? s->rebound_gap_factor : 1;
+    int (*saved_fn)(struct wetdem_sim*, void*) = sim->engine.monitor;
+    void* saved_ctx = sim->engine.monitor_ctx;
+    sim->engine.monitor = monitor;
+    sim->engine.monitor_ctx = tr;
+    int st = wetdem_sim_integrate(sim, s->t_end);
+    sim->settings = saved;
+    sim->engine.monitor = saved_fn;
+    sim->engine.monitor_ctx = saved_ctx;
+    return st;
+}
+
+/* Initial tracker state from the placed bodies. */
+static void start_tracker(const struct wetdem_sim* sim, const struct setup* su,
+                          const struct wetdem_collision_spec* s, struct tracker* tr)
+{
+    struct wetdem_contact c;
+    pair_contact(sim, &c);
+    *tr = (struct tracker){.r_eff = su->r_eff, .t_prev = 0, .gap_prev = c.gap, .vn_prev = c.v_n,
+                           .n_prev = c.normal, .dv_prev = relative_velocity(sim),
+                           .min_gap = c.gap, .interacting = c.gap < su->range, .t_first = 0,
+                           .t_observe = INFINITY, .observe_span = s->observe_time};
+    if (tr->interacting && s->observe_time > 0)
+        tr->t_observe = s->observe_time;
+}
+
+/* Tangential part of the velocity of i's surface relative to j's at the contact point on the
+ * line of centres with normal n (contact.c convention) [m/s]. */
+static struct wetdem_vec3 contact_slip(const struct wetdem_sim* sim, struct wetdem_vec3 n)
+{
+    const struct wetdem_particle* a = &sim->particles[0];
+    struct wetdem_vec3 v = vec3_add(a->vel, vec3_cross(a->omega, vec3_scale(n, -a->radius)));
+    if (!sim->n_walls) {
+        const struct wetdem_particle* b = &sim->particles[1];
+        v = vec3_sub(v, vec3_add(b->vel, vec3_cross(b->omega, vec3_scale(n, b->radius))));
+    }
+    return vec3_reject(v, n);
+}
+
+/* The initial state that the restitution coefficients refer to. */
+struct initial {
+    struct wetdem_vec3 dv, slip, n; /* relative velocity, contact slip [m/s], normal */
+};
+
+/* Contact time, contact/h_min flags and the last interaction end, from the event log. */
+static void scan_log(const struct wetdem_sim* sim, bool in_contact, struct wetdem_collision_result* r,
+                     double* t_last_end)
+{
+    double t_open = in_contact ? 0.0 : NAN, total = 0.0;
+    *t_last_end = sim->engine.time;
+    size_t n;
+    const struct wetdem_event_record* ev = wetdem_sim_events(sim, &n);
+    for (size_t k = 0; k < n; k++) {
+        if (ev[k].kind == WETDEM_EVENT_CONTACT_START) {
+            t_open = ev[k].time;
+            r->solid_contact = true;
+        } else if (ev[k].kind == WETDEM_EVENT_CONTACT_END && !isnan(t_open)) {
+            total += ev[k].time - t_open;
+            t_open = NAN;
+        } else if (ev[k].kind == WETDEM_EVENT_HMIN_REACHED) {
+            r->hmin_reached = true;
+        } else if (ev[k].kind == WETDEM_EVENT_INTERACTION_END) {
+            *t_last_end = ev[k].time;
+        }
+    }
+    if (!isnan(t_open))
+        total += sim->engine.time - t_open;
+    r->contact_duration = total;
+}
+
+/* Restitution coefficients and angles from the initial and final states. */
+static void restitution(const struct wetdem_sim* sim, const struct initial* in,
+                        const struct tracker* tr, struct wetdem_collision_result* r)
+{
+    struct wetdem_contact c;
+    pair_contact(sim, &c);
+    struct wetdem_vec3 dvf = relative_velocity(sim), nf = c.normal;
+    double dn0 = vec3_dot(in->dv, in->n), dnf = vec3_dot(dvf, nf);
+    r->e = vec3_norm(dvf) / vec3_norm(in->dv);
+    r->e_n = dn0 < 0 ? -dnf / dn0 : NAN;
+    r->angle_in = atan2(vec3_norm(vec3_reject(in->dv, in->n)), -dn0);
+    r->angle_out = atan2(vec3_norm(vec3_reject(dvf, nf)), dnf);
+    double u0 = vec3_norm(in->slip);
+    r->e_t = NAN;
+    if (u0 > 1e-12 * vec3_norm(in->dv)) {
+        struct wetdem_vec3 tf = vec3_reject(vec3_scale(in->slip, 1.0 / u0), nf);
+        double len = vec3_norm(tf);
+        if (len > 0)
+            r->e_t = -vec3_dot(contact_slip(sim, nf), vec3_scale(tf, 1.0 / len)) / u0;
+    }
+    r->e_n_observed = NAN;
+    if (tr->observe_span > 0) {
+        struct wetdem_vec3 n = tr->observed ? tr->n_obs : nf, dv = tr->observed ? tr->dv_obs : dvf;
+        double dn = vec3_dot(dv, n);
+        r->e_n_observed = dn > 0 && dn0 < 0 ? -dn / dn0 : 0.0;
+    }
+}
+
+static void analyse(const struct wetdem_sim* sim, const struct setup* su,
+                    const struct initial* in, const struct tracker* tr, bool separated,
+                    bool start_in_contact, struct wetdem_collision_result* r)
+{
+    double mu = sim->fluid.viscosity;
+    r->speed_n0 = su->speed_n0;
+    r->stokes_n = mu > 0 ? su->m_eff * su->speed_n0 / (6 * M_PI * mu * su->r_eff * su->r_eff)
+                         : INFINITY;
+    restitution(sim, in, tr, r);
+    r->omega_i = sim->particles[0].omega;
+    r->omega_j = sim->n_walls ? vec3(0, 0, 0) : sim->particles[1].omega;
+    double t_last_end;
+    scan_log(sim, start_in_contact, r, &t_last_end);
+    r->min_gap = tr->min_gap;
+    r->solid_contact = r->solid_contact || tr->min_gap <= 0;
+    r->hmin_reached = r->hmin_reached || r->solid_contact;
+    r->separated = separated;
+    r->t_first_interaction = tr->interacting ? tr->t_first : NAN;
+    r->t_final = sim->engine.time;
+    r->interaction_duration =
+        tr->interacting ? (separated ? t_last_end : sim->engine.time) - tr->t_first : 0.0;
+    r->rotation_angle = tr->rotation;
+    r->rotation_close = tr->rotation_close;
+    if (!separated)
+        r->outcome = WETDEM_OUTCOME_STICK;
+    else if (tr->rotation_close > SRS_ANGLE)
+        r->outcome = WETDEM_OUTCOME_STICK_ROTATE_SEPARATE;
+    else
+        r->outcome = WETDEM_OUTCOME_BOUNCE;
+    r->stats = wetdem_sim_stats(sim);
+}
+
+int wetdem_collision_run(struct wetdem_sim* sim, const struct wetdem_collision_spec* spec,
+                         struct wetdem_collision_result* result)
+{
+    if (!sim || !spec || !result)
+        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID, "collision: NULL argument");
+    memset(result, 0, sizeof *result);
+    int st = check_spec(sim, spec);
+    struct setup su;
+    if (st == WETDEM_OK)
+        st = place_bodies(sim, spec, &su);
+    if (st != WETDEM_OK)
+        return st;
+    struct tracker tr;
+    start_tracker(sim, &su, spec, &tr);
+    struct initial in = {.dv = relative_velocity(sim), .n = vec3(1, 0, 0)};
+    in.slip = contact_slip(sim, in.n);
+    bool in_contact = tr.gap_prev < 0;
+    st = run(sim, spec, &tr);
+    if (st < 0)
+        return st;
+    analyse(sim, &su, &in, &tr, st == WETDEM_EVENT, in_contact, result);
+    return WETDEM_OK;
+}
