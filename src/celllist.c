@@ -10,6 +10,7 @@
  * On a periodic axis with fewer than 3 cells the neighbouring cells coincide; they are
  * de-duplicated so that no pair is listed twice.
  */
+#include <omp.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -263,22 +264,69 @@ static int check_input(const struct wetdem_particle* p, size_t n, double* r_max,
     return WETDEM_OK;
 }
 
+/* Upper bound of the candidates of particle at x: the particles of its stencil cells. */
+static size_t stencil_population(const struct wetdem_celllist* cl, struct wetdem_vec3 x)
+{
+    size_t cells[27], total = 0;
+    int nc = stencil(cl, x, cells);
+    for (int q = 0; q < nc; q++)
+        total += cl->cell_start[cells[q] + 1] - cl->cell_start[cells[q]];
+    return total;
+}
+
+/* One pass: each thread scans a contiguous block of particles into its own buffer (count per
+ * particle into first_pair); the buffers are then concatenated in thread order, which is
+ * particle order, so the list is the same for any thread count. */
 static int fill_pairs(struct wetdem_celllist* cl, const struct wetdem_particle* p, size_t n)
 {
     if (reserve((void**)&cl->first_pair, &cl->first_cap, n + 1, sizeof(size_t)))
         return WETDEM_ERR_NOMEM;
+    int max_threads = omp_get_max_threads(), used_threads = 1;
+    struct wetdem_celllist_pair** buf = calloc((size_t)max_threads, sizeof *buf);
+    size_t* used = calloc((size_t)max_threads, sizeof *used);
+    bool nomem = !buf || !used;
+#pragma omp parallel if (!nomem)
+    {
+        int t = omp_get_thread_num(), nt = omp_get_num_threads();
+#pragma omp single
+        used_threads = nt;
+        size_t lo = n * (size_t)t / (size_t)nt, hi = n * (size_t)(t + 1) / (size_t)nt, cap = 0;
+        for (size_t i = lo; i < hi; i++) {
+            size_t bound = stencil_population(cl, p[i].pos);
+            if (used[t] + bound > cap) {
+                cap = 2 * (used[t] + bound) + 64;
+                struct wetdem_celllist_pair* b = realloc(buf[t], cap * sizeof *b);
+                if (!b) {
+#pragma omp atomic write
+                    nomem = true;
+                    break;
+                }
+                buf[t] = b;
+            }
+            size_t c = scan_particle(cl, p, i, buf[t] + used[t]);
+            cl->first_pair[i + 1] = c;
+            used[t] += c;
+        }
+    }
+    size_t total = 0;
+    for (int t = 0; !nomem && t < used_threads; t++)
+        total += used[t];
+    nomem = nomem || reserve((void**)&cl->pairs, &cl->pairs_cap, total ? total : 1,
+                             sizeof *cl->pairs);
+    size_t at = 0;
+    for (int t = 0; !nomem && t < used_threads; at += used[t], t++)
+        if (used[t])
+            memcpy(cl->pairs + at, buf[t], used[t] * sizeof *cl->pairs);
+    for (int t = 0; buf && t < max_threads; t++)
+        free(buf[t]);
+    free(buf);
+    free(used);
+    if (nomem)
+        return WETDEM_ERR_NOMEM;
     cl->first_pair[0] = 0;
-#pragma omp parallel for schedule(dynamic, 512)
-    for (size_t i = 0; i < n; i++)
-        cl->first_pair[i + 1] = scan_particle(cl, p, i, NULL);
     for (size_t i = 0; i < n; i++)
         cl->first_pair[i + 1] += cl->first_pair[i];
-    cl->n_pairs = cl->first_pair[n];
-    if (reserve((void**)&cl->pairs, &cl->pairs_cap, cl->n_pairs, sizeof *cl->pairs))
-        return WETDEM_ERR_NOMEM;
-#pragma omp parallel for schedule(dynamic, 512)
-    for (size_t i = 0; i < n; i++)
-        scan_particle(cl, p, i, cl->pairs + cl->first_pair[i]);
+    cl->n_pairs = total;
     return WETDEM_OK;
 }
 

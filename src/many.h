@@ -19,6 +19,7 @@ struct wetdem_many_pair_out {
 #define WETDEM_MANY_ACTIVE 1u  /* within the interaction range: force applied */
 #define WETDEM_MANY_CONTACT 2u /* gap < 0: solid contact */
 #define WETDEM_MANY_BRIDGE 4u  /* gap < film delta_ij with a fluid model: liquid bridge */
+#define WETDEM_MANY_DIRTY 8u   /* history may differ from a fresh one (reset when out of range) */
 
 /* Energy bookkeeping (sim_many.c accumulates, sim_many_io.c reports). */
 struct wetdem_many_energy {
@@ -46,6 +47,16 @@ struct wetdem_many {
     size_t old_cap, old_history_cap;
     struct wetdem_many_pair_out* out; /* per candidate pair */
     size_t out_cap;
+    unsigned char* old_flags;    /* out[].flags of the previous list, for remapping */
+    size_t old_flags_cap;
+    uint64_t* wall_mask;         /* per particle: bit w set if wall w is within reach + skin
+                                    at the last build (walls >= 64 are always evaluated) */
+    size_t wall_mask_cap;
+    uint32_t* wall_list;         /* particles with a non-zero wall_mask (or all if > 64 walls) */
+    size_t n_wall_list, wall_list_cap;
+    double max_disp2;            /* largest squared displacement since the build [m^2], */
+    bool max_disp_valid;         /* measured during the latest drift */
+    bool forces_zeroed;          /* force, torque, contacts cleared during the latest drift */
     struct wetdem_vec3 *force, *torque, *vh, *wh; /* per particle */
     uint32_t* contacts;          /* per particle: solid contacts at the latest evaluation */
     size_t particle_cap;

@@ -84,6 +84,9 @@ void wetdem_sim_many_free(struct wetdem_sim* sim)
     free(m->old_pairs);
     free(m->old_history);
     free(m->out);
+    free(m->old_flags);
+    free(m->wall_mask);
+    free(m->wall_list);
     free(m->force);
     free(m->torque);
     free(m->vh);
@@ -241,6 +244,52 @@ static int size_particle_arrays(struct wetdem_sim* sim)
     return WETDEM_OK;
 }
 
+/* Carries the DIRTY flag of surviving pairs over (merge walk over the sorted lists). */
+static void remap_dirty(struct wetdem_many* m, size_t n_old)
+{
+    size_t a = 0;
+    for (size_t b = 0; b < m->cl.n_pairs; b++) {
+        struct wetdem_celllist_pair q = m->cl.pairs[b];
+        while (a < n_old && (m->old_pairs[a].i < q.i ||
+                             (m->old_pairs[a].i == q.i && m->old_pairs[a].j < q.j)))
+            a++;
+        bool same = a < n_old && m->old_pairs[a].i == q.i && m->old_pairs[a].j == q.j;
+        m->out[b].flags = same ? (m->old_flags[a] & WETDEM_MANY_DIRTY) : 0;
+    }
+}
+
+/* Walls within reach + skin of each particle at this build (Verlet criterion as for pairs);
+ * the histories of the other particle-wall pairs are reset. */
+static int update_wall_masks(struct wetdem_sim* sim)
+{
+    struct wetdem_many* m = sim->many;
+    size_t n = sim->n_particles, nw = sim->n_walls, len = sim->history_len;
+    if (grow((void**)&m->wall_mask, &m->wall_mask_cap, n ? n : 1, sizeof *m->wall_mask))
+        return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory for %zu particles", n);
+    double lim = m->reach + m->cl.skin;
+#pragma omp parallel for schedule(static)
+    for (size_t i = 0; i < n; i++) {
+        uint64_t mask = 0;
+        for (size_t w = 0; w < nw && w < 64; w++) {
+            const struct wetdem_wall* wall = &sim->walls[w];
+            double gap = vec3_dot(vec3_sub(sim->particles[i].pos, wall->point), wall->normal) -
+                         sim->particles[i].radius;
+            if (gap < lim)
+                mask |= (uint64_t)1 << w;
+            else if (len)
+                wetdem_sim_history_init(sim, m->wall_history + (i * nw + w) * len);
+        }
+        m->wall_mask[i] = mask;
+    }
+    if (grow((void**)&m->wall_list, &m->wall_list_cap, n ? n : 1, sizeof *m->wall_list))
+        return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory for %zu particles", n);
+    m->n_wall_list = 0;
+    for (size_t i = 0; i < n; i++)
+        if (m->wall_mask[i] || nw > 64)
+            m->wall_list[m->n_wall_list++] = (uint32_t)i;
+    return WETDEM_OK;
+}
+
 /* Rebuilds the cell list and carries the histories of surviving pairs over. */
 static int rebuild(struct wetdem_sim* sim)
 {
@@ -249,6 +298,10 @@ static int rebuild(struct wetdem_sim* sim)
     if (grow((void**)&m->old_pairs, &m->old_cap, n_old ? n_old : 1, sizeof *m->old_pairs) ||
         grow((void**)&m->old_history, &m->old_history_cap, n_old * len + 1, sizeof(double)))
         return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory for the pair list");
+    if (grow((void**)&m->old_flags, &m->old_flags_cap, n_old ? n_old : 1, 1))
+        return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory for the pair list");
+    for (size_t q = 0; q < n_old; q++)
+        m->old_flags[q] = m->out[q].flags;
     if (n_old)
         memcpy(m->old_pairs, m->cl.pairs, n_old * sizeof *m->old_pairs);
     if (n_old * len > 0)
@@ -266,7 +319,8 @@ static int rebuild(struct wetdem_sim* sim)
         wetdem_sim_history_init(sim, fresh);
     wetdem_celllist_remap_history(m->old_pairs, m->old_history, n_old, m->cl.pairs, m->history,
                                   n_new, len, fresh);
-    return WETDEM_OK;
+    remap_dirty(m, n_old);
+    return update_wall_masks(sim);
 }
 
 int wetdem_sim_many_prepare(struct wetdem_sim* sim)
@@ -276,12 +330,15 @@ int wetdem_sim_many_prepare(struct wetdem_sim* sim)
         return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
                                "the enabled models keep %zu doubles of pair history; at most %d",
                                sim->history_len, HISTORY_MAX);
-    double r_min = INFINITY;
-    for (size_t k = 0; k < sim->n_particles; k++)
+    bool fresh_set = !m->started || sim->n_particles != m->cl.n_at_build;
+    double r_min = INFINITY, reach = m->reach, skin = m->cl.skin;
+    for (size_t k = 0; fresh_set && k < sim->n_particles; k++)
         r_min = fmin(r_min, sim->particles[k].radius);
-    double reach = reach_bound(sim);
-    double skin = m->set.skin > 0 ? m->set.skin : 0.1 * (isfinite(r_min) ? r_min : 1.0);
-    if (!m->started || reach != m->reach || skin != m->cl.skin) {
+    if (fresh_set) { /* the bound is set at start-up and when particles are added */
+        reach = reach_bound(sim);
+        skin = m->set.skin > 0 ? m->set.skin : 0.1 * (isfinite(r_min) ? r_min : 1.0);
+    }
+    if (fresh_set && (!m->started || reach != m->reach || skin != m->cl.skin)) {
         struct wetdem_celllist_box box = {{m->set.box_lo.x, m->set.box_lo.y, m->set.box_lo.z},
                                           {m->set.box_hi.x, m->set.box_hi.y, m->set.box_hi.z},
                                           {m->set.periodic[0], m->set.periodic[1],
@@ -302,7 +359,12 @@ int wetdem_sim_many_prepare(struct wetdem_sim* sim)
     if (size_particle_arrays(sim) != WETDEM_OK)
         return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory for %zu particles",
                                sim->n_particles);
-    if (wetdem_celllist_needs_rebuild(&m->cl, sim->particles, sim->n_particles))
+    bool moved = m->max_disp_valid && m->cl.n_builds > 0 &&
+                         m->cl.n_at_build == sim->n_particles
+                     ? m->max_disp2 > 0.25 * m->cl.skin * m->cl.skin
+                     : wetdem_celllist_needs_rebuild(&m->cl, sim->particles, sim->n_particles);
+    m->max_disp_valid = false;
+    if (moved)
         return rebuild(sim);
     return WETDEM_OK;
 }
@@ -357,9 +419,10 @@ static int eval_pair(const struct wetdem_sim* sim, struct wetdem_contact* c, dou
     double range = wetdem_sim_contact_range(sim, c);
     if (range > m->reach)
         return WETDEM_ERR_INVALID; /* reported by the caller: the start-up bound failed */
+    bool dirty = out->flags & WETDEM_MANY_DIRTY;
     out->flags = 0;
     if (c->gap > range) {
-        if (hist)
+        if (hist && dirty)
             wetdem_sim_history_init(sim, hist);
         return WETDEM_OK;
     }
@@ -371,7 +434,7 @@ static int eval_pair(const struct wetdem_sim* sim, struct wetdem_contact* c, dou
     out->force = vec3_axpy(f.f_tan, f.f_normal, c->normal);
     out->torque_i = f.torque_i;
     out->torque_j = f.torque_j;
-    out->flags = WETDEM_MANY_ACTIVE | (c->gap < 0 ? WETDEM_MANY_CONTACT : 0) |
+    out->flags = WETDEM_MANY_ACTIVE | WETDEM_MANY_DIRTY | (c->gap < 0 ? WETDEM_MANY_CONTACT : 0) |
                  (c->film > 0 && c->gap < c->film ? WETDEM_MANY_BRIDGE : 0);
     if (!(isfinite(f.f_normal) && vec3_is_finite(out->force) && vec3_is_finite(f.torque_i) &&
           vec3_is_finite(f.torque_j)))
@@ -428,10 +491,10 @@ static void eval_all_pairs(struct wetdem_sim* sim, struct failure* fail)
     for (size_t q = 0; q < n; q++) {
         struct wetdem_contact c;
         double* hist = len ? m->history + q * len : NULL;
-        m->out[q].flags = 0;
         if (!pair_contact(sim, m->cl.pairs[q].i, m->cl.pairs[q].j, &c)) {
-            if (hist)
+            if (hist && (m->out[q].flags & WETDEM_MANY_DIRTY))
                 wetdem_sim_history_init(sim, hist);
+            m->out[q].flags = 0;
             continue;
         }
         int st = eval_pair(sim, &c, hist, &m->out[q], thread_work(m, 0));
@@ -445,11 +508,20 @@ static void eval_walls(struct wetdem_sim* sim, struct failure* fail)
 {
     struct wetdem_many* m = sim->many;
     size_t len = sim->history_len, nw = sim->n_walls;
+    if (!m->forces_zeroed) {
 #pragma omp parallel for schedule(static)
-    for (size_t i = 0; i < sim->n_particles; i++) {
-        m->force[i] = m->torque[i] = vec3(0, 0, 0);
-        m->contacts[i] = 0;
+        for (size_t i = 0; i < sim->n_particles; i++) {
+            m->force[i] = m->torque[i] = vec3(0, 0, 0);
+            m->contacts[i] = 0;
+        }
+    }
+    m->forces_zeroed = false;
+#pragma omp parallel for schedule(static)
+    for (size_t q = 0; q < m->n_wall_list; q++) {
+        size_t i = m->wall_list[q];
         for (size_t w = 0; w < nw; w++) {
+            if (w < 64 && !(m->wall_mask[i] >> w & 1))
+                continue;
             const struct wetdem_particle* a = &sim->particles[i];
             const struct wetdem_wall* wall = &sim->walls[w];
             double gap = vec3_dot(vec3_sub(a->pos, wall->point), wall->normal) - a->radius;
@@ -461,7 +533,7 @@ static void eval_walls(struct wetdem_sim* sim, struct failure* fail)
             }
             struct wetdem_contact c;
             wetdem_sim_build_contact(sim, i, w, true, &c);
-            struct wetdem_many_pair_out o;
+            struct wetdem_many_pair_out o = {.flags = WETDEM_MANY_DIRTY}; /* always reset */
             int st = eval_pair(sim, &c, hist, &o, thread_work(m, 1));
             if (st != WETDEM_OK)
                 note_failure(fail, i * nw + w, st, true, &c, sim);
@@ -548,20 +620,34 @@ static void kick_drift(struct wetdem_sim* sim, double h)
 {
     struct wetdem_many* m = sim->many;
     struct wetdem_vec3 g = gravity(sim);
-#pragma omp parallel for schedule(static)
+    bool track = m->cl.n_builds > 0 && m->cl.n_at_build == sim->n_particles;
+    double worst = 0; /* max is exact: the same for any thread count */
+#pragma omp parallel for schedule(static) reduction(max : worst)
     for (size_t k = 0; k < sim->n_particles; k++) {
         struct wetdem_particle* p = &sim->particles[k];
-        if (p->is_fixed)
-            continue;
-        struct wetdem_vec3 a = vec3_axpy(g, 1.0 / p->mass, m->force[k]);
-        struct wetdem_vec3 alpha =
-            vec3_scale(m->torque[k], 1.0 / (0.4 * p->mass * p->radius * p->radius));
-        m->vh[k] = vec3_axpy(p->vel, 0.5 * h, a);
-        m->wh[k] = vec3_axpy(p->omega, 0.5 * h, alpha);
-        p->pos = wrap(&m->cl.box, vec3_axpy(p->pos, h, m->vh[k]));
-        p->vel = vec3_axpy(m->vh[k], 0.5 * h, a);
-        p->omega = vec3_axpy(m->wh[k], 0.5 * h, alpha);
+        if (!p->is_fixed) {
+            struct wetdem_vec3 a = vec3_axpy(g, 1.0 / p->mass, m->force[k]);
+            struct wetdem_vec3 alpha =
+                vec3_scale(m->torque[k], 1.0 / (0.4 * p->mass * p->radius * p->radius));
+            m->vh[k] = vec3_axpy(p->vel, 0.5 * h, a);
+            m->wh[k] = vec3_axpy(p->omega, 0.5 * h, alpha);
+            p->pos = wrap(&m->cl.box, vec3_axpy(p->pos, h, m->vh[k]));
+            p->vel = vec3_axpy(m->vh[k], 0.5 * h, a);
+            p->omega = vec3_axpy(m->wh[k], 0.5 * h, alpha);
+        }
+        /* fused passes: the forces of the new state start from zero, and the displacement
+         * since the last neighbour-list build is measured here (rebuild criterion) */
+        m->force[k] = m->torque[k] = vec3(0, 0, 0);
+        m->contacts[k] = 0;
+        if (track) {
+            struct wetdem_vec3 d = celllist_delta(&m->cl.box, p->pos, m->cl.pos_at_build[k]);
+            double d2 = vec3_dot(d, d);
+            worst = d2 > worst ? d2 : worst;
+        }
     }
+    m->max_disp2 = worst;
+    m->max_disp_valid = track;
+    m->forces_zeroed = true;
 }
 
 static void kick(struct wetdem_sim* sim, double h)

@@ -424,7 +424,8 @@ static int restore_pairs(struct wetdem_sim* sim, const struct wetdem_checkpoint*
     }
     if (n)
         memcpy(m->contacts, ck->extra + 16 + n * 48, n * sizeof(uint32_t));
-    memset(m->out, 0, m->cl.n_pairs * sizeof *m->out);
+    for (size_t q = 0; q < m->cl.n_pairs; q++) /* histories may be stale: check on next use */
+        m->out[q] = (struct wetdem_many_pair_out){.flags = WETDEM_MANY_DIRTY};
     m->started = true;
     return WETDEM_OK;
 }
