@@ -1,0 +1,951 @@
+/*
+ * pairwise.c — the pairwise engine's driver and public API (Davis 2023, Secs. II, III, V and
+ * Appendices A-B): configuration checks, adaptive integration with located events, the event
+ * log, per-pair restitution (Eq. 40) and the FA / PA / FS outcome.
+ *
+ * Integration: SUNDIALS CVODE, BDF with a dense direct linear solver, one step at a time.
+ * The film phase of a sticking pair is stiff: its normal velocity relaxes on the time
+ * m* h / (6 pi mu a^2), far shorter near h_min than the time over which the pair creeps or
+ * rotates (t_L = 4a / v_t0), so an implicit method takes steps of the slow scale.
+ * Events are guards that stay >= 0 while the discrete mode is valid (docs/derivations):
+ *     films apart:    h - delta_ij      films overlapping: delta_ij - h
+ *     free:           h - h_min         held at h_min:     lambda (contact force, >= 0)
+ * After every step the guards are evaluated; when one is negative its crossing is located
+ * on CVODE's dense output (CVodeGetDky) by the Illinois variant of regula falsi to a relative
+ * time tolerance of ~1e-13, the earliest crossing is processed (mode switch, impulse,
+ * partner change) and CVODE is restarted there. Guards that touch zero at a restart (films
+ * just touching at t = 0, h = h_min right after an impulse) need no special rule.
+ * Validity: as pairwise_rhs.c; contact instantaneous (hard sphere), planar motion.
+ */
+#include <float.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cvode/cvode.h>
+#include <nvector/nvector_serial.h>
+#include <sunlinsol/sunlinsol_dense.h>
+#include <sunmatrix/sunmatrix_dense.h>
+
+#include "pairwise.h"
+
+enum { REV_NONE = 0, REV_IMPULSE = 1, REV_FILM = 2 };
+enum { G_FILM = 0, G_CONTACT = 1, G_RELEASE = 2, G_KINDS = 3 };
+
+#define PW_MAX_STEPS 20000000ULL
+
+struct wetdem_pairwise {
+    char errmsg[1024];
+    struct wetdem_pairwise_config cfg;
+    struct wetdem_pairwise_system sys;
+    struct wetdem_pairwise_mode md;
+    double y[PW_YMAX];
+    double t;
+    /* CVODE */
+    SUNContext sunctx;
+    void* cvode;
+    N_Vector nv, atol;
+    SUNMatrix mat;
+    SUNLinearSolver ls;
+    size_t cv_dim;
+    /* log and observer */
+    struct wetdem_pairwise_event* events;
+    size_t n_events, events_cap;
+    wetdem_pairwise_observer_fn obs;
+    void* obs_ctx;
+    double obs_interval;
+    unsigned long long n_out;
+    /* per run */
+    struct wetdem_pairwise_result* res;
+    bool approaching[PW_PMAX];
+    int reversal[PW_PMAX];
+    double v_ref, rest_speed, v_scale;
+    bool done;
+};
+
+static int fail(struct wetdem_pairwise* pw, int status, const char* fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+
+static int fail(struct wetdem_pairwise* pw, int status, const char* fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(pw->errmsg, sizeof pw->errmsg, fmt, ap);
+    va_end(ap);
+    return status;
+}
+
+/* ---------------------------------------------------------------- lifecycle and names -- */
+
+struct wetdem_pairwise* wetdem_pairwise_create(void)
+{
+    return calloc(1, sizeof(struct wetdem_pairwise));
+}
+
+static void free_cvode(struct wetdem_pairwise* pw)
+{
+    if (pw->cvode)
+        CVodeFree(&pw->cvode);
+    if (pw->ls)
+        SUNLinSolFree(pw->ls);
+    if (pw->mat)
+        SUNMatDestroy(pw->mat);
+    if (pw->nv)
+        N_VDestroy(pw->nv);
+    if (pw->atol)
+        N_VDestroy(pw->atol);
+    if (pw->sunctx)
+        SUNContext_Free(&pw->sunctx);
+    pw->cvode = NULL;
+    pw->ls = NULL;
+    pw->mat = NULL;
+    pw->nv = pw->atol = NULL;
+    pw->sunctx = NULL;
+    pw->cv_dim = 0;
+}
+
+void wetdem_pairwise_free(struct wetdem_pairwise* pw)
+{
+    if (!pw)
+        return;
+    free_cvode(pw);
+    free(pw->events);
+    free(pw);
+}
+
+const char* wetdem_pairwise_errmsg(const struct wetdem_pairwise* pw)
+{
+    return pw ? pw->errmsg : "";
+}
+
+void wetdem_pairwise_set_observer(struct wetdem_pairwise* pw, double interval,
+                                  wetdem_pairwise_observer_fn fn, void* ctx)
+{
+    pw->obs = (interval > 0.0 && isfinite(interval)) ? fn : NULL;
+    pw->obs_ctx = ctx;
+    pw->obs_interval = interval;
+}
+
+const struct wetdem_pairwise_event* wetdem_pairwise_events(const struct wetdem_pairwise* pw,
+                                                           size_t* n)
+{
+    *n = pw->n_events;
+    return pw->events;
+}
+
+size_t wetdem_pairwise_pair_index(size_t n, size_t i, size_t j)
+{
+    if (i > j) {
+        size_t t = i;
+        i = j;
+        j = t;
+    }
+    return i * n - i * (i + 1) / 2 + (j - i - 1);
+}
+
+const char* wetdem_pairwise_event_name(enum wetdem_pairwise_event_kind kind)
+{
+    switch (kind) {
+    case WETDEM_PAIRWISE_FILM_START: return "film_start";
+    case WETDEM_PAIRWISE_CONTACT: return "contact";
+    case WETDEM_PAIRWISE_REST_START: return "rest_start";
+    case WETDEM_PAIRWISE_REST_END: return "rest_end";
+    case WETDEM_PAIRWISE_FILM_END: return "film_end";
+    case WETDEM_PAIRWISE_PARTNER_CHANGE: return "partner_change";
+    }
+    return "unknown";
+}
+
+const char* wetdem_pairwise_outcome_name(enum wetdem_pairwise_outcome outcome)
+{
+    switch (outcome) {
+    case WETDEM_PAIRWISE_FA: return "FA";
+    case WETDEM_PAIRWISE_PA: return "PA";
+    case WETDEM_PAIRWISE_FS: return "FS";
+    }
+    return "unknown";
+}
+
+/* ---------------------------------------------------------------------- configuration -- */
+
+void wetdem_pairwise_config_init(struct wetdem_pairwise_config* cfg)
+{
+    memset(cfg, 0, sizeof *cfg);
+    cfg->restitution = 1.0;
+    cfg->friction = 0.0;
+    cfg->t_end = 1.0;
+    cfg->rtol = 1e-9;
+    cfg->rest_speed_ratio = 1e-3;
+    cfg->stop_when_separated = true;
+    cfg->ref_i = 0;
+    cfg->ref_j = 1;
+    cfg->max_events = 100000;
+}
+
+static int bad(char* msg, size_t n, const char* fmt, ...) __attribute__((format(printf, 3, 4)));
+
+static int bad(char* msg, size_t n, const char* fmt, ...)
+{
+    if (msg && n > 0) {
+        va_list ap;
+        va_start(ap, fmt);
+        vsnprintf(msg, n, fmt, ap);
+        va_end(ap);
+    }
+    return WETDEM_ERR_INVALID;
+}
+
+static int validate_sphere(const struct wetdem_pairwise_sphere* s, size_t i, char* msg,
+                           size_t n)
+{
+    if (!(s->radius > 0.0) || !isfinite(s->radius))
+        return bad(msg, n, "spheres[%zu].radius = %g m: must be in (0, inf)", i, s->radius);
+    if (!(s->mass > 0.0) || !isfinite(s->mass))
+        return bad(msg, n, "spheres[%zu].mass = %g kg: must be in (0, inf)", i, s->mass);
+    if (!(s->film >= 0.0) || !isfinite(s->film))
+        return bad(msg, n, "spheres[%zu].film = %g m: must be in [0, inf)", i, s->film);
+    double v[5] = {s->x, s->y, s->vx, s->vy, s->omega};
+    const char* names[5] = {"x", "y", "vx", "vy", "omega"};
+    for (int k = 0; k < 5; k++)
+        if (!isfinite(v[k]))
+            return bad(msg, n, "spheres[%zu].%s = %g: must be finite", i, names[k], v[k]);
+    return WETDEM_OK;
+}
+
+static int validate_scalars(const struct wetdem_pairwise_config* c, char* msg, size_t n)
+{
+    if (!(c->viscosity >= 0.0) || !isfinite(c->viscosity))
+        return bad(msg, n, "viscosity = %g Pa s: must be in [0, inf)", c->viscosity);
+    if (!(c->surface_tension >= 0.0) || !isfinite(c->surface_tension))
+        return bad(msg, n, "surface_tension = %g N/m: must be in [0, inf)", c->surface_tension);
+    if (!(c->h_min > 0.0) || !isfinite(c->h_min))
+        return bad(msg, n, "h_min = %g m: must be in (0, inf)", c->h_min);
+    if (!(c->restitution > 0.0 && c->restitution <= 1.0))
+        return bad(msg, n, "restitution = %g: must be in (0, 1]", c->restitution);
+    if (!(c->friction >= 0.0) || !isfinite(c->friction))
+        return bad(msg, n, "friction = %g: must be in [0, inf)", c->friction);
+    if (!isfinite(c->gravity_x) || !isfinite(c->gravity_y))
+        return bad(msg, n, "gravity = (%g, %g) m/s^2: must be finite", c->gravity_x,
+                   c->gravity_y);
+    if (!(c->t_end > 0.0) || !isfinite(c->t_end))
+        return bad(msg, n, "t_end = %g s: must be in (0, inf)", c->t_end);
+    if (!(c->rtol >= 1e-14 && c->rtol <= 1e-3))
+        return bad(msg, n, "rtol = %g: must be in [1e-14, 1e-3]", c->rtol);
+    if (!(c->rest_speed_ratio >= 0.0 && c->rest_speed_ratio < 1.0))
+        return bad(msg, n, "rest_speed_ratio = %g: must be in [0, 1)", c->rest_speed_ratio);
+    if (c->max_events < 1)
+        return bad(msg, n, "max_events = %zu: must be >= 1", c->max_events);
+    return WETDEM_OK;
+}
+
+int wetdem_pairwise_config_validate(const struct wetdem_pairwise_config* c, char* msg, size_t n)
+{
+    if (c->n_spheres < 2 || c->n_spheres > WETDEM_PAIRWISE_MAX_SPHERES)
+        return bad(msg, n, "n_spheres = %zu: must be in [2, %d]", c->n_spheres,
+                   WETDEM_PAIRWISE_MAX_SPHERES);
+    int st = validate_scalars(c, msg, n);
+    for (size_t i = 0; i < c->n_spheres && st == WETDEM_OK; i++)
+        st = validate_sphere(&c->spheres[i], i, msg, n);
+    if (st != WETDEM_OK)
+        return st;
+    if (c->ref_i >= c->n_spheres || c->ref_j >= c->n_spheres || c->ref_i == c->ref_j)
+        return bad(msg, n, "reference pair (%zu, %zu): must be two different spheres < %zu",
+                   c->ref_i, c->ref_j, c->n_spheres);
+    for (size_t i = 0; i < c->n_spheres; i++)
+        for (size_t j = i + 1; j < c->n_spheres; j++) {
+            const struct wetdem_pairwise_sphere *a = &c->spheres[i], *b = &c->spheres[j];
+            double h = hypot(b->x - a->x, b->y - a->y) - a->radius - b->radius;
+            if (!(h >= c->h_min))
+                return bad(msg, n,
+                           "initial gap of spheres %zu and %zu = %g m: must be >= h_min = %g m",
+                           i, j, h, c->h_min);
+        }
+    return WETDEM_OK;
+}
+
+/* ---------------------------------------------------------------------------- CVODE -- */
+
+static int cv_rhs(sunrealtype t, N_Vector y, N_Vector ydot, void* ud)
+{
+    (void)t;
+    struct wetdem_pairwise* pw = ud;
+    pw->res->rhs_evals++;
+    return wetdem_pairwise_rhs_eval(&pw->sys, &pw->md, N_VGetArrayPointer(y),
+                                    N_VGetArrayPointer(ydot))
+               ? 0
+               : 1; /* recoverable: CVODE retries with a smaller step */
+}
+
+static void cv_err(int code, const char* module, const char* function, char* msg, void* ud)
+{
+    struct wetdem_pairwise* pw = ud;
+    if (code < 0)
+        snprintf(pw->errmsg, sizeof pw->errmsg, "%s %s: %s", module, function, msg);
+}
+
+/* Absolute tolerances: rtol times the scale of each component. */
+static void set_atol(struct wetdem_pairwise* pw)
+{
+    const struct wetdem_pairwise_system* sys = &pw->sys;
+    double* a = N_VGetArrayPointer(pw->atol);
+    double amin = sys->a[0];
+    for (size_t i = 1; i < sys->n; i++)
+        amin = fmin(amin, sys->a[i]);
+    double rt = pw->cfg.rtol, v = pw->v_scale;
+    double anchor[5] = {amin, amin, v, v, v / amin};
+    for (int c = 0; c < 5; c++)
+        a[c] = rt * anchor[c];
+    for (size_t e = 0; e + 1 < sys->n; e++) {
+        double* b = a + PW_ANCHOR_LEN + PW_EDGE_LEN * e;
+        b[PW_H] = rt * sys->h_min;
+        b[PW_THETA] = rt;
+        b[PW_VN] = rt * v;
+        b[PW_OMEGA] = rt * v / amin;
+        b[PW_VW] = rt * v;
+    }
+}
+
+static int setup_cvode(struct wetdem_pairwise* pw)
+{
+    size_t dim = 5 * pw->sys.n;
+    if (pw->cv_dim != dim) {
+        free_cvode(pw);
+        if (SUNContext_Create(NULL, &pw->sunctx) != 0)
+            return fail(pw, WETDEM_ERR_NOMEM, "cannot create the SUNDIALS context");
+        pw->nv = N_VNew_Serial((sunindextype)dim, pw->sunctx);
+        pw->atol = N_VNew_Serial((sunindextype)dim, pw->sunctx);
+        pw->cvode = CVodeCreate(CV_BDF, pw->sunctx);
+        if (!pw->nv || !pw->atol || !pw->cvode)
+            return fail(pw, WETDEM_ERR_NOMEM, "out of memory creating the integrator");
+        memcpy(N_VGetArrayPointer(pw->nv), pw->y, dim * sizeof(double));
+        if (CVodeInit(pw->cvode, cv_rhs, 0.0, pw->nv) != CV_SUCCESS)
+            return fail(pw, WETDEM_ERR_NOMEM, "CVodeInit failed");
+        pw->mat = SUNDenseMatrix((sunindextype)dim, (sunindextype)dim, pw->sunctx);
+        pw->ls = SUNLinSol_Dense(pw->nv, pw->mat, pw->sunctx);
+        if (!pw->mat || !pw->ls || CVodeSetLinearSolver(pw->cvode, pw->ls, pw->mat) != 0)
+            return fail(pw, WETDEM_ERR_NOMEM, "cannot attach the dense linear solver");
+        CVodeSetErrHandlerFn(pw->cvode, cv_err, pw);
+        CVodeSetMaxErrTestFails(pw->cvode, 20);
+        CVodeSetMaxConvFails(pw->cvode, 50);
+        pw->cv_dim = dim;
+    }
+    CVodeSetUserData(pw->cvode, pw);
+    set_atol(pw);
+    if (CVodeSVtolerances(pw->cvode, pw->cfg.rtol, pw->atol) != CV_SUCCESS)
+        return fail(pw, WETDEM_ERR_INVALID, "CVodeSVtolerances failed");
+    return WETDEM_OK;
+}
+
+static int restart(struct wetdem_pairwise* pw)
+{
+    memcpy(N_VGetArrayPointer(pw->nv), pw->y, pw->cv_dim * sizeof(double));
+    if (CVodeReInit(pw->cvode, pw->t, pw->nv) != CV_SUCCESS)
+        return fail(pw, WETDEM_ERR_STEP, "CVodeReInit failed at t = %g s", pw->t);
+    CVodeSetStopTime(pw->cvode, pw->cfg.t_end);
+    return WETDEM_OK;
+}
+
+/* y at time t inside the last step (dense output). */
+static bool interpolate(struct wetdem_pairwise* pw, double t, double* y)
+{
+    N_Vector tmp = N_VMake_Serial((sunindextype)pw->cv_dim, y, pw->sunctx);
+    int st = tmp ? CVodeGetDky(pw->cvode, t, 0, tmp) : -1;
+    if (tmp)
+        N_VDestroy(tmp);
+    return st == CV_SUCCESS;
+}
+
+/* ---------------------------------------------------------------------- event log ---- */
+
+static double t_hat(const struct wetdem_pairwise* pw, double t)
+{
+    const struct wetdem_pairwise_result* r = pw->res;
+    return (r->v_n0 > 0.0 && r->delta_ref > 0.0) ? r->v_n0 * t / r->delta_ref : NAN;
+}
+
+static double t_star(const struct wetdem_pairwise* pw, double t)
+{
+    return pw->res->v_10 * t / (4.0 * pw->res->a_ref);
+}
+
+static int log_event(struct wetdem_pairwise* pw, enum wetdem_pairwise_event_kind kind, size_t p,
+                     size_t p_old, double gap, double v_n)
+{
+    if (pw->n_events >= pw->cfg.max_events)
+        return fail(pw, WETDEM_ERR_MAX_STEPS,
+                    "event budget max_events = %zu exhausted at t = %g s (chattering contact?)",
+                    pw->cfg.max_events, pw->t);
+    if (pw->n_events == pw->events_cap) {
+        size_t cap = pw->events_cap ? 2 * pw->events_cap : 64;
+        void* mem = realloc(pw->events, cap * sizeof *pw->events);
+        if (!mem)
+            return fail(pw, WETDEM_ERR_NOMEM, "out of memory growing the event log");
+        pw->events = mem;
+        pw->events_cap = cap;
+    }
+    pw->events[pw->n_events++] = (struct wetdem_pairwise_event){
+        .kind = kind,
+        .time = pw->t,
+        .t_hat = t_hat(pw, pw->t),
+        .t_star = t_star(pw, pw->t),
+        .i = pw->sys.pi[p],
+        .j = pw->sys.pj[p],
+        .k = pw->sys.pi[p_old],
+        .l = pw->sys.pj[p_old],
+        .gap = gap,
+        .v_n = v_n,
+    };
+    return WETDEM_OK;
+}
+
+/* ------------------------------------------------------------------------- output ---- */
+
+static void fill_frame(const struct wetdem_pairwise* pw, const struct wetdem_pairwise_kin* k,
+                       double t, struct wetdem_pairwise_frame* fr)
+{
+    memset(fr, 0, sizeof *fr);
+    fr->time = t;
+    fr->t_hat = t_hat(pw, t);
+    fr->t_star = t_star(pw, t);
+    fr->n_spheres = pw->sys.n;
+    fr->n_pairs = pw->sys.n_pairs;
+    for (size_t i = 0; i < pw->sys.n; i++) {
+        fr->spheres[i] = pw->cfg.spheres[i];
+        fr->spheres[i].x = k->x[i];
+        fr->spheres[i].y = k->y[i];
+        fr->spheres[i].vx = k->vx[i];
+        fr->spheres[i].vy = k->vy[i];
+        fr->spheres[i].omega = k->w[i];
+    }
+    for (size_t p = 0; p < pw->sys.n_pairs; p++) {
+        fr->gap[p] = k->h[p];
+        fr->v_n[p] = k->v_n[p];
+    }
+}
+
+static int emit(struct wetdem_pairwise* pw, double t, const double* y)
+{
+    struct wetdem_pairwise_kin k;
+    struct wetdem_pairwise_frame fr;
+    wetdem_pairwise_state_kin(&pw->sys, &pw->md, y, &k);
+    fill_frame(pw, &k, t, &fr);
+    if (pw->obs(&fr, pw->obs_ctx) != 0)
+        return fail(pw, WETDEM_ERR_CALLBACK, "observer returned non-zero at t = %g s", t);
+    return WETDEM_OK;
+}
+
+/* Frames at the output times in (t_lo, t_hi] of the last step (t_hi is the current pw->t
+ * when `current`, else an interpolated time). */
+static int emit_until(struct wetdem_pairwise* pw, double t_hi)
+{
+    if (!pw->obs)
+        return WETDEM_OK;
+    for (;;) {
+        double t_out = (double)pw->n_out * pw->obs_interval;
+        if (t_out > t_hi || t_out > pw->cfg.t_end)
+            return WETDEM_OK;
+        double y[PW_YMAX];
+        if (!interpolate(pw, t_out, y))
+            memcpy(y, pw->y, sizeof y);
+        int st = emit(pw, t_out, y);
+        if (st != WETDEM_OK)
+            return st;
+        pw->n_out++;
+    }
+}
+
+/* --------------------------------------------------------------------------- guards ---- */
+
+/* Guard values of every pair at state y: g[G_KINDS * p + kind], >= 0 while the mode holds. */
+static bool guards(struct wetdem_pairwise* pw, const double* y, double* g)
+{
+    const struct wetdem_pairwise_system* sys = &pw->sys;
+    struct wetdem_pairwise_kin k;
+    struct wetdem_pairwise_forces f;
+    pw->res->guard_evals++;
+    if (!wetdem_pairwise_state_kin(sys, &pw->md, y, &k))
+        return false;
+    bool any_rest = false;
+    for (size_t p = 0; p < sys->n_pairs; p++) {
+        double* gp = g + G_KINDS * p;
+        bool has_film = sys->delta[p] > sys->h_min;
+        gp[G_FILM] = !has_film ? 1.0 : (pw->md.film[p] ? sys->delta[p] - k.h[p]
+                                                        : k.h[p] - sys->delta[p]);
+        gp[G_CONTACT] = pw->md.resting[p] ? 1.0 : k.h[p] - sys->h_min;
+        if (!(gp[G_CONTACT] > 0.0) && k.v_n[p] > 0.0) /* at h_min and approaching: now */
+            gp[G_CONTACT] = fmin(gp[G_CONTACT], -DBL_MIN);
+        gp[G_RELEASE] = 1.0;
+        any_rest = any_rest || pw->md.resting[p];
+    }
+    if (!any_rest)
+        return true;
+    if (!wetdem_pairwise_rhs_forces(sys, &pw->md, &k, &f))
+        return false;
+    for (size_t p = 0; p < sys->n_pairs; p++)
+        if (pw->md.resting[p])
+            g[G_KINDS * p + G_RELEASE] = f.lambda[p];
+    return true;
+}
+
+/* Value of guard `idx` at time t of the last step. */
+static double guard_at(struct wetdem_pairwise* pw, size_t idx, double t)
+{
+    double y[PW_YMAX], g[G_KINDS * PW_PMAX];
+    if (!interpolate(pw, t, y) || !guards(pw, y, g))
+        return NAN;
+    return g[idx];
+}
+
+/* Illinois regula falsi for the crossing of guard idx in [lo, hi], g(lo) >= 0 > g(hi).
+ * Returns the end of the final bracket where the guard is negative. */
+static double locate(struct wetdem_pairwise* pw, size_t idx, double lo, double hi, double g_hi)
+{
+    double g_lo = guard_at(pw, idx, lo);
+    if (!(g_lo >= 0.0))
+        return lo;
+    double tol = 1e-13 * (hi - lo) + 4.0 * DBL_EPSILON * fabs(hi);
+    int side = 0;
+    for (int it = 0; it < 200 && hi - lo > tol; it++) {
+        double t = (g_lo - g_hi != 0.0) ? hi - g_hi * (hi - lo) / (g_hi - g_lo) : 0.5 * (lo + hi);
+        if (!(t > lo && t < hi))
+            t = 0.5 * (lo + hi);
+        double gt = guard_at(pw, idx, t);
+        if (!isfinite(gt))
+            gt = -1.0;
+        if (gt < 0.0) {
+            hi = t;
+            g_hi = gt;
+            if (side == -1)
+                g_lo *= 0.5;
+            side = -1;
+        } else {
+            lo = t;
+            g_lo = gt;
+            if (side == 1)
+                g_hi *= 0.5;
+            side = 1;
+        }
+    }
+    return hi;
+}
+
+/* ------------------------------------------------------------------ mode changes ---- */
+
+/* Current kinematics from pw->y. */
+static bool current_kin(struct wetdem_pairwise* pw, struct wetdem_pairwise_kin* k)
+{
+    if (wetdem_pairwise_state_kin(&pw->sys, &pw->md, pw->y, k))
+        return true;
+    fail(pw, WETDEM_ERR_NUMERIC, "state not finite at t = %g s", pw->t);
+    return false;
+}
+
+/* Re-chooses the tracked tree (pair `force` must be tracked; PW_PMAX for none), converts the
+ * state and logs a partner change for every pair that entered the tree. */
+static int retree(struct wetdem_pairwise* pw, size_t force)
+{
+    struct wetdem_pairwise_kin k;
+    if (!current_kin(pw, &k))
+        return WETDEM_ERR_NUMERIC;
+    struct wetdem_pairwise_mode md = pw->md;
+    wetdem_pairwise_state_tree(&pw->sys, k.h, &pw->md, force, &md);
+    size_t n_edges = pw->sys.n - 1, left[PW_NMAX], n_left = 0;
+    for (size_t e = 0; e < n_edges; e++)
+        if (md.edge_of_pair[pw->md.edge[e]] < 0)
+            left[n_left++] = pw->md.edge[e];
+    if (n_left == 0)
+        return WETDEM_OK;
+    const struct wetdem_pairwise_mode old = pw->md;
+    pw->md = md;
+    wetdem_pairwise_state_pack(&pw->sys, &pw->md, &k, pw->y);
+    size_t a = 0;
+    for (size_t e = 0; e < n_edges; e++) {
+        size_t p = md.edge[e];
+        if (old.edge_of_pair[p] >= 0)
+            continue;
+        int st = log_event(pw, WETDEM_PAIRWISE_PARTNER_CHANGE, p, left[a++], k.h[p], k.v_n[p]);
+        if (st != WETDEM_OK)
+            return st;
+    }
+    return WETDEM_OK;
+}
+
+static int on_film(struct wetdem_pairwise* pw, size_t p, const struct wetdem_pairwise_kin* k)
+{
+    struct wetdem_pairwise_pair_result* r = &pw->res->pairs[p];
+    bool start = !pw->md.film[p];
+    pw->md.film[p] = start;
+    int st = log_event(pw, start ? WETDEM_PAIRWISE_FILM_START : WETDEM_PAIRWISE_FILM_END, p, p,
+                       k->h[p], k->v_n[p]);
+    if (st != WETDEM_OK)
+        return st;
+    if (start && !r->films_met) {
+        r->films_met = true;
+        r->v_n_in = k->v_n[p];
+        r->t_start = pw->t;
+    }
+    if (!start) {
+        r->v_n_out = -k->v_n[p];
+        r->t_end = pw->t;
+    }
+    return retree(pw, PW_PMAX);
+}
+
+/* New held set `hold` (from the force-level contact problem): logs the pairs that start or
+ * stop being held; pair `p`, if not PW_PMAX, is logged as the contact that caused it. */
+static int set_held(struct wetdem_pairwise* pw, const bool* hold, size_t p,
+                    const struct wetdem_pairwise_kin* k, double v_n)
+{
+    for (size_t q = 0; q < pw->sys.n_pairs; q++) {
+        bool was = pw->md.resting[q];
+        pw->md.resting[q] = hold[q];
+        enum wetdem_pairwise_event_kind kind;
+        if (q == p)
+            kind = hold[q] ? WETDEM_PAIRWISE_REST_START : WETDEM_PAIRWISE_CONTACT;
+        else if (was != hold[q])
+            kind = hold[q] ? WETDEM_PAIRWISE_REST_START : WETDEM_PAIRWISE_REST_END;
+        else
+            continue;
+        int st = log_event(pw, kind, q, q, k->h[q], q == p ? v_n : k->v_n[q]);
+        if (st != WETDEM_OK)
+            return st;
+    }
+    return WETDEM_OK;
+}
+
+/* Contact slower than the rest speed: the new pair and every slow pair touching at h_min stop
+ * together (plastic), then the force-level contact problem decides which stay held. */
+static int rest_contact(struct wetdem_pairwise* pw, size_t p, const struct wetdem_pairwise_kin* k,
+                        double v_n)
+{
+    bool cand[PW_PMAX], hold[PW_PMAX];
+    for (size_t q = 0; q < pw->sys.n_pairs; q++)
+        cand[q] = pw->md.resting[q] || q == p ||
+                  (k->h[q] <= pw->sys.h_min * (1.0 + 1e-9) && fabs(k->v_n[q]) < pw->rest_speed);
+    struct wetdem_pairwise_kin k2;
+    if (!wetdem_pairwise_jump_plastic(&pw->sys, &pw->md, k, cand, pw->y) ||
+        !current_kin(pw, &k2) || !wetdem_pairwise_rhs_hold_set(&pw->sys, &pw->md, &k2, cand, hold))
+        return fail(pw, WETDEM_ERR_NUMERIC, "singular resting-contact problem at t = %g s", pw->t);
+    return set_held(pw, hold, p, &k2, v_n);
+}
+
+/* Contact at the rest speed or faster: the hard-sphere impulse of Appendix A. Held pairs whose
+ * normal velocity it changes are let go (an approaching one is a contact of its own next). */
+static int hard_contact(struct wetdem_pairwise* pw, size_t p, struct wetdem_pairwise_kin* k,
+                        double v_n)
+{
+    int st = wetdem_pairwise_jump_apply(&pw->sys, &pw->md, p, k, pw->y);
+    if (st != WETDEM_OK)
+        return fail(pw, st, "hard-sphere impulse of spheres %zu and %zu failed at t = %g s",
+                    pw->sys.pi[p], pw->sys.pj[p], pw->t);
+    pw->res->pairs[p].n_contacts++;
+    if ((st = log_event(pw, WETDEM_PAIRWISE_CONTACT, p, p, pw->sys.h_min, v_n)) != WETDEM_OK)
+        return st;
+    struct wetdem_pairwise_kin k2;
+    if (!current_kin(pw, &k2))
+        return WETDEM_ERR_NUMERIC;
+    for (size_t q = 0; q < pw->sys.n_pairs; q++) {
+        if (!pw->md.resting[q] || k2.v_n[q] == k->v_n[q])
+            continue;
+        pw->md.resting[q] = false;
+        if ((st = log_event(pw, WETDEM_PAIRWISE_REST_END, q, q, k2.h[q], k2.v_n[q])) != WETDEM_OK)
+            return st;
+    }
+    return WETDEM_OK;
+}
+
+static int on_contact(struct wetdem_pairwise* pw, size_t p)
+{
+    int st = pw->md.edge_of_pair[p] < 0 ? retree(pw, p) : WETDEM_OK;
+    if (st != WETDEM_OK)
+        return st;
+    double* v = pw->y + PW_ANCHOR_LEN + PW_EDGE_LEN * (size_t)pw->md.edge_of_pair[p];
+    v[PW_H] = pw->sys.h_min; /* the located crossing is within ~1e-13 of it */
+    struct wetdem_pairwise_kin k;
+    if (!current_kin(pw, &k))
+        return WETDEM_ERR_NUMERIC;
+    double v_n = k.v_n[p];
+    if (!(v_n > 0.0))
+        return WETDEM_OK; /* grazing: nothing to reverse */
+    pw->approaching[p] = false;
+    pw->reversal[p] = REV_IMPULSE;
+    if (v_n < pw->rest_speed)
+        return rest_contact(pw, p, &k, v_n);
+    return hard_contact(pw, p, &k, v_n);
+}
+
+/* A held pair's contact force reached zero: the contact problem is solved again over the
+ * held pairs (the pair itself is let go). */
+static int on_release(struct wetdem_pairwise* pw, size_t p, const struct wetdem_pairwise_kin* k)
+{
+    bool cand[PW_PMAX], hold[PW_PMAX];
+    for (size_t q = 0; q < pw->sys.n_pairs; q++)
+        cand[q] = pw->md.resting[q];
+    if (!wetdem_pairwise_rhs_hold_set(&pw->sys, &pw->md, k, cand, hold))
+        return fail(pw, WETDEM_ERR_NUMERIC, "singular resting-contact problem at t = %g s", pw->t);
+    hold[p] = false;
+    pw->approaching[p] = false;
+    pw->reversal[p] = REV_IMPULSE;
+    return set_held(pw, hold, PW_PMAX, k, 0.0);
+}
+
+/* Processes every negative guard at the current state, one at a time, until none is left. */
+static int process_events(struct wetdem_pairwise* pw)
+{
+    double g[G_KINDS * PW_PMAX];
+    for (int round = 0; round < 4 * G_KINDS * PW_PMAX; round++) {
+        if (!guards(pw, pw->y, g))
+            return fail(pw, WETDEM_ERR_NUMERIC, "state outside the domain at t = %g s", pw->t);
+        size_t idx = 0;
+        while (idx < G_KINDS * pw->sys.n_pairs && !(g[idx] < 0.0))
+            idx++;
+        if (idx == G_KINDS * pw->sys.n_pairs)
+            return WETDEM_OK;
+        size_t p = idx / G_KINDS;
+        struct wetdem_pairwise_kin k;
+        if (!current_kin(pw, &k))
+            return WETDEM_ERR_NUMERIC;
+        int st;
+        switch (idx % G_KINDS) {
+        case G_FILM: st = on_film(pw, p, &k); break;
+        case G_CONTACT: st = on_contact(pw, p); break;
+        default: st = on_release(pw, p, &k); break;
+        }
+        if (st != WETDEM_OK)
+            return st;
+    }
+    return fail(pw, WETDEM_ERR_STEP, "events do not settle at t = %g s", pw->t);
+}
+
+/* ------------------------------------------------------------------- bookkeeping ---- */
+
+/* Turning points of film pairs and the smallest gaps, at an accepted state. */
+static void track_pairs(struct wetdem_pairwise* pw, const struct wetdem_pairwise_kin* k)
+{
+    for (size_t p = 0; p < pw->sys.n_pairs; p++) {
+        struct wetdem_pairwise_pair_result* r = &pw->res->pairs[p];
+        r->min_gap = fmin(r->min_gap, k->h[p]);
+        if (!pw->md.film[p] || pw->md.resting[p])
+            continue;
+        if (pw->approaching[p] && k->v_n[p] < 0.0) {
+            pw->approaching[p] = false;
+            pw->reversal[p] = REV_FILM;
+        } else if (!pw->approaching[p] && k->v_n[p] > 0.0) {
+            pw->approaching[p] = true;
+        }
+    }
+}
+
+/* True when no pair interacts and every pair recedes: nothing can change any more. */
+static bool all_apart(const struct wetdem_pairwise* pw, const struct wetdem_pairwise_kin* k)
+{
+    for (size_t p = 0; p < pw->sys.n_pairs; p++)
+        if (pw->md.film[p] || pw->md.resting[p] || k->v_n[p] > 0.0)
+            return false;
+    return true;
+}
+
+static size_t uf_root(size_t* parent, size_t i)
+{
+    while (parent[i] != i)
+        i = parent[i];
+    return i;
+}
+
+/* Clusters of bound pairs at the end: FA, PA (which sphere left) or FS. */
+static void classify(struct wetdem_pairwise* pw)
+{
+    struct wetdem_pairwise_result* res = pw->res;
+    size_t parent[PW_NMAX], size[PW_NMAX] = {0};
+    for (size_t i = 0; i < pw->sys.n; i++)
+        parent[i] = i;
+    for (size_t p = 0; p < pw->sys.n_pairs; p++) {
+        struct wetdem_pairwise_pair_result* r = &res->pairs[p];
+        r->bound = pw->md.film[p] || pw->md.resting[p];
+        if (!r->films_met) {
+            r->mechanism = -1;
+            r->e_wet = r->e_wet_own = NAN;
+            continue;
+        }
+        r->mechanism = r->bound ? WETDEM_OUTCOME_STICK
+                                : (pw->reversal[p] == REV_IMPULSE ? WETDEM_OUTCOME_BOUNCE
+                                                                   : WETDEM_OUTCOME_STICK_ROTATE_SEPARATE);
+        r->e_wet = r->bound ? 0.0 : r->v_n_out / pw->v_ref;
+        r->e_wet_own = (r->bound ? 0.0 : r->v_n_out) / r->v_n_in;
+        if (!(r->v_n_in > 0.0))
+            r->e_wet_own = NAN;
+        if (r->bound)
+            parent[uf_root(parent, pw->sys.pi[p])] = uf_root(parent, pw->sys.pj[p]);
+    }
+    size_t n_single = 0, n_comp = 0;
+    res->separated_sphere = -1;
+    for (size_t i = 0; i < pw->sys.n; i++)
+        size[uf_root(parent, i)]++;
+    for (size_t i = 0; i < pw->sys.n; i++) {
+        if (size[i] == 0)
+            continue;
+        n_comp++;
+        if (size[i] == 1) {
+            n_single++;
+            res->separated_sphere = (int)i;
+        }
+    }
+    if (n_single != 1)
+        res->separated_sphere = -1;
+    res->outcome = n_comp == 1 ? WETDEM_PAIRWISE_FA
+                               : (n_single == pw->sys.n ? WETDEM_PAIRWISE_FS : WETDEM_PAIRWISE_PA);
+}
+
+/* ------------------------------------------------------------------------------ run ---- */
+
+/* Reference quantities, initial modes, tree and state from the configuration. */
+static void initial_state(struct wetdem_pairwise* pw)
+{
+    const struct wetdem_pairwise_config* cfg = &pw->cfg;
+    struct wetdem_pairwise_system* sys = &pw->sys;
+    struct wetdem_pairwise_result* res = pw->res;
+    struct wetdem_pairwise_kin k;
+    memset(&k, 0, sizeof k);
+    wetdem_pairwise_state_system(cfg, sys);
+    for (size_t i = 0; i < sys->n; i++) {
+        k.x[i] = cfg->spheres[i].x;
+        k.y[i] = cfg->spheres[i].y;
+        k.vx[i] = cfg->spheres[i].vx;
+        k.vy[i] = cfg->spheres[i].vy;
+        k.w[i] = cfg->spheres[i].omega;
+    }
+    wetdem_pairwise_state_pairs_from_spheres(sys, &k);
+    size_t ref = wetdem_pairwise_pair_index(sys->n, cfg->ref_i, cfg->ref_j);
+    res->n_spheres = sys->n;
+    res->n_pairs = sys->n_pairs;
+    res->v_n0 = k.v_n[ref];
+    res->delta_ref = sys->delta[ref];
+    res->v_10 = hypot(k.vx[cfg->ref_i], k.vy[cfg->ref_i]);
+    res->a_ref = sys->a_eff[ref];
+    double v = 0.0;
+    for (size_t i = 0; i < sys->n; i++)
+        v = fmax(v, fmax(hypot(k.ux[i], k.uy[i]), hypot(k.vx[i], k.vy[i])));
+    pw->v_scale = v > 0.0 ? v : 1e-6;
+    pw->v_ref = res->v_n0 > 0.0 ? res->v_n0 : pw->v_scale;
+    pw->rest_speed = cfg->rest_speed_ratio * pw->v_ref;
+    memset(&pw->md, 0, sizeof pw->md);
+    for (size_t p = 0; p < sys->n_pairs; p++) {
+        struct wetdem_pairwise_pair_result* r = &res->pairs[p];
+        r->i = sys->pi[p];
+        r->j = sys->pj[p];
+        r->t_start = r->t_end = NAN;
+        r->min_gap = k.h[p];
+        r->mechanism = -1;
+        bool has_film = sys->delta[p] > sys->h_min;
+        pw->md.film[p] = has_film && (k.h[p] < sys->delta[p] ||
+                                      (k.h[p] == sys->delta[p] && k.v_n[p] >= 0.0));
+        if (pw->md.film[p]) {
+            r->films_met = true;
+            r->v_n_in = k.v_n[p];
+            r->t_start = 0.0;
+        }
+        pw->approaching[p] = k.v_n[p] > 0.0;
+        pw->reversal[p] = REV_NONE;
+    }
+    struct wetdem_pairwise_mode md = pw->md;
+    wetdem_pairwise_state_tree(sys, k.h, &pw->md, PW_PMAX, &md);
+    pw->md = md;
+    wetdem_pairwise_state_pack(sys, &pw->md, &k, pw->y);
+}
+
+/* One CVODE step and whatever events it contains. */
+static int advance(struct wetdem_pairwise* pw)
+{
+    double t_lo = pw->t, t;
+    int flag = CVode(pw->cvode, pw->cfg.t_end, pw->nv, &t, CV_ONE_STEP);
+    if (flag < 0)
+        return fail(pw, WETDEM_ERR_STEP, "integrator failed at t = %g s (%s)", t_lo, pw->errmsg);
+    if (++pw->res->steps > PW_MAX_STEPS)
+        return fail(pw, WETDEM_ERR_MAX_STEPS, "more than %llu steps", PW_MAX_STEPS);
+    double g[G_KINDS * PW_PMAX], y[PW_YMAX];
+    memcpy(y, N_VGetArrayPointer(pw->nv), pw->cv_dim * sizeof(double));
+    if (!guards(pw, y, g))
+        return fail(pw, WETDEM_ERR_NUMERIC, "state not finite at t = %g s", t);
+    double t_ev = INFINITY;
+    for (size_t idx = 0; idx < G_KINDS * pw->sys.n_pairs; idx++)
+        if (g[idx] < 0.0)
+            t_ev = fmin(t_ev, locate(pw, idx, t_lo, t, g[idx]));
+    if (isfinite(t_ev)) {
+        int st = emit_until(pw, t_ev);
+        if (st != WETDEM_OK)
+            return st;
+        pw->t = t_ev;
+        if (!interpolate(pw, t_ev, pw->y))
+            return fail(pw, WETDEM_ERR_STEP, "dense output failed at t = %g s", t_ev);
+        if ((st = process_events(pw)) != WETDEM_OK || (st = restart(pw)) != WETDEM_OK)
+            return st;
+    } else {
+        int st = emit_until(pw, t);
+        if (st != WETDEM_OK)
+            return st;
+        pw->t = t;
+        memcpy(pw->y, y, pw->cv_dim * sizeof(double));
+    }
+    struct wetdem_pairwise_kin k;
+    if (!current_kin(pw, &k))
+        return WETDEM_ERR_NUMERIC;
+    track_pairs(pw, &k);
+    pw->done = pw->t >= pw->cfg.t_end || (pw->cfg.stop_when_separated && all_apart(pw, &k));
+    return WETDEM_OK;
+}
+
+static void finish(struct wetdem_pairwise* pw)
+{
+    struct wetdem_pairwise_kin k;
+    struct wetdem_pairwise_result* res = pw->res;
+    wetdem_pairwise_state_kin(&pw->sys, &pw->md, pw->y, &k);
+    for (size_t i = 0; i < pw->sys.n; i++) {
+        res->final[i] = pw->cfg.spheres[i];
+        res->final[i].x = k.x[i];
+        res->final[i].y = k.y[i];
+        res->final[i].vx = k.vx[i];
+        res->final[i].vy = k.vy[i];
+        res->final[i].omega = k.w[i];
+    }
+    res->time = pw->t;
+    res->n_events = pw->n_events;
+    classify(pw);
+}
+
+int wetdem_pairwise_run(struct wetdem_pairwise* pw, const struct wetdem_pairwise_config* cfg,
+                        struct wetdem_pairwise_result* res)
+{
+    pw->errmsg[0] = '\0';
+    memset(res, 0, sizeof *res);
+    pw->n_events = 0;
+    int st = wetdem_pairwise_config_validate(cfg, pw->errmsg, sizeof pw->errmsg);
+    if (st != WETDEM_OK)
+        return st;
+    pw->cfg = *cfg;
+    pw->res = res;
+    pw->t = 0.0;
+    pw->n_out = 0;
+    pw->done = false;
+    initial_state(pw);
+    if ((st = setup_cvode(pw)) != WETDEM_OK || (st = process_events(pw)) != WETDEM_OK ||
+        (st = restart(pw)) != WETDEM_OK)
+        return st;
+    if (pw->obs) {
+        if ((st = emit(pw, 0.0, pw->y)) != WETDEM_OK)
+            return st;
+        pw->n_out = 1;
+    }
+    struct wetdem_pairwise_kin k;
+    if (!current_kin(pw, &k))
+        return WETDEM_ERR_NUMERIC;
+    pw->done = pw->cfg.stop_when_separated && all_apart(pw, &k);
+    while (!pw->done)
+        if ((st = advance(pw)) != WETDEM_OK)
+            return st;
+    if (pw->obs && (st = emit(pw, pw->t, pw->y)) != WETDEM_OK)
+        return st;
+    finish(pw);
+    return WETDEM_OK;
+}
