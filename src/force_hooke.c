@@ -11,7 +11,8 @@
  * rebounds with e = exp(-gamma t_c/(2 m*)); solving for gamma gives the expression above, so
  * e_dry is reproduced exactly at every impact speed. The force is NOT clipped at zero: near
  * the end of unloading it pulls by up to gamma v; clipping would raise the rebound speed and
- * break both closed forms. k is a model parameter, independent of the material moduli.
+ * break both closed forms. At delta = 0 the force jumps by gamma v_n (the dashpot acts from
+ * the first overlap), the one discontinuity of the law; thresholds() reports that gap. k is a model parameter, independent of the material moduli.
  * Validity: e in (0, 1]; choose k so that the overlap stays small, delta_max = v sqrt(m* / k)
  * (undamped) << R*.
  */
@@ -78,7 +79,8 @@ const struct wetdem_model wetdem_force_hooke = {
            "sqrt(ln^2 e + pi^2), which makes a head-on collision rebound with exactly e_dry at "
            "any speed; contact time pi / sqrt(k/m* - (gamma/(2 m*))^2). The force is not "
            "clipped, so it pulls slightly at the end of unloading (clipping would break both "
-           "closed forms). Cheaper and stiffer-to-tune than hertz; k does not follow from the "
+           "closed forms), and the dashpot makes it jump by gamma v_n where the overlap "
+           "begins and ends. Cheaper and stiffer-to-tune than hertz; k does not follow from the "
            "material moduli. Keep the overlap v sqrt(m* / k) small compared with R*.",
     .equations = "linear spring-dashpot (Cundall & Strack 1979; LIGGGHTS model hooke); "
                  "docs/derivations/contact.md",

@@ -13,7 +13,12 @@
  *      gamma_t = -2 sqrt(5/6) beta sqrt(m* k_t),  beta = ln e / sqrt(ln^2 e + pi^2)   [kg/s]
  *   4. if k_t |s| > mu F_lim (sliding): s <- s mu F_lim / (k_t |s|),  F_t = -k_t s
  *      (|F_t| = mu F_lim exactly, no damping), else (sticking) F_t = -k_t s - gamma_t v_t.
- * F_lim is the Hertz elastic normal force (4/3) E* sqrt(R*) delta^(3/2) for this model.
+ * F_lim is the Hertz elastic normal force (4/3) E* sqrt(R*) delta^(3/2) for this model
+ * (LIGGGHTS takes the total normal force, damping included; models do not read each other's
+ * force here, and the elastic part stays positive while unloading). LIGGGHTS projects s into
+ * the plane without restoring its length; here the length is kept (rigid rotation). Only the
+ * spring is compared with the limit, so a sticking contact carries the dashpot on top of it:
+ * |F_t| may exceed mu F_lim, and drops by gamma_t |v_t| when sliding starts.
  * delta <= 0 resets s to zero and gives no force. The damping is the normal Tsuji form with
  * k_t in place of S_n = 2 E* sqrt(R* delta) (as LIGGGHTS): the tangential restitution of a
  * Mindlin contact depends on the impact angle and mu, so no "exact" value exists.
@@ -132,15 +137,19 @@ const struct wetdem_model wetdem_force_mindlin = {
     .name = "mindlin",
     .kind = WETDEM_MODEL_CONTACT,
     .summary = "Mindlin tangential spring with history, damping and a Coulomb limit",
-    .doc = "Tangential solid contact for overlap delta = -h > 0, LIGGGHTS tangential-history "
-           "semantics. Per pair the elastic tangential displacement s [m] is kept; each "
-           "evaluation rotates it into the current tangent plane (length kept), adds v_t dt, "
+    .doc = "Tangential solid contact for overlap delta = -h > 0, after LIGGGHTS tangential "
+           "history. Per pair the elastic tangential displacement s [m] is kept; each "
+           "evaluation rotates it into the current tangent plane (length kept, where LIGGGHTS "
+           "projects it), adds v_t dt, "
            "and gives F_t = -k_t s - gamma_t v_t with k_t = 8 G* sqrt(R* delta) and "
            "gamma_t = -2 sqrt(5/6) beta sqrt(m* k_t), beta = ln e / sqrt(ln^2 e + pi^2) (the "
            "normal Tsuji damping with k_t). If the spring force k_t |s| exceeds "
-           "mu (4/3) E* sqrt(R*) delta^(3/2) (the Hertz elastic normal force), the contact "
-           "slides: s is shortened to that limit and F_t = -k_t s, so |F_t| = mu F_el "
-           "exactly. Separation (delta <= 0) resets s. The force acts at the contact point "
+           "mu (4/3) E* sqrt(R*) delta^(3/2) (the Hertz elastic normal force, where LIGGGHTS "
+           "takes the total normal force), the contact slides: s is shortened to that limit and "
+           "F_t = -k_t s, so |F_t| = mu F_el exactly. As in LIGGGHTS only the spring is "
+           "compared, so while sticking the dashpot can carry |F_t| above mu F_el (many times "
+           "at small overlaps), and |F_t| drops by gamma_t |v_t| when sliding starts. "
+           "Separation (delta <= 0) resets s. The force acts at the contact point "
            "and gives torques on both spheres. Use with hertz. mu is the pair's dry or "
            "lubricated coefficient (parameter friction). Valid for small overlaps; no "
            "micro-slip hysteresis inside the contact area.",

@@ -60,7 +60,8 @@ const struct wetdem_model wetdem_force_reynolds = {
     .summary = "normal lubrication 6 pi mu R*^2 v_n / h of fully immersed spheres",
     .doc = "Leading-order Reynolds lubrication between two fully immersed spheres, "
            "F = 6 pi mu R*^2 v_n / max(h, h_min), acting for 0 < h <= cutoff_ratio R*. "
-           "Repulsive when approaching, suction when separating; zero at solid overlap. "
+           "Repulsive when approaching, suction when separating; zero at solid overlap, so it "
+           "jumps at h = 0 (from its h_min value) and at the cut-off. "
            "For comparison with the nijssen model, which blends it into Hertz contact.",
     .equations = "Nijssen 2023 Eq. 1 (with the h_min truncation of Eq. 8)",
     .params = reynolds_params_desc,

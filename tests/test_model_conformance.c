@@ -37,12 +37,22 @@
 #define MB 1.2
 #define DT 1e-6 /* [s] time since the history was committed */
 
-static const struct wetdem_material mat_a = {
-    .density = 7800, .youngs_modulus = 200e9, .poisson_ratio = 0.3, .restitution = 0.9,
-    .friction_dry = 0.3, .friction_lub = 0.05, .roughness = 0.4e-6, .film = 60e-6};
-static const struct wetdem_material mat_b = {
-    .density = 2500, .youngs_modulus = 70e9, .poisson_ratio = 0.22, .restitution = 0.8,
-    .friction_dry = 0.2, .friction_lub = 0.03, .roughness = 1.6e-6, .film = 40e-6};
+static const struct wetdem_material mat_a = {.density = 7800,
+                                             .youngs_modulus = 200e9,
+                                             .poisson_ratio = 0.3,
+                                             .restitution = 0.9,
+                                             .friction_dry = 0.3,
+                                             .friction_lub = 0.05,
+                                             .roughness = 0.4e-6,
+                                             .film = 60e-6};
+static const struct wetdem_material mat_b = {.density = 2500,
+                                             .youngs_modulus = 70e9,
+                                             .poisson_ratio = 0.22,
+                                             .restitution = 0.8,
+                                             .friction_dry = 0.2,
+                                             .friction_lub = 0.03,
+                                             .roughness = 1.6e-6,
+                                             .film = 40e-6};
 /* delta = 100 um, h_sigma = 1 um. With mu = 200 Pa s and v_n = 0.3 m/s nijssen's
  * h_eps = 0.37 R* (mu v/(E* R*))^(2/5) = 1.9 um > h_sigma (E* = 5.51e10 Pa). */
 static const struct wetdem_fluid fluids[] = {{0.5, 0.02, 1000}, {200.0, 0.03, 1200}};
@@ -51,9 +61,9 @@ static const double h_mins[] = {1e-6, 200e-6};
 /* Motions: relative normal approach speed, tangential sliding of the centres, spins. */
 struct motion {
     const char* name;
-    double v_n;                  /* [m/s] > 0 approaching */
-    double slide_1, slide_2;     /* centre sliding of i relative to j along t1, t2 [m/s] */
-    struct wetdem_vec3 omega_a;  /* [rad/s] */
+    double v_n;                 /* [m/s] > 0 approaching */
+    double slide_1, slide_2;    /* centre sliding of i relative to j along t1, t2 [m/s] */
+    struct wetdem_vec3 omega_a; /* [rad/s] */
     struct wetdem_vec3 omega_b;
 };
 static const struct motion motions[] = {
@@ -141,7 +151,7 @@ static const char* variant_word(const struct variant* v, const char* name)
     const struct wetdem_param_desc* d = wetdem_param_find(v->model->params, name);
     if (!d || !d->choices)
         return "";
-    return d->choices[(size_t)*(const double*)((const char*)v->params + d->offset)];
+    return d->choices[(size_t) * (const double*)((const char*)v->params + d->offset)];
 }
 
 static bool is_force_model(const struct wetdem_model* m)
@@ -181,9 +191,8 @@ static void make_particles(const struct config* cfg, double gap, struct wetdem_p
     b->mass = MB;
     b->material = 1;
     a->pos = add(b->pos, scale(n, RA + RB + gap));
-    struct wetdem_vec3 rel = add(scale(n, -cfg->motion->v_n),
-                                 add(scale(t1, cfg->motion->slide_1),
-                                     scale(t2, cfg->motion->slide_2)));
+    struct wetdem_vec3 rel = add(scale(n, -cfg->motion->v_n), add(scale(t1, cfg->motion->slide_1),
+                                                                  scale(t2, cfg->motion->slide_2)));
     a->vel = add(b->vel, rel);
     a->omega = cfg->motion->omega_a;
     a->radius = RA;
@@ -425,8 +434,8 @@ static void test_conformance_min_separation_swap_invariant(void** state)
                         double a = reg[k]->min_separation(vars[v].params, &c, hc);
                         double b = reg[k]->min_separation(vars[v].params, &s, hs);
                         if (!(a == b) || !(a >= 0.0) || !isfinite(a))
-                            fail_msg("%s: h_min %g vs swapped %g at gap %g", vars[v].label, a,
-                                     b, scan_gaps[g]);
+                            fail_msg("%s: h_min %g vs swapped %g at gap %g", vars[v].label, a, b,
+                                     scan_gaps[g]);
                     }
                 }
     }
@@ -480,8 +489,9 @@ static void test_conformance_zero_beyond_range(void** state)
 
 /* The jumps that the models' docs state, by model and the role of the threshold:
  *   nijssen    at h_co                 "the force jumps only at h_co" (Nijssen Eq. 9)
- *   reynolds   at h_co; at 0 if h_min > 0   acts for 0 < h <= h_co, zero at solid overlap
- *   hooke      at 0                    the dashpot gamma v_n acts from the first overlap
+ *   reynolds   at h_co; at 0 if h_min > 0   "jumps at h = 0 (from its h_min value) and at
+ *                                      the cut-off"
+ *   hooke      at 0                    "jump by gamma v_n where the overlap begins and ends"
  *   sb, db, davis  at h_min' < delta with below_hmin = c   (Punch Eq. 12: zero below h_min)
  *   nase       at delta ("the force drops to zero there"); at h_min' < delta with c
  *   capillary  at delta                the bridge forms and breaks at the film edge
@@ -545,8 +555,8 @@ static void threshold_config(const struct variant* v, const struct config* cfg, 
             if (!(j_narrow > 1e-3 * s_narrow && j_narrow >= 0.5 * j_wide))
                 fail_msg("%s [mu %g, h_min %g, %s]: documented jump at %g m is absent: "
                          "%g N (half-width %g) and %g N (%g) of scale %g N",
-                         v->label, cfg->fluid->viscosity, cfg->h_min, cfg->motion->name, g,
-                         j_wide, 1e-4 * len, j_narrow, 1e-12 * len, s_narrow);
+                         v->label, cfg->fluid->viscosity, cfg->h_min, cfg->motion->name, g, j_wide,
+                         1e-4 * len, j_narrow, 1e-12 * len, s_narrow);
             (*n_jumps)++;
         } else {
             /* Continuous: the jump shrinks at least as the weakest branch, the Hertz damping
@@ -556,8 +566,8 @@ static void threshold_config(const struct variant* v, const struct config* cfg, 
             if (!(j_narrow <= 1e-12 * s_narrow || j_narrow <= 0.05 * j_wide))
                 fail_msg("%s [mu %g, h_min %g, %s]: undocumented jump at threshold %g m: "
                          "%g N (half-width %g) and %g N (%g) of scale %g N",
-                         v->label, cfg->fluid->viscosity, cfg->h_min, cfg->motion->name, g,
-                         j_wide, 1e-4 * len, j_narrow, 1e-12 * len, s_narrow);
+                         v->label, cfg->fluid->viscosity, cfg->h_min, cfg->motion->name, g, j_wide,
+                         1e-4 * len, j_narrow, 1e-12 * len, s_narrow);
         }
     }
 }
@@ -761,8 +771,8 @@ static void test_conformance_wall_is_limit_of_large_fixed_sphere(void** state)
                                             .omega = {5, 12, -3},
                                             .radius = RA,
                                             .mass = MA};
-                struct wetdem_particle b = {.pos = {0, 0, -big}, .radius = big, .mass = 1.0,
-                                            .is_fixed = true};
+                struct wetdem_particle b = {
+                    .pos = {0, 0, -big}, .radius = big, .mass = 1.0, .is_fixed = true};
                 struct wetdem_contact cw, cs;
                 wetdem_contact_with_wall(&cw, &a, &mat_a, v3(0, 0, 0), v3(0, 0, 1), &mat_b,
                                          &fluids[1]);
@@ -809,8 +819,7 @@ static struct davis_state davis_polar(struct wetdem_vec3 xi, struct wetdem_vec3 
     return d;
 }
 
-static struct wetdem_impulse_body solid_sphere(double m, double a, struct wetdem_vec3 v,
-                                               double wz)
+static struct wetdem_impulse_body solid_sphere(double m, double a, struct wetdem_vec3 v, double wz)
 {
     return (struct wetdem_impulse_body){v, v3(0, 0, wz), m, a, 0.4 * m * a * a};
 }
@@ -839,7 +848,7 @@ static void test_conformance_hard_matches_davis_appendix_a_unequal(void** state)
         struct wetdem_impulse_body bj = solid_sphere(mj, aj, v3(0.1, -0.2, 0), -5 * slips[k]);
         struct davis_state b = davis_polar(xi, xj, &bi, &bj);
         const double mu = 0.25;
-        double jn = m * (1 + e) * b.v_n; /* A3 */
+        double jn = m * (1 + e) * b.v_n;           /* A3 */
         bool stick = mt * fabs(b.slip) <= mu * jn; /* A36 generalised */
         double wi = bi.omega.z, wj = bj.omega.z;
         struct wetdem_impulse_result res;
@@ -848,17 +857,17 @@ static void test_conformance_hard_matches_davis_appendix_a_unequal(void** state)
         assert_int_equal(res.is_sticking, stick);
         n_stick += stick;
         /* tolerances 1e-13 absolute in m/s on O(1) quantities: a few roundings */
-        CHECK_ABS(a.v_n, -e * b.v_n, 1e-13);           /* A1 */
-        CHECK_REL(res.impulse_normal, jn, 1e-14);      /* A3 */
+        CHECK_ABS(a.v_n, -e * b.v_n, 1e-13);      /* A1 */
+        CHECK_REL(res.impulse_normal, jn, 1e-14); /* A3 */
         double sgn = b.slip > 0 ? 1.0 : -1.0;
         if (stick) {
-            CHECK_ABS(a.slip, 0.0, 1e-13); /* A30 */
+            CHECK_ABS(a.slip, 0.0, 1e-13);                              /* A30 */
             CHECK_REL(norm(res.impulse_tan), mt * fabs(b.slip), 1e-13); /* A33 */
             /* A31: m r (Omega^a - Omega^b) = I_t, the tangential impulse on j along e_t */
             CHECK_ABS(m * a.r * (a.omega_line - b.omega_line), -dot(res.impulse_tan, et), 1e-13);
         } else {
             double jump = mu * (1 + e) * b.v_n; /* the v_t jump of A9 */
-            CHECK_ABS(a.omega_line, b.omega_line + sgn * jump / b.r, 1e-12);       /* A10 */
+            CHECK_ABS(a.omega_line, b.omega_line + sgn * jump / b.r, 1e-12); /* A10 */
             CHECK_ABS(bi.omega.z, wi - sgn * jump * ai * m / (0.4 * mi * ai * ai), 1e-12);
             CHECK_ABS(bj.omega.z, wj - sgn * jump * aj * m / (0.4 * mj * aj * aj), 1e-12);
             /* A11 with I_j: the printed I_i would give a different omega_j for m_i != m_j */
@@ -895,16 +904,14 @@ static void test_conformance_hard_energy_never_grows(void** state)
         n = scale(n, 1.0 / norm(n));
         double mi = urand(&seed, 0.01, 2), mj = urand(&seed, 0.01, 2);
         double ai = urand(&seed, 1e-3, 0.05), aj = urand(&seed, 1e-3, 0.05);
-        struct wetdem_impulse_body bi = {v3(urand(&seed, -2, 2), urand(&seed, -2, 2),
-                                            urand(&seed, -2, 2)),
-                                         v3(urand(&seed, -50, 50), urand(&seed, -50, 50),
-                                            urand(&seed, -50, 50)),
-                                         mi, ai, 0.4 * mi * ai * ai};
-        struct wetdem_impulse_body bj = {v3(urand(&seed, -2, 2), urand(&seed, -2, 2),
-                                            urand(&seed, -2, 2)),
-                                         v3(urand(&seed, -50, 50), urand(&seed, -50, 50),
-                                            urand(&seed, -50, 50)),
-                                         mj, aj, 0.4 * mj * aj * aj};
+        struct wetdem_impulse_body bi = {
+            v3(urand(&seed, -2, 2), urand(&seed, -2, 2), urand(&seed, -2, 2)),
+            v3(urand(&seed, -50, 50), urand(&seed, -50, 50), urand(&seed, -50, 50)), mi, ai,
+            0.4 * mi * ai * ai};
+        struct wetdem_impulse_body bj = {
+            v3(urand(&seed, -2, 2), urand(&seed, -2, 2), urand(&seed, -2, 2)),
+            v3(urand(&seed, -50, 50), urand(&seed, -50, 50), urand(&seed, -50, 50)), mj, aj,
+            0.4 * mj * aj * aj};
         int kind = k % 4; /* 0, 1 free pair; 2 wall j; 3 fixed sphere j */
         if (kind == 2)
             bj = (struct wetdem_impulse_body){v3(0, 0, 0), v3(0, 0, 0), INFINITY, INFINITY, 0};
@@ -923,8 +930,8 @@ static void test_conformance_hard_energy_never_grows(void** state)
         if (elastic)
             CHECK_REL(ke1, ke0, 1e-12);
         else if (!(ke1 <= ke0 * (1 + 1e-12)))
-            fail_msg("case %d: kinetic energy grew from %.17g to %.17g J (e %g, mu %g)", k,
-                     ke0, ke1, e, mu);
+            fail_msg("case %d: kinetic energy grew from %.17g to %.17g J (e %g, mu %g)", k, ke0,
+                     ke1, e, mu);
     }
 }
 
