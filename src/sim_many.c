@@ -455,7 +455,7 @@ struct failure {
 static void note_failure(struct failure* fail, size_t index, int st, bool is_wall,
                          const struct wetdem_contact* c, const struct wetdem_sim* sim)
 {
-#pragma omp critical(wetdem_many_failure)
+#pragma omp critical
     if (fail->status == WETDEM_OK || index < fail->index)
         *fail = (struct failure){index, st, is_wall, c->gap, wetdem_sim_contact_range(sim, c)};
 }
