@@ -678,6 +678,64 @@ static void test_conformance_no_unreported_branch(void** state)
 }
 
 /* ======================================================================================== */
+/* Dissipation: viscous laws never do positive work                                          */
+/* ======================================================================================== */
+
+/* Power the pair's forces deliver to the two particles [W]: F on i and -F on j at their
+ * centre velocities plus the torques on their spins. For forces applied at the contact points
+ * it equals -F_n v_n + F_t . v_t (contact.c's v_t is the surface slip). */
+static double pair_power(const struct config* cfg, double gap, const struct wetdem_contact* c,
+                         const struct wetdem_pair_force* f)
+{
+    struct wetdem_particle a, b;
+    make_particles(cfg, gap, &a, &b);
+    struct wetdem_vec3 force = add(scale(c->normal, f->f_normal), f->f_tan);
+    return dot(force, sub(a.vel, b.vel)) + dot(f->torque_i, a.omega) + dot(f->torque_j, b.omega);
+}
+
+static const char* const viscous_models[] = {"reynolds", "sb", "db", "davis", "nase", NULL};
+
+static bool is_viscous(const struct wetdem_model* m)
+{
+    for (size_t k = 0; viscous_models[k]; k++)
+        if (strcmp(m->name, viscous_models[k]) == 0)
+            return true;
+    return false;
+}
+
+/* Purely viscous laws (normal squeeze and tangential shear, spins included) dissipate: the
+ * power is <= 0 in every configuration, and < 0 wherever they act. nijssen is purely viscous
+ * in its lubrication branch h > h_min. Tolerance: the power is a sum of a few products of
+ * size |F| |v|, so 1e-13 of that bounds the roundings. */
+static void dissipation_config(const struct variant* v, const struct config* cfg, void* ctx)
+{
+    size_t* n_strict = ctx;
+    bool viscous = is_viscous(v->model), nijssen = strcmp(v->model->name, "nijssen") == 0;
+    if (!viscous && !nijssen)
+        return;
+    for (size_t g = 0; g < N_GAPS; g++) {
+        if (nijssen && !(scan_gaps[g] > 2e-6)) /* above any h_min of these configurations */
+            continue;
+        struct wetdem_contact c = make_contact(cfg, scan_gaps[g], false);
+        struct wetdem_pair_force f = eval_fresh(v, &c);
+        double p = pair_power(cfg, scan_gaps[g], &c, &f);
+        double bound = 1e-13 * force_scale(&f, RA, RB) * (fabs(c.v_n) + norm(c.v_t) + 1.0);
+        if (!(p <= bound))
+            fail_msg("%s [mu %g, h_min %g, %s, gap %g]: viscous force does work %g W > 0", v->label,
+                     cfg->fluid->viscosity, cfg->h_min, cfg->motion->name, scan_gaps[g], p);
+        *n_strict += p < -bound;
+    }
+}
+
+static void test_conformance_viscous_laws_dissipate(void** state)
+{
+    (void)state;
+    size_t n_strict = 0;
+    assert_true(for_each_force_config(dissipation_config, &n_strict) > 0);
+    assert_true(n_strict > 100); /* the laws did act */
+}
+
+/* ======================================================================================== */
 /* src/contact.c: mixing rules and kinematics                                                */
 /* ======================================================================================== */
 
@@ -944,6 +1002,7 @@ int main(void)
         cmocka_unit_test(test_conformance_zero_beyond_range),
         cmocka_unit_test(test_conformance_continuity_at_thresholds),
         cmocka_unit_test(test_conformance_no_unreported_branch),
+        cmocka_unit_test(test_conformance_viscous_laws_dissipate),
         cmocka_unit_test(test_conformance_contact_mixing_and_kinematics),
         cmocka_unit_test(test_conformance_wall_is_limit_of_large_fixed_sphere),
         cmocka_unit_test(test_conformance_hard_matches_davis_appendix_a_unequal),
