@@ -372,8 +372,8 @@ static void test_conformance_swap_symmetry_and_torques(void** state)
     (void)state;
     size_t n_tangential = 0;
     size_t n = for_each_force_config(swap_config, &n_tangential);
-    /* 11 force models, 17 variants, 12 configurations each */
-    assert_true(n >= 11 * 12);
+    /* today 10 force models in 17 variants, 12 configurations each: 204 */
+    assert_true(n >= 17 * 12);
     /* the torque checks must have seen tangential forces (mindlin, nijssen, davis, nase) */
     assert_true(n_tangential > 100);
 }
