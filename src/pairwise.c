@@ -839,8 +839,11 @@ static void initial_state(struct wetdem_pairwise* pw)
         r->min_gap = k.h[p];
         r->mechanism = -1;
         bool has_film = sys->delta[p] > sys->h_min;
-        pw->md.film[p] = has_film && (k.h[p] < sys->delta[p] ||
-                                      (k.h[p] == sys->delta[p] && k.v_n[p] >= 0.0));
+        /* films "just touching" (to rounding of the input positions) count as touching */
+        if (has_film && fabs(k.h[p] - sys->delta[p]) <= 1e-12 * sys->delta[p] && k.v_n[p] >= 0.0)
+            k.h[p] = sys->delta[p];
+        pw->md.film[p] = has_film && k.h[p] <= sys->delta[p] && (k.h[p] < sys->delta[p] ||
+                                                                 k.v_n[p] >= 0.0);
         if (pw->md.film[p]) {
             r->films_met = true;
             r->v_n_in = k.v_n[p];

@@ -1,0 +1,427 @@
+/*
+ * run_pairwise.c — `[engine] type = pairwise` scenarios: the sections the pairwise engine reads
+ * (cli_pairwise_sections), building a struct wetdem_pairwise_config from them, running it
+ * (wetdem_pairwise_run, Davis 2023) and reporting: a text or JSON summary, trajectory and
+ * event CSVs in --out DIR, or one CSV row for `wetdem sweep` / `wetdem map`.
+ *
+ * Two ways to give the spheres:
+ *   [davis]      Davis's Table I groups (St_n, Ca, h_a, h_m, beta, d_23, d_13, h_23,0,
+ *                theta_23,0, e_dry, mu_f, t*_end) for two or three equal spheres, built by
+ *                wetdem_pairwise_davis_config();
+ *   [sphere.NAME] one section per sphere (in file order) with [pairwise] holding the fluid,
+ *                h_min, e_dry, mu_f and t_end.
+ * [pairwise] also holds the run settings (rtol, rest speed, stop rule, reference pair) and may
+ * override the [davis] run length. Spheres are numbered from 1 in every output (Davis's
+ * numbering: sphere 1 is the striker); the library counts from 0.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cli_util.h"
+#include "scenario.h"
+
+#define NUM(k, u, dflt, lo, hi, lo_open, hi_open, doc)                                            \
+    {k, CLI_VALUE_NUMBER, u, dflt, lo, hi, lo_open, hi_open, NULL, doc}
+
+static const struct cli_key_desc davis_keys[] = {
+    NUM("n_spheres", "-", "3", 2, 3, false, false,
+        "2: striker and target only (oblique two-sphere collision); 3: Davis Fig. 3."),
+    NUM("stokes", "-", "2", 0, 1e9, true, false, "Normal Stokes number St_n = m v_n0/(6 pi mu a^2)."),
+    NUM("capillary", "-", "1000", 0, 1e12, false, false,
+        "Capillary number Ca = 3 mu a v_n0/(sigma delta_12); 0 = no capillary force."),
+    NUM("film_ratio", "-", "0.01", 0, 0.5, true, true, "h_a = delta_12/4a (film over diameter)."),
+    NUM("hmin_ratio", "-", "0.01", 0, 1, true, true, "h_m = h_min/delta_12."),
+    NUM("angle_deg", "deg", "30", 0, 90, false, true,
+        "Impact angle beta between the striker's velocity and the 1-2 line of centres."),
+    NUM("d23", "-", "1", 0, 1e6, true, false, "delta_23/delta_12."),
+    NUM("d13", "-", "1", 0, 1e6, true, false, "delta_13/delta_12."),
+    NUM("h23", "-", "1", 0, 1e6, true, false, "Initial 2-3 gap h_23,0/delta_12 (>= hmin_ratio)."),
+    NUM("theta23_deg", "deg", "0", -180, 180, false, false,
+        "Angle of the 2-3 line of centres from the x axis."),
+    NUM("restitution", "-", "1", 0, 1, true, false, "Dry coefficient of restitution e_dry."),
+    NUM("friction", "-", "0", 0, 10, false, false, "Friction coefficient mu_f of the impulse."),
+    NUM("t_star_end", "-", "20", 0, 1e9, true, false, "Run length in t* = v_10 t/4a."),
+    NUM("a", "m", "1e-3", 0, 1, true, false, "Reduced radius a (sphere radius 2a); a unit only."),
+    NUM("viscosity", "Pa s", "1", 0, 1e9, true, false, "Film viscosity mu; a unit only."),
+    NUM("speed_n0", "m/s", "1", 0, 1e3, true, false, "Normal impact speed v_n0; a unit only."),
+    {0},
+};
+
+static const struct cli_key_desc pairwise_keys[] = {
+    NUM("viscosity", "Pa s", "0", 0, 1e9, false, false, "Film viscosity mu ([sphere.*] runs)."),
+    NUM("surface_tension", "N/m", "0", 0, 10, false, false,
+        "Surface tension sigma: capillary suction 8 pi a_ij sigma ([sphere.*] runs)."),
+    NUM("h_min", "m", "required with [sphere.*]", 0, 1, true, false,
+        "Minimum separation: hard-sphere contact when a gap reaches it."),
+    NUM("restitution", "-", "1", 0, 1, true, false, "Dry restitution e_dry ([sphere.*] runs)."),
+    NUM("friction", "-", "0", 0, 10, false, false, "Friction mu_f of the impulse ([sphere.*] runs)."),
+    NUM("gravity_x", "m/s^2", "0", -1e3, 1e3, false, false, "Gravity, x."),
+    NUM("gravity_y", "m/s^2", "0", -1e3, 1e3, false, false, "Gravity, y."),
+    NUM("t_end", "s", "from [davis] t_star_end, else required", 0, 1e9, true, false,
+        "Longest simulated time."),
+    NUM("rtol", "-", "1e-9", 1e-14, 1e-3, false, false, "Relative tolerance of CVODE."),
+    NUM("rest_speed_ratio", "-", "1e-3", 0, 1, false, true,
+        "Contacts slower than this times v_n0 are held at h_min (resting contact)."),
+    NUM("stop_when_separated", "-", "1", 0, 1, false, false,
+        "1: stop once every pair is apart and receding; 0: run to t_end."),
+    NUM("ref_i", "-", "1", 1, 8, false, false, "Reference pair (v_n0, delta_12, t-hat, t*): first."),
+    NUM("ref_j", "-", "2", 1, 8, false, false, "Reference pair: second sphere."),
+    NUM("max_events", "-", "100000", 1, 1e9, false, false, "Event budget of one run."),
+    {0},
+};
+
+static const struct cli_key_desc sphere_keys[] = {
+    NUM("radius", "m", "required", 0, 1, true, false, "Radius a_i."),
+    NUM("mass", "kg", "required", 0, 1e6, true, false, "Mass m_i."),
+    NUM("film", "m", "0", 0, 1, false, false, "Liquid film thickness delta_i."),
+    NUM("x", "m", "0", -1e3, 1e3, false, false, "Centre, x."),
+    NUM("y", "m", "0", -1e3, 1e3, false, false, "Centre, y."),
+    NUM("vx", "m/s", "0", -1e3, 1e3, false, false, "Velocity, x."),
+    NUM("vy", "m/s", "0", -1e3, 1e3, false, false, "Velocity, y."),
+    NUM("omega", "rad/s", "0", -1e6, 1e6, false, false, "Spin about z (counter-clockwise)."),
+    {0},
+};
+
+const struct cli_section_desc cli_pairwise_sections[] = {
+    {"davis", "Pairwise engine: Davis (2023) Table I groups for two or three equal spheres.",
+     davis_keys},
+    {"pairwise", "Pairwise engine: fluid and contact for [sphere.*] runs, and run settings.",
+     pairwise_keys},
+    {"sphere.*", "Pairwise engine: one sphere NAME (file order gives the numbering 1, 2, ...).",
+     sphere_keys},
+    {0},
+};
+
+/* ----------------------------------------------------------------- building the config -- */
+
+/* Reports a library message about `key` at its line in `section` (or at the section). */
+static int report(const struct cli_scenario* sc, const char* section, const char* msg)
+{
+    for (size_t k = 0; k < sc->n_entries; k++) {
+        const struct cli_entry* e = &sc->entries[k];
+        size_t n = strlen(e->key);
+        if (strcmp(e->section, section) == 0 && strncmp(msg, e->key, n) == 0 && msg[n] == ' ') {
+            cli_scenario_error(sc, e, "%s", msg);
+            return CLI_EXIT_USAGE;
+        }
+    }
+    cli_scenario_section_error(sc, section, "%s", msg);
+    return CLI_EXIT_USAGE;
+}
+
+static int from_davis(const struct cli_scenario* sc, struct wetdem_pairwise_config* cfg)
+{
+    struct wetdem_pairwise_davis d;
+    wetdem_pairwise_davis_init(&d);
+    for (const struct wetdem_param_desc* p = wetdem_pairwise_davis_params(); p->name; p++) {
+        double* field = (double*)((char*)&d + p->offset);
+        *field = cli_scenario_number(sc, "davis", p->name, *field);
+    }
+    char msg[512];
+    if (wetdem_pairwise_davis_config(&d, cfg, msg, sizeof msg) != WETDEM_OK)
+        return report(sc, "davis", msg);
+    return CLI_EXIT_OK;
+}
+
+static int from_spheres(const struct cli_scenario* sc, struct wetdem_pairwise_config* cfg)
+{
+    wetdem_pairwise_config_init(cfg);
+    for (size_t s = 0; s < sc->n_sections; s++) {
+        const char* name = sc->sections[s].name;
+        if (strncmp(name, "sphere.", 7) != 0)
+            continue;
+        if (cfg->n_spheres == WETDEM_PAIRWISE_MAX_SPHERES) {
+            cli_scenario_section_error(sc, name, "more than %d spheres",
+                                       WETDEM_PAIRWISE_MAX_SPHERES);
+            return CLI_EXIT_USAGE;
+        }
+        struct wetdem_pairwise_sphere* q = &cfg->spheres[cfg->n_spheres++];
+        const char* keys[] = {"radius", "mass", "film", "x", "y", "vx", "vy", "omega"};
+        double* fields[] = {&q->radius, &q->mass, &q->film, &q->x, &q->y, &q->vx, &q->vy, &q->omega};
+        for (int k = 0; k < 8; k++) {
+            if (k < 2 && !cli_scenario_find(sc, name, keys[k])) {
+                cli_scenario_section_error(sc, name, "[%s] needs %s", name, keys[k]);
+                return CLI_EXIT_USAGE;
+            }
+            *fields[k] = cli_scenario_number(sc, name, keys[k], 0.0);
+        }
+    }
+    if (cfg->n_spheres < 2) {
+        cli_scenario_section_error(sc, "pairwise",
+                                   "the pairwise engine needs [davis] or at least two "
+                                   "[sphere.NAME] sections");
+        return CLI_EXIT_USAGE;
+    }
+    const char* req[] = {"h_min", "t_end"};
+    for (int k = 0; k < 2; k++)
+        if (!cli_scenario_find(sc, "pairwise", req[k])) {
+            cli_scenario_section_error(sc, "pairwise", "[pairwise] needs %s with [sphere.*]",
+                                       req[k]);
+            return CLI_EXIT_USAGE;
+        }
+    cfg->viscosity = cli_scenario_number(sc, "pairwise", "viscosity", 0.0);
+    cfg->surface_tension = cli_scenario_number(sc, "pairwise", "surface_tension", 0.0);
+    cfg->h_min = cli_scenario_number(sc, "pairwise", "h_min", 0.0);
+    cfg->restitution = cli_scenario_number(sc, "pairwise", "restitution", 1.0);
+    cfg->friction = cli_scenario_number(sc, "pairwise", "friction", 0.0);
+    return CLI_EXIT_OK;
+}
+
+/* Run settings of [pairwise] on top of either way of giving the spheres. */
+static void run_settings(const struct cli_scenario* sc, struct wetdem_pairwise_config* cfg)
+{
+    cfg->gravity_x = cli_scenario_number(sc, "pairwise", "gravity_x", cfg->gravity_x);
+    cfg->gravity_y = cli_scenario_number(sc, "pairwise", "gravity_y", cfg->gravity_y);
+    cfg->t_end = cli_scenario_number(sc, "pairwise", "t_end", cfg->t_end);
+    cfg->rtol = cli_scenario_number(sc, "pairwise", "rtol", cfg->rtol);
+    cfg->rest_speed_ratio =
+        cli_scenario_number(sc, "pairwise", "rest_speed_ratio", cfg->rest_speed_ratio);
+    cfg->stop_when_separated =
+        cli_scenario_number(sc, "pairwise", "stop_when_separated", 1.0) != 0.0;
+    cfg->ref_i = (size_t)cli_scenario_number(sc, "pairwise", "ref_i", 1.0) - 1;
+    cfg->ref_j = (size_t)cli_scenario_number(sc, "pairwise", "ref_j", 2.0) - 1;
+    cfg->max_events = (size_t)cli_scenario_number(sc, "pairwise", "max_events", 100000.0);
+}
+
+/* Builds and checks the configuration; exit code. */
+static int build_config(const struct cli_scenario* sc, struct wetdem_pairwise_config* cfg)
+{
+    bool davis = cli_scenario_has_section(sc, "davis");
+    int rc = davis ? from_davis(sc, cfg) : from_spheres(sc, cfg);
+    if (rc != CLI_EXIT_OK)
+        return rc;
+    run_settings(sc, cfg);
+    char msg[512];
+    if (wetdem_pairwise_config_validate(cfg, msg, sizeof msg) != WETDEM_OK)
+        return report(sc, strncmp(msg, "spheres[", 8) == 0 && davis ? "davis" : "pairwise", msg);
+    return CLI_EXIT_OK;
+}
+
+/* ----------------------------------------------------------------------- reporting ---- */
+
+static const char* mechanism_name(int m)
+{
+    switch (m) {
+    case WETDEM_OUTCOME_STICK: return "stick";
+    case WETDEM_OUTCOME_STICK_ROTATE_SEPARATE: return "stick-rotate-separate";
+    case WETDEM_OUTCOME_BOUNCE: return "bounce";
+    default: return "none";
+    }
+}
+
+static void sweep_header(FILE* f, const struct wetdem_pairwise_config* cfg)
+{
+    fputs("pairwise_status [word],outcome [word],separated_sphere [-],time [s],t_star_end [-],"
+          "events [-],steps [-]",
+          f);
+    for (size_t i = 0; i < cfg->n_spheres; i++)
+        for (size_t j = i + 1; j < cfg->n_spheres; j++)
+            fprintf(f, ",e_w_%zu%zu [-],e_own_%zu%zu [-],contacts_%zu%zu [-],"
+                       "mechanism_%zu%zu [word],t_sep_star_%zu%zu [-]",
+                    i + 1, j + 1, i + 1, j + 1, i + 1, j + 1, i + 1, j + 1, i + 1, j + 1);
+}
+
+static double star(const struct wetdem_pairwise_result* r, double t)
+{
+    return r->v_10 * t / (4.0 * r->a_ref);
+}
+
+static void sweep_row(FILE* f, int status, const struct wetdem_pairwise_result* r)
+{
+    fprintf(f, "%s,%s,%d,%.12g,%.12g,%zu,%llu", wetdem_status_name(status),
+            status == WETDEM_OK ? wetdem_pairwise_outcome_name(r->outcome) : "none",
+            r->separated_sphere + 1, r->time, star(r, r->time), r->n_events, r->steps);
+    for (size_t p = 0; p < r->n_pairs; p++) {
+        const struct wetdem_pairwise_pair_result* q = &r->pairs[p];
+        fprintf(f, ",%.12g,%.12g,%u,%s,%.12g", q->e_wet, q->e_wet_own, q->n_contacts,
+                mechanism_name(q->mechanism), star(r, q->t_end));
+    }
+}
+
+static void summary_text(FILE* f, const struct wetdem_pairwise_result* r)
+{
+    fprintf(f, "outcome            %s", wetdem_pairwise_outcome_name(r->outcome));
+    if (r->separated_sphere >= 0)
+        fprintf(f, " (sphere %d left)", r->separated_sphere + 1);
+    fprintf(f, "\ntime               %.6g s  (t* = %.6g, t-hat = %.6g)\n", r->time,
+            star(r, r->time), r->v_n0 * r->time / r->delta_ref);
+    fprintf(f, "v_n0               %.6g m/s  (delta_12 = %.6g m)\n", r->v_n0, r->delta_ref);
+    fprintf(f, "events             %zu  (steps %llu, rhs %llu)\n", r->n_events, r->steps,
+            r->rhs_evals);
+    fprintf(f, "pair  e_w[-]     e_own[-]   contacts  mechanism\n");
+    for (size_t p = 0; p < r->n_pairs; p++) {
+        const struct wetdem_pairwise_pair_result* q = &r->pairs[p];
+        fprintf(f, "%zu-%zu   %-10.6g %-10.6g %-9u %s\n", q->i + 1, q->j + 1, q->e_wet,
+                q->e_wet_own, q->n_contacts, mechanism_name(q->mechanism));
+    }
+}
+
+static void json_number(FILE* f, double v)
+{
+    if (isfinite(v))
+        fprintf(f, "%.12g", v);
+    else
+        fputs("null", f);
+}
+
+static void summary_json(FILE* f, const struct wetdem_pairwise_result* r)
+{
+    fprintf(f, "{\"engine\": \"pairwise\", \"version\": \"%s\", \"outcome\": \"%s\", "
+               "\"separated_sphere\": %d, \"time_s\": ",
+            WETDEM_VERSION, wetdem_pairwise_outcome_name(r->outcome),
+            r->separated_sphere >= 0 ? r->separated_sphere + 1 : -1);
+    json_number(f, r->time);
+    fputs(", \"v_n0_m_s\": ", f);
+    json_number(f, r->v_n0);
+    fprintf(f, ", \"events\": %zu, \"steps\": %llu, \"pairs\": [", r->n_events, r->steps);
+    for (size_t p = 0; p < r->n_pairs; p++) {
+        const struct wetdem_pairwise_pair_result* q = &r->pairs[p];
+        fprintf(f, "%s{\"i\": %zu, \"j\": %zu, \"films_met\": %s, \"bound\": %s, \"contacts\": %u, "
+                   "\"mechanism\": \"%s\", \"e_w\": ",
+                p ? ", " : "", q->i + 1, q->j + 1, q->films_met ? "true" : "false",
+                q->bound ? "true" : "false", q->n_contacts, mechanism_name(q->mechanism));
+        json_number(f, q->e_wet);
+        fputs(", \"e_own\": ", f);
+        json_number(f, q->e_wet_own);
+        fputs("}", f);
+    }
+    fputs("]}\n", f);
+}
+
+/* Observer writing one trajectory row per frame. */
+struct traj {
+    FILE* f;
+};
+
+static int write_frame(const struct wetdem_pairwise_frame* fr, void* ctx)
+{
+    struct traj* t = ctx;
+    fprintf(t->f, "%.12g,%.12g,%.12g", fr->time, fr->t_hat, fr->t_star);
+    for (size_t i = 0; i < fr->n_spheres; i++) {
+        const struct wetdem_pairwise_sphere* s = &fr->spheres[i];
+        fprintf(t->f, ",%.12g,%.12g,%.12g,%.12g,%.12g", s->x, s->y, s->vx, s->vy, s->omega);
+    }
+    for (size_t p = 0; p < fr->n_pairs; p++)
+        fprintf(t->f, ",%.12g,%.12g", fr->gap[p], fr->v_n[p]);
+    fputc('\n', t->f);
+    return ferror(t->f) ? -1 : 0;
+}
+
+static void trajectory_header(FILE* f, size_t n)
+{
+    fputs("time [s],t_hat [-],t_star [-]", f);
+    for (size_t i = 1; i <= n; i++)
+        fprintf(f, ",x_%zu [m],y_%zu [m],vx_%zu [m/s],vy_%zu [m/s],omega_%zu [rad/s]", i, i, i,
+                i, i);
+    for (size_t i = 1; i <= n; i++)
+        for (size_t j = i + 1; j <= n; j++)
+            fprintf(f, ",h_%zu%zu [m],v_n_%zu%zu [m/s]", i, j, i, j);
+    fputc('\n', f);
+}
+
+static void events_csv(FILE* f, const struct wetdem_pairwise* pw)
+{
+    size_t n;
+    const struct wetdem_pairwise_event* ev = wetdem_pairwise_events(pw, &n);
+    fputs("time [s],t_hat [-],t_star [-],event [word],i [-],j [-],k [-],l [-],gap [m],"
+          "v_n [m/s]\n",
+          f);
+    for (size_t e = 0; e < n; e++)
+        fprintf(f, "%.12g,%.12g,%.12g,%s,%zu,%zu,%zu,%zu,%.12g,%.12g\n", ev[e].time, ev[e].t_hat,
+                ev[e].t_star, wetdem_pairwise_event_name(ev[e].kind), ev[e].i + 1, ev[e].j + 1,
+                ev[e].k + 1, ev[e].l + 1, ev[e].gap, ev[e].v_n);
+}
+
+/* Opens DIR/name for writing unless name is "none"; *f NULL then. Exit code. */
+static int open_out(const char* dir, const char* name, FILE** f, char* path, size_t n)
+{
+    *f = NULL;
+    if (strcmp(name, "none") == 0)
+        return CLI_EXIT_OK;
+    snprintf(path, n, "%s/%s", dir, name);
+    *f = fopen(path, "w");
+    if (!*f) {
+        cli_error("run: cannot write %s", path);
+        return CLI_EXIT_RUNTIME;
+    }
+    return CLI_EXIT_OK;
+}
+
+/* The run with files in opt->out_dir (trajectory during the run, events and summary after). */
+static int run_with_files(const struct cli_scenario* sc, const struct cli_run_options* opt,
+                          const struct wetdem_pairwise_config* cfg, struct wetdem_pairwise* pw,
+                          struct wetdem_pairwise_result* r, int* status)
+{
+    char path[1200];
+    FILE *ft = NULL, *fe = NULL, *fs = NULL;
+    if (cli_make_dirs(opt->out_dir) != 0) {
+        cli_error("run: cannot create directory %s", opt->out_dir);
+        return CLI_EXIT_RUNTIME;
+    }
+    int rc = open_out(opt->out_dir, cli_scenario_text(sc, "output", "trajectory", "trajectory.csv"),
+                      &ft, path, sizeof path);
+    struct traj t = {ft};
+    if (ft) {
+        cli_print_provenance(ft, opt->argc, opt->argv);
+        trajectory_header(ft, cfg->n_spheres);
+        double dt = cli_scenario_number(sc, "output", "trajectory_interval", 0.0);
+        wetdem_pairwise_set_observer(pw, dt > 0.0 ? dt : cfg->t_end / 2000.0, write_frame, &t);
+    }
+    *status = wetdem_pairwise_run(pw, cfg, r);
+    if (ft && fclose(ft) != 0)
+        rc = CLI_EXIT_RUNTIME;
+    if (rc == CLI_EXIT_OK)
+        rc = open_out(opt->out_dir, cli_scenario_text(sc, "output", "events", "events.csv"), &fe,
+                      path, sizeof path);
+    if (fe) {
+        cli_print_provenance(fe, opt->argc, opt->argv);
+        events_csv(fe, pw);
+        rc = fclose(fe) != 0 ? CLI_EXIT_RUNTIME : rc;
+    }
+    if (rc == CLI_EXIT_OK && *status == WETDEM_OK)
+        rc = open_out(opt->out_dir, cli_scenario_text(sc, "output", "summary", "summary.json"),
+                      &fs, path, sizeof path);
+    if (fs) {
+        summary_json(fs, r);
+        rc = fclose(fs) != 0 ? CLI_EXIT_RUNTIME : rc;
+    }
+    return rc;
+}
+
+int cli_run_pairwise(const struct cli_scenario* sc, const struct cli_run_options* opt)
+{
+    struct wetdem_pairwise_config cfg;
+    int rc = build_config(sc, &cfg);
+    if (rc != CLI_EXIT_OK)
+        return rc;
+    if (opt->sweep_row && opt->sweep_header) {
+        sweep_header(opt->sweep_row, &cfg);
+        return CLI_EXIT_OK;
+    }
+    struct wetdem_pairwise* pw = wetdem_pairwise_create();
+    struct wetdem_pairwise_result r;
+    if (!pw) {
+        cli_error("run: out of memory");
+        return CLI_EXIT_RUNTIME;
+    }
+    int status = WETDEM_OK;
+    if (opt->out_dir)
+        rc = run_with_files(sc, opt, &cfg, pw, &r, &status);
+    else
+        status = wetdem_pairwise_run(pw, &cfg, &r);
+    if (opt->sweep_row) {
+        sweep_row(opt->sweep_row, status, &r);
+    } else if (status != WETDEM_OK) {
+        cli_error("run %s: %s (%s)", sc->file, wetdem_pairwise_errmsg(pw),
+                  wetdem_status_name(status));
+        rc = CLI_EXIT_RUNTIME;
+    } else if (opt->json) {
+        summary_json(stdout, &r);
+    } else {
+        summary_text(stdout, &r);
+    }
+    wetdem_pairwise_free(pw);
+    return rc;
+}
