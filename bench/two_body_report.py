@@ -28,18 +28,19 @@ def totals(directory, label):
 
 
 def errors(directory, label, ref):
-    """Largest relative error of e against the reference on the subset, and where."""
+    """Largest relative error of e against the reference on the subset points that rebound
+    (separated by t_end), and the number of points where one separated and the other not."""
     worst = (0.0, "")
     mism = 0
     for m in MATERIALS:
         d = common.read_csv(os.path.join(directory, f"{label}_{m}.csv"))
         r = common.read_csv(os.path.join(directory, f"{ref}_{m}.csv"))
         st = d["collision.stokes"]
-        for s, er in zip(r["collision.stokes"], r["e"]):
+        for s, er, sr in zip(r["collision.stokes"], r["e"], r["separated"]):
             k = int(np.argmin(np.abs(np.log(st / s))))
-            e = d["e"][k]
-            if er <= 0 or e <= 0:
-                mism += (er > 0) != (e > 0)
+            e, sep = d["e"][k], d["separated"][k]
+            if not (sr > 0 and sep > 0):  # e of a pair that never separated is not a rebound
+                mism += (sr > 0) != (sep > 0)
                 continue
             rel = abs(e - er) / er
             if rel > worst[0]:
