@@ -40,7 +40,14 @@ $(BUILD)/obj/%.o: src/%.c include/wetdem.h $(wildcard src/*.h)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS_ALL) -c $< -o $@
 
-$(BUILD)/cli/%.o: cli/%.c include/wetdem.h $(wildcard cli/*.h)
+# The CLI prints the git hash: rebuild its objects when the hash changes.
+$(BUILD)/version.stamp: FORCE
+	@mkdir -p $(dir $@)
+	@echo '$(GIT_HASH)' | cmp -s - $@ || echo '$(GIT_HASH)' > $@
+
+FORCE:
+
+$(BUILD)/cli/%.o: cli/%.c include/wetdem.h $(wildcard cli/*.h) $(BUILD)/version.stamp
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS_ALL) -DWETDEM_GIT_HASH='"$(GIT_HASH)"' -c $< -o $@
 
