@@ -38,20 +38,20 @@ struct map_args {
 /* One grid point: its scenario, and after the run its row or error. */
 struct map_point {
     double value[2];
-    struct cli_scenario sc;   /* pairwise: the point's scenario */
-    struct cli_setup su;      /* soft: the built simulation */
+    struct cli_scenario sc; /* pairwise: the point's scenario */
+    struct cli_setup su;    /* soft: the built simulation */
     struct wetdem_collision_result res;
     int status;
-    char* row;                /* the engine's CSV fields (malloc'd) */
+    char* row; /* the engine's CSV fields (malloc'd) */
 };
 
 static void usage(FILE* f)
 {
-    fprintf(f,
-            "usage: wetdem map FILE --param KEY --values A:B:N --param2 KEY2 --values2 A:B:N\n"
-            "                  [--log] [--log2] [--out FILE.csv] [--set section.key=value ...]\n"
-            "A grid of independent collisions over two scenario keys (KEY slowest), in\n"
-            "parallel (OMP_NUM_THREADS); rows in grid order, bit-identical for any thread count.\n");
+    fprintf(
+        f, "usage: wetdem map FILE --param KEY --values A:B:N --param2 KEY2 --values2 A:B:N\n"
+           "                  [--log] [--log2] [--out FILE.csv] [--set section.key=value ...]\n"
+           "A grid of independent collisions over two scenario keys (KEY slowest), in\n"
+           "parallel (OMP_NUM_THREADS); rows in grid order, bit-identical for any thread count.\n");
 }
 
 static int parse_args(int argc, char** argv, struct map_args* a)

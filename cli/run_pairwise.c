@@ -22,13 +22,16 @@
 #include "cli_util.h"
 #include "scenario.h"
 
-#define NUM(k, u, dflt, lo, hi, lo_open, hi_open, doc)                                            \
-    {k, CLI_VALUE_NUMBER, u, dflt, lo, hi, lo_open, hi_open, NULL, doc}
+#define NUM(k, u, dflt, lo, hi, lo_open, hi_open, doc)                                             \
+    {                                                                                              \
+        k, CLI_VALUE_NUMBER, u, dflt, lo, hi, lo_open, hi_open, NULL, doc                          \
+    }
 
 static const struct cli_key_desc davis_keys[] = {
     NUM("n_spheres", "-", "3", 2, 3, false, false,
         "2: striker and target only (oblique two-sphere collision); 3: Davis Fig. 3."),
-    NUM("stokes", "-", "2", 0, 1e9, true, false, "Normal Stokes number St_n = m v_n0/(6 pi mu a^2)."),
+    NUM("stokes", "-", "2", 0, 1e9, true, false,
+        "Normal Stokes number St_n = m v_n0/(6 pi mu a^2)."),
     NUM("capillary", "-", "1000", 0, 1e12, false, false,
         "Capillary number Ca = 3 mu a v_n0/(sigma delta_12); 0 = no capillary force."),
     NUM("film_ratio", "-", "0.01", 0, 0.5, true, true, "h_a = delta_12/4a (film over diameter)."),
@@ -56,7 +59,8 @@ static const struct cli_key_desc pairwise_keys[] = {
     NUM("h_min", "m", "required with [sphere.*]", 0, 1, true, false,
         "Minimum separation: hard-sphere contact when a gap reaches it."),
     NUM("restitution", "-", "1", 0, 1, true, false, "Dry restitution e_dry ([sphere.*] runs)."),
-    NUM("friction", "-", "0", 0, 10, false, false, "Friction mu_f of the impulse ([sphere.*] runs)."),
+    NUM("friction", "-", "0", 0, 10, false, false,
+        "Friction mu_f of the impulse ([sphere.*] runs)."),
     NUM("gravity_x", "m/s^2", "0", -1e3, 1e3, false, false, "Gravity, x."),
     NUM("gravity_y", "m/s^2", "0", -1e3, 1e3, false, false, "Gravity, y."),
     NUM("t_end", "s", "from [davis] t_star_end, else required", 0, 1e9, true, false,
@@ -66,7 +70,8 @@ static const struct cli_key_desc pairwise_keys[] = {
         "Contacts slower than this times v_n0 are held at h_min (resting contact)."),
     NUM("stop_when_separated", "-", "1", 0, 1, false, false,
         "1: stop once every pair is apart and receding; 0: run to t_end."),
-    NUM("ref_i", "-", "1", 1, 8, false, false, "Reference pair (v_n0, delta_12, t-hat, t*): first."),
+    NUM("ref_i", "-", "1", 1, 8, false, false,
+        "Reference pair (v_n0, delta_12, t-hat, t*): first."),
     NUM("ref_j", "-", "2", 1, 8, false, false, "Reference pair: second sphere."),
     NUM("max_events", "-", "100000", 1, 1e9, false, false, "Event budget of one run."),
     {0},
@@ -139,7 +144,8 @@ static int from_spheres(const struct cli_scenario* sc, struct wetdem_pairwise_co
         }
         struct wetdem_pairwise_sphere* q = &cfg->spheres[cfg->n_spheres++];
         const char* keys[] = {"radius", "mass", "film", "x", "y", "vx", "vy", "omega"};
-        double* fields[] = {&q->radius, &q->mass, &q->film, &q->x, &q->y, &q->vx, &q->vy, &q->omega};
+        double* fields[] = {&q->radius, &q->mass, &q->film, &q->x,
+                            &q->y,      &q->vx,   &q->vy,   &q->omega};
         for (int k = 0; k < 8; k++) {
             if (k < 2 && !cli_scenario_find(sc, name, keys[k])) {
                 cli_scenario_section_error(sc, name, "[%s] needs %s", name, keys[k]);
@@ -218,8 +224,9 @@ static void sweep_header(FILE* f, const struct wetdem_pairwise_config* cfg)
           f);
     for (size_t i = 0; i < cfg->n_spheres; i++)
         for (size_t j = i + 1; j < cfg->n_spheres; j++)
-            fprintf(f, ",e_w_%zu%zu [-],e_own_%zu%zu [-],contacts_%zu%zu [-],"
-                       "mechanism_%zu%zu [word],t_sep_star_%zu%zu [-]",
+            fprintf(f,
+                    ",e_w_%zu%zu [-],e_own_%zu%zu [-],contacts_%zu%zu [-],"
+                    "mechanism_%zu%zu [word],t_sep_star_%zu%zu [-]",
                     i + 1, j + 1, i + 1, j + 1, i + 1, j + 1, i + 1, j + 1, i + 1, j + 1);
 }
 
@@ -268,8 +275,9 @@ static void json_number(FILE* f, double v)
 
 static void summary_json(FILE* f, const struct wetdem_pairwise_result* r)
 {
-    fprintf(f, "{\"engine\": \"pairwise\", \"version\": \"%s\", \"outcome\": \"%s\", "
-               "\"separated_sphere\": %d, \"time_s\": ",
+    fprintf(f,
+            "{\"engine\": \"pairwise\", \"version\": \"%s\", \"outcome\": \"%s\", "
+            "\"separated_sphere\": %d, \"time_s\": ",
             WETDEM_VERSION, wetdem_pairwise_outcome_name(r->outcome),
             r->separated_sphere >= 0 ? r->separated_sphere + 1 : -1);
     json_number(f, r->time);
@@ -278,8 +286,9 @@ static void summary_json(FILE* f, const struct wetdem_pairwise_result* r)
     fprintf(f, ", \"events\": %zu, \"steps\": %llu, \"pairs\": [", r->n_events, r->steps);
     for (size_t p = 0; p < r->n_pairs; p++) {
         const struct wetdem_pairwise_pair_result* q = &r->pairs[p];
-        fprintf(f, "%s{\"i\": %zu, \"j\": %zu, \"films_met\": %s, \"bound\": %s, \"contacts\": %u, "
-                   "\"mechanism\": \"%s\", \"e_w\": ",
+        fprintf(f,
+                "%s{\"i\": %zu, \"j\": %zu, \"films_met\": %s, \"bound\": %s, \"contacts\": %u, "
+                "\"mechanism\": \"%s\", \"e_w\": ",
                 p ? ", " : "", q->i + 1, q->j + 1, q->films_met ? "true" : "false",
                 q->bound ? "true" : "false", q->n_contacts, mechanism_name(q->mechanism));
         json_number(f, q->e_wet);
@@ -313,8 +322,8 @@ static void trajectory_header(FILE* f, size_t n)
 {
     fputs("time [s],t_hat [-],t_star [-]", f);
     for (size_t i = 1; i <= n; i++)
-        fprintf(f, ",x_%zu [m],y_%zu [m],vx_%zu [m/s],vy_%zu [m/s],omega_%zu [rad/s]", i, i, i,
-                i, i);
+        fprintf(f, ",x_%zu [m],y_%zu [m],vx_%zu [m/s],vy_%zu [m/s],omega_%zu [rad/s]", i, i, i, i,
+                i);
     for (size_t i = 1; i <= n; i++)
         for (size_t j = i + 1; j <= n; j++)
             fprintf(f, ",h_%zu%zu [m],v_n_%zu%zu [m/s]", i, j, i, j);
@@ -381,8 +390,8 @@ static int run_with_files(const struct cli_scenario* sc, const struct cli_run_op
         rc = fclose(fe) != 0 ? CLI_EXIT_RUNTIME : rc;
     }
     if (rc == CLI_EXIT_OK && *status == WETDEM_OK)
-        rc = open_out(opt->out_dir, cli_scenario_text(sc, "output", "summary", "summary.json"),
-                      &fs, path, sizeof path);
+        rc = open_out(opt->out_dir, cli_scenario_text(sc, "output", "summary", "summary.json"), &fs,
+                      path, sizeof path);
     if (fs) {
         summary_json(fs, r);
         rc = fclose(fs) != 0 ? CLI_EXIT_RUNTIME : rc;

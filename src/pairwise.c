@@ -197,8 +197,7 @@ static int bad(char* msg, size_t n, const char* fmt, ...)
     return WETDEM_ERR_INVALID;
 }
 
-static int validate_sphere(const struct wetdem_pairwise_sphere* s, size_t i, char* msg,
-                           size_t n)
+static int validate_sphere(const struct wetdem_pairwise_sphere* s, size_t i, char* msg, size_t n)
 {
     if (!(s->radius > 0.0) || !isfinite(s->radius))
         return bad(msg, n, "spheres[%zu].radius = %g m: must be in (0, inf)", i, s->radius);
@@ -227,8 +226,7 @@ static int validate_scalars(const struct wetdem_pairwise_config* c, char* msg, s
     if (!(c->friction >= 0.0) || !isfinite(c->friction))
         return bad(msg, n, "friction = %g: must be in [0, inf)", c->friction);
     if (!isfinite(c->gravity_x) || !isfinite(c->gravity_y))
-        return bad(msg, n, "gravity = (%g, %g) m/s^2: must be finite", c->gravity_x,
-                   c->gravity_y);
+        return bad(msg, n, "gravity = (%g, %g) m/s^2: must be finite", c->gravity_x, c->gravity_y);
     if (!(c->t_end > 0.0) || !isfinite(c->t_end))
         return bad(msg, n, "t_end = %g s: must be in (0, inf)", c->t_end);
     if (!(c->rtol >= 1e-14 && c->rtol <= 1e-3))
@@ -259,8 +257,8 @@ int wetdem_pairwise_config_validate(const struct wetdem_pairwise_config* c, char
             double h = hypot(b->x - a->x, b->y - a->y) - a->radius - b->radius;
             if (!(h >= c->h_min))
                 return bad(msg, n,
-                           "initial gap of spheres %zu and %zu = %g m: must be >= h_min = %g m",
-                           i, j, h, c->h_min);
+                           "initial gap of spheres %zu and %zu = %g m: must be >= h_min = %g m", i,
+                           j, h, c->h_min);
         }
     return WETDEM_OK;
 }
@@ -471,8 +469,8 @@ static bool guards(struct wetdem_pairwise* pw, const double* y, double* g)
     for (size_t p = 0; p < sys->n_pairs; p++) {
         double* gp = g + G_KINDS * p;
         bool has_film = sys->delta[p] > sys->h_min;
-        gp[G_FILM] = !has_film ? 1.0 : (pw->md.film[p] ? sys->delta[p] - k.h[p]
-                                                        : k.h[p] - sys->delta[p]);
+        gp[G_FILM] =
+            !has_film ? 1.0 : (pw->md.film[p] ? sys->delta[p] - k.h[p] : k.h[p] - sys->delta[p]);
         gp[G_CONTACT] = pw->md.resting[p] ? 1.0 : k.h[p] - sys->h_min;
         if (!(gp[G_CONTACT] > 0.0) && k.v_n[p] > 0.0) /* at h_min and approaching: now */
             gp[G_CONTACT] = fmin(gp[G_CONTACT], -DBL_MIN);
@@ -625,8 +623,8 @@ static int rest_contact(struct wetdem_pairwise* pw, size_t p, const struct wetde
         cand[q] = pw->md.resting[q] || q == p ||
                   (k->h[q] <= pw->sys.h_min * (1.0 + 1e-9) && fabs(k->v_n[q]) < pw->rest_speed);
     struct wetdem_pairwise_kin k2;
-    if (!wetdem_pairwise_jump_plastic(&pw->sys, &pw->md, k, cand, pw->y) ||
-        !current_kin(pw, &k2) || !wetdem_pairwise_rhs_hold_set(&pw->sys, &pw->md, &k2, cand, hold))
+    if (!wetdem_pairwise_jump_plastic(&pw->sys, &pw->md, k, cand, pw->y) || !current_kin(pw, &k2) ||
+        !wetdem_pairwise_rhs_hold_set(&pw->sys, &pw->md, &k2, cand, hold))
         return fail(pw, WETDEM_ERR_NUMERIC, "singular resting-contact problem at t = %g s", pw->t);
     return set_held(pw, hold, p, &k2, v_n);
 }
@@ -769,9 +767,10 @@ static void classify(struct wetdem_pairwise* pw)
             r->e_wet = r->e_wet_own = NAN;
             continue;
         }
-        r->mechanism = r->bound ? WETDEM_OUTCOME_STICK
-                                : (pw->reversal[p] == REV_IMPULSE ? WETDEM_OUTCOME_BOUNCE
-                                                                   : WETDEM_OUTCOME_STICK_ROTATE_SEPARATE);
+        r->mechanism =
+            r->bound ? WETDEM_OUTCOME_STICK
+                     : (pw->reversal[p] == REV_IMPULSE ? WETDEM_OUTCOME_BOUNCE
+                                                       : WETDEM_OUTCOME_STICK_ROTATE_SEPARATE);
         r->e_wet = r->bound ? 0.0 : r->v_n_out / pw->v_ref;
         r->e_wet_own = (r->bound ? 0.0 : r->v_n_out) / r->v_n_in;
         if (!(r->v_n_in > 0.0))
@@ -842,8 +841,8 @@ static void initial_state(struct wetdem_pairwise* pw)
         /* films "just touching" (to rounding of the input positions) count as touching */
         if (has_film && fabs(k.h[p] - sys->delta[p]) <= 1e-12 * sys->delta[p] && k.v_n[p] >= 0.0)
             k.h[p] = sys->delta[p];
-        pw->md.film[p] = has_film && k.h[p] <= sys->delta[p] && (k.h[p] < sys->delta[p] ||
-                                                                 k.v_n[p] >= 0.0);
+        pw->md.film[p] =
+            has_film && k.h[p] <= sys->delta[p] && (k.h[p] < sys->delta[p] || k.v_n[p] >= 0.0);
         if (pw->md.film[p]) {
             r->films_met = true;
             r->v_n_in = k.v_n[p];

@@ -31,7 +31,7 @@ enum { PW_H = 0, PW_THETA = 1, PW_VN = 2, PW_OMEGA = 3, PW_VW = 4 };
 /* Constant data of a run derived from the configuration. */
 struct wetdem_pairwise_system {
     size_t n, n_pairs;
-    size_t pi[PW_PMAX], pj[PW_PMAX]; /* pair p joins spheres pi < pj */
+    size_t pi[PW_PMAX], pj[PW_PMAX];                 /* pair p joins spheres pi < pj */
     double a[PW_NMAX], m[PW_NMAX], inertia[PW_NMAX]; /* a_i [m], m_i [kg], I_i = 2/5 m a^2 */
     double a_eff[PW_PMAX], m_eff[PW_PMAX];           /* a_ij [m], m_ij [kg] */
     double delta[PW_PMAX];                           /* delta_ij [m] */
@@ -41,26 +41,26 @@ struct wetdem_pairwise_system {
 
 /* Discrete mode of a run: tracked tree and the per-pair switches. */
 struct wetdem_pairwise_mode {
-    size_t edge[PW_NMAX - 1];      /* pair index of tracked edge e */
-    int edge_of_pair[PW_PMAX];     /* tracked edge of pair p, or -1 */
-    size_t order[PW_NMAX];         /* spheres in reconstruction order (order[0] = 0) */
-    size_t via[PW_NMAX];           /* edge that reaches order[k] (k >= 1) */
-    bool film[PW_PMAX];            /* films overlap: forces of Eqs. 3-4 act */
-    bool resting[PW_PMAX];         /* held at h = h_min by a constraint force */
+    size_t edge[PW_NMAX - 1];  /* pair index of tracked edge e */
+    int edge_of_pair[PW_PMAX]; /* tracked edge of pair p, or -1 */
+    size_t order[PW_NMAX];     /* spheres in reconstruction order (order[0] = 0) */
+    size_t via[PW_NMAX];       /* edge that reaches order[k] (k >= 1) */
+    bool film[PW_PMAX];        /* films overlap: forces of Eqs. 3-4 act */
+    bool resting[PW_PMAX];     /* held at h = h_min by a constraint force */
 };
 
 /* Every sphere and every pair at one state (the output of the reconstruction). */
 struct wetdem_pairwise_kin {
-    double x[PW_NMAX], y[PW_NMAX];       /* absolute centre [m] */
-    double dx[PW_NMAX], dy[PW_NMAX];     /* centre relative to sphere 0 [m] */
-    double vx[PW_NMAX], vy[PW_NMAX];     /* absolute velocity [m/s] */
-    double ux[PW_NMAX], uy[PW_NMAX];     /* velocity relative to sphere 0 [m/s] */
-    double w[PW_NMAX];                   /* spin [rad/s] */
-    double h[PW_PMAX], r[PW_PMAX];       /* gap, centre distance [m] */
+    double x[PW_NMAX], y[PW_NMAX];                 /* absolute centre [m] */
+    double dx[PW_NMAX], dy[PW_NMAX];               /* centre relative to sphere 0 [m] */
+    double vx[PW_NMAX], vy[PW_NMAX];               /* absolute velocity [m/s] */
+    double ux[PW_NMAX], uy[PW_NMAX];               /* velocity relative to sphere 0 [m/s] */
+    double w[PW_NMAX];                             /* spin [rad/s] */
+    double h[PW_PMAX], r[PW_PMAX];                 /* gap, centre distance [m] */
     double theta[PW_PMAX], c[PW_PMAX], s[PW_PMAX]; /* angle of x_j - x_i, cos, sin */
-    double v_n[PW_PMAX];                 /* e_ij . (v_i - v_j), > 0 approaching [m/s] */
-    double omega_lc[PW_PMAX];            /* Omega_ij = d theta_ij / dt [rad/s] */
-    double v_w[PW_PMAX];                 /* a_i w_i + a_j w_j [m/s] */
+    double v_n[PW_PMAX];                           /* e_ij . (v_i - v_j), > 0 approaching [m/s] */
+    double omega_lc[PW_PMAX];                      /* Omega_ij = d theta_ij / dt [rad/s] */
+    double v_w[PW_PMAX];                           /* a_i w_i + a_j w_j [m/s] */
 };
 
 /* Film and constraint forces of every pair (Davis sign convention: on i the force is
@@ -101,8 +101,8 @@ void wetdem_pairwise_state_pairs_from_spheres(const struct wetdem_pairwise_syste
 
 /* Normal film force of Eq. 3 [N]: 6 pi mu a^2 v_n [1 - h/(2 delta - h)]^2 / h - 8 pi a sigma,
  * for 0 < h <= delta. */
-double wetdem_pairwise_rhs_normal_force(double mu, double sigma, double a, double delta,
-                                        double h, double v_n);
+double wetdem_pairwise_rhs_normal_force(double mu, double sigma, double a, double delta, double h,
+                                        double v_n);
 /* Tangential film force of Eq. 4 [N]: 2 pi mu a v_s ln[(2 delta - h)/h], 0 < h <= delta,
  * v_s = -r Omega + a_i w_i + a_j w_j the relative surface speed [m/s]. */
 double wetdem_pairwise_rhs_tangential_force(double mu, double a, double delta, double h,
@@ -131,8 +131,7 @@ bool wetdem_pairwise_rhs_hold_set(const struct wetdem_pairwise_system* sys,
 /* dy/dt of the state (Eqs. 9, 14, 17, 18 per tracked pair; 34-36, 39 for sphere 0). Returns
  * false when the state is outside the domain (see wetdem_pairwise_rhs_forces). */
 bool wetdem_pairwise_rhs_eval(const struct wetdem_pairwise_system* sys,
-                              const struct wetdem_pairwise_mode* md, const double* y,
-                              double* dydt);
+                              const struct wetdem_pairwise_mode* md, const double* y, double* dydt);
 
 /* ---- pairwise_jump.c ---- */
 
@@ -150,16 +149,15 @@ int wetdem_pairwise_jump_apply(const struct wetdem_pairwise_system* sys,
  * which pairs stay held. Updates y; false if the system is singular. */
 bool wetdem_pairwise_jump_plastic(const struct wetdem_pairwise_system* sys,
                                   const struct wetdem_pairwise_mode* md,
-                                  const struct wetdem_pairwise_kin* k, const bool* set,
-                                  double* y);
+                                  const struct wetdem_pairwise_kin* k, const bool* set, double* y);
 
 /* Jumps of a neighbour pair j-k caused by a collision of pair i-j (A12-A14, corrected):
  * inputs v_ij,n before [m/s], theta_ij, theta_jk [rad], r_jk [m], m_ij, m_j [kg], the
  * tangential impulse ratio q = I_ij,t / I_ij,n (+-mu_f sliding, A33/I_n sticking) and e_dry.
  * Outputs the changes of v_jk,n [m/s], v_jk,t [m/s] and Omega_jk [rad/s]. */
 void wetdem_pairwise_jump_neighbour(double v_n_b, double theta_ij, double theta_jk, double r_jk,
-                                    double m_ij, double m_j, double q, double e_dry,
-                                    double* dv_n, double* dv_t, double* d_omega);
+                                    double m_ij, double m_j, double q, double e_dry, double* dv_n,
+                                    double* dv_t, double* d_omega);
 /* Jumps of the colliding pair i-j itself (A1, A9-A11 sliding or A33-A35 sticking): inputs
  * v_n, Omega, v_omega before, r_ij, a_i, a_j, m_i, m_j, e_dry, mu_f; outputs the values
  * after and the tangential impulse ratio q = I_t / I_n (sign: I_t acts on j along t_ij).

@@ -34,14 +34,16 @@ static const struct wetdem_param_desc davis_desc[] = {
      offsetof(struct wetdem_pairwise_davis, n_spheres), 3, 2, 3, false, false, NULL},
     {"stokes", "-", "Normal Stokes number St_n = m v_n0 / (6 pi mu a^2).",
      offsetof(struct wetdem_pairwise_davis, stokes), 2, 0, INFINITY, true, true, NULL},
-    {"capillary", "-", "Capillary number Ca = 3 mu a v_n0 / (sigma delta_12); 0 (or inf in "
+    {"capillary", "-",
+     "Capillary number Ca = 3 mu a v_n0 / (sigma delta_12); 0 (or inf in "
      "the C API) means no capillary force (Ca -> infinity).",
      offsetof(struct wetdem_pairwise_davis, capillary), 1000, 0, INFINITY, false, true, NULL},
     {"film_ratio", "-", "Film thickness h_a = delta_12 / 4a (film over sphere diameter).",
      offsetof(struct wetdem_pairwise_davis, film_ratio), 0.01, 0, 0.5, true, true, NULL},
     {"hmin_ratio", "-", "Minimum separation h_m = h_min / delta_12.",
      offsetof(struct wetdem_pairwise_davis, hmin_ratio), 0.01, 0, 1, true, true, NULL},
-    {"angle_deg", "deg", "Impact angle beta between the striker's velocity and the line of "
+    {"angle_deg", "deg",
+     "Impact angle beta between the striker's velocity and the line of "
      "centres (0 = head-on).",
      offsetof(struct wetdem_pairwise_davis, angle_deg), 30, 0, 90, false, true, NULL},
     {"d23", "-", "delta_23 / delta_12.", offsetof(struct wetdem_pairwise_davis, d23), 1, 0,
@@ -110,8 +112,7 @@ static int davis_validate(const struct wetdem_pairwise_davis* d, char* msg, size
                              "d23 + d13 >= 1 and |d23 - d13| <= 1",
                              d->d23, d->d13);
         if (d->h23 < d->hmin_ratio)
-            return davis_bad(msg, n, "h23 = %g: must be >= hmin_ratio = %g", d->h23,
-                             d->hmin_ratio);
+            return davis_bad(msg, n, "h23 = %g: must be >= hmin_ratio = %g", d->h23, d->hmin_ratio);
     }
     return WETDEM_OK;
 }
@@ -143,8 +144,8 @@ int wetdem_pairwise_davis_config(const struct wetdem_pairwise_davis* d,
         film[2] = 0.5 * delta12 * (d->d23 + d->d13 - 1.0);
     }
     for (size_t i = 0; i < cfg->n_spheres; i++)
-        cfg->spheres[i] = (struct wetdem_pairwise_sphere){
-            .radius = 2.0 * a, .mass = 2.0 * m, .film = film[i]};
+        cfg->spheres[i] =
+            (struct wetdem_pairwise_sphere){.radius = 2.0 * a, .mass = 2.0 * m, .film = film[i]};
     double r12 = 4.0 * a + delta12, th12 = -beta;
     cfg->spheres[0].vx = v10;
     cfg->spheres[1].x = r12 * cos(th12);

@@ -32,8 +32,8 @@
 #include "pairwise.h"
 
 void wetdem_pairwise_jump_neighbour(double v_n_b, double theta_ij, double theta_jk, double r_jk,
-                                    double m_ij, double m_j, double q, double e_dry,
-                                    double* dv_n, double* dv_t, double* d_omega)
+                                    double m_ij, double m_j, double q, double e_dry, double* dv_n,
+                                    double* dv_t, double* d_omega)
 {
     double x = (m_ij / m_j) * (1.0 + e_dry) * v_n_b;
     double d = theta_jk - theta_ij;
@@ -48,14 +48,14 @@ bool wetdem_pairwise_jump_own(double v_n, double omega_lc, double v_w, double r,
 {
     double m_ij = m_i * m_j / (m_i + m_j);
     double rot = a_i * a_i / (0.4 * m_i * a_i * a_i) + a_j * a_j / (0.4 * m_j * a_j * a_j);
-    double i_n = m_ij * (1.0 + e_dry) * v_n;                 /* A3 */
-    double v_s = -r * omega_lc + v_w;                        /* slip at contact */
-    double i_stick = v_s / (1.0 / m_ij + rot);               /* A33 */
-    bool sticking = fabs(i_stick) <= mu_f * i_n;             /* A36 */
+    double i_n = m_ij * (1.0 + e_dry) * v_n;     /* A3 */
+    double v_s = -r * omega_lc + v_w;            /* slip at contact */
+    double i_stick = v_s / (1.0 / m_ij + rot);   /* A33 */
+    bool sticking = fabs(i_stick) <= mu_f * i_n; /* A36 */
     double i_t = sticking ? i_stick : (v_s > 0.0 ? 1.0 : (v_s < 0.0 ? -1.0 : 0.0)) * mu_f * i_n;
-    *v_n_a = -e_dry * v_n;                                   /* A1 */
-    *omega_lc_a = omega_lc + i_t / (m_ij * r);               /* A10, A31 */
-    *v_w_a = v_w - rot * i_t;                                /* A11, A32 */
+    *v_n_a = -e_dry * v_n;                     /* A1 */
+    *omega_lc_a = omega_lc + i_t / (m_ij * r); /* A10, A31 */
+    *v_w_a = v_w - rot * i_t;                  /* A11, A32 */
     *q = i_n > 0.0 ? i_t / i_n : 0.0;
     return sticking;
 }
@@ -145,8 +145,7 @@ static bool plastic_solve(const struct wetdem_pairwise_system* sys,
 
 bool wetdem_pairwise_jump_plastic(const struct wetdem_pairwise_system* sys,
                                   const struct wetdem_pairwise_mode* md,
-                                  const struct wetdem_pairwise_kin* k, const bool* set,
-                                  double* y)
+                                  const struct wetdem_pairwise_kin* k, const bool* set, double* y)
 {
     size_t list[PW_PMAX], n = 0;
     double J[PW_PMAX];

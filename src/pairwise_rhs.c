@@ -33,23 +33,22 @@
 
 #include "pairwise.h"
 
-double wetdem_pairwise_rhs_normal_force(double mu, double sigma, double a, double delta,
-                                        double h, double v_n)
+double wetdem_pairwise_rhs_normal_force(double mu, double sigma, double a, double delta, double h,
+                                        double v_n)
 {
     double bracket = 1.0 - h / (2.0 * delta - h);
     return 6.0 * M_PI * mu * a * a * v_n * bracket * bracket / h - 8.0 * M_PI * a * sigma;
 }
 
-double wetdem_pairwise_rhs_tangential_force(double mu, double a, double delta, double h,
-                                            double v_s)
+double wetdem_pairwise_rhs_tangential_force(double mu, double a, double delta, double h, double v_s)
 {
     return 2.0 * M_PI * mu * a * v_s * log((2.0 * delta - h) / h);
 }
 
 /* Film forces (no constraint) of every pair; false if an overlapping pair has h <= 0. */
 static bool film_forces(const struct wetdem_pairwise_system* sys,
-                        const struct wetdem_pairwise_mode* md,
-                        const struct wetdem_pairwise_kin* k, struct wetdem_pairwise_forces* f)
+                        const struct wetdem_pairwise_mode* md, const struct wetdem_pairwise_kin* k,
+                        struct wetdem_pairwise_forces* f)
 {
     for (size_t p = 0; p < sys->n_pairs; p++) {
         f->f_n[p] = f->f_t[p] = f->lambda[p] = 0.0;
@@ -61,8 +60,8 @@ static bool film_forces(const struct wetdem_pairwise_system* sys,
         double v_s = -k->r[p] * k->omega_lc[p] + k->v_w[p];
         f->f_n[p] = wetdem_pairwise_rhs_normal_force(sys->mu, sys->sigma, sys->a_eff[p],
                                                      sys->delta[p], h, k->v_n[p]);
-        f->f_t[p] = wetdem_pairwise_rhs_tangential_force(sys->mu, sys->a_eff[p], sys->delta[p],
-                                                         h, v_s);
+        f->f_t[p] =
+            wetdem_pairwise_rhs_tangential_force(sys->mu, sys->a_eff[p], sys->delta[p], h, v_s);
     }
     return true;
 }
@@ -82,9 +81,8 @@ static void neighbour_projection(const struct wetdem_pairwise_system* sys,
 
 /* Eqs. 9 and 14 for any pair p: *dvn = dv_n/dt [m/s^2], *rdom = r dOmega/dt [m/s^2]. */
 static void pair_accel(const struct wetdem_pairwise_system* sys,
-                       const struct wetdem_pairwise_kin* k,
-                       const struct wetdem_pairwise_forces* f, size_t p, double* dvn,
-                       double* rdom)
+                       const struct wetdem_pairwise_kin* k, const struct wetdem_pairwise_forces* f,
+                       size_t p, double* dvn, double* rdom)
 {
     size_t i = sys->pi[p], j = sys->pj[p];
     double mi = sys->m[i], mj = sys->m[j], M = mi + mj, ms = sys->m_eff[p];
@@ -128,7 +126,7 @@ static double spin_accel(const struct wetdem_pairwise_system* sys,
 }
 
 double wetdem_pairwise_rhs_coupling(const struct wetdem_pairwise_system* sys,
-                               const struct wetdem_pairwise_kin* k, size_t p, size_t q)
+                                    const struct wetdem_pairwise_kin* k, size_t p, size_t q)
 {
     if (p == q)
         return -1.0 / sys->m_eff[p];
@@ -180,8 +178,7 @@ bool wetdem_pairwise_rhs_solve(size_t n, double A[PW_PMAX][PW_PMAX], double* b)
 /* Constraint forces of the resting pairs: dv_n/dt = 0 for each (added to f_n). */
 static bool constraint_forces(const struct wetdem_pairwise_system* sys,
                               const struct wetdem_pairwise_mode* md,
-                              const struct wetdem_pairwise_kin* k,
-                              struct wetdem_pairwise_forces* f)
+                              const struct wetdem_pairwise_kin* k, struct wetdem_pairwise_forces* f)
 {
     size_t rest[PW_PMAX], n = 0;
     for (size_t p = 0; p < sys->n_pairs; p++)
@@ -216,8 +213,8 @@ bool wetdem_pairwise_rhs_forces(const struct wetdem_pairwise_system* sys,
 
 /* Is `mask` (bit a = cand[a]) a solution of the contact problem: lambda >= 0 on the held
  * pairs and no approaching acceleration on the others? Writes lambda into lam. */
-static bool hold_valid(size_t m, double A[PW_PMAX][PW_PMAX], const double* b,
-                       unsigned long mask, double scale, double* lam)
+static bool hold_valid(size_t m, double A[PW_PMAX][PW_PMAX], const double* b, unsigned long mask,
+                       double scale, double* lam)
 {
     size_t idx[PW_PMAX], n = 0;
     double M[PW_PMAX][PW_PMAX], x[PW_PMAX];
@@ -252,8 +249,7 @@ static bool hold_valid(size_t m, double A[PW_PMAX][PW_PMAX], const double* b,
 
 bool wetdem_pairwise_rhs_hold_set(const struct wetdem_pairwise_system* sys,
                                   const struct wetdem_pairwise_mode* md,
-                                  const struct wetdem_pairwise_kin* k, const bool* cand,
-                                  bool* hold)
+                                  const struct wetdem_pairwise_kin* k, const bool* cand, bool* hold)
 {
     struct wetdem_pairwise_mode free_md = *md;
     struct wetdem_pairwise_forces f;
@@ -289,8 +285,8 @@ bool wetdem_pairwise_rhs_hold_set(const struct wetdem_pairwise_system* sys,
 
 /* Eqs. 34-36, 39 for sphere 0. */
 static void anchor_rhs(const struct wetdem_pairwise_system* sys,
-                       const struct wetdem_pairwise_kin* k,
-                       const struct wetdem_pairwise_forces* f, const double* y, double* dydt)
+                       const struct wetdem_pairwise_kin* k, const struct wetdem_pairwise_forces* f,
+                       const double* y, double* dydt)
 {
     double fx = 0.0, fy = 0.0, torque = 0.0;
     for (size_t q = 0; q + 1 < sys->n; q++) { /* pairs (0, j) come first */
@@ -306,8 +302,7 @@ static void anchor_rhs(const struct wetdem_pairwise_system* sys,
 }
 
 bool wetdem_pairwise_rhs_eval(const struct wetdem_pairwise_system* sys,
-                              const struct wetdem_pairwise_mode* md, const double* y,
-                              double* dydt)
+                              const struct wetdem_pairwise_mode* md, const double* y, double* dydt)
 {
     struct wetdem_pairwise_kin k;
     struct wetdem_pairwise_forces f;

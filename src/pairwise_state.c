@@ -183,12 +183,12 @@ static void pair_from_spheres(const struct wetdem_pairwise_system* sys, size_t p
     double c = rx / r, s = ry / r;
     double vx = k->ux[i] - k->ux[j], vy = k->uy[i] - k->uy[j];
     k->r[p] = r;
-    k->h[p] = r - sys->a[i] - sys->a[j];                 /* B3 */
-    k->theta[p] = atan2(ry, rx);                        /* B2 */
+    k->h[p] = r - sys->a[i] - sys->a[j]; /* B3 */
+    k->theta[p] = atan2(ry, rx);         /* B2 */
     k->c[p] = c;
     k->s[p] = s;
-    k->v_n[p] = vx * c + vy * s;                        /* B6 */
-    k->omega_lc[p] = -(-vx * s + vy * c) / r;           /* B7-B8 */
+    k->v_n[p] = vx * c + vy * s;                           /* B6 */
+    k->omega_lc[p] = -(-vx * s + vy * c) / r;              /* B7-B8 */
     k->v_w[p] = sys->a[i] * k->w[i] + sys->a[j] * k->w[j]; /* B9 */
 }
 

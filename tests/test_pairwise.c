@@ -32,12 +32,12 @@ static struct wetdem_pairwise_config head_on(double st, double film, double v0)
     wetdem_pairwise_config_init(&c);
     c.n_spheres = 2;
     double r0 = 2e-3, r1 = 3e-3, a = r0 * r1 / (r0 + r1);
-    double m_eff = st * 6.0 * M_PI * 1.0 * a * a / v0; /* St = m* v0 / (6 pi mu a^2) */
+    double m_eff = st * 6.0 * M_PI * 1.0 * a * a / v0;       /* St = m* v0 / (6 pi mu a^2) */
     double m0 = 1.6 * m_eff, m1 = m0 * m_eff / (m0 - m_eff); /* 1/m0 + 1/m1 = 1/m* */
-    c.spheres[0] = (struct wetdem_pairwise_sphere){.radius = r0, .mass = m0, .film = film / 2,
-                                                   .vx = v0};
-    c.spheres[1] = (struct wetdem_pairwise_sphere){.radius = r1, .mass = m1, .film = film / 2,
-                                                   .x = r0 + r1 + film};
+    c.spheres[0] =
+        (struct wetdem_pairwise_sphere){.radius = r0, .mass = m0, .film = film / 2, .vx = v0};
+    c.spheres[1] = (struct wetdem_pairwise_sphere){
+        .radius = r1, .mass = m1, .film = film / 2, .x = r0 + r1 + film};
     c.viscosity = 1.0;
     c.h_min = 0.01 * film;
     c.restitution = 0.8;
@@ -50,9 +50,8 @@ static double closed_form_integral(double u)
     return 2.0 - log(u) - 3.0 * log(2.0 - u) - 2.0 / (2.0 - u);
 }
 
-static const struct wetdem_pairwise_event* find_event(struct wetdem_pairwise* pw,
-                                                      enum wetdem_pairwise_event_kind kind,
-                                                      size_t nth)
+static const struct wetdem_pairwise_event*
+find_event(struct wetdem_pairwise* pw, enum wetdem_pairwise_event_kind kind, size_t nth)
 {
     size_t n;
     const struct wetdem_pairwise_event* ev = wetdem_pairwise_events(pw, &n);
@@ -181,14 +180,14 @@ static void test_pairwise_dry_restitution_and_friction(void** state)
     CHECK_REL(-v_n_after, 0.7 * hit->v_n, 1e-12);
     double v_t = -1.0 * ey + 0.3 * ex; /* t . (v_0 - v_1), nothing spins before */
     double vn_a, om_a, vw_a, q;
-    bool stick = wetdem_pairwise_jump_own(v_n_before, -v_t / d, 0.0, d, 2e-3, 3e-3,
-                                          c.spheres[0].mass, c.spheres[1].mass, 0.7, 0.02, &vn_a,
-                                          &om_a, &vw_a, &q);
+    bool stick =
+        wetdem_pairwise_jump_own(v_n_before, -v_t / d, 0.0, d, 2e-3, 3e-3, c.spheres[0].mass,
+                                 c.spheres[1].mass, 0.7, 0.02, &vn_a, &om_a, &vw_a, &q);
     if (stick)
         fail_msg("arrested: v_t = %g, v_n = %g", v_t, v_n_before);
     CHECK_REL(q, v_t > 0 ? 0.02 : -0.02, 1e-15);
     double m_eff = c.spheres[0].mass * c.spheres[1].mass / (c.spheres[0].mass + c.spheres[1].mass);
-    double i_t = q * m_eff * 1.7 * hit->v_n; /* A8, A3 */
+    double i_t = q * m_eff * 1.7 * hit->v_n;                                    /* A8, A3 */
     CHECK_REL(a->omega, -2e-3 * i_t / (0.4 * c.spheres[0].mass * 4e-6), 1e-12); /* A11 */
     CHECK_REL(b->omega, -3e-3 * i_t / (0.4 * c.spheres[1].mass * 9e-6), 1e-12); /* A11, I_j */
     wetdem_pairwise_free(pw);
@@ -209,8 +208,8 @@ static void jump_state(struct wetdem_pairwise_system* sys, struct wetdem_pairwis
     double vel[3][2] = {{1.0, 0.2}, {-0.1, 0.05}, {0.3, -0.4}};
     double spin[3] = {30.0, -20.0 + slip, 55.0};
     for (int i = 0; i < 3; i++)
-        c.spheres[i] = (struct wetdem_pairwise_sphere){rad[i], mass[i], 0, pos[i][0], pos[i][1],
-                                                       vel[i][0], vel[i][1], spin[i]};
+        c.spheres[i] = (struct wetdem_pairwise_sphere){rad[i],    mass[i],   0,         pos[i][0],
+                                                       pos[i][1], vel[i][0], vel[i][1], spin[i]};
     c.h_min = 1e-6;
     c.restitution = 0.75;
     c.friction = mu_f;
@@ -259,16 +258,16 @@ static void check_jumps(bool side_j, double mu_f, double slip, bool expect_stick
     bool stick = wetdem_pairwise_jump_own(vn, om, vw, r, sys.a[0], sys.a[1], sys.m[0], sys.m[1],
                                           sys.e_dry, mu_f, &vn_a, &om_a, &vw_a, &q);
     if (stick != expect_stick)
-        fail_msg("sticking %d, expected %d: v_s = %g, v_n = %g", stick, expect_stick,
-                 -r * om + vw, vn);
+        fail_msg("sticking %d, expected %d: v_s = %g, v_n = %g", stick, expect_stick, -r * om + vw,
+                 vn);
     CHECK_ABS(edge_var(&md, y, 0, PW_VN), vn_a, 1e-12);
     CHECK_ABS(edge_var(&md, y, 0, PW_OMEGA) * r, om_a * r, 1e-12);
     CHECK_ABS(edge_var(&md, y, 0, PW_VW), vw_a, 1e-12);
     size_t p = side_j ? 2 : 1;
     double dvn, dvt, dom;
     if (side_j) /* pair (1,2) = j-k with j = sphere 1 */
-        wetdem_pairwise_jump_neighbour(vn, k.theta[0], k.theta[2], k.r[2], sys.m_eff[0],
-                                       sys.m[1], q, sys.e_dry, &dvn, &dvt, &dom);
+        wetdem_pairwise_jump_neighbour(vn, k.theta[0], k.theta[2], k.r[2], sys.m_eff[0], sys.m[1],
+                                       q, sys.e_dry, &dvn, &dvt, &dom);
     else /* pair (0,2) = i-k: the collision seen from sphere 0 as "j" of pair (1,0) */
         wetdem_pairwise_jump_neighbour(vn, k.theta[0] + M_PI, k.theta[1], k.r[1], sys.m_eff[0],
                                        sys.m[0], q, sys.e_dry, &dvn, &dvt, &dom);
@@ -281,7 +280,7 @@ static void check_jumps(bool side_j, double mu_f, double slip, bool expect_stick
 static void test_pairwise_jump_formulas_match_vector_impulse(void** state)
 {
     (void)state;
-    check_jumps(true, 0.0, 0.0, false);  /* frictionless: A6-A7 */
+    check_jumps(true, 0.0, 0.0, false); /* frictionless: A6-A7 */
     check_jumps(false, 0.0, 0.0, false);
     /* sliding (A9-A14): a spin of 1000 rad/s more on sphere 1 gives a slip of ~2.5 m/s, above
      * the arrest limit 7 mu_f (1 + e) v_n / 2 = 0.67 m/s of A36 */
@@ -393,8 +392,10 @@ static void test_pairwise_dry_elastic_energy(void** state)
     CHECK_OK(run(&c, &r, NULL));
     double e0 = 0, e1 = 0;
     for (int i = 0; i < 3; i++) {
-        e0 += 0.5 * c.spheres[i].mass * (c.spheres[i].vx * c.spheres[i].vx + c.spheres[i].vy * c.spheres[i].vy);
-        e1 += 0.5 * r.final[i].mass * (r.final[i].vx * r.final[i].vx + r.final[i].vy * r.final[i].vy);
+        e0 += 0.5 * c.spheres[i].mass *
+              (c.spheres[i].vx * c.spheres[i].vx + c.spheres[i].vy * c.spheres[i].vy);
+        e1 +=
+            0.5 * r.final[i].mass * (r.final[i].vx * r.final[i].vx + r.final[i].vy * r.final[i].vy);
     }
     CHECK_REL(e1, e0, 1e-10);
     assert_true(r.pairs[0].n_contacts == 1 && r.pairs[2].n_contacts == 1);
@@ -445,8 +446,8 @@ static void check_relabel(double st, double ca, double t_star, bool stop)
 static void test_pairwise_relabelling_symmetry(void** state)
 {
     (void)state;
-    check_relabel(20.0, 1000.0, 5.0, true);  /* full separation, two impulses */
-    check_relabel(3.0, 1000.0, 3.0, false);  /* films stay overlapping: compare at t_end */
+    check_relabel(20.0, 1000.0, 5.0, true); /* full separation, two impulses */
+    check_relabel(3.0, 1000.0, 3.0, false); /* films stay overlapping: compare at t_end */
 }
 
 /* Determinism: the same input gives bit-identical results. */
@@ -560,15 +561,18 @@ static void test_pairwise_forces_match_models(void** state)
     (void)state;
     const double ri = 2e-3, rj = 3e-3, di = 40e-6, dj = 60e-6, h = 23e-6, h_min = 1e-6;
     const double vn = 0.37, vty = -0.21, wi = 40.0, wj = -15.0;
-    struct wetdem_material ma = {.density = 7800, .youngs_modulus = 2e11, .poisson_ratio = 0.3,
-                                 .restitution = 0.9, .film = di};
+    struct wetdem_material ma = {.density = 7800,
+                                 .youngs_modulus = 2e11,
+                                 .poisson_ratio = 0.3,
+                                 .restitution = 0.9,
+                                 .film = di};
     struct wetdem_material mb = ma;
     mb.film = dj;
     struct wetdem_fluid fl = {.viscosity = 2.5, .surface_tension = 0.03, .density = 1000};
-    struct wetdem_particle pi = {.pos = {0, 0, 0}, .vel = {vn, vty, 0}, .omega = {0, 0, wi},
-                                 .radius = ri, .mass = 0.1};
-    struct wetdem_particle pj = {.pos = {ri + rj + h, 0, 0}, .omega = {0, 0, wj}, .radius = rj,
-                                 .mass = 0.2};
+    struct wetdem_particle pi = {
+        .pos = {0, 0, 0}, .vel = {vn, vty, 0}, .omega = {0, 0, wi}, .radius = ri, .mass = 0.1};
+    struct wetdem_particle pj = {
+        .pos = {ri + rj + h, 0, 0}, .omega = {0, 0, wj}, .radius = rj, .mass = 0.2};
     struct wetdem_contact ct;
     wetdem_contact_from_particles(&ct, &pi, &ma, &pj, &mb, &fl);
     ct.h_min = h_min;
@@ -582,7 +586,7 @@ static void test_pairwise_forces_match_models(void** state)
     double fn = wetdem_pairwise_rhs_normal_force(2.5, 0.03, a, d, h, vn);
     double ft = wetdem_pairwise_rhs_tangential_force(2.5, a, d, h, vty + ri * wi + rj * wj);
     CHECK_REL(f.f_normal, fn, 1e-13);
-    CHECK_REL(f.f_tan.y, -ft, 1e-13); /* on i: -F_t t_ij */
+    CHECK_REL(f.f_tan.y, -ft, 1e-13);         /* on i: -F_t t_ij */
     CHECK_REL(f.torque_i.z, -ri * ft, 1e-13); /* Eq. 16 */
     CHECK_REL(f.torque_j.z, -rj * ft, 1e-13);
 }
@@ -599,8 +603,7 @@ static struct wetdem_pairwise_config cluster(size_t n)
     c.h_min = 1e-6;
     c.t_end = 2e-3;
     for (size_t i = 0; i < n; i++)
-        c.spheres[i] = (struct wetdem_pairwise_sphere){.radius = 1e-3, .mass = 3e-5,
-                                                       .film = 50e-6};
+        c.spheres[i] = (struct wetdem_pairwise_sphere){.radius = 1e-3, .mass = 3e-5, .film = 50e-6};
     return c;
 }
 

@@ -30,8 +30,11 @@ struct soft_times {
 static struct soft_times soft_run(double youngs)
 {
     struct wetdem_sim* sim = wetdem_sim_create();
-    struct wetdem_material m = {.density = DENSITY, .youngs_modulus = youngs,
-                                .poisson_ratio = 0.3, .restitution = EDRY, .film = FILM};
+    struct wetdem_material m = {.density = DENSITY,
+                                .youngs_modulus = youngs,
+                                .poisson_ratio = 0.3,
+                                .restitution = EDRY,
+                                .film = FILM};
     int im = wetdem_sim_add_material(sim, &m);
     struct wetdem_fluid fl = {.viscosity = 1.0, .surface_tension = 0.0, .density = 1000};
     CHECK_OK(wetdem_sim_set_fluid(sim, &fl));
@@ -43,8 +46,12 @@ static struct soft_times soft_run(double youngs)
     CHECK_OK(wetdem_sim_set_param(sim, "fixed.h_min", HMIN));
     CHECK_OK(wetdem_sim_set_integrator(sim, "cvode"));
     CHECK_OK(wetdem_sim_set_param(sim, "cvode.rtol", 1e-10));
-    struct wetdem_collision_spec sp = {.material_i = im, .material_j = im, .radius_i = RADIUS,
-                                       .radius_j = RADIUS, .stokes = STOKES, .t_end = 0.01};
+    struct wetdem_collision_spec sp = {.material_i = im,
+                                       .material_j = im,
+                                       .radius_i = RADIUS,
+                                       .radius_j = RADIUS,
+                                       .stokes = STOKES,
+                                       .t_end = 0.01};
     struct wetdem_collision_result r;
     CHECK_OK(wetdem_collision_run(sim, &sp, &r));
     size_t n;
@@ -71,10 +78,10 @@ static void test_pairwise_soft_engine_converges_to_hard_contact(void** state)
     struct wetdem_pairwise_config c;
     wetdem_pairwise_config_init(&c);
     c.n_spheres = 2;
-    c.spheres[0] = (struct wetdem_pairwise_sphere){.radius = RADIUS, .mass = mass, .film = FILM,
-                                                   .vx = v0};
-    c.spheres[1] = (struct wetdem_pairwise_sphere){.radius = RADIUS, .mass = mass, .film = FILM,
-                                                   .x = 2 * RADIUS + 2 * FILM};
+    c.spheres[0] =
+        (struct wetdem_pairwise_sphere){.radius = RADIUS, .mass = mass, .film = FILM, .vx = v0};
+    c.spheres[1] = (struct wetdem_pairwise_sphere){
+        .radius = RADIUS, .mass = mass, .film = FILM, .x = 2 * RADIUS + 2 * FILM};
     c.viscosity = 1.0;
     c.h_min = HMIN;
     c.restitution = EDRY;
