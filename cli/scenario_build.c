@@ -293,6 +293,7 @@ static int build_kinematics(const struct cli_scenario* sc, struct cli_setup* su,
         s->t_end = cli_scenario_number(sc, "collision", "t_end_crossings", 20) * t_cross;
     s->observe_time = cli_scenario_number(sc, "collision", "observe_time", 0);
     s->rebound_gap_factor = cli_scenario_number(sc, "collision", "rebound_gap_factor", 1);
+    s->close_gap = cli_scenario_number(sc, "collision", "close_gap", 0);
     su->trajectory_interval = cli_scenario_number(sc, "output", "trajectory_interval", 0);
     if (su->trajectory_interval == 0)
         su->trajectory_interval = t_cross / 500.0;

@@ -6,7 +6,8 @@
  *
  * Ranges of collision keys: radii in (0, 1] m and speeds up to 1e3 m/s cover every seed
  * set-up with margin (spheres of 12.7 mm diameter, impact speeds below 1 m/s); the angle is
- * measured from the line of centres, so a grazing 90 deg would never collide.
+ * that of the straight-line approach at contact (sin = b / (R_i + R_j), impact parameter b),
+ * so a grazing 90 deg would never collide.
  */
 #include <stdio.h>
 #include <string.h>
@@ -40,8 +41,10 @@ static const struct cli_key_desc collision_keys[] = {
         "Normal Stokes number St_n = m* v cos(angle) / (6 pi mu R*^2); the speed is derived "
         "as v = St_n 6 pi mu R*^2 / (m* cos(angle)). Needs fluid viscosity > 0."),
     NUM("angle_deg", "deg", "0", 0, 90, false, true,
-        "Impact angle between the striker's velocity and the line of centres at first "
-        "interaction (Nijssen Fig. 1c); 0 = head-on."),
+        "Impact angle: between the striker's velocity and the line of centres at contact of "
+        "the undisturbed straight-line approach, sin(angle) = b / (R_i + R_j) with the impact "
+        "parameter b (Yang & Hunt; Nijssen Fig. 1c; Punch Eq. 16; wall: to its normal); the "
+        "striker starts on that line just outside the interaction range; 0 = head-on."),
     NUM("spin_x", "rad/s", "0", -1e6, 1e6, false, false, "Initial spin of the striker, x."),
     NUM("spin_y", "rad/s", "0", -1e6, 1e6, false, false, "Initial spin of the striker, y."),
     NUM("spin_z", "rad/s", "0", -1e6, 1e6, false, false, "Initial spin of the striker, z."),
@@ -56,6 +59,11 @@ static const struct cli_key_desc collision_keys[] = {
         "Also report e_n at this time after the start (Punch Fig. 9 window)."),
     NUM("rebound_gap_factor", "-", "1", 1, 1e3, false, false,
         "Separation is declared when the gap exceeds this multiple of the interaction range."),
+    NUM("close_gap", "m", "0 (auto)", 0, 1, false, false,
+        "Outcome rule: a pair that separates after its line of centres turned by more than 5 "
+        "deg with the gap below close_gap (after the approach was first arrested) is "
+        "stick-rotate-separate. 0: the film thickness delta_ij when the pair has films (the "
+        "overlapping films hold the doublet), else 0.01 R*."),
     {0},
 };
 
@@ -82,7 +90,7 @@ static const struct cli_key_desc models_keys[] = {
     {0},
 };
 
-static const char* const cvode_methods[] = {"adams", "bdf", NULL};
+static const char* const cvode_methods[] = {"auto", "adams", "bdf", NULL};
 static const char* const yes_no[] = {"no", "yes", NULL};
 
 /* Keys after "name" are the integrators' parameters ("<name>.<key>" in the library); their
@@ -103,7 +111,13 @@ static const struct cli_key_desc integrator_keys[] = {
     NUM("atol", "-", NULL, 1e-16, 1e-2, false, false,
         "cvode: absolute tolerance in units of the length, speed and spin scales."),
     WORD("method", CLI_VALUE_CHOICE, NULL, cvode_methods,
-         "cvode: adams (non-stiff) or bdf (stiff, dense Newton)."),
+         "cvode: auto (Adams, switching to BDF for the rest of the run once a stretch without "
+         "events turns stiff, e.g. a resting lubricated contact), adams (non-stiff) or bdf "
+         "(stiff, dense Newton)."),
+    NUM("stiff_steps", "-", NULL, 10, 1e9, false, false,
+        "cvode, method auto: Adams steps without an event after which BDF takes over."),
+    NUM("max_order", "-", NULL, 1, 12, false, false,
+        "cvode: largest order of the method (BDF uses at most 5)."),
     NUM("max_step", "s", NULL, 0, 1e6, false, false,
         "cvode: largest step; 0 uses 0.1 x smallest radius / speed scale."),
     {0},

@@ -3,14 +3,9 @@ collisions in the three normal-Stokes ranges of the caption: St_n < 25 (Steel I 
 glycerol), 40 < St_n < 200 (Delrin in water), 500 < St_n < 2400 (Steel I in water). Angles are
 measured from the line of centres (the normal), Nijssen Fig. 1c; St_n = St cos(theta_0).
 
-Impact angle: wetdem's collision.angle_deg is the angle between the striker's velocity and the
-line of centres when the gap first reaches the interaction range h_co = R* (centre distance
-2R + R*); the experiments and Fig. 1c take it at contact (centre distance 2R). On the straight
-approach path the impact parameter b = (2R + R*) sin(theta_h) = 2R sin(theta_0), so the
-figure plots against theta_0 = asin((2R + R*)/(2R) sin(theta_h)) (the normal lubrication
-force is central, so it does not bend a path that stays on its line; it does slow the normal
-approach, which makes this the geometric, not the exact, contact angle). St_n in the file
-names is m* v cos(theta_h)/(6 pi mu R*^2).
+Impact angle: wetdem's collision.angle_deg is the angle of the undisturbed straight-line
+approach at contact, sin(theta_0) = b / 2R with the impact parameter b, as in the experiments
+and Fig. 1c, so it is plotted as it is (column angle_in). St_n = m* v cos(theta_0)/(6 pi mu R*^2).
 
 Input: DIR/fig5_<range>_st<St_n>.csv, sweeps over collision.angle_deg.
 Usage: nijssen_fig5.py [--dir DIR]
@@ -44,9 +39,7 @@ def main():
         outs = []
         for st, d in runs:
             ok = d["separated"] > 0
-            ratio = (2 * common.RADIUS + common.RADIUS / 2) / (2 * common.RADIUS)
-            theta0 = np.degrees(np.arcsin(np.clip(ratio * np.sin(np.radians(d["angle_in"])),
-                                                  0, 1)))[ok]
+            theta0 = d["angle_in"][ok]
             out = d["striker_angle_out"][ok]
             ax.plot(theta0, out, "-o", ms=3, label=f"St_n = {st:g}")
             outs.append(out[(theta0 > 10) & (theta0 < 70)])

@@ -452,24 +452,31 @@ struct wetdem_collision_spec {
     double stokes;              /* normal Stokes number St_n = m* v_n0/(6 pi mu R*^2), used
                                    when speed == 0 */
     double angle;               /* impact angle [rad] in [0, pi/2): between the velocity of i
-                                   and the line of centres at first interaction; 0 = head-on */
+                                   and the line of centres at contact of the undisturbed
+                                   straight-line approach, sin(angle) = b / (R_i + R_j) with
+                                   the impact parameter b (wall: to its normal); 0 = head-on */
     struct wetdem_vec3 omega_i; /* initial spin of i [rad/s] */
     double initial_gap;         /* gap at t = 0 [m]; <= 0: just outside the interaction range */
     double t_end;               /* longest simulated time [s] */
     double observe_time;        /* > 0: also report e_n at this time (Punch Fig. 9 window) */
     double rebound_gap_factor;  /* separation is declared when the gap exceeds this multiple
                                    of the interaction range (>= 1; 0 means 1) */
+    double close_gap;           /* [m] >= 0: gap below which the pair counts as a doublet for
+                                   the stick-rotate-separate outcome; 0: the film thickness
+                                   delta_ij when the pair has films, else 0.01 R* */
 };
 
 struct wetdem_collision_result {
     double stokes_n;            /* normal Stokes number of the impact [-] */
-    double speed_n0;            /* normal approach speed at first interaction [m/s] */
+    double speed_n0;            /* normal impact speed U cos(angle) [m/s] */
     double e;                   /* Nijssen: |dv_1|/|dv_0| of the relative velocity [-] */
     double e_n;                 /* normal restitution -v_f.n_f / v_0.n_0 (Punch Eq. 3) [-] */
     double e_t;                 /* tangential restitution of the contact-point velocity [-]
                                    (-1 smooth, +1 reversed; NAN without initial slip) */
     double e_n_observed;        /* e_n evaluated at observe_time (NAN if not requested) */
-    double angle_in, angle_out; /* impact and rebound angles to the normal [rad] */
+    double angle_in, angle_out; /* impact angle of the straight-line approach (= spec angle)
+                                   and rebound angle of the relative velocity, to the normal
+                                   [rad] */
     struct wetdem_vec3 omega_i, omega_j; /* final spins [rad/s] */
     double contact_duration;    /* total time with gap < 0 [s] */
     double interaction_duration;/* time from first interaction to separation [s] */
@@ -478,8 +485,10 @@ struct wetdem_collision_result {
     bool hmin_reached;          /* gap reached h_min */
     bool separated;             /* left the interaction range by t_end */
     double rotation_angle;      /* angle the line of centres turned during interaction [rad] */
-    double rotation_close;      /* the part of rotation_angle turned while the gap was below
-                                   h_close = 0.01 R* (stick-rotate-separate criterion) [rad] */
+    double rotation_close;      /* the part of rotation_angle turned after the approach was
+                                   first arrested (first minimum of the gap) while the gap was
+                                   below close_gap (stick-rotate-separate criterion) [rad] */
+    double close_gap;           /* the doublet gap used (spec close_gap or automatic) [m] */
     double t_first_interaction; /* time the gap first reached the interaction range [s]
                                    (0 when starting inside it) */
     double t_final;             /* time of the final state: separation or t_end [s] */

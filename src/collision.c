@@ -4,23 +4,34 @@
  * wetdem_outcome_*.
  *
  * Set-up: target j at rest at the origin (a sphere, or the wall x = 0 with normal +x); the
- * striker i moves with speed U at the impact angle theta to the line of centres, placed so
- * that the line of centres is +x when the gap first reaches the interaction range (free
- * flight before). U from the normal Stokes number when U = 0 (SPEC §2; Nijssen Eq. 2 with the
- * normal speed, Punch Eq. 2):  St_n = m* U cos(theta) / (6 pi mu R*^2).
+ * striker i moves with speed U at the impact angle theta, defined as in the experiments
+ * (Yang & Hunt 2006; Nijssen Fig. 1c; Punch Eq. 16, "the moment before collision") and in
+ * Davis's pairwise engine: the angle between the relative velocity and the line of centres
+ * at contact of the undisturbed straight-line approach, sin(theta) = b / (R_i + R_j) with the
+ * impact parameter b (for a wall: the angle to the wall normal). The striker starts on that
+ * straight line, just outside the interaction range, and the line meets contact at +x
+ * (centre distance R_i + R_j on the +x axis). U from the normal Stokes number when U = 0
+ * (SPEC §2; Nijssen Eq. 2 with the normal speed, Punch Eq. 2):
+ *   St_n = m* v_n0 / (6 pi mu R*^2),  v_n0 = U cos(theta).
  * Runs to separation (gap >= rebound_gap_factor x range, receding) or t_end.
- * With the relative velocity of centres dv = v_i - v_j, n0 = +x (first interaction) and n_f
- * the normal at the final state:
+ * With the relative velocity of centres dv = v_i - v_j, n0 = +x (the contact normal of the
+ * straight-line approach) and n_f the normal at the final state:
  *   e   = |dv_f| / |dv_0|                                   (Nijssen; Yang & Hunt)
  *   e_n = -(dv_f . n_f) / (dv_0 . n0)                        (Punch Eq. 3)
  *   e_t = -(u_f . t_f) / |u_0|,  u = tangential part of the contact-point velocity
  *         (v_i + w_i x (-R_i n)) - (v_j + w_j x (R_j n)), t_f = u_0/|u_0| projected on the
  *         final tangent plane; -1 smooth sliding, +1 full reversal (Walton's beta)
- *   angle_in = atan2(|dv_0,t|, -dv_0 . n0),  angle_out = atan2(|dv_f,t|, dv_f . n_f).
+ *   angle_in = atan2(|dv_0,t|, -dv_0 . n0) = theta (the nominal impact angle: the initial
+ *     relative velocity against the straight-line contact normal; lubrication slows the
+ *     normal approach before contact, so the velocity at the actual first contact is more
+ *     oblique than this, as in the experiments, which measure the approach before impact),
+ *   angle_out = atan2(|dv_f,t|, dv_f . n_f).
  * Outcome: stick if not separated by t_end; stick-rotate-separate if separated after the
- * line of centres turned by more than 5 degrees after the closest approach while the gap
- * stayed below h_close = 0.01 R* (a doublet rotating in near contact: a prompt bounce turns
- * it by well under a degree); else bounce.
+ * line of centres turned by more than 5 degrees, after the approach was first arrested (the
+ * first minimum of the gap), in steps with the gap below h_close (a doublet rotating in near contact: a prompt bounce turns it by a few
+ * degrees at most); else bounce. h_close = spec close_gap when > 0, else the pair's film
+ * thickness delta_ij when it has films (overlapping films are the bridge that holds the
+ * doublet, Punch; Davis), else 0.01 R* (immersed pairs).
  */
 #include <math.h>
 #include <string.h>
@@ -29,7 +40,7 @@
 #include "vec3.h"
 
 #define SRS_ANGLE (5.0 * M_PI / 180.0) /* rotation that marks stick-rotate-separate [rad] */
-#define CLOSE_GAP_RATIO 0.01           /* h_close / R* [-] */
+#define CLOSE_GAP_RATIO 0.01           /* h_close / R* without films [-] */
 #define START_MARGIN_RATIO 0.01        /* start gap beyond the range, / R* [-] */
 
 const char* wetdem_outcome_name(enum wetdem_outcome outcome)
@@ -44,13 +55,15 @@ const char* wetdem_outcome_name(enum wetdem_outcome outcome)
 
 /* Per-step record of the pair (0, 1) or (0, wall 0), kept by the monitor. */
 struct tracker {
-    double r_eff;                  /* R* [m] */
+    double h_close;                /* gap below which the pair counts as a doublet [m] */
     double t_prev, gap_prev, vn_prev;
     struct wetdem_vec3 n_prev, dv_prev;
     double min_gap;
     bool interacting;              /* after the first interaction */
     double t_first;                /* time of the first interaction [s] */
     double rotation, rotation_close;
+    bool arrested;                 /* the approach has been arrested once (first minimum of
+                                      the gap): rotation_close counts from there */
     size_t events_seen;
     double t_observe;              /* absolute observation time [s], INFINITY if none yet */
     double observe_span;           /* spec->observe_time [s] */
@@ -131,19 +144,17 @@ static int monitor(struct wetdem_sim* sim, void* ctx)
     struct wetdem_vec3 dv = relative_velocity(sim);
     scan_events(sim, tr);
     double low = c.gap;
-    if (tr->vn_prev > 0 && c.v_n <= 0)
+    bool turned_back = tr->vn_prev > 0 && c.v_n <= 0; /* a local minimum of the gap */
+    if (turned_back)
         low = fmin(low, hermite_min(t - tr->t_prev, tr->gap_prev, tr->vn_prev, c.gap, c.v_n));
-    if (low < tr->min_gap) {
-        tr->min_gap = low;
-        tr->rotation_close = 0.0; /* count the rotation after the closest approach only */
-    }
+    tr->min_gap = fmin(tr->min_gap, low);
     if (tr->interacting) {
         double turn = atan2(vec3_norm(vec3_cross(tr->n_prev, c.normal)),
                             vec3_dot(tr->n_prev, c.normal));
         tr->rotation += turn;
-        double h_close = CLOSE_GAP_RATIO * tr->r_eff;
-        if (tr->gap_prev < h_close && c.gap < h_close)
+        if (tr->arrested && tr->gap_prev < tr->h_close && c.gap < tr->h_close)
             tr->rotation_close += turn;
+        tr->arrested = tr->arrested || turned_back;
     }
     observe_in_step(tr, t, c.normal, dv);
     tr->t_prev = t;
@@ -191,6 +202,10 @@ static int check_spec(struct wetdem_sim* sim, const struct wetdem_collision_spec
                                "collision: t_end = %g s (valid > 0), observe_time = %g s "
                                "(valid >= 0)",
                                s->t_end, s->observe_time);
+    if (!(isfinite(s->close_gap) && s->close_gap >= 0))
+        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
+                               "collision: close_gap = %g m: valid [0, inf), 0 = automatic",
+                               s->close_gap);
     if (!(s->rebound_gap_factor == 0 || (isfinite(s->rebound_gap_factor) &&
                                          s->rebound_gap_factor >= 1)))
         return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
@@ -202,18 +217,23 @@ static int check_spec(struct wetdem_sim* sim, const struct wetdem_collision_spec
 /* Geometry of the pair, known once both bodies exist. */
 struct setup {
     double range, r_eff, m_eff; /* [m], [m], [kg] */
+    double h_close;             /* doublet gap of the outcome rule [m] */
     double speed, speed_n0;     /* [m/s] */
 };
 
-/* Distance back along the approach line from the first-interaction point at which the centre
- * distance is s, for first-interaction distance d and angle theta (|D x - v d| = s) [m]. */
+/* Distance back along the approach line from the contact point of the straight path (centre
+ * distance d on +x) to the point where the centre distance is s >= d, for impact angle theta
+ * (|d x - D u| = s with u the direction of motion) [m]. */
 static double back_distance(double d, double s, double theta)
 {
     double c = cos(theta), sn = sin(theta);
     return -d * c + sqrt(fmax(s * s - d * d * sn * sn, 0.0));
 }
 
-/* Replaces the particles and walls by striker and target and sets the initial state. */
+/* Replaces the particles and walls by striker and target and sets the initial state: the
+ * striker on the straight line with impact parameter b = (R_i + R_j) sin(theta) that reaches
+ * contact at centre distance R_i + R_j on +x, started at the gap initial_gap (default: just
+ * outside the interaction range). */
 static int place_bodies(struct wetdem_sim* sim, const struct wetdem_collision_spec* s,
                         struct setup* out)
 {
@@ -236,6 +256,9 @@ static int place_bodies(struct wetdem_sim* sim, const struct wetdem_collision_sp
     out->range = wetdem_sim_contact_range(sim, &c);
     out->r_eff = c.r_eff;
     out->m_eff = c.m_eff;
+    out->h_close = s->close_gap > 0 ? s->close_gap
+                   : c.film > 0    ? c.film
+                                   : CLOSE_GAP_RATIO * c.r_eff;
     double cos_a = cos(s->angle);
     out->speed = s->speed > 0 ? s->speed
                               : s->stokes * 6 * M_PI * sim->fluid.viscosity * c.r_eff *
@@ -244,14 +267,8 @@ static int place_bodies(struct wetdem_sim* sim, const struct wetdem_collision_sp
     double gap0 = s->initial_gap > 0 ? s->initial_gap
                                      : out->range + START_MARGIN_RATIO * c.r_eff;
     struct wetdem_vec3 dir = vec3(-cos_a, -sin(s->angle), 0); /* direction of motion of i */
-    double first = reach + out->range, back = 0.0;
-    if (s->target_is_wall)
-        back = cos_a > 0 ? fmax(gap0 - out->range, 0.0) / cos_a : 0.0;
-    else if (gap0 > out->range)
-        back = back_distance(first, reach + gap0, s->angle);
-    else
-        first = reach + gap0;
-    sim->particles[0].pos = vec3_axpy(vec3(first, 0, 0), -back, dir);
+    double back = s->target_is_wall ? gap0 / cos_a : back_distance(reach, reach + gap0, s->angle);
+    sim->particles[0].pos = vec3_axpy(vec3(reach, 0, 0), -back, dir);
     sim->particles[0].vel = vec3_scale(dir, out->speed);
     return WETDEM_OK;
 }
@@ -280,7 +297,7 @@ static void start_tracker(const struct wetdem_sim* sim, const struct setup* su,
 {
     struct wetdem_contact c;
     pair_contact(sim, &c);
-    *tr = (struct tracker){.r_eff = su->r_eff, .t_prev = 0, .gap_prev = c.gap, .vn_prev = c.v_n,
+    *tr = (struct tracker){.h_close = su->h_close, .t_prev = 0, .gap_prev = c.gap, .vn_prev = c.v_n,
                            .n_prev = c.normal, .dv_prev = relative_velocity(sim),
                            .min_gap = c.gap, .interacting = c.gap < su->range, .t_first = 0,
                            .t_observe = INFINITY, .observe_span = s->observe_time};
@@ -383,6 +400,7 @@ static void analyse(const struct wetdem_sim* sim, const struct setup* su,
         tr->interacting ? (separated ? t_last_end : sim->engine.time) - tr->t_first : 0.0;
     r->rotation_angle = tr->rotation;
     r->rotation_close = tr->rotation_close;
+    r->close_gap = su->h_close;
     if (!separated)
         r->outcome = WETDEM_OUTCOME_STICK;
     else if (tr->rotation_close > SRS_ANGLE)

@@ -329,10 +329,12 @@ static void test_collision_outcomes(void** state)
         CHECK_OK(wetdem_collision_run(sim, &s, &r));
         assert_true(r.separated);
         assert_int_equal(r.outcome, WETDEM_OUTCOME_STICK_ROTATE_SEPARATE);
-        /* measured: ~180 degrees in all, ~50 after the closest approach within h_close */
+        /* measured: ~176 degrees in all, 99 (verlet) and 116 (cvode) after the first arrest
+         * with the gap within h_close = 0.01 R* (steel has no film) */
         assert_true(r.rotation_close > 20 * M_PI / 180 && r.rotation_close <= r.rotation_angle);
         /* held near G_REST, pushed out by the centrifugal load 0.057 N / k = 5.7 um */
         assert_true(r.min_gap > G_REST && r.min_gap < 0.01 * R / 2);
+        CHECK_REL(r.close_gap, 0.01 * R / 2, 1e-12);
         wetdem_sim_free(sim);
 
         sim = make_sim("steel1", 0, NULL, NULL, integrators[q], &mat);
@@ -348,6 +350,140 @@ static void test_collision_outcomes(void** state)
     }
     assert_string_equal(wetdem_outcome_name(WETDEM_OUTCOME_STICK_ROTATE_SEPARATE),
                         "stick-rotate-separate");
+}
+
+/* A model that is never zero-ranged but exerts no force: events and the analysis run, the
+ * motion is free flight. */
+static double ghost_range(const void* params, const struct wetdem_contact* c)
+{
+    (void)params;
+    return c->r_eff;
+}
+
+static int ghost_pair(const void* params, const struct wetdem_contact* c, double* history,
+                      struct wetdem_pair_force* out)
+{
+    (void)params, (void)c, (void)history, (void)out;
+    return WETDEM_OK;
+}
+
+static const struct wetdem_model ghost_model = {
+    .name = "test_ghost",
+    .kind = WETDEM_MODEL_FLUID,
+    .summary = "",
+    .doc = "",
+    .equations = "",
+    .params = glue_desc,
+    .params_size = sizeof(struct glue_params),
+    .history_len = 0,
+    .range = ghost_range,
+    .pair = ghost_pair,
+};
+
+/* The impact angle is that of the undisturbed straight-line approach at contact: with no
+ * force the striker flies past the target centre at the impact parameter
+ * b = (R_i + R_j) sin(angle) exactly. Unequal spheres (6.35 mm and 4 mm), three angles, both
+ * integrators: the distance of the line of motion from the target centre,
+ * |x x v| / |v| (x relative to the target), is b to 1e-12 relative at the start and at the
+ * end (round-off of a few additions: free flight keeps the line); the smallest gap is
+ * b - (R_i + R_j) to 1e-5 of R_i + R_j (Hermite interpolation of the gap in the step of
+ * closest approach, a cubic through sqrt(b^2 + (U t)^2): measured 1e-13 with Verlet, up to
+ * 7e-7 with CVODE, whose free-flight steps reach 0.1 R_i / U); angle_in is the angle,
+ * and the approach starts just outside the range (gap R* + 0.01 R*). */
+static void test_collision_free_flight_impact_parameter(void** state)
+{
+    (void)state;
+    const double rj = 4e-3, reach = R + rj, rs = R * rj / (R + rj);
+    const double angles[] = {0.3, 1.0, 1.5};
+    for (int q = 0; q < 2; q++)
+        for (size_t k = 0; k < 3; k++) {
+            int mat;
+            struct wetdem_sim* sim = make_sim("steel1", 0, NULL, NULL, integrators[q], &mat);
+            struct glue_params gp = {0};
+            CHECK_OK(wetdem_sim_add_model(sim, &ghost_model, &gp));
+            CHECK_OK(wetdem_sim_set_param(sim, "verlet.dt", 1e-4));
+            struct wetdem_collision_spec s = {.material_i = mat, .material_j = mat,
+                                              .radius_i = R, .radius_j = rj, .speed = 0.1,
+                                              .angle = angles[k], .t_end = 1.0};
+            size_t n;
+            const struct wetdem_particle* p = wetdem_sim_particles_const(sim, &n);
+            struct wetdem_collision_result r;
+            CHECK_OK(wetdem_collision_run(sim, &s, &r));
+            double b = reach * sin(angles[k]);
+            CHECK_REL(r.angle_in, angles[k], 1e-12);
+            CHECK_REL(r.speed_n0, 0.1 * cos(angles[k]), 1e-12);
+            CHECK_ABS(r.min_gap, b - reach, 1e-5 * reach);
+            assert_true(r.separated);
+            p = wetdem_sim_particles_const(sim, &n);
+            struct wetdem_vec3 d = {p[0].pos.x - p[1].pos.x, p[0].pos.y - p[1].pos.y, 0};
+            struct wetdem_vec3 v = {p[0].vel.x - p[1].vel.x, p[0].vel.y - p[1].vel.y, 0};
+            double lever = fabs(d.x * v.y - d.y * v.x) / hypot(v.x, v.y);
+            CHECK_REL(lever, b, 1e-12);
+            CHECK_REL(hypot(v.x, v.y), 0.1, 1e-12);
+            /* the start, 1 ns in (the striker moves 0.1 nm): on the same line, at the gap
+             * R* + 0.01 R* (1e-7 relative covers the 1e-10 m moved) */
+            s.t_end = 1e-9;
+            CHECK_OK(wetdem_collision_run(sim, &s, &r));
+            p = wetdem_sim_particles_const(sim, &n);
+            d = (struct wetdem_vec3){p[0].pos.x - p[1].pos.x, p[0].pos.y - p[1].pos.y, 0};
+            v = (struct wetdem_vec3){p[0].vel.x - p[1].vel.x, p[0].vel.y - p[1].vel.y, 0};
+            CHECK_REL(fabs(d.x * v.y - d.y * v.x) / hypot(v.x, v.y), b, 1e-12);
+            CHECK_REL(hypot(d.x, d.y) - reach, 1.01 * rs, 1e-7);
+            wetdem_sim_free(sim);
+        }
+}
+
+/* Outcome rule with films (Punch et al. 2023, Sec. 3.3): a dry steel striker on a steel
+ * sphere coated with 270 um of 10 Pa s silicone oil, hertz + mindlin + db + davis with the
+ * glass-transition h_min, at 60 degrees. At St_n = 0.5 the films catch the pair, the doublet
+ * turns by ~49 degrees with its films overlapping (gap < delta_ij = 270 um) and then leaves
+ * (e_n ~ 0.08): stick-rotate-separate. With the immersed doublet gap 0.01 R* = 63.5 um as
+ * close_gap none of that turn counts (the gap stays above ~75 um): bounce; at St_n = 3.5 the pair bounces off the solid
+ * contact (e_n ~ 0.8) and the line of centres turns by under 3 degrees in all: bounce.
+ * The automatic close_gap is delta_ij, exactly. */
+static void test_collision_outcome_with_films(void** state)
+{
+    (void)state;
+    struct wetdem_sim* sim = wetdem_sim_create();
+    struct wetdem_fluid fluid;
+    CHECK_OK(wetdem_fluid_preset("silicone10", &fluid));
+    CHECK_OK(wetdem_sim_set_fluid(sim, &fluid));
+    int a = wetdem_sim_add_material_preset(sim, "punch_steel");
+    int b = wetdem_sim_add_material_preset(sim, "punch_steel_coated");
+    static const char* const models[] = {"hertz", "mindlin", "db", "davis", "glass"};
+    for (size_t k = 0; k < 5; k++)
+        CHECK_OK(wetdem_sim_enable_model(sim, models[k]));
+    CHECK_OK(wetdem_sim_set_param_str(sim, "glass.speed", "current"));
+    CHECK_OK(wetdem_sim_set_integrator(sim, "cvode"));
+    struct wetdem_collision_spec s = {.material_i = a, .material_j = b, .radius_i = 12.7e-3,
+                                      .radius_j = 12.7e-3, .stokes = 0.5, .angle = M_PI / 3,
+                                      .t_end = 1.0};
+    struct wetdem_collision_result r;
+    CHECK_OK(wetdem_collision_run(sim, &s, &r));
+    double film = wetdem_sim_material(sim, b)->film + wetdem_sim_material(sim, a)->film;
+    CHECK_REL(film, 270e-6, 1e-12);
+    CHECK_REL(r.close_gap, film, 0);
+    assert_true(r.separated);
+    assert_true(r.rotation_close > 30 * M_PI / 180); /* measured ~49 degrees */
+    assert_int_equal(r.outcome, WETDEM_OUTCOME_STICK_ROTATE_SEPARATE);
+    s.stokes = 3.5;
+    s.t_end = 0.2;
+    CHECK_OK(wetdem_collision_run(sim, &s, &r));
+    assert_true(r.separated && r.solid_contact);
+    assert_true(r.rotation_angle < 5 * M_PI / 180); /* measured ~2.6 degrees */
+    assert_int_equal(r.outcome, WETDEM_OUTCOME_BOUNCE);
+    /* an explicit close_gap overrides the film: the immersed rule's 0.01 R* */
+    s.stokes = 0.5;
+    s.t_end = 1.0;
+    s.close_gap = 0.01 * 12.7e-3 / 2;
+    CHECK_OK(wetdem_collision_run(sim, &s, &r));
+    CHECK_REL(r.close_gap, 63.5e-6, 1e-12);
+    assert_true(r.separated && r.min_gap > s.close_gap);
+    assert_int_equal(r.outcome, WETDEM_OUTCOME_BOUNCE);
+    s.close_gap = -1;
+    CHECK_STATUS(wetdem_collision_run(sim, &s, &r), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(wetdem_sim_errmsg(sim), "close_gap");
+    wetdem_sim_free(sim);
 }
 
 /* Speed from the normal Stokes number: St_n = m* U cos(theta) / (6 pi mu R*^2). Water
@@ -447,6 +583,8 @@ int main(void)
         cmocka_unit_test(test_collision_swap_roles),
         cmocka_unit_test(test_collision_deterministic_and_clone),
         cmocka_unit_test(test_collision_outcomes),
+        cmocka_unit_test(test_collision_free_flight_impact_parameter),
+        cmocka_unit_test(test_collision_outcome_with_films),
         cmocka_unit_test(test_collision_stokes_speed),
         cmocka_unit_test(test_collision_observe_window),
         cmocka_unit_test(test_collision_bad_spec),

@@ -51,21 +51,20 @@ plateau="$out/fig4_plateau.csv"
 $py figures/nijssen_fig4.py --dir "$out"
 
 echo "-- Fig. 5: rebound angle vs impact angle in the three St_n ranges of the caption"
-# wetdem's angle_deg is the angle at first interaction (gap = h_co = R*); the straight path
-# then meets the target at the contact angle asin((2R + R*)/(2R) sin angle), which reaches
-# 85 deg at angle_deg = 52.8 (figures/nijssen_fig5.py plots against the contact angle).
+# angle_deg is the impact angle at contact of the straight-line approach (as Fig. 1c): 0 to 85
+# deg in steps of 5 deg.
 for st in 10 15 20 25; do
   "$cli" sweep $S/nijssen_oblique.ini --set collision.striker=steel1 \
     --set fluid.preset=glycerol80 --set collision.stokes=$st \
-    --param collision.angle_deg --values 0:52.8:23 --out "$out/fig5_low_st$st.csv"
+    --param collision.angle_deg --values 0:85:18 --out "$out/fig5_low_st$st.csv"
 done
 for st in 40 100 200; do
   "$cli" sweep $S/nijssen_oblique.ini --set collision.stokes=$st \
-    --param collision.angle_deg --values 0:52.8:23 --out "$out/fig5_mid_st$st.csv"
+    --param collision.angle_deg --values 0:85:18 --out "$out/fig5_mid_st$st.csv"
 done
 for st in 500 1000 2400; do
   "$cli" sweep $S/nijssen_oblique.ini --set collision.striker=steel1 --set collision.stokes=$st \
-    --param collision.angle_deg --values 0:52.8:23 --out "$out/fig5_high_st$st.csv"
+    --param collision.angle_deg --values 0:85:18 --out "$out/fig5_high_st$st.csv"
 done
 $py figures/nijssen_fig5.py --dir "$out"
 
