@@ -8,12 +8,21 @@
 #include "celllist.h"
 #include "sim.h"
 
+/* Mixed properties of one material pair (as struct wetdem_contact) and the range of the
+ * enabled models for it. */
+struct wetdem_many_mix {
+    double e_star, g_star;                       /* [Pa] */
+    double restitution, friction_dry, friction_lub; /* [-] */
+    double roughness, film;                      /* [m] */
+    double viscosity, surface_tension;           /* [Pa s], [N/m] */
+    double range; /* largest model range [m]: exact with the fused kernel, else the reach */
+};
+
 /* Result of one candidate pair at the latest force evaluation. */
 struct wetdem_many_pair_out {
     struct wetdem_vec3 force;    /* on i (j receives the opposite) [N] */
     struct wetdem_vec3 torque_i; /* [N m] */
     struct wetdem_vec3 torque_j; /* [N m] */
-    unsigned char flags;         /* MANY_ACTIVE | MANY_CONTACT | MANY_BRIDGE */
 };
 
 #define WETDEM_MANY_ACTIVE 1u  /* within the interaction range: force applied */
@@ -45,9 +54,12 @@ struct wetdem_many {
     struct wetdem_celllist_pair* old_pairs; /* previous list, for history remapping */
     double* old_history;
     size_t old_cap, old_history_cap;
-    struct wetdem_many_pair_out* out; /* per candidate pair */
+    struct wetdem_many_pair_out* out; /* per candidate pair; valid where flags has ACTIVE */
     size_t out_cap;
-    unsigned char* old_flags;    /* out[].flags of the previous list, for remapping */
+    unsigned char* flags;        /* per candidate pair: MANY_ACTIVE | _CONTACT | _BRIDGE | _DIRTY
+                                    (a separate byte array: the gather scans it densely) */
+    size_t flags_cap;
+    unsigned char* old_flags;    /* flags of the previous list, for remapping */
     size_t old_flags_cap;
     uint64_t* wall_mask;         /* per particle: bit w set if wall w is within reach + skin
                                     at the last build (walls >= 64 are always evaluated) */
@@ -56,7 +68,19 @@ struct wetdem_many {
     size_t n_wall_list, wall_list_cap;
     double max_disp2;            /* largest squared displacement since the build [m^2], */
     bool max_disp_valid;         /* measured during the latest drift */
-    bool forces_zeroed;          /* force, torque, contacts cleared during the latest drift */
+    size_t *rev_start, *rev;     /* pairs (k, i) of particle i: rev[rev_start[i] ..
+                                    rev_start[i+1]], pair indices in increasing order */
+    size_t rev_start_cap, rev_cap;
+    /* force kernel (sim_many_force.c) */
+    struct wetdem_many_mix* mix; /* n_mix_materials^2 material pairs */
+    size_t mix_cap;
+    int n_mix_materials;
+    bool kernel_ready;           /* mix and kind[] match the current set-up */
+    bool fused;                  /* every enabled model has a fused kernel */
+    bool generic_only;           /* tests: never use the fused kernel */
+    bool periodic_any;           /* some axis is periodic */
+    unsigned char kind[WETDEM_MAX_MODELS]; /* fused kernel of model k */
+    double kind_opt[WETDEM_MAX_MODELS];    /* its switch parameter (hertz damping form, ...) */
     struct wetdem_vec3 *force, *torque, *vh, *wh; /* per particle */
     uint32_t* contacts;          /* per particle: solid contacts at the latest evaluation */
     size_t particle_cap;
@@ -80,6 +104,27 @@ void wetdem_sim_many_energies(const struct wetdem_sim* sim, double* kinetic, dou
 /* Makes sure the pair list, histories and per-particle arrays fit the current particles
  * (builds the cell list when needed). */
 int wetdem_sim_many_prepare(struct wetdem_sim* sim);
+
+/* sim_many_force.c */
+/* Builds the material-pair table and chooses the kernel (fused or generic); needs m->reach
+ * and the cell-list box. WETDEM_OK or WETDEM_ERR_NOMEM. */
+int wetdem_sim_many_setup_kernel(struct wetdem_sim* sim);
+/* Mixed properties of materials a and b (setup_kernel must have run). */
+const struct wetdem_many_mix* wetdem_sim_many_mix(const struct wetdem_sim* sim, int a, int b);
+/* Contact of particle i with particle j (minimum image) or with wall j, properties from the
+ * table: the same values as wetdem_sim_build_contact for a non-periodic pair. */
+void wetdem_sim_many_contact(const struct wetdem_sim* sim, size_t i, size_t j, bool is_wall,
+                             struct wetdem_contact* c);
+/* The fused kernel: the same contract and results as wetdem_sim_eval_contact, for model sets
+ * of hertz, mindlin, sb and capillary only (m->fused). */
+int wetdem_sim_many_eval_fused(const struct wetdem_sim* sim, struct wetdem_contact* c,
+                               double* history, struct wetdem_pair_force* out,
+                               struct wetdem_pair_force* per_model);
+/* Index of the pairs by their second particle (rev, rev_start), after a list build. */
+int wetdem_sim_many_index_pairs(struct wetdem_sim* sim);
+/* Forces, torques and contact counts of every particle at the current state, histories
+ * committed; with `kick`, also the closing half kick v = v' + a dt/2 of each particle. */
+int wetdem_sim_many_forces(struct wetdem_sim* sim, bool kick);
 
 /* sim_many_io.c */
 /* Writes the outputs due at the current step (VTK, CSV, periodic checkpoint). */

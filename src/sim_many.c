@@ -85,6 +85,7 @@ void wetdem_sim_many_free(struct wetdem_sim* sim)
     free(m->old_history);
     free(m->out);
     free(m->old_flags);
+    free(m->flags);
     free(m->wall_mask);
     free(m->wall_list);
     free(m->force);
@@ -93,6 +94,9 @@ void wetdem_sim_many_free(struct wetdem_sim* sim)
     free(m->wh);
     free(m->contacts);
     free(m->thread_work);
+    free(m->mix);
+    free(m->rev_start);
+    free(m->rev);
     for (size_t k = 0; k < m->vtk_files && m->vtk_names; k++)
         free(m->vtk_names[k]);
     free(m->vtk_names);
@@ -254,7 +258,7 @@ static void remap_dirty(struct wetdem_many* m, size_t n_old)
                              (m->old_pairs[a].i == q.i && m->old_pairs[a].j < q.j)))
             a++;
         bool same = a < n_old && m->old_pairs[a].i == q.i && m->old_pairs[a].j == q.j;
-        m->out[b].flags = same ? (m->old_flags[a] & WETDEM_MANY_DIRTY) : 0;
+        m->flags[b] = same ? (m->old_flags[a] & WETDEM_MANY_DIRTY) : 0;
     }
 }
 
@@ -301,7 +305,7 @@ static int rebuild(struct wetdem_sim* sim)
     if (grow((void**)&m->old_flags, &m->old_flags_cap, n_old ? n_old : 1, 1))
         return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory for the pair list");
     for (size_t q = 0; q < n_old; q++)
-        m->old_flags[q] = m->out[q].flags;
+        m->old_flags[q] = m->flags[q];
     if (n_old)
         memcpy(m->old_pairs, m->cl.pairs, n_old * sizeof *m->old_pairs);
     if (n_old * len > 0)
@@ -312,7 +316,8 @@ static int rebuild(struct wetdem_sim* sim)
         return wetdem_sim_fail(sim, st, "%s", msg);
     size_t n_new = m->cl.n_pairs;
     if (grow((void**)&m->history, &m->history_cap, n_new * len + 1, sizeof(double)) ||
-        grow((void**)&m->out, &m->out_cap, n_new ? n_new : 1, sizeof *m->out))
+        grow((void**)&m->out, &m->out_cap, n_new ? n_new : 1, sizeof *m->out) ||
+        grow((void**)&m->flags, &m->flags_cap, n_new ? n_new : 1, 1))
         return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory for %zu pairs", n_new);
     double fresh[HISTORY_MAX];
     if (len)
@@ -320,7 +325,8 @@ static int rebuild(struct wetdem_sim* sim)
     wetdem_celllist_remap_history(m->old_pairs, m->old_history, n_old, m->cl.pairs, m->history,
                                   n_new, len, fresh);
     remap_dirty(m, n_old);
-    return update_wall_masks(sim);
+    st = wetdem_sim_many_index_pairs(sim);
+    return st != WETDEM_OK ? st : update_wall_masks(sim);
 }
 
 int wetdem_sim_many_prepare(struct wetdem_sim* sim)
@@ -356,6 +362,12 @@ int wetdem_sim_many_prepare(struct wetdem_sim* sim)
             return wetdem_sim_fail(sim, st, "%s", msg);
         m->reach = reach;
     }
+    if (fresh_set || !m->kernel_ready) {
+        int st = wetdem_sim_many_setup_kernel(sim);
+        if (st != WETDEM_OK)
+            return st;
+        m->kernel_ready = true;
+    }
     if (size_particle_arrays(sim) != WETDEM_OK)
         return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory for %zu particles",
                                sim->n_particles);
@@ -369,220 +381,7 @@ int wetdem_sim_many_prepare(struct wetdem_sim* sim)
     return WETDEM_OK;
 }
 
-/* ---- forces ---- */
-
-/* Contact of pair (i, j) with j moved to its nearest periodic image; false if the pair is
- * certainly beyond reach (gap estimate from the centre distance). */
-static bool pair_contact(const struct wetdem_sim* sim, size_t i, size_t j,
-                         struct wetdem_contact* c)
-{
-    const struct wetdem_many* m = sim->many;
-    const struct wetdem_particle* a = &sim->particles[i];
-    struct wetdem_particle b = sim->particles[j];
-    struct wetdem_vec3 d = celllist_delta(&m->cl.box, a->pos, b.pos);
-    double reach = m->reach + a->radius + b.radius;
-    if (vec3_dot(d, d) > reach * reach)
-        return false;
-    b.pos = vec3_sub(a->pos, d);
-    wetdem_contact_from_particles(c, a, &sim->materials[a->material], &b,
-                                  &sim->materials[b.material], &sim->fluid);
-    c->i = i;
-    c->j = j;
-    return true;
-}
-
-/* Adds dt x the power of each model's force on the pair to work[model]. */
-static void add_work(const struct wetdem_sim* sim, const struct wetdem_contact* c,
-                     const struct wetdem_pair_force* per_model, double* work)
-{
-    const struct wetdem_particle* a = &sim->particles[c->i];
-    struct wetdem_vec3 dv = a->vel, wj = vec3(0, 0, 0);
-    if (!c->is_wall) {
-        dv = vec3_sub(dv, sim->particles[c->j].vel);
-        wj = sim->particles[c->j].omega;
-    }
-    for (size_t k = 0; k < sim->n_models; k++) {
-        const struct wetdem_pair_force* f = &per_model[k];
-        struct wetdem_vec3 fi = vec3_axpy(f->f_tan, f->f_normal, c->normal);
-        double p = vec3_dot(fi, dv) + vec3_dot(f->torque_i, a->omega) +
-                   (c->is_wall ? 0.0 : vec3_dot(f->torque_j, wj));
-        work[k] += sim->many->dt * p;
-    }
-}
-
-/* Evaluates contact c with history hist (advanced in place: committed every step). Returns
- * the status; *out gets force, torques and flags. */
-static int eval_pair(const struct wetdem_sim* sim, struct wetdem_contact* c, double* hist,
-                     struct wetdem_many_pair_out* out, double* work)
-{
-    const struct wetdem_many* m = sim->many;
-    double range = wetdem_sim_contact_range(sim, c);
-    if (range > m->reach)
-        return WETDEM_ERR_INVALID; /* reported by the caller: the start-up bound failed */
-    bool dirty = out->flags & WETDEM_MANY_DIRTY;
-    out->flags = 0;
-    if (c->gap > range) {
-        if (hist && dirty)
-            wetdem_sim_history_init(sim, hist);
-        return WETDEM_OK;
-    }
-    c->dt = m->dt;
-    struct wetdem_pair_force f, per_model[WETDEM_MAX_MODELS];
-    int st = wetdem_sim_eval_contact(sim, c, hist, &f, m->set.energy_budget ? per_model : NULL);
-    if (st < 0)
-        return st;
-    out->force = vec3_axpy(f.f_tan, f.f_normal, c->normal);
-    out->torque_i = f.torque_i;
-    out->torque_j = f.torque_j;
-    out->flags = WETDEM_MANY_ACTIVE | WETDEM_MANY_DIRTY | (c->gap < 0 ? WETDEM_MANY_CONTACT : 0) |
-                 (c->film > 0 && c->gap < c->film ? WETDEM_MANY_BRIDGE : 0);
-    if (!(isfinite(f.f_normal) && vec3_is_finite(out->force) && vec3_is_finite(f.torque_i) &&
-          vec3_is_finite(f.torque_j)))
-        return WETDEM_ERR_NUMERIC;
-    if (m->set.energy_budget)
-        add_work(sim, c, per_model, work);
-    return WETDEM_OK;
-}
-
-/* First failing pair (lowest index) of a parallel loop, for a deterministic message. */
-struct failure {
-    size_t index;
-    int status;
-    bool is_wall;
-    double gap, range;
-};
-
-static void note_failure(struct failure* fail, size_t index, int st, bool is_wall,
-                         const struct wetdem_contact* c, const struct wetdem_sim* sim)
-{
-#pragma omp critical
-    if (fail->status == WETDEM_OK || index < fail->index)
-        *fail = (struct failure){index, st, is_wall, c->gap, wetdem_sim_contact_range(sim, c)};
-}
-
-static int report_failure(struct wetdem_sim* sim, const struct failure* f)
-{
-    struct wetdem_many* m = sim->many;
-    size_t i = f->is_wall ? f->index / sim->n_walls : m->cl.pairs[f->index].i;
-    size_t j = f->is_wall ? f->index % sim->n_walls : m->cl.pairs[f->index].j;
-    const char* what = f->is_wall ? "wall " : "";
-    if (f->status == WETDEM_ERR_INVALID && f->range > m->reach)
-        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
-                               "pair (%zu, %s%zu): interaction range %.6g m exceeds the "
-                               "neighbour reach %.6g m bounded at start-up",
-                               i, what, j, f->range, m->reach);
-    return wetdem_sim_fail(sim, f->status, "pair (%zu, %s%zu) at t = %.9g s, gap %.6g m: %s", i,
-                           what, j, sim->engine.time, f->gap,
-                           f->status == WETDEM_ERR_NUMERIC ? "non-finite force"
-                                                           : wetdem_status_name(f->status));
-}
-
-static double* thread_work(struct wetdem_many* m, int wall)
-{
-    return m->thread_work + (size_t)omp_get_thread_num() * 2 * WETDEM_MAX_MODELS +
-           (size_t)wall * WETDEM_MAX_MODELS;
-}
-
-static void eval_all_pairs(struct wetdem_sim* sim, struct failure* fail)
-{
-    struct wetdem_many* m = sim->many;
-    size_t len = sim->history_len, n = m->cl.n_pairs;
-#pragma omp parallel for schedule(dynamic, 256)
-    for (size_t q = 0; q < n; q++) {
-        struct wetdem_contact c;
-        double* hist = len ? m->history + q * len : NULL;
-        if (!pair_contact(sim, m->cl.pairs[q].i, m->cl.pairs[q].j, &c)) {
-            if (hist && (m->out[q].flags & WETDEM_MANY_DIRTY))
-                wetdem_sim_history_init(sim, hist);
-            m->out[q].flags = 0;
-            continue;
-        }
-        int st = eval_pair(sim, &c, hist, &m->out[q], thread_work(m, 0));
-        if (st != WETDEM_OK)
-            note_failure(fail, q, st, false, &c, sim);
-    }
-}
-
-/* Wall forces go straight into the particle's own force (one iteration owns particle i). */
-static void eval_walls(struct wetdem_sim* sim, struct failure* fail)
-{
-    struct wetdem_many* m = sim->many;
-    size_t len = sim->history_len, nw = sim->n_walls;
-    if (!m->forces_zeroed) {
-#pragma omp parallel for schedule(static)
-        for (size_t i = 0; i < sim->n_particles; i++) {
-            m->force[i] = m->torque[i] = vec3(0, 0, 0);
-            m->contacts[i] = 0;
-        }
-    }
-    m->forces_zeroed = false;
-#pragma omp parallel for schedule(static)
-    for (size_t q = 0; q < m->n_wall_list; q++) {
-        size_t i = m->wall_list[q];
-        for (size_t w = 0; w < nw; w++) {
-            if (w < 64 && !(m->wall_mask[i] >> w & 1))
-                continue;
-            const struct wetdem_particle* a = &sim->particles[i];
-            const struct wetdem_wall* wall = &sim->walls[w];
-            double gap = vec3_dot(vec3_sub(a->pos, wall->point), wall->normal) - a->radius;
-            double* hist = len ? m->wall_history + (i * nw + w) * len : NULL;
-            if (gap > m->reach) {
-                if (hist)
-                    wetdem_sim_history_init(sim, hist);
-                continue;
-            }
-            struct wetdem_contact c;
-            wetdem_sim_build_contact(sim, i, w, true, &c);
-            struct wetdem_many_pair_out o = {.flags = WETDEM_MANY_DIRTY}; /* always reset */
-            int st = eval_pair(sim, &c, hist, &o, thread_work(m, 1));
-            if (st != WETDEM_OK)
-                note_failure(fail, i * nw + w, st, true, &c, sim);
-            if (!(o.flags & WETDEM_MANY_ACTIVE))
-                continue;
-            m->force[i] = vec3_add(m->force[i], o.force);
-            m->torque[i] = vec3_add(m->torque[i], o.torque_i);
-            m->contacts[i] += (o.flags & WETDEM_MANY_CONTACT) ? 1 : 0;
-        }
-    }
-}
-
-/* Serial scatter of the pair results in pair order (fixed summation order). */
-static void scatter_pairs(struct wetdem_sim* sim)
-{
-    struct wetdem_many* m = sim->many;
-    for (size_t q = 0; q < m->cl.n_pairs; q++) {
-        const struct wetdem_many_pair_out* o = &m->out[q];
-        if (!(o->flags & WETDEM_MANY_ACTIVE))
-            continue;
-        size_t i = m->cl.pairs[q].i, j = m->cl.pairs[q].j;
-        m->force[i] = vec3_add(m->force[i], o->force);
-        m->force[j] = vec3_sub(m->force[j], o->force);
-        m->torque[i] = vec3_add(m->torque[i], o->torque_i);
-        m->torque[j] = vec3_add(m->torque[j], o->torque_j);
-        if (o->flags & WETDEM_MANY_CONTACT) {
-            m->contacts[i]++;
-            m->contacts[j]++;
-        }
-    }
-}
-
-/* Forces and torques on every particle at the current state; histories committed. */
-static int compute_forces(struct wetdem_sim* sim)
-{
-    struct wetdem_many* m = sim->many;
-    int st = wetdem_sim_many_prepare(sim);
-    if (st != WETDEM_OK)
-        return st;
-    struct failure fail = {0};
-    eval_walls(sim, &fail);
-    eval_all_pairs(sim, &fail);
-    if (fail.status != WETDEM_OK)
-        return report_failure(sim, &fail);
-    scatter_pairs(sim);
-    sim->engine.stats.force_evals++;
-    sim->engine.stats.pair_evals += m->cl.n_pairs + sim->n_particles * sim->n_walls;
-    return WETDEM_OK;
-}
+/* ---- forces: sim_many_force.c ---- */
 
 /* Sums the per-thread work accumulators into the budget in thread order and clears them. */
 static void collect_work(struct wetdem_many* m, int n_threads)
@@ -635,10 +434,8 @@ static void kick_drift(struct wetdem_sim* sim, double h)
             p->vel = vec3_axpy(m->vh[k], 0.5 * h, a);
             p->omega = vec3_axpy(m->wh[k], 0.5 * h, alpha);
         }
-        /* fused passes: the forces of the new state start from zero, and the displacement
-         * since the last neighbour-list build is measured here (rebuild criterion) */
-        m->force[k] = m->torque[k] = vec3(0, 0, 0);
-        m->contacts[k] = 0;
+        /* fused pass: the displacement since the last neighbour-list build is measured here
+         * (rebuild criterion) */
         if (track) {
             struct wetdem_vec3 d = celllist_delta(&m->cl.box, p->pos, m->cl.pos_at_build[k]);
             double d2 = vec3_dot(d, d);
@@ -647,26 +444,10 @@ static void kick_drift(struct wetdem_sim* sim, double h)
     }
     m->max_disp2 = worst;
     m->max_disp_valid = track;
-    m->forces_zeroed = true;
 }
 
-static void kick(struct wetdem_sim* sim, double h)
-{
-    struct wetdem_many* m = sim->many;
-    struct wetdem_vec3 g = gravity(sim);
-#pragma omp parallel for schedule(static)
-    for (size_t k = 0; k < sim->n_particles; k++) {
-        struct wetdem_particle* p = &sim->particles[k];
-        if (p->is_fixed)
-            continue;
-        p->vel = vec3_axpy(m->vh[k], 0.5 * h, vec3_axpy(g, 1.0 / p->mass, m->force[k]));
-        p->omega = vec3_axpy(m->wh[k], 0.5 * h,
-                             vec3_scale(m->torque[k],
-                                        1.0 / (0.4 * p->mass * p->radius * p->radius)));
-    }
-}
-
-static int forces_and_work(struct wetdem_sim* sim)
+/* Forces at the current state (with the closing half kick when `kick`), work collected. */
+static int forces_and_work(struct wetdem_sim* sim, bool kick)
 {
     struct wetdem_many* m = sim->many;
     int n_threads = omp_get_max_threads();
@@ -678,7 +459,7 @@ static int forces_and_work(struct wetdem_sim* sim)
             return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory");
         m->thread_work_cap = need;
     }
-    int st = compute_forces(sim);
+    int st = wetdem_sim_many_forces(sim, kick);
     collect_work(m, n_threads);
     return st;
 }
@@ -701,7 +482,8 @@ void wetdem_sim_many_energies(const struct wetdem_sim* sim, double* kinetic, dou
      * integral of (4/3) E* sqrt(R*) delta^(3/2) over delta (Johnson 1985 Eq. 4.23). */
     for (size_t q = 0; m && q < m->cl.n_pairs; q++) {
         struct wetdem_contact c;
-        if (!pair_contact(sim, m->cl.pairs[q].i, m->cl.pairs[q].j, &c) || c.gap >= 0)
+        wetdem_sim_many_contact(sim, m->cl.pairs[q].i, m->cl.pairs[q].j, false, &c);
+        if (c.gap >= 0)
             continue;
         double d = -c.gap;
         el += 8.0 / 15.0 * c.e_star * sqrt(c.r_eff) * d * d * sqrt(d);
@@ -728,7 +510,7 @@ static int start(struct wetdem_sim* sim)
         return st;
     m->t0 = sim->engine.time;
     m->step = 0;
-    st = forces_and_work(sim);
+    st = forces_and_work(sim, false);
     if (st != WETDEM_OK)
         return st;
     m->started = true;
@@ -771,10 +553,9 @@ static int one_step(struct wetdem_sim* sim)
     m->step++;
     sim->engine.time = m->t0 + (double)m->step * m->dt; /* no accumulated round-off */
     sim->engine.t_committed = sim->engine.time;
-    int st = forces_and_work(sim);
+    int st = forces_and_work(sim, true); /* the closing half kick is fused into the gather */
     if (st != WETDEM_OK)
         return st;
-    kick(sim, m->dt);
     sim->engine.stats.steps++;
     st = wetdem_sim_many_outputs(sim, false);
     if (st == WETDEM_OK)
@@ -785,6 +566,7 @@ static int one_step(struct wetdem_sim* sim)
 int wetdem_sim_many_integrate(struct wetdem_sim* sim, double t_end)
 {
     struct wetdem_many* m = sim->many;
+    m->kernel_ready = false; /* materials, models or parameters may have changed */
     int st = m->started ? wetdem_sim_many_prepare(sim) : start(sim);
     if (st != WETDEM_OK)
         return st;

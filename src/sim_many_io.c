@@ -49,8 +49,8 @@ void wetdem_sim_many_agglomerates(const struct wetdem_sim* sim, size_t* count, d
         parent[k] = k;
         size[k] = 1;
     }
-    for (size_t q = 0; q < m->cl.n_pairs && m->out; q++) {
-        if (!(m->out[q].flags & WETDEM_MANY_BRIDGE))
+    for (size_t q = 0; q < m->cl.n_pairs && m->flags; q++) {
+        if (!(m->flags[q] & WETDEM_MANY_BRIDGE))
             continue;
         size_t a = find_root(parent, m->cl.pairs[q].i), b = find_root(parent, m->cl.pairs[q].j);
         if (a == b)
@@ -81,8 +81,8 @@ int wetdem_sim_many_stats(const struct wetdem_sim* sim, struct wetdem_many_stats
     if (!m || !m->started)
         return WETDEM_ERR_INVALID;
     for (size_t q = 0; q < m->cl.n_pairs; q++) {
-        s->contacts += (m->out[q].flags & WETDEM_MANY_CONTACT) ? 1 : 0;
-        s->bridges += (m->out[q].flags & WETDEM_MANY_BRIDGE) ? 1 : 0;
+        s->contacts += (m->flags[q] & WETDEM_MANY_CONTACT) ? 1 : 0;
+        s->bridges += (m->flags[q] & WETDEM_MANY_BRIDGE) ? 1 : 0;
     }
     size_t touching = 0; /* contact counts per particle hold pairs twice, walls once */
     for (size_t k = 0; k < sim->n_particles; k++)
@@ -425,7 +425,7 @@ static int restore_pairs(struct wetdem_sim* sim, const struct wetdem_checkpoint*
     if (n)
         memcpy(m->contacts, ck->extra + 16 + n * 48, n * sizeof(uint32_t));
     for (size_t q = 0; q < m->cl.n_pairs; q++) /* histories may be stale: check on next use */
-        m->out[q] = (struct wetdem_many_pair_out){.flags = WETDEM_MANY_DIRTY};
+        m->flags[q] = WETDEM_MANY_DIRTY;
     m->started = true;
     return WETDEM_OK;
 }

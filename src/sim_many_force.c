@@ -1,0 +1,567 @@
+/*
+ * sim_many_force.c — the force evaluation of the many-particle mode (docs/many.md,
+ * docs/performance.md): candidate pairs from the cell list, a cheap gap test on positions,
+ * contacts built from a per-material-pair table of mixed properties, fused kernels for the
+ * common model sets, and a parallel gather whose result does not depend on the thread count.
+ * Prefix: wetdem_sim_.
+ *
+ * Per step, for the candidate list (celllist.h) of pairs (i < j) sorted by (i, j):
+ *   1. pair pass (parallel, any schedule): pair q is evaluated into its own slot out[q]. A
+ *      pair is skipped before any contact is built when |x_i - x_j|^2 > (R_i + R_j + r_ab)^2
+ *      (1 + 1e-12), r_ab the model range of its material pair (the start-up reach for model
+ *      sets without a fused kernel); the exact test h > range(c) then decides as before.
+ *   2. gather (parallel over particles): particle k sums its wall forces (wall order), then
+ *      -F of every pair (i, k) in increasing i, then F of every pair (k, j) in increasing j,
+ *      and applies the closing half kick of velocity Verlet (sim_many.c) at once.
+ * Each particle's sum has a fixed order (pair index order, the order of the former serial
+ * scatter), so states are bit-identical for any number of threads, and, because pairs out of
+ * range add nothing and the order is by particle index, for any time at which the list was
+ * rebuilt (checkpoint + restart).
+ *
+ * Mixed properties (contact.c, SPEC §2): 1/E* = (1-nu_a^2)/E_a + (1-nu_b^2)/E_b, 1/G* =
+ * (2-nu_a)/G_a + (2-nu_b)/G_b, means of e, mu, sigma, sum of films; computed once per
+ * material pair with the same code (wetdem_contact_from_particles on probe particles) so the
+ * values are bit-identical to a contact built per pair.
+ *
+ * Fused kernel: when every enabled force model is one of hertz, mindlin, sb and capillary (any
+ * subset, any order), a switch over the models replaces the calls through the model table. It
+ * calls the same kernels (wetdem_force_hertz_elastic, wetdem_force_hertz_damping,
+ * wetdem_force_mindlin_update, wetdem_pair_force_add_tangential, thin_film_eval_gap) and writes
+ * the static-bridge force 6 pi mu a^2 v_n/h [1 - h/delta]^2 (Punch 2023 Eq. 7, corrected
+ * bracket; force_sb.c) and the capillary suction -8 pi a sigma (Punch 2023 Eq. 15;
+ * force_capillary.c) with the same operations in the same order, and sums the models as
+ * wetdem_sim_eval_contact does; the elastic Hertz force, which hertz and mindlin both need,
+ * is computed once. tests/test_many_force.c checks the forces and histories are bit-identical
+ * to the generic path. The range of these models is the film thickness delta_ab (0 for the
+ * contact models), a property of the material pair.
+ */
+#include <omp.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "many.h"
+#include "models.h"
+#include "thin_film.h"
+#include "vec3.h"
+
+/* Relative margin of the cheap gap test: its squared-distance bound must never reject a pair
+ * that the exact test (gap = |d| - R_i - R_j <= range) accepts; both are within a few ulps. */
+#define PREFILTER_MARGIN 1e-12
+
+enum fused_kind { FUSED_NONE = 0, FUSED_HERTZ, FUSED_MINDLIN, FUSED_SB, FUSED_CAPILLARY };
+
+/* ---- set-up: material-pair table and kernel choice ---- */
+
+/* Value of the numeric parameter `name` of slot s (0 when absent). */
+static double slot_param(const struct wetdem_model_slot* s, const char* name)
+{
+    const struct wetdem_param_desc* d = wetdem_param_find(s->model->params, name);
+    if (!d || !s->params)
+        return 0.0;
+    double v;
+    memcpy(&v, (const char*)s->params + d->offset, sizeof v);
+    return v;
+}
+
+static enum fused_kind fused_kind_of(const struct wetdem_model* model)
+{
+    if (model == &wetdem_force_hertz)
+        return FUSED_HERTZ;
+    if (model == &wetdem_force_mindlin)
+        return FUSED_MINDLIN;
+    if (model == &wetdem_force_sb)
+        return FUSED_SB;
+    if (model == &wetdem_force_capillary)
+        return FUSED_CAPILLARY;
+    return FUSED_NONE;
+}
+
+/* Mixed properties of materials a and b, from contact.c itself. */
+static void mix_pair(const struct wetdem_sim* sim, int a, int b, struct wetdem_many_mix* x)
+{
+    struct wetdem_particle p = {.radius = 1, .mass = 1, .material = a};
+    struct wetdem_particle q = {.pos = {0, 0, 3}, .radius = 1, .mass = 1, .material = b};
+    struct wetdem_contact c;
+    wetdem_contact_from_particles(&c, &p, &sim->materials[a], &q, &sim->materials[b],
+                                  &sim->fluid);
+    *x = (struct wetdem_many_mix){c.e_star,       c.g_star,    c.restitution,
+                                  c.friction_dry, c.friction_lub, c.roughness,
+                                  c.film,         c.viscosity, c.surface_tension,
+                                  0.0};
+}
+
+int wetdem_sim_many_setup_kernel(struct wetdem_sim* sim)
+{
+    struct wetdem_many* m = sim->many;
+    size_t nm = sim->n_materials > 0 ? (size_t)sim->n_materials : 1;
+    if (nm * nm > m->mix_cap) {
+        free(m->mix);
+        m->mix = malloc(nm * nm * sizeof *m->mix);
+        m->mix_cap = m->mix ? nm * nm : 0;
+        if (!m->mix)
+            return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory");
+    }
+    bool fused = !m->generic_only;
+    for (size_t k = 0; k < sim->n_models; k++) {
+        const struct wetdem_model_slot* s = &sim->models[k];
+        m->kind[k] = (unsigned char)fused_kind_of(s->model);
+        m->kind_opt[k] = m->kind[k] == FUSED_HERTZ     ? slot_param(s, "damping")
+                         : m->kind[k] == FUSED_MINDLIN ? slot_param(s, "friction")
+                         : m->kind[k] == FUSED_SB      ? slot_param(s, "below_hmin")
+                                                       : 0.0;
+        fused = fused && m->kind[k] != FUSED_NONE;
+    }
+    m->n_mix_materials = (int)nm;
+    for (int a = 0; a < sim->n_materials; a++)
+        for (int b = 0; b < sim->n_materials; b++) {
+            struct wetdem_many_mix* x = &m->mix[(size_t)a * nm + (size_t)b];
+            mix_pair(sim, a, b, x);
+            /* the range of the fused models is 0 or the film thickness: a material-pair value */
+            x->range = fused ? (x->film > 0.0 ? x->film : 0.0) : m->reach;
+        }
+    m->fused = fused;
+    m->periodic_any = m->cl.box.periodic[0] || m->cl.box.periodic[1] || m->cl.box.periodic[2];
+    return WETDEM_OK;
+}
+
+/* ---- contacts ---- */
+
+static double reduced(double a, double b)
+{
+    if (isinf(a))
+        return b;
+    if (isinf(b))
+        return a;
+    return a * b / (a + b);
+}
+
+static double effective_mass(const struct wetdem_particle* p)
+{
+    return p->is_fixed ? INFINITY : p->mass;
+}
+
+static void copy_mix(struct wetdem_contact* c, const struct wetdem_many_mix* x)
+{
+    c->e_star = x->e_star;
+    c->g_star = x->g_star;
+    c->restitution = x->restitution;
+    c->friction_dry = x->friction_dry;
+    c->friction_lub = x->friction_lub;
+    c->roughness = x->roughness;
+    c->film = x->film;
+    c->viscosity = x->viscosity;
+    c->surface_tension = x->surface_tension;
+    c->h_min = 0.0;
+    c->dt = 0.0;
+}
+
+/* Contact of a with b where d = x_a - x_b (minimum image): the operations of
+ * wetdem_contact_from_particles in the same order, mixed properties from the table. */
+static void pair_contact_from(const struct wetdem_particle* a, const struct wetdem_particle* b,
+                              struct wetdem_vec3 d, const struct wetdem_many_mix* x,
+                              struct wetdem_contact* c)
+{
+    double dist = vec3_norm(d);
+    c->is_wall = false;
+    c->normal = dist > 0 ? vec3_scale(d, 1.0 / dist) : vec3(1, 0, 0);
+    c->gap = dist - a->radius - b->radius;
+    c->radius_i = a->radius;
+    c->radius_j = b->radius;
+    c->r_eff = reduced(a->radius, b->radius);
+    c->m_eff = reduced(effective_mass(a), effective_mass(b));
+    struct wetdem_vec3 n = c->normal;
+    struct wetdem_vec3 va = vec3_add(a->vel, vec3_cross(a->omega, vec3_scale(n, -a->radius)));
+    struct wetdem_vec3 vb = vec3_add(b->vel, vec3_cross(b->omega, vec3_scale(n, b->radius)));
+    copy_mix(c, x);
+    c->v_n = -vec3_dot(vec3_sub(a->vel, b->vel), n);
+    c->v_t = vec3_reject(vec3_sub(va, vb), n);
+}
+
+/* Contact of particle a with a plane wall (wetdem_contact_with_wall, table properties). */
+static void wall_contact_from(const struct wetdem_particle* a, const struct wetdem_wall* w,
+                              const struct wetdem_many_mix* x, struct wetdem_contact* c)
+{
+    double dist = vec3_dot(vec3_sub(a->pos, w->point), w->normal);
+    c->is_wall = true;
+    c->normal = w->normal;
+    c->gap = dist - a->radius;
+    c->radius_i = a->radius;
+    c->radius_j = INFINITY;
+    c->r_eff = a->radius;
+    c->m_eff = effective_mass(a);
+    struct wetdem_vec3 va =
+        vec3_add(a->vel, vec3_cross(a->omega, vec3_scale(w->normal, -a->radius)));
+    copy_mix(c, x);
+    c->v_n = -vec3_dot(a->vel, c->normal);
+    c->v_t = vec3_reject(va, c->normal);
+}
+
+const struct wetdem_many_mix* wetdem_sim_many_mix(const struct wetdem_sim* sim, int a, int b)
+{
+    const struct wetdem_many* m = sim->many;
+    return &m->mix[(size_t)a * (size_t)m->n_mix_materials + (size_t)b];
+}
+
+void wetdem_sim_many_contact(const struct wetdem_sim* sim, size_t i, size_t j, bool is_wall,
+                             struct wetdem_contact* c)
+{
+    const struct wetdem_particle* a = &sim->particles[i];
+    if (is_wall) {
+        const struct wetdem_wall* w = &sim->walls[j];
+        wall_contact_from(a, w, wetdem_sim_many_mix(sim, a->material, w->material), c);
+    } else {
+        const struct wetdem_particle* b = &sim->particles[j];
+        struct wetdem_vec3 d = celllist_delta(&sim->many->cl.box, a->pos, b->pos);
+        pair_contact_from(a, b, d, wetdem_sim_many_mix(sim, a->material, b->material), c);
+    }
+    c->i = i;
+    c->j = j;
+}
+
+/* ---- the fused kernel ---- */
+
+static void add_force(struct wetdem_pair_force* out, const struct wetdem_pair_force* f)
+{
+    out->f_normal += f->f_normal;
+    out->f_tan = vec3_add(out->f_tan, f->f_tan);
+    out->torque_i = vec3_add(out->torque_i, f->torque_i);
+    out->torque_j = vec3_add(out->torque_j, f->torque_j);
+}
+
+/* One model's force, as its pair() function computes it. f_el: the Hertz elastic force at
+ * this overlap. Returns WETDEM_OK or WETDEM_ERR_INVALID (restitution outside (0, 1]). */
+static int fused_model(int kind, double opt, const struct wetdem_contact* c, double f_el,
+                       double* history, struct wetdem_pair_force* f)
+{
+    double overlap = -c->gap;
+    switch (kind) {
+    case FUSED_HERTZ:
+        if (!(c->restitution > 0.0 && c->restitution <= 1.0))
+            return WETDEM_ERR_INVALID;
+        if (overlap > 0.0)
+            f->f_normal += fmax(f_el + wetdem_force_hertz_damping(c->e_star, c->r_eff, c->m_eff,
+                                                                  overlap, c->v_n,
+                                                                  c->restitution, (int)opt),
+                                0.0);
+        return WETDEM_OK;
+    case FUSED_MINDLIN: {
+        if (!(c->restitution > 0.0 && c->restitution <= 1.0))
+            return WETDEM_ERR_INVALID;
+        double mu = opt == 0 ? c->friction_dry : c->friction_lub;
+        struct wetdem_vec3 ft = wetdem_force_mindlin_update(c, overlap, f_el, mu, history);
+        if (overlap > 0.0)
+            wetdem_pair_force_add_tangential(f, c, ft);
+        return WETDEM_OK;
+    }
+    case FUSED_SB: {
+        double h;
+        if (thin_film_eval_gap(c->gap, c->h_min, c->film, opt, &h)) {
+            double bracket = 1.0 - h / c->film;
+            f->f_normal += 6.0 * M_PI * c->viscosity * c->r_eff * c->r_eff * c->v_n / h *
+                           bracket * bracket;
+        }
+        return WETDEM_OK;
+    }
+    default: /* FUSED_CAPILLARY */
+        if (c->film > 0.0 && c->gap <= c->film)
+            f->f_normal -= 8.0 * M_PI * c->r_eff * c->surface_tension;
+        return WETDEM_OK;
+    }
+}
+
+int wetdem_sim_many_eval_fused(const struct wetdem_sim* sim, struct wetdem_contact* c,
+                               double* history, struct wetdem_pair_force* out,
+                               struct wetdem_pair_force* per_model)
+{
+    const struct wetdem_many* m = sim->many;
+    double scratch[1] = {0.0};
+    if (!history) /* only models without history are enabled */
+        history = scratch;
+    *out = (struct wetdem_pair_force){0};
+    c->h_min = sim->minsep.model->min_separation(sim->minsep.params, c, history);
+    double f_el = wetdem_force_hertz_elastic(c->e_star, c->r_eff, -c->gap);
+    for (size_t k = 0; k < sim->n_models; k++) {
+        struct wetdem_pair_force f = {0};
+        int st = fused_model(m->kind[k], m->kind_opt[k], c, f_el,
+                             history + sim->models[k].history_offset, &f);
+        if (st < 0)
+            return st;
+        add_force(out, &f);
+        if (per_model)
+            per_model[k] = f;
+    }
+    return WETDEM_OK;
+}
+
+/* ---- the pair pass ---- */
+
+/* First failing pair (lowest index) of a parallel loop, for a deterministic message. */
+struct failure {
+    size_t index;
+    int status;
+    bool is_wall;
+    double gap, range;
+};
+
+static void note_failure(struct failure* fail, size_t index, int st, bool is_wall,
+                         const struct wetdem_contact* c, double range)
+{
+#pragma omp critical
+    if (fail->status == WETDEM_OK || index < fail->index)
+        *fail = (struct failure){index, st, is_wall, c->gap, range};
+}
+
+static int report_failure(struct wetdem_sim* sim, const struct failure* f)
+{
+    struct wetdem_many* m = sim->many;
+    size_t i = f->is_wall ? f->index / sim->n_walls : m->cl.pairs[f->index].i;
+    size_t j = f->is_wall ? f->index % sim->n_walls : m->cl.pairs[f->index].j;
+    const char* what = f->is_wall ? "wall " : "";
+    if (f->status == WETDEM_ERR_INVALID && f->range > m->reach)
+        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
+                               "pair (%zu, %s%zu): interaction range %.6g m exceeds the "
+                               "neighbour reach %.6g m bounded at start-up",
+                               i, what, j, f->range, m->reach);
+    return wetdem_sim_fail(sim, f->status, "pair (%zu, %s%zu) at t = %.9g s, gap %.6g m: %s", i,
+                           what, j, sim->engine.time, f->gap,
+                           f->status == WETDEM_ERR_NUMERIC ? "non-finite force"
+                                                           : wetdem_status_name(f->status));
+}
+
+static double* thread_work(const struct wetdem_many* m, int wall)
+{
+    return m->thread_work + (size_t)omp_get_thread_num() * 2 * WETDEM_MAX_MODELS +
+           (size_t)wall * WETDEM_MAX_MODELS;
+}
+
+/* Adds dt x the power of each model's force on the pair to work[model]. */
+static void add_work(const struct wetdem_sim* sim, const struct wetdem_contact* c,
+                     const struct wetdem_pair_force* per_model, double* work)
+{
+    const struct wetdem_particle* a = &sim->particles[c->i];
+    struct wetdem_vec3 dv = a->vel, wj = vec3(0, 0, 0);
+    if (!c->is_wall) {
+        dv = vec3_sub(dv, sim->particles[c->j].vel);
+        wj = sim->particles[c->j].omega;
+    }
+    for (size_t k = 0; k < sim->n_models; k++) {
+        const struct wetdem_pair_force* f = &per_model[k];
+        struct wetdem_vec3 fi = vec3_axpy(f->f_tan, f->f_normal, c->normal);
+        double p = vec3_dot(fi, dv) + vec3_dot(f->torque_i, a->omega) +
+                   (c->is_wall ? 0.0 : vec3_dot(f->torque_j, wj));
+        work[k] += sim->many->dt * p;
+    }
+}
+
+/* Range of contact c: the table value for the fused models, else asked of every model. */
+static double contact_range(const struct wetdem_sim* sim, const struct wetdem_contact* c,
+                            const struct wetdem_many_mix* x)
+{
+    return sim->many->fused ? x->range : wetdem_sim_contact_range(sim, c);
+}
+
+/* Evaluates contact c (range `range`) with history hist, advanced in place (committed every
+ * step). Returns the status; *out gets force and torques (when active), *flags the flags. */
+static int eval_pair(const struct wetdem_sim* sim, struct wetdem_contact* c, double range,
+                     double* hist, struct wetdem_many_pair_out* out, unsigned char* flags,
+                     double* work)
+{
+    const struct wetdem_many* m = sim->many;
+    if (range > m->reach)
+        return WETDEM_ERR_INVALID; /* reported by the caller: the start-up bound failed */
+    bool dirty = *flags & WETDEM_MANY_DIRTY;
+    *flags = 0;
+    if (c->gap > range) {
+        if (hist && dirty)
+            wetdem_sim_history_init(sim, hist);
+        return WETDEM_OK;
+    }
+    c->dt = m->dt;
+    struct wetdem_pair_force f, per_model[WETDEM_MAX_MODELS];
+    struct wetdem_pair_force* pm = m->set.energy_budget ? per_model : NULL;
+    int st = m->fused ? wetdem_sim_many_eval_fused(sim, c, hist, &f, pm)
+                      : wetdem_sim_eval_contact(sim, c, hist, &f, pm);
+    if (st < 0)
+        return st;
+    out->force = vec3_axpy(f.f_tan, f.f_normal, c->normal);
+    out->torque_i = f.torque_i;
+    out->torque_j = f.torque_j;
+    *flags = WETDEM_MANY_ACTIVE | WETDEM_MANY_DIRTY | (c->gap < 0 ? WETDEM_MANY_CONTACT : 0) |
+             (c->film > 0 && c->gap < c->film ? WETDEM_MANY_BRIDGE : 0);
+    if (!(isfinite(f.f_normal) && vec3_is_finite(out->force) && vec3_is_finite(f.torque_i) &&
+          vec3_is_finite(f.torque_j)))
+        return WETDEM_ERR_NUMERIC;
+    if (pm)
+        add_work(sim, c, per_model, work);
+    return WETDEM_OK;
+}
+
+/* Pair q: cheap gap test on the positions, then the contact and its force. */
+static void eval_one_pair(const struct wetdem_sim* sim, size_t q, struct failure* fail)
+{
+    const struct wetdem_many* m = sim->many;
+    size_t i = m->cl.pairs[q].i, j = m->cl.pairs[q].j, len = sim->history_len;
+    const struct wetdem_particle* a = &sim->particles[i];
+    const struct wetdem_particle* b = &sim->particles[j];
+    struct wetdem_vec3 d = m->periodic_any ? celllist_delta(&m->cl.box, a->pos, b->pos)
+                                           : vec3_sub(a->pos, b->pos);
+    const struct wetdem_many_mix* x = wetdem_sim_many_mix(sim, a->material, b->material);
+    double lim = a->radius + b->radius + x->range;
+    double* hist = len ? m->history + q * len : NULL;
+    unsigned char* flags = &m->flags[q];
+    if (vec3_dot(d, d) > lim * lim * (1 + PREFILTER_MARGIN)) {
+        if (*flags & WETDEM_MANY_DIRTY && hist)
+            wetdem_sim_history_init(sim, hist);
+        *flags = 0;
+        return;
+    }
+    struct wetdem_contact c;
+    pair_contact_from(a, b, d, x, &c);
+    c.i = i;
+    c.j = j;
+    double range = contact_range(sim, &c, x);
+    int st = eval_pair(sim, &c, range, hist, &m->out[q], flags, thread_work(m, 0));
+    if (st != WETDEM_OK)
+        note_failure(fail, q, st, false, &c, range);
+}
+
+static void eval_all_pairs(const struct wetdem_sim* sim, struct failure* fail)
+{
+    size_t n = sim->many->cl.n_pairs;
+#pragma omp parallel for schedule(dynamic, 512)
+    for (size_t q = 0; q < n; q++)
+        eval_one_pair(sim, q, fail);
+}
+
+/* ---- the gather ---- */
+
+/* Wall forces on particle i, added to *f, *t, *n_contacts in wall order. */
+static void eval_walls_of(const struct wetdem_sim* sim, size_t i, struct wetdem_vec3* f,
+                          struct wetdem_vec3* t, uint32_t* n_contacts, struct failure* fail)
+{
+    const struct wetdem_many* m = sim->many;
+    size_t len = sim->history_len, nw = sim->n_walls;
+    const struct wetdem_particle* a = &sim->particles[i];
+    for (size_t w = 0; w < nw; w++) {
+        if (w < 64 && !(m->wall_mask[i] >> w & 1))
+            continue;
+        const struct wetdem_wall* wall = &sim->walls[w];
+        double gap = vec3_dot(vec3_sub(a->pos, wall->point), wall->normal) - a->radius;
+        double* hist = len ? m->wall_history + (i * nw + w) * len : NULL;
+        if (gap > m->reach) {
+            if (hist)
+                wetdem_sim_history_init(sim, hist);
+            continue;
+        }
+        struct wetdem_contact c;
+        const struct wetdem_many_mix* x = wetdem_sim_many_mix(sim, a->material, wall->material);
+        wall_contact_from(a, wall, x, &c);
+        c.i = i;
+        c.j = w;
+        double range = contact_range(sim, &c, x);
+        struct wetdem_many_pair_out o;
+        unsigned char flags = WETDEM_MANY_DIRTY; /* always reset */
+        int st = eval_pair(sim, &c, range, hist, &o, &flags, thread_work(m, 1));
+        if (st != WETDEM_OK)
+            note_failure(fail, i * nw + w, st, true, &c, range);
+        if (!(flags & WETDEM_MANY_ACTIVE))
+            continue;
+        *f = vec3_add(*f, o.force);
+        *t = vec3_add(*t, o.torque_i);
+        *n_contacts += (flags & WETDEM_MANY_CONTACT) ? 1 : 0;
+    }
+}
+
+/* Force, torque and contacts of particle i: walls, then its pairs in pair order. */
+static void gather_one(struct wetdem_sim* sim, size_t i, struct failure* fail)
+{
+    struct wetdem_many* m = sim->many;
+    struct wetdem_vec3 f = vec3(0, 0, 0), t = vec3(0, 0, 0);
+    uint32_t n_contacts = 0;
+    if (m->wall_mask[i] || sim->n_walls > 64)
+        eval_walls_of(sim, i, &f, &t, &n_contacts, fail);
+    for (size_t r = m->rev_start[i]; r < m->rev_start[i + 1]; r++) {
+        size_t q = m->rev[r];
+        if (!(m->flags[q] & WETDEM_MANY_ACTIVE))
+            continue;
+        f = vec3_sub(f, m->out[q].force);
+        t = vec3_add(t, m->out[q].torque_j);
+        n_contacts += (m->flags[q] & WETDEM_MANY_CONTACT) ? 1 : 0;
+    }
+    for (size_t q = m->cl.first_pair[i]; q < m->cl.first_pair[i + 1]; q++) {
+        if (!(m->flags[q] & WETDEM_MANY_ACTIVE))
+            continue;
+        f = vec3_add(f, m->out[q].force);
+        t = vec3_add(t, m->out[q].torque_i);
+        n_contacts += (m->flags[q] & WETDEM_MANY_CONTACT) ? 1 : 0;
+    }
+    m->force[i] = f;
+    m->torque[i] = t;
+    m->contacts[i] = n_contacts;
+}
+
+/* Closing half kick of particle k: v = v' + a dt/2, w = w' + alpha dt/2 (sim_many.c). */
+static void close_kick(struct wetdem_sim* sim, size_t k, struct wetdem_vec3 g)
+{
+    struct wetdem_many* m = sim->many;
+    struct wetdem_particle* p = &sim->particles[k];
+    if (p->is_fixed)
+        return;
+    double h = m->dt;
+    p->vel = vec3_axpy(m->vh[k], 0.5 * h, vec3_axpy(g, 1.0 / p->mass, m->force[k]));
+    p->omega = vec3_axpy(m->wh[k], 0.5 * h,
+                         vec3_scale(m->torque[k], 1.0 / (0.4 * p->mass * p->radius * p->radius)));
+}
+
+int wetdem_sim_many_index_pairs(struct wetdem_sim* sim)
+{
+    struct wetdem_many* m = sim->many;
+    size_t n = sim->n_particles, np = m->cl.n_pairs;
+    if (n + 1 > m->rev_start_cap) {
+        free(m->rev_start);
+        m->rev_start = malloc((n + 1) * sizeof *m->rev_start);
+        m->rev_start_cap = m->rev_start ? n + 1 : 0;
+    }
+    if (np > m->rev_cap || !m->rev) {
+        free(m->rev);
+        m->rev = malloc((np ? np : 1) * sizeof *m->rev);
+        m->rev_cap = m->rev ? np : 0;
+    }
+    if (!m->rev_start || !m->rev)
+        return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory for %zu pairs", np);
+    memset(m->rev_start, 0, (n + 1) * sizeof *m->rev_start);
+    for (size_t q = 0; q < np; q++)
+        m->rev_start[m->cl.pairs[q].j + 1]++;
+    for (size_t k = 0; k < n; k++)
+        m->rev_start[k + 1] += m->rev_start[k];
+    for (size_t q = 0; q < np; q++) /* in pair order: each segment ascends */
+        m->rev[m->rev_start[m->cl.pairs[q].j]++] = q;
+    for (size_t k = n; k > 0; k--) /* undo the shift left by the fill */
+        m->rev_start[k] = m->rev_start[k - 1];
+    m->rev_start[0] = 0;
+    return WETDEM_OK;
+}
+
+int wetdem_sim_many_forces(struct wetdem_sim* sim, bool kick)
+{
+    struct wetdem_many* m = sim->many;
+    int st = wetdem_sim_many_prepare(sim);
+    if (st != WETDEM_OK)
+        return st;
+    struct failure fail = {0};
+    eval_all_pairs(sim, &fail);
+    struct wetdem_vec3 g =
+        vec3(sim->settings.gravity_x, sim->settings.gravity_y, sim->settings.gravity_z);
+    size_t n = sim->n_particles;
+#pragma omp parallel for schedule(static)
+    for (size_t i = 0; i < n; i++) {
+        gather_one(sim, i, &fail);
+        if (kick)
+            close_kick(sim, i, g);
+    }
+    if (fail.status != WETDEM_OK)
+        return report_failure(sim, &fail);
+    sim->engine.stats.force_evals++;
+    sim->engine.stats.pair_evals += m->cl.n_pairs + sim->n_particles * sim->n_walls;
+    return WETDEM_OK;
+}
