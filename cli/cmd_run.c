@@ -4,6 +4,8 @@
  * (every field of struct wetdem_collision_result with units; JSON with --json). With --out,
  * writes DIR/trajectory.csv, DIR/events.csv and DIR/summary.json (names from [output]).
  * --check only reads, checks and resolves the scenario (derived speed, times) and prints that.
+ * Many-particle scenarios ([box], [insert], ...) go to cli_run_many (cli/run_many.c), which
+ * also handles --restart CHECKPOINT.
  *
  * Nothing half-written: the scenario is checked and the simulation built (every input check)
  * before any file is opened; files are written under temporary names and renamed only when
@@ -26,18 +28,22 @@ struct run_args {
     const char* sets[MAX_SETS];
     int n_sets;
     const char* out_dir;
+    const char* restart; /* many-particle runs: checkpoint to resume from */
     bool json, check;
 };
 
 static void usage(FILE* f)
 {
     fprintf(f, "usage: wetdem run FILE [--set section.key=value ...] [--out DIR] [--json] "
-               "[--check]\n"
-               "Runs the binary collision of a scenario file (docs/scenarios.md).\n"
+               "[--check] [--restart CHECKPOINT]\n"
+               "Runs the binary collision or the many-particle run of a scenario file "
+               "(docs/scenarios.md, docs/many.md).\n"
                "  --set K=V   override a scenario key, e.g. --set collision.stokes=50\n"
                "  --out DIR   write DIR/trajectory.csv, DIR/events.csv, DIR/summary.json\n"
+               "              (many-particle runs: VTK series, CSV, checkpoint, summary)\n"
                "  --json      print the summary as JSON\n"
-               "  --check     check the scenario and print the resolved set-up; do not run\n");
+               "  --check     check the scenario and print the resolved set-up; do not run\n"
+               "  --restart C resume a many-particle run from checkpoint C (same scenario)\n");
 }
 
 static int parse_args(int argc, char** argv, struct run_args* a)
@@ -50,6 +56,8 @@ static int parse_args(int argc, char** argv, struct run_args* a)
             a->sets[a->n_sets++] = argv[++k];
         else if (strcmp(s, "--out") == 0 && has_next)
             a->out_dir = argv[++k];
+        else if (strcmp(s, "--restart") == 0 && has_next)
+            a->restart = argv[++k];
         else if (strcmp(s, "--json") == 0)
             a->json = true;
         else if (strcmp(s, "--check") == 0)
@@ -58,8 +66,10 @@ static int parse_args(int argc, char** argv, struct run_args* a)
             a->file = s;
         else {
             cli_error("run: unexpected argument '%s'%s", s,
-                      (strcmp(s, "--set") == 0 || strcmp(s, "--out") == 0) ? " (needs a value)"
-                                                                            : "");
+                      (strcmp(s, "--set") == 0 || strcmp(s, "--out") == 0 ||
+                       strcmp(s, "--restart") == 0)
+                          ? " (needs a value)"
+                          : "");
             usage(stderr);
             return CLI_EXIT_USAGE;
         }
@@ -206,6 +216,20 @@ int cmd_run(int argc, char** argv)
                                           .argv = argv};
             rc = cli_run_pairwise(&sc, &opt);
         }
+        cli_scenario_free(&sc);
+        return rc;
+    }
+    bool many = rc == CLI_EXIT_OK && cli_scenario_is_many && cli_scenario_is_many(&sc);
+    if (many || (rc == CLI_EXIT_OK && a.restart)) {
+        struct cli_run_options opt = {.out_dir = a.out_dir, .json = a.json, .argc = argc,
+                                      .argv = argv, .restart = a.restart, .check = a.check};
+        if (!many || !cli_run_many) {
+            cli_error("run %s: %s", a.file,
+                      many ? "many-particle runs are not in this build"
+                           : "--restart resumes many-particle runs only ([box], [insert], ...)");
+            rc = many ? CLI_EXIT_RUNTIME : CLI_EXIT_USAGE;
+        } else
+            rc = cli_run_many(&sc, &opt);
         cli_scenario_free(&sc);
         return rc;
     }

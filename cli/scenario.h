@@ -79,6 +79,9 @@ struct cli_section_desc {
 /* Optional (weak): sections another engine reads, e.g. the pairwise engine's, as a
  * {0}-terminated table; they are accepted, validated and documented like the built-in ones. */
 extern const struct cli_section_desc cli_pairwise_sections[] __attribute__((weak));
+/* Optional (weak): the many-particle sections ([box], [walls], [insert], [particle.NAME],
+ * [run], [dump]; cli/scenario_many.c), accepted, validated and documented the same way. */
+extern const struct cli_section_desc cli_many_sections[] __attribute__((weak));
 
 /* ---- loading and overriding ---- */
 
@@ -206,12 +209,23 @@ struct cli_run_options {
     FILE* sweep_row;     /* non-NULL (sweep): write only one CSV row of results (no newline
                             handling by the caller: end it with '\n'), or the header */
     bool sweep_header;   /* with sweep_row: write the CSV column header line instead */
+    const char* restart; /* many-particle runs: checkpoint to resume from, or NULL */
+    bool check;          /* only check the scenario and print the resolved set-up */
 };
 
 /* Runs a scenario whose [engine] type is "pairwise" (cli/run_pairwise.c). Weak: when the
  * build has no pairwise engine, run and sweep report "engine 'pairwise' is not in this
  * build" and exit 1. Returns an exit code. */
 int cli_run_pairwise(const struct cli_scenario* sc, const struct cli_run_options* opt)
+    __attribute__((weak));
+
+/* Whether the scenario describes a many-particle run (it has one of cli_many_sections and no
+ * [collision]); cli/scenario_many.c. Weak: absent when the build has no many-particle CLI. */
+bool cli_scenario_is_many(const struct cli_scenario* sc) __attribute__((weak));
+/* Runs a many-particle scenario (cli/run_many.c): outputs in opt->out_dir, --restart from
+ * opt->restart, SIGINT/SIGTERM write a checkpoint. Returns an exit code (130/143 when
+ * interrupted by SIGINT/SIGTERM with a checkpoint written). Weak. */
+int cli_run_many(const struct cli_scenario* sc, const struct cli_run_options* opt)
     __attribute__((weak));
 
 #endif

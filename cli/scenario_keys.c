@@ -211,6 +211,8 @@ int cli_section_lookup(const char* name, struct cli_section_info* info)
     const struct cli_section_desc* d = find_in(sections, name, &member);
     if (!d && cli_pairwise_sections)
         d = find_in(cli_pairwise_sections, name, &member);
+    if (!d && cli_many_sections)
+        d = find_in(cli_many_sections, name, &member);
     if (!d)
         return -1;
     info->desc = d;
@@ -249,6 +251,9 @@ void cli_section_suggestion(const char* name, char* msg, size_t n)
             names[m++] = sections[k].name;
     for (size_t k = 0; cli_pairwise_sections && cli_pairwise_sections[k].name && m + 1 < 32; k++)
         names[m++] = cli_pairwise_sections[k].name;
+    for (size_t k = 0; cli_many_sections && cli_many_sections[k].name && m + 1 < 32; k++)
+        if (!strstr(cli_many_sections[k].name, ".*"))
+            names[m++] = cli_many_sections[k].name;
     names[m] = NULL;
     const char* hint = wetdem_param_suggest(name, names);
     if (hint) {
@@ -373,9 +378,9 @@ static int section_doc(FILE* f, const struct cli_section_desc* s)
         snprintf(star, sizeof probe - (size_t)(star - probe), "%s",
                  strcmp(s->name, "model.*") == 0 ? "hertz" : "NAME");
     cli_section_lookup(probe, &info);
-    fprintf(f, "\n### `[%s]`\n\n", star ? (strcmp(s->name, "model.*") == 0 ? "model.NAME"
-                                                                               : "material.NAME")
-                                         : s->name);
+    if (star)
+        snprintf(star, sizeof probe - (size_t)(star - probe), "NAME"); /* "sphere.NAME" */
+    fprintf(f, "\n### `[%s]`\n\n", probe);
     cell(f, s->doc);
     fputs("\n", f);
     if (strcmp(s->name, "model.*") == 0)
@@ -401,6 +406,8 @@ int cli_scenario_print_docs(FILE* f)
         rc |= section_doc(f, &sections[k]);
     for (size_t k = 0; cli_pairwise_sections && cli_pairwise_sections[k].name; k++)
         rc |= section_doc(f, &cli_pairwise_sections[k]);
+    for (size_t k = 0; cli_many_sections && cli_many_sections[k].name; k++)
+        rc |= section_doc(f, &cli_many_sections[k]);
     fputs("\n<!-- end of generated tables -->\n", f);
     return rc;
 }

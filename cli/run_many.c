@@ -1,0 +1,573 @@
+/*
+ * run_many.c — `wetdem run FILE [--out DIR] [--restart CHECKPOINT]` for many-particle
+ * scenarios (cli/scenario_many.c; docs/many.md "From the command line").
+ *
+ * Order of work, so that bad input never leaves files behind: the scenario is built and the
+ * run is started once without outputs (time step, neighbour lists, periodic-box checks,
+ * the reach bound: every library check of the set-up), then the mode is set again with the
+ * outputs, the --out directory is created and the run starts afresh or from the checkpoint.
+ *
+ * Outputs in DIR: PREFIX_NNNNNN.vtk frames every vtk_every steps (and the last step) with the
+ * ParaView index PREFIX.vtk.series, the library's CSV of global quantities every csv_every
+ * steps, the checkpoint (atomic; every checkpoint_every steps, on SIGINT/SIGTERM and at the
+ * end) and summary.json with the energy budget. The VTK frames are written here, from the
+ * progress callback (called after every step with the state at the end of the step), rather
+ * than by the library, so that the frame numbering and the series index continue across
+ * restarts: on --restart the existing index is read back and the entries after the
+ * checkpoint time are dropped, as are CSV rows after the checkpoint step (a run resumed from
+ * an older periodic checkpoint then rewrites them identically).
+ *
+ * Interruption: SIGINT and SIGTERM set a volatile flag that the library reads every step as
+ * its stop flag; it writes the checkpoint and returns, and the run exits with 128 + signal
+ * number (130, 143) after printing the command that resumes it. A second signal kills as
+ * usual (SA_RESETHAND); the checkpoint written before is intact (written atomically).
+ *
+ * Progress with an estimate of the time left goes to stderr, only when stderr is a terminal,
+ * at most twice a second.
+ */
+#include <errno.h>
+#include <math.h>
+#include <omp.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "cli_util.h"
+#include "output_csv.h"
+#include "scenario_many.h"
+
+#define PATH_CHARS 2048
+
+static volatile sig_atomic_t stop_signal = 0;
+
+static void on_signal(int sig)
+{
+    stop_signal = sig;
+}
+
+/* ------------------------------------------------------------------- VTK time series --- */
+
+struct series {
+    char dir[PATH_CHARS], prefix[CLI_VALUE_MAX];
+    bool binary;
+    double* times; /* time of frame k [s] */
+    size_t n, cap;
+    unsigned long long last_step; /* step of the latest frame (valid when n > 0) */
+};
+
+static void frame_name(const struct series* s, size_t k, char* buf, size_t n)
+{
+    snprintf(buf, n, "%s_%06zu.vtk", s->prefix, k);
+}
+
+/* Writes the .vtk.series index (temporary file, then rename). 0 or -1. */
+static int series_write(const struct series* s)
+{
+    char path[PATH_CHARS + CLI_VALUE_MAX + 40], tmp[sizeof path + 8];
+    snprintf(path, sizeof path, "%s/%s.vtk.series", s->dir, s->prefix);
+    snprintf(tmp, sizeof tmp, "%s.tmp", path);
+    FILE* f = fopen(tmp, "w");
+    if (!f)
+        return -1;
+    fputs("{\n  \"file-series-version\" : \"1.0\",\n  \"files\" : [\n", f);
+    for (size_t k = 0; k < s->n; k++) {
+        char name[CLI_VALUE_MAX + 40];
+        frame_name(s, k, name, sizeof name);
+        fprintf(f, "    { \"name\" : \"%s\", \"time\" : %.17g }%s\n", name, s->times[k],
+                k + 1 < s->n ? "," : "");
+    }
+    fputs("  ]\n}\n", f);
+    bool ok = !ferror(f);
+    ok = fclose(f) == 0 && ok;
+    if (ok && rename(tmp, path) == 0)
+        return 0;
+    remove(tmp);
+    return -1;
+}
+
+/* Appends a frame time to the index. 0 or -1 (out of memory). */
+static int push_time(struct series* s, double time)
+{
+    if (s->n == s->cap) {
+        size_t cap = s->cap ? 2 * s->cap : 64;
+        double* t = realloc(s->times, cap * sizeof *t);
+        if (!t)
+            return -1;
+        s->times = t;
+        s->cap = cap;
+    }
+    s->times[s->n++] = time;
+    return 0;
+}
+
+/* Writes frame n at the current state and appends it to the index. WETDEM status. */
+static int series_add(struct series* s, struct wetdem_sim* sim, unsigned long long step)
+{
+    char path[PATH_CHARS + CLI_VALUE_MAX + 40], name[CLI_VALUE_MAX + 40];
+    frame_name(s, s->n, name, sizeof name);
+    snprintf(path, sizeof path, "%s/%s", s->dir, name);
+    int st = wetdem_sim_write_vtk(sim, path, s->binary);
+    if (st != WETDEM_OK)
+        return st;
+    if (push_time(s, wetdem_sim_time(sim)) != 0)
+        return WETDEM_ERR_NOMEM;
+    s->last_step = step;
+    return series_write(s) == 0 ? WETDEM_OK : WETDEM_ERR_IO;
+}
+
+/* On restart: the frames of the existing index up to time t (entries in order, named as this
+ * run names them); the rest are dropped and will be written again. */
+static void series_resume(struct series* s, double t, unsigned long long step, double dt)
+{
+    char path[PATH_CHARS + CLI_VALUE_MAX + 40];
+    snprintf(path, sizeof path, "%s/%s.vtk.series", s->dir, s->prefix);
+    FILE* f = fopen(path, "r");
+    char line[1024];
+    while (f && fgets(line, sizeof line, f)) {
+        char name[CLI_VALUE_MAX + 40], want[CLI_VALUE_MAX + 40];
+        double time;
+        const char* p = strstr(line, "\"name\" : \"");
+        const char* q = p ? strstr(line, "\"time\" : ") : NULL;
+        if (!q || sscanf(p + 10, "%290[^\"]", name) != 1 || sscanf(q + 9, "%lf", &time) != 1)
+            continue;
+        frame_name(s, s->n, want, sizeof want);
+        if (strcmp(name, want) != 0 || !(time <= t) || push_time(s, time) != 0)
+            break;
+    }
+    if (f)
+        fclose(f);
+    /* the step of the last kept frame, from its time on the grid t = k dt */
+    s->last_step = s->n ? step - (unsigned long long)llround((t - s->times[s->n - 1]) / dt) : 0;
+}
+
+/* ------------------------------------------------------------------ CSV on restart --- */
+
+/* Keeps the comment and header lines of the CSV and the rows up to `step` (second column),
+ * rewriting the file atomically when rows are dropped. CLI exit code; a missing file is an
+ * input error (the rows before the checkpoint would be lost). */
+static int csv_resume(const char* path, unsigned long long step, const char* out_dir)
+{
+    FILE* f = fopen(path, "r");
+    if (!f) {
+        cli_error("--restart: %s is missing: give --out the directory of the interrupted run, "
+                  "whose outputs the resumed run continues (now %s)",
+                  path, out_dir);
+        return CLI_EXIT_USAGE;
+    }
+    char tmp[PATH_CHARS + 16];
+    snprintf(tmp, sizeof tmp, "%s.tmp", path);
+    FILE* g = fopen(tmp, "w");
+    char line[4096];
+    bool dropped = false;
+    while (g && fgets(line, sizeof line, f)) {
+        const char* comma = strchr(line, ',');
+        bool data = line[0] >= '0' && line[0] <= '9' && comma;
+        if (data && strtoull(comma + 1, NULL, 10) > step) {
+            dropped = true;
+            continue;
+        }
+        fputs(line, g);
+    }
+    fclose(f);
+    bool ok = g && !ferror(g);
+    ok = g && fclose(g) == 0 && ok;
+    if (ok && (!dropped || rename(tmp, path) == 0)) {
+        remove(tmp);
+        return CLI_EXIT_OK;
+    }
+    remove(tmp);
+    cli_error("--restart: cannot rewrite %s", path);
+    return CLI_EXIT_RUNTIME;
+}
+
+/* ----------------------------------------------------------------------- progress --- */
+
+struct progress {
+    struct wetdem_sim* sim;
+    struct series* vtk;              /* NULL: no frames */
+    unsigned long long vtk_every;
+    unsigned long long base_step;    /* step count when this integrate call began */
+    unsigned long long run_total;    /* steps of the whole run */
+    bool tty;
+    double last_print;               /* [s] of wall time */
+    int status;                      /* first failure writing a frame */
+};
+
+static void print_progress(struct progress* p, unsigned long long done, unsigned long long total,
+                           double elapsed)
+{
+    if (!(elapsed - p->last_print >= 0.5 || done == total) || done == 0)
+        return;
+    p->last_print = elapsed;
+    double left = elapsed * (double)(total - done) / (double)done;
+    unsigned long long step = p->base_step + done;
+    fprintf(stderr, "\rwetdem: step %llu/%llu (%5.1f %%), t = %.4g s, %.0f s elapsed, about "
+                    "%.0f s left   ",
+            step, p->run_total, 100.0 * (double)step / (double)p->run_total,
+            wetdem_sim_time(p->sim), elapsed, ceil(left));
+    if (done == total)
+        fprintf(stderr, "\r%110s\r", "");
+    fflush(stderr);
+}
+
+/* Library progress callback, after every step: VTK frames that are due, progress text. */
+static int on_progress(unsigned long long done, unsigned long long total, double elapsed,
+                       void* ctx)
+{
+    struct progress* p = ctx;
+    unsigned long long step = p->base_step + done;
+    if (p->vtk && p->vtk_every && step % p->vtk_every == 0) {
+        int st = series_add(p->vtk, p->sim, step);
+        if (st != WETDEM_OK) {
+            p->status = st;
+            return 1; /* stops the run (a checkpoint is written) */
+        }
+    }
+    if (p->tty)
+        print_progress(p, done, total, elapsed);
+    return 0;
+}
+
+/* ------------------------------------------------------------------------ summary --- */
+
+struct outcome {
+    struct wetdem_many_stats stats;
+    struct wetdem_energy_budget budget;
+    bool has_budget;
+    double wall;       /* [s] */
+    bool interrupted;
+};
+
+static void summary_text(FILE* f, const struct cli_many_setup* su, const struct outcome* o)
+{
+    const struct wetdem_many_stats* s = &o->stats;
+    fprintf(f, "particles          %zu  (walls %zu)\n", wetdem_sim_n_particles(su->sim),
+            wetdem_sim_n_walls(su->sim));
+    fprintf(f, "time               %.6g s  (step %llu, dt = %.4g s, %.3g s wall, %d threads)\n",
+            wetdem_sim_time(su->sim), s->step, s->dt, o->wall, omp_get_max_threads());
+    fprintf(f, "contacts           %zu\nliquid bridges     %zu\n", s->contacts, s->bridges);
+    fprintf(f, "agglomerates       %zu  (mean size %.3g)\n", s->agglomerates, s->mean_agglomerate);
+    if (!o->has_budget)
+        return;
+    const struct wetdem_energy_budget* b = &o->budget;
+    fprintf(f, "energy budget [J]  input = kinetic + potential + elastic + dissipated\n");
+    fprintf(f, "  input            %12.6g  (kinetic + potential + elastic at the start)\n",
+            b->input);
+    fprintf(f, "  kinetic          %12.6g\n  potential        %12.6g\n  elastic          "
+               "%12.6g\n  dissipated       %12.6g\n",
+            b->kinetic, b->potential, b->elastic, b->dissipated);
+    fprintf(f, "work by model [J]  %12s %12s %12s  (< 0: taken from the particles)\n",
+            "pairs", "walls", "total");
+    for (size_t k = 0; k < b->n_models && k < WETDEM_ENERGY_MAX_MODELS; k++)
+        fprintf(f, "  %-16s %12.6g %12.6g %12.6g\n", wetdem_sim_model(su->sim, k)->name,
+                b->work_pair[k], b->work_wall[k], b->work_pair[k] + b->work_wall[k]);
+    fprintf(f, "  %-16s %12s %12s %12.6g\n", "all", "", "", b->work_total);
+    double scale = fmax(fabs(b->input), fabs(b->work_total));
+    fprintf(f, "closure error      %12.6g  (change of kinetic + potential minus the work; "
+               "%.2g of the larger of input and work)\n",
+            b->balance_error, scale > 0 ? fabs(b->balance_error) / scale : 0.0);
+}
+
+static void json_num(FILE* f, const char* key, double v, bool comma)
+{
+    fprintf(f, "\"%s\": ", key);
+    if (isfinite(v))
+        fprintf(f, "%.17g", v);
+    else
+        fputs("null", f);
+    if (comma)
+        fputs(", ", f);
+}
+
+static void summary_json(FILE* f, const struct cli_scenario* sc, const struct cli_many_setup* su,
+                         const struct outcome* o)
+{
+    const struct wetdem_many_stats* s = &o->stats;
+    fprintf(f, "{\"engine\": \"many\", \"version\": \"%s\", \"git\": \"%s\", \"scenario\": ",
+            WETDEM_VERSION, WETDEM_GIT_HASH);
+    cli_json_string(f, sc->file);
+    fprintf(f, ", \"interrupted\": %s, \"particles\": %zu, \"walls\": %zu, \"step\": %llu, ",
+            o->interrupted ? "true" : "false", wetdem_sim_n_particles(su->sim),
+            wetdem_sim_n_walls(su->sim), s->step);
+    json_num(f, "time_s", wetdem_sim_time(su->sim), true);
+    json_num(f, "dt_s", s->dt, true);
+    fprintf(f, "\"contacts\": %zu, \"bridges\": %zu, \"agglomerates\": %zu, ", s->contacts,
+            s->bridges, s->agglomerates);
+    json_num(f, "mean_agglomerate_size", s->mean_agglomerate, !o->has_budget);
+    if (o->has_budget) {
+        const struct wetdem_energy_budget* b = &o->budget;
+        fputs("\"energy_J\": {", f);
+        json_num(f, "input", b->input, true);
+        json_num(f, "kinetic", b->kinetic, true);
+        json_num(f, "potential", b->potential, true);
+        json_num(f, "elastic", b->elastic, true);
+        json_num(f, "dissipated", b->dissipated, true);
+        json_num(f, "work_total", b->work_total, true);
+        json_num(f, "balance_error", b->balance_error, true);
+        fputs("\"work_by_model\": [", f);
+        for (size_t k = 0; k < b->n_models && k < WETDEM_ENERGY_MAX_MODELS; k++) {
+            fprintf(f, "%s{\"model\": \"%s\", ", k ? ", " : "", wetdem_sim_model(su->sim, k)->name);
+            json_num(f, "pairs", b->work_pair[k], true);
+            json_num(f, "walls", b->work_wall[k], false);
+            fputs("}", f);
+        }
+        fputs("]}", f);
+    }
+    fputs("}\n", f);
+}
+
+/* Writes DIR/summary.json atomically. CLI exit code. */
+static int write_summary(const char* dir, const struct cli_scenario* sc,
+                         const struct cli_many_setup* su, const struct outcome* o)
+{
+    if (!dir || !su->summary_name[0])
+        return CLI_EXIT_OK;
+    char path[PATH_CHARS + CLI_VALUE_MAX], tmp[sizeof path + 8];
+    snprintf(path, sizeof path, "%s/%s", dir, su->summary_name);
+    snprintf(tmp, sizeof tmp, "%s.tmp", path);
+    FILE* f = fopen(tmp, "w");
+    if (f)
+        summary_json(f, sc, su, o);
+    bool ok = f && !ferror(f);
+    ok = f && fclose(f) == 0 && ok;
+    if (ok && rename(tmp, path) == 0)
+        return CLI_EXIT_OK;
+    remove(tmp);
+    cli_error("run: cannot write %s", path);
+    return CLI_EXIT_RUNTIME;
+}
+
+/* Prints the command that resumes an interrupted run: the original arguments with
+ * --restart CHECKPOINT (replacing an earlier --restart). */
+static void print_resume(const struct cli_run_options* opt, const char* ckpt)
+{
+    fprintf(stderr, "wetdem: resume with: wetdem");
+    for (int k = 0; k < opt->argc; k++) {
+        if (strcmp(opt->argv[k], "--restart") == 0 && k + 1 < opt->argc) {
+            k++;
+            continue;
+        }
+        bool quote = strpbrk(opt->argv[k], " \t'\"$;&|<>()*?") != NULL;
+        fprintf(stderr, quote ? " '%s'" : " %s", opt->argv[k]);
+    }
+    fprintf(stderr, " --restart %s\n", ckpt);
+}
+
+/* ------------------------------------------------------------------------ the run --- */
+
+/* Everything resolved before any file is touched. */
+struct plan {
+    double t_end;                /* [s] */
+    unsigned long long total;    /* steps of the whole run */
+    double dt;                   /* [s] */
+    char csv_prefix[PATH_CHARS]; /* DIR/<csv name without .csv>, "" for none */
+    char checkpoint[PATH_CHARS]; /* DIR/<checkpoint>, "" for none */
+};
+
+/* Starts the run once without outputs: every library check of the set-up (time step, cell
+ * lists, periodic box, reach). Fills the run length and the default output intervals. */
+static int dry_start(const struct cli_scenario* sc, struct cli_many_setup* su, struct plan* pl)
+{
+    if (wetdem_sim_integrate(su->sim, wetdem_sim_time(su->sim)) != WETDEM_OK)
+        return cli_many_report_start(sc, wetdem_sim_errmsg(su->sim));
+    struct wetdem_many_stats s;
+    wetdem_sim_many_stats(su->sim, &s);
+    pl->dt = s.dt;
+    /* the library takes ceil((t_end - t)/dt) steps on the grid t = k dt */
+    pl->t_end = su->steps ? (double)su->steps * s.dt : su->t_end;
+    double span = pl->t_end / s.dt;
+    pl->total = su->steps ? su->steps : (unsigned long long)ceil(span - 1e-9);
+    if (!su->vtk_every_given)
+        su->vtk_every = pl->total / 50 > 0 ? pl->total / 50 : 1;
+    if (!su->csv_every_given)
+        su->csv_every = pl->total / 500 > 0 ? pl->total / 500 : 1;
+    return CLI_EXIT_OK;
+}
+
+static void print_check(const struct cli_scenario* sc, const struct cli_many_setup* su,
+                        const struct plan* pl)
+{
+    struct wetdem_many_stats s;
+    wetdem_sim_many_stats(su->sim, &s);
+    printf("scenario %s is valid (many-particle run)\n", sc->file);
+    printf("  particles     %zu\n  walls         %zu\n  box           %g x %g x %g m, periodic "
+           "%s%s%s%s\n",
+           wetdem_sim_n_particles(su->sim), wetdem_sim_n_walls(su->sim), su->box[0], su->box[1],
+           su->box[2], su->many.periodic[0] ? "x" : "", su->many.periodic[1] ? "y" : "",
+           su->many.periodic[2] ? "z" : "",
+           su->many.periodic[0] || su->many.periodic[1] || su->many.periodic[2] ? "" : "none");
+    printf("  dt            %.6g s\n  t_end         %.6g s\n  steps         %llu\n", pl->dt,
+           pl->t_end, pl->total);
+    printf("  vtk_every     %llu\n  csv_every     %llu\n  contacts      %zu  (bridges %zu) at "
+           "t = 0\n  models       ",
+           su->vtk_every, su->csv_every, s.contacts, s.bridges);
+    for (size_t k = 0; k < wetdem_sim_n_models(su->sim); k++)
+        printf(" %s", wetdem_sim_model(su->sim, k)->name);
+    printf("\n");
+}
+
+/* Sets the mode again with the outputs of --out DIR and the stop flag. */
+static int set_outputs(struct cli_many_setup* su, const struct cli_run_options* opt,
+                       struct plan* pl, struct progress* prog)
+{
+    struct wetdem_many_settings m = su->many;
+    pl->csv_prefix[0] = pl->checkpoint[0] = '\0';
+    if (opt->out_dir && su->csv_name[0] && su->csv_every)
+        snprintf(pl->csv_prefix, sizeof pl->csv_prefix, "%s/%.*s", opt->out_dir,
+                 (int)strlen(su->csv_name) - 4, su->csv_name);
+    if (opt->out_dir && su->checkpoint_name[0])
+        snprintf(pl->checkpoint, sizeof pl->checkpoint, "%s/%s", opt->out_dir,
+                 su->checkpoint_name);
+    m.output_prefix = pl->csv_prefix[0] ? pl->csv_prefix : NULL;
+    m.csv_every = su->csv_every;
+    m.vtk_every = 0; /* frames are written by on_progress */
+    m.checkpoint_path = pl->checkpoint[0] ? pl->checkpoint : NULL;
+    m.checkpoint_every = su->checkpoint_every;
+    m.stop_flag = &stop_signal;
+    m.progress = on_progress;
+    m.progress_ctx = prog;
+    m.progress_every = 1;
+    return wetdem_sim_set_many(su->sim, &m) == WETDEM_OK ? CLI_EXIT_OK : CLI_EXIT_RUNTIME;
+}
+
+/* Restores the checkpoint and trims the outputs after it. */
+static int resume(const struct cli_many_setup* su, const struct cli_run_options* opt,
+                  const struct plan* pl, struct series* vtk)
+{
+    if (wetdem_sim_read_checkpoint(su->sim, opt->restart) != WETDEM_OK) {
+        cli_error("--restart %s: %s", opt->restart, wetdem_sim_errmsg(su->sim));
+        return CLI_EXIT_USAGE;
+    }
+    struct wetdem_many_stats s;
+    wetdem_sim_many_stats(su->sim, &s);
+    if (pl->csv_prefix[0]) {
+        char path[PATH_CHARS + 8];
+        snprintf(path, sizeof path, "%s.csv", pl->csv_prefix);
+        int rc = csv_resume(path, s.step, opt->out_dir);
+        if (rc != CLI_EXIT_OK)
+            return rc;
+    }
+    if (vtk)
+        series_resume(vtk, wetdem_sim_time(su->sim), s.step, pl->dt);
+    return CLI_EXIT_OK;
+}
+
+/* The stepping, between signal handlers. Returns the library status. */
+static int integrate_with_signals(struct wetdem_sim* sim, double t_end)
+{
+    struct sigaction sa = {.sa_handler = on_signal, .sa_flags = SA_RESETHAND}, old_int, old_term;
+    sigemptyset(&sa.sa_mask);
+    stop_signal = 0;
+    sigaction(SIGINT, &sa, &old_int);
+    sigaction(SIGTERM, &sa, &old_term);
+    int st = wetdem_sim_integrate(sim, t_end);
+    sigaction(SIGINT, &old_int, NULL);
+    sigaction(SIGTERM, &old_term, NULL);
+    return st;
+}
+
+/* After the stepping: interrupted, failed or done (last frame, final checkpoint, summary). */
+static int finish(const struct cli_scenario* sc, struct cli_many_setup* su,
+                  const struct cli_run_options* opt, const struct plan* pl,
+                  struct progress* prog, int st, double wall)
+{
+    struct outcome o = {.wall = wall, .interrupted = st == WETDEM_EVENT};
+    wetdem_sim_many_stats(su->sim, &o.stats);
+    o.has_budget = wetdem_sim_energy_budget(su->sim, &o.budget) == WETDEM_OK;
+    if (prog->status != WETDEM_OK) {
+        cli_error("run %s: writing a VTK frame: %s", sc->file, wetdem_sim_errmsg(su->sim));
+        return CLI_EXIT_RUNTIME;
+    }
+    if (st < 0) {
+        cli_error("run %s: %s (%s)", sc->file, wetdem_sim_errmsg(su->sim), wetdem_status_name(st));
+        return CLI_EXIT_RUNTIME;
+    }
+    if (st == WETDEM_EVENT) {
+        int sig = stop_signal ? (int)stop_signal : SIGINT;
+        fprintf(stderr, "%swetdem: interrupted by %s at t = %.9g s (step %llu of %llu)",
+                prog->tty ? "\n" : "", sig == SIGTERM ? "SIGTERM" : "SIGINT",
+                wetdem_sim_time(su->sim), o.stats.step, pl->total);
+        if (!pl->checkpoint[0]) {
+            fprintf(stderr, "; no checkpoint (run with --out DIR to keep one)\n");
+            return 128 + sig;
+        }
+        fprintf(stderr, "; checkpoint %s written\n", pl->checkpoint);
+        write_summary(opt->out_dir, sc, su, &o);
+        print_resume(opt, pl->checkpoint);
+        return 128 + sig;
+    }
+    if (prog->vtk && (prog->vtk->n == 0 || prog->vtk->last_step != o.stats.step) &&
+        series_add(prog->vtk, su->sim, o.stats.step) != WETDEM_OK) {
+        cli_error("run %s: writing the last VTK frame: %s", sc->file, wetdem_sim_errmsg(su->sim));
+        return CLI_EXIT_RUNTIME;
+    }
+    if (pl->checkpoint[0] && wetdem_sim_write_checkpoint(su->sim, pl->checkpoint) != WETDEM_OK) {
+        cli_error("run %s: %s", sc->file, wetdem_sim_errmsg(su->sim));
+        return CLI_EXIT_RUNTIME;
+    }
+    int rc = write_summary(opt->out_dir, sc, su, &o);
+    if (opt->json)
+        summary_json(stdout, sc, su, &o);
+    else
+        summary_text(stdout, su, &o);
+    if (opt->out_dir && !opt->json && rc == CLI_EXIT_OK)
+        printf("files in %s/\n", opt->out_dir);
+    return rc;
+}
+
+/* Fresh start or restart, first frame, the stepping and the end. */
+static int run(const struct cli_scenario* sc, struct cli_many_setup* su,
+               const struct cli_run_options* opt, struct plan* pl, struct series* vtk)
+{
+    struct progress prog = {.sim = su->sim, .vtk = vtk, .vtk_every = su->vtk_every,
+                            .run_total = pl->total, .tty = isatty(STDERR_FILENO) == 1};
+    int rc = set_outputs(su, opt, pl, &prog);
+    if (rc == CLI_EXIT_OK && opt->restart)
+        rc = resume(su, opt, pl, vtk);
+    if (rc != CLI_EXIT_OK)
+        return rc;
+    if (opt->out_dir && cli_make_dirs(opt->out_dir) != 0) {
+        cli_error("run: cannot create directory %s: %s", opt->out_dir, strerror(errno));
+        return CLI_EXIT_RUNTIME;
+    }
+    double t0 = omp_get_wtime();
+    int st = opt->restart ? WETDEM_OK : wetdem_sim_integrate(su->sim, wetdem_sim_time(su->sim));
+    struct wetdem_many_stats s;
+    wetdem_sim_many_stats(su->sim, &s);
+    prog.base_step = s.step;
+    bool frame_due = vtk && su->vtk_every && s.step % su->vtk_every == 0 &&
+                     !(vtk->n > 0 && vtk->last_step == s.step);
+    if (st == WETDEM_OK && frame_due && series_add(vtk, su->sim, s.step) != WETDEM_OK)
+        prog.status = WETDEM_ERR_IO;
+    if (st == WETDEM_OK && prog.status == WETDEM_OK)
+        st = integrate_with_signals(su->sim, pl->t_end);
+    return finish(sc, su, opt, pl, &prog, st, omp_get_wtime() - t0);
+}
+
+int cli_run_many(const struct cli_scenario* sc, const struct cli_run_options* opt)
+{
+    if (opt->sweep_row) {
+        cli_error("%s: many-particle scenarios run with 'wetdem run', not sweeps", sc->file);
+        return CLI_EXIT_USAGE;
+    }
+    struct cli_many_setup su;
+    int rc = cli_many_build(sc, &su);
+    if (rc != CLI_EXIT_OK)
+        return rc;
+    struct plan pl = {0};
+    rc = dry_start(sc, &su, &pl);
+    if (rc == CLI_EXIT_OK && opt->check) {
+        print_check(sc, &su, &pl);
+    } else if (rc == CLI_EXIT_OK) {
+        struct series vtk = {.binary = su.vtk_binary};
+        bool has_vtk = opt->out_dir && su.vtk_prefix[0] && su.vtk_every;
+        snprintf(vtk.dir, sizeof vtk.dir, "%s", opt->out_dir ? opt->out_dir : "");
+        snprintf(vtk.prefix, sizeof vtk.prefix, "%s", su.vtk_prefix);
+        rc = run(sc, &su, opt, &pl, has_vtk ? &vtk : NULL);
+        free(vtk.times);
+    }
+    cli_many_setup_free(&su);
+    return rc;
+}

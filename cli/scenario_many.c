@@ -1,0 +1,724 @@
+/*
+ * scenario_many.c — the sections of many-particle scenarios (cli_many_sections: [box],
+ * [walls], [insert], [insert.NAME], [particle.NAME], [run], [dump]) and building a
+ * simulation from them together with the shared [fluid], [material.NAME], [models],
+ * [model.NAME], [integrator] and [sim] sections. docs/many.md ("From the command line") and
+ * the generated tables of docs/scenarios.md describe every key.
+ *
+ * Geometry: the box is [0, size_x] x [0, size_y] x [0, size_z] [m]. A periodic axis wraps
+ * (minimum image); on the other axes [walls] puts plane walls on the faces (by default on
+ * every face of a non-periodic axis), with normals into the box. A wall on a periodic axis
+ * would cut the periodic images and is refused. Insertion groups ([insert], [insert.NAME])
+ * and single spheres ([particle.NAME]) are added in file order; each group is free of
+ * overlaps by construction (src/insert.c) and the groups are checked against each other here
+ * (|x_i - x_j| >= R_i + R_j with the minimum image on periodic axes), as is every centre being
+ * inside the box and every sphere inside the walls.
+ *
+ * Every check runs before anything is written; each failure names the file, the line and the
+ * key (scenario.h error convention).
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cli_util.h"
+#include "scenario_many.h"
+
+#define NUM(k, u, dflt, lo, hi, lo_open, hi_open, doc)                                            \
+    {k, CLI_VALUE_NUMBER, u, dflt, lo, hi, lo_open, hi_open, NULL, doc}
+#define WORD(k, kind, dflt, choices, doc) {k, kind, "", dflt, 0, 0, false, false, choices, doc}
+#define MAX_MATERIALS 32
+
+static const char* const yes_no[] = {"no", "yes", NULL};
+static const char* const layouts[] = {"lattice", "random", NULL};
+static const char* const face_names[] = {"x_min", "x_max", "y_min", "y_max", "z_min", "z_max",
+                                         NULL};
+
+static const struct cli_key_desc box_keys[] = {
+    NUM("size_x", "m", "required", 0, 1e3, true, false, "Edge of the box along x: [0, size_x]."),
+    NUM("size_y", "m", "required", 0, 1e3, true, false, "Edge of the box along y: [0, size_y]."),
+    NUM("size_z", "m", "required", 0, 1e3, true, false, "Edge of the box along z: [0, size_z]."),
+    WORD("periodic", CLI_VALUE_NAME_LIST, "none", NULL,
+         "Periodic axes: any of x, y, z (e.g. 'x y'), or none. A periodic edge must be at least "
+         "twice the cell edge 2 R_max + reach + skin."),
+    {0},
+};
+
+static const struct cli_key_desc walls_keys[] = {
+    WORD("faces", CLI_VALUE_NAME_LIST, "all", NULL,
+         "Plane walls on faces of the box, normals inwards: any of x_min, x_max, y_min, y_max, "
+         "z_min, z_max; all (every face of a non-periodic axis) or none. A face of a periodic "
+         "axis is an error."),
+    WORD("material", CLI_VALUE_NAME, "material of the first sphere group", NULL,
+         "Material of the walls: a preset or NAME of a [material.NAME] section."),
+    {0},
+};
+
+static const struct cli_key_desc insert_keys[] = {
+    WORD("layout", CLI_VALUE_CHOICE, "random", layouts,
+         "lattice: simple cubic lattice of spacing 2 radius_max + gap, bottom layers first; "
+         "random: random sequential addition without overlap (jams near a volume fraction of "
+         "0.38)."),
+    NUM("count", "-", "required", 1, 1e8, false, false, "Number of spheres."),
+    NUM("radius", "m", "required unless radius_min/max", 0, 1, true, false,
+        "Radius of equal spheres."),
+    NUM("radius_min", "m", "none", 0, 1, true, false,
+        "Polydisperse: radii uniform in [radius_min, radius_max] (give both, not radius)."),
+    NUM("radius_max", "m", "none", 0, 1, true, false, "Polydisperse: largest radius."),
+    NUM("gap", "m", "0", 0, 1, false, false,
+        "Least surface gap between spheres and to the region's faces."),
+    NUM("seed", "-", "1", 0, 4294967295.0, false, false,
+        "Seed of the generator (mt19937): the same seed gives the same spheres."),
+    WORD("material", CLI_VALUE_NAME, "steel1", NULL,
+         "Material: a preset (steel1, steel2, glass, delrin, punch_steel, punch_steel_coated) "
+         "or NAME of a [material.NAME] section."),
+    NUM("velocity_x", "m/s", "0", -1e3, 1e3, false, false, "Mean initial velocity, x."),
+    NUM("velocity_y", "m/s", "0", -1e3, 1e3, false, false, "Mean initial velocity, y."),
+    NUM("velocity_z", "m/s", "0", -1e3, 1e3, false, false, "Mean initial velocity, z."),
+    NUM("velocity_sigma", "m/s", "0", 0, 1e3, false, false,
+        "Standard deviation of each velocity component (Gaussian)."),
+    NUM("x_min", "m", "0", -1e3, 1e3, false, false, "Insertion region: lower x (box by default)."),
+    NUM("x_max", "m", "size_x", -1e3, 1e3, false, false, "Insertion region: upper x."),
+    NUM("y_min", "m", "0", -1e3, 1e3, false, false, "Insertion region: lower y."),
+    NUM("y_max", "m", "size_y", -1e3, 1e3, false, false, "Insertion region: upper y."),
+    NUM("z_min", "m", "0", -1e3, 1e3, false, false, "Insertion region: lower z."),
+    NUM("z_max", "m", "size_z", -1e3, 1e3, false, false, "Insertion region: upper z."),
+    {0},
+};
+
+static const struct cli_key_desc particle_keys[] = {
+    NUM("radius", "m", "required", 0, 1, true, false, "Radius."),
+    NUM("x", "m", "required", -1e3, 1e3, false, false, "Centre, x (inside the box)."),
+    NUM("y", "m", "required", -1e3, 1e3, false, false, "Centre, y."),
+    NUM("z", "m", "required", -1e3, 1e3, false, false, "Centre, z."),
+    NUM("vx", "m/s", "0", -1e3, 1e3, false, false, "Velocity, x."),
+    NUM("vy", "m/s", "0", -1e3, 1e3, false, false, "Velocity, y."),
+    NUM("vz", "m/s", "0", -1e3, 1e3, false, false, "Velocity, z."),
+    NUM("spin_x", "rad/s", "0", -1e6, 1e6, false, false, "Spin, x."),
+    NUM("spin_y", "rad/s", "0", -1e6, 1e6, false, false, "Spin, y."),
+    NUM("spin_z", "rad/s", "0", -1e6, 1e6, false, false, "Spin, z."),
+    WORD("material", CLI_VALUE_NAME, "steel1", NULL, "Material, as in [insert]."),
+    WORD("fixed", CLI_VALUE_CHOICE, "no", yes_no, "yes: held in place (infinite mass)."),
+    {0},
+};
+
+static const struct cli_key_desc run_keys[] = {
+    NUM("t_end", "s", "give t_end or steps", 0, 1e6, true, false, "Simulated time of the run."),
+    NUM("steps", "-", "give t_end or steps", 1, 1e15, false, false, "Number of time steps."),
+    NUM("dt", "s", "0 ([integrator] dt, else dt_fraction)", 0, 1, false, false,
+        "Time step; 0: [integrator] dt, else dt_fraction x the Hertz contact time of the two "
+        "smallest spheres at twice the largest speed plus the speed gravity adds over the "
+        "packing height. Fixed for the run."),
+    NUM("skin", "m", "0 (0.1 x smallest radius)", 0, 1, false, false,
+        "Verlet skin of the neighbour lists."),
+    WORD("energy_budget", CLI_VALUE_CHOICE, "yes", yes_no,
+         "Accumulate the work of every model on particle pairs and walls (about 10 % slower)."),
+    {0},
+};
+
+static const struct cli_key_desc dump_keys[] = {
+    WORD("vtk", CLI_VALUE_TEXT, "particles", NULL,
+         "Prefix of the VTK files PREFIX_NNNNNN.vtk and of the ParaView index PREFIX.vtk.series "
+         "in --out DIR; none disables them."),
+    NUM("vtk_every", "-", "run steps / 50", 0, 1e15, false, false,
+        "Steps between VTK frames (the last step is always written); 0: none."),
+    WORD("vtk_binary", CLI_VALUE_CHOICE, "yes", yes_no,
+         "yes: binary legacy VTK (exact, compact); no: ASCII with 17 digits."),
+    WORD("csv", CLI_VALUE_TEXT, "global.csv", NULL,
+         "CSV of global quantities (energies, contacts, liquid bridges, agglomerates, work per "
+         "model) in --out DIR, ending in .csv; none disables it."),
+    NUM("csv_every", "-", "run steps / 500", 0, 1e15, false, false,
+        "Steps between CSV rows; 0: none."),
+    WORD("checkpoint", CLI_VALUE_TEXT, "checkpoint.ckpt", NULL,
+         "Checkpoint in --out DIR, written atomically every checkpoint_every steps, when "
+         "interrupted (SIGINT, SIGTERM) and at the end; none disables it."),
+    NUM("checkpoint_every", "-", "0 (interruption and end only)", 0, 1e15, false, false,
+        "Steps between periodic checkpoints."),
+    WORD("summary", CLI_VALUE_TEXT, "summary.json", NULL,
+         "Summary and energy budget (JSON) in --out DIR; none disables it."),
+    {0},
+};
+
+const struct cli_section_desc cli_many_sections[] = {
+    {"box", "Many-particle run: the box [0, size] on each axis and its periodic axes.",
+     box_keys},
+    {"walls", "Many-particle run: plane walls on faces of the box.", walls_keys},
+    {"insert", "Many-particle run: spheres inserted on a lattice or at random (seeded).",
+     insert_keys},
+    {"insert.*",
+     "Many-particle run: another insertion group NAME with the keys of [insert]; groups and "
+     "particles are added in file order and must not overlap.",
+     insert_keys},
+    {"particle.*", "Many-particle run: one sphere NAME placed explicitly.", particle_keys},
+    {"run", "Many-particle run: length, time step, neighbour-list skin, energy budget.",
+     run_keys},
+    {"dump", "Many-particle run: files written in `wetdem run --out DIR`.", dump_keys},
+    {0},
+};
+
+/* Whether a section name belongs to the many-particle sections. */
+static bool is_many_section(const char* name)
+{
+    for (size_t k = 0; cli_many_sections[k].name; k++) {
+        const char* s = cli_many_sections[k].name;
+        const char* star = strstr(s, ".*");
+        if (star ? strncmp(name, s, (size_t)(star - s) + 1) == 0 : strcmp(name, s) == 0)
+            return true;
+    }
+    return false;
+}
+
+bool cli_scenario_is_many(const struct cli_scenario* sc)
+{
+    for (size_t k = 0; k < sc->n_sections; k++)
+        if (is_many_section(sc->sections[k].name))
+            return true;
+    for (size_t k = 0; k < sc->n_entries; k++)
+        if (is_many_section(sc->entries[k].section))
+            return true;
+    return false;
+}
+
+/* ------------------------------------------------- fluid, models, integrator, settings --- */
+
+static int lib_error(const struct cli_scenario* sc, const struct cli_entry* e,
+                     const char* section, const struct wetdem_sim* sim)
+{
+    if (e)
+        cli_scenario_error(sc, e, "%s", wetdem_sim_errmsg(sim));
+    else
+        cli_scenario_section_error(sc, section, "%s", wetdem_sim_errmsg(sim));
+    return CLI_EXIT_USAGE;
+}
+
+static int build_fluid(const struct cli_scenario* sc, struct wetdem_sim* sim)
+{
+    struct wetdem_fluid f;
+    wetdem_fluid_preset(cli_scenario_text(sc, "fluid", "preset", "water"), &f); /* checked */
+    for (const struct wetdem_param_desc* d = wetdem_fluid_params(); d->name; d++)
+        *(double*)((char*)&f + d->offset) =
+            cli_scenario_number(sc, "fluid", d->name, *(double*)((char*)&f + d->offset));
+    return wetdem_sim_set_fluid(sim, &f) == WETDEM_OK ? CLI_EXIT_OK
+                                                      : lib_error(sc, NULL, "fluid", sim);
+}
+
+static int build_models(const struct cli_scenario* sc, struct wetdem_sim* sim)
+{
+    wetdem_sim_clear_models(sim);
+    const struct cli_entry* e = cli_scenario_find(sc, "models", "force");
+    char buf[CLI_VALUE_MAX];
+    snprintf(buf, sizeof buf, "%s", e ? e->value : "hertz");
+    for (char* tok = strtok(buf, " ,\t"); tok; tok = strtok(NULL, " ,\t")) {
+        const struct wetdem_model* m = wetdem_model_find(tok);
+        if (m && m->kind != WETDEM_MODEL_CONTACT && m->kind != WETDEM_MODEL_FLUID) {
+            cli_scenario_error(sc, e, "'%s' is a %s model: the many-particle mode sums force "
+                                      "models (contact and fluid) only",
+                               tok, wetdem_model_kind_name(m->kind));
+            return CLI_EXIT_USAGE;
+        }
+        if (wetdem_sim_enable_model(sim, tok) != WETDEM_OK)
+            return lib_error(sc, e, "models", sim);
+    }
+    const struct cli_entry* ms = cli_scenario_find(sc, "models", "min_separation");
+    if (ms && wetdem_sim_enable_model(sim, ms->value) != WETDEM_OK)
+        return lib_error(sc, ms, "models", sim);
+    for (size_t k = 0; k < sc->n_entries; k++) {
+        const struct cli_entry* p = &sc->entries[k];
+        if (strncmp(p->section, "model.", 6) != 0)
+            continue;
+        char name[2 * CLI_NAME_MAX];
+        snprintf(name, sizeof name, "%s.%s", p->section + 6, p->key);
+        double v;
+        if (wetdem_sim_param(sim, name, &v) != WETDEM_OK) {
+            cli_scenario_error(sc, p, "model '%s' is not enabled by [models] force or "
+                                      "min_separation, so it has no parameters to set",
+                               p->section + 6);
+            return CLI_EXIT_USAGE;
+        }
+        if (wetdem_sim_set_param_str(sim, name, p->value) != WETDEM_OK)
+            return lib_error(sc, p, p->section, sim);
+    }
+    return CLI_EXIT_OK;
+}
+
+/* [integrator] (the many mode steps with velocity Verlet: verlet.dt and verlet.dt_fraction
+ * choose the step) and [sim] settings (gravity). */
+static int build_settings(const struct cli_scenario* sc, struct wetdem_sim* sim)
+{
+    const struct cli_entry* n = cli_scenario_find(sc, "integrator", "name");
+    if (n && strcmp(n->value, "verlet") != 0) {
+        cli_scenario_error(sc, n, "the many-particle mode steps with velocity Verlet: use "
+                                  "name = verlet (or leave it out)");
+        return CLI_EXIT_USAGE;
+    }
+    for (size_t k = 0; k < sc->n_entries; k++) {
+        const struct cli_entry* p = &sc->entries[k];
+        bool integ = strcmp(p->section, "integrator") == 0 && strcmp(p->key, "name") != 0;
+        if (!integ && strcmp(p->section, "sim") != 0)
+            continue;
+        char full[2 * CLI_NAME_MAX];
+        snprintf(full, sizeof full, "%s.%s", integ ? "verlet" : "sim", p->key);
+        if (wetdem_sim_set_param_str(sim, full, p->value) != WETDEM_OK)
+            return lib_error(sc, p, p->section, sim);
+    }
+    return CLI_EXIT_OK;
+}
+
+/* ------------------------------------------------------------------------- materials --- */
+
+struct materials {
+    const char* names[MAX_MATERIALS];
+    int index[MAX_MATERIALS];
+    size_t n;
+};
+
+static int material_from_section(const struct cli_scenario* sc, const char* section,
+                                 struct wetdem_material* m)
+{
+    const struct cli_entry* p = cli_scenario_find(sc, section, "preset");
+    wetdem_param_init_defaults(wetdem_material_params(), m);
+    if (p && wetdem_material_preset(p->value, m) != WETDEM_OK) {
+        const char* hint = wetdem_param_suggest(p->value, wetdem_material_preset_names());
+        cli_scenario_error(sc, p, "unknown material preset%s%s%s", hint ? " (did you mean '" : "",
+                           hint ? hint : "", hint ? "'?)" : "");
+        return CLI_EXIT_USAGE;
+    }
+    for (const struct wetdem_param_desc* d = wetdem_material_params(); d->name; d++)
+        *(double*)((char*)m + d->offset) =
+            cli_scenario_number(sc, section, d->name, *(double*)((char*)m + d->offset));
+    char msg[512];
+    if (wetdem_material_validate(m, msg, sizeof msg) != WETDEM_OK) {
+        cli_scenario_section_error(sc, section, "%s", msg);
+        return CLI_EXIT_USAGE;
+    }
+    return CLI_EXIT_OK;
+}
+
+/* Index of material `name` in sim, added on first use ([material.NAME] first, then a preset).
+ * `use` is the entry naming it (NULL: the default, reported at `section`). */
+static int material_index(const struct cli_scenario* sc, struct wetdem_sim* sim,
+                          struct materials* mt, const char* section, const char* name, int* index)
+{
+    for (size_t k = 0; k < mt->n; k++)
+        if (strcmp(mt->names[k], name) == 0) {
+            *index = mt->index[k];
+            return CLI_EXIT_OK;
+        }
+    const struct cli_entry* use = cli_scenario_find(sc, section, "material");
+    char msec[CLI_NAME_MAX];
+    snprintf(msec, sizeof msec, "material.%s", name);
+    struct wetdem_material m;
+    if (cli_scenario_has_section(sc, msec)) {
+        int rc = material_from_section(sc, msec, &m);
+        if (rc != CLI_EXIT_OK)
+            return rc;
+    } else if (wetdem_material_preset(name, &m) != WETDEM_OK) {
+        const char* hint = wetdem_param_suggest(name, wetdem_material_preset_names());
+        const char* fmt = "unknown material '%s'%s%s%s: use a preset or define a [material.%s] "
+                          "section";
+        if (use)
+            cli_scenario_error(sc, use, fmt, name, hint ? " (did you mean '" : "",
+                               hint ? hint : "", hint ? "'?)" : "", name);
+        else
+            cli_scenario_section_error(sc, section, fmt, name, hint ? " (did you mean '" : "",
+                                       hint ? hint : "", hint ? "'?)" : "", name);
+        return CLI_EXIT_USAGE;
+    }
+    if (mt->n == MAX_MATERIALS) {
+        cli_scenario_section_error(sc, section, "more than %d materials", MAX_MATERIALS);
+        return CLI_EXIT_USAGE;
+    }
+    *index = wetdem_sim_add_material(sim, &m);
+    if (*index < 0)
+        return lib_error(sc, use, section, sim);
+    mt->names[mt->n] = name;
+    mt->index[mt->n++] = *index;
+    return CLI_EXIT_OK;
+}
+
+/* ------------------------------------------------------------------------------- box --- */
+
+static int build_box(const struct cli_scenario* sc, struct cli_many_setup* su)
+{
+    static const char* const size_keys[] = {"size_x", "size_y", "size_z"};
+    for (int k = 0; k < 3; k++) {
+        if (!cli_scenario_find(sc, "box", size_keys[k])) {
+            cli_scenario_section_error(sc, "box", "[box] needs size_x, size_y and size_z [m] "
+                                                  "(the box is [0, size] on each axis)");
+            return CLI_EXIT_USAGE;
+        }
+        su->box[k] = cli_scenario_number(sc, "box", size_keys[k], 0);
+    }
+    su->many.box_lo = (struct wetdem_vec3){0, 0, 0};
+    su->many.box_hi = (struct wetdem_vec3){su->box[0], su->box[1], su->box[2]};
+    const struct cli_entry* e = cli_scenario_find(sc, "box", "periodic");
+    char buf[CLI_VALUE_MAX];
+    snprintf(buf, sizeof buf, "%s", e ? e->value : "none");
+    for (char* tok = strtok(buf, " ,\t"); tok; tok = strtok(NULL, " ,\t")) {
+        if (strcmp(tok, "none") == 0)
+            continue;
+        if (strlen(tok) != 1 || !strchr("xyz", tok[0])) {
+            cli_scenario_error(sc, e, "'%s' is not an axis: list any of x, y, z, or none", tok);
+            return CLI_EXIT_USAGE;
+        }
+        su->many.periodic[tok[0] - 'x'] = true;
+    }
+    return CLI_EXIT_OK;
+}
+
+/* Which faces get walls: bit f (order of face_names) set. */
+static int wall_faces(const struct cli_scenario* sc, const struct cli_many_setup* su,
+                      unsigned* faces)
+{
+    const struct cli_entry* e = cli_scenario_find(sc, "walls", "faces");
+    char buf[CLI_VALUE_MAX];
+    snprintf(buf, sizeof buf, "%s", e ? e->value : "all");
+    *faces = 0;
+    for (char* tok = strtok(buf, " ,\t"); tok; tok = strtok(NULL, " ,\t")) {
+        if (strcmp(tok, "none") == 0)
+            continue;
+        if (strcmp(tok, "all") == 0) {
+            for (int k = 0; k < 3; k++)
+                *faces |= su->many.periodic[k] ? 0u : 3u << (2 * k);
+            continue;
+        }
+        int f = 0;
+        while (face_names[f] && strcmp(face_names[f], tok) != 0)
+            f++;
+        if (!face_names[f]) {
+            const char* hint = wetdem_param_suggest(tok, face_names);
+            cli_scenario_error(sc, e, "'%s' is not a face%s%s%s; faces: x_min, x_max, y_min, "
+                                      "y_max, z_min, z_max, all or none",
+                               tok, hint ? " (did you mean '" : "", hint ? hint : "",
+                               hint ? "'?)" : "");
+            return CLI_EXIT_USAGE;
+        }
+        if (su->many.periodic[f / 2]) {
+            cli_scenario_error(sc, e, "wall %s lies on axis %c, which [box] periodic makes "
+                                      "periodic: remove the wall or the periodic axis",
+                               tok, "xyz"[f / 2]);
+            return CLI_EXIT_USAGE;
+        }
+        *faces |= 1u << f;
+    }
+    return CLI_EXIT_OK;
+}
+
+static int build_walls(const struct cli_scenario* sc, struct cli_many_setup* su,
+                       struct materials* mt, const char* first_material)
+{
+    unsigned faces;
+    int rc = wall_faces(sc, su, &faces);
+    if (rc != CLI_EXIT_OK || !faces)
+        return rc;
+    int mat;
+    const char* name = cli_scenario_text(sc, "walls", "material", first_material);
+    if ((rc = material_index(sc, su->sim, mt, "walls", name, &mat)) != CLI_EXIT_OK)
+        return rc;
+    for (int f = 0; f < 6; f++) {
+        if (!(faces & (1u << f)))
+            continue;
+        double point[3] = {0, 0, 0}, normal[3] = {0, 0, 0};
+        point[f / 2] = (f % 2) ? su->box[f / 2] : 0.0;
+        normal[f / 2] = (f % 2) ? -1.0 : 1.0;
+        if (wetdem_sim_add_wall(su->sim, (struct wetdem_vec3){point[0], point[1], point[2]},
+                                (struct wetdem_vec3){normal[0], normal[1], normal[2]},
+                                mat) != WETDEM_OK)
+            return lib_error(sc, cli_scenario_find(sc, "walls", "faces"), "walls", su->sim);
+    }
+    return CLI_EXIT_OK;
+}
+
+/* --------------------------------------------------------------------------- spheres --- */
+
+/* Reports an insertion failure at the key the library message names ("insert.gap ...",
+ * "insert radii ...", "insert: ... count ..."), else at the section. */
+static int insert_error(const struct cli_scenario* sc, const char* section, const char* msg)
+{
+    const char* key = NULL;
+    if (strncmp(msg, "insert.", 7) == 0) {
+        static char k[CLI_NAME_MAX];
+        size_t n = strcspn(msg + 7, " ");
+        snprintf(k, sizeof k, "%.*s", (int)(n < sizeof k ? n : sizeof k - 1), msg + 7);
+        key = k;
+    } else if (strncmp(msg, "insert radii", 12) == 0)
+        key = cli_scenario_find(sc, section, "radius") ? "radius" : "radius_max";
+    else if (strncmp(msg, "insert:", 7) == 0)
+        key = "count";
+    const struct cli_entry* e = key ? cli_scenario_find(sc, section, key) : NULL;
+    if (e)
+        cli_scenario_error(sc, e, "%s", msg);
+    else
+        cli_scenario_section_error(sc, section, "%s", msg);
+    return CLI_EXIT_USAGE;
+}
+
+static int insert_radii(const struct cli_scenario* sc, const char* section,
+                        struct wetdem_insert_spec* s)
+{
+    const struct cli_entry* r = cli_scenario_find(sc, section, "radius");
+    const struct cli_entry* lo = cli_scenario_find(sc, section, "radius_min");
+    const struct cli_entry* hi = cli_scenario_find(sc, section, "radius_max");
+    if (r && (lo || hi)) {
+        cli_scenario_error(sc, lo ? lo : hi, "give radius (equal spheres) or radius_min and "
+                                             "radius_max (polydisperse), not both");
+        return CLI_EXIT_USAGE;
+    }
+    if (!r && !(lo && hi)) {
+        cli_scenario_section_error(sc, section, "[%s] needs radius, or radius_min and "
+                                                "radius_max [m]", section);
+        return CLI_EXIT_USAGE;
+    }
+    s->radius_min = strtod(r ? r->value : lo->value, NULL);
+    s->radius_max = strtod(r ? r->value : hi->value, NULL);
+    if (s->radius_max < s->radius_min) {
+        cli_scenario_error(sc, hi, "radius_max must be >= radius_min = %g m", s->radius_min);
+        return CLI_EXIT_USAGE;
+    }
+    return CLI_EXIT_OK;
+}
+
+static int build_insert(const struct cli_scenario* sc, struct cli_many_setup* su,
+                        struct materials* mt, const char* section)
+{
+    if (!cli_scenario_find(sc, section, "count")) {
+        cli_scenario_section_error(sc, section, "[%s] needs count", section);
+        return CLI_EXIT_USAGE;
+    }
+    struct wetdem_insert_spec s = {0};
+    int rc = insert_radii(sc, section, &s);
+    if (rc != CLI_EXIT_OK)
+        return rc;
+    const char* layout = cli_scenario_text(sc, section, "layout", "random");
+    s.layout = strcmp(layout, "lattice") == 0 ? WETDEM_INSERT_LATTICE : WETDEM_INSERT_RANDOM;
+    s.n = (size_t)cli_scenario_number(sc, section, "count", 1);
+    s.gap = cli_scenario_number(sc, section, "gap", 0);
+    s.seed = (unsigned long)cli_scenario_number(sc, section, "seed", 1);
+    s.velocity = (struct wetdem_vec3){cli_scenario_number(sc, section, "velocity_x", 0),
+                                      cli_scenario_number(sc, section, "velocity_y", 0),
+                                      cli_scenario_number(sc, section, "velocity_z", 0)};
+    s.velocity_sigma = cli_scenario_number(sc, section, "velocity_sigma", 0);
+    static const char* const lo_keys[] = {"x_min", "y_min", "z_min"};
+    static const char* const hi_keys[] = {"x_max", "y_max", "z_max"};
+    double lo[3], hi[3];
+    for (int k = 0; k < 3; k++) {
+        lo[k] = cli_scenario_number(sc, section, lo_keys[k], 0);
+        hi[k] = cli_scenario_number(sc, section, hi_keys[k], su->box[k]);
+        /* the region wraps only where it spans the whole periodic edge */
+        s.periodic[k] = su->many.periodic[k] && lo[k] == 0 && hi[k] == su->box[k];
+    }
+    s.lo = (struct wetdem_vec3){lo[0], lo[1], lo[2]};
+    s.hi = (struct wetdem_vec3){hi[0], hi[1], hi[2]};
+    rc = material_index(sc, su->sim, mt, section, cli_scenario_text(sc, section, "material",
+                                                                     "steel1"),
+                        &s.material);
+    if (rc != CLI_EXIT_OK)
+        return rc;
+    int st = wetdem_sim_insert(su->sim, &s);
+    if (st == WETDEM_ERR_NOMEM) {
+        cli_error("%s: out of memory inserting %zu spheres", sc->file, s.n);
+        return CLI_EXIT_RUNTIME;
+    }
+    return st == WETDEM_OK ? CLI_EXIT_OK : insert_error(sc, section, wetdem_sim_errmsg(su->sim));
+}
+
+static int build_particle(const struct cli_scenario* sc, struct cli_many_setup* su,
+                          struct materials* mt, const char* section)
+{
+    static const char* const req[] = {"radius", "x", "y", "z"};
+    for (int k = 0; k < 4; k++)
+        if (!cli_scenario_find(sc, section, req[k])) {
+            cli_scenario_section_error(sc, section, "[%s] needs radius, x, y and z", section);
+            return CLI_EXIT_USAGE;
+        }
+#define N(key) cli_scenario_number(sc, section, key, 0)
+    struct wetdem_particle p = {
+        .pos = {N("x"), N("y"), N("z")},       .vel = {N("vx"), N("vy"), N("vz")},
+        .omega = {N("spin_x"), N("spin_y"), N("spin_z")}, .radius = N("radius"),
+        .is_fixed = strcmp(cli_scenario_text(sc, section, "fixed", "no"), "yes") == 0};
+#undef N
+    int rc = material_index(sc, su->sim, mt, section,
+                            cli_scenario_text(sc, section, "material", "steel1"), &p.material);
+    if (rc != CLI_EXIT_OK)
+        return rc;
+    if (wetdem_sim_add_particle(su->sim, p) != WETDEM_OK)
+        return lib_error(sc, NULL, section, su->sim);
+    return CLI_EXIT_OK;
+}
+
+/* Separation of a and b along axis k, minimum image on periodic axes [m]. */
+static double axis_delta(const struct cli_many_setup* su, int k, double a, double b)
+{
+    double d = a - b;
+    if (su->many.periodic[k])
+        d -= su->box[k] * round(d / su->box[k]);
+    return d;
+}
+
+/* Spheres [from, n) (one group) against the spheres before them, and each inside the box:
+ * its centre in [0, size], and the whole sphere inside on an axis with walls. */
+static int check_group(const struct cli_scenario* sc, const struct cli_many_setup* su,
+                       const char* section, size_t from, unsigned faces)
+{
+    size_t n;
+    const struct wetdem_particle* p = wetdem_sim_particles_const(su->sim, &n);
+    for (size_t i = from; i < n; i++) {
+        double x[3] = {p[i].pos.x, p[i].pos.y, p[i].pos.z};
+        for (int k = 0; k < 3; k++) {
+            double lo = (faces >> (2 * k)) & 1u ? p[i].radius : 0.0;
+            double hi = (faces >> (2 * k + 1)) & 1u ? p[i].radius : 0.0;
+            if (!(x[k] >= lo && x[k] <= su->box[k] - hi)) {
+                cli_scenario_section_error(sc, section, "sphere %zu of [%s] (centre %c = %g m, "
+                                           "radius %g m) is outside the box [0, %g] m%s",
+                                           i - from + 1, section, "xyz"[k], x[k], p[i].radius,
+                                           su->box[k], (lo > 0 || hi > 0) ? " or cuts a wall" : "");
+                return CLI_EXIT_USAGE;
+            }
+        }
+        for (size_t j = 0; j < from; j++) {
+            double d[3] = {axis_delta(su, 0, p[i].pos.x, p[j].pos.x),
+                           axis_delta(su, 1, p[i].pos.y, p[j].pos.y),
+                           axis_delta(su, 2, p[i].pos.z, p[j].pos.z)};
+            double gap = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) - p[i].radius - p[j].radius;
+            if (gap < 0) {
+                cli_scenario_section_error(sc, section, "sphere %zu of [%s] overlaps sphere %zu "
+                                           "of an earlier group by %g m: move or shrink one of "
+                                           "the groups (they are inserted in file order)",
+                                           i - from + 1, section, j + 1, -gap);
+                return CLI_EXIT_USAGE;
+            }
+        }
+    }
+    return CLI_EXIT_OK;
+}
+
+/* Every [insert], [insert.NAME] and [particle.NAME] in file order. *first: material name of
+ * the first group (default of [walls] material). */
+static int build_spheres(const struct cli_scenario* sc, struct cli_many_setup* su,
+                         struct materials* mt, unsigned faces, const char** first)
+{
+    *first = NULL;
+    for (size_t s = 0; s < sc->n_sections; s++) {
+        const char* name = sc->sections[s].name;
+        bool ins = strcmp(name, "insert") == 0 || strncmp(name, "insert.", 7) == 0;
+        if (!ins && strncmp(name, "particle.", 9) != 0)
+            continue;
+        size_t from = wetdem_sim_n_particles(su->sim);
+        int rc = ins ? build_insert(sc, su, mt, name) : build_particle(sc, su, mt, name);
+        if (rc == CLI_EXIT_OK)
+            rc = check_group(sc, su, name, from, faces);
+        if (rc != CLI_EXIT_OK)
+            return rc;
+        if (!*first)
+            *first = cli_scenario_text(sc, name, "material", "steel1");
+    }
+    if (!*first) {
+        cli_scenario_section_error(sc, "box", "no spheres: add an [insert] section (or "
+                                              "[insert.NAME], [particle.NAME])");
+        return CLI_EXIT_USAGE;
+    }
+    return CLI_EXIT_OK;
+}
+
+/* --------------------------------------------------------------------- run and dump --- */
+
+/* A [dump] file name: "" for none; must be a plain name (no '/') so that everything stays in
+ * the --out directory. */
+static int dump_name(const struct cli_scenario* sc, const char* key, const char* def, char* out)
+{
+    const struct cli_entry* e = cli_scenario_find(sc, "dump", key);
+    const char* v = e ? e->value : def;
+    snprintf(out, CLI_VALUE_MAX, "%s", strcmp(v, "none") == 0 ? "" : v);
+    if (e && (strchr(v, '/') || !v[0] || v[0] == '.')) {
+        cli_scenario_error(sc, e, "a file name in the --out directory (no '/', not starting "
+                                  "with '.'), or none");
+        return CLI_EXIT_USAGE;
+    }
+    return CLI_EXIT_OK;
+}
+
+static int build_run(const struct cli_scenario* sc, struct cli_many_setup* su)
+{
+    const struct cli_entry* te = cli_scenario_find(sc, "run", "t_end");
+    const struct cli_entry* se = cli_scenario_find(sc, "run", "steps");
+    if (te && se) {
+        cli_scenario_error(sc, se, "give t_end or steps, not both");
+        return CLI_EXIT_USAGE;
+    }
+    if (!te && !se) {
+        cli_scenario_section_error(sc, "run", "[run] needs t_end [s] or steps");
+        return CLI_EXIT_USAGE;
+    }
+    su->t_end = te ? strtod(te->value, NULL) : 0;
+    su->steps = se ? (unsigned long long)strtod(se->value, NULL) : 0;
+    su->many.dt = cli_scenario_number(sc, "run", "dt", 0);
+    su->many.skin = cli_scenario_number(sc, "run", "skin", 0);
+    su->many.energy_budget = strcmp(cli_scenario_text(sc, "run", "energy_budget", "yes"), "yes") == 0;
+    su->vtk_every_given = cli_scenario_find(sc, "dump", "vtk_every") != NULL;
+    su->csv_every_given = cli_scenario_find(sc, "dump", "csv_every") != NULL;
+    su->vtk_every = (unsigned long long)cli_scenario_number(sc, "dump", "vtk_every", 0);
+    su->csv_every = (unsigned long long)cli_scenario_number(sc, "dump", "csv_every", 0);
+    su->checkpoint_every = (unsigned long long)cli_scenario_number(sc, "dump", "checkpoint_every", 0);
+    su->vtk_binary = strcmp(cli_scenario_text(sc, "dump", "vtk_binary", "yes"), "yes") == 0;
+    int rc;
+    if ((rc = dump_name(sc, "vtk", "particles", su->vtk_prefix)) != CLI_EXIT_OK ||
+        (rc = dump_name(sc, "csv", "global.csv", su->csv_name)) != CLI_EXIT_OK ||
+        (rc = dump_name(sc, "checkpoint", "checkpoint.ckpt", su->checkpoint_name)) != CLI_EXIT_OK ||
+        (rc = dump_name(sc, "summary", "summary.json", su->summary_name)) != CLI_EXIT_OK)
+        return rc;
+    size_t len = strlen(su->csv_name);
+    if (len && (len < 5 || strcmp(su->csv_name + len - 4, ".csv") != 0)) {
+        cli_scenario_error(sc, cli_scenario_find(sc, "dump", "csv"), "the CSV name must end in "
+                                                                     ".csv");
+        return CLI_EXIT_USAGE;
+    }
+    return CLI_EXIT_OK;
+}
+
+int cli_many_report_start(const struct cli_scenario* sc, const char* msg)
+{
+    bool box = strstr(msg, "periodic") || strstr(msg, "box") || strstr(msg, "cell");
+    cli_scenario_section_error(sc, box ? "box" : "run", "%s", msg);
+    return CLI_EXIT_USAGE;
+}
+
+int cli_many_build(const struct cli_scenario* sc, struct cli_many_setup* su)
+{
+    memset(su, 0, sizeof *su);
+    if (cli_scenario_has_section(sc, "collision")) {
+        cli_scenario_section_error(sc, "collision", "a scenario is a binary collision "
+                                   "([collision]) or a many-particle run ([box], [insert], "
+                                   "[run], ...), not both");
+        return CLI_EXIT_USAGE;
+    }
+    su->sim = wetdem_sim_create();
+    if (!su->sim) {
+        cli_error("out of memory creating a simulation");
+        return CLI_EXIT_RUNTIME;
+    }
+    struct materials mt = {.n = 0};
+    const char* first = NULL;
+    unsigned faces = 0;
+    int rc;
+    if ((rc = build_fluid(sc, su->sim)) != CLI_EXIT_OK ||
+        (rc = build_models(sc, su->sim)) != CLI_EXIT_OK ||
+        (rc = build_settings(sc, su->sim)) != CLI_EXIT_OK ||
+        (rc = build_box(sc, su)) != CLI_EXIT_OK || (rc = wall_faces(sc, su, &faces)) != CLI_EXIT_OK ||
+        (rc = build_spheres(sc, su, &mt, faces, &first)) != CLI_EXIT_OK ||
+        (rc = build_walls(sc, su, &mt, first)) != CLI_EXIT_OK ||
+        (rc = build_run(sc, su)) != CLI_EXIT_OK) {
+        cli_many_setup_free(su);
+        return rc;
+    }
+    if (wetdem_sim_set_many(su->sim, &su->many) != WETDEM_OK) {
+        rc = cli_many_report_start(sc, wetdem_sim_errmsg(su->sim));
+        cli_many_setup_free(su);
+    }
+    return rc;
+}
+
+void cli_many_setup_free(struct cli_many_setup* su)
+{
+    wetdem_sim_free(su->sim);
+    su->sim = NULL;
+}
