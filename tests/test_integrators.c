@@ -2,13 +2,18 @@
  * test_integrators.c — conformance matrix of the soft engine's integrators (STYLE §6.9.2):
  * every integrator on free flight, constant force (gravity and a constant torque), the
  * harmonic oscillator and the damped oscillator against their closed forms; the convergence
- * order of Verlet; its time reversibility; CVODE meeting its tolerance; parameter names.
+ * order of Verlet; its time reversibility; CVODE meeting its tolerance; parameter names; the
+ * CVODE vector kernels giving the same bits as the SUNDIALS serial kernels they replace.
  *
  * The oscillators use a test-local force model between a sphere and a plane wall:
  *     f_normal = -k h + c v_n,   h = gap, v_n = -dh/dt,
  * so that m h'' = -k h - c h': omega_0 = sqrt(k/m), zeta = c/(2 sqrt(k m)).
  */
 #include "harness.h"
+
+#include <string.h>
+
+#include "integrator_cvode_nvec.h"
 
 struct spring_params {
     double k;      /* [N/m] */
@@ -324,6 +329,144 @@ static void test_integrators_observer(void** state)
     }
 }
 
+/* ---- CVODE vector kernels (integrator_cvode_nvec.c) ---- */
+
+#define NV_N 19 /* odd length: no loop remainder left untested */
+
+/* Fills v with values of both signs and magnitudes and signed zeros from seed k, and two
+ * components equal in every vector. */
+static void nv_fill(N_Vector v, int k)
+{
+    double* d = N_VGetArrayPointer(v);
+    for (int i = 0; i < NV_N; i++) {
+        double u = sin(12.9898 * (i + 1) + 78.233 * (k + 1)) * 43758.5453;
+        d[i] = (u - floor(u) - 0.5) * pow(10.0, (i * 7 + k) % 9 - 4);
+    }
+    d[(3 + k) % NV_N] = 0.0;
+    d[(5 + 2 * k) % NV_N] = -0.0;
+    d[NV_N - 1] = 0.0; /* equal in every vector: x - y = +0, -(x - y) = -0 */
+    d[NV_N - 2] = 1.5;
+}
+
+/* Two copies of three vectors: L with the library's kernels, W with ours. */
+struct nv_pair {
+    N_Vector l[3], w[3];
+};
+
+static void nv_reset(struct nv_pair* p)
+{
+    for (int k = 0; k < 3; k++) {
+        nv_fill(p->l[k], k);
+        nv_fill(p->w[k], k);
+    }
+}
+
+/* Every component of every vector bit-identical between the two copies. */
+static void nv_same(const struct nv_pair* p, const char* what)
+{
+    for (int k = 0; k < 3; k++)
+        if (memcmp(N_VGetArrayPointer(p->l[k]), N_VGetArrayPointer(p->w[k]),
+                   NV_N * sizeof(double)) != 0)
+            fail_msg("%s: vector %d differs from the library's", what, k);
+}
+
+/* The replaced kernels must give exactly the library's bits (results of the Fig. 3 sweep are
+ * unchanged by them): linear sums for every special case of the coefficients (+-1, equal,
+ * opposite, general) and every aliasing of the output, scaling, constants, products,
+ * quotients, abs, inverse, WRMS and max norms, and the fused and array forms; exact equality,
+ * no tolerance. */
+static void test_integrators_cvode_vector_kernels(void** state)
+{
+    (void)state;
+    SUNContext ctx;
+    assert_int_equal(SUNContext_Create(NULL, &ctx), 0);
+    struct nv_pair p;
+    N_Vector proto = N_VNew_Serial(NV_N, ctx);
+    N_VEnableFusedOps_Serial(proto, SUNTRUE);
+    N_Vector mine = N_VClone(proto);
+    wetdem_integrator_cvode_nvec_install(mine);
+    for (int k = 0; k < 3; k++) {
+        p.l[k] = N_VClone(proto);
+        p.w[k] = N_VClone(mine); /* clones keep the installed kernels */
+    }
+    const double coef[] = {1.0, -1.0, 0.5, -0.5, 2.0, 0.0, 3.0};
+    for (int ia = 0; ia < 7; ia++)
+        for (int ib = 0; ib < 7; ib++)
+            for (int out = 0; out < 3; out++) { /* z = x, z = y, z separate */
+                double a = coef[ia], b = coef[ib];
+                nv_reset(&p);
+                N_VLinearSum_Serial(a, p.l[0], b, p.l[1], p.l[out == 2 ? 2 : out]);
+                N_VLinearSum(a, p.w[0], b, p.w[1], p.w[out == 2 ? 2 : out]);
+                nv_same(&p, "linear sum");
+            }
+    for (int ia = 0; ia < 7; ia++) {
+        double c = coef[ia];
+        nv_reset(&p);
+        N_VScale_Serial(c, p.l[0], p.l[2]);
+        N_VScale(c, p.w[0], p.w[2]);
+        N_VScale_Serial(c, p.l[1], p.l[1]);
+        N_VScale(c, p.w[1], p.w[1]);
+        N_VAddConst_Serial(p.l[0], c, p.l[0]);
+        N_VAddConst(p.w[0], c, p.w[0]);
+        nv_same(&p, "scale, add constant");
+        N_VConst_Serial(c, p.l[2]);
+        N_VConst(c, p.w[2]);
+        nv_same(&p, "constant");
+    }
+    nv_reset(&p);
+    assert_true(N_VWrmsNorm_Serial(p.l[0], p.l[1]) == N_VWrmsNorm(p.w[0], p.w[1]));
+    assert_true(N_VMaxNorm_Serial(p.l[0]) == N_VMaxNorm(p.w[0]));
+    N_VProd_Serial(p.l[0], p.l[1], p.l[2]);
+    N_VProd(p.w[0], p.w[1], p.w[2]);
+    N_VAbs_Serial(p.l[2], p.l[1]);
+    N_VAbs(p.w[2], p.w[1]);
+    N_VInv_Serial(p.l[1], p.l[0]);
+    N_VInv(p.w[1], p.w[0]);
+    N_VDiv_Serial(p.l[2], p.l[0], p.l[1]);
+    N_VDiv(p.w[2], p.w[0], p.w[1]);
+    nv_same(&p, "prod, abs, inv, div");
+    for (int nvec = 1; nvec <= 3; nvec++)
+        for (int alias = 0; alias < 2; alias++) {
+            double c[3] = {alias ? 1.0 : 0.7, -1.3, 2.1};
+            nv_reset(&p);
+            N_Vector zl = alias ? p.l[0] : p.l[2], zw = alias ? p.w[0] : p.w[2];
+            N_VLinearCombination_Serial(nvec, c, p.l, zl);
+            N_VLinearCombination(nvec, c, p.w, zw);
+            nv_same(&p, "linear combination");
+            c[0] = 0.7;
+            nv_reset(&p);
+            N_VLinearCombination_Serial(nvec, c, p.l, p.l[0]);
+            N_VLinearCombination(nvec, c, p.w, p.w[0]);
+            nv_same(&p, "linear combination in place");
+            nv_reset(&p);
+            N_Vector yl[2] = {p.l[1], p.l[2]}, yw[2] = {p.w[1], p.w[2]};
+            N_Vector zl2[2] = {p.l[2], p.l[1]}, zw2[2] = {p.w[2], p.w[1]};
+            int m = nvec < 3 ? nvec : 2;
+            N_VScaleAddMulti_Serial(m, c, p.l[0], yl, alias ? yl : zl2);
+            N_VScaleAddMulti(m, c, p.w[0], yw, alias ? yw : zw2);
+            nv_same(&p, "scale-add multi");
+            nv_reset(&p);
+            N_VScaleVectorArray_Serial(m, c, yl, alias ? yl : zl2);
+            N_VScaleVectorArray(m, c, yw, alias ? yw : zw2);
+            N_VLinearSumVectorArray_Serial(m, c[0], yl, c[1], yl, zl2);
+            N_VLinearSumVectorArray(m, c[0], yw, c[1], yw, zw2);
+            double nl[2], nw[2];
+            N_VWrmsNormVectorArray_Serial(m, yl, zl2, nl);
+            N_VWrmsNormVectorArray(m, yw, zw2, nw);
+            assert_true(memcmp(nl, nw, (size_t)m * sizeof(double)) == 0);
+            N_VConstVectorArray_Serial(m, c[2], yl);
+            N_VConstVectorArray(m, c[2], yw);
+            nv_same(&p, "vector arrays");
+        }
+    for (int k = 0; k < 3; k++) {
+        N_VDestroy(p.l[k]);
+        N_VDestroy(p.w[k]);
+    }
+    N_VDestroy(mine);
+    N_VDestroy(proto);
+    SUNContext_Free(&ctx);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -337,6 +480,7 @@ int main(void)
         cmocka_unit_test(test_integrators_params),
         cmocka_unit_test(test_integrators_cvode_bdf),
         cmocka_unit_test(test_integrators_observer),
+        cmocka_unit_test(test_integrators_cvode_vector_kernels),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
