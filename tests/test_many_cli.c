@@ -1,0 +1,433 @@
+/*
+ * test_many_cli.c — many-particle runs through the command line (cli/run_many.c,
+ * cli/scenario_many.c):
+ *   - bad scenarios (box too small for the count, negative radius, unknown key, a wall on a
+ *     periodic axis, overlapping groups, t_end and steps both, a periodic edge too short for
+ *     the neighbour cells, a foreign checkpoint) exit 2 with "FILE:LINE:" at the right line
+ *     and write nothing, not even the --out directory;
+ *   - a run split by --restart, and a run resumed from an older checkpoint after its outputs
+ *     went further, give byte-identical VTK frames, series index, CSV and summary to the
+ *     uninterrupted run;
+ *   - SIGINT sent to a running CLI writes a checkpoint, exits 130 and prints the command that
+ *     resumes it; resuming gives the uninterrupted run's files byte for byte;
+ *   - progress goes to stderr only when it is a terminal, with an estimate of the time left;
+ *   - the example scenarios check, and the summary's energy budget adds up.
+ *
+ * The runs use one OpenMP thread (results are bit-identical for a given thread count, and one
+ * thread is the fastest for 150 spheres on a shared machine) and the passive wait policy.
+ */
+#include <fcntl.h>
+#include <pty.h>
+#include <signal.h>
+#include <stdlib.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "harness.h"
+
+#define ENV "OMP_NUM_THREADS=1 OMP_WAIT_POLICY=passive"
+
+static char tmpdir[256];
+
+static const char* cli_path(void)
+{
+    const char* p = getenv("WETDEM_CLI");
+    return p && *p ? p : "build/wetdem";
+}
+
+/* Whole file into a heap buffer (NULL if missing); *len gets its size. */
+static char* slurp(const char* path, size_t* len)
+{
+    FILE* f = fopen(path, "rb");
+    if (!f)
+        return NULL;
+    size_t cap = 1 << 16, n = 0, got;
+    char* buf = malloc(cap);
+    assert_non_null(buf);
+    while ((got = fread(buf + n, 1, cap - n - 1, f)) > 0) {
+        n += got;
+        if (cap - n - 1 == 0) {
+            cap *= 2;
+            buf = realloc(buf, cap);
+            assert_non_null(buf);
+        }
+    }
+    fclose(f);
+    buf[n] = '\0';
+    if (len)
+        *len = n;
+    return buf;
+}
+
+/* tmpdir/name */
+static const char* tpath(const char* name)
+{
+    static char paths[8][600];
+    static int next = 0;
+    char* p = paths[next++ % 8];
+    snprintf(p, 600, "%s/%s", tmpdir, name);
+    return p;
+}
+
+static void write_text(const char* name, const char* text)
+{
+    FILE* f = fopen(tpath(name), "w");
+    assert_non_null(f);
+    fputs(text, f);
+    fclose(f);
+}
+
+static bool exists(const char* name)
+{
+    struct stat st;
+    return stat(tpath(name), &st) == 0;
+}
+
+/* Runs "cd tmpdir && ENV wetdem ARGS > out.txt 2> err.txt"; returns the exit code. */
+static int run_cli(const char* args)
+{
+    char cmd[4096];
+    snprintf(cmd, sizeof cmd, "cd '%s' && " ENV " '%s' %s > out.txt 2> err.txt", tmpdir,
+             cli_path(), args);
+    int status = system(cmd);
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+static char* stderr_text(void)
+{
+    char* s = slurp(tpath("err.txt"), NULL);
+    assert_non_null(s);
+    return s;
+}
+
+/* A wet granular box: 150 spheres, periodic in x and y, floor and lid, gravity. */
+static const char* const base =
+    "[box]\nsize_x = 6e-3\nsize_y = 6e-3\nsize_z = 8e-3\nperiodic = x y\n"
+    "[material.wet]\ndensity = 2500\nyoungs_modulus = 1e7\npoisson_ratio = 0.3\n"
+    "restitution = 0.6\nfriction_dry = 0.4\nfriction_lub = 0.1\nfilm = 20e-6\n"
+    "[fluid]\nviscosity = 0.01\nsurface_tension = 0.02\n"
+    "[models]\nforce = hertz mindlin sb capillary\nmin_separation = fixed\n"
+    "[sim]\ngravity_z = -9.81\n"
+    "[insert]\ncount = 150\nradius_min = 0.4e-3\nradius_max = 0.5e-3\nmaterial = wet\n"
+    "velocity_sigma = 0.2\nseed = 7\n"
+    "[run]\ndt = 2e-6\n";
+
+/* base + extra lines, into tmpdir/name. */
+static void scenario(const char* name, const char* extra)
+{
+    char text[4096];
+    snprintf(text, sizeof text, "%s%s", base, extra);
+    write_text(name, text);
+}
+
+/* Runs a bad scenario: exit 2, "NAME:LINE:" and `what` in the message, no --out directory. */
+static void expect_bad(const char* name, const char* text, int line, const char* what)
+{
+    write_text(name, text);
+    char args[600], where[128];
+    snprintf(args, sizeof args, "run %s --out %s.out", name, name);
+    int code = run_cli(args);
+    char* err = stderr_text();
+    if (code != 2)
+        fail_msg("%s: exit %d, expected 2\n%s", name, code, err);
+    snprintf(where, sizeof where, "%s:%d:", name, line);
+    CHECK_CONTAINS(err, where);
+    CHECK_CONTAINS(err, what);
+    char out[200];
+    snprintf(out, sizeof out, "%s.out", name);
+    if (exists(out))
+        fail_msg("%s: the --out directory was created for a bad scenario", name);
+    free(err);
+}
+
+static void test_many_cli_bad_inputs_exit_2_with_file_and_line(void** state)
+{
+    (void)state;
+    /* lattice of spacing 2 x 0.5 mm in a 2 mm cube: 2 x 2 x 2 = 8 sites < 150 (line 2: count) */
+    expect_bad("small.ini",
+               "[insert]\ncount = 150\nradius = 0.5e-3\nlayout = lattice\n[box]\nsize_x = 2e-3\n"
+               "size_y = 2e-3\nsize_z = 2e-3\n[run]\nsteps = 10\n",
+               2, "holds at most 8 spheres");
+    expect_bad("negative.ini",
+               "[box]\nsize_x = 1e-2\nsize_y = 1e-2\nsize_z = 1e-2\n[insert]\ncount = 5\n"
+               "radius = -1e-3\n[run]\nsteps = 10\n",
+               7, "radius");
+    expect_bad("typo.ini",
+               "[box]\nsize_x = 1e-2\nsize_y = 1e-2\nsize_z = 1e-2\n[insert]\ncuont = 5\n"
+               "radius = 1e-3\n[run]\nsteps = 10\n",
+               6, "did you mean 'count'");
+    expect_bad("periodic_wall.ini",
+               "[box]\nsize_x = 1e-2\nsize_y = 1e-2\nsize_z = 1e-2\nperiodic = x\n[walls]\n"
+               "faces = x_min z_min\n[insert]\ncount = 5\nradius = 1e-3\n[run]\nsteps = 10\n",
+               7, "wall x_min lies on axis x");
+    expect_bad("overlap.ini",
+               "[box]\nsize_x = 1e-2\nsize_y = 1e-2\nsize_z = 1e-2\n[particle.a]\nradius = 1e-3\n"
+               "x = 5e-3\ny = 5e-3\nz = 5e-3\n[particle.b]\nradius = 1e-3\nx = 6e-3\ny = 5e-3\n"
+               "z = 5e-3\n[run]\nsteps = 10\n",
+               10, "overlaps sphere 1");
+    expect_bad("both.ini",
+               "[box]\nsize_x = 1e-2\nsize_y = 1e-2\nsize_z = 1e-2\n[insert]\ncount = 5\n"
+               "radius = 1e-3\n[run]\nt_end = 1e-3\nsteps = 10\n",
+               10, "not both");
+    /* periodic edge 3 mm < 2 x (2 R_max + reach + skin) = 2 x (2 mm + 40 um + 0.1 mm) */
+    expect_bad("short_periodic.ini",
+               "[box]\nsize_x = 3e-3\nsize_y = 1e-2\nsize_z = 1e-2\nperiodic = x\n"
+               "[insert]\ncount = 1\nradius = 1e-3\n[material.steel1]\npreset = steel1\n"
+               "film = 20e-6\n[models]\nforce = hertz sb\n[run]\nsteps = 10\n",
+               1, "[box]");
+    expect_bad("mixed.ini",
+               "[collision]\nspeed = 1\n[box]\nsize_x = 1e-2\nsize_y = 1e-2\nsize_z = 1e-2\n"
+               "[insert]\ncount = 1\nradius = 1e-3\n[run]\nsteps = 10\n",
+               1, "not both");
+}
+
+/* Removes field `col` (0-based) from every comma-separated line of text, in place. */
+static void drop_column(char* text, int col)
+{
+    char* w = text;
+    const char* r = text;
+    while (*r) {
+        for (int field = 0;; field++) {
+            const char* end = r + strcspn(r, ",\n");
+            if (field != col) {
+                if (field > 0 && !(col == 0 && field == 1))
+                    *w++ = ',';
+                memmove(w, r, (size_t)(end - r)); /* w <= r: copying leftwards */
+                w += end - r;
+            }
+            r = end;
+            if (*r != ',')
+                break;
+            r++;
+        }
+        if (*r == '\n')
+            *w++ = *r++;
+    }
+    *w = '\0';
+}
+
+/* The files of two --out directories are byte-identical, except the CSV column
+ * candidate_pairs: the size of the neighbour list depends on when the list was last built,
+ * and a restart builds it afresh (the forces do not depend on it: every pair within range is
+ * in any valid list). The checkpoint holds such counters too and is not compared. */
+static void check_same_outputs(const char* a, const char* b, size_t frames)
+{
+    char names[64][64];
+    size_t n = 0;
+    snprintf(names[n++], 64, "global.csv");
+    snprintf(names[n++], 64, "particles.vtk.series");
+    snprintf(names[n++], 64, "summary.json");
+    for (size_t k = 0; k < frames && n < 64; k++)
+        snprintf(names[n++], 64, "particles_%06zu.vtk", k);
+    for (size_t k = 0; k < n; k++) {
+        char pa[300], pb[300];
+        snprintf(pa, sizeof pa, "%.100s/%.63s", a, names[k]);
+        snprintf(pb, sizeof pb, "%.100s/%.63s", b, names[k]);
+        size_t la, lb;
+        char* ta = slurp(tpath(pa), &la);
+        char* tb = slurp(tpath(pb), &lb);
+        if (!ta || !tb)
+            fail_msg("%s missing in %s", names[k], ta ? b : a);
+        if (k == 0) { /* global.csv: column 9 is candidate_pairs */
+            CHECK_CONTAINS(ta, ",mean_agglomerate_size,candidate_pairs,");
+            drop_column(ta, 9);
+            drop_column(tb, 9);
+            la = strlen(ta);
+            lb = strlen(tb);
+        }
+        if (la != lb || memcmp(ta, tb, la) != 0)
+            fail_msg("%s differs between %s and %s", names[k], a, b);
+        free(ta);
+        free(tb);
+    }
+    char extra[300];
+    snprintf(extra, sizeof extra, "%.100s/particles_%06zu.vtk", b, frames);
+    if (exists(extra))
+        fail_msg("%s has a frame more than %s", b, a);
+}
+
+static void test_many_cli_restart_is_bit_identical(void** state)
+{
+    (void)state;
+    scenario("box.ini", "[dump]\nvtk_every = 100\ncsv_every = 20\n");
+    /* 600 steps of 2 us: frames at 0, 100, ..., 600 -> 7 files */
+    assert_int_equal(run_cli("run box.ini --set run.steps=600 --out whole"), 0);
+    /* 300 steps, then extended to 600 from its final checkpoint */
+    assert_int_equal(run_cli("run box.ini --set run.steps=300 --out split"), 0);
+    int code = run_cli("run box.ini --set run.steps=600 --out split --restart split/checkpoint.ckpt");
+    if (code != 0)
+        fail_msg("restart: exit %d\n%s", code, stderr_text());
+    check_same_outputs("whole", "split", 7);
+    /* a crash after step 300: the outputs went on to 600, the checkpoint is the older one */
+    assert_int_equal(run_cli("run box.ini --set run.steps=300 --out crash"), 0);
+    char cmd[1200];
+    snprintf(cmd, sizeof cmd, "cp '%s/crash/checkpoint.ckpt' '%s/old.ckpt'", tmpdir, tmpdir);
+    assert_int_equal(system(cmd), 0);
+    assert_int_equal(run_cli("run box.ini --set run.steps=600 --out crash"), 0);
+    assert_int_equal(run_cli("run box.ini --set run.steps=600 --out crash --restart old.ckpt"), 0);
+    check_same_outputs("whole", "crash", 7);
+    /* a checkpoint of another set-up is refused: exit 2, and the outputs stay as they were */
+    code = run_cli("run box.ini --set run.steps=600 --set material.wet.film=30e-6 --out split "
+                   "--restart split/checkpoint.ckpt");
+    char* err = stderr_text();
+    assert_int_equal(code, 2);
+    CHECK_CONTAINS(err, "different materials");
+    free(err);
+    check_same_outputs("whole", "split", 7);
+}
+
+/* Number of data rows in a CSV (lines starting with a digit). */
+static size_t csv_rows(const char* path)
+{
+    char* t = slurp(path, NULL);
+    size_t n = 0;
+    for (const char* p = t; p && *p; p = strchr(p, '\n') ? strchr(p, '\n') + 1 : p + strlen(p))
+        n += (*p >= '0' && *p <= '9');
+    free(t);
+    return n;
+}
+
+/* Starts the CLI in the background (stderr to err.txt); returns its pid. */
+static pid_t spawn_cli(const char* args)
+{
+    char cmd[2048];
+    snprintf(cmd, sizeof cmd, "cd '%s' && exec env " ENV " '%s' %s > out.txt 2> err.txt",
+             tmpdir, cli_path(), args);
+    pid_t pid = fork();
+    assert_true(pid >= 0);
+    if (pid == 0) {
+        execl("/bin/sh", "sh", "-c", cmd, (char*)NULL);
+        _exit(127);
+    }
+    return pid;
+}
+
+static void test_many_cli_sigint_writes_a_checkpoint_and_resumes(void** state)
+{
+    (void)state;
+    scenario("long.ini", "[dump]\nvtk_every = 2000\ncsv_every = 10\n");
+    const char* args = "run long.ini --set run.steps=12000 --out sig";
+    pid_t pid = spawn_cli(args);
+    /* wait until the run is stepping (5 CSV rows: step 40), then interrupt it */
+    struct timespec nap = {0, 1000000};
+    for (int k = 0; k < 60000 && csv_rows(tpath("sig/global.csv")) < 5; k++)
+        nanosleep(&nap, NULL);
+    kill(pid, SIGINT);
+    int status;
+    assert_int_equal(waitpid(pid, &status, 0), pid);
+    char* err = stderr_text();
+    if (!WIFEXITED(status) || WEXITSTATUS(status) != 130)
+        fail_msg("interrupted run: status %d, expected exit 130 (the run must outlast the "
+                 "wait for 5 CSV rows)\n%s", status, err);
+    CHECK_CONTAINS(err, "interrupted by SIGINT");
+    CHECK_CONTAINS(err, "resume with: wetdem run long.ini --set run.steps=12000 --out sig "
+                        "--restart sig/checkpoint.ckpt");
+    free(err);
+    assert_true(exists("sig/checkpoint.ckpt"));
+    assert_int_equal(run_cli("run long.ini --set run.steps=12000 --out sig --restart "
+                             "sig/checkpoint.ckpt"),
+                     0);
+    assert_int_equal(run_cli("run long.ini --set run.steps=12000 --out ref"), 0);
+    check_same_outputs("ref", "sig", 7); /* frames at 0, 2000, ..., 12000 */
+}
+
+/* Progress: nothing on stderr when it is a file; a line with the time left on a terminal. */
+static void test_many_cli_progress_only_on_a_terminal(void** state)
+{
+    (void)state;
+    scenario("progress.ini", "");
+    assert_int_equal(run_cli("run progress.ini --set run.steps=200"), 0);
+    char* err = stderr_text();
+    assert_string_equal(err, "");
+    free(err);
+    int master;
+    pid_t pid = forkpty(&master, NULL, NULL, NULL);
+    assert_true(pid >= 0);
+    if (pid == 0) {
+        char cmd[2048];
+        snprintf(cmd, sizeof cmd, "cd '%s' && exec env " ENV " '%s' run progress.ini "
+                 "--set run.steps=200 > /dev/null", tmpdir, cli_path());
+        execl("/bin/sh", "sh", "-c", cmd, (char*)NULL);
+        _exit(127);
+    }
+    char buf[8192];
+    size_t n = 0;
+    ssize_t got;
+    while (n + 1 < sizeof buf && (got = read(master, buf + n, sizeof buf - n - 1)) > 0)
+        n += (size_t)got;
+    buf[n] = '\0';
+    int status;
+    waitpid(pid, &status, 0);
+    close(master);
+    assert_true(WIFEXITED(status) && WEXITSTATUS(status) == 0);
+    CHECK_CONTAINS(buf, "step 200/200 (100.0 %)");
+    CHECK_CONTAINS(buf, "s left");
+}
+
+/* The shipped examples check; the summary's budget: input = kinetic + potential + elastic +
+ * dissipated exactly as defined, and the closure error small against the energies. */
+static void test_many_cli_examples_and_budget(void** state)
+{
+    (void)state;
+    const char* files[] = {"many_stokes_cradle", "many_settling", "many_agglomeration"};
+    for (size_t k = 0; k < 3; k++) {
+        char args[1400], cwd[1024];
+        assert_non_null(getcwd(cwd, sizeof cwd)); /* the repository root */
+        snprintf(args, sizeof args, "run '%s/examples/scenarios/%s.ini' --check", cwd, files[k]);
+        int code = run_cli(args);
+        char* out = slurp(tpath("out.txt"), NULL);
+        if (code != 0)
+            fail_msg("%s: exit %d", files[k], code);
+        CHECK_CONTAINS(out, "is valid (many-particle run)");
+        free(out);
+    }
+    scenario("budget.ini", "");
+    assert_int_equal(run_cli("run budget.ini --set run.steps=500 --json"), 0);
+    char* js = slurp(tpath("out.txt"), NULL);
+    double v[7];
+    const char* keys[] = {"\"input\": ",   "\"kinetic\": ",    "\"potential\": ",
+                          "\"elastic\": ", "\"dissipated\": ", "\"work_total\": ",
+                          "\"balance_error\": "};
+    for (int k = 0; k < 7; k++) {
+        const char* p = strstr(js, keys[k]);
+        if (!p)
+            fail_msg("%s missing in %s", keys[k], js);
+        v[k] = strtod(p + strlen(keys[k]), NULL);
+    }
+    /* dissipated = input - (kinetic + potential + elastic): rounding of a few terms */
+    CHECK_ABS(v[0], v[1] + v[2] + v[3] + v[4], 1e-12 * fabs(v[0]));
+    /* closure: 500 steps of 2 us, about 1/60 of the contact time, close to 1e-3 of the energy
+       moved (tests/test_many.c); 1e-2 leaves room for the film forces' jumps at h = delta */
+    assert_true(fabs(v[6]) < 1e-2 * fmax(fabs(v[5]), fabs(v[1] - v[0])));
+    assert_true(v[4] > 0); /* damping and films took energy */
+    free(js);
+}
+
+static int setup(void** state)
+{
+    (void)state;
+    snprintf(tmpdir, sizeof tmpdir, "/tmp/wetdem_test_many_cli_XXXXXX");
+    return mkdtemp(tmpdir) ? 0 : -1;
+}
+
+static int teardown(void** state)
+{
+    (void)state;
+    char cmd[600];
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", tmpdir);
+    return system(cmd) == 0 ? 0 : -1;
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_many_cli_bad_inputs_exit_2_with_file_and_line),
+        cmocka_unit_test(test_many_cli_restart_is_bit_identical),
+        cmocka_unit_test(test_many_cli_sigint_writes_a_checkpoint_and_resumes),
+        cmocka_unit_test(test_many_cli_progress_only_on_a_terminal),
+        cmocka_unit_test(test_many_cli_examples_and_budget),
+    };
+    return cmocka_run_group_tests(tests, setup, getenv("WETDEM_KEEP_TMP") ? NULL : teardown);
+}
