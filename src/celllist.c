@@ -66,6 +66,7 @@ void wetdem_celllist_clear(struct wetdem_celllist* cl)
     free(cl->cell_start);
     free(cl->cell_items);
     free(cl->cell_of);
+    free(cl->sorted);
     free(cl->pairs);
     free(cl->first_pair);
     free(cl->pos_at_build);
@@ -171,8 +172,14 @@ static int bin_particles(struct wetdem_celllist* cl, const struct wetdem_particl
     }
     for (size_t c = 0; c < n_cells; c++)
         cl->cell_start[c + 1] += cl->cell_start[c];
-    for (size_t i = 0; i < n; i++)
-        cl->cell_items[cl->cell_start[cl->cell_of[i]]++] = (uint32_t)i;
+    if (reserve((void**)&cl->sorted, &cl->sorted_cap, n, sizeof *cl->sorted))
+        return WETDEM_ERR_NOMEM;
+    for (size_t i = 0; i < n; i++) {
+        size_t s = cl->cell_start[cl->cell_of[i]]++;
+        cl->cell_items[s] = (uint32_t)i;
+        cl->sorted[s] = (struct wetdem_celllist_item){p[i].pos.x, p[i].pos.y, p[i].pos.z,
+                                                       p[i].radius};
+    }
     for (size_t c = n_cells; c > 0; c--) /* undo the shift left by the fill */
         cl->cell_start[c] = cl->cell_start[c - 1];
     cl->cell_start[0] = 0;
@@ -213,31 +220,35 @@ static int stencil(const struct wetdem_celllist* cl, struct wetdem_vec3 x, size_
     return count;
 }
 
-/* Scans the candidates j > i of particle i; writes them to out (if non-NULL, sorted by j)
- * and returns their number. */
+/* Scans the candidates j > i of particle i in the nc cells `cells` (its stencil); writes them
+ * to out (sorted by j) and returns their number. Positions and radii come from the
+ * cell-ordered copy, so each cell is read as one contiguous block. */
 static size_t scan_particle(const struct wetdem_celllist* cl, const struct wetdem_particle* p,
-                            size_t i, struct wetdem_celllist_pair* out)
+                            size_t i, const size_t* cells, int nc,
+                            struct wetdem_celllist_pair* out)
 {
-    size_t cells[27], count = 0;
-    int nc = stencil(cl, p[i].pos, cells);
+    size_t count = 0;
     double extra = cl->reach + cl->skin;
+    bool periodic = cl->box.periodic[0] || cl->box.periodic[1] || cl->box.periodic[2];
+    struct wetdem_vec3 xi = p[i].pos;
+    double ri = p[i].radius;
     for (int q = 0; q < nc; q++) {
         for (size_t s = cl->cell_start[cells[q]]; s < cl->cell_start[cells[q] + 1]; s++) {
             uint32_t j = cl->cell_items[s];
             if (j <= i)
                 continue;
-            struct wetdem_vec3 d = celllist_delta(&cl->box, p[i].pos, p[j].pos);
-            double lim = p[i].radius + p[j].radius + extra;
+            const struct wetdem_celllist_item* b = &cl->sorted[s];
+            struct wetdem_vec3 xj = vec3(b->x, b->y, b->z);
+            struct wetdem_vec3 d = periodic ? celllist_delta(&cl->box, xi, xj) : vec3_sub(xi, xj);
+            double lim = ri + b->r + extra;
             if (vec3_dot(d, d) >= lim * lim)
                 continue;
-            if (out) {
-                size_t k = count; /* insertion sort by j: segments are short */
-                while (k > 0 && out[k - 1].j > j) {
-                    out[k] = out[k - 1];
-                    k--;
-                }
-                out[k] = (struct wetdem_celllist_pair){(uint32_t)i, j};
+            size_t k = count; /* insertion sort by j: segments are short */
+            while (k > 0 && out[k - 1].j > j) {
+                out[k] = out[k - 1];
+                k--;
             }
+            out[k] = (struct wetdem_celllist_pair){(uint32_t)i, j};
             count++;
         }
     }
@@ -264,11 +275,10 @@ static int check_input(const struct wetdem_particle* p, size_t n, double* r_max,
     return WETDEM_OK;
 }
 
-/* Upper bound of the candidates of particle at x: the particles of its stencil cells. */
-static size_t stencil_population(const struct wetdem_celllist* cl, struct wetdem_vec3 x)
+/* Upper bound of the candidates of a particle: the particles of its stencil cells. */
+static size_t stencil_population(const struct wetdem_celllist* cl, const size_t* cells, int nc)
 {
-    size_t cells[27], total = 0;
-    int nc = stencil(cl, x, cells);
+    size_t total = 0;
     for (int q = 0; q < nc; q++)
         total += cl->cell_start[cells[q] + 1] - cl->cell_start[cells[q]];
     return total;
@@ -292,7 +302,9 @@ static int fill_pairs(struct wetdem_celllist* cl, const struct wetdem_particle* 
         used_threads = nt;
         size_t lo = n * (size_t)t / (size_t)nt, hi = n * (size_t)(t + 1) / (size_t)nt, cap = 0;
         for (size_t i = lo; i < hi; i++) {
-            size_t bound = stencil_population(cl, p[i].pos);
+            size_t cells[27];
+            int nc = stencil(cl, p[i].pos, cells);
+            size_t bound = stencil_population(cl, cells, nc);
             if (used[t] + bound > cap) {
                 cap = 2 * (used[t] + bound) + 64;
                 struct wetdem_celllist_pair* b = realloc(buf[t], cap * sizeof *b);
@@ -303,7 +315,7 @@ static int fill_pairs(struct wetdem_celllist* cl, const struct wetdem_particle* 
                 }
                 buf[t] = b;
             }
-            size_t c = scan_particle(cl, p, i, buf[t] + used[t]);
+            size_t c = scan_particle(cl, p, i, cells, nc, buf[t] + used[t]);
             cl->first_pair[i + 1] = c;
             used[t] += c;
         }

@@ -39,6 +39,11 @@ struct wetdem_celllist_box {
     bool periodic[3];
 };
 
+/* Position [m] and radius [m] of a particle, in cell order (cache-friendly scans). */
+struct wetdem_celllist_item {
+    double x, y, z, r;
+};
+
 /* One candidate pair, i < j (particle indices). */
 struct wetdem_celllist_pair {
     uint32_t i, j;
@@ -54,7 +59,8 @@ struct wetdem_celllist {
     size_t* cell_start; /* n_cells_total + 1 offsets into cell_items */
     uint32_t* cell_items; /* particle indices grouped by cell */
     uint32_t* cell_of;    /* cell of each particle */
-    size_t cells_cap, items_cap, cell_of_cap;
+    struct wetdem_celllist_item* sorted; /* positions and radii aligned with cell_items */
+    size_t cells_cap, items_cap, cell_of_cap, sorted_cap;
     /* pair list, sorted by (i, j) */
     struct wetdem_celllist_pair* pairs;
     size_t n_pairs, pairs_cap;

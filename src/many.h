@@ -25,6 +25,13 @@ struct wetdem_many_pair_out {
     struct wetdem_vec3 torque_j; /* [N m] */
 };
 
+/* What a pair (i, j) gives j, stored for the gather of j: the force on i (j gets -force)
+ * and the torque on j. */
+struct wetdem_many_rev_out {
+    struct wetdem_vec3 force;    /* on i [N] */
+    struct wetdem_vec3 torque_j; /* [N m] */
+};
+
 #define WETDEM_MANY_ACTIVE 1u  /* within the interaction range: force applied */
 #define WETDEM_MANY_CONTACT 2u /* gap < 0: solid contact */
 #define WETDEM_MANY_BRIDGE 4u  /* gap < film delta_ij with a fluid model: liquid bridge */
@@ -54,8 +61,6 @@ struct wetdem_many {
     struct wetdem_celllist_pair* old_pairs; /* previous list, for history remapping */
     double* old_history;
     size_t old_cap, old_history_cap;
-    struct wetdem_many_pair_out* out; /* per candidate pair; valid where flags has ACTIVE */
-    size_t out_cap;
     unsigned char* flags;        /* per candidate pair: MANY_ACTIVE | _CONTACT | _BRIDGE | _DIRTY
                                     (a separate byte array: the gather scans it densely) */
     size_t flags_cap;
@@ -68,9 +73,12 @@ struct wetdem_many {
     size_t n_wall_list, wall_list_cap;
     double max_disp2;            /* largest squared displacement since the build [m^2], */
     bool max_disp_valid;         /* measured during the latest drift */
-    size_t *rev_start, *rev;     /* pairs (k, i) of particle i: rev[rev_start[i] ..
-                                    rev_start[i+1]], pair indices in increasing order */
-    size_t rev_start_cap, rev_cap;
+    /* the pairs ordered by their second particle: particle i's pairs (k, i) occupy the slots
+       rev_start[i] .. rev_start[i+1] in increasing k; pair q is in slot[q] */
+    size_t *rev_start, *slot;
+    struct wetdem_many_rev_out* rev_out; /* per slot: the reaction, valid where ACTIVE */
+    unsigned char* rev_flags;            /* per slot: the pair's flags */
+    size_t rev_start_cap, slot_cap, rev_out_cap, rev_flags_cap;
     /* force kernel (sim_many_force.c) */
     struct wetdem_many_mix* mix; /* n_mix_materials^2 material pairs */
     size_t mix_cap;

@@ -83,7 +83,6 @@ void wetdem_sim_many_free(struct wetdem_sim* sim)
     free(m->wall_history);
     free(m->old_pairs);
     free(m->old_history);
-    free(m->out);
     free(m->old_flags);
     free(m->flags);
     free(m->wall_mask);
@@ -96,7 +95,9 @@ void wetdem_sim_many_free(struct wetdem_sim* sim)
     free(m->thread_work);
     free(m->mix);
     free(m->rev_start);
-    free(m->rev);
+    free(m->slot);
+    free(m->rev_out);
+    free(m->rev_flags);
     for (size_t k = 0; k < m->vtk_files && m->vtk_names; k++)
         free(m->vtk_names[k]);
     free(m->vtk_names);
@@ -316,7 +317,6 @@ static int rebuild(struct wetdem_sim* sim)
         return wetdem_sim_fail(sim, st, "%s", msg);
     size_t n_new = m->cl.n_pairs;
     if (grow((void**)&m->history, &m->history_cap, n_new * len + 1, sizeof(double)) ||
-        grow((void**)&m->out, &m->out_cap, n_new ? n_new : 1, sizeof *m->out) ||
         grow((void**)&m->flags, &m->flags_cap, n_new ? n_new : 1, 1))
         return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory for %zu pairs", n_new);
     double fresh[HISTORY_MAX];
@@ -414,30 +414,40 @@ static struct wetdem_vec3 wrap(const struct wetdem_celllist_box* b, struct wetde
     return vec3(c[0], c[1], c[2]);
 }
 
-/* Half kick and drift; velocities become the predicted ones v' + a dt/2. */
+/* Half kick and drift of particle p (index k); its velocities become the predicted ones
+ * v' + a dt/2. */
+static void kick_drift_one(struct wetdem_many* m, struct wetdem_particle* p, size_t k,
+                           struct wetdem_vec3 g, double h, bool periodic)
+{
+    struct wetdem_vec3 a = vec3_axpy(g, 1.0 / p->mass, m->force[k]);
+    struct wetdem_vec3 alpha =
+        vec3_scale(m->torque[k], 1.0 / (0.4 * p->mass * p->radius * p->radius));
+    m->vh[k] = vec3_axpy(p->vel, 0.5 * h, a);
+    m->wh[k] = vec3_axpy(p->omega, 0.5 * h, alpha);
+    struct wetdem_vec3 x = vec3_axpy(p->pos, h, m->vh[k]);
+    p->pos = periodic ? wrap(&m->cl.box, x) : x;
+    p->vel = vec3_axpy(m->vh[k], 0.5 * h, a);
+    p->omega = vec3_axpy(m->wh[k], 0.5 * h, alpha);
+}
+
+/* Half kick and drift of every particle; the largest squared displacement since the last
+ * neighbour-list build is measured in the same pass (rebuild criterion). */
 static void kick_drift(struct wetdem_sim* sim, double h)
 {
     struct wetdem_many* m = sim->many;
     struct wetdem_vec3 g = gravity(sim);
     bool track = m->cl.n_builds > 0 && m->cl.n_at_build == sim->n_particles;
+    bool periodic = m->cl.box.periodic[0] || m->cl.box.periodic[1] || m->cl.box.periodic[2];
+    const struct wetdem_vec3* at_build = m->cl.pos_at_build;
     double worst = 0; /* max is exact: the same for any thread count */
 #pragma omp parallel for schedule(static) reduction(max : worst)
     for (size_t k = 0; k < sim->n_particles; k++) {
         struct wetdem_particle* p = &sim->particles[k];
-        if (!p->is_fixed) {
-            struct wetdem_vec3 a = vec3_axpy(g, 1.0 / p->mass, m->force[k]);
-            struct wetdem_vec3 alpha =
-                vec3_scale(m->torque[k], 1.0 / (0.4 * p->mass * p->radius * p->radius));
-            m->vh[k] = vec3_axpy(p->vel, 0.5 * h, a);
-            m->wh[k] = vec3_axpy(p->omega, 0.5 * h, alpha);
-            p->pos = wrap(&m->cl.box, vec3_axpy(p->pos, h, m->vh[k]));
-            p->vel = vec3_axpy(m->vh[k], 0.5 * h, a);
-            p->omega = vec3_axpy(m->wh[k], 0.5 * h, alpha);
-        }
-        /* fused pass: the displacement since the last neighbour-list build is measured here
-         * (rebuild criterion) */
+        if (!p->is_fixed)
+            kick_drift_one(m, p, k, g, h, periodic);
         if (track) {
-            struct wetdem_vec3 d = celllist_delta(&m->cl.box, p->pos, m->cl.pos_at_build[k]);
+            struct wetdem_vec3 d = periodic ? celllist_delta(&m->cl.box, p->pos, at_build[k])
+                                            : vec3_sub(p->pos, at_build[k]);
             double d2 = vec3_dot(d, d);
             worst = d2 > worst ? d2 : worst;
         }

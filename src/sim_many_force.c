@@ -6,17 +6,18 @@
  * Prefix: wetdem_sim_.
  *
  * Per step, for the candidate list (celllist.h) of pairs (i < j) sorted by (i, j):
- *   1. pair pass (parallel, any schedule): pair q is evaluated into its own slot out[q]. A
- *      pair is skipped before any contact is built when |x_i - x_j|^2 > (R_i + R_j + r_ab)^2
- *      (1 + 1e-12), r_ab the model range of its material pair (the start-up reach for model
- *      sets without a fused kernel); the exact test h > range(c) then decides as before.
- *   2. gather (parallel over particles): particle k sums its wall forces (wall order), then
- *      -F of every pair (i, k) in increasing i, then F of every pair (k, j) in increasing j,
- *      and applies the closing half kick of velocity Verlet (sim_many.c) at once.
- * Each particle's sum has a fixed order (pair index order, the order of the former serial
- * scatter), so states are bit-identical for any number of threads, and, because pairs out of
- * range add nothing and the order is by particle index, for any time at which the list was
- * rebuilt (checkpoint + restart).
+ *   1. pair pass (parallel over particles i, any schedule): the pairs (i, j) of particle i, in
+ *      increasing j. A pair is skipped before any contact is built when
+ *      |x_i - x_j|^2 > (R_i + R_j + r_ab)^2 (1 + 1e-12), r_ab the model range of its material
+ *      pair (the start-up reach for model sets without a fused kernel); the exact test
+ *      h > range(c) then decides as before. The forces on i are summed in j order (S_i); the
+ *      reaction on j goes to the pair's slot in the list ordered by second particle.
+ *   2. gather (parallel over particles, any schedule): particle k sums its wall forces (wall
+ *      order), then -F of every pair (i, k) in increasing i, then adds S_k, and applies the
+ *      closing half kick of velocity Verlet (sim_many.c) at once.
+ * Every sum has a fixed order set by particle indices only, so states are bit-identical for
+ * any number of threads and, because pairs out of range add nothing, for any time at which
+ * the list was rebuilt (checkpoint + restart).
  *
  * Mixed properties (contact.c, SPEC §2): 1/E* = (1-nu_a^2)/E_a + (1-nu_b^2)/E_b, 1/G* =
  * (2-nu_a)/G_a + (2-nu_b)/G_b, means of e, mu, sigma, sum of films; computed once per
@@ -367,10 +368,10 @@ static int eval_pair(const struct wetdem_sim* sim, struct wetdem_contact* c, dou
                      double* work)
 {
     const struct wetdem_many* m = sim->many;
-    if (range > m->reach)
-        return WETDEM_ERR_INVALID; /* reported by the caller: the start-up bound failed */
     bool dirty = *flags & WETDEM_MANY_DIRTY;
     *flags = 0;
+    if (range > m->reach)
+        return WETDEM_ERR_INVALID; /* reported by the caller: the start-up bound failed */
     if (c->gap > range) {
         if (hist && dirty)
             wetdem_sim_history_init(sim, hist);
@@ -396,41 +397,69 @@ static int eval_pair(const struct wetdem_sim* sim, struct wetdem_contact* c, dou
     return WETDEM_OK;
 }
 
-/* Pair q: cheap gap test on the positions, then the contact and its force. */
-static void eval_one_pair(const struct wetdem_sim* sim, size_t q, struct failure* fail)
+/* Pair q within reach of the cheap test (d = x_i - x_j): its contact and force into *o. */
+static void eval_near_pair(const struct wetdem_sim* sim, size_t q, struct wetdem_vec3 d,
+                           const struct wetdem_many_mix* x, struct wetdem_many_pair_out* o,
+                           struct failure* fail)
 {
     const struct wetdem_many* m = sim->many;
     size_t i = m->cl.pairs[q].i, j = m->cl.pairs[q].j, len = sim->history_len;
-    const struct wetdem_particle* a = &sim->particles[i];
-    const struct wetdem_particle* b = &sim->particles[j];
-    struct wetdem_vec3 d = m->periodic_any ? celllist_delta(&m->cl.box, a->pos, b->pos)
-                                           : vec3_sub(a->pos, b->pos);
-    const struct wetdem_many_mix* x = wetdem_sim_many_mix(sim, a->material, b->material);
-    double lim = a->radius + b->radius + x->range;
-    double* hist = len ? m->history + q * len : NULL;
-    unsigned char* flags = &m->flags[q];
-    if (vec3_dot(d, d) > lim * lim * (1 + PREFILTER_MARGIN)) {
-        if (*flags & WETDEM_MANY_DIRTY && hist)
-            wetdem_sim_history_init(sim, hist);
-        *flags = 0;
-        return;
-    }
     struct wetdem_contact c;
-    pair_contact_from(a, b, d, x, &c);
+    pair_contact_from(&sim->particles[i], &sim->particles[j], d, x, &c);
     c.i = i;
     c.j = j;
     double range = contact_range(sim, &c, x);
-    int st = eval_pair(sim, &c, range, hist, &m->out[q], flags, thread_work(m, 0));
+    double* hist = len ? m->history + q * len : NULL;
+    int st = eval_pair(sim, &c, range, hist, o, &m->flags[q], thread_work(m, 0));
     if (st != WETDEM_OK)
         note_failure(fail, q, st, false, &c, range);
 }
 
-static void eval_all_pairs(const struct wetdem_sim* sim, struct failure* fail)
+/* The pairs (i, j > i) of particle i: the gap test on the positions first (most candidates
+ * are beyond their range), the contact only for the others. The forces on i are summed here
+ * in j order into force[i], torque[i], contacts[i]; the reactions on j go to the slot of the
+ * pair in the by-second-particle order (rev_out, rev_flags) for the gather. */
+static void eval_pairs_of(const struct wetdem_sim* sim, size_t i, struct failure* fail)
 {
-    size_t n = sim->many->cl.n_pairs;
-#pragma omp parallel for schedule(dynamic, 512)
-    for (size_t q = 0; q < n; q++)
-        eval_one_pair(sim, q, fail);
+    struct wetdem_many* m = sim->many;
+    const struct wetdem_particle* p = sim->particles;
+    const struct wetdem_particle* a = &p[i];
+    const struct wetdem_many_mix* mix_a = m->mix + (size_t)a->material * (size_t)m->n_mix_materials;
+    const struct wetdem_celllist_pair* pairs = m->cl.pairs;
+    const size_t* slot = m->slot;
+    unsigned char *flags = m->flags, *rev_flags = m->rev_flags;
+    struct wetdem_many_rev_out* rev_out = m->rev_out;
+    size_t len = sim->history_len, end = m->cl.first_pair[i + 1];
+    bool periodic = m->periodic_any;
+    struct wetdem_vec3 xi = a->pos, f = vec3(0, 0, 0), t = vec3(0, 0, 0);
+    double ri = a->radius;
+    uint32_t n_contacts = 0;
+    for (size_t q = m->cl.first_pair[i]; q < end; q++) {
+        const struct wetdem_particle* b = &p[pairs[q].j];
+        struct wetdem_vec3 d = periodic ? celllist_delta(&m->cl.box, xi, b->pos)
+                                        : vec3_sub(xi, b->pos);
+        const struct wetdem_many_mix* x = &mix_a[b->material];
+        double lim = ri + b->radius + x->range;
+        size_t r = slot[q];
+        if (vec3_dot(d, d) > lim * lim * (1 + PREFILTER_MARGIN)) {
+            if (flags[q] & WETDEM_MANY_DIRTY && len)
+                wetdem_sim_history_init(sim, m->history + q * len);
+            flags[q] = rev_flags[r] = 0;
+            continue;
+        }
+        struct wetdem_many_pair_out o;
+        eval_near_pair(sim, q, d, x, &o, fail);
+        unsigned char fl = rev_flags[r] = flags[q];
+        if (!(fl & WETDEM_MANY_ACTIVE))
+            continue;
+        f = vec3_add(f, o.force);
+        t = vec3_add(t, o.torque_i);
+        n_contacts += (fl & WETDEM_MANY_CONTACT) ? 1 : 0;
+        rev_out[r] = (struct wetdem_many_rev_out){o.force, o.torque_j};
+    }
+    m->force[i] = f;
+    m->torque[i] = t;
+    m->contacts[i] = n_contacts;
 }
 
 /* ---- the gather ---- */
@@ -472,7 +501,8 @@ static void eval_walls_of(const struct wetdem_sim* sim, size_t i, struct wetdem_
     }
 }
 
-/* Force, torque and contacts of particle i: walls, then its pairs in pair order. */
+/* Force, torque and contacts of particle i: its walls, then the reactions of its pairs (k, i)
+ * in increasing k, then the sum of its own pairs (i, j) from the pair pass. */
 static void gather_one(struct wetdem_sim* sim, size_t i, struct failure* fail)
 {
     struct wetdem_many* m = sim->many;
@@ -480,24 +510,19 @@ static void gather_one(struct wetdem_sim* sim, size_t i, struct failure* fail)
     uint32_t n_contacts = 0;
     if (m->wall_mask[i] || sim->n_walls > 64)
         eval_walls_of(sim, i, &f, &t, &n_contacts, fail);
-    for (size_t r = m->rev_start[i]; r < m->rev_start[i + 1]; r++) {
-        size_t q = m->rev[r];
-        if (!(m->flags[q] & WETDEM_MANY_ACTIVE))
+    const unsigned char* rev_flags = m->rev_flags;
+    const struct wetdem_many_rev_out* rev_out = m->rev_out;
+    for (size_t r = m->rev_start[i], end = m->rev_start[i + 1]; r < end; r++) {
+        unsigned char fl = rev_flags[r];
+        if (!(fl & WETDEM_MANY_ACTIVE))
             continue;
-        f = vec3_sub(f, m->out[q].force);
-        t = vec3_add(t, m->out[q].torque_j);
-        n_contacts += (m->flags[q] & WETDEM_MANY_CONTACT) ? 1 : 0;
+        f = vec3_sub(f, rev_out[r].force);
+        t = vec3_add(t, rev_out[r].torque_j);
+        n_contacts += (fl & WETDEM_MANY_CONTACT) ? 1 : 0;
     }
-    for (size_t q = m->cl.first_pair[i]; q < m->cl.first_pair[i + 1]; q++) {
-        if (!(m->flags[q] & WETDEM_MANY_ACTIVE))
-            continue;
-        f = vec3_add(f, m->out[q].force);
-        t = vec3_add(t, m->out[q].torque_i);
-        n_contacts += (m->flags[q] & WETDEM_MANY_CONTACT) ? 1 : 0;
-    }
-    m->force[i] = f;
-    m->torque[i] = t;
-    m->contacts[i] = n_contacts;
+    m->force[i] = vec3_add(f, m->force[i]);
+    m->torque[i] = vec3_add(t, m->torque[i]);
+    m->contacts[i] += n_contacts;
 }
 
 /* Closing half kick of particle k: v = v' + a dt/2, w = w' + alpha dt/2 (sim_many.c). */
@@ -513,29 +538,33 @@ static void close_kick(struct wetdem_sim* sim, size_t k, struct wetdem_vec3 g)
                          vec3_scale(m->torque[k], 1.0 / (0.4 * p->mass * p->radius * p->radius)));
 }
 
+/* Grows *a to n elements of `size` bytes (contents not kept). */
+static bool reserve(void** a, size_t* cap, size_t n, size_t size)
+{
+    if (n <= *cap && *a)
+        return true;
+    free(*a);
+    *a = malloc((n ? n : 1) * size);
+    *cap = *a ? n : 0;
+    return *a != NULL;
+}
+
 int wetdem_sim_many_index_pairs(struct wetdem_sim* sim)
 {
     struct wetdem_many* m = sim->many;
     size_t n = sim->n_particles, np = m->cl.n_pairs;
-    if (n + 1 > m->rev_start_cap) {
-        free(m->rev_start);
-        m->rev_start = malloc((n + 1) * sizeof *m->rev_start);
-        m->rev_start_cap = m->rev_start ? n + 1 : 0;
-    }
-    if (np > m->rev_cap || !m->rev) {
-        free(m->rev);
-        m->rev = malloc((np ? np : 1) * sizeof *m->rev);
-        m->rev_cap = m->rev ? np : 0;
-    }
-    if (!m->rev_start || !m->rev)
+    if (!reserve((void**)&m->rev_start, &m->rev_start_cap, n + 1, sizeof *m->rev_start) ||
+        !reserve((void**)&m->slot, &m->slot_cap, np, sizeof *m->slot) ||
+        !reserve((void**)&m->rev_out, &m->rev_out_cap, np, sizeof *m->rev_out) ||
+        !reserve((void**)&m->rev_flags, &m->rev_flags_cap, np, 1))
         return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory for %zu pairs", np);
     memset(m->rev_start, 0, (n + 1) * sizeof *m->rev_start);
     for (size_t q = 0; q < np; q++)
         m->rev_start[m->cl.pairs[q].j + 1]++;
     for (size_t k = 0; k < n; k++)
         m->rev_start[k + 1] += m->rev_start[k];
-    for (size_t q = 0; q < np; q++) /* in pair order: each segment ascends */
-        m->rev[m->rev_start[m->cl.pairs[q].j]++] = q;
+    for (size_t q = 0; q < np; q++) /* in pair order: each particle's slots ascend with i */
+        m->slot[q] = m->rev_start[m->cl.pairs[q].j]++;
     for (size_t k = n; k > 0; k--) /* undo the shift left by the fill */
         m->rev_start[k] = m->rev_start[k - 1];
     m->rev_start[0] = 0;
@@ -549,10 +578,12 @@ int wetdem_sim_many_forces(struct wetdem_sim* sim, bool kick)
     if (st != WETDEM_OK)
         return st;
     struct failure fail = {0};
-    eval_all_pairs(sim, &fail);
+    size_t n = sim->n_particles;
+#pragma omp parallel for schedule(dynamic, 64)
+    for (size_t i = 0; i < n; i++)
+        eval_pairs_of(sim, i, &fail);
     struct wetdem_vec3 g =
         vec3(sim->settings.gravity_x, sim->settings.gravity_y, sim->settings.gravity_z);
-    size_t n = sim->n_particles;
 #pragma omp parallel for schedule(static)
     for (size_t i = 0; i < n; i++) {
         gather_one(sim, i, &fail);
