@@ -295,7 +295,7 @@ static void summary_json(FILE* f, const struct cli_scenario* sc, const struct cl
     json_num(f, "dt_s", s->dt, true);
     fprintf(f, "\"contacts\": %zu, \"bridges\": %zu, \"agglomerates\": %zu, ", s->contacts,
             s->bridges, s->agglomerates);
-    json_num(f, "mean_agglomerate_size", s->mean_agglomerate, !o->has_budget);
+    json_num(f, "mean_agglomerate_size", s->mean_agglomerate, o->has_budget);
     if (o->has_budget) {
         const struct wetdem_energy_budget* b = &o->budget;
         fputs("\"energy_J\": {", f);

@@ -641,6 +641,12 @@ static int build_run(const struct cli_scenario* sc, struct cli_many_setup* su)
 {
     const struct cli_entry* te = cli_scenario_find(sc, "run", "t_end");
     const struct cli_entry* se = cli_scenario_find(sc, "run", "steps");
+    if (te && se && (te->line == 0) != (se->line == 0)) { /* --set of one replaces the other */
+        if (te->line == 0)
+            se = NULL;
+        else
+            te = NULL;
+    }
     if (te && se) {
         cli_scenario_error(sc, se, "give t_end or steps, not both");
         return CLI_EXIT_USAGE;

@@ -402,6 +402,7 @@ static void test_many_cli_examples_and_budget(void** state)
        moved (tests/test_many.c); 1e-2 leaves room for the film forces' jumps at h = delta */
     assert_true(fabs(v[6]) < 1e-2 * fmax(fabs(v[5]), fabs(v[1] - v[0])));
     assert_true(v[4] > 0); /* damping and films took energy */
+    CHECK_CONTAINS(js, ", \"energy_J\": {\"input\": "); /* fields separated as JSON wants */
     free(js);
 }
 
