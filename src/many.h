@@ -91,6 +91,8 @@ struct wetdem_many {
     double kind_opt[WETDEM_MAX_MODELS];    /* its switch parameter (hertz damping form, ...) */
     struct wetdem_vec3 *force, *torque, *vh, *wh; /* per particle */
     uint32_t* contacts;          /* per particle: solid contacts at the latest evaluation */
+    struct wetdem_celllist_item* xr; /* per particle: position and radius, a compact copy for
+                                        the gap tests (kept by kick_drift) */
     size_t particle_cap;
     struct wetdem_many_energy energy;
     double* thread_work;         /* per thread: 2 x WETDEM_MAX_MODELS accumulators */

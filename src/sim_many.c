@@ -92,6 +92,7 @@ void wetdem_sim_many_free(struct wetdem_sim* sim)
     free(m->vh);
     free(m->wh);
     free(m->contacts);
+    free(m->xr);
     free(m->thread_work);
     free(m->mix);
     free(m->rev_start);
@@ -239,6 +240,9 @@ static int size_particle_arrays(struct wetdem_sim* sim)
     size_t c = cap;
     if (grow((void**)&m->contacts, &c, n, sizeof *m->contacts))
         return WETDEM_ERR_NOMEM;
+    c = cap;
+    if (grow((void**)&m->xr, &c, n, sizeof *m->xr))
+        return WETDEM_ERR_NOMEM;
     m->particle_cap = c;
     size_t len = sim->history_len, nw = sim->n_walls * n * len;
     size_t old = m->wall_history_cap;
@@ -362,7 +366,8 @@ int wetdem_sim_many_prepare(struct wetdem_sim* sim)
             return wetdem_sim_fail(sim, st, "%s", msg);
         m->reach = reach;
     }
-    if (fresh_set || !m->kernel_ready) {
+    bool refresh = fresh_set || !m->kernel_ready;
+    if (refresh) {
         int st = wetdem_sim_many_setup_kernel(sim);
         if (st != WETDEM_OK)
             return st;
@@ -371,6 +376,10 @@ int wetdem_sim_many_prepare(struct wetdem_sim* sim)
     if (size_particle_arrays(sim) != WETDEM_OK)
         return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory for %zu particles",
                                sim->n_particles);
+    for (size_t k = 0; refresh && k < sim->n_particles; k++) { /* the user may move particles */
+        const struct wetdem_particle* p = &sim->particles[k];
+        m->xr[k] = (struct wetdem_celllist_item){p->pos.x, p->pos.y, p->pos.z, p->radius};
+    }
     bool moved = m->max_disp_valid && m->cl.n_builds > 0 &&
                          m->cl.n_at_build == sim->n_particles
                      ? m->max_disp2 > 0.25 * m->cl.skin * m->cl.skin
@@ -426,6 +435,9 @@ static void kick_drift_one(struct wetdem_many* m, struct wetdem_particle* p, siz
     m->wh[k] = vec3_axpy(p->omega, 0.5 * h, alpha);
     struct wetdem_vec3 x = vec3_axpy(p->pos, h, m->vh[k]);
     p->pos = periodic ? wrap(&m->cl.box, x) : x;
+    m->xr[k].x = p->pos.x;
+    m->xr[k].y = p->pos.y;
+    m->xr[k].z = p->pos.z;
     p->vel = vec3_axpy(m->vh[k], 0.5 * h, a);
     p->omega = vec3_axpy(m->wh[k], 0.5 * h, alpha);
 }

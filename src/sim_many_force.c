@@ -423,23 +423,25 @@ static void eval_pairs_of(const struct wetdem_sim* sim, size_t i, struct failure
 {
     struct wetdem_many* m = sim->many;
     const struct wetdem_particle* p = sim->particles;
-    const struct wetdem_particle* a = &p[i];
-    const struct wetdem_many_mix* mix_a = m->mix + (size_t)a->material * (size_t)m->n_mix_materials;
+    const struct wetdem_celllist_item* xr = m->xr;
+    size_t nm = (size_t)m->n_mix_materials;
+    const struct wetdem_many_mix* mix_a = m->mix + (size_t)p[i].material * nm;
     const struct wetdem_celllist_pair* pairs = m->cl.pairs;
     const size_t* slot = m->slot;
     unsigned char *flags = m->flags, *rev_flags = m->rev_flags;
     struct wetdem_many_rev_out* rev_out = m->rev_out;
     size_t len = sim->history_len, end = m->cl.first_pair[i + 1];
     bool periodic = m->periodic_any;
-    struct wetdem_vec3 xi = a->pos, f = vec3(0, 0, 0), t = vec3(0, 0, 0);
-    double ri = a->radius;
+    struct wetdem_vec3 xi = vec3(xr[i].x, xr[i].y, xr[i].z), f = vec3(0, 0, 0),
+                       t = vec3(0, 0, 0);
+    double ri = xr[i].r;
     uint32_t n_contacts = 0;
     for (size_t q = m->cl.first_pair[i]; q < end; q++) {
-        const struct wetdem_particle* b = &p[pairs[q].j];
-        struct wetdem_vec3 d = periodic ? celllist_delta(&m->cl.box, xi, b->pos)
-                                        : vec3_sub(xi, b->pos);
-        const struct wetdem_many_mix* x = &mix_a[b->material];
-        double lim = ri + b->radius + x->range;
+        size_t j = pairs[q].j;
+        struct wetdem_vec3 xj = vec3(xr[j].x, xr[j].y, xr[j].z);
+        struct wetdem_vec3 d = periodic ? celllist_delta(&m->cl.box, xi, xj) : vec3_sub(xi, xj);
+        const struct wetdem_many_mix* x = nm == 1 ? mix_a : &mix_a[p[j].material];
+        double lim = ri + xr[j].r + x->range;
         size_t r = slot[q];
         if (vec3_dot(d, d) > lim * lim * (1 + PREFILTER_MARGIN)) {
             if (flags[q] & WETDEM_MANY_DIRTY && len)
