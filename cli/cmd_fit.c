@@ -355,7 +355,71 @@ static int fit_model(const double* params, double* predicted, char* msg, size_t 
 
 /* ---- parameters --------------------------------------------------------------------------- */
 
-/* Splits --fit into full "section.key" names. */
+/* A model name close to `word` (e.g. "glas" -> "glass"), or NULL. */
+static const char* model_suggestion(const char* word)
+{
+    const struct wetdem_model* const* reg = wetdem_model_registry();
+    const char* names[64];
+    size_t k = 0;
+    for (; reg[k] && k + 1 < 64; k++)
+        names[k] = reg[k]->name;
+    names[k] = NULL;
+    return wetdem_param_suggest(word, names);
+}
+
+/* The numeric key `key` of section `section` as named in --fit (tok): the section must exist,
+ * the key must be one of its keys (with a suggestion otherwise) and take a number. Sections
+ * whose keys are only known when built ([integrator], [sim]) pass here and are checked when
+ * the first point is built. */
+static int check_key(const char* tok, const char* section, const char* key)
+{
+    struct cli_section_info info;
+    char msg[512] = "";
+    if (cli_section_lookup(section, &info) != 0) {
+        const char* hint = strchr(section, '.') ? NULL : model_suggestion(section);
+        if (hint)
+            snprintf(msg, sizeof msg, " (did you mean '%s.%s'?)", hint, key);
+        else
+            cli_section_suggestion(section, msg, sizeof msg);
+        cli_error("fit: --fit %s: unknown section [%s]%s", tok, section, msg);
+        return CLI_EXIT_USAGE;
+    }
+    const char* names[128];
+    size_t n = 0;
+    for (size_t k = 0; info.desc->keys && info.desc->keys[k].key && n + 1 < 128; k++) {
+        const struct cli_key_desc* d = &info.desc->keys[k];
+        if (strcmp(d->key, key) == 0 && d->kind != CLI_VALUE_NUMBER) {
+            cli_error("fit: --fit %s: [%s] %s takes a word, not a number; only numeric keys "
+                      "can be fitted", tok, section, key);
+            return CLI_EXIT_USAGE;
+        }
+        if (strcmp(d->key, key) == 0)
+            return CLI_EXIT_OK;
+        names[n++] = d->key;
+    }
+    for (size_t k = 0; info.lib_keys && info.lib_keys[k].name && n + 1 < 128; k++) {
+        const struct wetdem_param_desc* d = &info.lib_keys[k];
+        if (strcmp(d->name, key) == 0 && d->choices) {
+            cli_error("fit: --fit %s: [%s] %s is a choice, not a number; only numeric "
+                      "parameters can be fitted", tok, section, key);
+            return CLI_EXIT_USAGE;
+        }
+        if (strcmp(d->name, key) == 0)
+            return CLI_EXIT_OK;
+        names[n++] = d->name;
+    }
+    if (info.open_keys)
+        return CLI_EXIT_OK;
+    names[n] = NULL;
+    const char* hint = wetdem_param_suggest(key, names);
+    if (hint)
+        snprintf(msg, sizeof msg, " (did you mean '%s'?)", hint);
+    cli_error("fit: --fit %s: unknown key '%s' in [%s]%s; 'wetdem describe' lists a model's "
+              "parameters, docs/scenarios.md the scenario keys", tok, key, section, msg);
+    return CLI_EXIT_USAGE;
+}
+
+/* Splits --fit into full "section.key" names and checks each. */
 static int parse_keys(const char* list, struct fit_ctx* c)
 {
     char buf[1024];
@@ -368,7 +432,8 @@ static int parse_keys(const char* list, struct fit_ctx* c)
         }
         char probe[CLI_NAME_MAX * 2 + 4], section[CLI_NAME_MAX], key[CLI_NAME_MAX];
         snprintf(probe, sizeof probe, "%s=0", tok);
-        if (cli_override_split(probe, section, key, NULL) != 0)
+        if (cli_override_split(probe, section, key, NULL) != 0 ||
+            check_key(tok, section, key) != CLI_EXIT_OK)
             return CLI_EXIT_USAGE;
         snprintf(c->keys[c->n_keys++], sizeof c->keys[0], "%s.%s", section, key);
     }
@@ -377,6 +442,30 @@ static int parse_keys(const char* list, struct fit_ctx* c)
         return CLI_EXIT_USAGE;
     }
     return CLI_EXIT_OK;
+}
+
+/* The residual variance needs a degree of freedom: more residuals than parameters. */
+static int check_counts(const struct fit_args* a, const struct fit_ctx* c)
+{
+    size_t n = c->n_pts * (c->use_omega ? 2 : 1);
+    if (n > c->n_keys)
+        return CLI_EXIT_OK;
+    cli_error("fit: %s has %zu data row%s (%zu residual%s%s) for %zu parameter%s: need more "
+              "residuals than parameters, at least %zu rows (the standard errors use the "
+              "residual variance cost/(n - p))", a->data, c->n_pts, c->n_pts == 1 ? "" : "s",
+              n, n == 1 ? "" : "s", c->use_omega ? ": e_n and spin" : "", c->n_keys,
+              c->n_keys == 1 ? "" : "s", c->use_omega ? c->n_keys / 2 + 1 : c->n_keys + 1);
+    return CLI_EXIT_USAGE;
+}
+
+/* Unit of a fitted key as documented ("-" when dimensionless or unknown). */
+static const char* key_unit(const char* full)
+{
+    const char* dot = strrchr(full, '.');
+    char section[CLI_NAME_MAX];
+    snprintf(section, sizeof section, "%.*s", (int)(dot - full), full);
+    const char* u = cli_scenario_key_unit(section, dot + 1);
+    return (u && *u) ? u : "-";
 }
 
 /* Value of a material or fluid field from the section's preset (material.NAME.KEY with
@@ -430,6 +519,13 @@ static int initial_value(const struct fit_ctx* c, size_t j, double* v)
         return CLI_EXIT_OK;
     if (preset_value(c->base, section, dot + 1, v) || model_value(c->base, section, dot + 1, v))
         return CLI_EXIT_OK;
+    struct cli_section_info info;
+    if (cli_section_lookup(section, &info) == 0 && info.open_keys) {
+        cli_error("fit: %s is not set in %s; give its initial value with --init", full,
+                  c->base->file);
+        return CLI_EXIT_USAGE;
+    }
+    /* Not settable here (e.g. a model the scenario does not enable): the checker says why. */
     struct cli_scenario probe;
     char set[2 * CLI_NAME_MAX + 8];
     snprintf(set, sizeof set, "%s=1", full);
@@ -474,18 +570,51 @@ static int initial_values(const struct fit_args* a, const struct fit_ctx* c, dou
 static const char* const converged_words[] = {"no", "small step", "small gradient",
                                               "small cost change"};
 
+/* Root mean square and largest magnitude of residuals r[0..n), and the index of the latter. */
+static void residual_stats(const double* r, size_t n, double* rms, double* max, size_t* at)
+{
+    double s = 0;
+    *max = 0, *at = 0;
+    for (size_t i = 0; i < n; i++) {
+        s += r[i] * r[i];
+        if (fabs(r[i]) > *max)
+            *max = fabs(r[i]), *at = i;
+    }
+    *rms = n ? sqrt(s / (double)n) : 0;
+}
+
 static void print_result(const struct fit_ctx* c, const double* init,
-                         const struct wetdem_fit_result* r, int argc, char** argv)
+                         const struct wetdem_fit_result* r, const double* pred, double omega_scale,
+                         int argc, char** argv)
 {
     cli_print_provenance(stdout, argc, argv);
-    printf("parameter,value,std_error,initial,fitted_as\n");
+    printf("parameter,unit,value,std_error,initial,fitted_as\n");
     for (size_t j = 0; j < c->n_keys; j++)
-        printf("%s,%.9g,%.3g,%.9g,%s\n", c->keys[j], r->values[j], r->std_errors[j], init[j],
-               init[j] > 0 ? "log" : "linear");
+        printf("%s,%s,%.9g,%.3g,%.9g,%s\n", c->keys[j], key_unit(c->keys[j]), r->values[j],
+               r->std_errors[j], init[j], init[j] > 0 ? "log" : "linear");
+    for (size_t j = 0; j < c->n_keys; j++)
+        printf("# %s = %.6g +- %.3g %s (%.2g %%)\n", c->keys[j], r->values[j], r->std_errors[j],
+               key_unit(c->keys[j]), 100 * r->std_errors[j] / fabs(r->values[j]));
     int by = (r->converged_by >= 0 && r->converged_by <= 3) ? r->converged_by : 0;
-    printf("# cost %.6g, residual std %.4g (%zu dof), %zu iterations, %zu model evaluations "
-           "(x %zu collisions), converged: %s\n", r->cost, r->residual_std, r->dof,
+    printf("# cost %.6g [-], residual std s = %.4g [-]%s over %zu dof, %zu iterations, %zu model "
+           "evaluations (x %zu collisions), converged: %s\n", r->cost, r->residual_std,
+           c->use_omega ? " (spin residuals in units of --omega-scale)" : " (e_n)", r->dof,
            r->iterations, r->model_evals, c->n_pts, converged_words[by]);
+    double* res = malloc(c->n_pts * sizeof *res);
+    for (size_t part = 0; res && part < (c->use_omega ? 2u : 1u); part++) {
+        for (size_t i = 0; i < c->n_pts; i++)
+            res[i] = part ? pred[c->n_pts + i] - c->pts[i].omega : pred[i] - c->pts[i].e_n;
+        double rms, max;
+        size_t at;
+        residual_stats(res, c->n_pts, &rms, &max, &at);
+        const char* unit = part ? "rad/s" : "-";
+        printf("# residuals %s (fit - data): rms %.3g [%s], largest %.3g [%s] at St_n = %g\n",
+               part ? "omega" : "e_n", rms, unit, res[at], unit, c->pts[at].stokes);
+    }
+    if (c->use_omega)
+        printf("# spin residuals weighed as e_n residuals times %g rad/s (--omega-scale)\n",
+               omega_scale);
+    free(res);
     for (size_t j = 0; j < c->n_keys && c->n_keys > 1; j++) {
         printf("# correlation %s:", c->keys[j]);
         for (size_t k = 0; k < c->n_keys; k++)
@@ -509,13 +638,14 @@ static int write_fit_csv(const char* path, const struct fit_ctx* c, const double
     }
     cli_print_provenance(f, argc, argv);
     fprintf(f, "stokes_n [-],angle_deg [deg],e_n_data [-],e_n_fit [-],e_n_residual [-]%s\n",
-            c->use_omega ? ",omega_data [rad/s],omega_fit [rad/s]" : "");
+            c->use_omega ? ",omega_data [rad/s],omega_fit [rad/s],omega_residual [rad/s]" : "");
     for (size_t i = 0; i < c->n_pts; i++) {
         const struct point* p = &c->pts[i];
         fprintf(f, "%.9g,%.9g,%.9g,%.9g,%.6g", p->stokes, point_angle(c, p), p->e_n, pred[i],
                 pred[i] - p->e_n);
         if (c->use_omega)
-            fprintf(f, ",%.9g,%.9g", p->omega, pred[c->n_pts + i]);
+            fprintf(f, ",%.9g,%.9g,%.6g", p->omega, pred[c->n_pts + i],
+                    pred[c->n_pts + i] - p->omega);
         fputc('\n', f);
     }
     return fclose(f) == 0 ? CLI_EXIT_OK : CLI_EXIT_RUNTIME;
@@ -601,7 +731,7 @@ static int run_fit(const struct fit_args* a, struct fit_ctx* c, const double* in
     int st = wetdem_fit_run(&pb, &o, &r, pred, msg, sizeof msg);
     int rc = CLI_EXIT_OK;
     if (st == WETDEM_OK || st == WETDEM_ERR_MAX_STEPS) {
-        print_result(c, init, &r, argc, argv);
+        print_result(c, init, &r, pred, a->omega_scale, argc, argv);
         if (a->out)
             rc = write_fit_csv(a->out, c, pred, argc, argv);
         if (rc == CLI_EXIT_OK && a->curve)
@@ -649,6 +779,8 @@ int cmd_fit(int argc, char** argv)
         }
     if (rc == CLI_EXIT_OK)
         rc = parse_keys(a.fit, &c);
+    if (rc == CLI_EXIT_OK)
+        rc = check_counts(&a, &c);
     if (rc == CLI_EXIT_OK)
         rc = initial_values(&a, &c, init);
     if (rc == CLI_EXIT_OK)

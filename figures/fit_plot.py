@@ -2,9 +2,11 @@
 --curve, or the fitted values at the data points), per impact angle, with the residuals.
 
 Usage: /usr/bin/python3 figures/fit_plot.py FIT.csv [--curve CURVE.csv] [--png OUT.png]
-       [--title TEXT]
+       [--title TEXT] [--summary SUMMARY.csv]
 FIT.csv is the --out file of `wetdem fit` (stokes_n, angle_deg, e_n_data, e_n_fit,
-e_n_residual[, omega_data, omega_fit]); CURVE.csv its --curve file. docs/calibration.md.
+e_n_residual[, omega_data, omega_fit, omega_residual]); CURVE.csv its --curve file;
+SUMMARY.csv its standard output, whose fitted values, standard errors and units are written
+on the plot. docs/calibration.md.
 """
 import argparse
 import os
@@ -16,12 +18,26 @@ from common import plt, read_csv  # noqa: E402
 import numpy as np  # noqa: E402
 
 
+def fitted_values(path):
+    """Lines "KEY = value +- std_error unit" from the standard output of `wetdem fit`."""
+    rows = [ln.strip().split(",") for ln in open(path) if ln.strip() and not ln.startswith("#")]
+    head = rows[0]
+    col = {name: k for k, name in enumerate(head)}
+    out = []
+    for r in rows[1:]:
+        unit = r[col["unit"]] if "unit" in col else ""
+        out.append(f"{r[col['parameter']]} = {float(r[col['value']]):.4g} "
+                   f"+- {float(r[col['std_error']]):.2g} {'' if unit == '-' else unit}")
+    return out
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("fit")
     ap.add_argument("--curve")
     ap.add_argument("--png")
     ap.add_argument("--title", default="wetdem fit")
+    ap.add_argument("--summary")
     a = ap.parse_args()
     d = read_csv(a.fit)
     c = read_csv(a.curve) if a.curve else None
@@ -48,9 +64,12 @@ def main():
             axes[2].plot(d["stokes_n"][m], d["omega_data"][m], "o", color=col)
     ax.set_ylabel("e_n [-]")
     ax.set_title(a.title)
-    ax.legend(fontsize=8)
+    ax.legend(fontsize=8, loc="lower right")
+    if a.summary:
+        ax.text(0.03, 0.97, "\n".join(fitted_values(a.summary)), transform=ax.transAxes,
+                va="top", fontsize=9)
     axr.axhline(0, color="k", lw=0.5)
-    axr.set_ylabel("fit - data")
+    axr.set_ylabel("fit - data [-]")
     if has_omega:
         axes[2].set_ylabel("|omega| striker [rad/s]")
     axes[-1].set_xlabel("St_n [-]")

@@ -2,9 +2,13 @@
  * test_fit.c — model calibration (src/fit.c): recovery of known parameters from noisy data
  * within the reported standard errors, calibration of those errors (coverage over many noise
  * draws), argument checks, and a glass-transition pressure P_gt recovered from restitution
- * data simulated by wetdem itself (Punch 2023 set-up, soft engine).
+ * data simulated by wetdem itself (Punch 2023 set-up, soft engine); the CLI `wetdem fit` on
+ * the example data (units in its report) and its messages for bad input (exit code 2).
  */
 #include <stdlib.h>
+#include <string.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <gsl/gsl_randist.h>
 #include <gsl/gsl_rng.h>
@@ -213,6 +217,101 @@ static void test_fit_recovers_glass_pressure_from_simulated_data(void** state)
     wetdem_sim_free(d.sim);
 }
 
+/* ---- the command line --------------------------------------------------------------------- */
+
+/* Runs `$WETDEM_CLI args 2>&1` into out; returns the exit code (-1 if it did not exit). */
+static int run_cli(const char* cli, const char* args, char* out, size_t n)
+{
+    char cmd[2048];
+    snprintf(cmd, sizeof cmd, "%s %s 2>&1", cli, args);
+    FILE* p = popen(cmd, "r");
+    assert_non_null(p);
+    size_t len = fread(out, 1, n - 1, p);
+    out[len] = '\0';
+    int rc = pclose(p);
+    return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
+}
+
+/* Writes text to /tmp/wetdem_fit_TAG_PID.csv; path receives the name. */
+static void temp_csv(char path[96], const char* tag, const char* text)
+{
+    snprintf(path, 96, "/tmp/wetdem_fit_%s_%d.csv", tag, (int)getpid());
+    FILE* f = fopen(path, "w");
+    assert_non_null(f);
+    fputs(text, f);
+    fclose(f);
+}
+
+/* `wetdem fit ARGS` must exit with `rc` and print `needle`. */
+static void expect_cli(const char* cli, const char* args, int rc, const char* needle)
+{
+    char out[8192];
+    int got = run_cli(cli, args, out, sizeof out);
+    if (got != rc)
+        fail_msg("wetdem %s: exit %d, expected %d; output:\n%s", args, got, rc, out);
+    CHECK_CONTAINS(out, needle);
+}
+
+static void test_fit_cli_rejects_bad_input(void** state)
+{
+    (void)state;
+    const char* cli = getenv("WETDEM_CLI");
+    if (!cli)
+        skip();
+    const char* ini = "examples/fit/punch_db_c.ini";
+    char good[96], bad[96];
+    temp_csv(good, "good", "stokes_n,e_n\n2,0.5\n3,0.6\n");
+    temp_csv(bad, "bad", "# comment\nstokes_n,e_n\n2,0.5\n3,abc\n");
+    char args[1024];
+    expect_cli(cli, "fit --help", 0, "usage: wetdem fit FILE --data CSV --fit KEY");
+    snprintf(args, sizeof args, "fit %s --data /nonexistent/data.csv --fit glass.p_gt", ini);
+    expect_cli(cli, args, 2, "cannot open data file /nonexistent/data.csv");
+    snprintf(args, sizeof args, "fit %s --data %s --fit glass.p_gt", ini, bad);
+    expect_cli(cli, args, 2, ":4: column e_n: 'abc' is not a finite number");
+    temp_csv(bad, "bad", "stokes_n,e_n\n2\n");
+    expect_cli(cli, args, 2, ":2: 1 columns, but column e_n is number 2");
+    temp_csv(bad, "bad", "stokes,e_n\n2,0.5\n");
+    expect_cli(cli, args, 2, ":1: the header must name columns stokes_n and e_n");
+    snprintf(args, sizeof args, "fit %s --data %s --fit glass.p_g", ini, good);
+    expect_cli(cli, args, 2, "unknown key 'p_g' in [model.glass] (did you mean 'p_gt'?)");
+    snprintf(args, sizeof args, "fit %s --data %s --fit glas.p_gt", ini, good);
+    expect_cli(cli, args, 2, "unknown section [glas] (did you mean 'glass.p_gt'?)");
+    snprintf(args, sizeof args, "fit %s --data %s --fit material.striker.restitutio", ini, good);
+    expect_cli(cli, args, 2, "(did you mean 'restitution'?)");
+    snprintf(args, sizeof args, "fit %s --data %s --fit glass.speed", ini, good);
+    expect_cli(cli, args, 2, "speed is a choice, not a number");
+    /* Two rows, two parameters: no degree of freedom left for the residual variance. */
+    snprintf(args, sizeof args, "fit %s --data %s --fit glass.p_gt,material.striker.restitution",
+             ini, good);
+    expect_cli(cli, args, 2, "has 2 data rows (2 residuals) for 2 parameters: need more "
+                             "residuals than parameters, at least 3 rows");
+    remove(good);
+    remove(bad);
+}
+
+static void test_fit_cli_reports_units_on_example(void** state)
+{
+    (void)state;
+    const char* cli = getenv("WETDEM_CLI");
+    if (!cli)
+        skip();
+    char out[8192];
+    int rc = run_cli(cli, "fit examples/fit/punch_db_c.ini --data examples/fit/punch_0deg.csv "
+                          "--fit glass.p_gt --init 4e6", out, sizeof out);
+    if (rc != 0)
+        fail_msg("exit %d:\n%s", rc, out);
+    CHECK_CONTAINS(out, "parameter,unit,value,std_error,initial,fitted_as\nmodel.glass.p_gt,Pa,");
+    CHECK_CONTAINS(out, "# residuals e_n (fit - data): rms ");
+    CHECK_CONTAINS(out, "residual std s = ");
+    const char* row = strstr(out, "model.glass.p_gt,Pa,");
+    double value = 0, se = 0;
+    assert_int_equal(sscanf(row, "model.glass.p_gt,Pa,%lf,%lf", &value, &se), 2);
+    /* The example data are e_n simulated at 11.6 MPa plus noise 0.02 (9 points): recovered
+     * within 3 reported standard errors, which are informative (< 5 % of P_gt). */
+    if (!(fabs(value - 11.6e6) < 3 * se && se < 0.05 * 11.6e6))
+        fail_msg("P_gt %.4g +- %.3g Pa vs 11.6e6", value, se);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -220,6 +319,8 @@ int main(void)
         cmocka_unit_test(test_fit_standard_errors_are_calibrated),
         cmocka_unit_test(test_fit_rejects_bad_problems),
         cmocka_unit_test(test_fit_recovers_glass_pressure_from_simulated_data),
+        cmocka_unit_test(test_fit_cli_rejects_bad_input),
+        cmocka_unit_test(test_fit_cli_reports_units_on_example),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
