@@ -1,0 +1,293 @@
+/*
+ * test_many_force.c — the force evaluation of the many-particle mode (src/sim_many_force.c):
+ * the contact built from the material-pair table equals the one contact.c builds, the fused
+ * hertz/mindlin/sb/capillary kernel gives bit-identical forces, per-model forces and
+ * histories to the generic model interface (wetdem_sim_eval_contact) over every branch of the
+ * four models, whole runs with the fused kernel equal runs through the generic interface bit
+ * for bit, and both stay independent of the thread count.
+ *
+ * Bit-identity is the right tolerance here: the fused kernel calls the same kernels with the
+ * same arguments and adds the models in the same order, so any difference is a bug.
+ */
+#include <gsl/gsl_rng.h>
+#include <omp.h>
+#include <stdlib.h>
+
+#include "harness.h"
+#include "many.h"
+
+/* Two materials that differ in every property the contact mixes, a fluid, and the model
+ * set given (in that order). */
+static struct wetdem_sim* two_material_sim(const char* const* models, int n_models)
+{
+    struct wetdem_sim* sim = wetdem_sim_create();
+    struct wetdem_material a = {.density = 2500, .youngs_modulus = 1e7, .poisson_ratio = 0.3,
+                                .restitution = 0.6, .friction_dry = 0.4, .friction_lub = 0.1,
+                                .roughness = 1e-7, .film = 20e-6};
+    struct wetdem_material b = {.density = 7800, .youngs_modulus = 2e8, .poisson_ratio = 0.25,
+                                .restitution = 0.8, .friction_dry = 0.3, .friction_lub = 0.05,
+                                .roughness = 3e-7, .film = 10e-6};
+    assert_int_equal(wetdem_sim_add_material(sim, &a), 0);
+    assert_int_equal(wetdem_sim_add_material(sim, &b), 1);
+    struct wetdem_fluid f = {.viscosity = 0.01, .surface_tension = 0.02, .density = 1000};
+    CHECK_OK(wetdem_sim_set_fluid(sim, &f));
+    for (int k = 0; k < n_models; k++)
+        CHECK_OK(wetdem_sim_enable_model(sim, models[k]));
+    return sim;
+}
+
+/* Random particles of both materials near one another, spinning, and a floor; the many
+ * state set up (table, kernel choice) without running. */
+static void add_particles(struct wetdem_sim* sim, size_t n, unsigned long seed)
+{
+    gsl_rng* rng = gsl_rng_alloc(gsl_rng_mt19937);
+    gsl_rng_set(rng, seed);
+    for (size_t k = 0; k < n; k++) {
+        struct wetdem_particle p = {
+            .pos = {2e-3 * gsl_rng_uniform(rng), 2e-3 * gsl_rng_uniform(rng),
+                    2e-3 * gsl_rng_uniform(rng)},
+            .vel = {gsl_rng_uniform(rng) - 0.5, gsl_rng_uniform(rng) - 0.5,
+                    gsl_rng_uniform(rng) - 0.5},
+            .omega = {100 * (gsl_rng_uniform(rng) - 0.5), 100 * (gsl_rng_uniform(rng) - 0.5),
+                      100 * (gsl_rng_uniform(rng) - 0.5)},
+            .radius = 0.3e-3 + 0.2e-3 * gsl_rng_uniform(rng),
+            .material = (int)(k % 2)};
+        CHECK_OK(wetdem_sim_add_particle(sim, p));
+    }
+    gsl_rng_free(rng);
+    CHECK_OK(wetdem_sim_add_wall(sim, (struct wetdem_vec3){0, 0, 0.2e-3},
+                                 (struct wetdem_vec3){0, 0, 1}, 1));
+    CHECK_OK(wetdem_sim_set_many(sim, &(struct wetdem_many_settings){.dt = 1e-7, .skin = 1e-4}));
+    sim->many->reach = 1.0; /* larger than any range here; set by the first run otherwise */
+    CHECK_OK(wetdem_sim_many_setup_kernel(sim));
+}
+
+static void check_same_contact(const struct wetdem_contact* a, const struct wetdem_contact* b)
+{
+    assert_int_equal(a->i, b->i);
+    assert_int_equal(a->j, b->j);
+    assert_int_equal(a->is_wall, b->is_wall);
+    const double fa[] = {a->normal.x, a->normal.y, a->normal.z, a->gap, a->radius_i,
+                         a->radius_j, a->r_eff, a->m_eff, a->v_n, a->v_t.x, a->v_t.y, a->v_t.z,
+                         a->dt, a->e_star, a->g_star, a->restitution, a->friction_dry,
+                         a->friction_lub, a->roughness, a->film, a->viscosity,
+                         a->surface_tension, a->h_min};
+    const double fb[] = {b->normal.x, b->normal.y, b->normal.z, b->gap, b->radius_i,
+                         b->radius_j, b->r_eff, b->m_eff, b->v_n, b->v_t.x, b->v_t.y, b->v_t.z,
+                         b->dt, b->e_star, b->g_star, b->restitution, b->friction_dry,
+                         b->friction_lub, b->roughness, b->film, b->viscosity,
+                         b->surface_tension, b->h_min};
+    assert_memory_equal(fa, fb, sizeof fa);
+}
+
+/* The contact from the table equals contact.c's for every pair of particles and every
+ * particle with the wall (both materials in every combination). */
+static void test_many_contact_matches_contact_c(void** state)
+{
+    (void)state;
+    const char* models[] = {"hertz"};
+    struct wetdem_sim* sim = two_material_sim(models, 1);
+    add_particles(sim, 12, 3);
+    for (size_t i = 0; i < 12; i++) {
+        for (size_t j = 0; j < 12; j++) {
+            if (j == i)
+                continue;
+            struct wetdem_contact fast, ref;
+            wetdem_sim_many_contact(sim, i, j, false, &fast);
+            wetdem_sim_build_contact(sim, i, j, false, &ref);
+            check_same_contact(&fast, &ref);
+        }
+        struct wetdem_contact fast, ref;
+        wetdem_sim_many_contact(sim, i, 0, true, &fast);
+        wetdem_sim_build_contact(sim, i, 0, true, &ref);
+        check_same_contact(&fast, &ref);
+    }
+    wetdem_sim_free(sim);
+}
+
+/* Evaluates contact c with history h through both paths and requires identical bits. The
+ * fused path must also leave identical histories. */
+static void check_fused_equals_generic(struct wetdem_sim* sim, const struct wetdem_contact* c,
+                                       const double* history)
+{
+    struct wetdem_contact cf = *c, cg = *c;
+    double hf[64], hg[64];
+    memcpy(hf, history, sim->history_len * sizeof(double));
+    memcpy(hg, history, sim->history_len * sizeof(double));
+    struct wetdem_pair_force of, og, pf[WETDEM_MAX_MODELS], pg[WETDEM_MAX_MODELS];
+    memset(pf, 0, sizeof pf);
+    memset(pg, 0, sizeof pg);
+    int sf = wetdem_sim_many_eval_fused(sim, &cf, sim->history_len ? hf : NULL, &of, pf);
+    int sg = wetdem_sim_eval_contact(sim, &cg, sim->history_len ? hg : NULL, &og, pg);
+    assert_int_equal(sf, sg);
+    assert_memory_equal(&of, &og, sizeof of);
+    assert_memory_equal(pf, pg, sim->n_models * sizeof pf[0]);
+    assert_memory_equal(hf, hg, sim->history_len * sizeof(double));
+    assert_memory_equal(&cf.h_min, &cg.h_min, sizeof cf.h_min);
+}
+
+/* Gaps spanning every branch: deep and shallow overlap (sticking and sliding Mindlin springs,
+ * clipped and unclipped Hertz damping), below h_min (c and nc), inside the film, at the film
+ * edge and beyond; approaching and separating; for walls too. */
+static void sweep_branches(struct wetdem_sim* sim, size_t* n_checked)
+{
+    const double gaps[] = {-20e-6, -2e-6, -1e-9, 0.0, 0.5e-6, 1e-6, 5e-6, 29.999e-6,
+                           30e-6, 40e-6, 41e-6};
+    const double springs[] = {0.0, 1e-7, 5e-6}; /* fresh, sticking, sliding */
+    for (size_t i = 0; i < 6; i++)
+        for (size_t j = 0; j < 7; j++) {
+            if (j == i)
+                continue;
+            bool wall = j == 6;
+            struct wetdem_contact c;
+            wetdem_sim_many_contact(sim, i, wall ? 0 : j, wall, &c);
+            c.dt = 1e-6;
+            for (size_t g = 0; g < sizeof gaps / sizeof gaps[0]; g++)
+                for (size_t s = 0; s < 3; s++)
+                    for (int sign = -1; sign <= 1; sign += 2) {
+                        struct wetdem_contact cc = c;
+                        cc.gap = gaps[g];
+                        cc.v_n = sign * fabs(c.v_n);
+                        double h[64] = {0};
+                        for (size_t k = 0; k < sim->history_len; k++)
+                            h[k] = springs[s] * (k % 3 == 0 ? 1.0 : 0.3);
+                        check_fused_equals_generic(sim, &cc, h);
+                        (*n_checked)++;
+                    }
+        }
+}
+
+static void test_many_fused_kernel_equals_generic(void** state)
+{
+    (void)state;
+    /* every subset order and option the fused kernel distinguishes */
+    const char* sets[][4] = {{"hertz", "mindlin", "sb", "capillary"},
+                             {"capillary", "sb", "mindlin", "hertz"},
+                             {"hertz", "mindlin", NULL, NULL},
+                             {"sb", "capillary", NULL, NULL}};
+    const int counts[] = {4, 4, 2, 2};
+    size_t n_checked = 0;
+    for (int s = 0; s < 4; s++)
+        for (int option = 0; option < 2; option++) {
+            struct wetdem_sim* sim = two_material_sim(sets[s], counts[s]);
+            const char* hertz = option ? "tsuji" : "exact";
+            const char* mindlin = option ? "lubricated" : "dry";
+            const char* below = option ? "nc" : "c";
+            for (int k = 0; k < counts[s]; k++) {
+                if (!strcmp(sets[s][k], "hertz"))
+                    CHECK_OK(wetdem_sim_set_param_str(sim, "hertz.damping", hertz));
+                if (!strcmp(sets[s][k], "mindlin"))
+                    CHECK_OK(wetdem_sim_set_param_str(sim, "mindlin.friction", mindlin));
+                if (!strcmp(sets[s][k], "sb"))
+                    CHECK_OK(wetdem_sim_set_param_str(sim, "sb.below_hmin", below));
+            }
+            add_particles(sim, 6, 11 + (unsigned long)s);
+            assert_true(sim->many->fused);
+            sweep_branches(sim, &n_checked);
+            wetdem_sim_free(sim);
+        }
+    assert_true(n_checked > 10000); /* 8 set-ups x 36 pairs x 11 gaps x 3 springs x 2 signs */
+}
+
+/* A set with a model outside the fused set (reynolds) takes the generic path. */
+static void test_many_unfused_set_uses_generic_path(void** state)
+{
+    (void)state;
+    const char* models[] = {"hertz", "reynolds"};
+    struct wetdem_sim* sim = two_material_sim(models, 2);
+    add_particles(sim, 4, 5);
+    assert_false(sim->many->fused);
+    wetdem_sim_free(sim);
+}
+
+/* A wet granular gas of two materials in a box periodic in x and y (floor and lid). */
+static struct wetdem_sim* wet_gas(bool generic_only, bool budget)
+{
+    const char* models[] = {"hertz", "mindlin", "sb", "capillary"};
+    struct wetdem_sim* sim = two_material_sim(models, 4);
+    struct wetdem_insert_spec spec = {.layout = WETDEM_INSERT_RANDOM, .n = 150, .lo = {0, 0, 0},
+                                      .hi = {6e-3, 6e-3, 8e-3}, .periodic = {true, true, false},
+                                      .radius_min = 0.4e-3, .radius_max = 0.5e-3,
+                                      .velocity_sigma = 0.2, .seed = 9};
+    CHECK_OK(wetdem_sim_insert(sim, &spec));
+    size_t n;
+    struct wetdem_particle* p = wetdem_sim_particles(sim, &n);
+    for (size_t k = 0; k < n; k += 3) { /* a third of the other material: mixed pairs */
+        p[k].material = 1;
+        p[k].mass *= 7800.0 / 2500.0;
+    }
+    CHECK_OK(wetdem_sim_add_wall(sim, (struct wetdem_vec3){0, 0, 0},
+                                 (struct wetdem_vec3){0, 0, 1}, 1));
+    CHECK_OK(wetdem_sim_add_wall(sim, (struct wetdem_vec3){0, 0, 8e-3},
+                                 (struct wetdem_vec3){0, 0, -1}, 0));
+    CHECK_OK(wetdem_sim_set_param(sim, "sim.gravity_z", -9.81));
+    struct wetdem_many_settings s = {.periodic = {true, true, false},
+                                     .box_lo = {0, 0, 0},
+                                     .box_hi = {6e-3, 6e-3, 8e-3},
+                                     .dt = 2e-6,
+                                     .skin = 0.05e-3,
+                                     .energy_budget = budget};
+    CHECK_OK(wetdem_sim_set_many(sim, &s));
+    sim->many->generic_only = generic_only;
+    return sim;
+}
+
+static void check_same_state(struct wetdem_sim* a, struct wetdem_sim* b)
+{
+    size_t na, nb;
+    const struct wetdem_particle* pa = wetdem_sim_particles_const(a, &na);
+    const struct wetdem_particle* pb = wetdem_sim_particles_const(b, &nb);
+    assert_int_equal(na, nb);
+    for (size_t k = 0; k < na; k++) {
+        assert_memory_equal(&pa[k].pos, &pb[k].pos, sizeof pa[k].pos);
+        assert_memory_equal(&pa[k].vel, &pb[k].vel, sizeof pa[k].vel);
+        assert_memory_equal(&pa[k].omega, &pb[k].omega, sizeof pa[k].omega);
+    }
+}
+
+/* Whole runs: fused against generic (with and without the energy budget, whose per-model
+ * forces go through a separate branch), on 1 and 3 threads. */
+static void test_many_fused_run_equals_generic_run(void** state)
+{
+    (void)state;
+    int saved = omp_get_max_threads();
+    for (int budget = 0; budget < 2; budget++) {
+        struct wetdem_sim* fused = wet_gas(false, budget);
+        struct wetdem_sim* generic = wet_gas(true, budget);
+        struct wetdem_sim* fused3 = wet_gas(false, budget);
+        omp_set_num_threads(1);
+        CHECK_OK(wetdem_sim_integrate(fused, 0.6e-3));
+        CHECK_OK(wetdem_sim_integrate(generic, 0.6e-3));
+        omp_set_num_threads(3);
+        CHECK_OK(wetdem_sim_integrate(fused3, 0.6e-3));
+        omp_set_num_threads(saved);
+        assert_true(fused->many->fused);
+        assert_false(generic->many->fused);
+        check_same_state(fused, generic);
+        check_same_state(fused, fused3);
+        struct wetdem_many_stats s;
+        CHECK_OK(wetdem_sim_many_stats(fused, &s));
+        assert_true(s.contacts > 0 && s.bridges > 0); /* contact and film branches were run */
+        if (budget) {
+            struct wetdem_energy_budget bf, bg;
+            CHECK_OK(wetdem_sim_energy_budget(fused, &bf));
+            CHECK_OK(wetdem_sim_energy_budget(generic, &bg));
+            assert_memory_equal(bf.work_pair, bg.work_pair, sizeof bf.work_pair);
+            assert_memory_equal(bf.work_wall, bg.work_wall, sizeof bf.work_wall);
+        }
+        wetdem_sim_free(fused);
+        wetdem_sim_free(generic);
+        wetdem_sim_free(fused3);
+    }
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_many_contact_matches_contact_c),
+        cmocka_unit_test(test_many_fused_kernel_equals_generic),
+        cmocka_unit_test(test_many_unfused_set_uses_generic_path),
+        cmocka_unit_test(test_many_fused_run_equals_generic_run),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
