@@ -1,8 +1,10 @@
 """Plot of a `wetdem fit` result: measured e_n (markers) and the fitted model (line, from
 --curve, or the fitted values at the data points), per impact angle, with the residuals.
 
-Usage: /usr/bin/python3 figures/fit_plot.py FIT.csv [--curve CURVE.csv] [--png OUT.png]
+Usage: /usr/bin/python3 figures/fit_plot.py [FIT.csv] [--curve CURVE.csv] [--png OUT.png]
        [--title TEXT] [--summary SUMMARY.csv]
+Without FIT.csv: the example of scripts/validate.d/26-fit.sh (out/validate/fit/fit.csv with its
+curve.csv and summary.csv) into docs/figures/fit_example.png.
 FIT.csv is the --out file of `wetdem fit` (stokes_n, angle_deg, e_n_data, e_n_fit,
 e_n_residual[, omega_data, omega_fit, omega_residual]); CURVE.csv its --curve file;
 SUMMARY.csv its standard output, whose fitted values, standard errors and units are written
@@ -13,7 +15,7 @@ import os
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from common import plt, read_csv  # noqa: E402
+from common import FIGURES, ROOT, plt, read_csv  # noqa: E402
 
 import numpy as np  # noqa: E402
 
@@ -33,12 +35,19 @@ def fitted_values(path):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("fit")
+    ap.add_argument("fit", nargs="?")
     ap.add_argument("--curve")
     ap.add_argument("--png")
     ap.add_argument("--title", default="wetdem fit")
     ap.add_argument("--summary")
     a = ap.parse_args()
+    if a.fit is None:
+        example = os.path.join(ROOT, "out", "validate", "fit")
+        a.fit = os.path.join(example, "fit.csv")
+        a.curve = a.curve or os.path.join(example, "curve.csv")
+        a.summary = a.summary or os.path.join(example, "summary.csv")
+        a.png = a.png or os.path.join(FIGURES, "fit_example.png")
+        a.title = "P_gt fitted to examples/fit/punch_0deg.csv"
     d = read_csv(a.fit)
     c = read_csv(a.curve) if a.curve else None
     png = a.png or os.path.splitext(a.fit)[0] + ".png"
