@@ -276,6 +276,11 @@ int cmd_sweep(int argc, char** argv)
         cli_error("sweep %s: engine 'pairwise' is not in this build", a.file);
         rc = CLI_EXIT_RUNTIME;
     }
+    if (rc == CLI_EXIT_OK && cli_scenario_is_many && cli_scenario_is_many(&sc)) {
+        cli_error("sweep %s: a many-particle scenario runs with 'wetdem run' (one run per "
+                  "file); sweeps vary binary collisions", a.file);
+        rc = CLI_EXIT_USAGE;
+    }
     struct point* pts = rc == CLI_EXIT_OK ? calloc(r.n, sizeof *pts) : NULL;
     if (rc == CLI_EXIT_OK && !pts) {
         cli_error("sweep: out of memory for %zu points", r.n);

@@ -181,6 +181,12 @@ static void test_many_cli_bad_inputs_exit_2_with_file_and_line(void** state)
                "[collision]\nspeed = 1\n[box]\nsize_x = 1e-2\nsize_y = 1e-2\nsize_z = 1e-2\n"
                "[insert]\ncount = 1\nradius = 1e-3\n[run]\nsteps = 10\n",
                1, "not both");
+    /* sweeps vary binary collisions; a many-particle file is refused, not misread */
+    scenario("sweep.ini", "");
+    assert_int_equal(run_cli("sweep sweep.ini --param run.dt --values 1e-6:2e-6:2"), 2);
+    char* err = stderr_text();
+    CHECK_CONTAINS(err, "runs with 'wetdem run'");
+    free(err);
 }
 
 /* Removes field `col` (0-based) from every comma-separated line of text, in place. */
