@@ -29,10 +29,10 @@ friction() { echo "--set material.striker.friction_dry=$1 --set material.target.
 echo "-- Fig. 8 (a-d) and Fig. 9: SB/DB x NC/C with Davis tangential force, 0-60 deg"
 for a in 0 15 30 45 60; do
   curve fig8a_a$a --set "models.force=hertz mindlin sb davis" --set sb.below_hmin=nc \
-    --set davis.below_hmin=nc --set glass.p_gt=4.9e6 --set collision.angle_deg=$a
+    --set model.davis.below_hmin=nc --set glass.p_gt=4.9e6 --set collision.angle_deg=$a
   curve fig8b_a$a --set "models.force=hertz mindlin sb davis" --set glass.p_gt=23e6 \
     --set collision.angle_deg=$a
-  curve fig8c_a$a --set db.below_hmin=nc --set davis.below_hmin=nc --set glass.p_gt=2.6e6 \
+  curve fig8c_a$a --set db.below_hmin=nc --set model.davis.below_hmin=nc --set glass.p_gt=2.6e6 \
     --set collision.angle_deg=$a
   curve fig8d_a$a --set collision.angle_deg=$a
 done
