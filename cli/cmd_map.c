@@ -42,7 +42,8 @@ struct map_point {
     struct cli_setup su;    /* soft: the built simulation */
     struct wetdem_collision_result res;
     int status;
-    char* row; /* the engine's CSV fields (malloc'd) */
+    char errmsg[256]; /* the engine's message of a failed run */
+    char* row;        /* the engine's CSV fields (malloc'd) */
 };
 
 static void usage(FILE* f)
@@ -131,12 +132,16 @@ static void run_point(struct map_point* p, enum cli_engine engine)
         return;
     }
     if (engine == CLI_ENGINE_PAIRWISE) {
-        struct cli_run_options opt = {.sweep_row = f};
-        p->status = cli_run_pairwise(&p->sc, &opt) == CLI_EXIT_OK ? WETDEM_OK : WETDEM_ERR_STEP;
+        struct cli_run_options opt = {.sweep_row = f, .status_out = &p->status,
+                                      .errmsg_out = p->errmsg, .errmsg_size = sizeof p->errmsg};
+        p->status = WETDEM_ERR_NOMEM; /* kept when the engine could not start */
+        cli_run_pairwise(&p->sc, &opt);
     } else {
         p->status = wetdem_collision_run(p->su.sim, &p->su.spec, &p->res);
         if (p->status >= 0)
             cli_setup_capture(&p->su);
+        else
+            snprintf(p->errmsg, sizeof p->errmsg, "%s", wetdem_sim_errmsg(p->su.sim));
         cli_csv_result_row(f, &p->su, &p->res);
         cli_setup_free(&p->su);
     }
@@ -280,8 +285,9 @@ int cmd_map(int argc, char** argv)
         rc = write_output(&a, pts, n, header, argc, argv, omp_get_wtime() - t0);
         for (size_t k = 0; k < n; k++)
             if (pts[k].status < 0) {
-                cli_error("map: %s = %.12g, %s = %.12g failed (%s)", a.key[0], pts[k].value[0],
-                          a.key[1], pts[k].value[1], wetdem_status_name(pts[k].status));
+                cli_error("map: %s = %.12g, %s = %.12g: %s (%s)", a.key[0], pts[k].value[0],
+                          a.key[1], pts[k].value[1], pts[k].errmsg,
+                          wetdem_status_name(pts[k].status));
                 rc = CLI_EXIT_RUNTIME;
             }
     }

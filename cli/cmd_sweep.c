@@ -9,10 +9,12 @@
  * `wetdem run FILE --set KEY=value_k` would (printed with %.17g, so the same bits), which keeps
  * coupled keys right: sweeping fluid.viscosity with a Stokes number given re-derives the speed.
  *
- * Determinism: every value gets its own simulation, built and checked serially before any
- * run; the runs share nothing, and rows are written in input order after all finished, so
- * the data rows are bit-identical for any OMP_NUM_THREADS. The trailer '#' line (totals and
- * wall time) is the only line that varies between runs.
+ * Determinism: every value gets its own simulation (soft engine) or scenario (pairwise engine),
+ * built and checked serially before any run; the runs, of either engine, share nothing and
+ * are distributed over the threads, and rows are written in input order after all finished,
+ * so the data rows are bit-identical for any OMP_NUM_THREADS. The trailer '#' line (totals and
+ * wall time) is the only line that varies between runs. The status column is the run's
+ * status (the pairwise engine's for pairwise scenarios); a failed point makes the exit code 1.
  *
  * Progress with an estimate of the time left goes to stderr only when stderr is a terminal.
  */
@@ -42,7 +44,8 @@ struct sweep_args {
 /* One sweep point: its set-up, and after the run its result or error. */
 struct point {
     double value;
-    struct cli_setup su;
+    struct cli_setup su;    /* soft engine: the built simulation */
+    struct cli_scenario sc; /* pairwise engine: the point's scenario (checked, not run) */
     struct wetdem_collision_result res;
     int status;
     char errmsg[256];
@@ -91,29 +94,59 @@ static int parse_args(int argc, char** argv, struct sweep_args* a)
     return CLI_EXIT_OK;
 }
 
-/* Builds point k: scenario copy, KEY = value, set-up. Returns an exit code. */
+/* Builds point k: scenario copy with KEY = value, then the soft engine's set-up, or the
+ * pairwise engine's configuration checked without running (the header mode builds and
+ * validates it). Returns an exit code. */
 static int build_point(const struct cli_scenario* base, const char* key, struct point* p,
                        enum cli_engine engine)
 {
-    struct cli_scenario sc;
-    int rc = cli_scenario_copy(base, &sc);
+    int rc = cli_scenario_copy(base, &p->sc);
     if (rc != CLI_EXIT_OK)
         return rc;
     char set[512];
     snprintf(set, sizeof set, "%s=%.17g", key, p->value);
-    rc = cli_scenario_override(&sc, set);
+    rc = cli_scenario_override(&p->sc, set);
     if (rc == CLI_EXIT_OK && engine == CLI_ENGINE_SOFT)
-        rc = cli_scenario_build(&sc, &p->su);
+        rc = cli_scenario_build(&p->sc, &p->su);
     if (rc == CLI_EXIT_OK && engine == CLI_ENGINE_PAIRWISE) {
+        char* text = NULL;
         size_t len = 0;
-        FILE* f = open_memstream(&p->pairwise_row, &len);
-        struct cli_run_options opt = {.sweep_row = f};
-        rc = f ? cli_run_pairwise(&sc, &opt) : CLI_EXIT_RUNTIME;
+        FILE* f = open_memstream(&text, &len);
+        struct cli_run_options opt = {.sweep_row = f, .sweep_header = true};
+        rc = f ? cli_run_pairwise(&p->sc, &opt) : CLI_EXIT_RUNTIME;
         if (f)
             fclose(f);
+        free(text);
     }
-    cli_scenario_free(&sc);
+    if (engine == CLI_ENGINE_SOFT)
+        cli_scenario_free(&p->sc); /* the set-up holds everything the run needs */
     return rc;
+}
+
+/* Runs one built point: the soft engine's collision, or the pairwise engine's run writing
+ * its row. Touches only *p, so points run concurrently. */
+static void run_point(struct point* p, enum cli_engine engine)
+{
+    if (engine == CLI_ENGINE_PAIRWISE) {
+        size_t len = 0;
+        FILE* f = open_memstream(&p->pairwise_row, &len);
+        struct cli_run_options opt = {.sweep_row = f, .status_out = &p->status,
+                                      .errmsg_out = p->errmsg, .errmsg_size = sizeof p->errmsg};
+        p->status = WETDEM_ERR_NOMEM; /* kept when the engine could not start */
+        snprintf(p->errmsg, sizeof p->errmsg, "out of memory");
+        if (f) {
+            cli_run_pairwise(&p->sc, &opt);
+            fclose(f);
+        }
+        cli_scenario_free(&p->sc);
+        return;
+    }
+    p->status = wetdem_collision_run(p->su.sim, &p->su.spec, &p->res);
+    if (p->status < 0)
+        snprintf(p->errmsg, sizeof p->errmsg, "%s", wetdem_sim_errmsg(p->su.sim));
+    else
+        cli_setup_capture(&p->su);
+    cli_setup_free(&p->su); /* the row needs only what su captured */
 }
 
 static void progress(size_t done, size_t n, double t0)
@@ -146,21 +179,16 @@ static char* pairwise_header(const struct cli_scenario* sc)
     return text;
 }
 
-/* Runs every soft-engine point in parallel. */
-static void run_points(struct point* pts, size_t n)
+/* Runs every point in parallel (dynamic scheduling: run times differ by orders of
+ * magnitude across a sweep). */
+static void run_points(struct point* pts, size_t n, enum cli_engine engine)
 {
     bool show = isatty(STDERR_FILENO);
     double t0 = omp_get_wtime(), last = 0;
     size_t done = 0;
 #pragma omp parallel for schedule(dynamic, 1)
     for (size_t k = 0; k < n; k++) {
-        struct point* p = &pts[k];
-        p->status = wetdem_collision_run(p->su.sim, &p->su.spec, &p->res);
-        if (p->status < 0)
-            snprintf(p->errmsg, sizeof p->errmsg, "%s", wetdem_sim_errmsg(p->su.sim));
-        else
-            cli_setup_capture(&p->su);
-        cli_setup_free(&p->su); /* the row needs only what su captured */
+        run_point(&pts[k], engine);
 #pragma omp critical(sweep_progress)
         {
             done++;
@@ -202,6 +230,11 @@ static void write_table(FILE* f, const struct sweep_args* a, const struct point*
         tot.root_evals += pts[k].res.stats.root_evals;
         tot.events += pts[k].res.stats.events;
     }
+    if (pairwise_header) { /* the engine's counts are in the rows (events, steps) */
+        fprintf(f, "# totals: runs=%zu wall_time_s=%.6f threads=%d\n", n, wall,
+                omp_get_max_threads());
+        return;
+    }
     fprintf(f, "# totals: runs=%zu steps=%llu force_evals=%llu pair_evals=%llu root_evals=%llu "
                "events=%llu wall_time_s=%.6f threads=%d\n",
             n, tot.steps, tot.force_evals, tot.pair_evals, tot.root_evals, tot.events, wall,
@@ -225,6 +258,7 @@ static void free_points(struct point* pts, size_t n)
 {
     for (size_t k = 0; pts && k < n; k++) {
         cli_setup_free(&pts[k].su);
+        cli_scenario_free(&pts[k].sc);
         free(pts[k].pairwise_row);
     }
     free(pts);
@@ -293,8 +327,7 @@ int cmd_sweep(int argc, char** argv)
     if (rc == CLI_EXIT_OK)
         rc = build_all(&sc, &a, &r, pts, engine);
     if (rc == CLI_EXIT_OK) {
-        if (engine == CLI_ENGINE_SOFT)
-            run_points(pts, r.n);
+        run_points(pts, r.n, engine);
         double wall = omp_get_wtime() - t0;
         rc = write_output(&a, pts, r.n, header, argc, argv, wall);
         for (size_t k = 0; k < r.n; k++)

@@ -235,11 +235,23 @@ static double star(const struct wetdem_pairwise_result* r, double t)
     return r->v_10 * t / (4.0 * r->a_ref);
 }
 
-static void sweep_row(FILE* f, int status, const struct wetdem_pairwise_result* r)
+/* One sweep row. A failed run writes its status, the steps and events it took, and "nan" or
+ * "none" for every result (the row keeps the header's columns). */
+static void sweep_row(FILE* f, int status, const struct wetdem_pairwise_config* cfg,
+                      const struct wetdem_pairwise* pw, const struct wetdem_pairwise_result* r)
 {
+    size_t n_events = 0;
+    wetdem_pairwise_events(pw, &n_events);
+    if (status != WETDEM_OK) {
+        fprintf(f, "%s,none,0,nan,nan,%zu,%llu", wetdem_status_name(status), n_events, r->steps);
+        for (size_t i = 0; i < cfg->n_spheres; i++)
+            for (size_t j = i + 1; j < cfg->n_spheres; j++)
+                fputs(",nan,nan,0,none,nan", f);
+        return;
+    }
     fprintf(f, "%s,%s,%d,%.12g,%.12g,%zu,%llu", wetdem_status_name(status),
-            status == WETDEM_OK ? wetdem_pairwise_outcome_name(r->outcome) : "none",
-            r->separated_sphere + 1, r->time, star(r, r->time), r->n_events, r->steps);
+            wetdem_pairwise_outcome_name(r->outcome), r->separated_sphere + 1, r->time,
+            star(r, r->time), r->n_events, r->steps);
     for (size_t p = 0; p < r->n_pairs; p++) {
         const struct wetdem_pairwise_pair_result* q = &r->pairs[p];
         fprintf(f, ",%.12g,%.12g,%u,%s,%.12g", q->e_wet, q->e_wet_own, q->n_contacts,
@@ -420,8 +432,13 @@ int cli_run_pairwise(const struct cli_scenario* sc, const struct cli_run_options
         rc = run_with_files(sc, opt, &cfg, pw, &r, &status);
     else
         status = wetdem_pairwise_run(pw, &cfg, &r);
+    if (opt->status_out)
+        *opt->status_out = status;
+    if (opt->errmsg_out && opt->errmsg_size > 0)
+        snprintf(opt->errmsg_out, opt->errmsg_size, "%s",
+                 status != WETDEM_OK ? wetdem_pairwise_errmsg(pw) : "");
     if (opt->sweep_row) {
-        sweep_row(opt->sweep_row, status, &r);
+        sweep_row(opt->sweep_row, status, &cfg, pw, &r);
     } else if (status != WETDEM_OK) {
         cli_error("run %s: %s (%s)", sc->file, wetdem_pairwise_errmsg(pw),
                   wetdem_status_name(status));

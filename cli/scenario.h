@@ -211,6 +211,10 @@ struct cli_run_options {
     bool sweep_header;   /* with sweep_row: write the CSV column header line instead */
     const char* restart; /* many-particle runs: checkpoint to resume from, or NULL */
     bool check;          /* only check the scenario and print the resolved set-up */
+    int* status_out;     /* non-NULL: receives the engine's run status (WETDEM_OK, or < 0 when
+                            the run failed; a sweep row is still written then) */
+    char* errmsg_out;    /* non-NULL: receives the engine's message of a failed run */
+    size_t errmsg_size;  /* bytes at errmsg_out */
 };
 
 /* Runs a scenario whose [engine] type is "pairwise" (cli/run_pairwise.c). Weak: when the

@@ -10,7 +10,9 @@
  *   - docs/scenarios.md contains the key tables `wetdem docs-scenarios` generates;
  *   - `run --out` writes trajectory, events and summary with unit headers, and nothing at all
  *     when the input is bad or the run fails;
- *   - `sweep` rows come in input order and are bit-identical with 1 and 2 threads.
+ *   - `sweep` rows come in input order and are bit-identical with 1 and 2 threads, for the
+ *     soft engine and for the pairwise engine (whose runs are in the parallel phase too);
+ *   - a failed pairwise point reports the engine's status in the status column and exits 1.
  */
 #include <stdlib.h>
 #include <sys/stat.h>
@@ -363,6 +365,66 @@ static void test_scenario_sweep_order_and_threads(void** state)
     assert_false(exists(tmpdir, "sweep.csv"));
 }
 
+/* Field `col` (0-based) of a CSV line, copied into out. */
+static void csv_field(const char* line, int col, char* out, size_t n)
+{
+    for (int c = 0; c < col; c++) {
+        line = strchr(line, ',');
+        assert_non_null(line);
+        line++;
+    }
+    size_t len = strcspn(line, ",\n");
+    snprintf(out, n, "%.*s", (int)(len < n ? len : n - 1), line);
+}
+
+static void test_scenario_sweep_pairwise_threads_and_status(void** state)
+{
+    (void)state;
+    /* Davis's three-sphere case over St_n = 1 ... 8: runs of 4 to 16 events, cheap enough
+     * (~10 ms each) for two passes. */
+    const char* args = "sweep examples/scenarios/davis_three.ini --param davis.stokes "
+                       "--values 1:8:8";
+    struct run r1 = run_env("OMP_NUM_THREADS=1", args, false);
+    struct run r2 = run_env("OMP_NUM_THREADS=2", args, false);
+    assert_int_equal(r1.code, 0);
+    assert_int_equal(r2.code, 0);
+    CHECK_CONTAINS(r2.out, "threads=2"); /* the second pass did use two threads */
+    char* d1 = data_lines(r1.out);
+    char* d2 = data_lines(r2.out);
+    if (strcmp(d1, d2) != 0)
+        fail_msg("pairwise sweep differs between 1 and 2 threads:\n%s\n---\n%s", d1, d2);
+    CHECK_CONTAINS(d1, "davis.stokes [-],status [word],pairwise_status [word],outcome [word]");
+    const char* line = strchr(d1, '\n') + 1;
+    for (int k = 0; k < 8; k++) {
+        char status[64], pw_status[64], outcome[16];
+        CHECK_REL(strtod(line, NULL), k + 1.0, 0.0); /* input order: 1, 2, ..., 8 exactly */
+        csv_field(line, 1, status, sizeof status);
+        csv_field(line, 2, pw_status, sizeof pw_status);
+        csv_field(line, 3, outcome, sizeof outcome);
+        assert_string_equal(status, "WETDEM_OK");
+        assert_string_equal(pw_status, "WETDEM_OK");
+        if (k == 1) /* St_n = 2 is the example itself: all three agglomerate (Davis Fig. 3) */
+            assert_string_equal(outcome, "FA");
+        line = strchr(line, '\n') + 1;
+    }
+    assert_int_equal(*line, '\0');
+    free(d1);
+    free(d2);
+    free(r1.out);
+    free(r2.out);
+    /* An event budget of 3 stops St_n = 1 and 3 (they need 5 and 10 events): the status
+     * column carries the engine's status, the message names the point, the exit code is 1. */
+    struct run r = run_env("OMP_NUM_THREADS=2",
+                           "sweep examples/scenarios/davis_three.ini --param davis.stokes "
+                           "--values 1:3:2 --set pairwise.max_events=3",
+                           true);
+    assert_int_equal(r.code, 1);
+    CHECK_CONTAINS(r.out, "\n1,WETDEM_ERR_MAX_STEPS,WETDEM_ERR_MAX_STEPS,none,");
+    CHECK_CONTAINS(r.out, "\n3,WETDEM_ERR_MAX_STEPS,WETDEM_ERR_MAX_STEPS,none,");
+    CHECK_CONTAINS(r.out, "sweep: davis.stokes = 1: event budget max_events = 3 exhausted");
+    free(r.out);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -373,6 +435,7 @@ int main(void)
         cmocka_unit_test(test_scenario_docs_list_every_key),
         cmocka_unit_test(test_scenario_run_writes_files_or_nothing),
         cmocka_unit_test(test_scenario_sweep_order_and_threads),
+        cmocka_unit_test(test_scenario_sweep_pairwise_threads_and_status),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
