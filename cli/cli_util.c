@@ -137,6 +137,14 @@ void cli_print_double(FILE* f, double v)
     fputs(buf, f);
 }
 
+bool cli_wants_help(int argc, char** argv)
+{
+    for (int k = 1; k < argc; k++)
+        if (strcmp(argv[k], "--help") == 0 || strcmp(argv[k], "-h") == 0)
+            return true;
+    return false;
+}
+
 void cli_param_default_text(const struct wetdem_param_desc* d, char* buf, size_t n)
 {
     if (d->choices) {

@@ -45,6 +45,10 @@ double cli_range_value(const struct cli_range* r, size_t k);
  * message>" and returns CLI_EXIT_USAGE. */
 int cli_apply_set(struct wetdem_sim* sim, const char* key_value);
 
+/* Whether any argument after the subcommand name is "--help" or "-h": every subcommand then
+ * prints its usage to stdout and exits 0, whatever else is on the line. */
+bool cli_wants_help(int argc, char** argv);
+
 /* Writes the '#' provenance lines that start every CSV the CLI prints:
  *     # wetdem <version> (git <hash>)
  *     # command: wetdem <argv[0]> <argv[1]> ...

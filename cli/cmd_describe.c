@@ -109,11 +109,12 @@ static int unknown_name(const char* name)
 
 int cmd_describe(int argc, char** argv)
 {
-    if (argc != 2 || strcmp(argv[1], "--help") == 0 || strcmp(argv[1], "-h") == 0) {
-        FILE* f = argc == 2 ? stdout : stderr;
+    bool help = cli_wants_help(argc, argv);
+    if (argc != 2 || help) {
+        FILE* f = help ? stdout : stderr;
         fprintf(f, "usage: wetdem describe NAME\n"
                    "NAME: a model (see 'wetdem models'), material, fluid, sim or presets\n");
-        return argc == 2 ? CLI_EXIT_OK : CLI_EXIT_USAGE;
+        return help ? CLI_EXIT_OK : CLI_EXIT_USAGE;
     }
     const char* name = argv[1];
     const struct wetdem_model* m = wetdem_model_find(name);

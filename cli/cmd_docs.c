@@ -155,6 +155,12 @@ static void tables_section(void)
 
 int cmd_docs_models(int argc, char** argv)
 {
+    if (cli_wants_help(argc, argv)) {
+        printf("usage: wetdem docs-models > docs/models.md\n"
+               "Writes the model reference (Markdown) to stdout, generated from the descriptor\n"
+               "tables; 'make docs' regenerates docs/models.md with it.\n");
+        return CLI_EXIT_OK;
+    }
     if (argc > 1) {
         cli_error("docs-models: unexpected argument '%s' (usage: wetdem docs-models > "
                   "docs/models.md)",

@@ -747,11 +747,10 @@ static int run_fit(const struct fit_args* a, struct fit_ctx* c, const double* in
 
 int cmd_fit(int argc, char** argv)
 {
-    for (int k = 1; k < argc; k++)
-        if (strcmp(argv[k], "--help") == 0 || strcmp(argv[k], "-h") == 0) {
-            usage(stdout);
-            return CLI_EXIT_OK;
-        }
+    if (cli_wants_help(argc, argv)) {
+        usage(stdout);
+        return CLI_EXIT_OK;
+    }
     struct fit_args a;
     int rc = parse_args(argc, argv, &a);
     if (rc != CLI_EXIT_OK)

@@ -207,11 +207,10 @@ static void print_header(struct wetdem_sim* sim, const struct forces_opts* o, in
 
 int cmd_forces(int argc, char** argv)
 {
-    for (int k = 1; k < argc; k++)
-        if (strcmp(argv[k], "--help") == 0 || strcmp(argv[k], "-h") == 0) {
-            usage(stdout);
-            return CLI_EXIT_OK;
-        }
+    if (cli_wants_help(argc, argv)) {
+        usage(stdout);
+        return CLI_EXIT_OK;
+    }
     struct forces_opts o = {.preset = "steel1", .radius = 6.35e-3, .speed = 0.1};
     int rc = parse_args(argc, argv, &o);
     if (rc == CLI_EXIT_OK)

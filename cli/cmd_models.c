@@ -18,12 +18,12 @@ static const enum wetdem_model_kind kind_order[] = {
 
 int cmd_models(int argc, char** argv)
 {
+    if (cli_wants_help(argc, argv)) {
+        printf("usage: wetdem models\nLists every built-in model: name, kind, summary.\n"
+               "Details of one model: wetdem describe NAME\n");
+        return CLI_EXIT_OK;
+    }
     if (argc > 1) {
-        if (strcmp(argv[1], "--help") == 0 || strcmp(argv[1], "-h") == 0) {
-            printf("usage: wetdem models\nLists every built-in model: name, kind, summary.\n"
-                   "Details of one model: wetdem describe NAME\n");
-            return CLI_EXIT_OK;
-        }
         cli_error("models: unexpected argument '%s' (usage: wetdem models)", argv[1]);
         return CLI_EXIT_USAGE;
     }

@@ -194,7 +194,7 @@ static int run_soft(const struct cli_scenario* sc, struct cli_setup* su, const s
 
 int cmd_run(int argc, char** argv)
 {
-    if (argc > 1 && (strcmp(argv[1], "--help") == 0 || strcmp(argv[1], "-h") == 0)) {
+    if (cli_wants_help(argc, argv)) {
         usage(stdout);
         return CLI_EXIT_OK;
     }

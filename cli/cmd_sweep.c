@@ -291,7 +291,7 @@ static int write_output(const struct sweep_args* a, const struct point* pts, siz
 
 int cmd_sweep(int argc, char** argv)
 {
-    if (argc > 1 && (strcmp(argv[1], "--help") == 0 || strcmp(argv[1], "-h") == 0)) {
+    if (cli_wants_help(argc, argv)) {
         usage(stdout);
         return CLI_EXIT_OK;
     }

@@ -188,11 +188,10 @@ static void print_summary(const struct wetdem_track_summary* s, bool json)
 
 int cmd_track(int argc, char** argv)
 {
-    for (int k = 1; k < argc; k++)
-        if (strcmp(argv[k], "--help") == 0 || strcmp(argv[k], "-h") == 0) {
-            fputs(usage, stdout);
-            return CLI_EXIT_OK;
-        }
+    if (cli_wants_help(argc, argv)) {
+        fputs(usage, stdout);
+        return CLI_EXIT_OK;
+    }
     struct track_cli c;
     int rc = parse_args(argc, argv, &c);
     if (rc != CLI_EXIT_OK)

@@ -414,9 +414,15 @@ int cli_scenario_print_docs(FILE* f)
 
 int cmd_docs_scenarios(int argc, char** argv)
 {
-    (void)argv;
+    if (cli_wants_help(argc, argv)) {
+        printf("usage: wetdem docs-scenarios\n"
+               "Writes the key tables of every scenario section (Markdown) to stdout: the\n"
+               "generated part of docs/scenarios.md.\n");
+        return CLI_EXIT_OK;
+    }
     if (argc > 1) {
-        cli_error("docs-scenarios: takes no arguments");
+        cli_error("docs-scenarios: unexpected argument '%s' (usage: wetdem docs-scenarios)",
+                  argv[1]);
         return CLI_EXIT_USAGE;
     }
     return cli_scenario_print_docs(stdout) == 0 ? CLI_EXIT_OK : CLI_EXIT_RUNTIME;

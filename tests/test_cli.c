@@ -2,7 +2,8 @@
  * test_cli.c — the wetdem command-line tool end to end: --version, --help, `models` (every
  * registry model listed), `describe` (parameters with units and ranges; unknown names give a
  * hint and exit 2), `forces` (CSV provenance and columns; one value checked against the closed
- * form of the reynolds model, F = 6 pi mu R*^2 v_n / h), and bad input (exit 2, message).
+ * form of the reynolds model, F = 6 pi mu R*^2 v_n / h), bad input (exit 2, message), and
+ * `--help`/`-h` of every subcommand listed by `wetdem --help` (usage on stdout, exit 0).
  *
  * The CLI path comes from the environment variable WETDEM_CLI (set by `make test`), falling
  * back to build/wetdem relative to the working directory (the repository root).
@@ -84,6 +85,38 @@ static void test_cli_version_and_help(void** state)
     assert_int_equal(r.code, 2);
     CHECK_CONTAINS(r.out, "did you mean 'models'");
     free(r.out);
+}
+
+/* Every subcommand that `wetdem --help` lists ("  wetdem NAME ..." lines) answers --help and
+ * -h, alone or after other arguments, with its usage on stdout and exit code 0. */
+static void test_cli_every_subcommand_help(void** state)
+{
+    (void)state;
+    struct run help = run_cli("--help", false);
+    assert_int_equal(help.code, 0);
+    size_t n_commands = 0;
+    for (const char* line = strstr(help.out, "\n  wetdem "); line;
+         line = strstr(line + 1, "\n  wetdem ")) {
+        char name[64];
+        if (sscanf(line + 10, "%63[a-z-]", name) != 1)
+            fail_msg("cannot read a command name at '%.40s'", line + 1);
+        n_commands++;
+        const char* forms[] = {"--help", "-h", "extra-argument --help", "--bogus -h"};
+        for (size_t f = 0; f < sizeof forms / sizeof forms[0]; f++) {
+            char args[160], want[96];
+            snprintf(args, sizeof args, "%s %s", name, forms[f]);
+            snprintf(want, sizeof want, "usage: wetdem %s", name);
+            struct run r = run_cli(args, false);
+            if (r.code != 0 || strncmp(r.out, want, strlen(want)) != 0)
+                fail_msg("'wetdem %s' exited %d with stdout:\n%s\n(expected exit 0 and '%s')",
+                         args, r.code, r.out, want);
+            free(r.out);
+        }
+    }
+    /* models, describe, forces, run, sweep, map, fit, track, docs-models, docs-scenarios */
+    if (n_commands < 10)
+        fail_msg("only %zu commands found in 'wetdem --help':\n%s", n_commands, help.out);
+    free(help.out);
 }
 
 static void test_cli_models_lists_every_model(void** state)
@@ -236,6 +269,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_cli_version_and_help),
+        cmocka_unit_test(test_cli_every_subcommand_help),
         cmocka_unit_test(test_cli_models_lists_every_model),
         cmocka_unit_test(test_cli_describe_lists_parameters_with_units),
         cmocka_unit_test(test_cli_describe_unknown_name),
