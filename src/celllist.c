@@ -21,6 +21,8 @@
 
 /* Upper bound on the number of cells per particle: keeps memory O(n) for sparse systems. */
 #define CELLS_PER_PARTICLE 4
+/* Fewest particles for which a build runs in parallel (threads cost more below). */
+#define PARALLEL_MIN 512
 
 static void set_msg(char* msg, size_t n, const char* fmt, ...) __attribute__((format(printf, 3, 4)));
 static void set_msg(char* msg, size_t n, const char* fmt, ...)
@@ -295,7 +297,7 @@ static int fill_pairs(struct wetdem_celllist* cl, const struct wetdem_particle* 
     struct wetdem_celllist_pair** buf = calloc((size_t)max_threads, sizeof *buf);
     size_t* used = calloc((size_t)max_threads, sizeof *used);
     bool nomem = !buf || !used;
-#pragma omp parallel if (!nomem)
+#pragma omp parallel if (!nomem && n >= PARALLEL_MIN)
     {
         int t = omp_get_thread_num(), nt = omp_get_num_threads();
 #pragma omp single
@@ -371,7 +373,7 @@ double wetdem_celllist_max_displacement(const struct wetdem_celllist* cl,
     if (cl->n_builds == 0 || n != cl->n_at_build)
         return INFINITY;
     double worst = 0; /* max is exact, so the reduction order does not matter */
-#pragma omp parallel for reduction(max : worst) schedule(static)
+#pragma omp parallel for reduction(max : worst) schedule(static) if (n >= PARALLEL_MIN)
     for (size_t i = 0; i < n; i++) {
         struct wetdem_vec3 d = celllist_delta(&cl->box, p[i].pos, cl->pos_at_build[i]);
         double d2 = vec3_dot(d, d);

@@ -25,6 +25,11 @@ struct wetdem_many_pair_out {
     struct wetdem_vec3 torque_j; /* [N m] */
 };
 
+/* Fewest particles for which the many-mode loops run in parallel: below it, waking the
+ * threads costs more than the work (a 5-sphere chain ran 35x slower on 2 threads). The result
+ * does not depend on the thread count either way. */
+#define WETDEM_MANY_PARALLEL_MIN 512
+
 /* What a pair (i, j) gives j, stored for the gather of j: the force on i (j gets -force)
  * and the torque on j. */
 struct wetdem_many_rev_out {
@@ -86,6 +91,8 @@ struct wetdem_many {
     bool kernel_ready;           /* mix and kind[] match the current set-up */
     bool fused;                  /* every enabled model has a fused kernel */
     bool generic_only;           /* tests: never use the fused kernel */
+    size_t parallel_min;         /* tests: fewest particles for parallel loops (0: default
+                                    WETDEM_MANY_PARALLEL_MIN) */
     bool periodic_any;           /* some axis is periodic */
     unsigned char kind[WETDEM_MAX_MODELS]; /* fused kernel of model k */
     double kind_opt[WETDEM_MAX_MODELS];    /* its switch parameter (hertz damping form, ...) */
@@ -104,6 +111,12 @@ struct wetdem_many {
     double* vtk_times;
     size_t vtk_names_cap;
 };
+
+/* Whether loops over n particles of m run in parallel. */
+static inline bool wetdem_many_parallel(const struct wetdem_many* m, size_t n)
+{
+    return n >= (m->parallel_min ? m->parallel_min : WETDEM_MANY_PARALLEL_MIN);
+}
 
 /* sim_many.c */
 /* wetdem_sim_many_free and wetdem_sim_many_integrate: sim.h. */

@@ -276,7 +276,7 @@ static int update_wall_masks(struct wetdem_sim* sim)
     if (grow((void**)&m->wall_mask, &m->wall_mask_cap, n ? n : 1, sizeof *m->wall_mask))
         return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory for %zu particles", n);
     double lim = m->reach + m->cl.skin;
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (wetdem_many_parallel(m, n))
     for (size_t i = 0; i < n; i++) {
         uint64_t mask = 0;
         for (size_t w = 0; w < nw && w < 64; w++) {
@@ -452,7 +452,8 @@ static void kick_drift(struct wetdem_sim* sim, double h)
     bool periodic = m->cl.box.periodic[0] || m->cl.box.periodic[1] || m->cl.box.periodic[2];
     const struct wetdem_vec3* at_build = m->cl.pos_at_build;
     double worst = 0; /* max is exact: the same for any thread count */
-#pragma omp parallel for schedule(static) reduction(max : worst)
+#pragma omp parallel for schedule(static) reduction(max : worst) \
+    if (wetdem_many_parallel(m, sim->n_particles))
     for (size_t k = 0; k < sim->n_particles; k++) {
         struct wetdem_particle* p = &sim->particles[k];
         if (!p->is_fixed)

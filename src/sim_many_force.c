@@ -581,16 +581,20 @@ int wetdem_sim_many_forces(struct wetdem_sim* sim, bool kick)
         return st;
     struct failure fail = {0};
     size_t n = sim->n_particles;
-#pragma omp parallel for schedule(dynamic, 64)
-    for (size_t i = 0; i < n; i++)
-        eval_pairs_of(sim, i, &fail);
     struct wetdem_vec3 g =
         vec3(sim->settings.gravity_x, sim->settings.gravity_y, sim->settings.gravity_z);
-#pragma omp parallel for schedule(static)
-    for (size_t i = 0; i < n; i++) {
-        gather_one(sim, i, &fail);
-        if (kick)
-            close_kick(sim, i, g);
+    /* one parallel region: the pair pass, a barrier, the gather */
+#pragma omp parallel if (wetdem_many_parallel(m, n))
+    {
+#pragma omp for schedule(dynamic, 64)
+        for (size_t i = 0; i < n; i++)
+            eval_pairs_of(sim, i, &fail);
+#pragma omp for schedule(static)
+        for (size_t i = 0; i < n; i++) {
+            gather_one(sim, i, &fail);
+            if (kick)
+                close_kick(sim, i, g);
+        }
     }
     if (fail.status != WETDEM_OK)
         return report_failure(sim, &fail);

@@ -43,6 +43,7 @@ static struct wetdem_sim* wet_box(size_t n, bool wet)
                                      .skin = 0.05e-3,
                                      .energy_budget = true};
     CHECK_OK(wetdem_sim_set_many(sim, &s));
+    sim->many->parallel_min = 1; /* run the parallel loops even for these small systems */
     return sim;
 }
 

@@ -229,6 +229,7 @@ static struct wetdem_sim* wet_gas(bool generic_only, bool budget)
                                      .energy_budget = budget};
     CHECK_OK(wetdem_sim_set_many(sim, &s));
     sim->many->generic_only = generic_only;
+    sim->many->parallel_min = 1; /* run the parallel loops even for this small system */
     return sim;
 }
 
