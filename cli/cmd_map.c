@@ -11,7 +11,7 @@
  * in grid order after all finished, so the data rows are bit-identical for any thread count.
  * The trailer '#' line (runs, wall time, threads, collisions per second) is the only line
  * that varies. Engines: pairwise (the row of cli_run_pairwise) and soft (the collision row of
- * `wetdem sweep`).
+ * `wetdem sweep`); many-particle scenarios are refused (exit 2), as by `wetdem sweep`.
  */
 #include <omp.h>
 #include <stdio.h>
@@ -265,6 +265,12 @@ int cmd_map(int argc, char** argv)
     if (rc == CLI_EXIT_OK && engine == CLI_ENGINE_PAIRWISE && !cli_run_pairwise) {
         cli_error("map %s: engine 'pairwise' is not in this build", a.file);
         rc = CLI_EXIT_RUNTIME;
+    }
+    if (rc == CLI_EXIT_OK && cli_scenario_is_many && cli_scenario_is_many(&sc)) {
+        cli_error("map %s: a many-particle scenario runs with 'wetdem run' (one run per "
+                  "file); maps vary binary or three-sphere collisions",
+                  a.file);
+        rc = CLI_EXIT_USAGE;
     }
     size_t n = r[0].n * r[1].n;
     struct map_point* pts = rc == CLI_EXIT_OK ? calloc(n, sizeof *pts) : NULL;

@@ -213,7 +213,7 @@ int cmd_run(int argc, char** argv)
             rc = CLI_EXIT_RUNTIME;
         } else {
             struct cli_run_options opt = {.out_dir = a.out_dir, .json = a.json, .argc = argc,
-                                          .argv = argv};
+                                          .argv = argv, .check = a.check};
             rc = cli_run_pairwise(&sc, &opt);
         }
         cli_scenario_free(&sc);

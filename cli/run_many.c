@@ -386,11 +386,36 @@ static int dry_start(const struct cli_scenario* sc, struct cli_many_setup* su, s
     return CLI_EXIT_OK;
 }
 
+/* The resolved set-up of `run --check --json`: the fields of the text form, one object. */
+static void print_check_json(const struct cli_scenario* sc, const struct cli_many_setup* su,
+                             const struct plan* pl, const struct wetdem_many_stats* s)
+{
+    printf("{\"scenario\": ");
+    cli_json_string(stdout, sc->file);
+    printf(", \"engine\": \"many\", \"particles\": %zu, \"walls\": %zu, \"box_m\": "
+           "[%.17g, %.17g, %.17g], \"periodic\": [%s, %s, %s], \"dt_s\": %.17g, "
+           "\"t_end_s\": %.17g, \"steps\": %llu, \"vtk_every\": %llu, \"csv_every\": %llu, "
+           "\"contacts\": %zu, \"bridges\": %zu, \"models\": [",
+           wetdem_sim_n_particles(su->sim), wetdem_sim_n_walls(su->sim), su->box[0], su->box[1],
+           su->box[2], su->many.periodic[0] ? "true" : "false",
+           su->many.periodic[1] ? "true" : "false", su->many.periodic[2] ? "true" : "false",
+           pl->dt, pl->t_end, pl->total, su->vtk_every, su->csv_every, s->contacts, s->bridges);
+    for (size_t k = 0; k < wetdem_sim_n_models(su->sim); k++) {
+        printf("%s", k ? ", " : "");
+        cli_json_string(stdout, wetdem_sim_model(su->sim, k)->name);
+    }
+    printf("]}\n");
+}
+
 static void print_check(const struct cli_scenario* sc, const struct cli_many_setup* su,
-                        const struct plan* pl)
+                        const struct plan* pl, bool json)
 {
     struct wetdem_many_stats s;
     wetdem_sim_many_stats(su->sim, &s);
+    if (json) {
+        print_check_json(sc, su, pl, &s);
+        return;
+    }
     printf("scenario %s is valid (many-particle run)\n", sc->file);
     printf("  particles     %zu\n  walls         %zu\n  box           %g x %g x %g m, periodic "
            "%s%s%s%s\n",
@@ -559,7 +584,7 @@ int cli_run_many(const struct cli_scenario* sc, const struct cli_run_options* op
     struct plan pl = {0};
     rc = dry_start(sc, &su, &pl);
     if (rc == CLI_EXIT_OK && opt->check) {
-        print_check(sc, &su, &pl);
+        print_check(sc, &su, &pl, opt->json);
     } else if (rc == CLI_EXIT_OK) {
         struct series vtk = {.binary = su.vtk_binary};
         bool has_vtk = opt->out_dir && su.vtk_prefix[0] && su.vtk_every;

@@ -2,7 +2,8 @@
  * run_pairwise.c — `[engine] type = pairwise` scenarios: the sections the pairwise engine reads
  * (cli_pairwise_sections), building a struct wetdem_pairwise_config from them, running it
  * (wetdem_pairwise_run, Davis 2023) and reporting: a text or JSON summary, trajectory and
- * event CSVs in --out DIR, or one CSV row for `wetdem sweep` / `wetdem map`.
+ * event CSVs in --out DIR, or one CSV row for `wetdem sweep` / `wetdem map`; with
+ * `run --check`, the resolved configuration (text or JSON) without running.
  *
  * Two ways to give the spheres:
  *   [davis]      Davis's Table I groups (St_n, Ca, h_a, h_m, beta, d_23, d_13, h_23,0,
@@ -20,6 +21,7 @@
 #include <string.h>
 
 #include "cli_util.h"
+#include "output_csv.h"
 #include "scenario.h"
 
 #define NUM(k, u, dflt, lo, hi, lo_open, hi_open, doc)                                             \
@@ -311,6 +313,43 @@ static void summary_json(FILE* f, const struct wetdem_pairwise_result* r)
     fputs("]}\n", f);
 }
 
+/* `run --check`: the resolved configuration, without running. */
+static void print_check(const struct cli_scenario* sc, const struct wetdem_pairwise_config* c,
+                        bool json)
+{
+    if (json) {
+        printf("{\"scenario\": ");
+        cli_json_string(stdout, sc->file);
+        printf(", \"engine\": \"pairwise\", \"viscosity\": %.17g, \"surface_tension\": %.17g, "
+               "\"h_min\": %.17g, \"restitution\": %.17g, \"friction\": %.17g, "
+               "\"t_end\": %.17g, \"rtol\": %.17g, \"spheres\": [",
+               c->viscosity, c->surface_tension, c->h_min, c->restitution, c->friction,
+               c->t_end, c->rtol);
+        for (size_t i = 0; i < c->n_spheres; i++) {
+            const struct wetdem_pairwise_sphere* s = &c->spheres[i];
+            printf("%s{\"radius\": %.17g, \"mass\": %.17g, \"film\": %.17g, \"x\": %.17g, "
+                   "\"y\": %.17g, \"vx\": %.17g, \"vy\": %.17g, \"omega\": %.17g}",
+                   i ? ", " : "", s->radius, s->mass, s->film, s->x, s->y, s->vx, s->vy,
+                   s->omega);
+        }
+        printf("]}\n");
+        return;
+    }
+    printf("scenario %s is valid (pairwise engine)\n", sc->file);
+    printf("  viscosity        %.10g Pa s\n  surface_tension  %.10g N/m\n  h_min            "
+           "%.10g m\n  restitution      %.10g -\n  friction         %.10g -\n  t_end            "
+           "%.10g s\n  rtol             %.10g -\n",
+           c->viscosity, c->surface_tension, c->h_min, c->restitution, c->friction, c->t_end,
+           c->rtol);
+    printf("  sphere  radius [m]    mass [kg]     film [m]      x [m]         y [m]         "
+           "vx [m/s]      vy [m/s]      omega [rad/s]\n");
+    for (size_t i = 0; i < c->n_spheres; i++) {
+        const struct wetdem_pairwise_sphere* s = &c->spheres[i];
+        printf("  %-6zu  %-12.6g  %-12.6g  %-12.6g  %-12.6g  %-12.6g  %-12.6g  %-12.6g  %.6g\n",
+               i + 1, s->radius, s->mass, s->film, s->x, s->y, s->vx, s->vy, s->omega);
+    }
+}
+
 /* Observer writing one trajectory row per frame. */
 struct traj {
     FILE* f;
@@ -419,6 +458,10 @@ int cli_run_pairwise(const struct cli_scenario* sc, const struct cli_run_options
         return rc;
     if (opt->sweep_row && opt->sweep_header) {
         sweep_header(opt->sweep_row, &cfg);
+        return CLI_EXIT_OK;
+    }
+    if (opt->check) {
+        print_check(sc, &cfg, opt->json);
         return CLI_EXIT_OK;
     }
     struct wetdem_pairwise* pw = wetdem_pairwise_create();

@@ -12,7 +12,9 @@
  *     when the input is bad or the run fails;
  *   - `sweep` rows come in input order and are bit-identical with 1 and 2 threads, for the
  *     soft engine and for the pairwise engine (whose runs are in the parallel phase too);
- *   - a failed pairwise point reports the engine's status in the status column and exits 1.
+ *   - a failed pairwise point reports the engine's status in the status column and exits 1;
+ *   - `map` refuses many-particle scenarios (exit 2, nothing written); `run --check` of
+ *     many-particle and pairwise scenarios honours --json and does not run.
  */
 #include <stdlib.h>
 #include <sys/stat.h>
@@ -425,6 +427,60 @@ static void test_scenario_sweep_pairwise_threads_and_status(void** state)
     free(r.out);
 }
 
+/* Value of "\"key\": <number>" in a JSON line. */
+static double json_value(const char* out, const char* key)
+{
+    char want[96];
+    snprintf(want, sizeof want, "\"%s\": ", key);
+    const char* p = strstr(out, want);
+    if (!p)
+        fail_msg("'%s' not in JSON:\n%s", want, out);
+    return strtod(p + strlen(want), NULL);
+}
+
+static void test_scenario_map_and_check_of_other_engines(void** state)
+{
+    (void)state;
+    char cmd[900];
+    snprintf(cmd, sizeof cmd,
+             "map examples/scenarios/many_stokes_cradle.ini --param box.size_x --values 1:2:2 "
+             "--param2 fluid.viscosity --values2 1:2:2 --out '%s/map.csv'",
+             tmpdir);
+    struct run r = run_cli(cmd);
+    assert_int_equal(r.code, 2);
+    CHECK_CONTAINS(r.out, "many-particle scenario runs with 'wetdem run'");
+    free(r.out);
+    assert_false(exists(tmpdir, "map.csv"));
+    /* many-particle --check --json: one JSON object, no text form. The cradle runs
+     * t_end = 0.04 s in steps = ceil(t_end / dt) of the library's dt, so
+     * (steps - 1) dt < t_end <= steps dt. */
+    r = run_env("", "run examples/scenarios/many_stokes_cradle.ini --check --json", false);
+    assert_int_equal(r.code, 0);
+    assert_int_equal(r.out[0], '{');
+    assert_null(strstr(r.out, "is valid"));
+    CHECK_REL(json_value(r.out, "particles"), 5.0, 0.0);
+    CHECK_REL(json_value(r.out, "t_end_s"), 0.04, 0.0);
+    double dt = json_value(r.out, "dt_s"), steps = json_value(r.out, "steps");
+    assert_true(dt > 0 && (steps - 1) * dt < 0.04 && 0.04 <= steps * dt * (1 + 1e-12));
+    CHECK_CONTAINS(r.out, "\"models\": [\"hertz\", \"mindlin\", \"sb\", \"capillary\"]}");
+    free(r.out);
+    /* pairwise --check resolves Davis's groups without running (no outcome line). Run length
+     * t_end = t*_end 4a / v_10 with v_10 = v_n0 / cos(beta): 20 x 4 x 2e-3 m / (1 m/s /
+     * cos 30 deg) = 0.0692820323 s; film delta = h_a 4a = 0.01 x 8e-3 m / 2 per sphere = 2e-5 m
+     * (delta_12 = 4e-5 m). Tolerance 1e-9: the hand value carries 10 digits. */
+    r = run_env("", "run examples/scenarios/davis_three.ini --check", false);
+    assert_int_equal(r.code, 0);
+    CHECK_CONTAINS(r.out, "is valid (pairwise engine)");
+    assert_null(strstr(r.out, "outcome"));
+    free(r.out);
+    r = run_env("", "run examples/scenarios/davis_three.ini --check --json", false);
+    assert_int_equal(r.code, 0);
+    assert_int_equal(r.out[0], '{');
+    CHECK_REL(json_value(r.out, "t_end"), 0.0692820323, 1e-9);
+    CHECK_REL(json_value(r.out, "film"), 2e-5, 1e-12);
+    free(r.out);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -436,6 +492,7 @@ int main(void)
         cmocka_unit_test(test_scenario_run_writes_files_or_nothing),
         cmocka_unit_test(test_scenario_sweep_order_and_threads),
         cmocka_unit_test(test_scenario_sweep_pairwise_threads_and_status),
+        cmocka_unit_test(test_scenario_map_and_check_of_other_engines),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
