@@ -9,7 +9,14 @@
  *   mu_f = 0.01 Pa s) + capillary (sigma = 0.02 N/m).
  * dt = 1e-5 s (as the LIGGGHTS decks). The first `settle` steps are not timed.
  *
+ * Same-state protocol (the like-for-like wet/dry comparison of bench/20-many.sh): --state-out
+ * writes the state at the end of the run (positions, radii, velocities, spins) as a LIGGGHTS
+ * data file; --state-in starts from such a file instead of the lattice (the box is the same),
+ * so wetdem dry, wetdem wet and both LIGGGHTS variants run the same configuration. Contact
+ * histories are not carried over, in either code.
+ *
  * Usage: many_bench [--wet] [--n N] [--settle S] [--steps S] [--data FILE] [--budget]
+ *                   [--state-in FILE] [--state-out FILE]
  * Prints one line: "wetdem <dry|wet> n=.. threads=.. steps=.. seconds=.. cpu_seconds=..
  * psteps_per_s=..
  * maxrss_kb=.. contacts=.. bridges=.. pairs=.. builds=..". Uses only the public API.
@@ -71,8 +78,63 @@ static void write_data(const char* path, struct wetdem_sim* sim, const double hi
                 p[k].pos.y, p[k].pos.z);
     fputs("\nVelocities\n\n", f);
     for (size_t k = 0; k < n; k++)
-        fprintf(f, "%zu %.17g %.17g %.17g 0 0 0\n", k + 1, p[k].vel.x, p[k].vel.y, p[k].vel.z);
+        fprintf(f, "%zu %.17g %.17g %.17g %.17g %.17g %.17g\n", k + 1, p[k].vel.x, p[k].vel.y,
+                p[k].vel.z, p[k].omega.x, p[k].omega.y, p[k].omega.z);
     fclose(f);
+}
+
+/* Number of atoms in a data file written by write_data (0 if unreadable). */
+static size_t data_atoms(const char* path)
+{
+    FILE* f = fopen(path, "r");
+    char line[512];
+    size_t n = 0;
+    while (f && fgets(line, sizeof line, f))
+        if (sscanf(line, "%zu atoms", &n) == 1)
+            break;
+    if (f)
+        fclose(f);
+    return n;
+}
+
+/* Replaces the particles of sim by those of a data file written by write_data. */
+static void read_data(const char* path, struct wetdem_sim* sim)
+{
+    FILE* f = fopen(path, "r");
+    if (!f) {
+        fprintf(stderr, "many_bench: cannot read %s\n", path);
+        exit(1);
+    }
+    size_t n;
+    struct wetdem_particle* p = wetdem_sim_particles(sim, &n);
+    char line[512];
+    int section = 0; /* 1 atoms, 2 velocities */
+    size_t seen = 0;
+    while (fgets(line, sizeof line, f)) {
+        size_t id;
+        double a[7];
+        if (!strncmp(line, "Atoms", 5))
+            section = 1;
+        else if (!strncmp(line, "Velocities", 10))
+            section = 2;
+        else if (section == 1 && sscanf(line, "%zu %*d %lf %lf %lf %lf %lf", &id, &a[0], &a[1],
+                                        &a[2], &a[3], &a[4]) == 6 && id >= 1 && id <= n) {
+            p[id - 1].radius = 0.5 * a[0];
+            p[id - 1].mass = a[1] * 4.0 / 3.0 * 3.14159265358979323846 * p[id - 1].radius *
+                             p[id - 1].radius * p[id - 1].radius;
+            p[id - 1].pos = (struct wetdem_vec3){a[2], a[3], a[4]};
+            seen++;
+        } else if (section == 2 && sscanf(line, "%zu %lf %lf %lf %lf %lf %lf", &id, &a[0], &a[1],
+                                          &a[2], &a[3], &a[4], &a[5]) == 7 && id >= 1 && id <= n) {
+            p[id - 1].vel = (struct wetdem_vec3){a[0], a[1], a[2]};
+            p[id - 1].omega = (struct wetdem_vec3){a[3], a[4], a[5]};
+        }
+    }
+    fclose(f);
+    if (seen != n) {
+        fprintf(stderr, "many_bench: %s holds %zu of %zu atoms\n", path, seen, n);
+        exit(1);
+    }
 }
 
 static void setup(struct wetdem_sim* sim, bool wet, size_t n, double hi[3])
@@ -118,6 +180,8 @@ int main(int argc, char** argv)
     size_t n = 20000;
     unsigned long settle = 1000, steps = 2000;
     const char* data = NULL;
+    const char* state_in = NULL;
+    const char* state_out = NULL;
     for (int k = 1; k < argc; k++) {
         if (!strcmp(argv[k], "--wet"))
             wet = true;
@@ -131,15 +195,25 @@ int main(int argc, char** argv)
             steps = strtoul(argv[++k], NULL, 10);
         else if (!strcmp(argv[k], "--data") && k + 1 < argc)
             data = argv[++k];
+        else if (!strcmp(argv[k], "--state-in") && k + 1 < argc)
+            state_in = argv[++k];
+        else if (!strcmp(argv[k], "--state-out") && k + 1 < argc)
+            state_out = argv[++k];
         else {
             fprintf(stderr, "usage: many_bench [--wet] [--budget] [--n N] [--settle S] "
-                            "[--steps S] [--data FILE]\n");
+                            "[--steps S] [--data FILE] [--state-in FILE] [--state-out FILE]\n");
             return 2;
         }
+    }
+    if (state_in && !(n = data_atoms(state_in))) {
+        fprintf(stderr, "many_bench: no atoms in %s\n", state_in);
+        return 1;
     }
     struct wetdem_sim* sim = wetdem_sim_create();
     double hi[3];
     setup(sim, wet, n, hi);
+    if (state_in)
+        read_data(state_in, sim);
     if (data) {
         write_data(data, sim, hi);
         return 0;
@@ -153,6 +227,8 @@ int main(int argc, char** argv)
     if ((st = wetdem_sim_integrate(sim, (settle + steps) * dt)) != WETDEM_OK)
         die(sim, st, "timed run");
     double secs = omp_get_wtime() - t0, cpu = cpu_seconds() - c0;
+    if (state_out)
+        write_data(state_out, sim, hi);
     struct wetdem_many_stats s;
     wetdem_sim_many_stats(sim, &s);
     printf("wetdem %s n=%zu threads=%d steps=%lu seconds=%.3f cpu_seconds=%.3f psteps_per_s=%.4g "
