@@ -37,14 +37,25 @@ size_t cli_result_fields(const struct cli_setup* su, const struct wetdem_collisi
                          struct cli_field* out)
 {
     size_t n = 0;
-    out[n++] = num("impact_speed", "m/s", "speed of the striker at t = 0", su->impact_speed);
+    out[n++] = num("impact_speed", "m/s", "speed U of the striker at t = 0", su->impact_speed);
     out[n++] = num("stokes_n", "-", "normal Stokes number m* v_n0 / (6 pi mu R*^2)", r->stokes_n);
-    out[n++] = num("speed_n0", "m/s", "normal approach speed at first interaction", r->speed_n0);
-    out[n++] = num("e", "-", "Nijssen restitution |dv_1|/|dv_0|", r->e);
-    out[n++] = num("e_n", "-", "normal restitution (Punch Eq. 3)", r->e_n);
-    out[n++] = num("e_t", "-", "tangential restitution of the contact point", r->e_t);
-    out[n++] = num("e_n_observed", "-", "e_n at observe_time", r->e_n_observed);
-    out[n++] = num("angle_in", "deg", "impact angle to the normal", r->angle_in * RAD2DEG);
+    out[n++] = num("speed_n0", "m/s",
+                   "normal impact speed v_n0 = U cos(angle) of the straight-line approach",
+                   r->speed_n0);
+    out[n++] = num("e", "-", "Nijssen restitution |dv_f|/|dv_0|", r->e);
+    out[n++] = num("e_n", "-",
+                   "normal restitution dv_f.n_f / v_n0: separation over impact speed (Punch "
+                   "Eq. 3)",
+                   r->e_n);
+    out[n++] = num("e_t", "-",
+                   "tangential restitution of the contact point (-1 smooth, +1 reversed; nan "
+                   "without initial slip)",
+                   r->e_t);
+    out[n++] = num("e_n_observed", "-", "e_n at observe_time after the first interaction",
+                   r->e_n_observed);
+    out[n++] = num("angle_in", "deg",
+                   "impact angle to the line of centres at contact of the straight-line approach",
+                   r->angle_in * RAD2DEG);
     out[n++] = num("angle_out", "deg", "rebound angle of the relative velocity to the normal",
                    r->angle_out * RAD2DEG);
     out[n++] = num("striker_angle_out", "deg",
@@ -59,14 +70,20 @@ size_t cli_result_fields(const struct cli_setup* su, const struct wetdem_collisi
     out[n++] = num("omega_j_y", "rad/s", "final spin of the target, y", r->omega_j.y);
     out[n++] = num("omega_j_z", "rad/s", "final spin of the target, z", r->omega_j.z);
     out[n++] = num("contact_duration", "s", "total time with gap < 0", r->contact_duration);
-    out[n++] = num("interaction_duration", "s", "first interaction to separation",
+    out[n++] = num("interaction_duration", "s",
+                   "first interaction start to last interaction end (to t_end if not separated)",
                    r->interaction_duration);
     out[n++] = num("min_gap", "m", "smallest gap reached", r->min_gap);
     out[n++] = flag("solid_contact", "the gap reached 0", r->solid_contact);
-    out[n++] = flag("hmin_reached", "the gap reached h_min", r->hmin_reached);
-    out[n++] = flag("separated", "left the interaction range by t_end", r->separated);
+    out[n++] = flag("hmin_reached", "the gap reached h_min (or 0)", r->hmin_reached);
+    out[n++] = flag("separated", "receding beyond the separation gap by t_end", r->separated);
     out[n++] = num("rotation_angle", "deg", "turn of the line of centres during interaction",
                    r->rotation_angle * RAD2DEG);
+    out[n++] = num("rotation_close", "deg",
+                   "part of rotation_angle turned below close_gap after the approach was "
+                   "arrested (> 5 deg and separated: stick-rotate-separate)",
+                   r->rotation_close * RAD2DEG);
+    out[n++] = num("close_gap", "m", "doublet gap of the outcome rule", r->close_gap);
     out[n] = (struct cli_field){.name = "outcome", .unit = "", .kind = CLI_FIELD_TEXT,
                                 .doc = "stick, stick-rotate-separate or bounce",
                                 .text = wetdem_outcome_name(r->outcome)};
