@@ -573,6 +573,24 @@ int wetdem_sim_many_index_pairs(struct wetdem_sim* sim)
     return WETDEM_OK;
 }
 
+/* First particle of thread t's block in the pair pass: contiguous blocks of about equal
+ * candidate counts, so each thread writes its own stretch of the reaction slots (interleaved
+ * chunks made the threads share cache lines there; the speed-up on 2 threads was 1.2x). */
+static size_t block_start(const struct wetdem_many* m, size_t n, int t, int nt)
+{
+    if (t >= nt)
+        return n;
+    size_t target = m->cl.n_pairs / (size_t)nt * (size_t)t, lo = 0, hi = n;
+    while (lo < hi) { /* smallest i with first_pair[i] >= target */
+        size_t mid = lo + (hi - lo) / 2;
+        if (m->cl.first_pair[mid] < target)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return lo;
+}
+
 int wetdem_sim_many_forces(struct wetdem_sim* sim, bool kick)
 {
     struct wetdem_many* m = sim->many;
@@ -586,9 +604,11 @@ int wetdem_sim_many_forces(struct wetdem_sim* sim, bool kick)
     /* one parallel region: the pair pass, a barrier, the gather */
 #pragma omp parallel if (wetdem_many_parallel(m, n))
     {
-#pragma omp for schedule(dynamic, 64)
-        for (size_t i = 0; i < n; i++)
+        int t = omp_get_thread_num(), nt = omp_get_num_threads();
+        for (size_t i = block_start(m, n, t, nt), end = block_start(m, n, t + 1, nt); i < end;
+             i++)
             eval_pairs_of(sim, i, &fail);
+#pragma omp barrier
 #pragma omp for schedule(static)
         for (size_t i = 0; i < n; i++) {
             gather_one(sim, i, &fail);
