@@ -157,14 +157,3 @@ void cli_param_default_text(const struct wetdem_param_desc* d, char* buf, size_t
     }
     snprintf(buf, n, "%g", d->default_value);
 }
-
-/* The settings table is declared in the library's internal header (src/sim.h), not in
- * wetdem.h: a weak reference keeps the CLI a client of the public header only, and lets it
- * say "not available" against a library that lacks the function. */
-#pragma weak wetdem_sim_settings_params
-const struct wetdem_param_desc* wetdem_sim_settings_params(void);
-
-const struct wetdem_param_desc* cli_sim_settings_params(void)
-{
-    return wetdem_sim_settings_params ? wetdem_sim_settings_params() : NULL;
-}

@@ -63,8 +63,4 @@ void cli_print_double(FILE* f, double v);
  * the number in %g format. */
 void cli_param_default_text(const struct wetdem_param_desc* d, char* buf, size_t n);
 
-/* Descriptor table of the simulation settings addressed as "sim.NAME", or NULL when the
- * library in use does not export it (wetdem_sim_settings_params). */
-const struct wetdem_param_desc* cli_sim_settings_params(void);
-
 #endif

@@ -1,9 +1,9 @@
 /*
  * cmd_describe.c — `wetdem describe NAME`: a model's summary, doc paragraph and equation
  * references, then every parameter with unit, default (the word for enumerations), valid
- * range and one-line doc. NAME may also be "material", "fluid" or "sim" (the descriptor
- * tables of materials, the fluid and simulation settings) or "presets" (the material presets
- * and their values). An unknown NAME gets a "did you mean" hint and exit code 2.
+ * range and one-line doc. NAME may also be an integrator ("verlet", "cvode": its summary and
+ * parameters), "material", "fluid" or "sim" (the descriptor tables of materials, the fluid and
+ * simulation settings) or "presets" (the material presets and their values). An unknown NAME gets a "did you mean" hint and exit code 2.
  * Everything printed comes from the library's descriptor tables.
  */
 #include <stdio.h>
@@ -87,8 +87,17 @@ static void describe_presets(void)
     }
 }
 
-/* The names `describe` accepts besides model names. */
+/* The names `describe` accepts besides model and integrator names. */
 static const char* const special_names[] = {"material", "fluid", "sim", "presets", NULL};
+
+static void describe_integrator(const char* name)
+{
+    printf("%s (integrator): %s\n\n", name, wetdem_integrator_summary(name));
+    printf("parameters (set as %s.NAME=VALUE, e.g. with --set, or in [integrator] of a "
+           "scenario):\n",
+           name);
+    print_table(wetdem_integrator_params(name));
+}
 
 static int unknown_name(const char* name)
 {
@@ -97,12 +106,14 @@ static int unknown_name(const char* name)
     const struct wetdem_model* const* reg = wetdem_model_registry();
     for (size_t k = 0; reg[k] && n < 80; k++)
         names[n++] = reg[k]->name;
+    for (const char* const* in = wetdem_integrator_names(); *in && n < 88; in++)
+        names[n++] = *in;
     for (size_t k = 0; special_names[k]; k++)
         names[n++] = special_names[k];
     names[n] = NULL;
     const char* hint = wetdem_param_suggest(name, names);
     cli_error("describe: unknown name '%s'%s%s%s; valid: a model name (see 'wetdem models'), "
-              "material, fluid, sim or presets",
+              "an integrator (verlet, cvode), material, fluid, sim or presets",
               name, hint ? " (did you mean '" : "", hint ? hint : "", hint ? "'?)" : "");
     return CLI_EXIT_USAGE;
 }
@@ -113,13 +124,16 @@ int cmd_describe(int argc, char** argv)
     if (argc != 2 || help) {
         FILE* f = help ? stdout : stderr;
         fprintf(f, "usage: wetdem describe NAME\n"
-                   "NAME: a model (see 'wetdem models'), material, fluid, sim or presets\n");
+                   "NAME: a model (see 'wetdem models'), an integrator (verlet, cvode),\n"
+                   "      material, fluid, sim or presets\n");
         return help ? CLI_EXIT_OK : CLI_EXIT_USAGE;
     }
     const char* name = argv[1];
     const struct wetdem_model* m = wetdem_model_find(name);
     if (m) {
         describe_model(m);
+    } else if (wetdem_integrator_params(name)) {
+        describe_integrator(name);
     } else if (strcmp(name, "material") == 0) {
         printf("material fields (struct wetdem_material, one per sphere or wall; pairs mix "
                "them):\n");
@@ -128,12 +142,8 @@ int cmd_describe(int argc, char** argv)
         printf("fluid (set as fluid.NAME=VALUE):\n");
         print_table(wetdem_fluid_params());
     } else if (strcmp(name, "sim") == 0) {
-        const struct wetdem_param_desc* table = cli_sim_settings_params();
         printf("simulation settings (set as sim.NAME=VALUE):\n");
-        if (table)
-            print_table(table);
-        else
-            printf("  (this build of the library does not list its settings)\n");
+        print_table(wetdem_sim_settings_params());
     } else if (strcmp(name, "presets") == 0) {
         describe_presets();
     } else {

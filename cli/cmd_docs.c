@@ -2,8 +2,8 @@
  * cmd_docs.c — `wetdem docs-models`: writes docs/models.md (Markdown) to stdout, generated
  * from the same descriptor tables that `wetdem models` and `wetdem describe` print: an
  * introduction, a table of contents, one section per model (summary, doc, equations,
- * parameter table), then the material and fluid fields, the simulation settings and the
- * material presets. `make docs` writes the file; `make check-docs` and tests/test_docs.c
+ * parameter table), then the integrators (summary and parameter table each), the material
+ * and fluid fields, the simulation settings and the material presets. `make docs` writes the file; `make check-docs` and tests/test_docs.c
  * fail when the committed file differs from this output. The text holds no version or git
  * hash, so it changes only when a table changes.
  */
@@ -90,7 +90,13 @@ static void contents(const struct wetdem_model* const* reg)
             }
         printf("\n");
     }
-    printf("- [Material fields](#material-fields), [Fluid](#fluid), "
+    printf("- [Integrators](#integrators):");
+    const char* sep = " ";
+    for (const char* const* in = wetdem_integrator_names(); *in; in++) {
+        printf("%s[`%s`](#integrator-%s)", sep, *in, *in);
+        sep = ", ";
+    }
+    printf("\n- [Material fields](#material-fields), [Fluid](#fluid), "
            "[Simulation settings](#simulation-settings), [Material presets](#material-presets)"
            "\n\n");
 }
@@ -106,6 +112,24 @@ static void model_section(const struct wetdem_model* m)
     char prefix[64];
     snprintf(prefix, sizeof prefix, "%s.", m->name);
     param_table(m->params, prefix);
+}
+
+static void integrators_section(void)
+{
+    printf("<a id=\"integrators\"></a>\n## Integrators\n\n"
+           "The soft engine's time integrators, chosen with "
+           "`wetdem_sim_set_integrator(sim, NAME)` or `[integrator] name = NAME` in a scenario "
+           "(default `verlet`). The parameters of every integrator are kept on the simulation "
+           "and set as `<integrator>.<name>`, e.g. `--set cvode.rtol=1e-9`; those of an "
+           "integrator not chosen are kept but unused. Semantics, events and costs: "
+           "[engines.md](engines.md).\n\n");
+    for (const char* const* in = wetdem_integrator_names(); *in; in++) {
+        printf("<a id=\"integrator-%s\"></a>\n### `%s` — %s\n\n", *in, *in,
+               wetdem_integrator_summary(*in));
+        char prefix[64];
+        snprintf(prefix, sizeof prefix, "%s.", *in);
+        param_table(wetdem_integrator_params(*in), prefix);
+    }
 }
 
 static void presets_section(void)
@@ -143,14 +167,11 @@ static void tables_section(void)
     printf("<a id=\"fluid\"></a>\n## Fluid\n\n"
            "Fields of `struct wetdem_fluid`, set as `fluid.<name>`.\n\n");
     param_table(wetdem_fluid_params(), "fluid.");
-    printf("<a id=\"simulation-settings\"></a>\n## Simulation settings\n\n");
-    const struct wetdem_param_desc* settings = cli_sim_settings_params();
-    if (settings) {
-        printf("Set as `sim.<name>`.\n\n");
-        param_table(settings, "sim.");
-    } else {
-        printf("Set as `sim.<name>`; this build of the library does not list them.\n\n");
-    }
+    printf("<a id=\"simulation-settings\"></a>\n## Simulation settings\n\n"
+           "Fields of the simulation's settings, set as `sim.<name>` "
+           "(`wetdem_sim_set_param(sim, \"sim.gravity_z\", -9.81)`, `[sim]` in a scenario); "
+           "the table is `wetdem_sim_settings_params()`.\n\n");
+    param_table(wetdem_sim_settings_params(), "sim.");
 }
 
 int cmd_docs_models(int argc, char** argv)
@@ -176,6 +197,7 @@ int cmd_docs_models(int argc, char** argv)
             if (reg[k]->kind == sections[s].kind)
                 model_section(reg[k]);
     }
+    integrators_section();
     tables_section();
     presets_section();
     return CLI_EXIT_OK;

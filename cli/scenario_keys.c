@@ -94,8 +94,9 @@ static const char* const cvode_methods[] = {"auto", "adams", "bdf", NULL};
 static const char* const yes_no[] = {"no", "yes", NULL};
 
 /* Keys after "name" are the integrators' parameters ("<name>.<key>" in the library); their
- * defaults are read from the library when the docs are generated (default_text NULL), and
- * generation fails if the library does not know a key listed here. */
+ * defaults are read from the library's descriptor tables when the docs are generated
+ * (default_text NULL), and generation fails if the library does not know a key listed here
+ * or gives it another range. */
 static const struct cli_key_desc integrator_keys[] = {
     WORD("name", CLI_VALUE_NAME, "verlet", NULL,
          "verlet (fixed step, a fraction of the Hertz contact time) or cvode (adaptive, "
@@ -291,35 +292,48 @@ static void cell(FILE* f, const char* text)
     }
 }
 
-/* Default of an integrator or sim key read from the library: "<value>" or, for integrator
- * keys, "<value> (<integrator>)" per integrator that has it. Returns 0, or -1 if the library
- * knows the key for none. */
+/* Whether a key's documented range is the library descriptor's (the library checks values
+ * against its own table when the scenario is built; the docs must say the same). */
+static bool same_range(const struct cli_key_desc* k, const struct wetdem_param_desc* d)
+{
+    if (k->kind == CLI_VALUE_CHOICE)
+        return d->choices != NULL;
+    return k->min == d->min && k->max == d->max && k->min_open == d->min_open &&
+           k->max_open == d->max_open && !d->choices;
+}
+
+/* Default of an integrator or sim key from the library's descriptor tables
+ * (wetdem_sim_settings_params, wetdem_integrator_params): "<value>" or, for integrator keys,
+ * "<value> (<integrator>)" per integrator that has it. Returns 0, or -1 (message printed) if
+ * the library knows the key for none or documents another range. */
 static int library_default(const char* section, const struct cli_key_desc* k, char* out,
                            size_t n)
 {
-    struct wetdem_sim* sim = wetdem_sim_create();
-    const char* const* names = wetdem_integrator_names();
     bool is_sim = strcmp(section, "sim") == 0;
+    const char* const* names = wetdem_integrator_names();
     size_t used = 0;
     out[0] = '\0';
-    for (size_t m = 0; sim && (is_sim ? m < 1 : names[m] != NULL); m++) {
-        char full[2 * CLI_NAME_MAX];
-        snprintf(full, sizeof full, "%s.%s", is_sim ? "sim" : names[m], k->key);
-        double v;
-        if (!is_sim && wetdem_sim_set_integrator(sim, names[m]) != WETDEM_OK)
+    for (size_t m = 0; is_sim ? m < 1 : names[m] != NULL; m++) {
+        const struct wetdem_param_desc* d = wetdem_param_find(
+            is_sim ? wetdem_sim_settings_params() : wetdem_integrator_params(names[m]), k->key);
+        if (!d)
             continue;
-        if (wetdem_sim_param(sim, full, &v) != WETDEM_OK)
-            continue;
+        if (!same_range(k, d)) {
+            char range[160];
+            wetdem_param_range_text(d, range, sizeof range);
+            fprintf(stderr, "wetdem: docs-scenarios: [%s] %s: the library's range is %s\n",
+                    section, k->key, range);
+            return -1;
+        }
         char value[64];
-        if (k->kind == CLI_VALUE_CHOICE && k->choices && v >= 0 && v < 8)
-            snprintf(value, sizeof value, "%s", k->choices[(size_t)v]);
-        else
-            snprintf(value, sizeof value, "%g", v);
+        cli_param_default_text(d, value, sizeof value);
         used += (size_t)snprintf(out + used, used < n ? n - used : 0, "%s%s%s%s%s",
                                  used ? ", " : "", value, is_sim ? "" : " (", is_sim ? "" : names[m],
                                  is_sim ? "" : ")");
     }
-    wetdem_sim_free(sim);
+    if (!out[0])
+        fprintf(stderr, "wetdem: docs-scenarios: the library has no parameter '%s' for [%s]\n",
+                k->key, section);
     return out[0] ? 0 : -1;
 }
 
@@ -328,11 +342,8 @@ static int key_row(FILE* f, const char* section, const struct cli_key_desc* k)
     char dflt[256];
     if (k->default_text)
         snprintf(dflt, sizeof dflt, "%s", k->default_text);
-    else if (library_default(section, k, dflt, sizeof dflt) != 0) {
-        fprintf(stderr, "wetdem: docs-scenarios: the library has no parameter '%s' for [%s]\n",
-                k->key, section);
+    else if (library_default(section, k, dflt, sizeof dflt) != 0)
         return -1;
-    }
     char range[256] = "name";
     if (k->kind == CLI_VALUE_NUMBER || k->kind == CLI_VALUE_CHOICE) {
         struct wetdem_param_desc d = cli_key_as_param(k);

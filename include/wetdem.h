@@ -357,6 +357,9 @@ WETDEM_API int wetdem_sim_set_param_str(struct wetdem_sim* sim, const char* name
                                         const char* value);
 /* Reads a parameter by dotted name into *value. */
 WETDEM_API int wetdem_sim_param(const struct wetdem_sim* sim, const char* name, double* value);
+/* Descriptor table ({0}-terminated, static) of the simulation settings, set as "sim.<name>"
+ * (gravity, stop on separation, speed floor); the defaults are those of a new simulation. */
+WETDEM_API const struct wetdem_param_desc* wetdem_sim_settings_params(void);
 
 /* Evaluates the sum of the enabled force models for particles i and j (j may equal
  * (size_t)-1 - w to address wall w) with the given per-pair history (may be NULL: fresh
@@ -377,6 +380,11 @@ WETDEM_API int wetdem_sim_set_integrator(struct wetdem_sim* sim, const char* nam
 WETDEM_API const char* wetdem_sim_integrator_name(const struct wetdem_sim* sim);
 /* NULL-terminated list of integrator names. */
 WETDEM_API const char* const* wetdem_integrator_names(void);
+/* Descriptor table ({0}-terminated, static) of integrator `name`'s parameters, set as
+ * "<name>.<param>" (e.g. "cvode.rtol"); NULL for an unknown name. */
+WETDEM_API const struct wetdem_param_desc* wetdem_integrator_params(const char* name);
+/* One-line summary of integrator `name` (static text), or NULL for an unknown name. */
+WETDEM_API const char* wetdem_integrator_summary(const char* name);
 
 /* Advances the simulation to time t_end [s]. Returns WETDEM_OK at t_end, WETDEM_EVENT when a
  * stop condition fired (sim.stop_on_separation), or a negative status (message in errmsg). */

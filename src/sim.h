@@ -120,9 +120,6 @@ void wetdem_sim_history_init(const struct wetdem_sim* sim, double* history);
 void wetdem_sim_build_contact(const struct wetdem_sim* sim, size_t i, size_t j, bool is_wall,
                               struct wetdem_contact* c);
 
-/* sim_models.c: descriptor table of struct wetdem_sim_settings ("sim.<name>"). */
-const struct wetdem_param_desc* wetdem_sim_settings_params(void);
-
 /* sim_many.c: frees the many-particle state (wetdem_sim_free calls it). */
 void wetdem_sim_many_free(struct wetdem_sim* sim);
 /* sim_many.c: runs the many-particle engine to t_end (wetdem_sim_integrate dispatches). */

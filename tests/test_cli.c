@@ -1,7 +1,7 @@
 /*
  * test_cli.c — the wetdem command-line tool end to end: --version, --help, `models` (every
- * registry model listed), `describe` (parameters with units and ranges; unknown names give a
- * hint and exit 2), `forces` (CSV provenance and columns; one value checked against the closed
+ * registry model listed), `describe` (parameters with units and ranges of every model, the
+ * simulation settings and both integrators; unknown names give a hint and exit 2), `forces` (CSV provenance and columns; one value checked against the closed
  * form of the reynolds model, F = 6 pi mu R*^2 v_n / h), bad input (exit 2, message), and
  * `--help`/`-h` of every subcommand listed by `wetdem --help` (usage on stdout, exit 0).
  *
@@ -159,6 +159,30 @@ static void test_cli_describe_lists_parameters_with_units(void** state)
     r = run_cli("describe fluid", false);
     assert_int_equal(r.code, 0);
     CHECK_CONTAINS(r.out, "viscosity [Pa s]  default 0.001, valid [0, 1e+06]");
+    free(r.out);
+    /* the simulation settings and both integrators, from the public descriptor tables */
+    const struct {
+        const char* name;
+        const struct wetdem_param_desc* table;
+    } tables[] = {{"sim", wetdem_sim_settings_params()},
+                  {"verlet", wetdem_integrator_params("verlet")},
+                  {"cvode", wetdem_integrator_params("cvode")}};
+    for (size_t t = 0; t < sizeof tables / sizeof tables[0]; t++) {
+        char args[64], want[160];
+        snprintf(args, sizeof args, "describe %s", tables[t].name);
+        r = run_cli(args, false);
+        assert_int_equal(r.code, 0);
+        assert_non_null(tables[t].table);
+        for (size_t q = 0; tables[t].table[q].name; q++) {
+            snprintf(want, sizeof want, "  %s [%s]  default ", tables[t].table[q].name,
+                     tables[t].table[q].unit);
+            CHECK_CONTAINS(r.out, want);
+        }
+        free(r.out);
+    }
+    r = run_cli("describe cvode", false);
+    CHECK_CONTAINS(r.out, "rtol [-]  default 1e-08, valid [1e-14, 0.01]");
+    CHECK_CONTAINS(r.out, "method [-]  default auto, valid one of: auto, adams, bdf");
     free(r.out);
     r = run_cli("describe presets", false);
     assert_int_equal(r.code, 0);

@@ -3,7 +3,9 @@
  * values are rejected with a message naming the parameter, value and valid range; unknown
  * parameter and model names get a "did you mean" hint; enumerated parameters are set by
  * word; range text; material presets against the seed tables (Nijssen 2023 Table 1, Punch
- * 2023 Table 1); simulation lifecycle; particle mass from the material density.
+ * 2023 Table 1); simulation lifecycle; particle mass from the material density; the public
+ * descriptor tables of the simulation settings and of each integrator describe exactly what
+ * wetdem_sim_param reads and wetdem_sim_set_param checks.
  */
 #include <stdlib.h>
 
@@ -284,6 +286,61 @@ static void test_params_mass_from_density(void** state)
     wetdem_sim_free(sim);
 }
 
+/* Every entry of `table` under "<prefix>.<name>": a new simulation reads its default, a value
+ * just beyond a finite bound is rejected naming the parameter, and the bound itself is
+ * accepted unless open. Returns the number of entries. */
+static size_t check_table_against_sim(struct wetdem_sim* sim, const char* prefix,
+                                      const struct wetdem_param_desc* table)
+{
+    size_t n = 0;
+    for (; table[n].name; n++) {
+        const struct wetdem_param_desc* d = &table[n];
+        char full[128];
+        snprintf(full, sizeof full, "%s.%s", prefix, d->name);
+        double v = NAN;
+        CHECK_OK(wetdem_sim_param(sim, full, &v));
+        CHECK_REL(v, d->default_value, 0.0); /* the same double, not a copy of its text */
+        if (d->choices)
+            continue;
+        /* 1e-3 of the bound's size (or 1e-3 absolute at 0) is well outside any rounding. */
+        double above = d->max + fmax(fabs(d->max) * 1e-3, 1e-3);
+        CHECK_STATUS(wetdem_sim_set_param(sim, full, above), WETDEM_ERR_INVALID);
+        CHECK_CONTAINS(wetdem_sim_errmsg(sim), d->name);
+        CHECK_STATUS(wetdem_sim_set_param(sim, full, d->max),
+                     d->max_open ? WETDEM_ERR_INVALID : WETDEM_OK);
+        CHECK_OK(wetdem_sim_set_param(sim, full, d->default_value));
+    }
+    return n;
+}
+
+static void test_params_public_settings_and_integrator_tables(void** state)
+{
+    (void)state;
+    struct wetdem_sim* sim = wetdem_sim_create();
+    assert_non_null(sim);
+    const struct wetdem_param_desc* settings = wetdem_sim_settings_params();
+    assert_non_null(settings);
+    assert_true(check_table_against_sim(sim, "sim", settings) >= 6); /* gravity x3, stop, ... */
+    assert_non_null(wetdem_param_find(settings, "speed_floor"));
+    size_t n_integrators = 0;
+    for (const char* const* name = wetdem_integrator_names(); *name; name++, n_integrators++) {
+        const struct wetdem_param_desc* table = wetdem_integrator_params(*name);
+        assert_non_null(table);
+        assert_non_null(wetdem_integrator_summary(*name));
+        /* Every integrator keeps its parameters on the simulation whichever one is chosen. */
+        assert_true(check_table_against_sim(sim, *name, table) >= 3);
+        CHECK_OK(wetdem_sim_set_integrator(sim, *name));
+        check_table_against_sim(sim, *name, table);
+    }
+    assert_int_equal(n_integrators, 2); /* verlet and cvode */
+    assert_non_null(wetdem_param_find(wetdem_integrator_params("cvode"), "rtol"));
+    assert_non_null(wetdem_param_find(wetdem_integrator_params("verlet"), "dt_fraction"));
+    assert_null(wetdem_integrator_params("cvod"));
+    assert_null(wetdem_integrator_params(NULL));
+    assert_null(wetdem_integrator_summary("rk45"));
+    wetdem_sim_free(sim);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -298,6 +355,7 @@ int main(void)
         cmocka_unit_test(test_params_suggest_threshold),
         cmocka_unit_test(test_params_presets_match_seed_tables),
         cmocka_unit_test(test_params_mass_from_density),
+        cmocka_unit_test(test_params_public_settings_and_integrator_tables),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
