@@ -326,6 +326,12 @@ double wetdem_force_hertz_damping(double e_star, double r_eff, double m_eff, dou
     return c * sqrt(m_eff * k) * sqrt(sqrt(overlap)) * v_n;
 }
 
+double wetdem_force_hertz_total(double f_el, double f_damp, int form)
+{
+    (void)form; /* both forms are clipped: contact.md Sec. 1.1 */
+    return fmax(f_el + f_damp, 0.0);
+}
+
 /* 2.868266... = (4/5) (15/16)^(2/5) B(2/5, 1/2), contact.md Sec. 1.4. */
 #define HERTZ_CONTACT_TIME_CONSTANT 2.8682656991953315
 
@@ -351,10 +357,13 @@ static int hertz_pair(const void* params, const struct wetdem_contact* c, double
     double overlap = -c->gap;
     if (!(overlap > 0.0))
         return WETDEM_OK;
-    double f = wetdem_force_hertz_elastic(c->e_star, c->r_eff, overlap) +
-               wetdem_force_hertz_damping(c->e_star, c->r_eff, c->m_eff, overlap, c->v_n,
-                                          c->restitution, (int)p->damping);
-    out->f_normal += fmax(f, 0.0);
+    int form = (int)p->damping;
+    double f_el = wetdem_force_hertz_elastic(c->e_star, c->r_eff, overlap);
+    out->f_normal += wetdem_force_hertz_total(
+        f_el,
+        wetdem_force_hertz_damping(c->e_star, c->r_eff, c->m_eff, overlap, c->v_n,
+                                   c->restitution, form),
+        form);
     return WETDEM_OK;
 }
 

@@ -40,6 +40,11 @@ double wetdem_force_hertz_elastic(double e_star, double r_eff, double overlap);
  * form. Callers that want e_dry exactly must clip the sum at zero as the hertz model does. */
 double wetdem_force_hertz_damping(double e_star, double r_eff, double m_eff, double overlap,
                                   double v_n, double restitution, int form);
+/* force_hertz.c: total normal force of the hertz law [N] from its elastic part f_el and its
+ * damping part f_damp (wetdem_force_hertz_damping with the same form): the one place that
+ * decides whether the sum is clipped at zero for a damping form. Every caller that composes
+ * the hertz law (the hertz model, the many-particle fused kernel) goes through it. */
+double wetdem_force_hertz_total(double f_el, double f_damp, int form);
 /* force_hertz.c: duration of an undamped head-on Hertz collision at impact speed v [s]:
  * 2.868266... (m*^2 / (E*^2 R* v))^(1/5) (Hertz theory; Johnson 1985 Sec. 11.4). */
 double wetdem_force_hertz_contact_time(double e_star, double r_eff, double m_eff, double v);
