@@ -107,9 +107,9 @@ struct wetdem_many {
     /* outputs */
     uint64_t vtk_files, csv_rows;
     uint64_t next_vtk_step, next_csv_step, next_checkpoint_step;
-    char** vtk_names;            /* names of the files written, for the .vtk.series file */
+    char** vtk_names;            /* the .vtk.series entries: file names and times [s] */
     double* vtk_times;
-    size_t vtk_names_cap;
+    size_t n_series, vtk_names_cap;
 };
 
 /* Whether loops over n particles of m run in parallel. */

@@ -99,7 +99,7 @@ void wetdem_sim_many_free(struct wetdem_sim* sim)
     free(m->slot);
     free(m->rev_out);
     free(m->rev_flags);
-    for (size_t k = 0; k < m->vtk_files && m->vtk_names; k++)
+    for (size_t k = 0; k < m->n_series && m->vtk_names; k++)
         free(m->vtk_names[k]);
     free(m->vtk_names);
     free(m->vtk_times);

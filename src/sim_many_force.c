@@ -442,13 +442,15 @@ static void eval_pairs_of(const struct wetdem_sim* sim, size_t i, struct failure
         struct wetdem_vec3 d = periodic ? celllist_delta(&m->cl.box, xi, xj) : vec3_sub(xi, xj);
         const struct wetdem_many_mix* x = nm == 1 ? mix_a : &mix_a[p[j].material];
         double lim = ri + xr[j].r + x->range;
-        size_t r = slot[q];
         if (vec3_dot(d, d) > lim * lim * (1 + PREFILTER_MARGIN)) {
+            if (!flags[q]) /* rev_flags[slot[q]] == flags[q] between passes */
+                continue;
             if (flags[q] & WETDEM_MANY_DIRTY && len)
                 wetdem_sim_history_init(sim, m->history + q * len);
-            flags[q] = rev_flags[r] = 0;
+            flags[q] = rev_flags[slot[q]] = 0;
             continue;
         }
+        size_t r = slot[q];
         struct wetdem_many_pair_out o;
         eval_near_pair(sim, q, d, x, &o, fail);
         unsigned char fl = rev_flags[r] = flags[q];
@@ -565,8 +567,10 @@ int wetdem_sim_many_index_pairs(struct wetdem_sim* sim)
         m->rev_start[m->cl.pairs[q].j + 1]++;
     for (size_t k = 0; k < n; k++)
         m->rev_start[k + 1] += m->rev_start[k];
-    for (size_t q = 0; q < np; q++) /* in pair order: each particle's slots ascend with i */
+    for (size_t q = 0; q < np; q++) { /* in pair order: each particle's slots ascend with i */
         m->slot[q] = m->rev_start[m->cl.pairs[q].j]++;
+        m->rev_flags[m->slot[q]] = m->flags[q]; /* the pair pass keeps the two equal */
+    }
     for (size_t k = n; k > 0; k--) /* undo the shift left by the fill */
         m->rev_start[k] = m->rev_start[k - 1];
     m->rev_start[0] = 0;

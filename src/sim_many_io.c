@@ -122,16 +122,12 @@ static const char* base_name(const char* path)
     return s ? s + 1 : path;
 }
 
-static int write_vtk_frame(struct wetdem_sim* sim)
+/* Appends an entry to the series index (names and times). */
+static int add_series_entry(struct wetdem_sim* sim, const char* name, double time)
 {
     struct wetdem_many* m = sim->many;
-    char path[4096], series[4096];
-    wetdem_output_vtk_path(path, sizeof path, m->output_prefix, m->vtk_files);
-    int st = wetdem_sim_write_vtk(sim, path, m->set.vtk_binary);
-    if (st != WETDEM_OK)
-        return st;
     size_t cap = m->vtk_names_cap;
-    if (m->vtk_files + 1 > cap) {
+    if (m->n_series + 1 > cap) {
         cap = cap ? 2 * cap : 64;
         char** names = realloc(m->vtk_names, cap * sizeof *names);
         if (names)
@@ -143,20 +139,67 @@ static int write_vtk_frame(struct wetdem_sim* sim)
             return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory");
         m->vtk_names_cap = cap;
     }
-    size_t k = m->vtk_files;
-    m->vtk_names[k] = malloc(strlen(base_name(path)) + 1);
+    size_t k = m->n_series;
+    m->vtk_names[k] = malloc(strlen(name) + 1);
     if (!m->vtk_names[k])
         return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory");
-    strcpy(m->vtk_names[k], base_name(path));
-    m->vtk_times[k] = sim->engine.time;
+    strcpy(m->vtk_names[k], name);
+    m->vtk_times[k] = time;
+    m->n_series++;
+    return WETDEM_OK;
+}
+
+static int write_vtk_frame(struct wetdem_sim* sim)
+{
+    struct wetdem_many* m = sim->many;
+    char path[4096], series[4096];
+    wetdem_output_vtk_path(path, sizeof path, m->output_prefix, m->vtk_files);
+    int st = wetdem_sim_write_vtk(sim, path, m->set.vtk_binary);
+    if (st == WETDEM_OK)
+        st = add_series_entry(sim, base_name(path), sim->engine.time);
+    if (st != WETDEM_OK)
+        return st;
     m->vtk_files++;
     st = prefixed(sim, series, sizeof series, SERIES_SUFFIX);
     char msg[512];
     if (st == WETDEM_OK &&
         wetdem_output_vtk_series_write(series, (const char* const*)m->vtk_names, m->vtk_times,
-                                       m->vtk_files, msg, sizeof msg) != WETDEM_OK)
+                                       m->n_series, msg, sizeof msg) != WETDEM_OK)
         st = wetdem_sim_fail(sim, WETDEM_ERR_IO, "%s", msg);
     return st;
+}
+
+/* After a restart: the frames 0 .. vtk_files-1 written before it go back into the series
+ * index, with the times the existing .vtk.series file gives them (frames it does not list are
+ * left out of the index; their files are not overwritten, numbering continues). */
+static int reload_series(struct wetdem_sim* sim)
+{
+    struct wetdem_many* m = sim->many;
+    char series[4096], line[8192];
+    if (!m->output_prefix || prefixed(sim, series, sizeof series, SERIES_SUFFIX) != WETDEM_OK)
+        return WETDEM_OK;
+    FILE* f = fopen(series, "r");
+    for (uint64_t k = 0; f && k < m->vtk_files && fgets(line, sizeof line, f);) {
+        char path[4096];
+        double t;
+        const char* at = strstr(line, "\"time\" : ");
+        if (!at || sscanf(at, "\"time\" : %lf", &t) != 1)
+            continue;
+        wetdem_output_vtk_path(path, sizeof path, m->output_prefix, k);
+        char quoted[4200];
+        snprintf(quoted, sizeof quoted, "\"%s\"", base_name(path));
+        if (strstr(line, quoted)) {
+            int st = add_series_entry(sim, base_name(path), t);
+            if (st != WETDEM_OK) {
+                fclose(f);
+                return st;
+            }
+        }
+        k++;
+    }
+    if (f)
+        fclose(f);
+    return WETDEM_OK;
 }
 
 static void csv_header(const struct wetdem_sim* sim, FILE* f)
@@ -181,7 +224,8 @@ static int write_csv_row(struct wetdem_sim* sim)
     if (!f)
         return st != WETDEM_OK ? st
                                : wetdem_sim_fail(sim, WETDEM_ERR_IO, "cannot open '%s'", path);
-    if (m->csv_rows == 0)
+    /* a header for a new file, also when a resumed run's CSV is missing or empty */
+    if (m->csv_rows == 0 || (fseek(f, 0, SEEK_END) == 0 && ftell(f) == 0))
         csv_header(sim, f);
     struct wetdem_many_stats s;
     wetdem_sim_many_stats(sim, &s);
@@ -380,7 +424,10 @@ static int restore_state(struct wetdem_sim* sim, const struct wetdem_checkpoint*
     m->energy.el0 = ck->energy[2];
     memcpy(m->energy.work_pair, ck->energy + 3, sizeof m->energy.work_pair);
     memcpy(m->energy.work_wall, ck->energy + 3 + WETDEM_MAX_MODELS, sizeof m->energy.work_wall);
-    m->vtk_files = 0; /* the series index restarts with the files written from now on */
+    for (size_t k = 0; k < m->n_series; k++)
+        free(m->vtk_names[k]);
+    m->n_series = 0;
+    m->vtk_files = ck->output.vtk_files; /* numbering continues: no frame is overwritten */
     m->csv_rows = ck->output.csv_rows;
     m->next_vtk_step = ck->output.next_vtk_step;
     m->next_csv_step = ck->output.next_csv_step;
@@ -425,7 +472,7 @@ static int restore_pairs(struct wetdem_sim* sim, const struct wetdem_checkpoint*
     if (n)
         memcpy(m->contacts, ck->extra + 16 + n * 48, n * sizeof(uint32_t));
     for (size_t q = 0; q < m->cl.n_pairs; q++) /* histories may be stale: check on next use */
-        m->flags[q] = WETDEM_MANY_DIRTY;
+        m->flags[q] = m->rev_flags[m->slot[q]] = WETDEM_MANY_DIRTY;
     m->started = true;
     return WETDEM_OK;
 }
@@ -446,6 +493,8 @@ int wetdem_sim_read_checkpoint(struct wetdem_sim* sim, const char* path)
         st = restore_state(sim, &ck);
     if (st == WETDEM_OK)
         st = restore_pairs(sim, &ck);
+    if (st == WETDEM_OK)
+        st = reload_series(sim);
     wetdem_checkpoint_clear(&ck);
     return st;
 }

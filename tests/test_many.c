@@ -280,6 +280,57 @@ static void test_many_writes_vtk_and_csv(void** state)
     wetdem_sim_free(sim);
 }
 
+/* A resumed run continues the VTK numbering (no frame overwritten) and its series index lists
+ * the frames of both pieces; a resumed run whose CSV is missing starts it with a header. */
+static void test_many_restart_continues_outputs(void** state)
+{
+    (void)state;
+    char dir[] = "/tmp/wetdem_test_many_rs_XXXXXX";
+    assert_non_null(mkdtemp(dir));
+    char prefix[128], path[192], ck[192];
+    snprintf(prefix, sizeof prefix, "%s/run", dir);
+    snprintf(ck, sizeof ck, "%s/ck", dir);
+    struct wetdem_many_settings s = {.periodic = {true, true, false}, .box_lo = {0, 0, 0},
+                                     .box_hi = {8e-3, 8e-3, 12e-3}, .dt = 2e-6, .skin = 0.05e-3,
+                                     .output_prefix = prefix, .vtk_every = 50, .csv_every = 50};
+    struct wetdem_sim* first = wet_box(40, true);
+    CHECK_OK(wetdem_sim_set_many(first, &s));
+    CHECK_OK(wetdem_sim_integrate(first, 2e-4)); /* frames 0, 1, 2 at steps 0, 50, 100 */
+    CHECK_OK(wetdem_sim_write_checkpoint(first, ck));
+    snprintf(path, sizeof path, "%s/run.csv", dir);
+    remove(path);
+    struct wetdem_sim* resumed = wet_box(40, true);
+    CHECK_OK(wetdem_sim_set_many(resumed, &s));
+    CHECK_OK(wetdem_sim_read_checkpoint(resumed, ck));
+    CHECK_OK(wetdem_sim_integrate(resumed, 4e-4)); /* frames 3, 4 at steps 150, 200 */
+    for (int k = 0; k < 5; k++) {
+        snprintf(path, sizeof path, "%s/run_%06d.vtk", dir, k);
+        assert_int_equal(access(path, F_OK), 0);
+        remove(path);
+    }
+    snprintf(path, sizeof path, "%s/run.vtk.series", dir);
+    FILE* f = fopen(path, "r");
+    assert_non_null(f);
+    char line[1024];
+    int entries = 0;
+    while (fgets(line, sizeof line, f))
+        entries += strstr(line, "\"name\"") != NULL;
+    fclose(f);
+    assert_int_equal(entries, 5);
+    remove(path);
+    snprintf(path, sizeof path, "%s/run.csv", dir);
+    f = fopen(path, "r");
+    assert_non_null(f);
+    assert_non_null(fgets(line, sizeof line, f));
+    CHECK_CONTAINS(line, "# wetdem");
+    fclose(f);
+    remove(path);
+    remove(ck);
+    rmdir(dir);
+    wetdem_sim_free(first);
+    wetdem_sim_free(resumed);
+}
+
 static void test_many_rejects_bad_settings(void** state)
 {
     (void)state;
@@ -309,6 +360,7 @@ int main(void)
         cmocka_unit_test(test_many_reach_bound_is_enforced),
         cmocka_unit_test(test_many_agglomerates_by_union_find),
         cmocka_unit_test(test_many_writes_vtk_and_csv),
+        cmocka_unit_test(test_many_restart_continues_outputs),
         cmocka_unit_test(test_many_rejects_bad_settings),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
