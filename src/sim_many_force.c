@@ -27,8 +27,8 @@
  * Fused kernel: when every enabled force model is one of hertz, mindlin, sb and capillary (any
  * subset, any order), a switch over the models replaces the calls through the model table. It
  * calls the same kernels (wetdem_force_hertz_elastic, wetdem_force_hertz_damping,
- * wetdem_force_mindlin_update, wetdem_pair_force_add_tangential, thin_film_eval_gap) and writes
- * the static-bridge force 6 pi mu a^2 v_n/h [1 - h/delta]^2 (Punch 2023 Eq. 7, corrected
+ * wetdem_force_hertz_total, wetdem_force_mindlin_update, wetdem_pair_force_add_tangential,
+ * thin_film_eval_gap) and writes the static-bridge force 6 pi mu a^2 v_n/h [1 - h/delta]^2 (Punch 2023 Eq. 7, corrected
  * bracket; force_sb.c) and the capillary suction -8 pi a sigma (Punch 2023 Eq. 15;
  * force_capillary.c) with the same operations in the same order, and sums the models as
  * wetdem_sim_eval_contact does; the elastic Hertz force, which hertz and mindlin both need,
@@ -240,10 +240,11 @@ static int fused_model(int kind, double opt, const struct wetdem_contact* c, dou
         if (!(c->restitution > 0.0 && c->restitution <= 1.0))
             return WETDEM_ERR_INVALID;
         if (overlap > 0.0)
-            f->f_normal += fmax(f_el + wetdem_force_hertz_damping(c->e_star, c->r_eff, c->m_eff,
-                                                                  overlap, c->v_n,
-                                                                  c->restitution, (int)opt),
-                                0.0);
+            f->f_normal += wetdem_force_hertz_total(
+                f_el,
+                wetdem_force_hertz_damping(c->e_star, c->r_eff, c->m_eff, overlap, c->v_n,
+                                           c->restitution, (int)opt),
+                (int)opt);
         return WETDEM_OK;
     case FUSED_MINDLIN: {
         if (!(c->restitution > 0.0 && c->restitution <= 1.0))
