@@ -11,14 +11,18 @@
  *   2. s <- s + v_t dt                                      (dt = c->dt)
  *   3. k_t = 8 G* sqrt(R* delta)                            [N/m]
  *      gamma_t = -2 sqrt(5/6) beta sqrt(m* k_t),  beta = ln e / sqrt(ln^2 e + pi^2)   [kg/s]
- *   4. if k_t |s| > mu F_lim (sliding): s <- s mu F_lim / (k_t |s|),  F_t = -k_t s
- *      (|F_t| = mu F_lim exactly, no damping), else (sticking) F_t = -k_t s - gamma_t v_t.
+ *   4. F_t = -k_t s - gamma_t v_t (spring and dashpot); if |F_t| > mu F_lim (sliding), the
+ *      total is capped, F_t <- F_t mu F_lim / |F_t|, and the spring is set to what gives
+ *      the capped total with this dashpot, s <- -(F_t + gamma_t v_t) / k_t.
+ * So |F_t| <= mu F_lim at every evaluation (Coulomb), as LAMMPS pair granular does, and the
+ * stored spring is consistent with the force (re-evaluating the same state with dt = 0 gives
+ * the same F_t). LIGGGHTS compares only the spring with the limit, which lets a sticking
+ * dashpot carry |F_t| far above mu F_lim at small overlaps; contact.md Sec. 2 shows the
+ * violations (up to 3.7 mu F_lim in oblique collisions at 5-20 deg) and why the cap is kept.
  * F_lim is the Hertz elastic normal force (4/3) E* sqrt(R*) delta^(3/2) for this model
  * (LIGGGHTS takes the total normal force, damping included; models do not read each other's
  * force here, and the elastic part stays positive while unloading). LIGGGHTS projects s into
- * the plane without restoring its length; here the length is kept (rigid rotation). Only the
- * spring is compared with the limit, so a sticking contact carries the dashpot on top of it:
- * |F_t| may exceed mu F_lim, and drops by gamma_t |v_t| when sliding starts.
+ * the plane without restoring its length; here the length is kept (rigid rotation).
  * delta <= 0 resets s to zero and gives no force. The damping is the normal Tsuji form with
  * k_t in place of S_n = 2 E* sqrt(R* delta) (as LIGGGHTS): the tangential restitution of a
  * Mindlin contact depends on the impact angle and mu, so no "exact" value exists.
@@ -87,15 +91,12 @@ struct wetdem_vec3 wetdem_force_mindlin_update(const struct wetdem_contact* c, d
     struct wetdem_vec3 s = rotate_into_plane(vec3(spring[0], spring[1], spring[2]), c->normal);
     s = vec3_axpy(s, c->dt, c->v_t);
     double k_t = tangential_stiffness(c->g_star, c->r_eff, overlap);
-    double f_spring = k_t * vec3_norm(s);
-    double f_max = mu * fabs(f_limit);
-    struct wetdem_vec3 ft;
-    if (f_spring > f_max) {
-        s = vec3_scale(s, f_max / f_spring);
-        ft = vec3_scale(s, -k_t);
-    } else {
-        double gamma_t = tangential_damping(k_t, c->m_eff, c->restitution);
-        ft = vec3_axpy(vec3_scale(s, -k_t), -gamma_t, c->v_t);
+    double gamma_t = tangential_damping(k_t, c->m_eff, c->restitution);
+    struct wetdem_vec3 ft = vec3_axpy(vec3_scale(s, -k_t), -gamma_t, c->v_t);
+    double f_total = vec3_norm(ft), f_max = mu * fabs(f_limit);
+    if (f_total > f_max) { /* sliding: total capped, spring set so that it gives the cap */
+        ft = vec3_scale(ft, f_max / f_total);
+        s = k_t > 0.0 ? vec3_scale(vec3_axpy(ft, gamma_t, c->v_t), -1.0 / k_t) : vec3(0, 0, 0);
     }
     store_spring(spring, s);
     return ft;
@@ -143,13 +144,14 @@ const struct wetdem_model wetdem_force_mindlin = {
            "projects it), adds v_t dt, "
            "and gives F_t = -k_t s - gamma_t v_t with k_t = 8 G* sqrt(R* delta) and "
            "gamma_t = -2 sqrt(5/6) beta sqrt(m* k_t), beta = ln e / sqrt(ln^2 e + pi^2) (the "
-           "normal Tsuji damping with k_t). If the spring force k_t |s| exceeds "
-           "mu (4/3) E* sqrt(R*) delta^(3/2) (the Hertz elastic normal force, where LIGGGHTS "
-           "takes the total normal force), the contact slides: s is shortened to that limit and "
-           "F_t = -k_t s, so |F_t| = mu F_el exactly. As in LIGGGHTS only the spring is "
-           "compared, so while sticking the dashpot can carry |F_t| above mu F_el (many times "
-           "at small overlaps), and |F_t| drops by gamma_t |v_t| when sliding starts. "
-           "Separation (delta <= 0) resets s. The force acts at the contact point "
+           "normal Tsuji damping with k_t). If this total, spring and dashpot, exceeds "
+           "mu F_el = mu (4/3) E* sqrt(R*) delta^(3/2) (the Hertz elastic normal force, where "
+           "LIGGGHTS takes the total normal force), the contact slides: F_t is scaled down to "
+           "|F_t| = mu F_el and s is set so that -k_t s - gamma_t v_t gives that force, as "
+           "LAMMPS pair granular does. So Coulomb's |F_t| <= mu F_el holds at every "
+           "evaluation; LIGGGHTS compares only the spring, which lets a sticking dashpot exceed "
+           "the limit many times at small overlaps. Separation (delta <= 0) resets s. The force "
+           "acts at the contact point "
            "and gives torques on both spheres. Use with hertz. mu is the pair's dry or "
            "lubricated coefficient (parameter friction). Valid for small overlaps; no "
            "micro-slip hysteresis inside the contact area.",

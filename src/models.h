@@ -51,8 +51,9 @@ double wetdem_force_hertz_contact_time(double e_star, double r_eff, double m_eff
 /* force_mindlin.c: Mindlin tangential spring with Coulomb limit. spring (3 doubles of history:
  * the elastic tangential displacement [m]) is rotated into the current tangent plane and
  * advanced by v_t dt; stiffness k_t = 8 G* sqrt(R* delta); Tsuji damping from `restitution`
- * with k_t; when the spring force k_t |s| > mu |f_limit| the spring is truncated to the
- * Coulomb limit and |F_t| = mu |f_limit| (sliding, LIGGGHTS semantics). Returns the
+ * with k_t; when the total spring + dashpot force exceeds mu |f_limit| it is capped at
+ * |F_t| = mu |f_limit| and the spring set so that spring + dashpot give the capped force
+ * (sliding, LAMMPS pair granular semantics), so |F_t| <= mu |f_limit| always. Returns the
  * tangential force on i [N]. overlap <= 0 resets the spring. */
 struct wetdem_vec3 wetdem_force_mindlin_update(const struct wetdem_contact* c, double overlap,
                                                double f_limit, double mu, double* spring);
