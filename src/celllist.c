@@ -24,7 +24,8 @@
 /* Fewest particles for which a build runs in parallel (threads cost more below). */
 #define PARALLEL_MIN 512
 
-static void set_msg(char* msg, size_t n, const char* fmt, ...) __attribute__((format(printf, 3, 4)));
+static void set_msg(char* msg, size_t n, const char* fmt, ...)
+    __attribute__((format(printf, 3, 4)));
 static void set_msg(char* msg, size_t n, const char* fmt, ...)
 {
     if (!msg || !n)
@@ -179,8 +180,8 @@ static int bin_particles(struct wetdem_celllist* cl, const struct wetdem_particl
     for (size_t i = 0; i < n; i++) {
         size_t s = cl->cell_start[cl->cell_of[i]]++;
         cl->cell_items[s] = (uint32_t)i;
-        cl->sorted[s] = (struct wetdem_celllist_item){p[i].pos.x, p[i].pos.y, p[i].pos.z,
-                                                       p[i].radius};
+        cl->sorted[s] =
+            (struct wetdem_celllist_item){p[i].pos.x, p[i].pos.y, p[i].pos.z, p[i].radius};
     }
     for (size_t c = n_cells; c > 0; c--) /* undo the shift left by the fill */
         cl->cell_start[c] = cl->cell_start[c - 1];
@@ -226,8 +227,7 @@ static int stencil(const struct wetdem_celllist* cl, struct wetdem_vec3 x, size_
  * to out (sorted by j) and returns their number. Positions and radii come from the
  * cell-ordered copy, so each cell is read as one contiguous block. */
 static size_t scan_particle(const struct wetdem_celllist* cl, const struct wetdem_particle* p,
-                            size_t i, const size_t* cells, int nc,
-                            struct wetdem_celllist_pair* out)
+                            size_t i, const size_t* cells, int nc, struct wetdem_celllist_pair* out)
 {
     size_t count = 0;
     double extra = cl->reach + cl->skin;
@@ -325,8 +325,8 @@ static int fill_pairs(struct wetdem_celllist* cl, const struct wetdem_particle* 
     size_t total = 0;
     for (int t = 0; !nomem && t < used_threads; t++)
         total += used[t];
-    nomem = nomem || reserve((void**)&cl->pairs, &cl->pairs_cap, total ? total : 1,
-                             sizeof *cl->pairs);
+    nomem =
+        nomem || reserve((void**)&cl->pairs, &cl->pairs_cap, total ? total : 1, sizeof *cl->pairs);
     size_t at = 0;
     for (int t = 0; !nomem && t < used_threads; at += used[t], t++)
         if (used[t])
@@ -395,9 +395,8 @@ static uint64_t pair_key(struct wetdem_celllist_pair q)
 
 size_t wetdem_celllist_remap_history(const struct wetdem_celllist_pair* old_pairs,
                                      const double* old_hist, size_t n_old,
-                                     const struct wetdem_celllist_pair* new_pairs,
-                                     double* new_hist, size_t n_new, size_t len,
-                                     const double* fresh)
+                                     const struct wetdem_celllist_pair* new_pairs, double* new_hist,
+                                     size_t n_new, size_t len, const double* fresh)
 {
     size_t a = 0, kept = 0;
     for (size_t b = 0; b < n_new; b++) {

@@ -51,14 +51,14 @@ struct wetdem_celllist_pair {
 
 struct wetdem_celllist {
     struct wetdem_celllist_box box;
-    double reach;  /* largest interaction gap [m] >= 0 */
-    double skin;   /* Verlet skin [m] > 0 */
+    double reach; /* largest interaction gap [m] >= 0 */
+    double skin;  /* Verlet skin [m] > 0 */
     /* current cell grid */
     double origin[3], cell[3]; /* [m] */
     int n_cells[3];
-    size_t* cell_start; /* n_cells_total + 1 offsets into cell_items */
-    uint32_t* cell_items; /* particle indices grouped by cell */
-    uint32_t* cell_of;    /* cell of each particle */
+    size_t* cell_start;                  /* n_cells_total + 1 offsets into cell_items */
+    uint32_t* cell_items;                /* particle indices grouped by cell */
+    uint32_t* cell_of;                   /* cell of each particle */
     struct wetdem_celllist_item* sorted; /* positions and radii aligned with cell_items */
     size_t cells_cap, items_cap, cell_of_cap, sorted_cap;
     /* pair list, sorted by (i, j) */
@@ -100,9 +100,8 @@ bool wetdem_celllist_needs_rebuild(const struct wetdem_celllist* cl,
  * Returns the number of pairs whose history was carried over. */
 size_t wetdem_celllist_remap_history(const struct wetdem_celllist_pair* old_pairs,
                                      const double* old_hist, size_t n_old,
-                                     const struct wetdem_celllist_pair* new_pairs,
-                                     double* new_hist, size_t n_new, size_t len,
-                                     const double* fresh);
+                                     const struct wetdem_celllist_pair* new_pairs, double* new_hist,
+                                     size_t n_new, size_t len, const double* fresh);
 
 /* Minimum-image displacement a - b on the periodic axes of box [m]. */
 static inline struct wetdem_vec3 celllist_delta(const struct wetdem_celllist_box* box,

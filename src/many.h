@@ -11,10 +11,10 @@
 /* Mixed properties of one material pair (as struct wetdem_contact) and the range of the
  * enabled models for it. */
 struct wetdem_many_mix {
-    double e_star, g_star;                       /* [Pa] */
+    double e_star, g_star;                          /* [Pa] */
     double restitution, friction_dry, friction_lub; /* [-] */
-    double roughness, film;                      /* [m] */
-    double viscosity, surface_tension;           /* [Pa s], [N/m] */
+    double roughness, film;                         /* [m] */
+    double viscosity, surface_tension;              /* [Pa s], [N/m] */
     double range; /* largest model range [m]: exact with the fused kernel, else the reach */
 };
 
@@ -44,9 +44,9 @@ struct wetdem_many_rev_out {
 
 /* Energy bookkeeping (sim_many.c accumulates, sim_many_io.c reports). */
 struct wetdem_many_energy {
-    double k0, u0, el0;                     /* kinetic, potential, elastic at the start [J] */
-    double work_pair[WETDEM_MAX_MODELS];    /* work of model k on particle pairs [J] */
-    double work_wall[WETDEM_MAX_MODELS];    /* work of model k on particle-wall pairs [J] */
+    double k0, u0, el0;                  /* kinetic, potential, elastic at the start [J] */
+    double work_pair[WETDEM_MAX_MODELS]; /* work of model k on particle pairs [J] */
+    double work_wall[WETDEM_MAX_MODELS]; /* work of model k on particle-wall pairs [J] */
 };
 
 struct wetdem_many {
@@ -54,30 +54,30 @@ struct wetdem_many {
     char* output_prefix;
     char* checkpoint_path;
     struct wetdem_celllist cl;
-    double reach;   /* largest interaction gap of any pair [m] (start-up bound) */
-    double dt;      /* time step [s], fixed once the many run starts */
-    double t0;      /* time of step 0 [s] */
-    uint64_t step;  /* steps since t0 */
+    double reach;  /* largest interaction gap of any pair [m] (start-up bound) */
+    double dt;     /* time step [s], fixed once the many run starts */
+    double t0;     /* time of step 0 [s] */
+    uint64_t step; /* steps since t0 */
     bool started;
-    double* history;             /* cl.n_pairs x history_len, aligned with cl.pairs */
+    double* history; /* cl.n_pairs x history_len, aligned with cl.pairs */
     size_t history_cap;
-    double* wall_history;        /* n_particles x n_walls x history_len */
+    double* wall_history; /* n_particles x n_walls x history_len */
     size_t wall_history_cap;
     struct wetdem_celllist_pair* old_pairs; /* previous list, for history remapping */
     double* old_history;
     size_t old_cap, old_history_cap;
-    unsigned char* flags;        /* per candidate pair: MANY_ACTIVE | _CONTACT | _BRIDGE | _DIRTY
+    unsigned char* flags; /* per candidate pair: MANY_ACTIVE | _CONTACT | _BRIDGE | _DIRTY
                                     (a separate byte array: the gather scans it densely) */
     size_t flags_cap;
-    unsigned char* old_flags;    /* flags of the previous list, for remapping */
+    unsigned char* old_flags; /* flags of the previous list, for remapping */
     size_t old_flags_cap;
-    uint64_t* wall_mask;         /* per particle: bit w set if wall w is within reach + skin
+    uint64_t* wall_mask; /* per particle: bit w set if wall w is within reach + skin
                                     at the last build (walls >= 64 are always evaluated) */
     size_t wall_mask_cap;
-    uint32_t* wall_list;         /* particles with a non-zero wall_mask (or all if > 64 walls) */
+    uint32_t* wall_list; /* particles with a non-zero wall_mask (or all if > 64 walls) */
     size_t n_wall_list, wall_list_cap;
-    double max_disp2;            /* largest squared displacement since the build [m^2], */
-    bool max_disp_valid;         /* measured during the latest drift */
+    double max_disp2;    /* largest squared displacement since the build [m^2], */
+    bool max_disp_valid; /* measured during the latest drift */
     /* the pairs ordered by their second particle: particle i's pairs (k, i) occupy the slots
        rev_start[i] .. rev_start[i+1] in increasing k; pair q is in slot[q] */
     size_t *rev_start, *slot;
@@ -88,26 +88,26 @@ struct wetdem_many {
     struct wetdem_many_mix* mix; /* n_mix_materials^2 material pairs */
     size_t mix_cap;
     int n_mix_materials;
-    bool kernel_ready;           /* mix and kind[] match the current set-up */
-    bool fused;                  /* every enabled model has a fused kernel */
-    bool generic_only;           /* tests: never use the fused kernel */
-    size_t parallel_min;         /* tests: fewest particles for parallel loops (0: default
+    bool kernel_ready;                     /* mix and kind[] match the current set-up */
+    bool fused;                            /* every enabled model has a fused kernel */
+    bool generic_only;                     /* tests: never use the fused kernel */
+    size_t parallel_min;                   /* tests: fewest particles for parallel loops (0: default
                                     WETDEM_MANY_PARALLEL_MIN) */
-    bool periodic_any;           /* some axis is periodic */
+    bool periodic_any;                     /* some axis is periodic */
     unsigned char kind[WETDEM_MAX_MODELS]; /* fused kernel of model k */
     double kind_opt[WETDEM_MAX_MODELS];    /* its switch parameter (hertz damping form, ...) */
     struct wetdem_vec3 *force, *torque, *vh, *wh; /* per particle */
-    uint32_t* contacts;          /* per particle: solid contacts at the latest evaluation */
+    uint32_t* contacts;              /* per particle: solid contacts at the latest evaluation */
     struct wetdem_celllist_item* xr; /* per particle: position and radius, a compact copy for
                                         the gap tests (kept by kick_drift) */
     size_t particle_cap;
     struct wetdem_many_energy energy;
-    double* thread_work;         /* per thread: 2 x WETDEM_MAX_MODELS accumulators */
+    double* thread_work; /* per thread: 2 x WETDEM_MAX_MODELS accumulators */
     size_t thread_work_cap;
     /* outputs */
     uint64_t vtk_files, csv_rows;
     uint64_t next_vtk_step, next_csv_step, next_checkpoint_step;
-    char** vtk_names;            /* the .vtk.series entries: file names and times [s] */
+    char** vtk_names; /* the .vtk.series entries: file names and times [s] */
     double* vtk_times;
     size_t n_series, vtk_names_cap;
 };

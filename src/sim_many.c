@@ -259,8 +259,8 @@ static void remap_dirty(struct wetdem_many* m, size_t n_old)
     size_t a = 0;
     for (size_t b = 0; b < m->cl.n_pairs; b++) {
         struct wetdem_celllist_pair q = m->cl.pairs[b];
-        while (a < n_old && (m->old_pairs[a].i < q.i ||
-                             (m->old_pairs[a].i == q.i && m->old_pairs[a].j < q.j)))
+        while (a < n_old &&
+               (m->old_pairs[a].i < q.i || (m->old_pairs[a].i == q.i && m->old_pairs[a].j < q.j)))
             a++;
         bool same = a < n_old && m->old_pairs[a].i == q.i && m->old_pairs[a].j == q.j;
         m->flags[b] = same ? (m->old_flags[a] & WETDEM_MANY_DIRTY) : 0;
@@ -349,10 +349,10 @@ int wetdem_sim_many_prepare(struct wetdem_sim* sim)
         skin = m->set.skin > 0 ? m->set.skin : 0.1 * (isfinite(r_min) ? r_min : 1.0);
     }
     if (fresh_set && (!m->started || reach != m->reach || skin != m->cl.skin)) {
-        struct wetdem_celllist_box box = {{m->set.box_lo.x, m->set.box_lo.y, m->set.box_lo.z},
-                                          {m->set.box_hi.x, m->set.box_hi.y, m->set.box_hi.z},
-                                          {m->set.periodic[0], m->set.periodic[1],
-                                           m->set.periodic[2]}};
+        struct wetdem_celllist_box box = {
+            {m->set.box_lo.x, m->set.box_lo.y, m->set.box_lo.z},
+            {m->set.box_hi.x, m->set.box_hi.y, m->set.box_hi.z},
+            {m->set.periodic[0], m->set.periodic[1], m->set.periodic[2]}};
         struct wetdem_celllist_pair* pairs = m->cl.pairs; /* keep the list for remapping */
         size_t n_pairs = m->cl.n_pairs, pairs_cap = m->cl.pairs_cap;
         m->cl.pairs = NULL;
@@ -380,8 +380,7 @@ int wetdem_sim_many_prepare(struct wetdem_sim* sim)
         const struct wetdem_particle* p = &sim->particles[k];
         m->xr[k] = (struct wetdem_celllist_item){p->pos.x, p->pos.y, p->pos.z, p->radius};
     }
-    bool moved = m->max_disp_valid && m->cl.n_builds > 0 &&
-                         m->cl.n_at_build == sim->n_particles
+    bool moved = m->max_disp_valid && m->cl.n_builds > 0 && m->cl.n_at_build == sim->n_particles
                      ? m->max_disp2 > 0.25 * m->cl.skin * m->cl.skin
                      : wetdem_celllist_needs_rebuild(&m->cl, sim->particles, sim->n_particles);
     m->max_disp_valid = false;
@@ -452,8 +451,9 @@ static void kick_drift(struct wetdem_sim* sim, double h)
     bool periodic = m->cl.box.periodic[0] || m->cl.box.periodic[1] || m->cl.box.periodic[2];
     const struct wetdem_vec3* at_build = m->cl.pos_at_build;
     double worst = 0; /* max is exact: the same for any thread count */
-#pragma omp parallel for schedule(static) reduction(max : worst) \
-    if (wetdem_many_parallel(m, sim->n_particles))
+#pragma omp parallel for schedule(static)                                                          \
+    reduction(max                                                                                  \
+              : worst) if (wetdem_many_parallel(m, sim->n_particles))
     for (size_t k = 0; k < sim->n_particles; k++) {
         struct wetdem_particle* p = &sim->particles[k];
         if (!p->is_fixed)

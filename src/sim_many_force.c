@@ -28,13 +28,13 @@
  * subset, any order), a switch over the models replaces the calls through the model table. It
  * calls the same kernels (wetdem_force_hertz_elastic, wetdem_force_hertz_damping,
  * wetdem_force_hertz_total, wetdem_force_mindlin_update, wetdem_pair_force_add_tangential,
- * thin_film_eval_gap) and writes the static-bridge force 6 pi mu a^2 v_n/h [1 - h/delta]^2 (Punch 2023 Eq. 7, corrected
- * bracket; force_sb.c) and the capillary suction -8 pi a sigma (Punch 2023 Eq. 15;
- * force_capillary.c) with the same operations in the same order, and sums the models as
- * wetdem_sim_eval_contact does; the elastic Hertz force, which hertz and mindlin both need,
- * is computed once. tests/test_many_force.c checks the forces and histories are bit-identical
- * to the generic path. The range of these models is the film thickness delta_ab (0 for the
- * contact models), a property of the material pair.
+ * thin_film_eval_gap) and writes the static-bridge force 6 pi mu a^2 v_n/h [1 - h/delta]^2
+ * (Punch 2023 Eq. 7, corrected bracket; force_sb.c) and the capillary suction -8 pi a sigma
+ * (Punch 2023 Eq. 15; force_capillary.c) with the same operations in the same order, and sums
+ * the models as wetdem_sim_eval_contact does; the elastic Hertz force, which hertz and mindlin
+ * both need, is computed once. tests/test_many_force.c checks the forces and histories are
+ * bit-identical to the generic path. The range of these models is the film thickness delta_ab
+ * (0 for the contact models), a property of the material pair.
  */
 #include <omp.h>
 #include <stdlib.h>
@@ -83,12 +83,10 @@ static void mix_pair(const struct wetdem_sim* sim, int a, int b, struct wetdem_m
     struct wetdem_particle p = {.radius = 1, .mass = 1, .material = a};
     struct wetdem_particle q = {.pos = {0, 0, 3}, .radius = 1, .mass = 1, .material = b};
     struct wetdem_contact c;
-    wetdem_contact_from_particles(&c, &p, &sim->materials[a], &q, &sim->materials[b],
-                                  &sim->fluid);
-    *x = (struct wetdem_many_mix){c.e_star,       c.g_star,    c.restitution,
-                                  c.friction_dry, c.friction_lub, c.roughness,
-                                  c.film,         c.viscosity, c.surface_tension,
-                                  0.0};
+    wetdem_contact_from_particles(&c, &p, &sim->materials[a], &q, &sim->materials[b], &sim->fluid);
+    *x = (struct wetdem_many_mix){c.e_star,          c.g_star,    c.restitution, c.friction_dry,
+                                  c.friction_lub,    c.roughness, c.film,        c.viscosity,
+                                  c.surface_tension, 0.0};
 }
 
 int wetdem_sim_many_setup_kernel(struct wetdem_sim* sim)
@@ -259,8 +257,8 @@ static int fused_model(int kind, double opt, const struct wetdem_contact* c, dou
         double h;
         if (thin_film_eval_gap(c->gap, c->h_min, c->film, opt, &h)) {
             double bracket = 1.0 - h / c->film;
-            f->f_normal += 6.0 * M_PI * c->viscosity * c->r_eff * c->r_eff * c->v_n / h *
-                           bracket * bracket;
+            f->f_normal +=
+                6.0 * M_PI * c->viscosity * c->r_eff * c->r_eff * c->v_n / h * bracket * bracket;
         }
         return WETDEM_OK;
     }
@@ -433,8 +431,7 @@ static void eval_pairs_of(const struct wetdem_sim* sim, size_t i, struct failure
     struct wetdem_many_rev_out* rev_out = m->rev_out;
     size_t len = sim->history_len, end = m->cl.first_pair[i + 1];
     bool periodic = m->periodic_any;
-    struct wetdem_vec3 xi = vec3(xr[i].x, xr[i].y, xr[i].z), f = vec3(0, 0, 0),
-                       t = vec3(0, 0, 0);
+    struct wetdem_vec3 xi = vec3(xr[i].x, xr[i].y, xr[i].z), f = vec3(0, 0, 0), t = vec3(0, 0, 0);
     double ri = xr[i].r;
     uint32_t n_contacts = 0;
     for (size_t q = m->cl.first_pair[i]; q < end; q++) {
@@ -610,8 +607,7 @@ int wetdem_sim_many_forces(struct wetdem_sim* sim, bool kick)
 #pragma omp parallel if (wetdem_many_parallel(m, n))
     {
         int t = omp_get_thread_num(), nt = omp_get_num_threads();
-        for (size_t i = block_start(m, n, t, nt), end = block_start(m, n, t + 1, nt); i < end;
-             i++)
+        for (size_t i = block_start(m, n, t, nt), end = block_start(m, n, t + 1, nt); i < end; i++)
             eval_pairs_of(sim, i, &fail);
 #pragma omp barrier
 #pragma omp for schedule(static)

@@ -222,8 +222,7 @@ static int write_csv_row(struct wetdem_sim* sim)
     int st = prefixed(sim, path, sizeof path, CSV_SUFFIX);
     FILE* f = st == WETDEM_OK ? fopen(path, m->csv_rows ? "a" : "w") : NULL;
     if (!f)
-        return st != WETDEM_OK ? st
-                               : wetdem_sim_fail(sim, WETDEM_ERR_IO, "cannot open '%s'", path);
+        return st != WETDEM_OK ? st : wetdem_sim_fail(sim, WETDEM_ERR_IO, "cannot open '%s'", path);
     /* a header for a new file, also when a resumed run's CSV is missing or empty */
     if (m->csv_rows == 0 || (fseek(f, 0, SEEK_END) == 0 && ftell(f) == 0))
         csv_header(sim, f);
@@ -260,7 +259,7 @@ int wetdem_sim_many_outputs(struct wetdem_sim* sim, bool final)
 {
     struct wetdem_many* m = sim->many;
     int st = WETDEM_OK;
-    (void)final;
+    (void) final;
     if (m->output_prefix && due(m->step, m->set.vtk_every, &m->next_vtk_step))
         st = write_vtk_frame(sim);
     if (st == WETDEM_OK && m->output_prefix && due(m->step, m->set.csv_every, &m->next_csv_step))
@@ -277,7 +276,8 @@ int wetdem_sim_many_outputs(struct wetdem_sim* sim, bool final)
 static uint64_t config_hash(const struct wetdem_sim* sim)
 {
     uint64_t h = wetdem_checkpoint_hash(0, "wetdem-many-1", 13);
-    h = wetdem_checkpoint_hash(h, sim->materials, (size_t)sim->n_materials * sizeof(*sim->materials));
+    h = wetdem_checkpoint_hash(h, sim->materials,
+                               (size_t)sim->n_materials * sizeof(*sim->materials));
     h = wetdem_checkpoint_hash(h, &sim->fluid, sizeof sim->fluid);
     h = wetdem_checkpoint_hash(h, &sim->settings, sizeof sim->settings);
     const struct wetdem_model_slot* slots[WETDEM_MAX_MODELS + 1];
@@ -330,7 +330,7 @@ static int fill_checkpoint(struct wetdem_sim* sim, struct wetdem_checkpoint* ck)
     }
     for (size_t w = 0; w < nw; w++)
         ck->walls[w] = (struct wetdem_checkpoint_wall){sim->walls[w].point, sim->walls[w].normal,
-                                                      sim->walls[w].material};
+                                                       sim->walls[w].material};
     unsigned char* b = ck->extra;
     memcpy(b, &m->dt, 8);
     memcpy(b + 8, &m->t0, 8);
@@ -348,11 +348,22 @@ static int fill_checkpoint(struct wetdem_sim* sim, struct wetdem_checkpoint* ck)
     memcpy(e + 3, m->energy.work_pair, sizeof m->energy.work_pair);
     memcpy(e + 3 + WETDEM_MAX_MODELS, m->energy.work_wall, sizeof m->energy.work_wall);
     *ck = (struct wetdem_checkpoint){
-        .time = sim->engine.time, .step = m->step, .config_hash = config_hash(sim),
-        .particles = sim->particles, .n_particles = n, .walls = ck->walls, .n_walls = nw,
-        .pairs = ck->pairs, .history = ck->history, .n_pairs = total, .history_len = len,
-        .stats = sim->engine.stats, .energy = ck->energy, .n_energy = 3 + 2 * WETDEM_MAX_MODELS,
-        .extra = ck->extra, .extra_size = blob_size(n),
+        .time = sim->engine.time,
+        .step = m->step,
+        .config_hash = config_hash(sim),
+        .particles = sim->particles,
+        .n_particles = n,
+        .walls = ck->walls,
+        .n_walls = nw,
+        .pairs = ck->pairs,
+        .history = ck->history,
+        .n_pairs = total,
+        .history_len = len,
+        .stats = sim->engine.stats,
+        .energy = ck->energy,
+        .n_energy = 3 + 2 * WETDEM_MAX_MODELS,
+        .extra = ck->extra,
+        .extra_size = blob_size(n),
         .output = {m->vtk_files, m->csv_rows, m->next_vtk_step, m->next_csv_step}};
     return WETDEM_OK;
 }
@@ -453,13 +464,13 @@ static int restore_pairs(struct wetdem_sim* sim, const struct wetdem_checkpoint*
     if (!pairs)
         return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory");
     for (size_t q = 0; q < np; q++)
-        pairs[q] = (struct wetdem_celllist_pair){(uint32_t)ck->pairs[q].i,
-                                                 (uint32_t)ck->pairs[q].j};
+        pairs[q] =
+            (struct wetdem_celllist_pair){(uint32_t)ck->pairs[q].i, (uint32_t)ck->pairs[q].j};
     double fresh[64];
     if (len)
         wetdem_sim_history_init(sim, fresh);
-    wetdem_celllist_remap_history(pairs, ck->history, np, m->cl.pairs, m->history,
-                                  m->cl.n_pairs, len, fresh);
+    wetdem_celllist_remap_history(pairs, ck->history, np, m->cl.pairs, m->history, m->cl.n_pairs,
+                                  len, fresh);
     free(pairs);
     if (len && n * nw > 0)
         memcpy(m->wall_history, ck->history + np * len, n * nw * len * sizeof(double));

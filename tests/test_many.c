@@ -17,8 +17,12 @@
 static struct wetdem_sim* wet_box(size_t n, bool wet)
 {
     struct wetdem_sim* sim = wetdem_sim_create();
-    struct wetdem_material m = {.density = 2500, .youngs_modulus = 1e7, .poisson_ratio = 0.3,
-                                .restitution = 0.6, .friction_dry = 0.4, .friction_lub = 0.1,
+    struct wetdem_material m = {.density = 2500,
+                                .youngs_modulus = 1e7,
+                                .poisson_ratio = 0.3,
+                                .restitution = 0.6,
+                                .friction_dry = 0.4,
+                                .friction_lub = 0.1,
                                 .film = wet ? 20e-6 : 0};
     assert_int_equal(wetdem_sim_add_material(sim, &m), 0);
     struct wetdem_fluid f = {.viscosity = 0.01, .surface_tension = 0.02, .density = 1000};
@@ -26,13 +30,19 @@ static struct wetdem_sim* wet_box(size_t n, bool wet)
     const char* models[] = {"hertz", "mindlin", "sb", "capillary"};
     for (int k = 0; k < (wet ? 4 : 2); k++)
         CHECK_OK(wetdem_sim_enable_model(sim, models[k]));
-    struct wetdem_insert_spec spec = {.layout = WETDEM_INSERT_RANDOM, .n = n, .lo = {0, 0, 0},
-                                      .hi = {8e-3, 8e-3, 12e-3}, .periodic = {true, true, false},
-                                      .radius_min = 0.4e-3, .radius_max = 0.5e-3, .gap = 0,
-                                      .velocity_sigma = 0.2, .seed = 7};
+    struct wetdem_insert_spec spec = {.layout = WETDEM_INSERT_RANDOM,
+                                      .n = n,
+                                      .lo = {0, 0, 0},
+                                      .hi = {8e-3, 8e-3, 12e-3},
+                                      .periodic = {true, true, false},
+                                      .radius_min = 0.4e-3,
+                                      .radius_max = 0.5e-3,
+                                      .gap = 0,
+                                      .velocity_sigma = 0.2,
+                                      .seed = 7};
     CHECK_OK(wetdem_sim_insert(sim, &spec));
-    CHECK_OK(wetdem_sim_add_wall(sim, (struct wetdem_vec3){0, 0, 0},
-                                 (struct wetdem_vec3){0, 0, 1}, 0));
+    CHECK_OK(
+        wetdem_sim_add_wall(sim, (struct wetdem_vec3){0, 0, 0}, (struct wetdem_vec3){0, 0, 1}, 0));
     CHECK_OK(wetdem_sim_add_wall(sim, (struct wetdem_vec3){0, 0, 12e-3},
                                  (struct wetdem_vec3){0, 0, -1}, 0));
     CHECK_OK(wetdem_sim_set_param(sim, "sim.gravity_z", -9.81));
@@ -110,8 +120,7 @@ static void test_many_restart_is_bit_identical(void** state)
 
 static volatile int stop_now = 0;
 
-static int stop_after(unsigned long long done, unsigned long long total, double elapsed,
-                      void* ctx)
+static int stop_after(unsigned long long done, unsigned long long total, double elapsed, void* ctx)
 {
     (void)total;
     (void)elapsed;
@@ -128,10 +137,15 @@ static void test_many_stop_flag_writes_a_checkpoint(void** state)
     close(mkstemp(path));
     remove(path);
     struct wetdem_sim* sim = wet_box(60, true);
-    struct wetdem_many_settings s = {.periodic = {true, true, false}, .box_lo = {0, 0, 0},
-                                     .box_hi = {8e-3, 8e-3, 12e-3}, .dt = 2e-6, .skin = 0.05e-3,
-                                     .checkpoint_path = path, .stop_flag = &stop_now,
-                                     .progress = stop_after, .progress_every = 10};
+    struct wetdem_many_settings s = {.periodic = {true, true, false},
+                                     .box_lo = {0, 0, 0},
+                                     .box_hi = {8e-3, 8e-3, 12e-3},
+                                     .dt = 2e-6,
+                                     .skin = 0.05e-3,
+                                     .checkpoint_path = path,
+                                     .stop_flag = &stop_now,
+                                     .progress = stop_after,
+                                     .progress_every = 10};
     CHECK_OK(wetdem_sim_set_many(sim, &s));
     CHECK_STATUS(wetdem_sim_integrate(sim, 1e-3), WETDEM_EVENT);
     CHECK_CONTAINS(wetdem_sim_errmsg(sim), "checkpoint");
@@ -246,10 +260,16 @@ static void test_many_writes_vtk_and_csv(void** state)
     char prefix[128], path[192];
     snprintf(prefix, sizeof prefix, "%s/run", dir);
     struct wetdem_sim* sim = wet_box(60, true);
-    struct wetdem_many_settings s = {.periodic = {true, true, false}, .box_lo = {0, 0, 0},
-                                     .box_hi = {8e-3, 8e-3, 12e-3}, .dt = 2e-6, .skin = 0.05e-3,
-                                     .output_prefix = prefix, .vtk_every = 50, .csv_every = 25,
-                                     .vtk_binary = true, .energy_budget = true};
+    struct wetdem_many_settings s = {.periodic = {true, true, false},
+                                     .box_lo = {0, 0, 0},
+                                     .box_hi = {8e-3, 8e-3, 12e-3},
+                                     .dt = 2e-6,
+                                     .skin = 0.05e-3,
+                                     .output_prefix = prefix,
+                                     .vtk_every = 50,
+                                     .csv_every = 25,
+                                     .vtk_binary = true,
+                                     .energy_budget = true};
     CHECK_OK(wetdem_sim_set_many(sim, &s));
     CHECK_OK(wetdem_sim_integrate(sim, 2e-4)); /* 100 steps: VTK at 0, 50, 100 */
     for (int k = 0; k < 3; k++) {
@@ -290,9 +310,14 @@ static void test_many_restart_continues_outputs(void** state)
     char prefix[128], path[192], ck[192];
     snprintf(prefix, sizeof prefix, "%s/run", dir);
     snprintf(ck, sizeof ck, "%s/ck", dir);
-    struct wetdem_many_settings s = {.periodic = {true, true, false}, .box_lo = {0, 0, 0},
-                                     .box_hi = {8e-3, 8e-3, 12e-3}, .dt = 2e-6, .skin = 0.05e-3,
-                                     .output_prefix = prefix, .vtk_every = 50, .csv_every = 50};
+    struct wetdem_many_settings s = {.periodic = {true, true, false},
+                                     .box_lo = {0, 0, 0},
+                                     .box_hi = {8e-3, 8e-3, 12e-3},
+                                     .dt = 2e-6,
+                                     .skin = 0.05e-3,
+                                     .output_prefix = prefix,
+                                     .vtk_every = 50,
+                                     .csv_every = 50};
     struct wetdem_sim* first = wet_box(40, true);
     CHECK_OK(wetdem_sim_set_many(first, &s));
     CHECK_OK(wetdem_sim_integrate(first, 2e-4)); /* frames 0, 1, 2 at steps 0, 50, 100 */
@@ -338,12 +363,12 @@ static void test_many_rejects_bad_settings(void** state)
     struct wetdem_many_settings s = {.skin = -1};
     CHECK_STATUS(wetdem_sim_set_many(sim, &s), WETDEM_ERR_INVALID);
     CHECK_CONTAINS(wetdem_sim_errmsg(sim), "many.skin");
-    s = (struct wetdem_many_settings){.periodic = {false, true, false}, .box_lo = {0, 1, 0},
-                                      .box_hi = {1, 1, 1}};
+    s = (struct wetdem_many_settings){
+        .periodic = {false, true, false}, .box_lo = {0, 1, 0}, .box_hi = {1, 1, 1}};
     CHECK_STATUS(wetdem_sim_set_many(sim, &s), WETDEM_ERR_INVALID);
     CHECK_CONTAINS(wetdem_sim_errmsg(sim), "periodic axis y");
-    struct wetdem_insert_spec spec = {.n = 1, .hi = {1, 1, 1}, .radius_min = 0.1,
-                                      .radius_max = 0.1, .material = 3};
+    struct wetdem_insert_spec spec = {
+        .n = 1, .hi = {1, 1, 1}, .radius_min = 0.1, .radius_max = 0.1, .material = 3};
     CHECK_STATUS(wetdem_sim_insert(sim, &spec), WETDEM_ERR_INVALID);
     CHECK_CONTAINS(wetdem_sim_errmsg(sim), "insert.material 3");
     wetdem_sim_free(sim);

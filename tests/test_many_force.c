@@ -21,12 +21,22 @@
 static struct wetdem_sim* two_material_sim(const char* const* models, int n_models)
 {
     struct wetdem_sim* sim = wetdem_sim_create();
-    struct wetdem_material a = {.density = 2500, .youngs_modulus = 1e7, .poisson_ratio = 0.3,
-                                .restitution = 0.6, .friction_dry = 0.4, .friction_lub = 0.1,
-                                .roughness = 1e-7, .film = 20e-6};
-    struct wetdem_material b = {.density = 7800, .youngs_modulus = 2e8, .poisson_ratio = 0.25,
-                                .restitution = 0.8, .friction_dry = 0.3, .friction_lub = 0.05,
-                                .roughness = 3e-7, .film = 10e-6};
+    struct wetdem_material a = {.density = 2500,
+                                .youngs_modulus = 1e7,
+                                .poisson_ratio = 0.3,
+                                .restitution = 0.6,
+                                .friction_dry = 0.4,
+                                .friction_lub = 0.1,
+                                .roughness = 1e-7,
+                                .film = 20e-6};
+    struct wetdem_material b = {.density = 7800,
+                                .youngs_modulus = 2e8,
+                                .poisson_ratio = 0.25,
+                                .restitution = 0.8,
+                                .friction_dry = 0.3,
+                                .friction_lub = 0.05,
+                                .roughness = 3e-7,
+                                .film = 10e-6};
     assert_int_equal(wetdem_sim_add_material(sim, &a), 0);
     assert_int_equal(wetdem_sim_add_material(sim, &b), 1);
     struct wetdem_fluid f = {.viscosity = 0.01, .surface_tension = 0.02, .density = 1000};
@@ -67,16 +77,18 @@ static void check_same_contact(const struct wetdem_contact* a, const struct wetd
     assert_int_equal(a->i, b->i);
     assert_int_equal(a->j, b->j);
     assert_int_equal(a->is_wall, b->is_wall);
-    const double fa[] = {a->normal.x, a->normal.y, a->normal.z, a->gap, a->radius_i,
-                         a->radius_j, a->r_eff, a->m_eff, a->v_n, a->v_t.x, a->v_t.y, a->v_t.z,
-                         a->dt, a->e_star, a->g_star, a->restitution, a->friction_dry,
-                         a->friction_lub, a->roughness, a->film, a->viscosity,
-                         a->surface_tension, a->h_min};
-    const double fb[] = {b->normal.x, b->normal.y, b->normal.z, b->gap, b->radius_i,
-                         b->radius_j, b->r_eff, b->m_eff, b->v_n, b->v_t.x, b->v_t.y, b->v_t.z,
-                         b->dt, b->e_star, b->g_star, b->restitution, b->friction_dry,
-                         b->friction_lub, b->roughness, b->film, b->viscosity,
-                         b->surface_tension, b->h_min};
+    const double fa[] = {a->normal.x,     a->normal.y,        a->normal.z,  a->gap,
+                         a->radius_i,     a->radius_j,        a->r_eff,     a->m_eff,
+                         a->v_n,          a->v_t.x,           a->v_t.y,     a->v_t.z,
+                         a->dt,           a->e_star,          a->g_star,    a->restitution,
+                         a->friction_dry, a->friction_lub,    a->roughness, a->film,
+                         a->viscosity,    a->surface_tension, a->h_min};
+    const double fb[] = {b->normal.x,     b->normal.y,        b->normal.z,  b->gap,
+                         b->radius_i,     b->radius_j,        b->r_eff,     b->m_eff,
+                         b->v_n,          b->v_t.x,           b->v_t.y,     b->v_t.z,
+                         b->dt,           b->e_star,          b->g_star,    b->restitution,
+                         b->friction_dry, b->friction_lub,    b->roughness, b->film,
+                         b->viscosity,    b->surface_tension, b->h_min};
     assert_memory_equal(fa, fb, sizeof fa);
 }
 
@@ -131,8 +143,8 @@ static void check_fused_equals_generic(struct wetdem_sim* sim, const struct wetd
  * edge and beyond; approaching and separating; for walls too. */
 static void sweep_branches(struct wetdem_sim* sim, size_t* n_checked)
 {
-    const double gaps[] = {-20e-6, -2e-6, -1e-9, 0.0, 0.5e-6, 1e-6, 5e-6, 29.999e-6,
-                           30e-6, 40e-6, 41e-6};
+    const double gaps[] = {-20e-6, -2e-6,     -1e-9, 0.0,   0.5e-6, 1e-6,
+                           5e-6,   29.999e-6, 30e-6, 40e-6, 41e-6};
     const double springs[] = {0.0, 1e-7, 5e-6}; /* fresh, sticking, sliding */
     for (size_t i = 0; i < 6; i++)
         for (size_t j = 0; j < 7; j++) {
@@ -205,10 +217,15 @@ static struct wetdem_sim* wet_gas(bool generic_only, bool budget)
 {
     const char* models[] = {"hertz", "mindlin", "sb", "capillary"};
     struct wetdem_sim* sim = two_material_sim(models, 4);
-    struct wetdem_insert_spec spec = {.layout = WETDEM_INSERT_RANDOM, .n = 150, .lo = {0, 0, 0},
-                                      .hi = {6e-3, 6e-3, 8e-3}, .periodic = {true, true, false},
-                                      .radius_min = 0.4e-3, .radius_max = 0.5e-3,
-                                      .velocity_sigma = 0.2, .seed = 9};
+    struct wetdem_insert_spec spec = {.layout = WETDEM_INSERT_RANDOM,
+                                      .n = 150,
+                                      .lo = {0, 0, 0},
+                                      .hi = {6e-3, 6e-3, 8e-3},
+                                      .periodic = {true, true, false},
+                                      .radius_min = 0.4e-3,
+                                      .radius_max = 0.5e-3,
+                                      .velocity_sigma = 0.2,
+                                      .seed = 9};
     CHECK_OK(wetdem_sim_insert(sim, &spec));
     size_t n;
     struct wetdem_particle* p = wetdem_sim_particles(sim, &n);
@@ -216,8 +233,8 @@ static struct wetdem_sim* wet_gas(bool generic_only, bool budget)
         p[k].material = 1;
         p[k].mass *= 7800.0 / 2500.0;
     }
-    CHECK_OK(wetdem_sim_add_wall(sim, (struct wetdem_vec3){0, 0, 0},
-                                 (struct wetdem_vec3){0, 0, 1}, 1));
+    CHECK_OK(
+        wetdem_sim_add_wall(sim, (struct wetdem_vec3){0, 0, 0}, (struct wetdem_vec3){0, 0, 1}, 1));
     CHECK_OK(wetdem_sim_add_wall(sim, (struct wetdem_vec3){0, 0, 8e-3},
                                  (struct wetdem_vec3){0, 0, -1}, 0));
     CHECK_OK(wetdem_sim_set_param(sim, "sim.gravity_z", -9.81));
