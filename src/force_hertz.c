@@ -4,16 +4,19 @@
  *
  *   F_el = (4/3) E* sqrt(R*) delta^(3/2)                      [N], delta = -h > 0 the overlap
  *   F_d  = c(e) sqrt(m* k) delta^(1/4) v_n,  k = (4/3) E* sqrt(R*)  [N], v_n > 0 approaching
- *   F_n  = max(0, F_el + F_d)                                 (no attraction at unloading)
+ *   F_n  = max(0, F_el + F_d)  (damping exact: no attraction at unloading)
+ *   F_n  = F_el + F_d          (damping tsuji: LIGGGHTS `model hertz`, which does not clip)
  *
  * (Hertz 1882; Johnson 1985 Sec. 11.4; damping form of Tsuji et al. 1992.) The dimensionless
  * damping c depends only on the dry restitution e, because x'' = -x^(3/2) - c x^(1/4) x' is the
  * collision in the units X, T of the text below and has no other parameter:
  *   - "tsuji": c = -sqrt(5) beta, beta = ln e / sqrt(ln^2 e + pi^2); this is LIGGGHTS
- *     `model hertz`, gamma_n = -2 sqrt(5/6) beta sqrt(S_n m*), S_n = 2 E* sqrt(R* delta). It is
- *     exact for the unclipped law (the force may pull at the end of unloading), so with the
- *     clipping used here it rebounds with more than e (0.40 instead of 0.30, for example).
- *   - "exact": c solves e = e(c) for the clipped law. In closed form (contact.md, Sec. 1.3),
+ *     `model hertz`, gamma_n = -2 sqrt(5/6) beta sqrt(S_n m*), S_n = 2 E* sqrt(R* delta), with
+ *     LIGGGHTS' default limitForce off: the sum is not clipped. c_tsuji is the exact
+ *     coefficient of the unclipped law (contact.md Sec. 1.3), so the collision rebounds with
+ *     e; the price is a pull at the end of unloading (at most 15 % of the peak force, at
+ *     e = 0.3; contact.md Sec. 1.5). Clipped, it would rebound with 0.40 instead of 0.30.
+ *   - "exact" (default): c solves e = e(c) for the clipped law. In closed form (contact.md, Sec. 1.3),
  *     with w = x'/x^(5/4) the ODE is separable and ln e = -(c/2) J(c),
  *       J = (2/sqrt(5 - c^2)) [pi/2 - atan((c^2 - 5/2)/(c sqrt(5 - c^2)))]   for c^2 < 5,
  *       J = (2/sqrt(c^2 - 5)) ln((c^2 + c sqrt(c^2 - 5) - 5/2)/(5/2))       for c^2 > 5,
@@ -35,8 +38,9 @@ static const char* const damping_choices[] = {"exact", "tsuji", NULL};
 
 static const struct wetdem_param_desc hertz_params_desc[] = {
     {"damping", "-",
-     "Normal damping coefficient: exact (rebounds with exactly e_dry under this clipped force "
-     "law) or tsuji (the LIGGGHTS model hertz coefficient).",
+     "Normal damping: exact (force clipped at zero, coefficient that rebounds with exactly "
+     "e_dry under the clipped law) or tsuji (LIGGGHTS model hertz: Tsuji coefficient, force "
+     "not clipped, which also rebounds with exactly e_dry but pulls at the end of unloading).",
      offsetof(struct hertz_params, damping), 0, 0, 1, false, false, damping_choices},
     {0},
 };
@@ -328,8 +332,8 @@ double wetdem_force_hertz_damping(double e_star, double r_eff, double m_eff, dou
 
 double wetdem_force_hertz_total(double f_el, double f_damp, int form)
 {
-    (void)form; /* both forms are clipped: contact.md Sec. 1.1 */
-    return fmax(f_el + f_damp, 0.0);
+    /* exact: clipped (contact.md Sec. 1.1); tsuji: LIGGGHTS semantics, unclipped (Sec. 1.5) */
+    return form == 1 ? f_el + f_damp : fmax(f_el + f_damp, 0.0);
 }
 
 /* 2.868266... = (4/5) (15/16)^(2/5) B(2/5, 1/2), contact.md Sec. 1.4. */
@@ -359,11 +363,11 @@ static int hertz_pair(const void* params, const struct wetdem_contact* c, double
         return WETDEM_OK;
     int form = (int)p->damping;
     double f_el = wetdem_force_hertz_elastic(c->e_star, c->r_eff, overlap);
-    out->f_normal += wetdem_force_hertz_total(
-        f_el,
-        wetdem_force_hertz_damping(c->e_star, c->r_eff, c->m_eff, overlap, c->v_n,
-                                   c->restitution, form),
-        form);
+    out->f_normal +=
+        wetdem_force_hertz_total(f_el,
+                                 wetdem_force_hertz_damping(c->e_star, c->r_eff, c->m_eff, overlap,
+                                                            c->v_n, c->restitution, form),
+                                 form);
     return WETDEM_OK;
 }
 
@@ -382,15 +386,18 @@ const struct wetdem_model wetdem_force_hertz = {
     .kind = WETDEM_MODEL_CONTACT,
     .summary = "Hertz normal contact with viscous damping from the dry restitution e_dry",
     .doc = "Normal solid contact of two elastic spheres for overlap delta = -h > 0: "
-           "F_n = max(0, (4/3) E* sqrt(R*) delta^(3/2) + c(e) sqrt(m* k) delta^(1/4) v_n), "
+           "F_n = (4/3) E* sqrt(R*) delta^(3/2) + c(e) sqrt(m* k) delta^(1/4) v_n, "
            "k = (4/3) E* sqrt(R*). The damping grows as delta^(1/4), so the restitution does "
-           "not depend on the impact speed; the sum is clipped at zero so the contact never "
-           "pulls at the end of unloading. damping = exact chooses c so that an isolated "
-           "head-on collision rebounds with exactly e_dry under this clipped law (tabulated "
-           "inverse of a closed form, relative error of c below 1e-8); damping = tsuji uses "
-           "the LIGGGHTS model hertz coefficient c = -sqrt(5) ln e / sqrt(ln^2 e + pi^2), "
-           "which is exact only without clipping and rebounds faster (e = 0.40 for e_dry = "
-           "0.30). Undamped contact time t_c = 2.8683 (m*^2/(E*^2 R* v))^(1/5). Valid for "
+           "not depend on the impact speed. damping = exact (default) clips the sum at zero, "
+           "so the contact never pulls at the end of unloading, and chooses c so that an "
+           "isolated head-on collision rebounds with exactly e_dry under this clipped law "
+           "(tabulated inverse of a closed form, relative error of c below 1e-8). "
+           "damping = tsuji is LIGGGHTS model hertz (default limitForce off), for comparisons "
+           "with LIGGGHTS: c = -sqrt(5) ln e / sqrt(ln^2 e + pi^2) and no clipping, which "
+           "also rebounds with exactly e_dry (c_tsuji is the exact coefficient of the "
+           "unclipped law) but pulls at the end of unloading, by up to 15 % of the peak "
+           "force (e_dry = 0.3); clipped, that coefficient would rebound with 0.40. Undamped "
+           "contact time t_c = 2.8683 (m*^2/(E*^2 R* v))^(1/5). Valid for "
            "delta << R* and impact speeds far below the elastic wave speed; e_dry in (0, 1]. "
            "Combine with mindlin for friction. Derivation: docs/derivations/contact.md.",
     .equations = "normal part of Punch 2023 Eq. 6 (Hertz-Mindlin as in LIGGGHTS); the contact "

@@ -36,8 +36,9 @@ double wetdem_force_hertz_elastic(double e_star, double r_eff, double overlap);
  * independent of speed. form 0 "exact": coefficient chosen so that an isolated Hertz
  * spring + dashpot collision, with elastic + damping clipped at >= 0, rebounds with exactly
  * `restitution`; form 1 "tsuji": the LIGGGHTS/Tsuji coefficient -2 sqrt(5/6) beta
- * sqrt(S_n m*) (exact only without clipping). NAN for restitution outside (0, 1] or another
- * form. Callers that want e_dry exactly must clip the sum at zero as the hertz model does. */
+ * sqrt(S_n m*) (exact for the unclipped sum, which the hertz model uses with this form).
+ * NAN for restitution outside (0, 1] or another form. Combine with the elastic part through
+ * wetdem_force_hertz_total to get the hertz law of the form. */
 double wetdem_force_hertz_damping(double e_star, double r_eff, double m_eff, double overlap,
                                   double v_n, double restitution, int form);
 /* force_hertz.c: total normal force of the hertz law [N] from its elastic part f_el and its
