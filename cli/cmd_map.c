@@ -132,8 +132,10 @@ static void run_point(struct map_point* p, enum cli_engine engine)
         return;
     }
     if (engine == CLI_ENGINE_PAIRWISE) {
-        struct cli_run_options opt = {.sweep_row = f, .status_out = &p->status,
-                                      .errmsg_out = p->errmsg, .errmsg_size = sizeof p->errmsg};
+        struct cli_run_options opt = {.sweep_row = f,
+                                      .status_out = &p->status,
+                                      .errmsg_out = p->errmsg,
+                                      .errmsg_size = sizeof p->errmsg};
         p->status = WETDEM_ERR_NOMEM; /* kept when the engine could not start */
         cli_run_pairwise(&p->sc, &opt);
     } else {

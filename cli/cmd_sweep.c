@@ -130,8 +130,10 @@ static void run_point(struct point* p, enum cli_engine engine)
     if (engine == CLI_ENGINE_PAIRWISE) {
         size_t len = 0;
         FILE* f = open_memstream(&p->pairwise_row, &len);
-        struct cli_run_options opt = {.sweep_row = f, .status_out = &p->status,
-                                      .errmsg_out = p->errmsg, .errmsg_size = sizeof p->errmsg};
+        struct cli_run_options opt = {.sweep_row = f,
+                                      .status_out = &p->status,
+                                      .errmsg_out = p->errmsg,
+                                      .errmsg_size = sizeof p->errmsg};
         p->status = WETDEM_ERR_NOMEM; /* kept when the engine could not start */
         snprintf(p->errmsg, sizeof p->errmsg, "out of memory");
         if (f) {
@@ -235,8 +237,9 @@ static void write_table(FILE* f, const struct sweep_args* a, const struct point*
                 omp_get_max_threads());
         return;
     }
-    fprintf(f, "# totals: runs=%zu steps=%llu force_evals=%llu pair_evals=%llu root_evals=%llu "
-               "events=%llu wall_time_s=%.6f threads=%d\n",
+    fprintf(f,
+            "# totals: runs=%zu steps=%llu force_evals=%llu pair_evals=%llu root_evals=%llu "
+            "events=%llu wall_time_s=%.6f threads=%d\n",
             n, tot.steps, tot.force_evals, tot.pair_evals, tot.root_evals, tot.events, wall,
             omp_get_max_threads());
 }
@@ -312,7 +315,8 @@ int cmd_sweep(int argc, char** argv)
     }
     if (rc == CLI_EXIT_OK && cli_scenario_is_many && cli_scenario_is_many(&sc)) {
         cli_error("sweep %s: a many-particle scenario runs with 'wetdem run' (one run per "
-                  "file); sweeps vary binary collisions", a.file);
+                  "file); sweeps vary binary collisions",
+                  a.file);
         rc = CLI_EXIT_USAGE;
     }
     struct point* pts = rc == CLI_EXIT_OK ? calloc(r.n, sizeof *pts) : NULL;

@@ -17,20 +17,20 @@
 
 static struct cli_field num(const char* name, const char* unit, const char* doc, double v)
 {
-    return (struct cli_field){.name = name, .unit = unit, .doc = doc, .kind = CLI_FIELD_NUMBER,
-                              .number = v};
+    return (struct cli_field){
+        .name = name, .unit = unit, .doc = doc, .kind = CLI_FIELD_NUMBER, .number = v};
 }
 
 static struct cli_field flag(const char* name, const char* doc, bool v)
 {
-    return (struct cli_field){.name = name, .unit = "", .doc = doc, .kind = CLI_FIELD_BOOL,
-                              .flag = v};
+    return (struct cli_field){
+        .name = name, .unit = "", .doc = doc, .kind = CLI_FIELD_BOOL, .flag = v};
 }
 
 static struct cli_field count(const char* name, const char* doc, unsigned long long v)
 {
-    return (struct cli_field){.name = name, .unit = "", .doc = doc, .kind = CLI_FIELD_COUNT,
-                              .count = v};
+    return (struct cli_field){
+        .name = name, .unit = "", .doc = doc, .kind = CLI_FIELD_COUNT, .count = v};
 }
 
 size_t cli_result_fields(const struct cli_setup* su, const struct wetdem_collision_result* r,
@@ -39,9 +39,9 @@ size_t cli_result_fields(const struct cli_setup* su, const struct wetdem_collisi
     size_t n = 0;
     out[n++] = num("impact_speed", "m/s", "speed U of the striker at t = 0", su->impact_speed);
     out[n++] = num("stokes_n", "-", "normal Stokes number m* v_n0 / (6 pi mu R*^2)", r->stokes_n);
-    out[n++] = num("speed_n0", "m/s",
-                   "normal impact speed v_n0 = U cos(angle) of the straight-line approach",
-                   r->speed_n0);
+    out[n++] =
+        num("speed_n0", "m/s",
+            "normal impact speed v_n0 = U cos(angle) of the straight-line approach", r->speed_n0);
     out[n++] = num("e", "-", "Nijssen restitution |dv_f|/|dv_0|", r->e);
     out[n++] = num("e_n", "-",
                    "normal restitution dv_f.n_f / v_n0: separation over impact speed (Punch "
@@ -61,8 +61,7 @@ size_t cli_result_fields(const struct cli_setup* su, const struct wetdem_collisi
     out[n++] = num("striker_angle_out", "deg",
                    "rebound angle of the striker's own velocity to the line of centres",
                    su->striker_angle_out * RAD2DEG);
-    out[n++] = num("striker_speed_out", "m/s", "final speed of the striker",
-                   su->striker_speed_out);
+    out[n++] = num("striker_speed_out", "m/s", "final speed of the striker", su->striker_speed_out);
     out[n++] = num("omega_i_x", "rad/s", "final spin of the striker, x", r->omega_i.x);
     out[n++] = num("omega_i_y", "rad/s", "final spin of the striker, y", r->omega_i.y);
     out[n++] = num("omega_i_z", "rad/s", "final spin of the striker, z", r->omega_i.z);
@@ -84,7 +83,9 @@ size_t cli_result_fields(const struct cli_setup* su, const struct wetdem_collisi
                    "arrested (> 5 deg and separated: stick-rotate-separate)",
                    r->rotation_close * RAD2DEG);
     out[n++] = num("close_gap", "m", "doublet gap of the outcome rule", r->close_gap);
-    out[n] = (struct cli_field){.name = "outcome", .unit = "", .kind = CLI_FIELD_TEXT,
+    out[n] = (struct cli_field){.name = "outcome",
+                                .unit = "",
+                                .kind = CLI_FIELD_TEXT,
                                 .doc = "stick, stick-rotate-separate or bounce",
                                 .text = wetdem_outcome_name(r->outcome)};
     n++;
@@ -129,7 +130,7 @@ void cli_csv_result_header(FILE* f)
     struct cli_field fields[CLI_MAX_FIELDS];
     size_t n = cli_result_fields(&su, &r, fields);
     for (size_t k = 0; k < n; k++) {
-        const char* unit = fields[k].kind == CLI_FIELD_BOOL   ? "0/1"
+        const char* unit = fields[k].kind == CLI_FIELD_BOOL    ? "0/1"
                            : fields[k].kind == CLI_FIELD_TEXT  ? "word"
                            : fields[k].kind == CLI_FIELD_COUNT ? "count"
                                                                : fields[k].unit;
@@ -263,8 +264,8 @@ static void trajectory_header(struct cli_trajectory* t, size_t n)
     cli_print_provenance(t->f, t->argc, t->argv);
     fputs("time [s]", t->f);
     static const char* const names[] = {"x", "y", "z", "vx", "vy", "vz", "wx", "wy", "wz"};
-    static const char* const units[] = {"m", "m", "m", "m/s", "m/s", "m/s", "rad/s", "rad/s",
-                                        "rad/s"};
+    static const char* const units[] = {"m",   "m",     "m",     "m/s",  "m/s",
+                                        "m/s", "rad/s", "rad/s", "rad/s"};
     for (size_t p = 0; p < n; p++)
         for (size_t k = 0; k < 9; k++)
             fprintf(t->f, ",%s_%c [%s]", names[k], p == 0 ? 'i' : 'j', units[k]);
@@ -284,8 +285,8 @@ static void pair_gap(const struct wetdem_sim* sim, const struct cli_trajectory* 
         /* wetdem_sim_pair_force writes to sim only on failure (its message buffer). */
         struct wetdem_contact c;
         struct wetdem_pair_force f;
-        if (n >= 1 && wetdem_sim_pair_force((struct wetdem_sim*)sim, 0, (size_t)-1, &c, &f) ==
-                          WETDEM_OK) {
+        if (n >= 1 &&
+            wetdem_sim_pair_force((struct wetdem_sim*)sim, 0, (size_t)-1, &c, &f) == WETDEM_OK) {
             *gap = c.gap;
             *v_n = c.v_n;
         }
@@ -293,8 +294,7 @@ static void pair_gap(const struct wetdem_sim* sim, const struct cli_trajectory* 
     }
     if (n < 2)
         return;
-    double dx = p[0].pos.x - p[1].pos.x, dy = p[0].pos.y - p[1].pos.y,
-           dz = p[0].pos.z - p[1].pos.z;
+    double dx = p[0].pos.x - p[1].pos.x, dy = p[0].pos.y - p[1].pos.y, dz = p[0].pos.z - p[1].pos.z;
     double d = sqrt(dx * dx + dy * dy + dz * dz);
     *gap = d - p[0].radius - p[1].radius;
     double dvx = p[0].vel.x - p[1].vel.x, dvy = p[0].vel.y - p[1].vel.y,
@@ -313,7 +313,7 @@ int cli_trajectory_observe(const struct wetdem_sim* sim, void* ctx)
         trajectory_header(t, n);
     fprintf(t->f, "%.12g", wetdem_sim_time(sim));
     for (size_t k = 0; k < n; k++) {
-        const double v[9] = {p[k].pos.x, p[k].pos.y, p[k].pos.z, p[k].vel.x, p[k].vel.y,
+        const double v[9] = {p[k].pos.x, p[k].pos.y,   p[k].pos.z,   p[k].vel.x,  p[k].vel.y,
                              p[k].vel.z, p[k].omega.x, p[k].omega.y, p[k].omega.z};
         for (size_t m = 0; m < 9; m++)
             fprintf(t->f, ",%.12g", v[m]);

@@ -186,13 +186,13 @@ static int csv_resume(const char* path, unsigned long long step, const char* out
 
 struct progress {
     struct wetdem_sim* sim;
-    struct series* vtk;              /* NULL: no frames */
+    struct series* vtk; /* NULL: no frames */
     unsigned long long vtk_every;
-    unsigned long long base_step;    /* step count when this integrate call began */
-    unsigned long long run_total;    /* steps of the whole run */
+    unsigned long long base_step; /* step count when this integrate call began */
+    unsigned long long run_total; /* steps of the whole run */
     bool tty;
-    double last_print;               /* [s] of wall time */
-    int status;                      /* first failure writing a frame */
+    double last_print; /* [s] of wall time */
+    int status;        /* first failure writing a frame */
 };
 
 static void print_progress(struct progress* p, unsigned long long done, unsigned long long total,
@@ -203,8 +203,9 @@ static void print_progress(struct progress* p, unsigned long long done, unsigned
     p->last_print = elapsed;
     double left = elapsed * (double)(total - done) / (double)done;
     unsigned long long step = p->base_step + done;
-    fprintf(stderr, "\rwetdem: step %llu/%llu (%5.1f %%), t = %.4g s, %.0f s elapsed, about "
-                    "%.0f s left   ",
+    fprintf(stderr,
+            "\rwetdem: step %llu/%llu (%5.1f %%), t = %.4g s, %.0f s elapsed, about "
+            "%.0f s left   ",
             step, p->run_total, 100.0 * (double)step / (double)p->run_total,
             wetdem_sim_time(p->sim), elapsed, ceil(left));
     if (done == total)
@@ -213,8 +214,7 @@ static void print_progress(struct progress* p, unsigned long long done, unsigned
 }
 
 /* Library progress callback, after every step: VTK frames that are due, progress text. */
-static int on_progress(unsigned long long done, unsigned long long total, double elapsed,
-                       void* ctx)
+static int on_progress(unsigned long long done, unsigned long long total, double elapsed, void* ctx)
 {
     struct progress* p = ctx;
     unsigned long long step = p->base_step + done;
@@ -236,7 +236,7 @@ struct outcome {
     struct wetdem_many_stats stats;
     struct wetdem_energy_budget budget;
     bool has_budget;
-    double wall;       /* [s] */
+    double wall; /* [s] */
     bool interrupted;
 };
 
@@ -255,18 +255,20 @@ static void summary_text(FILE* f, const struct cli_many_setup* su, const struct 
     fprintf(f, "energy budget [J]  input = kinetic + potential + elastic + dissipated\n");
     fprintf(f, "  input            %12.6g  (kinetic + potential + elastic at the start)\n",
             b->input);
-    fprintf(f, "  kinetic          %12.6g\n  potential        %12.6g\n  elastic          "
-               "%12.6g\n  dissipated       %12.6g\n",
+    fprintf(f,
+            "  kinetic          %12.6g\n  potential        %12.6g\n  elastic          "
+            "%12.6g\n  dissipated       %12.6g\n",
             b->kinetic, b->potential, b->elastic, b->dissipated);
-    fprintf(f, "work by model [J]  %12s %12s %12s  (< 0: taken from the particles)\n",
-            "pairs", "walls", "total");
+    fprintf(f, "work by model [J]  %12s %12s %12s  (< 0: taken from the particles)\n", "pairs",
+            "walls", "total");
     for (size_t k = 0; k < b->n_models && k < WETDEM_ENERGY_MAX_MODELS; k++)
         fprintf(f, "  %-16s %12.6g %12.6g %12.6g\n", wetdem_sim_model(su->sim, k)->name,
                 b->work_pair[k], b->work_wall[k], b->work_pair[k] + b->work_wall[k]);
     fprintf(f, "  %-16s %12s %12s %12.6g\n", "all", "", "", b->work_total);
     double scale = fmax(fabs(b->input), fabs(b->work_total));
-    fprintf(f, "closure error      %12.6g  (change of kinetic + potential minus the work; "
-               "%.2g of the larger of input and work)\n",
+    fprintf(f,
+            "closure error      %12.6g  (change of kinetic + potential minus the work; "
+            "%.2g of the larger of input and work)\n",
             b->balance_error, scale > 0 ? fabs(b->balance_error) / scale : 0.0);
 }
 
@@ -398,8 +400,8 @@ static void print_check_json(const struct cli_scenario* sc, const struct cli_man
            "\"contacts\": %zu, \"bridges\": %zu, \"models\": [",
            wetdem_sim_n_particles(su->sim), wetdem_sim_n_walls(su->sim), su->box[0], su->box[1],
            su->box[2], su->many.periodic[0] ? "true" : "false",
-           su->many.periodic[1] ? "true" : "false", su->many.periodic[2] ? "true" : "false",
-           pl->dt, pl->t_end, pl->total, su->vtk_every, su->csv_every, s->contacts, s->bridges);
+           su->many.periodic[1] ? "true" : "false", su->many.periodic[2] ? "true" : "false", pl->dt,
+           pl->t_end, pl->total, su->vtk_every, su->csv_every, s->contacts, s->bridges);
     for (size_t k = 0; k < wetdem_sim_n_models(su->sim); k++) {
         printf("%s", k ? ", " : "");
         cli_json_string(stdout, wetdem_sim_model(su->sim, k)->name);
@@ -443,8 +445,7 @@ static int set_outputs(struct cli_many_setup* su, const struct cli_run_options* 
         snprintf(pl->csv_prefix, sizeof pl->csv_prefix, "%s/%.*s", opt->out_dir,
                  (int)strlen(su->csv_name) - 4, su->csv_name);
     if (opt->out_dir && su->checkpoint_name[0])
-        snprintf(pl->checkpoint, sizeof pl->checkpoint, "%s/%s", opt->out_dir,
-                 su->checkpoint_name);
+        snprintf(pl->checkpoint, sizeof pl->checkpoint, "%s/%s", opt->out_dir, su->checkpoint_name);
     m.output_prefix = pl->csv_prefix[0] ? pl->csv_prefix : NULL;
     m.csv_every = su->csv_every;
     m.vtk_every = 0; /* frames are written by on_progress */
@@ -495,8 +496,8 @@ static int integrate_with_signals(struct wetdem_sim* sim, double t_end)
 
 /* After the stepping: interrupted, failed or done (last frame, final checkpoint, summary). */
 static int finish(const struct cli_scenario* sc, struct cli_many_setup* su,
-                  const struct cli_run_options* opt, const struct plan* pl,
-                  struct progress* prog, int st, double wall)
+                  const struct cli_run_options* opt, const struct plan* pl, struct progress* prog,
+                  int st, double wall)
 {
     struct outcome o = {.wall = wall, .interrupted = st == WETDEM_EVENT};
     wetdem_sim_many_stats(su->sim, &o.stats);
@@ -546,8 +547,11 @@ static int finish(const struct cli_scenario* sc, struct cli_many_setup* su,
 static int run(const struct cli_scenario* sc, struct cli_many_setup* su,
                const struct cli_run_options* opt, struct plan* pl, struct series* vtk)
 {
-    struct progress prog = {.sim = su->sim, .vtk = vtk, .vtk_every = su->vtk_every,
-                            .run_total = pl->total, .tty = isatty(STDERR_FILENO) == 1};
+    struct progress prog = {.sim = su->sim,
+                            .vtk = vtk,
+                            .vtk_every = su->vtk_every,
+                            .run_total = pl->total,
+                            .tty = isatty(STDERR_FILENO) == 1};
     int rc = set_outputs(su, opt, pl, &prog);
     if (rc == CLI_EXIT_OK && opt->restart)
         rc = resume(su, opt, pl, vtk);

@@ -323,14 +323,13 @@ static void print_check(const struct cli_scenario* sc, const struct wetdem_pairw
         printf(", \"engine\": \"pairwise\", \"viscosity\": %.17g, \"surface_tension\": %.17g, "
                "\"h_min\": %.17g, \"restitution\": %.17g, \"friction\": %.17g, "
                "\"t_end\": %.17g, \"rtol\": %.17g, \"spheres\": [",
-               c->viscosity, c->surface_tension, c->h_min, c->restitution, c->friction,
-               c->t_end, c->rtol);
+               c->viscosity, c->surface_tension, c->h_min, c->restitution, c->friction, c->t_end,
+               c->rtol);
         for (size_t i = 0; i < c->n_spheres; i++) {
             const struct wetdem_pairwise_sphere* s = &c->spheres[i];
             printf("%s{\"radius\": %.17g, \"mass\": %.17g, \"film\": %.17g, \"x\": %.17g, "
                    "\"y\": %.17g, \"vx\": %.17g, \"vy\": %.17g, \"omega\": %.17g}",
-                   i ? ", " : "", s->radius, s->mass, s->film, s->x, s->y, s->vx, s->vy,
-                   s->omega);
+                   i ? ", " : "", s->radius, s->mass, s->film, s->x, s->y, s->vx, s->vy, s->omega);
         }
         printf("]}\n");
         return;

@@ -19,9 +19,14 @@ static const char* const target_choices[] = {"sphere", "wall", "fixed", NULL};
 static const char* const fluid_choices[] = {"water", "glycerol80", "silicone10", NULL};
 static const char* const engine_choices[] = {"soft", "pairwise", NULL};
 
-#define NUM(k, u, dflt, lo, hi, lo_open, hi_open, doc)                                            \
-    {k, CLI_VALUE_NUMBER, u, dflt, lo, hi, lo_open, hi_open, NULL, doc}
-#define WORD(k, kind, dflt, choices, doc) {k, kind, "", dflt, 0, 0, false, false, choices, doc}
+#define NUM(k, u, dflt, lo, hi, lo_open, hi_open, doc)                                             \
+    {                                                                                              \
+        k, CLI_VALUE_NUMBER, u, dflt, lo, hi, lo_open, hi_open, NULL, doc                          \
+    }
+#define WORD(k, kind, dflt, choices, doc)                                                          \
+    {                                                                                              \
+        k, kind, "", dflt, 0, 0, false, false, choices, doc                                        \
+    }
 
 static const struct cli_key_desc collision_keys[] = {
     WORD("striker", CLI_VALUE_NAME, "steel1", NULL,
@@ -306,8 +311,7 @@ static bool same_range(const struct cli_key_desc* k, const struct wetdem_param_d
  * (wetdem_sim_settings_params, wetdem_integrator_params): "<value>" or, for integrator keys,
  * "<value> (<integrator>)" per integrator that has it. Returns 0, or -1 (message printed) if
  * the library knows the key for none or documents another range. */
-static int library_default(const char* section, const struct cli_key_desc* k, char* out,
-                           size_t n)
+static int library_default(const char* section, const struct cli_key_desc* k, char* out, size_t n)
 {
     bool is_sim = strcmp(section, "sim") == 0;
     const char* const* names = wetdem_integrator_names();
@@ -321,15 +325,15 @@ static int library_default(const char* section, const struct cli_key_desc* k, ch
         if (!same_range(k, d)) {
             char range[160];
             wetdem_param_range_text(d, range, sizeof range);
-            fprintf(stderr, "wetdem: docs-scenarios: [%s] %s: the library's range is %s\n",
-                    section, k->key, range);
+            fprintf(stderr, "wetdem: docs-scenarios: [%s] %s: the library's range is %s\n", section,
+                    k->key, range);
             return -1;
         }
         char value[64];
         cli_param_default_text(d, value, sizeof value);
-        used += (size_t)snprintf(out + used, used < n ? n - used : 0, "%s%s%s%s%s",
-                                 used ? ", " : "", value, is_sim ? "" : " (", is_sim ? "" : names[m],
-                                 is_sim ? "" : ")");
+        used +=
+            (size_t)snprintf(out + used, used < n ? n - used : 0, "%s%s%s%s%s", used ? ", " : "",
+                             value, is_sim ? "" : " (", is_sim ? "" : names[m], is_sim ? "" : ")");
     }
     if (!out[0])
         fprintf(stderr, "wetdem: docs-scenarios: the library has no parameter '%s' for [%s]\n",

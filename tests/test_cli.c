@@ -108,8 +108,8 @@ static void test_cli_every_subcommand_help(void** state)
             snprintf(want, sizeof want, "usage: wetdem %s", name);
             struct run r = run_cli(args, false);
             if (r.code != 0 || strncmp(r.out, want, strlen(want)) != 0)
-                fail_msg("'wetdem %s' exited %d with stdout:\n%s\n(expected exit 0 and '%s')",
-                         args, r.code, r.out, want);
+                fail_msg("'wetdem %s' exited %d with stdout:\n%s\n(expected exit 0 and '%s')", args,
+                         r.code, r.out, want);
             free(r.out);
         }
     }
