@@ -396,7 +396,11 @@ static int eval_pair(const struct wetdem_sim* sim, struct wetdem_contact* c, dou
     return WETDEM_OK;
 }
 
-/* Pair q within reach of the cheap test (d = x_i - x_j): its contact and force into *o. */
+/* Pair q within reach of the cheap test (d = x_i - x_j): its contact and force into *o. Kept
+ * out of line: inlined, it made the candidate loop spill its registers to the stack. */
+static void eval_near_pair(const struct wetdem_sim* sim, size_t q, struct wetdem_vec3 d,
+                           const struct wetdem_many_mix* x, struct wetdem_many_pair_out* o,
+                           struct failure* fail) __attribute__((noinline));
 static void eval_near_pair(const struct wetdem_sim* sim, size_t q, struct wetdem_vec3 d,
                            const struct wetdem_many_mix* x, struct wetdem_many_pair_out* o,
                            struct failure* fail)
