@@ -76,6 +76,8 @@ struct wetdem_many {
     size_t wall_mask_cap;
     uint32_t* wall_list; /* particles with a non-zero wall_mask (or all if > 64 walls) */
     size_t n_wall_list, wall_list_cap;
+    bool kick_pending;   /* the latest step's closing half kick is still to be applied
+                                    (sim_many.c one_step); never true outside a run */
     double max_disp2;    /* largest squared displacement since the build [m^2], */
     bool max_disp_valid; /* measured during the latest drift */
     /* the pairs ordered by their second particle: particle i's pairs (k, i) occupy the slots

@@ -130,6 +130,43 @@ static int stop_after(unsigned long long done, unsigned long long total, double 
     return 0;
 }
 
+static int count_calls(unsigned long long done, unsigned long long total, double elapsed, void* ctx)
+{
+    (void)done;
+    (void)total;
+    (void)elapsed;
+    ++*(int*)ctx;
+    return 0;
+}
+
+/* A step whose state nobody reads leaves its closing half kick to the next step's drift pass.
+ * A run with a progress callback after every step (never deferred) must give the same bits as
+ * one without (deferred except at the end). */
+static void test_many_deferred_kick_is_bit_identical(void** state)
+{
+    (void)state;
+    struct wetdem_sim* deferred = wet_box(150, true);
+    struct wetdem_sim* every = wet_box(150, true);
+    int calls = 0;
+    struct wetdem_many_settings s = {.periodic = {true, true, false},
+                                     .box_lo = {0, 0, 0},
+                                     .box_hi = {8e-3, 8e-3, 12e-3},
+                                     .dt = 2e-6,
+                                     .skin = 0.05e-3,
+                                     .energy_budget = true,
+                                     .progress = count_calls,
+                                     .progress_ctx = &calls,
+                                     .progress_every = 1};
+    CHECK_OK(wetdem_sim_set_many(every, &s));
+    every->many->parallel_min = 1;
+    CHECK_OK(wetdem_sim_integrate(deferred, 0.6e-3));
+    CHECK_OK(wetdem_sim_integrate(every, 0.6e-3));
+    assert_int_equal(calls, 300); /* every step was read */
+    check_same_particles(deferred, every);
+    wetdem_sim_free(deferred);
+    wetdem_sim_free(every);
+}
+
 static void test_many_stop_flag_writes_a_checkpoint(void** state)
 {
     (void)state;
@@ -380,6 +417,7 @@ int main(void)
         cmocka_unit_test(test_many_same_result_for_any_thread_count),
         cmocka_unit_test(test_many_restart_is_bit_identical),
         cmocka_unit_test(test_many_stop_flag_writes_a_checkpoint),
+        cmocka_unit_test(test_many_deferred_kick_is_bit_identical),
         cmocka_unit_test(test_many_energy_budget_closes),
         cmocka_unit_test(test_many_matches_few_body_engine),
         cmocka_unit_test(test_many_reach_bound_is_enforced),
