@@ -5,7 +5,7 @@
 #   make demo     the built-in default scenario
 #   make validate long validation sweeps and figures (docs/validation.md)
 #   make bench    benchmarks with ratios against baselines measured in the same run
-#   make figures  figures from CSV in build/validate
+#   make figures  redraw the figures from the CSV in out/validate (no new simulations)
 
 CC      ?= gcc
 BUILD   ?= build

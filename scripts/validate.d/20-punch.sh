@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Punch et al. (2023) thin-film oblique collisions: the simulation curves of Figs. 8 (a-d), 9,
 # 10 and 14, 11, 12 and 13 (e_n and spin vs St_n, impact angles 0-60 deg), the fit of P_gt
-# to the 0 deg curve (Punch Sec. 4.2: "P_gt fitted using the 0 deg case") and the tracking
-# round trip. CSV in out/validate/punch/, figures in docs/figures/punch_*.png
+# to the 0 deg curve (Punch Sec. 4.2: "P_gt fitted using the 0 deg case"); the tracking
+# round trip is piece 25-track.sh. CSV in out/validate/punch/, figures in docs/figures/punch_*.png
 # (figures/punch_figs.py, which checks the paper's statements on the data and fails the piece
 # when one does not hold), what they show in docs/validation_punch.md.
 # Every curve is two sweeps, as Punch simulates: t_end = 1 s for St_n <= 0.6, 0.2 s above;
