@@ -106,14 +106,14 @@ WETDEM_API const char* wetdem_status_name(int status);
  * A parameter with `choices` is an enumeration: the stored double is the index of the
  * chosen word (set it by word with wetdem_sim_set_param_str()). Tables end with {0}. */
 struct wetdem_param_desc {
-    const char* name;            /* "cutoff_ratio" */
-    const char* unit;            /* "m", "Pa s", "-" */
-    const char* doc;             /* one sentence */
-    size_t offset;               /* offsetof(params struct, field) */
-    double default_value;        /* also the index of the default choice */
-    double min, max;             /* valid closed range [min, max]; see *_open flags */
-    bool min_open, max_open;     /* exclude the bound itself */
-    const char* const* choices;  /* NULL-terminated words, or NULL for a number */
+    const char* name;           /* "cutoff_ratio" */
+    const char* unit;           /* "m", "Pa s", "-" */
+    const char* doc;            /* one sentence */
+    size_t offset;              /* offsetof(params struct, field) */
+    double default_value;       /* also the index of the default choice */
+    double min, max;            /* valid closed range [min, max]; see *_open flags */
+    bool min_open, max_open;    /* exclude the bound itself */
+    const char* const* choices; /* NULL-terminated words, or NULL for a number */
 };
 
 /* Number of descriptors in a {0}-terminated table. */
@@ -177,16 +177,16 @@ struct wetdem_contact {
                                   contact point [m/s] */
     double dt;                 /* time since the pair's history was last committed [s] */
     /* mixed pair properties */
-    double e_star;             /* 1/E* = (1-nu_i^2)/E_i + (1-nu_j^2)/E_j [Pa] */
-    double g_star;             /* 1/G* = (2-nu_i)/G_i + (2-nu_j)/G_j [Pa] */
-    double restitution;        /* e_dry, mean of the two [-] */
-    double friction_dry;       /* mean of the two [-] */
-    double friction_lub;       /* mean of the two [-] */
-    double roughness;          /* h_sigma = (sigma_i + sigma_j)/2 [m] (Nijssen Eq. 3) */
-    double film;               /* delta_ij = delta_i + delta_j [m] */
-    double viscosity;          /* fluid mu [Pa s] */
-    double surface_tension;    /* fluid sigma [N/m] */
-    double h_min;              /* minimum separation from the min-separation model [m] */
+    double e_star;          /* 1/E* = (1-nu_i^2)/E_i + (1-nu_j^2)/E_j [Pa] */
+    double g_star;          /* 1/G* = (2-nu_i)/G_i + (2-nu_j)/G_j [Pa] */
+    double restitution;     /* e_dry, mean of the two [-] */
+    double friction_dry;    /* mean of the two [-] */
+    double friction_lub;    /* mean of the two [-] */
+    double roughness;       /* h_sigma = (sigma_i + sigma_j)/2 [m] (Nijssen Eq. 3) */
+    double film;            /* delta_ij = delta_i + delta_j [m] */
+    double viscosity;       /* fluid mu [Pa s] */
+    double surface_tension; /* fluid sigma [N/m] */
+    double h_min;           /* minimum separation from the min-separation model [m] */
 };
 
 /* What one model adds for one pair. Forces act on i; j receives the opposite. */
@@ -208,7 +208,7 @@ enum wetdem_model_kind {
 
 /* A named, documented, parameter-checked model (force, minimum separation or impulse). */
 struct wetdem_model {
-    const char* name;                       /* keyword used by the CLI, scenarios and docs */
+    const char* name; /* keyword used by the CLI, scenarios and docs */
     enum wetdem_model_kind kind;
     const char* summary;                    /* one line */
     const char* doc;                        /* a paragraph: physics, validity, units */
@@ -224,12 +224,11 @@ struct wetdem_model {
     int (*pair)(const void* params, const struct wetdem_contact* c, double* history,
                 struct wetdem_pair_force* out);
     /* Minimum separation h_min [m] (min-separation models); may update history. */
-    double (*min_separation)(const void* params, const struct wetdem_contact* c,
-                             double* history);
+    double (*min_separation)(const void* params, const struct wetdem_contact* c, double* history);
     /* Gaps [m] at which the force law changes branch, for event location; returns the count
      * written (<= WETDEM_MAX_THRESHOLDS). Optional. */
-    size_t (*thresholds)(const void* params, const struct wetdem_contact* c,
-                         const double* history, double* gaps);
+    size_t (*thresholds)(const void* params, const struct wetdem_contact* c, const double* history,
+                         double* gaps);
 };
 
 /* NULL-terminated table of every built-in model. */
@@ -241,17 +240,15 @@ WETDEM_API const char* wetdem_model_kind_name(enum wetdem_model_kind kind);
 
 /* Builds the contact of particles a (as i) and b (as j) with their materials and the fluid.
  * h_min and dt are left 0 for the caller to fill. */
-WETDEM_API void wetdem_contact_from_particles(struct wetdem_contact* c,
-                                              const struct wetdem_particle* a,
-                                              const struct wetdem_material* ma,
-                                              const struct wetdem_particle* b,
-                                              const struct wetdem_material* mb,
-                                              const struct wetdem_fluid* fluid);
+WETDEM_API void
+wetdem_contact_from_particles(struct wetdem_contact* c, const struct wetdem_particle* a,
+                              const struct wetdem_material* ma, const struct wetdem_particle* b,
+                              const struct wetdem_material* mb, const struct wetdem_fluid* fluid);
 /* Builds the contact of particle a (as i) with a plane wall through `point` with unit normal
  * `normal` pointing into the domain; mw is the wall's material. */
 WETDEM_API void wetdem_contact_with_wall(struct wetdem_contact* c, const struct wetdem_particle* a,
-                                         const struct wetdem_material* ma,
-                                         struct wetdem_vec3 point, struct wetdem_vec3 normal,
+                                         const struct wetdem_material* ma, struct wetdem_vec3 point,
+                                         struct wetdem_vec3 normal,
                                          const struct wetdem_material* mw,
                                          const struct wetdem_fluid* fluid);
 /* The same contact seen from j: normal, v_t reversed, i and j swapped. */
@@ -417,12 +414,12 @@ enum wetdem_event_kind {
                                            lists in thresholds() (either direction) */
 };
 struct wetdem_event_record {
-    double time;                /* [s] */
+    double time; /* [s] */
     enum wetdem_event_kind kind;
-    size_t i, j;                /* pair (j: wall index when is_wall) */
+    size_t i, j; /* pair (j: wall index when is_wall) */
     bool is_wall;
-    double gap;                 /* gap at the event [m] */
-    double v_n;                 /* normal approach speed at the event [m/s] */
+    double gap; /* gap at the event [m] */
+    double v_n; /* normal approach speed at the event [m/s] */
 };
 /* Name of an event kind, e.g. "contact_start". */
 WETDEM_API const char* wetdem_event_kind_name(enum wetdem_event_kind kind);
@@ -486,12 +483,12 @@ struct wetdem_collision_result {
                                    and rebound angle of the relative velocity, to the normal
                                    [rad] */
     struct wetdem_vec3 omega_i, omega_j; /* final spins [rad/s] */
-    double contact_duration;    /* total time with gap < 0 [s] */
-    double interaction_duration;/* time from first interaction to separation [s] */
-    double min_gap;             /* smallest gap reached [m] */
-    bool solid_contact;         /* gap reached 0 */
-    bool hmin_reached;          /* gap reached h_min */
-    bool separated;             /* left the interaction range by t_end */
+    double contact_duration;             /* total time with gap < 0 [s] */
+    double interaction_duration;         /* time from first interaction to separation [s] */
+    double min_gap;                      /* smallest gap reached [m] */
+    bool solid_contact;                  /* gap reached 0 */
+    bool hmin_reached;                   /* gap reached h_min */
+    bool separated;                      /* left the interaction range by t_end */
     double rotation_angle;      /* angle the line of centres turned during interaction [rad] */
     double rotation_close;      /* the part of rotation_angle turned after the approach was
                                    first arrested (first minimum of the gap) while the gap was
@@ -507,7 +504,8 @@ struct wetdem_collision_result {
 /* Sets up and runs one binary collision on `sim` (its particles are replaced; its materials,
  * fluid, models, integrator and parameters are used). Returns WETDEM_OK or a negative status.
  * The event log of the run stays available through wetdem_sim_events(). */
-WETDEM_API int wetdem_collision_run(struct wetdem_sim* sim, const struct wetdem_collision_spec* spec,
+WETDEM_API int wetdem_collision_run(struct wetdem_sim* sim,
+                                    const struct wetdem_collision_spec* spec,
                                     struct wetdem_collision_result* result);
 /* Removes all particles and walls, the event log, pair histories and statistics, and sets
  * the time to 0; materials, fluid, models and parameters are kept. */
@@ -524,8 +522,8 @@ WETDEM_API struct wetdem_sim* wetdem_sim_clone(const struct wetdem_sim* sim);
 /* Called every progress_every steps of a many-particle run with the steps done and the total
  * of this integrate call and the wall-clock time since its start [s]. A non-zero return stops
  * the run like the stop flag. */
-typedef int (*wetdem_progress_fn)(unsigned long long done, unsigned long long total,
-                                  double elapsed, void* ctx);
+typedef int (*wetdem_progress_fn)(unsigned long long done, unsigned long long total, double elapsed,
+                                  void* ctx);
 
 /* Settings of the many-particle mode. Zero-initialise, then set what you need. */
 struct wetdem_many_settings {
@@ -547,7 +545,7 @@ struct wetdem_many_settings {
                                             return WETDEM_EVENT (e.g. set by a SIGINT handler) */
     wetdem_progress_fn progress;         /* optional progress callback */
     void* progress_ctx;
-    unsigned long long progress_every;   /* steps between progress calls; 0: 1000 */
+    unsigned long long progress_every; /* steps between progress calls; 0: 1000 */
 };
 
 /* Switches sim to the many-particle mode: wetdem_sim_integrate() then runs velocity Verlet
@@ -560,17 +558,17 @@ WETDEM_API int wetdem_sim_set_many(struct wetdem_sim* sim, const struct wetdem_m
 /* Energy budget of a many-particle run since its start [J]. work_* > 0 means energy given to
  * the particles, < 0 taken from them (dissipated, or stored as by the Hertz spring). */
 struct wetdem_energy_budget {
-    double kinetic;   /* translational + rotational kinetic energy now */
-    double potential; /* gravitational potential energy now, -sum m g.x */
-    double elastic;   /* Hertz elastic energy (8/15) E* sqrt(R*) delta^(5/2) stored now */
-    double input;     /* kinetic + potential + elastic at the start */
+    double kinetic;    /* translational + rotational kinetic energy now */
+    double potential;  /* gravitational potential energy now, -sum m g.x */
+    double elastic;    /* Hertz elastic energy (8/15) E* sqrt(R*) delta^(5/2) stored now */
+    double input;      /* kinetic + potential + elastic at the start */
     double dissipated; /* input - (kinetic + potential + elastic): lost to damping, friction,
                           viscous forces, plus what capillary bridges and tangential springs
                           hold */
-    size_t n_models;  /* enabled force models (wetdem_sim_model(sim, k) names them) */
+    size_t n_models;   /* enabled force models (wetdem_sim_model(sim, k) names them) */
     double work_pair[WETDEM_ENERGY_MAX_MODELS]; /* work of model k in particle pairs */
     double work_wall[WETDEM_ENERGY_MAX_MODELS]; /* work of model k in particle-wall pairs */
-    double work_total;    /* sum of all work */
+    double work_total;                          /* sum of all work */
     double balance_error; /* (kinetic + potential) - (their start values) - work_total: zero
                              up to the O(dt^2) integration error */
 };
@@ -580,14 +578,14 @@ WETDEM_API int wetdem_sim_energy_budget(const struct wetdem_sim* sim,
 
 /* Global quantities at the latest force evaluation of a many-particle run. */
 struct wetdem_many_stats {
-    size_t contacts;             /* pairs (and particle-wall pairs) with gap < 0 */
-    size_t bridges;              /* particle pairs with a liquid bridge (gap < film) */
-    size_t agglomerates;         /* clusters of >= 2 particles joined by bridges */
-    double mean_agglomerate;     /* their mean number of particles (0 if none) */
-    size_t candidate_pairs;      /* pairs in the neighbour list */
+    size_t contacts;                /* pairs (and particle-wall pairs) with gap < 0 */
+    size_t bridges;                 /* particle pairs with a liquid bridge (gap < film) */
+    size_t agglomerates;            /* clusters of >= 2 particles joined by bridges */
+    double mean_agglomerate;        /* their mean number of particles (0 if none) */
+    size_t candidate_pairs;         /* pairs in the neighbour list */
     unsigned long long list_builds; /* neighbour-list builds so far */
-    double dt;                   /* step [s] */
-    unsigned long long step;     /* steps since the start of the many run */
+    double dt;                      /* step [s] */
+    unsigned long long step;        /* steps since the start of the many run */
 };
 WETDEM_API int wetdem_sim_many_stats(const struct wetdem_sim* sim, struct wetdem_many_stats* s);
 
@@ -663,18 +661,18 @@ struct wetdem_pairwise_sphere {
 struct wetdem_pairwise_config {
     size_t n_spheres; /* 2..WETDEM_PAIRWISE_MAX_SPHERES */
     struct wetdem_pairwise_sphere spheres[WETDEM_PAIRWISE_MAX_SPHERES];
-    double viscosity;         /* mu [Pa s] >= 0 */
-    double surface_tension;   /* sigma [N/m] >= 0 (capillary suction 8 pi a_ij sigma) */
-    double h_min;             /* minimum separation where solid-like contact occurs [m] > 0 */
-    double restitution;       /* e_dry (0, 1] */
-    double friction;          /* mu_f of the contact impulse [-] >= 0 */
+    double viscosity;            /* mu [Pa s] >= 0 */
+    double surface_tension;      /* sigma [N/m] >= 0 (capillary suction 8 pi a_ij sigma) */
+    double h_min;                /* minimum separation where solid-like contact occurs [m] > 0 */
+    double restitution;          /* e_dry (0, 1] */
+    double friction;             /* mu_f of the contact impulse [-] >= 0 */
     double gravity_x, gravity_y; /* [m/s^2] */
-    double t_end;             /* longest simulated time [s] > 0 */
-    double rtol;              /* relative tolerance of the integrator, (0, 1e-3]; 1e-9 */
-    double rest_speed_ratio;  /* contacts slower than this x v_n0 become resting [-]; 1e-3 */
-    bool stop_when_separated; /* stop once every pair is apart and receding (default true) */
-    size_t ref_i, ref_j;      /* reference pair for v_n0, delta_12, t-hat, t* (default 0, 1) */
-    size_t max_events;        /* event budget (default 100000) */
+    double t_end;                /* longest simulated time [s] > 0 */
+    double rtol;                 /* relative tolerance of the integrator, (0, 1e-3]; 1e-9 */
+    double rest_speed_ratio;     /* contacts slower than this x v_n0 become resting [-]; 1e-3 */
+    bool stop_when_separated;    /* stop once every pair is apart and receding (default true) */
+    size_t ref_i, ref_j;         /* reference pair for v_n0, delta_12, t-hat, t* (default 0, 1) */
+    size_t max_events;           /* event budget (default 100000) */
 };
 
 /* What happened, in the event log of a pairwise run. */
@@ -709,17 +707,17 @@ enum wetdem_pairwise_outcome {
 /* Per-pair summary of a run. */
 struct wetdem_pairwise_pair_result {
     size_t i, j;
-    bool films_met;     /* the films overlapped at some time */
-    bool bound;         /* films still overlapping (or held at h_min) at the end */
-    unsigned n_contacts;/* hard-sphere impulses */
-    double v_n_in;      /* normal approach speed when the films first overlapped [m/s] */
-    double v_n_out;     /* normal separation speed at the last film separation [m/s] */
-    double e_wet;       /* Eq. 40: v_n_out / v_n0 (0 if bound, NAN if films never met) [-] */
-    double e_wet_own;   /* v_n_out / v_n_in (NAN if v_n_in <= 0 or films never met) [-] */
-    double t_start;     /* first film overlap [s] (NAN if none) */
-    double t_end;       /* last film separation [s] (NAN if none) */
-    double min_gap;     /* smallest gap seen at step ends and events [m] */
-    int mechanism;      /* enum wetdem_outcome: stick, stick-rotate-separate (reversed by the
+    bool films_met;      /* the films overlapped at some time */
+    bool bound;          /* films still overlapping (or held at h_min) at the end */
+    unsigned n_contacts; /* hard-sphere impulses */
+    double v_n_in;       /* normal approach speed when the films first overlapped [m/s] */
+    double v_n_out;      /* normal separation speed at the last film separation [m/s] */
+    double e_wet;        /* Eq. 40: v_n_out / v_n0 (0 if bound, NAN if films never met) [-] */
+    double e_wet_own;    /* v_n_out / v_n_in (NAN if v_n_in <= 0 or films never met) [-] */
+    double t_start;      /* first film overlap [s] (NAN if none) */
+    double t_end;        /* last film separation [s] (NAN if none) */
+    double min_gap;      /* smallest gap seen at step ends and events [m] */
+    int mechanism;       /* enum wetdem_outcome: stick, stick-rotate-separate (reversed by the
                            film and centrifugal forces) or bounce (reversed by an impulse);
                            -1 if the films never met */
 };
@@ -730,13 +728,13 @@ struct wetdem_pairwise_result {
     struct wetdem_pairwise_pair_result pairs[WETDEM_PAIRWISE_MAX_PAIRS]; /* order of
                                           wetdem_pairwise_pair_index() */
     enum wetdem_pairwise_outcome outcome;
-    int separated_sphere;  /* PA with one sphere alone: its index; else -1 */
+    int separated_sphere; /* PA with one sphere alone: its index; else -1 */
     struct wetdem_pairwise_sphere final[WETDEM_PAIRWISE_MAX_SPHERES]; /* state at the end */
-    double time;           /* time reached [s] */
-    double v_n0;           /* normal approach speed of the reference pair at t = 0 [m/s] */
-    double delta_ref;      /* delta_12 of the reference pair [m] */
-    double v_10;           /* speed of sphere ref_i at t = 0 [m/s] */
-    double a_ref;          /* reduced radius a of the reference pair [m] */
+    double time;                                                      /* time reached [s] */
+    double v_n0;      /* normal approach speed of the reference pair at t = 0 [m/s] */
+    double delta_ref; /* delta_12 of the reference pair [m] */
+    double v_10;      /* speed of sphere ref_i at t = 0 [m/s] */
+    double a_ref;     /* reduced radius a of the reference pair [m] */
     size_t n_events;
     unsigned long long steps, rhs_evals, guard_evals;
 };
@@ -746,8 +744,8 @@ struct wetdem_pairwise_frame {
     double time, t_hat, t_star; /* [s], [-], [-] */
     size_t n_spheres, n_pairs;
     struct wetdem_pairwise_sphere spheres[WETDEM_PAIRWISE_MAX_SPHERES];
-    double gap[WETDEM_PAIRWISE_MAX_PAIRS];  /* h of every pair [m] */
-    double v_n[WETDEM_PAIRWISE_MAX_PAIRS];  /* normal approach speed of every pair [m/s] */
+    double gap[WETDEM_PAIRWISE_MAX_PAIRS]; /* h of every pair [m] */
+    double v_n[WETDEM_PAIRWISE_MAX_PAIRS]; /* normal approach speed of every pair [m/s] */
 };
 /* Observer: called at t = 0, every `interval` seconds and at the end; non-zero stops the run
  * with WETDEM_ERR_CALLBACK. */
@@ -798,8 +796,8 @@ WETDEM_API int wetdem_pairwise_run(struct wetdem_pairwise* pw,
                                    const struct wetdem_pairwise_config* cfg,
                                    struct wetdem_pairwise_result* res);
 /* Borrowed view of the last run's event log; *n receives the count. */
-WETDEM_API const struct wetdem_pairwise_event* wetdem_pairwise_events(const struct wetdem_pairwise* pw,
-                                                                      size_t* n);
+WETDEM_API const struct wetdem_pairwise_event*
+wetdem_pairwise_events(const struct wetdem_pairwise* pw, size_t* n);
 /* Index of pair (i, j), i != j < n, in the per-pair arrays: (0,1), (0,2), ..., (1,2), ... */
 WETDEM_API size_t wetdem_pairwise_pair_index(size_t n, size_t i, size_t j);
 /* "film_start", "contact", "rest_start", "rest_end", "film_end", "partner_change". */
@@ -821,7 +819,6 @@ WETDEM_API int wetdem_pairwise_davis_config(const struct wetdem_pairwise_davis* 
                                             struct wetdem_pairwise_config* cfg, char* msg,
                                             size_t msg_size);
 
-
 /* ======================================================================================== */
 /* Experiment tracking and fitting (Punch 2023 Sec. 3.2)                                    */
 /* ======================================================================================== */
@@ -835,56 +832,56 @@ struct wetdem_track;
 
 /* Settings of wetdem_track_analyse(); wetdem_track_options_init() gives the defaults. */
 struct wetdem_track_options {
-    double fps;          /* frame rate [1/s] > 0 (Punch: 5000) */
-    double pixel_size;   /* image resolution [m/pixel] > 0 (Punch: 175e-6) */
-    bool y_down;         /* the y pixel axis points down (image rows): y is negated on input so
+    double fps;        /* frame rate [1/s] > 0 (Punch: 5000) */
+    double pixel_size; /* image resolution [m/pixel] > 0 (Punch: 175e-6) */
+    bool y_down;       /* the y pixel axis points down (image rows): y is negated on input so
                             that (x, y) is right-handed and omega > 0 is counter-clockwise on
                             screen (default false) */
-    int window;          /* Savitzky-Golay window [frames], odd, > order (7); 1: no smoothing */
-    int order;           /* Savitzky-Golay polynomial order, >= 0, < window (2) */
-    double threshold;    /* collision: striker velocity change [m/s] > 0 (0.05) */
-    int offset;          /* frames before/after the collision frame where the velocities are
+    int window;        /* Savitzky-Golay window [frames], odd, > order (7); 1: no smoothing */
+    int order;         /* Savitzky-Golay polynomial order, >= 0, < window (2) */
+    double threshold;  /* collision: striker velocity change [m/s] > 0 (0.05) */
+    int offset;        /* frames before/after the collision frame where the velocities are
                             taken (5), >= 1 */
-    int fit_frames;      /* frame intervals in each straight-line fit, >= 3; 0: all (0) */
-    int striker;         /* sphere id of the striker; -1: the faster sphere at the start (-1) */
-    double radius;       /* sphere radius [m] for St_n; 0: not given (no St_n) */
-    double mass;         /* sphere mass [kg] for St_n; 0: not given */
-    double viscosity;    /* film viscosity [Pa s] for St_n; 0: not given */
+    int fit_frames;    /* frame intervals in each straight-line fit, >= 3; 0: all (0) */
+    int striker;       /* sphere id of the striker; -1: the faster sphere at the start (-1) */
+    double radius;     /* sphere radius [m] for St_n; 0: not given (no St_n) */
+    double mass;       /* sphere mass [kg] for St_n; 0: not given */
+    double viscosity;  /* film viscosity [Pa s] for St_n; 0: not given */
 };
 
 /* Velocity of one sphere over the frame interval frame -> frame + 1 (Punch Eq. 23). */
 struct wetdem_track_sample {
-    long frame;                        /* first frame of the interval */
-    double time;                       /* interval midpoint (frame + 1/2)/fps [s] */
-    double vx_raw, vy_raw, omega_raw;  /* from the unsmoothed dots [m/s], [rad/s] */
-    double vx, vy, omega;              /* from the Savitzky-Golay smoothed dots */
-    double residual;                   /* rms residual of Eq. 23 on the smoothed dots [m] */
+    long frame;                       /* first frame of the interval */
+    double time;                      /* interval midpoint (frame + 1/2)/fps [s] */
+    double vx_raw, vy_raw, omega_raw; /* from the unsmoothed dots [m/s], [rad/s] */
+    double vx, vy, omega;             /* from the Savitzky-Golay smoothed dots */
+    double residual;                  /* rms residual of Eq. 23 on the smoothed dots [m] */
 };
 
 /* Velocities and dot-1 position of one sphere at one frame (straight-line fit values). */
 struct wetdem_track_state {
-    double vx, vy;  /* [m/s] */
-    double omega;   /* spin about the camera axis, counter-clockwise in (x, y) [rad/s] */
-    double x, y;    /* smoothed position of dot 1 (the centre) [m] */
+    double vx, vy; /* [m/s] */
+    double omega;  /* spin about the camera axis, counter-clockwise in (x, y) [rad/s] */
+    double x, y;   /* smoothed position of dot 1 (the centre) [m] */
 };
 
 /* The collision found in a two-sphere track. */
 struct wetdem_track_summary {
-    size_t n_spheres;                /* 1 or 2; the fields below need 2 */
+    size_t n_spheres; /* 1 or 2; the fields below need 2 */
     bool has_collision;
-    int striker_id, target_id;       /* sphere ids as in the input */
-    long collision_frame;            /* last frame before the striker's velocity changes */
-    double collision_time;           /* collision_frame / fps [s] */
+    int striker_id, target_id; /* sphere ids as in the input */
+    long collision_frame;      /* last frame before the striker's velocity changes */
+    double collision_time;     /* collision_frame / fps [s] */
     struct wetdem_track_state striker_before, striker_after; /* at collision_frame -/+ offset */
     struct wetdem_track_state target_before, target_after;
-    double angle_centres;            /* Eq. 16: atan of dy/dx of the centres at the collision
+    double angle_centres;      /* Eq. 16: atan of dy/dx of the centres at the collision
                                         frame [rad], in (-pi/2, pi/2] */
-    double impact_angle;             /* angle between the relative velocity before and the
+    double impact_angle;       /* angle between the relative velocity before and the
                                         line of centres at the collision frame [rad] */
-    double speed_n0, speed_nf;       /* normal relative speed before (approach > 0) and after
+    double speed_n0, speed_nf; /* normal relative speed before (approach > 0) and after
                                         (separation > 0) [m/s] */
-    double e_n;                      /* Eq. 3: speed_nf / speed_n0 [-] */
-    double stokes_n;                 /* Eq. 2 with m* = m/2, R* = R/2; NAN without options */
+    double e_n;                /* Eq. 3: speed_nf / speed_n0 [-] */
+    double stokes_n;           /* Eq. 2 with m* = m/2, R* = R/2; NAN without options */
 };
 
 /* Allocates an empty track. NULL only if out of memory. */
@@ -931,23 +928,23 @@ typedef int (*wetdem_fit_model_fn)(const double* params, double* predicted, char
 
 /* A least-squares problem: minimise sum_i ((predicted_i - observed_i)/scale_i)^2. */
 struct wetdem_fit_problem {
-    size_t n_params;           /* 1..WETDEM_FIT_MAX_PARAMS */
-    const char* const* names;  /* parameter names for messages (may be NULL) */
-    const double* initial;     /* initial values [n_params] */
-    const bool* is_log;        /* fit ln(p) (p stays > 0) per parameter; NULL: when initial > 0 */
-    size_t n_data;             /* > n_params (the residual variance needs a degree of freedom) */
-    const double* observed;    /* [n_data] */
-    const double* scale;       /* [n_data] divisor of each residual (> 0), NULL: all 1 */
+    size_t n_params;          /* 1..WETDEM_FIT_MAX_PARAMS */
+    const char* const* names; /* parameter names for messages (may be NULL) */
+    const double* initial;    /* initial values [n_params] */
+    const bool* is_log;       /* fit ln(p) (p stays > 0) per parameter; NULL: when initial > 0 */
+    size_t n_data;            /* > n_params (the residual variance needs a degree of freedom) */
+    const double* observed;   /* [n_data] */
+    const double* scale;      /* [n_data] divisor of each residual (> 0), NULL: all 1 */
     wetdem_fit_model_fn model;
     void* ctx;
 };
 
 struct wetdem_fit_options {
-    int max_iter;    /* trust-region iterations (50) */
-    double xtol;     /* step tolerance, relative in the fitted variables (1e-6) */
-    double gtol;     /* gradient tolerance (1e-8) */
-    double ftol;     /* cost-reduction tolerance (1e-10) */
-    double fd_step;  /* central-difference step of the Jacobian in the fitted variable:
+    int max_iter;   /* trust-region iterations (50) */
+    double xtol;    /* step tolerance, relative in the fitted variables (1e-6) */
+    double gtol;    /* gradient tolerance (1e-8) */
+    double ftol;    /* cost-reduction tolerance (1e-10) */
+    double fd_step; /* central-difference step of the Jacobian in the fitted variable:
                         relative change for log parameters, absolute x max(|p|, 1) otherwise
                         (1e-2: larger than the integration noise of simulated predictions) */
 };
@@ -958,12 +955,12 @@ struct wetdem_fit_result {
                                                  the fitted variable, s^2 = cost/dof, mapped to
                                                  p by dp = p d(ln p) for log parameters */
     double correlation[WETDEM_FIT_MAX_PARAMS][WETDEM_FIT_MAX_PARAMS]; /* of the estimates */
-    double cost;          /* sum of squared scaled residuals at the solution */
-    double residual_std;  /* s = sqrt(cost/dof), in units of the scale */
-    size_t dof;           /* n_data - n_params */
+    double cost;         /* sum of squared scaled residuals at the solution */
+    double residual_std; /* s = sqrt(cost/dof), in units of the scale */
+    size_t dof;          /* n_data - n_params */
     size_t iterations;
-    size_t model_evals;   /* calls of the model function */
-    int converged_by;     /* 1 small step (xtol), 2 small gradient (gtol), 3 small cost change */
+    size_t model_evals; /* calls of the model function */
+    int converged_by;   /* 1 small step (xtol), 2 small gradient (gtol), 3 small cost change */
 };
 
 /* Fills *opt with the defaults above. */

@@ -24,28 +24,64 @@ struct named_material {
 };
 
 static const struct named_material material_presets[] = {
-    {"steel1", {.density = 7780, .youngs_modulus = 190e9, .poisson_ratio = 0.27,
-                .restitution = 0.97, .friction_dry = 0.11, .friction_lub = 0.02,
-                .roughness = 24e-9, .film = 0}},
-    {"steel2", {.density = 7780, .youngs_modulus = 190e9, .poisson_ratio = 0.27,
-                .restitution = 0.97, .friction_dry = 0.11, .friction_lub = 0.02,
-                .roughness = 272e-9, .film = 0}},
-    {"glass", {.density = 2540, .youngs_modulus = 60e9, .poisson_ratio = 0.23,
-               .restitution = 0.97, .friction_dry = 0.40, .friction_lub = 0.10,
-               .roughness = 134e-9, .film = 0}},
-    {"delrin", {.density = 1400, .youngs_modulus = 2.8e9, .poisson_ratio = 0.35,
-                .restitution = 0.97, .friction_dry = 0.20, .friction_lub = 0.10,
-                .roughness = 796e-9, .film = 0}},
-    {"punch_steel", {.density = 7960, .youngs_modulus = 2.0e11, .poisson_ratio = 0.35,
-                     .restitution = 0.9, .friction_dry = 0.05, .friction_lub = 0.05,
-                     .roughness = 0, .film = 0}},
-    {"punch_steel_coated", {.density = 7960, .youngs_modulus = 2.0e11, .poisson_ratio = 0.35,
-                            .restitution = 0.9, .friction_dry = 0.05, .friction_lub = 0.05,
-                            .roughness = 0, .film = 270e-6}},
+    {"steel1",
+     {.density = 7780,
+      .youngs_modulus = 190e9,
+      .poisson_ratio = 0.27,
+      .restitution = 0.97,
+      .friction_dry = 0.11,
+      .friction_lub = 0.02,
+      .roughness = 24e-9,
+      .film = 0}},
+    {"steel2",
+     {.density = 7780,
+      .youngs_modulus = 190e9,
+      .poisson_ratio = 0.27,
+      .restitution = 0.97,
+      .friction_dry = 0.11,
+      .friction_lub = 0.02,
+      .roughness = 272e-9,
+      .film = 0}},
+    {"glass",
+     {.density = 2540,
+      .youngs_modulus = 60e9,
+      .poisson_ratio = 0.23,
+      .restitution = 0.97,
+      .friction_dry = 0.40,
+      .friction_lub = 0.10,
+      .roughness = 134e-9,
+      .film = 0}},
+    {"delrin",
+     {.density = 1400,
+      .youngs_modulus = 2.8e9,
+      .poisson_ratio = 0.35,
+      .restitution = 0.97,
+      .friction_dry = 0.20,
+      .friction_lub = 0.10,
+      .roughness = 796e-9,
+      .film = 0}},
+    {"punch_steel",
+     {.density = 7960,
+      .youngs_modulus = 2.0e11,
+      .poisson_ratio = 0.35,
+      .restitution = 0.9,
+      .friction_dry = 0.05,
+      .friction_lub = 0.05,
+      .roughness = 0,
+      .film = 0}},
+    {"punch_steel_coated",
+     {.density = 7960,
+      .youngs_modulus = 2.0e11,
+      .poisson_ratio = 0.35,
+      .restitution = 0.9,
+      .friction_dry = 0.05,
+      .friction_lub = 0.05,
+      .roughness = 0,
+      .film = 270e-6}},
 };
 
-static const char* const material_names[] = {"steel1", "steel2", "glass", "delrin",
-                                             "punch_steel", "punch_steel_coated", NULL};
+static const char* const material_names[] = {
+    "steel1", "steel2", "glass", "delrin", "punch_steel", "punch_steel_coated", NULL};
 
 struct named_fluid {
     const char* name;
@@ -94,8 +130,8 @@ static const struct wetdem_param_desc material_params[] = {
      true, false, NULL},
     {"friction_dry", "-", "Coulomb friction coefficient of dry contact.", MAT(friction_dry), 0.11,
      0, 10, false, false, NULL},
-    {"friction_lub", "-", "Coulomb friction coefficient of lubricated contact.",
-     MAT(friction_lub), 0.02, 0, 10, false, false, NULL},
+    {"friction_lub", "-", "Coulomb friction coefficient of lubricated contact.", MAT(friction_lub),
+     0.02, 0, 10, false, false, NULL},
     {"roughness", "m", "Mean asperity height sigma (Nijssen Eq. 3).", MAT(roughness), 0, 0, 1e-2,
      false, false, NULL},
     {"film", "m", "Liquid film thickness on this sphere (delta_i).", MAT(film), 0, 0, 1, false,
@@ -126,8 +162,8 @@ const struct wetdem_param_desc* wetdem_fluid_params(void)
 }
 
 /* Validates every double field of `obj` described by `table`. */
-static int validate_struct(const struct wetdem_param_desc* table, const void* obj,
-                           const char* what, char* msg, size_t n)
+static int validate_struct(const struct wetdem_param_desc* table, const void* obj, const char* what,
+                           char* msg, size_t n)
 {
     for (size_t k = 0; table[k].name; k++) {
         double v = *(const double*)((const char*)obj + table[k].offset);

@@ -10,12 +10,23 @@
 #include "wetdem.h"
 
 static const struct wetdem_model* const registry[] = {
-    &wetdem_force_hertz,       &wetdem_force_mindlin,     &wetdem_force_hooke,
-    &wetdem_hard_model,        &wetdem_force_nijssen,     &wetdem_force_reynolds,
-    &wetdem_force_sb,          &wetdem_force_db,          &wetdem_force_davis,
-    &wetdem_force_nase,        &wetdem_force_capillary,   &wetdem_minsep_fixed,
-    &wetdem_minsep_roughness,  &wetdem_minsep_ehd,        &wetdem_minsep_max,
-    &wetdem_minsep_glass,      NULL,
+    &wetdem_force_hertz,
+    &wetdem_force_mindlin,
+    &wetdem_force_hooke,
+    &wetdem_hard_model,
+    &wetdem_force_nijssen,
+    &wetdem_force_reynolds,
+    &wetdem_force_sb,
+    &wetdem_force_db,
+    &wetdem_force_davis,
+    &wetdem_force_nase,
+    &wetdem_force_capillary,
+    &wetdem_minsep_fixed,
+    &wetdem_minsep_roughness,
+    &wetdem_minsep_ehd,
+    &wetdem_minsep_max,
+    &wetdem_minsep_glass,
+    NULL,
 };
 
 const struct wetdem_model* const* wetdem_model_registry(void)

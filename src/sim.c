@@ -34,7 +34,8 @@ struct wetdem_sim* wetdem_sim_create(void)
         return NULL;
     wetdem_fluid_preset("water", &sim->fluid);
     sim->minsep.model = &wetdem_minsep_fixed;
-    sim->minsep.params = calloc(1, wetdem_minsep_fixed.params_size ? wetdem_minsep_fixed.params_size : 1);
+    sim->minsep.params =
+        calloc(1, wetdem_minsep_fixed.params_size ? wetdem_minsep_fixed.params_size : 1);
     if (!sim->minsep.params) {
         free(sim);
         return NULL;
@@ -140,8 +141,8 @@ int wetdem_sim_add_particle(struct wetdem_sim* sim, struct wetdem_particle p)
                                "particle %zu: material %d does not exist (valid 0..%d)", k,
                                p.material, sim->n_materials - 1);
     if (p.mass == 0)
-        p.mass = sim->materials[p.material].density * 4.0 / 3.0 * M_PI * p.radius * p.radius *
-                 p.radius;
+        p.mass =
+            sim->materials[p.material].density * 4.0 / 3.0 * M_PI * p.radius * p.radius * p.radius;
     if (!(isfinite(p.mass) && p.mass > 0))
         return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
                                "particle %zu: mass must be > 0 and finite, got %g kg", k, p.mass);
@@ -164,8 +165,8 @@ size_t wetdem_sim_n_particles(const struct wetdem_sim* sim)
     return sim->n_particles;
 }
 
-int wetdem_sim_add_wall(struct wetdem_sim* sim, struct wetdem_vec3 point,
-                        struct wetdem_vec3 normal, int material)
+int wetdem_sim_add_wall(struct wetdem_sim* sim, struct wetdem_vec3 point, struct wetdem_vec3 normal,
+                        int material)
 {
     double len = vec3_norm(normal);
     if (!vec3_is_finite(point) || !(isfinite(len) && len > 0))
@@ -178,9 +179,8 @@ int wetdem_sim_add_wall(struct wetdem_sim* sim, struct wetdem_vec3 point,
     if (grow((void**)&sim->walls, &sim->walls_cap, sim->n_walls + 1, sizeof *sim->walls) !=
         WETDEM_OK)
         return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory adding a wall");
-    sim->walls[sim->n_walls++] =
-        (struct wetdem_wall){.point = point, .normal = vec3_scale(normal, 1.0 / len),
-                             .material = material};
+    sim->walls[sim->n_walls++] = (struct wetdem_wall){
+        .point = point, .normal = vec3_scale(normal, 1.0 / len), .material = material};
     return WETDEM_OK;
 }
 

@@ -12,8 +12,8 @@
 
 #define WETDEM_MAX_MODELS 16
 #define WETDEM_ERRMSG_SIZE 1024
-#define WETDEM_MAX_INTEGRATORS 4         /* registered integrators (integrator.c) */
-#define WETDEM_INTEGRATOR_PARAMS_MAX 16  /* doubles of one integrator's parameter block */
+#define WETDEM_MAX_INTEGRATORS 4        /* registered integrators (integrator.c) */
+#define WETDEM_INTEGRATOR_PARAMS_MAX 16 /* doubles of one integrator's parameter block */
 
 /* A model enabled on this simulation with its own parameter block. */
 struct wetdem_model_slot {
@@ -91,8 +91,8 @@ struct wetdem_sim {
 
     struct wetdem_model_slot models[WETDEM_MAX_MODELS]; /* force models, summed */
     size_t n_models;
-    struct wetdem_model_slot minsep;                    /* gives h_min; history at offset 0 */
-    size_t history_len;                                 /* doubles per pair, all slices */
+    struct wetdem_model_slot minsep; /* gives h_min; history at offset 0 */
+    size_t history_len;              /* doubles per pair, all slices */
 
     struct wetdem_engine engine; /* soft engine: time, pairs, events, integrator */
     struct wetdem_many* many;    /* many-particle mode (many.h, sim_many.c), NULL if off */
@@ -106,9 +106,8 @@ int wetdem_sim_fail(struct wetdem_sim* sim, int status, const char* fmt, ...)
  * *out (zeroed first). history: sim->history_len doubles (committed state in, advanced state
  * out), or NULL for a fresh pair with nothing kept. per_model (optional, n_models entries)
  * receives each model's own contribution. */
-int wetdem_sim_eval_contact(const struct wetdem_sim* sim, struct wetdem_contact* c,
-                            double* history, struct wetdem_pair_force* out,
-                            struct wetdem_pair_force* per_model);
+int wetdem_sim_eval_contact(const struct wetdem_sim* sim, struct wetdem_contact* c, double* history,
+                            struct wetdem_pair_force* out, struct wetdem_pair_force* per_model);
 
 /* Largest gap at which any enabled force model acts for this contact [m]. */
 double wetdem_sim_contact_range(const struct wetdem_sim* sim, const struct wetdem_contact* c);

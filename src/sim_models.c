@@ -21,12 +21,12 @@ static const char* const yes_no[] = {"no", "yes", NULL};
 
 #define SET(field) offsetof(struct wetdem_sim_settings, field)
 static const struct wetdem_param_desc settings_params[] = {
-    {"gravity_x", "m/s^2", "Gravitational acceleration, x component.", SET(gravity_x), 0, -1e4,
-     1e4, false, false, NULL},
-    {"gravity_y", "m/s^2", "Gravitational acceleration, y component.", SET(gravity_y), 0, -1e4,
-     1e4, false, false, NULL},
-    {"gravity_z", "m/s^2", "Gravitational acceleration, z component.", SET(gravity_z), 0, -1e4,
-     1e4, false, false, NULL},
+    {"gravity_x", "m/s^2", "Gravitational acceleration, x component.", SET(gravity_x), 0, -1e4, 1e4,
+     false, false, NULL},
+    {"gravity_y", "m/s^2", "Gravitational acceleration, y component.", SET(gravity_y), 0, -1e4, 1e4,
+     false, false, NULL},
+    {"gravity_z", "m/s^2", "Gravitational acceleration, z component.", SET(gravity_z), 0, -1e4, 1e4,
+     false, false, NULL},
     {"stop_on_separation", "-",
      "Stop integrating (status WETDEM_EVENT) once every pair that interacted has left its "
      "interaction range and recedes.",
@@ -124,8 +124,7 @@ int wetdem_sim_enable_model(struct wetdem_sim* sim, const char* name)
         const char* hint = wetdem_param_suggest(name, names);
         return wetdem_sim_fail(sim, WETDEM_ERR_NOT_FOUND,
                                "unknown model '%s'%s%s%s (see 'wetdem models')", name,
-                               hint ? " (did you mean '" : "", hint ? hint : "",
-                               hint ? "'?)" : "");
+                               hint ? " (did you mean '" : "", hint ? hint : "", hint ? "'?)" : "");
     }
     return wetdem_sim_add_model(sim, m, NULL);
 }
@@ -184,8 +183,8 @@ static size_t all_param_names(const struct wetdem_sim* sim, char (*buf)[96], con
         for (size_t k = 0; integ[m]->params[k].name && n + 1 < cap; k++, n++)
             snprintf(buf[n], 96, "%s.%s", integ[m]->name, integ[m]->params[k].name);
     for (size_t m = 0; m <= sim->n_models; m++) {
-        const struct wetdem_model* model = m < sim->n_models ? sim->models[m].model
-                                                             : sim->minsep.model;
+        const struct wetdem_model* model =
+            m < sim->n_models ? sim->models[m].model : sim->minsep.model;
         for (size_t k = 0; model->params[k].name && n + 1 < cap; k++, n++)
             snprintf(buf[n], 96, "%s.%s", model->name, model->params[k].name);
     }
@@ -199,7 +198,7 @@ static int not_found(const struct wetdem_sim* sim_c, const char* name)
 {
     struct wetdem_sim* sim = (struct wetdem_sim*)sim_c;
     static const size_t cap = 256;
-    char (*buf)[96] = malloc(cap * sizeof *buf);
+    char(*buf)[96] = malloc(cap * sizeof *buf);
     const char** names = malloc(cap * sizeof *names);
     const char* hint = NULL;
     char hint_copy[96] = "";
@@ -327,9 +326,8 @@ double wetdem_sim_contact_range(const struct wetdem_sim* sim, const struct wetde
     return r;
 }
 
-int wetdem_sim_eval_contact(const struct wetdem_sim* sim, struct wetdem_contact* c,
-                            double* history, struct wetdem_pair_force* out,
-                            struct wetdem_pair_force* per_model)
+int wetdem_sim_eval_contact(const struct wetdem_sim* sim, struct wetdem_contact* c, double* history,
+                            struct wetdem_pair_force* out, struct wetdem_pair_force* per_model)
 {
     double scratch[64];
     if (!history) {

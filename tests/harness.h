@@ -18,39 +18,39 @@
 #include "wetdem.h"
 
 /* |a - b| <= tol * max(|a|, |b|), or both exactly zero. */
-#define CHECK_REL(a, b, tol)                                                                     \
-    do {                                                                                         \
-        double a_ = (a), b_ = (b), t_ = (tol);                                                   \
-        double s_ = fmax(fabs(a_), fabs(b_));                                                    \
-        if (!(fabs(a_ - b_) <= t_ * s_) && !(a_ == b_))                                          \
-            fail_msg("%s = %.17g vs %s = %.17g: relative difference %.3g > %.3g", #a, a_, #b,    \
-                     b_, s_ > 0 ? fabs(a_ - b_) / s_ : 0.0, t_);                                 \
+#define CHECK_REL(a, b, tol)                                                                       \
+    do {                                                                                           \
+        double a_ = (a), b_ = (b), t_ = (tol);                                                     \
+        double s_ = fmax(fabs(a_), fabs(b_));                                                      \
+        if (!(fabs(a_ - b_) <= t_ * s_) && !(a_ == b_))                                            \
+            fail_msg("%s = %.17g vs %s = %.17g: relative difference %.3g > %.3g", #a, a_, #b, b_,  \
+                     s_ > 0 ? fabs(a_ - b_) / s_ : 0.0, t_);                                       \
     } while (0)
 
-#define CHECK_ABS(a, b, tol)                                                                     \
-    do {                                                                                         \
-        double a_ = (a), b_ = (b), t_ = (tol);                                                   \
-        if (!(fabs(a_ - b_) <= t_))                                                              \
-            fail_msg("%s = %.17g vs %s = %.17g: difference %.3g > %.3g", #a, a_, #b, b_,         \
-                     fabs(a_ - b_), t_);                                                         \
+#define CHECK_ABS(a, b, tol)                                                                       \
+    do {                                                                                           \
+        double a_ = (a), b_ = (b), t_ = (tol);                                                     \
+        if (!(fabs(a_ - b_) <= t_))                                                                \
+            fail_msg("%s = %.17g vs %s = %.17g: difference %.3g > %.3g", #a, a_, #b, b_,           \
+                     fabs(a_ - b_), t_);                                                           \
     } while (0)
 
-#define CHECK_STATUS(expr, want)                                                                 \
-    do {                                                                                         \
-        int st_ = (expr);                                                                        \
-        if (st_ != (want))                                                                       \
-            fail_msg("%s returned %s, expected %s", #expr, wetdem_status_name(st_),              \
-                     wetdem_status_name(want));                                                  \
+#define CHECK_STATUS(expr, want)                                                                   \
+    do {                                                                                           \
+        int st_ = (expr);                                                                          \
+        if (st_ != (want))                                                                         \
+            fail_msg("%s returned %s, expected %s", #expr, wetdem_status_name(st_),                \
+                     wetdem_status_name(want));                                                    \
     } while (0)
 
 #define CHECK_OK(expr) CHECK_STATUS(expr, WETDEM_OK)
 
 /* Asserts that haystack contains needle. */
-#define CHECK_CONTAINS(haystack, needle)                                                         \
-    do {                                                                                         \
-        const char* h_ = (haystack);                                                             \
-        if (!h_ || !strstr(h_, (needle)))                                                        \
-            fail_msg("'%s' does not contain '%s'", h_ ? h_ : "(null)", (needle));                \
+#define CHECK_CONTAINS(haystack, needle)                                                           \
+    do {                                                                                           \
+        const char* h_ = (haystack);                                                               \
+        if (!h_ || !strstr(h_, (needle)))                                                          \
+            fail_msg("'%s' does not contain '%s'", h_ ? h_ : "(null)", (needle));                  \
     } while (0)
 
 /* Two spheres on the x axis: i at +x, j at the origin, so the normal (j to i) is +x.
