@@ -1,6 +1,7 @@
 /*
  * cli_util.c — helpers shared by the CLI subcommands (see cli_util.h): messages, strict
- * parsing of numbers and "A:B:N" ranges, "--set KEY=VALUE", CSV provenance lines.
+ * parsing of numbers and "A:B:N" ranges, "--set KEY=VALUE", CSV provenance lines, tables
+ * written whole (temporary file, then rename) or not at all.
  *
  * Range values: linear x_k = A + (B - A) k/(N - 1); geometric x_k = A (B/A)^(k/(N - 1)),
  * computed as 10^(log10 A + (log10 B - log10 A) k/(N - 1)) so that decades come out as the
@@ -11,6 +12,7 @@
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "cli_util.h"
 
@@ -124,6 +126,31 @@ void cli_print_provenance(FILE* f, int argc, char** argv)
     for (int k = 0; k < argc; k++)
         fprintf(f, " %s", argv[k]);
     fputc('\n', f);
+}
+
+int cli_write_output(const char* path, const char* what, void (*write)(FILE* f, const void* ctx),
+                     const void* ctx)
+{
+    if (!path) {
+        write(stdout, ctx);
+        return fflush(stdout) == 0 ? CLI_EXIT_OK : CLI_EXIT_RUNTIME;
+    }
+    char tmp[1100];
+    snprintf(tmp, sizeof tmp, "%s.tmp%ld", path, (long)getpid());
+    FILE* f = fopen(tmp, "w");
+    if (!f) {
+        cli_error("%s: cannot write %s", what, tmp);
+        return CLI_EXIT_RUNTIME;
+    }
+    write(f, ctx);
+    bool bad = ferror(f) != 0;
+    bad = fclose(f) != 0 || bad;
+    if (bad || rename(tmp, path) != 0) {
+        remove(tmp);
+        cli_error("%s: cannot write %s", what, path);
+        return CLI_EXIT_RUNTIME;
+    }
+    return CLI_EXIT_OK;
 }
 
 void cli_print_double(FILE* f, double v)

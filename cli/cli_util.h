@@ -1,7 +1,7 @@
 /*
  * cli_util.h — small helpers shared by the CLI subcommands: error messages, strict number
  * parsing, "A:B:N" value ranges, "--set KEY=VALUE" parameters, the provenance header of CSV
- * output and the text of a parameter's default. Uses only the public header wetdem.h.
+ * output, writing a table whole or not at all, and the text of a parameter's default. Uses only the public header wetdem.h.
  *
  * Conventions: every function that can reject user input prints one line
  * "wetdem: <what>: <why>" to stderr and returns an exit code (CLI_EXIT_USAGE, i.e. 2, for bad
@@ -54,6 +54,13 @@ bool cli_wants_help(int argc, char** argv);
  *     # command: wetdem <argv[0]> <argv[1]> ...
  * argv is the subcommand's argument vector (argv[0] = subcommand name). */
 void cli_print_provenance(FILE* f, int argc, char** argv);
+
+/* Writes a table with write(f, ctx): to stdout when path is NULL, otherwise to path under a
+ * temporary name renamed only when everything was written, so a failed write leaves no
+ * half-written file. `what` names the command in the message. Returns CLI_EXIT_OK, or prints
+ * "wetdem: <what>: cannot write <file>" and returns CLI_EXIT_RUNTIME. */
+int cli_write_output(const char* path, const char* what, void (*write)(FILE* f, const void* ctx),
+                     const void* ctx);
 
 /* Writes v to f with the fewest significant digits (15, 16 or 17) that read back as exactly
  * v, so CSV output is both exact and readable ("1e-05", not "1.0000000000000001e-05"). */

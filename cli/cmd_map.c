@@ -5,8 +5,8 @@
  * one CSV row per grid point, KEY varying slowest.
  *
  * Each point is the scenario with `--set KEY=a_i --set KEY2=b_j` (values printed with %.17g,
- * as `wetdem sweep` does), so coupled keys stay right. Every point is built and checked
- * serially first (all input errors are reported before anything runs); the runs are then
+ * as `wetdem sweep` does), so coupled keys stay right. The batch machinery is the one of
+ * `wetdem sweep` (cli/batch.c): every point is built and checked serially first (all input errors are reported before anything runs); the runs are then
  * distributed over OpenMP threads with dynamic scheduling and share nothing; rows are written
  * in grid order after all finished, so the data rows are bit-identical for any thread count.
  * The trailer '#' line (runs, wall time, threads, collisions per second) is the only line
@@ -15,13 +15,9 @@
  */
 #include <omp.h>
 #include <stdio.h>
-#include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
-#include "cli_util.h"
-#include "output_csv.h"
-#include "scenario.h"
+#include "batch.h"
 
 #define MAP_MAX_SETS 256
 
@@ -35,15 +31,11 @@ struct map_args {
     int n_sets;
 };
 
-/* One grid point: its scenario, and after the run its row or error. */
-struct map_point {
-    double value[2];
-    struct cli_scenario sc; /* pairwise: the point's scenario */
-    struct cli_setup su;    /* soft: the built simulation */
-    struct wetdem_collision_result res;
-    int status;
-    char errmsg[256]; /* the engine's message of a failed run */
-    char* row;        /* the engine's CSV fields (malloc'd) */
+/* What the table writer needs. */
+struct map_table {
+    const struct cli_batch* batch;
+    int argc;
+    char** argv;
 };
 
 static void usage(FILE* f)
@@ -97,153 +89,14 @@ static int parse_args(int argc, char** argv, struct map_args* a)
     return CLI_EXIT_OK;
 }
 
-/* Scenario of one point: base with both keys set. Exit code. */
-static int build_point(const struct cli_scenario* base, const struct map_args* a,
-                       struct map_point* p, enum cli_engine engine)
+/* The table with the map's trailer. */
+static void write_table(FILE* f, const void* ctx)
 {
-    int rc = cli_scenario_copy(base, &p->sc);
-    for (int d = 0; d < 2 && rc == CLI_EXIT_OK; d++) {
-        char set[512];
-        snprintf(set, sizeof set, "%s=%.17g", a->key[d], p->value[d]);
-        rc = cli_scenario_override(&p->sc, set);
-    }
-    if (rc == CLI_EXIT_OK && engine == CLI_ENGINE_SOFT)
-        rc = cli_scenario_build(&p->sc, &p->su);
-    if (rc == CLI_EXIT_OK && engine == CLI_ENGINE_PAIRWISE) { /* check the build, no run */
-        char* text = NULL;
-        size_t len = 0;
-        FILE* f = open_memstream(&text, &len);
-        struct cli_run_options opt = {.sweep_row = f, .sweep_header = true};
-        rc = f ? cli_run_pairwise(&p->sc, &opt) : CLI_EXIT_RUNTIME;
-        if (f)
-            fclose(f);
-        free(text);
-    }
-    return rc;
-}
-
-/* Runs one built point and keeps its row. */
-static void run_point(struct map_point* p, enum cli_engine engine)
-{
-    size_t len = 0;
-    FILE* f = open_memstream(&p->row, &len);
-    if (!f) {
-        p->status = WETDEM_ERR_NOMEM;
-        return;
-    }
-    if (engine == CLI_ENGINE_PAIRWISE) {
-        struct cli_run_options opt = {.sweep_row = f,
-                                      .status_out = &p->status,
-                                      .errmsg_out = p->errmsg,
-                                      .errmsg_size = sizeof p->errmsg};
-        p->status = WETDEM_ERR_NOMEM; /* kept when the engine could not start */
-        cli_run_pairwise(&p->sc, &opt);
-    } else {
-        p->status = wetdem_collision_run(p->su.sim, &p->su.spec, &p->res);
-        if (p->status >= 0)
-            cli_setup_capture(&p->su);
-        else
-            snprintf(p->errmsg, sizeof p->errmsg, "%s", wetdem_sim_errmsg(p->su.sim));
-        cli_csv_result_row(f, &p->su, &p->res);
-        cli_setup_free(&p->su);
-    }
-    fclose(f);
-}
-
-/* The engine's column header (malloc'd) or NULL. */
-static char* engine_header(const struct cli_scenario* sc, enum cli_engine engine)
-{
-    char* text = NULL;
-    size_t len = 0;
-    FILE* f = open_memstream(&text, &len);
-    if (!f)
-        return NULL;
-    if (engine == CLI_ENGINE_PAIRWISE) {
-        struct cli_run_options opt = {.sweep_row = f, .sweep_header = true};
-        if (cli_run_pairwise(sc, &opt) != CLI_EXIT_OK) {
-            fclose(f);
-            free(text);
-            return NULL;
-        }
-    } else {
-        cli_csv_result_header(f);
-    }
-    fclose(f);
-    return text;
-}
-
-static const char* key_unit(const char* key)
-{
-    char section[CLI_NAME_MAX], name[CLI_NAME_MAX], probe[CLI_VALUE_MAX];
-    snprintf(probe, sizeof probe, "%s=0", key);
-    const char* u = cli_override_split(probe, section, name, NULL) == 0
-                        ? cli_scenario_key_unit(section, name)
-                        : "";
-    return u[0] ? u : "-";
-}
-
-static void write_table(FILE* f, const struct map_args* a, const struct map_point* pts, size_t n,
-                        const char* header, int argc, char** argv, double wall)
-{
-    cli_print_provenance(f, argc, argv);
-    fprintf(f, "%s [%s],%s [%s],status [word],%s\n", a->key[0], key_unit(a->key[0]), a->key[1],
-            key_unit(a->key[1]), header);
-    for (size_t k = 0; k < n; k++)
-        fprintf(f, "%.12g,%.12g,%s,%s\n", pts[k].value[0], pts[k].value[1],
-                wetdem_status_name(pts[k].status), pts[k].row ? pts[k].row : "");
-    fprintf(f, "# totals: runs=%zu wall_time_s=%.6f threads=%d collisions_per_s=%.3f\n", n, wall,
-            omp_get_max_threads(), wall > 0 ? (double)n / wall : 0.0);
-}
-
-static int write_output(const struct map_args* a, const struct map_point* pts, size_t n,
-                        const char* header, int argc, char** argv, double wall)
-{
-    if (!a->out) {
-        write_table(stdout, a, pts, n, header, argc, argv, wall);
-        return fflush(stdout) == 0 ? CLI_EXIT_OK : CLI_EXIT_RUNTIME;
-    }
-    char tmp[1100];
-    snprintf(tmp, sizeof tmp, "%s.tmp%ld", a->out, (long)getpid());
-    FILE* f = fopen(tmp, "w");
-    if (!f) {
-        cli_error("map: cannot write %s", tmp);
-        return CLI_EXIT_RUNTIME;
-    }
-    write_table(f, a, pts, n, header, argc, argv, wall);
-    bool bad = ferror(f) != 0;
-    bad = fclose(f) != 0 || bad;
-    if (bad || rename(tmp, a->out) != 0) {
-        remove(tmp);
-        cli_error("map: cannot write %s", a->out);
-        return CLI_EXIT_RUNTIME;
-    }
-    return CLI_EXIT_OK;
-}
-
-/* Builds every point serially; exit code. */
-static int build_all(const struct cli_scenario* sc, const struct map_args* a,
-                     const struct cli_range* r, struct map_point* pts, enum cli_engine engine)
-{
-    for (size_t i = 0; i < r[0].n; i++)
-        for (size_t j = 0; j < r[1].n; j++) {
-            struct map_point* p = &pts[i * r[1].n + j];
-            p->value[0] = cli_range_value(&r[0], i);
-            p->value[1] = cli_range_value(&r[1], j);
-            int rc = build_point(sc, a, p, engine);
-            if (rc != CLI_EXIT_OK)
-                return rc;
-        }
-    return CLI_EXIT_OK;
-}
-
-static void free_points(struct map_point* pts, size_t n)
-{
-    for (size_t k = 0; pts && k < n; k++) {
-        cli_scenario_free(&pts[k].sc);
-        cli_setup_free(&pts[k].su);
-        free(pts[k].row);
-    }
-    free(pts);
+    const struct map_table* t = ctx;
+    const struct cli_batch* b = t->batch;
+    cli_batch_write_table(f, b, t->argc, t->argv);
+    fprintf(f, "# totals: runs=%zu wall_time_s=%.6f threads=%d collisions_per_s=%.3f\n", b->n_pts,
+            b->wall, omp_get_max_threads(), b->wall > 0 ? (double)b->n_pts / b->wall : 0.0);
 }
 
 int cmd_map(int argc, char** argv)
@@ -253,54 +106,24 @@ int cmd_map(int argc, char** argv)
         return CLI_EXIT_OK;
     }
     struct map_args a;
-    struct cli_range r[2];
     int rc = parse_args(argc, argv, &a);
+    struct cli_batch b = {.cmd = "map",
+                          .many_note = "maps vary binary or three-sphere collisions",
+                          .file = a.file,
+                          .sets = a.sets,
+                          .n_sets = a.n_sets,
+                          .n_keys = 2,
+                          .key = {a.key[0], a.key[1]}};
     for (int d = 0; d < 2 && rc == CLI_EXIT_OK; d++)
-        rc = cli_parse_range(a.values[d], a.is_log[d], d ? "--values2" : "--values", &r[d]);
+        rc = cli_parse_range(a.values[d], a.is_log[d], d ? "--values2" : "--values", &b.range[d]);
     if (rc != CLI_EXIT_OK)
         return rc;
-    struct cli_scenario sc;
-    rc = cli_load_with_overrides(a.file, a.sets, a.n_sets, &sc);
-    enum cli_engine engine = CLI_ENGINE_SOFT;
-    if (rc == CLI_EXIT_OK)
-        rc = cli_scenario_engine(&sc, &engine);
-    if (rc == CLI_EXIT_OK && engine == CLI_ENGINE_PAIRWISE && !cli_run_pairwise) {
-        cli_error("map %s: engine 'pairwise' is not in this build", a.file);
-        rc = CLI_EXIT_RUNTIME;
-    }
-    if (rc == CLI_EXIT_OK && cli_scenario_is_many && cli_scenario_is_many(&sc)) {
-        cli_error("map %s: a many-particle scenario runs with 'wetdem run' (one run per "
-                  "file); maps vary binary or three-sphere collisions",
-                  a.file);
-        rc = CLI_EXIT_USAGE;
-    }
-    size_t n = r[0].n * r[1].n;
-    struct map_point* pts = rc == CLI_EXIT_OK ? calloc(n, sizeof *pts) : NULL;
-    if (rc == CLI_EXIT_OK && !pts) {
-        cli_error("map: out of memory for %zu points", n);
-        rc = CLI_EXIT_RUNTIME;
-    }
-    char* header = rc == CLI_EXIT_OK ? engine_header(&sc, engine) : NULL;
-    if (rc == CLI_EXIT_OK && !header)
-        rc = CLI_EXIT_USAGE;
-    double t0 = omp_get_wtime();
-    if (rc == CLI_EXIT_OK)
-        rc = build_all(&sc, &a, r, pts, engine);
+    rc = cli_batch_run(&b);
     if (rc == CLI_EXIT_OK) {
-#pragma omp parallel for schedule(dynamic, 1)
-        for (size_t k = 0; k < n; k++)
-            run_point(&pts[k], engine);
-        rc = write_output(&a, pts, n, header, argc, argv, omp_get_wtime() - t0);
-        for (size_t k = 0; k < n; k++)
-            if (pts[k].status < 0) {
-                cli_error("map: %s = %.12g, %s = %.12g: %s (%s)", a.key[0], pts[k].value[0],
-                          a.key[1], pts[k].value[1], pts[k].errmsg,
-                          wetdem_status_name(pts[k].status));
-                rc = CLI_EXIT_RUNTIME;
-            }
+        struct map_table t = {&b, argc, argv};
+        rc = cli_write_output(a.out, "map", write_table, &t);
+        rc = cli_batch_report_failures(&b, rc);
     }
-    free(header);
-    free_points(pts, pts ? n : 0);
-    cli_scenario_free(&sc);
+    cli_batch_free(&b);
     return rc;
 }

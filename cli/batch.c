@@ -1,0 +1,244 @@
+/*
+ * batch.c — the batch of independent collisions behind `wetdem sweep` and `wetdem map` (see
+ * batch.h): load and check the scenario, build every point serially, run the points in
+ * parallel, write the table in input order, report the failed runs.
+ *
+ * Engines: soft (a CSV row of every field of struct wetdem_collision_result, cli/output_csv.c)
+ * and pairwise (the row of cli_run_pairwise, whose status column is the engine's status).
+ */
+#include <omp.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "batch.h"
+#include "output_csv.h"
+
+/* The scenario of point p: base with every key set; then the soft engine's set-up, or the
+ * pairwise engine's configuration checked without running (its header mode builds and
+ * validates it). Returns an exit code. */
+static int build_point(const struct cli_scenario* base, const struct cli_batch* b,
+                       struct cli_batch_point* p)
+{
+    int rc = cli_scenario_copy(base, &p->sc);
+    for (int d = 0; d < b->n_keys && rc == CLI_EXIT_OK; d++) {
+        char set[512];
+        snprintf(set, sizeof set, "%s=%.17g", b->key[d], p->value[d]);
+        rc = cli_scenario_override(&p->sc, set);
+    }
+    if (rc == CLI_EXIT_OK && b->engine == CLI_ENGINE_SOFT)
+        rc = cli_scenario_build(&p->sc, &p->su);
+    if (rc == CLI_EXIT_OK && b->engine == CLI_ENGINE_PAIRWISE) {
+        char* text = NULL;
+        size_t len = 0;
+        FILE* f = open_memstream(&text, &len);
+        struct cli_run_options opt = {.sweep_row = f, .sweep_header = true};
+        rc = f ? cli_run_pairwise(&p->sc, &opt) : CLI_EXIT_RUNTIME;
+        if (f)
+            fclose(f);
+        free(text);
+    }
+    if (b->engine == CLI_ENGINE_SOFT)
+        cli_scenario_free(&p->sc); /* the set-up holds everything the run needs */
+    return rc;
+}
+
+/* Builds every point (serially: every input error is reported before anything runs). */
+static int build_all(const struct cli_scenario* base, struct cli_batch* b)
+{
+    for (size_t k = 0; k < b->n_pts; k++) {
+        struct cli_batch_point* p = &b->pts[k];
+        size_t rest = k; /* k in mixed radix, the last key fastest */
+        for (int d = b->n_keys - 1; d >= 0; d--) {
+            p->value[d] = cli_range_value(&b->range[d], rest % b->range[d].n);
+            rest /= b->range[d].n;
+        }
+        int rc = build_point(base, b, p);
+        if (rc != CLI_EXIT_OK)
+            return rc;
+    }
+    return CLI_EXIT_OK;
+}
+
+/* Runs one built point and keeps its status and CSV fields; releases its set-up. Touches
+ * only *p, so points run concurrently. */
+static void run_point(struct cli_batch_point* p, enum cli_engine engine)
+{
+    size_t len = 0;
+    FILE* f = open_memstream(&p->row, &len);
+    p->status = WETDEM_ERR_NOMEM; /* kept when the engine could not start */
+    snprintf(p->errmsg, sizeof p->errmsg, "out of memory");
+    if (f && engine == CLI_ENGINE_PAIRWISE) {
+        struct cli_run_options opt = {.sweep_row = f,
+                                      .status_out = &p->status,
+                                      .errmsg_out = p->errmsg,
+                                      .errmsg_size = sizeof p->errmsg};
+        cli_run_pairwise(&p->sc, &opt);
+    } else if (f) {
+        p->status = wetdem_collision_run(p->su.sim, &p->su.spec, &p->res);
+        if (p->status < 0)
+            snprintf(p->errmsg, sizeof p->errmsg, "%s", wetdem_sim_errmsg(p->su.sim));
+        else
+            cli_setup_capture(&p->su);
+        cli_csv_result_row(f, &p->su, &p->res);
+    }
+    if (f)
+        fclose(f);
+    cli_scenario_free(&p->sc);
+    cli_setup_free(&p->su); /* the row holds all that is reported */
+}
+
+static void show_progress(const char* cmd, size_t done, size_t n, double t0)
+{
+    double elapsed = omp_get_wtime() - t0;
+    double left = done ? elapsed * (double)(n - done) / (double)done : 0;
+    fprintf(stderr, "\r%s: %zu/%zu done, %.1f s elapsed, ~%.1f s left   ", cmd, done, n, elapsed,
+            left);
+    if (done == n)
+        fputc('\n', stderr);
+}
+
+/* Runs every point in parallel (dynamic scheduling: run times differ by orders of
+ * magnitude across a batch). */
+static void run_all(struct cli_batch* b)
+{
+    bool show = b->progress && isatty(STDERR_FILENO);
+    double t0 = omp_get_wtime(), last = 0;
+    size_t done = 0, n = b->n_pts;
+#pragma omp parallel for schedule(dynamic, 1)
+    for (size_t k = 0; k < n; k++) {
+        run_point(&b->pts[k], b->engine);
+#pragma omp critical(batch_progress)
+        {
+            done++;
+            double now = omp_get_wtime();
+            if (show && (now - last > 0.2 || done == n)) {
+                show_progress(b->cmd, done, n, t0);
+                last = now;
+            }
+        }
+    }
+}
+
+/* The engine's column header into b->header (malloc'd). Exit code. */
+static int engine_header(const struct cli_scenario* sc, struct cli_batch* b)
+{
+    size_t len = 0;
+    FILE* f = open_memstream(&b->header, &len);
+    if (!f) {
+        cli_error("%s: out of memory", b->cmd);
+        return CLI_EXIT_RUNTIME;
+    }
+    int rc = CLI_EXIT_OK;
+    if (b->engine == CLI_ENGINE_PAIRWISE) {
+        struct cli_run_options opt = {.sweep_row = f, .sweep_header = true};
+        rc = cli_run_pairwise(sc, &opt);
+    } else {
+        cli_csv_result_header(f);
+    }
+    fclose(f);
+    return rc;
+}
+
+/* Whether the scenario's engine can run here; exit code, message printed. */
+static int check_engine(const struct cli_scenario* sc, struct cli_batch* b)
+{
+    int rc = cli_scenario_engine(sc, &b->engine);
+    if (rc == CLI_EXIT_OK && b->engine == CLI_ENGINE_PAIRWISE && !cli_run_pairwise) {
+        cli_error("%s %s: engine 'pairwise' is not in this build", b->cmd, b->file);
+        rc = CLI_EXIT_RUNTIME;
+    }
+    if (rc == CLI_EXIT_OK && cli_scenario_is_many && cli_scenario_is_many(sc)) {
+        cli_error("%s %s: a many-particle scenario runs with 'wetdem run' (one run per "
+                  "file); %s",
+                  b->cmd, b->file, b->many_note);
+        rc = CLI_EXIT_USAGE;
+    }
+    return rc;
+}
+
+int cli_batch_run(struct cli_batch* b)
+{
+    b->engine = CLI_ENGINE_SOFT;
+    b->header = NULL;
+    b->pts = NULL;
+    b->n_pts = 1;
+    b->wall = 0;
+    for (int d = 0; d < b->n_keys; d++)
+        b->n_pts *= b->range[d].n;
+    struct cli_scenario sc;
+    int rc = cli_load_with_overrides(b->file, b->sets, b->n_sets, &sc);
+    if (rc == CLI_EXIT_OK)
+        rc = check_engine(&sc, b);
+    if (rc == CLI_EXIT_OK && !(b->pts = calloc(b->n_pts, sizeof *b->pts))) {
+        cli_error("%s: out of memory for %zu points", b->cmd, b->n_pts);
+        rc = CLI_EXIT_RUNTIME;
+    }
+    if (rc == CLI_EXIT_OK)
+        rc = engine_header(&sc, b);
+    double t0 = omp_get_wtime();
+    if (rc == CLI_EXIT_OK)
+        rc = build_all(&sc, b);
+    cli_scenario_free(&sc);
+    if (rc == CLI_EXIT_OK) {
+        run_all(b);
+        b->wall = omp_get_wtime() - t0;
+    }
+    return rc;
+}
+
+/* The unit of a scenario key for the header, "-" when it has none or is unknown. */
+static const char* key_unit(const char* key)
+{
+    char section[CLI_NAME_MAX], name[CLI_NAME_MAX], probe[CLI_VALUE_MAX];
+    snprintf(probe, sizeof probe, "%s=0", key);
+    const char* u = cli_override_split(probe, section, name, NULL) == 0
+                        ? cli_scenario_key_unit(section, name)
+                        : "";
+    return u[0] ? u : "-";
+}
+
+void cli_batch_write_table(FILE* f, const struct cli_batch* b, int argc, char** argv)
+{
+    cli_print_provenance(f, argc, argv);
+    for (int d = 0; d < b->n_keys; d++)
+        fprintf(f, "%s [%s],", b->key[d], key_unit(b->key[d]));
+    fprintf(f, "status [word],%s\n", b->header);
+    for (size_t k = 0; k < b->n_pts; k++) {
+        const struct cli_batch_point* p = &b->pts[k];
+        for (int d = 0; d < b->n_keys; d++)
+            fprintf(f, "%.12g,", p->value[d]);
+        fprintf(f, "%s,%s\n", wetdem_status_name(p->status), p->row ? p->row : "");
+    }
+}
+
+int cli_batch_report_failures(const struct cli_batch* b, int rc)
+{
+    for (size_t k = 0; k < b->n_pts; k++) {
+        const struct cli_batch_point* p = &b->pts[k];
+        if (p->status >= 0)
+            continue;
+        char where[1024];
+        size_t used = 0;
+        for (int d = 0; d < b->n_keys && used < sizeof where; d++)
+            used += (size_t)snprintf(where + used, sizeof where - used, "%s%s = %.12g",
+                                     d ? ", " : "", b->key[d], p->value[d]);
+        cli_error("%s: %s: %s (%s)", b->cmd, where, p->errmsg, wetdem_status_name(p->status));
+        rc = CLI_EXIT_RUNTIME;
+    }
+    return rc;
+}
+
+void cli_batch_free(struct cli_batch* b)
+{
+    for (size_t k = 0; b->pts && k < b->n_pts; k++) {
+        cli_scenario_free(&b->pts[k].sc);
+        cli_setup_free(&b->pts[k].su);
+        free(b->pts[k].row);
+    }
+    free(b->pts);
+    free(b->header);
+    b->pts = NULL;
+    b->header = NULL;
+}

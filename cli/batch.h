@@ -1,0 +1,73 @@
+/*
+ * batch.h — what `wetdem sweep` and `wetdem map` share: a batch of independent collisions, the
+ * scenario of a file with one or two keys set to every combination of their values, built and
+ * checked serially, run in parallel, written in input order.
+ *
+ * Each point is the scenario with `--set KEY=value` for each key (values printed with %.17g,
+ * so the same bits as `wetdem run FILE --set KEY=value`, and coupled keys stay right). Every
+ * point is built (soft engine) or its configuration checked (pairwise engine) before any runs,
+ * so every input error is reported before anything runs; the runs share nothing and are
+ * distributed over OpenMP threads with dynamic scheduling (run times differ by orders of
+ * magnitude across a batch); each keeps its engine's CSV fields, and the table is written
+ * after all finished, so its data rows are bit-identical for any thread count.
+ * Many-particle scenarios are refused (exit 2): they run with `wetdem run`.
+ */
+#ifndef WETDEM_CLI_BATCH_H
+#define WETDEM_CLI_BATCH_H
+
+#include <stdio.h>
+
+#include "cli_util.h"
+#include "scenario.h"
+
+#define CLI_BATCH_MAX_KEYS 2
+
+/* One point: its set-up, and after the run its status and CSV fields. */
+struct cli_batch_point {
+    double value[CLI_BATCH_MAX_KEYS];   /* the keys' values at this point [their units] */
+    struct cli_scenario sc;             /* pairwise engine: the point's scenario until run */
+    struct cli_setup su;                /* soft engine: the built simulation until run */
+    struct wetdem_collision_result res; /* soft engine: the run's result (zero for pairwise) */
+    int status;                         /* the run's status (the pairwise engine's own) */
+    char errmsg[256];                   /* the engine's message of a failed run */
+    char* row;                          /* the engine's CSV fields, no newline (malloc'd) */
+};
+
+/* A batch: the caller fills the first block, cli_batch_run() the second. */
+struct cli_batch {
+    const char* cmd;         /* "sweep", "map": names the command in messages */
+    const char* many_note;   /* why a many-particle scenario is refused, e.g. "sweeps vary
+                                binary collisions" */
+    const char* file;        /* scenario file */
+    const char* const* sets; /* "--set section.key=value" overrides of the file */
+    int n_sets;
+    int n_keys; /* 1 or 2 */
+    const char* key[CLI_BATCH_MAX_KEYS];
+    struct cli_range range[CLI_BATCH_MAX_KEYS];
+    bool progress; /* progress and time left on stderr when it is a terminal */
+
+    enum cli_engine engine;
+    char* header;                /* the engine's CSV column header, no newline (malloc'd) */
+    struct cli_batch_point* pts; /* n_pts points, the first key varying slowest */
+    size_t n_pts;
+    double wall; /* build and run time [s] */
+};
+
+/* Loads the file with the overrides, checks the engine, builds every point serially and runs
+ * them in parallel. Returns an exit code: an input error of the file or of any point stops
+ * before anything runs (message printed); a failed run is not an error here, its status is
+ * in its point (see cli_batch_report_failures). Free with cli_batch_free() in every case. */
+int cli_batch_run(struct cli_batch* b);
+
+/* Writes the '#' provenance lines, the header "KEY [unit],...,status [word],<engine columns>"
+ * and one row per point "value,...,status,<engine fields>"; the caller adds its trailer. */
+void cli_batch_write_table(FILE* f, const struct cli_batch* b, int argc, char** argv);
+
+/* Prints "CMD: KEY = value, ...: message (status)" for every failed run. Returns rc, or
+ * CLI_EXIT_RUNTIME when any run failed. */
+int cli_batch_report_failures(const struct cli_batch* b, int rc);
+
+/* Frees the points, the header and the scenario. */
+void cli_batch_free(struct cli_batch* b);
+
+#endif
