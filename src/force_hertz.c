@@ -318,16 +318,29 @@ double wetdem_force_hertz_elastic(double e_star, double r_eff, double overlap)
     return (4.0 / 3.0) * e_star * sqrt(r_eff) * overlap * sqrt(overlap);
 }
 
-double wetdem_force_hertz_damping(double e_star, double r_eff, double m_eff, double overlap,
-                                  double v_n, double restitution, int form)
+double wetdem_force_hertz_damping_coefficient(double restitution, int form)
 {
     if (!(restitution > 0.0 && restitution <= 1.0) || (form != 0 && form != 1))
         return NAN;
+    return form == 0 ? exact_coefficient(restitution) : tsuji_coefficient(restitution);
+}
+
+double wetdem_force_hertz_damping_with(double coefficient, double e_star, double r_eff,
+                                       double m_eff, double overlap, double v_n)
+{
     if (!(overlap > 0.0))
         return 0.0;
-    double c = form == 0 ? exact_coefficient(restitution) : tsuji_coefficient(restitution);
     double k = (4.0 / 3.0) * e_star * sqrt(r_eff);
-    return c * sqrt(m_eff * k) * sqrt(sqrt(overlap)) * v_n;
+    return coefficient * sqrt(m_eff * k) * sqrt(sqrt(overlap)) * v_n;
+}
+
+double wetdem_force_hertz_damping(double e_star, double r_eff, double m_eff, double overlap,
+                                  double v_n, double restitution, int form)
+{
+    double c = wetdem_force_hertz_damping_coefficient(restitution, form);
+    if (isnan(c))
+        return NAN;
+    return wetdem_force_hertz_damping_with(c, e_star, r_eff, m_eff, overlap, v_n);
 }
 
 double wetdem_force_hertz_total(double f_el, double f_damp, int form)

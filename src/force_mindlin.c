@@ -55,12 +55,18 @@ static double tangential_stiffness(double g_star, double r_eff, double overlap)
     return 8.0 * g_star * sqrt(r_eff * overlap);
 }
 
-/* Tsuji-form tangential damping coefficient -2 sqrt(5/6) beta sqrt(m* k_t) [kg/s]. */
-static double tangential_damping(double k_t, double m_eff, double restitution)
+double wetdem_force_mindlin_damping_factor(double restitution)
 {
     double l = log(restitution);
     double beta = l / sqrt(l * l + M_PI * M_PI);
-    return -2.0 * sqrt(5.0 / 6.0) * beta * sqrt(m_eff * k_t);
+    return -2.0 * sqrt(5.0 / 6.0) * beta;
+}
+
+/* Tsuji-form tangential damping coefficient -2 sqrt(5/6) beta sqrt(m* k_t) [kg/s], from the
+ * factor -2 sqrt(5/6) beta (the product is formed in that order either way). */
+static double tangential_damping(double k_t, double m_eff, double factor)
+{
+    return factor * sqrt(m_eff * k_t);
 }
 
 /* The spring s rotated rigidly into the plane normal to n, keeping its length. */
@@ -84,6 +90,14 @@ static void store_spring(double* spring, struct wetdem_vec3 s)
 struct wetdem_vec3 wetdem_force_mindlin_update(const struct wetdem_contact* c, double overlap,
                                                double f_limit, double mu, double* spring)
 {
+    double factor = overlap > 0.0 ? wetdem_force_mindlin_damping_factor(c->restitution) : 0.0;
+    return wetdem_force_mindlin_update_with(c, overlap, f_limit, mu, factor, spring);
+}
+
+struct wetdem_vec3 wetdem_force_mindlin_update_with(const struct wetdem_contact* c, double overlap,
+                                                    double f_limit, double mu,
+                                                    double damping_factor, double* spring)
+{
     if (!(overlap > 0.0)) {
         store_spring(spring, vec3(0, 0, 0));
         return vec3(0, 0, 0);
@@ -91,7 +105,7 @@ struct wetdem_vec3 wetdem_force_mindlin_update(const struct wetdem_contact* c, d
     struct wetdem_vec3 s = rotate_into_plane(vec3(spring[0], spring[1], spring[2]), c->normal);
     s = vec3_axpy(s, c->dt, c->v_t);
     double k_t = tangential_stiffness(c->g_star, c->r_eff, overlap);
-    double gamma_t = tangential_damping(k_t, c->m_eff, c->restitution);
+    double gamma_t = tangential_damping(k_t, c->m_eff, damping_factor);
     struct wetdem_vec3 ft = vec3_axpy(vec3_scale(s, -k_t), -gamma_t, c->v_t);
     double f_total = vec3_norm(ft), f_max = mu * fabs(f_limit);
     if (f_total > f_max) { /* sliding: total capped, spring set so that it gives the cap */

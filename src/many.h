@@ -16,6 +16,10 @@ struct wetdem_many_mix {
     double roughness, film;                         /* [m] */
     double viscosity, surface_tension;              /* [Pa s], [N/m] */
     double range; /* largest model range [m]: exact with the fused kernel, else the reach */
+    /* damping coefficients of the restitution, computed once (force_hertz.c, force_mindlin.c):
+       hertz by damping form (0 exact, 1 tsuji) [-] and the Mindlin factor [-]; NAN when the
+       restitution is outside (0, 1] (the kernel reports that before using them) */
+    double hertz_damping[2], mindlin_damping;
 };
 
 /* Result of one candidate pair at the latest force evaluation. */
@@ -141,10 +145,11 @@ const struct wetdem_many_mix* wetdem_sim_many_mix(const struct wetdem_sim* sim, 
 void wetdem_sim_many_contact(const struct wetdem_sim* sim, size_t i, size_t j, bool is_wall,
                              struct wetdem_contact* c);
 /* The fused kernel: the same contract and results as wetdem_sim_eval_contact, for model sets
- * of hertz, mindlin, sb and capillary only (m->fused). */
+ * of hertz, mindlin, sb and capillary only (m->fused); x: the mixed properties of the pair's
+ * materials, from which c was built. */
 int wetdem_sim_many_eval_fused(const struct wetdem_sim* sim, struct wetdem_contact* c,
-                               double* history, struct wetdem_pair_force* out,
-                               struct wetdem_pair_force* per_model);
+                               const struct wetdem_many_mix* x, double* history,
+                               struct wetdem_pair_force* out, struct wetdem_pair_force* per_model);
 /* Index of the pairs by their second particle (rev, rev_start), after a list build. */
 int wetdem_sim_many_index_pairs(struct wetdem_sim* sim);
 /* Forces, torques and contact counts of every particle at the current state, histories

@@ -41,6 +41,15 @@ double wetdem_force_hertz_elastic(double e_star, double r_eff, double overlap);
  * wetdem_force_hertz_total to get the hertz law of the form. */
 double wetdem_force_hertz_damping(double e_star, double r_eff, double m_eff, double overlap,
                                   double v_n, double restitution, int form);
+/* force_hertz.c: the dimensionless damping coefficient of wetdem_force_hertz_damping for
+ * `restitution` and `form` [-] (the exact-table or Tsuji value; NAN for restitution outside
+ * (0, 1] or another form), to be computed once per material pair. */
+double wetdem_force_hertz_damping_coefficient(double restitution, int form);
+/* force_hertz.c: wetdem_force_hertz_damping from a precomputed coefficient
+ * (wetdem_force_hertz_damping_coefficient) [N]: bit-identical to it for valid arguments;
+ * 0 if overlap <= 0. */
+double wetdem_force_hertz_damping_with(double coefficient, double e_star, double r_eff,
+                                       double m_eff, double overlap, double v_n);
 /* force_hertz.c: total normal force of the hertz law [N] from its elastic part f_el and its
  * damping part f_damp (wetdem_force_hertz_damping with the same form): the one place that
  * decides whether the sum is clipped at zero for a damping form. Every caller that composes
@@ -58,5 +67,13 @@ double wetdem_force_hertz_contact_time(double e_star, double r_eff, double m_eff
  * tangential force on i [N]. overlap <= 0 resets the spring. */
 struct wetdem_vec3 wetdem_force_mindlin_update(const struct wetdem_contact* c, double overlap,
                                                double f_limit, double mu, double* spring);
+/* force_mindlin.c: the factor -2 sqrt(5/6) beta(e) of the Tsuji tangential damping [-],
+ * beta = ln e / sqrt(ln^2 e + pi^2), to be computed once per material pair (e in (0, 1]). */
+double wetdem_force_mindlin_damping_factor(double restitution);
+/* force_mindlin.c: wetdem_force_mindlin_update with the damping factor precomputed
+ * (wetdem_force_mindlin_damping_factor(c->restitution)); bit-identical results. */
+struct wetdem_vec3 wetdem_force_mindlin_update_with(const struct wetdem_contact* c, double overlap,
+                                                    double f_limit, double mu,
+                                                    double damping_factor, double* spring);
 
 #endif

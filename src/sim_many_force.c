@@ -26,9 +26,10 @@
  *
  * Fused kernel: when every enabled force model is one of hertz, mindlin, sb and capillary (any
  * subset, any order), a switch over the models replaces the calls through the model table. It
- * calls the same kernels (wetdem_force_hertz_elastic, wetdem_force_hertz_damping,
- * wetdem_force_hertz_total, wetdem_force_mindlin_update, wetdem_pair_force_add_tangential,
- * thin_film_eval_gap) and writes the static-bridge force 6 pi mu a^2 v_n/h [1 - h/delta]^2
+ * calls the same kernels (wetdem_force_hertz_elastic, wetdem_force_hertz_damping_with,
+ * wetdem_force_hertz_total, wetdem_force_mindlin_update_with, wetdem_pair_force_add_tangential,
+ * thin_film_eval_gap), the damping coefficients of the restitution (the exact-table lookup,
+ * log e) computed once per material pair in the table by the force files' own functions and writes the static-bridge force 6 pi mu a^2 v_n/h [1 - h/delta]^2
  * (Punch 2023 Eq. 7, corrected bracket; force_sb.c) and the capillary suction -8 pi a sigma
  * (Punch 2023 Eq. 15; force_capillary.c) with the same operations in the same order, and sums
  * the models as wetdem_sim_eval_contact does; the elastic Hertz force, which hertz and mindlin
@@ -84,9 +85,19 @@ static void mix_pair(const struct wetdem_sim* sim, int a, int b, struct wetdem_m
     struct wetdem_particle q = {.pos = {0, 0, 3}, .radius = 1, .mass = 1, .material = b};
     struct wetdem_contact c;
     wetdem_contact_from_particles(&c, &p, &sim->materials[a], &q, &sim->materials[b], &sim->fluid);
-    *x = (struct wetdem_many_mix){c.e_star,          c.g_star,    c.restitution, c.friction_dry,
-                                  c.friction_lub,    c.roughness, c.film,        c.viscosity,
-                                  c.surface_tension, 0.0};
+    *x = (struct wetdem_many_mix){.e_star = c.e_star,
+                                  .g_star = c.g_star,
+                                  .restitution = c.restitution,
+                                  .friction_dry = c.friction_dry,
+                                  .friction_lub = c.friction_lub,
+                                  .roughness = c.roughness,
+                                  .film = c.film,
+                                  .viscosity = c.viscosity,
+                                  .surface_tension = c.surface_tension};
+    bool valid = c.restitution > 0.0 && c.restitution <= 1.0;
+    x->hertz_damping[0] = wetdem_force_hertz_damping_coefficient(c.restitution, 0);
+    x->hertz_damping[1] = wetdem_force_hertz_damping_coefficient(c.restitution, 1);
+    x->mindlin_damping = valid ? wetdem_force_mindlin_damping_factor(c.restitution) : NAN;
 }
 
 int wetdem_sim_many_setup_kernel(struct wetdem_sim* sim)
@@ -229,8 +240,9 @@ static void add_force(struct wetdem_pair_force* out, const struct wetdem_pair_fo
 
 /* One model's force, as its pair() function computes it. f_el: the Hertz elastic force at
  * this overlap. Returns WETDEM_OK or WETDEM_ERR_INVALID (restitution outside (0, 1]). */
-static int fused_model(int kind, double opt, const struct wetdem_contact* c, double f_el,
-                       double* history, struct wetdem_pair_force* f)
+static int fused_model(int kind, double opt, const struct wetdem_contact* c,
+                       const struct wetdem_many_mix* x, double f_el, double* history,
+                       struct wetdem_pair_force* f)
 {
     double overlap = -c->gap;
     switch (kind) {
@@ -240,15 +252,16 @@ static int fused_model(int kind, double opt, const struct wetdem_contact* c, dou
         if (overlap > 0.0)
             f->f_normal += wetdem_force_hertz_total(
                 f_el,
-                wetdem_force_hertz_damping(c->e_star, c->r_eff, c->m_eff, overlap, c->v_n,
-                                           c->restitution, (int)opt),
+                wetdem_force_hertz_damping_with(x->hertz_damping[(int)opt], c->e_star, c->r_eff,
+                                                c->m_eff, overlap, c->v_n),
                 (int)opt);
         return WETDEM_OK;
     case FUSED_MINDLIN: {
         if (!(c->restitution > 0.0 && c->restitution <= 1.0))
             return WETDEM_ERR_INVALID;
         double mu = opt == 0 ? c->friction_dry : c->friction_lub;
-        struct wetdem_vec3 ft = wetdem_force_mindlin_update(c, overlap, f_el, mu, history);
+        struct wetdem_vec3 ft =
+            wetdem_force_mindlin_update_with(c, overlap, f_el, mu, x->mindlin_damping, history);
         if (overlap > 0.0)
             wetdem_pair_force_add_tangential(f, c, ft);
         return WETDEM_OK;
@@ -270,8 +283,8 @@ static int fused_model(int kind, double opt, const struct wetdem_contact* c, dou
 }
 
 int wetdem_sim_many_eval_fused(const struct wetdem_sim* sim, struct wetdem_contact* c,
-                               double* history, struct wetdem_pair_force* out,
-                               struct wetdem_pair_force* per_model)
+                               const struct wetdem_many_mix* x, double* history,
+                               struct wetdem_pair_force* out, struct wetdem_pair_force* per_model)
 {
     const struct wetdem_many* m = sim->many;
     double scratch[1] = {0.0};
@@ -282,7 +295,7 @@ int wetdem_sim_many_eval_fused(const struct wetdem_sim* sim, struct wetdem_conta
     double f_el = wetdem_force_hertz_elastic(c->e_star, c->r_eff, -c->gap);
     for (size_t k = 0; k < sim->n_models; k++) {
         struct wetdem_pair_force f = {0};
-        int st = fused_model(m->kind[k], m->kind_opt[k], c, f_el,
+        int st = fused_model(m->kind[k], m->kind_opt[k], c, x, f_el,
                              history + sim->models[k].history_offset, &f);
         if (st < 0)
             return st;
@@ -360,11 +373,11 @@ static double contact_range(const struct wetdem_sim* sim, const struct wetdem_co
     return sim->many->fused ? x->range : wetdem_sim_contact_range(sim, c);
 }
 
-/* Evaluates contact c (range `range`) with history hist, advanced in place (committed every
+/* Evaluates contact c (materials' mixed properties x, range `range`) with history hist, advanced in place (committed every
  * step). Returns the status; *out gets force and torques (when active), *flags the flags. */
-static int eval_pair(const struct wetdem_sim* sim, struct wetdem_contact* c, double range,
-                     double* hist, struct wetdem_many_pair_out* out, unsigned char* flags,
-                     double* work)
+static int eval_pair(const struct wetdem_sim* sim, struct wetdem_contact* c,
+                     const struct wetdem_many_mix* x, double range, double* hist,
+                     struct wetdem_many_pair_out* out, unsigned char* flags, double* work)
 {
     const struct wetdem_many* m = sim->many;
     bool dirty = *flags & WETDEM_MANY_DIRTY;
@@ -379,7 +392,7 @@ static int eval_pair(const struct wetdem_sim* sim, struct wetdem_contact* c, dou
     c->dt = m->dt;
     struct wetdem_pair_force f, per_model[WETDEM_MAX_MODELS];
     struct wetdem_pair_force* pm = m->set.energy_budget ? per_model : NULL;
-    int st = m->fused ? wetdem_sim_many_eval_fused(sim, c, hist, &f, pm)
+    int st = m->fused ? wetdem_sim_many_eval_fused(sim, c, x, hist, &f, pm)
                       : wetdem_sim_eval_contact(sim, c, hist, &f, pm);
     if (st < 0)
         return st;
@@ -413,7 +426,7 @@ static void eval_near_pair(const struct wetdem_sim* sim, size_t q, struct wetdem
     c.j = j;
     double range = contact_range(sim, &c, x);
     double* hist = len ? m->history + q * len : NULL;
-    int st = eval_pair(sim, &c, range, hist, o, &m->flags[q], thread_work(m, 0));
+    int st = eval_pair(sim, &c, x, range, hist, o, &m->flags[q], thread_work(m, 0));
     if (st != WETDEM_OK)
         note_failure(fail, q, st, false, &c, range);
 }
@@ -496,7 +509,7 @@ static void eval_walls_of(const struct wetdem_sim* sim, size_t i, struct wetdem_
         double range = contact_range(sim, &c, x);
         struct wetdem_many_pair_out o;
         unsigned char flags = WETDEM_MANY_DIRTY; /* always reset */
-        int st = eval_pair(sim, &c, range, hist, &o, &flags, thread_work(m, 1));
+        int st = eval_pair(sim, &c, x, range, hist, &o, &flags, thread_work(m, 1));
         if (st != WETDEM_OK)
             note_failure(fail, i * nw + w, st, true, &c, range);
         if (!(flags & WETDEM_MANY_ACTIVE))

@@ -3,7 +3,8 @@
  * the contact built from the material-pair table equals the one contact.c builds, the fused
  * hertz/mindlin/sb/capillary kernel gives bit-identical forces, per-model forces and
  * histories to the generic model interface (wetdem_sim_eval_contact) over every branch of the
- * four models, whole runs with the fused kernel equal runs through the generic interface bit
+ * four models, the precomputed-coefficient damping kernels it calls equal the per-call ones,
+ * whole runs with the fused kernel equal runs through the generic interface bit
  * for bit, and both stay independent of the thread count.
  *
  * Bit-identity is the right tolerance here: the fused kernel calls the same kernels with the
@@ -15,6 +16,7 @@
 
 #include "harness.h"
 #include "many.h"
+#include "models.h"
 
 /* Two materials that differ in every property the contact mixes, a fluid, and the model
  * set given (in that order). */
@@ -129,7 +131,9 @@ static void check_fused_equals_generic(struct wetdem_sim* sim, const struct wetd
     struct wetdem_pair_force of, og, pf[WETDEM_MAX_MODELS], pg[WETDEM_MAX_MODELS];
     memset(pf, 0, sizeof pf);
     memset(pg, 0, sizeof pg);
-    int sf = wetdem_sim_many_eval_fused(sim, &cf, sim->history_len ? hf : NULL, &of, pf);
+    int mb = c->is_wall ? sim->walls[c->j].material : sim->particles[c->j].material;
+    const struct wetdem_many_mix* x = wetdem_sim_many_mix(sim, sim->particles[c->i].material, mb);
+    int sf = wetdem_sim_many_eval_fused(sim, &cf, x, sim->history_len ? hf : NULL, &of, pf);
     int sg = wetdem_sim_eval_contact(sim, &cg, sim->history_len ? hg : NULL, &og, pg);
     assert_int_equal(sf, sg);
     assert_memory_equal(&of, &og, sizeof of);
@@ -199,6 +203,52 @@ static void test_many_fused_kernel_equals_generic(void** state)
             wetdem_sim_free(sim);
         }
     assert_true(n_checked > 10000); /* 8 set-ups x 36 pairs x 11 gaps x 3 springs x 2 signs */
+}
+
+/* The precomputed-coefficient kernels the fused path calls (wetdem_force_hertz_damping_with,
+ * wetdem_force_mindlin_update_with) give the same bits as the kernels that compute the
+ * coefficient per call, over restitutions spanning the exact table (1e-6 <= e < 1), the
+ * strong-damping closed form below it, e = 1 (no damping), both Hertz forms, sticking and
+ * sliding springs, and overlaps on both sides of zero. */
+static void test_many_precomputed_damping_is_bit_identical(void** state)
+{
+    (void)state;
+    const double es[] = {1e-9, 3e-7, 1e-6, 0.01, 0.3, 0.5, 0.77, 0.95, 0.999999, 1.0};
+    const double overlaps[] = {-1e-6, 0.0, 1e-9, 2e-6, 5e-5};
+    size_t n_checked = 0;
+    for (size_t k = 0; k < sizeof es / sizeof es[0]; k++)
+        for (size_t o = 0; o < sizeof overlaps / sizeof overlaps[0]; o++) {
+            double e = es[k], d = overlaps[o];
+            for (int form = 0; form < 2; form++) {
+                double c = wetdem_force_hertz_damping_coefficient(e, form);
+                double want = wetdem_force_hertz_damping(1e9, 4.7e-4, 3.1e-5, d, -0.37, e, form);
+                double got = wetdem_force_hertz_damping_with(c, 1e9, 4.7e-4, 3.1e-5, d, -0.37);
+                assert_memory_equal(&got, &want, sizeof got);
+                n_checked++;
+            }
+            struct wetdem_contact c = {.normal = {0, 0.6, 0.8},
+                                       .v_t = {0.3, 0.08, -0.06},
+                                       .g_star = 4e8,
+                                       .r_eff = 4.7e-4,
+                                       .m_eff = 3.1e-5,
+                                       .restitution = e,
+                                       .dt = 1e-6};
+            for (int slide = 0; slide < 2; slide++) {
+                double mu = slide ? 0.01 : 10.0; /* 0.01: capped; 10: sticking */
+                double s_ref[3] = {1e-7, -2e-8, 3e-8}, s_new[3] = {1e-7, -2e-8, 3e-8};
+                struct wetdem_vec3 want = wetdem_force_mindlin_update(&c, d, 0.2, mu, s_ref);
+                struct wetdem_vec3 got = wetdem_force_mindlin_update_with(
+                    &c, d, 0.2, mu, wetdem_force_mindlin_damping_factor(e), s_new);
+                assert_memory_equal(&got, &want, sizeof got);
+                assert_memory_equal(s_new, s_ref, sizeof s_ref);
+                n_checked++;
+            }
+        }
+    assert_int_equal(n_checked, 10 * 5 * 4);
+    /* invalid restitution: NAN, as the per-call kernel */
+    assert_true(isnan(wetdem_force_hertz_damping_coefficient(0.0, 0)));
+    assert_true(isnan(wetdem_force_hertz_damping_coefficient(1.5, 1)));
+    assert_true(isnan(wetdem_force_hertz_damping_coefficient(0.5, 2)));
 }
 
 /* A set with a model outside the fused set (reynolds) takes the generic path. */
@@ -304,6 +354,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_many_contact_matches_contact_c),
         cmocka_unit_test(test_many_fused_kernel_equals_generic),
+        cmocka_unit_test(test_many_precomputed_damping_is_bit_identical),
         cmocka_unit_test(test_many_unfused_set_uses_generic_path),
         cmocka_unit_test(test_many_fused_run_equals_generic_run),
     };
