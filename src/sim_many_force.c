@@ -34,7 +34,11 @@
  * (Punch 2023 Eq. 15; force_capillary.c) with the same operations in the same order, and sums
  * the models as wetdem_sim_eval_contact does; the elastic Hertz force, which hertz and mindlin
  * both need, is computed once. tests/test_many_force.c checks the forces and histories are
- * bit-identical to the generic path. The range of these models is the film thickness delta_ab
+ * bit-identical to the generic path. Without per-model output each model adds its terms
+ * straight into the sum instead of into a zeroed record that is then added field by field:
+ * the same bits, because the sum starts at +0 and so is never -0 (x + (+0) = x and
+ * x + (0 + y) = x + y for every x other than -0), so the skipped additions of zero fields
+ * and the dropped 0 + y change nothing. The range of these models is the film thickness delta_ab
  * (0 for the contact models), a property of the material pair.
  */
 #include <omp.h>
@@ -293,6 +297,15 @@ int wetdem_sim_many_eval_fused(const struct wetdem_sim* sim, struct wetdem_conta
     *out = (struct wetdem_pair_force){0};
     c->h_min = sim->minsep.model->min_separation(sim->minsep.params, c, history);
     double f_el = wetdem_force_hertz_elastic(c->e_star, c->r_eff, -c->gap);
+    if (!per_model) { /* each model adds into *out at once: see the file header */
+        for (size_t k = 0; k < sim->n_models; k++) {
+            int st = fused_model(m->kind[k], m->kind_opt[k], c, x, f_el,
+                                 history + sim->models[k].history_offset, out);
+            if (st < 0)
+                return st;
+        }
+        return WETDEM_OK;
+    }
     for (size_t k = 0; k < sim->n_models; k++) {
         struct wetdem_pair_force f = {0};
         int st = fused_model(m->kind[k], m->kind_opt[k], c, x, f_el,
