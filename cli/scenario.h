@@ -154,6 +154,23 @@ void cli_setup_free(struct cli_setup* setup);
 double cli_stokes_speed(double stokes_n, double viscosity, double m_eff, double r_eff,
                         double angle);
 
+/* ---- internal: building blocks of the soft-engine and many-particle builders
+ * (scenario_build.c, used by scenario_many.c) ---- */
+
+/* Prints the library's message of sim against entry e (or against [section] when e is NULL)
+ * and returns CLI_EXIT_USAGE. */
+int cli_scenario_lib_error(const struct cli_scenario* sc, const struct cli_entry* e,
+                           const char* section, const struct wetdem_sim* sim);
+/* [fluid]: the preset, then every field given, set on sim. Returns an exit code. */
+int cli_scenario_build_fluid(const struct cli_scenario* sc, struct wetdem_sim* sim);
+/* A [material.NAME] section into *m: the library defaults, then its preset, then every field
+ * given; checked with wetdem_material_validate. Returns an exit code. */
+int cli_scenario_material_section(const struct cli_scenario* sc, const char* section,
+                                  struct wetdem_material* m);
+/* Every [model.NAME] key as the parameter NAME.key of sim's enabled model NAME (an error when
+ * NAME is not enabled). Returns an exit code. */
+int cli_scenario_set_model_params(const struct cli_scenario* sc, struct wetdem_sim* sim);
+
 /* ---- internal: section lookup (scenario_keys.c), shared by scenario*.c ---- */
 
 /* What a section accepts: its descriptor, keys from a library table, or any key. */

@@ -2,7 +2,9 @@
  * scenario_build.c — turns a checked scenario into a simulation and a collision spec:
  * fluid, materials, models and their parameters, integrator, settings, and the derived
  * quantities of the collision. Every library check runs here, so a scenario that builds
- * runs without input errors; each failure names the file, the line and the key.
+ * runs without input errors; each failure names the file, the line and the key. [fluid],
+ * [material.NAME] sections, [model.NAME] parameters and library errors are read the same way
+ * by the many-particle builder (scenario_many.c), through the cli_scenario_* functions here.
  *
  * Derived quantities (SPEC §2, Nijssen 2023 Eq. 2 with the normal speed):
  *   m_i = rho_i (4/3) pi R_i^3;  m* = m_i m_j / (m_i + m_j) for a free target sphere, m* = m_i
@@ -27,9 +29,8 @@ double cli_stokes_speed(double stokes_n, double viscosity, double m_eff, double 
     return stokes_n * 6.0 * PI * viscosity * r_eff * r_eff / (m_eff * cos(angle));
 }
 
-/* Reports a library failure of `sim` against entry e (or the section when e is NULL). */
-static int lib_error(const struct cli_scenario* sc, const struct cli_entry* e,
-                     const char* section, const struct wetdem_sim* sim)
+int cli_scenario_lib_error(const struct cli_scenario* sc, const struct cli_entry* e,
+                           const char* section, const struct wetdem_sim* sim)
 {
     if (e)
         cli_scenario_error(sc, e, "%s", wetdem_sim_errmsg(sim));
@@ -38,7 +39,7 @@ static int lib_error(const struct cli_scenario* sc, const struct cli_entry* e,
     return CLI_EXIT_USAGE;
 }
 
-static int build_fluid(const struct cli_scenario* sc, struct wetdem_sim* sim)
+int cli_scenario_build_fluid(const struct cli_scenario* sc, struct wetdem_sim* sim)
 {
     struct wetdem_fluid f;
     const char* preset = cli_scenario_text(sc, "fluid", "preset", "water");
@@ -53,7 +54,53 @@ static int build_fluid(const struct cli_scenario* sc, struct wetdem_sim* sim)
             *(double*)((char*)&f + d[k].offset) = strtod(e->value, NULL);
     }
     if (wetdem_sim_set_fluid(sim, &f) != WETDEM_OK)
-        return lib_error(sc, NULL, "fluid", sim);
+        return cli_scenario_lib_error(sc, NULL, "fluid", sim);
+    return CLI_EXIT_OK;
+}
+
+int cli_scenario_material_section(const struct cli_scenario* sc, const char* section,
+                                  struct wetdem_material* m)
+{
+    const struct cli_entry* p = cli_scenario_find(sc, section, "preset");
+    wetdem_param_init_defaults(wetdem_material_params(), m);
+    if (p && wetdem_material_preset(p->value, m) != WETDEM_OK) {
+        const char* hint = wetdem_param_suggest(p->value, wetdem_material_preset_names());
+        cli_scenario_error(sc, p, "unknown material preset%s%s%s", hint ? " (did you mean '" : "",
+                           hint ? hint : "", hint ? "'?)" : "");
+        return CLI_EXIT_USAGE;
+    }
+    const struct wetdem_param_desc* d = wetdem_material_params();
+    for (size_t k = 0; d[k].name; k++) {
+        const struct cli_entry* e = cli_scenario_find(sc, section, d[k].name);
+        if (e)
+            *(double*)((char*)m + d[k].offset) = strtod(e->value, NULL);
+    }
+    char msg[512];
+    if (wetdem_material_validate(m, msg, sizeof msg) != WETDEM_OK) {
+        cli_scenario_section_error(sc, section, "%s", msg);
+        return CLI_EXIT_USAGE;
+    }
+    return CLI_EXIT_OK;
+}
+
+int cli_scenario_set_model_params(const struct cli_scenario* sc, struct wetdem_sim* sim)
+{
+    for (size_t k = 0; k < sc->n_entries; k++) {
+        const struct cli_entry* p = &sc->entries[k];
+        if (strncmp(p->section, "model.", 6) != 0)
+            continue;
+        char name[2 * CLI_NAME_MAX];
+        snprintf(name, sizeof name, "%s.%s", p->section + 6, p->key);
+        double v;
+        if (wetdem_sim_param(sim, name, &v) != WETDEM_OK) {
+            cli_scenario_error(sc, p, "model '%s' is not enabled by [models] force or "
+                                      "min_separation, so it has no parameters to set",
+                               p->section + 6);
+            return CLI_EXIT_USAGE;
+        }
+        if (wetdem_sim_set_param_str(sim, name, p->value) != WETDEM_OK)
+            return cli_scenario_lib_error(sc, p, p->section, sim);
+    }
     return CLI_EXIT_OK;
 }
 
@@ -89,26 +136,7 @@ static int resolve_material(const struct cli_scenario* sc, const struct cli_entr
                            hint ? "'?)" : "", name);
         return CLI_EXIT_USAGE;
     }
-    const struct cli_entry* p = cli_scenario_find(sc, section, "preset");
-    wetdem_param_init_defaults(wetdem_material_params(), m);
-    if (p && wetdem_material_preset(p->value, m) != WETDEM_OK) {
-        const char* hint = wetdem_param_suggest(p->value, wetdem_material_preset_names());
-        cli_scenario_error(sc, p, "unknown material preset%s%s%s", hint ? " (did you mean '" : "",
-                           hint ? hint : "", hint ? "'?)" : "");
-        return CLI_EXIT_USAGE;
-    }
-    const struct wetdem_param_desc* d = wetdem_material_params();
-    for (size_t k = 0; d[k].name; k++) {
-        const struct cli_entry* e = cli_scenario_find(sc, section, d[k].name);
-        if (e)
-            *(double*)((char*)m + d[k].offset) = strtod(e->value, NULL);
-    }
-    char msg[512];
-    if (wetdem_material_validate(m, msg, sizeof msg) != WETDEM_OK) {
-        cli_scenario_section_error(sc, section, "%s", msg);
-        return CLI_EXIT_USAGE;
-    }
-    return CLI_EXIT_OK;
+    return cli_scenario_material_section(sc, section, m);
 }
 
 /* Adds striker and target materials; sets spec material indices. */
@@ -126,10 +154,10 @@ static int build_materials(const struct cli_scenario* sc, struct cli_setup* su,
         return rc;
     int ki = wetdem_sim_add_material(su->sim, mi);
     if (ki < 0)
-        return lib_error(sc, ei, "collision", su->sim);
+        return cli_scenario_lib_error(sc, ei, "collision", su->sim);
     int kj = ki;
     if (strcmp(si, sj) != 0 && (kj = wetdem_sim_add_material(su->sim, mj)) < 0)
-        return lib_error(sc, ej, "collision", su->sim);
+        return cli_scenario_lib_error(sc, ej, "collision", su->sim);
     su->spec.material_i = ki;
     su->spec.material_j = kj;
     return CLI_EXIT_OK;
@@ -148,7 +176,7 @@ static int enable_forces(const struct cli_scenario* sc, struct wetdem_sim* sim)
             return CLI_EXIT_USAGE;
         }
         if (wetdem_sim_enable_model(sim, tok) != WETDEM_OK)
-            return lib_error(sc, e, "models", sim);
+            return cli_scenario_lib_error(sc, e, "models", sim);
     }
     return CLI_EXIT_OK;
 }
@@ -168,27 +196,9 @@ static int build_models(const struct cli_scenario* sc, struct wetdem_sim* sim)
             return CLI_EXIT_USAGE;
         }
         if (wetdem_sim_enable_model(sim, e->value) != WETDEM_OK)
-            return lib_error(sc, e, "models", sim);
+            return cli_scenario_lib_error(sc, e, "models", sim);
     }
-    for (size_t k = 0; k < sc->n_entries; k++) {
-        const struct cli_entry* p = &sc->entries[k];
-        if (strncmp(p->section, "model.", 6) != 0)
-            continue;
-        char name[2 * CLI_NAME_MAX];
-        snprintf(name, sizeof name, "%s.%s", p->section + 6, p->key);
-        if (wetdem_sim_set_param_str(sim, name, p->value) == WETDEM_OK)
-            continue;
-        double dummy;
-        bool enabled = wetdem_sim_param(sim, name, &dummy) == WETDEM_OK;
-        if (!enabled)
-            cli_scenario_error(sc, p, "model '%s' is not enabled by [models] force or "
-                                      "min_separation, so it has no parameters to set",
-                               p->section + 6);
-        else
-            cli_scenario_error(sc, p, "%s", wetdem_sim_errmsg(sim));
-        return CLI_EXIT_USAGE;
-    }
-    return CLI_EXIT_OK;
+    return cli_scenario_set_model_params(sc, sim);
 }
 
 /* Whether an integrator other than `chosen` has the parameter `key`. */
@@ -234,7 +244,7 @@ static int build_integrator(const struct cli_scenario* sc, struct wetdem_sim* si
             other_integrator_has(name, p->key))
             continue; /* a parameter of the integrator not chosen (e.g. --set name=verlet) */
         if (wetdem_sim_set_param_str(sim, full, p->value) != WETDEM_OK)
-            return lib_error(sc, p, p->section, sim);
+            return cli_scenario_lib_error(sc, p, p->section, sim);
     }
     return CLI_EXIT_OK;
 }
@@ -325,7 +335,7 @@ int cli_scenario_build(const struct cli_scenario* sc, struct cli_setup* su)
     }
     struct wetdem_material mi, mj;
     int rc;
-    if ((rc = build_fluid(sc, su->sim)) != CLI_EXIT_OK ||
+    if ((rc = cli_scenario_build_fluid(sc, su->sim)) != CLI_EXIT_OK ||
         (rc = build_materials(sc, su, &mi, &mj)) != CLI_EXIT_OK ||
         (rc = build_models(sc, su->sim)) != CLI_EXIT_OK ||
         (rc = build_integrator(sc, su->sim)) != CLI_EXIT_OK ||

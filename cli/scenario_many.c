@@ -181,27 +181,6 @@ bool cli_scenario_is_many(const struct cli_scenario* sc)
 
 /* ------------------------------------------------- fluid, models, integrator, settings --- */
 
-static int lib_error(const struct cli_scenario* sc, const struct cli_entry* e,
-                     const char* section, const struct wetdem_sim* sim)
-{
-    if (e)
-        cli_scenario_error(sc, e, "%s", wetdem_sim_errmsg(sim));
-    else
-        cli_scenario_section_error(sc, section, "%s", wetdem_sim_errmsg(sim));
-    return CLI_EXIT_USAGE;
-}
-
-static int build_fluid(const struct cli_scenario* sc, struct wetdem_sim* sim)
-{
-    struct wetdem_fluid f;
-    wetdem_fluid_preset(cli_scenario_text(sc, "fluid", "preset", "water"), &f); /* checked */
-    for (const struct wetdem_param_desc* d = wetdem_fluid_params(); d->name; d++)
-        *(double*)((char*)&f + d->offset) =
-            cli_scenario_number(sc, "fluid", d->name, *(double*)((char*)&f + d->offset));
-    return wetdem_sim_set_fluid(sim, &f) == WETDEM_OK ? CLI_EXIT_OK
-                                                      : lib_error(sc, NULL, "fluid", sim);
-}
-
 static int build_models(const struct cli_scenario* sc, struct wetdem_sim* sim)
 {
     wetdem_sim_clear_models(sim);
@@ -217,28 +196,12 @@ static int build_models(const struct cli_scenario* sc, struct wetdem_sim* sim)
             return CLI_EXIT_USAGE;
         }
         if (wetdem_sim_enable_model(sim, tok) != WETDEM_OK)
-            return lib_error(sc, e, "models", sim);
+            return cli_scenario_lib_error(sc, e, "models", sim);
     }
     const struct cli_entry* ms = cli_scenario_find(sc, "models", "min_separation");
     if (ms && wetdem_sim_enable_model(sim, ms->value) != WETDEM_OK)
-        return lib_error(sc, ms, "models", sim);
-    for (size_t k = 0; k < sc->n_entries; k++) {
-        const struct cli_entry* p = &sc->entries[k];
-        if (strncmp(p->section, "model.", 6) != 0)
-            continue;
-        char name[2 * CLI_NAME_MAX];
-        snprintf(name, sizeof name, "%s.%s", p->section + 6, p->key);
-        double v;
-        if (wetdem_sim_param(sim, name, &v) != WETDEM_OK) {
-            cli_scenario_error(sc, p, "model '%s' is not enabled by [models] force or "
-                                      "min_separation, so it has no parameters to set",
-                               p->section + 6);
-            return CLI_EXIT_USAGE;
-        }
-        if (wetdem_sim_set_param_str(sim, name, p->value) != WETDEM_OK)
-            return lib_error(sc, p, p->section, sim);
-    }
-    return CLI_EXIT_OK;
+        return cli_scenario_lib_error(sc, ms, "models", sim);
+    return cli_scenario_set_model_params(sc, sim);
 }
 
 /* [integrator] (the many mode steps with velocity Verlet: verlet.dt and verlet.dt_fraction
@@ -259,7 +222,7 @@ static int build_settings(const struct cli_scenario* sc, struct wetdem_sim* sim)
         char full[2 * CLI_NAME_MAX];
         snprintf(full, sizeof full, "%s.%s", integ ? "verlet" : "sim", p->key);
         if (wetdem_sim_set_param_str(sim, full, p->value) != WETDEM_OK)
-            return lib_error(sc, p, p->section, sim);
+            return cli_scenario_lib_error(sc, p, p->section, sim);
     }
     return CLI_EXIT_OK;
 }
@@ -271,28 +234,6 @@ struct materials {
     int index[MAX_MATERIALS];
     size_t n;
 };
-
-static int material_from_section(const struct cli_scenario* sc, const char* section,
-                                 struct wetdem_material* m)
-{
-    const struct cli_entry* p = cli_scenario_find(sc, section, "preset");
-    wetdem_param_init_defaults(wetdem_material_params(), m);
-    if (p && wetdem_material_preset(p->value, m) != WETDEM_OK) {
-        const char* hint = wetdem_param_suggest(p->value, wetdem_material_preset_names());
-        cli_scenario_error(sc, p, "unknown material preset%s%s%s", hint ? " (did you mean '" : "",
-                           hint ? hint : "", hint ? "'?)" : "");
-        return CLI_EXIT_USAGE;
-    }
-    for (const struct wetdem_param_desc* d = wetdem_material_params(); d->name; d++)
-        *(double*)((char*)m + d->offset) =
-            cli_scenario_number(sc, section, d->name, *(double*)((char*)m + d->offset));
-    char msg[512];
-    if (wetdem_material_validate(m, msg, sizeof msg) != WETDEM_OK) {
-        cli_scenario_section_error(sc, section, "%s", msg);
-        return CLI_EXIT_USAGE;
-    }
-    return CLI_EXIT_OK;
-}
 
 /* Index of material `name` in sim, added on first use ([material.NAME] first, then a preset).
  * `use` is the entry naming it (NULL: the default, reported at `section`). */
@@ -309,7 +250,7 @@ static int material_index(const struct cli_scenario* sc, struct wetdem_sim* sim,
     snprintf(msec, sizeof msec, "material.%s", name);
     struct wetdem_material m;
     if (cli_scenario_has_section(sc, msec)) {
-        int rc = material_from_section(sc, msec, &m);
+        int rc = cli_scenario_material_section(sc, msec, &m);
         if (rc != CLI_EXIT_OK)
             return rc;
     } else if (wetdem_material_preset(name, &m) != WETDEM_OK) {
@@ -330,7 +271,7 @@ static int material_index(const struct cli_scenario* sc, struct wetdem_sim* sim,
     }
     *index = wetdem_sim_add_material(sim, &m);
     if (*index < 0)
-        return lib_error(sc, use, section, sim);
+        return cli_scenario_lib_error(sc, use, section, sim);
     mt->names[mt->n] = name;
     mt->index[mt->n++] = *index;
     return CLI_EXIT_OK;
@@ -424,7 +365,8 @@ static int build_walls(const struct cli_scenario* sc, struct cli_many_setup* su,
         if (wetdem_sim_add_wall(su->sim, (struct wetdem_vec3){point[0], point[1], point[2]},
                                 (struct wetdem_vec3){normal[0], normal[1], normal[2]},
                                 mat) != WETDEM_OK)
-            return lib_error(sc, cli_scenario_find(sc, "walls", "faces"), "walls", su->sim);
+            return cli_scenario_lib_error(sc, cli_scenario_find(sc, "walls", "faces"), "walls",
+                                          su->sim);
     }
     return CLI_EXIT_OK;
 }
@@ -542,7 +484,7 @@ static int build_particle(const struct cli_scenario* sc, struct cli_many_setup* 
     if (rc != CLI_EXIT_OK)
         return rc;
     if (wetdem_sim_add_particle(su->sim, p) != WETDEM_OK)
-        return lib_error(sc, NULL, section, su->sim);
+        return cli_scenario_lib_error(sc, NULL, section, su->sim);
     return CLI_EXIT_OK;
 }
 
@@ -706,7 +648,7 @@ int cli_many_build(const struct cli_scenario* sc, struct cli_many_setup* su)
     const char* first = NULL;
     unsigned faces = 0;
     int rc;
-    if ((rc = build_fluid(sc, su->sim)) != CLI_EXIT_OK ||
+    if ((rc = cli_scenario_build_fluid(sc, su->sim)) != CLI_EXIT_OK ||
         (rc = build_models(sc, su->sim)) != CLI_EXIT_OK ||
         (rc = build_settings(sc, su->sim)) != CLI_EXIT_OK ||
         (rc = build_box(sc, su)) != CLI_EXIT_OK || (rc = wall_faces(sc, su, &faces)) != CLI_EXIT_OK ||
