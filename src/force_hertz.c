@@ -357,13 +357,6 @@ double wetdem_force_hertz_contact_time(double e_star, double r_eff, double m_eff
     return HERTZ_CONTACT_TIME_CONSTANT * pow(m_eff * m_eff / (e_star * e_star * r_eff * v), 0.2);
 }
 
-static double hertz_range(const void* params, const struct wetdem_contact* c)
-{
-    (void)params;
-    (void)c;
-    return 0.0;
-}
-
 static int hertz_pair(const void* params, const struct wetdem_contact* c, double* history,
                       struct wetdem_pair_force* out)
 {
@@ -382,16 +375,6 @@ static int hertz_pair(const void* params, const struct wetdem_contact* c, double
                                                             c->v_n, c->restitution, form),
                                  form);
     return WETDEM_OK;
-}
-
-static size_t hertz_thresholds(const void* params, const struct wetdem_contact* c,
-                               const double* history, double* gaps)
-{
-    (void)params;
-    (void)c;
-    (void)history;
-    gaps[0] = 0.0;
-    return 1;
 }
 
 const struct wetdem_model wetdem_force_hertz = {
@@ -420,7 +403,7 @@ const struct wetdem_model wetdem_force_hertz = {
     .params = hertz_params_desc,
     .params_size = sizeof(struct hertz_params),
     .history_len = 0,
-    .range = hertz_range,
+    .range = contact_only_range,
     .pair = hertz_pair,
-    .thresholds = hertz_thresholds,
+    .thresholds = contact_only_thresholds,
 };

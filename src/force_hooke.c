@@ -39,13 +39,6 @@ static double hooke_damping(double k, double m_eff, double e)
     return -2.0 * l * sqrt(m_eff * k) / sqrt(l * l + M_PI * M_PI);
 }
 
-static double hooke_range(const void* params, const struct wetdem_contact* c)
-{
-    (void)params;
-    (void)c;
-    return 0.0;
-}
-
 static int hooke_pair(const void* params, const struct wetdem_contact* c, double* history,
                       struct wetdem_pair_force* out)
 {
@@ -58,16 +51,6 @@ static int hooke_pair(const void* params, const struct wetdem_contact* c, double
         return WETDEM_OK;
     out->f_normal += k * overlap + hooke_damping(k, c->m_eff, c->restitution) * c->v_n;
     return WETDEM_OK;
-}
-
-static size_t hooke_thresholds(const void* params, const struct wetdem_contact* c,
-                               const double* history, double* gaps)
-{
-    (void)params;
-    (void)c;
-    (void)history;
-    gaps[0] = 0.0;
-    return 1;
 }
 
 const struct wetdem_model wetdem_force_hooke = {
@@ -87,7 +70,7 @@ const struct wetdem_model wetdem_force_hooke = {
     .params = hooke_params_desc,
     .params_size = sizeof(struct hooke_params),
     .history_len = 0,
-    .range = hooke_range,
+    .range = contact_only_range,
     .pair = hooke_pair,
-    .thresholds = hooke_thresholds,
+    .thresholds = contact_only_thresholds,
 };

@@ -116,13 +116,6 @@ struct wetdem_vec3 wetdem_force_mindlin_update_with(const struct wetdem_contact*
     return ft;
 }
 
-static double mindlin_range(const void* params, const struct wetdem_contact* c)
-{
-    (void)params;
-    (void)c;
-    return 0.0;
-}
-
 static int mindlin_pair(const void* params, const struct wetdem_contact* c, double* history,
                         struct wetdem_pair_force* out)
 {
@@ -136,16 +129,6 @@ static int mindlin_pair(const void* params, const struct wetdem_contact* c, doub
     if (overlap > 0.0)
         wetdem_pair_force_add_tangential(out, c, ft);
     return WETDEM_OK;
-}
-
-static size_t mindlin_thresholds(const void* params, const struct wetdem_contact* c,
-                                 const double* history, double* gaps)
-{
-    (void)params;
-    (void)c;
-    (void)history;
-    gaps[0] = 0.0;
-    return 1;
 }
 
 const struct wetdem_model wetdem_force_mindlin = {
@@ -175,7 +158,7 @@ const struct wetdem_model wetdem_force_mindlin = {
     .params = mindlin_params_desc,
     .params_size = sizeof(struct mindlin_params),
     .history_len = 3,
-    .range = mindlin_range,
+    .range = contact_only_range,
     .pair = mindlin_pair,
-    .thresholds = mindlin_thresholds,
+    .thresholds = contact_only_thresholds,
 };

@@ -27,6 +27,27 @@ extern const struct wetdem_model wetdem_minsep_ehd;
 extern const struct wetdem_model wetdem_minsep_max;
 extern const struct wetdem_model wetdem_minsep_glass;
 
+/* ---- hooks shared by the models that act only in solid contact (hertz, mindlin, hooke) ---- */
+
+/* Range of a contact-only model [m]: 0, it acts only where the gap is negative. */
+static inline double contact_only_range(const void* params, const struct wetdem_contact* c)
+{
+    (void)params;
+    (void)c;
+    return 0.0;
+}
+
+/* Branch gaps of a contact-only model: the force switches on at gap 0 [m]. Returns 1. */
+static inline size_t contact_only_thresholds(const void* params, const struct wetdem_contact* c,
+                                             const double* history, double* gaps)
+{
+    (void)params;
+    (void)c;
+    (void)history;
+    gaps[0] = 0.0;
+    return 1;
+}
+
 /* ---- shared kernels (pure functions; defined in the file of the family they belong to) ---- */
 
 /* force_hertz.c: Hertz elastic normal force (4/3) E* sqrt(R*) delta^(3/2) [N]; 0 if delta <= 0. */
