@@ -354,8 +354,11 @@ static int report_failure(struct wetdem_sim* sim, const struct failure* f)
                                                            : wetdem_status_name(f->status));
 }
 
+/* This thread's work accumulators (pair or wall contacts), NULL without an energy budget. */
 static double* thread_work(const struct wetdem_many* m, int wall)
 {
+    if (!m->set.energy_budget)
+        return NULL;
     return m->thread_work + (size_t)omp_get_thread_num() * 2 * WETDEM_MAX_MODELS +
            (size_t)wall * WETDEM_MAX_MODELS;
 }
