@@ -37,12 +37,6 @@ static double davis_resistance(double mu, double a, double h, double delta)
     return 2.0 * M_PI * mu * a * log((2.0 * delta - h) / h);
 }
 
-static double davis_range(const void* params, const struct wetdem_contact* c)
-{
-    (void)params;
-    return thin_film_range(c);
-}
-
 static int davis_pair(const void* params, const struct wetdem_contact* c, double* history,
                       struct wetdem_pair_force* out)
 {
@@ -54,14 +48,6 @@ static int davis_pair(const void* params, const struct wetdem_contact* c, double
     double k = davis_resistance(c->viscosity, c->r_eff, h, c->film);
     wetdem_pair_force_add_tangential(out, c, vec3_scale(c->v_t, -k));
     return WETDEM_OK;
-}
-
-static size_t davis_thresholds(const void* params, const struct wetdem_contact* c,
-                               const double* history, double* gaps)
-{
-    (void)params;
-    (void)history;
-    return thin_film_thresholds(c, gaps);
 }
 
 const struct wetdem_model wetdem_force_davis = {
@@ -81,7 +67,7 @@ const struct wetdem_model wetdem_force_davis = {
     .params = davis_params_desc,
     .params_size = sizeof(struct davis_params),
     .history_len = 0,
-    .range = davis_range,
+    .range = thin_film_range,
     .pair = davis_pair,
-    .thresholds = davis_thresholds,
+    .thresholds = thin_film_thresholds,
 };

@@ -35,12 +35,6 @@ static double db_force(double mu, double a, double v_n, double h, double delta)
     return 6.0 * M_PI * mu * a * a * v_n / h * bracket * bracket;
 }
 
-static double db_range(const void* params, const struct wetdem_contact* c)
-{
-    (void)params;
-    return thin_film_range(c);
-}
-
 static int db_pair(const void* params, const struct wetdem_contact* c, double* history,
                    struct wetdem_pair_force* out)
 {
@@ -50,14 +44,6 @@ static int db_pair(const void* params, const struct wetdem_contact* c, double* h
     if (thin_film_eval_gap(c->gap, c->h_min, c->film, p->below_hmin, &h))
         out->f_normal += db_force(c->viscosity, c->r_eff, c->v_n, h, c->film);
     return WETDEM_OK;
-}
-
-static size_t db_thresholds(const void* params, const struct wetdem_contact* c,
-                            const double* history, double* gaps)
-{
-    (void)params;
-    (void)history;
-    return thin_film_thresholds(c, gaps);
 }
 
 const struct wetdem_model wetdem_force_db = {
@@ -80,7 +66,7 @@ const struct wetdem_model wetdem_force_db = {
     .params = db_params_desc,
     .params_size = sizeof(struct db_params),
     .history_len = 0,
-    .range = db_range,
+    .range = thin_film_range,
     .pair = db_pair,
-    .thresholds = db_thresholds,
+    .thresholds = thin_film_thresholds,
 };

@@ -43,12 +43,6 @@ static double nase_resistance(double mu, double a, double h)
     return 6.0 * M_PI * mu * a * fmax(factor, 0.0);
 }
 
-static double nase_range(const void* params, const struct wetdem_contact* c)
-{
-    (void)params;
-    return thin_film_range(c);
-}
-
 static int nase_pair(const void* params, const struct wetdem_contact* c, double* history,
                      struct wetdem_pair_force* out)
 {
@@ -60,14 +54,6 @@ static int nase_pair(const void* params, const struct wetdem_contact* c, double*
     double k = nase_resistance(c->viscosity, c->r_eff, h);
     wetdem_pair_force_add_tangential(out, c, vec3_scale(c->v_t, -k));
     return WETDEM_OK;
-}
-
-static size_t nase_thresholds(const void* params, const struct wetdem_contact* c,
-                              const double* history, double* gaps)
-{
-    (void)params;
-    (void)history;
-    return thin_film_thresholds(c, gaps);
 }
 
 const struct wetdem_model wetdem_force_nase = {
@@ -89,7 +75,7 @@ const struct wetdem_model wetdem_force_nase = {
     .params = nase_params_desc,
     .params_size = sizeof(struct nase_params),
     .history_len = 0,
-    .range = nase_range,
+    .range = thin_film_range,
     .pair = nase_pair,
-    .thresholds = nase_thresholds,
+    .thresholds = thin_film_thresholds,
 };

@@ -36,12 +36,6 @@ static double sb_force(double mu, double a, double v_n, double h, double delta)
     return 6.0 * M_PI * mu * a * a * v_n / h * bracket * bracket;
 }
 
-static double sb_range(const void* params, const struct wetdem_contact* c)
-{
-    (void)params;
-    return thin_film_range(c);
-}
-
 static int sb_pair(const void* params, const struct wetdem_contact* c, double* history,
                    struct wetdem_pair_force* out)
 {
@@ -51,14 +45,6 @@ static int sb_pair(const void* params, const struct wetdem_contact* c, double* h
     if (thin_film_eval_gap(c->gap, c->h_min, c->film, p->below_hmin, &h))
         out->f_normal += sb_force(c->viscosity, c->r_eff, c->v_n, h, c->film);
     return WETDEM_OK;
-}
-
-static size_t sb_thresholds(const void* params, const struct wetdem_contact* c,
-                            const double* history, double* gaps)
-{
-    (void)params;
-    (void)history;
-    return thin_film_thresholds(c, gaps);
 }
 
 const struct wetdem_model wetdem_force_sb = {
@@ -80,7 +66,7 @@ const struct wetdem_model wetdem_force_sb = {
     .params = sb_params_desc,
     .params_size = sizeof(struct sb_params),
     .history_len = 0,
-    .range = sb_range,
+    .range = thin_film_range,
     .pair = sb_pair,
-    .thresholds = sb_thresholds,
+    .thresholds = thin_film_thresholds,
 };

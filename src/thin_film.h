@@ -71,16 +71,20 @@ static inline bool thin_film_eval_gap(double h, double h_min, double delta, doub
     return *h_eval > 0.0;
 }
 
-/* Range of a thin-film law: the film thickness delta [m]. */
-static inline double thin_film_range(const struct wetdem_contact* c)
+/* Range of a thin-film law: the film thickness delta [m]. The models' range hook. */
+static inline double thin_film_range(const void* params, const struct wetdem_contact* c)
 {
+    (void)params;
     return c->film > 0.0 ? c->film : 0.0;
 }
 
-/* Branch gaps of a thin-film law: delta (on/off) and h_min' (c/nc switch). Returns 2. */
-static inline size_t thin_film_thresholds(const struct wetdem_contact* c, double* gaps)
+/* Branch gaps of a thin-film law: delta (on/off) and h_min' (c/nc switch). Returns 2. The
+ * models' thresholds hook. */
+static inline size_t thin_film_thresholds(const void* params, const struct wetdem_contact* c,
+                                          const double* history, double* gaps)
 {
-    gaps[0] = thin_film_range(c);
+    (void)history;
+    gaps[0] = thin_film_range(params, c);
     gaps[1] = thin_film_h_min(c->h_min, gaps[0]);
     return 2;
 }
