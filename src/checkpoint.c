@@ -26,13 +26,13 @@
  * an existing section bumps the version.
  */
 #include <errno.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
 
 #include "checkpoint.h"
+#include "status.h"
 
 #define MAGIC "WETDEMCK"
 #define ENDIAN_MARK 0x01020304u
@@ -41,19 +41,6 @@
 #define PART_BYTES 96
 #define WALL_BYTES 56
 #define KEY_BYTES 24
-
-static int report(char* msg, size_t n, int status, const char* fmt, ...)
-    __attribute__((format(printf, 4, 5)));
-static int report(char* msg, size_t n, int status, const char* fmt, ...)
-{
-    if (msg && n) {
-        va_list ap;
-        va_start(ap, fmt);
-        vsnprintf(msg, n, fmt, ap);
-        va_end(ap);
-    }
-    return status;
-}
 
 /* CRC-32 with a 16-entry table (half a byte per step): small and fast enough for files of a
  * few hundred MB. table[k] = CRC of the 4-bit value k. */
@@ -211,19 +198,19 @@ static int write_file(const char* path, const struct buf* b, char* msg, size_t n
 {
     char tmp[4096];
     if ((size_t)snprintf(tmp, sizeof tmp, "%s.tmp", path) >= sizeof tmp)
-        return report(msg, n, WETDEM_ERR_IO, "checkpoint path too long: '%s'", path);
+        return wetdem_status_fail(msg, n, WETDEM_ERR_IO, "checkpoint path too long: '%s'", path);
     FILE* f = fopen(tmp, "wb");
     if (!f)
-        return report(msg, n, WETDEM_ERR_IO, "cannot open '%s' for writing: %s", tmp,
-                      strerror(errno));
+        return wetdem_status_fail(msg, n, WETDEM_ERR_IO, "cannot open '%s' for writing: %s", tmp,
+                                  strerror(errno));
     bool ok = fwrite(b->data, 1, b->len, f) == b->len && fflush(f) == 0 && fsync(fileno(f)) == 0;
     int err = errno;
     ok = (fclose(f) == 0) && ok;
     if (!ok || rename(tmp, path) != 0) {
         err = ok ? errno : err;
         remove(tmp);
-        return report(msg, n, WETDEM_ERR_IO, "cannot write checkpoint '%s': %s", path,
-                      strerror(err));
+        return wetdem_status_fail(msg, n, WETDEM_ERR_IO, "cannot write checkpoint '%s': %s", path,
+                                  strerror(err));
     }
     return WETDEM_OK;
 }
@@ -245,8 +232,8 @@ int wetdem_checkpoint_write(const char* path, const struct wetdem_checkpoint* ck
         memcpy(b.data + 16, &n_sections, 4);
         put_u32(&b, wetdem_checkpoint_crc32(0, b.data, b.len));
     }
-    int st = b.nomem ? report(msg, msg_size, WETDEM_ERR_NOMEM,
-                              "out of memory writing checkpoint '%s'", path)
+    int st = b.nomem ? wetdem_status_fail(msg, msg_size, WETDEM_ERR_NOMEM,
+                                          "out of memory writing checkpoint '%s'", path)
                      : write_file(path, &b, msg, msg_size);
     free(b.data);
     return st;
@@ -436,21 +423,24 @@ static int parse_section(struct cursor* c, const char tag[4], uint64_t bytes,
 static int check_image(const unsigned char* d, size_t len, const char* path, char* msg, size_t n)
 {
     if (len < HEADER_BYTES + 4 || memcmp(d, MAGIC, 8) != 0)
-        return report(msg, n, WETDEM_ERR_PARSE, "'%s' is not a wetdem checkpoint", path);
+        return wetdem_status_fail(msg, n, WETDEM_ERR_PARSE, "'%s' is not a wetdem checkpoint",
+                                  path);
     uint32_t version, mark, crc;
     memcpy(&version, d + 8, 4);
     memcpy(&mark, d + 12, 4);
     if (mark != ENDIAN_MARK)
-        return report(msg, n, WETDEM_ERR_PARSE,
-                      "checkpoint '%s' was written on a machine of the other byte order", path);
+        return wetdem_status_fail(
+            msg, n, WETDEM_ERR_PARSE,
+            "checkpoint '%s' was written on a machine of the other byte order", path);
     if (version != WETDEM_CHECKPOINT_VERSION)
-        return report(msg, n, WETDEM_ERR_PARSE,
-                      "checkpoint '%s' has format version %u; this wetdem reads version %u",
-                      path, version, WETDEM_CHECKPOINT_VERSION);
+        return wetdem_status_fail(
+            msg, n, WETDEM_ERR_PARSE,
+            "checkpoint '%s' has format version %u; this wetdem reads version %u", path, version,
+            WETDEM_CHECKPOINT_VERSION);
     memcpy(&crc, d + len - 4, 4);
     if (crc != wetdem_checkpoint_crc32(0, d, len - 4))
-        return report(msg, n, WETDEM_ERR_PARSE,
-                      "checkpoint '%s' is corrupted or truncated (CRC mismatch)", path);
+        return wetdem_status_fail(msg, n, WETDEM_ERR_PARSE,
+                                  "checkpoint '%s' is corrupted or truncated (CRC mismatch)", path);
     return WETDEM_OK;
 }
 
@@ -490,8 +480,8 @@ static int slurp(const char* path, unsigned char** data, size_t* len, char* msg,
 {
     FILE* f = fopen(path, "rb");
     if (!f)
-        return report(msg, n, WETDEM_ERR_IO, "cannot open checkpoint '%s': %s", path,
-                      strerror(errno));
+        return wetdem_status_fail(msg, n, WETDEM_ERR_IO, "cannot open checkpoint '%s': %s", path,
+                                  strerror(errno));
     long size = (fseek(f, 0, SEEK_END) == 0) ? ftell(f) : -1;
     *data = size >= 0 ? malloc(size ? (size_t)size : 1) : NULL;
     bool ok = *data && fseek(f, 0, SEEK_SET) == 0 &&
@@ -500,8 +490,8 @@ static int slurp(const char* path, unsigned char** data, size_t* len, char* msg,
     if (!ok) {
         free(*data);
         *data = NULL;
-        return report(msg, n, size < 0 ? WETDEM_ERR_IO : WETDEM_ERR_NOMEM,
-                      "cannot read checkpoint '%s'", path);
+        return wetdem_status_fail(msg, n, size < 0 ? WETDEM_ERR_IO : WETDEM_ERR_NOMEM,
+                                  "cannot read checkpoint '%s'", path);
     }
     *len = (size_t)size;
     return WETDEM_OK;
@@ -520,11 +510,12 @@ int wetdem_checkpoint_read(const char* path, struct wetdem_checkpoint* ck, char*
         st = parse_image(data, len, ck);
         if (st != WETDEM_OK) {
             wetdem_checkpoint_clear(ck);
-            report(msg, msg_size, st,
-                   st == WETDEM_ERR_NOMEM ? "out of memory reading checkpoint '%s'"
-                                          : "checkpoint '%s' is malformed (sections or sizes "
-                                            "inconsistent)",
-                   path);
+            wetdem_status_fail(msg, msg_size, st,
+                               st == WETDEM_ERR_NOMEM
+                                   ? "out of memory reading checkpoint '%s'"
+                                   : "checkpoint '%s' is malformed (sections or sizes "
+                                     "inconsistent)",
+                               path);
         }
     }
     free(data);
@@ -563,9 +554,10 @@ int wetdem_checkpoint_restore_rng(const struct wetdem_checkpoint* ck, gsl_rng* r
                                   size_t msg_size)
 {
     if (strcmp(ck->rng_name, gsl_rng_name(rng)) != 0 || ck->rng_size != gsl_rng_size(rng))
-        return report(msg, msg_size, WETDEM_ERR_INVALID,
-                      "checkpoint RNG is '%s' (%zu bytes), the run uses '%s' (%zu bytes)",
-                      ck->rng_name, ck->rng_size, gsl_rng_name(rng), gsl_rng_size(rng));
+        return wetdem_status_fail(
+            msg, msg_size, WETDEM_ERR_INVALID,
+            "checkpoint RNG is '%s' (%zu bytes), the run uses '%s' (%zu bytes)", ck->rng_name,
+            ck->rng_size, gsl_rng_name(rng), gsl_rng_size(rng));
     memcpy(gsl_rng_state(rng), ck->rng_state, ck->rng_size);
     return WETDEM_OK;
 }

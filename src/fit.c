@@ -17,7 +17,6 @@
  * independent with equal variance (after division by s_i).
  */
 #include <math.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -28,6 +27,7 @@
 #include <gsl/gsl_multifit_nlinear.h>
 #include <gsl/gsl_vector.h>
 
+#include "status.h"
 #include "wetdem.h"
 
 struct fit_ctx {
@@ -40,20 +40,6 @@ struct fit_ctx {
     int status;        /* first failure of the model */
     char msg[512];
 };
-
-static int say(char* msg, size_t n, int status, const char* fmt, ...)
-    __attribute__((format(printf, 4, 5)));
-
-static int say(char* msg, size_t n, int status, const char* fmt, ...)
-{
-    if (msg && n > 0) {
-        va_list ap;
-        va_start(ap, fmt);
-        vsnprintf(msg, n, fmt, ap);
-        va_end(ap);
-    }
-    return status;
-}
 
 void wetdem_fit_options_init(struct wetdem_fit_options* opt)
 {
@@ -84,9 +70,9 @@ static int residuals_at(struct fit_ctx* c, const double* q, double* r)
         double s = pb->scale ? pb->scale[i] : 1.0;
         r[i] = (c->pred[i] - pb->observed[i]) / s;
         if (!isfinite(r[i]))
-            st = say(c->msg, sizeof c->msg, WETDEM_ERR_NUMERIC,
-                     "the model gave a non-finite prediction %g for data point %zu", c->pred[i],
-                     i + 1);
+            st = wetdem_status_fail(c->msg, sizeof c->msg, WETDEM_ERR_NUMERIC,
+                                    "the model gave a non-finite prediction %g for data point %zu",
+                                    c->pred[i], i + 1);
     }
     if (st != WETDEM_OK && c->status == WETDEM_OK)
         c->status = st;
@@ -128,31 +114,38 @@ static int check_problem(const struct wetdem_fit_problem* pb, const struct wetde
                          char* msg, size_t n)
 {
     if (pb->n_params < 1 || pb->n_params > WETDEM_FIT_MAX_PARAMS)
-        return say(msg, n, WETDEM_ERR_INVALID, "%zu parameters to fit: must be in [1, %d]",
-                   pb->n_params, WETDEM_FIT_MAX_PARAMS);
+        return wetdem_status_fail(msg, n, WETDEM_ERR_INVALID,
+                                  "%zu parameters to fit: must be in [1, %d]", pb->n_params,
+                                  WETDEM_FIT_MAX_PARAMS);
     if (pb->n_data <= pb->n_params)
-        return say(msg, n, WETDEM_ERR_INVALID,
-                   "%zu data points for %zu parameters: need more points than parameters (the "
-                   "standard errors use the residual variance)", pb->n_data, pb->n_params);
+        return wetdem_status_fail(
+            msg, n, WETDEM_ERR_INVALID,
+            "%zu data points for %zu parameters: need more points than parameters (the "
+            "standard errors use the residual variance)",
+            pb->n_data, pb->n_params);
     if (!pb->model || !pb->initial || !pb->observed)
-        return say(msg, n, WETDEM_ERR_INVALID, "model, initial values and observations needed");
+        return wetdem_status_fail(msg, n, WETDEM_ERR_INVALID,
+                                  "model, initial values and observations needed");
     for (size_t j = 0; j < pb->n_params; j++) {
         bool lg = pb->is_log ? pb->is_log[j] : pb->initial[j] > 0;
         if (!isfinite(pb->initial[j]) || (lg && !(pb->initial[j] > 0)))
-            return say(msg, n, WETDEM_ERR_INVALID, "%s: initial value %g must be finite%s",
-                       param_name(pb, j), pb->initial[j], lg ? " and > 0 (log fit)" : "");
+            return wetdem_status_fail(msg, n, WETDEM_ERR_INVALID,
+                                      "%s: initial value %g must be finite%s", param_name(pb, j),
+                                      pb->initial[j], lg ? " and > 0 (log fit)" : "");
     }
     for (size_t i = 0; i < pb->n_data; i++)
         if (!isfinite(pb->observed[i]) || (pb->scale && !(pb->scale[i] > 0)))
-            return say(msg, n, WETDEM_ERR_INVALID,
-                       "data point %zu: observation %g must be finite and its scale > 0", i + 1,
-                       pb->observed[i]);
+            return wetdem_status_fail(
+                msg, n, WETDEM_ERR_INVALID,
+                "data point %zu: observation %g must be finite and its scale > 0", i + 1,
+                pb->observed[i]);
     if (o->max_iter < 1 || !(o->fd_step > 0 && o->fd_step < 1) || !(o->xtol > 0) ||
         !(o->gtol > 0) || !(o->ftol > 0))
-        return say(msg, n, WETDEM_ERR_INVALID,
-                   "fit options: max_iter >= 1, tolerances > 0 and fd_step in (0, 1) needed "
-                   "(got %d, %g, %g, %g, %g)", o->max_iter, o->xtol, o->gtol, o->ftol,
-                   o->fd_step);
+        return wetdem_status_fail(
+            msg, n, WETDEM_ERR_INVALID,
+            "fit options: max_iter >= 1, tolerances > 0 and fd_step in (0, 1) needed "
+            "(got %d, %g, %g, %g, %g)",
+            o->max_iter, o->xtol, o->gtol, o->ftol, o->fd_step);
     return WETDEM_OK;
 }
 
@@ -197,8 +190,8 @@ static int solve(struct fit_ctx* c, const struct wetdem_fit_options* o, gsl_vect
     if (gst == GSL_EMAXITER)
         return WETDEM_ERR_MAX_STEPS;
     if (gst != GSL_SUCCESS)
-        return say(c->msg, sizeof c->msg, WETDEM_ERR_STEP, "the trust-region solver stopped: %s",
-                   gsl_strerror(gst));
+        return wetdem_status_fail(c->msg, sizeof c->msg, WETDEM_ERR_STEP,
+                                  "the trust-region solver stopped: %s", gsl_strerror(gst));
     return WETDEM_OK;
 }
 
@@ -220,7 +213,7 @@ int wetdem_fit_run(const struct wetdem_fit_problem* problem, const struct wetdem
     gsl_multifit_nlinear_workspace* w =
         gsl_multifit_nlinear_alloc(gsl_multifit_nlinear_trust, &fp, n, np);
     if (!c.pred || !c.r_plus || !x0 || !covar || !w) {
-        st = say(msg, msg_size, WETDEM_ERR_NOMEM, "out of memory");
+        st = wetdem_status_fail(msg, msg_size, WETDEM_ERR_NOMEM, "out of memory");
         goto done;
     }
     for (size_t j = 0; j < np; j++) {
@@ -236,10 +229,10 @@ int wetdem_fit_run(const struct wetdem_fit_problem* problem, const struct wetdem
             memcpy(predicted, c.pred, n * sizeof *predicted);
     }
     if (st == WETDEM_ERR_MAX_STEPS)
-        say(msg, msg_size, st, "no convergence in %d iterations (cost %g)", opt->max_iter,
-            result->cost);
+        wetdem_status_fail(msg, msg_size, st, "no convergence in %d iterations (cost %g)",
+                           opt->max_iter, result->cost);
     else if (st != WETDEM_OK)
-        say(msg, msg_size, st, "%s", c.msg);
+        wetdem_status_fail(msg, msg_size, st, "%s", c.msg);
 done:
     gsl_multifit_nlinear_free(w);
     gsl_matrix_free(covar);

@@ -15,29 +15,16 @@
  */
 #include <gsl/gsl_randist.h>
 #include <gsl/gsl_rng.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "insert.h"
+#include "status.h"
 #include "vec3.h"
 
 #define DEFAULT_ATTEMPTS 10000
 #define RSA_JAMMING 0.38 /* random sequential addition limit of equal spheres [-] */
-
-static int fail(char* msg, size_t n, int status, const char* fmt, ...)
-    __attribute__((format(printf, 4, 5)));
-static int fail(char* msg, size_t n, int status, const char* fmt, ...)
-{
-    if (msg && n) {
-        va_list ap;
-        va_start(ap, fmt);
-        vsnprintf(msg, n, fmt, ap);
-        va_end(ap);
-    }
-    return status;
-}
 
 static double axis(struct wetdem_vec3 v, int k)
 {
@@ -52,33 +39,36 @@ static void set_axis(struct wetdem_vec3* v, int k, double x)
 static int check_spec(const struct wetdem_insert_spec* s, char* msg, size_t n)
 {
     if (s->layout != WETDEM_INSERT_LATTICE && s->layout != WETDEM_INSERT_RANDOM)
-        return fail(msg, n, WETDEM_ERR_INVALID, "insert.layout must be lattice or random");
+        return wetdem_status_fail(msg, n, WETDEM_ERR_INVALID,
+                                  "insert.layout must be lattice or random");
     if (s->n == 0)
-        return fail(msg, n, WETDEM_ERR_INVALID, "insert.count must be >= 1, got 0");
+        return wetdem_status_fail(msg, n, WETDEM_ERR_INVALID, "insert.count must be >= 1, got 0");
     for (int k = 0; k < 3; k++) {
         double lo = axis(s->lo, k), hi = axis(s->hi, k);
         if (!(isfinite(lo) && isfinite(hi) && hi > lo))
-            return fail(msg, n, WETDEM_ERR_INVALID,
-                        "insert region: %c range [%g, %g] m must be finite with hi > lo",
-                        "xyz"[k], lo, hi);
+            return wetdem_status_fail(
+                msg, n, WETDEM_ERR_INVALID,
+                "insert region: %c range [%g, %g] m must be finite with hi > lo", "xyz"[k], lo, hi);
     }
     if (!s->radii && !(isfinite(s->radius_min) && s->radius_min > 0 &&
                        isfinite(s->radius_max) && s->radius_max >= s->radius_min))
-        return fail(msg, n, WETDEM_ERR_INVALID,
-                    "insert radii: need 0 < radius_min <= radius_max (finite), got [%g, %g] m",
-                    s->radius_min, s->radius_max);
+        return wetdem_status_fail(
+            msg, n, WETDEM_ERR_INVALID,
+            "insert radii: need 0 < radius_min <= radius_max (finite), got [%g, %g] m",
+            s->radius_min, s->radius_max);
     if (!(isfinite(s->gap) && s->gap >= 0))
-        return fail(msg, n, WETDEM_ERR_INVALID, "insert.gap must be finite and >= 0 m, got %g",
-                    s->gap);
+        return wetdem_status_fail(msg, n, WETDEM_ERR_INVALID,
+                                  "insert.gap must be finite and >= 0 m, got %g", s->gap);
     if (!(isfinite(s->velocity_sigma) && s->velocity_sigma >= 0) || !vec3_is_finite(s->velocity))
-        return fail(msg, n, WETDEM_ERR_INVALID,
-                    "insert velocity: mean must be finite and sigma >= 0 m/s, got sigma %g",
-                    s->velocity_sigma);
+        return wetdem_status_fail(
+            msg, n, WETDEM_ERR_INVALID,
+            "insert velocity: mean must be finite and sigma >= 0 m/s, got sigma %g",
+            s->velocity_sigma);
     for (size_t i = 0; s->radii && i < s->n; i++)
         if (!(isfinite(s->radii[i]) && s->radii[i] > 0))
-            return fail(msg, n, WETDEM_ERR_INVALID,
-                        "insert radii: radius %zu must be finite and > 0 m, got %g", i,
-                        s->radii[i]);
+            return wetdem_status_fail(msg, n, WETDEM_ERR_INVALID,
+                                      "insert radii: radius %zu must be finite and > 0 m, got %g",
+                                      i, s->radii[i]);
     return WETDEM_OK;
 }
 
@@ -123,11 +113,12 @@ static int place_lattice(const struct wetdem_insert_spec* s, double r_max,
         m[k] = lattice_axis(s, k, r_max, &first[k], &step[k]);
     double sites = (double)m[0] * (double)m[1] * (double)m[2];
     if (sites < (double)s->n)
-        return fail(msg, n, WETDEM_ERR_INVALID,
-                    "insert: the region holds at most %.0f spheres (%zu x %zu x %zu) on a "
-                    "lattice of spacing 2 radius_max + gap = %g m, but count = %zu; enlarge "
-                    "the region or reduce count, radius_max (%g m) or gap (%g m)",
-                    sites, m[0], m[1], m[2], 2 * r_max + s->gap, s->n, r_max, s->gap);
+        return wetdem_status_fail(
+            msg, n, WETDEM_ERR_INVALID,
+            "insert: the region holds at most %.0f spheres (%zu x %zu x %zu) on a "
+            "lattice of spacing 2 radius_max + gap = %g m, but count = %zu; enlarge "
+            "the region or reduce count, radius_max (%g m) or gap (%g m)",
+            sites, m[0], m[1], m[2], 2 * r_max + s->gap, s->n, r_max, s->gap);
     for (size_t i = 0; i < s->n; i++) {
         size_t c[3] = {i % m[0], (i / m[0]) % m[1], i / (m[0] * m[1])};
         for (int k = 0; k < 3; k++)
@@ -247,9 +238,11 @@ static int place_one(const struct wetdem_insert_spec* s, gsl_rng* rng, struct gr
     for (size_t t = 0; t < attempts; t++) {
         struct wetdem_vec3 x;
         if (!random_position(s, rng, out[i].radius, &x))
-            return fail(msg, n, WETDEM_ERR_INVALID,
-                        "insert: sphere %zu of radius %g m plus gap %g m does not fit in the "
-                        "region", i, out[i].radius, s->gap);
+            return wetdem_status_fail(
+                msg, n, WETDEM_ERR_INVALID,
+                "insert: sphere %zu of radius %g m plus gap %g m does not fit in the "
+                "region",
+                i, out[i].radius, s->gap);
         if (!is_free(g, out, x, out[i].radius, s->gap))
             continue;
         out[i].pos = x;
@@ -261,12 +254,13 @@ static int place_one(const struct wetdem_insert_spec* s, gsl_rng* rng, struct gr
     double vol = g->len[0] * g->len[1] * g->len[2], solid = 0;
     for (size_t q = 0; q < s->n; q++)
         solid += 4.0 / 3.0 * M_PI * out[q].radius * out[q].radius * out[q].radius;
-    return fail(msg, n, WETDEM_ERR_INVALID,
-                "insert: placed %zu of %zu spheres; sphere %zu (radius %g m) found no free "
-                "place in %zu random trials. The requested volume fraction %.3f is too close to "
-                "the random-insertion limit (~%.2f): use layout = lattice, a larger region or "
-                "fewer spheres",
-                placed, s->n, i, out[i].radius, attempts, solid / vol, RSA_JAMMING);
+    return wetdem_status_fail(
+        msg, n, WETDEM_ERR_INVALID,
+        "insert: placed %zu of %zu spheres; sphere %zu (radius %g m) found no free "
+        "place in %zu random trials. The requested volume fraction %.3f is too close to "
+        "the random-insertion limit (~%.2f): use layout = lattice, a larger region or "
+        "fewer spheres",
+        placed, s->n, i, out[i].radius, attempts, solid / vol, RSA_JAMMING);
 }
 
 static int place_random(const struct wetdem_insert_spec* s, gsl_rng* rng, double r_max,
@@ -274,15 +268,17 @@ static int place_random(const struct wetdem_insert_spec* s, gsl_rng* rng, double
 {
     for (int k = 0; k < 3; k++)
         if (s->periodic[k] && axis(s->hi, k) - axis(s->lo, k) < 2 * r_max + s->gap)
-            return fail(msg, n, WETDEM_ERR_INVALID,
-                        "insert: periodic length along %c (%g m) is below 2 radius_max + gap "
-                        "= %g m: a sphere would touch its own image",
-                        "xyz"[k], axis(s->hi, k) - axis(s->lo, k), 2 * r_max + s->gap);
+            return wetdem_status_fail(
+                msg, n, WETDEM_ERR_INVALID,
+                "insert: periodic length along %c (%g m) is below 2 radius_max + gap "
+                "= %g m: a sphere would touch its own image",
+                "xyz"[k], axis(s->hi, k) - axis(s->lo, k), 2 * r_max + s->gap);
     struct grid g = {0};
     double* order = malloc(2 * s->n * sizeof *order);
     int st = order ? grid_init(&g, s, 2 * r_max + s->gap) : WETDEM_ERR_NOMEM;
     if (st != WETDEM_OK) {
-        st = fail(msg, n, WETDEM_ERR_NOMEM, "insert: out of memory for %zu spheres", s->n);
+        st = wetdem_status_fail(msg, n, WETDEM_ERR_NOMEM, "insert: out of memory for %zu spheres",
+                                s->n);
     } else {
         for (size_t i = 0; i < s->n; i++) {
             order[2 * i] = out[i].radius;
@@ -306,12 +302,11 @@ int wetdem_insert_particles(const struct wetdem_insert_spec* spec, struct wetdem
         return st;
     gsl_rng* rng = gsl_rng_alloc(gsl_rng_mt19937);
     if (!rng)
-        return fail(msg, msg_size, WETDEM_ERR_NOMEM, "insert: out of memory");
+        return wetdem_status_fail(msg, msg_size, WETDEM_ERR_NOMEM, "insert: out of memory");
     gsl_rng_set(rng, spec->seed);
     double r_max = draw_radii(spec, rng, out);
     st = spec->layout == WETDEM_INSERT_LATTICE ? place_lattice(spec, r_max, out, msg, msg_size)
-                                               : place_random(spec, rng, r_max, out, msg,
-                                                              msg_size);
+                                               : place_random(spec, rng, r_max, out, msg, msg_size);
     for (size_t i = 0; st == WETDEM_OK && i < spec->n; i++) {
         double sd = spec->velocity_sigma;
         out[i].vel = vec3(spec->velocity.x + gsl_ran_gaussian_ziggurat(rng, sd),

@@ -17,24 +17,12 @@
  * Files are written to "<path>.tmp" and renamed into place (atomic on POSIX file systems).
  */
 #include <errno.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "output_vtk.h"
-
-static int io_fail(char* msg, size_t n, const char* fmt, ...) __attribute__((format(printf, 3, 4)));
-static int io_fail(char* msg, size_t n, const char* fmt, ...)
-{
-    if (msg && n) {
-        va_list ap;
-        va_start(ap, fmt);
-        vsnprintf(msg, n, fmt, ap);
-        va_end(ap);
-    }
-    return WETDEM_ERR_IO;
-}
+#include "status.h"
 
 static bool host_is_little_endian(void)
 {
@@ -156,7 +144,8 @@ static int finish_atomic(FILE* f, const char* tmp, const char* path, char* msg, 
     if (!ok || rename(tmp, path) != 0) {
         int err = errno;
         remove(tmp);
-        return io_fail(msg, n, "cannot write '%s': %s", path, strerror(err));
+        return wetdem_status_fail(msg, n, WETDEM_ERR_IO, "cannot write '%s': %s", path,
+                                  strerror(err));
     }
     return WETDEM_OK;
 }
@@ -164,12 +153,13 @@ static int finish_atomic(FILE* f, const char* tmp, const char* path, char* msg, 
 static FILE* open_tmp(const char* path, char* tmp, size_t tmp_size, char* msg, size_t n)
 {
     if ((size_t)snprintf(tmp, tmp_size, "%s.tmp", path) >= tmp_size) {
-        io_fail(msg, n, "output path too long: '%s'", path);
+        wetdem_status_fail(msg, n, WETDEM_ERR_IO, "output path too long: '%s'", path);
         return NULL;
     }
     FILE* f = fopen(tmp, "wb");
     if (!f)
-        io_fail(msg, n, "cannot open '%s' for writing: %s", tmp, strerror(errno));
+        wetdem_status_fail(msg, n, WETDEM_ERR_IO, "cannot open '%s' for writing: %s", tmp,
+                           strerror(errno));
     return f;
 }
 
@@ -178,7 +168,8 @@ int wetdem_output_vtk_write(const char* path, const struct wetdem_particle* p, s
                             size_t msg_size)
 {
     if (n > INT32_MAX)
-        return io_fail(msg, msg_size, "too many particles for a legacy VTK file: %zu", n);
+        return wetdem_status_fail(msg, msg_size, WETDEM_ERR_IO,
+                                  "too many particles for a legacy VTK file: %zu", n);
     char tmp[4096];
     FILE* f = open_tmp(path, tmp, sizeof tmp, msg, msg_size);
     if (!f)

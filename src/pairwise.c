@@ -30,6 +30,7 @@
 #include <sunmatrix/sunmatrix_dense.h>
 
 #include "pairwise.h"
+#include "status.h"
 
 enum { REV_NONE = 0, REV_IMPULSE = 1, REV_FILM = 2 };
 enum { G_FILM = 0, G_CONTACT = 1, G_RELEASE = 2, G_KINDS = 3 };
@@ -184,81 +185,86 @@ void wetdem_pairwise_config_init(struct wetdem_pairwise_config* cfg)
     cfg->max_events = 100000;
 }
 
-static int bad(char* msg, size_t n, const char* fmt, ...) __attribute__((format(printf, 3, 4)));
-
-static int bad(char* msg, size_t n, const char* fmt, ...)
-{
-    if (msg && n > 0) {
-        va_list ap;
-        va_start(ap, fmt);
-        vsnprintf(msg, n, fmt, ap);
-        va_end(ap);
-    }
-    return WETDEM_ERR_INVALID;
-}
-
 static int validate_sphere(const struct wetdem_pairwise_sphere* s, size_t i, char* msg, size_t n)
 {
     if (!(s->radius > 0.0) || !isfinite(s->radius))
-        return bad(msg, n, "spheres[%zu].radius = %g m: must be in (0, inf)", i, s->radius);
+        return wetdem_status_fail(msg, n, WETDEM_ERR_INVALID,
+                                  "spheres[%zu].radius = %g m: must be in (0, inf)", i, s->radius);
     if (!(s->mass > 0.0) || !isfinite(s->mass))
-        return bad(msg, n, "spheres[%zu].mass = %g kg: must be in (0, inf)", i, s->mass);
+        return wetdem_status_fail(msg, n, WETDEM_ERR_INVALID,
+                                  "spheres[%zu].mass = %g kg: must be in (0, inf)", i, s->mass);
     if (!(s->film >= 0.0) || !isfinite(s->film))
-        return bad(msg, n, "spheres[%zu].film = %g m: must be in [0, inf)", i, s->film);
+        return wetdem_status_fail(msg, n, WETDEM_ERR_INVALID,
+                                  "spheres[%zu].film = %g m: must be in [0, inf)", i, s->film);
     double v[5] = {s->x, s->y, s->vx, s->vy, s->omega};
     const char* names[5] = {"x", "y", "vx", "vy", "omega"};
     for (int k = 0; k < 5; k++)
         if (!isfinite(v[k]))
-            return bad(msg, n, "spheres[%zu].%s = %g: must be finite", i, names[k], v[k]);
+            return wetdem_status_fail(msg, n, WETDEM_ERR_INVALID,
+                                      "spheres[%zu].%s = %g: must be finite", i, names[k], v[k]);
     return WETDEM_OK;
 }
 
 static int validate_scalars(const struct wetdem_pairwise_config* c, char* msg, size_t n)
 {
     if (!(c->viscosity >= 0.0) || !isfinite(c->viscosity))
-        return bad(msg, n, "viscosity = %g Pa s: must be in [0, inf)", c->viscosity);
+        return wetdem_status_fail(msg, n, WETDEM_ERR_INVALID,
+                                  "viscosity = %g Pa s: must be in [0, inf)", c->viscosity);
     if (!(c->surface_tension >= 0.0) || !isfinite(c->surface_tension))
-        return bad(msg, n, "surface_tension = %g N/m: must be in [0, inf)", c->surface_tension);
+        return wetdem_status_fail(msg, n, WETDEM_ERR_INVALID,
+                                  "surface_tension = %g N/m: must be in [0, inf)",
+                                  c->surface_tension);
     if (!(c->h_min > 0.0) || !isfinite(c->h_min))
-        return bad(msg, n, "h_min = %g m: must be in (0, inf)", c->h_min);
+        return wetdem_status_fail(msg, n, WETDEM_ERR_INVALID, "h_min = %g m: must be in (0, inf)",
+                                  c->h_min);
     if (!(c->restitution > 0.0 && c->restitution <= 1.0))
-        return bad(msg, n, "restitution = %g: must be in (0, 1]", c->restitution);
+        return wetdem_status_fail(msg, n, WETDEM_ERR_INVALID, "restitution = %g: must be in (0, 1]",
+                                  c->restitution);
     if (!(c->friction >= 0.0) || !isfinite(c->friction))
-        return bad(msg, n, "friction = %g: must be in [0, inf)", c->friction);
+        return wetdem_status_fail(msg, n, WETDEM_ERR_INVALID, "friction = %g: must be in [0, inf)",
+                                  c->friction);
     if (!isfinite(c->gravity_x) || !isfinite(c->gravity_y))
-        return bad(msg, n, "gravity = (%g, %g) m/s^2: must be finite", c->gravity_x, c->gravity_y);
+        return wetdem_status_fail(msg, n, WETDEM_ERR_INVALID,
+                                  "gravity = (%g, %g) m/s^2: must be finite", c->gravity_x,
+                                  c->gravity_y);
     if (!(c->t_end > 0.0) || !isfinite(c->t_end))
-        return bad(msg, n, "t_end = %g s: must be in (0, inf)", c->t_end);
+        return wetdem_status_fail(msg, n, WETDEM_ERR_INVALID, "t_end = %g s: must be in (0, inf)",
+                                  c->t_end);
     if (!(c->rtol >= 1e-14 && c->rtol <= 1e-3))
-        return bad(msg, n, "rtol = %g: must be in [1e-14, 1e-3]", c->rtol);
+        return wetdem_status_fail(msg, n, WETDEM_ERR_INVALID, "rtol = %g: must be in [1e-14, 1e-3]",
+                                  c->rtol);
     if (!(c->rest_speed_ratio >= 0.0 && c->rest_speed_ratio < 1.0))
-        return bad(msg, n, "rest_speed_ratio = %g: must be in [0, 1)", c->rest_speed_ratio);
+        return wetdem_status_fail(msg, n, WETDEM_ERR_INVALID,
+                                  "rest_speed_ratio = %g: must be in [0, 1)", c->rest_speed_ratio);
     if (c->max_events < 1)
-        return bad(msg, n, "max_events = %zu: must be >= 1", c->max_events);
+        return wetdem_status_fail(msg, n, WETDEM_ERR_INVALID, "max_events = %zu: must be >= 1",
+                                  c->max_events);
     return WETDEM_OK;
 }
 
 int wetdem_pairwise_config_validate(const struct wetdem_pairwise_config* c, char* msg, size_t n)
 {
     if (c->n_spheres < 2 || c->n_spheres > WETDEM_PAIRWISE_MAX_SPHERES)
-        return bad(msg, n, "n_spheres = %zu: must be in [2, %d]", c->n_spheres,
-                   WETDEM_PAIRWISE_MAX_SPHERES);
+        return wetdem_status_fail(msg, n, WETDEM_ERR_INVALID, "n_spheres = %zu: must be in [2, %d]",
+                                  c->n_spheres, WETDEM_PAIRWISE_MAX_SPHERES);
     int st = validate_scalars(c, msg, n);
     for (size_t i = 0; i < c->n_spheres && st == WETDEM_OK; i++)
         st = validate_sphere(&c->spheres[i], i, msg, n);
     if (st != WETDEM_OK)
         return st;
     if (c->ref_i >= c->n_spheres || c->ref_j >= c->n_spheres || c->ref_i == c->ref_j)
-        return bad(msg, n, "reference pair (%zu, %zu): must be two different spheres < %zu",
-                   c->ref_i, c->ref_j, c->n_spheres);
+        return wetdem_status_fail(msg, n, WETDEM_ERR_INVALID,
+                                  "reference pair (%zu, %zu): must be two different spheres < %zu",
+                                  c->ref_i, c->ref_j, c->n_spheres);
     for (size_t i = 0; i < c->n_spheres; i++)
         for (size_t j = i + 1; j < c->n_spheres; j++) {
             const struct wetdem_pairwise_sphere *a = &c->spheres[i], *b = &c->spheres[j];
             double h = hypot(b->x - a->x, b->y - a->y) - a->radius - b->radius;
             if (!(h >= c->h_min))
-                return bad(msg, n,
-                           "initial gap of spheres %zu and %zu = %g m: must be >= h_min = %g m", i,
-                           j, h, c->h_min);
+                return wetdem_status_fail(
+                    msg, n, WETDEM_ERR_INVALID,
+                    "initial gap of spheres %zu and %zu = %g m: must be >= h_min = %g m", i, j, h,
+                    c->h_min);
         }
     return WETDEM_OK;
 }

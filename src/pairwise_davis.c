@@ -21,11 +21,11 @@
  * on the groups alone.
  */
 #include <math.h>
-#include <stdarg.h>
 #include <stddef.h>
 #include <stdio.h>
 
 #include "pairwise.h"
+#include "status.h"
 
 #define DEG (M_PI / 180.0)
 
@@ -79,20 +79,6 @@ void wetdem_pairwise_davis_init(struct wetdem_pairwise_davis* d)
     wetdem_param_init_defaults(davis_desc, d);
 }
 
-static int davis_bad(char* msg, size_t n, const char* fmt, ...)
-    __attribute__((format(printf, 3, 4)));
-
-static int davis_bad(char* msg, size_t n, const char* fmt, ...)
-{
-    if (msg && n > 0) {
-        va_list ap;
-        va_start(ap, fmt);
-        vsnprintf(msg, n, fmt, ap);
-        va_end(ap);
-    }
-    return WETDEM_ERR_INVALID;
-}
-
 /* Range checks of every field, then the cross-field rules. */
 static int davis_validate(const struct wetdem_pairwise_davis* d, char* msg, size_t n)
 {
@@ -104,15 +90,19 @@ static int davis_validate(const struct wetdem_pairwise_davis* d, char* msg, size
             return WETDEM_ERR_INVALID;
     }
     if (d->n_spheres != 2 && d->n_spheres != 3)
-        return davis_bad(msg, n, "n_spheres = %g: must be 2 or 3", d->n_spheres);
+        return wetdem_status_fail(msg, n, WETDEM_ERR_INVALID, "n_spheres = %g: must be 2 or 3",
+                                  d->n_spheres);
     if (d->n_spheres == 3) {
         if (d->d23 + d->d13 < 1.0 || d->d13 - d->d23 < -1.0 || d->d23 - d->d13 < -1.0)
-            return davis_bad(msg, n,
-                             "d23 = %g, d13 = %g: the single films would be negative; need "
-                             "d23 + d13 >= 1 and |d23 - d13| <= 1",
-                             d->d23, d->d13);
+            return wetdem_status_fail(
+                msg, n, WETDEM_ERR_INVALID,
+                "d23 = %g, d13 = %g: the single films would be negative; need "
+                "d23 + d13 >= 1 and |d23 - d13| <= 1",
+                d->d23, d->d13);
         if (d->h23 < d->hmin_ratio)
-            return davis_bad(msg, n, "h23 = %g: must be >= hmin_ratio = %g", d->h23, d->hmin_ratio);
+            return wetdem_status_fail(msg, n, WETDEM_ERR_INVALID,
+                                      "h23 = %g: must be >= hmin_ratio = %g", d->h23,
+                                      d->hmin_ratio);
     }
     return WETDEM_OK;
 }

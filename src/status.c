@@ -1,7 +1,12 @@
 /*
- * status.c — names of status codes (enum wetdem_status in wetdem.h).
+ * status.c — names of status codes (enum wetdem_status in wetdem.h), and the message of a
+ * failed call into a caller's buffer (status.h).
  * Sign convention as CVODE: 0 success, > 0 success with information, < 0 error.
  */
+#include <stdarg.h>
+#include <stdio.h>
+
+#include "status.h"
 #include "wetdem.h"
 
 const char* wetdem_status_name(int status)
@@ -21,4 +26,15 @@ const char* wetdem_status_name(int status)
     case WETDEM_ERR_NUMERIC: return "WETDEM_ERR_NUMERIC";
     default: return "WETDEM_UNKNOWN";
     }
+}
+
+int wetdem_status_fail(char* msg, size_t msg_size, int status, const char* fmt, ...)
+{
+    if (msg && msg_size > 0) {
+        va_list ap;
+        va_start(ap, fmt);
+        vsnprintf(msg, msg_size, fmt, ap);
+        va_end(ap);
+    }
+    return status;
 }
