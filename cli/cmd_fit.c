@@ -355,18 +355,6 @@ static int fit_model(const double* params, double* predicted, char* msg, size_t 
 
 /* ---- parameters --------------------------------------------------------------------------- */
 
-/* A model name close to `word` (e.g. "glas" -> "glass"), or NULL. */
-static const char* model_suggestion(const char* word)
-{
-    const struct wetdem_model* const* reg = wetdem_model_registry();
-    const char* names[64];
-    size_t k = 0;
-    for (; reg[k] && k + 1 < 64; k++)
-        names[k] = reg[k]->name;
-    names[k] = NULL;
-    return wetdem_param_suggest(word, names);
-}
-
 /* The numeric key `key` of section `section` as named in --fit (tok): the section must exist,
  * the key must be one of its keys (with a suggestion otherwise) and take a number. Sections
  * whose keys are only known when built ([integrator], [sim]) pass here and are checked when
@@ -376,7 +364,7 @@ static int check_key(const char* tok, const char* section, const char* key)
     struct cli_section_info info;
     char msg[512] = "";
     if (cli_section_lookup(section, &info) != 0) {
-        const char* hint = strchr(section, '.') ? NULL : model_suggestion(section);
+        const char* hint = strchr(section, '.') ? NULL : cli_model_suggestion(section);
         if (hint)
             snprintf(msg, sizeof msg, " (did you mean '%s.%s'?)", hint, key);
         else

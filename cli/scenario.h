@@ -182,6 +182,8 @@ struct cli_section_info {
 };
 /* Looks a section name up ("collision", "material.delrin", "model.nijssen"). 0 or -1. */
 int cli_section_lookup(const char* name, struct cli_section_info* info);
+/* The name of a built-in model close to `word` (e.g. "nijsen" -> "nijssen"), or NULL. */
+const char* cli_model_suggestion(const char* word);
 /* Writes " (did you mean [x]?)" or a list of valid sections for an unknown name into msg. */
 void cli_section_suggestion(const char* name, char* msg, size_t n);
 /* Whether s is a non-empty name of letters, digits, '_' and '-'. */

@@ -236,16 +236,21 @@ int cli_section_lookup(const char* name, struct cli_section_info* info)
     return 0;
 }
 
+const char* cli_model_suggestion(const char* word)
+{
+    const struct wetdem_model* const* reg = wetdem_model_registry();
+    const char* names[64];
+    size_t k = 0;
+    for (; reg[k] && k + 1 < 64; k++)
+        names[k] = reg[k]->name;
+    names[k] = NULL;
+    return wetdem_param_suggest(word, names);
+}
+
 void cli_section_suggestion(const char* name, char* msg, size_t n)
 {
     if (strncmp(name, "model.", 6) == 0) {
-        const struct wetdem_model* const* reg = wetdem_model_registry();
-        const char* names[64];
-        size_t k = 0;
-        for (; reg[k] && k + 1 < 64; k++)
-            names[k] = reg[k]->name;
-        names[k] = NULL;
-        const char* hint = wetdem_param_suggest(name + 6, names);
+        const char* hint = cli_model_suggestion(name + 6);
         snprintf(msg, n, ": '%s' is not a model%s%s%s (see 'wetdem models')", name + 6,
                  hint ? "; did you mean [model." : "", hint ? hint : "", hint ? "]?" : "");
         return;
