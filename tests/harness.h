@@ -1,6 +1,7 @@
 /*
  * harness.h — small helpers on top of cmocka for wetdem tests: relative/absolute comparisons
- * that print the test's numbers on failure, and builders of two-sphere contacts.
+ * that print the test's numbers on failure, builders of two-sphere contacts, and running the
+ * command-line tool end to end (its output read whole).
  */
 #ifndef WETDEM_TEST_HARNESS_H
 #define WETDEM_TEST_HARNESS_H
@@ -8,10 +9,13 @@
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
+#include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
+#include <sys/wait.h>
 
 #include <cmocka.h>
 
@@ -88,6 +92,84 @@ static inline void* test_default_params(const struct wetdem_model* model, void* 
 {
     wetdem_param_init_defaults(model->params, storage);
     return storage;
+}
+
+/* ---- the command-line tool ---- */
+
+/* Path of the CLI: $WETDEM_CLI (set by `make test`), else build/wetdem relative to the
+ * working directory (the repository root). */
+static inline const char* test_cli_path(void)
+{
+    const char* p = getenv("WETDEM_CLI");
+    return p && *p ? p : "build/wetdem";
+}
+
+/* Reads the rest of stream f into a NUL-terminated heap buffer (the caller frees it); *len,
+ * if not NULL, receives its length in bytes. */
+static inline char* test_slurp(FILE* f, size_t* len)
+{
+    size_t cap = 1 << 16, n = 0, got;
+    char* buf = malloc(cap);
+    assert_non_null(buf);
+    while ((got = fread(buf + n, 1, cap - n - 1, f)) > 0) {
+        n += got;
+        if (n + 1 == cap) {
+            cap *= 2;
+            buf = realloc(buf, cap);
+            assert_non_null(buf);
+        }
+    }
+    buf[n] = '\0';
+    if (len)
+        *len = n;
+    return buf;
+}
+
+/* The whole file at path as test_slurp gives it, or NULL (and *len 0) when it cannot be
+ * opened. */
+static inline char* test_read_file(const char* path, size_t* len)
+{
+    FILE* f = fopen(path, "rb");
+    if (!f) {
+        if (len)
+            *len = 0;
+        return NULL;
+    }
+    char* text = test_slurp(f, len);
+    fclose(f);
+    return text;
+}
+
+/* Output of one CLI run (heap buffer, the caller frees it) and its exit code (-1 if the
+ * program did not exit normally). */
+struct test_run {
+    char* out;
+    int code;
+};
+
+/* Runs the shell command line "ENV '<CLI>' ARGS" (env may be ""): stdout, and stderr merged
+ * into it when with_stderr (discarded otherwise). */
+static inline struct test_run test_run_cli(const char* env, const char* args, bool with_stderr)
+{
+    char cmd[4096];
+    snprintf(cmd, sizeof cmd, "%s '%s' %s %s", env, test_cli_path(), args,
+             with_stderr ? "2>&1" : "2>/dev/null");
+    FILE* p = popen(cmd, "r");
+    if (!p)
+        fail_msg("popen failed for: %s", cmd);
+    char* out = test_slurp(p, NULL);
+    int status = pclose(p);
+    return (struct test_run){out, WIFEXITED(status) ? WEXITSTATUS(status) : -1};
+}
+
+/* test_run_cli("", args, true) with the output copied into out (n bytes, truncated). Returns
+ * the exit code. */
+static inline int test_run_cli_into(const char* args, char* out, size_t n)
+{
+    struct test_run r = test_run_cli("", args, true);
+    snprintf(out, n, "%s", r.out);
+    free(r.out);
+    return r.code;
 }
 
 #endif

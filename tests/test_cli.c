@@ -8,48 +8,12 @@
  * The CLI path comes from the environment variable WETDEM_CLI (set by `make test`), falling
  * back to build/wetdem relative to the working directory (the repository root).
  */
-#include <stdlib.h>
-#include <sys/wait.h>
-
 #include "harness.h"
 
-/* Output of one CLI run (heap buffer) and its exit code. */
-struct run {
-    char* out;
-    int code;
-};
-
-static const char* cli_path(void)
+/* Runs "$WETDEM_CLI args"; stderr is merged into out when with_stderr, discarded otherwise. */
+static struct test_run run_cli(const char* args, bool with_stderr)
 {
-    const char* p = getenv("WETDEM_CLI");
-    return p && *p ? p : "build/wetdem";
-}
-
-/* Runs "$WETDEM_CLI args" through the shell; stderr is merged into out when with_stderr,
- * discarded otherwise. */
-static struct run run_cli(const char* args, bool with_stderr)
-{
-    char cmd[2048];
-    snprintf(cmd, sizeof cmd, "'%s' %s %s", cli_path(), args, with_stderr ? "2>&1" : "2>/dev/null");
-    FILE* p = popen(cmd, "r");
-    if (!p)
-        fail_msg("popen failed for: %s", cmd);
-    size_t cap = 4096, len = 0;
-    char* out = malloc(cap);
-    assert_non_null(out);
-    size_t got;
-    while ((got = fread(out + len, 1, cap - len - 1, p)) > 0) {
-        len += got;
-        if (cap - len - 1 == 0) {
-            cap *= 2;
-            out = realloc(out, cap);
-            assert_non_null(out);
-        }
-    }
-    out[len] = '\0';
-    int status = pclose(p);
-    struct run r = {out, WIFEXITED(status) ? WEXITSTATUS(status) : -1};
-    return r;
+    return test_run_cli("", args, with_stderr);
 }
 
 /* True if some line of text starts with `word` followed by a space. */
@@ -70,7 +34,7 @@ static bool has_line_starting_with(const char* text, const char* word)
 static void test_cli_version_and_help(void** state)
 {
     (void)state;
-    struct run r = run_cli("--version", true);
+    struct test_run r = run_cli("--version", true);
     assert_int_equal(r.code, 0);
     CHECK_CONTAINS(r.out, "wetdem " WETDEM_VERSION " (git ");
     free(r.out);
@@ -92,7 +56,7 @@ static void test_cli_version_and_help(void** state)
 static void test_cli_every_subcommand_help(void** state)
 {
     (void)state;
-    struct run help = run_cli("--help", false);
+    struct test_run help = run_cli("--help", false);
     assert_int_equal(help.code, 0);
     size_t n_commands = 0;
     for (const char* line = strstr(help.out, "\n  wetdem "); line;
@@ -106,7 +70,7 @@ static void test_cli_every_subcommand_help(void** state)
             char args[160], want[96];
             snprintf(args, sizeof args, "%s %s", name, forms[f]);
             snprintf(want, sizeof want, "usage: wetdem %s", name);
-            struct run r = run_cli(args, false);
+            struct test_run r = run_cli(args, false);
             if (r.code != 0 || strncmp(r.out, want, strlen(want)) != 0)
                 fail_msg("'wetdem %s' exited %d with stdout:\n%s\n(expected exit 0 and '%s')", args,
                          r.code, r.out, want);
@@ -122,7 +86,7 @@ static void test_cli_every_subcommand_help(void** state)
 static void test_cli_models_lists_every_model(void** state)
 {
     (void)state;
-    struct run r = run_cli("models", false);
+    struct test_run r = run_cli("models", false);
     assert_int_equal(r.code, 0);
     const struct wetdem_model* const* reg = wetdem_model_registry();
     size_t n = 0;
@@ -137,7 +101,7 @@ static void test_cli_models_lists_every_model(void** state)
 static void test_cli_describe_lists_parameters_with_units(void** state)
 {
     (void)state;
-    struct run r = run_cli("describe reynolds", false);
+    struct test_run r = run_cli("describe reynolds", false);
     assert_int_equal(r.code, 0);
     CHECK_CONTAINS(r.out, "cutoff_ratio [-]  default 1, valid (0, 100]");
     CHECK_CONTAINS(r.out, "Nijssen 2023 Eq. 1");
@@ -194,7 +158,7 @@ static void test_cli_describe_lists_parameters_with_units(void** state)
 static void test_cli_describe_unknown_name(void** state)
 {
     (void)state;
-    struct run r = run_cli("describe nijsen", true);
+    struct test_run r = run_cli("describe nijsen", true);
     assert_int_equal(r.code, 2);
     CHECK_CONTAINS(r.out, "unknown name 'nijsen'");
     CHECK_CONTAINS(r.out, "did you mean 'nijssen'");
@@ -222,9 +186,9 @@ static void parse_forces_csv(const char* csv, double cols[4])
 static void test_cli_forces_matches_reynolds_closed_form(void** state)
 {
     (void)state;
-    struct run r = run_cli("forces --model reynolds --preset steel1 --radius 6.35e-3 "
-                           "--speed 0.1 --gaps 1e-5:1e-5:1 --set fluid.viscosity=0.5",
-                           false);
+    struct test_run r = run_cli("forces --model reynolds --preset steel1 --radius 6.35e-3 "
+                                "--speed 0.1 --gaps 1e-5:1e-5:1 --set fluid.viscosity=0.5",
+                                false);
     assert_int_equal(r.code, 0);
     double c[4];
     parse_forces_csv(r.out, c);
@@ -245,7 +209,7 @@ static void test_cli_forces_matches_reynolds_closed_form(void** state)
 static void test_cli_forces_log_gaps_are_decades(void** state)
 {
     (void)state;
-    struct run r = run_cli("forces --model reynolds --gaps 1e-7:1e-3:5 --log", false);
+    struct test_run r = run_cli("forces --model reynolds --gaps 1e-7:1e-3:5 --log", false);
     assert_int_equal(r.code, 0);
     const char* row = strstr(r.out, "h_min_m\n");
     assert_non_null(row);
@@ -280,7 +244,7 @@ static void test_cli_forces_bad_input(void** state)
         {"forces", "no model given"},
     };
     for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
-        struct run r = run_cli(cases[k].args, true);
+        struct test_run r = run_cli(cases[k].args, true);
         if (r.code != 2)
             fail_msg("'%s' exited %d, expected 2:\n%s", cases[k].args, r.code, r.out);
         CHECK_CONTAINS(r.out, "wetdem: ");

@@ -5,52 +5,22 @@
  * The CLI path comes from WETDEM_CLI (set by `make test`), falling back to build/wetdem; the
  * working directory is the repository root. On failure: run `make docs` and commit the file.
  */
-#include <stdlib.h>
-#include <sys/wait.h>
-
 #include "harness.h"
-
-/* Reads all of stream f into a NUL-terminated heap buffer. */
-static char* slurp(FILE* f)
-{
-    size_t cap = 1 << 16, len = 0, got;
-    char* buf = malloc(cap);
-    assert_non_null(buf);
-    while ((got = fread(buf + len, 1, cap - len - 1, f)) > 0) {
-        len += got;
-        if (len + 1 == cap) {
-            cap *= 2;
-            buf = realloc(buf, cap);
-            assert_non_null(buf);
-        }
-    }
-    buf[len] = '\0';
-    return buf;
-}
 
 static char* generated_docs(void)
 {
-    const char* cli = getenv("WETDEM_CLI");
-    char cmd[1024];
-    snprintf(cmd, sizeof cmd, "'%s' docs-models", cli && *cli ? cli : "build/wetdem");
-    FILE* p = popen(cmd, "r");
-    if (!p)
-        fail_msg("cannot run %s", cmd);
-    char* text = slurp(p);
-    int status = pclose(p);
-    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
-        fail_msg("'%s' failed (status %d)", cmd, status);
-    return text;
+    struct test_run r = test_run_cli("", "docs-models", false);
+    if (r.code != 0)
+        fail_msg("'%s docs-models' failed (exit %d)", test_cli_path(), r.code);
+    return r.out;
 }
 
 static char* committed_docs(void)
 {
-    FILE* f = fopen("docs/models.md", "r");
-    if (!f)
+    char* text = test_read_file("docs/models.md", NULL);
+    if (!text)
         fail_msg("docs/models.md not found (the working directory must be the repository "
                  "root; create the file with 'make docs')");
-    char* text = slurp(f);
-    fclose(f);
     return text;
 }
 

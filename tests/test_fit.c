@@ -7,7 +7,6 @@
  */
 #include <stdlib.h>
 #include <string.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <gsl/gsl_randist.h>
@@ -219,19 +218,6 @@ static void test_fit_recovers_glass_pressure_from_simulated_data(void** state)
 
 /* ---- the command line --------------------------------------------------------------------- */
 
-/* Runs `$WETDEM_CLI args 2>&1` into out; returns the exit code (-1 if it did not exit). */
-static int run_cli(const char* cli, const char* args, char* out, size_t n)
-{
-    char cmd[2048];
-    snprintf(cmd, sizeof cmd, "%s %s 2>&1", cli, args);
-    FILE* p = popen(cmd, "r");
-    assert_non_null(p);
-    size_t len = fread(out, 1, n - 1, p);
-    out[len] = '\0';
-    int rc = pclose(p);
-    return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
-}
-
 /* Writes text to /tmp/wetdem_fit_TAG_PID.csv; path receives the name. */
 static void temp_csv(char path[96], const char* tag, const char* text)
 {
@@ -243,10 +229,10 @@ static void temp_csv(char path[96], const char* tag, const char* text)
 }
 
 /* `wetdem fit ARGS` must exit with `rc` and print `needle`. */
-static void expect_cli(const char* cli, const char* args, int rc, const char* needle)
+static void expect_cli(const char* args, int rc, const char* needle)
 {
     char out[8192];
-    int got = run_cli(cli, args, out, sizeof out);
+    int got = test_run_cli_into(args, out, sizeof out);
     if (got != rc)
         fail_msg("wetdem %s: exit %d, expected %d; output:\n%s", args, got, rc, out);
     CHECK_CONTAINS(out, needle);
@@ -263,28 +249,29 @@ static void test_fit_cli_rejects_bad_input(void** state)
     temp_csv(good, "good", "stokes_n,e_n\n2,0.5\n3,0.6\n");
     temp_csv(bad, "bad", "# comment\nstokes_n,e_n\n2,0.5\n3,abc\n");
     char args[1024];
-    expect_cli(cli, "fit --help", 0, "usage: wetdem fit FILE --data CSV --fit KEY");
+    expect_cli("fit --help", 0, "usage: wetdem fit FILE --data CSV --fit KEY");
     snprintf(args, sizeof args, "fit %s --data /nonexistent/data.csv --fit glass.p_gt", ini);
-    expect_cli(cli, args, 2, "cannot open data file /nonexistent/data.csv");
+    expect_cli(args, 2, "cannot open data file /nonexistent/data.csv");
     snprintf(args, sizeof args, "fit %s --data %s --fit glass.p_gt", ini, bad);
-    expect_cli(cli, args, 2, ":4: column e_n: 'abc' is not a finite number");
+    expect_cli(args, 2, ":4: column e_n: 'abc' is not a finite number");
     temp_csv(bad, "bad", "stokes_n,e_n\n2\n");
-    expect_cli(cli, args, 2, ":2: 1 columns, but column e_n is number 2");
+    expect_cli(args, 2, ":2: 1 columns, but column e_n is number 2");
     temp_csv(bad, "bad", "stokes,e_n\n2,0.5\n");
-    expect_cli(cli, args, 2, ":1: the header must name columns stokes_n and e_n");
+    expect_cli(args, 2, ":1: the header must name columns stokes_n and e_n");
     snprintf(args, sizeof args, "fit %s --data %s --fit glass.p_g", ini, good);
-    expect_cli(cli, args, 2, "unknown key 'p_g' in [model.glass] (did you mean 'p_gt'?)");
+    expect_cli(args, 2, "unknown key 'p_g' in [model.glass] (did you mean 'p_gt'?)");
     snprintf(args, sizeof args, "fit %s --data %s --fit glas.p_gt", ini, good);
-    expect_cli(cli, args, 2, "unknown section [glas] (did you mean 'glass.p_gt'?)");
+    expect_cli(args, 2, "unknown section [glas] (did you mean 'glass.p_gt'?)");
     snprintf(args, sizeof args, "fit %s --data %s --fit material.striker.restitutio", ini, good);
-    expect_cli(cli, args, 2, "(did you mean 'restitution'?)");
+    expect_cli(args, 2, "(did you mean 'restitution'?)");
     snprintf(args, sizeof args, "fit %s --data %s --fit glass.speed", ini, good);
-    expect_cli(cli, args, 2, "speed is a choice, not a number");
+    expect_cli(args, 2, "speed is a choice, not a number");
     /* Two rows, two parameters: no degree of freedom left for the residual variance. */
     snprintf(args, sizeof args, "fit %s --data %s --fit glass.p_gt,material.striker.restitution",
              ini, good);
-    expect_cli(cli, args, 2, "has 2 data rows (2 residuals) for 2 parameters: need more "
-                             "residuals than parameters, at least 3 rows");
+    expect_cli(args, 2,
+               "has 2 data rows (2 residuals) for 2 parameters: need more "
+               "residuals than parameters, at least 3 rows");
     remove(good);
     remove(bad);
 }
@@ -296,8 +283,9 @@ static void test_fit_cli_reports_units_on_example(void** state)
     if (!cli)
         skip();
     char out[8192];
-    int rc = run_cli(cli, "fit examples/fit/punch_db_c.ini --data examples/fit/punch_0deg.csv "
-                          "--fit glass.p_gt --init 4e6", out, sizeof out);
+    int rc = test_run_cli_into("fit examples/fit/punch_db_c.ini --data examples/fit/punch_0deg.csv "
+                               "--fit glass.p_gt --init 4e6",
+                               out, sizeof out);
     if (rc != 0)
         fail_msg("exit %d:\n%s", rc, out);
     CHECK_CONTAINS(out, "parameter,unit,value,std_error,initial,fitted_as\nmodel.glass.p_gt,Pa,");

@@ -31,36 +31,6 @@
 
 static char tmpdir[256];
 
-static const char* cli_path(void)
-{
-    const char* p = getenv("WETDEM_CLI");
-    return p && *p ? p : "build/wetdem";
-}
-
-/* Whole file into a heap buffer (NULL if missing); *len gets its size. */
-static char* slurp(const char* path, size_t* len)
-{
-    FILE* f = fopen(path, "rb");
-    if (!f)
-        return NULL;
-    size_t cap = 1 << 16, n = 0, got;
-    char* buf = malloc(cap);
-    assert_non_null(buf);
-    while ((got = fread(buf + n, 1, cap - n - 1, f)) > 0) {
-        n += got;
-        if (cap - n - 1 == 0) {
-            cap *= 2;
-            buf = realloc(buf, cap);
-            assert_non_null(buf);
-        }
-    }
-    fclose(f);
-    buf[n] = '\0';
-    if (len)
-        *len = n;
-    return buf;
-}
-
 /* tmpdir/name */
 static const char* tpath(const char* name)
 {
@@ -90,14 +60,14 @@ static int run_cli(const char* args)
 {
     char cmd[4096];
     snprintf(cmd, sizeof cmd, "cd '%s' && " ENV " '%s' %s > out.txt 2> err.txt", tmpdir,
-             cli_path(), args);
+             test_cli_path(), args);
     int status = system(cmd);
     return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
 static char* stderr_text(void)
 {
-    char* s = slurp(tpath("err.txt"), NULL);
+    char* s = test_read_file(tpath("err.txt"), NULL);
     assert_non_null(s);
     return s;
 }
@@ -232,8 +202,8 @@ static void check_same_outputs(const char* a, const char* b, size_t frames)
         snprintf(pa, sizeof pa, "%.100s/%.63s", a, names[k]);
         snprintf(pb, sizeof pb, "%.100s/%.63s", b, names[k]);
         size_t la, lb;
-        char* ta = slurp(tpath(pa), &la);
-        char* tb = slurp(tpath(pb), &lb);
+        char* ta = test_read_file(tpath(pa), &la);
+        char* tb = test_read_file(tpath(pb), &lb);
         if (!ta || !tb)
             fail_msg("%s missing in %s", names[k], ta ? b : a);
         if (k == 0) { /* global.csv: column 9 is candidate_pairs */
@@ -287,7 +257,7 @@ static void test_many_cli_restart_is_bit_identical(void** state)
 /* Number of data rows in a CSV (lines starting with a digit). */
 static size_t csv_rows(const char* path)
 {
-    char* t = slurp(path, NULL);
+    char* t = test_read_file(path, NULL);
     size_t n = 0;
     for (const char* p = t; p && *p; p = strchr(p, '\n') ? strchr(p, '\n') + 1 : p + strlen(p))
         n += (*p >= '0' && *p <= '9');
@@ -299,8 +269,8 @@ static size_t csv_rows(const char* path)
 static pid_t spawn_cli(const char* args)
 {
     char cmd[2048];
-    snprintf(cmd, sizeof cmd, "cd '%s' && exec env " ENV " '%s' %s > out.txt 2> err.txt",
-             tmpdir, cli_path(), args);
+    snprintf(cmd, sizeof cmd, "cd '%s' && exec env " ENV " '%s' %s > out.txt 2> err.txt", tmpdir,
+             test_cli_path(), args);
     pid_t pid = fork();
     assert_true(pid >= 0);
     if (pid == 0) {
@@ -353,8 +323,10 @@ static void test_many_cli_progress_only_on_a_terminal(void** state)
     assert_true(pid >= 0);
     if (pid == 0) {
         char cmd[2048];
-        snprintf(cmd, sizeof cmd, "cd '%s' && exec env " ENV " '%s' run progress.ini "
-                 "--set run.steps=200 > /dev/null", tmpdir, cli_path());
+        snprintf(cmd, sizeof cmd,
+                 "cd '%s' && exec env " ENV " '%s' run progress.ini "
+                 "--set run.steps=200 > /dev/null",
+                 tmpdir, test_cli_path());
         execl("/bin/sh", "sh", "-c", cmd, (char*)NULL);
         _exit(127);
     }
@@ -383,7 +355,7 @@ static void test_many_cli_examples_and_budget(void** state)
         assert_non_null(getcwd(cwd, sizeof cwd)); /* the repository root */
         snprintf(args, sizeof args, "run '%s/examples/scenarios/%s.ini' --check", cwd, files[k]);
         int code = run_cli(args);
-        char* out = slurp(tpath("out.txt"), NULL);
+        char* out = test_read_file(tpath("out.txt"), NULL);
         if (code != 0)
             fail_msg("%s: exit %d", files[k], code);
         CHECK_CONTAINS(out, "is valid (many-particle run)");
@@ -391,11 +363,11 @@ static void test_many_cli_examples_and_budget(void** state)
     }
     scenario("budget.ini", "");
     assert_int_equal(run_cli("run budget.ini --set run.steps=500 --json"), 0);
-    char* js = slurp(tpath("out.txt"), NULL);
+    char* js = test_read_file(tpath("out.txt"), NULL);
     double v[7];
-    const char* keys[] = {"\"input\": ",   "\"kinetic\": ",    "\"potential\": ",
-                          "\"elastic\": ", "\"dissipated\": ", "\"work_total\": ",
-                          "\"balance_error\": "};
+    const char* keys[] = {
+        "\"input\": ",      "\"kinetic\": ",    "\"potential\": ",    "\"elastic\": ",
+        "\"dissipated\": ", "\"work_total\": ", "\"balance_error\": "};
     for (int k = 0; k < 7; k++) {
         const char* p = strstr(js, keys[k]);
         if (!p)

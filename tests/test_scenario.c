@@ -23,47 +23,12 @@
 
 #include "harness.h"
 
-struct run {
-    char* out;
-    int code;
-};
-
 static char tmpdir[256];
 
-static const char* cli_path(void)
+/* Runs "$WETDEM_CLI args" with stderr merged into the output. */
+static struct test_run run_cli(const char* args)
 {
-    const char* p = getenv("WETDEM_CLI");
-    return p && *p ? p : "build/wetdem";
-}
-
-/* Runs a shell command line "ENV '$WETDEM_CLI' args"; stdout (and stderr if with_stderr). */
-static struct run run_env(const char* env, const char* args, bool with_stderr)
-{
-    char cmd[4096];
-    snprintf(cmd, sizeof cmd, "%s '%s' %s %s", env, cli_path(), args,
-             with_stderr ? "2>&1" : "2>/dev/null");
-    FILE* p = popen(cmd, "r");
-    if (!p)
-        fail_msg("popen failed for: %s", cmd);
-    size_t cap = 1 << 16, len = 0, got;
-    char* out = malloc(cap);
-    assert_non_null(out);
-    while ((got = fread(out + len, 1, cap - len - 1, p)) > 0) {
-        len += got;
-        if (cap - len - 1 == 0) {
-            cap *= 2;
-            out = realloc(out, cap);
-            assert_non_null(out);
-        }
-    }
-    out[len] = '\0';
-    int status = pclose(p);
-    return (struct run){out, WIFEXITED(status) ? WEXITSTATUS(status) : -1};
-}
-
-static struct run run_cli(const char* args)
-{
-    return run_env("", args, true);
+    return test_run_cli("", args, true);
 }
 
 /* Writes text to tmpdir/name; returns the path (static buffer rotation of 4). */
@@ -114,7 +79,7 @@ static void test_scenario_examples_check(void** state)
     for (size_t k = 0; k < sizeof files / sizeof files[0]; k++) {
         char args[256];
         snprintf(args, sizeof args, "run examples/scenarios/%s.ini --check", files[k]);
-        struct run r = run_cli(args);
+        struct test_run r = run_cli(args);
         if (r.code != 0)
             fail_msg("%s: exit %d\n%s", files[k], r.code, r.out);
         CHECK_CONTAINS(r.out, "is valid");
@@ -132,7 +97,7 @@ static void test_scenario_examples_check(void** state)
 static void test_scenario_stokes_gives_speed(void** state)
 {
     (void)state;
-    struct run r = run_cli("run examples/scenarios/nijssen_head_on.ini --check");
+    struct test_run r = run_cli("run examples/scenarios/nijssen_head_on.ini --check");
     assert_int_equal(r.code, 0);
     CHECK_REL(check_value(r.out, "impact_speed"), 0.0253093363, 1e-6);
     CHECK_REL(check_value(r.out, "m_eff"), 7.50771582e-4, 1e-6);
@@ -153,8 +118,8 @@ static void test_scenario_set_overrides(void** state)
 {
     (void)state;
     /* St is linear in v: St = 50 halves the St = 100 speed exactly (to print precision). */
-    struct run r = run_cli("run examples/scenarios/nijssen_head_on.ini --check "
-                           "--set collision.stokes=50");
+    struct test_run r = run_cli("run examples/scenarios/nijssen_head_on.ini --check "
+                                "--set collision.stokes=50");
     assert_int_equal(r.code, 0);
     CHECK_REL(check_value(r.out, "impact_speed"), 0.0253093363 / 2, 1e-6);
     free(r.out);
@@ -220,7 +185,7 @@ static void test_scenario_bad_files_exit_2_with_line(void** state)
         snprintf(name, sizeof name, "bad_%s.ini", cases[k].name);
         const char* path = write_file(name, cases[k].text);
         snprintf(args, sizeof args, "run '%s' --check", path);
-        struct run r = run_cli(args);
+        struct test_run r = run_cli(args);
         if (r.code != 2)
             fail_msg("%s: exit %d, expected 2\n%s", cases[k].name, r.code, r.out);
         snprintf(where, sizeof where, "%s%s", path, cases[k].where);
@@ -228,7 +193,7 @@ static void test_scenario_bad_files_exit_2_with_line(void** state)
         CHECK_CONTAINS(r.out, cases[k].message);
         free(r.out);
     }
-    struct run r = run_cli("run /nonexistent/scenario.ini");
+    struct test_run r = run_cli("run /nonexistent/scenario.ini");
     assert_int_equal(r.code, 2);
     CHECK_CONTAINS(r.out, "cannot open scenario file");
     free(r.out);
@@ -238,7 +203,7 @@ static void test_scenario_bad_files_exit_2_with_line(void** state)
 static void test_scenario_docs_list_every_key(void** state)
 {
     (void)state;
-    struct run r = run_env("", "docs-scenarios", false);
+    struct test_run r = test_run_cli("", "docs-scenarios", false);
     assert_int_equal(r.code, 0);
     FILE* f = fopen("docs/scenarios.md", "r");
     if (!f)
@@ -271,7 +236,7 @@ static void test_scenario_run_writes_files_or_nothing(void** state)
     snprintf(out, sizeof out, "%s/bad_run", tmpdir);
     snprintf(args, sizeof args,
              "run examples/scenarios/dry_hertz.ini --out '%s' --set collision.speed=-1", out);
-    struct run r = run_cli(args);
+    struct test_run r = run_cli(args);
     assert_int_equal(r.code, 2);
     free(r.out);
     assert_false(exists(out, "."));
@@ -332,8 +297,8 @@ static void test_scenario_sweep_order_and_threads(void** state)
     (void)state;
     const char* args = "sweep examples/scenarios/nijssen_head_on.ini --param collision.stokes "
                        "--values 5:500:12 --log";
-    struct run r1 = run_env("OMP_NUM_THREADS=1", args, false);
-    struct run r2 = run_env("OMP_NUM_THREADS=2", args, false);
+    struct test_run r1 = test_run_cli("OMP_NUM_THREADS=1", args, false);
+    struct test_run r2 = test_run_cli("OMP_NUM_THREADS=2", args, false);
     assert_int_equal(r1.code, 0);
     assert_int_equal(r2.code, 0);
     char* d1 = data_lines(r1.out);
@@ -360,7 +325,7 @@ static void test_scenario_sweep_order_and_threads(void** state)
              "sweep examples/scenarios/nijssen_head_on.ini --param collision.angle_deg "
              "--values 0:120:3 --out '%s/sweep.csv'",
              tmpdir);
-    struct run r = run_cli(cmd);
+    struct test_run r = run_cli(cmd);
     assert_int_equal(r.code, 2);
     CHECK_CONTAINS(r.out, "angle_deg");
     free(r.out);
@@ -386,8 +351,8 @@ static void test_scenario_sweep_pairwise_threads_and_status(void** state)
      * (~10 ms each) for two passes. */
     const char* args = "sweep examples/scenarios/davis_three.ini --param davis.stokes "
                        "--values 1:8:8";
-    struct run r1 = run_env("OMP_NUM_THREADS=1", args, false);
-    struct run r2 = run_env("OMP_NUM_THREADS=2", args, false);
+    struct test_run r1 = test_run_cli("OMP_NUM_THREADS=1", args, false);
+    struct test_run r2 = test_run_cli("OMP_NUM_THREADS=2", args, false);
     assert_int_equal(r1.code, 0);
     assert_int_equal(r2.code, 0);
     CHECK_CONTAINS(r2.out, "threads=2"); /* the second pass did use two threads */
@@ -416,10 +381,11 @@ static void test_scenario_sweep_pairwise_threads_and_status(void** state)
     free(r2.out);
     /* An event budget of 3 stops St_n = 1 and 3 (they need 5 and 10 events): the status
      * column carries the engine's status, the message names the point, the exit code is 1. */
-    struct run r = run_env("OMP_NUM_THREADS=2",
-                           "sweep examples/scenarios/davis_three.ini --param davis.stokes "
-                           "--values 1:3:2 --set pairwise.max_events=3",
-                           true);
+    struct test_run r =
+        test_run_cli("OMP_NUM_THREADS=2",
+                     "sweep examples/scenarios/davis_three.ini --param davis.stokes "
+                     "--values 1:3:2 --set pairwise.max_events=3",
+                     true);
     assert_int_equal(r.code, 1);
     CHECK_CONTAINS(r.out, "\n1,WETDEM_ERR_MAX_STEPS,WETDEM_ERR_MAX_STEPS,none,");
     CHECK_CONTAINS(r.out, "\n3,WETDEM_ERR_MAX_STEPS,WETDEM_ERR_MAX_STEPS,none,");
@@ -446,7 +412,7 @@ static void test_scenario_map_and_check_of_other_engines(void** state)
              "map examples/scenarios/many_stokes_cradle.ini --param box.size_x --values 1:2:2 "
              "--param2 fluid.viscosity --values2 1:2:2 --out '%s/map.csv'",
              tmpdir);
-    struct run r = run_cli(cmd);
+    struct test_run r = run_cli(cmd);
     assert_int_equal(r.code, 2);
     CHECK_CONTAINS(r.out, "many-particle scenario runs with 'wetdem run'");
     free(r.out);
@@ -454,7 +420,7 @@ static void test_scenario_map_and_check_of_other_engines(void** state)
     /* many-particle --check --json: one JSON object, no text form. The cradle runs
      * t_end = 0.04 s in steps = ceil(t_end / dt) of the library's dt, so
      * (steps - 1) dt < t_end <= steps dt. */
-    r = run_env("", "run examples/scenarios/many_stokes_cradle.ini --check --json", false);
+    r = test_run_cli("", "run examples/scenarios/many_stokes_cradle.ini --check --json", false);
     assert_int_equal(r.code, 0);
     assert_int_equal(r.out[0], '{');
     assert_null(strstr(r.out, "is valid"));
@@ -468,12 +434,12 @@ static void test_scenario_map_and_check_of_other_engines(void** state)
      * t_end = t*_end 4a / v_10 with v_10 = v_n0 / cos(beta): 20 x 4 x 2e-3 m / (1 m/s /
      * cos 30 deg) = 0.0692820323 s; film delta = h_a 4a = 0.01 x 8e-3 m / 2 per sphere = 2e-5 m
      * (delta_12 = 4e-5 m). Tolerance 1e-9: the hand value carries 10 digits. */
-    r = run_env("", "run examples/scenarios/davis_three.ini --check", false);
+    r = test_run_cli("", "run examples/scenarios/davis_three.ini --check", false);
     assert_int_equal(r.code, 0);
     CHECK_CONTAINS(r.out, "is valid (pairwise engine)");
     assert_null(strstr(r.out, "outcome"));
     free(r.out);
-    r = run_env("", "run examples/scenarios/davis_three.ini --check --json", false);
+    r = test_run_cli("", "run examples/scenarios/davis_three.ini --check --json", false);
     assert_int_equal(r.code, 0);
     assert_int_equal(r.out[0], '{');
     CHECK_REL(json_value(r.out, "t_end"), 0.0692820323, 1e-9);

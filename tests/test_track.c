@@ -16,7 +16,6 @@
  */
 #include <stdlib.h>
 #include <string.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <gsl/gsl_randist.h>
@@ -667,19 +666,6 @@ static void test_track_rejects_short_or_mismatched_tracks(void** state)
     wetdem_track_free(t);
 }
 
-/* Runs `$WETDEM_CLI args 2>&1` into out; returns the exit code (-1 if it did not exit). */
-static int run_cli(const char* cli, const char* args, char* out, size_t n)
-{
-    char cmd[1024];
-    snprintf(cmd, sizeof cmd, "%s %s 2>&1", cli, args);
-    FILE* p = popen(cmd, "r");
-    assert_non_null(p);
-    size_t len = fread(out, 1, n - 1, p);
-    out[len] = '\0';
-    int rc = pclose(p);
-    return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
-}
-
 static void test_track_cli_exits_2_with_line_number(void** state)
 {
     (void)state;
@@ -689,16 +675,16 @@ static void test_track_cli_exits_2_with_line_number(void** state)
     const char* path = write_temp("frame,sphere,x1,y1,x2,y2,x3,y3\n0,1,1,1,2,2,3,3\n2,1,1,1,2,2,3,3\n");
     char args[512], out[4096];
     snprintf(args, sizeof args, "track %s --fps 5000 --pixel-size 175e-6", path);
-    int rc = run_cli(cli, args, out, sizeof out);
+    int rc = test_run_cli_into(args, out, sizeof out);
     remove(path);
     assert_int_equal(rc, 2);
     CHECK_CONTAINS(out, ":3: sphere 1: frame 2 follows frame 0");
     /* --help anywhere prints the usage and succeeds, also before the required options. */
-    assert_int_equal(run_cli(cli, "track --help", out, sizeof out), 0);
+    assert_int_equal(test_run_cli_into("track --help", out, sizeof out), 0);
     CHECK_CONTAINS(out, "usage: wetdem track DOTS.csv --fps F --pixel-size S");
-    assert_int_equal(run_cli(cli, "track dots.csv --fps 5000 -h", out, sizeof out), 0);
+    assert_int_equal(test_run_cli_into("track dots.csv --fps 5000 -h", out, sizeof out), 0);
     CHECK_CONTAINS(out, "--frames FILE");
-    assert_int_equal(run_cli(cli, "track dots.csv --fps", out, sizeof out), 2);
+    assert_int_equal(test_run_cli_into("track dots.csv --fps", out, sizeof out), 2);
     CHECK_CONTAINS(out, "option --fps needs a value");
 }
 
