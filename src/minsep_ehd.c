@@ -18,24 +18,15 @@
 #include "minsep_ehd.h"
 #include "models.h"
 
-struct minsep_ehd_params {
-    double reset_ratio; /* gap, as a multiple of R*, beyond which the speed record resets [-] */
-};
-
 static const struct wetdem_param_desc ehd_params[] = {
-    {"reset_ratio", "-",
-     "Gap, as a multiple of R*, beyond which the pair's largest approach speed is forgotten.",
-     offsetof(struct minsep_ehd_params, reset_ratio), 1.0, 0, 100, true, false, NULL},
+    MINSEP_RESET_RATIO_PARAM,
     {0},
 };
 
 static double ehd_min_separation(const void* params, const struct wetdem_contact* c,
                                  double* history)
 {
-    const struct minsep_ehd_params* p = params;
-    bool is_interacting = c->gap <= p->reset_ratio * c->r_eff;
-    double v0 = minsep_largest_speed(&history[0], c->v_n, is_interacting);
-    return minsep_ehd_gap(c->viscosity, v0, c->e_star, c->r_eff);
+    return minsep_ehd_recorded_gap(params, c, history);
 }
 
 const struct wetdem_model wetdem_minsep_ehd = {
@@ -51,7 +42,7 @@ const struct wetdem_model wetdem_minsep_ehd = {
            "eps = 4 mu v0 R*^(3/2) / (pi E* h0^(5/2)).",
     .equations = "Nijssen 2023 Eqs. 4-5 (exponents corrected); Davis et al. 1986",
     .params = ehd_params,
-    .params_size = sizeof(struct minsep_ehd_params),
+    .params_size = sizeof(struct minsep_speed_params),
     .history_len = 1,
     .min_separation = ehd_min_separation,
 };

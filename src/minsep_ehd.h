@@ -2,7 +2,8 @@
  * minsep_ehd.h — shared kernels of the velocity-dependent minimum separations (internal):
  * the elastohydrodynamic minimum gap of Nijssen 2023 Eq. 5 (root corrected to a fifth root,
  * SPEC §6; derivation in docs/derivations/fluid.md) and the per-pair record of the largest
- * approach speed that sets it. Used by minsep_ehd.c, minsep_max.c and force_nijssen.c.
+ * approach speed that sets it, and the reset_ratio parameter of the two min-separation models
+ * built on them. Used by minsep_ehd.c, minsep_max.c and force_nijssen.c.
  *
  *     h_eps = 0.37 ((mu v0 / E*)^2 R*^3)^(1/5) = 0.37 R* (mu v0 / (E* R*))^(2/5)     [m]
  *
@@ -15,6 +16,9 @@
 
 #include <math.h>
 #include <stdbool.h>
+#include <stddef.h>
+
+#include "wetdem.h"
 
 /* Elastohydrodynamic minimum gap 0.37 R* (mu v0/(E* R*))^(2/5) [m]; 0 for v0 <= 0. */
 static inline double minsep_ehd_gap(double mu, double v0, double e_star, double r_eff)
@@ -38,6 +42,30 @@ static inline double minsep_largest_speed(double* v_max, double v_n, bool is_int
     if (v > *v_max)
         *v_max = v;
     return *v_max;
+}
+
+/* Parameters of the min-separation models whose h_min follows the recorded speed (ehd, max). */
+struct minsep_speed_params {
+    double reset_ratio; /* gap, as a multiple of R*, beyond which the speed record resets [-] */
+};
+
+/* Descriptor row of reset_ratio in struct minsep_speed_params. */
+#define MINSEP_RESET_RATIO_PARAM                                                                   \
+    {                                                                                              \
+        "reset_ratio", "-",                                                                        \
+            "Gap, as a multiple of R*, beyond which the pair's largest approach speed is "         \
+            "forgotten.",                                                                          \
+            offsetof(struct minsep_speed_params, reset_ratio), 1.0, 0, 100, true, false, NULL      \
+    }
+
+/* h_eps [m] of the pair of contact c with v0 its largest approach speed during the current
+ * interaction (gap <= reset_ratio R*), recorded in history[0] (minsep_largest_speed). */
+static inline double minsep_ehd_recorded_gap(const struct minsep_speed_params* p,
+                                             const struct wetdem_contact* c, double* history)
+{
+    bool is_interacting = c->gap <= p->reset_ratio * c->r_eff;
+    double v0 = minsep_largest_speed(&history[0], c->v_n, is_interacting);
+    return minsep_ehd_gap(c->viscosity, v0, c->e_star, c->r_eff);
 }
 
 #endif

@@ -17,24 +17,15 @@
 #include "minsep_ehd.h"
 #include "models.h"
 
-struct minsep_max_params {
-    double reset_ratio; /* gap, as a multiple of R*, beyond which the speed record resets [-] */
-};
-
 static const struct wetdem_param_desc max_params[] = {
-    {"reset_ratio", "-",
-     "Gap, as a multiple of R*, beyond which the pair's largest approach speed is forgotten.",
-     offsetof(struct minsep_max_params, reset_ratio), 1.0, 0, 100, true, false, NULL},
+    MINSEP_RESET_RATIO_PARAM,
     {0},
 };
 
 static double max_min_separation(const void* params, const struct wetdem_contact* c,
                                  double* history)
 {
-    const struct minsep_max_params* p = params;
-    bool is_interacting = c->gap <= p->reset_ratio * c->r_eff;
-    double v0 = minsep_largest_speed(&history[0], c->v_n, is_interacting);
-    return fmax(c->roughness, minsep_ehd_gap(c->viscosity, v0, c->e_star, c->r_eff));
+    return fmax(c->roughness, minsep_ehd_recorded_gap(params, c, history));
 }
 
 const struct wetdem_model wetdem_minsep_max = {
@@ -49,7 +40,7 @@ const struct wetdem_model wetdem_minsep_max = {
            "same h_min as the composite nijssen model.",
     .equations = "Nijssen 2023 Eqs. 3, 5 (corrected), 6",
     .params = max_params,
-    .params_size = sizeof(struct minsep_max_params),
+    .params_size = sizeof(struct minsep_speed_params),
     .history_len = 1,
     .min_separation = max_min_separation,
 };
