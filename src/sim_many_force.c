@@ -499,6 +499,16 @@ static void eval_pairs_of(const struct wetdem_sim* sim, size_t i, struct failure
 
 /* ---- the gather ---- */
 
+/* Index of the lowest set bit of *mask, cleared; 64 (>= every wall count here) when none. */
+static size_t next_wall(uint64_t* mask)
+{
+    if (!*mask)
+        return 64;
+    size_t w = (size_t)__builtin_ctzll(*mask);
+    *mask &= *mask - 1;
+    return w;
+}
+
 /* Wall forces on particle i, added to *f, *t, *n_contacts in wall order. */
 static void eval_walls_of(const struct wetdem_sim* sim, size_t i, struct wetdem_vec3* f,
                           struct wetdem_vec3* t, uint32_t* n_contacts, struct failure* fail)
@@ -506,7 +516,10 @@ static void eval_walls_of(const struct wetdem_sim* sim, size_t i, struct wetdem_
     const struct wetdem_many* m = sim->many;
     size_t len = sim->history_len, nw = sim->n_walls;
     const struct wetdem_particle* a = &sim->particles[i];
-    for (size_t w = 0; w < nw; w++) {
+    /* up to 64 walls: the set bits of the mask, in increasing w; beyond, every wall */
+    uint64_t mask = nw <= 64 ? m->wall_mask[i] : 0;
+    for (size_t w = nw <= 64 ? next_wall(&mask) : 0; w < nw;
+         w = nw <= 64 ? next_wall(&mask) : w + 1) {
         if (w < 64 && !(m->wall_mask[i] >> w & 1))
             continue;
         const struct wetdem_wall* wall = &sim->walls[w];
