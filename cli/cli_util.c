@@ -12,6 +12,7 @@
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "cli_util.h"
@@ -128,12 +129,45 @@ void cli_print_provenance(FILE* f, int argc, char** argv)
     fputc('\n', f);
 }
 
+/* Creates dir and its parents (mkdir -p). */
+int cli_make_dirs(const char* dir)
+{
+    char path[1024];
+    if (snprintf(path, sizeof path, "%s", dir) >= (int)sizeof path)
+        return -1;
+    for (char* p = path + 1; *p; p++)
+        if (*p == '/') {
+            *p = '\0';
+            if (mkdir(path, 0777) != 0 && errno != EEXIST)
+                return -1;
+            *p = '/';
+        }
+    return (mkdir(path, 0777) == 0 || errno == EEXIST) ? 0 : -1;
+}
+
+/* The parent directory of path (empty when it has none). */
+static void parent_dir(const char* path, char* dir, size_t n)
+{
+    snprintf(dir, n, "%s", path);
+    char* slash = strrchr(dir, '/');
+    if (slash)
+        *slash = '\0';
+    else
+        dir[0] = '\0';
+}
+
 int cli_write_output(const char* path, const char* what, void (*write)(FILE* f, const void* ctx),
                      const void* ctx)
 {
     if (!path) {
         write(stdout, ctx);
         return fflush(stdout) == 0 ? CLI_EXIT_OK : CLI_EXIT_RUNTIME;
+    }
+    char dir[1024];
+    parent_dir(path, dir, sizeof dir);
+    if (dir[0] && cli_make_dirs(dir) != 0) {
+        cli_error("%s: cannot create directory %s for %s", what, dir, path);
+        return CLI_EXIT_RUNTIME;
     }
     char tmp[1100];
     snprintf(tmp, sizeof tmp, "%s.tmp%ld", path, (long)getpid());

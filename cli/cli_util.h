@@ -55,9 +55,11 @@ bool cli_wants_help(int argc, char** argv);
  * argv is the subcommand's argument vector (argv[0] = subcommand name). */
 void cli_print_provenance(FILE* f, int argc, char** argv);
 
-/* Writes a table with write(f, ctx): to stdout when path is NULL, otherwise to path under a
- * temporary name renamed only when everything was written, so a failed write leaves no
- * half-written file. `what` names the command in the message. Returns CLI_EXIT_OK, or prints
+/* mkdir -p: creates dir and its parents. 0, or -1 with errno set. */
+int cli_make_dirs(const char* dir);
+/* Writes a table with write(f, ctx): to stdout when path is NULL, otherwise to path (its
+ * directory is created when missing) under a temporary name renamed only when everything was
+ * written, so a failed write leaves no half-written file. `what` names the command in the message. Returns CLI_EXIT_OK, or prints
  * "wetdem: <what>: cannot write <file>" and returns CLI_EXIT_RUNTIME. */
 int cli_write_output(const char* path, const char* what, void (*write)(FILE* f, const void* ctx),
                      const void* ctx);

@@ -612,19 +612,3 @@ int cli_load_with_overrides(const char* file, const char* const* sets, int n_set
         rc = cli_scenario_override(sc, sets[k]);
     return rc;
 }
-
-/* Creates dir and its parents (mkdir -p). */
-int cli_make_dirs(const char* dir)
-{
-    char path[1024];
-    if (snprintf(path, sizeof path, "%s", dir) >= (int)sizeof path)
-        return -1;
-    for (char* p = path + 1; *p; p++)
-        if (*p == '/') {
-            *p = '\0';
-            if (mkdir(path, 0777) != 0 && errno != EEXIST)
-                return -1;
-            *p = '/';
-        }
-    return (mkdir(path, 0777) == 0 || errno == EEXIST) ? 0 : -1;
-}

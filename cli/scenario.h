@@ -204,8 +204,6 @@ int cli_override_split(const char* text, char* section, char* key, char* value);
 /* cli_scenario_load() then cli_scenario_override() for each of sets. Returns an exit code. */
 int cli_load_with_overrides(const char* file, const char* const* sets, int n_sets,
                             struct cli_scenario* sc);
-/* mkdir -p. 0 or -1 (errno set). */
-int cli_make_dirs(const char* dir);
 
 /* ---- documentation ---- */
 

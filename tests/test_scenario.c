@@ -330,6 +330,15 @@ static void test_scenario_sweep_order_and_threads(void** state)
     CHECK_CONTAINS(r.out, "angle_deg");
     free(r.out);
     assert_false(exists(tmpdir, "sweep.csv"));
+    /* --out into a directory that does not exist yet: it is created, the table written whole */
+    snprintf(cmd, sizeof cmd,
+             "sweep examples/scenarios/nijssen_head_on.ini --param collision.stokes "
+             "--values 50:60:2 --out '%s/new/dir/sweep.csv'",
+             tmpdir);
+    r = run_cli(cmd);
+    assert_int_equal(r.code, 0);
+    free(r.out);
+    assert_true(exists(tmpdir, "new/dir/sweep.csv"));
 }
 
 /* Field `col` (0-based) of a CSV line, copied into out. */
