@@ -176,15 +176,16 @@ static int read_header(const char* path, long line, char** f, int n, int col[N_C
     }
     if (col[COL_STOKES] < 0 || col[COL_EN] < 0) {
         cli_error("%s:%ld: the header must name columns stokes_n and e_n (optional: angle_deg, "
-                  "omega_rad_s)", path, line);
+                  "omega_rad_s)",
+                  path, line);
         return CLI_EXIT_USAGE;
     }
     return CLI_EXIT_OK;
 }
 
 /* Reads column c of a row into *v with its range check. */
-static int read_value(const char* path, long line, char** f, int n, const int col[N_COLS],
-                      int c, double* v)
+static int read_value(const char* path, long line, char** f, int n, const int col[N_COLS], int c,
+                      double* v)
 {
     if (col[c] >= n) {
         cli_error("%s:%ld: %d columns, but column %s is number %d", path, line, n, col_names[c],
@@ -312,8 +313,7 @@ static int simulate(const struct fit_ctx* c, const double* params, const struct 
         if (build_point(c, params, &pts[built], &su[built]) != CLI_EXIT_OK) {
             st = WETDEM_ERR_INVALID;
             snprintf(msg, msg_size, "the scenario was rejected at St_n = %g with %s = %g%s",
-                     pts[built].stokes, c->keys[0], params[0],
-                     c->n_keys > 1 ? ", ..." : "");
+                     pts[built].stokes, c->keys[0], params[0], c->n_keys > 1 ? ", ..." : "");
         }
     if (st == WETDEM_OK) {
 #pragma omp parallel for schedule(dynamic, 1)
@@ -339,8 +339,7 @@ static int simulate(const struct fit_ctx* c, const double* params, const struct 
 }
 
 /* wetdem_fit_model_fn: e_n of every point, then (with omega) |omega_i| of every point. */
-static int fit_model(const double* params, double* predicted, char* msg, size_t msg_size,
-                     void* ctx)
+static int fit_model(const double* params, double* predicted, char* msg, size_t msg_size, void* ctx)
 {
     const struct fit_ctx* c = ctx;
     double* omega = malloc(c->n_pts * sizeof *omega);
@@ -378,7 +377,8 @@ static int check_key(const char* tok, const char* section, const char* key)
         const struct cli_key_desc* d = &info.desc->keys[k];
         if (strcmp(d->key, key) == 0 && d->kind != CLI_VALUE_NUMBER) {
             cli_error("fit: --fit %s: [%s] %s takes a word, not a number; only numeric keys "
-                      "can be fitted", tok, section, key);
+                      "can be fitted",
+                      tok, section, key);
             return CLI_EXIT_USAGE;
         }
         if (strcmp(d->key, key) == 0)
@@ -389,7 +389,8 @@ static int check_key(const char* tok, const char* section, const char* key)
         const struct wetdem_param_desc* d = &info.lib_keys[k];
         if (strcmp(d->name, key) == 0 && d->choices) {
             cli_error("fit: --fit %s: [%s] %s is a choice, not a number; only numeric "
-                      "parameters can be fitted", tok, section, key);
+                      "parameters can be fitted",
+                      tok, section, key);
             return CLI_EXIT_USAGE;
         }
         if (strcmp(d->name, key) == 0)
@@ -403,7 +404,8 @@ static int check_key(const char* tok, const char* section, const char* key)
     if (hint)
         snprintf(msg, sizeof msg, " (did you mean '%s'?)", hint);
     cli_error("fit: --fit %s: unknown key '%s' in [%s]%s; 'wetdem describe' lists a model's "
-              "parameters, docs/scenarios.md the scenario keys", tok, key, section, msg);
+              "parameters, docs/scenarios.md the scenario keys",
+              tok, key, section, msg);
     return CLI_EXIT_USAGE;
 }
 
@@ -440,9 +442,10 @@ static int check_counts(const struct fit_args* a, const struct fit_ctx* c)
         return CLI_EXIT_OK;
     cli_error("fit: %s has %zu data row%s (%zu residual%s%s) for %zu parameter%s: need more "
               "residuals than parameters, at least %zu rows (the standard errors use the "
-              "residual variance cost/(n - p))", a->data, c->n_pts, c->n_pts == 1 ? "" : "s",
-              n, n == 1 ? "" : "s", c->use_omega ? ": e_n and spin" : "", c->n_keys,
-              c->n_keys == 1 ? "" : "s", c->use_omega ? c->n_keys / 2 + 1 : c->n_keys + 1);
+              "residual variance cost/(n - p))",
+              a->data, c->n_pts, c->n_pts == 1 ? "" : "s", n, n == 1 ? "" : "s",
+              c->use_omega ? ": e_n and spin" : "", c->n_keys, c->n_keys == 1 ? "" : "s",
+              c->use_omega ? c->n_keys / 2 + 1 : c->n_keys + 1);
     return CLI_EXIT_USAGE;
 }
 
@@ -468,7 +471,8 @@ static bool preset_value(const struct cli_scenario* sc, const char* section, con
     struct wetdem_material m;
     struct wetdem_fluid f;
     const void* base = is_fluid ? (const void*)&f : (const void*)&m;
-    if (!preset || (is_fluid ? wetdem_fluid_preset(preset, &f) : wetdem_material_preset(preset, &m)))
+    if (!preset ||
+        (is_fluid ? wetdem_fluid_preset(preset, &f) : wetdem_material_preset(preset, &m)))
         return false;
     const struct wetdem_param_desc* d =
         wetdem_param_find(is_fluid ? wetdem_fluid_params() : wetdem_material_params(), key);
@@ -522,8 +526,7 @@ static int initial_value(const struct fit_ctx* c, size_t j, double* v)
     int rc = cli_scenario_override(&probe, set);
     cli_scenario_free(&probe);
     if (rc == CLI_EXIT_OK)
-        cli_error("fit: %s has no numeric value in %s; give it with --init", full,
-                  c->base->file);
+        cli_error("fit: %s has no numeric value in %s; give it with --init", full, c->base->file);
     return CLI_EXIT_USAGE;
 }
 
@@ -585,7 +588,8 @@ static void print_result(const struct fit_ctx* c, const double* init,
                key_unit(c->keys[j]), 100 * r->std_errors[j] / fabs(r->values[j]));
     int by = (r->converged_by >= 0 && r->converged_by <= 3) ? r->converged_by : 0;
     printf("# cost %.6g [-], residual std s = %.4g [-]%s over %zu dof, %zu iterations, %zu model "
-           "evaluations (x %zu collisions), converged: %s\n", r->cost, r->residual_std,
+           "evaluations (x %zu collisions), converged: %s\n",
+           r->cost, r->residual_std,
            c->use_omega ? " (spin residuals in units of --omega-scale)" : " (e_n)", r->dof,
            r->iterations, r->model_evals, c->n_pts, converged_words[by]);
     double* res = malloc(c->n_pts * sizeof *res);
@@ -616,8 +620,8 @@ static double point_angle(const struct fit_ctx* c, const struct point* p)
     return p->has_angle ? p->angle_deg : cli_scenario_number(c->base, "collision", "angle_deg", 0);
 }
 
-static int write_fit_csv(const char* path, const struct fit_ctx* c, const double* pred,
-                         int argc, char** argv)
+static int write_fit_csv(const char* path, const struct fit_ctx* c, const double* pred, int argc,
+                         char** argv)
 {
     FILE* f = fopen(path, "w");
     if (!f) {
@@ -640,8 +644,8 @@ static int write_fit_csv(const char* path, const struct fit_ctx* c, const double
 }
 
 /* The fitted model on `m` log-spaced Stokes numbers over the data range, per distinct angle. */
-static int write_curve_csv(const char* path, const struct fit_ctx* c, const double* values,
-                           int m, int argc, char** argv)
+static int write_curve_csv(const char* path, const struct fit_ctx* c, const double* values, int m,
+                           int argc, char** argv)
 {
     double lo = INFINITY, hi = 0, angles[64];
     size_t n_ang = 0;
@@ -661,8 +665,8 @@ static int write_curve_csv(const char* path, const struct fit_ctx* c, const doub
     int st = (pts && e) ? WETDEM_OK : WETDEM_ERR_NOMEM;
     for (size_t k = 0; st == WETDEM_OK && k < n; k++) {
         double u = m > 1 ? (double)(k % (size_t)m) / (m - 1) : 0;
-        pts[k] = (struct point){.stokes = lo * pow(hi / lo, u), .angle_deg = angles[k / (size_t)m],
-                                .has_angle = true};
+        pts[k] = (struct point){
+            .stokes = lo * pow(hi / lo, u), .angle_deg = angles[k / (size_t)m], .has_angle = true};
     }
     if (st == WETDEM_OK)
         st = simulate(c, values, pts, n, e, e + n, msg, sizeof msg);
@@ -707,9 +711,14 @@ static int run_fit(const struct fit_args* a, struct fit_ctx* c, const double* in
     const char* names[WETDEM_FIT_MAX_PARAMS];
     for (size_t j = 0; j < c->n_keys; j++)
         names[j] = c->keys[j];
-    struct wetdem_fit_problem pb = {.n_params = c->n_keys, .names = names, .initial = init,
-                                    .n_data = n, .observed = obs, .scale = scale,
-                                    .model = fit_model, .ctx = c};
+    struct wetdem_fit_problem pb = {.n_params = c->n_keys,
+                                    .names = names,
+                                    .initial = init,
+                                    .n_data = n,
+                                    .observed = obs,
+                                    .scale = scale,
+                                    .model = fit_model,
+                                    .ctx = c};
     struct wetdem_fit_options o;
     wetdem_fit_options_init(&o);
     o.max_iter = a->max_iter;

@@ -65,11 +65,11 @@ static int parse_args(int argc, char** argv, struct run_args* a)
         else if (s[0] != '-' && !a->file)
             a->file = s;
         else {
-            cli_error("run: unexpected argument '%s'%s", s,
-                      (strcmp(s, "--set") == 0 || strcmp(s, "--out") == 0 ||
-                       strcmp(s, "--restart") == 0)
-                          ? " (needs a value)"
-                          : "");
+            cli_error(
+                "run: unexpected argument '%s'%s", s,
+                (strcmp(s, "--set") == 0 || strcmp(s, "--out") == 0 || strcmp(s, "--restart") == 0)
+                    ? " (needs a value)"
+                    : "");
             usage(stderr);
             return CLI_EXIT_USAGE;
         }
@@ -159,8 +159,8 @@ static int run_soft(const struct cli_scenario* sc, struct cli_setup* su, const s
     }
     if (open_out(&traj, a->out_dir, su->trajectory_file) != 0)
         return CLI_EXIT_RUNTIME;
-    struct cli_trajectory t = {.f = traj.f, .target_is_wall = su->spec.target_is_wall,
-                               .argc = argc, .argv = argv};
+    struct cli_trajectory t = {
+        .f = traj.f, .target_is_wall = su->spec.target_is_wall, .argc = argc, .argv = argv};
     if (traj.f)
         wetdem_sim_set_observer(su->sim, su->trajectory_interval, cli_trajectory_observe, &t);
     struct wetdem_collision_result res;
@@ -212,8 +212,8 @@ int cmd_run(int argc, char** argv)
             cli_error("run %s: engine 'pairwise' is not in this build", a.file);
             rc = CLI_EXIT_RUNTIME;
         } else {
-            struct cli_run_options opt = {.out_dir = a.out_dir, .json = a.json, .argc = argc,
-                                          .argv = argv, .check = a.check};
+            struct cli_run_options opt = {
+                .out_dir = a.out_dir, .json = a.json, .argc = argc, .argv = argv, .check = a.check};
             rc = cli_run_pairwise(&sc, &opt);
         }
         cli_scenario_free(&sc);
@@ -221,8 +221,12 @@ int cmd_run(int argc, char** argv)
     }
     bool many = rc == CLI_EXIT_OK && cli_scenario_is_many && cli_scenario_is_many(&sc);
     if (many || (rc == CLI_EXIT_OK && a.restart)) {
-        struct cli_run_options opt = {.out_dir = a.out_dir, .json = a.json, .argc = argc,
-                                      .argv = argv, .restart = a.restart, .check = a.check};
+        struct cli_run_options opt = {.out_dir = a.out_dir,
+                                      .json = a.json,
+                                      .argc = argc,
+                                      .argv = argv,
+                                      .restart = a.restart,
+                                      .check = a.check};
         if (!many || !cli_run_many) {
             cli_error("run %s: %s", a.file,
                       many ? "many-particle runs are not in this build"

@@ -55,10 +55,9 @@ static int parse_int(const char* text, const char* what, int* out)
 static int parse_option(struct track_cli* c, const char* name, const char* value)
 {
     struct wetdem_track_options* o = &c->opt;
-    static const char* const dnames[] = {"--fps", "--pixel-size", "--threshold", "--radius",
-                                         "--mass", "--viscosity"};
-    double* dvals[] = {&o->fps, &o->pixel_size, &o->threshold, &o->radius, &o->mass,
-                       &o->viscosity};
+    static const char* const dnames[] = {"--fps",    "--pixel-size", "--threshold",
+                                         "--radius", "--mass",       "--viscosity"};
+    double* dvals[] = {&o->fps, &o->pixel_size, &o->threshold, &o->radius, &o->mass, &o->viscosity};
     for (size_t k = 0; k < sizeof dnames / sizeof dnames[0]; k++)
         if (strcmp(name, dnames[k]) == 0)
             return cli_parse_double(value, name, dvals[k]);
@@ -123,8 +122,8 @@ static int write_frames(const struct wetdem_track* t, const char* path, int argc
         const struct wetdem_track_sample* q = wetdem_track_samples(t, k, &n);
         for (size_t i = 0; i < n; i++)
             fprintf(f, "%d,%ld,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.6g\n",
-                    wetdem_track_sphere_id(t, k), q[i].frame, q[i].time, q[i].vx_raw,
-                    q[i].vy_raw, q[i].omega_raw, q[i].vx, q[i].vy, q[i].omega, q[i].residual);
+                    wetdem_track_sphere_id(t, k), q[i].frame, q[i].time, q[i].vx_raw, q[i].vy_raw,
+                    q[i].omega_raw, q[i].vx, q[i].vy, q[i].omega, q[i].residual);
     }
     int bad = ferror(f);
     if (fclose(f) != 0 || bad) {

@@ -136,16 +136,15 @@ static void vreport(const struct cli_scenario* sc, const struct cli_entry* e, co
                     va_list ap)
 {
     if (e->line > 0)
-        fprintf(stderr, "%s:%d: [%s] %s = %s: ", sc->file, e->line, e->section, e->key,
-                e->value);
+        fprintf(stderr, "%s:%d: [%s] %s = %s: ", sc->file, e->line, e->section, e->key, e->value);
     else
         fprintf(stderr, "%s: --set %s.%s=%s: ", sc->file, e->section, e->key, e->value);
     vfprintf(stderr, fmt, ap);
     fputc('\n', stderr);
 }
 
-void cli_scenario_error(const struct cli_scenario* sc, const struct cli_entry* e,
-                        const char* fmt, ...)
+void cli_scenario_error(const struct cli_scenario* sc, const struct cli_entry* e, const char* fmt,
+                        ...)
 {
     va_list ap;
     va_start(ap, fmt);
@@ -164,8 +163,8 @@ static int section_line(const struct cli_scenario* sc, const char* section)
     return 1;
 }
 
-void cli_scenario_section_error(const struct cli_scenario* sc, const char* section,
-                                const char* fmt, ...)
+void cli_scenario_section_error(const struct cli_scenario* sc, const char* section, const char* fmt,
+                                ...)
 {
     va_list ap;
     va_start(ap, fmt);
@@ -204,8 +203,8 @@ double cli_scenario_number(const struct cli_scenario* sc, const char* section, c
     return e ? strtod(e->value, NULL) : def;
 }
 
-const char* cli_scenario_text(const struct cli_scenario* sc, const char* section,
-                              const char* key, const char* def)
+const char* cli_scenario_text(const struct cli_scenario* sc, const char* section, const char* key,
+                              const char* def)
 {
     const struct cli_entry* e = cli_scenario_find(sc, section, key);
     return e ? e->value : def;
@@ -320,8 +319,7 @@ static int check_lib_value(const struct cli_scenario* sc, const struct cli_entry
 /* ---- keys of a section ---- */
 
 /* Collects every key name a section accepts into names (NULL-terminated), for suggestions. */
-static size_t section_key_names(const struct cli_section_info* info, const char** names,
-                                size_t cap)
+static size_t section_key_names(const struct cli_section_info* info, const char** names, size_t cap)
 {
     size_t n = 0;
     for (size_t k = 0; info->desc && info->desc->keys && info->desc->keys[k].key && n + 1 < cap;
@@ -349,8 +347,7 @@ static void unknown_key(const struct cli_scenario* sc, const struct cli_entry* e
         size_t len = strlen(list);
         snprintf(list + len, sizeof list - len, "%s%s", k ? ", " : "", names[k]);
     }
-    cli_scenario_error(sc, e, "unknown key '%s' in [%s]; valid keys: %s", e->key, e->section,
-                       list);
+    cli_scenario_error(sc, e, "unknown key '%s' in [%s]; valid keys: %s", e->key, e->section, list);
 }
 
 /* Checks one entry against its section. Returns an exit code; prints the error. */
@@ -396,9 +393,8 @@ static int check_all(const struct cli_scenario* sc)
         }
         for (size_t m = 0; m < k; m++)
             if (strcmp(sc->sections[m].name, sc->sections[k].name) == 0) {
-                fprintf(stderr, "%s:%d: section [%s] appears twice (first at line %d)\n",
-                        sc->file, sc->sections[k].line, sc->sections[k].name,
-                        sc->sections[m].line);
+                fprintf(stderr, "%s:%d: section [%s] appears twice (first at line %d)\n", sc->file,
+                        sc->sections[k].line, sc->sections[k].name, sc->sections[m].line);
                 rc = CLI_EXIT_USAGE;
             }
     }
@@ -515,8 +511,9 @@ int cli_scenario_load(const char* path, struct cli_scenario* sc)
     }
     int rc = r.n_errors ? CLI_EXIT_USAGE : CLI_EXIT_OK;
     if (bad_line > 0) {
-        fprintf(stderr, "%s:%d: malformed line: expected '[section]', 'key = value' or a "
-                        "comment\n",
+        fprintf(stderr,
+                "%s:%d: malformed line: expected '[section]', 'key = value' or a "
+                "comment\n",
                 path, bad_line);
         rc = CLI_EXIT_USAGE;
     }
@@ -537,8 +534,7 @@ int cli_override_split(const char* text, char* section, char* key, char* value)
         if (*p == '.')
             dot = p;
     if (!eq || !dot || dot == text || dot + 1 == eq) {
-        cli_error("--set '%s': expected section.key=value, e.g. --set collision.stokes=50",
-                  text);
+        cli_error("--set '%s': expected section.key=value, e.g. --set collision.stokes=50", text);
         return -1;
     }
     size_t slen = (size_t)(dot - text), klen = (size_t)(eq - dot - 1);

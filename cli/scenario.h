@@ -28,7 +28,7 @@ struct cli_entry {
     char section[CLI_NAME_MAX]; /* "collision", "material.delrin", "model.nijssen" */
     char key[CLI_NAME_MAX];
     char value[CLI_VALUE_MAX];
-    int line;                   /* 1-based line in the file; 0 for a --set override */
+    int line; /* 1-based line in the file; 0 for a --set override */
 };
 
 /* A "[section]" header line. */
@@ -58,13 +58,13 @@ enum cli_value_kind {
 struct cli_key_desc {
     const char* key;
     enum cli_value_kind kind;
-    const char* unit;         /* "m", "-", ... ("" for words) */
-    const char* default_text; /* as documented, e.g. "0 (derive from stokes)"; NULL: read
+    const char* unit;           /* "m", "-", ... ("" for words) */
+    const char* default_text;   /* as documented, e.g. "0 (derive from stokes)"; NULL: read
                                  from the library ([integrator], [sim] parameters) */
-    double min, max;          /* numbers: valid range */
-    bool min_open, max_open;  /* exclude the bound */
+    double min, max;            /* numbers: valid range */
+    bool min_open, max_open;    /* exclude the bound */
     const char* const* choices; /* CLI_VALUE_CHOICE: NULL-terminated words */
-    const char* doc;          /* one or two sentences */
+    const char* doc;            /* one or two sentences */
 };
 
 /* Descriptor of one section. A name ending in ".*" (e.g. "material.*") is a family of
@@ -110,14 +110,14 @@ bool cli_scenario_has_section(const struct cli_scenario* sc, const char* section
 double cli_scenario_number(const struct cli_scenario* sc, const char* section, const char* key,
                            double def);
 /* Reads a word or text (default `def` when absent). Borrowed pointer. */
-const char* cli_scenario_text(const struct cli_scenario* sc, const char* section,
-                              const char* key, const char* def);
+const char* cli_scenario_text(const struct cli_scenario* sc, const char* section, const char* key,
+                              const char* def);
 /* Prints "FILE:LINE: [section] key = value: <message>" (or the --set form) to stderr. */
-void cli_scenario_error(const struct cli_scenario* sc, const struct cli_entry* e,
-                        const char* fmt, ...) __attribute__((format(printf, 3, 4)));
+void cli_scenario_error(const struct cli_scenario* sc, const struct cli_entry* e, const char* fmt,
+                        ...) __attribute__((format(printf, 3, 4)));
 /* Prints "FILE:LINE: <message>" for a whole section (its header line, or line 1 if absent). */
-void cli_scenario_section_error(const struct cli_scenario* sc, const char* section,
-                                const char* fmt, ...) __attribute__((format(printf, 3, 4)));
+void cli_scenario_section_error(const struct cli_scenario* sc, const char* section, const char* fmt,
+                                ...) __attribute__((format(printf, 3, 4)));
 
 /* ---- building a soft-engine collision ---- */
 
@@ -125,19 +125,19 @@ enum cli_engine { CLI_ENGINE_SOFT = 0, CLI_ENGINE_PAIRWISE = 1 };
 
 /* Everything a soft-engine run needs, resolved from a scenario. */
 struct cli_setup {
-    struct wetdem_sim* sim;             /* owned; materials, fluid, models, integrator set */
-    struct wetdem_collision_spec spec;  /* speed always explicit (derived from stokes) */
+    struct wetdem_sim* sim;            /* owned; materials, fluid, models, integrator set */
+    struct wetdem_collision_spec spec; /* speed always explicit (derived from stokes) */
     enum cli_engine engine;
-    double impact_speed;                /* |v_i| at t = 0 [m/s] */
-    double stokes_n;                    /* normal Stokes number of the impact [-] */
-    double m_eff, r_eff;                /* m* [kg], R* [m] used for the Stokes number */
-    double trajectory_interval;         /* [s], resolved from auto */
+    double impact_speed;                 /* |v_i| at t = 0 [m/s] */
+    double stokes_n;                     /* normal Stokes number of the impact [-] */
+    double m_eff, r_eff;                 /* m* [kg], R* [m] used for the Stokes number */
+    double trajectory_interval;          /* [s], resolved from auto */
     char trajectory_file[CLI_VALUE_MAX]; /* "" = not written */
     char events_file[CLI_VALUE_MAX];
     char summary_file[CLI_VALUE_MAX];
     /* filled by cli_setup_capture() after the run: */
-    double striker_speed_out;          /* |v_i| at the end [m/s] */
-    double striker_angle_out;          /* angle of v_i to the final line of centres [rad] */
+    double striker_speed_out; /* |v_i| at the end [m/s] */
+    double striker_angle_out; /* angle of v_i to the final line of centres [rad] */
 };
 
 /* Reads [engine] type only. CLI_EXIT_OK or CLI_EXIT_USAGE. */

@@ -23,8 +23,7 @@
 
 #define PI 3.14159265358979323846
 
-double cli_stokes_speed(double stokes_n, double viscosity, double m_eff, double r_eff,
-                        double angle)
+double cli_stokes_speed(double stokes_n, double viscosity, double m_eff, double r_eff, double angle)
 {
     return stokes_n * 6.0 * PI * viscosity * r_eff * r_eff / (m_eff * cos(angle));
 }
@@ -93,8 +92,9 @@ int cli_scenario_set_model_params(const struct cli_scenario* sc, struct wetdem_s
         snprintf(name, sizeof name, "%s.%s", p->section + 6, p->key);
         double v;
         if (wetdem_sim_param(sim, name, &v) != WETDEM_OK) {
-            cli_scenario_error(sc, p, "model '%s' is not enabled by [models] force or "
-                                      "min_separation, so it has no parameters to set",
+            cli_scenario_error(sc, p,
+                               "model '%s' is not enabled by [models] force or "
+                               "min_separation, so it has no parameters to set",
                                p->section + 6);
             return CLI_EXIT_USAGE;
         }
@@ -147,7 +147,8 @@ static int build_materials(const struct cli_scenario* sc, struct cli_setup* su,
     const char* sj = cli_scenario_text(sc, "collision", "target_material", si);
     const struct cli_entry* ei = cli_scenario_find(sc, "collision", "striker");
     const struct cli_entry* ej = cli_scenario_find(sc, "collision", "target_material");
-    struct cli_entry dflt = {.section = "collision", .key = "striker", .value = "steel1", .line = 1};
+    struct cli_entry dflt = {
+        .section = "collision", .key = "striker", .value = "steel1", .line = 1};
     int rc;
     if ((rc = resolve_material(sc, ei ? ei : &dflt, si, mi)) != CLI_EXIT_OK ||
         (rc = resolve_material(sc, ej ? ej : (ei ? ei : &dflt), sj, mj)) != CLI_EXIT_OK)
@@ -171,8 +172,10 @@ static int enable_forces(const struct cli_scenario* sc, struct wetdem_sim* sim)
     for (char* tok = strtok(buf, " ,\t"); tok; tok = strtok(NULL, " ,\t")) {
         const struct wetdem_model* m = wetdem_model_find(tok);
         if (m && m->kind == WETDEM_MODEL_MIN_SEPARATION) {
-            cli_scenario_error(sc, e, "'%s' is a minimum-separation model: write "
-                                      "'min_separation = %s'", tok, tok);
+            cli_scenario_error(sc, e,
+                               "'%s' is a minimum-separation model: write "
+                               "'min_separation = %s'",
+                               tok, tok);
             return CLI_EXIT_USAGE;
         }
         if (wetdem_sim_enable_model(sim, tok) != WETDEM_OK)
@@ -263,7 +266,8 @@ static int build_kinematics(const struct cli_scenario* sc, struct cli_setup* su,
     double m_j = mj->density * 4.0 / 3.0 * PI * pow(s->radius_j, 3);
     bool free_target = !s->target_is_wall && !s->target_is_fixed;
     su->m_eff = free_target ? m_i * m_j / (m_i + m_j) : m_i;
-    su->r_eff = s->target_is_wall ? s->radius_i : s->radius_i * s->radius_j / (s->radius_i + s->radius_j);
+    su->r_eff =
+        s->target_is_wall ? s->radius_i : s->radius_i * s->radius_j / (s->radius_i + s->radius_j);
     s->angle = cli_scenario_number(sc, "collision", "angle_deg", 0) * PI / 180.0;
     const struct cli_entry* ev = cli_scenario_find(sc, "collision", "speed");
     const struct cli_entry* es = cli_scenario_find(sc, "collision", "stokes");
@@ -310,8 +314,7 @@ static int build_kinematics(const struct cli_scenario* sc, struct cli_setup* su,
     return CLI_EXIT_OK;
 }
 
-static void output_name(const struct cli_scenario* sc, const char* key, const char* def,
-                        char* out)
+static void output_name(const struct cli_scenario* sc, const char* key, const char* def, char* out)
 {
     const char* v = cli_scenario_text(sc, "output", key, def);
     snprintf(out, CLI_VALUE_MAX, "%s", strcmp(v, "none") == 0 ? "" : v);

@@ -24,15 +24,20 @@
 #include "cli_util.h"
 #include "scenario_many.h"
 
-#define NUM(k, u, dflt, lo, hi, lo_open, hi_open, doc)                                            \
-    {k, CLI_VALUE_NUMBER, u, dflt, lo, hi, lo_open, hi_open, NULL, doc}
-#define WORD(k, kind, dflt, choices, doc) {k, kind, "", dflt, 0, 0, false, false, choices, doc}
+#define NUM(k, u, dflt, lo, hi, lo_open, hi_open, doc)                                             \
+    {                                                                                              \
+        k, CLI_VALUE_NUMBER, u, dflt, lo, hi, lo_open, hi_open, NULL, doc                          \
+    }
+#define WORD(k, kind, dflt, choices, doc)                                                          \
+    {                                                                                              \
+        k, kind, "", dflt, 0, 0, false, false, choices, doc                                        \
+    }
 #define MAX_MATERIALS 32
 
 static const char* const yes_no[] = {"no", "yes", NULL};
 static const char* const layouts[] = {"lattice", "random", NULL};
-static const char* const face_names[] = {"x_min", "x_max", "y_min", "y_max", "z_min", "z_max",
-                                         NULL};
+static const char* const face_names[] = {"x_min", "x_max", "y_min", "y_max",
+                                         "z_min", "z_max", NULL};
 
 static const struct cli_key_desc box_keys[] = {
     NUM("size_x", "m", "required", 0, 1e3, true, false, "Edge of the box along x: [0, size_x]."),
@@ -140,8 +145,7 @@ static const struct cli_key_desc dump_keys[] = {
 };
 
 const struct cli_section_desc cli_many_sections[] = {
-    {"box", "Many-particle run: the box [0, size] on each axis and its periodic axes.",
-     box_keys},
+    {"box", "Many-particle run: the box [0, size] on each axis and its periodic axes.", box_keys},
     {"walls", "Many-particle run: plane walls on faces of the box.", walls_keys},
     {"insert", "Many-particle run: spheres inserted on a lattice or at random (seeded).",
      insert_keys},
@@ -150,8 +154,7 @@ const struct cli_section_desc cli_many_sections[] = {
      "particles are added in file order and must not overlap.",
      insert_keys},
     {"particle.*", "Many-particle run: one sphere NAME placed explicitly.", particle_keys},
-    {"run", "Many-particle run: length, time step, neighbour-list skin, energy budget.",
-     run_keys},
+    {"run", "Many-particle run: length, time step, neighbour-list skin, energy budget.", run_keys},
     {"dump", "Many-particle run: files written in `wetdem run --out DIR`.", dump_keys},
     {0},
 };
@@ -190,8 +193,9 @@ static int build_models(const struct cli_scenario* sc, struct wetdem_sim* sim)
     for (char* tok = strtok(buf, " ,\t"); tok; tok = strtok(NULL, " ,\t")) {
         const struct wetdem_model* m = wetdem_model_find(tok);
         if (m && m->kind != WETDEM_MODEL_CONTACT && m->kind != WETDEM_MODEL_FLUID) {
-            cli_scenario_error(sc, e, "'%s' is a %s model: the many-particle mode sums force "
-                                      "models (contact and fluid) only",
+            cli_scenario_error(sc, e,
+                               "'%s' is a %s model: the many-particle mode sums force "
+                               "models (contact and fluid) only",
                                tok, wetdem_model_kind_name(m->kind));
             return CLI_EXIT_USAGE;
         }
@@ -210,8 +214,9 @@ static int build_settings(const struct cli_scenario* sc, struct wetdem_sim* sim)
 {
     const struct cli_entry* n = cli_scenario_find(sc, "integrator", "name");
     if (n && strcmp(n->value, "verlet") != 0) {
-        cli_scenario_error(sc, n, "the many-particle mode steps with velocity Verlet: use "
-                                  "name = verlet (or leave it out)");
+        cli_scenario_error(sc, n,
+                           "the many-particle mode steps with velocity Verlet: use "
+                           "name = verlet (or leave it out)");
         return CLI_EXIT_USAGE;
     }
     for (size_t k = 0; k < sc->n_entries; k++) {
@@ -258,8 +263,8 @@ static int material_index(const struct cli_scenario* sc, struct wetdem_sim* sim,
         const char* fmt = "unknown material '%s'%s%s%s: use a preset or define a [material.%s] "
                           "section";
         if (use)
-            cli_scenario_error(sc, use, fmt, name, hint ? " (did you mean '" : "",
-                               hint ? hint : "", hint ? "'?)" : "", name);
+            cli_scenario_error(sc, use, fmt, name, hint ? " (did you mean '" : "", hint ? hint : "",
+                               hint ? "'?)" : "", name);
         else
             cli_scenario_section_error(sc, section, fmt, name, hint ? " (did you mean '" : "",
                                        hint ? hint : "", hint ? "'?)" : "", name);
@@ -284,8 +289,9 @@ static int build_box(const struct cli_scenario* sc, struct cli_many_setup* su)
     static const char* const size_keys[] = {"size_x", "size_y", "size_z"};
     for (int k = 0; k < 3; k++) {
         if (!cli_scenario_find(sc, "box", size_keys[k])) {
-            cli_scenario_section_error(sc, "box", "[box] needs size_x, size_y and size_z [m] "
-                                                  "(the box is [0, size] on each axis)");
+            cli_scenario_section_error(sc, "box",
+                                       "[box] needs size_x, size_y and size_z [m] "
+                                       "(the box is [0, size] on each axis)");
             return CLI_EXIT_USAGE;
         }
         su->box[k] = cli_scenario_number(sc, "box", size_keys[k], 0);
@@ -328,15 +334,17 @@ static int wall_faces(const struct cli_scenario* sc, const struct cli_many_setup
             f++;
         if (!face_names[f]) {
             const char* hint = wetdem_param_suggest(tok, face_names);
-            cli_scenario_error(sc, e, "'%s' is not a face%s%s%s; faces: x_min, x_max, y_min, "
-                                      "y_max, z_min, z_max, all or none",
+            cli_scenario_error(sc, e,
+                               "'%s' is not a face%s%s%s; faces: x_min, x_max, y_min, "
+                               "y_max, z_min, z_max, all or none",
                                tok, hint ? " (did you mean '" : "", hint ? hint : "",
                                hint ? "'?)" : "");
             return CLI_EXIT_USAGE;
         }
         if (su->many.periodic[f / 2]) {
-            cli_scenario_error(sc, e, "wall %s lies on axis %c, which [box] periodic makes "
-                                      "periodic: remove the wall or the periodic axis",
+            cli_scenario_error(sc, e,
+                               "wall %s lies on axis %c, which [box] periodic makes "
+                               "periodic: remove the wall or the periodic axis",
                                tok, "xyz"[f / 2]);
             return CLI_EXIT_USAGE;
         }
@@ -402,13 +410,16 @@ static int insert_radii(const struct cli_scenario* sc, const char* section,
     const struct cli_entry* lo = cli_scenario_find(sc, section, "radius_min");
     const struct cli_entry* hi = cli_scenario_find(sc, section, "radius_max");
     if (r && (lo || hi)) {
-        cli_scenario_error(sc, lo ? lo : hi, "give radius (equal spheres) or radius_min and "
-                                             "radius_max (polydisperse), not both");
+        cli_scenario_error(sc, lo ? lo : hi,
+                           "give radius (equal spheres) or radius_min and "
+                           "radius_max (polydisperse), not both");
         return CLI_EXIT_USAGE;
     }
     if (!r && !(lo && hi)) {
-        cli_scenario_section_error(sc, section, "[%s] needs radius, or radius_min and "
-                                                "radius_max [m]", section);
+        cli_scenario_section_error(sc, section,
+                                   "[%s] needs radius, or radius_min and "
+                                   "radius_max [m]",
+                                   section);
         return CLI_EXIT_USAGE;
     }
     s->radius_min = strtod(r ? r->value : lo->value, NULL);
@@ -451,9 +462,8 @@ static int build_insert(const struct cli_scenario* sc, struct cli_many_setup* su
     }
     s.lo = (struct wetdem_vec3){lo[0], lo[1], lo[2]};
     s.hi = (struct wetdem_vec3){hi[0], hi[1], hi[2]};
-    rc = material_index(sc, su->sim, mt, section, cli_scenario_text(sc, section, "material",
-                                                                     "steel1"),
-                        &s.material);
+    rc = material_index(sc, su->sim, mt, section,
+                        cli_scenario_text(sc, section, "material", "steel1"), &s.material);
     if (rc != CLI_EXIT_OK)
         return rc;
     int st = wetdem_sim_insert(su->sim, &s);
@@ -475,8 +485,10 @@ static int build_particle(const struct cli_scenario* sc, struct cli_many_setup* 
         }
 #define N(key) cli_scenario_number(sc, section, key, 0)
     struct wetdem_particle p = {
-        .pos = {N("x"), N("y"), N("z")},       .vel = {N("vx"), N("vy"), N("vz")},
-        .omega = {N("spin_x"), N("spin_y"), N("spin_z")}, .radius = N("radius"),
+        .pos = {N("x"), N("y"), N("z")},
+        .vel = {N("vx"), N("vy"), N("vz")},
+        .omega = {N("spin_x"), N("spin_y"), N("spin_z")},
+        .radius = N("radius"),
         .is_fixed = strcmp(cli_scenario_text(sc, section, "fixed", "no"), "yes") == 0};
 #undef N
     int rc = material_index(sc, su->sim, mt, section,
@@ -510,7 +522,8 @@ static int check_group(const struct cli_scenario* sc, const struct cli_many_setu
             double lo = (faces >> (2 * k)) & 1u ? p[i].radius : 0.0;
             double hi = (faces >> (2 * k + 1)) & 1u ? p[i].radius : 0.0;
             if (!(x[k] >= lo && x[k] <= su->box[k] - hi)) {
-                cli_scenario_section_error(sc, section, "sphere %zu of [%s] (centre %c = %g m, "
+                cli_scenario_section_error(sc, section,
+                                           "sphere %zu of [%s] (centre %c = %g m, "
                                            "radius %g m) is outside the box [0, %g] m%s",
                                            i - from + 1, section, "xyz"[k], x[k], p[i].radius,
                                            su->box[k], (lo > 0 || hi > 0) ? " or cuts a wall" : "");
@@ -523,7 +536,8 @@ static int check_group(const struct cli_scenario* sc, const struct cli_many_setu
                            axis_delta(su, 2, p[i].pos.z, p[j].pos.z)};
             double gap = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) - p[i].radius - p[j].radius;
             if (gap < 0) {
-                cli_scenario_section_error(sc, section, "sphere %zu of [%s] overlaps sphere %zu "
+                cli_scenario_section_error(sc, section,
+                                           "sphere %zu of [%s] overlaps sphere %zu "
                                            "of an earlier group by %g m: move or shrink one of "
                                            "the groups (they are inserted in file order)",
                                            i - from + 1, section, j + 1, -gap);
@@ -555,8 +569,9 @@ static int build_spheres(const struct cli_scenario* sc, struct cli_many_setup* s
             *first = cli_scenario_text(sc, name, "material", "steel1");
     }
     if (!*first) {
-        cli_scenario_section_error(sc, "box", "no spheres: add an [insert] section (or "
-                                              "[insert.NAME], [particle.NAME])");
+        cli_scenario_section_error(sc, "box",
+                                   "no spheres: add an [insert] section (or "
+                                   "[insert.NAME], [particle.NAME])");
         return CLI_EXIT_USAGE;
     }
     return CLI_EXIT_OK;
@@ -572,8 +587,9 @@ static int dump_name(const struct cli_scenario* sc, const char* key, const char*
     const char* v = e ? e->value : def;
     snprintf(out, CLI_VALUE_MAX, "%s", strcmp(v, "none") == 0 ? "" : v);
     if (e && (strchr(v, '/') || !v[0] || v[0] == '.')) {
-        cli_scenario_error(sc, e, "a file name in the --out directory (no '/', not starting "
-                                  "with '.'), or none");
+        cli_scenario_error(sc, e,
+                           "a file name in the --out directory (no '/', not starting "
+                           "with '.'), or none");
         return CLI_EXIT_USAGE;
     }
     return CLI_EXIT_OK;
@@ -601,12 +617,14 @@ static int build_run(const struct cli_scenario* sc, struct cli_many_setup* su)
     su->steps = se ? (unsigned long long)strtod(se->value, NULL) : 0;
     su->many.dt = cli_scenario_number(sc, "run", "dt", 0);
     su->many.skin = cli_scenario_number(sc, "run", "skin", 0);
-    su->many.energy_budget = strcmp(cli_scenario_text(sc, "run", "energy_budget", "yes"), "yes") == 0;
+    su->many.energy_budget =
+        strcmp(cli_scenario_text(sc, "run", "energy_budget", "yes"), "yes") == 0;
     su->vtk_every_given = cli_scenario_find(sc, "dump", "vtk_every") != NULL;
     su->csv_every_given = cli_scenario_find(sc, "dump", "csv_every") != NULL;
     su->vtk_every = (unsigned long long)cli_scenario_number(sc, "dump", "vtk_every", 0);
     su->csv_every = (unsigned long long)cli_scenario_number(sc, "dump", "csv_every", 0);
-    su->checkpoint_every = (unsigned long long)cli_scenario_number(sc, "dump", "checkpoint_every", 0);
+    su->checkpoint_every =
+        (unsigned long long)cli_scenario_number(sc, "dump", "checkpoint_every", 0);
     su->vtk_binary = strcmp(cli_scenario_text(sc, "dump", "vtk_binary", "yes"), "yes") == 0;
     int rc;
     if ((rc = dump_name(sc, "vtk", "particles", su->vtk_prefix)) != CLI_EXIT_OK ||
@@ -616,8 +634,9 @@ static int build_run(const struct cli_scenario* sc, struct cli_many_setup* su)
         return rc;
     size_t len = strlen(su->csv_name);
     if (len && (len < 5 || strcmp(su->csv_name + len - 4, ".csv") != 0)) {
-        cli_scenario_error(sc, cli_scenario_find(sc, "dump", "csv"), "the CSV name must end in "
-                                                                     ".csv");
+        cli_scenario_error(sc, cli_scenario_find(sc, "dump", "csv"),
+                           "the CSV name must end in "
+                           ".csv");
         return CLI_EXIT_USAGE;
     }
     return CLI_EXIT_OK;
@@ -634,7 +653,8 @@ int cli_many_build(const struct cli_scenario* sc, struct cli_many_setup* su)
 {
     memset(su, 0, sizeof *su);
     if (cli_scenario_has_section(sc, "collision")) {
-        cli_scenario_section_error(sc, "collision", "a scenario is a binary collision "
+        cli_scenario_section_error(sc, "collision",
+                                   "a scenario is a binary collision "
                                    "([collision]) or a many-particle run ([box], [insert], "
                                    "[run], ...), not both");
         return CLI_EXIT_USAGE;
@@ -651,7 +671,8 @@ int cli_many_build(const struct cli_scenario* sc, struct cli_many_setup* su)
     if ((rc = cli_scenario_build_fluid(sc, su->sim)) != CLI_EXIT_OK ||
         (rc = build_models(sc, su->sim)) != CLI_EXIT_OK ||
         (rc = build_settings(sc, su->sim)) != CLI_EXIT_OK ||
-        (rc = build_box(sc, su)) != CLI_EXIT_OK || (rc = wall_faces(sc, su, &faces)) != CLI_EXIT_OK ||
+        (rc = build_box(sc, su)) != CLI_EXIT_OK ||
+        (rc = wall_faces(sc, su, &faces)) != CLI_EXIT_OK ||
         (rc = build_spheres(sc, su, &mt, faces, &first)) != CLI_EXIT_OK ||
         (rc = build_walls(sc, su, &mt, first)) != CLI_EXIT_OK ||
         (rc = build_run(sc, su)) != CLI_EXIT_OK) {

@@ -46,10 +46,10 @@
  * few hundred MB. table[k] = CRC of the 4-bit value k. */
 uint32_t wetdem_checkpoint_crc32(uint32_t crc, const void* data, size_t n)
 {
-    static const uint32_t table[16] = {
-        0x00000000u, 0x1db71064u, 0x3b6e20c8u, 0x26d930acu, 0x76dc4190u, 0x6b6b51f4u,
-        0x4db26158u, 0x5005713cu, 0xedb88320u, 0xf00f9344u, 0xd6d6a3e8u, 0xcb61b38cu,
-        0x9b64c2b0u, 0x86d3d2d4u, 0xa00ae278u, 0xbdbdf21cu};
+    static const uint32_t table[16] = {0x00000000u, 0x1db71064u, 0x3b6e20c8u, 0x26d930acu,
+                                       0x76dc4190u, 0x6b6b51f4u, 0x4db26158u, 0x5005713cu,
+                                       0xedb88320u, 0xf00f9344u, 0xd6d6a3e8u, 0xcb61b38cu,
+                                       0x9b64c2b0u, 0x86d3d2d4u, 0xa00ae278u, 0xbdbdf21cu};
     const unsigned char* p = data;
     crc = ~crc;
     for (size_t k = 0; k < n; k++) {
@@ -100,10 +100,22 @@ static void put(struct buf* b, const void* x, size_t n)
     b->len += n;
 }
 
-static void put_u64(struct buf* b, uint64_t x) { put(b, &x, 8); }
-static void put_u32(struct buf* b, uint32_t x) { put(b, &x, 4); }
-static void put_i32(struct buf* b, int32_t x) { put(b, &x, 4); }
-static void put_f64(struct buf* b, double x) { put(b, &x, 8); }
+static void put_u64(struct buf* b, uint64_t x)
+{
+    put(b, &x, 8);
+}
+static void put_u32(struct buf* b, uint32_t x)
+{
+    put(b, &x, 4);
+}
+static void put_i32(struct buf* b, int32_t x)
+{
+    put(b, &x, 4);
+}
+static void put_f64(struct buf* b, double x)
+{
+    put(b, &x, 8);
+}
 static void put_vec(struct buf* b, struct wetdem_vec3 v)
 {
     put_f64(b, v.x);
@@ -131,8 +143,7 @@ static void put_meta(struct buf* b, const struct wetdem_checkpoint* ck, uint32_t
     put_f64(b, ck->time);
     put_u64(b, ck->step);
     put_u64(b, ck->config_hash);
-    uint64_t counts[5] = {ck->n_particles, ck->n_walls, ck->n_pairs, ck->history_len,
-                          ck->n_energy};
+    uint64_t counts[5] = {ck->n_particles, ck->n_walls, ck->n_pairs, ck->history_len, ck->n_energy};
     put(b, counts, sizeof counts);
     const struct wetdem_stats* s = &ck->stats;
     uint64_t stats[6] = {s->steps,      s->rejected_steps, s->force_evals,
@@ -451,8 +462,7 @@ static int parse_image(const unsigned char* d, size_t len, struct wetdem_checkpo
     while (c.pos < c.len) {
         char tag[4];
         uint64_t bytes = 0;
-        if (!get(&c, tag, 4) || !get(&c, NULL, 4) || !get(&c, &bytes, 8) ||
-            bytes > c.len - c.pos)
+        if (!get(&c, tag, 4) || !get(&c, NULL, 4) || !get(&c, &bytes, 8) || bytes > c.len - c.pos)
             return WETDEM_ERR_PARSE;
         size_t end = c.pos + (size_t)bytes;
         int st = WETDEM_OK;
@@ -484,8 +494,8 @@ static int slurp(const char* path, unsigned char** data, size_t* len, char* msg,
                                   strerror(errno));
     long size = (fseek(f, 0, SEEK_END) == 0) ? ftell(f) : -1;
     *data = size >= 0 ? malloc(size ? (size_t)size : 1) : NULL;
-    bool ok = *data && fseek(f, 0, SEEK_SET) == 0 &&
-              fread(*data, 1, (size_t)size, f) == (size_t)size;
+    bool ok =
+        *data && fseek(f, 0, SEEK_SET) == 0 && fread(*data, 1, (size_t)size, f) == (size_t)size;
     fclose(f);
     if (!ok) {
         free(*data);

@@ -29,10 +29,10 @@ struct wetdem_checkpoint_wall {
 
 /* Where the outputs stand, so that a resumed run continues the same file sequence. */
 struct wetdem_checkpoint_output {
-    uint64_t vtk_files;       /* VTK files written so far */
-    uint64_t csv_rows;        /* data rows of the global-quantities CSV written so far */
-    uint64_t next_vtk_step;   /* step of the next VTK file */
-    uint64_t next_csv_step;   /* step of the next CSV row */
+    uint64_t vtk_files;     /* VTK files written so far */
+    uint64_t csv_rows;      /* data rows of the global-quantities CSV written so far */
+    uint64_t next_vtk_step; /* step of the next VTK file */
+    uint64_t next_csv_step; /* step of the next CSV row */
 };
 
 /* Everything needed to resume a run bit-identically. Arrays are owned by the caller when

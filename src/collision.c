@@ -55,18 +55,18 @@ const char* wetdem_outcome_name(enum wetdem_outcome outcome)
 
 /* Per-step record of the pair (0, 1) or (0, wall 0), kept by the monitor. */
 struct tracker {
-    double h_close;                /* gap below which the pair counts as a doublet [m] */
+    double h_close; /* gap below which the pair counts as a doublet [m] */
     double t_prev, gap_prev, vn_prev;
     struct wetdem_vec3 n_prev, dv_prev;
     double min_gap;
-    bool interacting;              /* after the first interaction */
-    double t_first;                /* time of the first interaction [s] */
+    bool interacting; /* after the first interaction */
+    double t_first;   /* time of the first interaction [s] */
     double rotation, rotation_close;
-    bool arrested;                 /* the approach has been arrested once (first minimum of
+    bool arrested; /* the approach has been arrested once (first minimum of
                                       the gap): rotation_close counts from there */
     size_t events_seen;
-    double t_observe;              /* absolute observation time [s], INFINITY if none yet */
-    double observe_span;           /* spec->observe_time [s] */
+    double t_observe;    /* absolute observation time [s], INFINITY if none yet */
+    double observe_span; /* spec->observe_time [s] */
     bool observed;
     struct wetdem_vec3 n_obs, dv_obs;
 };
@@ -149,8 +149,8 @@ static int monitor(struct wetdem_sim* sim, void* ctx)
         low = fmin(low, hermite_min(t - tr->t_prev, tr->gap_prev, tr->vn_prev, c.gap, c.v_n));
     tr->min_gap = fmin(tr->min_gap, low);
     if (tr->interacting) {
-        double turn = atan2(vec3_norm(vec3_cross(tr->n_prev, c.normal)),
-                            vec3_dot(tr->n_prev, c.normal));
+        double turn =
+            atan2(vec3_norm(vec3_cross(tr->n_prev, c.normal)), vec3_dot(tr->n_prev, c.normal));
         tr->rotation += turn;
         if (tr->arrested && tr->gap_prev < tr->h_close && c.gap < tr->h_close)
             tr->rotation_close += turn;
@@ -186,8 +186,8 @@ static int check_spec(struct wetdem_sim* sim, const struct wetdem_collision_spec
         return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
                                "collision: speed = %g m/s: valid [0, inf), 0 = from stokes",
                                s->speed);
-    if (s->speed == 0 && !(isfinite(s->stokes) && s->stokes > 0 && s->angle < M_PI / 2 &&
-                           sim->fluid.viscosity > 0))
+    if (s->speed == 0 &&
+        !(isfinite(s->stokes) && s->stokes > 0 && s->angle < M_PI / 2 && sim->fluid.viscosity > 0))
         return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
                                "collision: speed 0 asks for it from stokes = %g (valid > 0), "
                                "which needs angle < pi/2 (%g rad) and fluid.viscosity > 0 "
@@ -206,8 +206,8 @@ static int check_spec(struct wetdem_sim* sim, const struct wetdem_collision_spec
         return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
                                "collision: close_gap = %g m: valid [0, inf), 0 = automatic",
                                s->close_gap);
-    if (!(s->rebound_gap_factor == 0 || (isfinite(s->rebound_gap_factor) &&
-                                         s->rebound_gap_factor >= 1)))
+    if (!(s->rebound_gap_factor == 0 ||
+          (isfinite(s->rebound_gap_factor) && s->rebound_gap_factor >= 1)))
         return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
                                "collision: rebound_gap_factor = %g: valid 0 (= 1) or >= 1",
                                s->rebound_gap_factor);
@@ -238,13 +238,13 @@ static int place_bodies(struct wetdem_sim* sim, const struct wetdem_collision_sp
                         struct setup* out)
 {
     wetdem_sim_reset(sim);
-    struct wetdem_particle pi = {.radius = s->radius_i, .material = s->material_i,
-                                 .omega = s->omega_i};
+    struct wetdem_particle pi = {
+        .radius = s->radius_i, .material = s->material_i, .omega = s->omega_i};
     int st = wetdem_sim_add_particle(sim, pi);
     if (st == WETDEM_OK && s->target_is_wall)
         st = wetdem_sim_add_wall(sim, vec3(0, 0, 0), vec3(1, 0, 0), s->material_j);
-    struct wetdem_particle pj = {.radius = s->radius_j, .material = s->material_j,
-                                 .is_fixed = s->target_is_fixed};
+    struct wetdem_particle pj = {
+        .radius = s->radius_j, .material = s->material_j, .is_fixed = s->target_is_fixed};
     if (st == WETDEM_OK && !s->target_is_wall)
         st = wetdem_sim_add_particle(sim, pj);
     if (st != WETDEM_OK)
@@ -257,15 +257,14 @@ static int place_bodies(struct wetdem_sim* sim, const struct wetdem_collision_sp
     out->r_eff = c.r_eff;
     out->m_eff = c.m_eff;
     out->h_close = s->close_gap > 0 ? s->close_gap
-                   : c.film > 0    ? c.film
-                                   : CLOSE_GAP_RATIO * c.r_eff;
+                   : c.film > 0     ? c.film
+                                    : CLOSE_GAP_RATIO * c.r_eff;
     double cos_a = cos(s->angle);
     out->speed = s->speed > 0 ? s->speed
-                              : s->stokes * 6 * M_PI * sim->fluid.viscosity * c.r_eff *
-                                    c.r_eff / (c.m_eff * cos_a);
+                              : s->stokes * 6 * M_PI * sim->fluid.viscosity * c.r_eff * c.r_eff /
+                                    (c.m_eff * cos_a);
     out->speed_n0 = out->speed * cos_a;
-    double gap0 = s->initial_gap > 0 ? s->initial_gap
-                                     : out->range + START_MARGIN_RATIO * c.r_eff;
+    double gap0 = s->initial_gap > 0 ? s->initial_gap : out->range + START_MARGIN_RATIO * c.r_eff;
     struct wetdem_vec3 dir = vec3(-cos_a, -sin(s->angle), 0); /* direction of motion of i */
     double back = s->target_is_wall ? gap0 / cos_a : back_distance(reach, reach + gap0, s->angle);
     sim->particles[0].pos = vec3_axpy(vec3(reach, 0, 0), -back, dir);
@@ -274,8 +273,7 @@ static int place_bodies(struct wetdem_sim* sim, const struct wetdem_collision_sp
 }
 
 /* Runs with the separation stop and the monitor, restoring the caller's settings. */
-static int run(struct wetdem_sim* sim, const struct wetdem_collision_spec* s,
-               struct tracker* tr)
+static int run(struct wetdem_sim* sim, const struct wetdem_collision_spec* s, struct tracker* tr)
 {
     struct wetdem_sim_settings saved = sim->settings;
     sim->settings.stop_on_separation = 1;
@@ -297,10 +295,17 @@ static void start_tracker(const struct wetdem_sim* sim, const struct setup* su,
 {
     struct wetdem_contact c;
     pair_contact(sim, &c);
-    *tr = (struct tracker){.h_close = su->h_close, .t_prev = 0, .gap_prev = c.gap, .vn_prev = c.v_n,
-                           .n_prev = c.normal, .dv_prev = relative_velocity(sim),
-                           .min_gap = c.gap, .interacting = c.gap < su->range, .t_first = 0,
-                           .t_observe = INFINITY, .observe_span = s->observe_time};
+    *tr = (struct tracker){.h_close = su->h_close,
+                           .t_prev = 0,
+                           .gap_prev = c.gap,
+                           .vn_prev = c.v_n,
+                           .n_prev = c.normal,
+                           .dv_prev = relative_velocity(sim),
+                           .min_gap = c.gap,
+                           .interacting = c.gap < su->range,
+                           .t_first = 0,
+                           .t_observe = INFINITY,
+                           .observe_span = s->observe_time};
     if (tr->interacting && s->observe_time > 0)
         tr->t_observe = s->observe_time;
 }
@@ -324,8 +329,8 @@ struct initial {
 };
 
 /* Contact time, contact/h_min flags and the last interaction end, from the event log. */
-static void scan_log(const struct wetdem_sim* sim, bool in_contact, struct wetdem_collision_result* r,
-                     double* t_last_end)
+static void scan_log(const struct wetdem_sim* sim, bool in_contact,
+                     struct wetdem_collision_result* r, double* t_last_end)
 {
     double t_open = in_contact ? 0.0 : NAN, total = 0.0;
     *t_last_end = sim->engine.time;
@@ -377,14 +382,14 @@ static void restitution(const struct wetdem_sim* sim, const struct initial* in,
     }
 }
 
-static void analyse(const struct wetdem_sim* sim, const struct setup* su,
-                    const struct initial* in, const struct tracker* tr, bool separated,
-                    bool start_in_contact, struct wetdem_collision_result* r)
+static void analyse(const struct wetdem_sim* sim, const struct setup* su, const struct initial* in,
+                    const struct tracker* tr, bool separated, bool start_in_contact,
+                    struct wetdem_collision_result* r)
 {
     double mu = sim->fluid.viscosity;
     r->speed_n0 = su->speed_n0;
-    r->stokes_n = mu > 0 ? su->m_eff * su->speed_n0 / (6 * M_PI * mu * su->r_eff * su->r_eff)
-                         : INFINITY;
+    r->stokes_n =
+        mu > 0 ? su->m_eff * su->speed_n0 / (6 * M_PI * mu * su->r_eff * su->r_eff) : INFINITY;
     restitution(sim, in, tr, r);
     r->omega_i = sim->particles[0].omega;
     r->omega_j = sim->n_walls ? vec3(0, 0, 0) : sim->particles[1].omega;

@@ -132,8 +132,7 @@ static int build_pair_slots(struct wetdem_sim* sim, size_t k)
         st = append_slot(e, (struct wetdem_event_slot){k, WETDEM_EVENT_SOURCE_ZERO, 0, 0, 0});
     if (st == WETDEM_OK && sim->settings.stop_on_separation != 0 &&
         sim->settings.separation_factor > 1)
-        st = append_slot(e,
-                         (struct wetdem_event_slot){k, WETDEM_EVENT_SOURCE_SEPARATION, 0, 0, 0});
+        st = append_slot(e, (struct wetdem_event_slot){k, WETDEM_EVENT_SOURCE_SEPARATION, 0, 0, 0});
     return st;
 }
 
@@ -225,8 +224,7 @@ static int kind_of(const struct wetdem_event_slot* s, int dir)
     return 0;
 }
 
-int wetdem_event_record(struct wetdem_sim* sim, size_t k, int dir, double t, double gap,
-                        double v_n)
+int wetdem_event_record(struct wetdem_sim* sim, size_t k, int dir, double t, double gap, double v_n)
 {
     struct wetdem_engine* e = &sim->engine;
     const struct wetdem_event_slot* s = &e->slots[k];
@@ -244,9 +242,13 @@ int wetdem_event_record(struct wetdem_sim* sim, size_t k, int dir, double t, dou
         e->events = r;
         e->events_cap = cap;
     }
-    e->events[e->n_events++] = (struct wetdem_event_record){
-        .time = t, .kind = (enum wetdem_event_kind)kind, .i = p->i, .j = p->j,
-        .is_wall = p->is_wall, .gap = gap, .v_n = v_n};
+    e->events[e->n_events++] = (struct wetdem_event_record){.time = t,
+                                                            .kind = (enum wetdem_event_kind)kind,
+                                                            .i = p->i,
+                                                            .j = p->j,
+                                                            .is_wall = p->is_wall,
+                                                            .gap = gap,
+                                                            .v_n = v_n};
     e->stats.events++;
     return WETDEM_OK;
 }

@@ -34,10 +34,10 @@ struct fit_ctx {
     const struct wetdem_fit_problem* pb;
     bool is_log[WETDEM_FIT_MAX_PARAMS];
     double fd_step;
-    double* pred;      /* scratch predictions [n_data] */
-    double* r_plus;    /* scratch residuals [n_data] */
+    double* pred;   /* scratch predictions [n_data] */
+    double* r_plus; /* scratch residuals [n_data] */
     size_t evals;
-    int status;        /* first failure of the model */
+    int status; /* first failure of the model */
     char msg[512];
 };
 
@@ -167,8 +167,9 @@ static void fill_statistics(const struct fit_ctx* c, gsl_multifit_nlinear_worksp
         res->values[j] = to_param(c, j, q);
         res->std_errors[j] = c->is_log[j] ? res->values[j] * sq : sq;
         for (size_t k = 0; k < np; k++)
-            res->correlation[j][k] = gsl_matrix_get(covar, j, k) /
-                                     sqrt(gsl_matrix_get(covar, j, j) * gsl_matrix_get(covar, k, k));
+            res->correlation[j][k] =
+                gsl_matrix_get(covar, j, k) /
+                sqrt(gsl_matrix_get(covar, j, j) * gsl_matrix_get(covar, k, k));
     }
 }
 
@@ -176,8 +177,12 @@ static void fill_statistics(const struct fit_ctx* c, gsl_multifit_nlinear_worksp
 static int solve(struct fit_ctx* c, const struct wetdem_fit_options* o, gsl_vector* x0,
                  gsl_multifit_nlinear_workspace* w, struct wetdem_fit_result* res)
 {
-    gsl_multifit_nlinear_fdf fdf = {.f = gsl_f, .df = gsl_df, .fvv = NULL,
-                                    .n = c->pb->n_data, .p = c->pb->n_params, .params = c};
+    gsl_multifit_nlinear_fdf fdf = {.f = gsl_f,
+                                    .df = gsl_df,
+                                    .fvv = NULL,
+                                    .n = c->pb->n_data,
+                                    .p = c->pb->n_params,
+                                    .params = c};
     int info = 0;
     int gst = gsl_multifit_nlinear_init(x0, &fdf, w);
     if (gst == GSL_SUCCESS)
@@ -196,8 +201,7 @@ static int solve(struct fit_ctx* c, const struct wetdem_fit_options* o, gsl_vect
 }
 
 int wetdem_fit_run(const struct wetdem_fit_problem* problem, const struct wetdem_fit_options* opt,
-                   struct wetdem_fit_result* result, double* predicted, char* msg,
-                   size_t msg_size)
+                   struct wetdem_fit_result* result, double* predicted, char* msg, size_t msg_size)
 {
     memset(result, 0, sizeof *result);
     int st = check_problem(problem, opt, msg, msg_size);
@@ -224,8 +228,8 @@ int wetdem_fit_run(const struct wetdem_fit_problem* problem, const struct wetdem
     result->model_evals = c.evals;
     if (st == WETDEM_OK || st == WETDEM_ERR_MAX_STEPS) {
         fill_statistics(&c, w, covar, result);
-        if (predicted && residuals_at(&c, gsl_multifit_nlinear_position(w)->data, c.r_plus) ==
-                             WETDEM_OK)
+        if (predicted &&
+            residuals_at(&c, gsl_multifit_nlinear_position(w)->data, c.r_plus) == WETDEM_OK)
             memcpy(predicted, c.pred, n * sizeof *predicted);
     }
     if (st == WETDEM_ERR_MAX_STEPS)

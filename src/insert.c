@@ -50,8 +50,8 @@ static int check_spec(const struct wetdem_insert_spec* s, char* msg, size_t n)
                 msg, n, WETDEM_ERR_INVALID,
                 "insert region: %c range [%g, %g] m must be finite with hi > lo", "xyz"[k], lo, hi);
     }
-    if (!s->radii && !(isfinite(s->radius_min) && s->radius_min > 0 &&
-                       isfinite(s->radius_max) && s->radius_max >= s->radius_min))
+    if (!s->radii && !(isfinite(s->radius_min) && s->radius_min > 0 && isfinite(s->radius_max) &&
+                       s->radius_max >= s->radius_min))
         return wetdem_status_fail(
             msg, n, WETDEM_ERR_INVALID,
             "insert radii: need 0 < radius_min <= radius_max (finite), got [%g, %g] m",
@@ -78,9 +78,9 @@ static double draw_radii(const struct wetdem_insert_spec* s, gsl_rng* rng,
 {
     double r_max = 0;
     for (size_t i = 0; i < s->n; i++) {
-        double r = s->radii ? s->radii[i]
-                            : s->radius_min + (s->radius_max - s->radius_min) *
-                                                  gsl_rng_uniform(rng);
+        double r = s->radii
+                       ? s->radii[i]
+                       : s->radius_min + (s->radius_max - s->radius_min) * gsl_rng_uniform(rng);
         out[i] = (struct wetdem_particle){.radius = r, .material = s->material};
         r_max = fmax(r_max, r);
     }
@@ -88,8 +88,8 @@ static double draw_radii(const struct wetdem_insert_spec* s, gsl_rng* rng,
 }
 
 /* Sites along axis k of the lattice: count, first site and spacing [m]. */
-static size_t lattice_axis(const struct wetdem_insert_spec* s, int k, double r_max,
-                           double* first, double* step)
+static size_t lattice_axis(const struct wetdem_insert_spec* s, int k, double r_max, double* first,
+                           double* step)
 {
     double lo = axis(s->lo, k), len = axis(s->hi, k) - lo, a = 2 * r_max + s->gap;
     if (s->periodic[k]) {

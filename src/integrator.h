@@ -50,10 +50,10 @@ enum wetdem_event_source {
 
 /* One event function g = gap - threshold of one pair. */
 struct wetdem_event_slot {
-    size_t pair;                      /* index in engine.pairs */
+    size_t pair; /* index in engine.pairs */
     enum wetdem_event_source source;
-    size_t model, index;              /* SOURCE_MODEL: force model slot, threshold index */
-    bool as_hmin;                     /* SOURCE_MODEL: logged as h_min reached/left */
+    size_t model, index; /* SOURCE_MODEL: force model slot, threshold index */
+    bool as_hmin;        /* SOURCE_MODEL: logged as h_min reached/left */
 };
 
 /* Builds the event functions of every pair of engine.pairs at the current state. Returns

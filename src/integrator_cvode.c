@@ -47,9 +47,9 @@ static const char* const method_choices[] = {"auto", "adams", "bdf", NULL};
 enum { METHOD_AUTO = 0, METHOD_ADAMS = 1, METHOD_BDF = 2 };
 
 struct cvode_params {
-    double rtol;      /* relative tolerance [-] */
-    double atol;      /* absolute tolerance in units of the length/speed scales [-] */
-    double max_steps; /* most steps one integrate call may take [-] */
+    double rtol;        /* relative tolerance [-] */
+    double atol;        /* absolute tolerance in units of the length/speed scales [-] */
+    double max_steps;   /* most steps one integrate call may take [-] */
     double method;      /* index into method_choices */
     double max_step;    /* largest step [s]; 0: 0.1 L/V */
     double stiff_steps; /* auto: Adams steps without an event before switching to BDF [-] */
@@ -92,7 +92,7 @@ struct run {
     struct wetdem_sim* sim;
     size_t* free_index; /* particle index of each state block */
     size_t n_free;
-    int status;         /* first non-recoverable error raised in a callback */
+    int status; /* first non-recoverable error raised in a callback */
 };
 
 static void unpack(struct run* r, const double* y)
@@ -153,8 +153,7 @@ static int roots(sunrealtype t, N_Vector yv, sunrealtype* g, void* data)
     return 0;
 }
 
-static void error_handler(int code, const char* module, const char* function, char* msg,
-                          void* data)
+static void error_handler(int code, const char* module, const char* function, char* msg, void* data)
 {
     if (code < 0)
         wetdem_sim_fail(data, WETDEM_ERR_STEP, "cvode: %s in %s (%s)", msg, function, module);
@@ -275,8 +274,8 @@ static int solver_create(struct wetdem_sim* sim, struct run* r, const struct cvo
          CVodeRootInit(s->mem, (int)sim->engine.n_slots, roots) == CV_SUCCESS &&
          CVodeSetMaxOrd(s->mem, (int)fmin(p->max_order, bdf ? 5 : 12)) == CV_SUCCESS &&
          attach_solvers(s, bdf, n) == 0;
-    return ok ? WETDEM_OK : wetdem_sim_fail(sim, WETDEM_ERR_INVALID, "cvode: set-up failed: %s",
-                                            sim->errmsg);
+    return ok ? WETDEM_OK
+              : wetdem_sim_fail(sim, WETDEM_ERR_INVALID, "cvode: set-up failed: %s", sim->errmsg);
 }
 
 /* Observer calls at the observer times in (previous time, t_new], on the interpolant. */
@@ -318,8 +317,8 @@ static int log_roots(struct wetdem_sim* sim, const int* found, double t)
 
 /* Bookkeeping after CVode returned flag >= 0 at t: observer, commit, events, restart at a
  * root, stop check, monitor. *stop is set when the separation condition holds. */
-static int after_return(struct wetdem_sim* sim, struct run* r, struct solver* s, int flag,
-                        double t, bool* stop)
+static int after_return(struct wetdem_sim* sim, struct run* r, struct solver* s, int flag, double t,
+                        bool* stop)
 {
     struct wetdem_engine* e = &sim->engine;
     int st = observe_between(sim, r, s, t);

@@ -31,7 +31,7 @@
  * library computes, the same bits as a x + b y, signed zeros included). */
 static void linear_sum(sunrealtype a, N_Vector x, sunrealtype b, N_Vector y, N_Vector z)
 {
-    const sunrealtype *restrict xd = DATA(x), *restrict yd = DATA(y);
+    const sunrealtype* restrict xd = DATA(x), * restrict yd = DATA(y);
     sunrealtype* zd = DATA(z);
     sunindextype n = LEN(x);
     bool unit = a == 1.0 || a == -1.0 || b == 1.0 || b == -1.0; /* library: general form */

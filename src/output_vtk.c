@@ -104,11 +104,12 @@ static void write_ints(FILE* f, const char* name, const struct wetdem_particle* 
         fputc('\n', f);
 }
 
-static void write_body(FILE* f, const struct wetdem_particle* p, size_t n,
-                       const uint32_t* contacts, double time, bool binary)
+static void write_body(FILE* f, const struct wetdem_particle* p, size_t n, const uint32_t* contacts,
+                       double time, bool binary)
 {
-    fprintf(f, "# vtk DataFile Version 3.0\nwetdem particles t = %.17g s\n%s\n"
-               "DATASET POLYDATA\nFIELD FieldData 1\nTIME 1 1 double\n",
+    fprintf(f,
+            "# vtk DataFile Version 3.0\nwetdem particles t = %.17g s\n%s\n"
+            "DATASET POLYDATA\nFIELD FieldData 1\nTIME 1 1 double\n",
             time, binary ? "BINARY" : "ASCII");
     put_double(f, time, binary);
     if (binary)
@@ -195,8 +196,8 @@ static void put_json_string(FILE* f, const char* s)
     fputc('"', f);
 }
 
-int wetdem_output_vtk_series_write(const char* path, const char* const* files,
-                                   const double* times, size_t n, char* msg, size_t msg_size)
+int wetdem_output_vtk_series_write(const char* path, const char* const* files, const double* times,
+                                   size_t n, char* msg, size_t msg_size)
 {
     char tmp[4096];
     FILE* f = open_tmp(path, tmp, sizeof tmp, msg, msg_size);

@@ -26,7 +26,7 @@ int wetdem_output_vtk_path(char* buf, size_t size, const char* prefix, uint64_t 
 /* Writes a ParaView time-series file (path ends in ".vtk.series": JSON listing the files,
  * given relative to the series file's directory, with their times [s]). Atomic like the
  * above. Returns WETDEM_OK or WETDEM_ERR_IO. */
-int wetdem_output_vtk_series_write(const char* path, const char* const* files,
-                                   const double* times, size_t n, char* msg, size_t msg_size);
+int wetdem_output_vtk_series_write(const char* path, const char* const* files, const double* times,
+                                   size_t n, char* msg, size_t msg_size);
 
 #endif

@@ -19,18 +19,18 @@ struct wetdem_sim;
 
 /* One candidate pair. The key (i, is_wall, j) orders the list. */
 struct wetdem_pair {
-    size_t i;             /* particle index */
-    size_t j;             /* particle index (> i), or wall index when is_wall */
-    bool is_wall;         /* j is a plane wall */
-    bool has_interacted;  /* came within the interaction range since the last separation stop */
+    size_t i;            /* particle index */
+    size_t j;            /* particle index (> i), or wall index when is_wall */
+    bool is_wall;        /* j is a plane wall */
+    bool has_interacted; /* came within the interaction range since the last separation stop */
 };
 
 struct wetdem_pairs {
     struct wetdem_pair* items; /* n pairs, sorted by key */
     size_t n, cap;
-    double* history;           /* n * history_len doubles: committed per-pair state */
-    size_t history_cap;        /* doubles allocated */
-    size_t history_len;        /* doubles per pair when the list was built */
+    double* history;    /* n * history_len doubles: committed per-pair state */
+    size_t history_cap; /* doubles allocated */
+    size_t history_len; /* doubles per pair when the list was built */
 };
 
 /* Rebuilds the list for the particles and walls of sim; keeps the history and flags of pairs

@@ -187,9 +187,10 @@ static int eval_pair(struct wetdem_sim* sim, size_t k, double t, bool commit, bo
     int st = wetdem_sim_eval_contact(sim, &c, scratch, &f, NULL);
     e->stats.pair_evals++;
     if (st < 0)
-        return wetdem_sim_fail(sim, st, "pair (%zu, %s%zu) at t = %.9g s: a force model failed "
-                               "(%s)", p->i, p->is_wall ? "wall " : "", p->j, t,
-                               wetdem_status_name(st));
+        return wetdem_sim_fail(sim, st,
+                               "pair (%zu, %s%zu) at t = %.9g s: a force model failed "
+                               "(%s)",
+                               p->i, p->is_wall ? "wall " : "", p->j, t, wetdem_status_name(st));
     if (!pair_force_is_finite(&f))
         return wetdem_sim_fail(sim, WETDEM_ERR_NUMERIC,
                                "pair (%zu, %s%zu) at t = %.9g s, gap %.6g m: non-finite force",

@@ -54,10 +54,10 @@
 struct sphere_track {
     int id;
     long first_frame;
-    size_t n, cap;                      /* frames stored */
-    double* xy;                         /* 6 per frame: dots in pixels as given */
-    double* raw;                        /* 6 per frame [m], y negated when y_down */
-    double* smooth;                     /* 6 per frame [m], Savitzky-Golay smoothed */
+    size_t n, cap;                       /* frames stored */
+    double* xy;                          /* 6 per frame: dots in pixels as given */
+    double* raw;                         /* 6 per frame [m], y negated when y_down */
+    double* smooth;                      /* 6 per frame [m], Savitzky-Golay smoothed */
     struct wetdem_track_sample* samples; /* n - 1 intervals, after analysis */
 };
 
@@ -160,14 +160,14 @@ int wetdem_track_add_frame(struct wetdem_track* track, int sphere_id, long frame
     struct sphere_track* s = sphere_slot(track, sphere_id);
     if (!s)
         return fail(track, WETDEM_ERR_INVALID,
-                    "sphere %d: at most %d spheres per track (found %d and %d already)",
-                    sphere_id, TRACK_MAX_SPHERES, track->s[0].id, track->s[1].id);
+                    "sphere %d: at most %d spheres per track (found %d and %d already)", sphere_id,
+                    TRACK_MAX_SPHERES, track->s[0].id, track->s[1].id);
     if (s->n > 0) {
         long last = s->first_frame + (long)s->n - 1;
         if (frame <= last)
             return fail(track, WETDEM_ERR_INVALID,
-                        "sphere %d: frame %ld follows frame %ld; frames must increase",
-                        sphere_id, frame, last);
+                        "sphere %d: frame %ld follows frame %ld; frames must increase", sphere_id,
+                        frame, last);
         if (frame > last + 1)
             return fail(track, WETDEM_ERR_INVALID,
                         "sphere %d: frame %ld follows frame %ld; frames %ld to %ld are missing",
@@ -195,8 +195,8 @@ static char* trim(char* f)
     while (*f == ' ' || *f == '\t')
         f++;
     size_t len = strlen(f);
-    while (len > 0 && (f[len - 1] == ' ' || f[len - 1] == '\t' || f[len - 1] == '\r' ||
-                       f[len - 1] == '\n'))
+    while (len > 0 &&
+           (f[len - 1] == ' ' || f[len - 1] == '\t' || f[len - 1] == '\r' || f[len - 1] == '\n'))
         f[--len] = '\0';
     return f;
 }
@@ -261,8 +261,8 @@ static int parse_row(struct wetdem_track* t, char** f)
     if (!parse_long(f[0], &frame))
         return fail(t, WETDEM_ERR_PARSE, "column frame: '%s' is not an integer", f[0]);
     if (!parse_long(f[1], &sphere) || sphere < 0 || sphere > 1000000)
-        return fail(t, WETDEM_ERR_PARSE,
-                    "column sphere: '%s' is not an integer id in [0, 1000000]", f[1]);
+        return fail(t, WETDEM_ERR_PARSE, "column sphere: '%s' is not an integer id in [0, 1000000]",
+                    f[1]);
     for (int c = 0; c < 6; c++)
         if (!parse_number(f[2 + c], &xy[c]) || !isfinite(xy[c]))
             return fail(t, WETDEM_ERR_PARSE, "column %s: '%s' is not a finite number",
@@ -313,8 +313,10 @@ int wetdem_track_read_csv(struct wetdem_track* track, const char* path)
     while (st == WETDEM_OK && fgets(buf, sizeof buf, fp)) {
         line++;
         if (!strchr(buf, '\n') && !feof(fp)) {
-            st = located(track, fail(track, WETDEM_ERR_PARSE, "line longer than %d characters",
-                                     TRACK_LINE_MAX - 2), path, line);
+            st = located(
+                track,
+                fail(track, WETDEM_ERR_PARSE, "line longer than %d characters", TRACK_LINE_MAX - 2),
+                path, line);
             break;
         }
         char* text = trim(buf);
@@ -441,19 +443,17 @@ static int check_options(struct wetdem_track* t, const struct wetdem_track_optio
     if (!(isfinite(o->fps) && o->fps > 0))
         return fail(t, WETDEM_ERR_INVALID, "fps = %g: must be a frame rate > 0 [1/s]", o->fps);
     if (!(isfinite(o->pixel_size) && o->pixel_size > 0))
-        return fail(t, WETDEM_ERR_INVALID, "pixel_size = %g: must be > 0 [m/pixel]",
-                    o->pixel_size);
+        return fail(t, WETDEM_ERR_INVALID, "pixel_size = %g: must be > 0 [m/pixel]", o->pixel_size);
     if (o->window < 1 || o->window % 2 == 0 || o->window > 1001)
         return fail(t, WETDEM_ERR_INVALID, "window = %d: must be odd, in [1, 1001] frames",
                     o->window);
     if (o->order < 0 || o->order >= o->window)
-        return fail(t, WETDEM_ERR_INVALID, "order = %d: must be in [0, window - 1 = %d]",
-                    o->order, o->window - 1);
+        return fail(t, WETDEM_ERR_INVALID, "order = %d: must be in [0, window - 1 = %d]", o->order,
+                    o->window - 1);
     if (!(isfinite(o->threshold) && o->threshold > 0))
         return fail(t, WETDEM_ERR_INVALID, "threshold = %g: must be > 0 [m/s]", o->threshold);
     if (o->offset < 1 || o->offset > 100000)
-        return fail(t, WETDEM_ERR_INVALID, "offset = %d: must be in [1, 100000] frames",
-                    o->offset);
+        return fail(t, WETDEM_ERR_INVALID, "offset = %d: must be in [1, 100000] frames", o->offset);
     if (o->fit_frames != 0 && (o->fit_frames < TRACK_MIN_FIT || o->fit_frames > 1000000))
         return fail(t, WETDEM_ERR_INVALID, "fit_frames = %d: must be 0 (all) or in [%d, 1000000]",
                     o->fit_frames, TRACK_MIN_FIT);
@@ -505,7 +505,8 @@ static int sphere_velocities(struct wetdem_track* t, struct sphere_track* s,
         if (st != WETDEM_OK)
             return fail(t, WETDEM_ERR_INVALID,
                         "sphere %d frame %ld: dots 2 and 3 coincide with dot 1 (or are not "
-                        "finite); spin cannot be resolved", s->id, q->frame);
+                        "finite); spin cannot be resolved",
+                        s->id, q->frame);
     }
     return WETDEM_OK;
 }
@@ -516,8 +517,8 @@ static double sample_component(const struct wetdem_track_sample* q, int c)
 }
 
 /* Index of the striker among the two spheres. */
-static int pick_striker(struct wetdem_track* t, const struct wetdem_track_options* o,
-                        size_t n_ref, size_t* striker)
+static int pick_striker(struct wetdem_track* t, const struct wetdem_track_options* o, size_t n_ref,
+                        size_t* striker)
 {
     if (o->striker >= 0) {
         for (size_t k = 0; k < t->n_spheres; k++)
@@ -597,8 +598,8 @@ struct fit_windows {
     size_t before_first, before_count, after_first, after_count;
 };
 
-static int fit_windows(struct wetdem_track* t, const struct wetdem_track_options* o,
-                       size_t n_int, size_t k, struct fit_windows* w)
+static int fit_windows(struct wetdem_track* t, const struct wetdem_track_options* o, size_t n_int,
+                       size_t k, struct fit_windows* w)
 {
     size_t h = (size_t)o->window / 2, fit = (size_t)o->fit_frames;
     size_t b_end = k > h ? k - h : 0, a_first = k + 2 * h + 1;
@@ -656,11 +657,13 @@ static int restitution(struct wetdem_track* t, const struct wetdem_track_options
     if (!(sum->speed_n0 > 0))
         return fail(t, WETDEM_ERR_INVALID,
                     "the spheres are not approaching before the collision at frame %ld "
-                    "(normal relative speed %g m/s)", sum->collision_frame, -sum->speed_n0);
+                    "(normal relative speed %g m/s)",
+                    sum->collision_frame, -sum->speed_n0);
     sum->e_n = sum->speed_nf / sum->speed_n0;
     double cosine = sum->speed_n0 / hypot(v0x, v0y);
     sum->impact_angle = acos(cosine > 1 ? 1 : cosine);
-    double dx = g->smooth[6 * k] - s->smooth[6 * k], dy = g->smooth[6 * k + 1] - s->smooth[6 * k + 1];
+    double dx = g->smooth[6 * k] - s->smooth[6 * k],
+           dy = g->smooth[6 * k + 1] - s->smooth[6 * k + 1];
     sum->angle_centres = dx != 0 ? atan(dy / dx) : M_PI / 2;
     sum->stokes_n = NAN;
     if (o->radius > 0 && o->mass > 0 && o->viscosity > 0) {
@@ -695,13 +698,13 @@ static int collision_summary(struct wetdem_track* t, const struct wetdem_track_o
         return fail(t, WETDEM_ERR_INVALID,
                     "no collision found: the velocity of the striker (sphere %d) never differs "
                     "from its initial value by more than threshold = %g m/s for %zu frames in a "
-                    "row (largest change %.3g m/s)", s->id, o->threshold, h + 1,
-                    largest_change(s, n_ref));
+                    "row (largest change %.3g m/s)",
+                    s->id, o->threshold, h + 1, largest_change(s, n_ref));
     if (k < n_ref)
         return fail(t, WETDEM_ERR_INVALID,
                     "collision at frame %ld is within the first %zu frames, which set the "
-                    "reference velocity; the track must start earlier", s->first_frame + (long)k,
-                    n_ref);
+                    "reference velocity; the track must start earlier",
+                    s->first_frame + (long)k, n_ref);
     struct fit_windows w;
     if ((st = fit_windows(t, o, n_int, k, &w)) != WETDEM_OK)
         return st;
@@ -734,14 +737,14 @@ int wetdem_track_analyse(struct wetdem_track* track, const struct wetdem_track_o
         (track->s[1].first_frame != a->first_frame || track->s[1].n != a->n))
         return fail(track, WETDEM_ERR_INVALID,
                     "sphere %d covers frames %ld to %ld but sphere %d covers %ld to %ld; both "
-                    "spheres must be tracked over the same frames", a->id, a->first_frame,
-                    a->first_frame + (long)a->n - 1, track->s[1].id, track->s[1].first_frame,
-                    track->s[1].first_frame + (long)track->s[1].n - 1);
+                    "spheres must be tracked over the same frames",
+                    a->id, a->first_frame, a->first_frame + (long)a->n - 1, track->s[1].id,
+                    track->s[1].first_frame, track->s[1].first_frame + (long)track->s[1].n - 1);
     size_t need = (size_t)(opt->window > 2 ? opt->window : 2);
     if (a->n < need)
         return fail(track, WETDEM_ERR_INVALID,
-                    "sphere %d has %zu frames; at least %zu are needed (window = %d)", a->id,
-                    a->n, need, opt->window);
+                    "sphere %d has %zu frames; at least %zu are needed (window = %d)", a->id, a->n,
+                    need, opt->window);
     double* hat = malloc((size_t)opt->window * (size_t)opt->window * sizeof *hat);
     if (!hat)
         return fail(track, WETDEM_ERR_NOMEM, "out of memory");

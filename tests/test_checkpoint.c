@@ -53,12 +53,23 @@ static int setup(void** state)
     for (size_t k = 0; k < NE; k++)
         f->energy[k] = 1e-7 * (k + 1) / 3;
     memcpy(f->extra, "hello\0world", 11);
-    f->ck = (struct wetdem_checkpoint){
-        .time = 0.1 + 0.2, .step = 123456789012ull, .config_hash = 0xdeadbeefcafef00dull,
-        .particles = f->particles, .n_particles = NP, .walls = f->walls, .n_walls = NW,
-        .pairs = f->pairs, .history = f->history, .n_pairs = NPAIR, .history_len = HLEN,
-        .stats = {1, 2, 3, 4, 5, 6}, .output = {7, 8, 9, 10},
-        .energy = f->energy, .n_energy = NE, .extra = f->extra, .extra_size = sizeof f->extra};
+    f->ck = (struct wetdem_checkpoint){.time = 0.1 + 0.2,
+                                       .step = 123456789012ull,
+                                       .config_hash = 0xdeadbeefcafef00dull,
+                                       .particles = f->particles,
+                                       .n_particles = NP,
+                                       .walls = f->walls,
+                                       .n_walls = NW,
+                                       .pairs = f->pairs,
+                                       .history = f->history,
+                                       .n_pairs = NPAIR,
+                                       .history_len = HLEN,
+                                       .stats = {1, 2, 3, 4, 5, 6},
+                                       .output = {7, 8, 9, 10},
+                                       .energy = f->energy,
+                                       .n_energy = NE,
+                                       .extra = f->extra,
+                                       .extra_size = sizeof f->extra};
     CHECK_OK(wetdem_checkpoint_save_rng(&f->ck, f->rng));
     strcpy(f->path, "/tmp/wetdem_test_ckpt_XXXXXX");
     int fd = mkstemp(f->path);
@@ -253,8 +264,7 @@ static void test_checkpoint_failed_write_keeps_the_old_file(void** state)
     CHECK_OK(wetdem_checkpoint_read(f->path, &r, NULL, 0));
     CHECK_ABS(r.time, 0.1 + 0.2, 0); /* the old checkpoint, untouched */
     wetdem_checkpoint_clear(&r);
-    CHECK_STATUS(wetdem_checkpoint_read("/nonexistent/ck.bin", &r, msg, sizeof msg),
-                 WETDEM_ERR_IO);
+    CHECK_STATUS(wetdem_checkpoint_read("/nonexistent/ck.bin", &r, msg, sizeof msg), WETDEM_ERR_IO);
     CHECK_CONTAINS(msg, "/nonexistent/ck.bin");
 }
 
@@ -287,8 +297,8 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test_setup_teardown(test_checkpoint_round_trip_is_exact, setup, teardown),
-        cmocka_unit_test_setup_teardown(test_checkpoint_restored_rng_continues_the_sequence,
-                                        setup, teardown),
+        cmocka_unit_test_setup_teardown(test_checkpoint_restored_rng_continues_the_sequence, setup,
+                                        teardown),
         cmocka_unit_test_setup_teardown(test_checkpoint_equal_states_give_identical_files, setup,
                                         teardown),
         cmocka_unit_test_setup_teardown(test_checkpoint_detects_damage, setup, teardown),

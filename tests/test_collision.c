@@ -32,8 +32,12 @@ static struct wetdem_sim* make_sim(const char* preset, double e, const char* mod
 
 static struct wetdem_collision_spec head_on(int mat, double speed, double t_end)
 {
-    return (struct wetdem_collision_spec){.material_i = mat, .material_j = mat, .radius_i = R,
-                                          .radius_j = R, .speed = speed, .t_end = t_end};
+    return (struct wetdem_collision_spec){.material_i = mat,
+                                          .material_j = mat,
+                                          .radius_i = R,
+                                          .radius_j = R,
+                                          .speed = speed,
+                                          .t_end = t_end};
 }
 
 /* Undamped head-on Hertz impact of two equal steel spheres at v = 0.5 m/s. Closed form
@@ -102,9 +106,14 @@ static void test_collision_momentum(void** state)
         int b = wetdem_sim_add_material_preset(sim, "glass");
         CHECK_OK(wetdem_sim_enable_model(sim, "nijssen"));
         CHECK_OK(wetdem_sim_set_integrator(sim, integrators[q]));
-        struct wetdem_collision_spec s = {.material_i = a, .material_j = b, .radius_i = R,
-                                          .radius_j = 4e-3, .stokes = 500, .angle = 0.4,
-                                          .omega_i = {0, 0, 30}, .t_end = 1.0};
+        struct wetdem_collision_spec s = {.material_i = a,
+                                          .material_j = b,
+                                          .radius_i = R,
+                                          .radius_j = 4e-3,
+                                          .stokes = 500,
+                                          .angle = 0.4,
+                                          .omega_i = {0, 0, 30},
+                                          .t_end = 1.0};
         struct wetdem_collision_result r;
         CHECK_OK(wetdem_collision_run(sim, &s, &r));
         assert_true(r.separated && r.solid_contact);
@@ -154,8 +163,12 @@ static void test_collision_wall_lubrication(void** state)
     for (int q = 0; q < 2; q++) {
         int mat;
         struct wetdem_sim* sim = make_sim("delrin", 0, "nijssen", NULL, integrators[q], &mat);
-        struct wetdem_collision_spec s = {.material_i = mat, .material_j = mat, .radius_i = R,
-                                          .target_is_wall = true, .stokes = 50, .t_end = 5};
+        struct wetdem_collision_spec s = {.material_i = mat,
+                                          .material_j = mat,
+                                          .radius_i = R,
+                                          .target_is_wall = true,
+                                          .stokes = 50,
+                                          .t_end = 5};
         struct wetdem_collision_result r;
         CHECK_OK(wetdem_collision_run(sim, &s, &r));
         double e_dry = wetdem_sim_material(sim, mat)->restitution;
@@ -213,9 +226,11 @@ static void test_collision_swap_roles(void** state)
         CHECK_OK(wetdem_sim_set_integrator(sim, "cvode"));
         CHECK_OK(wetdem_sim_set_param(sim, "cvode.rtol", 1e-10));
         CHECK_OK(wetdem_sim_set_param(sim, "cvode.atol", 1e-11));
-        struct wetdem_collision_spec s = {.material_i = swap ? b : a, .material_j = swap ? a : b,
+        struct wetdem_collision_spec s = {.material_i = swap ? b : a,
+                                          .material_j = swap ? a : b,
                                           .radius_i = swap ? R : 4e-3,
-                                          .radius_j = swap ? 4e-3 : R, .speed = 0.3,
+                                          .radius_j = swap ? 4e-3 : R,
+                                          .speed = 0.3,
                                           .t_end = 1.0};
         struct wetdem_collision_result r;
         CHECK_OK(wetdem_collision_run(sim, &s, &r));
@@ -402,9 +417,13 @@ static void test_collision_free_flight_impact_parameter(void** state)
             struct glue_params gp = {0};
             CHECK_OK(wetdem_sim_add_model(sim, &ghost_model, &gp));
             CHECK_OK(wetdem_sim_set_param(sim, "verlet.dt", 1e-4));
-            struct wetdem_collision_spec s = {.material_i = mat, .material_j = mat,
-                                              .radius_i = R, .radius_j = rj, .speed = 0.1,
-                                              .angle = angles[k], .t_end = 1.0};
+            struct wetdem_collision_spec s = {.material_i = mat,
+                                              .material_j = mat,
+                                              .radius_i = R,
+                                              .radius_j = rj,
+                                              .speed = 0.1,
+                                              .angle = angles[k],
+                                              .t_end = 1.0};
             size_t n;
             const struct wetdem_particle* p = wetdem_sim_particles_const(sim, &n);
             struct wetdem_collision_result r;
@@ -455,8 +474,12 @@ static void test_collision_outcome_with_films(void** state)
         CHECK_OK(wetdem_sim_enable_model(sim, models[k]));
     CHECK_OK(wetdem_sim_set_param_str(sim, "glass.speed", "current"));
     CHECK_OK(wetdem_sim_set_integrator(sim, "cvode"));
-    struct wetdem_collision_spec s = {.material_i = a, .material_j = b, .radius_i = 12.7e-3,
-                                      .radius_j = 12.7e-3, .stokes = 0.5, .angle = M_PI / 3,
+    struct wetdem_collision_spec s = {.material_i = a,
+                                      .material_j = b,
+                                      .radius_i = 12.7e-3,
+                                      .radius_j = 12.7e-3,
+                                      .stokes = 0.5,
+                                      .angle = M_PI / 3,
                                       .t_end = 1.0};
     struct wetdem_collision_result r;
     CHECK_OK(wetdem_collision_run(sim, &s, &r));

@@ -60,11 +60,11 @@ static struct wetdem_sim* wall_sim(const char* integrator, double h0, double v,
 {
     struct wetdem_sim* sim = wetdem_sim_create();
     int mat = wetdem_sim_add_material_preset(sim, "steel1");
-    struct wetdem_particle p = {.pos = {1e-3 + h0, 0, 0}, .vel = {v, 0, 0}, .radius = 1e-3,
-                                .material = mat};
+    struct wetdem_particle p = {
+        .pos = {1e-3 + h0, 0, 0}, .vel = {v, 0, 0}, .radius = 1e-3, .material = mat};
     CHECK_OK(wetdem_sim_add_particle(sim, p));
-    CHECK_OK(wetdem_sim_add_wall(sim, (struct wetdem_vec3){0, 0, 0},
-                                 (struct wetdem_vec3){1, 0, 0}, mat));
+    CHECK_OK(wetdem_sim_add_wall(sim, (struct wetdem_vec3){0, 0, 0}, (struct wetdem_vec3){1, 0, 0},
+                                 mat));
     if (model)
         CHECK_OK(wetdem_sim_add_model(sim, model, NULL));
     CHECK_OK(wetdem_sim_set_param(sim, "fixed.h_min", HMIN));
@@ -252,10 +252,10 @@ static void test_events_pair_lubrication(void** state)
         struct wetdem_sim* sim = wetdem_sim_create();
         int mat = wetdem_sim_add_material_preset(sim, "glass");
         double x1 = r1 + r2 + 1e-3;
-        struct wetdem_particle a = {.pos = {x1, 0, 0}, .vel = {swap ? 0 : -0.5, 0, 0},
-                                    .radius = r1, .material = mat};
-        struct wetdem_particle b = {.pos = {0, 0, 0}, .vel = {swap ? 0.5 : 0, 0, 0},
-                                    .radius = r2, .material = mat};
+        struct wetdem_particle a = {
+            .pos = {x1, 0, 0}, .vel = {swap ? 0 : -0.5, 0, 0}, .radius = r1, .material = mat};
+        struct wetdem_particle b = {
+            .pos = {0, 0, 0}, .vel = {swap ? 0.5 : 0, 0, 0}, .radius = r2, .material = mat};
         CHECK_OK(wetdem_sim_add_particle(sim, a));
         CHECK_OK(wetdem_sim_add_particle(sim, b));
         CHECK_OK(wetdem_sim_enable_model(sim, "reynolds"));

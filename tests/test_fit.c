@@ -46,8 +46,12 @@ static void fit_curve_once(gsl_rng* rng, double sigma, double z[2], struct wetde
     struct curve c = {stokes, N_CURVE};
     const double init[2] = {0.5, 1.0};
     const char* names[2] = {"e_dry", "st_c"};
-    struct wetdem_fit_problem pb = {.n_params = 2, .names = names, .initial = init,
-                                    .n_data = N_CURVE, .observed = obs, .model = curve_model,
+    struct wetdem_fit_problem pb = {.n_params = 2,
+                                    .names = names,
+                                    .initial = init,
+                                    .n_data = N_CURVE,
+                                    .observed = obs,
+                                    .model = curve_model,
                                     .ctx = &c};
     struct wetdem_fit_options o;
     wetdem_fit_options_init(&o);
@@ -121,8 +125,8 @@ static void test_fit_rejects_bad_problems(void** state)
 {
     (void)state;
     const double init[1] = {1.0}, obs[2] = {1, 2};
-    struct wetdem_fit_problem pb = {.n_params = 1, .initial = init, .n_data = 1,
-                                    .observed = obs, .model = failing_model};
+    struct wetdem_fit_problem pb = {
+        .n_params = 1, .initial = init, .n_data = 1, .observed = obs, .model = failing_model};
     struct wetdem_fit_options o;
     wetdem_fit_options_init(&o);
     struct wetdem_fit_result r;
@@ -170,9 +174,12 @@ static int punch_model(const double* p, double* out, char* msg, size_t n, void* 
     const struct punch_data* d = ctx;
     int st = wetdem_sim_set_param(d->sim, "glass.p_gt", p[0]);
     for (size_t i = 0; st == WETDEM_OK && i < d->n; i++) {
-        struct wetdem_collision_spec spec = {.material_i = 0, .material_j = 1,
-                                             .radius_i = 12.7e-3, .radius_j = 12.7e-3,
-                                             .stokes = d->stokes[i], .t_end = 0.05};
+        struct wetdem_collision_spec spec = {.material_i = 0,
+                                             .material_j = 1,
+                                             .radius_i = 12.7e-3,
+                                             .radius_j = 12.7e-3,
+                                             .stokes = d->stokes[i],
+                                             .t_end = 0.05};
         struct wetdem_collision_result res;
         st = wetdem_collision_run(d->sim, &spec, &res);
         out[i] = res.e_n;
@@ -200,8 +207,13 @@ static void test_fit_recovers_glass_pressure_from_simulated_data(void** state)
     gsl_rng_free(rng);
     const double init[1] = {4e6};
     const char* names[1] = {"glass.p_gt"};
-    struct wetdem_fit_problem pb = {.n_params = 1, .names = names, .initial = init, .n_data = 5,
-                                    .observed = obs, .model = punch_model, .ctx = &d};
+    struct wetdem_fit_problem pb = {.n_params = 1,
+                                    .names = names,
+                                    .initial = init,
+                                    .n_data = 5,
+                                    .observed = obs,
+                                    .model = punch_model,
+                                    .ctx = &d};
     struct wetdem_fit_options o;
     wetdem_fit_options_init(&o);
     struct wetdem_fit_result r;

@@ -35,8 +35,7 @@ static double worst_gap_excess(const struct wetdem_insert_spec* s, const struct 
             for (int k = 0; k < 3; k++)
                 if (s->periodic[k])
                     d[k] -= len[k] * round(d[k] / len[k]);
-            double gap = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) - p[i].radius -
-                         p[j].radius;
+            double gap = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) - p[i].radius - p[j].radius;
             worst = fmin(worst, gap - s->gap);
         }
     return worst;

@@ -72,8 +72,11 @@ static struct wetdem_sim* make_sim(const char* integrator, double gap0, double v
     assert_non_null(sim);
     int mat = wetdem_sim_add_material_preset(sim, "steel1");
     assert_true(mat >= 0);
-    struct wetdem_particle p = {.pos = {RADIUS + gap0, 0, 0}, .vel = {v0, 0, 0},
-                                .radius = RADIUS, .mass = MASS, .material = mat};
+    struct wetdem_particle p = {.pos = {RADIUS + gap0, 0, 0},
+                                .vel = {v0, 0, 0},
+                                .radius = RADIUS,
+                                .mass = MASS,
+                                .material = mat};
     CHECK_OK(wetdem_sim_add_particle(sim, p));
     if (with_wall)
         CHECK_OK(wetdem_sim_add_wall(sim, (struct wetdem_vec3){0, 0, 0},
@@ -191,8 +194,8 @@ static void test_integrators_verlet_order_two(void** state)
         double e2 = oscillator_error("verlet", c, 0.02 / w0, 1e-8);
         double ratio = e1 / e2;
         if (!(ratio > 3.6 && ratio < 4.4))
-            fail_msg("zeta = %g: error ratio %g (errors %g, %g), expected ~4", d ? 0.2 : 0.0,
-                     ratio, e1, e2);
+            fail_msg("zeta = %g: error ratio %g (errors %g, %g), expected ~4", d ? 0.2 : 0.0, ratio,
+                     e1, e2);
     }
 }
 

@@ -130,8 +130,8 @@ static void check_header(FILE* f, double time, bool binary)
     assert_true(get_double(f, binary) == time);
 }
 
-static void parse_back(const char* path, const struct wetdem_particle* p,
-                       const uint32_t* contacts, double time, bool binary)
+static void parse_back(const char* path, const struct wetdem_particle* p, const uint32_t* contacts,
+                       double time, bool binary)
 {
     FILE* f = fopen(path, "rb");
     assert_non_null(f);
@@ -258,9 +258,9 @@ static void test_output_vtk_bad_path_is_an_io_error(void** state)
     uint32_t contacts[N];
     make_particles(p, contacts);
     char msg[256] = "";
-    CHECK_STATUS(wetdem_output_vtk_write("/nonexistent-dir/x.vtk", p, N, NULL, 0, false, msg,
-                                         sizeof msg),
-                 WETDEM_ERR_IO);
+    CHECK_STATUS(
+        wetdem_output_vtk_write("/nonexistent-dir/x.vtk", p, N, NULL, 0, false, msg, sizeof msg),
+        WETDEM_ERR_IO);
     CHECK_CONTAINS(msg, "/nonexistent-dir/x.vtk");
 }
 

@@ -162,8 +162,8 @@ static void test_scenario_bad_files_exit_2_with_line(void** state)
     (void)state;
     static const struct bad_case cases[] = {
         {"malformed", "[collision]\nstokes = 5\nstriker delrin\n", ":3:", "malformed line"},
-        {"section", "[collision]\nstokes = 5\n[fluids]\nviscosity = 1\n", ":3:",
-         "did you mean [fluid]"},
+        {"section", "[collision]\nstokes = 5\n[fluids]\nviscosity = 1\n",
+         ":3:", "did you mean [fluid]"},
         {"key", "[collision]\nstokse = 5\n", ":2:", "did you mean 'stokes'"},
         {"nan", "[collision]\n\nstokes = nan\n", ":3:", "not a finite number"},
         {"inf", "[collision]\nspeed = inf\n", ":2:", "not a finite number"},
@@ -174,10 +174,10 @@ static void test_scenario_bad_files_exit_2_with_line(void** state)
         {"material", "[collision]\nstriker = delrn\nstokes = 5\n", ":2:", "did you mean 'delrin'"},
         {"matfield", "[collision]\nstokes = 5\n[material.m]\npreset = delrin\nroughness = -1\n",
          ":5:", "roughness"},
-        {"model", "[collision]\nstokes = 5\n[models]\nforce = nijsen\n", ":4:",
-         "did you mean 'nijssen'"},
-        {"notenabled", "[collision]\nstokes = 5\n[model.nijssen]\ncutoff_ratio = 2\n", ":4:",
-         "not enabled"},
+        {"model", "[collision]\nstokes = 5\n[models]\nforce = nijsen\n",
+         ":4:", "did you mean 'nijssen'"},
+        {"notenabled", "[collision]\nstokes = 5\n[model.nijssen]\ncutoff_ratio = 2\n",
+         ":4:", "not enabled"},
         {"nospeed", "[collision]\nstriker = delrin\n", ":1:", "speed > 0"},
     };
     for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {

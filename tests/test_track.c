@@ -38,10 +38,19 @@ struct synth {
 
 static void synth_init(struct synth* y, double theta)
 {
-    *y = (struct synth){.fps = 5000, .pixel = 175e-6, .radius = 12.7e-3, .beta = 25 * M_PI / 180,
-                        .t_c = 50.37 / 5000, .speed = 0.3, .theta = theta, .e_n = 0.6,
-                        .e_t = 0.8, .acc = {-0.4, 0.1}, .omega_pre = {3, 0},
-                        .omega_post = {-18, 25}, .yaw = {0.4, 2.1}};
+    *y = (struct synth){.fps = 5000,
+                        .pixel = 175e-6,
+                        .radius = 12.7e-3,
+                        .beta = 25 * M_PI / 180,
+                        .t_c = 50.37 / 5000,
+                        .speed = 0.3,
+                        .theta = theta,
+                        .e_n = 0.6,
+                        .e_t = 0.8,
+                        .acc = {-0.4, 0.1},
+                        .omega_pre = {3, 0},
+                        .omega_post = {-18, 25},
+                        .yaw = {0.4, 2.1}};
     /* Equal chords |p1 p2| = |p2 p3|: 2R sin(beta/2) = 2R sin(beta) sin(dphi/2). */
     y->dphi = 2 * asin(sin(y->beta / 2) / sin(y->beta));
     double n[2] = {-cos(theta), -sin(theta)}; /* from target to striker at contact */
@@ -179,17 +188,24 @@ static int analyse_dots(const double* dots, const struct wetdem_track_options* o
     if (st != WETDEM_OK)
         print_error("%s\n", wetdem_track_errmsg(t));
     wetdem_track_free(t);
-    double v[N_OUT] = {sum->striker_before.vx,  sum->striker_before.vy, sum->striker_after.vx,
-                       sum->striker_after.vy,   sum->striker_after.omega, sum->target_after.vx,
-                       sum->target_after.vy,    sum->target_after.omega, sum->e_n,
-                       sum->impact_angle,       sum->stokes_n};
+    double v[N_OUT] = {sum->striker_before.vx,
+                       sum->striker_before.vy,
+                       sum->striker_after.vx,
+                       sum->striker_after.vy,
+                       sum->striker_after.omega,
+                       sum->target_after.vx,
+                       sum->target_after.vy,
+                       sum->target_after.omega,
+                       sum->e_n,
+                       sum->impact_angle,
+                       sum->stokes_n};
     memcpy(out, v, sizeof v);
     return st;
 }
 
 /* The same outputs from the true motion, using the tracker's definitions at its frames. */
-static void true_outputs(const struct synth* y, const struct wetdem_track_options* o,
-                         long c, double out[N_OUT])
+static void true_outputs(const struct synth* y, const struct wetdem_track_options* o, long c,
+                         double out[N_OUT])
 {
     double ps0[2], pg0[2], psf[2], pgf[2], vs0[2], vg0[2], vsf[2], vgf[2], yaw, ws, wg, tmp[2];
     double tb = (double)(c - o->offset) / y->fps, ta = (double)(c + o->offset) / y->fps;
@@ -204,7 +220,15 @@ static void true_outputs(const struct synth* y, const struct wetdem_track_option
     double vn0 = -((vs0[0] - vg0[0]) * n0[0] + (vs0[1] - vg0[1]) * n0[1]) / l0;
     double vnf = ((vsf[0] - vgf[0]) * nf[0] + (vsf[1] - vgf[1]) * nf[1]) / lf;
     double m = 7960 * 4.0 / 3.0 * M_PI * pow(y->radius, 3), r_eff = y->radius / 2;
-    double v[N_OUT] = {vs0[0], vs0[1], vsf[0], vsf[1], ws, vgf[0], vgf[1], wg, vnf / vn0,
+    double v[N_OUT] = {vs0[0],
+                       vs0[1],
+                       vsf[0],
+                       vsf[1],
+                       ws,
+                       vgf[0],
+                       vgf[1],
+                       wg,
+                       vnf / vn0,
                        acos(vn0 / hypot(vs0[0] - vg0[0], vs0[1] - vg0[1])),
                        (m / 2) * vn0 / (6 * M_PI * 10.0 * r_eff * r_eff)};
     memcpy(out, v, sizeof v);
@@ -219,8 +243,8 @@ static void true_outputs(const struct synth* y, const struct wetdem_track_option
  *   (1.9e-4 + 1.0e-4)/0.15 = 2e-3; impact angle and St_n use pre-collision values (3 rad/s);
  * - the rotation of the outer dots within a 7-frame window departs from a quadratic by
  *   O((3 omega dt)^3 rho) ~ 2e-9 m, negligible. */
-static const double method_bias[N_OUT] = {1e-5, 1e-5, 2.5e-4, 2.5e-4, 2e-4, 2.5e-4,
-                                          2.5e-4, 2e-4, 3e-3, 1e-4, 1e-4};
+static const double method_bias[N_OUT] = {1e-5,   1e-5, 2.5e-4, 2.5e-4, 2e-4, 2.5e-4,
+                                          2.5e-4, 2e-4, 3e-3,   1e-4,   1e-4};
 
 static void track_options(struct wetdem_track_options* o, const struct synth* y)
 {
@@ -287,8 +311,9 @@ static void check_recovery(double theta, unsigned long seed)
     for (int q = 0; q < N_OUT; q++)
         if (!(fabs(got[q] - want[q]) <= 4 * sigma[q] + method_bias[q]))
             fail_msg("theta %.0f deg output %d: got %.6g, true %.6g, |diff| %.3g > 4 sigma %.3g "
-                     "+ bias %.3g", theta * 180 / M_PI, q, got[q], want[q],
-                     fabs(got[q] - want[q]), 4 * sigma[q], method_bias[q]);
+                     "+ bias %.3g",
+                     theta * 180 / M_PI, q, got[q], want[q], fabs(got[q] - want[q]), 4 * sigma[q],
+                     method_bias[q]);
     /* The tolerance must stay meaningful: at 0.05 px, sigma(e_n) is 0.008 head-on and 0.018
      * at 60 deg (v_n0 = 0.15 m/s), sigma(omega) 0.4 rad/s; require 4 sigma(e_n) < 0.1. */
     assert_true(sigma[8] < 0.025);
@@ -316,7 +341,7 @@ static void test_track_noise_free_recovery_is_tight(void** state)
     synth_init(&y, 30 * M_PI / 180);
     struct wetdem_track_options o;
     track_options(&o, &y);
-    double* dots = malloc(12 * N_FRAMES * sizeof *dots), got[N_OUT], want[N_OUT];
+    double *dots = malloc(12 * N_FRAMES * sizeof *dots), got[N_OUT], want[N_OUT];
     render(&y, NULL, 0, dots);
     struct wetdem_track_summary s;
     CHECK_OK(analyse_dots(dots, &o, got, &s));
@@ -397,8 +422,12 @@ static void punch_collision(double stokes, double angle, double fps, const doubl
     CHECK_OK(wetdem_sim_set_integrator(sim, "cvode"));
     memset(rec, 0, sizeof *rec);
     wetdem_sim_set_observer(sim, 1.0 / (SIM_SUB * fps), record_state, rec);
-    struct wetdem_collision_spec spec = {.material_i = 0, .material_j = 1, .radius_i = 12.7e-3,
-                                         .radius_j = 12.7e-3, .stokes = stokes, .angle = angle,
+    struct wetdem_collision_spec spec = {.material_i = 0,
+                                         .material_j = 1,
+                                         .radius_i = 12.7e-3,
+                                         .radius_j = 12.7e-3,
+                                         .stokes = stokes,
+                                         .angle = angle,
                                          .t_end = 0.05};
     CHECK_OK(wetdem_collision_run(sim, &spec, res));
     wetdem_sim_free(sim);
@@ -452,8 +481,8 @@ static void sim_pose(const struct sim_record* r, double fps, int k, double t, do
  * Eq. 23's small-angle bias (track.c header): omega^2 dt |D2 + D3|/6 on the velocities and
  * omega (omega dt)^2/6 on the spin. */
 static void simulated_truth(const struct sim_record* r, const struct synth* y,
-                            const struct wetdem_track_options* o, long frame_k,
-                            double want[N_OUT], double bias[N_OUT])
+                            const struct wetdem_track_options* o, long frame_k, double want[N_OUT],
+                            double bias[N_OUT])
 {
     const double* q0 = r->q + 1;
     const double* qf = r->q + SIM_COLS * (r->n - 1) + 1;
@@ -469,8 +498,17 @@ static void simulated_truth(const struct sim_record* r, const struct synth* y,
     double vn0 = -(u0[0] * nc[0] + u0[1] * nc[1]), vt0 = fabs(u0[0] * nc[1] - u0[1] * nc[0]);
     double vnf = uf[0] * nf[0] + uf[1] * nf[1], vtf = fabs(uf[0] * nf[1] - uf[1] * nf[0]);
     double mass = 7960 * 4.0 / 3.0 * M_PI * pow(y->radius, 3), r_eff = y->radius / 2;
-    double v[N_OUT] = {q0[2], q0[3], qf[2], qf[3], qf[4], qf[8], qf[9], qf[10], vnf / vn0,
-                       atan2(vt0, vn0), (mass / 2) * vn0 / (6 * M_PI * 10.0 * r_eff * r_eff)};
+    double v[N_OUT] = {q0[2],
+                       q0[3],
+                       qf[2],
+                       qf[3],
+                       qf[4],
+                       qf[8],
+                       qf[9],
+                       qf[10],
+                       vnf / vn0,
+                       atan2(vt0, vn0),
+                       (mass / 2) * vn0 / (6 * M_PI * 10.0 * r_eff * r_eff)};
     memcpy(want, v, sizeof v);
     double dt = 1 / y->fps, t_k = (double)(frame_k - SIM_PRE) * dt;
     double t_final = qf[-1], delta0 = vt0 / d * fabs(t_k - t_c);
@@ -502,8 +540,8 @@ static void render_simulated(const struct synth* y, const struct sim_record* rec
  * bounds of simulated_truth() must hold (10 % margin for the line of centres turning slower
  * than v_t0/d farther from contact and the film's deflection of the path). */
 static void check_noise_free(const struct synth* y, const struct wetdem_track_options* o,
-                             const struct sim_record* rec, const struct wetdem_collision_result* res,
-                             double* dots)
+                             const struct sim_record* rec,
+                             const struct wetdem_collision_result* res, double* dots)
 {
     double got[N_OUT], want[N_OUT], bias[N_OUT];
     struct wetdem_track_summary s;
@@ -526,7 +564,8 @@ static void check_noise_free(const struct synth* y, const struct wetdem_track_op
     for (int q = 0; q < N_OUT; q++)
         if (!(fabs(got[q] - want[q]) <= 1.1 * bias[q] + floor_abs[q]))
             fail_msg("noise-free, angle %.0f deg, output %d: got %.9g, simulated %.9g, bias "
-                     "bound %.3g", y->theta * 180 / M_PI, q, got[q], want[q], bias[q]);
+                     "bound %.3g",
+                     y->theta * 180 / M_PI, q, got[q], want[q], bias[q]);
 }
 
 static void check_simulated_recovery(double stokes, double angle, unsigned long seed)
@@ -563,8 +602,9 @@ static void check_simulated_recovery(double stokes, double angle, unsigned long 
     for (int q = 0; q < N_OUT; q++)
         if (!(fabs(got[q] - want[q]) <= 4 * sigma[q] + bias[q]))
             fail_msg("angle %.0f deg, output %d: got %.6g, simulated %.6g, |diff| %.3g > 4 sigma "
-                     "%.3g + bias %.3g", angle * 180 / M_PI, q, got[q], want[q],
-                     fabs(got[q] - want[q]), 4 * sigma[q], bias[q]);
+                     "%.3g + bias %.3g",
+                     angle * 180 / M_PI, q, got[q], want[q], fabs(got[q] - want[q]), 4 * sigma[q],
+                     bias[q]);
     /* The tolerances stay meaningful: e_n within +-0.03 (4 sigma + bias) of the simulated
      * 0.70, the spins (-5.8 rad/s) to better than 2 rad/s, the angle to 1.5 degrees. */
     assert_true(4 * sigma[8] + bias[8] < 0.03);
@@ -617,7 +657,8 @@ static void test_track_rejects_malformed_files(void** state)
     snprintf(buf, sizeof buf, "%s0,1,1,1,2,2,3,3\n1,1,1,nan,2,2,3,3\n", head);
     expect_read_error(buf, WETDEM_ERR_PARSE, ":3: column y1: 'nan' is not a finite number");
     snprintf(buf, sizeof buf, "%s# c\n0,1,1,1,2,2,3,3\n1,1,1,1,2,2,3,3\n3,1,1,1,2,2,3,3\n", head);
-    expect_read_error(buf, WETDEM_ERR_PARSE, ":5: sphere 1: frame 3 follows frame 1; frames 2 to 2");
+    expect_read_error(buf, WETDEM_ERR_PARSE,
+                      ":5: sphere 1: frame 3 follows frame 1; frames 2 to 2");
     snprintf(buf, sizeof buf, "%s0,1,1,1,2,2,3,3\n1,1,1,1,2,2,3,3\n1,1,1,1,2,2,3,3\n", head);
     expect_read_error(buf, WETDEM_ERR_PARSE, ":4: sphere 1: frame 1 follows frame 1; frames must");
     expect_read_error("frame,ball,x1,y1,x2,y2,x3,y3\n", WETDEM_ERR_PARSE, ":1: header must be");
@@ -672,7 +713,8 @@ static void test_track_cli_exits_2_with_line_number(void** state)
     const char* cli = getenv("WETDEM_CLI");
     if (!cli)
         skip();
-    const char* path = write_temp("frame,sphere,x1,y1,x2,y2,x3,y3\n0,1,1,1,2,2,3,3\n2,1,1,1,2,2,3,3\n");
+    const char* path =
+        write_temp("frame,sphere,x1,y1,x2,y2,x3,y3\n0,1,1,1,2,2,3,3\n2,1,1,1,2,2,3,3\n");
     char args[512], out[4096];
     snprintf(args, sizeof args, "track %s --fps 5000 --pixel-size 175e-6", path);
     int rc = test_run_cli_into(args, out, sizeof out);
