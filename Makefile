@@ -1,7 +1,8 @@
 # wetdem — build, test, demo, validation, benchmarks.
 #   make          library (static + shared) and the wetdem CLI in build/
 #   make test     build and run every unit test (installs missing Debian packages first)
-#   make check    everything CI checks: tests under ASan+UBSan, symbol prefixes, docs freshness
+#   make check    everything CI checks: tests under ASan+UBSan, symbol prefixes, docs freshness,
+#                 C layout (clang-format)
 #   make demo     the built-in default scenario
 #   make validate long validation sweeps and figures (docs/validation.md)
 #   make bench    benchmarks with ratios against baselines measured in the same run
@@ -87,12 +88,13 @@ check-docs: all
 	@$(BUILD)/wetdem docs-models > $(BUILD)/models.md && diff -u docs/models.md $(BUILD)/models.md \
 	  || { echo "docs/models.md is stale: run 'make docs'"; exit 1; }
 
+# Layout of every C file against .clang-format (clang-format 14, installed when missing).
 check-format:
-	@if command -v clang-format >/dev/null; then \
-	  clang-format --dry-run -Werror src/*.c src/*.h include/*.h cli/*.c cli/*.h tests/*.c tests/*.h; \
-	else echo "clang-format not installed: format check skipped"; fi
+	@scripts/install-deps check
+	@clang-format --dry-run -Werror src/*.c src/*.h include/*.h cli/*.c cli/*.h tests/*.c \
+	  tests/*.h examples/*/main.c bench/*.c && echo "check-format: ok"
 
-check: test test-san check-prefix check-docs
+check: test test-san check-prefix check-docs check-format
 
 docs: all
 	$(BUILD)/wetdem docs-models > docs/models.md
@@ -114,7 +116,8 @@ bench: all
 	@scripts/bench $(BUILD)/wetdem
 
 format:
-	clang-format -i src/*.c src/*.h include/*.h cli/*.c cli/*.h tests/*.c tests/*.h
+	clang-format -i src/*.c src/*.h include/*.h cli/*.c cli/*.h tests/*.c tests/*.h examples/*/main.c \
+	  bench/*.c
 
 clean:
 	rm -rf build build-san

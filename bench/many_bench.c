@@ -70,8 +70,9 @@ static void write_data(const char* path, struct wetdem_sim* sim, const double hi
         fprintf(stderr, "many_bench: cannot write %s\n", path);
         exit(1);
     }
-    fprintf(f, "wetdem benchmark system (bench/many_bench.c)\n\n%zu atoms\n1 atom types\n\n"
-               "0 %.17g xlo xhi\n0 %.17g ylo yhi\n0 %.17g zlo zhi\n\nAtoms\n\n",
+    fprintf(f,
+            "wetdem benchmark system (bench/many_bench.c)\n\n%zu atoms\n1 atom types\n\n"
+            "0 %.17g xlo xhi\n0 %.17g ylo yhi\n0 %.17g zlo zhi\n\nAtoms\n\n",
             n, hi[0], hi[1], hi[2]);
     for (size_t k = 0; k < n; k++)
         fprintf(f, "%zu 1 %.17g 2500 %.17g %.17g %.17g\n", k + 1, 2 * p[k].radius, p[k].pos.x,
@@ -117,15 +118,19 @@ static void read_data(const char* path, struct wetdem_sim* sim)
             section = 1;
         else if (!strncmp(line, "Velocities", 10))
             section = 2;
-        else if (section == 1 && sscanf(line, "%zu %*d %lf %lf %lf %lf %lf", &id, &a[0], &a[1],
-                                        &a[2], &a[3], &a[4]) == 6 && id >= 1 && id <= n) {
+        else if (section == 1 &&
+                 sscanf(line, "%zu %*d %lf %lf %lf %lf %lf", &id, &a[0], &a[1], &a[2], &a[3],
+                        &a[4]) == 6 &&
+                 id >= 1 && id <= n) {
             p[id - 1].radius = 0.5 * a[0];
             p[id - 1].mass = a[1] * 4.0 / 3.0 * 3.14159265358979323846 * p[id - 1].radius *
                              p[id - 1].radius * p[id - 1].radius;
             p[id - 1].pos = (struct wetdem_vec3){a[2], a[3], a[4]};
             seen++;
-        } else if (section == 2 && sscanf(line, "%zu %lf %lf %lf %lf %lf %lf", &id, &a[0], &a[1],
-                                          &a[2], &a[3], &a[4], &a[5]) == 7 && id >= 1 && id <= n) {
+        } else if (section == 2 &&
+                   sscanf(line, "%zu %lf %lf %lf %lf %lf %lf", &id, &a[0], &a[1], &a[2], &a[3],
+                          &a[4], &a[5]) == 7 &&
+                   id >= 1 && id <= n) {
             p[id - 1].vel = (struct wetdem_vec3){a[0], a[1], a[2]};
             p[id - 1].omega = (struct wetdem_vec3){a[3], a[4], a[5]};
         }
@@ -139,9 +144,14 @@ static void read_data(const char* path, struct wetdem_sim* sim)
 
 static void setup(struct wetdem_sim* sim, bool wet, size_t n, double hi[3])
 {
-    struct wetdem_material m = {.density = 2500, .youngs_modulus = 1e7, .poisson_ratio = 0.3,
-                                .restitution = 0.5, .friction_dry = 0.5, .friction_lub = 0.5,
-                                .roughness = 0, .film = wet ? 20e-6 : 0};
+    struct wetdem_material m = {.density = 2500,
+                                .youngs_modulus = 1e7,
+                                .poisson_ratio = 0.3,
+                                .restitution = 0.5,
+                                .friction_dry = 0.5,
+                                .friction_lub = 0.5,
+                                .roughness = 0,
+                                .film = wet ? 20e-6 : 0};
     int st = wetdem_sim_add_material(sim, &m);
     if (st < 0)
         die(sim, st, "material");
@@ -155,14 +165,19 @@ static void setup(struct wetdem_sim* sim, bool wet, size_t n, double hi[3])
     size_t layers = (n + 399) / 400;
     hi[0] = hi[1] = 20 * SPACING + 2 * GAP;
     hi[2] = 1.3 * layers * SPACING + 2 * GAP;
-    struct wetdem_insert_spec spec = {
-        .layout = WETDEM_INSERT_LATTICE, .n = n, .lo = {0, 0, 0}, .hi = {hi[0], hi[1], hi[2]},
-        .radius_min = 0.9e-3, .radius_max = 1.0e-3, .gap = GAP, .velocity_sigma = 0.1,
-        .seed = 1};
+    struct wetdem_insert_spec spec = {.layout = WETDEM_INSERT_LATTICE,
+                                      .n = n,
+                                      .lo = {0, 0, 0},
+                                      .hi = {hi[0], hi[1], hi[2]},
+                                      .radius_min = 0.9e-3,
+                                      .radius_max = 1.0e-3,
+                                      .gap = GAP,
+                                      .velocity_sigma = 0.1,
+                                      .seed = 1};
     if ((st = wetdem_sim_insert(sim, &spec)) != WETDEM_OK)
         die(sim, st, "insert");
-    struct wetdem_vec3 normals[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0},
-                                     {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+    struct wetdem_vec3 normals[6] = {{1, 0, 0},  {-1, 0, 0}, {0, 1, 0},
+                                     {0, -1, 0}, {0, 0, 1},  {0, 0, -1}};
     for (int w = 0; w < 6; w++) {
         struct wetdem_vec3 point = {w == 1 ? hi[0] : 0, w == 3 ? hi[1] : 0, w == 5 ? hi[2] : 0};
         if ((st = wetdem_sim_add_wall(sim, point, normals[w], 0)) != WETDEM_OK)
@@ -234,8 +249,8 @@ int main(int argc, char** argv)
     printf("wetdem %s n=%zu threads=%d steps=%lu seconds=%.3f cpu_seconds=%.3f psteps_per_s=%.4g "
            "maxrss_kb=%ld contacts=%zu bridges=%zu pairs=%zu builds=%llu\n",
            wet ? "wet" : "dry", n, omp_get_max_threads(), steps, secs, cpu,
-           (double)n * (double)steps / secs, max_rss_kb(), s.contacts, s.bridges,
-           s.candidate_pairs, s.list_builds);
+           (double)n * (double)steps / secs, max_rss_kb(), s.contacts, s.bridges, s.candidate_pairs,
+           s.list_builds);
     if (budget) {
         struct wetdem_energy_budget b;
         wetdem_sim_energy_budget(sim, &b);

@@ -14,11 +14,11 @@
 
 /* Everything a many-particle run needs, resolved from a scenario. */
 struct cli_many_setup {
-    struct wetdem_sim* sim;              /* owned: materials, fluid, models, walls, particles */
-    struct wetdem_many_settings many;    /* periodic box, dt, skin, energy budget; no outputs */
-    double box[3];                       /* box edges [m]: the box is [0, box[k]] */
-    unsigned long long steps;            /* from [run] steps, or 0 when t_end is given */
-    double t_end;                        /* [run] t_end [s], or 0 when steps is given */
+    struct wetdem_sim* sim;           /* owned: materials, fluid, models, walls, particles */
+    struct wetdem_many_settings many; /* periodic box, dt, skin, energy budget; no outputs */
+    double box[3];                    /* box edges [m]: the box is [0, box[k]] */
+    unsigned long long steps;         /* from [run] steps, or 0 when t_end is given */
+    double t_end;                     /* [run] t_end [s], or 0 when steps is given */
     bool vtk_every_given, csv_every_given;
     unsigned long long vtk_every;        /* steps between VTK frames (0: none) */
     unsigned long long csv_every;        /* steps between CSV rows (0: none) */

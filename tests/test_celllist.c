@@ -29,8 +29,8 @@ static struct wetdem_particle* random_spheres(size_t n, double len, double r_lo,
     return p;
 }
 
-static bool within(const struct wetdem_celllist_box* box, const struct wetdem_particle* p,
-                   size_t i, size_t j, double gap_max)
+static bool within(const struct wetdem_celllist_box* box, const struct wetdem_particle* p, size_t i,
+                   size_t j, double gap_max)
 {
     struct wetdem_vec3 d = celllist_delta(box, p[i].pos, p[j].pos);
     double lim = p[i].radius + p[j].radius + gap_max;
@@ -47,8 +47,7 @@ static void check_against_brute_force(const struct wetdem_celllist* cl,
             if (!within(&cl->box, p, i, j, cl->reach + cl->skin))
                 continue;
             if (k >= cl->n_pairs || cl->pairs[k].i != i || cl->pairs[k].j != j)
-                fail_msg("pair (%zu, %zu) missing or out of order at list position %zu", i, j,
-                         k);
+                fail_msg("pair (%zu, %zu) missing or out of order at list position %zu", i, j, k);
             k++;
         }
     assert_int_equal(k, cl->n_pairs);
@@ -107,8 +106,7 @@ static void test_celllist_rejects_too_small_periodic_box(void** state)
     CHECK_OK(wetdem_celllist_init(&cl, &box, 0.4e-3, 0.2e-3, msg, sizeof msg));
     CHECK_STATUS(wetdem_celllist_build(&cl, p, 10, msg, sizeof msg), WETDEM_ERR_INVALID);
     CHECK_CONTAINS(msg, "periodic box length");
-    CHECK_STATUS(wetdem_celllist_init(&cl, &box, 0.4e-3, 0.0, msg, sizeof msg),
-                 WETDEM_ERR_INVALID);
+    CHECK_STATUS(wetdem_celllist_init(&cl, &box, 0.4e-3, 0.0, msg, sizeof msg), WETDEM_ERR_INVALID);
     CHECK_CONTAINS(msg, "skin");
     CHECK_STATUS(wetdem_celllist_init(&cl, &box, NAN, 1e-4, msg, sizeof msg), WETDEM_ERR_INVALID);
     CHECK_CONTAINS(msg, "reach");
@@ -206,9 +204,8 @@ static void test_celllist_remap_history_keeps_common_pairs(void** state)
     double old_hist[] = {1, 10, 2, 20, 3, 30, 4, 40};
     struct wetdem_celllist_pair new_pairs[] = {{0, 1}, {0, 2}, {2, 3}, {3, 4}, {4, 7}};
     double new_hist[10], fresh[2] = {-1, -2};
-    assert_int_equal(wetdem_celllist_remap_history(old_pairs, old_hist, 4, new_pairs, new_hist,
-                                                   5, 2, fresh),
-                     3);
+    assert_int_equal(
+        wetdem_celllist_remap_history(old_pairs, old_hist, 4, new_pairs, new_hist, 5, 2, fresh), 3);
     double want[] = {1, 10, -1, -2, 3, 30, -1, -2, 4, 40};
     for (int k = 0; k < 10; k++)
         CHECK_ABS(new_hist[k], want[k], 0); /* copies: exact */
@@ -224,7 +221,7 @@ static void test_celllist_rebuild_criterion_is_half_skin(void** state)
     assert_true(wetdem_celllist_needs_rebuild(&cl, p, 2)); /* never built */
     CHECK_OK(wetdem_celllist_build(&cl, p, 2, NULL, 0));
     assert_int_equal(cl.n_pairs, 0); /* gap 3 mm > 0.2 mm */
-    p[0].pos.y = 0.099e-3;             /* 0.099 mm < skin/2 = 0.1 mm */
+    p[0].pos.y = 0.099e-3;           /* 0.099 mm < skin/2 = 0.1 mm */
     assert_false(wetdem_celllist_needs_rebuild(&cl, p, 2));
     CHECK_REL(wetdem_celllist_max_displacement(&cl, p, 2), 0.099e-3, 1e-12);
     p[0].pos.y = 0.101e-3;

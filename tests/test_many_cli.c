@@ -232,7 +232,8 @@ static void test_many_cli_restart_is_bit_identical(void** state)
     assert_int_equal(run_cli("run box.ini --set run.steps=600 --out whole"), 0);
     /* 300 steps, then extended to 600 from its final checkpoint */
     assert_int_equal(run_cli("run box.ini --set run.steps=300 --out split"), 0);
-    int code = run_cli("run box.ini --set run.steps=600 --out split --restart split/checkpoint.ckpt");
+    int code =
+        run_cli("run box.ini --set run.steps=600 --out split --restart split/checkpoint.ckpt");
     if (code != 0)
         fail_msg("restart: exit %d\n%s", code, stderr_text());
     check_same_outputs("whole", "split", 7);
@@ -296,7 +297,8 @@ static void test_many_cli_sigint_writes_a_checkpoint_and_resumes(void** state)
     char* err = stderr_text();
     if (!WIFEXITED(status) || WEXITSTATUS(status) != 130)
         fail_msg("interrupted run: status %d, expected exit 130 (the run must outlast the "
-                 "wait for 5 CSV rows)\n%s", status, err);
+                 "wait for 5 CSV rows)\n%s",
+                 status, err);
     CHECK_CONTAINS(err, "interrupted by SIGINT");
     CHECK_CONTAINS(err, "resume with: wetdem run long.ini --set run.steps=12000 --out sig "
                         "--restart sig/checkpoint.ckpt");
@@ -379,7 +381,7 @@ static void test_many_cli_examples_and_budget(void** state)
     /* closure: 500 steps of 2 us, about 1/60 of the contact time, close to 1e-3 of the energy
        moved (tests/test_many.c); 1e-2 leaves room for the film forces' jumps at h = delta */
     assert_true(fabs(v[6]) < 1e-2 * fmax(fabs(v[5]), fabs(v[1] - v[0])));
-    assert_true(v[4] > 0); /* damping and films took energy */
+    assert_true(v[4] > 0);                              /* damping and films took energy */
     CHECK_CONTAINS(js, ", \"energy_J\": {\"input\": "); /* fields separated as JSON wants */
     free(js);
 }
