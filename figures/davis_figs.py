@@ -174,37 +174,65 @@ def fig_map():
     plt.close(fig)
 
 
+def snapshot_positions(traj, n, tstar):
+    """Sphere centres [mm] relative to the centre of mass (equal masses: the mean) at t*."""
+    ts = traj["t_star"]
+    k = min(np.searchsorted(ts, tstar), len(ts) - 1)
+    # beyond the end of a run that stopped early the spheres fly freely: extrapolate
+    dt = (tstar - ts[k]) * 4e-3 / (traj["vx_1"][0] if "vx_1" in traj else 1.0)
+    dt = max(dt, 0.0)
+    xs = np.array([traj[f"x_{i}"][k] + traj[f"vx_{i}"][k] * dt for i in range(1, n + 1)])
+    ys = np.array([traj[f"y_{i}"][k] + traj[f"vy_{i}"][k] * dt for i in range(1, n + 1)])
+    return (xs - np.mean(xs)) * 1e3, (ys - np.mean(ys)) * 1e3
+
+
+def snapshot_box(pos, radius, aspect):
+    """Limits (x0, x1, y0, y1) [mm] holding every sphere at every shown time, width/height =
+    aspect, never smaller than 20 mm x 16 mm so rows where the spheres stay together keep
+    one scale."""
+    xs = np.concatenate([p[0] for p in pos])
+    ys = np.concatenate([p[1] for p in pos])
+    margin = radius * 1.15
+    x0, x1 = min(xs.min() - margin, -10.0), max(xs.max() + margin, 10.0)
+    y0, y1 = min(ys.min() - margin, -8.0), max(ys.max() + margin, 8.0)
+    w, h = x1 - x0, y1 - y0
+    if w < aspect * h:  # widen about the middle to keep the panel shape and equal aspect
+        x0, x1 = 0.5 * (x0 + x1) - 0.5 * aspect * h, 0.5 * (x0 + x1) + 0.5 * aspect * h
+    else:
+        y0, y1 = 0.5 * (y0 + y1) - 0.5 * w / aspect, 0.5 * (y0 + y1) + 0.5 * w / aspect
+    return x0, x1, y0, y1
+
+
 def snapshot_row(ax_row, name, t_stars, title):
-    """Spheres in the centre-of-mass frame (equal masses: the mean position) at given t*."""
+    """Spheres in the centre-of-mass frame at given t*, one scale per row (equal aspect) that
+    holds every sphere at every shown time; a 5 mm scale bar in the first panel."""
     traj = read_csv(os.path.join(DATA, "snap_" + name, "trajectory.csv"))
     n = sum(1 for k in traj if k.startswith("x_"))
-    radius = 2e-3  # sphere radius 2a, a = 1 mm (Table-I builder default)
-    ts = traj["t_star"]
-    for ax, tstar in zip(ax_row, t_stars):
-        k = min(np.searchsorted(ts, tstar), len(ts) - 1)
-        # beyond the end of a run that stopped early the spheres fly freely: extrapolate
-        dt = (tstar - ts[k]) * 4e-3 / (traj["vx_1"][0] if "vx_1" in traj else 1.0)
-        dt = max(dt, 0.0)
-        xs = [traj[f"x_{i}"][k] + traj[f"vx_{i}"][k] * dt for i in range(1, n + 1)]
-        ys = [traj[f"y_{i}"][k] + traj[f"vy_{i}"][k] * dt for i in range(1, n + 1)]
-        xc, yc = np.mean(xs), np.mean(ys)
+    radius = 2.0  # [mm]: sphere radius 2a, a = 1 mm (Table-I builder default)
+    pos = [snapshot_positions(traj, n, t) for t in t_stars]
+    x0, x1, y0, y1 = snapshot_box(pos, radius, 1.25)
+    for ax, tstar, (xs, ys) in zip(ax_row, t_stars, pos):
         for i in range(n):
-            x, y = (xs[i] - xc) * 1e3, (ys[i] - yc) * 1e3
-            ax.add_patch(plt.Circle((x, y), radius * 1e3, fc=f"C{i}", alpha=0.5))
-            ax.text(x, y, str(i + 1), ha="center", va="center", fontsize=9, clip_on=True)
-        ax.set(xlim=(-10, 10), ylim=(-8, 8), aspect="equal", xticks=[], yticks=[])
+            ax.add_patch(plt.Circle((xs[i], ys[i]), radius, fc=f"C{i}", alpha=0.5))
+            ax.text(xs[i], ys[i], str(i + 1), ha="center", va="center", fontsize=9, clip_on=True)
+        ax.set(xlim=(x0, x1), ylim=(y0, y1), aspect="equal", xticks=[], yticks=[])
         ax.set_title(f"t* = {tstar:g}", fontsize=8)
+    bx, by = x0 + 0.05 * (x1 - x0), y0 + 0.06 * (y1 - y0)
+    ax_row[0].plot([bx, bx + 5], [by, by], "k-", lw=1.5)
+    ax_row[0].text(bx + 2.5, by + 0.02 * (y1 - y0), "5 mm", ha="center", va="bottom", fontsize=7)
     ax_row[0].set_ylabel(title, fontsize=8)
 
 
 def fig_snapshots():
     rows = [("stick", [0, 2, 5, 9.5, 20], "St 2: FA, 1 turns to 3\n(partner change)"),
-            ("pa", [0, 1, 3, 8, 20], "St 7: PA, sphere 1 leaves"),
+            ("pa", [0, 1, 3, 8, 20], "St 7: PA, sphere 1 leaves\n(smaller scale)"),
             ("fs", [0, 0.02, 0.05, 0.2, 0.5], "St 30: FS (rapid bounces)"),
-            ("theta45", [0, 1, 3, 8, 20], "St 7, θ23,0 = -45°")]
-    fig, ax = plt.subplots(len(rows), 5, figsize=(11, 9))
+            ("theta45", [0, 1, 3, 8, 20], "St 7, θ23,0 = -45°\n(smaller scale)")]
+    fig, ax = plt.subplots(len(rows), 5, figsize=(11, 9.4))
     for r, (name, ts, title) in enumerate(rows):
         snapshot_row(ax[r], name, ts, title)
+    fig.suptitle("Centre-of-mass frame of the three spheres; one scale per row (5 mm bar)",
+                 fontsize=10)
     fig.tight_layout()
     fig.savefig(os.path.join(FIGURES, "davis_snapshots.png"), dpi=110)
     plt.close(fig)
