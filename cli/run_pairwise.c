@@ -193,6 +193,28 @@ static void run_settings(const struct cli_scenario* sc, struct wetdem_pairwise_c
     cfg->max_events = (size_t)cli_scenario_number(sc, "pairwise", "max_events", 100000.0);
 }
 
+/* A library message about the initial gap of spheres I and J (counted from 1, file order of the
+ * [sphere.*] sections) is reported at the section of sphere J and names both sections. */
+static int report_gap(const struct cli_scenario* sc, const char* msg)
+{
+    size_t want[2], k = 0;
+    const char* names[2] = {NULL, NULL};
+    if (sscanf(msg, "initial gap of spheres %zu and %zu", &want[0], &want[1]) != 2)
+        return report(sc, "pairwise", msg);
+    for (size_t s = 0; s < sc->n_sections; s++)
+        if (strncmp(sc->sections[s].name, "sphere.", 7) == 0) {
+            k++;
+            for (int w = 0; w < 2; w++)
+                if (k == want[w])
+                    names[w] = sc->sections[s].name;
+        }
+    if (!names[0] || !names[1])
+        return report(sc, "pairwise", msg);
+    cli_scenario_section_error(sc, names[1], "%s: sphere %zu is [%s], sphere %zu [%s]", msg,
+                               want[0], names[0], want[1], names[1]);
+    return CLI_EXIT_USAGE;
+}
+
 /* Builds and checks the configuration; exit code. */
 static int build_config(const struct cli_scenario* sc, struct wetdem_pairwise_config* cfg)
 {
@@ -202,8 +224,11 @@ static int build_config(const struct cli_scenario* sc, struct wetdem_pairwise_co
         return rc;
     run_settings(sc, cfg);
     char msg[512];
-    if (wetdem_pairwise_config_validate(cfg, msg, sizeof msg) != WETDEM_OK)
+    if (wetdem_pairwise_config_validate(cfg, msg, sizeof msg) != WETDEM_OK) {
+        if (!davis && strncmp(msg, "initial gap", 11) == 0)
+            return report_gap(sc, msg);
         return report(sc, strncmp(msg, "spheres[", 8) == 0 && davis ? "davis" : "pairwise", msg);
+    }
     return CLI_EXIT_OK;
 }
 

@@ -783,7 +783,8 @@ WETDEM_API const char* wetdem_pairwise_errmsg(const struct wetdem_pairwise* pw);
 /* Fills *cfg with defaults (no spheres, e_dry 1, mu_f 0, rtol 1e-9, ...). */
 WETDEM_API void wetdem_pairwise_config_init(struct wetdem_pairwise_config* cfg);
 /* Checks a configuration; a message naming the parameter, value and valid range goes to
- * msg. Returns WETDEM_OK or WETDEM_ERR_INVALID. */
+ * msg (spheres counted from 1 as in the CLI and output columns, with the array index:
+ * "spheres 1 and 2 (spheres[0], spheres[1])"). Returns WETDEM_OK or WETDEM_ERR_INVALID. */
 WETDEM_API int wetdem_pairwise_config_validate(const struct wetdem_pairwise_config* cfg, char* msg,
                                                size_t msg_size);
 /* Sets the observer called every `interval` seconds [s] (> 0) of a run; fn NULL removes it. */

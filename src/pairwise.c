@@ -242,6 +242,8 @@ static int validate_scalars(const struct wetdem_pairwise_config* c, char* msg, s
     return WETDEM_OK;
 }
 
+/* Messages about a pair count spheres from 1 (as the CLI, the scenario files and the output
+ * columns x_1, e_w_12 do) and add the array index: "spheres 1 and 2 (spheres[0], spheres[1])". */
 int wetdem_pairwise_config_validate(const struct wetdem_pairwise_config* c, char* msg, size_t n)
 {
     if (c->n_spheres < 2 || c->n_spheres > WETDEM_PAIRWISE_MAX_SPHERES)
@@ -254,8 +256,9 @@ int wetdem_pairwise_config_validate(const struct wetdem_pairwise_config* c, char
         return st;
     if (c->ref_i >= c->n_spheres || c->ref_j >= c->n_spheres || c->ref_i == c->ref_j)
         return wetdem_status_fail(msg, n, WETDEM_ERR_INVALID,
-                                  "reference pair (%zu, %zu): must be two different spheres < %zu",
-                                  c->ref_i, c->ref_j, c->n_spheres);
+                                  "reference pair: spheres %zu and %zu (ref_i = %zu, ref_j = %zu): "
+                                  "must be two different spheres of 1..%zu",
+                                  c->ref_i + 1, c->ref_j + 1, c->ref_i, c->ref_j, c->n_spheres);
     for (size_t i = 0; i < c->n_spheres; i++)
         for (size_t j = i + 1; j < c->n_spheres; j++) {
             const struct wetdem_pairwise_sphere *a = &c->spheres[i], *b = &c->spheres[j];
@@ -263,8 +266,9 @@ int wetdem_pairwise_config_validate(const struct wetdem_pairwise_config* c, char
             if (!(h >= c->h_min))
                 return wetdem_status_fail(
                     msg, n, WETDEM_ERR_INVALID,
-                    "initial gap of spheres %zu and %zu = %g m: must be >= h_min = %g m", i, j, h,
-                    c->h_min);
+                    "initial gap of spheres %zu and %zu (spheres[%zu], spheres[%zu]) = %g m: "
+                    "must be >= h_min = %g m",
+                    i + 1, j + 1, i, j, h, c->h_min);
         }
     return WETDEM_OK;
 }
@@ -642,8 +646,10 @@ static int hard_contact(struct wetdem_pairwise* pw, size_t p, struct wetdem_pair
 {
     int st = wetdem_pairwise_jump_apply(&pw->sys, &pw->md, p, k, pw->y);
     if (st != WETDEM_OK)
-        return fail(pw, st, "hard-sphere impulse of spheres %zu and %zu failed at t = %g s",
-                    pw->sys.pi[p], pw->sys.pj[p], pw->t);
+        return fail(pw, st,
+                    "hard-sphere impulse of spheres %zu and %zu (spheres[%zu], spheres[%zu]) "
+                    "failed at t = %g s",
+                    pw->sys.pi[p] + 1, pw->sys.pj[p] + 1, pw->sys.pi[p], pw->sys.pj[p], pw->t);
     pw->res->pairs[p].n_contacts++;
     if ((st = log_event(pw, WETDEM_PAIRWISE_CONTACT, p, p, pw->sys.h_min, v_n)) != WETDEM_OK)
         return st;

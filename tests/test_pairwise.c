@@ -803,7 +803,12 @@ static void test_pairwise_config_rejected(void** state)
     b = c;
     b.spheres[2].x = b.spheres[1].x;
     CHECK_STATUS(wetdem_pairwise_config_validate(&b, msg, sizeof msg), WETDEM_ERR_INVALID);
-    CHECK_CONTAINS(msg, "initial gap of spheres 1 and 2");
+    /* spheres[1] and spheres[2] overlap: counted from 1 they are spheres 2 and 3 */
+    CHECK_CONTAINS(msg, "initial gap of spheres 2 and 3 (spheres[1], spheres[2])");
+    b = c;
+    b.ref_j = 3; /* three spheres: indices 0..2 */
+    CHECK_STATUS(wetdem_pairwise_config_validate(&b, msg, sizeof msg), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(msg, "reference pair: spheres 1 and 4 (ref_i = 0, ref_j = 3)");
     b = c;
     b.restitution = 0.0;
     CHECK_STATUS(wetdem_pairwise_config_validate(&b, msg, sizeof msg), WETDEM_ERR_INVALID);

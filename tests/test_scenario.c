@@ -179,6 +179,13 @@ static void test_scenario_bad_files_exit_2_with_line(void** state)
         {"notenabled", "[collision]\nstokes = 5\n[model.nijssen]\ncutoff_ratio = 2\n",
          ":4:", "not enabled"},
         {"nospeed", "[collision]\nstriker = delrin\n", ":1:", "speed > 0"},
+        /* two spheres of radius 1 mm 1.5 mm apart overlap: reported at the second section, with
+         * the spheres counted from 1 in file order as the CLI and output columns count them */
+        {"overlap",
+         "[engine]\ntype = pairwise\n[pairwise]\nh_min = 1e-6\nt_end = 1\n[sphere.a]\nradius = "
+         "1e-3\nmass = 1e-5\n"
+         "[sphere.b]\nradius = 1e-3\nmass = 1e-5\nx = 1.5e-3\n",
+         ":9:", "initial gap of spheres 1 and 2"},
     };
     for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
         char name[64], args[700], where[600];
