@@ -16,22 +16,9 @@
  */
 #include <math.h>
 
+#include "contact.h"
 #include "vec3.h"
 #include "wetdem.h"
-
-static double reduced(double a, double b)
-{
-    if (isinf(a))
-        return b;
-    if (isinf(b))
-        return a;
-    return a * b / (a + b);
-}
-
-static double effective_mass(const struct wetdem_particle* p)
-{
-    return p->is_fixed ? INFINITY : p->mass;
-}
 
 static void mix_properties(struct wetdem_contact* c, const struct wetdem_material* a,
                            const struct wetdem_material* b, const struct wetdem_fluid* fluid)
@@ -72,8 +59,8 @@ void wetdem_contact_from_particles(struct wetdem_contact* c, const struct wetdem
     c->gap = dist - a->radius - b->radius;
     c->radius_i = a->radius;
     c->radius_j = b->radius;
-    c->r_eff = reduced(a->radius, b->radius);
-    c->m_eff = reduced(effective_mass(a), effective_mass(b));
+    c->r_eff = contact_reduced(a->radius, b->radius);
+    c->m_eff = contact_reduced(contact_effective_mass(a), contact_effective_mass(b));
     struct wetdem_vec3 n = c->normal;
     struct wetdem_vec3 va = vec3_add(a->vel, vec3_cross(a->omega, vec3_scale(n, -a->radius)));
     struct wetdem_vec3 vb = vec3_add(b->vel, vec3_cross(b->omega, vec3_scale(n, b->radius)));
@@ -93,7 +80,7 @@ void wetdem_contact_with_wall(struct wetdem_contact* c, const struct wetdem_part
     c->radius_i = a->radius;
     c->radius_j = INFINITY;
     c->r_eff = a->radius;
-    c->m_eff = effective_mass(a);
+    c->m_eff = contact_effective_mass(a);
     struct wetdem_vec3 va = vec3_add(a->vel, vec3_cross(a->omega, vec3_scale(normal, -a->radius)));
     mix_properties(c, ma, mw, fluid);
     set_kinematics(c, a->vel, va);

@@ -48,6 +48,7 @@
 #include "many.h"
 #include "models.h"
 #include "thin_film.h"
+#include "contact.h"
 #include "vec3.h"
 
 /* Relative margin of the cheap gap test: its squared-distance bound must never reject a pair
@@ -140,20 +141,6 @@ int wetdem_sim_many_setup_kernel(struct wetdem_sim* sim)
 
 /* ---- contacts ---- */
 
-static double reduced(double a, double b)
-{
-    if (isinf(a))
-        return b;
-    if (isinf(b))
-        return a;
-    return a * b / (a + b);
-}
-
-static double effective_mass(const struct wetdem_particle* p)
-{
-    return p->is_fixed ? INFINITY : p->mass;
-}
-
 static void copy_mix(struct wetdem_contact* c, const struct wetdem_many_mix* x)
 {
     c->e_star = x->e_star;
@@ -181,8 +168,8 @@ static void pair_contact_from(const struct wetdem_particle* a, const struct wetd
     c->gap = dist - a->radius - b->radius;
     c->radius_i = a->radius;
     c->radius_j = b->radius;
-    c->r_eff = reduced(a->radius, b->radius);
-    c->m_eff = reduced(effective_mass(a), effective_mass(b));
+    c->r_eff = contact_reduced(a->radius, b->radius);
+    c->m_eff = contact_reduced(contact_effective_mass(a), contact_effective_mass(b));
     struct wetdem_vec3 n = c->normal;
     struct wetdem_vec3 va = vec3_add(a->vel, vec3_cross(a->omega, vec3_scale(n, -a->radius)));
     struct wetdem_vec3 vb = vec3_add(b->vel, vec3_cross(b->omega, vec3_scale(n, b->radius)));
@@ -202,7 +189,7 @@ static void wall_contact_from(const struct wetdem_particle* a, const struct wetd
     c->radius_i = a->radius;
     c->radius_j = INFINITY;
     c->r_eff = a->radius;
-    c->m_eff = effective_mass(a);
+    c->m_eff = contact_effective_mass(a);
     struct wetdem_vec3 va =
         vec3_add(a->vel, vec3_cross(a->omega, vec3_scale(w->normal, -a->radius)));
     copy_mix(c, x);
