@@ -315,7 +315,7 @@ double wetdem_force_hertz_elastic(double e_star, double r_eff, double overlap)
 {
     if (!(overlap > 0.0))
         return 0.0;
-    return (4.0 / 3.0) * e_star * sqrt(r_eff) * overlap * sqrt(overlap);
+    return hertz_elastic_k(hertz_stiffness(e_star, r_eff), overlap);
 }
 
 double wetdem_force_hertz_damping_coefficient(double restitution, int form)
@@ -330,8 +330,7 @@ double wetdem_force_hertz_damping_with(double coefficient, double e_star, double
 {
     if (!(overlap > 0.0))
         return 0.0;
-    double k = (4.0 / 3.0) * e_star * sqrt(r_eff);
-    return coefficient * sqrt(m_eff * k) * sqrt(sqrt(overlap)) * v_n;
+    return hertz_damping_k(coefficient, hertz_stiffness(e_star, r_eff), m_eff, overlap, v_n);
 }
 
 double wetdem_force_hertz_damping(double e_star, double r_eff, double m_eff, double overlap,

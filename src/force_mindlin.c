@@ -98,19 +98,28 @@ struct wetdem_vec3 wetdem_force_mindlin_update_with(const struct wetdem_contact*
                                                     double f_limit, double mu,
                                                     double damping_factor, double* spring)
 {
+    return wetdem_force_mindlin_spring(c->normal, c->v_t, c->dt, c->g_star, c->r_eff, c->m_eff,
+                                       overlap, f_limit, mu, damping_factor, spring);
+}
+
+struct wetdem_vec3 wetdem_force_mindlin_spring(struct wetdem_vec3 n, struct wetdem_vec3 v_t,
+                                               double dt, double g_star, double r_eff, double m_eff,
+                                               double overlap, double f_limit, double mu,
+                                               double damping_factor, double* spring)
+{
     if (!(overlap > 0.0)) {
         store_spring(spring, vec3(0, 0, 0));
         return vec3(0, 0, 0);
     }
-    struct wetdem_vec3 s = rotate_into_plane(vec3(spring[0], spring[1], spring[2]), c->normal);
-    s = vec3_axpy(s, c->dt, c->v_t);
-    double k_t = tangential_stiffness(c->g_star, c->r_eff, overlap);
-    double gamma_t = tangential_damping(k_t, c->m_eff, damping_factor);
-    struct wetdem_vec3 ft = vec3_axpy(vec3_scale(s, -k_t), -gamma_t, c->v_t);
+    struct wetdem_vec3 s = rotate_into_plane(vec3(spring[0], spring[1], spring[2]), n);
+    s = vec3_axpy(s, dt, v_t);
+    double k_t = tangential_stiffness(g_star, r_eff, overlap);
+    double gamma_t = tangential_damping(k_t, m_eff, damping_factor);
+    struct wetdem_vec3 ft = vec3_axpy(vec3_scale(s, -k_t), -gamma_t, v_t);
     double f_total = vec3_norm(ft), f_max = mu * fabs(f_limit);
     if (f_total > f_max) { /* sliding: total capped, spring set so that it gives the cap */
         ft = vec3_scale(ft, f_max / f_total);
-        s = k_t > 0.0 ? vec3_scale(vec3_axpy(ft, gamma_t, c->v_t), -1.0 / k_t) : vec3(0, 0, 0);
+        s = k_t > 0.0 ? vec3_scale(vec3_axpy(ft, gamma_t, v_t), -1.0 / k_t) : vec3(0, 0, 0);
     }
     store_spring(spring, s);
     return ft;

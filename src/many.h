@@ -22,6 +22,22 @@ struct wetdem_many_mix {
     double hertz_damping[2], mindlin_damping;
 };
 
+/* The lean pair kernel (sim_many_force.c): for the model sets of the fused kernel without an
+ * energy budget, the pair's force computed straight from the particles, without a struct
+ * wetdem_contact, with the same arithmetic in the same order (bit-identical). */
+struct wetdem_many_lean {
+    bool on;            /* usable: fused models, valid restitutions, constant h_min */
+    int hertz_form;     /* damping form of hertz (0 exact, 1 tsuji), -1 without hertz */
+    bool mindlin;       /* mindlin enabled */
+    bool mindlin_lub;   /* mindlin limits with friction_lub (else friction_dry) */
+    size_t mindlin_off; /* its history offset [doubles] */
+    bool sb;            /* sb enabled */
+    double sb_below;    /* its below_hmin treatment */
+    double h_min;       /* h_min of the constant min-separation model [m] */
+    int n_normal;       /* models adding to the normal force, in model order: */
+    unsigned char normal[WETDEM_MAX_MODELS]; /* 0 hertz, 1 sb, 2 capillary */
+};
+
 /* Result of one candidate pair at the latest force evaluation. */
 struct wetdem_many_pair_out {
     struct wetdem_vec3 force;    /* on i (j receives the opposite) [N] */
@@ -94,6 +110,7 @@ struct wetdem_many {
     struct wetdem_many_mix* mix; /* n_mix_materials^2 material pairs */
     size_t mix_cap;
     int n_mix_materials;
+    struct wetdem_many_lean lean;          /* the lean pair kernel's plan */
     bool kernel_ready;                     /* mix and kind[] match the current set-up */
     bool fused;                            /* every enabled model has a fused kernel */
     bool generic_only;                     /* tests: never use the fused kernel */
@@ -106,6 +123,8 @@ struct wetdem_many {
     uint32_t* contacts;              /* per particle: solid contacts at the latest evaluation */
     struct wetdem_celllist_item* xr; /* per particle: position and radius, a compact copy for
                                         the gap tests (kept by kick_drift) */
+    double (*inv)[2]; /* per particle: 1/m [1/kg] and 1/I = 1/(0.4 m R^2) [1/(kg m^2)], computed
+                         with the integrator's own expressions when a run (re)starts */
     size_t particle_cap;
     struct wetdem_many_energy energy;
     double* thread_work; /* per thread: 2 x WETDEM_MAX_MODELS accumulators */

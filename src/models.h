@@ -5,6 +5,8 @@
 #ifndef WETDEM_MODELS_H
 #define WETDEM_MODELS_H
 
+#include <math.h>
+
 #include "wetdem.h"
 
 /* contact */
@@ -52,6 +54,24 @@ static inline size_t contact_only_thresholds(const void* params, const struct we
 
 /* force_hertz.c: Hertz elastic normal force (4/3) E* sqrt(R*) delta^(3/2) [N]; 0 if delta <= 0. */
 double wetdem_force_hertz_elastic(double e_star, double r_eff, double overlap);
+/* Hertz stiffness factor k = (4/3) E* sqrt(R*) [N/m^(3/2)] and the parts of the hertz law
+ * written with it: the elastic force k delta^(3/2) and the damping force
+ * coefficient sqrt(m* k) delta^(1/4) v_n [N] (delta > 0). The one definition of this
+ * arithmetic: force_hertz.c and the many-particle kernel (sim_many_force.c) both use it, so
+ * that their forces are bit-identical. */
+static inline double hertz_stiffness(double e_star, double r_eff)
+{
+    return (4.0 / 3.0) * e_star * sqrt(r_eff);
+}
+static inline double hertz_elastic_k(double k, double overlap)
+{
+    return k * overlap * sqrt(overlap);
+}
+static inline double hertz_damping_k(double coefficient, double k, double m_eff, double overlap,
+                                     double v_n)
+{
+    return coefficient * sqrt(m_eff * k) * sqrt(sqrt(overlap)) * v_n;
+}
 /* force_hertz.c: normal viscous damping force of the Hertz contact [N], > 0 (repulsive) for
  * v_n > 0 (approaching), proportional to delta^(1/4) v_n so that the restitution is
  * independent of speed. form 0 "exact": coefficient chosen so that an isolated Hertz
@@ -96,5 +116,12 @@ double wetdem_force_mindlin_damping_factor(double restitution);
 struct wetdem_vec3 wetdem_force_mindlin_update_with(const struct wetdem_contact* c, double overlap,
                                                     double f_limit, double mu,
                                                     double damping_factor, double* spring);
+/* force_mindlin.c: wetdem_force_mindlin_update_with from the contact quantities it reads: unit
+ * normal n, tangential velocity v_t [m/s], dt [s], G* [Pa], R* [m], m* [kg] (for callers that
+ * do not build a struct wetdem_contact; bit-identical). */
+struct wetdem_vec3 wetdem_force_mindlin_spring(struct wetdem_vec3 n, struct wetdem_vec3 v_t,
+                                               double dt, double g_star, double r_eff, double m_eff,
+                                               double overlap, double f_limit, double mu,
+                                               double damping_factor, double* spring);
 
 #endif

@@ -93,6 +93,7 @@ void wetdem_sim_many_free(struct wetdem_sim* sim)
     free(m->wh);
     free(m->contacts);
     free(m->xr);
+    free(m->inv);
     free(m->thread_work);
     free(m->mix);
     free(m->rev_start);
@@ -243,6 +244,9 @@ static int size_particle_arrays(struct wetdem_sim* sim)
     c = cap;
     if (grow((void**)&m->xr, &c, n, sizeof *m->xr))
         return WETDEM_ERR_NOMEM;
+    c = cap;
+    if (grow((void**)&m->inv, &c, n, sizeof *m->inv))
+        return WETDEM_ERR_NOMEM;
     m->particle_cap = c;
     size_t len = sim->history_len, nw = sim->n_walls * n * len;
     size_t old = m->wall_history_cap;
@@ -379,6 +383,8 @@ int wetdem_sim_many_prepare(struct wetdem_sim* sim)
     for (size_t k = 0; refresh && k < sim->n_particles; k++) { /* the user may move particles */
         const struct wetdem_particle* p = &sim->particles[k];
         m->xr[k] = (struct wetdem_celllist_item){p->pos.x, p->pos.y, p->pos.z, p->radius};
+        m->inv[k][0] = 1.0 / p->mass;
+        m->inv[k][1] = 1.0 / (0.4 * p->mass * p->radius * p->radius);
     }
     bool moved = m->max_disp_valid && m->cl.n_builds > 0 && m->cl.n_at_build == sim->n_particles
                      ? m->max_disp2 > 0.25 * m->cl.skin * m->cl.skin
@@ -427,9 +433,8 @@ static struct wetdem_vec3 wrap(const struct wetdem_celllist_box* b, struct wetde
 static void kick_drift_one(struct wetdem_many* m, struct wetdem_particle* p, size_t k,
                            struct wetdem_vec3 g, double h, bool periodic, bool pending)
 {
-    struct wetdem_vec3 a = vec3_axpy(g, 1.0 / p->mass, m->force[k]);
-    struct wetdem_vec3 alpha =
-        vec3_scale(m->torque[k], 1.0 / (0.4 * p->mass * p->radius * p->radius));
+    struct wetdem_vec3 a = vec3_axpy(g, m->inv[k][0], m->force[k]);
+    struct wetdem_vec3 alpha = vec3_scale(m->torque[k], m->inv[k][1]);
     if (pending) { /* the previous step's closing half kick, with the same a and alpha */
         p->vel = vec3_axpy(m->vh[k], 0.5 * h, a);
         p->omega = vec3_axpy(m->wh[k], 0.5 * h, alpha);
@@ -490,9 +495,8 @@ static void finish_kick(struct wetdem_sim* sim)
         struct wetdem_particle* p = &sim->particles[k];
         if (p->is_fixed)
             continue;
-        struct wetdem_vec3 a = vec3_axpy(g, 1.0 / p->mass, m->force[k]);
-        struct wetdem_vec3 alpha =
-            vec3_scale(m->torque[k], 1.0 / (0.4 * p->mass * p->radius * p->radius));
+        struct wetdem_vec3 a = vec3_axpy(g, m->inv[k][0], m->force[k]);
+        struct wetdem_vec3 alpha = vec3_scale(m->torque[k], m->inv[k][1]);
         p->vel = vec3_axpy(m->vh[k], 0.5 * h, a);
         p->omega = vec3_axpy(m->wh[k], 0.5 * h, alpha);
     }

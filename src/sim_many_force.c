@@ -105,6 +105,53 @@ static void mix_pair(const struct wetdem_sim* sim, int a, int b, struct wetdem_m
     x->mindlin_damping = valid ? wetdem_force_mindlin_damping_factor(c.restitution) : NAN;
 }
 
+/* The lean kernel's plan: on for fused model sets whose restitutions are all valid (else the
+ * fused kernel runs and reports the bad one) and, with sb, a constant h_min (minsep "fixed"). */
+static void plan_lean(struct wetdem_sim* sim)
+{
+    struct wetdem_many* m = sim->many;
+    struct wetdem_many_lean* L = &m->lean;
+    *L = (struct wetdem_many_lean){.on = m->fused, .hertz_form = -1};
+    bool contact_models = false;
+    unsigned seen = 0;
+    for (size_t k = 0; k < sim->n_models; k++) {
+        L->on = L->on && !(seen >> m->kind[k] & 1u); /* a model twice: the fused kernel */
+        seen |= 1u << m->kind[k];
+        switch (m->kind[k]) {
+        case FUSED_HERTZ:
+            L->hertz_form = (int)m->kind_opt[k];
+            L->normal[L->n_normal++] = 0;
+            contact_models = true;
+            break;
+        case FUSED_MINDLIN:
+            L->mindlin = true;
+            L->mindlin_lub = m->kind_opt[k] != 0;
+            L->mindlin_off = sim->models[k].history_offset;
+            contact_models = true;
+            break;
+        case FUSED_SB:
+            L->sb = true;
+            L->sb_below = m->kind_opt[k];
+            L->normal[L->n_normal++] = 1;
+            break;
+        case FUSED_CAPILLARY: L->normal[L->n_normal++] = 2; break;
+        default: L->on = false;
+        }
+    }
+    if (L->sb) { /* h_min must not depend on the pair */
+        struct wetdem_contact probe = {0};
+        double scratch[1] = {0.0};
+        L->on = L->on && sim->minsep.model == &wetdem_minsep_fixed;
+        if (L->on)
+            L->h_min = sim->minsep.model->min_separation(sim->minsep.params, &probe, scratch);
+    }
+    for (size_t k = 0; L->on && k < (size_t)m->n_mix_materials * (size_t)m->n_mix_materials; k++) {
+        const struct wetdem_many_mix* x = &m->mix[k];
+        bool valid = x->restitution > 0.0 && x->restitution <= 1.0;
+        L->on = (valid || !contact_models) && x->range <= m->reach;
+    }
+}
+
 int wetdem_sim_many_setup_kernel(struct wetdem_sim* sim)
 {
     struct wetdem_many* m = sim->many;
@@ -135,6 +182,7 @@ int wetdem_sim_many_setup_kernel(struct wetdem_sim* sim)
             x->range = fused ? (x->film > 0.0 ? x->film : 0.0) : m->reach;
         }
     m->fused = fused;
+    plan_lean(sim);
     m->periodic_any = m->cl.box.periodic[0] || m->cl.box.periodic[1] || m->cl.box.periodic[2];
     return WETDEM_OK;
 }
@@ -306,6 +354,77 @@ int wetdem_sim_many_eval_fused(const struct wetdem_sim* sim, struct wetdem_conta
     return WETDEM_OK;
 }
 
+/* ---- the lean kernel ---- */
+
+/* Pair (a, b) with d = x_a - x_b (minimum image) and mixed properties x: the operations of
+ * pair_contact_from, wetdem_sim_many_eval_fused and eval_pair in the same order on the
+ * quantities the enabled models read, so force, torques, history and flags are bit-identical
+ * to theirs (tests/test_many_force.c). The sum of the normal forces starts at +0 and adds the
+ * models in model order; a model that does not act adds +0, which changes no sum that is not
+ * -0 (and a sum from +0 never is). Returns WETDEM_OK or WETDEM_ERR_NUMERIC (non-finite
+ * force). */
+static int lean_pair(const struct wetdem_many* m, const struct wetdem_particle* a,
+                     const struct wetdem_particle* b, struct wetdem_vec3 d,
+                     const struct wetdem_many_mix* x, double* hist, unsigned char* flags,
+                     struct wetdem_many_pair_out* o) __attribute__((noinline));
+static int lean_pair(const struct wetdem_many* m, const struct wetdem_particle* a,
+                     const struct wetdem_particle* b, struct wetdem_vec3 d,
+                     const struct wetdem_many_mix* x, double* hist, unsigned char* flags,
+                     struct wetdem_many_pair_out* o)
+{
+    const struct wetdem_many_lean* L = &m->lean;
+    double dist = vec3_norm(d);
+    double gap = dist - a->radius - b->radius;
+    *flags = 0;
+    if (gap > x->range)
+        return WETDEM_OK;
+    struct wetdem_vec3 n = dist > 0 ? vec3_scale(d, 1.0 / dist) : vec3(1, 0, 0);
+    double r_eff = contact_reduced(a->radius, b->radius);
+    double m_eff = contact_reduced(contact_effective_mass(a), contact_effective_mass(b));
+    double v_n = -vec3_dot(vec3_sub(a->vel, b->vel), n), overlap = -gap;
+    double k = hertz_stiffness(x->e_star, r_eff);
+    double f_el = overlap > 0.0 ? hertz_elastic_k(k, overlap) : 0.0;
+    double term[3] = {0.0, 0.0, 0.0}; /* hertz, sb, capillary */
+    if (L->hertz_form >= 0 && overlap > 0.0)
+        term[0] = wetdem_force_hertz_total(
+            f_el, hertz_damping_k(x->hertz_damping[L->hertz_form], k, m_eff, overlap, v_n),
+            L->hertz_form);
+    double h;
+    if (L->sb && thin_film_eval_gap(gap, L->h_min, x->film, L->sb_below, &h)) {
+        double bracket = 1.0 - h / x->film;
+        term[1] = 6.0 * M_PI * x->viscosity * r_eff * r_eff * v_n / h * bracket * bracket;
+    }
+    if (x->film > 0.0 && gap <= x->film)
+        term[2] = -(8.0 * M_PI * r_eff * x->surface_tension);
+    double f_n = 0.0;
+    for (int q = 0; q < L->n_normal; q++)
+        f_n += term[L->normal[q]];
+    struct wetdem_vec3 zero = vec3(0, 0, 0), f_tan = zero, t_i = zero, t_j = zero;
+    if (L->mindlin) {
+        struct wetdem_vec3 va = vec3_add(a->vel, vec3_cross(a->omega, vec3_scale(n, -a->radius)));
+        struct wetdem_vec3 vb = vec3_add(b->vel, vec3_cross(b->omega, vec3_scale(n, b->radius)));
+        struct wetdem_vec3 v_t = vec3_reject(vec3_sub(va, vb), n);
+        struct wetdem_vec3 ft =
+            wetdem_force_mindlin_spring(n, v_t, m->dt, x->g_star, r_eff, m_eff, overlap, f_el,
+                                        L->mindlin_lub ? x->friction_lub : x->friction_dry,
+                                        x->mindlin_damping, hist + L->mindlin_off);
+        if (overlap > 0.0) { /* wetdem_pair_force_add_tangential onto a zero record */
+            f_tan = vec3_add(zero, ft);
+            struct wetdem_vec3 nxf = vec3_cross(n, ft);
+            t_i = vec3_axpy(zero, -a->radius, nxf);
+            t_j = vec3_axpy(zero, -b->radius, nxf);
+        }
+    }
+    o->force = vec3_axpy(f_tan, f_n, n);
+    o->torque_i = t_i;
+    o->torque_j = t_j;
+    *flags = WETDEM_MANY_ACTIVE | WETDEM_MANY_DIRTY | (gap < 0 ? WETDEM_MANY_CONTACT : 0) |
+             (x->film > 0 && gap < x->film ? WETDEM_MANY_BRIDGE : 0);
+    if (!(isfinite(f_n) && vec3_is_finite(o->force) && vec3_is_finite(t_i) && vec3_is_finite(t_j)))
+        return WETDEM_ERR_NUMERIC;
+    return WETDEM_OK;
+}
+
 /* ---- the pair pass ---- */
 
 /* First failing pair (lowest index) of a parallel loop, for a deterministic message. */
@@ -450,7 +569,7 @@ static void eval_pairs_of(const struct wetdem_sim* sim, size_t i, struct failure
     unsigned char *flags = m->flags, *rev_flags = m->rev_flags;
     struct wetdem_many_rev_out* rev_out = m->rev_out;
     size_t len = sim->history_len, end = m->cl.first_pair[i + 1];
-    bool periodic = m->periodic_any;
+    bool periodic = m->periodic_any, lean = m->lean.on && !m->set.energy_budget;
     struct wetdem_vec3 xi = vec3(xr[i].x, xr[i].y, xr[i].z), f = vec3(0, 0, 0), t = vec3(0, 0, 0);
     double ri = xr[i].r;
     uint32_t n_contacts = 0;
@@ -470,7 +589,19 @@ static void eval_pairs_of(const struct wetdem_sim* sim, size_t i, struct failure
         }
         size_t r = slot[q];
         struct wetdem_many_pair_out o;
-        eval_near_pair(sim, q, d, x, &o, fail);
+        if (lean) {
+            unsigned char was = flags[q];
+            double* hist = m->history + q * len;
+            int st = lean_pair(m, &p[i], &p[j], d, x, hist, &flags[q], &o);
+            if (!flags[q] && (was & WETDEM_MANY_DIRTY) && len)
+                wetdem_sim_history_init(sim, hist);
+            if (st != WETDEM_OK) {
+                struct wetdem_contact c = {.gap = vec3_norm(d) - p[i].radius - p[j].radius};
+                note_failure(fail, q, st, false, &c, x->range);
+            }
+        } else {
+            eval_near_pair(sim, q, d, x, &o, fail);
+        }
         unsigned char fl = rev_flags[r] = flags[q];
         if (!(fl & WETDEM_MANY_ACTIVE))
             continue;
@@ -568,9 +699,8 @@ static void close_kick(struct wetdem_sim* sim, size_t k, struct wetdem_vec3 g)
     if (p->is_fixed)
         return;
     double h = m->dt;
-    p->vel = vec3_axpy(m->vh[k], 0.5 * h, vec3_axpy(g, 1.0 / p->mass, m->force[k]));
-    p->omega = vec3_axpy(m->wh[k], 0.5 * h,
-                         vec3_scale(m->torque[k], 1.0 / (0.4 * p->mass * p->radius * p->radius)));
+    p->vel = vec3_axpy(m->vh[k], 0.5 * h, vec3_axpy(g, m->inv[k][0], m->force[k]));
+    p->omega = vec3_axpy(m->wh[k], 0.5 * h, vec3_scale(m->torque[k], m->inv[k][1]));
 }
 
 /* Grows *a to n elements of `size` bytes (contents not kept). */

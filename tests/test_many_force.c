@@ -4,8 +4,9 @@
  * hertz/mindlin/sb/capillary kernel gives bit-identical forces, per-model forces and
  * histories to the generic model interface (wetdem_sim_eval_contact) over every branch of the
  * four models, the precomputed-coefficient damping kernels it calls equal the per-call ones,
- * whole runs with the fused kernel equal runs through the generic interface bit
- * for bit, and both stay independent of the thread count.
+ * whole runs with the fused kernel, and with the lean kernel that computes the same forces
+ * without building contacts, equal runs through the generic interface bit for bit, and all
+ * stay independent of the thread count.
  *
  * Bit-identity is the right tolerance here: the fused kernel calls the same kernels with the
  * same arguments and adds the models in the same order, so any difference is a bug.
@@ -340,6 +341,9 @@ static void test_many_fused_run_equals_generic_run(void** state)
         omp_set_num_threads(saved);
         assert_true(fused->many->fused);
         assert_false(generic->many->fused);
+        /* without the budget the lean kernel runs (sim_many_force.c), with it the fused one */
+        assert_true(fused->many->lean.on);
+        assert_false(generic->many->lean.on);
         check_same_state(fused, generic);
         check_same_state(fused, fused3);
         struct wetdem_many_stats s;
