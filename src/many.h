@@ -50,13 +50,6 @@ struct wetdem_many_pair_out {
  * does not depend on the thread count either way. */
 #define WETDEM_MANY_PARALLEL_MIN 512
 
-/* What a pair (i, j) gives j, stored for the gather of j: the force on i (j gets -force)
- * and the torque on j. */
-struct wetdem_many_rev_out {
-    struct wetdem_vec3 force;    /* on i [N] */
-    struct wetdem_vec3 torque_j; /* [N m] */
-};
-
 #define WETDEM_MANY_ACTIVE 1u  /* within the interaction range: force applied */
 #define WETDEM_MANY_CONTACT 2u /* gap < 0: solid contact */
 #define WETDEM_MANY_BRIDGE 4u  /* gap < film delta_ij with a fluid model: liquid bridge */
@@ -100,12 +93,18 @@ struct wetdem_many {
                                     (sim_many.c one_step); never true outside a run */
     double max_disp2;    /* largest squared displacement since the build [m^2], */
     bool max_disp_valid; /* measured during the latest drift */
-    /* the pairs ordered by their second particle: particle i's pairs (k, i) occupy the slots
-       rev_start[i] .. rev_start[i+1] in increasing k; pair q is in slot[q] */
-    size_t *rev_start, *slot;
-    struct wetdem_many_rev_out* rev_out; /* per slot: the reaction, valid where ACTIVE */
-    unsigned char* rev_flags;            /* per slot: the pair's flags */
-    size_t rev_start_cap, slot_cap, rev_out_cap, rev_flags_cap;
+    /* blocks of the force pass (sim_many_force.c), one per thread: particles blk[b] ..
+       blk[b+1]; the pairs crossing blocks (first particle in an earlier block), in pair order
+       (cross_q, with their results cross_out), grouped by the block of the first particle
+       (cross_first[b] ..) and, through cross_in, by the block of the second particle
+       (cross_first[n_blocks + 1 + b] ..) ordered by (second, first) */
+    size_t *blk, *cross_first;
+    uint32_t *cross_q, *cross_in;
+    struct wetdem_many_pair_out* cross_out;
+    size_t blk_cap, cross_first_cap, cross_q_cap, cross_in_cap, cross_out_cap;
+    size_t n_blocks, blocks_n;
+    uint64_t blocks_build; /* list build the blocks were indexed for */
+    bool blocks_ready;
     /* force kernel (sim_many_force.c) */
     struct wetdem_many_mix* mix; /* n_mix_materials^2 material pairs */
     size_t mix_cap;
@@ -169,8 +168,6 @@ void wetdem_sim_many_contact(const struct wetdem_sim* sim, size_t i, size_t j, b
 int wetdem_sim_many_eval_fused(const struct wetdem_sim* sim, struct wetdem_contact* c,
                                const struct wetdem_many_mix* x, double* history,
                                struct wetdem_pair_force* out, struct wetdem_pair_force* per_model);
-/* Index of the pairs by their second particle (rev, rev_start), after a list build. */
-int wetdem_sim_many_index_pairs(struct wetdem_sim* sim);
 /* Forces, torques and contact counts of every particle at the current state, histories
  * committed; with `kick`, also the closing half kick v = v' + a dt/2 of each particle. */
 int wetdem_sim_many_forces(struct wetdem_sim* sim, bool kick);

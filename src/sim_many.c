@@ -96,10 +96,11 @@ void wetdem_sim_many_free(struct wetdem_sim* sim)
     free(m->inv);
     free(m->thread_work);
     free(m->mix);
-    free(m->rev_start);
-    free(m->slot);
-    free(m->rev_out);
-    free(m->rev_flags);
+    free(m->blk);
+    free(m->cross_first);
+    free(m->cross_q);
+    free(m->cross_in);
+    free(m->cross_out);
     for (size_t k = 0; k < m->n_series && m->vtk_names; k++)
         free(m->vtk_names[k]);
     free(m->vtk_names);
@@ -333,8 +334,8 @@ static int rebuild(struct wetdem_sim* sim)
     wetdem_celllist_remap_history(m->old_pairs, m->old_history, n_old, m->cl.pairs, m->history,
                                   n_new, len, fresh);
     remap_dirty(m, n_old);
-    st = wetdem_sim_many_index_pairs(sim);
-    return st != WETDEM_OK ? st : update_wall_masks(sim);
+    m->blocks_ready = false; /* the force pass indexes the new list */
+    return update_wall_masks(sim);
 }
 
 int wetdem_sim_many_prepare(struct wetdem_sim* sim)

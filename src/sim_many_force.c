@@ -531,11 +531,7 @@ static int eval_pair(const struct wetdem_sim* sim, struct wetdem_contact* c,
     return WETDEM_OK;
 }
 
-/* Pair q within reach of the cheap test (d = x_i - x_j): its contact and force into *o. Kept
- * out of line: inlined, it made the candidate loop spill its registers to the stack. */
-static void eval_near_pair(const struct wetdem_sim* sim, size_t q, struct wetdem_vec3 d,
-                           const struct wetdem_many_mix* x, struct wetdem_many_pair_out* o,
-                           struct failure* fail) __attribute__((noinline));
+/* Pair q within reach of the cheap test (d = x_i - x_j): its contact and force into *o. */
 static void eval_near_pair(const struct wetdem_sim* sim, size_t q, struct wetdem_vec3 d,
                            const struct wetdem_many_mix* x, struct wetdem_many_pair_out* o,
                            struct failure* fail)
@@ -553,69 +549,70 @@ static void eval_near_pair(const struct wetdem_sim* sim, size_t q, struct wetdem
         note_failure(fail, q, st, false, &c, range);
 }
 
-/* The pairs (i, j > i) of particle i: the gap test on the positions first (most candidates
- * are beyond their range), the contact only for the others. The forces on i are summed here
- * in j order into force[i], torque[i], contacts[i]; the reactions on j go to the slot of the
- * pair in the by-second-particle order (rev_out, rev_flags) for the gather. */
-static void eval_pairs_of(const struct wetdem_sim* sim, size_t i, struct failure* fail)
+/* What every candidate evaluation of one force pass reads, gathered once. */
+struct pass {
+    const struct wetdem_sim* sim;
+    struct wetdem_many* m;
+    const struct wetdem_particle* p;
+    const struct wetdem_celllist_item* xr;
+    const struct wetdem_celllist_pair* pairs;
+    unsigned char* flags;
+    double* history;
+    size_t len, nm;
+    bool periodic, lean;
+};
+
+/* Candidate q = (i, j, d = x_i - x_j) that passed the gap test: its kernel. Returns its flags.
+ * Out of line: inlined, it made the candidate loops spill their registers. */
+static unsigned char near_candidate(const struct pass* P, size_t q, size_t i, size_t j,
+                                    struct wetdem_vec3 d, const struct wetdem_many_mix* x,
+                                    struct wetdem_many_pair_out* o, struct failure* fail)
+    __attribute__((noinline));
+static unsigned char near_candidate(const struct pass* P, size_t q, size_t i, size_t j,
+                                    struct wetdem_vec3 d, const struct wetdem_many_mix* x,
+                                    struct wetdem_many_pair_out* o, struct failure* fail)
 {
-    struct wetdem_many* m = sim->many;
-    const struct wetdem_particle* p = sim->particles;
-    const struct wetdem_celllist_item* xr = m->xr;
-    size_t nm = (size_t)m->n_mix_materials;
-    const struct wetdem_many_mix* mix_a = m->mix + (size_t)p[i].material * nm;
-    const struct wetdem_celllist_pair* pairs = m->cl.pairs;
-    const size_t* slot = m->slot;
-    unsigned char *flags = m->flags, *rev_flags = m->rev_flags;
-    struct wetdem_many_rev_out* rev_out = m->rev_out;
-    size_t len = sim->history_len, end = m->cl.first_pair[i + 1];
-    bool periodic = m->periodic_any, lean = m->lean.on && !m->set.energy_budget;
-    struct wetdem_vec3 xi = vec3(xr[i].x, xr[i].y, xr[i].z), f = vec3(0, 0, 0), t = vec3(0, 0, 0);
-    double ri = xr[i].r;
-    uint32_t n_contacts = 0;
-    for (size_t q = m->cl.first_pair[i]; q < end; q++) {
-        size_t j = pairs[q].j;
-        struct wetdem_vec3 xj = vec3(xr[j].x, xr[j].y, xr[j].z);
-        struct wetdem_vec3 d = periodic ? celllist_delta(&m->cl.box, xi, xj) : vec3_sub(xi, xj);
-        const struct wetdem_many_mix* x = nm == 1 ? mix_a : &mix_a[p[j].material];
-        double lim = ri + xr[j].r + x->range;
-        if (vec3_dot(d, d) > lim * lim * (1 + PREFILTER_MARGIN)) {
-            if (!flags[q]) /* rev_flags[slot[q]] == flags[q] between passes */
-                continue;
-            if (flags[q] & WETDEM_MANY_DIRTY && len)
-                wetdem_sim_history_init(sim, m->history + q * len);
-            flags[q] = rev_flags[slot[q]] = 0;
-            continue;
-        }
-        size_t r = slot[q];
-        struct wetdem_many_pair_out o;
-        if (lean) {
-            unsigned char was = flags[q];
-            double* hist = m->history + q * len;
-            int st = lean_pair(m, &p[i], &p[j], d, x, hist, &flags[q], &o);
-            if (!flags[q] && (was & WETDEM_MANY_DIRTY) && len)
-                wetdem_sim_history_init(sim, hist);
-            if (st != WETDEM_OK) {
-                struct wetdem_contact c = {.gap = vec3_norm(d) - p[i].radius - p[j].radius};
-                note_failure(fail, q, st, false, &c, x->range);
-            }
-        } else {
-            eval_near_pair(sim, q, d, x, &o, fail);
-        }
-        unsigned char fl = rev_flags[r] = flags[q];
-        if (!(fl & WETDEM_MANY_ACTIVE))
-            continue;
-        f = vec3_add(f, o.force);
-        t = vec3_add(t, o.torque_i);
-        n_contacts += (fl & WETDEM_MANY_CONTACT) ? 1 : 0;
-        rev_out[r] = (struct wetdem_many_rev_out){o.force, o.torque_j};
+    unsigned char* fl = &P->flags[q];
+    if (!P->lean) {
+        eval_near_pair(P->sim, q, d, x, o, fail);
+        return *fl;
     }
-    m->force[i] = f;
-    m->torque[i] = t;
-    m->contacts[i] = n_contacts;
+    unsigned char was = *fl;
+    double* hist = P->history + q * P->len;
+    int st = lean_pair(P->m, &P->p[i], &P->p[j], d, x, hist, fl, o);
+    if (!*fl && (was & WETDEM_MANY_DIRTY) && P->len)
+        wetdem_sim_history_init(P->sim, hist);
+    if (st != WETDEM_OK) {
+        struct wetdem_contact c = {.gap = vec3_norm(d) - P->p[i].radius - P->p[j].radius};
+        note_failure(fail, q, st, false, &c, x->range);
+    }
+    return *fl;
 }
 
-/* ---- the gather ---- */
+/* Candidate pair q = (i, j): the gap test on the positions first (most candidates are beyond
+ * their range), the kernel only for the others. Returns the pair's new flags; *o holds the
+ * force and torques where they include WETDEM_MANY_ACTIVE. */
+static inline __attribute__((always_inline)) unsigned char
+eval_candidate(const struct pass* P, size_t q, size_t i, size_t j, struct wetdem_vec3 xi,
+               struct wetdem_many_pair_out* o, struct failure* fail)
+{
+    const struct wetdem_celllist_item* xr = P->xr;
+    struct wetdem_vec3 xj = vec3(xr[j].x, xr[j].y, xr[j].z);
+    struct wetdem_vec3 d = P->periodic ? celllist_delta(&P->m->cl.box, xi, xj) : vec3_sub(xi, xj);
+    const struct wetdem_many_mix* x =
+        P->nm == 1 ? P->m->mix
+                   : &P->m->mix[(size_t)P->p[i].material * P->nm + (size_t)P->p[j].material];
+    double lim = xr[i].r + xr[j].r + x->range;
+    if (vec3_dot(d, d) <= lim * lim * (1 + PREFILTER_MARGIN))
+        return near_candidate(P, q, i, j, d, x, o, fail);
+    unsigned char* fl = &P->flags[q];
+    if (*fl) { /* the pair has just left its range */
+        if (*fl & WETDEM_MANY_DIRTY && P->len)
+            wetdem_sim_history_init(P->sim, P->history + q * P->len);
+        *fl = 0;
+    }
+    return 0;
+}
 
 /* Index of the lowest set bit of *mask, cleared; 64 (>= every wall count here) when none. */
 static size_t next_wall(uint64_t* mask)
@@ -667,32 +664,8 @@ static void eval_walls_of(const struct wetdem_sim* sim, size_t i, struct wetdem_
     }
 }
 
-/* Force, torque and contacts of particle i: its walls, then the reactions of its pairs (k, i)
- * in increasing k, then the sum of its own pairs (i, j) from the pair pass. */
-static void gather_one(struct wetdem_sim* sim, size_t i, struct failure* fail)
-{
-    struct wetdem_many* m = sim->many;
-    struct wetdem_vec3 f = vec3(0, 0, 0), t = vec3(0, 0, 0);
-    uint32_t n_contacts = 0;
-    if (m->wall_mask[i] || sim->n_walls > 64)
-        eval_walls_of(sim, i, &f, &t, &n_contacts, fail);
-    const unsigned char* rev_flags = m->rev_flags;
-    const struct wetdem_many_rev_out* rev_out = m->rev_out;
-    for (size_t r = m->rev_start[i], end = m->rev_start[i + 1]; r < end; r++) {
-        unsigned char fl = rev_flags[r];
-        if (!(fl & WETDEM_MANY_ACTIVE))
-            continue;
-        f = vec3_sub(f, rev_out[r].force);
-        t = vec3_add(t, rev_out[r].torque_j);
-        n_contacts += (fl & WETDEM_MANY_CONTACT) ? 1 : 0;
-    }
-    m->force[i] = vec3_add(f, m->force[i]);
-    m->torque[i] = vec3_add(t, m->torque[i]);
-    m->contacts[i] += n_contacts;
-}
-
 /* Closing half kick of particle k: v = v' + a dt/2, w = w' + alpha dt/2 (sim_many.c). */
-static void close_kick(struct wetdem_sim* sim, size_t k, struct wetdem_vec3 g)
+static void close_kick(const struct wetdem_sim* sim, size_t k, struct wetdem_vec3 g)
 {
     struct wetdem_many* m = sim->many;
     struct wetdem_particle* p = &sim->particles[k];
@@ -714,38 +687,14 @@ static bool reserve(void** a, size_t* cap, size_t n, size_t size)
     return *a != NULL;
 }
 
-int wetdem_sim_many_index_pairs(struct wetdem_sim* sim)
-{
-    struct wetdem_many* m = sim->many;
-    size_t n = sim->n_particles, np = m->cl.n_pairs;
-    if (!reserve((void**)&m->rev_start, &m->rev_start_cap, n + 1, sizeof *m->rev_start) ||
-        !reserve((void**)&m->slot, &m->slot_cap, np, sizeof *m->slot) ||
-        !reserve((void**)&m->rev_out, &m->rev_out_cap, np, sizeof *m->rev_out) ||
-        !reserve((void**)&m->rev_flags, &m->rev_flags_cap, np, 1))
-        return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory for %zu pairs", np);
-    memset(m->rev_start, 0, (n + 1) * sizeof *m->rev_start);
-    for (size_t q = 0; q < np; q++)
-        m->rev_start[m->cl.pairs[q].j + 1]++;
-    for (size_t k = 0; k < n; k++)
-        m->rev_start[k + 1] += m->rev_start[k];
-    for (size_t q = 0; q < np; q++) { /* in pair order: each particle's slots ascend with i */
-        m->slot[q] = m->rev_start[m->cl.pairs[q].j]++;
-        m->rev_flags[m->slot[q]] = m->flags[q]; /* the pair pass keeps the two equal */
-    }
-    for (size_t k = n; k > 0; k--) /* undo the shift left by the fill */
-        m->rev_start[k] = m->rev_start[k - 1];
-    m->rev_start[0] = 0;
-    return WETDEM_OK;
-}
+/* ---- blocks and the cross-block index ---- */
 
-/* First particle of thread t's block in the pair pass: contiguous blocks of about equal
- * candidate counts, so each thread writes its own stretch of the reaction slots (interleaved
- * chunks made the threads share cache lines there; the speed-up on 2 threads was 1.2x). */
-static size_t block_start(const struct wetdem_many* m, size_t n, int t, int nt)
+/* First particle of block b of nb: contiguous blocks of about equal candidate counts. */
+static size_t block_start(const struct wetdem_many* m, size_t n, size_t b, size_t nb)
 {
-    if (t >= nt)
+    if (b >= nb)
         return n;
-    size_t target = m->cl.n_pairs / (size_t)nt * (size_t)t, lo = 0, hi = n;
+    size_t target = m->cl.n_pairs / nb * b, lo = 0, hi = n;
     while (lo < hi) { /* smallest i with first_pair[i] >= target */
         size_t mid = lo + (hi - lo) / 2;
         if (m->cl.first_pair[mid] < target)
@@ -756,28 +705,209 @@ static size_t block_start(const struct wetdem_many* m, size_t n, int t, int nt)
     return lo;
 }
 
+/* Block of particle k (blk: nb + 1 starts). */
+static size_t block_of(const size_t* blk, size_t nb, size_t k)
+{
+    size_t b = 0;
+    while (b + 1 < nb && k >= blk[b + 1])
+        b++;
+    return b;
+}
+
+/* Orders cross entries by their pair's second particle, then first (qsort context-free: the
+ * pair list is reached through a file-scope pointer set by the caller under a lock). */
+static const struct wetdem_celllist_pair* sort_pairs;
+static const uint32_t* sort_cross;
+static int by_second(const void* a, const void* b)
+{
+    struct wetdem_celllist_pair x = sort_pairs[sort_cross[*(const uint32_t*)a]];
+    struct wetdem_celllist_pair y = sort_pairs[sort_cross[*(const uint32_t*)b]];
+    if (x.j != y.j)
+        return x.j < y.j ? -1 : 1;
+    return x.i < y.i ? -1 : (x.i > y.i);
+}
+
+/* Blocks for nb threads and the pairs that cross them (first particle in an earlier block
+ * than the second), when the list, the particle count or nb changed. */
+static int index_blocks(struct wetdem_sim* sim, size_t nb)
+{
+    struct wetdem_many* m = sim->many;
+    size_t n = sim->n_particles, np = m->cl.n_pairs;
+    if (m->blocks_ready && m->blocks_build == m->cl.n_builds && m->blocks_n == n &&
+        m->n_blocks == nb)
+        return WETDEM_OK;
+    if (!reserve((void**)&m->blk, &m->blk_cap, nb + 1, sizeof *m->blk) ||
+        !reserve((void**)&m->cross_first, &m->cross_first_cap, 2 * (nb + 1),
+                 sizeof *m->cross_first))
+        return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory for %zu threads", nb);
+    for (size_t b = 0; b <= nb; b++)
+        m->blk[b] = block_start(m, n, b, nb);
+    size_t nc = 0;
+    for (size_t q = 0; nb > 1 && q < np; q++)
+        nc += block_of(m->blk, nb, m->cl.pairs[q].i) != block_of(m->blk, nb, m->cl.pairs[q].j);
+    if (!reserve((void**)&m->cross_q, &m->cross_q_cap, nc, sizeof *m->cross_q) ||
+        !reserve((void**)&m->cross_in, &m->cross_in_cap, nc, sizeof *m->cross_in) ||
+        !reserve((void**)&m->cross_out, &m->cross_out_cap, nc, sizeof *m->cross_out))
+        return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory for %zu pairs", nc);
+    size_t* first_out = m->cross_first;         /* by block of the first particle */
+    size_t* first_in = m->cross_first + nb + 1; /* by block of the second particle */
+    memset(m->cross_first, 0, 2 * (nb + 1) * sizeof *m->cross_first);
+    size_t e = 0;
+    for (size_t q = 0; nb > 1 && q < np; q++) {
+        size_t bi = block_of(m->blk, nb, m->cl.pairs[q].i);
+        size_t bj = block_of(m->blk, nb, m->cl.pairs[q].j);
+        if (bi == bj)
+            continue;
+        m->cross_q[e] = (uint32_t)q;
+        m->cross_in[e] = (uint32_t)e;
+        first_out[bi + 1]++;
+        first_in[bj + 1]++;
+        e++;
+    }
+    for (size_t b = 0; b < nb; b++) {
+        first_out[b + 1] += first_out[b];
+        first_in[b + 1] += first_in[b];
+    }
+    if (nc > 1) {
+#pragma omp critical(wetdem_many_sort)
+        {
+            sort_pairs = m->cl.pairs;
+            sort_cross = m->cross_q;
+            qsort(m->cross_in, nc, sizeof *m->cross_in, by_second);
+        }
+    }
+    m->n_blocks = nb;
+    m->blocks_n = n;
+    m->blocks_build = m->cl.n_builds;
+    m->blocks_ready = true;
+    return WETDEM_OK;
+}
+
+/* ---- the force pass ---- */
+
+/* Phase 1 of block b: the pairs whose second particle lies in a later block, into cross_out. */
+static void cross_pairs_of_block(const struct pass* P, size_t b, struct failure* fail)
+{
+    struct wetdem_many* m = P->m;
+    for (size_t e = m->cross_first[b]; e < m->cross_first[b + 1]; e++) {
+        size_t q = m->cross_q[e];
+        size_t i = P->pairs[q].i;
+        struct wetdem_vec3 xi = vec3(P->xr[i].x, P->xr[i].y, P->xr[i].z);
+        eval_candidate(P, q, i, P->pairs[q].j, xi, &m->cross_out[e], fail);
+    }
+}
+
+/* Phase 2, start of block b: each particle's sum begins with its walls (wall order), then the
+ * reactions of the cross pairs (k, i) from earlier blocks, in increasing k. */
+static void start_sums_of_block(const struct pass* P, size_t b, struct failure* fail)
+{
+    struct wetdem_many* m = P->m;
+    const struct wetdem_sim* sim = P->sim;
+    for (size_t k = m->blk[b]; k < m->blk[b + 1]; k++) {
+        struct wetdem_vec3 f = vec3(0, 0, 0), t = vec3(0, 0, 0);
+        uint32_t n_contacts = 0;
+        if (m->wall_mask[k] || sim->n_walls > 64)
+            eval_walls_of(sim, k, &f, &t, &n_contacts, fail);
+        m->force[k] = f;
+        m->torque[k] = t;
+        m->contacts[k] = n_contacts;
+    }
+    const size_t* first_in = m->cross_first + m->n_blocks + 1;
+    for (size_t s = first_in[b]; s < first_in[b + 1]; s++) {
+        size_t e = m->cross_in[s], q = m->cross_q[e], k = P->pairs[q].j;
+        unsigned char fl = P->flags[q];
+        if (!(fl & WETDEM_MANY_ACTIVE))
+            continue;
+        m->force[k] = vec3_sub(m->force[k], m->cross_out[e].force);
+        m->torque[k] = vec3_add(m->torque[k], m->cross_out[e].torque_j);
+        m->contacts[k] += (fl & WETDEM_MANY_CONTACT) ? 1 : 0;
+    }
+}
+
+/* Phase 2 of block b: every particle i in index order; its pairs within the block are
+ * evaluated and their reactions added to the second particle at once (so each particle
+ * receives its reactions in increasing i), its cross pairs are read from phase 1; the sum of
+ * its own pairs, in j order, is added last, and the closing half kick applied. */
+static void pairs_of_block(const struct pass* P, size_t b, bool kick, struct wetdem_vec3 g,
+                           struct failure* fail)
+{
+    struct wetdem_many* m = P->m;
+    const struct wetdem_celllist_pair* pairs = P->pairs;
+    struct wetdem_vec3* force = m->force;
+    struct wetdem_vec3* torque = m->torque;
+    uint32_t* contacts = m->contacts;
+    size_t end_block = m->blk[b + 1], e = m->cross_first[b];
+    for (size_t i = m->blk[b]; i < end_block; i++) {
+        struct wetdem_vec3 f = vec3(0, 0, 0), t = vec3(0, 0, 0);
+        uint32_t n_contacts = 0;
+        size_t q = m->cl.first_pair[i], end = m->cl.first_pair[i + 1];
+        struct wetdem_vec3 xi = vec3(P->xr[i].x, P->xr[i].y, P->xr[i].z);
+        for (; q < end && pairs[q].j < end_block; q++) {
+            size_t j = pairs[q].j;
+            struct wetdem_many_pair_out o;
+            unsigned char fl = eval_candidate(P, q, i, j, xi, &o, fail);
+            if (!(fl & WETDEM_MANY_ACTIVE))
+                continue;
+            uint32_t c = (fl & WETDEM_MANY_CONTACT) ? 1 : 0;
+            f = vec3_add(f, o.force);
+            t = vec3_add(t, o.torque_i);
+            n_contacts += c;
+            force[j] = vec3_sub(force[j], o.force);
+            torque[j] = vec3_add(torque[j], o.torque_j);
+            contacts[j] += c;
+        }
+        for (; q < end; q++, e++) { /* the cross pairs of i, in j order */
+            unsigned char fl = P->flags[q];
+            if (!(fl & WETDEM_MANY_ACTIVE))
+                continue;
+            f = vec3_add(f, m->cross_out[e].force);
+            t = vec3_add(t, m->cross_out[e].torque_i);
+            n_contacts += (fl & WETDEM_MANY_CONTACT) ? 1 : 0;
+        }
+        force[i] = vec3_add(force[i], f);
+        torque[i] = vec3_add(torque[i], t);
+        contacts[i] += n_contacts;
+        if (kick)
+            close_kick(P->sim, i, g);
+    }
+}
+
 int wetdem_sim_many_forces(struct wetdem_sim* sim, bool kick)
 {
     struct wetdem_many* m = sim->many;
     int st = wetdem_sim_many_prepare(sim);
     if (st != WETDEM_OK)
         return st;
-    struct failure fail = {0};
     size_t n = sim->n_particles;
+    bool parallel = wetdem_many_parallel(m, n);
+    size_t nb = parallel ? (size_t)omp_get_max_threads() : 1;
+    st = index_blocks(sim, nb);
+    if (st != WETDEM_OK)
+        return st;
+    struct failure fail = {0};
     struct wetdem_vec3 g =
         vec3(sim->settings.gravity_x, sim->settings.gravity_y, sim->settings.gravity_z);
-    /* one parallel region: the pair pass, a barrier, the gather */
-#pragma omp parallel if (wetdem_many_parallel(m, n))
+    struct pass P = {.sim = sim,
+                     .m = m,
+                     .p = sim->particles,
+                     .xr = m->xr,
+                     .pairs = m->cl.pairs,
+                     .flags = m->flags,
+                     .history = m->history,
+                     .len = sim->history_len,
+                     .nm = (size_t)m->n_mix_materials,
+                     .periodic = m->periodic_any,
+                     .lean = m->lean.on && !m->set.energy_budget};
+    /* one region: cross pairs, a barrier, then each block on its own */
+#pragma omp parallel if (parallel)
     {
-        int t = omp_get_thread_num(), nt = omp_get_num_threads();
-        for (size_t i = block_start(m, n, t, nt), end = block_start(m, n, t + 1, nt); i < end; i++)
-            eval_pairs_of(sim, i, &fail);
+        size_t t = (size_t)omp_get_thread_num(), nt = (size_t)omp_get_num_threads();
+        for (size_t b = t; b < nb; b += nt)
+            cross_pairs_of_block(&P, b, &fail);
 #pragma omp barrier
-#pragma omp for schedule(static)
-        for (size_t i = 0; i < n; i++) {
-            gather_one(sim, i, &fail);
-            if (kick)
-                close_kick(sim, i, g);
+        for (size_t b = t; b < nb; b += nt) {
+            start_sums_of_block(&P, b, &fail);
+            pairs_of_block(&P, b, kick, g, &fail);
         }
     }
     if (fail.status != WETDEM_OK)
