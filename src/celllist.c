@@ -2,13 +2,27 @@
  * celllist.c — cell-list neighbour search with a Verlet skin (see celllist.h for the
  * criterion, Eq. 1 there, and its validity domain). Prefix: wetdem_celllist.
  *
- * A build bins the particles into cells of edge >= d_cut = 2 R_max + reach + skin [m]
- * (counting sort, particles of a cell in index order), then for every particle i scans its
- * own and the 26 neighbouring cells for j > i with h_ij < reach + skin. Two passes (count,
- * then fill) give every i its own segment of the list, so the parallel loops write disjoint
- * memory and the list is the same for any thread count; each segment is sorted by j.
- * On a periodic axis with fewer than 3 cells the neighbouring cells coincide; they are
- * de-duplicated so that no pair is listed twice.
+ * A build
+ *  1. bins the particles into cells of edge >= d_cut = 2 R_max + reach + skin [m] (counting
+ *     sort; the particles of a cell are in index order and their positions and radii are copied
+ *     into one contiguous, cell-ordered array);
+ *  2. searches every pair of neighbouring cells once (half stencil): a cell A is paired with
+ *     itself and with the 13 "forward" neighbours A + o, o = (dx, dy, dz) in {-1, 0, 1}^3 with
+ *     dz > 0, or dz = 0 and dy > 0, or dz = dy = 0 and dx > 0. Cells of one x row are
+ *     contiguous in memory, so the forward neighbours of a cell are at most 5 contiguous runs
+ *     of particles: (x+1, y, z), (x-1..x+1, y+1, z) and (x-1..x+1, y-1..y+1, z+1). On a
+ *     periodic axis with n >= 3 cells the offsets wrap and still name distinct cells; with
+ *     n <= 2 they would coincide, so there the distinct neighbours B of A are enumerated and
+ *     only those with index B > A are searched. A pair (a, b) with h_ab < reach + skin is
+ *     stored as (min, max) in a per-thread buffer; threads take contiguous blocks of cells
+ *     with about n / threads particles each;
+ *  3. counting-sorts the buffers by i into the list (first_pair holds the offsets) and sorts
+ *     each segment by j (insertion sort: segments are short). The result does not depend on
+ *     the order in which pairs were found, so it is the same for any thread count.
+ * The gap test evaluates exactly the expression of the minimum-image convention of
+ * celllist_delta, so the list equals a brute-force search bit for bit.
+ * Cost: each neighbouring pair of particles is tested once instead of twice, and no particle
+ * recomputes its stencil.
  */
 #include <omp.h>
 #include <stdarg.h>
@@ -23,6 +37,8 @@
 #define CELLS_PER_PARTICLE 4
 /* Fewest particles for which a build runs in parallel (threads cost more below). */
 #define PARALLEL_MIN 512
+/* Most runs of particles searched against one cell: 26 distinct neighbours at worst. */
+#define MAX_RUNS 27
 
 static void set_msg(char* msg, size_t n, const char* fmt, ...)
     __attribute__((format(printf, 3, 4)));
@@ -73,6 +89,11 @@ void wetdem_celllist_clear(struct wetdem_celllist* cl)
     free(cl->pairs);
     free(cl->first_pair);
     free(cl->pos_at_build);
+    for (int t = 0; t < cl->n_scratch; t++)
+        free(cl->scratch[t]);
+    free(cl->scratch);
+    free(cl->scratch_cap);
+    free(cl->scratch_used);
     memset(cl, 0, sizeof *cl);
 }
 
@@ -92,16 +113,13 @@ static int reserve(void** a, size_t* cap, size_t need, size_t size)
     return WETDEM_OK;
 }
 
-static double coord(struct wetdem_vec3 v, int k)
+/* Cell grid: periodic axes span the box, the others the particles' bounding box [bb_lo,
+ * bb_hi]. The cells are at least d_cut (1 + 1e-9) wide: the margin covers the rounding of the
+ * cell coordinate, so two particles closer than d_cut are never binned two cells apart. */
+static int setup_grid(struct wetdem_celllist* cl, const double bb_lo[3], const double bb_hi[3],
+                      size_t n, double d_cut, char* msg, size_t msg_size)
 {
-    return k == 0 ? v.x : (k == 1 ? v.y : v.z);
-}
-
-/* Cell grid: periodic axes span the box, the others the particles' bounding box. */
-static int setup_grid(struct wetdem_celllist* cl, const struct wetdem_particle* p, size_t n,
-                      double d_cut, char* msg, size_t msg_size)
-{
-    double total = 1;
+    double total = 1, edge_min = d_cut * (1 + 1e-9);
     for (int k = 0; k < 3; k++) {
         double lo = cl->box.lo[k], hi = cl->box.hi[k];
         if (cl->box.periodic[k]) {
@@ -113,16 +131,10 @@ static int setup_grid(struct wetdem_celllist* cl, const struct wetdem_particle* 
                 return WETDEM_ERR_INVALID;
             }
         } else {
-            lo = INFINITY;
-            hi = -INFINITY;
-            for (size_t i = 0; i < n; i++) {
-                lo = fmin(lo, coord(p[i].pos, k));
-                hi = fmax(hi, coord(p[i].pos, k));
-            }
-            if (n == 0)
-                lo = hi = 0;
+            lo = n ? bb_lo[k] : 0;
+            hi = n ? bb_hi[k] : 0;
         }
-        double nc = floor((hi - lo) / d_cut);
+        double nc = floor((hi - lo) / edge_min);
         cl->n_cells[k] = nc < 1 ? 1 : (nc > 1e6 ? 1000000 : (int)nc);
         cl->origin[k] = lo;
         cl->cell[k] = hi > lo ? (hi - lo) / cl->n_cells[k] : d_cut;
@@ -146,16 +158,15 @@ static int cell_coord(const struct wetdem_celllist* cl, double x, int k)
 {
     double t = (x - cl->origin[k]) / cl->cell[k];
     int nc = cl->n_cells[k];
-    if (cl->box.periodic[k])
+    if (cl->box.periodic[k] && !(t >= 0 && t < nc))
         t -= nc * floor(t / nc);
-    int c = (int)floor(t);
+    int c = (int)t; /* t >= 0 up to rounding: truncation is floor, and the clamp catches -0.x */
     return c < 0 ? 0 : (c >= nc ? nc - 1 : c);
 }
 
-static size_t cell_index(const struct wetdem_celllist* cl, const int c[3])
+static size_t cell_index(const struct wetdem_celllist* cl, int x, int y, int z)
 {
-    return ((size_t)c[2] * (size_t)cl->n_cells[1] + (size_t)c[1]) * (size_t)cl->n_cells[0] +
-           (size_t)c[0];
+    return ((size_t)z * (size_t)cl->n_cells[1] + (size_t)y) * (size_t)cl->n_cells[0] + (size_t)x;
 }
 
 /* Counting sort of the particles into cells (cell_start, cell_items; items in index order). */
@@ -164,19 +175,18 @@ static int bin_particles(struct wetdem_celllist* cl, const struct wetdem_particl
     size_t n_cells = (size_t)cl->n_cells[0] * (size_t)cl->n_cells[1] * (size_t)cl->n_cells[2];
     if (reserve((void**)&cl->cell_start, &cl->cells_cap, n_cells + 1, sizeof(size_t)) ||
         reserve((void**)&cl->cell_items, &cl->items_cap, n, sizeof(uint32_t)) ||
-        reserve((void**)&cl->cell_of, &cl->cell_of_cap, n, sizeof(uint32_t)))
+        reserve((void**)&cl->cell_of, &cl->cell_of_cap, n, sizeof(uint32_t)) ||
+        reserve((void**)&cl->sorted, &cl->sorted_cap, n, sizeof *cl->sorted))
         return WETDEM_ERR_NOMEM;
     memset(cl->cell_start, 0, (n_cells + 1) * sizeof(size_t));
     for (size_t i = 0; i < n; i++) {
-        int c[3] = {cell_coord(cl, p[i].pos.x, 0), cell_coord(cl, p[i].pos.y, 1),
-                    cell_coord(cl, p[i].pos.z, 2)};
-        cl->cell_of[i] = (uint32_t)cell_index(cl, c);
-        cl->cell_start[cl->cell_of[i] + 1]++;
+        size_t c = cell_index(cl, cell_coord(cl, p[i].pos.x, 0), cell_coord(cl, p[i].pos.y, 1),
+                              cell_coord(cl, p[i].pos.z, 2));
+        cl->cell_of[i] = (uint32_t)c;
+        cl->cell_start[c + 1]++;
     }
     for (size_t c = 0; c < n_cells; c++)
         cl->cell_start[c + 1] += cl->cell_start[c];
-    if (reserve((void**)&cl->sorted, &cl->sorted_cap, n, sizeof *cl->sorted))
-        return WETDEM_ERR_NOMEM;
     for (size_t i = 0; i < n; i++) {
         size_t s = cl->cell_start[cl->cell_of[i]]++;
         cl->cell_items[s] = (uint32_t)i;
@@ -189,15 +199,69 @@ static int bin_particles(struct wetdem_celllist* cl, const struct wetdem_particl
     return WETDEM_OK;
 }
 
+/* A contiguous block [lo, hi) of the cell-ordered particles. */
+struct run {
+    size_t lo, hi;
+};
+
+/* Wraps a cell coordinate on a periodic axis; false when it lies outside a bounded axis. */
+static bool wrap_cell(const struct wetdem_celllist* cl, int k, int* c)
+{
+    int nc = cl->n_cells[k];
+    if (*c >= 0 && *c < nc)
+        return true;
+    if (!cl->box.periodic[k])
+        return false;
+    *c = (*c + nc) % nc;
+    return true;
+}
+
+/* Appends the particles of cells x0..x1 of row (y, z) (x already wrapped or in range) as runs. */
+static int row_runs(const struct wetdem_celllist* cl, int x0, int x1, int y, int z,
+                    struct run* runs, int m)
+{
+    int nx = cl->n_cells[0];
+    if (!cl->box.periodic[0]) {
+        x0 = x0 < 0 ? 0 : x0;
+        x1 = x1 >= nx ? nx - 1 : x1;
+    } else if (x0 < 0 || x1 >= nx) { /* wrapped row: one run per cell */
+        for (int x = x0; x <= x1; x++) {
+            int w = x;
+            wrap_cell(cl, 0, &w);
+            m = row_runs(cl, w, w, y, z, runs, m);
+        }
+        return m;
+    }
+    if (x0 > x1)
+        return m;
+    size_t base = cell_index(cl, 0, y, z);
+    struct run r = {cl->cell_start[base + (size_t)x0], cl->cell_start[base + (size_t)x1 + 1]};
+    if (r.hi > r.lo)
+        runs[m++] = r;
+    return m;
+}
+
+/* Forward half stencil of cell (x, y, z) as runs (valid when every periodic axis has >= 3
+ * cells): rows (x+1; y; z), (x-1..x+1; y+1; z), (x-1..x+1; y-1..y+1; z+1). */
+static int forward_runs(const struct wetdem_celllist* cl, int x, int y, int z, struct run* runs)
+{
+    static const int rows[5][3] = {{1, 0, 0}, {-1, 1, 0}, {-1, -1, 1}, {-1, 0, 1}, {-1, 1, 1}};
+    int m = 0;
+    for (int r = 0; r < 5; r++) {
+        int yy = y + rows[r][1], zz = z + rows[r][2];
+        if (wrap_cell(cl, 1, &yy) && wrap_cell(cl, 2, &zz))
+            m = row_runs(cl, x + rows[r][0], x + 1, yy, zz, runs, m);
+    }
+    return m;
+}
+
 /* Distinct neighbouring cell coordinates of c along axis k (1 to 3 values). */
 static int axis_neighbours(const struct wetdem_celllist* cl, int c, int k, int out[3])
 {
-    int nc = cl->n_cells[k], m = 0;
+    int m = 0;
     for (int d = -1; d <= 1; d++) {
         int x = c + d;
-        if (cl->box.periodic[k])
-            x = (x + nc) % nc;
-        else if (x < 0 || x >= nc)
+        if (!wrap_cell(cl, k, &x))
             continue;
         bool seen = false;
         for (int q = 0; q < m; q++)
@@ -208,153 +272,289 @@ static int axis_neighbours(const struct wetdem_celllist* cl, int c, int k, int o
     return m;
 }
 
-/* Distinct neighbouring cells (including its own) of the cell of particle i; returns count. */
-static int stencil(const struct wetdem_celllist* cl, struct wetdem_vec3 x, size_t cells[27])
+/* Half stencil for periodic axes of 1 or 2 cells, where offsets coincide: the distinct
+ * neighbouring cells with a larger index than cell a = (x, y, z), one run each. */
+static int distinct_runs(const struct wetdem_celllist* cl, int x, int y, int z, struct run* runs)
 {
-    int c[3] = {cell_coord(cl, x.x, 0), cell_coord(cl, x.y, 1), cell_coord(cl, x.z, 2)};
-    int ax[3][3], m[3];
-    for (int k = 0; k < 3; k++)
-        m[k] = axis_neighbours(cl, c[k], k, ax[k]);
+    int ax[3][3], m[3] = {axis_neighbours(cl, x, 0, ax[0]), axis_neighbours(cl, y, 1, ax[1]),
+                          axis_neighbours(cl, z, 2, ax[2])};
+    size_t a = cell_index(cl, x, y, z);
     int count = 0;
-    for (int a = 0; a < m[2]; a++)
-        for (int b = 0; b < m[1]; b++)
-            for (int d = 0; d < m[0]; d++)
-                cells[count++] = cell_index(cl, (int[3]){ax[0][d], ax[1][b], ax[2][a]});
+    for (int k = 0; k < m[2]; k++)
+        for (int j = 0; j < m[1]; j++)
+            for (int i = 0; i < m[0]; i++) {
+                size_t b = cell_index(cl, ax[0][i], ax[1][j], ax[2][k]);
+                struct run r = {cl->cell_start[b], cl->cell_start[b + 1]};
+                if (b > a && r.hi > r.lo)
+                    runs[count++] = r;
+            }
     return count;
 }
 
-/* Scans the candidates j > i of particle i in the nc cells `cells` (its stencil); writes them
- * to out (sorted by j) and returns their number. Positions and radii come from the
- * cell-ordered copy, so each cell is read as one contiguous block. */
-static size_t scan_particle(const struct wetdem_celllist* cl, const struct wetdem_particle* p,
-                            size_t i, const size_t* cells, int nc, struct wetdem_celllist_pair* out)
+/* What the scan of one cell needs. */
+struct scan {
+    const struct wetdem_celllist_item* x; /* cell-ordered positions and radii */
+    const uint32_t* id;                   /* cell-ordered particle indices */
+    const struct wetdem_celllist_box* box;
+    double extra;     /* reach + skin [m] */
+    ptrdiff_t off[5]; /* first cell of the 5 forward rows of an interior cell, from the cell */
+};
+
+static struct wetdem_celllist_pair ordered(uint32_t a, uint32_t b)
 {
+    return a < b ? (struct wetdem_celllist_pair){a, b} : (struct wetdem_celllist_pair){b, a};
+}
+
+/* Tests particle s against the runs; appends the listed pairs as (min, max) to out and
+ * returns their number. No periodic axis: the displacement is the plain difference. */
+static size_t scan_plain(const struct scan* sc, size_t s, const struct run* runs, int m,
+                         struct wetdem_celllist_pair* out)
+{
+    const struct wetdem_celllist_item a = sc->x[s];
     size_t count = 0;
-    double extra = cl->reach + cl->skin;
-    bool periodic = cl->box.periodic[0] || cl->box.periodic[1] || cl->box.periodic[2];
-    struct wetdem_vec3 xi = p[i].pos;
-    double ri = p[i].radius;
-    for (int q = 0; q < nc; q++) {
-        for (size_t s = cl->cell_start[cells[q]]; s < cl->cell_start[cells[q] + 1]; s++) {
-            uint32_t j = cl->cell_items[s];
-            if (j <= i)
-                continue;
-            const struct wetdem_celllist_item* b = &cl->sorted[s];
-            struct wetdem_vec3 xj = vec3(b->x, b->y, b->z);
-            struct wetdem_vec3 d = periodic ? celllist_delta(&cl->box, xi, xj) : vec3_sub(xi, xj);
-            double lim = ri + b->r + extra;
-            if (vec3_dot(d, d) >= lim * lim)
-                continue;
-            size_t k = count; /* insertion sort by j: segments are short */
-            while (k > 0 && out[k - 1].j > j) {
-                out[k] = out[k - 1];
-                k--;
+    for (int r = 0; r < m; r++)
+        for (size_t t = runs[r].lo; t < runs[r].hi; t++) {
+            const struct wetdem_celllist_item* b = &sc->x[t];
+            struct wetdem_vec3 d = vec3(a.x - b->x, a.y - b->y, a.z - b->z);
+            double lim = a.r + b->r + sc->extra;
+            if (vec3_dot(d, d) < lim * lim)
+                out[count++] = ordered(sc->id[s], sc->id[t]);
+        }
+    return count;
+}
+
+/* As scan_plain with the minimum-image displacement of celllist_delta. */
+static size_t scan_image(const struct scan* sc, size_t s, const struct run* runs, int m,
+                         struct wetdem_celllist_pair* out)
+{
+    const struct wetdem_celllist_item a = sc->x[s];
+    size_t count = 0;
+    for (int r = 0; r < m; r++)
+        for (size_t t = runs[r].lo; t < runs[r].hi; t++) {
+            const struct wetdem_celllist_item* b = &sc->x[t];
+            struct wetdem_vec3 d =
+                celllist_delta(sc->box, vec3(a.x, a.y, a.z), vec3(b->x, b->y, b->z));
+            double lim = a.r + b->r + sc->extra;
+            if (vec3_dot(d, d) < lim * lim)
+                out[count++] = ordered(sc->id[s], sc->id[t]);
+        }
+    return count;
+}
+
+/* Runs of the half stencil of cell c = (x, y, z) after runs[0] (kept for the cell itself). */
+static int stencil_runs(const struct wetdem_celllist* cl, const struct scan* sc, size_t c, int x,
+                        int y, int z, bool distinct, struct run* runs)
+{
+    if (distinct)
+        return 1 + distinct_runs(cl, x, y, z, runs + 1);
+    if (x < 1 || x > cl->n_cells[0] - 2 || y < 1 || y > cl->n_cells[1] - 2 ||
+        z > cl->n_cells[2] - 2)
+        return 1 + forward_runs(cl, x, y, z, runs + 1);
+    static const int width[5] = {1, 3, 3, 3, 3}; /* interior: fixed offsets */
+    for (int r = 0; r < 5; r++) {
+        size_t first = (size_t)((ptrdiff_t)c + sc->off[r]);
+        runs[r + 1] = (struct run){cl->cell_start[first], cl->cell_start[first + width[r]]};
+    }
+    return 6;
+}
+
+/* Searches cell (x, y, z) against itself and its half stencil; appends to the buffer of
+ * thread t (grown as needed). Returns WETDEM_OK or WETDEM_ERR_NOMEM. */
+static int scan_cell(struct wetdem_celllist* cl, const struct scan* sc, int x, int y, int z,
+                     bool distinct, int t)
+{
+    size_t c = cell_index(cl, x, y, z), a0 = cl->cell_start[c], a1 = cl->cell_start[c + 1];
+    struct run runs[MAX_RUNS + 1];
+    int m = stencil_runs(cl, sc, c, x, y, z, distinct, runs);
+    size_t others = 0, na = a1 - a0;
+    for (int r = 1; r < m; r++)
+        others += runs[r].hi - runs[r].lo;
+    size_t used = cl->scratch_used[t], need = used + na * (na - 1) / 2 + na * others;
+    if (need > cl->scratch_cap[t] &&
+        reserve((void**)&cl->scratch[t], &cl->scratch_cap[t], need, sizeof **cl->scratch))
+        return WETDEM_ERR_NOMEM;
+    bool image = cl->box.periodic[0] || cl->box.periodic[1] || cl->box.periodic[2];
+    struct wetdem_celllist_pair* out = cl->scratch[t];
+    for (size_t s = a0; s < a1; s++) {
+        runs[0] = (struct run){s + 1, a1};
+        used +=
+            image ? scan_image(sc, s, runs, m, out + used) : scan_plain(sc, s, runs, m, out + used);
+    }
+    cl->scratch_used[t] = used;
+    return WETDEM_OK;
+}
+
+/* First cell of the block of thread t of nt: blocks hold about n / nt particles each. */
+static size_t block_start(const struct wetdem_celllist* cl, size_t n_cells, size_t n, int t, int nt)
+{
+    size_t target = n * (size_t)t / (size_t)nt, lo = 0, hi = n_cells;
+    while (lo < hi) { /* first c with cell_start[c] >= target */
+        size_t mid = lo + (hi - lo) / 2;
+        if (cl->cell_start[mid] < target)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return t == 0 ? 0 : (t == nt ? n_cells : lo);
+}
+
+/* Scans the cells [c0, c1) into the buffer of thread t. */
+static int scan_block(struct wetdem_celllist* cl, const struct scan* sc, size_t c0, size_t c1,
+                      bool distinct, int t)
+{
+    int nx = cl->n_cells[0], ny = cl->n_cells[1];
+    int x = (int)(c0 % (size_t)nx), y = (int)(c0 / (size_t)nx % (size_t)ny);
+    int z = (int)(c0 / ((size_t)nx * (size_t)ny));
+    for (size_t c = c0; c < c1; c++) {
+        if (cl->cell_start[c + 1] > cl->cell_start[c] && scan_cell(cl, sc, x, y, z, distinct, t))
+            return WETDEM_ERR_NOMEM;
+        if (++x == nx) {
+            x = 0;
+            if (++y == ny) {
+                y = 0;
+                z++;
             }
-            out[k] = (struct wetdem_celllist_pair){(uint32_t)i, j};
-            count++;
         }
     }
-    return count;
+    return WETDEM_OK;
 }
 
-static int check_input(const struct wetdem_particle* p, size_t n, double* r_max, char* msg,
-                       size_t msg_size)
+/* Checks the particles; r_max [m] is the largest radius, [lo, hi] the bounding box [m]. */
+static int check_input(const struct wetdem_particle* p, size_t n, double* r_max, double lo[3],
+                       double hi[3], char* msg, size_t msg_size)
 {
     if (n >= UINT32_MAX) {
         set_msg(msg, msg_size, "too many particles for the neighbour list: %zu (limit %u)", n,
                 UINT32_MAX - 1);
         return WETDEM_ERR_INVALID;
     }
-    *r_max = 0;
+    double r = 0, l[3] = {INFINITY, INFINITY, INFINITY}, h[3] = {-INFINITY, -INFINITY, -INFINITY};
     for (size_t i = 0; i < n; i++) {
+        double x[3] = {p[i].pos.x, p[i].pos.y, p[i].pos.z};
         if (!vec3_is_finite(p[i].pos) || !(p[i].radius > 0 && isfinite(p[i].radius))) {
             set_msg(msg, msg_size, "particle %zu has a non-finite position or a bad radius %g m", i,
                     p[i].radius);
             return WETDEM_ERR_INVALID;
         }
-        *r_max = fmax(*r_max, p[i].radius);
+        r = p[i].radius > r ? p[i].radius : r;
+        for (int k = 0; k < 3; k++) {
+            l[k] = x[k] < l[k] ? x[k] : l[k];
+            h[k] = x[k] > h[k] ? x[k] : h[k];
+        }
     }
+    *r_max = r;
+    memcpy(lo, l, sizeof l);
+    memcpy(hi, h, sizeof h);
     return WETDEM_OK;
 }
 
-/* Upper bound of the candidates of a particle: the particles of its stencil cells. */
-static size_t stencil_population(const struct wetdem_celllist* cl, const size_t* cells, int nc)
+/* One per-thread pair buffer for each of nt threads (kept across builds). */
+static int reserve_scratch(struct wetdem_celllist* cl, int nt)
 {
-    size_t total = 0;
-    for (int q = 0; q < nc; q++)
-        total += cl->cell_start[cells[q] + 1] - cl->cell_start[cells[q]];
-    return total;
+    if (nt <= cl->n_scratch)
+        return WETDEM_OK;
+    struct wetdem_celllist_pair** s = realloc(cl->scratch, (size_t)nt * sizeof *s);
+    if (s)
+        cl->scratch = s;
+    size_t* cap = realloc(cl->scratch_cap, (size_t)nt * sizeof *cap);
+    if (cap)
+        cl->scratch_cap = cap;
+    size_t* used = realloc(cl->scratch_used, (size_t)nt * sizeof *used);
+    if (used)
+        cl->scratch_used = used;
+    if (!s || !cap || !used)
+        return WETDEM_ERR_NOMEM;
+    for (int t = cl->n_scratch; t < nt; t++) {
+        cl->scratch[t] = NULL;
+        cl->scratch_cap[t] = 0;
+    }
+    cl->n_scratch = nt;
+    return WETDEM_OK;
 }
 
-/* One pass: each thread scans a contiguous block of particles into its own buffer (count per
- * particle into first_pair); the buffers are then concatenated in thread order, which is
- * particle order, so the list is the same for any thread count. */
-static int fill_pairs(struct wetdem_celllist* cl, const struct wetdem_particle* p, size_t n)
+/* Sorts the j of one segment (all with the same i): insertion sort, segments are short. */
+static void sort_segment(struct wetdem_celllist_pair* q, size_t len)
 {
-    if (reserve((void**)&cl->first_pair, &cl->first_cap, n + 1, sizeof(size_t)))
+    for (size_t a = 1; a < len; a++) {
+        struct wetdem_celllist_pair key = q[a];
+        size_t b = a;
+        while (b > 0 && q[b - 1].j > key.j) {
+            q[b] = q[b - 1];
+            b--;
+        }
+        q[b] = key;
+    }
+}
+
+/* Counting sort of the thread buffers by i into pairs / first_pair, then each segment by j. */
+static int gather_pairs(struct wetdem_celllist* cl, size_t n, int nt)
+{
+    size_t total = 0;
+    for (int t = 0; t < nt; t++)
+        total += cl->scratch_used[t];
+    if (reserve((void**)&cl->first_pair, &cl->first_cap, n + 2, sizeof(size_t)) ||
+        reserve((void**)&cl->pairs, &cl->pairs_cap, total ? total : 1, sizeof *cl->pairs))
         return WETDEM_ERR_NOMEM;
-    int max_threads = omp_get_max_threads(), used_threads = 1;
-    struct wetdem_celllist_pair** buf = calloc((size_t)max_threads, sizeof *buf);
-    size_t* used = calloc((size_t)max_threads, sizeof *used);
-    bool nomem = !buf || !used;
-#pragma omp parallel if (!nomem && n >= PARALLEL_MIN)
+    size_t* start = cl->first_pair; /* counts at i + 2, so the scatter leaves starts at i */
+    memset(start, 0, (n + 2) * sizeof *start);
+    for (int t = 0; t < nt; t++)
+        for (size_t q = 0; q < cl->scratch_used[t]; q++)
+            start[cl->scratch[t][q].i + 2]++;
+    for (size_t i = 2; i < n + 2; i++)
+        start[i] += start[i - 1];
+    for (int t = 0; t < nt; t++)
+        for (size_t q = 0; q < cl->scratch_used[t]; q++)
+            cl->pairs[start[cl->scratch[t][q].i + 1]++] = cl->scratch[t][q];
+#pragma omp parallel for schedule(static) if (n >= PARALLEL_MIN)
+    for (size_t i = 0; i < n; i++)
+        sort_segment(cl->pairs + start[i], start[i + 1] - start[i]);
+    cl->n_pairs = total;
+    return WETDEM_OK;
+}
+
+/* Finds the pairs: threads scan contiguous blocks of cells into their own buffers, which are
+ * then sorted into the list (the same list for any thread count). */
+static int fill_pairs(struct wetdem_celllist* cl, size_t n)
+{
+    int max_threads = n >= PARALLEL_MIN ? omp_get_max_threads() : 1, used_threads = 1;
+    if (reserve_scratch(cl, max_threads))
+        return WETDEM_ERR_NOMEM;
+    size_t n_cells = (size_t)cl->n_cells[0] * (size_t)cl->n_cells[1] * (size_t)cl->n_cells[2];
+    bool distinct = false, nomem = false;
+    for (int k = 0; k < 3; k++)
+        distinct = distinct || (cl->box.periodic[k] && cl->n_cells[k] < 3);
+    ptrdiff_t nx = cl->n_cells[0], nxy = nx * cl->n_cells[1];
+    struct scan sc = {cl->sorted,
+                      cl->cell_items,
+                      &cl->box,
+                      cl->reach + cl->skin,
+                      {1, nx - 1, nxy - nx - 1, nxy - 1, nxy + nx - 1}};
+#pragma omp parallel num_threads(max_threads)
     {
         int t = omp_get_thread_num(), nt = omp_get_num_threads();
 #pragma omp single
         used_threads = nt;
-        size_t lo = n * (size_t)t / (size_t)nt, hi = n * (size_t)(t + 1) / (size_t)nt, cap = 0;
-        for (size_t i = lo; i < hi; i++) {
-            size_t cells[27];
-            int nc = stencil(cl, p[i].pos, cells);
-            size_t bound = stencil_population(cl, cells, nc);
-            if (used[t] + bound > cap) {
-                cap = 2 * (used[t] + bound) + 64;
-                struct wetdem_celllist_pair* b = realloc(buf[t], cap * sizeof *b);
-                if (!b) {
+        cl->scratch_used[t] = 0;
+        if (scan_block(cl, &sc, block_start(cl, n_cells, n, t, nt),
+                       block_start(cl, n_cells, n, t + 1, nt), distinct, t)) {
 #pragma omp atomic write
-                    nomem = true;
-                    break;
-                }
-                buf[t] = b;
-            }
-            size_t c = scan_particle(cl, p, i, cells, nc, buf[t] + used[t]);
-            cl->first_pair[i + 1] = c;
-            used[t] += c;
+            nomem = true;
         }
     }
-    size_t total = 0;
-    for (int t = 0; !nomem && t < used_threads; t++)
-        total += used[t];
-    nomem =
-        nomem || reserve((void**)&cl->pairs, &cl->pairs_cap, total ? total : 1, sizeof *cl->pairs);
-    size_t at = 0;
-    for (int t = 0; !nomem && t < used_threads; at += used[t], t++)
-        if (used[t])
-            memcpy(cl->pairs + at, buf[t], used[t] * sizeof *cl->pairs);
-    for (int t = 0; buf && t < max_threads; t++)
-        free(buf[t]);
-    free(buf);
-    free(used);
-    if (nomem)
-        return WETDEM_ERR_NOMEM;
-    cl->first_pair[0] = 0;
-    for (size_t i = 0; i < n; i++)
-        cl->first_pair[i + 1] += cl->first_pair[i];
-    cl->n_pairs = total;
-    return WETDEM_OK;
+    return nomem ? WETDEM_ERR_NOMEM : gather_pairs(cl, n, used_threads);
 }
 
 int wetdem_celllist_build(struct wetdem_celllist* cl, const struct wetdem_particle* p, size_t n,
                           char* msg, size_t msg_size)
 {
-    double r_max;
-    int st = check_input(p, n, &r_max, msg, msg_size);
+    double r_max, lo[3], hi[3];
+    int st = check_input(p, n, &r_max, lo, hi, msg, msg_size);
     if (st != WETDEM_OK)
         return st;
-    st = setup_grid(cl, p, n, 2 * r_max + cl->reach + cl->skin, msg, msg_size);
+    st = setup_grid(cl, lo, hi, n, 2 * r_max + cl->reach + cl->skin, msg, msg_size);
     if (st != WETDEM_OK)
         return st;
-    if (bin_particles(cl, p, n) != WETDEM_OK || fill_pairs(cl, p, n) != WETDEM_OK ||
+    if (bin_particles(cl, p, n) != WETDEM_OK || fill_pairs(cl, n) != WETDEM_OK ||
         reserve((void**)&cl->pos_at_build, &cl->at_build_cap, n, sizeof *cl->pos_at_build)) {
         set_msg(msg, msg_size, "out of memory building the neighbour list of %zu particles", n);
         return WETDEM_ERR_NOMEM;

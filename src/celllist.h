@@ -15,9 +15,10 @@
  * restored for beyond-contact granular pairs).
  *
  * Cells are cubes-or-boxes of edge >= 2 R_max + reach + skin, so every candidate of a particle
- * lies in its own cell or one of the 26 neighbouring cells. The list is sorted by (i, j): it is
- * a pure function of the positions and radii, independent of the thread count, and two lists
- * can be merged in one pass to carry per-pair history across rebuilds.
+ * lies in its own cell or one of the 26 neighbouring cells; each pair of neighbouring cells is
+ * searched once (half stencil, see celllist.c). The list is sorted by (i, j): it is a pure
+ * function of the positions and radii, independent of the thread count, and two lists can be
+ * merged in one pass to carry per-pair history across rebuilds.
  *
  * Validity: radii > 0 and constant between builds; on a periodic axis the box length must be
  * at least 2 (2 R_max + reach + skin) so that a pair interacts through one image only.
@@ -66,6 +67,11 @@ struct wetdem_celllist {
     size_t n_pairs, pairs_cap;
     size_t* first_pair; /* n + 1 offsets: pairs of i are first_pair[i] .. first_pair[i+1] */
     size_t first_cap;
+    /* per-thread scratch of a build (pairs in cell order), kept to avoid reallocation */
+    struct wetdem_celllist_pair** scratch;
+    size_t* scratch_cap;
+    size_t* scratch_used;
+    int n_scratch;
     /* state at the last build */
     struct wetdem_vec3* pos_at_build;
     size_t n_at_build, at_build_cap;

@@ -51,9 +51,32 @@ static void check_against_brute_force(const struct wetdem_celllist* cl,
             k++;
         }
     assert_int_equal(k, cl->n_pairs);
+    assert_int_equal(cl->first_pair[0], 0);
+    assert_int_equal(cl->first_pair[n], cl->n_pairs);
     for (size_t i = 0; i < n; i++)
         for (size_t q = cl->first_pair[i]; q < cl->first_pair[i + 1]; q++)
             assert_int_equal(cl->pairs[q].i, i);
+}
+
+/* Builds the list of p (n spheres) in `box` with the given reach and a 0.2 mm skin, with
+ * `threads` threads, compares it with brute force and returns the number of pairs. */
+static size_t build_and_check(const struct wetdem_celllist_box* box,
+                              const struct wetdem_particle* p, size_t n, double reach, int threads,
+                              int cells_x)
+{
+    struct wetdem_celllist cl;
+    char msg[256];
+    CHECK_OK(wetdem_celllist_init(&cl, box, reach, 0.2e-3, msg, sizeof msg));
+    int saved = omp_get_max_threads();
+    omp_set_num_threads(threads);
+    CHECK_OK(wetdem_celllist_build(&cl, p, n, msg, sizeof msg));
+    omp_set_num_threads(saved);
+    if (cells_x > 0) /* the case meant to be exercised */
+        assert_int_equal(cl.n_cells[0], cells_x);
+    check_against_brute_force(&cl, p, n);
+    size_t n_pairs = cl.n_pairs;
+    wetdem_celllist_clear(&cl);
+    return n_pairs;
 }
 
 static void run_case(const bool periodic[3], double len, size_t n, unsigned long seed)
@@ -61,13 +84,7 @@ static void run_case(const bool periodic[3], double len, size_t n, unsigned long
     struct wetdem_particle* p = random_spheres(n, len, 0.5e-3, 1.5e-3, seed);
     struct wetdem_celllist_box box = {{0, 0, 0}, {len, len, len}, {0}};
     memcpy(box.periodic, periodic, sizeof box.periodic);
-    struct wetdem_celllist cl;
-    char msg[256];
-    CHECK_OK(wetdem_celllist_init(&cl, &box, 0.4e-3, 0.2e-3, msg, sizeof msg));
-    CHECK_OK(wetdem_celllist_build(&cl, p, n, msg, sizeof msg));
-    check_against_brute_force(&cl, p, n);
-    assert_true(cl.n_pairs > 0);
-    wetdem_celllist_clear(&cl);
+    assert_true(build_and_check(&box, p, n, 0.4e-3, 1, 0) > 0);
     free(p);
 }
 
@@ -93,6 +110,82 @@ static void test_celllist_small_periodic_boxes_have_no_duplicates(void** state)
     (void)state;
     run_case((bool[3]){true, true, true}, 7.5e-3, 40, 4);
     run_case((bool[3]){true, true, true}, 11e-3, 90, 5);
+}
+
+/* A single cell on a periodic axis: 7.5 mm periodic along x (2 cells of >= 3.6 mm), y and z
+ * open over 100 mm (27 cells each); with 20 spheres the grid is coarsened to at most
+ * 4 x 20 + 27 = 107 cells: 2 x 27 x 27 -> 1 x 13 x 13 -> 1 x 6 x 6, so x has one cell and
+ * every pair along x is found through the minimum image within that cell. */
+static void test_celllist_single_periodic_cell(void** state)
+{
+    (void)state;
+    size_t n = 20;
+    struct wetdem_particle* p = random_spheres(n, 100e-3, 0.5e-3, 1.5e-3, 11);
+    for (size_t i = 0; i < n; i++) /* squeeze x into the periodic box */
+        p[i].pos.x *= 7.5e-3 / 100e-3;
+    for (size_t i = 0; i + 1 < n; i += 2) { /* the image of i + 1 is 2.5 mm from i along x */
+        p[i + 1].pos = vec3(fmod(p[i].pos.x + 5e-3, 7.5e-3), p[i].pos.y + 0.5e-3, p[i].pos.z);
+        p[i].radius = p[i + 1].radius = 1.2e-3; /* 2.55 mm apart < 2.4 + 0.4 + 0.2 = 3.0 mm */
+    }
+    struct wetdem_celllist_box box = {{0, 0, 0}, {7.5e-3, 0, 0}, {true, false, false}};
+    assert_true(build_and_check(&box, p, n, 0.4e-3, 1, 1) >= n / 2);
+    free(p);
+}
+
+/* Periodic along x with 1, 2 and 3 cells, the other axes open or periodic: each offset of
+ * the half stencil must name a distinct cell or be de-duplicated. d_cut = 3.6 mm; 7.5 mm ->
+ * 2 cells, 11 mm -> 3 cells (the rows that wrap), 30 mm -> 8. */
+static void test_celllist_periodic_axes_of_few_cells(void** state)
+{
+    (void)state;
+    const double len[3] = {7.5e-3, 11e-3, 30e-3};
+    const int cells[3] = {2, 3, 8};
+    for (int a = 0; a < 3; a++)
+        for (int other = 0; other < 2; other++) {
+            size_t n = 300;
+            struct wetdem_particle* p = random_spheres(n, 30e-3, 0.5e-3, 1.5e-3, 20 + a);
+            for (size_t i = 0; i < n; i++)
+                p[i].pos.x *= len[a] / 30e-3;
+            struct wetdem_celllist_box box = {
+                {0, 0, 0}, {len[a], 30e-3, 30e-3}, {true, other == 1, other == 1}};
+            assert_true(build_and_check(&box, p, n, 0.4e-3, 1, cells[a]) > 0);
+            free(p);
+        }
+}
+
+/* Particles outside the periodic box (an engine may hand over unwrapped positions): binned
+ * modulo the box, paired through the minimum image; the list is that of brute force. */
+static void test_celllist_unwrapped_positions(void** state)
+{
+    (void)state;
+    size_t n = 600;
+    struct wetdem_particle* p = random_spheres(n, 30e-3, 0.5e-3, 1.5e-3, 12);
+    for (size_t i = 0; i < n; i += 3)
+        p[i].pos = vec3_add(p[i].pos, vec3(i % 2 ? 30e-3 : -30e-3, 60e-3, 0));
+    struct wetdem_celllist_box box = {{0, 0, 0}, {30e-3, 30e-3, 30e-3}, {true, true, false}};
+    assert_true(build_and_check(&box, p, n, 0.4e-3, 1, 8) > 0);
+    free(p);
+}
+
+/* Strong polydispersity (radii 0.05 .. 2 mm, a ratio of 40) and a long reach (3 mm, e.g. a
+ * lubrication cut-off): cells of d_cut = 7.2 mm hold ~30 spheres, a sphere has tens of
+ * candidates, and the list must still equal brute force for 1 and 2 threads. */
+static void test_celllist_polydisperse_long_reach(void** state)
+{
+    (void)state;
+    size_t n = 2000;
+    struct wetdem_particle* p = random_spheres(n, 40e-3, 0.05e-3, 2e-3, 13);
+    struct wetdem_celllist_box open = {{0, 0, 0}, {40e-3, 40e-3, 40e-3}, {0}};
+    struct wetdem_celllist_box per = {{0, 0, 0}, {40e-3, 40e-3, 40e-3}, {true, false, true}};
+    size_t a = build_and_check(&open, p, n, 3e-3, 1, 0),
+           b = build_and_check(&open, p, n, 3e-3, 2, 0);
+    assert_int_equal(a, b);
+    /* mean pair range ~2 x 1 + 3.2 = 5.2 mm: ~0.031 spheres/mm^3 x 589 mm^3 / 2 ~ 9 pairs per
+     * sphere in the bulk, fewer at the walls: long segments, so the per-i sort is exercised */
+    assert_true(a > 5 * n);
+    assert_int_equal(build_and_check(&per, p, n, 3e-3, 1, 0),
+                     build_and_check(&per, p, n, 3e-3, 2, 0));
+    free(p);
 }
 
 static void test_celllist_rejects_too_small_periodic_box(void** state)
@@ -126,11 +219,15 @@ static void test_celllist_same_list_for_any_thread_count(void** state)
     int saved = omp_get_max_threads();
     omp_set_num_threads(1);
     CHECK_OK(wetdem_celllist_build(&a, p, n, NULL, 0));
-    omp_set_num_threads(4);
-    CHECK_OK(wetdem_celllist_build(&b, p, n, NULL, 0));
+    for (int threads = 2; threads <= 4; threads += 2) {
+        omp_set_num_threads(threads);
+        CHECK_OK(wetdem_celllist_build(&b, p, n, NULL, 0));
+        assert_int_equal(a.n_pairs, b.n_pairs);
+        assert_memory_equal(a.pairs, b.pairs, a.n_pairs * sizeof *a.pairs);
+        assert_memory_equal(a.first_pair, b.first_pair, (n + 1) * sizeof *a.first_pair);
+    }
     omp_set_num_threads(saved);
-    assert_int_equal(a.n_pairs, b.n_pairs);
-    assert_memory_equal(a.pairs, b.pairs, a.n_pairs * sizeof *a.pairs);
+    check_against_brute_force(&a, p, n);
     wetdem_celllist_clear(&a);
     wetdem_celllist_clear(&b);
     free(p);
@@ -236,6 +333,10 @@ int main(void)
         cmocka_unit_test(test_celllist_matches_brute_force_open_box),
         cmocka_unit_test(test_celllist_matches_brute_force_periodic),
         cmocka_unit_test(test_celllist_small_periodic_boxes_have_no_duplicates),
+        cmocka_unit_test(test_celllist_single_periodic_cell),
+        cmocka_unit_test(test_celllist_periodic_axes_of_few_cells),
+        cmocka_unit_test(test_celllist_unwrapped_positions),
+        cmocka_unit_test(test_celllist_polydisperse_long_reach),
         cmocka_unit_test(test_celllist_rejects_too_small_periodic_box),
         cmocka_unit_test(test_celllist_same_list_for_any_thread_count),
         cmocka_unit_test(test_celllist_never_misses_beyond_contact_pairs),
