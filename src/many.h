@@ -87,7 +87,10 @@ struct wetdem_many {
     uint64_t* wall_mask; /* per particle: bit w set if wall w is within reach + skin
                                     at the last build (walls >= 64 are always evaluated) */
     size_t wall_mask_cap;
-    uint32_t* wall_list; /* particles with a non-zero wall_mask (or all if > 64 walls) */
+    uint64_t* wall_dirty; /* per particle: bit w set if the history of wall w may differ
+                                    from a fresh one (walls >= 64: always treated as set); all
+                                    set when a run (re)starts (sim_many.c prepare) */
+    uint32_t* wall_list;  /* particles with a non-zero wall_mask (or all if > 64 walls) */
     size_t n_wall_list, wall_list_cap;
     bool kick_pending;   /* the latest step's closing half kick is still to be applied
                                     (sim_many.c one_step); never true outside a run */

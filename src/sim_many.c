@@ -86,6 +86,7 @@ void wetdem_sim_many_free(struct wetdem_sim* sim)
     free(m->old_flags);
     free(m->flags);
     free(m->wall_mask);
+    free(m->wall_dirty);
     free(m->wall_list);
     free(m->force);
     free(m->torque);
@@ -248,6 +249,9 @@ static int size_particle_arrays(struct wetdem_sim* sim)
     c = cap;
     if (grow((void**)&m->inv, &c, n, sizeof *m->inv))
         return WETDEM_ERR_NOMEM;
+    c = cap;
+    if (grow((void**)&m->wall_dirty, &c, n, sizeof *m->wall_dirty))
+        return WETDEM_ERR_NOMEM;
     m->particle_cap = c;
     size_t len = sim->history_len, nw = sim->n_walls * n * len;
     size_t old = m->wall_history_cap;
@@ -290,8 +294,10 @@ static int update_wall_masks(struct wetdem_sim* sim)
                          sim->particles[i].radius;
             if (gap < lim)
                 mask |= (uint64_t)1 << w;
-            else if (len)
+            else if (len && m->wall_dirty[i] >> w & 1) {
                 wetdem_sim_history_init(sim, m->wall_history + (i * nw + w) * len);
+                m->wall_dirty[i] &= ~((uint64_t)1 << w);
+            }
         }
         m->wall_mask[i] = mask;
     }
@@ -386,6 +392,7 @@ int wetdem_sim_many_prepare(struct wetdem_sim* sim)
         m->xr[k] = (struct wetdem_celllist_item){p->pos.x, p->pos.y, p->pos.z, p->radius};
         m->inv[k][0] = 1.0 / p->mass;
         m->inv[k][1] = 1.0 / (0.4 * p->mass * p->radius * p->radius);
+        m->wall_dirty[k] = ~(uint64_t)0; /* histories may have been restored or changed */
     }
     bool moved = m->max_disp_valid && m->cl.n_builds > 0 && m->cl.n_at_build == sim->n_particles
                      ? m->max_disp2 > 0.25 * m->cl.skin * m->cl.skin

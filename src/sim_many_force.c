@@ -356,32 +356,31 @@ int wetdem_sim_many_eval_fused(const struct wetdem_sim* sim, struct wetdem_conta
 
 /* ---- the lean kernel ---- */
 
-/* Pair (a, b) with d = x_a - x_b (minimum image) and mixed properties x: the operations of
- * pair_contact_from, wetdem_sim_many_eval_fused and eval_pair in the same order on the
- * quantities the enabled models read, so force, torques, history and flags are bit-identical
- * to theirs (tests/test_many_force.c). The sum of the normal forces starts at +0 and adds the
- * models in model order; a model that does not act adds +0, which changes no sum that is not
- * -0 (and a sum from +0 never is). Returns WETDEM_OK or WETDEM_ERR_NUMERIC (non-finite
- * force). */
-static int lean_pair(const struct wetdem_many* m, const struct wetdem_particle* a,
-                     const struct wetdem_particle* b, struct wetdem_vec3 d,
-                     const struct wetdem_many_mix* x, double* hist, unsigned char* flags,
-                     struct wetdem_many_pair_out* o) __attribute__((noinline));
-static int lean_pair(const struct wetdem_many* m, const struct wetdem_particle* a,
-                     const struct wetdem_particle* b, struct wetdem_vec3 d,
-                     const struct wetdem_many_mix* x, double* hist, unsigned char* flags,
-                     struct wetdem_many_pair_out* o)
+/* What the lean kernel reads of a pair or particle-wall pair (as struct wetdem_contact). */
+struct lean_geometry {
+    struct wetdem_vec3 n;   /* unit normal, j to i */
+    double gap, r_i, r_j;   /* [m]; r_j unused for walls */
+    double r_eff, m_eff;    /* R* [m], m* [kg] */
+    double v_n;             /* [m/s] */
+    struct wetdem_vec3 v_t; /* [m/s], set only when mindlin is enabled */
+    bool wall;
+};
+
+/* Force of pair g with mixed properties x: the operations of wetdem_sim_many_eval_fused and
+ * eval_pair in the same order on the quantities the enabled models read, so force, torques,
+ * history and flags are bit-identical to theirs (tests/test_many_force.c). The sum of the
+ * normal forces starts at +0 and adds the models in model order; a model that does not act
+ * adds +0, which changes no sum that is not -0 (and a sum from +0 never is). Needs
+ * g->gap <= x->range. Returns WETDEM_OK or WETDEM_ERR_NUMERIC (non-finite force). */
+static inline __attribute__((always_inline)) int lean_force(const struct wetdem_many* m,
+                                                            const struct lean_geometry* g,
+                                                            const struct wetdem_many_mix* x,
+                                                            double* hist, unsigned char* flags,
+                                                            struct wetdem_many_pair_out* o)
 {
     const struct wetdem_many_lean* L = &m->lean;
-    double dist = vec3_norm(d);
-    double gap = dist - a->radius - b->radius;
-    *flags = 0;
-    if (gap > x->range)
-        return WETDEM_OK;
-    struct wetdem_vec3 n = dist > 0 ? vec3_scale(d, 1.0 / dist) : vec3(1, 0, 0);
-    double r_eff = contact_reduced(a->radius, b->radius);
-    double m_eff = contact_reduced(contact_effective_mass(a), contact_effective_mass(b));
-    double v_n = -vec3_dot(vec3_sub(a->vel, b->vel), n), overlap = -gap;
+    double gap = g->gap, r_eff = g->r_eff, m_eff = g->m_eff, v_n = g->v_n, overlap = -gap;
+    struct wetdem_vec3 n = g->n;
     double k = hertz_stiffness(x->e_star, r_eff);
     double f_el = overlap > 0.0 ? hertz_elastic_k(k, overlap) : 0.0;
     double term[3] = {0.0, 0.0, 0.0}; /* hertz, sb, capillary */
@@ -401,18 +400,16 @@ static int lean_pair(const struct wetdem_many* m, const struct wetdem_particle* 
         f_n += term[L->normal[q]];
     struct wetdem_vec3 zero = vec3(0, 0, 0), f_tan = zero, t_i = zero, t_j = zero;
     if (L->mindlin) {
-        struct wetdem_vec3 va = vec3_add(a->vel, vec3_cross(a->omega, vec3_scale(n, -a->radius)));
-        struct wetdem_vec3 vb = vec3_add(b->vel, vec3_cross(b->omega, vec3_scale(n, b->radius)));
-        struct wetdem_vec3 v_t = vec3_reject(vec3_sub(va, vb), n);
         struct wetdem_vec3 ft =
-            wetdem_force_mindlin_spring(n, v_t, m->dt, x->g_star, r_eff, m_eff, overlap, f_el,
+            wetdem_force_mindlin_spring(n, g->v_t, m->dt, x->g_star, r_eff, m_eff, overlap, f_el,
                                         L->mindlin_lub ? x->friction_lub : x->friction_dry,
                                         x->mindlin_damping, hist + L->mindlin_off);
         if (overlap > 0.0) { /* wetdem_pair_force_add_tangential onto a zero record */
             f_tan = vec3_add(zero, ft);
             struct wetdem_vec3 nxf = vec3_cross(n, ft);
-            t_i = vec3_axpy(zero, -a->radius, nxf);
-            t_j = vec3_axpy(zero, -b->radius, nxf);
+            t_i = vec3_axpy(zero, -g->r_i, nxf);
+            if (!g->wall)
+                t_j = vec3_axpy(zero, -g->r_j, nxf);
         }
     }
     o->force = vec3_axpy(f_tan, f_n, n);
@@ -423,6 +420,64 @@ static int lean_pair(const struct wetdem_many* m, const struct wetdem_particle* 
     if (!(isfinite(f_n) && vec3_is_finite(o->force) && vec3_is_finite(t_i) && vec3_is_finite(t_j)))
         return WETDEM_ERR_NUMERIC;
     return WETDEM_OK;
+}
+
+/* Pair (a, b) with d = x_a - x_b (minimum image): its geometry as pair_contact_from computes
+ * it, then lean_force; *flags = 0 beyond the range. */
+static int lean_pair(const struct wetdem_many* m, const struct wetdem_particle* a,
+                     const struct wetdem_particle* b, struct wetdem_vec3 d,
+                     const struct wetdem_many_mix* x, double* hist, unsigned char* flags,
+                     struct wetdem_many_pair_out* o) __attribute__((noinline));
+static int lean_pair(const struct wetdem_many* m, const struct wetdem_particle* a,
+                     const struct wetdem_particle* b, struct wetdem_vec3 d,
+                     const struct wetdem_many_mix* x, double* hist, unsigned char* flags,
+                     struct wetdem_many_pair_out* o)
+{
+    double dist = vec3_norm(d);
+    struct lean_geometry g = {
+        .gap = dist - a->radius - b->radius, .r_i = a->radius, .r_j = b->radius};
+    *flags = 0;
+    if (g.gap > x->range)
+        return WETDEM_OK;
+    g.n = dist > 0 ? vec3_scale(d, 1.0 / dist) : vec3(1, 0, 0);
+    g.r_eff = contact_reduced(a->radius, b->radius);
+    g.m_eff = contact_reduced(contact_effective_mass(a), contact_effective_mass(b));
+    g.v_n = -vec3_dot(vec3_sub(a->vel, b->vel), g.n);
+    if (m->lean.mindlin) {
+        struct wetdem_vec3 va = vec3_add(a->vel, vec3_cross(a->omega, vec3_scale(g.n, -a->radius)));
+        struct wetdem_vec3 vb = vec3_add(b->vel, vec3_cross(b->omega, vec3_scale(g.n, b->radius)));
+        g.v_t = vec3_reject(vec3_sub(va, vb), g.n);
+    }
+    return lean_force(m, &g, x, hist, flags, o);
+}
+
+/* Particle a and plane wall w: the geometry of wall_contact_from, then lean_force; *flags = 0
+ * beyond the range. */
+static int lean_wall(const struct wetdem_many* m, const struct wetdem_particle* a,
+                     const struct wetdem_wall* w, const struct wetdem_many_mix* x, double* hist,
+                     unsigned char* flags, struct wetdem_many_pair_out* o)
+    __attribute__((noinline));
+static int lean_wall(const struct wetdem_many* m, const struct wetdem_particle* a,
+                     const struct wetdem_wall* w, const struct wetdem_many_mix* x, double* hist,
+                     unsigned char* flags, struct wetdem_many_pair_out* o)
+{
+    double dist = vec3_dot(vec3_sub(a->pos, w->point), w->normal);
+    struct lean_geometry g = {.n = w->normal,
+                              .gap = dist - a->radius,
+                              .r_i = a->radius,
+                              .r_eff = a->radius,
+                              .m_eff = contact_effective_mass(a),
+                              .wall = true};
+    *flags = 0;
+    if (g.gap > x->range)
+        return WETDEM_OK;
+    g.v_n = -vec3_dot(a->vel, g.n);
+    if (m->lean.mindlin) {
+        struct wetdem_vec3 va =
+            vec3_add(a->vel, vec3_cross(a->omega, vec3_scale(w->normal, -a->radius)));
+        g.v_t = vec3_reject(va, g.n);
+    }
+    return lean_force(m, &g, x, hist, flags, o);
 }
 
 /* ---- the pair pass ---- */
@@ -589,6 +644,15 @@ static unsigned char near_candidate(const struct pass* P, size_t q, size_t i, si
     return *fl;
 }
 
+/* Pair q, which had flags, has left its range: fresh history, no flags. */
+static void leave_range(const struct pass* P, size_t q) __attribute__((noinline));
+static void leave_range(const struct pass* P, size_t q)
+{
+    if (P->flags[q] & WETDEM_MANY_DIRTY && P->len)
+        wetdem_sim_history_init(P->sim, P->history + q * P->len);
+    P->flags[q] = 0;
+}
+
 /* Candidate pair q = (i, j): the gap test on the positions first (most candidates are beyond
  * their range), the kernel only for the others. Returns the pair's new flags; *o holds the
  * force and torques where they include WETDEM_MANY_ACTIVE. */
@@ -605,12 +669,8 @@ eval_candidate(const struct pass* P, size_t q, size_t i, size_t j, struct wetdem
     double lim = xr[i].r + xr[j].r + x->range;
     if (vec3_dot(d, d) <= lim * lim * (1 + PREFILTER_MARGIN))
         return near_candidate(P, q, i, j, d, x, o, fail);
-    unsigned char* fl = &P->flags[q];
-    if (*fl) { /* the pair has just left its range */
-        if (*fl & WETDEM_MANY_DIRTY && P->len)
-            wetdem_sim_history_init(P->sim, P->history + q * P->len);
-        *fl = 0;
-    }
+    if (P->flags[q])
+        leave_range(P, q);
     return 0;
 }
 
@@ -640,13 +700,34 @@ static void eval_walls_of(const struct wetdem_sim* sim, size_t i, struct wetdem_
         const struct wetdem_wall* wall = &sim->walls[w];
         double gap = vec3_dot(vec3_sub(a->pos, wall->point), wall->normal) - a->radius;
         double* hist = len ? m->wall_history + (i * nw + w) * len : NULL;
+        uint64_t bit = w < 64 ? (uint64_t)1 << w : 0;
+        bool dirty = w >= 64 || (m->wall_dirty[i] & bit);
         if (gap > m->reach) {
-            if (hist)
+            if (hist && dirty)
                 wetdem_sim_history_init(sim, hist);
+            m->wall_dirty[i] &= ~bit;
+            continue;
+        }
+        const struct wetdem_many_mix* x = wetdem_sim_many_mix(sim, a->material, wall->material);
+        if (m->lean.on && !m->set.energy_budget) {
+            struct wetdem_many_pair_out o;
+            unsigned char flags;
+            int st = lean_wall(m, a, wall, x, hist, &flags, &o);
+            if (!flags && hist && dirty) /* reset beyond the range, as eval_pair does */
+                wetdem_sim_history_init(sim, hist);
+            m->wall_dirty[i] = flags ? m->wall_dirty[i] | bit : m->wall_dirty[i] & ~bit;
+            if (st != WETDEM_OK) {
+                struct wetdem_contact c = {.gap = gap};
+                note_failure(fail, i * nw + w, st, true, &c, x->range);
+            }
+            if (flags & WETDEM_MANY_ACTIVE) {
+                *f = vec3_add(*f, o.force);
+                *t = vec3_add(*t, o.torque_i);
+                *n_contacts += (flags & WETDEM_MANY_CONTACT) ? 1 : 0;
+            }
             continue;
         }
         struct wetdem_contact c;
-        const struct wetdem_many_mix* x = wetdem_sim_many_mix(sim, a->material, wall->material);
         wall_contact_from(a, wall, x, &c);
         c.i = i;
         c.j = w;
@@ -656,6 +737,8 @@ static void eval_walls_of(const struct wetdem_sim* sim, size_t i, struct wetdem_
         int st = eval_pair(sim, &c, x, range, hist, &o, &flags, thread_work(m, 1));
         if (st != WETDEM_OK)
             note_failure(fail, i * nw + w, st, true, &c, range);
+        /* eval_pair reset the history beyond the range */
+        m->wall_dirty[i] = flags ? m->wall_dirty[i] | bit : m->wall_dirty[i] & ~bit;
         if (!(flags & WETDEM_MANY_ACTIVE))
             continue;
         *f = vec3_add(*f, o.force);
@@ -837,15 +920,34 @@ static void pairs_of_block(const struct pass* P, size_t b, bool kick, struct wet
     struct wetdem_vec3* torque = m->torque;
     uint32_t* contacts = m->contacts;
     size_t end_block = m->blk[b + 1], e = m->cross_first[b];
+    /* the pass's invariants in locals: the stores to the force arrays could alias them */
+    const struct wetdem_celllist_item* xr = P->xr;
+    const struct wetdem_particle* p = P->p;
+    const struct wetdem_many_mix* mix = m->mix;
+    const struct wetdem_celllist_box* box = &m->cl.box;
+    const unsigned char* flags = P->flags;
+    size_t nm = P->nm;
+    bool single = nm == 1, periodic = P->periodic;
     for (size_t i = m->blk[b]; i < end_block; i++) {
         struct wetdem_vec3 f = vec3(0, 0, 0), t = vec3(0, 0, 0);
         uint32_t n_contacts = 0;
         size_t q = m->cl.first_pair[i], end = m->cl.first_pair[i + 1];
-        struct wetdem_vec3 xi = vec3(P->xr[i].x, P->xr[i].y, P->xr[i].z);
+        struct wetdem_vec3 xi = vec3(xr[i].x, xr[i].y, xr[i].z);
+        double ri = xr[i].r;
+        const struct wetdem_many_mix* mix_i = single ? mix : mix + (size_t)p[i].material * nm;
         for (; q < end && pairs[q].j < end_block; q++) {
             size_t j = pairs[q].j;
+            struct wetdem_vec3 xj = vec3(xr[j].x, xr[j].y, xr[j].z);
+            struct wetdem_vec3 d = periodic ? celllist_delta(box, xi, xj) : vec3_sub(xi, xj);
+            const struct wetdem_many_mix* x = single ? mix : &mix_i[p[j].material];
+            double lim = ri + xr[j].r + x->range;
+            if (vec3_dot(d, d) > lim * lim * (1 + PREFILTER_MARGIN)) { /* eval_candidate's test */
+                if (flags[q])
+                    leave_range(P, q);
+                continue;
+            }
             struct wetdem_many_pair_out o;
-            unsigned char fl = eval_candidate(P, q, i, j, xi, &o, fail);
+            unsigned char fl = near_candidate(P, q, i, j, d, x, &o, fail);
             if (!(fl & WETDEM_MANY_ACTIVE))
                 continue;
             uint32_t c = (fl & WETDEM_MANY_CONTACT) ? 1 : 0;
