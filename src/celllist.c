@@ -593,20 +593,58 @@ static uint64_t pair_key(struct wetdem_celllist_pair q)
     return ((uint64_t)q.i << 32) | q.j;
 }
 
+/* First index of sorted `pairs` (n) whose key is >= key. */
+static size_t lower_bound(const struct wetdem_celllist_pair* pairs, size_t n, uint64_t key)
+{
+    size_t lo = 0, hi = n;
+    while (lo < hi) {
+        size_t mid = lo + (hi - lo) / 2;
+        if (pair_key(pairs[mid]) < key)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return lo;
+}
+
+/* Chunks of the new list merged independently (a fixed count: the same work split for any
+ * number of threads). */
+#define REMAP_CHUNKS 64
+
+size_t wetdem_celllist_remap(const struct wetdem_celllist_pair* old_pairs, const double* old_hist,
+                             const unsigned char* old_flags, size_t n_old,
+                             const struct wetdem_celllist_pair* new_pairs, double* new_hist,
+                             unsigned char* new_flags, unsigned char keep, size_t n_new, size_t len,
+                             const double* fresh)
+{
+    size_t kept = 0;
+#pragma omp parallel for schedule(static) reduction(+ : kept) if (n_new >= 4096)
+    for (size_t c = 0; c < REMAP_CHUNKS; c++) {
+        size_t b0 = n_new * c / REMAP_CHUNKS, b1 = n_new * (c + 1) / REMAP_CHUNKS;
+        if (b0 == b1)
+            continue;
+        size_t a = lower_bound(old_pairs, n_old, pair_key(new_pairs[b0]));
+        for (size_t b = b0; b < b1; b++) { /* merge walk over both sorted lists */
+            uint64_t key = pair_key(new_pairs[b]);
+            while (a < n_old && pair_key(old_pairs[a]) < key)
+                a++;
+            bool found = a < n_old && pair_key(old_pairs[a]) == key;
+            if (len)
+                memcpy(new_hist + b * len, found ? old_hist + a * len : fresh,
+                       len * sizeof(double));
+            if (new_flags)
+                new_flags[b] = found && old_flags ? old_flags[a] & keep : 0;
+            kept += found;
+        }
+    }
+    return kept;
+}
+
 size_t wetdem_celllist_remap_history(const struct wetdem_celllist_pair* old_pairs,
                                      const double* old_hist, size_t n_old,
                                      const struct wetdem_celllist_pair* new_pairs, double* new_hist,
                                      size_t n_new, size_t len, const double* fresh)
 {
-    size_t a = 0, kept = 0;
-    for (size_t b = 0; b < n_new; b++) {
-        uint64_t key = pair_key(new_pairs[b]);
-        while (a < n_old && pair_key(old_pairs[a]) < key)
-            a++;
-        bool found = a < n_old && pair_key(old_pairs[a]) == key;
-        if (len)
-            memcpy(new_hist + b * len, found ? old_hist + a * len : fresh, len * sizeof(double));
-        kept += found;
-    }
-    return kept;
+    return wetdem_celllist_remap(old_pairs, old_hist, NULL, n_old, new_pairs, new_hist, NULL, 0,
+                                 n_new, len, fresh);
 }

@@ -100,6 +100,15 @@ double wetdem_celllist_max_displacement(const struct wetdem_celllist* cl,
 bool wetdem_celllist_needs_rebuild(const struct wetdem_celllist* cl,
                                    const struct wetdem_particle* p, size_t n);
 
+/* wetdem_celllist_remap_history that also carries per-pair flags: new_flags[b] =
+ * old_flags[a] & keep for a pair kept from old index a, 0 for a new pair (both flag arrays
+ * may be NULL). Parallel over chunks of the new list; the result does not depend on the
+ * thread count. */
+size_t wetdem_celllist_remap(const struct wetdem_celllist_pair* old_pairs, const double* old_hist,
+                             const unsigned char* old_flags, size_t n_old,
+                             const struct wetdem_celllist_pair* new_pairs, double* new_hist,
+                             unsigned char* new_flags, unsigned char keep, size_t n_new, size_t len,
+                             const double* fresh);
 /* Carries per-pair history across a rebuild. old_pairs (n_old, sorted by (i, j)) with
  * old_hist (n_old x len doubles) and new_pairs (n_new, sorted) -> new_hist (n_new x len):
  * a pair present in both keeps its history, a new pair gets `fresh` (len doubles).

@@ -262,18 +262,21 @@ static int size_particle_arrays(struct wetdem_sim* sim)
     return WETDEM_OK;
 }
 
-/* Carries the DIRTY flag of surviving pairs over (merge walk over the sorted lists). */
-static void remap_dirty(struct wetdem_many* m, size_t n_old)
+/* Exchanges the pair histories and flags with the old-list buffers. */
+static void swap_pair_arrays(struct wetdem_many* m)
 {
-    size_t a = 0;
-    for (size_t b = 0; b < m->cl.n_pairs; b++) {
-        struct wetdem_celllist_pair q = m->cl.pairs[b];
-        while (a < n_old &&
-               (m->old_pairs[a].i < q.i || (m->old_pairs[a].i == q.i && m->old_pairs[a].j < q.j)))
-            a++;
-        bool same = a < n_old && m->old_pairs[a].i == q.i && m->old_pairs[a].j == q.j;
-        m->flags[b] = same ? (m->old_flags[a] & WETDEM_MANY_DIRTY) : 0;
-    }
+    double* h = m->old_history;
+    m->old_history = m->history;
+    m->history = h;
+    size_t cap = m->old_history_cap;
+    m->old_history_cap = m->history_cap;
+    m->history_cap = cap;
+    unsigned char* f = m->old_flags;
+    m->old_flags = m->flags;
+    m->flags = f;
+    cap = m->old_flags_cap;
+    m->old_flags_cap = m->flags_cap;
+    m->flags_cap = cap;
 }
 
 /* Walls within reach + skin of each particle at this build (Verlet criterion as for pairs);
@@ -315,21 +318,15 @@ static int rebuild(struct wetdem_sim* sim)
 {
     struct wetdem_many* m = sim->many;
     size_t len = sim->history_len, n_old = m->cl.n_pairs;
-    if (grow((void**)&m->old_pairs, &m->old_cap, n_old ? n_old : 1, sizeof *m->old_pairs) ||
-        grow((void**)&m->old_history, &m->old_history_cap, n_old * len + 1, sizeof(double)))
+    if (grow((void**)&m->old_pairs, &m->old_cap, n_old ? n_old : 1, sizeof *m->old_pairs))
         return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory for the pair list");
-    if (grow((void**)&m->old_flags, &m->old_flags_cap, n_old ? n_old : 1, 1))
-        return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory for the pair list");
-    for (size_t q = 0; q < n_old; q++)
-        m->old_flags[q] = m->flags[q];
     if (n_old)
         memcpy(m->old_pairs, m->cl.pairs, n_old * sizeof *m->old_pairs);
-    if (n_old * len > 0)
-        memcpy(m->old_history, m->history, n_old * len * sizeof(double));
     char msg[512];
     int st = wetdem_celllist_build(&m->cl, sim->particles, sim->n_particles, msg, sizeof msg);
     if (st != WETDEM_OK)
         return wetdem_sim_fail(sim, st, "%s", msg);
+    swap_pair_arrays(m); /* the current histories and flags become the old ones (no copy) */
     size_t n_new = m->cl.n_pairs;
     if (grow((void**)&m->history, &m->history_cap, n_new * len + 1, sizeof(double)) ||
         grow((void**)&m->flags, &m->flags_cap, n_new ? n_new : 1, 1))
@@ -337,9 +334,9 @@ static int rebuild(struct wetdem_sim* sim)
     double fresh[HISTORY_MAX];
     if (len)
         wetdem_sim_history_init(sim, fresh);
-    wetdem_celllist_remap_history(m->old_pairs, m->old_history, n_old, m->cl.pairs, m->history,
-                                  n_new, len, fresh);
-    remap_dirty(m, n_old);
+    /* surviving pairs keep their history and DIRTY flag */
+    wetdem_celllist_remap(m->old_pairs, m->old_history, m->old_flags, n_old, m->cl.pairs,
+                          m->history, m->flags, WETDEM_MANY_DIRTY, n_new, len, fresh);
     m->blocks_ready = false; /* the force pass indexes the new list */
     return update_wall_masks(sim);
 }

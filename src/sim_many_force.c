@@ -772,20 +772,34 @@ static bool reserve(void** a, size_t* cap, size_t n, size_t size)
 
 /* ---- blocks and the cross-block index ---- */
 
-/* First particle of block b of nb: contiguous blocks of about equal candidate counts. */
-static size_t block_start(const struct wetdem_many* m, size_t n, size_t b, size_t nb)
+/* Work of particle i in the force pass, in units of one candidate's gap test: the particle's
+ * own steps (about 4.5), its candidates, and about 15 for each pair that was active (flags set
+ * when the list was built; the kernel costs that much more than a rejected candidate). */
+static double particle_work(const struct wetdem_many* m, size_t i)
 {
-    if (b >= nb)
-        return n;
-    size_t target = m->cl.n_pairs / nb * b, lo = 0, hi = n;
-    while (lo < hi) { /* smallest i with first_pair[i] >= target */
-        size_t mid = lo + (hi - lo) / 2;
-        if (m->cl.first_pair[mid] < target)
-            lo = mid + 1;
-        else
-            hi = mid;
+    size_t q0 = m->cl.first_pair[i], q1 = m->cl.first_pair[i + 1], active = 0;
+    for (size_t q = q0; q < q1; q++)
+        active += m->flags[q] != 0;
+    return 4.5 + (double)(q1 - q0) + 15.0 * (double)active + (m->wall_mask[i] ? 8.0 : 0.0);
+}
+
+/* Block starts blk[0..nb]: contiguous blocks of about equal estimated work, so that the
+ * threads finish together (the result does not depend on the boundaries). */
+static void partition_blocks(struct wetdem_many* m, size_t n, size_t nb)
+{
+    double total = 0;
+    for (size_t i = 0; i < n; i++)
+        total += particle_work(m, i);
+    double sum = 0;
+    size_t b = 1;
+    m->blk[0] = 0;
+    for (size_t i = 0; i < n && b < nb; i++) {
+        sum += particle_work(m, i);
+        while (b < nb && sum >= total * (double)b / (double)nb)
+            m->blk[b++] = i + 1;
     }
-    return lo;
+    while (b <= nb)
+        m->blk[b++] = n;
 }
 
 /* Block of particle k (blk: nb + 1 starts). */
@@ -823,8 +837,7 @@ static int index_blocks(struct wetdem_sim* sim, size_t nb)
         !reserve((void**)&m->cross_first, &m->cross_first_cap, 2 * (nb + 1),
                  sizeof *m->cross_first))
         return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory for %zu threads", nb);
-    for (size_t b = 0; b <= nb; b++)
-        m->blk[b] = block_start(m, n, b, nb);
+    partition_blocks(m, n, nb);
     size_t nc = 0;
     for (size_t q = 0; nb > 1 && q < np; q++)
         nc += block_of(m->blk, nb, m->cl.pairs[q].i) != block_of(m->blk, nb, m->cl.pairs[q].j);
