@@ -32,6 +32,7 @@
 #include <math.h>
 #include <stddef.h>
 
+#include "mindlin.h"
 #include "models.h"
 #include "vec3.h"
 
@@ -49,42 +50,11 @@ static const struct wetdem_param_desc mindlin_params_desc[] = {
     {0},
 };
 
-/* Mindlin tangential stiffness 8 G* sqrt(R* delta) [N/m]. */
-static double tangential_stiffness(double g_star, double r_eff, double overlap)
-{
-    return 8.0 * g_star * sqrt(r_eff * overlap);
-}
-
 double wetdem_force_mindlin_damping_factor(double restitution)
 {
     double l = log(restitution);
     double beta = l / sqrt(l * l + M_PI * M_PI);
     return -2.0 * sqrt(5.0 / 6.0) * beta;
-}
-
-/* Tsuji-form tangential damping coefficient -2 sqrt(5/6) beta sqrt(m* k_t) [kg/s], from the
- * factor -2 sqrt(5/6) beta (the product is formed in that order either way). */
-static double tangential_damping(double k_t, double m_eff, double factor)
-{
-    return factor * sqrt(m_eff * k_t);
-}
-
-/* The spring s rotated rigidly into the plane normal to n, keeping its length. */
-static struct wetdem_vec3 rotate_into_plane(struct wetdem_vec3 s, struct wetdem_vec3 n)
-{
-    double len = vec3_norm(s);
-    struct wetdem_vec3 p = vec3_reject(s, n);
-    double plen = vec3_norm(p);
-    if (!(plen > 0.0))
-        return vec3(0, 0, 0);
-    return vec3_scale(p, len / plen);
-}
-
-static void store_spring(double* spring, struct wetdem_vec3 s)
-{
-    spring[0] = s.x;
-    spring[1] = s.y;
-    spring[2] = s.z;
 }
 
 struct wetdem_vec3 wetdem_force_mindlin_update(const struct wetdem_contact* c, double overlap,
@@ -98,31 +68,8 @@ struct wetdem_vec3 wetdem_force_mindlin_update_with(const struct wetdem_contact*
                                                     double f_limit, double mu,
                                                     double damping_factor, double* spring)
 {
-    return wetdem_force_mindlin_spring(c->normal, c->v_t, c->dt, c->g_star, c->r_eff, c->m_eff,
-                                       overlap, f_limit, mu, damping_factor, spring);
-}
-
-struct wetdem_vec3 wetdem_force_mindlin_spring(struct wetdem_vec3 n, struct wetdem_vec3 v_t,
-                                               double dt, double g_star, double r_eff, double m_eff,
-                                               double overlap, double f_limit, double mu,
-                                               double damping_factor, double* spring)
-{
-    if (!(overlap > 0.0)) {
-        store_spring(spring, vec3(0, 0, 0));
-        return vec3(0, 0, 0);
-    }
-    struct wetdem_vec3 s = rotate_into_plane(vec3(spring[0], spring[1], spring[2]), n);
-    s = vec3_axpy(s, dt, v_t);
-    double k_t = tangential_stiffness(g_star, r_eff, overlap);
-    double gamma_t = tangential_damping(k_t, m_eff, damping_factor);
-    struct wetdem_vec3 ft = vec3_axpy(vec3_scale(s, -k_t), -gamma_t, v_t);
-    double f_total = vec3_norm(ft), f_max = mu * fabs(f_limit);
-    if (f_total > f_max) { /* sliding: total capped, spring set so that it gives the cap */
-        ft = vec3_scale(ft, f_max / f_total);
-        s = k_t > 0.0 ? vec3_scale(vec3_axpy(ft, gamma_t, v_t), -1.0 / k_t) : vec3(0, 0, 0);
-    }
-    store_spring(spring, s);
-    return ft;
+    return mindlin_spring(c->normal, c->v_t, c->dt, c->g_star, c->r_eff, c->m_eff, overlap, f_limit,
+                          mu, damping_factor, spring);
 }
 
 static int mindlin_pair(const void* params, const struct wetdem_contact* c, double* history,

@@ -116,12 +116,5 @@ double wetdem_force_mindlin_damping_factor(double restitution);
 struct wetdem_vec3 wetdem_force_mindlin_update_with(const struct wetdem_contact* c, double overlap,
                                                     double f_limit, double mu,
                                                     double damping_factor, double* spring);
-/* force_mindlin.c: wetdem_force_mindlin_update_with from the contact quantities it reads: unit
- * normal n, tangential velocity v_t [m/s], dt [s], G* [Pa], R* [m], m* [kg] (for callers that
- * do not build a struct wetdem_contact; bit-identical). */
-struct wetdem_vec3 wetdem_force_mindlin_spring(struct wetdem_vec3 n, struct wetdem_vec3 v_t,
-                                               double dt, double g_star, double r_eff, double m_eff,
-                                               double overlap, double f_limit, double mu,
-                                               double damping_factor, double* spring);
 
 #endif

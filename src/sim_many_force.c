@@ -46,6 +46,7 @@
 #include <string.h>
 
 #include "many.h"
+#include "mindlin.h"
 #include "models.h"
 #include "thin_film.h"
 #include "contact.h"
@@ -401,9 +402,9 @@ static inline __attribute__((always_inline)) int lean_force(const struct wetdem_
     struct wetdem_vec3 zero = vec3(0, 0, 0), f_tan = zero, t_i = zero, t_j = zero;
     if (L->mindlin) {
         struct wetdem_vec3 ft =
-            wetdem_force_mindlin_spring(n, g->v_t, m->dt, x->g_star, r_eff, m_eff, overlap, f_el,
-                                        L->mindlin_lub ? x->friction_lub : x->friction_dry,
-                                        x->mindlin_damping, hist + L->mindlin_off);
+            mindlin_spring(n, g->v_t, m->dt, x->g_star, r_eff, m_eff, overlap, f_el,
+                           L->mindlin_lub ? x->friction_lub : x->friction_dry, x->mindlin_damping,
+                           hist + L->mindlin_off);
         if (overlap > 0.0) { /* wetdem_pair_force_add_tangential onto a zero record */
             f_tan = vec3_add(zero, ft);
             struct wetdem_vec3 nxf = vec3_cross(n, ft);
@@ -434,15 +435,19 @@ static int lean_pair(const struct wetdem_many* m, const struct wetdem_particle* 
                      struct wetdem_many_pair_out* o)
 {
     double dist = vec3_norm(d);
-    struct lean_geometry g = {
-        .gap = dist - a->radius - b->radius, .r_i = a->radius, .r_j = b->radius};
+    struct lean_geometry g; /* every field read is set (no zeroing of the whole record) */
+    g.gap = dist - a->radius - b->radius;
     *flags = 0;
     if (g.gap > x->range)
         return WETDEM_OK;
+    g.r_i = a->radius;
+    g.r_j = b->radius;
+    g.wall = false;
     g.n = dist > 0 ? vec3_scale(d, 1.0 / dist) : vec3(1, 0, 0);
     g.r_eff = contact_reduced(a->radius, b->radius);
     g.m_eff = contact_reduced(contact_effective_mass(a), contact_effective_mass(b));
     g.v_n = -vec3_dot(vec3_sub(a->vel, b->vel), g.n);
+    g.v_t = vec3(0, 0, 0);
     if (m->lean.mindlin) {
         struct wetdem_vec3 va = vec3_add(a->vel, vec3_cross(a->omega, vec3_scale(g.n, -a->radius)));
         struct wetdem_vec3 vb = vec3_add(b->vel, vec3_cross(b->omega, vec3_scale(g.n, b->radius)));
