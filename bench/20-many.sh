@@ -8,9 +8,12 @@
 #  full:  from the lattice, SETTLE untimed steps, then STEPS timed steps (each variant follows
 #         its own trajectory: wet spheres cluster, so the wet run ends with many more contacts);
 #  same:  from one shared state, the dry run's state after STATE steps (written by wetdem as a
-#         LIGGGHTS data file), SAME_STEPS timed steps of every variant; this is the like-for-like
-#         measure of the cost of the wet models (the configurations start equal and, over the
-#         short window, stay close; contacts and bridges at the end are printed).
+#         LIGGGHTS data file), SAME_STEPS timed steps of every variant (the configurations start
+#         equal, but the capillary force gathers the wet spheres within the window: contacts and
+#         bridges at the end are printed);
+#  frozen: the same state, FROZEN_STEPS timed steps of dt = FROZEN_DT (1e-9 s: the spheres move
+#         by < 1e-9 m, so every variant evaluates the same configuration at every step); the
+#         like-for-like measure of the cost of the wet models.
 # Reports particle-steps per second (wall clock of the timed steps), per CPU-second for the
 # full runs on 1 thread (user + system time of the timed steps; for LIGGGHTS the CPU time of a
 # settle-only run is subtracted), memory per particle ((max RSS - RSS of a 1-particle run) / N)
@@ -18,8 +21,8 @@
 # 2 threads, wet <= 1.3x dry.
 #
 # Usage: bench/20-many.sh [WETDEM_CLI]    (make bench passes the CLI; it is not needed here)
-# Environment: N (20000), SETTLE (500), STEPS (1500), STATE (3000), SAME_STEPS (300) — about
-# 4 minutes on 2 cores; OMP_WAIT_POLICY (default passive: spinning threads collapse when the
+# Environment: N (20000), SETTLE (500), STEPS (1500), STATE (3000), SAME_STEPS (300),
+# FROZEN_STEPS (300), FROZEN_DT (1e-9) — about 5 minutes on 2 cores; OMP_WAIT_POLICY (default passive: spinning threads collapse when the
 # cores are shared).
 # Results go to build/bench/many/ (logs, results.txt, summary.txt). The ratios are printed, not
 # enforced: the machine may be shared, which the load average printed with the results shows.
@@ -31,6 +34,8 @@ SETTLE=${SETTLE:-500}
 STEPS=${STEPS:-1500}
 STATE=${STATE:-3000}
 SAME_STEPS=${SAME_STEPS:-300}
+FROZEN_STEPS=${FROZEN_STEPS:-300}
+FROZEN_DT=${FROZEN_DT:-1e-9}
 out=build/bench/many
 mkdir -p "$out"
 res="$out/results.txt"
@@ -55,6 +60,7 @@ run_wd() {
   shift 3
   [ "$variant" = wet ] && flag="--wet"
   [ "$proto" = same ] && steps=$SAME_STEPS
+  [ "$proto" = frozen ] && steps=$FROZEN_STEPS
   local line
   line=$(OMP_NUM_THREADS=$t OMP_PROC_BIND=false "$out/many_bench" $flag "$@")
   echo "$proto $line" | tee -a "$out/wetdem.log" >&2
@@ -67,13 +73,13 @@ run_wd() {
        $(echo "$line" | field bridges)" >> "$res"
 }
 
-# LIGGGHTS run: variant ranks data nsettle nsteps -> "rate kb cpu_seconds"
+# LIGGGHTS run: variant ranks data nsettle nsteps [dt] -> "rate kb cpu_seconds"
 run_lg() {
   local log="$out/liggghts_$1_$2_$4.log"
   /usr/bin/time -f "maxrss_kb=%M cpu=%U+%S" -o "$out/time_$1_$2.txt" \
     mpirun --allow-run-as-root --oversubscribe -np "$2" liggghts -in "$deck/$1.in" \
     -var deckdir "$deck" -var data "$3" -var nsettle "$4" -var nsteps "$5" \
-    -log "$log" -screen none -nocite
+    -var dt "${6:-1e-5}" -log "$log" -screen none -nocite
   local secs kb cpu # the second "Loop time" line is the timed run
   secs=$(grep "^Loop time" "$log" | sed -n 2p | awk '{print $4}')
   kb=$(field maxrss_kb < "$out/time_$1_$2.txt")
@@ -115,21 +121,35 @@ for variant in dry wet; do
     echo "same liggghts $variant $t $r - -" >> "$res"
   done
 done
+
+# ---- frozen-configuration protocol ----
+for variant in dry wet; do
+  for t in 1 2; do
+    run_wd frozen "$variant" "$t" --state-in "$out/state.data" --settle 0 \
+      --steps "$FROZEN_STEPS" --dt "$FROZEN_DT"
+    $have_lg || continue
+    r=$(run_lg "$variant" "$t" "$out/state.data" 0 "$FROZEN_STEPS" "$FROZEN_DT" |
+        awk '{print $1, $2, 0}')
+    echo "frozen liggghts $variant $t $r" | tee -a "$out/liggghts.log" >&2
+    echo "frozen liggghts $variant $t $r - -" >> "$res"
+  done
+done
 $have_lg || echo "20-many: liggghts or mpirun not installed: LIGGGHTS half skipped" \
   "(scripts/install-deps bench)"
 
 # ---- report ----
 echo "load average after the run: $(cut -d' ' -f1-3 /proc/loadavg), $(nproc) cores" | tee -a "$res"
-awk -v n="$N" -v wb="$base_kb" -v lb="$lg_base" -v steps="$STEPS" -v same="$SAME_STEPS" '
-  /^(full|same) / { k = $1 " " $2 " " $3 " " $4; rate[k] = $5; kb[k] = $6; cpu[k] = $7
+awk -v n="$N" -v wb="$base_kb" -v lb="$lg_base" -v steps="$STEPS" -v same="$SAME_STEPS" \
+    -v fsteps="$FROZEN_STEPS" -v fdt="$FROZEN_DT" '
+  /^(full|same|frozen) / { k = $1 " " $2 " " $3 " " $4; rate[k] = $5; kb[k] = $6; cpu[k] = $7
                     con[k] = $8; bri[k] = $9 }
   function r(a, b) { return (b > 0) ? a / b : 0 }
   END {
     printf "\n%-5s %-9s %-4s %7s %12s %14s %14s %9s %9s\n", "proto", "code", "kind", "threads",
            "psteps/s", "psteps/CPU-s", "bytes/particle", "contacts", "bridges"
-    for (p = 1; p <= 2; p++) for (c = 1; c <= 2; c++) for (v = 1; v <= 2; v++)
+    for (p = 1; p <= 3; p++) for (c = 1; c <= 2; c++) for (v = 1; v <= 2; v++)
       for (t = 1; t <= 2; t++) {
-        proto = p == 1 ? "full" : "same"; code = c == 1 ? "wetdem" : "liggghts"
+        proto = p == 1 ? "full" : (p == 2 ? "same" : "frozen"); code = c == 1 ? "wetdem" : "liggghts"
         kind = v == 1 ? "dry" : "wet"; key = proto " " code " " kind " " t
         if (!(key in rate)) continue
         b = code == "wetdem" ? wb : lb
@@ -162,9 +182,23 @@ awk -v n="$N" -v wb="$base_kb" -v lb="$lg_base" -v steps="$STEPS" -v same="$SAME
       printf "  %s: wetdem 2-thread speed-up       %.2fx (target >= 1.8)\n", kind,
              r(rate[w " 2"], rate[w " 1"])
     }
-    printf "  cost wet / dry (1 thread): wetdem %.2fx (target <= 1.3)", r(rate["same wetdem dry 1"],
+    printf "  cost wet / dry (1 thread): wetdem %.2fx", r(rate["same wetdem dry 1"],
            rate["same wetdem wet 1"])
     if (rate["same liggghts wet 1"] > 0)
       printf ", LIGGGHTS %.2fx", r(rate["same liggghts dry 1"], rate["same liggghts wet 1"])
+    printf " (the wet run ends with more contacts)\n"
+    printf "frozen-configuration protocol (%d steps of %s s from the same state):\n", fsteps, fdt
+    for (v = 1; v <= 2; v++) {
+      kind = v == 1 ? "dry" : "wet"; w = "frozen wetdem " kind; l = "frozen liggghts " kind
+      if (rate[l " 1"] > 0)
+        printf "  %s: wetdem / LIGGGHTS per core  %.2fx wall (target >= 2)\n", kind,
+               r(rate[w " 1"], rate[l " 1"])
+      printf "  %s: wetdem 2-thread speed-up       %.2fx (target >= 1.8)\n", kind,
+             r(rate[w " 2"], rate[w " 1"])
+    }
+    printf "  cost wet / dry (1 thread): wetdem %.2fx (target <= 1.3)",
+           r(rate["frozen wetdem dry 1"], rate["frozen wetdem wet 1"])
+    if (rate["frozen liggghts wet 1"] > 0)
+      printf ", LIGGGHTS %.2fx", r(rate["frozen liggghts dry 1"], rate["frozen liggghts wet 1"])
     printf "\n"
   }' "$res" | tee "$out/summary.txt"

@@ -7,7 +7,8 @@
  * velocities (sigma 0.1 m/s, seed 1), settling in a closed box under gravity.
  *   dry: hertz + mindlin;  wet: hertz + mindlin + sb (thin-film viscous, 20 um films,
  *   mu_f = 0.01 Pa s) + capillary (sigma = 0.02 N/m).
- * dt = 1e-5 s (as the LIGGGHTS decks). The first `settle` steps are not timed.
+ * dt = 1e-5 s (as the LIGGGHTS decks; --dt changes it, e.g. 1e-9 s for the frozen-configuration
+ * protocol of bench/20-many.sh). The first `settle` steps are not timed.
  *
  * Same-state protocol (the like-for-like wet/dry comparison of bench/20-many.sh): --state-out
  * writes the state at the end of the run (positions, radii, velocities, spins) as a LIGGGHTS
@@ -15,7 +16,7 @@
  * so wetdem dry, wetdem wet and both LIGGGHTS variants run the same configuration. Contact
  * histories are not carried over, in either code.
  *
- * Usage: many_bench [--wet] [--n N] [--settle S] [--steps S] [--data FILE] [--budget]
+ * Usage: many_bench [--wet] [--n N] [--settle S] [--steps S] [--dt DT] [--data FILE] [--budget]
  *                   [--state-in FILE] [--state-out FILE]
  * Prints one line: "wetdem <dry|wet> n=.. threads=.. steps=.. seconds=.. cpu_seconds=..
  * psteps_per_s=..
@@ -197,6 +198,7 @@ int main(int argc, char** argv)
     const char* data = NULL;
     const char* state_in = NULL;
     const char* state_out = NULL;
+    double dt = 1e-5;
     for (int k = 1; k < argc; k++) {
         if (!strcmp(argv[k], "--wet"))
             wet = true;
@@ -214,9 +216,12 @@ int main(int argc, char** argv)
             state_in = argv[++k];
         else if (!strcmp(argv[k], "--state-out") && k + 1 < argc)
             state_out = argv[++k];
+        else if (!strcmp(argv[k], "--dt") && k + 1 < argc && (dt = strtod(argv[++k], NULL)) > 0)
+            continue;
         else {
             fprintf(stderr, "usage: many_bench [--wet] [--budget] [--n N] [--settle S] "
-                            "[--steps S] [--data FILE] [--state-in FILE] [--state-out FILE]\n");
+                            "[--steps S] [--dt DT] [--data FILE] [--state-in FILE] "
+                            "[--state-out FILE]\n");
             return 2;
         }
     }
@@ -233,7 +238,6 @@ int main(int argc, char** argv)
         write_data(data, sim, hi);
         return 0;
     }
-    const double dt = 1e-5;
     struct wetdem_many_settings ms = {.dt = dt, .skin = 0.2e-3, .energy_budget = budget};
     int st = wetdem_sim_set_many(sim, &ms);
     if (st != WETDEM_OK || (st = wetdem_sim_integrate(sim, settle * dt)) != WETDEM_OK)

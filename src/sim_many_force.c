@@ -380,15 +380,31 @@ static inline __attribute__((always_inline)) int lean_force(const struct wetdem_
                                                             struct wetdem_many_pair_out* o)
 {
     const struct wetdem_many_lean* L = &m->lean;
-    double gap = g->gap, r_eff = g->r_eff, m_eff = g->m_eff, v_n = g->v_n, overlap = -gap;
-    struct wetdem_vec3 n = g->n;
-    double k = hertz_stiffness(x->e_star, r_eff);
-    double f_el = overlap > 0.0 ? hertz_elastic_k(k, overlap) : 0.0;
+    double gap = g->gap, r_eff = g->r_eff, v_n = g->v_n, overlap = -gap;
+    struct wetdem_vec3 n = g->n, zero = vec3(0, 0, 0), f_tan = zero, t_i = zero, t_j = zero;
     double term[3] = {0.0, 0.0, 0.0}; /* hertz, sb, capillary */
-    if (L->hertz_form >= 0 && overlap > 0.0)
-        term[0] = wetdem_force_hertz_total(
-            f_el, hertz_damping_k(x->hertz_damping[L->hertz_form], k, m_eff, overlap, v_n),
-            L->hertz_form);
+    if (overlap > 0.0) {              /* solid contact: hertz and mindlin act */
+        double m_eff = g->m_eff, k = hertz_stiffness(x->e_star, r_eff);
+        double f_el = hertz_elastic_k(k, overlap);
+        if (L->hertz_form >= 0)
+            term[0] = wetdem_force_hertz_total(
+                f_el, hertz_damping_k(x->hertz_damping[L->hertz_form], k, m_eff, overlap, v_n),
+                L->hertz_form);
+        if (L->mindlin) { /* wetdem_pair_force_add_tangential onto a zero record */
+            struct wetdem_vec3 ft =
+                mindlin_spring(n, g->v_t, m->dt, x->g_star, r_eff, m_eff, overlap, f_el,
+                               L->mindlin_lub ? x->friction_lub : x->friction_dry,
+                               x->mindlin_damping, hist + L->mindlin_off);
+            f_tan = vec3_add(zero, ft);
+            struct wetdem_vec3 nxf = vec3_cross(n, ft);
+            t_i = vec3_axpy(zero, -g->r_i, nxf);
+            if (!g->wall)
+                t_j = vec3_axpy(zero, -g->r_j, nxf);
+        }
+    } else if (L->mindlin) { /* apart: mindlin_spring resets the spring and gives no force */
+        double* spring = hist + L->mindlin_off;
+        spring[0] = spring[1] = spring[2] = 0.0;
+    }
     double h;
     if (L->sb && thin_film_eval_gap(gap, L->h_min, x->film, L->sb_below, &h)) {
         double bracket = 1.0 - h / x->film;
@@ -399,20 +415,6 @@ static inline __attribute__((always_inline)) int lean_force(const struct wetdem_
     double f_n = 0.0;
     for (int q = 0; q < L->n_normal; q++)
         f_n += term[L->normal[q]];
-    struct wetdem_vec3 zero = vec3(0, 0, 0), f_tan = zero, t_i = zero, t_j = zero;
-    if (L->mindlin) {
-        struct wetdem_vec3 ft =
-            mindlin_spring(n, g->v_t, m->dt, x->g_star, r_eff, m_eff, overlap, f_el,
-                           L->mindlin_lub ? x->friction_lub : x->friction_dry, x->mindlin_damping,
-                           hist + L->mindlin_off);
-        if (overlap > 0.0) { /* wetdem_pair_force_add_tangential onto a zero record */
-            f_tan = vec3_add(zero, ft);
-            struct wetdem_vec3 nxf = vec3_cross(n, ft);
-            t_i = vec3_axpy(zero, -g->r_i, nxf);
-            if (!g->wall)
-                t_j = vec3_axpy(zero, -g->r_j, nxf);
-        }
-    }
     o->force = vec3_axpy(f_tan, f_n, n);
     o->torque_i = t_i;
     o->torque_j = t_j;
@@ -445,10 +447,12 @@ static int lean_pair(const struct wetdem_many* m, const struct wetdem_particle* 
     g.wall = false;
     g.n = dist > 0 ? vec3_scale(d, 1.0 / dist) : vec3(1, 0, 0);
     g.r_eff = contact_reduced(a->radius, b->radius);
-    g.m_eff = contact_reduced(contact_effective_mass(a), contact_effective_mass(b));
     g.v_n = -vec3_dot(vec3_sub(a->vel, b->vel), g.n);
+    g.m_eff = 0.0; /* m* and v_t: read in solid contact only */
     g.v_t = vec3(0, 0, 0);
-    if (m->lean.mindlin) {
+    if (g.gap < 0.0)
+        g.m_eff = contact_reduced(contact_effective_mass(a), contact_effective_mass(b));
+    if (g.gap < 0.0 && m->lean.mindlin) {
         struct wetdem_vec3 va = vec3_add(a->vel, vec3_cross(a->omega, vec3_scale(g.n, -a->radius)));
         struct wetdem_vec3 vb = vec3_add(b->vel, vec3_cross(b->omega, vec3_scale(g.n, b->radius)));
         g.v_t = vec3_reject(vec3_sub(va, vb), g.n);
@@ -477,7 +481,7 @@ static int lean_wall(const struct wetdem_many* m, const struct wetdem_particle* 
     if (g.gap > x->range)
         return WETDEM_OK;
     g.v_n = -vec3_dot(a->vel, g.n);
-    if (m->lean.mindlin) {
+    if (g.gap < 0.0 && m->lean.mindlin) {
         struct wetdem_vec3 va =
             vec3_add(a->vel, vec3_cross(a->omega, vec3_scale(w->normal, -a->radius)));
         g.v_t = vec3_reject(va, g.n);
