@@ -104,6 +104,8 @@ struct wetdem_many {
     size_t *blk, *cross_first;
     uint32_t *cross_q, *cross_in;
     struct wetdem_many_pair_out* cross_out;
+    uint32_t* hits; /* per pair: the force pass's list of candidates within range (scratch) */
+    size_t hits_cap;
     size_t blk_cap, cross_first_cap, cross_q_cap, cross_in_cap, cross_out_cap;
     size_t n_blocks, blocks_n;
     uint64_t blocks_build; /* list build the blocks were indexed for */

@@ -852,7 +852,8 @@ static int index_blocks(struct wetdem_sim* sim, size_t nb)
         nc += block_of(m->blk, nb, m->cl.pairs[q].i) != block_of(m->blk, nb, m->cl.pairs[q].j);
     if (!reserve((void**)&m->cross_q, &m->cross_q_cap, nc, sizeof *m->cross_q) ||
         !reserve((void**)&m->cross_in, &m->cross_in_cap, nc, sizeof *m->cross_in) ||
-        !reserve((void**)&m->cross_out, &m->cross_out_cap, nc, sizeof *m->cross_out))
+        !reserve((void**)&m->cross_out, &m->cross_out_cap, nc, sizeof *m->cross_out) ||
+        !reserve((void**)&m->hits, &m->hits_cap, np, sizeof *m->hits))
         return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory for %zu pairs", nc);
     size_t* first_out = m->cross_first;         /* by block of the first particle */
     size_t* first_in = m->cross_first + nb + 1; /* by block of the second particle */
@@ -941,7 +942,7 @@ static void pairs_of_block(const struct pass* P, size_t b, bool kick, struct wet
     struct wetdem_vec3* force = m->force;
     struct wetdem_vec3* torque = m->torque;
     uint32_t* contacts = m->contacts;
-    size_t end_block = m->blk[b + 1], e = m->cross_first[b];
+    size_t begin_block = m->blk[b], end_block = m->blk[b + 1], e = m->cross_first[b];
     /* the pass's invariants in locals: the stores to the force arrays could alias them */
     const struct wetdem_celllist_item* xr = P->xr;
     const struct wetdem_particle* p = P->p;
@@ -950,22 +951,40 @@ static void pairs_of_block(const struct pass* P, size_t b, bool kick, struct wet
     const unsigned char* flags = P->flags;
     size_t nm = P->nm;
     bool single = nm == 1, periodic = P->periodic;
-    for (size_t i = m->blk[b]; i < end_block; i++) {
+    /* 1. the gap test of every candidate of the block whose second particle is in the block,
+          in one flat loop without branches on its outcome: the pairs within range, and those
+          with flags (they may have just left it), are listed in pair order */
+    size_t q_begin = m->cl.first_pair[begin_block], q_end = m->cl.first_pair[end_block];
+    uint32_t* hits = m->hits + q_begin;
+    size_t n_hits = 0;
+    for (size_t q = q_begin; q < q_end; q++) {
+        size_t i = pairs[q].i, j = pairs[q].j;
+        struct wetdem_vec3 xi = vec3(xr[i].x, xr[i].y, xr[i].z),
+                           xj = vec3(xr[j].x, xr[j].y, xr[j].z);
+        struct wetdem_vec3 d = periodic ? celllist_delta(box, xi, xj) : vec3_sub(xi, xj);
+        const struct wetdem_many_mix* x =
+            single ? mix : &mix[(size_t)p[i].material * nm + (size_t)p[j].material];
+        double lim = xr[i].r + xr[j].r + x->range;
+        bool near = vec3_dot(d, d) <= lim * lim * (1 + PREFILTER_MARGIN);
+        hits[n_hits] = (uint32_t)q;
+        n_hits += (near || flags[q]) && j < end_block;
+    }
+    /* 2. every particle in index order: its listed pairs (reactions to the second particle at
+          once), its cross pairs from phase 1, then its own sum and the closing half kick */
+    size_t h = 0;
+    for (size_t i = begin_block; i < end_block; i++) {
         struct wetdem_vec3 f = vec3(0, 0, 0), t = vec3(0, 0, 0);
         uint32_t n_contacts = 0;
-        size_t q = m->cl.first_pair[i], end = m->cl.first_pair[i + 1];
         struct wetdem_vec3 xi = vec3(xr[i].x, xr[i].y, xr[i].z);
-        double ri = xr[i].r;
-        const struct wetdem_many_mix* mix_i = single ? mix : mix + (size_t)p[i].material * nm;
-        for (; q < end && pairs[q].j < end_block; q++) {
-            size_t j = pairs[q].j;
+        for (; h < n_hits && pairs[hits[h]].i == i; h++) {
+            size_t q = hits[h], j = pairs[q].j;
             struct wetdem_vec3 xj = vec3(xr[j].x, xr[j].y, xr[j].z);
             struct wetdem_vec3 d = periodic ? celllist_delta(box, xi, xj) : vec3_sub(xi, xj);
-            const struct wetdem_many_mix* x = single ? mix : &mix_i[p[j].material];
-            double lim = ri + xr[j].r + x->range;
+            const struct wetdem_many_mix* x =
+                single ? mix : &mix[(size_t)p[i].material * nm + (size_t)p[j].material];
+            double lim = xr[i].r + xr[j].r + x->range;
             if (vec3_dot(d, d) > lim * lim * (1 + PREFILTER_MARGIN)) { /* eval_candidate's test */
-                if (flags[q])
-                    leave_range(P, q);
+                leave_range(P, q);
                 continue;
             }
             struct wetdem_many_pair_out o;
@@ -980,8 +999,11 @@ static void pairs_of_block(const struct pass* P, size_t b, bool kick, struct wet
             torque[j] = vec3_add(torque[j], o.torque_j);
             contacts[j] += c;
         }
-        for (; q < end; q++, e++) { /* the cross pairs of i, in j order */
-            unsigned char fl = P->flags[q];
+        size_t q = m->cl.first_pair[i + 1];
+        while (q > m->cl.first_pair[i] && pairs[q - 1].j >= end_block)
+            q--;                                                        /* first cross pair of i */
+        for (size_t end = m->cl.first_pair[i + 1]; q < end; q++, e++) { /* in j order */
+            unsigned char fl = flags[q];
             if (!(fl & WETDEM_MANY_ACTIVE))
                 continue;
             f = vec3_add(f, m->cross_out[e].force);
