@@ -18,10 +18,10 @@
  * across rebuilds; pairs beyond their range get a fresh history (each encounter starts
  * afresh, as in sim_integrate.c). Particle-wall pairs are all n x n_walls pairs.
  *
- * Determinism: each candidate pair is evaluated independently (in parallel) into its own
- * slot; the forces are then added to the particles serially in pair order, so positions and
- * velocities are bit-identical for any number of threads. The energy accumulators are summed
- * per thread and are reproducible for a given thread count.
+ * Determinism: every particle sums the forces on it in an order set by particle indices only
+ * (sim_many_force.c), so positions and velocities are bit-identical for any number of
+ * threads. The energy accumulators are summed per thread and are reproducible for a given
+ * thread count.
  *
  * Energy budget: the work of model k on a pair over one step is W = dt P(t + dt) with the
  * power P = F_i.(v*_i - v*_j) + T_i.w*_i + T_j.w*_j of that model's force at the evaluated

@@ -1,23 +1,27 @@
 /*
  * sim_many_force.c — the force evaluation of the many-particle mode (docs/many.md,
  * docs/performance.md): candidate pairs from the cell list, a cheap gap test on positions,
- * contacts built from a per-material-pair table of mixed properties, fused kernels for the
- * common model sets, and a parallel gather whose result does not depend on the thread count.
- * Prefix: wetdem_sim_.
+ * mixed properties from a per-material-pair table, a lean kernel (and a fused one) for the
+ * common model sets, and a block-parallel pass whose result does not depend on the thread
+ * count. Prefix: wetdem_sim_.
  *
- * Per step, for the candidate list (celllist.h) of pairs (i < j) sorted by (i, j):
- *   1. pair pass (parallel over particles i, any schedule): the pairs (i, j) of particle i, in
- *      increasing j. A pair is skipped before any contact is built when
- *      |x_i - x_j|^2 > (R_i + R_j + r_ab)^2 (1 + 1e-12), r_ab the model range of its material
- *      pair (the start-up reach for model sets without a fused kernel); the exact test
- *      h > range(c) then decides as before. The forces on i are summed in j order (S_i); the
- *      reaction on j goes to the pair's slot in the list ordered by second particle.
- *   2. gather (parallel over particles, any schedule): particle k sums its wall forces (wall
- *      order), then -F of every pair (i, k) in increasing i, then adds S_k, and applies the
- *      closing half kick of velocity Verlet (sim_many.c) at once.
- * Every sum has a fixed order set by particle indices only, so states are bit-identical for
- * any number of threads and, because pairs out of range add nothing, for any time at which
- * the list was rebuilt (checkpoint + restart).
+ * Per step, for the candidate list (celllist.h) of pairs (i < j) sorted by (i, j), with the
+ * particles split into contiguous blocks (one per thread, of about equal estimated work):
+ *   1. cross pairs (parallel over blocks): the pairs whose j lies in a later block than i are
+ *      evaluated and their results stored; a barrier follows.
+ *   2. block pass (parallel over blocks): every particle k of the block starts its sum with its
+ *      wall forces (wall order) and the reactions -F of the cross pairs (i, k) from earlier
+ *      blocks (increasing i). A flat loop gap-tests every in-block candidate,
+ *      |x_i - x_j|^2 > (R_i + R_j + r_ab)^2 (1 + 1e-12) (r_ab the model range of the material
+ *      pair, or the start-up reach for model sets without a fused kernel), and lists those
+ *      within range or with flags. Then, for i in index order: its listed pairs (the exact test
+ *      h > range decides), each reaction -F added to j at once; its cross pairs from step 1;
+ *      the sum S_i of its own pairs in j order added last; the closing half kick of velocity
+ *      Verlet (sim_many.c).
+ * So particle k always sums walls, then -F of every pair (i, k) in increasing i, then S_k: an
+ * order set by particle indices only, whatever the blocks, so states are bit-identical for any
+ * number of threads and, because pairs out of range add nothing, for any time at which the
+ * list was rebuilt (checkpoint + restart).
  *
  * Mixed properties (contact.c, SPEC §2): 1/E* = (1-nu_a^2)/E_a + (1-nu_b^2)/E_b, 1/G* =
  * (2-nu_a)/G_a + (2-nu_b)/G_b, means of e, mu, sigma, sum of films; computed once per
@@ -29,7 +33,8 @@
  * calls the same kernels (wetdem_force_hertz_elastic, wetdem_force_hertz_damping_with,
  * wetdem_force_hertz_total, wetdem_force_mindlin_update_with, wetdem_pair_force_add_tangential,
  * thin_film_eval_gap), the damping coefficients of the restitution (the exact-table lookup,
- * log e) computed once per material pair in the table by the force files' own functions and writes the static-bridge force 6 pi mu a^2 v_n/h [1 - h/delta]^2
+ * log e) computed once per material pair in the table by the force files' own functions, and
+ * writes the static-bridge force 6 pi mu a^2 v_n/h [1 - h/delta]^2
  * (Punch 2023 Eq. 7, corrected bracket; force_sb.c) and the capillary suction -8 pi a sigma
  * (Punch 2023 Eq. 15; force_capillary.c) with the same operations in the same order, and sums
  * the models as wetdem_sim_eval_contact does; the elastic Hertz force, which hertz and mindlin
@@ -40,6 +45,12 @@
  * x + (0 + y) = x + y for every x other than -0), so the skipped additions of zero fields
  * and the dropped 0 + y change nothing. The range of these models is the film thickness delta_ab
  * (0 for the contact models), a property of the material pair.
+ *
+ * Lean kernel: for the same model sets without an energy budget (and, with sb, a constant
+ * h_min), the force is computed straight from the two particles (or particle and wall),
+ * without a contact record or the switch, by the same definitions (models.h: Hertz stiffness,
+ * elastic and damping parts; mindlin.h: the tangential spring) in the same order, so it is
+ * bit-identical to the fused kernel and the generic path (tests/test_many_force.c).
  */
 #include <omp.h>
 #include <stdlib.h>
