@@ -50,6 +50,9 @@ struct wetdem_many_pair_out {
  * does not depend on the thread count either way. */
 #define WETDEM_MANY_PARALLEL_MIN 512
 
+/* Most threads (blocks) of the force pass. */
+#define WETDEM_MANY_MAX_BLOCKS 256
+
 #define WETDEM_MANY_ACTIVE 1u  /* within the interaction range: force applied */
 #define WETDEM_MANY_CONTACT 2u /* gap < 0: solid contact */
 #define WETDEM_MANY_BRIDGE 4u  /* gap < film delta_ij with a fluid model: liquid bridge */
@@ -108,7 +111,13 @@ struct wetdem_many {
     size_t hits_cap;
     size_t blk_cap, cross_first_cap, cross_q_cap, cross_in_cap, cross_out_cap;
     size_t n_blocks, blocks_n;
-    uint64_t blocks_build; /* list build the blocks were indexed for */
+    uint64_t blocks_build;  /* list build the blocks were indexed for */
+    uint64_t blocks_passes; /* force passes since the blocks were indexed */
+    bool blocks_refined;    /* re-indexed since the list build, with flags from a pass */
+    double block_est[WETDEM_MANY_MAX_BLOCKS];  /* estimated work of each block */
+    double block_time[WETDEM_MANY_MAX_BLOCKS]; /* its time in the passes since [s] */
+    double* work;                              /* per particle: scratch of the partition */
+    size_t work_cap;
     bool blocks_ready;
     /* force kernel (sim_many_force.c) */
     struct wetdem_many_mix* mix; /* n_mix_materials^2 material pairs */

@@ -800,26 +800,61 @@ static double particle_work(const struct wetdem_many* m, size_t i)
     size_t q0 = m->cl.first_pair[i], q1 = m->cl.first_pair[i + 1], active = 0;
     for (size_t q = q0; q < q1; q++)
         active += m->flags[q] != 0;
-    return 4.5 + (double)(q1 - q0) + 15.0 * (double)active + (m->wall_mask[i] ? 8.0 : 0.0);
+    return 4.5 + (double)(q1 - q0) + 20.0 * (double)active +
+           12.0 * (double)__builtin_popcountll(m->wall_mask[i]);
 }
 
 /* Block starts blk[0..nb]: contiguous blocks of about equal estimated work, so that the
- * threads finish together (the result does not depend on the boundaries). */
+ * threads finish together (the result does not depend on the boundaries). When the blocks of
+ * the same count were timed, the estimate of each particle is scaled by its old block's time
+ * per unit of estimate: a feedback on what the estimate misses (walls, sliding contacts). */
 static void partition_blocks(struct wetdem_many* m, size_t n, size_t nb)
 {
+    double scale[WETDEM_MANY_MAX_BLOCKS] = {0}, mean = 0;
+    bool timed = m->blocks_ready && m->n_blocks == nb && m->blocks_n == n && m->blocks_passes > 0;
+    for (size_t b = 0; timed && b < nb; b++) {
+        timed = m->block_est[b] > 0 && m->block_time[b] > 0;
+        scale[b] = timed ? m->block_time[b] / m->block_est[b] : 0;
+        mean += scale[b] / (double)nb;
+    }
     double total = 0;
-    for (size_t i = 0; i < n; i++)
-        total += particle_work(m, i);
+    for (size_t i = 0, b = 0; i < n; i++) {
+        while (timed && b + 1 < nb && i >= m->blk[b + 1])
+            b++;
+        double w = particle_work(m, i) * (timed ? scale[b] / mean : 1.0);
+        m->work[i] = w;
+        total += w;
+    }
     double sum = 0;
     size_t b = 1;
     m->blk[0] = 0;
     for (size_t i = 0; i < n && b < nb; i++) {
-        sum += particle_work(m, i);
+        sum += m->work[i];
         while (b < nb && sum >= total * (double)b / (double)nb)
             m->blk[b++] = i + 1;
     }
     while (b <= nb)
         m->blk[b++] = n;
+    for (b = 0; b < nb; b++) { /* the estimate of each new block, for the next feedback */
+        m->block_est[b] = 0;
+        for (size_t i = m->blk[b]; i < m->blk[b + 1]; i++)
+            m->block_est[b] += particle_work(m, i);
+        m->block_time[b] = 0;
+    }
+}
+
+/* Whether the timed blocks finished more than 10 % apart (after a few passes, so that one
+ * slow step on a shared machine does not move them). */
+static bool blocks_unbalanced(const struct wetdem_many* m)
+{
+    if (m->n_blocks < 2 || m->blocks_passes < 8)
+        return false;
+    double lo = INFINITY, hi = 0;
+    for (size_t b = 0; b < m->n_blocks; b++) {
+        lo = fmin(lo, m->block_time[b]);
+        hi = fmax(hi, m->block_time[b]);
+    }
+    return hi > 1.1 * lo;
 }
 
 /* Block of particle k (blk: nb + 1 starts). */
@@ -850,10 +885,19 @@ static int index_blocks(struct wetdem_sim* sim, size_t nb)
 {
     struct wetdem_many* m = sim->many;
     size_t n = sim->n_particles, np = m->cl.n_pairs;
-    if (m->blocks_ready && m->blocks_build == m->cl.n_builds && m->blocks_n == n &&
-        m->n_blocks == nb)
+    /* kept until the next list build; but once more after the first pass: the work estimate
+       counts the pairs with flags, which a run starting from fresh histories has only then */
+    bool same_list = m->blocks_ready && m->blocks_build == m->cl.n_builds && m->blocks_n == n &&
+                     m->n_blocks == nb;
+    bool first_pass_done = same_list && !m->blocks_refined && m->blocks_passes >= 1;
+    if (same_list && !first_pass_done && !blocks_unbalanced(m))
         return WETDEM_OK;
+    m->blocks_refined = same_list; /* the re-index after the first pass is done */
+    if (nb > WETDEM_MANY_MAX_BLOCKS)
+        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID, "%zu threads: at most %d", nb,
+                               WETDEM_MANY_MAX_BLOCKS);
     if (!reserve((void**)&m->blk, &m->blk_cap, nb + 1, sizeof *m->blk) ||
+        !reserve((void**)&m->work, &m->work_cap, n, sizeof *m->work) ||
         !reserve((void**)&m->cross_first, &m->cross_first_cap, 2 * (nb + 1),
                  sizeof *m->cross_first))
         return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory for %zu threads", nb);
@@ -897,6 +941,7 @@ static int index_blocks(struct wetdem_sim* sim, size_t nb)
     m->blocks_n = n;
     m->blocks_build = m->cl.n_builds;
     m->blocks_ready = true;
+    m->blocks_passes = 0;
     return WETDEM_OK;
 }
 
@@ -1038,6 +1083,7 @@ int wetdem_sim_many_forces(struct wetdem_sim* sim, bool kick)
     size_t n = sim->n_particles;
     bool parallel = wetdem_many_parallel(m, n);
     size_t nb = parallel ? (size_t)omp_get_max_threads() : 1;
+    nb = nb < WETDEM_MANY_MAX_BLOCKS ? nb : WETDEM_MANY_MAX_BLOCKS;
     st = index_blocks(sim, nb);
     if (st != WETDEM_OK)
         return st;
@@ -1063,10 +1109,13 @@ int wetdem_sim_many_forces(struct wetdem_sim* sim, bool kick)
             cross_pairs_of_block(&P, b, &fail);
 #pragma omp barrier
         for (size_t b = t; b < nb; b += nt) {
+            double t0 = omp_get_wtime();
             start_sums_of_block(&P, b, &fail);
             pairs_of_block(&P, b, kick, g, &fail);
+            m->block_time[b] += omp_get_wtime() - t0;
         }
     }
+    m->blocks_passes++;
     if (fail.status != WETDEM_OK)
         return report_failure(sim, &fail);
     sim->engine.stats.force_evals++;
