@@ -24,7 +24,7 @@
 #
 # Usage: bench/20-many.sh [WETDEM_CLI]    (make bench passes the CLI; it is not needed here)
 # Environment: N (20000), SETTLE (500), STEPS (1500), STATE (3000), SAME_STEPS (300),
-# FROZEN_STEPS (300), FROZEN_DT (1e-9), REPEAT (2) — about 10 minutes on 2 cores;
+# FROZEN_STEPS (300), FROZEN_DT (1e-9), REPEAT (3) — about 15 minutes on 2 cores;
 # OMP_WAIT_POLICY (default passive: spinning threads collapse when the cores are shared).
 # Results go to build/bench/many/ (logs, results.txt, summary.txt). The ratios are printed, not
 # enforced: the machine may be shared, which the load average printed with the results shows.
@@ -38,7 +38,7 @@ STATE=${STATE:-3000}
 SAME_STEPS=${SAME_STEPS:-300}
 FROZEN_STEPS=${FROZEN_STEPS:-300}
 FROZEN_DT=${FROZEN_DT:-1e-9}
-REPEAT=${REPEAT:-2}
+REPEAT=${REPEAT:-3}
 out=build/bench/many
 mkdir -p "$out"
 res="$out/results.txt"
@@ -52,6 +52,9 @@ cc -std=c11 -D_DEFAULT_SOURCE -O2 -fopenmp -Iinclude bench/many_bench.c build/li
 "$out/many_bench" --n 1 --data "$out/one.data"
 
 field() { sed -n "s/.*$1=\([^ ]*\).*/\1/p"; }
+# CPU time the host took from this virtual machine so far (steal, all cores) [s]
+steal_s() { awk -v hz="$(getconf CLK_TCK)" '/^cpu /{printf "%.2f", $9 / hz}' /proc/stat; }
+steal0=$(steal_s)
 export OMP_WAIT_POLICY=${OMP_WAIT_POLICY:-passive}
 have_lg=false
 command -v liggghts >/dev/null && command -v mpirun >/dev/null && have_lg=true
@@ -148,7 +151,9 @@ $have_lg || echo "20-many: liggghts or mpirun not installed: LIGGGHTS half skipp
   "(scripts/install-deps bench)"
 
 # ---- report ----
-echo "load average after the run: $(cut -d' ' -f1-3 /proc/loadavg), $(nproc) cores" | tee -a "$res"
+echo "load average after the run: $(cut -d' ' -f1-3 /proc/loadavg), $(nproc) cores;" \
+     "time taken by the host (steal) during the run: $(awk -v a="$steal0" -v b="$(steal_s)" \
+     'BEGIN{printf "%.1f", b - a}') s" | tee -a "$res"
 awk -v n="$N" -v wb="$base_kb" -v lb="$lg_base" -v steps="$STEPS" -v same="$SAME_STEPS" \
     -v fsteps="$FROZEN_STEPS" -v fdt="$FROZEN_DT" '
   /^(full|same|frozen) / { k = $1 " " $2 " " $3 " " $4; rate[k] = $5; kb[k] = $6; cpu[k] = $7
