@@ -441,11 +441,11 @@ static inline __attribute__((always_inline)) int lean_force(const struct wetdem_
 static int lean_pair(const struct wetdem_many* m, const struct wetdem_particle* a,
                      const struct wetdem_particle* b, struct wetdem_vec3 d,
                      const struct wetdem_many_mix* x, double* hist, unsigned char* flags,
-                     struct wetdem_many_pair_out* o) __attribute__((noinline));
-static int lean_pair(const struct wetdem_many* m, const struct wetdem_particle* a,
-                     const struct wetdem_particle* b, struct wetdem_vec3 d,
-                     const struct wetdem_many_mix* x, double* hist, unsigned char* flags,
-                     struct wetdem_many_pair_out* o)
+                     struct wetdem_many_pair_out* o) __attribute__((always_inline));
+static inline int lean_pair(const struct wetdem_many* m, const struct wetdem_particle* a,
+                            const struct wetdem_particle* b, struct wetdem_vec3 d,
+                            const struct wetdem_many_mix* x, double* hist, unsigned char* flags,
+                            struct wetdem_many_pair_out* o)
 {
     double dist = vec3_norm(d);
     struct lean_geometry g; /* every field read is set (no zeroing of the whole record) */
@@ -1023,7 +1023,7 @@ static void pairs_of_block(const struct pass* P, size_t b, bool kick, struct wet
         double lim = xr[i].r + xr[j].r + x->range;
         bool near = vec3_dot(d, d) <= lim * lim * (1 + PREFILTER_MARGIN);
         hits[n_hits] = (uint32_t)q;
-        n_hits += (near || flags[q]) && j < end_block;
+        n_hits += ((size_t)near | (size_t)(flags[q] != 0)) & (size_t)(j < end_block);
     }
     /* 2. every particle in index order: its listed pairs (reactions to the second particle at
           once), its cross pairs from phase 1, then its own sum and the closing half kick */
