@@ -123,13 +123,14 @@ struct wetdem_many {
     struct wetdem_many_mix* mix; /* n_mix_materials^2 material pairs */
     size_t mix_cap;
     int n_mix_materials;
-    struct wetdem_many_lean lean;          /* the lean pair kernel's plan */
-    bool kernel_ready;                     /* mix and kind[] match the current set-up */
-    bool fused;                            /* every enabled model has a fused kernel */
-    bool generic_only;                     /* tests: never use the fused kernel */
-    size_t parallel_min;                   /* tests: fewest particles for parallel loops (0: default
+    struct wetdem_many_lean lean; /* the lean pair kernel's plan */
+    bool kernel_ready;            /* mix and kind[] match the current set-up */
+    bool fused;                   /* every enabled model has a fused kernel */
+    bool generic_only;            /* tests: never use the fused kernel */
+    uint64_t block_jitter; /* tests: non-zero cuts the force-pass blocks at random (a seed) */
+    size_t parallel_min;   /* tests: fewest particles for parallel loops (0: default
                                     WETDEM_MANY_PARALLEL_MIN) */
-    bool periodic_any;                     /* some axis is periodic */
+    bool periodic_any;     /* some axis is periodic */
     unsigned char kind[WETDEM_MAX_MODELS]; /* fused kernel of model k */
     double kind_opt[WETDEM_MAX_MODELS];    /* its switch parameter (hertz damping form, ...) */
     struct wetdem_vec3 *force, *torque, *vh, *wh; /* per particle */

@@ -835,6 +835,15 @@ static void partition_blocks(struct wetdem_many* m, size_t n, size_t nb)
     }
     while (b <= nb)
         m->blk[b++] = n;
+    if (m->block_jitter) { /* tests: arbitrary increasing cuts, new at every re-cut */
+        uint64_t r = m->block_jitter =
+            m->block_jitter * 6364136223846793005u + 1442695040888963407u;
+        for (b = 1; b < nb; b++) {
+            r = r * 6364136223846793005u + 1442695040888963407u;
+            size_t lo = m->blk[b - 1], hi = n;
+            m->blk[b] = lo + (size_t)((r >> 33) % (hi - lo + 1));
+        }
+    }
     for (b = 0; b < nb; b++) { /* the estimate of each new block, for the next feedback */
         m->block_est[b] = 0;
         for (size_t i = m->blk[b]; i < m->blk[b + 1]; i++)
