@@ -306,26 +306,12 @@ static struct wetdem_celllist_pair ordered(uint32_t a, uint32_t b)
 }
 
 /* Tests particle s against the runs; appends the listed pairs as (min, max) to out and
- * returns their number. No periodic axis: the displacement is the plain difference. */
-static size_t scan_plain(const struct scan* sc, size_t s, const struct run* runs, int m,
-                         struct wetdem_celllist_pair* out)
-{
-    const struct wetdem_celllist_item a = sc->x[s];
-    size_t count = 0;
-    for (int r = 0; r < m; r++)
-        for (size_t t = runs[r].lo; t < runs[r].hi; t++) {
-            const struct wetdem_celllist_item* b = &sc->x[t];
-            struct wetdem_vec3 d = vec3(a.x - b->x, a.y - b->y, a.z - b->z);
-            double lim = a.r + b->r + sc->extra;
-            if (vec3_dot(d, d) < lim * lim)
-                out[count++] = ordered(sc->id[s], sc->id[t]);
-        }
-    return count;
-}
-
-/* As scan_plain with the minimum-image displacement of celllist_delta. */
-static size_t scan_image(const struct scan* sc, size_t s, const struct run* runs, int m,
-                         struct wetdem_celllist_pair* out)
+ * returns their number. `periodic`: the minimum-image displacement of celllist_delta, else
+ * the plain difference (a constant at each call, so each variant compiles to its own loop). */
+static inline __attribute__((always_inline)) size_t scan_runs(const struct scan* sc, size_t s,
+                                                              const struct run* runs, int m,
+                                                              struct wetdem_celllist_pair* out,
+                                                              bool periodic)
 {
     const struct wetdem_celllist_item a = sc->x[s];
     size_t count = 0;
@@ -333,12 +319,25 @@ static size_t scan_image(const struct scan* sc, size_t s, const struct run* runs
         for (size_t t = runs[r].lo; t < runs[r].hi; t++) {
             const struct wetdem_celllist_item* b = &sc->x[t];
             struct wetdem_vec3 d =
-                celllist_delta(sc->box, vec3(a.x, a.y, a.z), vec3(b->x, b->y, b->z));
+                periodic ? celllist_delta(sc->box, vec3(a.x, a.y, a.z), vec3(b->x, b->y, b->z))
+                         : vec3(a.x - b->x, a.y - b->y, a.z - b->z);
             double lim = a.r + b->r + sc->extra;
             if (vec3_dot(d, d) < lim * lim)
                 out[count++] = ordered(sc->id[s], sc->id[t]);
         }
     return count;
+}
+
+static size_t scan_plain(const struct scan* sc, size_t s, const struct run* runs, int m,
+                         struct wetdem_celllist_pair* out)
+{
+    return scan_runs(sc, s, runs, m, out, false);
+}
+
+static size_t scan_image(const struct scan* sc, size_t s, const struct run* runs, int m,
+                         struct wetdem_celllist_pair* out)
+{
+    return scan_runs(sc, s, runs, m, out, true);
 }
 
 /* Runs of the half stencil of cell c = (x, y, z) after runs[0] (kept for the cell itself). */
