@@ -875,17 +875,34 @@ static size_t block_of(const size_t* blk, size_t nb, size_t k)
     return b;
 }
 
-/* Orders cross entries by their pair's second particle, then first (qsort context-free: the
- * pair list is reached through a file-scope pointer set by the caller under a lock). */
-static const struct wetdem_celllist_pair* sort_pairs;
-static const uint32_t* sort_cross;
+/* A cross entry e with its pair (i, j), for sorting by (j, i). */
+struct cross_key {
+    uint32_t j, i, e;
+};
+
 static int by_second(const void* a, const void* b)
 {
-    struct wetdem_celllist_pair x = sort_pairs[sort_cross[*(const uint32_t*)a]];
-    struct wetdem_celllist_pair y = sort_pairs[sort_cross[*(const uint32_t*)b]];
-    if (x.j != y.j)
-        return x.j < y.j ? -1 : 1;
-    return x.i < y.i ? -1 : (x.i > y.i);
+    const struct cross_key *x = a, *y = b;
+    if (x->j != y->j)
+        return x->j < y->j ? -1 : 1;
+    return x->i < y->i ? -1 : (x->i > y->i);
+}
+
+/* cross_in: the cross entries (n) ordered by their pair's second particle, then first. */
+static int sort_cross_in(struct wetdem_many* m, size_t n)
+{
+    struct cross_key* k = malloc((n ? n : 1) * sizeof *k);
+    if (!k)
+        return WETDEM_ERR_NOMEM;
+    for (size_t e = 0; e < n; e++) {
+        struct wetdem_celllist_pair q = m->cl.pairs[m->cross_q[e]];
+        k[e] = (struct cross_key){q.j, q.i, (uint32_t)e};
+    }
+    qsort(k, n, sizeof *k, by_second);
+    for (size_t e = 0; e < n; e++)
+        m->cross_in[e] = k[e].e;
+    free(k);
+    return WETDEM_OK;
 }
 
 /* Blocks for nb threads and the pairs that cross them (first particle in an earlier block
@@ -938,14 +955,8 @@ static int index_blocks(struct wetdem_sim* sim, size_t nb)
         first_out[b + 1] += first_out[b];
         first_in[b + 1] += first_in[b];
     }
-    if (nc > 1) {
-#pragma omp critical(wetdem_many_sort)
-        {
-            sort_pairs = m->cl.pairs;
-            sort_cross = m->cross_q;
-            qsort(m->cross_in, nc, sizeof *m->cross_in, by_second);
-        }
-    }
+    if (nc > 1 && sort_cross_in(m, nc) != WETDEM_OK)
+        return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory for %zu pairs", nc);
     m->n_blocks = nb;
     m->blocks_n = n;
     m->blocks_build = m->cl.n_builds;
