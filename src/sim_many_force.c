@@ -1006,6 +1006,37 @@ static void start_sums_of_block(const struct pass* P, size_t b, struct failure* 
     }
 }
 
+/* The gap test of candidates q_begin .. q_end in one flat loop without branches on its outcome:
+ * those within range, and those with flags (they may have just left it), whose second particle
+ * is below end_block, are listed in hits in pair order; returns their number. `periodic` and
+ * `single` (one material pair) are constants at each call, so each case compiles to its own
+ * loop. */
+static inline __attribute__((always_inline)) size_t gap_test(const struct pass* P, size_t q_begin,
+                                                             size_t q_end, size_t end_block,
+                                                             uint32_t* hits, bool periodic,
+                                                             bool single)
+{
+    const struct wetdem_celllist_pair* pairs = P->pairs;
+    const struct wetdem_celllist_item* xr = P->xr;
+    const struct wetdem_many_mix* mix = P->m->mix;
+    const unsigned char* flags = P->flags;
+    size_t nm = P->nm, n_hits = 0;
+    double range0 = mix[0].range;
+    for (size_t q = q_begin; q < q_end; q++) {
+        size_t i = pairs[q].i, j = pairs[q].j;
+        struct wetdem_vec3 xi = vec3(xr[i].x, xr[i].y, xr[i].z),
+                           xj = vec3(xr[j].x, xr[j].y, xr[j].z);
+        struct wetdem_vec3 d = periodic ? celllist_delta(&P->m->cl.box, xi, xj) : vec3_sub(xi, xj);
+        double range =
+            single ? range0 : mix[(size_t)P->p[i].material * nm + (size_t)P->p[j].material].range;
+        double lim = xr[i].r + xr[j].r + range;
+        bool near = vec3_dot(d, d) <= lim * lim * (1 + PREFILTER_MARGIN);
+        hits[n_hits] = (uint32_t)q;
+        n_hits += ((size_t)near | (size_t)(flags[q] != 0)) & (size_t)(j < end_block);
+    }
+    return n_hits;
+}
+
 /* Phase 2 of block b: every particle i in index order; its pairs within the block are
  * evaluated and their reactions added to the second particle at once (so each particle
  * receives its reactions in increasing i), its cross pairs are read from phase 1; the sum of
@@ -1032,19 +1063,9 @@ static void pairs_of_block(const struct pass* P, size_t b, bool kick, struct wet
           with flags (they may have just left it), are listed in pair order */
     size_t q_begin = m->cl.first_pair[begin_block], q_end = m->cl.first_pair[end_block];
     uint32_t* hits = m->hits + q_begin;
-    size_t n_hits = 0;
-    for (size_t q = q_begin; q < q_end; q++) {
-        size_t i = pairs[q].i, j = pairs[q].j;
-        struct wetdem_vec3 xi = vec3(xr[i].x, xr[i].y, xr[i].z),
-                           xj = vec3(xr[j].x, xr[j].y, xr[j].z);
-        struct wetdem_vec3 d = periodic ? celllist_delta(box, xi, xj) : vec3_sub(xi, xj);
-        const struct wetdem_many_mix* x =
-            single ? mix : &mix[(size_t)p[i].material * nm + (size_t)p[j].material];
-        double lim = xr[i].r + xr[j].r + x->range;
-        bool near = vec3_dot(d, d) <= lim * lim * (1 + PREFILTER_MARGIN);
-        hits[n_hits] = (uint32_t)q;
-        n_hits += ((size_t)near | (size_t)(flags[q] != 0)) & (size_t)(j < end_block);
-    }
+    size_t n_hits = single && !periodic /* the common case, in its own loop */
+                        ? gap_test(P, q_begin, q_end, end_block, hits, false, true)
+                        : gap_test(P, q_begin, q_end, end_block, hits, periodic, false);
     /* 2. every particle in index order: its listed pairs (reactions to the second particle at
           once), its cross pairs from phase 1, then its own sum and the closing half kick */
     size_t h = 0;
