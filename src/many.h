@@ -57,6 +57,9 @@ struct wetdem_many_pair_out {
 #define WETDEM_MANY_CONTACT 2u /* gap < 0: solid contact */
 #define WETDEM_MANY_BRIDGE 4u  /* gap < film delta_ij with a fluid model: liquid bridge */
 #define WETDEM_MANY_DIRTY 8u   /* history may differ from a fresh one (reset when out of range) */
+#define WETDEM_MANY_CACHED                                                                         \
+    16u /* pair_cache holds the pair's constants (lean kernel; cleared with
+                                  the flags when the pair leaves its range) */
 
 /* Energy bookkeeping (sim_many.c accumulates, sim_many_io.c reports). */
 struct wetdem_many_energy {
@@ -85,6 +88,11 @@ struct wetdem_many {
     unsigned char* flags; /* per candidate pair: MANY_ACTIVE | _CONTACT | _BRIDGE | _DIRTY
                                     (a separate byte array: the gather scans it densely) */
     size_t flags_cap;
+    double (*pair_cache)[4]; /* per candidate pair, valid where WETDEM_MANY_CACHED: R* [m],
+                                m* [kg], the Hertz stiffness (4/3) E* sqrt(R*) [N/m^1.5] and the
+                                damping factor c sqrt(m* k) of the hertz form [kg/(s m^0.25)] */
+    double (*old_cache)[4];
+    size_t pair_cache_cap, old_cache_cap;
     unsigned char* old_flags; /* flags of the previous list, for remapping */
     size_t old_flags_cap;
     uint64_t* wall_mask; /* per particle: bit w set if wall w is within reach + skin

@@ -56,7 +56,8 @@ static inline size_t contact_only_thresholds(const void* params, const struct we
 double wetdem_force_hertz_elastic(double e_star, double r_eff, double overlap);
 /* Hertz stiffness factor k = (4/3) E* sqrt(R*) [N/m^(3/2)] and the parts of the hertz law
  * written with it: the elastic force k delta^(3/2) and the damping force
- * coefficient sqrt(m* k) delta^(1/4) v_n [N] (delta > 0). The one definition of this
+ * (coefficient sqrt(m* k)) delta^(1/4) v_n [N] (delta > 0), whose first factor depends on the
+ * pair only. The one definition of this
  * arithmetic: force_hertz.c and the many-particle kernel (sim_many_force.c) both use it, so
  * that their forces are bit-identical. */
 static inline double hertz_stiffness(double e_star, double r_eff)
@@ -67,10 +68,18 @@ static inline double hertz_elastic_k(double k, double overlap)
 {
     return k * overlap * sqrt(overlap);
 }
+static inline double hertz_damping_factor(double coefficient, double k, double m_eff)
+{
+    return coefficient * sqrt(m_eff * k);
+}
+static inline double hertz_damping_from(double factor, double overlap, double v_n)
+{
+    return factor * sqrt(sqrt(overlap)) * v_n;
+}
 static inline double hertz_damping_k(double coefficient, double k, double m_eff, double overlap,
                                      double v_n)
 {
-    return coefficient * sqrt(m_eff * k) * sqrt(sqrt(overlap)) * v_n;
+    return hertz_damping_from(hertz_damping_factor(coefficient, k, m_eff), overlap, v_n);
 }
 /* force_hertz.c: normal viscous damping force of the Hertz contact [N], > 0 (repulsive) for
  * v_n > 0 (approaching), proportional to delta^(1/4) v_n so that the restitution is

@@ -373,6 +373,7 @@ struct lean_geometry {
     struct wetdem_vec3 n;   /* unit normal, j to i */
     double gap, r_i, r_j;   /* [m]; r_j unused for walls */
     double r_eff, m_eff;    /* R* [m], m* [kg] */
+    double k, damping;      /* hertz_stiffness and hertz_damping_factor of the pair */
     double v_n;             /* [m/s] */
     struct wetdem_vec3 v_t; /* [m/s], set only when mindlin is enabled */
     bool wall;
@@ -395,12 +396,11 @@ static inline __attribute__((always_inline)) int lean_force(const struct wetdem_
     struct wetdem_vec3 n = g->n, zero = vec3(0, 0, 0), f_tan = zero, t_i = zero, t_j = zero;
     double term[3] = {0.0, 0.0, 0.0}; /* hertz, sb, capillary */
     if (overlap > 0.0) {              /* solid contact: hertz and mindlin act */
-        double m_eff = g->m_eff, k = hertz_stiffness(x->e_star, r_eff);
+        double m_eff = g->m_eff, k = g->k;
         double f_el = hertz_elastic_k(k, overlap);
         if (L->hertz_form >= 0)
-            term[0] = wetdem_force_hertz_total(
-                f_el, hertz_damping_k(x->hertz_damping[L->hertz_form], k, m_eff, overlap, v_n),
-                L->hertz_form);
+            term[0] = wetdem_force_hertz_total(f_el, hertz_damping_from(g->damping, overlap, v_n),
+                                               L->hertz_form);
         if (L->mindlin) { /* wetdem_pair_force_add_tangential onto a zero record */
             struct wetdem_vec3 ft =
                 mindlin_spring(n, g->v_t, m->dt, x->g_star, r_eff, m_eff, overlap, f_el,
@@ -440,16 +440,18 @@ static inline __attribute__((always_inline)) int lean_force(const struct wetdem_
  * it, then lean_force; *flags = 0 beyond the range. */
 static int lean_pair(const struct wetdem_many* m, const struct wetdem_particle* a,
                      const struct wetdem_particle* b, struct wetdem_vec3 d,
-                     const struct wetdem_many_mix* x, double* hist, unsigned char* flags,
-                     struct wetdem_many_pair_out* o) __attribute__((always_inline));
+                     const struct wetdem_many_mix* x, double* hist, double* cache,
+                     unsigned char* flags, struct wetdem_many_pair_out* o)
+    __attribute__((always_inline));
 static inline int lean_pair(const struct wetdem_many* m, const struct wetdem_particle* a,
                             const struct wetdem_particle* b, struct wetdem_vec3 d,
-                            const struct wetdem_many_mix* x, double* hist, unsigned char* flags,
-                            struct wetdem_many_pair_out* o)
+                            const struct wetdem_many_mix* x, double* hist, double* cache,
+                            unsigned char* flags, struct wetdem_many_pair_out* o)
 {
     double dist = vec3_norm(d);
     struct lean_geometry g; /* every field read is set (no zeroing of the whole record) */
     g.gap = dist - a->radius - b->radius;
+    bool cached = *flags & WETDEM_MANY_CACHED;
     *flags = 0;
     if (g.gap > x->range)
         return WETDEM_OK;
@@ -457,18 +459,29 @@ static inline int lean_pair(const struct wetdem_many* m, const struct wetdem_par
     g.r_j = b->radius;
     g.wall = false;
     g.n = dist > 0 ? vec3_scale(d, 1.0 / dist) : vec3(1, 0, 0);
-    g.r_eff = contact_reduced(a->radius, b->radius);
+    if (!cached) { /* the pair's constants, computed as they would be at every step */
+        cache[0] = contact_reduced(a->radius, b->radius);
+        cache[1] = contact_reduced(contact_effective_mass(a), contact_effective_mass(b));
+        cache[2] = hertz_stiffness(x->e_star, cache[0]);
+        cache[3] =
+            m->lean.hertz_form >= 0
+                ? hertz_damping_factor(x->hertz_damping[m->lean.hertz_form], cache[2], cache[1])
+                : 0.0;
+    }
+    g.r_eff = cache[0];
+    g.m_eff = cache[1];
+    g.k = cache[2];
+    g.damping = cache[3];
     g.v_n = -vec3_dot(vec3_sub(a->vel, b->vel), g.n);
-    g.m_eff = 0.0; /* m* and v_t: read in solid contact only */
-    g.v_t = vec3(0, 0, 0);
-    if (g.gap < 0.0)
-        g.m_eff = contact_reduced(contact_effective_mass(a), contact_effective_mass(b));
+    g.v_t = vec3(0, 0, 0); /* read in solid contact only */
     if (g.gap < 0.0 && m->lean.mindlin) {
         struct wetdem_vec3 va = vec3_add(a->vel, vec3_cross(a->omega, vec3_scale(g.n, -a->radius)));
         struct wetdem_vec3 vb = vec3_add(b->vel, vec3_cross(b->omega, vec3_scale(g.n, b->radius)));
         g.v_t = vec3_reject(vec3_sub(va, vb), g.n);
     }
-    return lean_force(m, &g, x, hist, flags, o);
+    int st = lean_force(m, &g, x, hist, flags, o);
+    *flags |= WETDEM_MANY_CACHED;
+    return st;
 }
 
 /* Particle a and plane wall w: the geometry of wall_contact_from, then lean_force; *flags = 0
@@ -492,6 +505,12 @@ static int lean_wall(const struct wetdem_many* m, const struct wetdem_particle* 
     if (g.gap > x->range)
         return WETDEM_OK;
     g.v_n = -vec3_dot(a->vel, g.n);
+    if (g.gap < 0.0) {
+        g.k = hertz_stiffness(x->e_star, g.r_eff);
+        g.damping = m->lean.hertz_form >= 0
+                        ? hertz_damping_factor(x->hertz_damping[m->lean.hertz_form], g.k, g.m_eff)
+                        : 0.0;
+    }
     if (g.gap < 0.0 && m->lean.mindlin) {
         struct wetdem_vec3 va =
             vec3_add(a->vel, vec3_cross(a->omega, vec3_scale(w->normal, -a->radius)));
@@ -654,7 +673,7 @@ static unsigned char near_candidate(const struct pass* P, size_t q, size_t i, si
     }
     unsigned char was = *fl;
     double* hist = P->history + q * P->len;
-    int st = lean_pair(P->m, &P->p[i], &P->p[j], d, x, hist, fl, o);
+    int st = lean_pair(P->m, &P->p[i], &P->p[j], d, x, hist, P->m->pair_cache[q], fl, o);
     if (!*fl && (was & WETDEM_MANY_DIRTY) && P->len)
         wetdem_sim_history_init(P->sim, hist);
     if (st != WETDEM_OK) {
@@ -1128,6 +1147,13 @@ int wetdem_sim_many_forces(struct wetdem_sim* sim, bool kick)
     st = index_blocks(sim, nb);
     if (st != WETDEM_OK)
         return st;
+    if (m->cl.n_pairs > m->pair_cache_cap) { /* a list not built by rebuild (restart) */
+        if (!reserve((void**)&m->pair_cache, &m->pair_cache_cap, m->cl.n_pairs,
+                     sizeof *m->pair_cache))
+            return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory");
+        for (size_t q = 0; q < m->cl.n_pairs; q++)
+            m->flags[q] &= (unsigned char)~WETDEM_MANY_CACHED;
+    }
     struct failure fail = {0};
     struct wetdem_vec3 g =
         vec3(sim->settings.gravity_x, sim->settings.gravity_y, sim->settings.gravity_z);
