@@ -39,33 +39,14 @@ static void mix_properties(struct wetdem_contact* c, const struct wetdem_materia
     c->dt = 0.0;
 }
 
-static void set_kinematics(struct wetdem_contact* c, struct wetdem_vec3 dv,
-                           struct wetdem_vec3 surface_rel)
-{
-    c->v_n = -vec3_dot(dv, c->normal);
-    c->v_t = vec3_reject(surface_rel, c->normal);
-}
-
 void wetdem_contact_from_particles(struct wetdem_contact* c, const struct wetdem_particle* a,
                                    const struct wetdem_material* ma,
                                    const struct wetdem_particle* b,
                                    const struct wetdem_material* mb,
                                    const struct wetdem_fluid* fluid)
 {
-    struct wetdem_vec3 d = vec3_sub(a->pos, b->pos);
-    double dist = vec3_norm(d);
-    c->is_wall = false;
-    c->normal = dist > 0 ? vec3_scale(d, 1.0 / dist) : vec3(1, 0, 0);
-    c->gap = dist - a->radius - b->radius;
-    c->radius_i = a->radius;
-    c->radius_j = b->radius;
-    c->r_eff = contact_reduced(a->radius, b->radius);
-    c->m_eff = contact_reduced(contact_effective_mass(a), contact_effective_mass(b));
-    struct wetdem_vec3 n = c->normal;
-    struct wetdem_vec3 va = vec3_add(a->vel, vec3_cross(a->omega, vec3_scale(n, -a->radius)));
-    struct wetdem_vec3 vb = vec3_add(b->vel, vec3_cross(b->omega, vec3_scale(n, b->radius)));
+    contact_pair_geometry(c, a, b, vec3_sub(a->pos, b->pos));
     mix_properties(c, ma, mb, fluid);
-    set_kinematics(c, vec3_sub(a->vel, b->vel), vec3_sub(va, vb));
 }
 
 void wetdem_contact_with_wall(struct wetdem_contact* c, const struct wetdem_particle* a,
@@ -73,17 +54,8 @@ void wetdem_contact_with_wall(struct wetdem_contact* c, const struct wetdem_part
                               struct wetdem_vec3 normal, const struct wetdem_material* mw,
                               const struct wetdem_fluid* fluid)
 {
-    double dist = vec3_dot(vec3_sub(a->pos, point), normal);
-    c->is_wall = true;
-    c->normal = normal;
-    c->gap = dist - a->radius;
-    c->radius_i = a->radius;
-    c->radius_j = INFINITY;
-    c->r_eff = a->radius;
-    c->m_eff = contact_effective_mass(a);
-    struct wetdem_vec3 va = vec3_add(a->vel, vec3_cross(a->omega, vec3_scale(normal, -a->radius)));
+    contact_wall_geometry(c, a, point, normal);
     mix_properties(c, ma, mw, fluid);
-    set_kinematics(c, a->vel, va);
 }
 
 struct wetdem_contact wetdem_contact_swapped(const struct wetdem_contact* c)

@@ -1,6 +1,7 @@
 /*
- * contact.h — pair reductions shared by contact.c (wetdem_contact_from_particles) and the
- * many-particle fast path (sim_many_force.c), so both build a contact with the same arithmetic:
+ * contact.h — pair reductions and contact geometry shared by contact.c
+ * (wetdem_contact_from_particles, wetdem_contact_with_wall) and the many-particle engine
+ * (sim_many_force.c), so both build a contact with the same arithmetic:
  * R* = R_i R_j/(R_i + R_j) and m* = m_i m_j/(m_i + m_j), where an infinite radius or mass
  * (wall, fixed particle) leaves the other one.
  */
@@ -9,6 +10,7 @@
 
 #include <math.h>
 
+#include "vec3.h"
 #include "wetdem.h"
 
 /* a b/(a + b), with an infinite argument giving the other one. */
@@ -25,6 +27,45 @@ static inline double contact_reduced(double a, double b)
 static inline double contact_effective_mass(const struct wetdem_particle* p)
 {
     return p->is_fixed ? INFINITY : p->mass;
+}
+
+/* The geometry and kinematics of the contact of a with b, d = x_a - x_b (minimum image where
+ * the caller needs it): normal (b to a), gap, radii, R*, m*, v_n, v_t; the mixed properties
+ * are the caller's. */
+static inline void contact_pair_geometry(struct wetdem_contact* c, const struct wetdem_particle* a,
+                                         const struct wetdem_particle* b, struct wetdem_vec3 d)
+{
+    double dist = vec3_norm(d);
+    c->is_wall = false;
+    c->normal = dist > 0 ? vec3_scale(d, 1.0 / dist) : vec3(1, 0, 0);
+    c->gap = dist - a->radius - b->radius;
+    c->radius_i = a->radius;
+    c->radius_j = b->radius;
+    c->r_eff = contact_reduced(a->radius, b->radius);
+    c->m_eff = contact_reduced(contact_effective_mass(a), contact_effective_mass(b));
+    struct wetdem_vec3 n = c->normal;
+    struct wetdem_vec3 va = vec3_add(a->vel, vec3_cross(a->omega, vec3_scale(n, -a->radius)));
+    struct wetdem_vec3 vb = vec3_add(b->vel, vec3_cross(b->omega, vec3_scale(n, b->radius)));
+    c->v_n = -vec3_dot(vec3_sub(a->vel, b->vel), n);
+    c->v_t = vec3_reject(vec3_sub(va, vb), n);
+}
+
+/* The same for particle a and the plane through `point` with unit `normal` (into the side of
+ * a): R* = R_a, m* = m_a, a wall does not move. */
+static inline void contact_wall_geometry(struct wetdem_contact* c, const struct wetdem_particle* a,
+                                         struct wetdem_vec3 point, struct wetdem_vec3 normal)
+{
+    double dist = vec3_dot(vec3_sub(a->pos, point), normal);
+    c->is_wall = true;
+    c->normal = normal;
+    c->gap = dist - a->radius;
+    c->radius_i = a->radius;
+    c->radius_j = INFINITY;
+    c->r_eff = a->radius;
+    c->m_eff = contact_effective_mass(a);
+    struct wetdem_vec3 va = vec3_add(a->vel, vec3_cross(a->omega, vec3_scale(normal, -a->radius)));
+    c->v_n = -vec3_dot(a->vel, normal);
+    c->v_t = vec3_reject(va, normal);
 }
 
 #endif

@@ -216,45 +216,22 @@ static void copy_mix(struct wetdem_contact* c, const struct wetdem_many_mix* x)
     c->dt = 0.0;
 }
 
-/* Contact of a with b where d = x_a - x_b (minimum image): the operations of
- * wetdem_contact_from_particles in the same order, mixed properties from the table. */
+/* Contact of a with b where d = x_a - x_b (minimum image): the geometry of
+ * wetdem_contact_from_particles (contact.h), mixed properties from the table. */
 static void pair_contact_from(const struct wetdem_particle* a, const struct wetdem_particle* b,
                               struct wetdem_vec3 d, const struct wetdem_many_mix* x,
                               struct wetdem_contact* c)
 {
-    double dist = vec3_norm(d);
-    c->is_wall = false;
-    c->normal = dist > 0 ? vec3_scale(d, 1.0 / dist) : vec3(1, 0, 0);
-    c->gap = dist - a->radius - b->radius;
-    c->radius_i = a->radius;
-    c->radius_j = b->radius;
-    c->r_eff = contact_reduced(a->radius, b->radius);
-    c->m_eff = contact_reduced(contact_effective_mass(a), contact_effective_mass(b));
-    struct wetdem_vec3 n = c->normal;
-    struct wetdem_vec3 va = vec3_add(a->vel, vec3_cross(a->omega, vec3_scale(n, -a->radius)));
-    struct wetdem_vec3 vb = vec3_add(b->vel, vec3_cross(b->omega, vec3_scale(n, b->radius)));
+    contact_pair_geometry(c, a, b, d);
     copy_mix(c, x);
-    c->v_n = -vec3_dot(vec3_sub(a->vel, b->vel), n);
-    c->v_t = vec3_reject(vec3_sub(va, vb), n);
 }
 
 /* Contact of particle a with a plane wall (wetdem_contact_with_wall, table properties). */
 static void wall_contact_from(const struct wetdem_particle* a, const struct wetdem_wall* w,
                               const struct wetdem_many_mix* x, struct wetdem_contact* c)
 {
-    double dist = vec3_dot(vec3_sub(a->pos, w->point), w->normal);
-    c->is_wall = true;
-    c->normal = w->normal;
-    c->gap = dist - a->radius;
-    c->radius_i = a->radius;
-    c->radius_j = INFINITY;
-    c->r_eff = a->radius;
-    c->m_eff = contact_effective_mass(a);
-    struct wetdem_vec3 va =
-        vec3_add(a->vel, vec3_cross(a->omega, vec3_scale(w->normal, -a->radius)));
+    contact_wall_geometry(c, a, w->point, w->normal);
     copy_mix(c, x);
-    c->v_n = -vec3_dot(a->vel, c->normal);
-    c->v_t = vec3_reject(va, c->normal);
 }
 
 const struct wetdem_many_mix* wetdem_sim_many_mix(const struct wetdem_sim* sim, int a, int b)
@@ -692,21 +669,33 @@ static void leave_range(const struct pass* P, size_t q)
     P->flags[q] = 0;
 }
 
+/* The cheap gap test of pair (i, j): d = x_i - x_j (minimum image when `periodic`) into *d and
+ * the pair's mixed properties into *x (the first when `single`: one material pair); true when
+ * |d|^2 <= (R_i + R_j + r_ab)^2 (1 + PREFILTER_MARGIN). */
+static inline __attribute__((always_inline)) bool within_reach(const struct pass* P, size_t i,
+                                                               size_t j, bool periodic, bool single,
+                                                               struct wetdem_vec3* d,
+                                                               const struct wetdem_many_mix** x)
+{
+    const struct wetdem_celllist_item* xr = P->xr;
+    struct wetdem_vec3 xi = vec3(xr[i].x, xr[i].y, xr[i].z), xj = vec3(xr[j].x, xr[j].y, xr[j].z);
+    *d = periodic ? celllist_delta(&P->m->cl.box, xi, xj) : vec3_sub(xi, xj);
+    *x = single ? P->m->mix
+                : &P->m->mix[(size_t)P->p[i].material * P->nm + (size_t)P->p[j].material];
+    double lim = xr[i].r + xr[j].r + (*x)->range;
+    return vec3_dot(*d, *d) <= lim * lim * (1 + PREFILTER_MARGIN);
+}
+
 /* Candidate pair q = (i, j): the gap test on the positions first (most candidates are beyond
  * their range), the kernel only for the others. Returns the pair's new flags; *o holds the
  * force and torques where they include WETDEM_MANY_ACTIVE. */
 static inline __attribute__((always_inline)) unsigned char
-eval_candidate(const struct pass* P, size_t q, size_t i, size_t j, struct wetdem_vec3 xi,
-               struct wetdem_many_pair_out* o, struct failure* fail)
+eval_candidate(const struct pass* P, size_t q, size_t i, size_t j, struct wetdem_many_pair_out* o,
+               struct failure* fail)
 {
-    const struct wetdem_celllist_item* xr = P->xr;
-    struct wetdem_vec3 xj = vec3(xr[j].x, xr[j].y, xr[j].z);
-    struct wetdem_vec3 d = P->periodic ? celllist_delta(&P->m->cl.box, xi, xj) : vec3_sub(xi, xj);
-    const struct wetdem_many_mix* x =
-        P->nm == 1 ? P->m->mix
-                   : &P->m->mix[(size_t)P->p[i].material * P->nm + (size_t)P->p[j].material];
-    double lim = xr[i].r + xr[j].r + x->range;
-    if (vec3_dot(d, d) <= lim * lim * (1 + PREFILTER_MARGIN))
+    struct wetdem_vec3 d;
+    const struct wetdem_many_mix* x;
+    if (within_reach(P, i, j, P->periodic, P->nm == 1, &d, &x))
         return near_candidate(P, q, i, j, d, x, o, fail);
     if (P->flags[q])
         leave_range(P, q);
@@ -992,9 +981,7 @@ static void cross_pairs_of_block(const struct pass* P, size_t b, struct failure*
     struct wetdem_many* m = P->m;
     for (size_t e = m->cross_first[b]; e < m->cross_first[b + 1]; e++) {
         size_t q = m->cross_q[e];
-        size_t i = P->pairs[q].i;
-        struct wetdem_vec3 xi = vec3(P->xr[i].x, P->xr[i].y, P->xr[i].z);
-        eval_candidate(P, q, i, P->pairs[q].j, xi, &m->cross_out[e], fail);
+        eval_candidate(P, q, P->pairs[q].i, P->pairs[q].j, &m->cross_out[e], fail);
     }
 }
 
@@ -1036,20 +1023,13 @@ static inline __attribute__((always_inline)) size_t gap_test(const struct pass* 
                                                              bool single)
 {
     const struct wetdem_celllist_pair* pairs = P->pairs;
-    const struct wetdem_celllist_item* xr = P->xr;
-    const struct wetdem_many_mix* mix = P->m->mix;
     const unsigned char* flags = P->flags;
-    size_t nm = P->nm, n_hits = 0;
-    double range0 = mix[0].range;
+    size_t n_hits = 0;
     for (size_t q = q_begin; q < q_end; q++) {
         size_t i = pairs[q].i, j = pairs[q].j;
-        struct wetdem_vec3 xi = vec3(xr[i].x, xr[i].y, xr[i].z),
-                           xj = vec3(xr[j].x, xr[j].y, xr[j].z);
-        struct wetdem_vec3 d = periodic ? celllist_delta(&P->m->cl.box, xi, xj) : vec3_sub(xi, xj);
-        double range =
-            single ? range0 : mix[(size_t)P->p[i].material * nm + (size_t)P->p[j].material].range;
-        double lim = xr[i].r + xr[j].r + range;
-        bool near = vec3_dot(d, d) <= lim * lim * (1 + PREFILTER_MARGIN);
+        struct wetdem_vec3 d;
+        const struct wetdem_many_mix* x;
+        bool near = within_reach(P, i, j, periodic, single, &d, &x);
         hits[n_hits] = (uint32_t)q;
         n_hits += ((size_t)near | (size_t)(flags[q] != 0)) & (size_t)(j < end_block);
     }
@@ -1069,14 +1049,8 @@ static void pairs_of_block(const struct pass* P, size_t b, bool kick, struct wet
     struct wetdem_vec3* torque = m->torque;
     uint32_t* contacts = m->contacts;
     size_t begin_block = m->blk[b], end_block = m->blk[b + 1], e = m->cross_first[b];
-    /* the pass's invariants in locals: the stores to the force arrays could alias them */
-    const struct wetdem_celllist_item* xr = P->xr;
-    const struct wetdem_particle* p = P->p;
-    const struct wetdem_many_mix* mix = m->mix;
-    const struct wetdem_celllist_box* box = &m->cl.box;
     const unsigned char* flags = P->flags;
-    size_t nm = P->nm;
-    bool single = nm == 1, periodic = P->periodic;
+    bool single = P->nm == 1, periodic = P->periodic;
     /* 1. the gap test of every candidate of the block whose second particle is in the block,
           in one flat loop without branches on its outcome: the pairs within range, and those
           with flags (they may have just left it), are listed in pair order */
@@ -1091,15 +1065,11 @@ static void pairs_of_block(const struct pass* P, size_t b, bool kick, struct wet
     for (size_t i = begin_block; i < end_block; i++) {
         struct wetdem_vec3 f = vec3(0, 0, 0), t = vec3(0, 0, 0);
         uint32_t n_contacts = 0;
-        struct wetdem_vec3 xi = vec3(xr[i].x, xr[i].y, xr[i].z);
         for (; h < n_hits && pairs[hits[h]].i == i; h++) {
             size_t q = hits[h], j = pairs[q].j;
-            struct wetdem_vec3 xj = vec3(xr[j].x, xr[j].y, xr[j].z);
-            struct wetdem_vec3 d = periodic ? celllist_delta(box, xi, xj) : vec3_sub(xi, xj);
-            const struct wetdem_many_mix* x =
-                single ? mix : &mix[(size_t)p[i].material * nm + (size_t)p[j].material];
-            double lim = xr[i].r + xr[j].r + x->range;
-            if (vec3_dot(d, d) > lim * lim * (1 + PREFILTER_MARGIN)) { /* eval_candidate's test */
+            struct wetdem_vec3 d;
+            const struct wetdem_many_mix* x;
+            if (!within_reach(P, i, j, periodic, single, &d, &x)) { /* listed for its flags */
                 leave_range(P, q);
                 continue;
             }
