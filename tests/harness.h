@@ -94,6 +94,20 @@ static inline void* test_default_params(const struct wetdem_model* model, void* 
     return storage;
 }
 
+/* Asserts that the particles of a and b have bit-identical positions, velocities and spins. */
+static inline void test_check_same_particles(const struct wetdem_sim* a, const struct wetdem_sim* b)
+{
+    size_t na, nb;
+    const struct wetdem_particle* pa = wetdem_sim_particles_const(a, &na);
+    const struct wetdem_particle* pb = wetdem_sim_particles_const(b, &nb);
+    assert_int_equal(na, nb);
+    for (size_t k = 0; k < na; k++) {
+        assert_memory_equal(&pa[k].pos, &pb[k].pos, sizeof pa[k].pos);
+        assert_memory_equal(&pa[k].vel, &pb[k].vel, sizeof pa[k].vel);
+        assert_memory_equal(&pa[k].omega, &pb[k].omega, sizeof pa[k].omega);
+    }
+}
+
 /* ---- the command-line tool ---- */
 
 /* Path of the CLI: $WETDEM_CLI (set by `make test`), else build/wetdem relative to the

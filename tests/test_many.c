@@ -57,19 +57,6 @@ static struct wetdem_sim* wet_box(size_t n, bool wet)
     return sim;
 }
 
-static void check_same_particles(struct wetdem_sim* a, struct wetdem_sim* b)
-{
-    size_t na, nb;
-    const struct wetdem_particle* pa = wetdem_sim_particles_const(a, &na);
-    const struct wetdem_particle* pb = wetdem_sim_particles_const(b, &nb);
-    assert_int_equal(na, nb);
-    for (size_t k = 0; k < na; k++) {
-        assert_memory_equal(&pa[k].pos, &pb[k].pos, sizeof pa[k].pos);
-        assert_memory_equal(&pa[k].vel, &pb[k].vel, sizeof pa[k].vel);
-        assert_memory_equal(&pa[k].omega, &pb[k].omega, sizeof pa[k].omega);
-    }
-}
-
 static void test_many_same_result_for_any_thread_count(void** state)
 {
     (void)state;
@@ -81,7 +68,7 @@ static void test_many_same_result_for_any_thread_count(void** state)
     omp_set_num_threads(3);
     CHECK_OK(wetdem_sim_integrate(b, 1e-3));
     omp_set_num_threads(saved);
-    check_same_particles(a, b);
+    test_check_same_particles(a, b);
     struct wetdem_many_stats s;
     CHECK_OK(wetdem_sim_many_stats(a, &s));
     assert_true(s.contacts + s.bridges > 0); /* the run did exercise pair forces */
@@ -101,12 +88,12 @@ static void test_many_restart_is_bit_identical(void** state)
     CHECK_OK(wetdem_sim_integrate(first, 0.5e-3));
     CHECK_OK(wetdem_sim_write_checkpoint(first, path));
     CHECK_OK(wetdem_sim_integrate(first, 1.2e-3)); /* continuing in memory is the same too */
-    check_same_particles(whole, first);
+    test_check_same_particles(whole, first);
     struct wetdem_sim* resumed = wet_box(150, true);
     CHECK_OK(wetdem_sim_read_checkpoint(resumed, path));
     CHECK_ABS(wetdem_sim_time(resumed), 0.5e-3, 1e-18);
     CHECK_OK(wetdem_sim_integrate(resumed, 1.2e-3));
-    check_same_particles(whole, resumed);
+    test_check_same_particles(whole, resumed);
     /* a sim set up differently refuses the checkpoint */
     struct wetdem_sim* dry = wet_box(150, false);
     CHECK_STATUS(wetdem_sim_read_checkpoint(dry, path), WETDEM_ERR_INVALID);
@@ -162,7 +149,7 @@ static void test_many_deferred_kick_is_bit_identical(void** state)
     CHECK_OK(wetdem_sim_integrate(deferred, 0.6e-3));
     CHECK_OK(wetdem_sim_integrate(every, 0.6e-3));
     assert_int_equal(calls, 300); /* every step was read */
-    check_same_particles(deferred, every);
+    test_check_same_particles(deferred, every);
     wetdem_sim_free(deferred);
     wetdem_sim_free(every);
 }

@@ -310,19 +310,6 @@ static struct wetdem_sim* wet_gas(bool generic_only, bool budget)
     return sim;
 }
 
-static void check_same_state(struct wetdem_sim* a, struct wetdem_sim* b)
-{
-    size_t na, nb;
-    const struct wetdem_particle* pa = wetdem_sim_particles_const(a, &na);
-    const struct wetdem_particle* pb = wetdem_sim_particles_const(b, &nb);
-    assert_int_equal(na, nb);
-    for (size_t k = 0; k < na; k++) {
-        assert_memory_equal(&pa[k].pos, &pb[k].pos, sizeof pa[k].pos);
-        assert_memory_equal(&pa[k].vel, &pb[k].vel, sizeof pa[k].vel);
-        assert_memory_equal(&pa[k].omega, &pb[k].omega, sizeof pa[k].omega);
-    }
-}
-
 /* Whole runs: fused against generic (with and without the energy budget, whose per-model
  * forces go through a separate branch), on 1 and 3 threads. */
 static void test_many_fused_run_equals_generic_run(void** state)
@@ -344,8 +331,8 @@ static void test_many_fused_run_equals_generic_run(void** state)
         /* without the budget the lean kernel runs (sim_many_force.c), with it the fused one */
         assert_true(fused->many->lean.on);
         assert_false(generic->many->lean.on);
-        check_same_state(fused, generic);
-        check_same_state(fused, fused3);
+        test_check_same_particles(fused, generic);
+        test_check_same_particles(fused, fused3);
         struct wetdem_many_stats s;
         CHECK_OK(wetdem_sim_many_stats(fused, &s));
         assert_true(s.contacts > 0 && s.bridges > 0); /* contact and film branches were run */
@@ -378,7 +365,7 @@ static void test_many_block_cuts_do_not_change_the_result(void** state)
         omp_set_num_threads(threads);
         CHECK_OK(wetdem_sim_integrate(cut, 0.6e-3));
         assert_true(cut->many->n_blocks == (size_t)threads);
-        check_same_state(one, cut);
+        test_check_same_particles(one, cut);
         wetdem_sim_free(cut);
     }
     omp_set_num_threads(saved);
