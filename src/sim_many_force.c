@@ -712,6 +712,40 @@ static size_t next_wall(uint64_t* mask)
     return w;
 }
 
+/* Wall w of particle i, within the start-up reach: its force into *o through the lean kernel
+ * or eval_pair; returns its flags. The history is reset beyond the range (when it may have
+ * been used: `dirty`). */
+static unsigned char eval_wall(const struct wetdem_sim* sim, size_t i, size_t w, double* hist,
+                               bool dirty, struct wetdem_many_pair_out* o, struct failure* fail)
+{
+    const struct wetdem_many* m = sim->many;
+    const struct wetdem_particle* a = &sim->particles[i];
+    const struct wetdem_wall* wall = &sim->walls[w];
+    const struct wetdem_many_mix* x = wetdem_sim_many_mix(sim, a->material, wall->material);
+    unsigned char flags;
+    if (m->lean.on && !m->set.energy_budget) {
+        int st = lean_wall(m, a, wall, x, hist, &flags, o);
+        if (!flags && hist && dirty) /* reset beyond the range, as eval_pair does */
+            wetdem_sim_history_init(sim, hist);
+        if (st != WETDEM_OK) {
+            struct wetdem_contact c = {
+                .gap = vec3_dot(vec3_sub(a->pos, wall->point), wall->normal) - a->radius};
+            note_failure(fail, i * sim->n_walls + w, st, true, &c, x->range);
+        }
+        return flags;
+    }
+    struct wetdem_contact c;
+    wall_contact_from(a, wall, x, &c);
+    c.i = i;
+    c.j = w;
+    double range = contact_range(sim, &c, x);
+    flags = WETDEM_MANY_DIRTY; /* eval_pair resets the history beyond the range */
+    int st = eval_pair(sim, &c, x, range, hist, o, &flags, thread_work(m, 1));
+    if (st != WETDEM_OK)
+        note_failure(fail, i * sim->n_walls + w, st, true, &c, range);
+    return flags;
+}
+
 /* Wall forces on particle i, added to *f, *t, *n_contacts in wall order. */
 static void eval_walls_of(const struct wetdem_sim* sim, size_t i, struct wetdem_vec3* f,
                           struct wetdem_vec3* t, uint32_t* n_contacts, struct failure* fail)
@@ -730,42 +764,12 @@ static void eval_walls_of(const struct wetdem_sim* sim, size_t i, struct wetdem_
         double* hist = len ? m->wall_history + (i * nw + w) * len : NULL;
         uint64_t bit = w < 64 ? (uint64_t)1 << w : 0;
         bool dirty = w >= 64 || (m->wall_dirty[i] & bit);
-        if (gap > m->reach) {
-            if (hist && dirty)
-                wetdem_sim_history_init(sim, hist);
-            m->wall_dirty[i] &= ~bit;
-            continue;
-        }
-        const struct wetdem_many_mix* x = wetdem_sim_many_mix(sim, a->material, wall->material);
-        if (m->lean.on && !m->set.energy_budget) {
-            struct wetdem_many_pair_out o;
-            unsigned char flags;
-            int st = lean_wall(m, a, wall, x, hist, &flags, &o);
-            if (!flags && hist && dirty) /* reset beyond the range, as eval_pair does */
-                wetdem_sim_history_init(sim, hist);
-            m->wall_dirty[i] = flags ? m->wall_dirty[i] | bit : m->wall_dirty[i] & ~bit;
-            if (st != WETDEM_OK) {
-                struct wetdem_contact c = {.gap = gap};
-                note_failure(fail, i * nw + w, st, true, &c, x->range);
-            }
-            if (flags & WETDEM_MANY_ACTIVE) {
-                *f = vec3_add(*f, o.force);
-                *t = vec3_add(*t, o.torque_i);
-                *n_contacts += (flags & WETDEM_MANY_CONTACT) ? 1 : 0;
-            }
-            continue;
-        }
-        struct wetdem_contact c;
-        wall_contact_from(a, wall, x, &c);
-        c.i = i;
-        c.j = w;
-        double range = contact_range(sim, &c, x);
         struct wetdem_many_pair_out o;
-        unsigned char flags = WETDEM_MANY_DIRTY; /* always reset */
-        int st = eval_pair(sim, &c, x, range, hist, &o, &flags, thread_work(m, 1));
-        if (st != WETDEM_OK)
-            note_failure(fail, i * nw + w, st, true, &c, range);
-        /* eval_pair reset the history beyond the range */
+        unsigned char flags = 0;
+        if (gap <= m->reach)
+            flags = eval_wall(sim, i, w, hist, dirty, &o, fail);
+        else if (hist && dirty)
+            wetdem_sim_history_init(sim, hist);
         m->wall_dirty[i] = flags ? m->wall_dirty[i] | bit : m->wall_dirty[i] & ~bit;
         if (!(flags & WETDEM_MANY_ACTIVE))
             continue;
