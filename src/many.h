@@ -20,6 +20,7 @@ struct wetdem_many_mix {
        hertz by damping form (0 exact, 1 tsuji) [-] and the Mindlin factor [-]; NAN when the
        restitution is outside (0, 1] (the kernel reports that before using them) */
     double hertz_damping[2], mindlin_damping;
+    double film_h_min; /* thin_film_h_min(h_min, film) of the lean kernel's constant h_min [m] */
 };
 
 /* The lean pair kernel (sim_many_force.c): for the model sets of the fused kernel without an
@@ -34,6 +35,7 @@ struct wetdem_many_lean {
     bool sb;            /* sb enabled */
     double sb_below;    /* its below_hmin treatment */
     double h_min;       /* h_min of the constant min-separation model [m] */
+    bool capillary;     /* capillary enabled */
     int n_normal;       /* models adding to the normal force, in model order: */
     unsigned char normal[WETDEM_MAX_MODELS]; /* 0 hertz, 1 sb, 2 capillary */
 };
@@ -115,8 +117,10 @@ struct wetdem_many {
     size_t *blk, *cross_first;
     uint32_t *cross_q, *cross_in;
     struct wetdem_many_pair_out* cross_out;
-    uint32_t* hits; /* per pair: the force pass's list of candidates within range (scratch) */
-    size_t hits_cap;
+    uint32_t* hits;          /* per pair: the force pass's list of candidates within range or with
+                       flags (scratch) */
+    unsigned char* hit_near; /* per entry of hits: within range (1) or listed for its flags */
+    size_t hits_cap, hit_near_cap;
     size_t blk_cap, cross_first_cap, cross_q_cap, cross_in_cap, cross_out_cap;
     size_t n_blocks, blocks_n;
     uint64_t blocks_build;  /* list build the blocks were indexed for */

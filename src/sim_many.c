@@ -105,6 +105,7 @@ void wetdem_sim_many_free(struct wetdem_sim* sim)
     free(m->cross_in);
     free(m->cross_out);
     free(m->hits);
+    free(m->hit_near);
     free(m->work);
     for (size_t k = 0; k < m->n_series && m->vtk_names; k++)
         free(m->vtk_names[k]);
@@ -452,25 +453,30 @@ static struct wetdem_vec3 wrap(const struct wetdem_celllist_box* b, struct wetde
 }
 
 /* Half kick and drift of particle p (index k); its velocities become the predicted ones
- * v' + a dt/2. */
+ * v' + a dt/2. Works on local copies: the stores of p, vh and wh may alias as far as the
+ * compiler knows, and each is written once. */
 static void kick_drift_one(struct wetdem_many* m, struct wetdem_particle* p, size_t k,
                            struct wetdem_vec3 g, double h, bool periodic, bool pending)
 {
+    double half = 0.5 * h;
     struct wetdem_vec3 a = vec3_axpy(g, m->inv[k][0], m->force[k]);
     struct wetdem_vec3 alpha = vec3_scale(m->torque[k], m->inv[k][1]);
+    struct wetdem_vec3 v = p->vel, w = p->omega;
     if (pending) { /* the previous step's closing half kick, with the same a and alpha */
-        p->vel = vec3_axpy(m->vh[k], 0.5 * h, a);
-        p->omega = vec3_axpy(m->wh[k], 0.5 * h, alpha);
+        v = vec3_axpy(m->vh[k], half, a);
+        w = vec3_axpy(m->wh[k], half, alpha);
     }
-    m->vh[k] = vec3_axpy(p->vel, 0.5 * h, a);
-    m->wh[k] = vec3_axpy(p->omega, 0.5 * h, alpha);
-    struct wetdem_vec3 x = vec3_axpy(p->pos, h, m->vh[k]);
-    p->pos = periodic ? wrap(&m->cl.box, x) : x;
-    m->xr[k].x = p->pos.x;
-    m->xr[k].y = p->pos.y;
-    m->xr[k].z = p->pos.z;
-    p->vel = vec3_axpy(m->vh[k], 0.5 * h, a);
-    p->omega = vec3_axpy(m->wh[k], 0.5 * h, alpha);
+    struct wetdem_vec3 vh = vec3_axpy(v, half, a), wh = vec3_axpy(w, half, alpha);
+    struct wetdem_vec3 x = vec3_axpy(p->pos, h, vh);
+    x = periodic ? wrap(&m->cl.box, x) : x;
+    m->vh[k] = vh;
+    m->wh[k] = wh;
+    p->pos = x;
+    m->xr[k].x = x.x;
+    m->xr[k].y = x.y;
+    m->xr[k].z = x.z;
+    p->vel = vec3_axpy(vh, half, a);
+    p->omega = vec3_axpy(wh, half, alpha);
 }
 
 /* Half kick and drift of every particle (preceded by the previous step's closing half kick if

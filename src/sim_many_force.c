@@ -146,7 +146,10 @@ static void plan_lean(struct wetdem_sim* sim)
             L->sb_below = m->kind_opt[k];
             L->normal[L->n_normal++] = 1;
             break;
-        case FUSED_CAPILLARY: L->normal[L->n_normal++] = 2; break;
+        case FUSED_CAPILLARY:
+            L->capillary = true;
+            L->normal[L->n_normal++] = 2;
+            break;
         default: L->on = false;
         }
     }
@@ -158,9 +161,10 @@ static void plan_lean(struct wetdem_sim* sim)
             L->h_min = sim->minsep.model->min_separation(sim->minsep.params, &probe, scratch);
     }
     for (size_t k = 0; L->on && k < (size_t)m->n_mix_materials * (size_t)m->n_mix_materials; k++) {
-        const struct wetdem_many_mix* x = &m->mix[k];
+        struct wetdem_many_mix* x = &m->mix[k];
         bool valid = x->restitution > 0.0 && x->restitution <= 1.0;
         L->on = (valid || !contact_models) && x->range <= m->reach;
+        x->film_h_min = thin_film_h_min(L->h_min, x->film);
     }
 }
 
@@ -356,6 +360,23 @@ struct lean_geometry {
     bool wall;
 };
 
+/* The normal forces of the film models at gap `gap` [m] (R* = r_eff [m], v_n [m/s]), as
+ * force_sb.c and force_capillary.c compute them, into term[1] (sb) and term[2] (capillary);
+ * the terms of models that do not act are left as they are (+0). */
+static inline __attribute__((always_inline)) void film_terms(const struct wetdem_many_lean* L,
+                                                             const struct wetdem_many_mix* x,
+                                                             double gap, double r_eff, double v_n,
+                                                             double term[3])
+{
+    double h;
+    if (L->sb && thin_film_eval_gap_at(gap, x->film_h_min, x->film, L->sb_below, &h)) {
+        double bracket = 1.0 - h / x->film;
+        term[1] = 6.0 * M_PI * x->viscosity * r_eff * r_eff * v_n / h * bracket * bracket;
+    }
+    if (L->capillary && x->film > 0.0 && gap <= x->film)
+        term[2] = -(8.0 * M_PI * r_eff * x->surface_tension);
+}
+
 /* Force of pair g with mixed properties x: the operations of wetdem_sim_many_eval_fused and
  * eval_pair in the same order on the quantities the enabled models read, so force, torques,
  * history and flags are bit-identical to theirs (tests/test_many_force.c). The sum of the
@@ -393,13 +414,7 @@ static inline __attribute__((always_inline)) int lean_force(const struct wetdem_
         double* spring = hist + L->mindlin_off;
         spring[0] = spring[1] = spring[2] = 0.0;
     }
-    double h;
-    if (L->sb && thin_film_eval_gap(gap, L->h_min, x->film, L->sb_below, &h)) {
-        double bracket = 1.0 - h / x->film;
-        term[1] = 6.0 * M_PI * x->viscosity * r_eff * r_eff * v_n / h * bracket * bracket;
-    }
-    if (x->film > 0.0 && gap <= x->film)
-        term[2] = -(8.0 * M_PI * r_eff * x->surface_tension);
+    film_terms(L, x, gap, r_eff, v_n, term);
     double f_n = 0.0;
     for (int q = 0; q < L->n_normal; q++)
         f_n += term[L->normal[q]];
@@ -413,8 +428,31 @@ static inline __attribute__((always_inline)) int lean_force(const struct wetdem_
     return WETDEM_OK;
 }
 
+/* Pair apart (gap >= 0) within its range: the operations of lean_force for that case, where
+ * only the film models act, along the normal n, and the torques are zero (left unset: the
+ * callers add none, see adds_torque). The normal sum is lean_force's: hertz adds +0 there,
+ * which changes no sum from +0, and the other two commute. The force is finite when f_n is
+ * (|n| = 1). */
+static inline __attribute__((always_inline)) int
+lean_apart(const struct wetdem_many_lean* L, const struct wetdem_many_mix* x, struct wetdem_vec3 n,
+           double gap, double r_eff, double v_n, double* hist, unsigned char* flags,
+           struct wetdem_many_pair_out* o)
+{
+    if (L->mindlin) { /* mindlin_spring resets the spring apart */
+        double* spring = hist + L->mindlin_off;
+        spring[0] = spring[1] = spring[2] = 0.0;
+    }
+    double term[3] = {0.0, 0.0, 0.0};
+    film_terms(L, x, gap, r_eff, v_n, term);
+    double f_n = 0.0 + term[1] + term[2];
+    o->force = vec3_axpy(vec3(0, 0, 0), f_n, n);
+    *flags = WETDEM_MANY_ACTIVE | WETDEM_MANY_DIRTY | WETDEM_MANY_CACHED |
+             (x->film > 0 && gap < x->film ? WETDEM_MANY_BRIDGE : 0);
+    return isfinite(f_n) ? WETDEM_OK : WETDEM_ERR_NUMERIC;
+}
+
 /* Pair (a, b) with d = x_a - x_b (minimum image): its geometry as pair_contact_from computes
- * it, then lean_force; *flags = 0 beyond the range. */
+ * it, then lean_apart or lean_force; *flags = 0 beyond the range. */
 static int lean_pair(const struct wetdem_many* m, const struct wetdem_particle* a,
                      const struct wetdem_particle* b, struct wetdem_vec3 d,
                      const struct wetdem_many_mix* x, double* hist, double* cache,
@@ -450,8 +488,10 @@ static inline int lean_pair(const struct wetdem_many* m, const struct wetdem_par
     g.k = cache[2];
     g.damping = cache[3];
     g.v_n = -vec3_dot(vec3_sub(a->vel, b->vel), g.n);
+    if (!(g.gap < 0.0))
+        return lean_apart(&m->lean, x, g.n, g.gap, g.r_eff, g.v_n, hist, flags, o);
     g.v_t = vec3(0, 0, 0); /* read in solid contact only */
-    if (g.gap < 0.0 && m->lean.mindlin) {
+    if (m->lean.mindlin) {
         struct wetdem_vec3 va = vec3_add(a->vel, vec3_cross(a->omega, vec3_scale(g.n, -a->radius)));
         struct wetdem_vec3 vb = vec3_add(b->vel, vec3_cross(b->omega, vec3_scale(g.n, b->radius)));
         g.v_t = vec3_reject(vec3_sub(va, vb), g.n);
@@ -660,6 +700,14 @@ static unsigned char near_candidate(const struct pass* P, size_t q, size_t i, si
     return *fl;
 }
 
+/* Whether the result of a pair with flags fl has torques to add: the lean kernel leaves them
+ * unset, as zero, for pairs apart (lean_apart); adding a zero would change no sum (every sum
+ * starts from +0, and a sum from +0 is never -0). */
+static inline bool adds_torque(const struct pass* P, unsigned char fl)
+{
+    return !P->lean || (fl & WETDEM_MANY_CONTACT);
+}
+
 /* Pair q, which had flags, has left its range: fresh history, no flags. */
 static void leave_range(const struct pass* P, size_t q) __attribute__((noinline));
 static void leave_range(const struct pass* P, size_t q)
@@ -669,20 +717,29 @@ static void leave_range(const struct pass* P, size_t q)
     P->flags[q] = 0;
 }
 
-/* The cheap gap test of pair (i, j): d = x_i - x_j (minimum image when `periodic`) into *d and
- * the pair's mixed properties into *x (the first when `single`: one material pair); true when
- * |d|^2 <= (R_i + R_j + r_ab)^2 (1 + PREFILTER_MARGIN). */
-static inline __attribute__((always_inline)) bool within_reach(const struct pass* P, size_t i,
-                                                               size_t j, bool periodic, bool single,
-                                                               struct wetdem_vec3* d,
-                                                               const struct wetdem_many_mix** x)
+/* Pair (i, j): d = x_i - x_j (minimum image when `periodic`) into *d and the pair's mixed
+ * properties into *x (the first when `single`: one material pair). */
+static inline __attribute__((always_inline)) void pair_delta(const struct pass* P, size_t i,
+                                                             size_t j, bool periodic, bool single,
+                                                             struct wetdem_vec3* d,
+                                                             const struct wetdem_many_mix** x)
 {
     const struct wetdem_celllist_item* xr = P->xr;
     struct wetdem_vec3 xi = vec3(xr[i].x, xr[i].y, xr[i].z), xj = vec3(xr[j].x, xr[j].y, xr[j].z);
     *d = periodic ? celllist_delta(&P->m->cl.box, xi, xj) : vec3_sub(xi, xj);
     *x = single ? P->m->mix
                 : &P->m->mix[(size_t)P->p[i].material * P->nm + (size_t)P->p[j].material];
-    double lim = xr[i].r + xr[j].r + (*x)->range;
+}
+
+/* The cheap gap test of pair (i, j): pair_delta, then true when
+ * |d|^2 <= (R_i + R_j + r_ab)^2 (1 + PREFILTER_MARGIN). */
+static inline __attribute__((always_inline)) bool within_reach(const struct pass* P, size_t i,
+                                                               size_t j, bool periodic, bool single,
+                                                               struct wetdem_vec3* d,
+                                                               const struct wetdem_many_mix** x)
+{
+    pair_delta(P, i, j, periodic, single, d, x);
+    double lim = P->xr[i].r + P->xr[j].r + (*x)->range;
     return vec3_dot(*d, *d) <= lim * lim * (1 + PREFILTER_MARGIN);
 }
 
@@ -939,6 +996,10 @@ static int index_blocks(struct wetdem_sim* sim, size_t nb)
         !reserve((void**)&m->cross_first, &m->cross_first_cap, 2 * (nb + 1),
                  sizeof *m->cross_first))
         return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory for %zu threads", nb);
+    if (np > UINT32_MAX) /* pair indices are stored in 32 bits (cross_q, hits) */
+        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
+                               "too many candidate pairs for the force pass: %zu (limit %u)", np,
+                               UINT32_MAX);
     partition_blocks(m, n, nb);
     size_t nc = 0;
     for (size_t q = 0; nb > 1 && q < np; q++)
@@ -946,7 +1007,8 @@ static int index_blocks(struct wetdem_sim* sim, size_t nb)
     if (!reserve((void**)&m->cross_q, &m->cross_q_cap, nc, sizeof *m->cross_q) ||
         !reserve((void**)&m->cross_in, &m->cross_in_cap, nc, sizeof *m->cross_in) ||
         !reserve((void**)&m->cross_out, &m->cross_out_cap, nc, sizeof *m->cross_out) ||
-        !reserve((void**)&m->hits, &m->hits_cap, np, sizeof *m->hits))
+        !reserve((void**)&m->hits, &m->hits_cap, np, sizeof *m->hits) ||
+        !reserve((void**)&m->hit_near, &m->hit_near_cap, np, sizeof *m->hit_near))
         return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory for %zu pairs", nc);
     size_t* first_out = m->cross_first;         /* by block of the first particle */
     size_t* first_in = m->cross_first + nb + 1; /* by block of the second particle */
@@ -1011,7 +1073,8 @@ static void start_sums_of_block(const struct pass* P, size_t b, struct failure* 
         if (!(fl & WETDEM_MANY_ACTIVE))
             continue;
         m->force[k] = vec3_sub(m->force[k], m->cross_out[e].force);
-        m->torque[k] = vec3_add(m->torque[k], m->cross_out[e].torque_j);
+        if (adds_torque(P, fl))
+            m->torque[k] = vec3_add(m->torque[k], m->cross_out[e].torque_j);
         m->contacts[k] += (fl & WETDEM_MANY_CONTACT) ? 1 : 0;
     }
 }
@@ -1021,10 +1084,9 @@ static void start_sums_of_block(const struct pass* P, size_t b, struct failure* 
  * is below end_block, are listed in hits in pair order; returns their number. `periodic` and
  * `single` (one material pair) are constants at each call, so each case compiles to its own
  * loop. */
-static inline __attribute__((always_inline)) size_t gap_test(const struct pass* P, size_t q_begin,
-                                                             size_t q_end, size_t end_block,
-                                                             uint32_t* hits, bool periodic,
-                                                             bool single)
+static inline __attribute__((always_inline)) size_t
+gap_test(const struct pass* P, size_t q_begin, size_t q_end, size_t end_block, uint32_t* hits,
+         unsigned char* hit_near, bool periodic, bool single)
 {
     const struct wetdem_celllist_pair* pairs = P->pairs;
     const unsigned char* flags = P->flags;
@@ -1035,6 +1097,7 @@ static inline __attribute__((always_inline)) size_t gap_test(const struct pass* 
         const struct wetdem_many_mix* x;
         bool near = within_reach(P, i, j, periodic, single, &d, &x);
         hits[n_hits] = (uint32_t)q;
+        hit_near[n_hits] = near;
         n_hits += ((size_t)near | (size_t)(flags[q] != 0)) & (size_t)(j < end_block);
     }
     return n_hits;
@@ -1060,9 +1123,10 @@ static void pairs_of_block(const struct pass* P, size_t b, bool kick, struct wet
           with flags (they may have just left it), are listed in pair order */
     size_t q_begin = m->cl.first_pair[begin_block], q_end = m->cl.first_pair[end_block];
     uint32_t* hits = m->hits + q_begin;
+    unsigned char* near = m->hit_near + q_begin;
     size_t n_hits = single && !periodic /* the common case, in its own loop */
-                        ? gap_test(P, q_begin, q_end, end_block, hits, false, true)
-                        : gap_test(P, q_begin, q_end, end_block, hits, periodic, false);
+                        ? gap_test(P, q_begin, q_end, end_block, hits, near, false, true)
+                        : gap_test(P, q_begin, q_end, end_block, hits, near, periodic, false);
     /* 2. every particle in index order: its listed pairs (reactions to the second particle at
           once), its cross pairs from phase 1, then its own sum and the closing half kick */
     size_t h = 0;
@@ -1073,21 +1137,24 @@ static void pairs_of_block(const struct pass* P, size_t b, bool kick, struct wet
             size_t q = hits[h], j = pairs[q].j;
             struct wetdem_vec3 d;
             const struct wetdem_many_mix* x;
-            if (!within_reach(P, i, j, periodic, single, &d, &x)) { /* listed for its flags */
+            if (!near[h]) { /* listed for its flags */
                 leave_range(P, q);
                 continue;
             }
+            pair_delta(P, i, j, periodic, single, &d, &x);
             struct wetdem_many_pair_out o;
             unsigned char fl = near_candidate(P, q, i, j, d, x, &o, fail);
             if (!(fl & WETDEM_MANY_ACTIVE))
                 continue;
             uint32_t c = (fl & WETDEM_MANY_CONTACT) ? 1 : 0;
             f = vec3_add(f, o.force);
-            t = vec3_add(t, o.torque_i);
             n_contacts += c;
             force[j] = vec3_sub(force[j], o.force);
-            torque[j] = vec3_add(torque[j], o.torque_j);
             contacts[j] += c;
+            if (adds_torque(P, fl)) {
+                t = vec3_add(t, o.torque_i);
+                torque[j] = vec3_add(torque[j], o.torque_j);
+            }
         }
         size_t q = m->cl.first_pair[i + 1];
         while (q > m->cl.first_pair[i] && pairs[q - 1].j >= end_block)
@@ -1097,7 +1164,8 @@ static void pairs_of_block(const struct pass* P, size_t b, bool kick, struct wet
             if (!(fl & WETDEM_MANY_ACTIVE))
                 continue;
             f = vec3_add(f, m->cross_out[e].force);
-            t = vec3_add(t, m->cross_out[e].torque_i);
+            if (adds_torque(P, fl))
+                t = vec3_add(t, m->cross_out[e].torque_i);
             n_contacts += (fl & WETDEM_MANY_CONTACT) ? 1 : 0;
         }
         force[i] = vec3_add(force[i], f);

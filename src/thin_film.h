@@ -53,15 +53,15 @@ static inline double thin_film_h_min(double h_min, double delta)
     return fmin(h_min, delta);
 }
 
-/* Gap [m] at which a thin-film law is evaluated for gap h, minimum separation h_min and film
- * thickness delta (all [m]) with treatment `below` (enum thin_film_below). Returns false when
- * the force is zero (films apart, "c" below h_min, no film, or no positive gap to use). */
-static inline bool thin_film_eval_gap(double h, double h_min, double delta, double below,
-                                      double* h_eval)
+/* Gap [m] at which a thin-film law is evaluated for gap h, capped minimum separation
+ * hm = thin_film_h_min(h_min, delta) and film thickness delta (all [m]) with treatment `below`
+ * (enum thin_film_below). Returns false when the force is zero (films apart, "c" below h_min,
+ * no film, or no positive gap to use). */
+static inline bool thin_film_eval_gap_at(double h, double hm, double delta, double below,
+                                         double* h_eval)
 {
     if (!(delta > 0.0) || h > delta)
         return false;
-    double hm = thin_film_h_min(h_min, delta);
     if (h >= hm)
         *h_eval = h;
     else if ((int)below == THIN_FILM_BELOW_NC)
@@ -69,6 +69,13 @@ static inline bool thin_film_eval_gap(double h, double h_min, double delta, doub
     else
         return false;
     return *h_eval > 0.0;
+}
+
+/* The same with the minimum separation h_min [m] itself. */
+static inline bool thin_film_eval_gap(double h, double h_min, double delta, double below,
+                                      double* h_eval)
+{
+    return thin_film_eval_gap_at(h, thin_film_h_min(h_min, delta), delta, below, h_eval);
 }
 
 /* Range of a thin-film law: the film thickness delta [m]. The models' range hook. */
