@@ -501,8 +501,8 @@ static inline int lean_pair(const struct wetdem_many* m, const struct wetdem_par
     return st;
 }
 
-/* Particle a and plane wall w: the geometry of wall_contact_from, then lean_force; *flags = 0
- * beyond the range. */
+/* Particle a and plane wall w: the geometry of wall_contact_from, then lean_force (walls
+ * apart are too few for a path of their own to pay); *flags = 0 beyond the range. */
 static int lean_wall(const struct wetdem_many* m, const struct wetdem_particle* a,
                      const struct wetdem_wall* w, const struct wetdem_many_mix* x, double* hist,
                      unsigned char* flags, struct wetdem_many_pair_out* o)
@@ -537,6 +537,20 @@ static int lean_wall(const struct wetdem_many* m, const struct wetdem_particle* 
 }
 
 /* ---- the pair pass ---- */
+
+/* Whether the lean kernel evaluates the pairs (else the fused kernel or the generic models). */
+static bool lean_active(const struct wetdem_many* m)
+{
+    return m->lean.on && !m->set.energy_budget;
+}
+
+/* Whether the result of a particle pair with flags fl has torques to add (`lean`: the lean
+ * kernel made it): lean_apart leaves them unset, as zero, for pairs apart; adding a zero
+ * would change no sum (every sum starts from +0, and a sum from +0 is never -0). */
+static bool adds_torque(bool lean, unsigned char fl)
+{
+    return !lean || (fl & WETDEM_MANY_CONTACT);
+}
 
 /* First failing pair (lowest index) of a parallel loop, for a deterministic message. */
 struct failure {
@@ -674,14 +688,15 @@ struct pass {
 };
 
 /* Candidate q = (i, j, d = x_i - x_j) that passed the gap test: its kernel. Returns its flags.
- * Out of line: inlined, it made the candidate loops spill their registers. */
+ * Inlined into its two loops (cross pairs, pairs of a block): with the pairs apart on their
+ * own short path (lean_apart), the call cost more than the spills it used to save. */
 static unsigned char near_candidate(const struct pass* P, size_t q, size_t i, size_t j,
                                     struct wetdem_vec3 d, const struct wetdem_many_mix* x,
                                     struct wetdem_many_pair_out* o, struct failure* fail)
-    __attribute__((noinline));
-static unsigned char near_candidate(const struct pass* P, size_t q, size_t i, size_t j,
-                                    struct wetdem_vec3 d, const struct wetdem_many_mix* x,
-                                    struct wetdem_many_pair_out* o, struct failure* fail)
+    __attribute__((always_inline));
+static inline unsigned char near_candidate(const struct pass* P, size_t q, size_t i, size_t j,
+                                           struct wetdem_vec3 d, const struct wetdem_many_mix* x,
+                                           struct wetdem_many_pair_out* o, struct failure* fail)
 {
     unsigned char* fl = &P->flags[q];
     if (!P->lean) {
@@ -698,14 +713,6 @@ static unsigned char near_candidate(const struct pass* P, size_t q, size_t i, si
         note_failure(fail, q, st, false, &c, x->range);
     }
     return *fl;
-}
-
-/* Whether the result of a pair with flags fl has torques to add: the lean kernel leaves them
- * unset, as zero, for pairs apart (lean_apart); adding a zero would change no sum (every sum
- * starts from +0, and a sum from +0 is never -0). */
-static inline bool adds_torque(const struct pass* P, unsigned char fl)
-{
-    return !P->lean || (fl & WETDEM_MANY_CONTACT);
 }
 
 /* Pair q, which had flags, has left its range: fresh history, no flags. */
@@ -780,7 +787,7 @@ static unsigned char eval_wall(const struct wetdem_sim* sim, size_t i, size_t w,
     const struct wetdem_wall* wall = &sim->walls[w];
     const struct wetdem_many_mix* x = wetdem_sim_many_mix(sim, a->material, wall->material);
     unsigned char flags;
-    if (m->lean.on && !m->set.energy_budget) {
+    if (lean_active(m)) {
         int st = lean_wall(m, a, wall, x, hist, &flags, o);
         if (!flags && hist && dirty) /* reset beyond the range, as eval_pair does */
             wetdem_sim_history_init(sim, hist);
@@ -1073,7 +1080,7 @@ static void start_sums_of_block(const struct pass* P, size_t b, struct failure* 
         if (!(fl & WETDEM_MANY_ACTIVE))
             continue;
         m->force[k] = vec3_sub(m->force[k], m->cross_out[e].force);
-        if (adds_torque(P, fl))
+        if (adds_torque(P->lean, fl))
             m->torque[k] = vec3_add(m->torque[k], m->cross_out[e].torque_j);
         m->contacts[k] += (fl & WETDEM_MANY_CONTACT) ? 1 : 0;
     }
@@ -1151,7 +1158,7 @@ static void pairs_of_block(const struct pass* P, size_t b, bool kick, struct wet
             n_contacts += c;
             force[j] = vec3_sub(force[j], o.force);
             contacts[j] += c;
-            if (adds_torque(P, fl)) {
+            if (adds_torque(P->lean, fl)) {
                 t = vec3_add(t, o.torque_i);
                 torque[j] = vec3_add(torque[j], o.torque_j);
             }
@@ -1164,7 +1171,7 @@ static void pairs_of_block(const struct pass* P, size_t b, bool kick, struct wet
             if (!(fl & WETDEM_MANY_ACTIVE))
                 continue;
             f = vec3_add(f, m->cross_out[e].force);
-            if (adds_torque(P, fl))
+            if (adds_torque(P->lean, fl))
                 t = vec3_add(t, m->cross_out[e].torque_i);
             n_contacts += (fl & WETDEM_MANY_CONTACT) ? 1 : 0;
         }
@@ -1209,7 +1216,7 @@ int wetdem_sim_many_forces(struct wetdem_sim* sim, bool kick)
                      .len = sim->history_len,
                      .nm = (size_t)m->n_mix_materials,
                      .periodic = m->periodic_any,
-                     .lean = m->lean.on && !m->set.energy_budget};
+                     .lean = lean_active(m)};
     /* one region: cross pairs, a barrier, then each block on its own */
 #pragma omp parallel if (parallel)
     {
