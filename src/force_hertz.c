@@ -344,8 +344,7 @@ double wetdem_force_hertz_damping(double e_star, double r_eff, double m_eff, dou
 
 double wetdem_force_hertz_total(double f_el, double f_damp, int form)
 {
-    /* exact: clipped (contact.md Sec. 1.1); tsuji: LIGGGHTS semantics, unclipped (Sec. 1.5) */
-    return form == 1 ? f_el + f_damp : fmax(f_el + f_damp, 0.0);
+    return hertz_total(f_el, f_damp, form);
 }
 
 /* 2.868266... = (4/5) (15/16)^(2/5) B(2/5, 1/2), contact.md Sec. 1.4. */

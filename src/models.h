@@ -76,6 +76,14 @@ static inline double hertz_damping_from(double factor, double overlap, double v_
 {
     return factor * sqrt(sqrt(overlap)) * v_n;
 }
+/* The hertz law of damping form `form` from its elastic and damping parts [N]: form 1 (tsuji)
+ * their sum, form 0 (exact) the sum clipped at >= 0 (contact.md Secs. 1.1, 1.5); a NaN sum
+ * clips to 0, as fmax does. */
+static inline double hertz_total(double f_el, double f_damp, int form)
+{
+    double sum = f_el + f_damp;
+    return form == 1 ? sum : (sum > 0.0 ? sum : 0.0);
+}
 static inline double hertz_damping_k(double coefficient, double k, double m_eff, double overlap,
                                      double v_n)
 {

@@ -31,7 +31,7 @@
  * Fused kernel: when every enabled force model is one of hertz, mindlin, sb and capillary (any
  * subset, any order), a switch over the models replaces the calls through the model table. It
  * calls the same kernels (wetdem_force_hertz_elastic, wetdem_force_hertz_damping_with,
- * wetdem_force_hertz_total, wetdem_force_mindlin_update_with, wetdem_pair_force_add_tangential,
+ * hertz_total (models.h), wetdem_force_mindlin_update_with, wetdem_pair_force_add_tangential,
  * thin_film_eval_gap), the damping coefficients of the restitution (the exact-table lookup,
  * log e) computed once per material pair in the table by the force files' own functions, and
  * writes the static-bridge force 6 pi mu a^2 v_n/h [1 - h/delta]^2
@@ -282,11 +282,11 @@ static int fused_model(int kind, double opt, const struct wetdem_contact* c,
         if (!(c->restitution > 0.0 && c->restitution <= 1.0))
             return WETDEM_ERR_INVALID;
         if (overlap > 0.0)
-            f->f_normal += wetdem_force_hertz_total(
-                f_el,
-                wetdem_force_hertz_damping_with(x->hertz_damping[(int)opt], c->e_star, c->r_eff,
-                                                c->m_eff, overlap, c->v_n),
-                (int)opt);
+            f->f_normal +=
+                hertz_total(f_el,
+                            wetdem_force_hertz_damping_with(x->hertz_damping[(int)opt], c->e_star,
+                                                            c->r_eff, c->m_eff, overlap, c->v_n),
+                            (int)opt);
         return WETDEM_OK;
     case FUSED_MINDLIN: {
         if (!(c->restitution > 0.0 && c->restitution <= 1.0))
@@ -397,8 +397,8 @@ static inline __attribute__((always_inline)) int lean_force(const struct wetdem_
         double m_eff = g->m_eff, k = g->k;
         double f_el = hertz_elastic_k(k, overlap);
         if (L->hertz_form >= 0)
-            term[0] = wetdem_force_hertz_total(f_el, hertz_damping_from(g->damping, overlap, v_n),
-                                               L->hertz_form);
+            term[0] =
+                hertz_total(f_el, hertz_damping_from(g->damping, overlap, v_n), L->hertz_form);
         if (L->mindlin) { /* wetdem_pair_force_add_tangential onto a zero record */
             struct wetdem_vec3 ft =
                 mindlin_spring(n, g->v_t, m->dt, x->g_star, r_eff, m_eff, overlap, f_el,
