@@ -14,8 +14,11 @@ PYTHON  ?= /usr/bin/python3
 CSTD     = -std=c11 -D_DEFAULT_SOURCE
 WARN     = -Wall -Wextra -Wpedantic -Wshadow -Werror
 OPT     ?= -O2
-CFLAGS_ALL = $(CSTD) $(WARN) $(OPT) -g -fPIC -fvisibility=hidden -ffp-contract=off -fopenmp \
-             -Iinclude -Isrc $(EXTRA_CFLAGS)
+# -ffp-contract=off: no fused multiply-adds, so results do not depend on the instruction set;
+# -fno-math-errno: sqrt compiles to the instruction alone (it is correctly rounded either way;
+# nothing here reads errno after a math function)
+CFLAGS_ALL = $(CSTD) $(WARN) $(OPT) -g -fPIC -fvisibility=hidden -ffp-contract=off \
+             -fno-math-errno -fopenmp -Iinclude -Isrc $(EXTRA_CFLAGS)
 LDLIBS   = -lsundials_cvode -lsundials_nvecserial -lgsl -lgslcblas -linih -lm -fopenmp
 VERSION := $(shell sed -n 's/^\#define WETDEM_VERSION "\(.*\)"/\1/p' include/wetdem.h)
 GIT_HASH := $(shell git rev-parse --short HEAD 2>/dev/null || echo unknown)
@@ -37,9 +40,14 @@ all: deps $(BUILD)/libwetdem.a $(BUILD)/libwetdem.so $(BUILD)/wetdem
 deps:
 	@scripts/install-deps build
 
-$(BUILD)/obj/%.o: src/%.c include/wetdem.h $(wildcard src/*.h)
+$(BUILD)/obj/%.o: src/%.c include/wetdem.h $(wildcard src/*.h) $(BUILD)/flags.stamp
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS_ALL) -c $< -o $@
+
+# Rebuild everything when the compiler flags change.
+$(BUILD)/flags.stamp: FORCE
+	@mkdir -p $(dir $@)
+	@echo '$(CC) $(CFLAGS_ALL)' | cmp -s - $@ || echo '$(CC) $(CFLAGS_ALL)' > $@
 
 # The CLI prints the git hash: rebuild its objects when the hash changes.
 $(BUILD)/version.stamp: FORCE
@@ -48,7 +56,8 @@ $(BUILD)/version.stamp: FORCE
 
 FORCE:
 
-$(BUILD)/cli/%.o: cli/%.c include/wetdem.h $(wildcard cli/*.h) $(BUILD)/version.stamp
+$(BUILD)/cli/%.o: cli/%.c include/wetdem.h $(wildcard cli/*.h) $(BUILD)/version.stamp \
+                  $(BUILD)/flags.stamp
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS_ALL) -DWETDEM_GIT_HASH='"$(GIT_HASH)"' -c $< -o $@
 
@@ -62,11 +71,11 @@ $(BUILD)/libwetdem.so: $(LIB_OBJ)
 $(BUILD)/wetdem: $(CLI_OBJ) $(BUILD)/libwetdem.a
 	$(CC) -o $@ $(CLI_OBJ) $(BUILD)/libwetdem.a $(LDLIBS)
 
-$(BUILD)/tests/%: tests/%.c tests/harness.h $(BUILD)/libwetdem.a
+$(BUILD)/tests/%: tests/%.c tests/harness.h $(BUILD)/libwetdem.a $(BUILD)/flags.stamp
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS_ALL) -Itests -o $@ $< $(BUILD)/libwetdem.a $(LDLIBS) -lcmocka
 
-$(BUILD)/examples/%: examples/%/main.c $(BUILD)/libwetdem.a
+$(BUILD)/examples/%: examples/%/main.c $(BUILD)/libwetdem.a $(BUILD)/flags.stamp
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS_ALL) -o $@ $< $(BUILD)/libwetdem.a $(LDLIBS)
 
