@@ -453,8 +453,7 @@ static struct wetdem_vec3 wrap(const struct wetdem_celllist_box* b, struct wetde
 }
 
 /* Half kick and drift of particle p (index k); its velocities become the predicted ones
- * v' + a dt/2. Works on local copies: the stores of p, vh and wh may alias as far as the
- * compiler knows, and each is written once. */
+ * v' + a dt/2. Every value is formed in a local and stored once. */
 static void kick_drift_one(struct wetdem_many* m, struct wetdem_particle* p, size_t k,
                            struct wetdem_vec3 g, double h, bool periodic, bool pending)
 {
