@@ -1090,10 +1090,11 @@ static void start_sums_of_block(const struct pass* P, size_t b, struct failure* 
  * those within range, and those with flags (they may have just left it), whose second particle
  * is below end_block, are listed in hits in pair order; returns their number. `periodic` and
  * `single` (one material pair) are constants at each call, so each case compiles to its own
- * loop. */
+ * loop. The lists are `restrict`: a store through the byte list could otherwise alias
+ * anything, and every read of the pass would be repeated after it. */
 static inline __attribute__((always_inline)) size_t
-gap_test(const struct pass* P, size_t q_begin, size_t q_end, size_t end_block, uint32_t* hits,
-         unsigned char* hit_near, bool periodic, bool single)
+gap_test(const struct pass* P, size_t q_begin, size_t q_end, size_t end_block,
+         uint32_t* restrict hits, unsigned char* restrict hit_near, bool periodic, bool single)
 {
     const struct wetdem_celllist_pair* pairs = P->pairs;
     const unsigned char* flags = P->flags;
