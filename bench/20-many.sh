@@ -21,10 +21,13 @@
 # other guests, CPU time leaves out the time the host took away, and wall time does not), memory
 # per particle ((max RSS - RSS of a 1-particle run) / N) and the ratios against the targets:
 # >= 2x LIGGGHTS per core dry and wet, >= 1.8x speed-up on 2 threads, wet <= 1.3x dry.
+# Then, with valgrind, the load-independent measure: instructions per particle-step of both
+# codes on the shared state (same-state and frozen protocols, callgrind, one thread).
 #
 # Usage: bench/20-many.sh [WETDEM_CLI]    (make bench passes the CLI; it is not needed here)
 # Environment: N (20000), SETTLE (500), STEPS (1500), STATE (3000), SAME_STEPS (300),
-# FROZEN_STEPS (300), FROZEN_DT (1e-9), REPEAT (3) — about 15 minutes on 2 cores;
+# FROZEN_STEPS (300), FROZEN_DT (1e-9), REPEAT (3), INSTR_STEPS (100; 0 skips the instruction
+# counts) — about 10-20 minutes on 2 cores;
 # OMP_WAIT_POLICY (default passive: spinning threads collapse when the cores are shared).
 # Results go to build/bench/many/ (logs, results.txt, summary.txt). The ratios are printed, not
 # enforced: the machine may be shared, which the load average printed with the results shows.
@@ -39,6 +42,7 @@ SAME_STEPS=${SAME_STEPS:-300}
 FROZEN_STEPS=${FROZEN_STEPS:-300}
 FROZEN_DT=${FROZEN_DT:-1e-9}
 REPEAT=${REPEAT:-3}
+INSTR_STEPS=${INSTR_STEPS:-100}
 out=build/bench/many
 mkdir -p "$out"
 res="$out/results.txt"
@@ -150,14 +154,50 @@ done
 $have_lg || echo "20-many: liggghts or mpirun not installed: LIGGGHTS half skipped" \
   "(scripts/install-deps bench)"
 
+# ---- instruction counts (load-independent) ----
+# Instructions per particle-step of each code and variant on the shared state, same-state
+# (dt 1e-5) and frozen (FROZEN_DT) protocols, one thread / one rank without mpirun, under
+# callgrind: a run of INSTR_STEPS steps minus a run of 0 steps (start-up, reading the state).
+# Arguments: code variant dt steps -> instructions of the whole run
+count_instr() {
+  local flag="" vg=(valgrind --tool=callgrind --callgrind-out-file=/dev/null)
+  [ "$2" = wet ] && flag="--wet"
+  if [ "$1" = wetdem ]; then
+    OMP_NUM_THREADS=1 "${vg[@]}" "$out/many_bench" $flag --state-in "$out/state.data" \
+      --settle 0 --steps "$4" --dt "$3" 2>&1 >/dev/null | sed -n 's/.*Collected : //p'
+  else
+    "${vg[@]}" liggghts -in "$deck/$2.in" -var deckdir "$deck" -var data "$out/state.data" \
+      -var nsettle 0 -var nsteps "$4" -var dt "$3" -log "$out/liggghts_instr.log" \
+      -screen none -nocite 2>&1 | sed -n 's/.*Collected : //p'
+  fi
+}
+if [ "$INSTR_STEPS" -gt 0 ] && command -v valgrind >/dev/null; then
+  for variant in dry wet; do
+    for code in wetdem liggghts; do
+      [ "$code" = liggghts ] && ! command -v liggghts >/dev/null && continue
+      base=$(count_instr "$code" "$variant" 1e-5 0)
+      for proto in same frozen; do
+        dt=1e-5
+        [ "$proto" = frozen ] && dt=$FROZEN_DT
+        total=$(count_instr "$code" "$variant" "$dt" "$INSTR_STEPS")
+        echo "instr $proto $code $variant $(( (total - base) / (N * INSTR_STEPS) ))" |
+          tee -a "$res" >&2
+      done
+    done
+  done
+else
+  echo "20-many: valgrind not installed or INSTR_STEPS=0: instruction counts skipped" >&2
+fi
+
 # ---- report ----
 echo "load average after the run: $(cut -d' ' -f1-3 /proc/loadavg), $(nproc) cores;" \
      "time taken by the host (steal) during the run: $(awk -v a="$steal0" -v b="$(steal_s)" \
      'BEGIN{printf "%.1f", b - a}') s" | tee -a "$res"
 awk -v n="$N" -v wb="$base_kb" -v lb="$lg_base" -v steps="$STEPS" -v same="$SAME_STEPS" \
-    -v fsteps="$FROZEN_STEPS" -v fdt="$FROZEN_DT" '
+    -v fsteps="$FROZEN_STEPS" -v fdt="$FROZEN_DT" -v isteps="$INSTR_STEPS" '
   /^(full|same|frozen) / { k = $1 " " $2 " " $3 " " $4; rate[k] = $5; kb[k] = $6; cpu[k] = $7
                     con[k] = $8; bri[k] = $9 }
+  /^instr / { ins[$2 " " $3 " " $4] = $5 }
   function r(a, b) { return (b > 0) ? a / b : 0 }
   END {
     printf "\n%-5s %-9s %-4s %7s %12s %14s %14s %9s %9s\n", "proto", "code", "kind", "threads",
@@ -197,5 +237,18 @@ awk -v n="$N" -v wb="$base_kb" -v lb="$lg_base" -v steps="$STEPS" -v same="$SAME
       note = p == 1 ? " (different final states)" : " (target <= 1.3)"
       if (p == 2) note = " (the wet run ends with more contacts)"
       printf "%s\n", note
+    }
+    if (length(ins) > 0)
+      printf "instructions per particle-step (callgrind, 1 thread, %d steps minus 0):\n", isteps
+    for (p = 2; p <= 3; p++) {
+      proto = p == 2 ? "same" : "frozen"; w = proto " wetdem "; l = proto " liggghts "
+      if (!((w "dry") in ins)) continue
+      printf "  %-6s wetdem dry %d, wet %d (wet / dry %.2fx)", proto, ins[w "dry"], ins[w "wet"],
+             r(ins[w "wet"], ins[w "dry"])
+      if ((l "dry") in ins)
+        printf "; LIGGGHTS dry %d, wet %d (%.2fx); LIGGGHTS / wetdem dry %.2fx, wet %.2fx",
+               ins[l "dry"], ins[l "wet"], r(ins[l "wet"], ins[l "dry"]),
+               r(ins[l "dry"], ins[w "dry"]), r(ins[l "wet"], ins[w "wet"])
+      printf "\n"
     }
   }' "$res" | tee "$out/summary.txt"
