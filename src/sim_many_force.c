@@ -1123,7 +1123,8 @@ static void pairs_of_block(const struct pass* P, size_t b, bool kick, struct wet
     struct wetdem_vec3* force = m->force;
     struct wetdem_vec3* torque = m->torque;
     uint32_t* contacts = m->contacts;
-    size_t begin_block = m->blk[b], end_block = m->blk[b + 1], e = m->cross_first[b];
+    size_t begin_block = m->blk[b], end_block = m->blk[b + 1];
+    size_t e = m->cross_first[b], e_end = m->cross_first[b + 1]; /* the block's cross pairs */
     const unsigned char* flags = P->flags;
     bool single = P->nm == 1, periodic = P->periodic;
     /* 1. the gap test of every candidate of the block whose second particle is in the block,
@@ -1164,11 +1165,8 @@ static void pairs_of_block(const struct pass* P, size_t b, bool kick, struct wet
                 torque[j] = vec3_add(torque[j], o.torque_j);
             }
         }
-        size_t q = m->cl.first_pair[i + 1];
-        while (q > m->cl.first_pair[i] && pairs[q - 1].j >= end_block)
-            q--;                                                        /* first cross pair of i */
-        for (size_t end = m->cl.first_pair[i + 1]; q < end; q++, e++) { /* in j order */
-            unsigned char fl = flags[q];
+        for (; e < e_end && pairs[m->cross_q[e]].i == i; e++) { /* its cross pairs, j order */
+            unsigned char fl = flags[m->cross_q[e]];
             if (!(fl & WETDEM_MANY_ACTIVE))
                 continue;
             f = vec3_add(f, m->cross_out[e].force);
