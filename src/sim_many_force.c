@@ -1140,6 +1140,13 @@ static void pairs_of_block(const struct pass* P, size_t b, bool kick, struct wet
           once), its cross pairs from phase 1, then its own sum and the closing half kick */
     size_t h = 0;
     for (size_t i = begin_block; i < end_block; i++) {
+        bool own = h < n_hits && pairs[hits[h]].i == i;
+        bool cross = e < e_end && pairs[m->cross_q[e]].i == i;
+        if (!own && !cross) { /* nothing to add (adding +0 would change no sum) */
+            if (kick)
+                close_kick(P->sim, i, g);
+            continue;
+        }
         struct wetdem_vec3 f = vec3(0, 0, 0), t = vec3(0, 0, 0);
         uint32_t n_contacts = 0;
         for (; h < n_hits && pairs[hits[h]].i == i; h++) {
