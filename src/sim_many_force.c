@@ -1064,14 +1064,19 @@ static void start_sums_of_block(const struct pass* P, size_t b, struct failure* 
 {
     struct wetdem_many* m = P->m;
     const struct wetdem_sim* sim = P->sim;
-    for (size_t k = m->blk[b]; k < m->blk[b + 1]; k++) {
+    /* locals, not fields of m: the stores below could otherwise alias them */
+    struct wetdem_vec3 *force = m->force, *torque = m->torque;
+    uint32_t* contacts = m->contacts;
+    const uint64_t* wall_mask = m->wall_mask;
+    bool every_wall = sim->n_walls > 64;
+    for (size_t k = m->blk[b], end = m->blk[b + 1]; k < end; k++) {
         struct wetdem_vec3 f = vec3(0, 0, 0), t = vec3(0, 0, 0);
         uint32_t n_contacts = 0;
-        if (m->wall_mask[k] || sim->n_walls > 64)
+        if (wall_mask[k] || every_wall)
             eval_walls_of(sim, k, &f, &t, &n_contacts, fail);
-        m->force[k] = f;
-        m->torque[k] = t;
-        m->contacts[k] = n_contacts;
+        force[k] = f;
+        torque[k] = t;
+        contacts[k] = n_contacts;
     }
     const size_t* first_in = m->cross_first + m->n_blocks + 1;
     for (size_t s = first_in[b]; s < first_in[b + 1]; s++) {
