@@ -117,9 +117,10 @@ struct wetdem_many {
     size_t *blk, *cross_first;
     uint32_t *cross_q, *cross_in;
     struct wetdem_many_pair_out* cross_out;
-    uint32_t* hits;          /* per pair: the force pass's list of candidates within range or with
-                       flags (scratch) */
-    unsigned char* hit_near; /* per entry of hits: within range (1) or listed for its flags */
+    /* scratch of the force pass, per pair: the candidates within range or with flags, and for
+       each entry whether it is within range (1) or listed for its flags (0) */
+    uint32_t* hits;
+    unsigned char* hit_near;
     size_t hits_cap, hit_near_cap;
     size_t blk_cap, cross_first_cap, cross_q_cap, cross_in_cap, cross_out_cap;
     size_t n_blocks, blocks_n;
