@@ -94,6 +94,11 @@ struct wetdem_many {
                                 m* [kg], the Hertz stiffness (4/3) E* sqrt(R*) [N/m^1.5] and the
                                 damping factor c sqrt(m* k) of the hertz form [kg/(s m^0.25)] */
     double (*old_cache)[4];
+    double* pair_lim2; /* per candidate pair: (R_i + R_j + r_ab)^2 (1 + margin) of the gap test
+                           [m^2], valid for the list build pair_lim2_build when pair_lim2_ready */
+    size_t pair_lim2_cap;
+    uint64_t pair_lim2_build;
+    bool pair_lim2_ready; /* cleared when the kernel is set up (radii or ranges may change) */
     size_t pair_cache_cap, old_cache_cap;
     unsigned char* old_flags; /* flags of the previous list, for remapping */
     size_t old_flags_cap;

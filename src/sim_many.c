@@ -106,6 +106,7 @@ void wetdem_sim_many_free(struct wetdem_sim* sim)
     free(m->cross_out);
     free(m->hits);
     free(m->hit_near);
+    free(m->pair_lim2);
     free(m->work);
     for (size_t k = 0; k < m->n_series && m->vtk_names; k++)
         free(m->vtk_names[k]);

@@ -198,6 +198,7 @@ int wetdem_sim_many_setup_kernel(struct wetdem_sim* sim)
             x->range = fused ? (x->film > 0.0 ? x->film : 0.0) : m->reach;
         }
     m->fused = fused;
+    m->pair_lim2_ready = false; /* the ranges, and the radii, may have changed */
     plan_lean(sim);
     m->periodic_any = m->cl.box.periodic[0] || m->cl.box.periodic[1] || m->cl.box.periodic[2];
     return WETDEM_OK;
@@ -682,6 +683,7 @@ struct pass {
     const struct wetdem_celllist_item* xr;
     const struct wetdem_celllist_pair* pairs;
     unsigned char* flags;
+    const double* lim2; /* pair_lim2 */
     double* history;
     size_t len, nm;
     bool periodic, lean;
@@ -738,16 +740,23 @@ static inline __attribute__((always_inline)) void pair_delta(const struct pass* 
                 : &P->m->mix[(size_t)P->p[i].material * P->nm + (size_t)P->p[j].material];
 }
 
-/* The cheap gap test of pair (i, j): pair_delta, then true when
- * |d|^2 <= (R_i + R_j + r_ab)^2 (1 + PREFILTER_MARGIN). */
-static inline __attribute__((always_inline)) bool within_reach(const struct pass* P, size_t i,
-                                                               size_t j, bool periodic, bool single,
-                                                               struct wetdem_vec3* d,
+/* The squared reach of the cheap gap test of pair (i, j) with mixed properties x [m^2]. */
+static double reach2(const struct wetdem_celllist_item* xr, size_t i, size_t j,
+                     const struct wetdem_many_mix* x)
+{
+    double lim = xr[i].r + xr[j].r + x->range;
+    return lim * lim * (1 + PREFILTER_MARGIN);
+}
+
+/* The cheap gap test of candidate q = (i, j): pair_delta, then true when
+ * |d|^2 <= (R_i + R_j + r_ab)^2 (1 + PREFILTER_MARGIN), the bound kept per pair (pair_lim2). */
+static inline __attribute__((always_inline)) bool within_reach(const struct pass* P, size_t q,
+                                                               size_t i, size_t j, bool periodic,
+                                                               bool single, struct wetdem_vec3* d,
                                                                const struct wetdem_many_mix** x)
 {
     pair_delta(P, i, j, periodic, single, d, x);
-    double lim = P->xr[i].r + P->xr[j].r + (*x)->range;
-    return vec3_dot(*d, *d) <= lim * lim * (1 + PREFILTER_MARGIN);
+    return vec3_dot(*d, *d) <= P->lim2[q];
 }
 
 /* Candidate pair q = (i, j): the gap test on the positions first (most candidates are beyond
@@ -759,7 +768,7 @@ eval_candidate(const struct pass* P, size_t q, size_t i, size_t j, struct wetdem
 {
     struct wetdem_vec3 d;
     const struct wetdem_many_mix* x;
-    if (within_reach(P, i, j, P->periodic, P->nm == 1, &d, &x))
+    if (within_reach(P, q, i, j, P->periodic, P->nm == 1, &d, &x))
         return near_candidate(P, q, i, j, d, x, o, fail);
     if (P->flags[q])
         leave_range(P, q);
@@ -1108,7 +1117,7 @@ gap_test(const struct pass* P, size_t q_begin, size_t q_end, size_t end_block,
         size_t i = pairs[q].i, j = pairs[q].j;
         struct wetdem_vec3 d;
         const struct wetdem_many_mix* x;
-        bool near = within_reach(P, i, j, periodic, single, &d, &x);
+        bool near = within_reach(P, q, i, j, periodic, single, &d, &x);
         hits[n_hits] = (uint32_t)q;
         hit_near[n_hits] = near;
         n_hits += ((size_t)near | (size_t)(flags[q] != 0)) & (size_t)(j < end_block);
@@ -1194,6 +1203,26 @@ static void pairs_of_block(const struct pass* P, size_t b, bool kick, struct wet
     }
 }
 
+/* The gap test's bound of every candidate pair (pair_lim2), once per list build and kernel
+ * set-up: the radii and the ranges do not change in between. */
+static int pair_limits(struct wetdem_sim* sim)
+{
+    struct wetdem_many* m = sim->many;
+    if (m->pair_lim2_ready && m->pair_lim2_build == m->cl.n_builds)
+        return WETDEM_OK;
+    size_t np = m->cl.n_pairs, nm = (size_t)m->n_mix_materials;
+    if (!reserve((void**)&m->pair_lim2, &m->pair_lim2_cap, np, sizeof *m->pair_lim2))
+        return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory for %zu pairs", np);
+    for (size_t q = 0; q < np; q++) {
+        size_t i = m->cl.pairs[q].i, j = m->cl.pairs[q].j;
+        size_t ab = (size_t)sim->particles[i].material * nm + (size_t)sim->particles[j].material;
+        m->pair_lim2[q] = reach2(m->xr, i, j, &m->mix[ab]);
+    }
+    m->pair_lim2_build = m->cl.n_builds;
+    m->pair_lim2_ready = true;
+    return WETDEM_OK;
+}
+
 int wetdem_sim_many_forces(struct wetdem_sim* sim, bool kick)
 {
     struct wetdem_many* m = sim->many;
@@ -1214,6 +1243,9 @@ int wetdem_sim_many_forces(struct wetdem_sim* sim, bool kick)
         for (size_t q = 0; q < m->cl.n_pairs; q++)
             m->flags[q] &= (unsigned char)~WETDEM_MANY_CACHED;
     }
+    st = pair_limits(sim);
+    if (st != WETDEM_OK)
+        return st;
     struct failure fail = {0};
     struct wetdem_vec3 g =
         vec3(sim->settings.gravity_x, sim->settings.gravity_y, sim->settings.gravity_z);
@@ -1223,6 +1255,7 @@ int wetdem_sim_many_forces(struct wetdem_sim* sim, bool kick)
                      .xr = m->xr,
                      .pairs = m->cl.pairs,
                      .flags = m->flags,
+                     .lim2 = m->pair_lim2,
                      .history = m->history,
                      .len = sim->history_len,
                      .nm = (size_t)m->n_mix_materials,
