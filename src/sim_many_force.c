@@ -13,11 +13,12 @@
  *      wall forces (wall order) and the reactions -F of the cross pairs (i, k) from earlier
  *      blocks (increasing i). A flat loop gap-tests every in-block candidate,
  *      |x_i - x_j|^2 > (R_i + R_j + r_ab)^2 (1 + 1e-12) (r_ab the model range of the material
- *      pair, or the start-up reach for model sets without a fused kernel), and lists those
- *      within range or with flags. Then, for i in index order: its listed pairs (the exact test
- *      h > range decides), each reaction -F added to j at once; its cross pairs from step 1;
- *      the sum S_i of its own pairs in j order added last; the closing half kick of velocity
- *      Verlet (sim_many.c).
+ *      pair, or the start-up reach for model sets without a fused kernel; the bound is kept
+ *      per candidate from the list build), and lists those within range or with flags. Then,
+ *      for i in index order: its listed pairs (the exact test h > range decides), each
+ *      reaction -F added to j at once; its cross pairs from step 1; the sum S_i of its own
+ *      pairs in j order added last (a particle with no pairs adds nothing: +0 would change no
+ *      sum); the closing half kick of velocity Verlet (sim_many.c).
  * So particle k always sums walls, then -F of every pair (i, k) in increasing i, then S_k: an
  * order set by particle indices only, whatever the blocks, so states are bit-identical for any
  * number of threads and, because pairs out of range add nothing, for any time at which the
@@ -50,7 +51,8 @@
  * h_min), the force is computed straight from the two particles (or particle and wall),
  * without a contact record or the switch, by the same definitions (models.h: Hertz stiffness,
  * elastic and damping parts; mindlin.h: the tangential spring) in the same order, so it is
- * bit-identical to the fused kernel and the generic path (tests/test_many_force.c).
+ * bit-identical to the fused kernel and the generic path (tests/test_many_force.c). Pairs
+ * apart (gap >= 0, liquid bridges) take a short path with the film terms only (lean_apart).
  */
 #include <omp.h>
 #include <stdlib.h>
