@@ -59,9 +59,6 @@ struct wetdem_many_pair_out {
 #define WETDEM_MANY_CONTACT 2u /* gap < 0: solid contact */
 #define WETDEM_MANY_BRIDGE 4u  /* gap < film delta_ij with a fluid model: liquid bridge */
 #define WETDEM_MANY_DIRTY 8u   /* history may differ from a fresh one (reset when out of range) */
-#define WETDEM_MANY_CACHED                                                                         \
-    16u /* pair_cache holds the pair's constants (lean kernel; cleared with
-                                  the flags when the pair leaves its range) */
 
 /* Energy bookkeeping (sim_many.c accumulates, sim_many_io.c reports). */
 struct wetdem_many_energy {
@@ -90,17 +87,17 @@ struct wetdem_many {
     unsigned char* flags; /* per candidate pair: MANY_ACTIVE | _CONTACT | _BRIDGE | _DIRTY
                                     (a separate byte array: the gather scans it densely) */
     size_t flags_cap;
-    double (*pair_cache)[4]; /* per candidate pair, valid where WETDEM_MANY_CACHED: R* [m],
-                                m* [kg], the Hertz stiffness (4/3) E* sqrt(R*) [N/m^1.5] and the
-                                damping factor c sqrt(m* k) of the hertz form [kg/(s m^0.25)] */
-    double (*old_cache)[4];
-    double* pair_lim2; /* per candidate pair: (R_i + R_j + r_ab)^2 (1 + margin) of the gap test
-                           [m^2], valid for the list build pair_lim2_build when pair_lim2_ready */
-    size_t pair_lim2_cap;
-    uint64_t pair_lim2_build;
-    bool pair_lim2_ready; /* cleared when the kernel is set up (radii or ranges may change) */
-    size_t pair_cache_cap, old_cache_cap;
-    unsigned char* old_flags; /* flags of the previous list, for remapping */
+    /* constants of each candidate pair, computed once per list build and kernel set-up (the
+       radii, masses and ranges do not change in between; sim_many_force.c pair_constants):
+       the gap test's bound (R_i + R_j + r_ab)^2 (1 + margin) [m^2], and for the lean kernel
+       R* [m], m* [kg], the Hertz stiffness (4/3) E* sqrt(R*) [N/m^1.5] and the damping factor
+       c sqrt(m* k) of the hertz form [kg/(s m^0.25)] */
+    double* pair_lim2;
+    double (*pair_cache)[4];
+    size_t pair_lim2_cap, pair_cache_cap;
+    uint64_t pair_consts_build; /* the list build they were computed for */
+    bool pair_consts_ready;     /* cleared when the kernel is set up */
+    unsigned char* old_flags;   /* flags of the previous list, for remapping */
     size_t old_flags_cap;
     uint64_t* wall_mask; /* per particle: bit w set if wall w is within reach + skin
                                     at the last build (walls >= 64 are always evaluated) */

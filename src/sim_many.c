@@ -85,7 +85,6 @@ void wetdem_sim_many_free(struct wetdem_sim* sim)
     free(m->old_history);
     free(m->old_flags);
     free(m->pair_cache);
-    free(m->old_cache);
     free(m->flags);
     free(m->wall_mask);
     free(m->wall_dirty);
@@ -283,12 +282,6 @@ static void swap_pair_arrays(struct wetdem_many* m)
     cap = m->old_flags_cap;
     m->old_flags_cap = m->flags_cap;
     m->flags_cap = cap;
-    double(*c)[4] = m->old_cache;
-    m->old_cache = m->pair_cache;
-    m->pair_cache = c;
-    cap = m->old_cache_cap;
-    m->old_cache_cap = m->pair_cache_cap;
-    m->pair_cache_cap = cap;
 }
 
 /* Walls within reach + skin of each particle at this build (Verlet criterion as for pairs);
@@ -341,20 +334,14 @@ static int rebuild(struct wetdem_sim* sim)
     swap_pair_arrays(m); /* the current histories and flags become the old ones (no copy) */
     size_t n_new = m->cl.n_pairs;
     if (grow((void**)&m->history, &m->history_cap, n_new * len + 1, sizeof(double)) ||
-        grow((void**)&m->flags, &m->flags_cap, n_new ? n_new : 1, 1) ||
-        grow((void**)&m->pair_cache, &m->pair_cache_cap, n_new ? n_new : 1, sizeof *m->pair_cache))
+        grow((void**)&m->flags, &m->flags_cap, n_new ? n_new : 1, 1))
         return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory for %zu pairs", n_new);
     double fresh[HISTORY_MAX];
     if (len)
         wetdem_sim_history_init(sim, fresh);
-    /* surviving pairs keep their history, their cached constants and those two flags */
+    /* surviving pairs keep their history and its DIRTY flag */
     wetdem_celllist_remap(m->old_pairs, m->old_history, m->old_flags, n_old, m->cl.pairs,
-                          m->history, m->flags, WETDEM_MANY_DIRTY | WETDEM_MANY_CACHED, n_new, len,
-                          fresh);
-    double none[4] = {0, 0, 0, 0};
-    if (m->old_cache)
-        wetdem_celllist_remap(m->old_pairs, m->old_cache[0], NULL, n_old, m->cl.pairs,
-                              m->pair_cache[0], NULL, 0, n_new, 4, none);
+                          m->history, m->flags, WETDEM_MANY_DIRTY, n_new, len, fresh);
     m->blocks_ready = false; /* the force pass indexes the new list */
     return update_wall_masks(sim);
 }
@@ -409,8 +396,6 @@ int wetdem_sim_many_prepare(struct wetdem_sim* sim)
         m->inv[k][1] = 1.0 / (0.4 * p->mass * p->radius * p->radius);
         m->wall_dirty[k] = ~(uint64_t)0; /* histories may have been restored or changed */
     }
-    for (size_t q = 0; refresh && m->flags && q < m->cl.n_pairs; q++) /* masses may have changed */
-        m->flags[q] &= (unsigned char)~WETDEM_MANY_CACHED;
     bool moved = m->max_disp_valid && m->cl.n_builds > 0 && m->cl.n_at_build == sim->n_particles
                      ? m->max_disp2 > 0.25 * m->cl.skin * m->cl.skin
                      : wetdem_celllist_needs_rebuild(&m->cl, sim->particles, sim->n_particles);

@@ -200,7 +200,7 @@ int wetdem_sim_many_setup_kernel(struct wetdem_sim* sim)
             x->range = fused ? (x->film > 0.0 ? x->film : 0.0) : m->reach;
         }
     m->fused = fused;
-    m->pair_lim2_ready = false; /* the ranges, and the radii, may have changed */
+    m->pair_consts_ready = false; /* the ranges, radii and masses may have changed */
     plan_lean(sim);
     m->periodic_any = m->cl.box.periodic[0] || m->cl.box.periodic[1] || m->cl.box.periodic[2];
     return WETDEM_OK;
@@ -449,7 +449,7 @@ lean_apart(const struct wetdem_many_lean* L, const struct wetdem_many_mix* x, st
     film_terms(L, x, gap, r_eff, v_n, term);
     double f_n = 0.0 + term[1] + term[2];
     o->force = vec3_axpy(vec3(0, 0, 0), f_n, n);
-    *flags = WETDEM_MANY_ACTIVE | WETDEM_MANY_DIRTY | WETDEM_MANY_CACHED |
+    *flags = WETDEM_MANY_ACTIVE | WETDEM_MANY_DIRTY |
              (x->film > 0 && gap < x->film ? WETDEM_MANY_BRIDGE : 0);
     return isfinite(f_n) ? WETDEM_OK : WETDEM_ERR_NUMERIC;
 }
@@ -458,18 +458,17 @@ lean_apart(const struct wetdem_many_lean* L, const struct wetdem_many_mix* x, st
  * it, then lean_apart or lean_force; *flags = 0 beyond the range. */
 static int lean_pair(const struct wetdem_many* m, const struct wetdem_particle* a,
                      const struct wetdem_particle* b, struct wetdem_vec3 d,
-                     const struct wetdem_many_mix* x, double* hist, double* cache,
+                     const struct wetdem_many_mix* x, double* hist, const double* cache,
                      unsigned char* flags, struct wetdem_many_pair_out* o)
     __attribute__((always_inline));
 static inline int lean_pair(const struct wetdem_many* m, const struct wetdem_particle* a,
                             const struct wetdem_particle* b, struct wetdem_vec3 d,
-                            const struct wetdem_many_mix* x, double* hist, double* cache,
+                            const struct wetdem_many_mix* x, double* hist, const double* cache,
                             unsigned char* flags, struct wetdem_many_pair_out* o)
 {
     double dist = vec3_norm(d);
     struct lean_geometry g; /* every field read is set (no zeroing of the whole record) */
     g.gap = dist - a->radius - b->radius;
-    bool cached = *flags & WETDEM_MANY_CACHED;
     *flags = 0;
     if (g.gap > x->range)
         return WETDEM_OK;
@@ -477,15 +476,6 @@ static inline int lean_pair(const struct wetdem_many* m, const struct wetdem_par
     g.r_j = b->radius;
     g.wall = false;
     g.n = dist > 0 ? vec3_scale(d, 1.0 / dist) : vec3(1, 0, 0);
-    if (!cached) { /* the pair's constants, computed as they would be at every step */
-        cache[0] = contact_reduced(a->radius, b->radius);
-        cache[1] = contact_reduced(contact_effective_mass(a), contact_effective_mass(b));
-        cache[2] = hertz_stiffness(x->e_star, cache[0]);
-        cache[3] =
-            m->lean.hertz_form >= 0
-                ? hertz_damping_factor(x->hertz_damping[m->lean.hertz_form], cache[2], cache[1])
-                : 0.0;
-    }
     g.r_eff = cache[0];
     g.m_eff = cache[1];
     g.k = cache[2];
@@ -499,9 +489,7 @@ static inline int lean_pair(const struct wetdem_many* m, const struct wetdem_par
         struct wetdem_vec3 vb = vec3_add(b->vel, vec3_cross(b->omega, vec3_scale(g.n, b->radius)));
         g.v_t = vec3_reject(vec3_sub(va, vb), g.n);
     }
-    int st = lean_force(m, &g, x, hist, flags, o);
-    *flags |= WETDEM_MANY_CACHED;
-    return st;
+    return lean_force(m, &g, x, hist, flags, o);
 }
 
 /* Particle a and plane wall w: the geometry of wall_contact_from, then lean_force (walls
@@ -1205,23 +1193,35 @@ static void pairs_of_block(const struct pass* P, size_t b, bool kick, struct wet
     }
 }
 
-/* The gap test's bound of every candidate pair (pair_lim2), once per list build and kernel
- * set-up: the radii and the ranges do not change in between. */
-static int pair_limits(struct wetdem_sim* sim)
+/* The constants of every candidate pair (many.h: pair_lim2, and pair_cache for the lean
+ * kernel), once per list build and kernel set-up: radii, masses and ranges do not change in
+ * between. The same expressions as per evaluation, so the same bits. */
+static int pair_constants(struct wetdem_sim* sim)
 {
     struct wetdem_many* m = sim->many;
-    if (m->pair_lim2_ready && m->pair_lim2_build == m->cl.n_builds)
+    if (m->pair_consts_ready && m->pair_consts_build == m->cl.n_builds)
         return WETDEM_OK;
     size_t np = m->cl.n_pairs, nm = (size_t)m->n_mix_materials;
-    if (!reserve((void**)&m->pair_lim2, &m->pair_lim2_cap, np, sizeof *m->pair_lim2))
+    bool lean = lean_active(m);
+    int form = m->lean.hertz_form;
+    if (!reserve((void**)&m->pair_lim2, &m->pair_lim2_cap, np, sizeof *m->pair_lim2) ||
+        (lean && !reserve((void**)&m->pair_cache, &m->pair_cache_cap, np, sizeof *m->pair_cache)))
         return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory for %zu pairs", np);
     for (size_t q = 0; q < np; q++) {
         size_t i = m->cl.pairs[q].i, j = m->cl.pairs[q].j;
-        size_t ab = (size_t)sim->particles[i].material * nm + (size_t)sim->particles[j].material;
-        m->pair_lim2[q] = reach2(m->xr, i, j, &m->mix[ab]);
+        const struct wetdem_particle *a = &sim->particles[i], *b = &sim->particles[j];
+        const struct wetdem_many_mix* x = &m->mix[(size_t)a->material * nm + (size_t)b->material];
+        m->pair_lim2[q] = reach2(m->xr, i, j, x);
+        if (!lean)
+            continue;
+        double* c = m->pair_cache[q];
+        c[0] = contact_reduced(a->radius, b->radius);
+        c[1] = contact_reduced(contact_effective_mass(a), contact_effective_mass(b));
+        c[2] = hertz_stiffness(x->e_star, c[0]);
+        c[3] = form >= 0 ? hertz_damping_factor(x->hertz_damping[form], c[2], c[1]) : 0.0;
     }
-    m->pair_lim2_build = m->cl.n_builds;
-    m->pair_lim2_ready = true;
+    m->pair_consts_build = m->cl.n_builds;
+    m->pair_consts_ready = true;
     return WETDEM_OK;
 }
 
@@ -1238,14 +1238,7 @@ int wetdem_sim_many_forces(struct wetdem_sim* sim, bool kick)
     st = index_blocks(sim, nb);
     if (st != WETDEM_OK)
         return st;
-    if (m->cl.n_pairs > m->pair_cache_cap) { /* a list not built by rebuild (restart) */
-        if (!reserve((void**)&m->pair_cache, &m->pair_cache_cap, m->cl.n_pairs,
-                     sizeof *m->pair_cache))
-            return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory");
-        for (size_t q = 0; q < m->cl.n_pairs; q++)
-            m->flags[q] &= (unsigned char)~WETDEM_MANY_CACHED;
-    }
-    st = pair_limits(sim);
+    st = pair_constants(sim);
     if (st != WETDEM_OK)
         return st;
     struct failure fail = {0};
