@@ -109,6 +109,9 @@ struct wetdem_many {
     size_t n_wall_list, wall_list_cap;
     bool kick_pending;   /* the latest step's closing half kick is still to be applied
                                     (sim_many.c one_step); never true outside a run */
+    size_t sums_zeroed;  /* the kick-drift pass set force, torque and contacts of this many
+                                    particles to zero (0: not); the next force pass then starts
+                                    only the sums of the particles with walls */
     double max_disp2;    /* largest squared displacement since the build [m^2], */
     bool max_disp_valid; /* measured during the latest drift */
     /* blocks of the force pass (sim_many_force.c), one per thread: particles blk[b] ..

@@ -476,6 +476,10 @@ static void kick_drift(struct wetdem_sim* sim, double h)
     bool track = m->cl.n_builds > 0 && m->cl.n_at_build == sim->n_particles;
     bool periodic = m->cl.box.periodic[0] || m->cl.box.periodic[1] || m->cl.box.periodic[2];
     const struct wetdem_vec3* at_build = m->cl.pos_at_build;
+    /* the force pass's sums start here, from zero, while the lines are in cache (the force
+       pass then starts only the particles with walls) */
+    struct wetdem_vec3 *force = m->force, *torque = m->torque;
+    uint32_t* contacts = m->contacts;
     double worst = 0; /* max is exact: the same for any thread count */
 #pragma omp parallel for schedule(static)                                                          \
     reduction(max                                                                                  \
@@ -484,6 +488,8 @@ static void kick_drift(struct wetdem_sim* sim, double h)
         struct wetdem_particle* p = &sim->particles[k];
         if (!p->is_fixed)
             kick_drift_one(m, p, k, g, h, periodic, pending);
+        force[k] = torque[k] = vec3(0, 0, 0);
+        contacts[k] = 0;
         if (track) {
             struct wetdem_vec3 d = periodic ? celllist_delta(&m->cl.box, p->pos, at_build[k])
                                             : vec3_sub(p->pos, at_build[k]);
@@ -493,6 +499,7 @@ static void kick_drift(struct wetdem_sim* sim, double h)
     }
     m->max_disp2 = worst;
     m->max_disp_valid = track;
+    m->sums_zeroed = sim->n_particles;
 }
 
 /* The deferred closing half kick of every particle, before anything reads the state. */

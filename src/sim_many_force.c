@@ -677,6 +677,7 @@ struct pass {
     double* history;
     size_t len, nm;
     bool periodic, lean;
+    bool zeroed; /* the sums start from zero already (many.h sums_zeroed) */
 };
 
 /* Candidate q = (i, j, d = x_i - x_j) that passed the gap test: its kernel. Returns its flags.
@@ -1068,15 +1069,36 @@ static void start_sums_of_block(const struct pass* P, size_t b, struct failure* 
     uint32_t* contacts = m->contacts;
     const uint64_t* wall_mask = m->wall_mask;
     bool every_wall = sim->n_walls > 64;
-    for (size_t k = m->blk[b], end = m->blk[b + 1]; k < end; k++) {
-        struct wetdem_vec3 f = vec3(0, 0, 0), t = vec3(0, 0, 0);
-        uint32_t n_contacts = 0;
-        if (wall_mask[k] || every_wall)
+    size_t begin = m->blk[b], end = m->blk[b + 1];
+    if (P->zeroed) { /* the others are zero already: the particles with walls (wall_list) */
+        const uint32_t* list = m->wall_list;
+        size_t lo = 0, hi = m->n_wall_list; /* the first entry >= begin */
+        while (lo < hi) {
+            size_t mid = lo + (hi - lo) / 2;
+            if (list[mid] < begin)
+                lo = mid + 1;
+            else
+                hi = mid;
+        }
+        for (size_t s = lo; s < m->n_wall_list && list[s] < end; s++) {
+            size_t k = list[s];
+            struct wetdem_vec3 f = vec3(0, 0, 0), t = vec3(0, 0, 0);
+            uint32_t n_contacts = 0;
             eval_walls_of(sim, k, &f, &t, &n_contacts, fail);
-        force[k] = f;
-        torque[k] = t;
-        contacts[k] = n_contacts;
-    }
+            force[k] = f;
+            torque[k] = t;
+            contacts[k] = n_contacts;
+        }
+    } else
+        for (size_t k = begin; k < end; k++) {
+            struct wetdem_vec3 f = vec3(0, 0, 0), t = vec3(0, 0, 0);
+            uint32_t n_contacts = 0;
+            if (wall_mask[k] || every_wall)
+                eval_walls_of(sim, k, &f, &t, &n_contacts, fail);
+            force[k] = f;
+            torque[k] = t;
+            contacts[k] = n_contacts;
+        }
     const size_t* first_in = m->cross_first + m->n_blocks + 1;
     for (size_t s = first_in[b]; s < first_in[b + 1]; s++) {
         size_t e = m->cross_in[s], q = m->cross_q[e], k = P->pairs[q].j;
@@ -1255,7 +1277,8 @@ int wetdem_sim_many_forces(struct wetdem_sim* sim, bool kick)
                      .len = sim->history_len,
                      .nm = (size_t)m->n_mix_materials,
                      .periodic = m->periodic_any,
-                     .lean = lean_active(m)};
+                     .lean = lean_active(m),
+                     .zeroed = m->sums_zeroed == n};
     /* one region: cross pairs, a barrier, then each block on its own */
 #pragma omp parallel if (parallel)
     {
@@ -1271,6 +1294,7 @@ int wetdem_sim_many_forces(struct wetdem_sim* sim, bool kick)
         }
     }
     m->blocks_passes++;
+    m->sums_zeroed = 0;
     if (fail.status != WETDEM_OK)
         return report_failure(sim, &fail);
     sim->engine.stats.force_evals++;
