@@ -29,6 +29,7 @@
  * kicks by exactly dt F.v(t + dt); v* differs from v(t + dt) by O(dt^2), so the sum of the
  * work of all models and of gravity equals the change of kinetic energy to second order.
  */
+#include <float.h>
 #include <omp.h>
 #include <stdlib.h>
 #include <string.h>
@@ -438,10 +439,22 @@ static struct wetdem_vec3 wrap(const struct wetdem_celllist_box* b, struct wetde
     return vec3(c[0], c[1], c[2]);
 }
 
+/* The largest of m and the magnitudes of the components of x (comparisons: no call). */
+static double abs_max(struct wetdem_vec3 x, double m)
+{
+    double a = fabs(x.x), b = fabs(x.y), c = fabs(x.z);
+    m = a > m ? a : m;
+    m = b > m ? b : m;
+    return c > m ? c : m;
+}
+
 /* Half kick and drift of particle p (index k); its velocities become the predicted ones
- * v' + a dt/2. Every value is formed in a local and stored once. */
+ * v' + a dt/2, and *v2_max the larger of itself and |v'|^2 of the half-step velocity. Every
+ * value is formed in a local and stored once. */
+
 static void kick_drift_one(struct wetdem_many* m, struct wetdem_particle* p, size_t k,
-                           struct wetdem_vec3 g, double h, bool periodic, bool pending)
+                           struct wetdem_vec3 g, double h, bool periodic, bool pending,
+                           double* v2_max)
 {
     double half = 0.5 * h;
     struct wetdem_vec3 a = vec3_axpy(g, m->inv[k][0], m->force[k]);
@@ -453,6 +466,8 @@ static void kick_drift_one(struct wetdem_many* m, struct wetdem_particle* p, siz
     }
     struct wetdem_vec3 vh = vec3_axpy(v, half, a), wh = vec3_axpy(w, half, alpha);
     struct wetdem_vec3 x = vec3_axpy(p->pos, h, vh);
+    double v2 = vec3_dot(vh, vh);
+    *v2_max = v2 > *v2_max ? v2 : *v2_max;
     x = periodic ? wrap(&m->cl.box, x) : x;
     m->vh[k] = vh;
     m->wh[k] = wh;
@@ -464,9 +479,55 @@ static void kick_drift_one(struct wetdem_many* m, struct wetdem_particle* p, siz
     p->omega = vec3_axpy(wh, half, alpha);
 }
 
+/* The largest magnitude of a coordinate at the last list build, and of a bound of a periodic
+ * axis [m]. */
+static double coordinate_max(const struct wetdem_sim* sim)
+{
+    const struct wetdem_many* m = sim->many;
+    const struct wetdem_vec3* at_build = m->cl.pos_at_build;
+    double x_max = 0; /* max is exact: the same for any thread count */
+#pragma omp parallel for schedule(static)                                                          \
+    reduction(max                                                                                  \
+              : x_max) if (wetdem_many_parallel(m, sim->n_particles))
+    for (size_t k = 0; k < sim->n_particles; k++)
+        x_max = abs_max(at_build[k], x_max);
+    for (int a = 0; a < 3; a++)
+        if (m->cl.box.periodic[a])
+            x_max = abs_max(vec3(m->cl.box.lo[a], m->cl.box.hi[a], 0), x_max);
+    return x_max;
+}
+
+/* Largest squared displacement of any particle since the last neighbour-list build [m^2]. */
+static double max_displacement2(const struct wetdem_sim* sim)
+{
+    const struct wetdem_many* m = sim->many;
+    bool periodic = m->cl.box.periodic[0] || m->cl.box.periodic[1] || m->cl.box.periodic[2];
+    const struct wetdem_vec3* at_build = m->cl.pos_at_build;
+    double worst = 0; /* max is exact: the same for any thread count */
+#pragma omp parallel for schedule(static)                                                          \
+    reduction(max                                                                                  \
+              : worst) if (wetdem_many_parallel(m, sim->n_particles))
+    for (size_t k = 0; k < sim->n_particles; k++) {
+        struct wetdem_vec3 x = sim->particles[k].pos;
+        struct wetdem_vec3 d =
+            periodic ? celllist_delta(&m->cl.box, x, at_build[k]) : vec3_sub(x, at_build[k]);
+        double d2 = vec3_dot(d, d);
+        worst = d2 > worst ? d2 : worst;
+    }
+    return worst;
+}
+
 /* Half kick and drift of every particle (preceded by the previous step's closing half kick if
- * it was deferred); the largest squared displacement since the last neighbour-list build is
- * measured in the same pass (rebuild criterion). */
+ * it was deferred). The rebuild criterion (largest displacement since the last neighbour-list
+ * build > skin/2) is decided without reading the positions at the build at every step: the
+ * pass bounds this step's displacement of every particle by h max|v'| plus the round-off of
+ * the drift (16 u max|x|, u the unit round-off; the drift x + h v' and the periodic wrap
+ * each round by at most u|x| per component), and adds it to m->disp_bound, an upper bound of
+ * the largest displacement since the build. Only when that bound exceeds skin/2 (less a
+ * relative 1e-6 for the round-off of the sum) are the displacements measured, and the bound
+ * reset to the measured one. Where the measurement is skipped, the true displacement is below
+ * skin/2 and the measured one would not have triggered a rebuild either: the lists are
+ * rebuilt at the same steps, so the results are those of a measurement at every step. */
 static void kick_drift(struct wetdem_sim* sim, double h)
 {
     struct wetdem_many* m = sim->many;
@@ -475,31 +536,41 @@ static void kick_drift(struct wetdem_sim* sim, double h)
     struct wetdem_vec3 g = gravity(sim);
     bool track = m->cl.n_builds > 0 && m->cl.n_at_build == sim->n_particles;
     bool periodic = m->cl.box.periodic[0] || m->cl.box.periodic[1] || m->cl.box.periodic[2];
-    const struct wetdem_vec3* at_build = m->cl.pos_at_build;
     /* the force pass's sums start here, from zero, while the lines are in cache (the force
        pass then starts only the particles with walls) */
     struct wetdem_vec3 *force = m->force, *torque = m->torque;
     uint32_t* contacts = m->contacts;
-    double worst = 0; /* max is exact: the same for any thread count */
+    double v2_max = 0; /* max is exact: the same for any thread count */
 #pragma omp parallel for schedule(static)                                                          \
     reduction(max                                                                                  \
-              : worst) if (wetdem_many_parallel(m, sim->n_particles))
+              : v2_max) if (wetdem_many_parallel(m, sim->n_particles))
     for (size_t k = 0; k < sim->n_particles; k++) {
         struct wetdem_particle* p = &sim->particles[k];
         if (!p->is_fixed)
-            kick_drift_one(m, p, k, g, h, periodic, pending);
+            kick_drift_one(m, p, k, g, h, periodic, pending, &v2_max);
         force[k] = torque[k] = vec3(0, 0, 0);
         contacts[k] = 0;
-        if (track) {
-            struct wetdem_vec3 d = periodic ? celllist_delta(&m->cl.box, p->pos, at_build[k])
-                                            : vec3_sub(p->pos, at_build[k]);
-            double d2 = vec3_dot(d, d);
-            worst = d2 > worst ? d2 : worst;
-        }
     }
-    m->max_disp2 = worst;
-    m->max_disp_valid = track;
     m->sums_zeroed = sim->n_particles;
+    m->max_disp_valid = track;
+    if (!track)
+        return;
+    if (m->disp_bound_build != m->cl.n_builds) { /* a new list: nothing has moved since */
+        m->disp_bound_build = m->cl.n_builds;
+        m->disp_bound = 0;
+        m->x_build_max = coordinate_max(sim);
+    }
+    /* |x| <= its value at the build + the displacement since, or within the periodic box */
+    if (isfinite(m->disp_bound)) /* else unknown (a new call): measured below */
+        m->disp_bound += h * sqrt(v2_max) * (1 + 16 * DBL_EPSILON) +
+                         16 * DBL_EPSILON * (m->x_build_max + m->disp_bound);
+    m->max_disp2 = 0;
+    if (!(m->disp_bound <= 0.5 * m->cl.skin * (1 - 1e-6))) {
+        m->max_disp2 = max_displacement2(sim);
+        m->disp_measures++;
+        double d = sqrt(m->max_disp2);
+        m->disp_bound = d * (1 + 16 * DBL_EPSILON) + 16 * DBL_EPSILON * (m->x_build_max + d);
+    }
 }
 
 /* The deferred closing half kick of every particle, before anything reads the state. */
@@ -662,7 +733,8 @@ static int one_step(struct wetdem_sim* sim, bool defer)
 int wetdem_sim_many_integrate(struct wetdem_sim* sim, double t_end)
 {
     struct wetdem_many* m = sim->many;
-    m->kernel_ready = false; /* materials, models or parameters may have changed */
+    m->kernel_ready = false;  /* materials, models or parameters may have changed */
+    m->disp_bound = INFINITY; /* particles may have been moved: measure at the first step */
     int st = m->started ? wetdem_sim_many_prepare(sim) : start(sim);
     if (st != WETDEM_OK)
         return st;

@@ -154,6 +154,43 @@ static void test_many_deferred_kick_is_bit_identical(void** state)
     wetdem_sim_free(every);
 }
 
+/* The kick-drift pass measures the displacements since the list build only when its bound
+ * (sum of h max|v| and the round-off) passes skin/2. A run stepped one call per step measures
+ * at every step (each call starts with an unknown bound): both must rebuild the lists at the
+ * same steps and end bit-identical, and the run in five calls must have skipped most
+ * measurements (else the bound would not be exercised, or not after the first call). */
+static void test_many_displacement_bound_rebuilds_at_the_same_steps(void** state)
+{
+    (void)state;
+    struct wetdem_sim* bound = wet_box(150, true);
+    struct wetdem_sim* every = wet_box(150, true);
+    const int steps = 400;
+    CHECK_OK(wetdem_sim_integrate(bound, steps / 2 * 2e-6));
+    for (int k = 1; k <= 3; k++) { /* a call starts with an unknown bound, measures, and goes
+                                      on with a finite one (also when no list was built) */
+        CHECK_OK(wetdem_sim_integrate(bound, (steps / 2 + k) * 2e-6));
+        assert_true(isfinite(bound->many->disp_bound));
+        assert_true(bound->many->disp_bound <= 0.5 * bound->many->cl.skin);
+    }
+    CHECK_OK(wetdem_sim_integrate(bound, steps * 2e-6));
+    uint64_t measured_bound = bound->many->disp_measures;
+    for (int k = 1; k <= steps; k++)
+        CHECK_OK(wetdem_sim_integrate(every, k * 2e-6));
+    struct wetdem_many_stats sb, se;
+    CHECK_OK(wetdem_sim_many_stats(bound, &sb));
+    CHECK_OK(wetdem_sim_many_stats(every, &se));
+    assert_int_equal(sb.step, steps);
+    assert_int_equal(se.step, steps);
+    assert_true(sb.list_builds >= 4); /* the lists were rebuilt during the run */
+    assert_int_equal(sb.list_builds, se.list_builds);
+    /* each step of `every` measured, except those right after a build (nothing moved yet) */
+    assert_true(every->many->disp_measures + se.list_builds >= (uint64_t)steps);
+    assert_true(measured_bound < (uint64_t)steps / 2);
+    test_check_same_particles(bound, every);
+    wetdem_sim_free(bound);
+    wetdem_sim_free(every);
+}
+
 static void test_many_stop_flag_writes_a_checkpoint(void** state)
 {
     (void)state;
@@ -405,6 +442,7 @@ int main(void)
         cmocka_unit_test(test_many_restart_is_bit_identical),
         cmocka_unit_test(test_many_stop_flag_writes_a_checkpoint),
         cmocka_unit_test(test_many_deferred_kick_is_bit_identical),
+        cmocka_unit_test(test_many_displacement_bound_rebuilds_at_the_same_steps),
         cmocka_unit_test(test_many_energy_budget_closes),
         cmocka_unit_test(test_many_matches_few_body_engine),
         cmocka_unit_test(test_many_reach_bound_is_enforced),
