@@ -157,10 +157,18 @@ struct wetdem_many {
     unsigned char kind[WETDEM_MAX_MODELS]; /* fused kernel of model k */
     double kind_opt[WETDEM_MAX_MODELS];    /* its switch parameter (hertz damping form, ...) */
     struct wetdem_vec3 *force, *torque, *vh, *wh; /* per particle */
-    uint32_t* contacts;              /* per particle: solid contacts at the latest evaluation */
-    struct wetdem_celllist_item* xr; /* per particle: position and radius, a compact copy for
-                                        the gap tests (kept by kick_drift) */
-    double (*inv)[2]; /* per particle: 1/m [1/kg] and 1/I = 1/(0.4 m R^2) [1/(kg m^2)], computed
+    uint32_t* contacts; /* per particle: solid contacts at the latest evaluation */
+    /* The engine state of a run: per particle, position and radius (xr, also what the gap
+       tests read) and velocity and spin (vw; the predicted v' + a dt/2 during a force pass).
+       Loaded from the particle records when a call starts (wetdem_sim_many_prepare), and
+       written back to them (records_stale cleared) whenever the state can be read: after a
+       step that is not deferred, at a stop, at the end of a call, at a failure; and the
+       positions before a list build. Between, the steps touch only these compact arrays. */
+    struct wetdem_celllist_item* xr;
+    struct wetdem_vec3 (*vw)[2];
+    unsigned char* fixed; /* per particle: is_fixed of the record */
+    bool records_stale;   /* the records' positions, velocities and spins are behind */
+    double (*inv)[2];     /* per particle: 1/m [1/kg] and 1/I = 1/(0.4 m R^2) [1/(kg m^2)], computed
                          with the integrator's own expressions when a run (re)starts */
     size_t particle_cap;
     struct wetdem_many_energy energy;
@@ -178,6 +186,17 @@ struct wetdem_many {
 static inline bool wetdem_many_parallel(const struct wetdem_many* m, size_t n)
 {
     return n >= (m->parallel_min ? m->parallel_min : WETDEM_MANY_PARALLEL_MIN);
+}
+
+/* Particle k with the engine state (position, velocity, spin) in place of its record's. */
+static inline struct wetdem_particle wetdem_many_particle(const struct wetdem_sim* sim, size_t k)
+{
+    const struct wetdem_many* m = sim->many;
+    struct wetdem_particle p = sim->particles[k];
+    p.pos = (struct wetdem_vec3){m->xr[k].x, m->xr[k].y, m->xr[k].z};
+    p.vel = m->vw[k][0];
+    p.omega = m->vw[k][1];
+    return p;
 }
 
 /* sim_many.c */

@@ -256,6 +256,12 @@ static int size_particle_arrays(struct wetdem_sim* sim)
     if (grow((void**)&m->inv, &c, n, sizeof *m->inv))
         return WETDEM_ERR_NOMEM;
     c = cap;
+    if (grow((void**)&m->vw, &c, n, sizeof *m->vw))
+        return WETDEM_ERR_NOMEM;
+    c = cap;
+    if (grow((void**)&m->fixed, &c, n, sizeof *m->fixed))
+        return WETDEM_ERR_NOMEM;
+    c = cap;
     if (grow((void**)&m->wall_dirty, &c, n, sizeof *m->wall_dirty))
         return WETDEM_ERR_NOMEM;
     m->particle_cap = c;
@@ -319,6 +325,36 @@ static int update_wall_masks(struct wetdem_sim* sim)
     return WETDEM_OK;
 }
 
+/* Writes the engine state back to the particle records: positions, and with `motion` the
+ * velocities and spins (many.h, struct wetdem_many: xr, vw). */
+static void write_back(struct wetdem_sim* sim, bool motion)
+{
+    struct wetdem_many* m = sim->many;
+    if (!m->records_stale)
+        return;
+#pragma omp parallel for schedule(static) if (wetdem_many_parallel(m, sim->n_particles))
+    for (size_t k = 0; k < sim->n_particles; k++) {
+        struct wetdem_particle* p = &sim->particles[k];
+        p->pos = vec3(m->xr[k].x, m->xr[k].y, m->xr[k].z);
+        if (motion) {
+            p->vel = m->vw[k][0];
+            p->omega = m->vw[k][1];
+        }
+    }
+    m->records_stale = !motion;
+}
+
+static void sync_positions(struct wetdem_sim* sim)
+{
+    write_back(sim, false);
+}
+
+/* Writes the whole engine state back to the particle records (before anything reads them). */
+static void sync_records(struct wetdem_sim* sim)
+{
+    write_back(sim, true);
+}
+
 /* Rebuilds the cell list and carries the histories of surviving pairs over. */
 static int rebuild(struct wetdem_sim* sim)
 {
@@ -328,6 +364,7 @@ static int rebuild(struct wetdem_sim* sim)
         return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory for the pair list");
     if (n_old)
         memcpy(m->old_pairs, m->cl.pairs, n_old * sizeof *m->old_pairs);
+    sync_positions(sim); /* the build and the wall masks read the records */
     char msg[512];
     int st = wetdem_celllist_build(&m->cl, sim->particles, sim->n_particles, msg, sizeof msg);
     if (st != WETDEM_OK)
@@ -390,16 +427,23 @@ int wetdem_sim_many_prepare(struct wetdem_sim* sim)
     if (size_particle_arrays(sim) != WETDEM_OK)
         return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory for %zu particles",
                                sim->n_particles);
+    if (refresh)
+        sync_records(sim); /* (never stale here: a call ends with them written) */
     for (size_t k = 0; refresh && k < sim->n_particles; k++) { /* the user may move particles */
         const struct wetdem_particle* p = &sim->particles[k];
         m->xr[k] = (struct wetdem_celllist_item){p->pos.x, p->pos.y, p->pos.z, p->radius};
+        m->vw[k][0] = p->vel;
+        m->vw[k][1] = p->omega;
+        m->fixed[k] = p->is_fixed;
         m->inv[k][0] = 1.0 / p->mass;
         m->inv[k][1] = 1.0 / (0.4 * p->mass * p->radius * p->radius);
         m->wall_dirty[k] = ~(uint64_t)0; /* histories may have been restored or changed */
     }
-    bool moved = m->max_disp_valid && m->cl.n_builds > 0 && m->cl.n_at_build == sim->n_particles
-                     ? m->max_disp2 > 0.25 * m->cl.skin * m->cl.skin
-                     : wetdem_celllist_needs_rebuild(&m->cl, sim->particles, sim->n_particles);
+    bool track = m->max_disp_valid && m->cl.n_builds > 0 && m->cl.n_at_build == sim->n_particles;
+    if (!track)
+        sync_positions(sim); /* needs_rebuild reads the records */
+    bool moved = track ? m->max_disp2 > 0.25 * m->cl.skin * m->cl.skin
+                       : wetdem_celllist_needs_rebuild(&m->cl, sim->particles, sim->n_particles);
     m->max_disp_valid = false;
     if (moved)
         return rebuild(sim);
@@ -452,31 +496,29 @@ static double abs_max(struct wetdem_vec3 x, double m)
  * v' + a dt/2, and *v2_max the larger of itself and |v'|^2 of the half-step velocity. Every
  * value is formed in a local and stored once. */
 
-static void kick_drift_one(struct wetdem_many* m, struct wetdem_particle* p, size_t k,
-                           struct wetdem_vec3 g, double h, bool periodic, bool pending,
-                           double* v2_max)
+static void kick_drift_one(struct wetdem_many* m, size_t k, struct wetdem_vec3 g, double h,
+                           bool periodic, bool pending, double* v2_max)
 {
     double half = 0.5 * h;
     struct wetdem_vec3 a = vec3_axpy(g, m->inv[k][0], m->force[k]);
     struct wetdem_vec3 alpha = vec3_scale(m->torque[k], m->inv[k][1]);
-    struct wetdem_vec3 v = p->vel, w = p->omega;
+    struct wetdem_vec3 v = m->vw[k][0], w = m->vw[k][1];
     if (pending) { /* the previous step's closing half kick, with the same a and alpha */
         v = vec3_axpy(m->vh[k], half, a);
         w = vec3_axpy(m->wh[k], half, alpha);
     }
     struct wetdem_vec3 vh = vec3_axpy(v, half, a), wh = vec3_axpy(w, half, alpha);
-    struct wetdem_vec3 x = vec3_axpy(p->pos, h, vh);
+    struct wetdem_vec3 x = vec3_axpy(vec3(m->xr[k].x, m->xr[k].y, m->xr[k].z), h, vh);
     double v2 = vec3_dot(vh, vh);
     *v2_max = v2 > *v2_max ? v2 : *v2_max;
     x = periodic ? wrap(&m->cl.box, x) : x;
     m->vh[k] = vh;
     m->wh[k] = wh;
-    p->pos = x;
     m->xr[k].x = x.x;
     m->xr[k].y = x.y;
     m->xr[k].z = x.z;
-    p->vel = vec3_axpy(vh, half, a);
-    p->omega = vec3_axpy(wh, half, alpha);
+    m->vw[k][0] = vec3_axpy(vh, half, a);
+    m->vw[k][1] = vec3_axpy(wh, half, alpha);
 }
 
 /* The largest magnitude of a coordinate at the last list build, and of a bound of a periodic
@@ -508,7 +550,7 @@ static double max_displacement2(const struct wetdem_sim* sim)
     reduction(max                                                                                  \
               : worst) if (wetdem_many_parallel(m, sim->n_particles))
     for (size_t k = 0; k < sim->n_particles; k++) {
-        struct wetdem_vec3 x = sim->particles[k].pos;
+        struct wetdem_vec3 x = vec3(m->xr[k].x, m->xr[k].y, m->xr[k].z);
         struct wetdem_vec3 d =
             periodic ? celllist_delta(&m->cl.box, x, at_build[k]) : vec3_sub(x, at_build[k]);
         double d2 = vec3_dot(d, d);
@@ -545,13 +587,13 @@ static void kick_drift(struct wetdem_sim* sim, double h)
     reduction(max                                                                                  \
               : v2_max) if (wetdem_many_parallel(m, sim->n_particles))
     for (size_t k = 0; k < sim->n_particles; k++) {
-        struct wetdem_particle* p = &sim->particles[k];
-        if (!p->is_fixed)
-            kick_drift_one(m, p, k, g, h, periodic, pending, &v2_max);
+        if (!m->fixed[k])
+            kick_drift_one(m, k, g, h, periodic, pending, &v2_max);
         force[k] = torque[k] = vec3(0, 0, 0);
         contacts[k] = 0;
     }
     m->sums_zeroed = sim->n_particles;
+    m->records_stale = true;
     m->max_disp_valid = track;
     if (!track)
         return;
@@ -584,13 +626,12 @@ static void finish_kick(struct wetdem_sim* sim)
     double h = m->dt;
 #pragma omp parallel for schedule(static) if (wetdem_many_parallel(m, sim->n_particles))
     for (size_t k = 0; k < sim->n_particles; k++) {
-        struct wetdem_particle* p = &sim->particles[k];
-        if (p->is_fixed)
+        if (m->fixed[k])
             continue;
         struct wetdem_vec3 a = vec3_axpy(g, m->inv[k][0], m->force[k]);
         struct wetdem_vec3 alpha = vec3_scale(m->torque[k], m->inv[k][1]);
-        p->vel = vec3_axpy(m->vh[k], 0.5 * h, a);
-        p->omega = vec3_axpy(m->wh[k], 0.5 * h, alpha);
+        m->vw[k][0] = vec3_axpy(m->vh[k], 0.5 * h, a);
+        m->vw[k][1] = vec3_axpy(m->wh[k], 0.5 * h, alpha);
     }
 }
 
@@ -684,6 +725,7 @@ static int poll_stop(struct wetdem_sim* sim, unsigned long long done, unsigned l
     if (!stop)
         return WETDEM_OK;
     finish_kick(sim); /* a stop flag raised during a deferred step */
+    sync_records(sim);
     if (m->checkpoint_path) {
         int st = wetdem_sim_write_checkpoint(sim, m->checkpoint_path);
         if (st != WETDEM_OK)
@@ -723,6 +765,8 @@ static int one_step(struct wetdem_sim* sim, bool defer)
     if (st != WETDEM_OK)
         return st;
     m->kick_pending = defer;
+    if (!defer) /* the state is read after this step */
+        sync_records(sim);
     sim->engine.stats.steps++;
     st = wetdem_sim_many_outputs(sim, false);
     if (st == WETDEM_OK)
@@ -748,6 +792,7 @@ int wetdem_sim_many_integrate(struct wetdem_sim* sim, double t_end)
         if (st == WETDEM_OK)
             st = poll_stop(sim, k, total, t_start);
     }
+    sync_records(sim); /* done after the last step; here for a step that failed */
     if (st == WETDEM_OK)
         st = wetdem_sim_many_outputs(sim, true);
     if (st >= 0 && sim->engine.observer && !(sim->engine.last_observed == sim->engine.time)) {

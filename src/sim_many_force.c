@@ -454,39 +454,40 @@ lean_apart(const struct wetdem_many_lean* L, const struct wetdem_many_mix* x, st
     return isfinite(f_n) ? WETDEM_OK : WETDEM_ERR_NUMERIC;
 }
 
-/* Pair (a, b) with d = x_a - x_b (minimum image): its geometry as pair_contact_from computes
- * it, then lean_apart or lean_force; *flags = 0 beyond the range. */
-static int lean_pair(const struct wetdem_many* m, const struct wetdem_particle* a,
-                     const struct wetdem_particle* b, struct wetdem_vec3 d,
+/* Pair (ia, ib) with d = x_a - x_b (minimum image), from the engine state (radii in xr,
+ * velocities and spins in vw): its geometry as pair_contact_from computes it, then lean_apart
+ * or lean_force; *flags = 0 beyond the range. */
+static int lean_pair(const struct wetdem_many* m, size_t ia, size_t ib, struct wetdem_vec3 d,
                      const struct wetdem_many_mix* x, double* hist, const double* cache,
                      unsigned char* flags, struct wetdem_many_pair_out* o)
     __attribute__((always_inline));
-static inline int lean_pair(const struct wetdem_many* m, const struct wetdem_particle* a,
-                            const struct wetdem_particle* b, struct wetdem_vec3 d,
+static inline int lean_pair(const struct wetdem_many* m, size_t ia, size_t ib, struct wetdem_vec3 d,
                             const struct wetdem_many_mix* x, double* hist, const double* cache,
                             unsigned char* flags, struct wetdem_many_pair_out* o)
 {
+    double r_a = m->xr[ia].r, r_b = m->xr[ib].r;
+    const struct wetdem_vec3 *vw_a = m->vw[ia], *vw_b = m->vw[ib]; /* velocity, spin */
     double dist = vec3_norm(d);
     struct lean_geometry g; /* every field read is set (no zeroing of the whole record) */
-    g.gap = dist - a->radius - b->radius;
+    g.gap = dist - r_a - r_b;
     *flags = 0;
     if (g.gap > x->range)
         return WETDEM_OK;
-    g.r_i = a->radius;
-    g.r_j = b->radius;
+    g.r_i = r_a;
+    g.r_j = r_b;
     g.wall = false;
     g.n = dist > 0 ? vec3_scale(d, 1.0 / dist) : vec3(1, 0, 0);
     g.r_eff = cache[0];
     g.m_eff = cache[1];
     g.k = cache[2];
     g.damping = cache[3];
-    g.v_n = -vec3_dot(vec3_sub(a->vel, b->vel), g.n);
+    g.v_n = -vec3_dot(vec3_sub(vw_a[0], vw_b[0]), g.n);
     if (!(g.gap < 0.0))
         return lean_apart(&m->lean, x, g.n, g.gap, g.r_eff, g.v_n, hist, flags, o);
     g.v_t = vec3(0, 0, 0); /* read in solid contact only */
     if (m->lean.mindlin) {
-        struct wetdem_vec3 va = vec3_add(a->vel, vec3_cross(a->omega, vec3_scale(g.n, -a->radius)));
-        struct wetdem_vec3 vb = vec3_add(b->vel, vec3_cross(b->omega, vec3_scale(g.n, b->radius)));
+        struct wetdem_vec3 va = vec3_add(vw_a[0], vec3_cross(vw_a[1], vec3_scale(g.n, -r_a)));
+        struct wetdem_vec3 vb = vec3_add(vw_b[0], vec3_cross(vw_b[1], vec3_scale(g.n, r_b)));
         g.v_t = vec3_reject(vec3_sub(va, vb), g.n);
     }
     return lean_force(m, &g, x, hist, flags, o);
@@ -589,16 +590,16 @@ static double* thread_work(const struct wetdem_many* m, int wall)
 static void add_work(const struct wetdem_sim* sim, const struct wetdem_contact* c,
                      const struct wetdem_pair_force* per_model, double* work)
 {
-    const struct wetdem_particle* a = &sim->particles[c->i];
-    struct wetdem_vec3 dv = a->vel, wj = vec3(0, 0, 0);
+    const struct wetdem_many* m = sim->many;
+    struct wetdem_vec3 dv = m->vw[c->i][0], wi = m->vw[c->i][1], wj = vec3(0, 0, 0);
     if (!c->is_wall) {
-        dv = vec3_sub(dv, sim->particles[c->j].vel);
-        wj = sim->particles[c->j].omega;
+        dv = vec3_sub(dv, m->vw[c->j][0]);
+        wj = m->vw[c->j][1];
     }
     for (size_t k = 0; k < sim->n_models; k++) {
         const struct wetdem_pair_force* f = &per_model[k];
         struct wetdem_vec3 fi = vec3_axpy(f->f_tan, f->f_normal, c->normal);
-        double p = vec3_dot(fi, dv) + vec3_dot(f->torque_i, a->omega) +
+        double p = vec3_dot(fi, dv) + vec3_dot(f->torque_i, wi) +
                    (c->is_wall ? 0.0 : vec3_dot(f->torque_j, wj));
         work[k] += sim->many->dt * p;
     }
@@ -655,7 +656,8 @@ static void eval_near_pair(const struct wetdem_sim* sim, size_t q, struct wetdem
     const struct wetdem_many* m = sim->many;
     size_t i = m->cl.pairs[q].i, j = m->cl.pairs[q].j, len = sim->history_len;
     struct wetdem_contact c;
-    pair_contact_from(&sim->particles[i], &sim->particles[j], d, x, &c);
+    struct wetdem_particle a = wetdem_many_particle(sim, i), b = wetdem_many_particle(sim, j);
+    pair_contact_from(&a, &b, d, x, &c);
     c.i = i;
     c.j = j;
     double range = contact_range(sim, &c, x);
@@ -698,7 +700,7 @@ static inline unsigned char near_candidate(const struct pass* P, size_t q, size_
     }
     unsigned char was = *fl;
     double* hist = P->history + q * P->len;
-    int st = lean_pair(P->m, &P->p[i], &P->p[j], d, x, hist, P->m->pair_cache[q], fl, o);
+    int st = lean_pair(P->m, i, j, d, x, hist, P->m->pair_cache[q], fl, o);
     if (!*fl && (was & WETDEM_MANY_DIRTY) && P->len)
         wetdem_sim_history_init(P->sim, hist);
     if (st != WETDEM_OK) {
@@ -783,7 +785,8 @@ static unsigned char eval_wall(const struct wetdem_sim* sim, size_t i, size_t w,
                                bool dirty, struct wetdem_many_pair_out* o, struct failure* fail)
 {
     const struct wetdem_many* m = sim->many;
-    const struct wetdem_particle* a = &sim->particles[i];
+    struct wetdem_particle state = wetdem_many_particle(sim, i);
+    const struct wetdem_particle* a = &state;
     const struct wetdem_wall* wall = &sim->walls[w];
     const struct wetdem_many_mix* x = wetdem_sim_many_mix(sim, a->material, wall->material);
     unsigned char flags;
@@ -816,7 +819,8 @@ static void eval_walls_of(const struct wetdem_sim* sim, size_t i, struct wetdem_
 {
     const struct wetdem_many* m = sim->many;
     size_t len = sim->history_len, nw = sim->n_walls;
-    const struct wetdem_particle* a = &sim->particles[i];
+    struct wetdem_vec3 pos = vec3(m->xr[i].x, m->xr[i].y, m->xr[i].z);
+    double radius = m->xr[i].r;
     /* up to 64 walls: the set bits of the mask, in increasing w; beyond, every wall */
     uint64_t mask = nw <= 64 ? m->wall_mask[i] : 0;
     for (size_t w = nw <= 64 ? next_wall(&mask) : 0; w < nw;
@@ -824,7 +828,7 @@ static void eval_walls_of(const struct wetdem_sim* sim, size_t i, struct wetdem_
         if (w < 64 && !(m->wall_mask[i] >> w & 1))
             continue;
         const struct wetdem_wall* wall = &sim->walls[w];
-        double gap = vec3_dot(vec3_sub(a->pos, wall->point), wall->normal) - a->radius;
+        double gap = vec3_dot(vec3_sub(pos, wall->point), wall->normal) - radius;
         double* hist = len ? m->wall_history + (i * nw + w) * len : NULL;
         uint64_t bit = w < 64 ? (uint64_t)1 << w : 0;
         bool dirty = w >= 64 || (m->wall_dirty[i] & bit);
@@ -847,12 +851,11 @@ static void eval_walls_of(const struct wetdem_sim* sim, size_t i, struct wetdem_
 static void close_kick(const struct wetdem_sim* sim, size_t k, struct wetdem_vec3 g)
 {
     struct wetdem_many* m = sim->many;
-    struct wetdem_particle* p = &sim->particles[k];
-    if (p->is_fixed)
+    if (m->fixed[k])
         return;
     double h = m->dt;
-    p->vel = vec3_axpy(m->vh[k], 0.5 * h, vec3_axpy(g, m->inv[k][0], m->force[k]));
-    p->omega = vec3_axpy(m->wh[k], 0.5 * h, vec3_scale(m->torque[k], m->inv[k][1]));
+    m->vw[k][0] = vec3_axpy(m->vh[k], 0.5 * h, vec3_axpy(g, m->inv[k][0], m->force[k]));
+    m->vw[k][1] = vec3_axpy(m->wh[k], 0.5 * h, vec3_scale(m->torque[k], m->inv[k][1]));
 }
 
 /* Grows *a to n elements of `size` bytes (contents not kept). */

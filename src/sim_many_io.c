@@ -457,6 +457,7 @@ static int restore_pairs(struct wetdem_sim* sim, const struct wetdem_checkpoint*
     size_t np = ck->n_pairs - n * nw;
     m->started = false; /* prepare() re-initialises the cell list */
     m->cl.n_pairs = 0;
+    m->records_stale = false; /* the records hold the checkpoint's state: load it */
     int st = wetdem_sim_many_prepare(sim);
     if (st != WETDEM_OK)
         return st;
