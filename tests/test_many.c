@@ -2,7 +2,8 @@
  * test_many.c — the many-particle mode (src/sim_many.c, src/sim_many_io.c): results
  * independent of the thread count, checkpoint + restart bit-identical to an uninterrupted run,
  * the energy budget closes, agreement with the few-body engine on a binary collision, the
- * start-up reach bound is enforced, agglomerates by union-find, VTK/CSV outputs.
+ * start-up reach bound is enforced, agglomerates by union-find, VTK/CSV outputs, lists rebuilt
+ * at the same steps with the displacement bound, callbacks see the current state.
  */
 #include <omp.h>
 #include <stdlib.h>
@@ -189,6 +190,61 @@ static void test_many_displacement_bound_rebuilds_at_the_same_steps(void** state
     test_check_same_particles(bound, every);
     wetdem_sim_free(bound);
     wetdem_sim_free(every);
+}
+
+/* What a progress callback sees: the position and velocity of particle 5 at each call. */
+struct seen {
+    const struct wetdem_sim* sim;
+    double x[64], v[64];
+    int n;
+};
+
+static int note_state(unsigned long long done, unsigned long long total, double elapsed, void* ctx)
+{
+    (void)done;
+    (void)total;
+    (void)elapsed;
+    struct seen* s = ctx;
+    const struct wetdem_particle* p = wetdem_sim_particles_const(s->sim, NULL);
+    if (s->n < 64) {
+        s->x[s->n] = p[5].pos.x;
+        s->v[s->n] = p[5].vel.x;
+        s->n++;
+    }
+    return 0;
+}
+
+/* The steps advance the engine's compact arrays, and the particle records are written back
+ * whenever the state can be read: a progress callback every 10 steps sees the records at its
+ * step, the same bits as a run stepped 10 steps per call (which ends each call with them). */
+static void test_many_callbacks_see_the_current_state(void** state)
+{
+    (void)state;
+    struct wetdem_sim* watched = wet_box(150, true);
+    struct wetdem_sim* stepped = wet_box(150, true);
+    struct seen seen = {.sim = watched};
+    struct wetdem_many_settings s = {.periodic = {true, true, false},
+                                     .box_lo = {0, 0, 0},
+                                     .box_hi = {8e-3, 8e-3, 12e-3},
+                                     .dt = 2e-6,
+                                     .skin = 0.05e-3,
+                                     .energy_budget = true,
+                                     .progress = note_state,
+                                     .progress_ctx = &seen,
+                                     .progress_every = 10};
+    CHECK_OK(wetdem_sim_set_many(watched, &s));
+    watched->many->parallel_min = 1;
+    CHECK_OK(wetdem_sim_integrate(watched, 300 * 2e-6));
+    assert_int_equal(seen.n, 30);
+    for (int k = 1; k <= 30; k++) {
+        CHECK_OK(wetdem_sim_integrate(stepped, k * 10 * 2e-6));
+        const struct wetdem_particle* p = wetdem_sim_particles_const(stepped, NULL);
+        assert_true(p[5].pos.x == seen.x[k - 1]);
+        assert_true(p[5].vel.x == seen.v[k - 1]);
+    }
+    test_check_same_particles(watched, stepped);
+    wetdem_sim_free(watched);
+    wetdem_sim_free(stepped);
 }
 
 static void test_many_stop_flag_writes_a_checkpoint(void** state)
@@ -443,6 +499,7 @@ int main(void)
         cmocka_unit_test(test_many_stop_flag_writes_a_checkpoint),
         cmocka_unit_test(test_many_deferred_kick_is_bit_identical),
         cmocka_unit_test(test_many_displacement_bound_rebuilds_at_the_same_steps),
+        cmocka_unit_test(test_many_callbacks_see_the_current_state),
         cmocka_unit_test(test_many_energy_budget_closes),
         cmocka_unit_test(test_many_matches_few_body_engine),
         cmocka_unit_test(test_many_reach_bound_is_enforced),
