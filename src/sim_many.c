@@ -240,30 +240,25 @@ static int size_particle_arrays(struct wetdem_sim* sim)
     size_t n = sim->n_particles ? sim->n_particles : 1, cap = m->particle_cap;
     if (n <= cap && m->force)
         return WETDEM_OK;
-    struct wetdem_vec3** arrays[4] = {&m->force, &m->torque, &m->vh, &m->wh};
-    for (int k = 0; k < 4; k++) {
-        size_t c = cap;
-        if (grow((void**)arrays[k], &c, n, sizeof(struct wetdem_vec3)))
+    struct {
+        void** a;
+        size_t size;
+    } arrays[] = {{(void**)&m->force, sizeof *m->force},
+                  {(void**)&m->torque, sizeof *m->torque},
+                  {(void**)&m->vh, sizeof *m->vh},
+                  {(void**)&m->wh, sizeof *m->wh},
+                  {(void**)&m->contacts, sizeof *m->contacts},
+                  {(void**)&m->xr, sizeof *m->xr},
+                  {(void**)&m->inv, sizeof *m->inv},
+                  {(void**)&m->vw, sizeof *m->vw},
+                  {(void**)&m->fixed, sizeof *m->fixed},
+                  {(void**)&m->wall_dirty, sizeof *m->wall_dirty}};
+    size_t c = cap;
+    for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++) {
+        c = cap;
+        if (grow(arrays[k].a, &c, n, arrays[k].size))
             return WETDEM_ERR_NOMEM;
     }
-    size_t c = cap;
-    if (grow((void**)&m->contacts, &c, n, sizeof *m->contacts))
-        return WETDEM_ERR_NOMEM;
-    c = cap;
-    if (grow((void**)&m->xr, &c, n, sizeof *m->xr))
-        return WETDEM_ERR_NOMEM;
-    c = cap;
-    if (grow((void**)&m->inv, &c, n, sizeof *m->inv))
-        return WETDEM_ERR_NOMEM;
-    c = cap;
-    if (grow((void**)&m->vw, &c, n, sizeof *m->vw))
-        return WETDEM_ERR_NOMEM;
-    c = cap;
-    if (grow((void**)&m->fixed, &c, n, sizeof *m->fixed))
-        return WETDEM_ERR_NOMEM;
-    c = cap;
-    if (grow((void**)&m->wall_dirty, &c, n, sizeof *m->wall_dirty))
-        return WETDEM_ERR_NOMEM;
     m->particle_cap = c;
     size_t len = sim->history_len, nw = sim->n_walls * n * len;
     size_t old = m->wall_history_cap;

@@ -13,6 +13,24 @@
 #include "harness.h"
 #include "many.h"
 
+/* The many-particle settings of wet_box (its box, dt 2 us, skin 50 um, energy budget), with
+ * a progress callback every `every` steps if fn is given. */
+static void set_box_many(struct wetdem_sim* sim, wetdem_progress_fn fn, void* ctx,
+                         unsigned long long every)
+{
+    struct wetdem_many_settings s = {.periodic = {true, true, false},
+                                     .box_lo = {0, 0, 0},
+                                     .box_hi = {8e-3, 8e-3, 12e-3},
+                                     .dt = 2e-6,
+                                     .skin = 0.05e-3,
+                                     .energy_budget = true,
+                                     .progress = fn,
+                                     .progress_ctx = ctx,
+                                     .progress_every = every};
+    CHECK_OK(wetdem_sim_set_many(sim, &s));
+    sim->many->parallel_min = 1; /* run the parallel loops even for these small systems */
+}
+
 /* A wet granular gas: n spheres (R 0.4-0.5 mm, 20 um films) in a box periodic in x and y with
  * a floor and a lid, gravity, hertz + mindlin + sb + capillary. */
 static struct wetdem_sim* wet_box(size_t n, bool wet)
@@ -47,14 +65,7 @@ static struct wetdem_sim* wet_box(size_t n, bool wet)
     CHECK_OK(wetdem_sim_add_wall(sim, (struct wetdem_vec3){0, 0, 12e-3},
                                  (struct wetdem_vec3){0, 0, -1}, 0));
     CHECK_OK(wetdem_sim_set_param(sim, "sim.gravity_z", -9.81));
-    struct wetdem_many_settings s = {.periodic = {true, true, false},
-                                     .box_lo = {0, 0, 0},
-                                     .box_hi = {8e-3, 8e-3, 12e-3},
-                                     .dt = 2e-6,
-                                     .skin = 0.05e-3,
-                                     .energy_budget = true};
-    CHECK_OK(wetdem_sim_set_many(sim, &s));
-    sim->many->parallel_min = 1; /* run the parallel loops even for these small systems */
+    set_box_many(sim, NULL, NULL, 0);
     return sim;
 }
 
@@ -136,17 +147,7 @@ static void test_many_deferred_kick_is_bit_identical(void** state)
     struct wetdem_sim* deferred = wet_box(150, true);
     struct wetdem_sim* every = wet_box(150, true);
     int calls = 0;
-    struct wetdem_many_settings s = {.periodic = {true, true, false},
-                                     .box_lo = {0, 0, 0},
-                                     .box_hi = {8e-3, 8e-3, 12e-3},
-                                     .dt = 2e-6,
-                                     .skin = 0.05e-3,
-                                     .energy_budget = true,
-                                     .progress = count_calls,
-                                     .progress_ctx = &calls,
-                                     .progress_every = 1};
-    CHECK_OK(wetdem_sim_set_many(every, &s));
-    every->many->parallel_min = 1;
+    set_box_many(every, count_calls, &calls, 1);
     CHECK_OK(wetdem_sim_integrate(deferred, 0.6e-3));
     CHECK_OK(wetdem_sim_integrate(every, 0.6e-3));
     assert_int_equal(calls, 300); /* every step was read */
@@ -223,17 +224,7 @@ static void test_many_callbacks_see_the_current_state(void** state)
     struct wetdem_sim* watched = wet_box(150, true);
     struct wetdem_sim* stepped = wet_box(150, true);
     struct seen seen = {.sim = watched};
-    struct wetdem_many_settings s = {.periodic = {true, true, false},
-                                     .box_lo = {0, 0, 0},
-                                     .box_hi = {8e-3, 8e-3, 12e-3},
-                                     .dt = 2e-6,
-                                     .skin = 0.05e-3,
-                                     .energy_budget = true,
-                                     .progress = note_state,
-                                     .progress_ctx = &seen,
-                                     .progress_every = 10};
-    CHECK_OK(wetdem_sim_set_many(watched, &s));
-    watched->many->parallel_min = 1;
+    set_box_many(watched, note_state, &seen, 10);
     CHECK_OK(wetdem_sim_integrate(watched, 300 * 2e-6));
     assert_int_equal(seen.n, 30);
     for (int k = 1; k <= 30; k++) {
