@@ -97,6 +97,8 @@ void wetdem_sim_many_free(struct wetdem_sim* sim)
     free(m->contacts);
     free(m->xr);
     free(m->inv);
+    free(m->vw);
+    free(m->fixed);
     free(m->thread_work);
     free(m->mix);
     free(m->blk);
