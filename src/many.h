@@ -59,6 +59,10 @@ struct wetdem_many_pair_out {
 #define WETDEM_MANY_CONTACT 2u /* gap < 0: solid contact */
 #define WETDEM_MANY_BRIDGE 4u  /* gap < film delta_ij with a fluid model: liquid bridge */
 #define WETDEM_MANY_DIRTY 8u   /* history may differ from a fresh one (reset when out of range) */
+#define WETDEM_MANY_SPRING                                                                         \
+    16u /* its tangential spring may be non-zero: set in solid contact,
+                                  kept across rebuilds and restarts; the lean kernel resets the
+                                  spring of a pair apart only then (else it is zero already) */
 
 /* Energy bookkeeping (sim_many.c accumulates, sim_many_io.c reports). */
 struct wetdem_many_energy {

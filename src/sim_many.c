@@ -374,9 +374,10 @@ static int rebuild(struct wetdem_sim* sim)
     double fresh[HISTORY_MAX];
     if (len)
         wetdem_sim_history_init(sim, fresh);
-    /* surviving pairs keep their history and its DIRTY flag */
+    /* surviving pairs keep their history and its DIRTY and SPRING flags */
     wetdem_celllist_remap(m->old_pairs, m->old_history, m->old_flags, n_old, m->cl.pairs,
-                          m->history, m->flags, WETDEM_MANY_DIRTY, n_new, len, fresh);
+                          m->history, m->flags, WETDEM_MANY_DIRTY | WETDEM_MANY_SPRING, n_new, len,
+                          fresh);
     m->blocks_ready = false; /* the force pass indexes the new list */
     return update_wall_masks(sim);
 }

@@ -424,7 +424,8 @@ static inline __attribute__((always_inline)) int lean_force(const struct wetdem_
     o->force = vec3_axpy(f_tan, f_n, n);
     o->torque_i = t_i;
     o->torque_j = t_j;
-    *flags = WETDEM_MANY_ACTIVE | WETDEM_MANY_DIRTY | (gap < 0 ? WETDEM_MANY_CONTACT : 0) |
+    *flags = WETDEM_MANY_ACTIVE | WETDEM_MANY_DIRTY |
+             (gap < 0 ? WETDEM_MANY_CONTACT | WETDEM_MANY_SPRING : 0) |
              (x->film > 0 && gap < x->film ? WETDEM_MANY_BRIDGE : 0);
     if (!(isfinite(f_n) && vec3_is_finite(o->force) && vec3_is_finite(t_i) && vec3_is_finite(t_j)))
         return WETDEM_ERR_NUMERIC;
@@ -438,10 +439,10 @@ static inline __attribute__((always_inline)) int lean_force(const struct wetdem_
  * (|n| = 1). */
 static inline __attribute__((always_inline)) int
 lean_apart(const struct wetdem_many_lean* L, const struct wetdem_many_mix* x, struct wetdem_vec3 n,
-           double gap, double r_eff, double v_n, double* hist, unsigned char* flags,
-           struct wetdem_many_pair_out* o)
+           double gap, double r_eff, double v_n, bool spring_set, double* hist,
+           unsigned char* flags, struct wetdem_many_pair_out* o)
 {
-    if (L->mindlin) { /* mindlin_spring resets the spring apart */
+    if (L->mindlin && spring_set) { /* mindlin_spring resets the spring apart (if it may be set) */
         double* spring = hist + L->mindlin_off;
         spring[0] = spring[1] = spring[2] = 0.0;
     }
@@ -470,6 +471,7 @@ static inline int lean_pair(const struct wetdem_many* m, size_t ia, size_t ib, s
     double dist = vec3_norm(d);
     struct lean_geometry g; /* every field read is set (no zeroing of the whole record) */
     g.gap = dist - r_a - r_b;
+    bool spring_set = *flags & WETDEM_MANY_SPRING; /* by the previous evaluation */
     *flags = 0;
     if (g.gap > x->range)
         return WETDEM_OK;
@@ -483,7 +485,7 @@ static inline int lean_pair(const struct wetdem_many* m, size_t ia, size_t ib, s
     g.damping = cache[3];
     g.v_n = -vec3_dot(vec3_sub(vw_a[0], vw_b[0]), g.n);
     if (!(g.gap < 0.0))
-        return lean_apart(&m->lean, x, g.n, g.gap, g.r_eff, g.v_n, hist, flags, o);
+        return lean_apart(&m->lean, x, g.n, g.gap, g.r_eff, g.v_n, spring_set, hist, flags, o);
     g.v_t = vec3(0, 0, 0); /* read in solid contact only */
     if (m->lean.mindlin) {
         struct wetdem_vec3 va = vec3_add(vw_a[0], vec3_cross(vw_a[1], vec3_scale(g.n, -r_a)));
@@ -638,7 +640,8 @@ static int eval_pair(const struct wetdem_sim* sim, struct wetdem_contact* c,
     out->force = vec3_axpy(f.f_tan, f.f_normal, c->normal);
     out->torque_i = f.torque_i;
     out->torque_j = f.torque_j;
-    *flags = WETDEM_MANY_ACTIVE | WETDEM_MANY_DIRTY | (c->gap < 0 ? WETDEM_MANY_CONTACT : 0) |
+    *flags = WETDEM_MANY_ACTIVE | WETDEM_MANY_DIRTY |
+             (c->gap < 0 ? WETDEM_MANY_CONTACT | WETDEM_MANY_SPRING : 0) |
              (c->film > 0 && c->gap < c->film ? WETDEM_MANY_BRIDGE : 0);
     if (!(isfinite(f.f_normal) && vec3_is_finite(out->force) && vec3_is_finite(f.torque_i) &&
           vec3_is_finite(f.torque_j)))

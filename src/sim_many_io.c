@@ -484,7 +484,7 @@ static int restore_pairs(struct wetdem_sim* sim, const struct wetdem_checkpoint*
     if (n)
         memcpy(m->contacts, ck->extra + 16 + n * 48, n * sizeof(uint32_t));
     for (size_t q = 0; q < m->cl.n_pairs; q++) /* histories may be stale: check on next use */
-        m->flags[q] = WETDEM_MANY_DIRTY;
+        m->flags[q] = WETDEM_MANY_DIRTY | WETDEM_MANY_SPRING;
     m->started = true;
     return WETDEM_OK;
 }
