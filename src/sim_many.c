@@ -341,6 +341,7 @@ static void write_back(struct wetdem_sim* sim, bool motion)
     m->records_stale = !motion;
 }
 
+/* Writes the engine's positions back to the particle records (before a list build). */
 static void sync_positions(struct wetdem_sim* sim)
 {
     write_back(sim, false);
@@ -493,7 +494,6 @@ static double abs_max(struct wetdem_vec3 x, double m)
 /* Half kick and drift of particle p (index k); its velocities become the predicted ones
  * v' + a dt/2, and *v2_max the larger of itself and |v'|^2 of the half-step velocity. Every
  * value is formed in a local and stored once. */
-
 static void kick_drift_one(struct wetdem_many* m, size_t k, struct wetdem_vec3 g, double h,
                            bool periodic, bool pending, double* v2_max)
 {
@@ -561,8 +561,8 @@ static double max_displacement2(const struct wetdem_sim* sim)
  * it was deferred). The rebuild criterion (largest displacement since the last neighbour-list
  * build > skin/2) is decided without reading the positions at the build at every step: the
  * pass bounds this step's displacement of every particle by h max|v'| plus the round-off of
- * the drift (16 u max|x|, u the unit round-off; the drift x + h v' and the periodic wrap
- * each round by at most u|x| per component), and adds it to m->disp_bound, an upper bound of
+ * the drift (16 eps max|x|, eps = DBL_EPSILON; the drift x + h v' and the periodic wrap each
+ * round by at most eps|x| per component), and adds it to m->disp_bound, an upper bound of
  * the largest displacement since the build. Only when that bound exceeds skin/2 (less a
  * relative 1e-6 for the round-off of the sum) are the displacements measured, and the bound
  * reset to the measured one. Where the measurement is skipped, the true displacement is below
