@@ -1064,15 +1064,26 @@ static void cross_pairs_of_block(const struct pass* P, size_t b, struct failure*
     }
 }
 
+/* The start of particle k's sum: its walls (wall order) when it has some within reach. */
+static inline void start_sum(const struct wetdem_sim* sim, size_t k, bool walls,
+                             struct failure* fail)
+{
+    struct wetdem_many* m = sim->many;
+    struct wetdem_vec3 f = vec3(0, 0, 0), t = vec3(0, 0, 0);
+    uint32_t n_contacts = 0;
+    if (walls)
+        eval_walls_of(sim, k, &f, &t, &n_contacts, fail);
+    m->force[k] = f;
+    m->torque[k] = t;
+    m->contacts[k] = n_contacts;
+}
+
 /* Phase 2, start of block b: each particle's sum begins with its walls (wall order), then the
  * reactions of the cross pairs (k, i) from earlier blocks, in increasing k. */
 static void start_sums_of_block(const struct pass* P, size_t b, struct failure* fail)
 {
     struct wetdem_many* m = P->m;
     const struct wetdem_sim* sim = P->sim;
-    /* locals, not fields of m: the stores below could otherwise alias them */
-    struct wetdem_vec3 *force = m->force, *torque = m->torque;
-    uint32_t* contacts = m->contacts;
     const uint64_t* wall_mask = m->wall_mask;
     bool every_wall = sim->n_walls > 64;
     size_t begin = m->blk[b], end = m->blk[b + 1];
@@ -1086,25 +1097,11 @@ static void start_sums_of_block(const struct pass* P, size_t b, struct failure* 
             else
                 hi = mid;
         }
-        for (size_t s = lo; s < m->n_wall_list && list[s] < end; s++) {
-            size_t k = list[s];
-            struct wetdem_vec3 f = vec3(0, 0, 0), t = vec3(0, 0, 0);
-            uint32_t n_contacts = 0;
-            eval_walls_of(sim, k, &f, &t, &n_contacts, fail);
-            force[k] = f;
-            torque[k] = t;
-            contacts[k] = n_contacts;
-        }
+        for (size_t s = lo; s < m->n_wall_list && list[s] < end; s++)
+            start_sum(sim, list[s], true, fail);
     } else
-        for (size_t k = begin; k < end; k++) {
-            struct wetdem_vec3 f = vec3(0, 0, 0), t = vec3(0, 0, 0);
-            uint32_t n_contacts = 0;
-            if (wall_mask[k] || every_wall)
-                eval_walls_of(sim, k, &f, &t, &n_contacts, fail);
-            force[k] = f;
-            torque[k] = t;
-            contacts[k] = n_contacts;
-        }
+        for (size_t k = begin; k < end; k++)
+            start_sum(sim, k, wall_mask[k] || every_wall, fail);
     const size_t* first_in = m->cross_first + m->n_blocks + 1;
     for (size_t s = first_in[b]; s < first_in[b + 1]; s++) {
         size_t e = m->cross_in[s], q = m->cross_q[e], k = P->pairs[q].j;
