@@ -7,6 +7,7 @@
 
 #include "celllist.h"
 #include "sim.h"
+#include "vec3.h"
 
 /* Mixed properties of one material pair (as struct wetdem_contact) and the range of the
  * enabled models for it. */
@@ -201,6 +202,18 @@ static inline struct wetdem_particle wetdem_many_particle(const struct wetdem_si
     p.vel = m->vw[k][0];
     p.omega = m->vw[k][1];
     return p;
+}
+
+/* Closing half kick of particle k with gravity g: v = v' + a dt/2, w = w' + alpha dt/2 from
+ * the half-step velocities and the latest forces (the force pass, or a deferred kick before
+ * the state is read; sim_many.c's kick-drift pass applies it with the same arithmetic). */
+static inline void wetdem_many_close_kick(struct wetdem_many* m, size_t k, struct wetdem_vec3 g)
+{
+    if (m->fixed[k])
+        return;
+    double h = m->dt;
+    m->vw[k][0] = vec3_axpy(m->vh[k], 0.5 * h, vec3_axpy(g, m->inv[k][0], m->force[k]));
+    m->vw[k][1] = vec3_axpy(m->wh[k], 0.5 * h, vec3_scale(m->torque[k], m->inv[k][1]));
 }
 
 /* sim_many.c */

@@ -621,16 +621,9 @@ static void finish_kick(struct wetdem_sim* sim)
         return;
     m->kick_pending = false;
     struct wetdem_vec3 g = gravity(sim);
-    double h = m->dt;
 #pragma omp parallel for schedule(static) if (wetdem_many_parallel(m, sim->n_particles))
-    for (size_t k = 0; k < sim->n_particles; k++) {
-        if (m->fixed[k])
-            continue;
-        struct wetdem_vec3 a = vec3_axpy(g, m->inv[k][0], m->force[k]);
-        struct wetdem_vec3 alpha = vec3_scale(m->torque[k], m->inv[k][1]);
-        m->vw[k][0] = vec3_axpy(m->vh[k], 0.5 * h, a);
-        m->vw[k][1] = vec3_axpy(m->wh[k], 0.5 * h, alpha);
-    }
+    for (size_t k = 0; k < sim->n_particles; k++)
+        wetdem_many_close_kick(m, k, g);
 }
 
 /* Forces at the current state (with the closing half kick when `kick`), work collected. */

@@ -850,17 +850,6 @@ static void eval_walls_of(const struct wetdem_sim* sim, size_t i, struct wetdem_
     }
 }
 
-/* Closing half kick of particle k: v = v' + a dt/2, w = w' + alpha dt/2 (sim_many.c). */
-static void close_kick(const struct wetdem_sim* sim, size_t k, struct wetdem_vec3 g)
-{
-    struct wetdem_many* m = sim->many;
-    if (m->fixed[k])
-        return;
-    double h = m->dt;
-    m->vw[k][0] = vec3_axpy(m->vh[k], 0.5 * h, vec3_axpy(g, m->inv[k][0], m->force[k]));
-    m->vw[k][1] = vec3_axpy(m->wh[k], 0.5 * h, vec3_scale(m->torque[k], m->inv[k][1]));
-}
-
 /* Grows *a to n elements of `size` bytes (contents not kept). */
 static bool reserve(void** a, size_t* cap, size_t n, size_t size)
 {
@@ -1173,7 +1162,7 @@ static void pairs_of_block(const struct pass* P, size_t b, bool kick, struct wet
         bool cross = e < e_end && pairs[m->cross_q[e]].i == i;
         if (!own && !cross) { /* nothing to add (adding +0 would change no sum) */
             if (kick)
-                close_kick(P->sim, i, g);
+                wetdem_many_close_kick(m, i, g);
             continue;
         }
         struct wetdem_vec3 f = vec3(0, 0, 0), t = vec3(0, 0, 0);
@@ -1214,7 +1203,7 @@ static void pairs_of_block(const struct pass* P, size_t b, bool kick, struct wet
         torque[i] = vec3_add(torque[i], t);
         contacts[i] += n_contacts;
         if (kick)
-            close_kick(P->sim, i, g);
+            wetdem_many_close_kick(m, i, g);
     }
 }
 
