@@ -112,18 +112,18 @@ struct wetdem_many {
                                     set when a run (re)starts (sim_many.c prepare) */
     uint32_t* wall_list;  /* particles with a non-zero wall_mask (or all if > 64 walls) */
     size_t n_wall_list, wall_list_cap;
-    bool kick_pending;         /* the latest step's closing half kick is still to be applied
+    bool kick_pending;      /* the latest step's closing half kick is still to be applied
                                     (sim_many.c one_step); never true outside a run */
-    size_t sums_zeroed;        /* the kick-drift pass set force, torque and contacts of this many
+    size_t sums_zeroed;     /* the kick-drift pass set force, torque and contacts of this many
                                     particles to zero (0: not); the next force pass then starts
                                     only the sums of the particles with walls */
-    double disp_bound;         /* upper bound of the largest displacement since the build [m]
-                                    (sim_many.c kick_drift), */
-    uint64_t disp_bound_build; /* for the list build with this number; */
-    double x_build_max;        /* and the largest |coordinate| at that build [m] */
-    uint64_t disp_measures;    /* displacement measurements so far (tests) */
-    double max_disp2;          /* largest squared displacement since the build [m^2], */
-    bool max_disp_valid;       /* measured during the latest drift */
+    double disp_bound;      /* upper bound of the largest displacement since the build [m]
+                                    (sim_many.c kick_drift; 0 at a build, INFINITY when a call
+                                    starts) */
+    double x_build_max;     /* the largest |coordinate| at the build [m] */
+    uint64_t disp_measures; /* displacement measurements so far (tests) */
+    double max_disp2;       /* largest squared displacement since the build [m^2], */
+    bool max_disp_valid;    /* measured during the latest drift */
     /* blocks of the force pass (sim_many_force.c), one per thread: particles blk[b] ..
        blk[b+1]; the pairs crossing blocks (first particle in an earlier block), in pair order
        (cross_q, with their results cross_out), grouped by the block of the first particle

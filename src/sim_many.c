@@ -353,6 +353,33 @@ static void sync_records(struct wetdem_sim* sim)
     write_back(sim, true);
 }
 
+/* The largest of m and the magnitudes of the components of x (comparisons: no call). */
+static double abs_max(struct wetdem_vec3 x, double m)
+{
+    double a = fabs(x.x), b = fabs(x.y), c = fabs(x.z);
+    m = a > m ? a : m;
+    m = b > m ? b : m;
+    return c > m ? c : m;
+}
+
+/* The largest magnitude of a coordinate at the last list build, and of a bound of a periodic
+ * axis [m]. */
+static double coordinate_max(const struct wetdem_sim* sim)
+{
+    const struct wetdem_many* m = sim->many;
+    const struct wetdem_vec3* at_build = m->cl.pos_at_build;
+    double x_max = 0; /* max is exact: the same for any thread count */
+#pragma omp parallel for schedule(static)                                                          \
+    reduction(max                                                                                  \
+              : x_max) if (wetdem_many_parallel(m, sim->n_particles))
+    for (size_t k = 0; k < sim->n_particles; k++)
+        x_max = abs_max(at_build[k], x_max);
+    for (int a = 0; a < 3; a++)
+        if (m->cl.box.periodic[a])
+            x_max = abs_max(vec3(m->cl.box.lo[a], m->cl.box.hi[a], 0), x_max);
+    return x_max;
+}
+
 /* Rebuilds the cell list and carries the histories of surviving pairs over. */
 static int rebuild(struct wetdem_sim* sim)
 {
@@ -367,6 +394,8 @@ static int rebuild(struct wetdem_sim* sim)
     int st = wetdem_celllist_build(&m->cl, sim->particles, sim->n_particles, msg, sizeof msg);
     if (st != WETDEM_OK)
         return wetdem_sim_fail(sim, st, "%s", msg);
+    m->disp_bound = 0; /* nothing has moved since the build (kick_drift) */
+    m->x_build_max = coordinate_max(sim);
     swap_pair_arrays(m); /* the current histories and flags become the old ones (no copy) */
     size_t n_new = m->cl.n_pairs;
     if (grow((void**)&m->history, &m->history_cap, n_new * len + 1, sizeof(double)) ||
@@ -482,15 +511,6 @@ static struct wetdem_vec3 wrap(const struct wetdem_celllist_box* b, struct wetde
     return vec3(c[0], c[1], c[2]);
 }
 
-/* The largest of m and the magnitudes of the components of x (comparisons: no call). */
-static double abs_max(struct wetdem_vec3 x, double m)
-{
-    double a = fabs(x.x), b = fabs(x.y), c = fabs(x.z);
-    m = a > m ? a : m;
-    m = b > m ? b : m;
-    return c > m ? c : m;
-}
-
 /* Half kick and drift of particle p (index k); its velocities become the predicted ones
  * v' + a dt/2, and *v2_max the larger of itself and |v'|^2 of the half-step velocity. Every
  * value is formed in a local and stored once. */
@@ -517,24 +537,6 @@ static void kick_drift_one(struct wetdem_many* m, size_t k, struct wetdem_vec3 g
     m->xr[k].z = x.z;
     m->vw[k][0] = vec3_axpy(vh, half, a);
     m->vw[k][1] = vec3_axpy(wh, half, alpha);
-}
-
-/* The largest magnitude of a coordinate at the last list build, and of a bound of a periodic
- * axis [m]. */
-static double coordinate_max(const struct wetdem_sim* sim)
-{
-    const struct wetdem_many* m = sim->many;
-    const struct wetdem_vec3* at_build = m->cl.pos_at_build;
-    double x_max = 0; /* max is exact: the same for any thread count */
-#pragma omp parallel for schedule(static)                                                          \
-    reduction(max                                                                                  \
-              : x_max) if (wetdem_many_parallel(m, sim->n_particles))
-    for (size_t k = 0; k < sim->n_particles; k++)
-        x_max = abs_max(at_build[k], x_max);
-    for (int a = 0; a < 3; a++)
-        if (m->cl.box.periodic[a])
-            x_max = abs_max(vec3(m->cl.box.lo[a], m->cl.box.hi[a], 0), x_max);
-    return x_max;
 }
 
 /* Largest squared displacement of any particle since the last neighbour-list build [m^2]. */
@@ -595,11 +597,6 @@ static void kick_drift(struct wetdem_sim* sim, double h)
     m->max_disp_valid = track;
     if (!track)
         return;
-    if (m->disp_bound_build != m->cl.n_builds) { /* a new list: nothing has moved since */
-        m->disp_bound_build = m->cl.n_builds;
-        m->disp_bound = 0;
-        m->x_build_max = coordinate_max(sim);
-    }
     /* |x| <= its value at the build + the displacement since, or within the periodic box */
     if (isfinite(m->disp_bound)) /* else unknown (a new call): measured below */
         m->disp_bound += h * sqrt(v2_max) * (1 + 16 * DBL_EPSILON) +
