@@ -355,6 +355,21 @@ static void test_many_fused_run_equals_generic_run(void** state)
     }
 }
 
+/* Runs the lean and the generic simulation to time t, checks that the first ran the lean
+ * kernel and the second not, and that they end bit-identical; returns the lean run's stats. */
+static struct wetdem_many_stats lean_equals_generic(struct wetdem_sim* lean,
+                                                    struct wetdem_sim* generic, double t)
+{
+    CHECK_OK(wetdem_sim_integrate(lean, t));
+    CHECK_OK(wetdem_sim_integrate(generic, t));
+    assert_true(lean->many->lean.on);
+    assert_false(generic->many->lean.on);
+    test_check_same_particles(lean, generic);
+    struct wetdem_many_stats s;
+    CHECK_OK(wetdem_sim_many_stats(lean, &s));
+    return s;
+}
+
 /* The lean kernel sums the two film terms of a pair apart directly, whatever the model order
  * (the Hertz term there is +0, and two terms commute), and adds no torques for it: whole runs
  * with the models in reverse order equal the generic interface's bit for bit. */
@@ -364,13 +379,7 @@ static void test_many_lean_run_any_model_order(void** state)
     const char* const reverse[] = {"capillary", "sb", "mindlin", "hertz"};
     struct wetdem_sim* lean = wet_gas_of(reverse, false, false);
     struct wetdem_sim* generic = wet_gas_of(reverse, true, false);
-    CHECK_OK(wetdem_sim_integrate(lean, 0.6e-3));
-    CHECK_OK(wetdem_sim_integrate(generic, 0.6e-3));
-    assert_true(lean->many->lean.on);
-    assert_false(generic->many->lean.on);
-    test_check_same_particles(lean, generic);
-    struct wetdem_many_stats s;
-    CHECK_OK(wetdem_sim_many_stats(lean, &s));
+    struct wetdem_many_stats s = lean_equals_generic(lean, generic, 0.6e-3);
     assert_true(s.contacts > 0 && s.bridges > 0); /* both paths of the lean kernel were run */
     wetdem_sim_free(lean);
     wetdem_sim_free(generic);
@@ -386,13 +395,8 @@ static void test_many_lean_springs_across_rebuilds(void** state)
     (void)state;
     struct wetdem_sim* lean = wet_gas(false, false);
     struct wetdem_sim* generic = wet_gas(true, false);
-    CHECK_OK(wetdem_sim_integrate(lean, 4e-3));
-    CHECK_OK(wetdem_sim_integrate(generic, 4e-3));
-    assert_true(lean->many->lean.on);
-    struct wetdem_many_stats s;
-    CHECK_OK(wetdem_sim_many_stats(lean, &s));
+    struct wetdem_many_stats s = lean_equals_generic(lean, generic, 4e-3);
     assert_true(s.list_builds >= 20);
-    test_check_same_particles(lean, generic);
     wetdem_sim_free(lean);
     wetdem_sim_free(generic);
 }
@@ -416,12 +420,7 @@ static void test_many_lean_constants_follow_changed_particles(void** state)
             p[k].radius *= 0.97;
         }
     }
-    CHECK_OK(wetdem_sim_integrate(lean, 0.6e-3));
-    CHECK_OK(wetdem_sim_integrate(generic, 0.6e-3));
-    assert_true(lean->many->lean.on);
-    test_check_same_particles(lean, generic);
-    struct wetdem_many_stats st;
-    CHECK_OK(wetdem_sim_many_stats(lean, &st));
+    struct wetdem_many_stats st = lean_equals_generic(lean, generic, 0.6e-3);
     assert_true(st.contacts > 0); /* the changed constants were used in contacts */
     wetdem_sim_free(lean);
     wetdem_sim_free(generic);
