@@ -868,42 +868,55 @@ static bool reserve(void** a, size_t* cap, size_t n, size_t size)
  * when the list was built; the kernel costs that much more than a rejected candidate). */
 static double particle_work(const struct wetdem_many* m, size_t i)
 {
-    size_t q0 = m->cl.first_pair[i], q1 = m->cl.first_pair[i + 1], active = 0;
+    size_t q0 = m->cl.first_pair[i], q1 = m->cl.first_pair[i + 1], active = 0, walls = 0;
     for (size_t q = q0; q < q1; q++)
         active += m->flags[q] != 0;
-    return 4.5 + (double)(q1 - q0) + 20.0 * (double)active +
-           12.0 * (double)__builtin_popcountll(m->wall_mask[i]);
+    for (uint64_t w = m->wall_mask[i]; w; w &= w - 1) /* its walls within reach */
+        walls++;
+    return 4.5 + (double)(q1 - q0) + 20.0 * (double)active + 12.0 * (double)walls;
 }
 
 /* Block starts blk[0..nb]: contiguous blocks of about equal estimated work, so that the
  * threads finish together (the result does not depend on the boundaries). When the blocks of
  * the same count were timed, the estimate of each particle is scaled by its old block's time
- * per unit of estimate: a feedback on what the estimate misses (walls, sliding contacts). */
+ * per unit of estimate: a feedback on what the estimate misses (walls, sliding contacts).
+ * One block is all particles, with nothing to estimate. */
 static void partition_blocks(struct wetdem_many* m, size_t n, size_t nb)
 {
+    if (nb == 1) {
+        m->blk[0] = 0;
+        m->blk[1] = n;
+        m->block_est[0] = 1; /* never read: one block is never re-cut for balance */
+        m->block_time[0] = 0;
+        return;
+    }
     double scale[WETDEM_MANY_MAX_BLOCKS] = {0}, mean = 0;
+    size_t old_blk[WETDEM_MANY_MAX_BLOCKS + 1]; /* the timed blocks */
     bool timed = m->blocks_ready && m->n_blocks == nb && m->blocks_n == n && m->blocks_passes > 0;
     for (size_t b = 0; timed && b < nb; b++) {
         timed = m->block_est[b] > 0 && m->block_time[b] > 0;
         scale[b] = timed ? m->block_time[b] / m->block_est[b] : 0;
         mean += scale[b] / (double)nb;
     }
+    if (timed)
+        memcpy(old_blk, m->blk, (nb + 1) * sizeof *old_blk);
     double total = 0;
-    for (size_t i = 0, b = 0; i < n; i++) {
-        while (timed && b + 1 < nb && i >= m->blk[b + 1])
+    for (size_t i = 0, b = 0; i < n; i++) { /* work[i]: the unscaled estimate */
+        while (timed && b + 1 < nb && i >= old_blk[b + 1])
             b++;
-        double w = particle_work(m, i) * (timed ? scale[b] / mean : 1.0);
-        m->work[i] = w;
-        total += w;
+        m->work[i] = particle_work(m, i);
+        total += m->work[i] * (timed ? scale[b] / mean : 1.0);
     }
     double sum = 0;
     size_t b = 1;
-    m->blk[0] = 0;
-    for (size_t i = 0; i < n && b < nb; i++) {
-        sum += m->work[i];
+    for (size_t i = 0, old = 0; i < n && b < nb; i++) { /* the cuts, on the scaled estimates */
+        while (timed && old + 1 < nb && i >= old_blk[old + 1])
+            old++;
+        sum += m->work[i] * (timed ? scale[old] / mean : 1.0);
         while (b < nb && sum >= total * (double)b / (double)nb)
             m->blk[b++] = i + 1;
     }
+    m->blk[0] = 0;
     while (b <= nb)
         m->blk[b++] = n;
     if (m->block_jitter) { /* tests: arbitrary increasing cuts, new at every re-cut */
@@ -918,7 +931,7 @@ static void partition_blocks(struct wetdem_many* m, size_t n, size_t nb)
     for (b = 0; b < nb; b++) { /* the estimate of each new block, for the next feedback */
         m->block_est[b] = 0;
         for (size_t i = m->blk[b]; i < m->blk[b + 1]; i++)
-            m->block_est[b] += particle_work(m, i);
+            m->block_est[b] += m->work[i];
         m->block_time[b] = 0;
     }
 }
@@ -1003,9 +1016,10 @@ static int index_blocks(struct wetdem_sim* sim, size_t nb)
                                "too many candidate pairs for the force pass: %zu (limit %u)", np,
                                UINT32_MAX);
     partition_blocks(m, n, nb);
-    size_t nc = 0;
-    for (size_t q = 0; nb > 1 && q < np; q++)
-        nc += block_of(m->blk, nb, m->cl.pairs[q].i) != block_of(m->blk, nb, m->cl.pairs[q].j);
+    size_t nc = 0; /* pairs (i, j > i) leave i's block when j is at or beyond its end */
+    for (size_t b = 0; nb > 1 && b < nb; b++)
+        for (size_t q = m->cl.first_pair[m->blk[b]]; q < m->cl.first_pair[m->blk[b + 1]]; q++)
+            nc += m->cl.pairs[q].j >= m->blk[b + 1];
     if (!reserve((void**)&m->cross_q, &m->cross_q_cap, nc, sizeof *m->cross_q) ||
         !reserve((void**)&m->cross_in, &m->cross_in_cap, nc, sizeof *m->cross_in) ||
         !reserve((void**)&m->cross_out, &m->cross_out_cap, nc, sizeof *m->cross_out) ||
@@ -1016,17 +1030,17 @@ static int index_blocks(struct wetdem_sim* sim, size_t nb)
     size_t* first_in = m->cross_first + nb + 1; /* by block of the second particle */
     memset(m->cross_first, 0, 2 * (nb + 1) * sizeof *m->cross_first);
     size_t e = 0;
-    for (size_t q = 0; nb > 1 && q < np; q++) {
-        size_t bi = block_of(m->blk, nb, m->cl.pairs[q].i);
-        size_t bj = block_of(m->blk, nb, m->cl.pairs[q].j);
-        if (bi == bj)
-            continue;
-        m->cross_q[e] = (uint32_t)q;
-        m->cross_in[e] = (uint32_t)e;
-        first_out[bi + 1]++;
-        first_in[bj + 1]++;
-        e++;
-    }
+    for (size_t bi = 0; nb > 1 && bi < nb; bi++)
+        for (size_t q = m->cl.first_pair[m->blk[bi]]; q < m->cl.first_pair[m->blk[bi + 1]]; q++) {
+            size_t j = m->cl.pairs[q].j;
+            if (j < m->blk[bi + 1])
+                continue;
+            m->cross_q[e] = (uint32_t)q;
+            m->cross_in[e] = (uint32_t)e;
+            first_out[bi + 1]++;
+            first_in[block_of(m->blk, nb, j) + 1]++;
+            e++;
+        }
     for (size_t b = 0; b < nb; b++) {
         first_out[b + 1] += first_out[b];
         first_in[b + 1] += first_in[b];
@@ -1221,7 +1235,8 @@ static int pair_constants(struct wetdem_sim* sim)
     if (!reserve((void**)&m->pair_lim2, &m->pair_lim2_cap, np, sizeof *m->pair_lim2) ||
         (lean && !reserve((void**)&m->pair_cache, &m->pair_cache_cap, np, sizeof *m->pair_cache)))
         return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory for %zu pairs", np);
-    for (size_t q = 0; q < np; q++) {
+#pragma omp parallel for schedule(static) if (wetdem_many_parallel(m, sim->n_particles))
+    for (size_t q = 0; q < np; q++) { /* each pair on its own: the same for any thread count */
         size_t i = m->cl.pairs[q].i, j = m->cl.pairs[q].j;
         const struct wetdem_particle *a = &sim->particles[i], *b = &sim->particles[j];
         const struct wetdem_many_mix* x = &m->mix[(size_t)a->material * nm + (size_t)b->material];
