@@ -455,44 +455,67 @@ lean_apart(const struct wetdem_many_lean* L, const struct wetdem_many_mix* x, st
     return isfinite(f_n) ? WETDEM_OK : WETDEM_ERR_NUMERIC;
 }
 
-/* Pair (ia, ib) with d = x_a - x_b (minimum image), from the engine state (radii in xr,
- * velocities and spins in vw): its geometry as pair_contact_from computes it, then lean_apart
- * or lean_force; *flags = 0 beyond the range. */
-static int lean_pair(const struct wetdem_many* m, size_t ia, size_t ib, struct wetdem_vec3 d,
-                     const struct wetdem_many_mix* x, double* hist, const double* cache,
-                     unsigned char* flags, struct wetdem_many_pair_out* o)
-    __attribute__((always_inline));
-static inline int lean_pair(const struct wetdem_many* m, size_t ia, size_t ib, struct wetdem_vec3 d,
-                            const struct wetdem_many_mix* x, double* hist, const double* cache,
-                            unsigned char* flags, struct wetdem_many_pair_out* o)
+/* The start of pair (ia, ib)'s geometry with d = x_a - x_b (minimum image), from the engine
+ * state (radii in xr, velocities in vw), as pair_contact_from computes it: the gap [m], and,
+ * when it is within the range of x (returns true), the unit normal and the normal velocity
+ * v_n [m/s]. */
+static inline __attribute__((always_inline)) bool
+lean_pair_start(const struct wetdem_many* m, size_t ia, size_t ib, struct wetdem_vec3 d,
+                const struct wetdem_many_mix* x, double* gap, struct wetdem_vec3* n, double* v_n)
+{
+    double dist = vec3_norm(d);
+    *gap = dist - m->xr[ia].r - m->xr[ib].r;
+    if (*gap > x->range)
+        return false;
+    *n = dist > 0 ? vec3_scale(d, 1.0 / dist) : vec3(1, 0, 0);
+    *v_n = -vec3_dot(vec3_sub(m->vw[ia][0], m->vw[ib][0]), *n);
+    return true;
+}
+
+/* Pair (ia, ib) in solid contact (gap < 0) with the start of its geometry (lean_pair_start)
+ * and its constants `cache` (pair_cache): the rest of the geometry, then lean_force. */
+static inline __attribute__((always_inline)) int
+lean_contact(const struct wetdem_many* m, size_t ia, size_t ib, struct wetdem_vec3 n, double gap,
+             double v_n, const struct wetdem_many_mix* x, double* hist, const double* cache,
+             unsigned char* flags, struct wetdem_many_pair_out* o)
 {
     double r_a = m->xr[ia].r, r_b = m->xr[ib].r;
     const struct wetdem_vec3 *vw_a = m->vw[ia], *vw_b = m->vw[ib]; /* velocity, spin */
-    double dist = vec3_norm(d);
-    struct lean_geometry g; /* every field read is set (no zeroing of the whole record) */
-    g.gap = dist - r_a - r_b;
-    bool spring_set = *flags & WETDEM_MANY_SPRING; /* by the previous evaluation */
-    *flags = 0;
-    if (g.gap > x->range)
-        return WETDEM_OK;
-    g.r_i = r_a;
-    g.r_j = r_b;
-    g.wall = false;
-    g.n = dist > 0 ? vec3_scale(d, 1.0 / dist) : vec3(1, 0, 0);
-    g.r_eff = cache[0];
-    g.m_eff = cache[1];
-    g.k = cache[2];
-    g.damping = cache[3];
-    g.v_n = -vec3_dot(vec3_sub(vw_a[0], vw_b[0]), g.n);
-    if (!(g.gap < 0.0))
-        return lean_apart(&m->lean, x, g.n, g.gap, g.r_eff, g.v_n, spring_set, hist, flags, o);
-    g.v_t = vec3(0, 0, 0); /* read in solid contact only */
+    struct lean_geometry g = {.n = n,
+                              .gap = gap,
+                              .r_i = r_a,
+                              .r_j = r_b,
+                              .r_eff = cache[0],
+                              .m_eff = cache[1],
+                              .k = cache[2],
+                              .damping = cache[3],
+                              .v_n = v_n,
+                              .v_t = vec3(0, 0, 0), /* read in solid contact only */
+                              .wall = false};
     if (m->lean.mindlin) {
-        struct wetdem_vec3 va = vec3_add(vw_a[0], vec3_cross(vw_a[1], vec3_scale(g.n, -r_a)));
-        struct wetdem_vec3 vb = vec3_add(vw_b[0], vec3_cross(vw_b[1], vec3_scale(g.n, r_b)));
-        g.v_t = vec3_reject(vec3_sub(va, vb), g.n);
+        struct wetdem_vec3 va = vec3_add(vw_a[0], vec3_cross(vw_a[1], vec3_scale(n, -r_a)));
+        struct wetdem_vec3 vb = vec3_add(vw_b[0], vec3_cross(vw_b[1], vec3_scale(n, r_b)));
+        g.v_t = vec3_reject(vec3_sub(va, vb), n);
     }
     return lean_force(m, &g, x, hist, flags, o);
+}
+
+/* Pair (ia, ib) with d = x_a - x_b (minimum image): lean_pair_start, then lean_apart or
+ * lean_contact; *flags = 0 beyond the range. */
+static inline __attribute__((always_inline)) int
+lean_pair(const struct wetdem_many* m, size_t ia, size_t ib, struct wetdem_vec3 d,
+          const struct wetdem_many_mix* x, double* hist, const double* cache, unsigned char* flags,
+          struct wetdem_many_pair_out* o)
+{
+    bool spring_set = *flags & WETDEM_MANY_SPRING; /* by the previous evaluation */
+    double gap, v_n;
+    struct wetdem_vec3 n;
+    *flags = 0;
+    if (!lean_pair_start(m, ia, ib, d, x, &gap, &n, &v_n))
+        return WETDEM_OK;
+    if (!(gap < 0.0))
+        return lean_apart(&m->lean, x, n, gap, cache[0], v_n, spring_set, hist, flags, o);
+    return lean_contact(m, ia, ib, n, gap, v_n, x, hist, cache, flags, o);
 }
 
 /* Particle a and plane wall w: the geometry of wall_contact_from, then lean_force (walls
@@ -690,14 +713,15 @@ struct pass {
  * own short path (lean_apart), the call cost more than the spills it used to save. */
 static unsigned char near_candidate(const struct pass* P, size_t q, size_t i, size_t j,
                                     struct wetdem_vec3 d, const struct wetdem_many_mix* x,
-                                    struct wetdem_many_pair_out* o, struct failure* fail)
+                                    bool lean, struct wetdem_many_pair_out* o, struct failure* fail)
     __attribute__((always_inline));
 static inline unsigned char near_candidate(const struct pass* P, size_t q, size_t i, size_t j,
                                            struct wetdem_vec3 d, const struct wetdem_many_mix* x,
-                                           struct wetdem_many_pair_out* o, struct failure* fail)
+                                           bool lean, struct wetdem_many_pair_out* o,
+                                           struct failure* fail)
 {
     unsigned char* fl = &P->flags[q];
-    if (!P->lean) {
+    if (!lean) {
         eval_near_pair(P->sim, q, d, x, o, fail);
         return *fl;
     }
@@ -765,7 +789,7 @@ eval_candidate(const struct pass* P, size_t q, size_t i, size_t j, struct wetdem
     struct wetdem_vec3 d;
     const struct wetdem_many_mix* x;
     if (within_reach(P, q, i, j, P->periodic, P->nm == 1, &d, &x))
-        return near_candidate(P, q, i, j, d, x, o, fail);
+        return near_candidate(P, q, i, j, d, x, P->lean, o, fail);
     if (P->flags[q])
         leave_range(P, q);
     return 0;
@@ -1191,7 +1215,7 @@ static void pairs_of_block(const struct pass* P, size_t b, bool kick, struct wet
             }
             pair_delta(P, i, j, periodic, single, &d, &x);
             struct wetdem_many_pair_out o;
-            unsigned char fl = near_candidate(P, q, i, j, d, x, &o, fail);
+            unsigned char fl = near_candidate(P, q, i, j, d, x, P->lean, &o, fail);
             if (!(fl & WETDEM_MANY_ACTIVE))
                 continue;
             uint32_t c = (fl & WETDEM_MANY_CONTACT) ? 1 : 0;
@@ -1220,7 +1244,6 @@ static void pairs_of_block(const struct pass* P, size_t b, bool kick, struct wet
             wetdem_many_close_kick(m, i, g);
     }
 }
-
 /* The constants of every candidate pair (many.h: pair_lim2, and pair_cache for the lean
  * kernel), once per list build and kernel set-up: radii, masses and ranges do not change in
  * between. The same expressions as per evaluation, so the same bits. */
