@@ -1081,11 +1081,15 @@ static int index_blocks(struct wetdem_sim* sim, size_t nb)
 
 /* ---- the force pass ---- */
 
-/* Phase 1 of block b: the pairs whose second particle lies in a later block, into cross_out. */
-static void cross_pairs_of_block(const struct pass* P, size_t b, struct failure* fail)
+/* Phase 1, thread t of nt: an equal share of the cross pairs (second particle in a later
+ * block than the first) of all blocks, into cross_out. Each result is the pair's own, so the
+ * shares change none; by block, all of them would fall to the threads of the first blocks
+ * (the last block has none), and the others would wait. */
+static void cross_pairs_share(const struct pass* P, size_t t, size_t nt, struct failure* fail)
 {
     struct wetdem_many* m = P->m;
-    for (size_t e = m->cross_first[b]; e < m->cross_first[b + 1]; e++) {
+    size_t n = m->cross_first[m->n_blocks];
+    for (size_t e = n * t / nt; e < n * (t + 1) / nt; e++) {
         size_t q = m->cross_q[e];
         eval_candidate(P, q, P->pairs[q].i, P->pairs[q].j, &m->cross_out[e], fail);
     }
@@ -1313,8 +1317,7 @@ int wetdem_sim_many_forces(struct wetdem_sim* sim, bool kick)
 #pragma omp parallel if (parallel)
     {
         size_t t = (size_t)omp_get_thread_num(), nt = (size_t)omp_get_num_threads();
-        for (size_t b = t; b < nb; b += nt)
-            cross_pairs_of_block(&P, b, &fail);
+        cross_pairs_share(&P, t, nt, &fail);
 #pragma omp barrier
         for (size_t b = t; b < nb; b += nt) {
             double t0 = omp_get_wtime();
