@@ -100,6 +100,31 @@ struct wetdem_many {
     double* pair_lim2;
     double (*pair_cache)[4];
     size_t pair_lim2_cap, pair_cache_cap;
+    /* The gap test's skip clock (sim_many_force.c gap_test): drift_clock is the sum since the
+       list build of every step's bound on the displacement of any particle (sim_many.c
+       kick_drift) [m], so two particles have come closer by at most twice its growth. A
+       candidate rejected at clock c with |d| - far = g > 0 cannot pass the test while the
+       clock is below c + g/2, its skip_until; until then it is not tested (its result would be
+       the same: a rejection). The times are kept (skip_on) from each list build, and again
+       32 passes after they were dropped (skip_off_passes), for as long as at least half of
+       the candidates are skipped (in a flowing system few are, and keeping the times costs
+       more than the skips save); they are usable when the previous pass kept them
+       (skip_valid) on this list (skip_build) and every step since had a bound
+       (clock_known). */
+    float* skip_until; /* [m], rounded down */
+    size_t skip_until_cap;
+    struct skip_bound {
+        double rel, abs, inv_2dmax, cap;
+    } skip_bound; /* the constants of the skip times, per list build (sim_many_force.c) */
+    double drift_clock;
+    bool clock_known, skip_on, skip_valid;
+    uint64_t skip_build;
+    unsigned skip_off_passes;
+    bool no_skip;               /* tests: test every candidate at every pass */
+    bool skip_always;           /* tests: keep the times whatever share is skipped */
+    uint64_t pass_candidates;   /* candidates of the latest pass's gap tests */
+    uint64_t pass_skipped;      /* of which skipped */
+    uint64_t skipped_tests;     /* candidates not tested thanks to the clock (tests) */
     uint64_t pair_consts_build; /* the list build they were computed for */
     bool pair_consts_ready;     /* cleared when the kernel is set up */
     unsigned char* old_flags;   /* flags of the previous list, for remapping */

@@ -109,6 +109,7 @@ void wetdem_sim_many_free(struct wetdem_sim* sim)
     free(m->hits);
     free(m->hit_near);
     free(m->pair_lim2);
+    free(m->skip_until);
     free(m->work);
     for (size_t k = 0; k < m->n_series && m->vtk_names; k++)
         free(m->vtk_names[k]);
@@ -394,7 +395,8 @@ static int rebuild(struct wetdem_sim* sim)
     int st = wetdem_celllist_build(&m->cl, sim->particles, sim->n_particles, msg, sizeof msg);
     if (st != WETDEM_OK)
         return wetdem_sim_fail(sim, st, "%s", msg);
-    m->disp_bound = 0; /* nothing has moved since the build (kick_drift) */
+    m->disp_bound = 0;  /* nothing has moved since the build (kick_drift) */
+    m->drift_clock = 0; /* the gap test's skip clock starts again (its times are set anew) */
     m->x_build_max = coordinate_max(sim);
     swap_pair_arrays(m); /* the current histories and flags become the old ones (no copy) */
     size_t n_new = m->cl.n_pairs;
@@ -455,8 +457,10 @@ int wetdem_sim_many_prepare(struct wetdem_sim* sim)
     if (size_particle_arrays(sim) != WETDEM_OK)
         return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory for %zu particles",
                                sim->n_particles);
-    if (refresh)
-        sync_records(sim); /* (never stale here: a call ends with them written) */
+    if (refresh) {
+        sync_records(sim);      /* (never stale here: a call ends with them written) */
+        m->clock_known = false; /* the positions are loaded anew: no skips at the next pass */
+    }
     for (size_t k = 0; refresh && k < sim->n_particles; k++) { /* the user may move particles */
         const struct wetdem_particle* p = &sim->particles[k];
         m->xr[k] = (struct wetdem_celllist_item){p->pos.x, p->pos.y, p->pos.z, p->radius};
@@ -595,12 +599,22 @@ static void kick_drift(struct wetdem_sim* sim, double h)
     m->sums_zeroed = sim->n_particles;
     m->records_stale = true;
     m->max_disp_valid = track;
-    if (!track)
+    if (!track) {
+        m->clock_known = false;
         return;
+    }
     /* |x| <= its value at the build + the displacement since, or within the periodic box */
-    if (isfinite(m->disp_bound)) /* else unknown (a new call): measured below */
-        m->disp_bound += h * sqrt(v2_max) * (1 + 16 * DBL_EPSILON) +
-                         16 * DBL_EPSILON * (m->x_build_max + m->disp_bound);
+    if (isfinite(m->disp_bound)) { /* else unknown (a new call): measured below */
+        double step = h * sqrt(v2_max) * (1 + 16 * DBL_EPSILON) +
+                      16 * DBL_EPSILON * (m->x_build_max + m->disp_bound);
+        m->disp_bound += step;
+        m->drift_clock += step;            /* the gap test's skip clock (many.h) */
+        if (m->drift_clock > m->cl.skin) { /* restarted while small against the coordinates, */
+            m->drift_clock = 0;            /* so that its round-off stays below the 16 eps */
+            m->clock_known = false;        /* x_build_max each step adds */
+        }
+    } else
+        m->clock_known = false; /* the particles may have been moved since the last pass */
     m->max_disp2 = 0;
     if (!(m->disp_bound <= 0.5 * m->cl.skin * (1 - 1e-6))) {
         m->max_disp2 = max_displacement2(sim);
@@ -767,6 +781,7 @@ int wetdem_sim_many_integrate(struct wetdem_sim* sim, double t_end)
     struct wetdem_many* m = sim->many;
     m->kernel_ready = false;  /* materials, models or parameters may have changed */
     m->disp_bound = INFINITY; /* particles may have been moved: measure at the first step */
+    m->clock_known = false;   /* and test every candidate at the first force pass */
     int st = m->started ? wetdem_sim_many_prepare(sim) : start(sim);
     if (st != WETDEM_OK)
         return st;

@@ -693,6 +693,16 @@ static void eval_near_pair(const struct wetdem_sim* sim, size_t q, struct wetdem
         note_failure(fail, q, st, false, &c, range);
 }
 
+/* The constants of a candidate's skip time (within_reach), per list build: with far_q the
+ * distance sqrt(pair_lim2) (1 + 1e-9) + 1e-12 (x_build_max + skin) [m], beyond which the gap
+ * test rejects it with room to spare for every round-off, and d_max the largest far_q plus the
+ * skin, a rejected candidate at squared distance r2 has |d| - far_q >=
+ * min((r2 - far_q^2) / (2 d_max), skin): (|d|^2 - far_q^2) / (|d| + far_q) with the
+ * denominator at most 2 d_max, or, beyond d_max, more than the skin. far_q^2 is bounded above
+ * by pair_lim2 rel + abs; no square root per candidate. */
+/* (many.h: rel [-], abs [m^2], inv_2dmax = 1 / (2 d_max) rounded down [1/m], cap = the skin
+ * [m].) */
+
 /* What every candidate evaluation of one force pass reads, gathered once. */
 struct pass {
     const struct wetdem_sim* sim;
@@ -702,10 +712,15 @@ struct pass {
     const struct wetdem_celllist_pair* pairs;
     unsigned char* flags;
     const double* lim2; /* pair_lim2 */
+    float* skip_until;  /* many.h: the gap test's skip clock */
+    double clock;       /* drift_clock */
+    struct skip_bound bound;
     double* history;
     size_t len, nm;
     bool periodic, lean;
-    bool zeroed; /* the sums start from zero already (many.h sums_zeroed) */
+    bool skip;     /* the skip times are usable (else every candidate is tested) */
+    bool maintain; /* each tested candidate gets its skip time anew */
+    bool zeroed;   /* the sums start from zero already (many.h sums_zeroed) */
 };
 
 /* Candidate q = (i, j, d = x_i - x_j) that passed the gap test: its kernel. Returns its flags.
@@ -769,14 +784,35 @@ static double reach2(const struct wetdem_celllist_item* xr, size_t i, size_t j,
 }
 
 /* The cheap gap test of candidate q = (i, j): pair_delta, then true when
- * |d|^2 <= (R_i + R_j + r_ab)^2 (1 + PREFILTER_MARGIN), the bound kept per pair (pair_lim2). */
-static inline __attribute__((always_inline)) bool within_reach(const struct pass* P, size_t q,
-                                                               size_t i, size_t j, bool periodic,
-                                                               bool single, struct wetdem_vec3* d,
-                                                               const struct wetdem_many_mix** x)
+ * |d|^2 <= (R_i + R_j + r_ab)^2 (1 + PREFILTER_MARGIN), the bound kept per pair (pair_lim2).
+ * Sets the candidate's skip time (many.h): the skip clock plus half of a lower bound of
+ * |d| - far_q (struct skip_bound), before the clock when it passes. Until the clock gets there,
+ * its two particles cannot have come closer by that much, and the test would reject it again:
+ * the margins of far_q, a relative 1e-9 and 1e-12 of the largest coordinate, exceed the
+ * round-off of the distances, of the test and of the times by orders of magnitude. */
+static inline __attribute__((always_inline)) bool
+within_reach(const struct pass* P, size_t q, size_t i, size_t j, bool periodic, bool single,
+             bool maintain, struct wetdem_vec3* d, const struct wetdem_many_mix** x)
 {
     pair_delta(P, i, j, periodic, single, d, x);
-    return vec3_dot(*d, *d) <= P->lim2[q];
+    double r2 = vec3_dot(*d, *d);
+    bool near = r2 <= P->lim2[q];
+    if (maintain) { /* P->maintain */
+        const struct skip_bound* B = &P->bound;
+        double beyond = (r2 - (P->lim2[q] * B->rel + B->abs)) * B->inv_2dmax; /* <= |d| - far */
+        /* (a candidate that passes has beyond < 0, a time before the clock: tested again) */
+        double until = P->clock + 0.5 * (beyond < B->cap ? beyond : B->cap);
+        /* kept as a float rounded down (one float ulp off, then to nearest): never later */
+        P->skip_until[q] = (float)(until - fabs(until) * 1.2e-7);
+    }
+    return near;
+}
+
+/* Whether candidate q's skip time has not come: its gap test would reject it. It then has no
+ * flags (the test that set the time cleared them). */
+static inline __attribute__((always_inline)) bool skipped(const struct pass* P, size_t q)
+{
+    return P->skip && P->clock < P->skip_until[q];
 }
 
 /* Candidate pair q = (i, j): the gap test on the positions first (most candidates are beyond
@@ -788,7 +824,9 @@ eval_candidate(const struct pass* P, size_t q, size_t i, size_t j, struct wetdem
 {
     struct wetdem_vec3 d;
     const struct wetdem_many_mix* x;
-    if (within_reach(P, q, i, j, P->periodic, P->nm == 1, &d, &x))
+    if (skipped(P, q))
+        return 0;
+    if (within_reach(P, q, i, j, P->periodic, P->nm == 1, P->maintain, &d, &x))
         return near_candidate(P, q, i, j, d, x, P->lean, o, fail);
     if (P->flags[q])
         leave_range(P, q);
@@ -1146,28 +1184,55 @@ static void start_sums_of_block(const struct pass* P, size_t b, struct failure* 
     }
 }
 
-/* The gap test of candidates q_begin .. q_end in one flat loop without branches on its outcome:
+/* The gap test of candidates q_begin .. q_end in flat loops without branches on their outcome:
  * those within range, and those with flags (they may have just left it), whose second particle
- * is below end_block, are listed in hits in pair order; returns their number. `periodic` and
- * `single` (one material pair) are constants at each call, so each case compiles to its own
- * loop. The lists are `restrict`: a store through the byte list could otherwise alias
- * anything, and every read of the pass would be repeated after it. */
+ * is below end_block, are listed in hits in pair order; returns their number. With usable
+ * skip times (many.h), a first loop lists the candidates whose time has come in hits, and the
+ * test runs over that list, writing its result over it (never ahead of its reading): a branch
+ * per candidate on its time would be mispredicted half of the time in a flowing system. The
+ * skipped ones have no flags. `periodic` and `single` (one material pair) are constants at
+ * each call, so each case compiles to its own loop. The lists are `restrict`: a store through
+ * the byte list could otherwise alias anything, and every read of the pass would be repeated
+ * after it. */
 static inline __attribute__((always_inline)) size_t
 gap_test(const struct pass* P, size_t q_begin, size_t q_end, size_t end_block,
-         uint32_t* restrict hits, unsigned char* restrict hit_near, bool periodic, bool single)
+         uint32_t* restrict hits, unsigned char* restrict hit_near, bool periodic, bool single,
+         uint64_t* n_skipped)
 {
     const struct wetdem_celllist_pair* pairs = P->pairs;
     const unsigned char* flags = P->flags;
-    size_t n_hits = 0;
-    for (size_t q = q_begin; q < q_end; q++) {
-        size_t i = pairs[q].i, j = pairs[q].j;
-        struct wetdem_vec3 d;
-        const struct wetdem_many_mix* x;
-        bool near = within_reach(P, q, i, j, periodic, single, &d, &x);
-        hits[n_hits] = (uint32_t)q;
-        hit_near[n_hits] = near;
-        n_hits += ((size_t)near | (size_t)(flags[q] != 0)) & (size_t)(j < end_block);
+    size_t n_test = q_end - q_begin, n_hits = 0;
+    if (P->skip) { /* the candidates to test, in order */
+        const float* restrict until = P->skip_until;
+        double clock = P->clock;
+        n_test = 0;
+        for (size_t q = q_begin; q < q_end; q++) {
+            hits[n_test] = (uint32_t)q;
+            n_test += !(clock < until[q]);
+        }
+        *n_skipped += (q_end - q_begin) - n_test;
     }
+#define GAP_TEST_LOOP(candidate)                                                                   \
+    for (size_t k = 0; k < n_test; k++) {                                                          \
+        size_t q = (candidate), i = pairs[q].i, j = pairs[q].j;                                    \
+        struct wetdem_vec3 d;                                                                      \
+        const struct wetdem_many_mix* x;                                                           \
+        bool near = within_reach(P, q, i, j, periodic, single, maintain, &d, &x);                  \
+        hits[n_hits] = (uint32_t)q;                                                                \
+        hit_near[n_hits] = near;                                                                   \
+        n_hits += ((size_t)near | (size_t)(flags[q] != 0)) & (size_t)(j < end_block);              \
+    }
+    if (P->skip) { /* (P->skip implies P->maintain) */
+        bool maintain = true;
+        GAP_TEST_LOOP(hits[k])
+    } else if (P->maintain) {
+        bool maintain = true;
+        GAP_TEST_LOOP(q_begin + k)
+    } else {
+        bool maintain = false;
+        GAP_TEST_LOOP(q_begin + k)
+    }
+#undef GAP_TEST_LOOP
     return n_hits;
 }
 
@@ -1193,9 +1258,15 @@ static void pairs_of_block(const struct pass* P, size_t b, bool kick, struct wet
     size_t q_begin = m->cl.first_pair[begin_block], q_end = m->cl.first_pair[end_block];
     uint32_t* hits = m->hits + q_begin;
     unsigned char* near = m->hit_near + q_begin;
-    size_t n_hits = single && !periodic /* the common case, in its own loop */
-                        ? gap_test(P, q_begin, q_end, end_block, hits, near, false, true)
-                        : gap_test(P, q_begin, q_end, end_block, hits, near, periodic, false);
+    uint64_t n_skipped = 0;
+    size_t n_hits =
+        single && !periodic /* the common case, in its own loop */
+            ? gap_test(P, q_begin, q_end, end_block, hits, near, false, true, &n_skipped)
+            : gap_test(P, q_begin, q_end, end_block, hits, near, periodic, false, &n_skipped);
+#pragma omp atomic
+    m->pass_skipped += n_skipped;
+#pragma omp atomic
+    m->pass_candidates += q_end - q_begin;
     /* 2. every particle in index order: its listed pairs (reactions to the second particle at
           once), its cross pairs from phase 1, then its own sum and the closing half kick */
     size_t h = 0;
@@ -1259,6 +1330,7 @@ static int pair_constants(struct wetdem_sim* sim)
     size_t np = m->cl.n_pairs, nm = (size_t)m->n_mix_materials;
     bool lean = lean_active(m);
     int form = m->lean.hertz_form;
+
     if (!reserve((void**)&m->pair_lim2, &m->pair_lim2_cap, np, sizeof *m->pair_lim2) ||
         (lean && !reserve((void**)&m->pair_cache, &m->pair_cache_cap, np, sizeof *m->pair_cache)))
         return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory for %zu pairs", np);
@@ -1276,6 +1348,20 @@ static int pair_constants(struct wetdem_sim* sim)
         c[2] = hertz_stiffness(x->e_star, c[0]);
         c[3] = form >= 0 ? hertz_damping_factor(x->hertz_damping[form], c[2], c[1]) : 0.0;
     }
+    double lim2_max = 0; /* max is exact: the same for any thread count */
+#pragma omp parallel for schedule(static)                                                          \
+    reduction(max                                                                                  \
+              : lim2_max) if (wetdem_many_parallel(m, sim->n_particles))
+    for (size_t q = 0; q < np; q++)
+        lim2_max = m->pair_lim2[q] > lim2_max ? m->pair_lim2[q] : lim2_max;
+    /* every coordinate stays below x_build_max + skin/2 until the next build: margin of a
+       difference of coordinates (struct skip_bound) */
+    double margin = 1e-12 * (m->x_build_max + m->cl.skin);
+    double d_max = sqrt(lim2_max) * (1 + 1e-9) + margin + m->cl.skin;
+    m->skip_bound = (struct skip_bound){.rel = 1 + 3e-9,
+                                        .abs = 3 * d_max * margin,
+                                        .inv_2dmax = 1 / (2 * d_max) * (1 - 1e-12),
+                                        .cap = m->cl.skin};
     m->pair_consts_build = m->cl.n_builds;
     m->pair_consts_ready = true;
     return WETDEM_OK;
@@ -1300,6 +1386,15 @@ int wetdem_sim_many_forces(struct wetdem_sim* sim, bool kick)
     struct failure fail = {0};
     struct wetdem_vec3 g =
         vec3(sim->settings.gravity_x, sim->settings.gravity_y, sim->settings.gravity_z);
+    if (!reserve((void**)&m->skip_until, &m->skip_until_cap, m->cl.n_pairs, sizeof *m->skip_until))
+        return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory for %zu pairs", m->cl.n_pairs);
+    if (m->skip_build != m->cl.n_builds || (!m->skip_on && ++m->skip_off_passes >= 32)) {
+        m->skip_on = !m->no_skip; /* a new list, or 32 passes without: keep the times again */
+        m->skip_valid = false;
+        m->skip_off_passes = 0;
+    }
+    bool skip = m->skip_on && m->skip_valid && m->clock_known;
+    m->pass_candidates = m->pass_skipped = 0;
     struct pass P = {.sim = sim,
                      .m = m,
                      .p = sim->particles,
@@ -1307,6 +1402,11 @@ int wetdem_sim_many_forces(struct wetdem_sim* sim, bool kick)
                      .pairs = m->cl.pairs,
                      .flags = m->flags,
                      .lim2 = m->pair_lim2,
+                     .bound = m->skip_bound,
+                     .skip_until = m->skip_until,
+                     .clock = m->drift_clock,
+                     .skip = skip,
+                     .maintain = m->skip_on,
                      .history = m->history,
                      .len = sim->history_len,
                      .nm = (size_t)m->n_mix_materials,
@@ -1328,6 +1428,12 @@ int wetdem_sim_many_forces(struct wetdem_sim* sim, bool kick)
     }
     m->blocks_passes++;
     m->sums_zeroed = 0;
+    m->skip_build = m->cl.n_builds;
+    m->skip_valid = m->skip_on && fail.status == WETDEM_OK; /* every candidate has its time */
+    m->clock_known = fail.status == WETDEM_OK;
+    m->skipped_tests += m->pass_skipped;
+    if (skip && 2 * m->pass_skipped < m->pass_candidates && !m->skip_always)
+        m->skip_on = false; /* until the next list build (many.h) */
     if (fail.status != WETDEM_OK)
         return report_failure(sim, &fail);
     sim->engine.stats.force_evals++;

@@ -449,6 +449,85 @@ static void test_many_block_cuts_do_not_change_the_result(void** state)
     wetdem_sim_free(one);
 }
 
+/* The gap test skips a candidate until the skip clock (the sum of every step's bound on the
+ * displacements, many.h) says it may have come within reach; a skipped candidate would have
+ * been rejected, so runs with and without skipping are bit-identical: in a flowing gas with
+ * the skip times kept at every pass, with the default choice (which drops them there after
+ * the first passes of a list, as too few candidates are skipped), and the same spheres from
+ * rest. Between calls the user may move particles: the run then tests every candidate at its
+ * first pass. Here the first particle of the nearest skipped candidate is moved, between
+ * calls, to within its reach (less than skin/2: no list rebuild); the run with skipping must
+ * see it at once. */
+static void test_many_skipped_candidates_change_no_result(void** state)
+{
+    (void)state;
+    int saved = omp_get_max_threads();
+    omp_set_num_threads(2);
+    struct wetdem_sim* skip = wet_gas(false, false);
+    struct wetdem_sim* by_default = wet_gas(false, false);
+    struct wetdem_sim* test_all = wet_gas(false, false);
+    skip->many->skip_always = true;
+    test_all->many->no_skip = true;
+    struct wetdem_sim* sims[] = {skip, by_default, test_all};
+    for (int s = 0; s < 3; s++)
+        CHECK_OK(wetdem_sim_integrate(sims[s], 1e-3));
+    test_check_same_particles(skip, test_all);
+    test_check_same_particles(by_default, test_all);
+    struct wetdem_many* m = skip->many;
+    assert_true(m->skipped_tests > by_default->many->skipped_tests);
+    assert_true(by_default->many->skipped_tests > 0);
+    for (int s = 0; s < 3; s++) { /* from rest */
+        size_t n;
+        struct wetdem_particle* ps = wetdem_sim_particles(sims[s], &n);
+        for (size_t k = 0; k < n; k++)
+            ps[k].vel = ps[k].omega = vec3(0, 0, 0);
+    }
+    double t = 1e-3 + 20 * 2e-6;
+    for (int s = 0; s < 3; s++)
+        CHECK_OK(wetdem_sim_integrate(sims[s], t));
+    test_check_same_particles(skip, test_all);
+    assert_true(m->skip_on && m->skip_valid && m->pass_skipped > 0); /* the times are used */
+    assert_int_equal(test_all->many->skipped_tests, 0);
+    /* the skipped candidate closest to the gap test's reach */
+    size_t n, best = SIZE_MAX;
+    const struct wetdem_particle* p = wetdem_sim_particles_const(skip, &n);
+    double best_beyond = INFINITY;
+    for (size_t q = 0; q < m->cl.n_pairs; q++) {
+        if (!(m->drift_clock < m->skip_until[q]))
+            continue;
+        struct wetdem_celllist_pair pq = m->cl.pairs[q];
+        struct wetdem_vec3 d = celllist_delta(&m->cl.box, p[pq.i].pos, p[pq.j].pos);
+        double beyond = vec3_norm(d) - sqrt(m->pair_lim2[q]);
+        if (beyond < best_beyond) {
+            best_beyond = beyond;
+            best = q;
+        }
+    }
+    assert_true(best != SIZE_MAX && best_beyond > 0 && best_beyond < 0.4 * m->cl.skin);
+    struct wetdem_celllist_pair pb = m->cl.pairs[best];
+    struct wetdem_vec3 d = celllist_delta(&m->cl.box, p[pb.i].pos, p[pb.j].pos);
+    struct wetdem_vec3 move = vec3_scale(d, -(best_beyond + 1e-7) / vec3_norm(d)); /* i to j */
+    uint64_t builds = m->cl.n_builds;
+    for (int s = 0; s < 3; s++) {
+        struct wetdem_particle* ps = wetdem_sim_particles(sims[s], &n);
+        ps[pb.i].pos = vec3_add(ps[pb.i].pos, move);
+    }
+    t += 2e-6; /* one step: without a list build, the run must see the move */
+    for (int s = 0; s < 3; s++)
+        CHECK_OK(wetdem_sim_integrate(sims[s], t));
+    assert_true(m->cl.n_builds == builds);
+    assert_true(m->flags[best] & WETDEM_MANY_ACTIVE); /* the moved pair came within range */
+    test_check_same_particles(skip, test_all);
+    for (int call = 1; call <= 4; call++) /* and several calls */
+        for (int s = 0; s < 3; s++)
+            CHECK_OK(wetdem_sim_integrate(sims[s], t + call * 0.25e-3));
+    test_check_same_particles(skip, test_all);
+    test_check_same_particles(by_default, test_all);
+    omp_set_num_threads(saved);
+    for (int s = 0; s < 3; s++)
+        wetdem_sim_free(sims[s]);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -461,6 +540,7 @@ int main(void)
         cmocka_unit_test(test_many_lean_springs_across_rebuilds),
         cmocka_unit_test(test_many_lean_constants_follow_changed_particles),
         cmocka_unit_test(test_many_block_cuts_do_not_change_the_result),
+        cmocka_unit_test(test_many_skipped_candidates_change_no_result),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
