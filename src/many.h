@@ -113,9 +113,18 @@ struct wetdem_many {
        (clock_known). */
     float* skip_until; /* [m], rounded down */
     size_t skip_until_cap;
+    /* The constants of the skip times, per list build (sim_many_force.c pair_constants and
+       within_reach). With far_q = sqrt(pair_lim2) (1 + 1e-9) + 1e-12 (x_build_max + skin)
+       [m], the distance beyond which the gap test rejects candidate q with room to spare for
+       every round-off, and d_max the largest far_q plus the skin, a rejected candidate at
+       squared distance r2 has |d| - far_q >= min((r2 - far_q^2) / (2 d_max), skin): that is
+       (|d|^2 - far_q^2) / (|d| + far_q) with the denominator at most 2 d_max, or, beyond
+       d_max, more than the skin. far_q^2 <= pair_lim2 rel + abs; no square root per
+       candidate. rel [-], abs [m^2], inv_2dmax = 1 / (2 d_max) rounded down [1/m], cap = the
+       skin [m]. */
     struct skip_bound {
         double rel, abs, inv_2dmax, cap;
-    } skip_bound; /* the constants of the skip times, per list build (sim_many_force.c) */
+    } skip_bound;
     double drift_clock;
     bool clock_known, skip_on, skip_valid;
     uint64_t skip_build;

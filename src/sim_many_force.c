@@ -7,14 +7,16 @@
  *
  * Per step, for the candidate list (celllist.h) of pairs (i < j) sorted by (i, j), with the
  * particles split into contiguous blocks (one per thread, of about equal estimated work):
- *   1. cross pairs (parallel over blocks): the pairs whose j lies in a later block than i are
- *      evaluated and their results stored; a barrier follows.
+ *   1. cross pairs (an equal share of them per thread): the pairs whose j lies in a later
+ *      block than i are evaluated and their results stored; a barrier follows.
  *   2. block pass (parallel over blocks): every particle k of the block starts its sum with its
  *      wall forces (wall order) and the reactions -F of the cross pairs (i, k) from earlier
  *      blocks (increasing i). A flat loop gap-tests every in-block candidate,
  *      |x_i - x_j|^2 > (R_i + R_j + r_ab)^2 (1 + 1e-12) (r_ab the model range of the material
  *      pair, or the start-up reach for model sets without a fused kernel; the bound is kept
- *      per candidate from the list build), and lists those within range or with flags. Then,
+ *      per candidate from the list build), and lists those within range or with flags; a
+ *      candidate it rejected is not tested again until the skip clock (many.h: the sum of the
+ *      steps' displacement bounds) shows it may have come within reach. Then,
  *      for i in index order: its listed pairs (the exact test h > range decides), each
  *      reaction -F added to j at once; its cross pairs from step 1; the sum S_i of its own
  *      pairs in j order added last (a particle with no pairs adds nothing: +0 would change no
@@ -693,16 +695,6 @@ static void eval_near_pair(const struct wetdem_sim* sim, size_t q, struct wetdem
         note_failure(fail, q, st, false, &c, range);
 }
 
-/* The constants of a candidate's skip time (within_reach), per list build: with far_q the
- * distance sqrt(pair_lim2) (1 + 1e-9) + 1e-12 (x_build_max + skin) [m], beyond which the gap
- * test rejects it with room to spare for every round-off, and d_max the largest far_q plus the
- * skin, a rejected candidate at squared distance r2 has |d| - far_q >=
- * min((r2 - far_q^2) / (2 d_max), skin): (|d|^2 - far_q^2) / (|d| + far_q) with the
- * denominator at most 2 d_max, or, beyond d_max, more than the skin. far_q^2 is bounded above
- * by pair_lim2 rel + abs; no square root per candidate. */
-/* (many.h: rel [-], abs [m^2], inv_2dmax = 1 / (2 d_max) rounded down [1/m], cap = the skin
- * [m].) */
-
 /* What every candidate evaluation of one force pass reads, gathered once. */
 struct pass {
     const struct wetdem_sim* sim;
@@ -786,7 +778,7 @@ static double reach2(const struct wetdem_celllist_item* xr, size_t i, size_t j,
 /* The cheap gap test of candidate q = (i, j): pair_delta, then true when
  * |d|^2 <= (R_i + R_j + r_ab)^2 (1 + PREFILTER_MARGIN), the bound kept per pair (pair_lim2).
  * Sets the candidate's skip time (many.h): the skip clock plus half of a lower bound of
- * |d| - far_q (struct skip_bound), before the clock when it passes. Until the clock gets there,
+ * |d| - far_q (many.h, struct skip_bound), before the clock when it passes. Until the clock gets there,
  * its two particles cannot have come closer by that much, and the test would reject it again:
  * the margins of far_q, a relative 1e-9 and 1e-12 of the largest coordinate, exceed the
  * round-off of the distances, of the test and of the times by orders of magnitude. */
