@@ -131,6 +131,8 @@ struct wetdem_many {
     unsigned skip_off_passes;
     bool no_skip;               /* tests: test every candidate at every pass */
     bool skip_always;           /* tests: keep the times whatever share is skipped */
+    double clock_limit;         /* tests: restart the skip clock beyond this [m] (0: the skin) */
+    uint64_t clock_restarts;    /* restarts of the skip clock (tests) */
     uint64_t pass_candidates;   /* candidates of the latest pass's gap tests */
     uint64_t pass_skipped;      /* of which skipped */
     uint64_t skipped_tests;     /* candidates not tested thanks to the clock (tests) */

@@ -608,10 +608,12 @@ static void kick_drift(struct wetdem_sim* sim, double h)
         double step = h * sqrt(v2_max) * (1 + 16 * DBL_EPSILON) +
                       16 * DBL_EPSILON * (m->x_build_max + m->disp_bound);
         m->disp_bound += step;
-        m->drift_clock += step;            /* the gap test's skip clock (many.h) */
-        if (m->drift_clock > m->cl.skin) { /* restarted while small against the coordinates, */
-            m->drift_clock = 0;            /* so that its round-off stays below the 16 eps */
-            m->clock_known = false;        /* x_build_max each step adds */
+        m->drift_clock += step; /* the gap test's skip clock (many.h) */
+        double limit = m->clock_limit > 0 ? m->clock_limit : m->cl.skin;
+        if (m->drift_clock > limit) { /* restarted while small against the coordinates, so */
+            m->drift_clock = 0;       /* that its round-off stays below the 16 eps x_build_max */
+            m->clock_known = false;   /* each step adds */
+            m->clock_restarts++;
         }
     } else
         m->clock_known = false; /* the particles may have been moved since the last pass */
