@@ -108,9 +108,9 @@ struct wetdem_many {
        the same: a rejection). The times are kept (skip_on) from each list build, and again
        32 passes after they were dropped (skip_off_passes), for as long as at least half of
        the candidates are skipped (in a flowing system few are, and keeping the times costs
-       more than the skips save); they are usable when the previous pass kept them
-       (skip_valid) on this list (skip_build) and every step since had a bound
-       (clock_known). */
+       more than the skips save). They are usable (skip_ready) when the previous pass kept
+       them and every step since had a bound; a list build, a call, particles loaded anew, a
+       step without a bound and a restart of the clock clear it. */
     float* skip_until; /* [m], rounded down */
     size_t skip_until_cap;
     /* The constants of the skip times, per list build (sim_many_force.c pair_constants and
@@ -126,8 +126,7 @@ struct wetdem_many {
         double rel, abs, inv_2dmax, cap;
     } skip_bound;
     double drift_clock;
-    bool clock_known, skip_on, skip_valid;
-    uint64_t skip_build;
+    bool skip_on, skip_ready;
     unsigned skip_off_passes;
     bool no_skip;               /* tests: test every candidate at every pass */
     bool skip_always;           /* tests: keep the times whatever share is skipped */

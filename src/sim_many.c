@@ -396,7 +396,10 @@ static int rebuild(struct wetdem_sim* sim)
     if (st != WETDEM_OK)
         return wetdem_sim_fail(sim, st, "%s", msg);
     m->disp_bound = 0;  /* nothing has moved since the build (kick_drift) */
-    m->drift_clock = 0; /* the gap test's skip clock starts again (its times are set anew) */
+    m->drift_clock = 0; /* the gap test's skip clock starts again, its times kept anew */
+    m->skip_on = !m->no_skip;
+    m->skip_ready = false;
+    m->skip_off_passes = 0;
     m->x_build_max = coordinate_max(sim);
     swap_pair_arrays(m); /* the current histories and flags become the old ones (no copy) */
     size_t n_new = m->cl.n_pairs;
@@ -458,8 +461,8 @@ int wetdem_sim_many_prepare(struct wetdem_sim* sim)
         return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory for %zu particles",
                                sim->n_particles);
     if (refresh) {
-        sync_records(sim);      /* (never stale here: a call ends with them written) */
-        m->clock_known = false; /* the positions are loaded anew: no skips at the next pass */
+        sync_records(sim);     /* (never stale here: a call ends with them written) */
+        m->skip_ready = false; /* the positions are loaded anew: no skips at the next pass */
     }
     for (size_t k = 0; refresh && k < sim->n_particles; k++) { /* the user may move particles */
         const struct wetdem_particle* p = &sim->particles[k];
@@ -600,7 +603,7 @@ static void kick_drift(struct wetdem_sim* sim, double h)
     m->records_stale = true;
     m->max_disp_valid = track;
     if (!track) {
-        m->clock_known = false;
+        m->skip_ready = false;
         return;
     }
     /* |x| <= its value at the build + the displacement since, or within the periodic box */
@@ -612,11 +615,11 @@ static void kick_drift(struct wetdem_sim* sim, double h)
         double limit = m->clock_limit > 0 ? m->clock_limit : m->cl.skin;
         if (m->drift_clock > limit) { /* restarted while small against the coordinates, so */
             m->drift_clock = 0;       /* that its round-off stays below the 16 eps x_build_max */
-            m->clock_known = false;   /* each step adds */
+            m->skip_ready = false;    /* each step adds */
             m->clock_restarts++;
         }
     } else
-        m->clock_known = false; /* the particles may have been moved since the last pass */
+        m->skip_ready = false; /* the particles may have been moved since the last pass */
     m->max_disp2 = 0;
     if (!(m->disp_bound <= 0.5 * m->cl.skin * (1 - 1e-6))) {
         m->max_disp2 = max_displacement2(sim);
@@ -783,7 +786,7 @@ int wetdem_sim_many_integrate(struct wetdem_sim* sim, double t_end)
     struct wetdem_many* m = sim->many;
     m->kernel_ready = false;  /* materials, models or parameters may have changed */
     m->disp_bound = INFINITY; /* particles may have been moved: measure at the first step */
-    m->clock_known = false;   /* and test every candidate at the first force pass */
+    m->skip_ready = false;    /* and test every candidate at the first force pass */
     int st = m->started ? wetdem_sim_many_prepare(sim) : start(sim);
     if (st != WETDEM_OK)
         return st;

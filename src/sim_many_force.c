@@ -720,15 +720,14 @@ struct pass {
  * own short path (lean_apart), the call cost more than the spills it used to save. */
 static unsigned char near_candidate(const struct pass* P, size_t q, size_t i, size_t j,
                                     struct wetdem_vec3 d, const struct wetdem_many_mix* x,
-                                    bool lean, struct wetdem_many_pair_out* o, struct failure* fail)
+                                    struct wetdem_many_pair_out* o, struct failure* fail)
     __attribute__((always_inline));
 static inline unsigned char near_candidate(const struct pass* P, size_t q, size_t i, size_t j,
                                            struct wetdem_vec3 d, const struct wetdem_many_mix* x,
-                                           bool lean, struct wetdem_many_pair_out* o,
-                                           struct failure* fail)
+                                           struct wetdem_many_pair_out* o, struct failure* fail)
 {
     unsigned char* fl = &P->flags[q];
-    if (!lean) {
+    if (!P->lean) {
         eval_near_pair(P->sim, q, d, x, o, fail);
         return *fl;
     }
@@ -819,7 +818,7 @@ eval_candidate(const struct pass* P, size_t q, size_t i, size_t j, struct wetdem
     if (skipped(P, q))
         return 0;
     if (within_reach(P, q, i, j, P->periodic, P->nm == 1, P->maintain, &d, &x))
-        return near_candidate(P, q, i, j, d, x, P->lean, o, fail);
+        return near_candidate(P, q, i, j, d, x, o, fail);
     if (P->flags[q])
         leave_range(P, q);
     return 0;
@@ -940,8 +939,7 @@ static void partition_blocks(struct wetdem_many* m, size_t n, size_t nb)
     if (nb == 1) {
         m->blk[0] = 0;
         m->blk[1] = n;
-        m->block_est[0] = 1; /* never read: one block is never re-cut for balance */
-        m->block_time[0] = 0;
+        m->block_time[0] = 0; /* (one block is never re-cut for balance) */
         return;
     }
     double scale[WETDEM_MANY_MAX_BLOCKS] = {0}, mean = 0;
@@ -1176,6 +1174,30 @@ static void start_sums_of_block(const struct pass* P, size_t b, struct failure* 
     }
 }
 
+/* The gap test (within_reach) of n candidates, hits[k] when `listed` (the list of gap_test),
+ * else q_begin + k, in one flat loop without branches on its outcome: those within range, and
+ * those with flags, whose second particle is below end_block, are listed in hits in order
+ * (over the list: each entry is written at or behind the one read); returns their number. */
+static inline __attribute__((always_inline)) size_t
+test_candidates(const struct pass* P, bool listed, size_t q_begin, size_t n, size_t end_block,
+                uint32_t* restrict hits, unsigned char* restrict hit_near, bool periodic,
+                bool single, bool maintain)
+{
+    const struct wetdem_celllist_pair* pairs = P->pairs;
+    const unsigned char* flags = P->flags;
+    size_t n_hits = 0;
+    for (size_t k = 0; k < n; k++) {
+        size_t q = listed ? hits[k] : q_begin + k, i = pairs[q].i, j = pairs[q].j;
+        struct wetdem_vec3 d;
+        const struct wetdem_many_mix* x;
+        bool near = within_reach(P, q, i, j, periodic, single, maintain, &d, &x);
+        hits[n_hits] = (uint32_t)q;
+        hit_near[n_hits] = near;
+        n_hits += ((size_t)near | (size_t)(flags[q] != 0)) & (size_t)(j < end_block);
+    }
+    return n_hits;
+}
+
 /* The gap test of candidates q_begin .. q_end in flat loops without branches on their outcome:
  * those within range, and those with flags (they may have just left it), whose second particle
  * is below end_block, are listed in hits in pair order; returns their number. With usable
@@ -1191,41 +1213,23 @@ gap_test(const struct pass* P, size_t q_begin, size_t q_end, size_t end_block,
          uint32_t* restrict hits, unsigned char* restrict hit_near, bool periodic, bool single,
          uint64_t* n_skipped)
 {
-    const struct wetdem_celllist_pair* pairs = P->pairs;
-    const unsigned char* flags = P->flags;
-    size_t n_test = q_end - q_begin, n_hits = 0;
-    if (P->skip) { /* the candidates to test, in order */
-        const float* restrict until = P->skip_until;
-        double clock = P->clock;
-        n_test = 0;
-        for (size_t q = q_begin; q < q_end; q++) {
-            hits[n_test] = (uint32_t)q;
-            n_test += !(clock < until[q]);
-        }
-        *n_skipped += (q_end - q_begin) - n_test;
+    if (!P->skip) {
+        size_t n = q_end - q_begin;
+        return P->maintain ? test_candidates(P, false, q_begin, n, end_block, hits, hit_near,
+                                             periodic, single, true)
+                           : test_candidates(P, false, q_begin, n, end_block, hits, hit_near,
+                                             periodic, single, false);
     }
-#define GAP_TEST_LOOP(candidate)                                                                   \
-    for (size_t k = 0; k < n_test; k++) {                                                          \
-        size_t q = (candidate), i = pairs[q].i, j = pairs[q].j;                                    \
-        struct wetdem_vec3 d;                                                                      \
-        const struct wetdem_many_mix* x;                                                           \
-        bool near = within_reach(P, q, i, j, periodic, single, maintain, &d, &x);                  \
-        hits[n_hits] = (uint32_t)q;                                                                \
-        hit_near[n_hits] = near;                                                                   \
-        n_hits += ((size_t)near | (size_t)(flags[q] != 0)) & (size_t)(j < end_block);              \
+    const float* restrict until = P->skip_until; /* the candidates to test, in order */
+    double clock = P->clock;
+    size_t n_test = 0;
+    for (size_t q = q_begin; q < q_end; q++) {
+        hits[n_test] = (uint32_t)q;
+        n_test += !(clock < until[q]);
     }
-    if (P->skip) { /* (P->skip implies P->maintain) */
-        bool maintain = true;
-        GAP_TEST_LOOP(hits[k])
-    } else if (P->maintain) {
-        bool maintain = true;
-        GAP_TEST_LOOP(q_begin + k)
-    } else {
-        bool maintain = false;
-        GAP_TEST_LOOP(q_begin + k)
-    }
-#undef GAP_TEST_LOOP
-    return n_hits;
+    *n_skipped += (q_end - q_begin) - n_test;
+    return test_candidates(P, true, q_begin, n_test, end_block, hits, hit_near, periodic, single,
+                           true); /* (P->skip implies P->maintain) */
 }
 
 /* Phase 2 of block b: every particle i in index order; its pairs within the block are
@@ -1282,7 +1286,7 @@ static void pairs_of_block(const struct pass* P, size_t b, bool kick, struct wet
             }
             pair_delta(P, i, j, periodic, single, &d, &x);
             struct wetdem_many_pair_out o;
-            unsigned char fl = near_candidate(P, q, i, j, d, x, P->lean, &o, fail);
+            unsigned char fl = near_candidate(P, q, i, j, d, x, &o, fail);
             if (!(fl & WETDEM_MANY_ACTIVE))
                 continue;
             uint32_t c = (fl & WETDEM_MANY_CONTACT) ? 1 : 0;
@@ -1311,6 +1315,7 @@ static void pairs_of_block(const struct pass* P, size_t b, bool kick, struct wet
             wetdem_many_close_kick(m, i, g);
     }
 }
+
 /* The constants of every candidate pair (many.h: pair_lim2, and pair_cache for the lean
  * kernel), once per list build and kernel set-up: radii, masses and ranges do not change in
  * between. The same expressions as per evaluation, so the same bits. */
@@ -1322,7 +1327,6 @@ static int pair_constants(struct wetdem_sim* sim)
     size_t np = m->cl.n_pairs, nm = (size_t)m->n_mix_materials;
     bool lean = lean_active(m);
     int form = m->lean.hertz_form;
-
     if (!reserve((void**)&m->pair_lim2, &m->pair_lim2_cap, np, sizeof *m->pair_lim2) ||
         (lean && !reserve((void**)&m->pair_cache, &m->pair_cache_cap, np, sizeof *m->pair_cache)))
         return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory for %zu pairs", np);
@@ -1380,12 +1384,11 @@ int wetdem_sim_many_forces(struct wetdem_sim* sim, bool kick)
         vec3(sim->settings.gravity_x, sim->settings.gravity_y, sim->settings.gravity_z);
     if (!reserve((void**)&m->skip_until, &m->skip_until_cap, m->cl.n_pairs, sizeof *m->skip_until))
         return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory for %zu pairs", m->cl.n_pairs);
-    if (m->skip_build != m->cl.n_builds || (!m->skip_on && ++m->skip_off_passes >= 32)) {
-        m->skip_on = !m->no_skip; /* a new list, or 32 passes without: keep the times again */
-        m->skip_valid = false;
+    if (!m->skip_on && ++m->skip_off_passes >= 32) { /* keep the times again (many.h) */
+        m->skip_on = !m->no_skip;
         m->skip_off_passes = 0;
     }
-    bool skip = m->skip_on && m->skip_valid && m->clock_known;
+    bool skip = m->skip_ready; /* (kept by the previous pass, so skip_on) */
     m->pass_candidates = m->pass_skipped = 0;
     struct pass P = {.sim = sim,
                      .m = m,
@@ -1420,12 +1423,10 @@ int wetdem_sim_many_forces(struct wetdem_sim* sim, bool kick)
     }
     m->blocks_passes++;
     m->sums_zeroed = 0;
-    m->skip_build = m->cl.n_builds;
-    m->skip_valid = m->skip_on && fail.status == WETDEM_OK; /* every candidate has its time */
-    m->clock_known = fail.status == WETDEM_OK;
     m->skipped_tests += m->pass_skipped;
     if (skip && 2 * m->pass_skipped < m->pass_candidates && !m->skip_always)
-        m->skip_on = false; /* until the next list build (many.h) */
+        m->skip_on = false; /* for 32 passes or until the next list build (many.h) */
+    m->skip_ready = m->skip_on && fail.status == WETDEM_OK; /* every candidate has its time */
     if (fail.status != WETDEM_OK)
         return report_failure(sim, &fail);
     sim->engine.stats.force_evals++;
