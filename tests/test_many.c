@@ -13,20 +13,26 @@
 #include "harness.h"
 #include "many.h"
 
-/* The many-particle settings of wet_box (its box, dt 2 us, skin 50 um, energy budget), with
- * a progress callback every `every` steps if fn is given. */
+/* The many-particle settings of wet_box's box: periodic in x and y, dt 2 us, skin 50 um. */
+static struct wetdem_many_settings box_settings(void)
+{
+    return (struct wetdem_many_settings){.periodic = {true, true, false},
+                                         .box_lo = {0, 0, 0},
+                                         .box_hi = {8e-3, 8e-3, 12e-3},
+                                         .dt = 2e-6,
+                                         .skin = 0.05e-3};
+}
+
+/* box_settings with the energy budget, and a progress callback every `every` steps if fn is
+ * given. */
 static void set_box_many(struct wetdem_sim* sim, wetdem_progress_fn fn, void* ctx,
                          unsigned long long every)
 {
-    struct wetdem_many_settings s = {.periodic = {true, true, false},
-                                     .box_lo = {0, 0, 0},
-                                     .box_hi = {8e-3, 8e-3, 12e-3},
-                                     .dt = 2e-6,
-                                     .skin = 0.05e-3,
-                                     .energy_budget = true,
-                                     .progress = fn,
-                                     .progress_ctx = ctx,
-                                     .progress_every = every};
+    struct wetdem_many_settings s = box_settings();
+    s.energy_budget = true;
+    s.progress = fn;
+    s.progress_ctx = ctx;
+    s.progress_every = every;
     CHECK_OK(wetdem_sim_set_many(sim, &s));
     sim->many->parallel_min = 1; /* run the parallel loops even for these small systems */
 }
@@ -245,15 +251,11 @@ static void test_many_stop_flag_writes_a_checkpoint(void** state)
     close(mkstemp(path));
     remove(path);
     struct wetdem_sim* sim = wet_box(60, true);
-    struct wetdem_many_settings s = {.periodic = {true, true, false},
-                                     .box_lo = {0, 0, 0},
-                                     .box_hi = {8e-3, 8e-3, 12e-3},
-                                     .dt = 2e-6,
-                                     .skin = 0.05e-3,
-                                     .checkpoint_path = path,
-                                     .stop_flag = &stop_now,
-                                     .progress = stop_after,
-                                     .progress_every = 10};
+    struct wetdem_many_settings s = box_settings();
+    s.checkpoint_path = path;
+    s.stop_flag = &stop_now;
+    s.progress = stop_after;
+    s.progress_every = 10;
     CHECK_OK(wetdem_sim_set_many(sim, &s));
     CHECK_STATUS(wetdem_sim_integrate(sim, 1e-3), WETDEM_EVENT);
     CHECK_CONTAINS(wetdem_sim_errmsg(sim), "checkpoint");
@@ -368,16 +370,12 @@ static void test_many_writes_vtk_and_csv(void** state)
     char prefix[128], path[192];
     snprintf(prefix, sizeof prefix, "%s/run", dir);
     struct wetdem_sim* sim = wet_box(60, true);
-    struct wetdem_many_settings s = {.periodic = {true, true, false},
-                                     .box_lo = {0, 0, 0},
-                                     .box_hi = {8e-3, 8e-3, 12e-3},
-                                     .dt = 2e-6,
-                                     .skin = 0.05e-3,
-                                     .output_prefix = prefix,
-                                     .vtk_every = 50,
-                                     .csv_every = 25,
-                                     .vtk_binary = true,
-                                     .energy_budget = true};
+    struct wetdem_many_settings s = box_settings();
+    s.output_prefix = prefix;
+    s.vtk_every = 50;
+    s.csv_every = 25;
+    s.vtk_binary = true;
+    s.energy_budget = true;
     CHECK_OK(wetdem_sim_set_many(sim, &s));
     CHECK_OK(wetdem_sim_integrate(sim, 2e-4)); /* 100 steps: VTK at 0, 50, 100 */
     for (int k = 0; k < 3; k++) {
@@ -418,14 +416,10 @@ static void test_many_restart_continues_outputs(void** state)
     char prefix[128], path[192], ck[192];
     snprintf(prefix, sizeof prefix, "%s/run", dir);
     snprintf(ck, sizeof ck, "%s/ck", dir);
-    struct wetdem_many_settings s = {.periodic = {true, true, false},
-                                     .box_lo = {0, 0, 0},
-                                     .box_hi = {8e-3, 8e-3, 12e-3},
-                                     .dt = 2e-6,
-                                     .skin = 0.05e-3,
-                                     .output_prefix = prefix,
-                                     .vtk_every = 50,
-                                     .csv_every = 50};
+    struct wetdem_many_settings s = box_settings();
+    s.output_prefix = prefix;
+    s.vtk_every = 50;
+    s.csv_every = 50;
     struct wetdem_sim* first = wet_box(40, true);
     CHECK_OK(wetdem_sim_set_many(first, &s));
     CHECK_OK(wetdem_sim_integrate(first, 2e-4)); /* frames 0, 1, 2 at steps 0, 50, 100 */
