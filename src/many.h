@@ -128,13 +128,24 @@ struct wetdem_many {
     double drift_clock;
     bool skip_on, skip_ready;
     unsigned skip_off_passes;
-    bool no_skip;               /* tests: test every candidate at every pass */
-    bool skip_always;           /* tests: keep the times whatever share is skipped */
-    double clock_limit;         /* tests: restart the skip clock beyond this [m] (0: the skin) */
-    uint64_t clock_restarts;    /* restarts of the skip clock (tests) */
-    uint64_t pass_candidates;   /* candidates of the latest pass's gap tests */
-    uint64_t pass_skipped;      /* of which skipped */
-    uint64_t skipped_tests;     /* candidates not tested thanks to the clock (tests) */
+    bool no_skip;             /* tests: test every candidate at every pass */
+    bool skip_always;         /* tests: keep the times whatever share is skipped */
+    double clock_limit;       /* tests: restart the skip clock beyond this [m] (0: the skin) */
+    uint64_t clock_restarts;  /* restarts of the skip clock (tests) */
+    uint64_t pass_candidates; /* candidates of the latest pass's gap tests */
+    uint64_t pass_skipped;    /* of which skipped */
+    uint64_t skipped_tests;   /* candidates not tested thanks to the clock (tests) */
+    /* With usable skip times, the tested candidates of a block are either gap-tested in one
+       flat loop and the kernels run over the list of those within range (two loops), or, when
+       most of them are within range (a slow or resting packing, where the far candidates are
+       skipped), tested and evaluated in one loop, their geometry computed once (fused). The
+       latest pass decides: fused when at least 3/4 of the tested candidates were within
+       range. Either way the same kernels run in the same order (sim_many_force.c). */
+    uint64_t pass_tested;       /* candidates of the latest pass's blocks that were tested */
+    uint64_t pass_near;         /* of which within range */
+    bool fuse_on;               /* the next pass with usable skip times runs fused */
+    int fuse_mode;              /* tests: 0 decided as above, 1 never fused, 2 always fused */
+    uint64_t fused_passes;      /* passes run fused (tests) */
     uint64_t pair_consts_build; /* the list build they were computed for */
     bool pair_consts_ready;     /* cleared when the kernel is set up */
     unsigned char* old_flags;   /* flags of the previous list, for remapping */

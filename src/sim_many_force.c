@@ -711,6 +711,7 @@ struct pass {
     size_t len, nm;
     bool periodic, lean;
     bool skip;     /* the skip times are usable (else every candidate is tested) */
+    bool fused;    /* skip, and the block's candidates are tested and evaluated in one loop */
     bool maintain; /* each tested candidate gets its skip time anew */
     bool zeroed;   /* the sums start from zero already (many.h sums_zeroed) */
 };
@@ -766,6 +767,18 @@ static inline __attribute__((always_inline)) void pair_delta(const struct pass* 
                 : &P->m->mix[(size_t)P->p[i].material * P->nm + (size_t)P->p[j].material];
 }
 
+/* Candidate q's skip time from its squared distance r2 [m^2] (within_reach). A candidate
+ * that passes gets a time before the clock (beyond < 0): it is tested again. */
+static inline __attribute__((always_inline)) void set_skip_time(const struct pass* P, size_t q,
+                                                                double r2)
+{
+    const struct skip_bound* B = &P->bound;
+    double beyond = (r2 - (P->lim2[q] * B->rel + B->abs)) * B->inv_2dmax; /* <= |d| - far */
+    double until = P->clock + 0.5 * (beyond < B->cap ? beyond : B->cap);
+    /* kept as a float rounded down (one float ulp off, then to nearest): never later */
+    P->skip_until[q] = (float)(until - fabs(until) * 1.2e-7);
+}
+
 /* The squared reach of the cheap gap test of pair (i, j) with mixed properties x [m^2]. */
 static double reach2(const struct wetdem_celllist_item* xr, size_t i, size_t j,
                      const struct wetdem_many_mix* x)
@@ -788,14 +801,8 @@ within_reach(const struct pass* P, size_t q, size_t i, size_t j, bool periodic, 
     pair_delta(P, i, j, periodic, single, d, x);
     double r2 = vec3_dot(*d, *d);
     bool near = r2 <= P->lim2[q];
-    if (maintain) { /* P->maintain */
-        const struct skip_bound* B = &P->bound;
-        double beyond = (r2 - (P->lim2[q] * B->rel + B->abs)) * B->inv_2dmax; /* <= |d| - far */
-        /* (a candidate that passes has beyond < 0, a time before the clock: tested again) */
-        double until = P->clock + 0.5 * (beyond < B->cap ? beyond : B->cap);
-        /* kept as a float rounded down (one float ulp off, then to nearest): never later */
-        P->skip_until[q] = (float)(until - fabs(until) * 1.2e-7);
-    }
+    if (maintain) /* P->maintain */
+        set_skip_time(P, q, r2);
     return near;
 }
 
@@ -1198,14 +1205,29 @@ test_candidates(const struct pass* P, bool listed, size_t q_begin, size_t n, siz
     return n_hits;
 }
 
+/* The candidates q_begin .. q_end whose skip time has come (all of them to test), in order,
+ * into list; returns their number. Branch-free: a branch per candidate on its time would be
+ * mispredicted half of the time in a flowing system. */
+static inline __attribute__((always_inline)) size_t
+due_candidates(const struct pass* P, size_t q_begin, size_t q_end, uint32_t* restrict list)
+{
+    const float* restrict until = P->skip_until;
+    double clock = P->clock;
+    size_t n_test = 0;
+    for (size_t q = q_begin; q < q_end; q++) {
+        list[n_test] = (uint32_t)q;
+        n_test += !(clock < until[q]);
+    }
+    return n_test;
+}
+
 /* The gap test of candidates q_begin .. q_end in flat loops without branches on their outcome:
  * those within range, and those with flags (they may have just left it), whose second particle
  * is below end_block, are listed in hits in pair order; returns their number. With usable
- * skip times (many.h), a first loop lists the candidates whose time has come in hits, and the
- * test runs over that list, writing its result over it (never ahead of its reading): a branch
- * per candidate on its time would be mispredicted half of the time in a flowing system. The
- * skipped ones have no flags. `periodic` and `single` (one material pair) are constants at
- * each call, so each case compiles to its own loop. The lists are `restrict`: a store through
+ * skip times (many.h), a first loop lists the candidates whose time has come in hits
+ * (due_candidates), and the test runs over that list, writing its result over it (never ahead
+ * of its reading). The skipped ones have no flags. `periodic` and `single` (one material
+ * pair) are constants at each call, so each case compiles to its own loop. The lists are `restrict`: a store through
  * the byte list could otherwise alias anything, and every read of the pass would be repeated
  * after it. */
 static inline __attribute__((always_inline)) size_t
@@ -1220,54 +1242,78 @@ gap_test(const struct pass* P, size_t q_begin, size_t q_end, size_t end_block,
                            : test_candidates(P, false, q_begin, n, end_block, hits, hit_near,
                                              periodic, single, false);
     }
-    const float* restrict until = P->skip_until; /* the candidates to test, in order */
-    double clock = P->clock;
-    size_t n_test = 0;
-    for (size_t q = q_begin; q < q_end; q++) {
-        hits[n_test] = (uint32_t)q;
-        n_test += !(clock < until[q]);
-    }
+    size_t n_test = due_candidates(P, q_begin, q_end, hits);
     *n_skipped += (q_end - q_begin) - n_test;
     return test_candidates(P, true, q_begin, n_test, end_block, hits, hit_near, periodic, single,
                            true); /* (P->skip implies P->maintain) */
 }
 
+/* Pair q = (i, j) of block b, with result o and flags fl: into particle i's running sums
+ * (f, t, n_contacts), and its reaction at once into j's sums. */
+static inline __attribute__((always_inline)) void
+add_pair(const struct pass* P, size_t j, unsigned char fl, const struct wetdem_many_pair_out* o,
+         struct wetdem_vec3* f, struct wetdem_vec3* t, uint32_t* n_contacts)
+{
+    if (!(fl & WETDEM_MANY_ACTIVE))
+        return;
+    struct wetdem_many* m = P->m;
+    uint32_t c = (fl & WETDEM_MANY_CONTACT) ? 1 : 0;
+    *f = vec3_add(*f, o->force);
+    *n_contacts += c;
+    m->force[j] = vec3_sub(m->force[j], o->force);
+    m->contacts[j] += c;
+    if (adds_torque(P->lean, fl)) {
+        *t = vec3_add(*t, o->torque_i);
+        m->torque[j] = vec3_add(m->torque[j], o->torque_j);
+    }
+}
+
 /* Phase 2 of block b: every particle i in index order; its pairs within the block are
  * evaluated and their reactions added to the second particle at once (so each particle
  * receives its reactions in increasing i), its cross pairs are read from phase 1; the sum of
- * its own pairs, in j order, is added last, and the closing half kick applied. */
-static void pairs_of_block(const struct pass* P, size_t b, bool kick, struct wetdem_vec3 g,
-                           struct failure* fail)
+ * its own pairs, in j order, is added last, and the closing half kick applied. Two loops
+ * (`fused` false): the gap test of the block's candidates (gap_test), then the kernels over
+ * the list of those within range; one loop (`fused`, with usable skip times only): the
+ * candidates whose time has come, each tested and, within range, evaluated at once, with the
+ * geometry of the test (many.h fuse_on). The same kernels run in the same order. */
+static inline __attribute__((always_inline)) void pairs_of_block_as(const struct pass* P, size_t b,
+                                                                    bool kick, struct wetdem_vec3 g,
+                                                                    struct failure* fail,
+                                                                    bool fused, bool common)
 {
+    /* a private copy of the pass, whose fields no store of the loop can change (as those of
+       *P could, through the byte stores of flags and hit lists): kept in registers, not
+       loaded again after every store; leave_range, out of line, gets P */
+    const struct pass own_copy = *P, *const P_out = P;
+    P = &own_copy;
     struct wetdem_many* m = P->m;
     const struct wetdem_celllist_pair* pairs = P->pairs;
-    struct wetdem_vec3* force = m->force;
-    struct wetdem_vec3* torque = m->torque;
-    uint32_t* contacts = m->contacts;
     size_t begin_block = m->blk[b], end_block = m->blk[b + 1];
     size_t e = m->cross_first[b], e_end = m->cross_first[b + 1]; /* the block's cross pairs */
     const unsigned char* flags = P->flags;
-    bool single = P->nm == 1, periodic = P->periodic;
-    /* 1. the gap test of every candidate of the block whose second particle is in the block,
-          in one flat loop without branches on its outcome: the pairs within range, and those
-          with flags (they may have just left it), are listed in pair order */
+    bool single = common || P->nm == 1, periodic = !common && P->periodic;
+    /* 1. the candidates to test (fused), or the gap test of every candidate of the block whose
+          second particle is in the block, in one flat loop without branches on its outcome:
+          the pairs within range, and those with flags (they may have just left it), are listed
+          in pair order */
     size_t q_begin = m->cl.first_pair[begin_block], q_end = m->cl.first_pair[end_block];
-    uint32_t* hits = m->hits + q_begin;
+    uint32_t* list = m->hits + q_begin;
     unsigned char* near = m->hit_near + q_begin;
-    uint64_t n_skipped = 0;
-    size_t n_hits =
-        single && !periodic /* the common case, in its own loop */
-            ? gap_test(P, q_begin, q_end, end_block, hits, near, false, true, &n_skipped)
-            : gap_test(P, q_begin, q_end, end_block, hits, near, periodic, false, &n_skipped);
-#pragma omp atomic
-    m->pass_skipped += n_skipped;
-#pragma omp atomic
-    m->pass_candidates += q_end - q_begin;
+    uint64_t n_skipped = 0, n_near = 0;
+    size_t n_list;
+    if (fused) {
+        n_list = due_candidates(P, q_begin, q_end, list);
+        n_skipped = (q_end - q_begin) - n_list;
+    } else
+        n_list =
+            single && !periodic /* the common case, in its own loop */
+                ? gap_test(P, q_begin, q_end, end_block, list, near, false, true, &n_skipped)
+                : gap_test(P, q_begin, q_end, end_block, list, near, periodic, false, &n_skipped);
     /* 2. every particle in index order: its listed pairs (reactions to the second particle at
           once), its cross pairs from phase 1, then its own sum and the closing half kick */
     size_t h = 0;
     for (size_t i = begin_block; i < end_block; i++) {
-        bool own = h < n_hits && pairs[hits[h]].i == i;
+        bool own = h < n_list && pairs[list[h]].i == i;
         bool cross = e < e_end && pairs[m->cross_q[e]].i == i;
         if (!own && !cross) { /* nothing to add (adding +0 would change no sum) */
             if (kick)
@@ -1276,28 +1322,36 @@ static void pairs_of_block(const struct pass* P, size_t b, bool kick, struct wet
         }
         struct wetdem_vec3 f = vec3(0, 0, 0), t = vec3(0, 0, 0);
         uint32_t n_contacts = 0;
-        for (; h < n_hits && pairs[hits[h]].i == i; h++) {
-            size_t q = hits[h], j = pairs[q].j;
+        for (; h < n_list && pairs[list[h]].i == i; h++) {
+            size_t q = list[h], j = pairs[q].j;
             struct wetdem_vec3 d;
             const struct wetdem_many_mix* x;
-            if (!near[h]) { /* listed for its flags */
-                leave_range(P, q);
-                continue;
+            if (fused) {
+                if (j >= end_block) /* a cross pair: tested and evaluated in phase 1 */
+                    continue;
+                /* within_reach, with the skip time set only for those beyond: those within
+                   range (most here) keep theirs, which came before this pass's clock and so
+                   before every later one (until a restart, after which all are tested) */
+                pair_delta(P, i, j, periodic, single, &d, &x);
+                double r2 = vec3_dot(d, d);
+                if (!(r2 <= P->lim2[q])) {
+                    set_skip_time(P, q, r2);
+                    if (flags[q])
+                        leave_range(P_out, q);
+                    continue;
+                }
+                n_near++;
+            } else {
+                n_near += near[h];
+                if (!near[h]) { /* listed for its flags */
+                    leave_range(P_out, q);
+                    continue;
+                }
+                pair_delta(P, i, j, periodic, single, &d, &x);
             }
-            pair_delta(P, i, j, periodic, single, &d, &x);
             struct wetdem_many_pair_out o;
             unsigned char fl = near_candidate(P, q, i, j, d, x, &o, fail);
-            if (!(fl & WETDEM_MANY_ACTIVE))
-                continue;
-            uint32_t c = (fl & WETDEM_MANY_CONTACT) ? 1 : 0;
-            f = vec3_add(f, o.force);
-            n_contacts += c;
-            force[j] = vec3_sub(force[j], o.force);
-            contacts[j] += c;
-            if (adds_torque(P->lean, fl)) {
-                t = vec3_add(t, o.torque_i);
-                torque[j] = vec3_add(torque[j], o.torque_j);
-            }
+            add_pair(P, j, fl, &o, &f, &t, &n_contacts);
         }
         for (; e < e_end && pairs[m->cross_q[e]].i == i; e++) { /* its cross pairs, j order */
             unsigned char fl = flags[m->cross_q[e]];
@@ -1308,12 +1362,32 @@ static void pairs_of_block(const struct pass* P, size_t b, bool kick, struct wet
                 t = vec3_add(t, m->cross_out[e].torque_i);
             n_contacts += (fl & WETDEM_MANY_CONTACT) ? 1 : 0;
         }
-        force[i] = vec3_add(force[i], f);
-        torque[i] = vec3_add(torque[i], t);
-        contacts[i] += n_contacts;
+        m->force[i] = vec3_add(m->force[i], f);
+        m->torque[i] = vec3_add(m->torque[i], t);
+        m->contacts[i] += n_contacts;
         if (kick)
             wetdem_many_close_kick(m, i, g);
     }
+#pragma omp atomic
+    m->pass_skipped += n_skipped;
+#pragma omp atomic
+    m->pass_candidates += q_end - q_begin;
+#pragma omp atomic
+    m->pass_tested += (q_end - q_begin) - n_skipped;
+#pragma omp atomic
+    m->pass_near += n_near;
+}
+
+static void pairs_of_block(const struct pass* P, size_t b, bool kick, struct wetdem_vec3 g,
+                           struct failure* fail)
+{
+    bool common = P->nm == 1 && !P->periodic; /* one material pair, no periodic axis */
+    if (P->fused && common)
+        pairs_of_block_as(P, b, kick, g, fail, true, true);
+    else if (P->fused)
+        pairs_of_block_as(P, b, kick, g, fail, true, false);
+    else
+        pairs_of_block_as(P, b, kick, g, fail, false, false);
 }
 
 /* The constants of every candidate pair (many.h: pair_lim2, and pair_cache for the lean
@@ -1389,7 +1463,9 @@ int wetdem_sim_many_forces(struct wetdem_sim* sim, bool kick)
         m->skip_off_passes = 0;
     }
     bool skip = m->skip_ready; /* (kept by the previous pass, so skip_on) */
-    m->pass_candidates = m->pass_skipped = 0;
+    bool fused = skip && (m->fuse_mode == 2 || (m->fuse_mode == 0 && m->fuse_on));
+    m->pass_candidates = m->pass_skipped = m->pass_tested = m->pass_near = 0;
+    m->fused_passes += fused;
     struct pass P = {.sim = sim,
                      .m = m,
                      .p = sim->particles,
@@ -1401,6 +1477,7 @@ int wetdem_sim_many_forces(struct wetdem_sim* sim, bool kick)
                      .skip_until = m->skip_until,
                      .clock = m->drift_clock,
                      .skip = skip,
+                     .fused = fused,
                      .maintain = m->skip_on,
                      .history = m->history,
                      .len = sim->history_len,
@@ -1427,6 +1504,7 @@ int wetdem_sim_many_forces(struct wetdem_sim* sim, bool kick)
     if (skip && 2 * m->pass_skipped < m->pass_candidates && !m->skip_always)
         m->skip_on = false; /* for 32 passes or until the next list build (many.h) */
     m->skip_ready = m->skip_on && fail.status == WETDEM_OK; /* every candidate has its time */
+    m->fuse_on = 4 * m->pass_near >= 3 * m->pass_tested;    /* (many.h) */
     if (fail.status != WETDEM_OK)
         return report_failure(sim, &fail);
     sim->engine.stats.force_evals++;

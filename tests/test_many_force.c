@@ -449,15 +449,28 @@ static void test_many_block_cuts_do_not_change_the_result(void** state)
     wetdem_sim_free(one);
 }
 
+/* Runs a and b are bit-identical: particles, and every candidate pair's flags (contact,
+ * bridge: what the statistics count) over the same list. */
+static void same_run(const struct wetdem_sim* a, const struct wetdem_sim* b)
+{
+    test_check_same_particles(a, b);
+    assert_int_equal(a->many->cl.n_pairs, b->many->cl.n_pairs);
+    assert_memory_equal(a->many->cl.pairs, b->many->cl.pairs,
+                        a->many->cl.n_pairs * sizeof *a->many->cl.pairs);
+    assert_memory_equal(a->many->flags, b->many->flags, a->many->cl.n_pairs);
+}
+
 /* The gap test skips a candidate until the skip clock (the sum of every step's bound on the
  * displacements, many.h) says it may have come within reach; a skipped candidate would have
  * been rejected, so runs with and without skipping are bit-identical: in a flowing gas with
  * the skip times kept at every pass, with the default choice (which drops them there after
  * the first passes of a list, as too few candidates are skipped), and the same spheres from
- * rest. Between calls the user may move particles: the run then tests every candidate at its
- * first pass. Here the first particle of the nearest skipped candidate is moved, between
- * calls, to within its reach (less than skin/2: no list rebuild); the run with skipping must
- * see it at once. Last, the clock is restarted often. */
+ * rest; and with the candidates whose time has come tested and evaluated in one loop (fused,
+ * where those within range keep their old times, many.h) instead of a gap test and the kernels
+ * over its list. Between calls the user may move particles: the run then tests every candidate
+ * at its first pass. Here the first particle of the nearest skipped candidate is moved,
+ * between calls, to within its reach (less than skin/2: no list rebuild); the runs with
+ * skipping must see it at once. Last, the clock is restarted often. */
 static void test_many_skipped_candidates_change_no_result(void** state)
 {
     (void)state;
@@ -466,26 +479,45 @@ static void test_many_skipped_candidates_change_no_result(void** state)
     struct wetdem_sim* skip = wet_gas(false, false);
     struct wetdem_sim* by_default = wet_gas(false, false);
     struct wetdem_sim* test_all = wet_gas(false, false);
+    struct wetdem_sim* fused = wet_gas(false, false);
     skip->many->skip_always = true;
+    skip->many->fuse_mode = 1; /* the gap test, then the kernels over its list */
     test_all->many->no_skip = true;
-    struct wetdem_sim* sims[] = {skip, by_default, test_all};
-    for (int s = 0; s < 3; s++)
+    fused->many->skip_always = true;
+    fused->many->fuse_mode = 2; /* tested and evaluated in one loop whenever the times are usable */
+    struct wetdem_sim* sims[] = {skip, by_default, test_all, fused};
+    enum { NS = 4 };
+    for (int s = 0; s < NS; s++)
         CHECK_OK(wetdem_sim_integrate(sims[s], 1e-3));
-    test_check_same_particles(skip, test_all);
-    test_check_same_particles(by_default, test_all);
+    same_run(skip, test_all);
+    same_run(by_default, test_all);
+    same_run(fused, test_all);
+    assert_int_equal(skip->many->fused_passes, 0);
+    assert_true(fused->many->fused_passes > 0);
+    /* short calls, the flags compared after each: a pair leaving its range in the last
+       passes of a call loses them at once */
+    double t_call = 1e-3;
+    for (int call = 0; call < 40; call++) {
+        t_call += 6 * 2e-6;
+        for (int s = 0; s < NS; s++)
+            CHECK_OK(wetdem_sim_integrate(sims[s], t_call));
+        same_run(skip, test_all);
+        same_run(fused, test_all);
+    }
     struct wetdem_many* m = skip->many;
     assert_true(m->skipped_tests > by_default->many->skipped_tests);
     assert_true(by_default->many->skipped_tests > 0);
-    for (int s = 0; s < 3; s++) { /* from rest */
+    for (int s = 0; s < NS; s++) { /* from rest */
         size_t n;
         struct wetdem_particle* ps = wetdem_sim_particles(sims[s], &n);
         for (size_t k = 0; k < n; k++)
             ps[k].vel = ps[k].omega = vec3(0, 0, 0);
     }
-    double t = 1e-3 + 20 * 2e-6;
-    for (int s = 0; s < 3; s++)
+    double t = t_call + 20 * 2e-6;
+    for (int s = 0; s < NS; s++)
         CHECK_OK(wetdem_sim_integrate(sims[s], t));
-    test_check_same_particles(skip, test_all);
+    same_run(skip, test_all);
+    same_run(fused, test_all);
     assert_true(m->skip_on && m->skip_ready && m->pass_skipped > 0); /* the times are used */
     assert_int_equal(test_all->many->skipped_tests, 0);
     /* the skipped candidate closest to the gap test's reach */
@@ -508,31 +540,39 @@ static void test_many_skipped_candidates_change_no_result(void** state)
     struct wetdem_vec3 d = celllist_delta(&m->cl.box, p[pb.i].pos, p[pb.j].pos);
     struct wetdem_vec3 move = vec3_scale(d, -(best_beyond + 1e-7) / vec3_norm(d)); /* i to j */
     uint64_t builds = m->cl.n_builds;
-    for (int s = 0; s < 3; s++) {
+    for (int s = 0; s < NS; s++) {
         struct wetdem_particle* ps = wetdem_sim_particles(sims[s], &n);
         ps[pb.i].pos = vec3_add(ps[pb.i].pos, move);
     }
     t += 2e-6; /* one step: without a list build, the run must see the move */
-    for (int s = 0; s < 3; s++)
+    for (int s = 0; s < NS; s++)
         CHECK_OK(wetdem_sim_integrate(sims[s], t));
     assert_true(m->cl.n_builds == builds);
     assert_true(m->flags[best] & WETDEM_MANY_ACTIVE); /* the moved pair came within range */
-    test_check_same_particles(skip, test_all);
+    same_run(skip, test_all);
+    same_run(fused, test_all);
     for (int call = 1; call <= 4; call++) /* and several calls */
-        for (int s = 0; s < 3; s++)
+        for (int s = 0; s < NS; s++)
             CHECK_OK(wetdem_sim_integrate(sims[s], t + call * 0.25e-3));
-    test_check_same_particles(skip, test_all);
-    test_check_same_particles(by_default, test_all);
+    same_run(skip, test_all);
+    same_run(by_default, test_all);
+    same_run(fused, test_all);
     /* the clock restarted often (its limit lowered from the skin): every restart makes the
        next pass test every candidate, and the run stays bit-identical */
     skip->many->clock_limit = 0.02 * m->cl.skin;
     uint64_t restarts = m->clock_restarts, skipped = m->skipped_tests;
-    for (int s = 0; s < 3; s += 2)
-        CHECK_OK(wetdem_sim_integrate(sims[s], t + 1.5e-3));
+    fused->many->clock_limit = skip->many->clock_limit;
+    uint64_t fused_restarts = fused->many->clock_restarts, fused_passes = fused->many->fused_passes;
+    for (int s = 0; s < NS; s++)
+        if (sims[s] != by_default)
+            CHECK_OK(wetdem_sim_integrate(sims[s], t + 1.5e-3));
     assert_true(m->clock_restarts > restarts + 10 && m->skipped_tests > skipped);
-    test_check_same_particles(skip, test_all);
+    assert_true(fused->many->clock_restarts > fused_restarts + 10 &&
+                fused->many->fused_passes > fused_passes);
+    same_run(skip, test_all);
+    same_run(fused, test_all);
     omp_set_num_threads(saved);
-    for (int s = 0; s < 3; s++)
+    for (int s = 0; s < NS; s++)
         wetdem_sim_free(sims[s]);
 }
 
