@@ -789,11 +789,12 @@ static double reach2(const struct wetdem_celllist_item* xr, size_t i, size_t j,
 
 /* The cheap gap test of candidate q = (i, j): pair_delta, then true when
  * |d|^2 <= (R_i + R_j + r_ab)^2 (1 + PREFILTER_MARGIN), the bound kept per pair (pair_lim2).
- * Sets the candidate's skip time (many.h): the skip clock plus half of a lower bound of
- * |d| - far_q (many.h, struct skip_bound), before the clock when it passes. Until the clock gets there,
- * its two particles cannot have come closer by that much, and the test would reject it again:
- * the margins of far_q, a relative 1e-9 and 1e-12 of the largest coordinate, exceed the
- * round-off of the distances, of the test and of the times by orders of magnitude. */
+ * With `maintain`, sets the candidate's skip time (many.h, set_skip_time): the skip clock
+ * plus half of a lower bound of |d| - far_q (many.h, struct skip_bound), before the clock when
+ * it passes. Until the clock gets there, its two particles cannot have come closer by that
+ * much, and the test would reject it again: the margins of far_q, a relative 1e-9 and 1e-12 of
+ * the largest coordinate, exceed the round-off of the distances, of the test and of the times
+ * by orders of magnitude. */
 static inline __attribute__((always_inline)) bool
 within_reach(const struct pass* P, size_t q, size_t i, size_t j, bool periodic, bool single,
              bool maintain, struct wetdem_vec3* d, const struct wetdem_many_mix** x)
@@ -1227,9 +1228,9 @@ due_candidates(const struct pass* P, size_t q_begin, size_t q_end, uint32_t* res
  * skip times (many.h), a first loop lists the candidates whose time has come in hits
  * (due_candidates), and the test runs over that list, writing its result over it (never ahead
  * of its reading). The skipped ones have no flags. `periodic` and `single` (one material
- * pair) are constants at each call, so each case compiles to its own loop. The lists are `restrict`: a store through
- * the byte list could otherwise alias anything, and every read of the pass would be repeated
- * after it. */
+ * pair) are constants at each call, so each case compiles to its own loop. The lists are
+ * `restrict`: a store through the byte list could otherwise alias anything, and every read of
+ * the pass would be repeated after it. */
 static inline __attribute__((always_inline)) size_t
 gap_test(const struct pass* P, size_t q_begin, size_t q_end, size_t end_block,
          uint32_t* restrict hits, unsigned char* restrict hit_near, bool periodic, bool single,
