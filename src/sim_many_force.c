@@ -1379,6 +1379,8 @@ static inline __attribute__((always_inline)) void pairs_of_block_as(const struct
     m->pass_near += n_near;
 }
 
+/* Phase 2 of block b (pairs_of_block_as), compiled apart for the one-loop pass in the common
+ * case (one material pair, no periodic axis), the one-loop pass in general, and two loops. */
 static void pairs_of_block(const struct pass* P, size_t b, bool kick, struct wetdem_vec3 g,
                            struct failure* fail)
 {
