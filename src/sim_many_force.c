@@ -59,6 +59,9 @@
 #include <omp.h>
 #include <stdlib.h>
 #include <string.h>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 #include "many.h"
 #include "mindlin.h"
@@ -1208,14 +1211,38 @@ test_candidates(const struct pass* P, bool listed, size_t q_begin, size_t n, siz
 
 /* The candidates q_begin .. q_end whose skip time has come (all of them to test), in order,
  * into list; returns their number. Branch-free: a branch per candidate on its time would be
- * mispredicted half of the time in a flowing system. */
+ * mispredicted half of the time in a flowing system. With SSE2 (every x86-64), four
+ * candidates a step: 5 instructions a candidate instead of 11 (9 and 10 fewer per
+ * particle-step on the frozen configuration, dry and wet). */
 static inline __attribute__((always_inline)) size_t
 due_candidates(const struct pass* P, size_t q_begin, size_t q_end, uint32_t* restrict list)
 {
     const float* restrict until = P->skip_until;
     double clock = P->clock;
-    size_t n_test = 0;
-    for (size_t q = q_begin; q < q_end; q++) {
+    size_t n_test = 0, q = q_begin;
+#if defined(__SSE2__)
+    /* four at a time: their times widened to doubles (exact) and compared with the clock as
+       below (not less: due, as is a NaN), the due lanes' offsets taken from a table by the
+       4-bit mask and written as four indices, of which the first `count` are kept; the
+       write stays within the candidates read so far plus three (n_test <= q - q_begin) */
+    static const uint32_t lanes[16][4] = {{0, 0, 0, 0}, {0, 0, 0, 0}, {1, 0, 0, 0}, {0, 1, 0, 0},
+                                          {2, 0, 0, 0}, {0, 2, 0, 0}, {1, 2, 0, 0}, {0, 1, 2, 0},
+                                          {3, 0, 0, 0}, {0, 3, 0, 0}, {1, 3, 0, 0}, {0, 1, 3, 0},
+                                          {2, 3, 0, 0}, {0, 2, 3, 0}, {1, 2, 3, 0}, {0, 1, 2, 3}};
+    static const unsigned char count[16] = {0, 1, 1, 2, 1, 2, 2, 3, 1, 2, 2, 3, 2, 3, 3, 4};
+    __m128d c = _mm_set1_pd(clock);
+    for (; q_end - q >= 4; q += 4) {
+        __m128 u = _mm_loadu_ps(until + q);
+        __m128d lo = _mm_cvtps_pd(u), hi = _mm_cvtps_pd(_mm_movehl_ps(u, u));
+        int mask_lo = _mm_movemask_pd(_mm_cmpnlt_pd(c, lo));
+        int mask = mask_lo | _mm_movemask_pd(_mm_cmpnlt_pd(c, hi)) << 2;
+        __m128i idx = _mm_add_epi32(_mm_set1_epi32((int)(uint32_t)q), /* (mod 2^32, as list) */
+                                    _mm_loadu_si128((const __m128i*)(const void*)lanes[mask]));
+        _mm_storeu_si128((__m128i*)(void*)(list + n_test), idx);
+        n_test += count[mask];
+    }
+#endif
+    for (; q < q_end; q++) {
         list[n_test] = (uint32_t)q;
         n_test += !(clock < until[q]);
     }
