@@ -518,32 +518,47 @@ static struct wetdem_vec3 wrap(const struct wetdem_celllist_box* b, struct wetde
     return vec3(c[0], c[1], c[2]);
 }
 
-/* Half kick and drift of particle p (index k); its velocities become the predicted ones
- * v' + a dt/2, and *v2_max the larger of itself and |v'|^2 of the half-step velocity. Every
- * value is formed in a local and stored once. */
-static void kick_drift_one(struct wetdem_many* m, size_t k, struct wetdem_vec3 g, double h,
-                           bool periodic, bool pending, double* v2_max)
+/* The arrays the kick-drift pass reads and writes, none of them overlapping another: held in
+ * registers across the stores of a particle, where the engine's fields would be loaded again
+ * after each (14 fewer instructions per particle-step). */
+struct kick_arrays {
+    struct wetdem_vec3* restrict force;
+    struct wetdem_vec3* restrict torque;
+    struct wetdem_vec3* restrict vh;
+    struct wetdem_vec3* restrict wh;
+    const double (*restrict inv)[2];
+    struct wetdem_celllist_item* restrict xr;
+    struct wetdem_vec3 (*restrict vw)[2];
+};
+
+/* Half kick and drift of particle k; its velocities become the predicted ones v' + a dt/2,
+ * and *v2_max the larger of itself and |v'|^2 of the half-step velocity. Every value is formed
+ * in a local and stored once. */
+static inline void kick_drift_one(const struct kick_arrays* A,
+                                  const struct wetdem_celllist_box* box, size_t k,
+                                  struct wetdem_vec3 g, double h, bool periodic, bool pending,
+                                  double* v2_max)
 {
     double half = 0.5 * h;
-    struct wetdem_vec3 a = vec3_axpy(g, m->inv[k][0], m->force[k]);
-    struct wetdem_vec3 alpha = vec3_scale(m->torque[k], m->inv[k][1]);
-    struct wetdem_vec3 v = m->vw[k][0], w = m->vw[k][1];
+    struct wetdem_vec3 a = vec3_axpy(g, A->inv[k][0], A->force[k]);
+    struct wetdem_vec3 alpha = vec3_scale(A->torque[k], A->inv[k][1]);
+    struct wetdem_vec3 v = A->vw[k][0], w = A->vw[k][1];
     if (pending) { /* the previous step's closing half kick, with the same a and alpha */
-        v = vec3_axpy(m->vh[k], half, a);
-        w = vec3_axpy(m->wh[k], half, alpha);
+        v = vec3_axpy(A->vh[k], half, a);
+        w = vec3_axpy(A->wh[k], half, alpha);
     }
     struct wetdem_vec3 vh = vec3_axpy(v, half, a), wh = vec3_axpy(w, half, alpha);
-    struct wetdem_vec3 x = vec3_axpy(vec3(m->xr[k].x, m->xr[k].y, m->xr[k].z), h, vh);
+    struct wetdem_vec3 x = vec3_axpy(vec3(A->xr[k].x, A->xr[k].y, A->xr[k].z), h, vh);
     double v2 = vec3_dot(vh, vh);
     *v2_max = v2 > *v2_max ? v2 : *v2_max;
-    x = periodic ? wrap(&m->cl.box, x) : x;
-    m->vh[k] = vh;
-    m->wh[k] = wh;
-    m->xr[k].x = x.x;
-    m->xr[k].y = x.y;
-    m->xr[k].z = x.z;
-    m->vw[k][0] = vec3_axpy(vh, half, a);
-    m->vw[k][1] = vec3_axpy(wh, half, alpha);
+    x = periodic ? wrap(box, x) : x;
+    A->vh[k] = vh;
+    A->wh[k] = wh;
+    A->xr[k].x = x.x;
+    A->xr[k].y = x.y;
+    A->xr[k].z = x.z;
+    A->vw[k][0] = vec3_axpy(vh, half, a);
+    A->vw[k][1] = vec3_axpy(wh, half, alpha);
 }
 
 /* Largest squared displacement of any particle since the last neighbour-list build [m^2]. */
@@ -587,16 +602,24 @@ static void kick_drift(struct wetdem_sim* sim, double h)
     bool periodic = m->cl.box.periodic[0] || m->cl.box.periodic[1] || m->cl.box.periodic[2];
     /* the force pass's sums start here, from zero, while the lines are in cache (the force
        pass then starts only the particles with walls) */
-    struct wetdem_vec3 *force = m->force, *torque = m->torque;
+    const struct kick_arrays arrays = {.force = m->force,
+                                       .torque = m->torque,
+                                       .vh = m->vh,
+                                       .wh = m->wh,
+                                       .inv = (const double(*)[2])m->inv,
+                                       .xr = m->xr,
+                                       .vw = m->vw};
+    const unsigned char* fixed = m->fixed;
     uint32_t* contacts = m->contacts;
+    const struct wetdem_celllist_box* box = &m->cl.box;
+    size_t n = sim->n_particles;
     double v2_max = 0; /* max is exact: the same for any thread count */
-#pragma omp parallel for schedule(static)                                                          \
-    reduction(max                                                                                  \
-              : v2_max) if (wetdem_many_parallel(m, sim->n_particles))
-    for (size_t k = 0; k < sim->n_particles; k++) {
-        if (!m->fixed[k])
-            kick_drift_one(m, k, g, h, periodic, pending, &v2_max);
-        force[k] = torque[k] = vec3(0, 0, 0);
+#pragma omp parallel for schedule(static) reduction(max : v2_max) if (wetdem_many_parallel(m, n))
+    for (size_t k = 0; k < n; k++) {
+        const struct kick_arrays A = arrays; /* (a copy of the thread's own: in registers) */
+        if (!fixed[k])
+            kick_drift_one(&A, box, k, g, h, periodic, pending, &v2_max);
+        A.force[k] = A.torque[k] = vec3(0, 0, 0);
         contacts[k] = 0;
     }
     m->sums_zeroed = sim->n_particles;
