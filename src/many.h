@@ -139,10 +139,10 @@ struct wetdem_many {
        flat loop and the kernels run over the list of those within range (two loops), or, when
        most of them are within range (a slow or resting packing, where the far candidates are
        skipped), tested and evaluated in one loop, their geometry computed once (fused). The
-       latest pass decides: fused when at least 3/4 of the tested candidates were within
-       range. Either way the same kernels run in the same order (sim_many_force.c). */
-    uint64_t pass_tested;       /* candidates of the latest pass's blocks that were tested */
-    uint64_t pass_near;         /* of which within range */
+       latest pass decides: fused when at least 3/4 of the tested candidates (pass_candidates
+       less pass_skipped) were within range. Either way the same kernels run in the same order
+       (sim_many_force.c). */
+    uint64_t pass_near;         /* in-block candidates of the latest pass within range */
     bool fuse_on;               /* the next pass with usable skip times runs fused */
     int fuse_mode;              /* tests: 0 decided as above, 1 never fused, 2 always fused */
     uint64_t fused_passes;      /* passes run fused (tests) */

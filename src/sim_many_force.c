@@ -1357,13 +1357,11 @@ static inline __attribute__((always_inline)) void pairs_of_block_as(const struct
             if (fused) {
                 if (j >= end_block) /* a cross pair: tested and evaluated in phase 1 */
                     continue;
-                /* within_reach, with the skip time set only for those beyond: those within
-                   range (most here) keep theirs, which came before this pass's clock and so
-                   before every later one (until a restart, after which all are tested) */
-                pair_delta(P, i, j, periodic, single, &d, &x);
-                double r2 = vec3_dot(d, d);
-                if (!(r2 <= P->lim2[q])) {
-                    set_skip_time(P, q, r2);
+                /* the skip time set only for those beyond: those within range (most here)
+                   keep theirs, which came before this pass's clock and so before every later
+                   one (until a restart, after which all are tested) */
+                if (!within_reach(P, q, i, j, periodic, single, false, &d, &x)) {
+                    set_skip_time(P, q, vec3_dot(d, d));
                     if (flags[q])
                         leave_range(P_out, q);
                     continue;
@@ -1400,8 +1398,6 @@ static inline __attribute__((always_inline)) void pairs_of_block_as(const struct
     m->pass_skipped += n_skipped;
 #pragma omp atomic
     m->pass_candidates += q_end - q_begin;
-#pragma omp atomic
-    m->pass_tested += (q_end - q_begin) - n_skipped;
 #pragma omp atomic
     m->pass_near += n_near;
 }
@@ -1494,7 +1490,7 @@ int wetdem_sim_many_forces(struct wetdem_sim* sim, bool kick)
     }
     bool skip = m->skip_ready; /* (kept by the previous pass, so skip_on) */
     bool fused = skip && (m->fuse_mode == 2 || (m->fuse_mode == 0 && m->fuse_on));
-    m->pass_candidates = m->pass_skipped = m->pass_tested = m->pass_near = 0;
+    m->pass_candidates = m->pass_skipped = m->pass_near = 0;
     m->fused_passes += fused;
     struct pass P = {.sim = sim,
                      .m = m,
@@ -1534,7 +1530,7 @@ int wetdem_sim_many_forces(struct wetdem_sim* sim, bool kick)
     if (skip && 2 * m->pass_skipped < m->pass_candidates && !m->skip_always)
         m->skip_on = false; /* for 32 passes or until the next list build (many.h) */
     m->skip_ready = m->skip_on && fail.status == WETDEM_OK; /* every candidate has its time */
-    m->fuse_on = 4 * m->pass_near >= 3 * m->pass_tested;    /* (many.h) */
+    m->fuse_on = 4 * m->pass_near >= 3 * (m->pass_candidates - m->pass_skipped); /* (many.h) */
     if (fail.status != WETDEM_OK)
         return report_failure(sim, &fail);
     sim->engine.stats.force_evals++;
