@@ -65,6 +65,43 @@ struct wetdem_many_pair_out {
                                   kept across rebuilds and restarts; the lean kernel resets the
                                   spring of a pair apart only then (else it is zero already) */
 
+/* Four pairs at a time (many_bulk.h): what the bulk geometry of one particle's candidates
+ * reads, and what it gives per candidate. For the one-loop pass of the lean kernel in the
+ * common case (one material pair, no periodic axis). */
+#define WETDEM_MANY_BULK_MAX 64 /* candidates per call (a multiple of 4) */
+struct wetdem_many_bulk_in {
+    const struct wetdem_celllist_item* xr;
+    const struct wetdem_vec3 (*vw)[2];
+    const struct wetdem_celllist_pair* pairs;
+    const double (*pair_cache)[4];
+    const double* lim2;             /* pair_lim2 */
+    double film, film_h_min, range; /* of the material pair [m] */
+    double sb_coef;                 /* 6 pi mu [Pa s] */
+    double cap_coef;                /* 8 pi */
+    double surface_tension;         /* [N/m] */
+    bool sb, sb_nc, capillary;      /* sb and capillary enabled; sb's "nc" treatment below h_min' */
+};
+struct wetdem_many_bulk_out { /* by component, each entry 32-byte aligned */
+    /* 0: beyond the gap test's reach (|x_i - x_j|^2 > pair_lim2); 1: within it, for the scalar
+       kernel; else apart within the range with a finite force, and these are its flags */
+    long long cls[WETDEM_MANY_BULK_MAX] __attribute__((aligned(32)));
+    uint32_t j[WETDEM_MANY_BULK_MAX];                               /* the pair's second particle */
+    double r2[WETDEM_MANY_BULK_MAX] __attribute__((aligned(32)));   /* |x_i - x_j|^2 [m^2] */
+    double gap[WETDEM_MANY_BULK_MAX] __attribute__((aligned(32)));  /* [m] */
+    double n[3][WETDEM_MANY_BULK_MAX] __attribute__((aligned(32))); /* unit normal, j to i */
+    double v_n[WETDEM_MANY_BULK_MAX] __attribute__((aligned(32)));  /* [m/s] */
+    double f_n[WETDEM_MANY_BULK_MAX] __attribute__((aligned(32)));  /* normal force apart [N] */
+    double f_sb[WETDEM_MANY_BULK_MAX] __attribute__((aligned(32))); /* its sb term [N] */
+    double f_cap[WETDEM_MANY_BULK_MAX] __attribute__((aligned(32)));    /* its capillary term [N] */
+    double force[3][WETDEM_MANY_BULK_MAX] __attribute__((aligned(32))); /* its force on i [N] */
+};
+typedef void wetdem_many_bulk_fn(const struct wetdem_many_bulk_in* in, const uint32_t* list,
+                                 size_t n, size_t j_end, struct wetdem_many_bulk_out* out);
+/* many_bulk.c: the baseline version; many_bulk_avx2.c: the AVX2 one (x86-64 with GCC). */
+wetdem_many_bulk_fn wetdem_many_bulk_base, wetdem_many_bulk_avx2;
+/* The version for this processor (AVX2 where it has it), or the baseline with `base_only`. */
+wetdem_many_bulk_fn* wetdem_many_bulk_choose(bool base_only);
+
 /* Energy bookkeeping (sim_many.c accumulates, sim_many_io.c reports). */
 struct wetdem_many_energy {
     double k0, u0, el0;                  /* kinetic, potential, elastic at the start [J] */
@@ -142,10 +179,13 @@ struct wetdem_many {
        latest pass decides: fused when at least 3/4 of the tested candidates (pass_candidates
        less pass_skipped) were within range. Either way the same kernels run in the same order
        (sim_many_force.c). */
-    uint64_t pass_near;         /* in-block candidates of the latest pass within range */
-    bool fuse_on;               /* the next pass with usable skip times runs fused */
-    int fuse_mode;              /* tests: 0 decided as above, 1 never fused, 2 always fused */
-    uint64_t fused_passes;      /* passes run fused (tests) */
+    uint64_t pass_near;    /* in-block candidates of the latest pass within range */
+    bool fuse_on;          /* the next pass with usable skip times runs fused */
+    int fuse_mode;         /* tests: 0 decided as above, 1 never fused, 2 always fused */
+    int bulk_mode;         /* tests: 0 four pairs at a time where it applies (many_bulk.h), 1 never,
+                      2 with the baseline instruction set only */
+    uint64_t fused_passes; /* passes run fused (tests) */
+    uint64_t bulk_passes;  /* of those, passes with four pairs at a time (tests) */
     uint64_t pair_consts_build; /* the list build they were computed for */
     bool pair_consts_ready;     /* cleared when the kernel is set up */
     unsigned char* old_flags;   /* flags of the previous list, for remapping */

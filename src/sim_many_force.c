@@ -387,15 +387,15 @@ static inline __attribute__((always_inline)) void film_terms(const struct wetdem
 
 /* Force of pair g with mixed properties x: the operations of wetdem_sim_many_eval_fused and
  * eval_pair in the same order on the quantities the enabled models read, so force, torques,
- * history and flags are bit-identical to theirs (tests/test_many_force.c). The sum of the
+ * history and flags are bit-identical to theirs (tests/test_many_force.c). The film terms are
+ * film_terms', or film[0] and film[1] when film is not NULL. The sum of the
  * normal forces starts at +0 and adds the models in model order; a model that does not act
  * adds +0, which changes no sum that is not -0 (and a sum from +0 never is). Needs
  * g->gap <= x->range. Returns WETDEM_OK or WETDEM_ERR_NUMERIC (non-finite force). */
-static inline __attribute__((always_inline)) int lean_force(const struct wetdem_many* m,
-                                                            const struct lean_geometry* g,
-                                                            const struct wetdem_many_mix* x,
-                                                            double* hist, unsigned char* flags,
-                                                            struct wetdem_many_pair_out* o)
+static inline __attribute__((always_inline)) int
+lean_force(const struct wetdem_many* m, const struct lean_geometry* g,
+           const struct wetdem_many_mix* x, double* hist, unsigned char* flags,
+           struct wetdem_many_pair_out* o, const double* film)
 {
     const struct wetdem_many_lean* L = &m->lean;
     double gap = g->gap, r_eff = g->r_eff, v_n = g->v_n, overlap = -gap;
@@ -422,7 +422,11 @@ static inline __attribute__((always_inline)) int lean_force(const struct wetdem_
         double* spring = hist + L->mindlin_off;
         spring[0] = spring[1] = spring[2] = 0.0;
     }
-    film_terms(L, x, gap, r_eff, v_n, term);
+    if (film) { /* the film terms of four pairs at a time (many_bulk.h), the same bits */
+        term[1] = film[0];
+        term[2] = film[1];
+    } else
+        film_terms(L, x, gap, r_eff, v_n, term);
     double f_n = 0.0;
     for (int q = 0; q < L->n_normal; q++)
         f_n += term[L->normal[q]];
@@ -437,27 +441,45 @@ static inline __attribute__((always_inline)) int lean_force(const struct wetdem_
     return WETDEM_OK;
 }
 
-/* Pair apart (gap >= 0) within its range: the operations of lean_force for that case, where
- * only the film models act, along the normal n, and the torques are zero (left unset: the
- * callers add none, see adds_torque). The normal sum is lean_force's: hertz adds +0 there,
- * which changes no sum from +0, and the other two commute. The force is finite when f_n is
- * (|n| = 1). */
-static inline __attribute__((always_inline)) int
-lean_apart(const struct wetdem_many_lean* L, const struct wetdem_many_mix* x, struct wetdem_vec3 n,
-           double gap, double r_eff, double v_n, bool spring_set, double* hist,
-           unsigned char* flags, struct wetdem_many_pair_out* o)
+/* Mindlin's spring of a pair apart reset (mindlin_spring does so apart), where the pair's
+ * flags `was` before this evaluation say it may be set (else it is zero already). */
+static inline __attribute__((always_inline)) void
+reset_spring_apart(const struct wetdem_many_lean* L, unsigned char was, double* hist)
 {
-    if (L->mindlin && spring_set) { /* mindlin_spring resets the spring apart (if it may be set) */
+    if (L->mindlin && (was & WETDEM_MANY_SPRING)) {
         double* spring = hist + L->mindlin_off;
         spring[0] = spring[1] = spring[2] = 0.0;
     }
-    double term[3] = {0.0, 0.0, 0.0};
-    film_terms(L, x, gap, r_eff, v_n, term);
-    double f_n = 0.0 + term[1] + term[2];
-    o->force = vec3_axpy(vec3(0, 0, 0), f_n, n);
+}
+
+/* The result of a pair apart (gap >= 0) within its range, from its normal force f_n [N] and
+ * force on i (lean_apart, or four pairs at a time: many_bulk.h): the spring reset, the flags,
+ * the force; the torques are zero (left unset: the callers add none, see adds_torque). The
+ * force is finite when f_n is (|n| = 1). */
+static inline __attribute__((always_inline)) int
+apart_result(const struct wetdem_many_lean* L, const struct wetdem_many_mix* x, double gap,
+             double f_n, struct wetdem_vec3 force, unsigned char was, double* hist,
+             unsigned char* flags, struct wetdem_many_pair_out* o)
+{
+    reset_spring_apart(L, was, hist);
+    o->force = force;
     *flags = WETDEM_MANY_ACTIVE | WETDEM_MANY_DIRTY |
              (x->film > 0 && gap < x->film ? WETDEM_MANY_BRIDGE : 0);
     return isfinite(f_n) ? WETDEM_OK : WETDEM_ERR_NUMERIC;
+}
+
+/* Pair apart (gap >= 0) within its range: the operations of lean_force for that case, where
+ * only the film models act, along the normal n. The normal sum is lean_force's: hertz adds +0
+ * there, which changes no sum from +0, and the other two commute. */
+static inline __attribute__((always_inline)) int
+lean_apart(const struct wetdem_many_lean* L, const struct wetdem_many_mix* x, struct wetdem_vec3 n,
+           double gap, double r_eff, double v_n, unsigned char was, double* hist,
+           unsigned char* flags, struct wetdem_many_pair_out* o)
+{
+    double term[3] = {0.0, 0.0, 0.0};
+    film_terms(L, x, gap, r_eff, v_n, term);
+    double f_n = 0.0 + term[1] + term[2];
+    return apart_result(L, x, gap, f_n, vec3_axpy(vec3(0, 0, 0), f_n, n), was, hist, flags, o);
 }
 
 /* The start of pair (ia, ib)'s geometry with d = x_a - x_b (minimum image), from the engine
@@ -478,11 +500,12 @@ lean_pair_start(const struct wetdem_many* m, size_t ia, size_t ib, struct wetdem
 }
 
 /* Pair (ia, ib) in solid contact (gap < 0) with the start of its geometry (lean_pair_start)
- * and its constants `cache` (pair_cache): the rest of the geometry, then lean_force. */
+ * and its constants `cache` (pair_cache): the rest of the geometry, then lean_force (with the
+ * film terms `film`, or NULL). */
 static inline __attribute__((always_inline)) int
 lean_contact(const struct wetdem_many* m, size_t ia, size_t ib, struct wetdem_vec3 n, double gap,
              double v_n, const struct wetdem_many_mix* x, double* hist, const double* cache,
-             unsigned char* flags, struct wetdem_many_pair_out* o)
+             unsigned char* flags, struct wetdem_many_pair_out* o, const double* film)
 {
     double r_a = m->xr[ia].r, r_b = m->xr[ib].r;
     const struct wetdem_vec3 *vw_a = m->vw[ia], *vw_b = m->vw[ib]; /* velocity, spin */
@@ -502,25 +525,40 @@ lean_contact(const struct wetdem_many* m, size_t ia, size_t ib, struct wetdem_ve
         struct wetdem_vec3 vb = vec3_add(vw_b[0], vec3_cross(vw_b[1], vec3_scale(n, r_b)));
         g.v_t = vec3_reject(vec3_sub(va, vb), n);
     }
-    return lean_force(m, &g, x, hist, flags, o);
+    return lean_force(m, &g, x, hist, flags, o, film);
 }
 
 /* Pair (ia, ib) with d = x_a - x_b (minimum image): lean_pair_start, then lean_apart or
- * lean_contact; *flags = 0 beyond the range. */
+ * lean_contact; *flags = 0 beyond the range. With bulk results (bo, not NULL), the start of
+ * the geometry and the force apart are candidate k's there (the same bits). */
 static inline __attribute__((always_inline)) int
 lean_pair(const struct wetdem_many* m, size_t ia, size_t ib, struct wetdem_vec3 d,
           const struct wetdem_many_mix* x, double* hist, const double* cache, unsigned char* flags,
-          struct wetdem_many_pair_out* o)
+          struct wetdem_many_pair_out* o, const struct wetdem_many_bulk_out* bo, size_t k)
 {
-    bool spring_set = *flags & WETDEM_MANY_SPRING; /* by the previous evaluation */
-    double gap, v_n;
+    unsigned char was = *flags; /* of the previous evaluation */
+    double gap, v_n, film[2];
     struct wetdem_vec3 n;
     *flags = 0;
-    if (!lean_pair_start(m, ia, ib, d, x, &gap, &n, &v_n))
-        return WETDEM_OK;
-    if (!(gap < 0.0))
-        return lean_apart(&m->lean, x, n, gap, cache[0], v_n, spring_set, hist, flags, o);
-    return lean_contact(m, ia, ib, n, gap, v_n, x, hist, cache, flags, o);
+    if (bo) {
+        gap = bo->gap[k];
+        if (gap > x->range)
+            return WETDEM_OK;
+        n = vec3(bo->n[0][k], bo->n[1][k], bo->n[2][k]);
+        v_n = bo->v_n[k];
+        if (!(gap < 0.0))
+            return apart_result(&m->lean, x, gap, bo->f_n[k],
+                                vec3(bo->force[0][k], bo->force[1][k], bo->force[2][k]), was, hist,
+                                flags, o);
+        film[0] = bo->f_sb[k];
+        film[1] = bo->f_cap[k];
+    } else {
+        if (!lean_pair_start(m, ia, ib, d, x, &gap, &n, &v_n))
+            return WETDEM_OK;
+        if (!(gap < 0.0))
+            return lean_apart(&m->lean, x, n, gap, cache[0], v_n, was, hist, flags, o);
+    }
+    return lean_contact(m, ia, ib, n, gap, v_n, x, hist, cache, flags, o, bo ? film : NULL);
 }
 
 /* Particle a and plane wall w: the geometry of wall_contact_from, then lean_force (walls
@@ -555,7 +593,7 @@ static int lean_wall(const struct wetdem_many* m, const struct wetdem_particle* 
             vec3_add(a->vel, vec3_cross(a->omega, vec3_scale(w->normal, -a->radius)));
         g.v_t = vec3_reject(va, g.n);
     }
-    return lean_force(m, &g, x, hist, flags, o);
+    return lean_force(m, &g, x, hist, flags, o, NULL);
 }
 
 /* ---- the pair pass ---- */
@@ -717,6 +755,10 @@ struct pass {
     bool fused;    /* skip, and the block's candidates are tested and evaluated in one loop */
     bool maintain; /* each tested candidate gets its skip time anew */
     bool zeroed;   /* the sums start from zero already (many.h sums_zeroed) */
+    /* four pairs at a time (many_bulk.h) in the one-loop pass of the lean kernel's common case,
+       or NULL */
+    wetdem_many_bulk_fn* bulk;
+    struct wetdem_many_bulk_in bulk_in;
 };
 
 /* Candidate q = (i, j, d = x_i - x_j) that passed the gap test: its kernel. Returns its flags.
@@ -724,11 +766,13 @@ struct pass {
  * own short path (lean_apart), the call cost more than the spills it used to save. */
 static unsigned char near_candidate(const struct pass* P, size_t q, size_t i, size_t j,
                                     struct wetdem_vec3 d, const struct wetdem_many_mix* x,
-                                    struct wetdem_many_pair_out* o, struct failure* fail)
+                                    struct wetdem_many_pair_out* o, struct failure* fail,
+                                    const struct wetdem_many_bulk_out* bo, size_t k)
     __attribute__((always_inline));
 static inline unsigned char near_candidate(const struct pass* P, size_t q, size_t i, size_t j,
                                            struct wetdem_vec3 d, const struct wetdem_many_mix* x,
-                                           struct wetdem_many_pair_out* o, struct failure* fail)
+                                           struct wetdem_many_pair_out* o, struct failure* fail,
+                                           const struct wetdem_many_bulk_out* bo, size_t k)
 {
     unsigned char* fl = &P->flags[q];
     if (!P->lean) {
@@ -737,11 +781,12 @@ static inline unsigned char near_candidate(const struct pass* P, size_t q, size_
     }
     unsigned char was = *fl;
     double* hist = P->history + q * P->len;
-    int st = lean_pair(P->m, i, j, d, x, hist, P->m->pair_cache[q], fl, o);
+    int st = lean_pair(P->m, i, j, d, x, hist, P->m->pair_cache[q], fl, o, bo, k);
     if (!*fl && (was & WETDEM_MANY_DIRTY) && P->len)
         wetdem_sim_history_init(P->sim, hist);
     if (st != WETDEM_OK) {
-        struct wetdem_contact c = {.gap = vec3_norm(d) - P->p[i].radius - P->p[j].radius};
+        struct wetdem_contact c = {.gap = bo ? bo->gap[k]
+                                             : vec3_norm(d) - P->p[i].radius - P->p[j].radius};
         note_failure(fail, q, st, false, &c, x->range);
     }
     return *fl;
@@ -829,7 +874,7 @@ eval_candidate(const struct pass* P, size_t q, size_t i, size_t j, struct wetdem
     if (skipped(P, q))
         return 0;
     if (within_reach(P, q, i, j, P->periodic, P->nm == 1, P->maintain, &d, &x))
-        return near_candidate(P, q, i, j, d, x, o, fail);
+        return near_candidate(P, q, i, j, d, x, o, fail, NULL, 0);
     if (P->flags[q])
         leave_range(P, q);
     return 0;
@@ -1306,10 +1351,9 @@ add_pair(const struct pass* P, size_t j, unsigned char fl, const struct wetdem_m
  * the list of those within range; one loop (`fused`, with usable skip times only): the
  * candidates whose time has come, each tested and, within range, evaluated at once, with the
  * geometry of the test (many.h fuse_on). The same kernels run in the same order. */
-static inline __attribute__((always_inline)) void pairs_of_block_as(const struct pass* P, size_t b,
-                                                                    bool kick, struct wetdem_vec3 g,
-                                                                    struct failure* fail,
-                                                                    bool fused, bool common)
+static inline __attribute__((always_inline)) void
+pairs_of_block_as(const struct pass* P, size_t b, bool kick, struct wetdem_vec3 g,
+                  struct failure* fail, bool fused, bool common, bool bulk)
 {
     /* a private copy of the pass, whose fields no store of the loop can change (as those of
        *P could, through the byte stores of flags and hit lists): kept in registers, not
@@ -1322,6 +1366,8 @@ static inline __attribute__((always_inline)) void pairs_of_block_as(const struct
     size_t e = m->cross_first[b], e_end = m->cross_first[b + 1]; /* the block's cross pairs */
     const unsigned char* flags = P->flags;
     bool single = common || P->nm == 1, periodic = !common && P->periodic;
+    struct wetdem_many_bulk_out bo; /* results of list[bulk_begin, bulk_end) */
+    size_t bulk_begin = 0, bulk_end = 0;
     /* 1. the candidates to test (fused), or the gap test of every candidate of the block whose
           second particle is in the block, in one flat loop without branches on its outcome:
           the pairs within range, and those with flags (they may have just left it), are listed
@@ -1352,7 +1398,44 @@ static inline __attribute__((always_inline)) void pairs_of_block_as(const struct
         }
         struct wetdem_vec3 f = vec3(0, 0, 0), t = vec3(0, 0, 0);
         uint32_t n_contacts = 0;
-        for (; h < n_list && pairs[list[h]].i == i; h++) {
+        if (bulk) /* its candidates, from the results of up to WETDEM_MANY_BULK_MAX at a time */
+            for (size_t q_next = m->cl.first_pair[i + 1];; h++) { /* i's come before q_next */
+                if (h == bulk_end) {                              /* the next candidates' results */
+                    if (h == n_list)
+                        break;
+                    size_t n_w =
+                        n_list - h < WETDEM_MANY_BULK_MAX ? n_list - h : WETDEM_MANY_BULK_MAX;
+                    P->bulk(&P->bulk_in, list + h, n_w, end_block, &bo);
+                    bulk_begin = h;
+                    bulk_end = h + n_w;
+                }
+                size_t k = h - bulk_begin, q = list[h], j = bo.j[k];
+                if (q >= q_next) /* a later particle's */
+                    break;
+                if (j >= end_block) /* a cross pair: tested and evaluated in phase 1 */
+                    continue;
+                long long cls = bo.cls[k];
+                if (!cls) { /* beyond within_reach's test, as below */
+                    set_skip_time(P, q, bo.r2[k]);
+                    if (flags[q])
+                        leave_range(P_out, q);
+                    continue;
+                }
+                n_near++;
+                if (cls != 1) { /* apart, finite: what near_candidate and add_pair do then */
+                    reset_spring_apart(&m->lean, flags[q], P->history + q * P->len);
+                    P->flags[q] = (unsigned char)cls;
+                    struct wetdem_vec3 fo = vec3(bo.force[0][k], bo.force[1][k], bo.force[2][k]);
+                    f = vec3_add(f, fo);
+                    m->force[j] = vec3_sub(m->force[j], fo);
+                    continue;
+                }
+                struct wetdem_many_pair_out o;
+                unsigned char fl =
+                    near_candidate(P, q, i, j, vec3(0, 0, 0), m->mix, &o, fail, &bo, k);
+                add_pair(P, j, fl, &o, &f, &t, &n_contacts);
+            }
+        for (; !bulk && h < n_list && pairs[list[h]].i == i; h++) {
             size_t q = list[h], j = pairs[q].j;
             struct wetdem_vec3 d;
             const struct wetdem_many_mix* x;
@@ -1378,7 +1461,7 @@ static inline __attribute__((always_inline)) void pairs_of_block_as(const struct
                 pair_delta(P, i, j, periodic, single, &d, &x);
             }
             struct wetdem_many_pair_out o;
-            unsigned char fl = near_candidate(P, q, i, j, d, x, &o, fail);
+            unsigned char fl = near_candidate(P, q, i, j, d, x, &o, fail, NULL, 0);
             add_pair(P, j, fl, &o, &f, &t, &n_contacts);
         }
         for (; e < e_end && pairs[m->cross_q[e]].i == i; e++) { /* its cross pairs, j order */
@@ -1405,17 +1488,20 @@ static inline __attribute__((always_inline)) void pairs_of_block_as(const struct
 }
 
 /* Phase 2 of block b (pairs_of_block_as), compiled apart for the one-loop pass in the common
- * case (one material pair, no periodic axis), the one-loop pass in general, and two loops. */
+ * case (one material pair, no periodic axis) with and without four pairs at a time, the
+ * one-loop pass in general, and two loops. */
 static void pairs_of_block(const struct pass* P, size_t b, bool kick, struct wetdem_vec3 g,
                            struct failure* fail)
 {
     bool common = P->nm == 1 && !P->periodic; /* one material pair, no periodic axis */
-    if (P->fused && common)
-        pairs_of_block_as(P, b, kick, g, fail, true, true);
+    if (P->fused && common && P->bulk)
+        pairs_of_block_as(P, b, kick, g, fail, true, true, true);
+    else if (P->fused && common)
+        pairs_of_block_as(P, b, kick, g, fail, true, true, false);
     else if (P->fused)
-        pairs_of_block_as(P, b, kick, g, fail, true, false);
+        pairs_of_block_as(P, b, kick, g, fail, true, false, false);
     else
-        pairs_of_block_as(P, b, kick, g, fail, false, false);
+        pairs_of_block_as(P, b, kick, g, fail, false, false, false);
 }
 
 /* The constants of every candidate pair (many.h: pair_lim2, and pair_cache for the lean
@@ -1513,6 +1599,29 @@ int wetdem_sim_many_forces(struct wetdem_sim* sim, bool kick)
                      .periodic = m->periodic_any,
                      .lean = lean_active(m),
                      .zeroed = m->sums_zeroed == n};
+    /* four pairs at a time where the film models act (their pairs apart are most of the
+       work; dry packings keep the scalar kernel, as fast there) */
+    if (P.lean && P.nm == 1 && !P.periodic && (m->lean.sb || m->lean.capillary) &&
+        m->bulk_mode != 1) {
+        const struct wetdem_many_mix* x = m->mix;
+        P.bulk = wetdem_many_bulk_choose(m->bulk_mode == 2);
+        P.bulk_in = (struct wetdem_many_bulk_in){
+            .xr = m->xr,
+            .vw = (const struct wetdem_vec3(*)[2])m->vw,
+            .pairs = m->cl.pairs,
+            .pair_cache = (const double(*)[4])m->pair_cache,
+            .lim2 = m->pair_lim2,
+            .film = x->film,
+            .film_h_min = x->film_h_min,
+            .range = x->range,
+            .sb_coef = 6.0 * M_PI * x->viscosity, /* the first product of film_terms' */
+            .cap_coef = 8.0 * M_PI,
+            .surface_tension = x->surface_tension,
+            .sb = m->lean.sb,
+            .sb_nc = (int)m->lean.sb_below == THIN_FILM_BELOW_NC,
+            .capillary = m->lean.capillary};
+    }
+    m->bulk_passes += fused && P.bulk;
     /* one region: cross pairs, a barrier, then each block on its own */
 #pragma omp parallel if (parallel)
     {

@@ -576,6 +576,107 @@ static void test_many_skipped_candidates_change_no_result(void** state)
         wetdem_sim_free(sims[s]);
 }
 
+/* A wet pile settling in a closed box, one material and no periodic axis (the case where the
+ * one-loop pass evaluates four pairs at a time, many_bulk.h), with the pass always in one loop
+ * and the given choice of the four-at-a-time version (many.h bulk_mode: 0 the processor's,
+ * 1 never, 2 the baseline instruction set). */
+static struct wetdem_sim* wet_pile(const char* const* models, int n_models, bool nc, int bulk_mode)
+{
+    struct wetdem_sim* sim = wetdem_sim_create();
+    struct wetdem_material a = {.density = 2500,
+                                .youngs_modulus = 1e7,
+                                .poisson_ratio = 0.3,
+                                .restitution = 0.6,
+                                .friction_dry = 0.4,
+                                .friction_lub = 0.1,
+                                .roughness = 1e-7,
+                                .film = 20e-6};
+    assert_int_equal(wetdem_sim_add_material(sim, &a), 0);
+    struct wetdem_fluid f = {.viscosity = 0.01, .surface_tension = 0.02, .density = 1000};
+    CHECK_OK(wetdem_sim_set_fluid(sim, &f));
+    for (int k = 0; k < n_models; k++)
+        CHECK_OK(wetdem_sim_enable_model(sim, models[k]));
+    if (nc)
+        CHECK_OK(wetdem_sim_set_param_str(sim, "sb.below_hmin", "nc"));
+    double hi[3] = {5e-3, 5e-3, 10e-3};
+    struct wetdem_insert_spec spec = {.layout = WETDEM_INSERT_RANDOM,
+                                      .n = 200,
+                                      .lo = {0, 0, 0},
+                                      .hi = {hi[0], hi[1], hi[2]},
+                                      .radius_min = 0.4e-3,
+                                      .radius_max = 0.5e-3,
+                                      .velocity_sigma = 0.2,
+                                      .seed = 5};
+    CHECK_OK(wetdem_sim_insert(sim, &spec));
+    for (int w = 0; w < 6; w++) {
+        struct wetdem_vec3 point = {w == 1 ? hi[0] : 0, w == 3 ? hi[1] : 0, w == 5 ? hi[2] : 0};
+        struct wetdem_vec3 normal = {w == 0   ? 1
+                                     : w == 1 ? -1
+                                              : 0,
+                                     w == 2   ? 1
+                                     : w == 3 ? -1
+                                              : 0,
+                                     w == 4   ? 1
+                                     : w == 5 ? -1
+                                              : 0};
+        CHECK_OK(wetdem_sim_add_wall(sim, point, normal, 0));
+    }
+    CHECK_OK(wetdem_sim_set_param(sim, "sim.gravity_z", -9.81));
+    struct wetdem_many_settings s = {
+        .box_lo = {0, 0, 0}, .box_hi = {hi[0], hi[1], hi[2]}, .dt = 2e-6, .skin = 0.05e-3};
+    CHECK_OK(wetdem_sim_set_many(sim, &s));
+    sim->many->parallel_min = 1; /* run the parallel loops even for this small system */
+    sim->many->skip_always = true;
+    sim->many->fuse_mode = 2;
+    sim->many->bulk_mode = bulk_mode;
+    return sim;
+}
+
+/* Four pairs at a time (many_bulk.h) in AVX2 where the processor has it and in the baseline
+ * instruction set give runs bit-identical to the scalar kernel's, with and without mindlin
+ * (whose springs are reset apart) and capillary, in either model order, with both treatments
+ * of sb below h_min', on 1 and 2 threads (cross pairs, whose lanes are left out), several
+ * calls, each compared: particles, pairs and flags (contacts, bridges). */
+static void test_many_four_at_a_time_change_no_result(void** state)
+{
+    (void)state;
+    static const char* const all[] = {"hertz", "mindlin", "sb", "capillary"};
+    static const char* const reordered[] = {"capillary", "hertz", "sb", "mindlin"};
+    static const char* const sb_only[] = {"hertz", "sb"};
+    struct {
+        const char* const* models;
+        int n_models;
+        bool nc;
+    } cases[] = {{all, 4, false}, {reordered, 4, true}, {sb_only, 2, true}};
+    int saved = omp_get_max_threads();
+    for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++)
+        for (int threads = 1; threads <= 2; threads++) {
+            omp_set_num_threads(threads);
+            struct wetdem_sim* sims[3];
+            for (int mode = 0; mode < 3; mode++) /* the processor's, never, the baseline */
+                sims[mode] = wet_pile(cases[c].models, cases[c].n_models, cases[c].nc, mode);
+            for (int call = 1; call <= 8; call++) {
+                for (int mode = 0; mode < 3; mode++)
+                    CHECK_OK(wetdem_sim_integrate(sims[mode], call * 1e-3));
+                same_run(sims[0], sims[1]);
+                same_run(sims[2], sims[1]);
+            }
+            const struct wetdem_many* m = sims[0]->many;
+            assert_true(m->bulk_passes > m->fused_passes / 2);
+            assert_true(sims[2]->many->bulk_passes == m->bulk_passes);
+            assert_int_equal(sims[1]->many->bulk_passes, 0);
+            size_t contacts = 0, apart = 0; /* both kinds were met at the end */
+            for (size_t q = 0; q < m->cl.n_pairs; q++) {
+                contacts += (m->flags[q] & WETDEM_MANY_CONTACT) != 0;
+                apart += (m->flags[q] & WETDEM_MANY_BRIDGE) && !(m->flags[q] & WETDEM_MANY_CONTACT);
+            }
+            assert_true(contacts > 10 && apart > 10);
+            for (int mode = 0; mode < 3; mode++)
+                wetdem_sim_free(sims[mode]);
+        }
+    omp_set_num_threads(saved);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -589,6 +690,7 @@ int main(void)
         cmocka_unit_test(test_many_lean_constants_follow_changed_particles),
         cmocka_unit_test(test_many_block_cuts_do_not_change_the_result),
         cmocka_unit_test(test_many_skipped_candidates_change_no_result),
+        cmocka_unit_test(test_many_four_at_a_time_change_no_result),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

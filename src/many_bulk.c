@@ -1,0 +1,18 @@
+/*
+ * many_bulk.c — four pairs at a time (many_bulk.h) for the baseline instruction set (SSE2 on
+ * x86-64, plain C elsewhere), and the choice of the version for the processor.
+ */
+#define WETDEM_MANY_BULK_NAME wetdem_many_bulk_base
+#include "many_bulk.h"
+
+wetdem_many_bulk_fn* wetdem_many_bulk_choose(bool base_only)
+{
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+    /* (libgcc's check includes the operating system's support of the AVX registers) */
+    if (!base_only && __builtin_cpu_supports("avx2"))
+        return wetdem_many_bulk_avx2;
+#else
+    (void)base_only;
+#endif
+    return wetdem_many_bulk_base;
+}
