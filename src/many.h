@@ -65,9 +65,9 @@ struct wetdem_many_pair_out {
                                   kept across rebuilds and restarts; the lean kernel resets the
                                   spring of a pair apart only then (else it is zero already) */
 
-/* Four pairs at a time (many_bulk.h): what the bulk geometry of one particle's candidates
- * reads, and what it gives per candidate. For the one-loop pass of the lean kernel in the
- * common case (one material pair, no periodic axis). */
+/* Four pairs at a time (many_bulk.h): what the bulk evaluation of a block's listed
+ * candidates reads, and what it gives per candidate. For the lean kernel with a film model in
+ * the common case (one material pair, no periodic axis). */
 #define WETDEM_MANY_BULK_MAX 64 /* candidates per call (a multiple of 4) */
 struct wetdem_many_bulk_in {
     const struct wetdem_celllist_item* xr;
@@ -185,7 +185,7 @@ struct wetdem_many {
     int bulk_mode;         /* tests: 0 four pairs at a time where it applies (many_bulk.h), 1 never,
                       2 with the baseline instruction set only */
     uint64_t fused_passes; /* passes run fused (tests) */
-    uint64_t bulk_passes;  /* of those, passes with four pairs at a time (tests) */
+    uint64_t bulk_passes;  /* passes with four pairs at a time (tests) */
     uint64_t pair_consts_build; /* the list build they were computed for */
     bool pair_consts_ready;     /* cleared when the kernel is set up */
     unsigned char* old_flags;   /* flags of the previous list, for remapping */

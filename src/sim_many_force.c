@@ -755,8 +755,7 @@ struct pass {
     bool fused;    /* skip, and the block's candidates are tested and evaluated in one loop */
     bool maintain; /* each tested candidate gets its skip time anew */
     bool zeroed;   /* the sums start from zero already (many.h sums_zeroed) */
-    /* four pairs at a time (many_bulk.h) in the one-loop pass of the lean kernel's common case,
-       or NULL */
+    /* four pairs at a time (many_bulk.h) for the lean kernel's common case, or NULL */
     wetdem_many_bulk_fn* bulk;
     struct wetdem_many_bulk_in bulk_in;
 };
@@ -1415,8 +1414,10 @@ pairs_of_block_as(const struct pass* P, size_t b, bool kick, struct wetdem_vec3 
                 if (j >= end_block) /* a cross pair: tested and evaluated in phase 1 */
                     continue;
                 long long cls = bo.cls[k];
-                if (!cls) { /* beyond within_reach's test, as below */
-                    set_skip_time(P, q, bo.r2[k]);
+                if (!cls) { /* beyond the gap test (as below): a new time in one loop; in two,
+                               the test gave it one, and listed it for its flags */
+                    if (fused)
+                        set_skip_time(P, q, bo.r2[k]);
                     if (flags[q])
                         leave_range(P_out, q);
                     continue;
@@ -1500,6 +1501,8 @@ static void pairs_of_block(const struct pass* P, size_t b, bool kick, struct wet
         pairs_of_block_as(P, b, kick, g, fail, true, true, false);
     else if (P->fused)
         pairs_of_block_as(P, b, kick, g, fail, true, false, false);
+    else if (common && P->bulk)
+        pairs_of_block_as(P, b, kick, g, fail, false, true, true);
     else
         pairs_of_block_as(P, b, kick, g, fail, false, false, false);
 }
@@ -1621,7 +1624,7 @@ int wetdem_sim_many_forces(struct wetdem_sim* sim, bool kick)
             .sb_nc = (int)m->lean.sb_below == THIN_FILM_BELOW_NC,
             .capillary = m->lean.capillary};
     }
-    m->bulk_passes += fused && P.bulk;
+    m->bulk_passes += P.bulk != NULL;
     /* one region: cross pairs, a barrier, then each block on its own */
 #pragma omp parallel if (parallel)
     {
