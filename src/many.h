@@ -90,7 +90,6 @@ struct wetdem_many_bulk_out { /* by component, each entry 32-byte aligned */
     double gap[WETDEM_MANY_BULK_MAX] __attribute__((aligned(32)));  /* [m] */
     double n[3][WETDEM_MANY_BULK_MAX] __attribute__((aligned(32))); /* unit normal, j to i */
     double v_n[WETDEM_MANY_BULK_MAX] __attribute__((aligned(32)));  /* [m/s] */
-    double f_n[WETDEM_MANY_BULK_MAX] __attribute__((aligned(32)));  /* normal force apart [N] */
     double f_sb[WETDEM_MANY_BULK_MAX] __attribute__((aligned(32))); /* its sb term [N] */
     double f_cap[WETDEM_MANY_BULK_MAX] __attribute__((aligned(32)));    /* its capillary term [N] */
     double force[3][WETDEM_MANY_BULK_MAX] __attribute__((aligned(32))); /* its force on i [N] */

@@ -99,12 +99,17 @@ struct bulk_constants {
     wetdem_v4i sb_on, nc, cap_on, bridge_on;
 };
 
-/* Candidates list[k..k+4) (with `tail`, those of them before n, the last one repeated). */
+/* Candidates list[k..k+4) (with `tail`, those of them before n, the last one repeated). With
+ * `both`, sb and capillary act within the films (film > 0) and sb is zero below h_min' (the
+ * masks of C are then known to be all ones, all ones, zeros and all ones). */
 static inline __attribute__((always_inline)) void
 bulk_four(const struct wetdem_many_bulk_in* in, const struct bulk_constants* C,
           const uint32_t* list, size_t n, size_t j_end, struct wetdem_many_bulk_out* out, size_t k,
-          bool tail)
+          bool tail, bool both)
 {
+    const wetdem_v4i all = {-1, -1, -1, -1}, none = {0, 0, 0, 0};
+    const wetdem_v4i sb_on = both ? all : C->sb_on, nc = both ? none : C->nc,
+                     cap_on = both ? all : C->cap_on, bridge_on = both ? all : C->bridge_on;
     const struct wetdem_celllist_item* xr = in->xr;
     const struct wetdem_vec3(*vw)[2] = in->vw;
     const wetdem_v4d zero = C->zero, one = C->one, film = C->film;
@@ -141,12 +146,12 @@ bulk_four(const struct wetdem_many_bulk_in* in, const struct bulk_constants* C,
     wetdem_v4i in_film = ~(gap > film); /* also where gap is NaN, as the scalar test */
     wetdem_v4i at_gap = gap >= C->h_min;
     wetdem_v4d h = BULK_SELECT(at_gap, gap, C->h_min);
-    wetdem_v4i sb_acts = C->sb_on & in_film & (at_gap | C->nc) & (h > zero);
+    wetdem_v4i sb_acts = sb_on & in_film & (at_gap | nc) & (h > zero);
     wetdem_v4d bracket = one - h / film;
     /* R* = R_i R_j / (R_i + R_j): contact_reduced of finite radii, the pair constants' */
     wetdem_v4d r_eff = pi[3] * pj[3] / (pi[3] + pj[3]);
     wetdem_v4d f_sb = C->sb_coef * r_eff * r_eff * v_n / h * bracket * bracket;
-    wetdem_v4i cap_acts = C->cap_on & (gap <= film);
+    wetdem_v4i cap_acts = cap_on & (gap <= film);
     wetdem_v4d f_cap = -(C->cap_coef * r_eff * C->tension);
     f_sb = BULK_SELECT(sb_acts, f_sb, zero); /* film_terms': +0 where a law does not act */
     f_cap = BULK_SELECT(cap_acts, f_cap, zero);
@@ -155,8 +160,8 @@ bulk_four(const struct wetdem_many_bulk_in* in, const struct bulk_constants* C,
        with a finite force (odd, >= 9), else 1 (the scalar kernel decides) */
     wetdem_v4i near = r2 <= lim2;
     wetdem_v4i fast = ~(gap < zero) & ~(gap > C->range) & ((f_n - f_n) == zero);
-    wetdem_v4i apart_flags = (WETDEM_MANY_ACTIVE | WETDEM_MANY_DIRTY) |
-                             (C->bridge_on & (gap < film) & WETDEM_MANY_BRIDGE);
+    wetdem_v4i apart_flags =
+        (WETDEM_MANY_ACTIVE | WETDEM_MANY_DIRTY) | (bridge_on & (gap < film) & WETDEM_MANY_BRIDGE);
     *(wetdem_v4i*)&out->cls[k] = near & ((fast & (apart_flags - 1)) | 1);
     *(wetdem_v4d*)&out->r2[k] = r2; /* (out has room for the lanes past n) */
     *(wetdem_v4d*)&out->gap[k] = gap;
@@ -164,7 +169,6 @@ bulk_four(const struct wetdem_many_bulk_in* in, const struct bulk_constants* C,
     *(wetdem_v4d*)&out->n[1][k] = ny;
     *(wetdem_v4d*)&out->n[2][k] = nz;
     *(wetdem_v4d*)&out->v_n[k] = v_n;
-    *(wetdem_v4d*)&out->f_n[k] = f_n;
     *(wetdem_v4d*)&out->f_sb[k] = f_sb;
     *(wetdem_v4d*)&out->f_cap[k] = f_cap;
     *(wetdem_v4d*)&out->force[0][k] = zero + f_n * nx;
@@ -190,11 +194,16 @@ void WETDEM_MANY_BULK_NAME(const struct wetdem_many_bulk_in* in, const uint32_t*
                                      .nc = BULK_UNIFORM(in->sb_nc),
                                      .cap_on = BULK_UNIFORM(in->capillary && in->film > 0),
                                      .bridge_on = BULK_UNIFORM(in->film > 0)};
+    bool both = in->sb && in->capillary && in->film > 0 && !in->sb_nc; /* the usual case */
     size_t k = 0;
-    for (; k + 4 <= n; k += 4)
-        bulk_four(in, &C, list, n, j_end, out, k, false);
+    if (both)
+        for (; k + 4 <= n; k += 4)
+            bulk_four(in, &C, list, n, j_end, out, k, false, true);
+    else
+        for (; k + 4 <= n; k += 4)
+            bulk_four(in, &C, list, n, j_end, out, k, false, false);
     if (k < n)
-        bulk_four(in, &C, list, n, j_end, out, k, true);
+        bulk_four(in, &C, list, n, j_end, out, k, true, false);
 }
 
 #endif

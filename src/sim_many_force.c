@@ -547,7 +547,7 @@ lean_pair(const struct wetdem_many* m, size_t ia, size_t ib, struct wetdem_vec3 
         n = vec3(bo->n[0][k], bo->n[1][k], bo->n[2][k]);
         v_n = bo->v_n[k];
         if (!(gap < 0.0))
-            return apart_result(&m->lean, x, gap, bo->f_n[k],
+            return apart_result(&m->lean, x, gap, (0.0 + bo->f_sb[k]) + bo->f_cap[k],
                                 vec3(bo->force[0][k], bo->force[1][k], bo->force[2][k]), was, hist,
                                 flags, o);
         film[0] = bo->f_sb[k];
