@@ -19,9 +19,9 @@
 #include "many.h"
 #include "models.h"
 
-/* Two materials that differ in every property the contact mixes, a fluid, and the model
- * set given (in that order). */
-static struct wetdem_sim* two_material_sim(const char* const* models, int n_models)
+/* The first material, or two that differ in every property the contact mixes, a fluid, and
+ * the model set given (in that order). */
+static struct wetdem_sim* materials_sim(const char* const* models, int n_models, bool two)
 {
     struct wetdem_sim* sim = wetdem_sim_create();
     struct wetdem_material a = {.density = 2500,
@@ -41,12 +41,18 @@ static struct wetdem_sim* two_material_sim(const char* const* models, int n_mode
                                 .roughness = 3e-7,
                                 .film = 10e-6};
     assert_int_equal(wetdem_sim_add_material(sim, &a), 0);
-    assert_int_equal(wetdem_sim_add_material(sim, &b), 1);
+    if (two)
+        assert_int_equal(wetdem_sim_add_material(sim, &b), 1);
     struct wetdem_fluid f = {.viscosity = 0.01, .surface_tension = 0.02, .density = 1000};
     CHECK_OK(wetdem_sim_set_fluid(sim, &f));
     for (int k = 0; k < n_models; k++)
         CHECK_OK(wetdem_sim_enable_model(sim, models[k]));
     return sim;
+}
+
+static struct wetdem_sim* two_material_sim(const char* const* models, int n_models)
+{
+    return materials_sim(models, n_models, true);
 }
 
 /* Random particles of both materials near one another, spinning, and a floor; the many
@@ -584,20 +590,7 @@ static void test_many_skipped_candidates_change_no_result(void** state)
 static struct wetdem_sim* wet_pile(const char* const* models, int n_models, bool nc, int fuse_mode,
                                    int bulk_mode)
 {
-    struct wetdem_sim* sim = wetdem_sim_create();
-    struct wetdem_material a = {.density = 2500,
-                                .youngs_modulus = 1e7,
-                                .poisson_ratio = 0.3,
-                                .restitution = 0.6,
-                                .friction_dry = 0.4,
-                                .friction_lub = 0.1,
-                                .roughness = 1e-7,
-                                .film = 20e-6};
-    assert_int_equal(wetdem_sim_add_material(sim, &a), 0);
-    struct wetdem_fluid f = {.viscosity = 0.01, .surface_tension = 0.02, .density = 1000};
-    CHECK_OK(wetdem_sim_set_fluid(sim, &f));
-    for (int k = 0; k < n_models; k++)
-        CHECK_OK(wetdem_sim_enable_model(sim, models[k]));
+    struct wetdem_sim* sim = materials_sim(models, n_models, false);
     if (nc)
         CHECK_OK(wetdem_sim_set_param_str(sim, "sb.below_hmin", "nc"));
     double hi[3] = {5e-3, 5e-3, 10e-3};
