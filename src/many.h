@@ -73,7 +73,6 @@ struct wetdem_many_bulk_in {
     const struct wetdem_celllist_item* xr;
     const struct wetdem_vec3 (*vw)[2];
     const struct wetdem_celllist_pair* pairs;
-    const double (*pair_cache)[4];
     const double* lim2;             /* pair_lim2 */
     double film, film_h_min, range; /* of the material pair [m] */
     double sb_coef;                 /* 6 pi mu [Pa s] */
@@ -178,13 +177,13 @@ struct wetdem_many {
        latest pass decides: fused when at least 3/4 of the tested candidates (pass_candidates
        less pass_skipped) were within range. Either way the same kernels run in the same order
        (sim_many_force.c). */
-    uint64_t pass_near;    /* in-block candidates of the latest pass within range */
-    bool fuse_on;          /* the next pass with usable skip times runs fused */
-    int fuse_mode;         /* tests: 0 decided as above, 1 never fused, 2 always fused */
-    int bulk_mode;         /* tests: 0 four pairs at a time where it applies (many_bulk.h), 1 never,
-                      2 with the baseline instruction set only */
-    uint64_t fused_passes; /* passes run fused (tests) */
-    uint64_t bulk_passes;  /* passes with four pairs at a time (tests) */
+    uint64_t pass_near;         /* in-block candidates of the latest pass within range */
+    bool fuse_on;               /* the next pass with usable skip times runs fused */
+    int fuse_mode;              /* tests: 0 decided as above, 1 never fused, 2 always fused */
+    int bulk_mode;              /* tests: four pairs at a time (many_bulk.h) where it applies (0),
+                              never (1), or in the baseline instruction set only (2) */
+    uint64_t fused_passes;      /* passes run fused (tests) */
+    uint64_t bulk_passes;       /* passes with four pairs at a time (tests) */
     uint64_t pair_consts_build; /* the list build they were computed for */
     bool pair_consts_ready;     /* cleared when the kernel is set up */
     unsigned char* old_flags;   /* flags of the previous list, for remapping */

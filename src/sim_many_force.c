@@ -1612,7 +1612,6 @@ int wetdem_sim_many_forces(struct wetdem_sim* sim, bool kick)
             .xr = m->xr,
             .vw = (const struct wetdem_vec3(*)[2])m->vw,
             .pairs = m->cl.pairs,
-            .pair_cache = (const double(*)[4])m->pair_cache,
             .lim2 = m->pair_lim2,
             .film = x->film,
             .film_h_min = x->film_h_min,
