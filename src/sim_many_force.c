@@ -1322,6 +1322,25 @@ gap_test(const struct pass* P, size_t q_begin, size_t q_end, size_t end_block,
                            true); /* (P->skip implies P->maintain) */
 }
 
+/* A pair's force on i into i's running sum f, and its reaction at once into j's force. */
+static inline __attribute__((always_inline)) void
+add_reaction_pair(struct wetdem_many* m, size_t j, struct wetdem_vec3 force, struct wetdem_vec3* f)
+{
+    *f = vec3_add(*f, force);
+    m->force[j] = vec3_sub(m->force[j], force);
+}
+
+/* Candidate q beyond the gap test's reach (squared distance r2 [m^2]): in one loop (`fused`)
+ * its new skip time; the flags it may have, dropped (leave_range, out of line, gets P_out). */
+static inline __attribute__((always_inline)) void
+beyond_reach(const struct pass* P, const struct pass* P_out, size_t q, double r2, bool fused)
+{
+    if (fused)
+        set_skip_time(P, q, r2);
+    if (P->flags[q])
+        leave_range(P_out, q);
+}
+
 /* Pair q = (i, j) of block b, with result o and flags fl: into particle i's running sums
  * (f, t, n_contacts), and its reaction at once into j's sums. */
 static inline __attribute__((always_inline)) void
@@ -1332,9 +1351,8 @@ add_pair(const struct pass* P, size_t j, unsigned char fl, const struct wetdem_m
         return;
     struct wetdem_many* m = P->m;
     uint32_t c = (fl & WETDEM_MANY_CONTACT) ? 1 : 0;
-    *f = vec3_add(*f, o->force);
+    add_reaction_pair(m, j, o->force, f);
     *n_contacts += c;
-    m->force[j] = vec3_sub(m->force[j], o->force);
     m->contacts[j] += c;
     if (adds_torque(P->lean, fl)) {
         *t = vec3_add(*t, o->torque_i);
@@ -1414,21 +1432,17 @@ pairs_of_block_as(const struct pass* P, size_t b, bool kick, struct wetdem_vec3 
                 if (j >= end_block) /* a cross pair: tested and evaluated in phase 1 */
                     continue;
                 long long cls = bo.cls[k];
-                if (!cls) { /* beyond the gap test (as below): a new time in one loop; in two,
-                               the test gave it one, and listed it for its flags */
-                    if (fused)
-                        set_skip_time(P, q, bo.r2[k]);
-                    if (flags[q])
-                        leave_range(P_out, q);
+                if (!cls) { /* beyond (in two loops the test gave it its time and listed it for
+                               its flags) */
+                    beyond_reach(P, P_out, q, bo.r2[k], fused);
                     continue;
                 }
                 n_near++;
                 if (cls != 1) { /* apart, finite: what near_candidate and add_pair do then */
                     reset_spring_apart(&m->lean, flags[q], P->history + q * P->len);
-                    P->flags[q] = (unsigned char)cls;
-                    struct wetdem_vec3 fo = vec3(bo.force[0][k], bo.force[1][k], bo.force[2][k]);
-                    f = vec3_add(f, fo);
-                    m->force[j] = vec3_sub(m->force[j], fo);
+                    P->flags[q] = (unsigned char)cls; /* (no contact: no counts, no torques) */
+                    add_reaction_pair(m, j, vec3(bo.force[0][k], bo.force[1][k], bo.force[2][k]),
+                                      &f);
                     continue;
                 }
                 struct wetdem_many_pair_out o;
@@ -1447,9 +1461,7 @@ pairs_of_block_as(const struct pass* P, size_t b, bool kick, struct wetdem_vec3 
                    keep theirs, which came before this pass's clock and so before every later
                    one (until a restart, after which all are tested) */
                 if (!within_reach(P, q, i, j, periodic, single, false, &d, &x)) {
-                    set_skip_time(P, q, vec3_dot(d, d));
-                    if (flags[q])
-                        leave_range(P_out, q);
+                    beyond_reach(P, P_out, q, vec3_dot(d, d), true);
                     continue;
                 }
                 n_near++;
