@@ -79,10 +79,25 @@ struct wetdem_many_bulk_in {
     double cap_coef;                /* 8 pi */
     double surface_tension;         /* [N/m] */
     bool sb, sb_nc, capillary;      /* sb and capillary enabled; sb's "nc" treatment below h_min' */
+    /* solid contacts (gap < 0) four at a time too (many_bulk.h bulk_contacts), with the lean
+       kernel's plan: hertz (form 0 exact, 1 tsuji, -1 absent), mindlin, the normal forces in
+       model order (0 hertz, 1 sb, 2 capillary) */
+    bool contacts;
+    int hertz_form;
+    bool mindlin;
+    int n_normal;
+    unsigned char normal[WETDEM_MAX_MODELS];
+    const double (*cache)[4]; /* pair_cache: R* [m], m* [kg], Hertz k, damping factor */
+    double* history;          /* the pair histories, len doubles each; the Mindlin spring at */
+    size_t len, spring_off;   /* spring_off of them [m] */
+    double dt;                /* [s] */
+    double g_star, mu;        /* G* [Pa] and the Coulomb coefficient of the Mindlin limit [-] */
+    double tangential_factor; /* the Mindlin damping factor -2 sqrt(5/6) beta [-] */
 };
 struct wetdem_many_bulk_out { /* by component, each entry 32-byte aligned */
     /* 0: beyond the gap test's reach (|x_i - x_j|^2 > pair_lim2); 1: within it, for the scalar
-       kernel; else apart within the range with a finite force, and these are its flags */
+       kernel; else its flags: apart within the range with a finite force, or (with `contacts`
+       in the input) in solid contact with a finite force and torques, its spring stored */
     long long cls[WETDEM_MANY_BULK_MAX] __attribute__((aligned(32)));
     uint32_t j[WETDEM_MANY_BULK_MAX];                               /* the pair's second particle */
     double r2[WETDEM_MANY_BULK_MAX] __attribute__((aligned(32)));   /* |x_i - x_j|^2 [m^2] */
@@ -92,6 +107,8 @@ struct wetdem_many_bulk_out { /* by component, each entry 32-byte aligned */
     double f_sb[WETDEM_MANY_BULK_MAX] __attribute__((aligned(32))); /* its sb term [N] */
     double f_cap[WETDEM_MANY_BULK_MAX] __attribute__((aligned(32)));    /* its capillary term [N] */
     double force[3][WETDEM_MANY_BULK_MAX] __attribute__((aligned(32))); /* its force on i [N] */
+    /* in solid contact (cls has WETDEM_MANY_CONTACT): the torques on i and j [N m] */
+    double torque_i[3][WETDEM_MANY_BULK_MAX], torque_j[3][WETDEM_MANY_BULK_MAX];
 };
 typedef void wetdem_many_bulk_fn(const struct wetdem_many_bulk_in* in, const uint32_t* list,
                                  size_t n, size_t j_end, struct wetdem_many_bulk_out* out);
@@ -184,6 +201,7 @@ struct wetdem_many {
                               never (1), or in the baseline instruction set only (2) */
     uint64_t fused_passes;      /* passes run fused (tests) */
     uint64_t bulk_passes;       /* passes with four pairs at a time (tests) */
+    uint64_t bulk_contacts;     /* solid contacts evaluated four at a time (tests) */
     uint64_t pair_consts_build; /* the list build they were computed for */
     bool pair_consts_ready;     /* cleared when the kernel is set up */
     unsigned char* old_flags;   /* flags of the previous list, for remapping */

@@ -14,6 +14,20 @@
  *   capillary (force_capillary.c; Punch 2023 Eq. 15):  F_cap = -8 pi R* sigma,
  *   each for gap <= delta and +0 where it does not act;
  *   apart: f_n = (+0 + F_sb) + F_cap,  force = +0 + f_n n.
+ * With `contacts` in the input, the candidates in solid contact (gap < 0) are then evaluated
+ * four at a time as well (bulk_contacts): lean_contact and lean_force of sim_many_force.c for
+ * hertz and mindlin, lane by lane, with R*, m*, k and the damping factor from the pair
+ * constants (Hertz: Nijssen 2023 Eq. 2 and the Tsuji damping, force_hertz.c; Mindlin: the
+ * spring of force_mindlin.c, mindlin.h):
+ *   v_t = (v_i + w_i x (-R_i n)) - (v_j + w_j x (R_j n)), less its normal part,
+ *   delta = -gap,  F_el = k delta sqrt(delta),  F_d = c sqrt(sqrt(delta)) v_n,
+ *   F_hertz = F_el + F_d (tsuji) or max(F_el + F_d, 0) (exact),
+ *   s = the spring rotated into the tangent plane (its length kept) + dt v_t,
+ *   k_t = 8 G* sqrt(R* delta),  gamma_t = factor sqrt(m* k_t),  F_t = -k_t s - gamma_t v_t,
+ *   where |F_t| > mu |F_el|: F_t scaled to mu |F_el|, s = -(F_t + gamma_t v_t) / k_t,
+ *   torques -R_i n x F_t and -R_j n x F_t,  F = F_t + (the normal terms in model order) n.
+ * A lane whose force or torques are not finite is left to the scalar kernel (class 1, spring
+ * not stored), which reports it.
  * IEEE 754 addition, multiplication, division and square root are correctly rounded lane by
  * lane, and the build has no contraction into fused multiply-adds (-ffp-contract=off), so every
  * value is bit-identical to the scalar kernel's (tests/test_many_force.c compares whole runs
@@ -91,6 +105,14 @@ static inline __attribute__((always_inline)) void bulk_columns(const double* p0,
 #endif
 }
 
+/* The lanes of v at the entries idx[0..3] of the array a. */
+#define BULK_GATHER(a, idx)                                                                        \
+    ((wetdem_v4d){(a)[(idx)[0]], (a)[(idx)[1]], (a)[(idx)[2]], (a)[(idx)[3]]})
+
+/* All ones in the lanes where a is finite (a - a is 0 there, NaN elsewhere); a is evaluated
+ * twice. (A macro: GCC warns about 32-byte vectors returned by value without AVX.) */
+#define BULK_FINITE(a) (((a) - (a)) == (wetdem_v4d){0, 0, 0, 0})
+
 /* The constants of a call, in every lane. */
 struct bulk_constants {
     wetdem_v4d zero, one, film, h_min, range, sb_coef, cap_coef, tension;
@@ -99,17 +121,28 @@ struct bulk_constants {
     wetdem_v4i sb_on, nc, cap_on, bridge_on;
 };
 
-/* Candidates list[k..k+4) (with `tail`, those of them before n, the last one repeated). With
- * `both`, sb and capillary act within the films (film > 0) and sb is zero below h_min' (the
- * masks of C are then known to be all ones, all ones, zeros and all ones). */
+/* The film models of a call, when known at compile time: BULK_BOTH, sb and capillary act within
+ * the films (film > 0) and sb is zero below h_min' (the masks of C are then all ones, all ones,
+ * zeros and all ones); BULK_DRY, neither acts (their terms are +0, as film_terms leaves
+ * them). */
+enum bulk_films { BULK_ANY, BULK_BOTH, BULK_DRY };
+
+/* Candidates list[k..k+4) (with `tail`, those of them before n, the last one repeated). */
 static inline __attribute__((always_inline)) void
 bulk_four(const struct wetdem_many_bulk_in* in, const struct bulk_constants* C,
           const uint32_t* list, size_t n, size_t j_end, struct wetdem_many_bulk_out* out, size_t k,
-          bool tail, bool both)
+          bool tail, enum bulk_films films)
 {
     const wetdem_v4i all = {-1, -1, -1, -1}, none = {0, 0, 0, 0};
-    const wetdem_v4i sb_on = both ? all : C->sb_on, nc = both ? none : C->nc,
-                     cap_on = both ? all : C->cap_on, bridge_on = both ? all : C->bridge_on;
+    bool both = films == BULK_BOTH, dry = films == BULK_DRY;
+    const wetdem_v4i sb_on = both  ? all
+                             : dry ? none
+                                   : C->sb_on,
+                     nc = both || dry ? none : C->nc,
+                     cap_on = both  ? all
+                              : dry ? none
+                                    : C->cap_on,
+                     bridge_on = both ? all : C->bridge_on;
     const struct wetdem_celllist_item* xr = in->xr;
     const struct wetdem_vec3(*vw)[2] = in->vw;
     const wetdem_v4d zero = C->zero, one = C->one, film = C->film;
@@ -146,15 +179,18 @@ bulk_four(const struct wetdem_many_bulk_in* in, const struct bulk_constants* C,
     wetdem_v4i in_film = ~(gap > film); /* also where gap is NaN, as the scalar test */
     wetdem_v4i at_gap = gap >= C->h_min;
     wetdem_v4d h = BULK_SELECT(at_gap, gap, C->h_min);
-    wetdem_v4i sb_acts = sb_on & in_film & (at_gap | nc) & (h > zero);
-    wetdem_v4d bracket = one - h / film;
-    /* R* = R_i R_j / (R_i + R_j): contact_reduced of finite radii, the pair constants' */
-    wetdem_v4d r_eff = pi[3] * pj[3] / (pi[3] + pj[3]);
-    wetdem_v4d f_sb = C->sb_coef * r_eff * r_eff * v_n / h * bracket * bracket;
-    wetdem_v4i cap_acts = cap_on & (gap <= film);
-    wetdem_v4d f_cap = -(C->cap_coef * r_eff * C->tension);
-    f_sb = BULK_SELECT(sb_acts, f_sb, zero); /* film_terms': +0 where a law does not act */
-    f_cap = BULK_SELECT(cap_acts, f_cap, zero);
+    wetdem_v4d f_sb = zero, f_cap = zero; /* film_terms': +0 where a law does not act */
+    if (!dry) {
+        wetdem_v4i sb_acts = sb_on & in_film & (at_gap | nc) & (h > zero);
+        wetdem_v4d bracket = one - h / film;
+        /* R* = R_i R_j / (R_i + R_j): contact_reduced of finite radii, the pair constants' */
+        wetdem_v4d r_eff = pi[3] * pj[3] / (pi[3] + pj[3]);
+        f_sb = C->sb_coef * r_eff * r_eff * v_n / h * bracket * bracket;
+        wetdem_v4i cap_acts = cap_on & (gap <= film);
+        f_cap = -(C->cap_coef * r_eff * C->tension);
+        f_sb = BULK_SELECT(sb_acts, f_sb, zero);
+        f_cap = BULK_SELECT(cap_acts, f_cap, zero);
+    }
     wetdem_v4d f_n = (zero + f_sb) + f_cap;
     /* the class: 0 beyond the gap test's reach, else the flags of a pair apart within its range
        with a finite force (odd, >= 9), else 1 (the scalar kernel decides) */
@@ -176,9 +212,152 @@ bulk_four(const struct wetdem_many_bulk_in* in, const struct bulk_constants* C,
     *(wetdem_v4d*)&out->force[2][k] = zero + f_n * nz;
 }
 
+/* The out entries at[0..4) (candidates list[at[l]]) in solid contact, with the geometry and
+ * film terms bulk_four gave them: lean_contact and lean_force lane by lane (the header); each
+ * lane with a finite result gets its force, torques and flags (cls) and its spring stored,
+ * the others keep class 1. Lanes may repeat an entry (they compute and store the same). */
+static inline __attribute__((always_inline)) void
+bulk_contacts(const struct wetdem_many_bulk_in* in, const struct bulk_constants* C,
+              const uint32_t* list, const uint32_t at[4], struct wetdem_many_bulk_out* out,
+              bool films)
+{
+    const wetdem_v4d zero = C->zero;
+    uint32_t q[4], i[4], j[4];
+    for (int l = 0; l < 4; l++) {
+        q[l] = list[at[l]];
+        i[l] = in->pairs[q[l]].i;
+        j[l] = out->j[at[l]];
+    }
+    wetdem_v4d gap = BULK_GATHER(out->gap, at), v_n = BULK_GATHER(out->v_n, at);
+    wetdem_v4d nx = BULK_GATHER(out->n[0], at), ny = BULK_GATHER(out->n[1], at),
+               nz = BULK_GATHER(out->n[2], at);
+    wetdem_v4d r_a = {in->xr[i[0]].r, in->xr[i[1]].r, in->xr[i[2]].r, in->xr[i[3]].r};
+    wetdem_v4d r_b = {in->xr[j[0]].r, in->xr[j[1]].r, in->xr[j[2]].r, in->xr[j[3]].r};
+    wetdem_v4d pc[4]; /* R*, m*, k, damping factor */
+    bulk_columns(in->cache[q[0]], in->cache[q[1]], in->cache[q[2]], in->cache[q[3]], pc);
+    wetdem_v4d overlap = -gap, root = overlap;
+    bulk_sqrt(&root);
+    wetdem_v4d f_el = pc[2] * overlap * root; /* hertz_elastic_k */
+    wetdem_v4d term[3] = {zero, zero, zero};  /* hertz, sb, capillary */
+    if (in->hertz_form >= 0) {                /* hertz_total of hertz_damping_from */
+        wetdem_v4d quarter = root;
+        bulk_sqrt(&quarter);
+        wetdem_v4d sum = f_el + pc[3] * quarter * v_n;
+        term[0] = in->hertz_form == 1 ? sum : BULK_SELECT(sum > zero, sum, zero);
+    }
+    if (films) {
+        term[1] = BULK_GATHER(out->f_sb, at);
+        term[2] = BULK_GATHER(out->f_cap, at);
+    }
+    wetdem_v4d ft[3] = {zero, zero, zero}, ti[3] = {zero, zero, zero}, tj[3] = {zero, zero, zero};
+    wetdem_v4d s[3];
+    if (in->mindlin) {
+        /* the contact points' velocities (velocity, spin: columns at the record's start and at
+           its third double) and the tangential velocity, vec3_reject */
+        const struct wetdem_vec3(*vw)[2] = in->vw;
+        wetdem_v4d a0[4], a1[4], b0[4], b1[4]; /* v_x v_y v_z w_x, v_z w_x w_y w_z */
+        bulk_columns(&vw[i[0]][0].x, &vw[i[1]][0].x, &vw[i[2]][0].x, &vw[i[3]][0].x, a0);
+        bulk_columns(&vw[i[0]][0].z, &vw[i[1]][0].z, &vw[i[2]][0].z, &vw[i[3]][0].z, a1);
+        bulk_columns(&vw[j[0]][0].x, &vw[j[1]][0].x, &vw[j[2]][0].x, &vw[j[3]][0].x, b0);
+        bulk_columns(&vw[j[0]][0].z, &vw[j[1]][0].z, &vw[j[2]][0].z, &vw[j[3]][0].z, b1);
+        wetdem_v4d mra = -r_a, ax = nx * mra, ay = ny * mra, az = nz * mra; /* n (-R_i) */
+        wetdem_v4d bx = nx * r_b, by = ny * r_b, bz = nz * r_b;             /* n R_j */
+        wetdem_v4d wa_x = a1[1], wa_y = a1[2], wa_z = a1[3], wb_x = b1[1], wb_y = b1[2],
+                   wb_z = b1[3];
+        wetdem_v4d va_x = a0[0] + (wa_y * az - wa_z * ay), va_y = a0[1] + (wa_z * ax - wa_x * az),
+                   va_z = a0[2] + (wa_x * ay - wa_y * ax);
+        wetdem_v4d vb_x = b0[0] + (wb_y * bz - wb_z * by), vb_y = b0[1] + (wb_z * bx - wb_x * bz),
+                   vb_z = b0[2] + (wb_x * by - wb_y * bx);
+        wetdem_v4d rx = va_x - vb_x, ry = va_y - vb_y, rz = va_z - vb_z;
+        wetdem_v4d rn = -(rx * nx + ry * ny + rz * nz);
+        wetdem_v4d vt_x = rx + rn * nx, vt_y = ry + rn * ny, vt_z = rz + rn * nz;
+        /* mindlin_spring: the spring rotated into the plane (rotate_into_plane), advanced */
+        for (int c = 0; c < 3; c++)
+            s[c] = (wetdem_v4d){in->history[q[0] * in->len + in->spring_off + c],
+                                in->history[q[1] * in->len + in->spring_off + c],
+                                in->history[q[2] * in->len + in->spring_off + c],
+                                in->history[q[3] * in->len + in->spring_off + c]};
+        wetdem_v4d len = s[0] * s[0] + s[1] * s[1] + s[2] * s[2];
+        bulk_sqrt(&len);
+        wetdem_v4d sn = -(s[0] * nx + s[1] * ny + s[2] * nz);
+        wetdem_v4d px = s[0] + sn * nx, py = s[1] + sn * ny, pz = s[2] + sn * nz;
+        wetdem_v4d plen = px * px + py * py + pz * pz;
+        bulk_sqrt(&plen);
+        wetdem_v4i some = plen > zero;
+        wetdem_v4d ratio = len / BULK_SELECT(some, plen, C->one);
+        s[0] = BULK_SELECT(some, px * ratio, zero) + BULK_SPLAT(in->dt) * vt_x;
+        s[1] = BULK_SELECT(some, py * ratio, zero) + BULK_SPLAT(in->dt) * vt_y;
+        s[2] = BULK_SELECT(some, pz * ratio, zero) + BULK_SPLAT(in->dt) * vt_z;
+        wetdem_v4d k_t = pc[0] * overlap;
+        bulk_sqrt(&k_t);
+        k_t = BULK_SPLAT(8.0 * in->g_star) * k_t; /* tangential_stiffness */
+        wetdem_v4d gamma_t = pc[1] * k_t;
+        bulk_sqrt(&gamma_t);
+        gamma_t = BULK_SPLAT(in->tangential_factor) * gamma_t; /* tangential_damping */
+        wetdem_v4d mk = -k_t, mg = -gamma_t;
+        ft[0] = s[0] * mk + mg * vt_x;
+        ft[1] = s[1] * mk + mg * vt_y;
+        ft[2] = s[2] * mk + mg * vt_z;
+        wetdem_v4d f_total = ft[0] * ft[0] + ft[1] * ft[1] + ft[2] * ft[2];
+        bulk_sqrt(&f_total);
+        const wetdem_v4i magnitude = {INT64_MAX, INT64_MAX, INT64_MAX, INT64_MAX};
+        wetdem_v4d f_max = BULK_SPLAT(in->mu) * (wetdem_v4d)((wetdem_v4i)f_el & magnitude);
+        wetdem_v4i slide = f_total > f_max;
+        if (slide[0] | slide[1] | slide[2] | slide[3]) { /* capped, the spring set to match */
+            wetdem_v4d cap = f_max / BULK_SELECT(slide, f_total, C->one);
+            wetdem_v4i stiff = k_t > zero;
+            wetdem_v4d inv_k = BULK_SPLAT(-1.0) / BULK_SELECT(stiff, k_t, C->one);
+            for (int c = 0; c < 3; c++) {
+                wetdem_v4d vt = c == 0 ? vt_x : c == 1 ? vt_y : vt_z;
+                wetdem_v4d capped = ft[c] * cap;
+                wetdem_v4d back = BULK_SELECT(stiff, (capped + gamma_t * vt) * inv_k, zero);
+                ft[c] = BULK_SELECT(slide, capped, ft[c]);
+                s[c] = BULK_SELECT(slide, back, s[c]);
+            }
+        }
+        /* the torques, -R n x F_t (lean_force: from zero, so +0 + ...) */
+        wetdem_v4d cx = ny * ft[2] - nz * ft[1], cy = nz * ft[0] - nx * ft[2],
+                   cz = nx * ft[1] - ny * ft[0];
+        wetdem_v4d mrb = -r_b;
+        ti[0] = zero + mra * cx;
+        ti[1] = zero + mra * cy;
+        ti[2] = zero + mra * cz;
+        tj[0] = zero + mrb * cx;
+        tj[1] = zero + mrb * cy;
+        tj[2] = zero + mrb * cz;
+        for (int c = 0; c < 3; c++)
+            ft[c] = zero + ft[c];
+    }
+    wetdem_v4d f_n = zero;
+    for (int m = 0; m < in->n_normal; m++)
+        f_n += term[in->normal[m]];
+    wetdem_v4d force[3] = {ft[0] + f_n * nx, ft[1] + f_n * ny, ft[2] + f_n * nz};
+    wetdem_v4i finite = BULK_FINITE(f_n);
+    for (int c = 0; c < 3; c++)
+        finite &= BULK_FINITE(force[c]) & BULK_FINITE(ti[c]) & BULK_FINITE(tj[c]);
+    const wetdem_v4d film = C->film;
+    wetdem_v4i flags =
+        (WETDEM_MANY_ACTIVE | WETDEM_MANY_DIRTY | WETDEM_MANY_CONTACT | WETDEM_MANY_SPRING) |
+        (C->bridge_on & (gap < film) & WETDEM_MANY_BRIDGE);
+    for (int l = 0; l < 4; l++) {
+        if (!finite[l])
+            continue; /* the scalar kernel evaluates it again, from the unchanged spring */
+        size_t k = at[l];
+        out->cls[k] = flags[l];
+        for (int c = 0; c < 3; c++) {
+            out->force[c][k] = force[c][l];
+            out->torque_i[c][k] = ti[c][l];
+            out->torque_j[c][k] = tj[c][l];
+            if (in->mindlin)
+                in->history[q[l] * in->len + in->spring_off + c] = s[c][l];
+        }
+    }
+}
+
 /* Candidates list[0..n) (1 <= n <= WETDEM_MANY_BULK_MAX, in any particles): their geometry,
  * and the force apart of the film models, into out's entries 0..n); those whose second
- * particle is at or past j_end are left out (their entries but j are not used). */
+ * particle is at or past j_end are left out (their entries but j are not used). With
+ * `contacts`, then those in solid contact (bulk_contacts). */
 void WETDEM_MANY_BULK_NAME(const struct wetdem_many_bulk_in* in, const uint32_t* list, size_t n,
                            size_t j_end, struct wetdem_many_bulk_out* out)
 {
@@ -194,16 +373,39 @@ void WETDEM_MANY_BULK_NAME(const struct wetdem_many_bulk_in* in, const uint32_t*
                                      .nc = BULK_UNIFORM(in->sb_nc),
                                      .cap_on = BULK_UNIFORM(in->capillary && in->film > 0),
                                      .bridge_on = BULK_UNIFORM(in->film > 0)};
+    bool films = (in->sb || in->capillary) && in->film > 0;
     bool both = in->sb && in->capillary && in->film > 0 && !in->sb_nc; /* the usual case */
     size_t k = 0;
     if (both)
         for (; k + 4 <= n; k += 4)
-            bulk_four(in, &C, list, n, j_end, out, k, false, true);
+            bulk_four(in, &C, list, n, j_end, out, k, false, BULK_BOTH);
+    else if (!films)
+        for (; k + 4 <= n; k += 4)
+            bulk_four(in, &C, list, n, j_end, out, k, false, BULK_DRY);
     else
         for (; k + 4 <= n; k += 4)
-            bulk_four(in, &C, list, n, j_end, out, k, false, false);
+            bulk_four(in, &C, list, n, j_end, out, k, false, BULK_ANY);
     if (k < n)
-        bulk_four(in, &C, list, n, j_end, out, k, true, false);
+        bulk_four(in, &C, list, n, j_end, out, k, true, films ? BULK_ANY : BULK_DRY);
+    if (!in->contacts)
+        return;
+    /* the entries in solid contact (class 1 with gap < 0, of this thread's particles), four at
+       a time, the last group filled up with its last entry */
+    uint32_t at[WETDEM_MANY_BULK_MAX + 3];
+    size_t n_at = 0;
+    for (k = 0; k < n; k++) {
+        at[n_at] = (uint32_t)k;
+        n_at += out->cls[k] == 1 && out->gap[k] < 0.0 && out->j[k] < j_end;
+    }
+    if (!n_at)
+        return;
+    for (size_t r = n_at; r % 4; r++)
+        at[r] = at[n_at - 1];
+    for (size_t g = 0; g < n_at; g += 4)
+        if (films)
+            bulk_contacts(in, &C, list, at + g, out, true);
+        else
+            bulk_contacts(in, &C, list, at + g, out, false);
 }
 
 #endif

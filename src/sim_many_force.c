@@ -186,10 +186,11 @@ int wetdem_sim_many_setup_kernel(struct wetdem_sim* sim)
         if (!m->mix)
             return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory");
     }
-    bool fused = !m->generic_only;
+    bool fused = !m->generic_only, films = false;
     for (size_t k = 0; k < sim->n_models; k++) {
         const struct wetdem_model_slot* s = &sim->models[k];
         m->kind[k] = (unsigned char)fused_kind_of(s->model);
+        films = films || m->kind[k] == FUSED_SB || m->kind[k] == FUSED_CAPILLARY;
         m->kind_opt[k] = m->kind[k] == FUSED_HERTZ     ? slot_param(s, "damping")
                          : m->kind[k] == FUSED_MINDLIN ? slot_param(s, "friction")
                          : m->kind[k] == FUSED_SB      ? slot_param(s, "below_hmin")
@@ -201,8 +202,10 @@ int wetdem_sim_many_setup_kernel(struct wetdem_sim* sim)
         for (int b = 0; b < sim->n_materials; b++) {
             struct wetdem_many_mix* x = &m->mix[(size_t)a * nm + (size_t)b];
             mix_pair(sim, a, b, x);
-            /* the range of the fused models is 0 or the film thickness: a material-pair value */
-            x->range = fused ? (x->film > 0.0 ? x->film : 0.0) : m->reach;
+            /* the range of the fused models is the film thickness with a film model (sb,
+               capillary), else 0 (hertz and mindlin act in contact only): a material-pair
+               value */
+            x->range = fused ? (films && x->film > 0.0 ? x->film : 0.0) : m->reach;
         }
     m->fused = fused;
     m->pair_consts_ready = false; /* the ranges, radii and masses may have changed */
@@ -1392,7 +1395,7 @@ pairs_of_block_as(const struct pass* P, size_t b, bool kick, struct wetdem_vec3 
     size_t q_begin = m->cl.first_pair[begin_block], q_end = m->cl.first_pair[end_block];
     uint32_t* list = m->hits + q_begin;
     unsigned char* near = m->hit_near + q_begin;
-    uint64_t n_skipped = 0, n_near = 0;
+    uint64_t n_skipped = 0, n_near = 0, n_bulk_contacts = 0;
     size_t n_list;
     if (fused) {
         n_list = due_candidates(P, q_begin, q_end, list);
@@ -1438,6 +1441,17 @@ pairs_of_block_as(const struct pass* P, size_t b, bool kick, struct wetdem_vec3 
                     continue;
                 }
                 n_near++;
+                if (cls & WETDEM_MANY_CONTACT) { /* in solid contact, evaluated four at a time
+                                                    (spring stored): what add_pair does then */
+                    P->flags[q] = (unsigned char)cls;
+                    struct wetdem_many_pair_out o = {
+                        .force = vec3(bo.force[0][k], bo.force[1][k], bo.force[2][k]),
+                        .torque_i = vec3(bo.torque_i[0][k], bo.torque_i[1][k], bo.torque_i[2][k]),
+                        .torque_j = vec3(bo.torque_j[0][k], bo.torque_j[1][k], bo.torque_j[2][k])};
+                    add_pair(P, j, (unsigned char)cls, &o, &f, &t, &n_contacts);
+                    n_bulk_contacts++;
+                    continue;
+                }
                 if (cls != 1) { /* apart, finite: what near_candidate and add_pair do then */
                     reset_spring_apart(&m->lean, flags[q], P->history + q * P->len);
                     P->flags[q] = (unsigned char)cls; /* (no contact: no counts, no torques) */
@@ -1498,6 +1512,10 @@ pairs_of_block_as(const struct pass* P, size_t b, bool kick, struct wetdem_vec3 
     m->pass_candidates += q_end - q_begin;
 #pragma omp atomic
     m->pass_near += n_near;
+    if (bulk) {
+#pragma omp atomic
+        m->bulk_contacts += n_bulk_contacts;
+    }
 }
 
 /* Phase 2 of block b (pairs_of_block_as), compiled apart for the one-loop pass in the common
@@ -1614,11 +1632,11 @@ int wetdem_sim_many_forces(struct wetdem_sim* sim, bool kick)
                      .periodic = m->periodic_any,
                      .lean = lean_active(m),
                      .zeroed = m->sums_zeroed == n};
-    /* four pairs at a time where the film models act (their pairs apart are most of the
-       work; dry packings keep the scalar kernel, as fast there) */
-    if (P.lean && P.nm == 1 && !P.periodic && (m->lean.sb || m->lean.capillary) &&
-        m->bulk_mode != 1) {
+    /* four pairs at a time for the lean kernel in the common case: the geometry and film
+       terms of every listed candidate, then the solid contacts among them */
+    if (P.lean && P.nm == 1 && !P.periodic && m->bulk_mode != 1) {
         const struct wetdem_many_mix* x = m->mix;
+        const struct wetdem_many_lean* L = &m->lean;
         P.bulk = wetdem_many_bulk_choose(m->bulk_mode == 2);
         P.bulk_in = (struct wetdem_many_bulk_in){
             .xr = m->xr,
@@ -1633,7 +1651,20 @@ int wetdem_sim_many_forces(struct wetdem_sim* sim, bool kick)
             .surface_tension = x->surface_tension,
             .sb = m->lean.sb,
             .sb_nc = (int)m->lean.sb_below == THIN_FILM_BELOW_NC,
-            .capillary = m->lean.capillary};
+            .capillary = m->lean.capillary,
+            .contacts = true,
+            .hertz_form = L->hertz_form,
+            .mindlin = L->mindlin,
+            .n_normal = L->n_normal,
+            .cache = (const double(*)[4])m->pair_cache,
+            .history = m->history,
+            .len = sim->history_len,
+            .spring_off = L->mindlin_off,
+            .dt = m->dt,
+            .g_star = x->g_star,
+            .mu = L->mindlin_lub ? x->friction_lub : x->friction_dry,
+            .tangential_factor = x->mindlin_damping};
+        memcpy(P.bulk_in.normal, L->normal, sizeof P.bulk_in.normal);
     }
     m->bulk_passes += P.bulk != NULL;
     /* one region: cross pairs, a barrier, then each block on its own */
