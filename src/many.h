@@ -93,6 +93,14 @@ struct wetdem_many_bulk_in {
     double dt;                /* [s] */
     double g_star, mu;        /* G* [Pa] and the Coulomb coefficient of the Mindlin limit [-] */
     double tangential_factor; /* the Mindlin damping factor -2 sqrt(5/6) beta [-] */
+    /* particle-wall pairs four at a time (many_bulk.h bulk_walls) */
+    const struct wetdem_wall* walls;
+    size_t n_walls;
+    double* wall_history; /* n_walls x len doubles per particle */
+    const double* m_eff;  /* per particle: its mass against a wall [kg] (contact.h) */
+    double reach;         /* the start-up reach of the pass [m] */
+    double e_star;        /* E* [Pa] */
+    double hertz_coef;    /* the damping coefficient of hertz's form [-] */
 };
 struct wetdem_many_bulk_out { /* by component, each entry 32-byte aligned */
     /* 0: beyond the gap test's reach (|x_i - x_j|^2 > pair_lim2); 1: within it, for the scalar
@@ -112,10 +120,17 @@ struct wetdem_many_bulk_out { /* by component, each entry 32-byte aligned */
 };
 typedef void wetdem_many_bulk_fn(const struct wetdem_many_bulk_in* in, const uint32_t* list,
                                  size_t n, size_t j_end, struct wetdem_many_bulk_out* out);
+/* Particle-wall pairs (part[e], wall[e]), e < n <= WETDEM_MANY_BULK_MAX: cls (0 beyond the
+ * reach or the range, 1 for the scalar kernel, else the flags), force and torque_i. */
+typedef void wetdem_many_bulk_walls_fn(const struct wetdem_many_bulk_in* in, const uint32_t* part,
+                                       const unsigned char* wall, size_t n,
+                                       struct wetdem_many_bulk_out* out);
 /* many_bulk.c: the baseline version; many_bulk_avx2.c: the AVX2 one (x86-64 with GCC). */
 wetdem_many_bulk_fn wetdem_many_bulk_base, wetdem_many_bulk_avx2;
-/* The version for this processor (AVX2 where it has it), or the baseline with `base_only`. */
+wetdem_many_bulk_walls_fn wetdem_many_bulk_walls_base, wetdem_many_bulk_walls_avx2;
+/* The versions for this processor (AVX2 where it has it), or the baseline with `base_only`. */
 wetdem_many_bulk_fn* wetdem_many_bulk_choose(bool base_only);
+wetdem_many_bulk_walls_fn* wetdem_many_bulk_walls_choose(bool base_only);
 
 /* Energy bookkeeping (sim_many.c accumulates, sim_many_io.c reports). */
 struct wetdem_many_energy {
@@ -202,6 +217,7 @@ struct wetdem_many {
     uint64_t fused_passes;      /* passes run fused (tests) */
     uint64_t bulk_passes;       /* passes with four pairs at a time (tests) */
     uint64_t bulk_contacts;     /* solid contacts evaluated four at a time (tests) */
+    uint64_t bulk_walls;        /* particle-wall pairs within range evaluated so (tests) */
     uint64_t pair_consts_build; /* the list build they were computed for */
     bool pair_consts_ready;     /* cleared when the kernel is set up */
     unsigned char* old_flags;   /* flags of the previous list, for remapping */
@@ -277,6 +293,7 @@ struct wetdem_many {
     bool records_stale;   /* the records' positions, velocities and spins are behind */
     double (*inv)[2];     /* per particle: 1/m [1/kg] and 1/I = 1/(0.4 m R^2) [1/(kg m^2)], computed
                          with the integrator's own expressions when a run (re)starts */
+    double* m_eff;        /* per particle: contact_effective_mass (the mass, infinite if fixed) */
     size_t particle_cap;
     struct wetdem_many_energy energy;
     double* thread_work; /* per thread: 2 x WETDEM_MAX_MODELS accumulators */

@@ -3,6 +3,7 @@
  * x86-64, plain C elsewhere), and the choice of the version for the processor.
  */
 #define WETDEM_MANY_BULK_NAME wetdem_many_bulk_base
+#define WETDEM_MANY_BULK_WALLS_NAME wetdem_many_bulk_walls_base
 #include "many_bulk.h"
 
 wetdem_many_bulk_fn* wetdem_many_bulk_choose(bool base_only)
@@ -15,4 +16,15 @@ wetdem_many_bulk_fn* wetdem_many_bulk_choose(bool base_only)
     (void)base_only;
 #endif
     return wetdem_many_bulk_base;
+}
+
+wetdem_many_bulk_walls_fn* wetdem_many_bulk_walls_choose(bool base_only)
+{
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+    if (!base_only && __builtin_cpu_supports("avx2"))
+        return wetdem_many_bulk_walls_avx2;
+#else
+    (void)base_only;
+#endif
+    return wetdem_many_bulk_walls_base;
 }

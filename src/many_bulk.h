@@ -127,22 +127,41 @@ struct bulk_constants {
  * them). */
 enum bulk_films { BULK_ANY, BULK_BOTH, BULK_DRY };
 
+/* film_terms of sim_many_force.c lane by lane, at gap [m] with R* = r_eff [m] and v_n [m/s]
+ * (thin_film_eval_gap_at, then the sb and capillary laws; force_sb.c, force_capillary.c):
+ * *f_sb and *f_cap, +0 where a law does not act. */
+static inline __attribute__((always_inline)) void
+bulk_film_terms(const struct bulk_constants* C, enum bulk_films films, const wetdem_v4d* gap_in,
+                const wetdem_v4d* r_eff_in, const wetdem_v4d* v_n_in, wetdem_v4d* f_sb,
+                wetdem_v4d* f_cap)
+{
+    /* (through pointers: GCC notes an ABI change for 32-byte vectors passed by value) */
+    const wetdem_v4d gap = *gap_in, r_eff = *r_eff_in, v_n = *v_n_in;
+    const wetdem_v4i all = {-1, -1, -1, -1}, none = {0, 0, 0, 0};
+    bool both = films == BULK_BOTH;
+    const wetdem_v4i sb_on = both ? all : C->sb_on, nc = both ? none : C->nc,
+                     cap_on = both ? all : C->cap_on;
+    const wetdem_v4d zero = C->zero, film = C->film;
+    wetdem_v4i in_film = ~(gap > film); /* also where gap is NaN, as the scalar test */
+    wetdem_v4i at_gap = gap >= C->h_min;
+    wetdem_v4d h = BULK_SELECT(at_gap, gap, C->h_min);
+    wetdem_v4i sb_acts = sb_on & in_film & (at_gap | nc) & (h > zero);
+    wetdem_v4d bracket = C->one - h / film;
+    wetdem_v4d sb = C->sb_coef * r_eff * r_eff * v_n / h * bracket * bracket;
+    wetdem_v4i cap_acts = cap_on & (gap <= film);
+    wetdem_v4d cap = -(C->cap_coef * r_eff * C->tension);
+    *f_sb = BULK_SELECT(sb_acts, sb, zero);
+    *f_cap = BULK_SELECT(cap_acts, cap, zero);
+}
+
 /* Candidates list[k..k+4) (with `tail`, those of them before n, the last one repeated). */
 static inline __attribute__((always_inline)) void
 bulk_four(const struct wetdem_many_bulk_in* in, const struct bulk_constants* C,
           const uint32_t* list, size_t n, size_t j_end, struct wetdem_many_bulk_out* out, size_t k,
           bool tail, enum bulk_films films)
 {
-    const wetdem_v4i all = {-1, -1, -1, -1}, none = {0, 0, 0, 0};
-    bool both = films == BULK_BOTH, dry = films == BULK_DRY;
-    const wetdem_v4i sb_on = both  ? all
-                             : dry ? none
-                                   : C->sb_on,
-                     nc = both || dry ? none : C->nc,
-                     cap_on = both  ? all
-                              : dry ? none
-                                    : C->cap_on,
-                     bridge_on = both ? all : C->bridge_on;
+    bool dry = films == BULK_DRY;
+    const wetdem_v4i bridge_on = films == BULK_BOTH ? (wetdem_v4i){-1, -1, -1, -1} : C->bridge_on;
     const struct wetdem_celllist_item* xr = in->xr;
     const struct wetdem_vec3(*vw)[2] = in->vw;
     const wetdem_v4d zero = C->zero, one = C->one, film = C->film;
@@ -175,21 +194,12 @@ bulk_four(const struct wetdem_many_bulk_in* in, const struct bulk_constants* C,
     wetdem_v4d ny = BULK_SELECT(positive, dy * inv, zero);
     wetdem_v4d nz = BULK_SELECT(positive, dz * inv, zero);
     wetdem_v4d v_n = -((vi[0] - vj[0]) * nx + (vi[1] - vj[1]) * ny + (vi[2] - vj[2]) * nz);
-    /* film_terms (thin_film_eval_gap_at, then the two laws) and lean_apart's sums */
-    wetdem_v4i in_film = ~(gap > film); /* also where gap is NaN, as the scalar test */
-    wetdem_v4i at_gap = gap >= C->h_min;
-    wetdem_v4d h = BULK_SELECT(at_gap, gap, C->h_min);
-    wetdem_v4d f_sb = zero, f_cap = zero; /* film_terms': +0 where a law does not act */
+    /* film_terms and lean_apart's sums */
+    wetdem_v4d f_sb = zero, f_cap = zero;
     if (!dry) {
-        wetdem_v4i sb_acts = sb_on & in_film & (at_gap | nc) & (h > zero);
-        wetdem_v4d bracket = one - h / film;
         /* R* = R_i R_j / (R_i + R_j): contact_reduced of finite radii, the pair constants' */
         wetdem_v4d r_eff = pi[3] * pj[3] / (pi[3] + pj[3]);
-        f_sb = C->sb_coef * r_eff * r_eff * v_n / h * bracket * bracket;
-        wetdem_v4i cap_acts = cap_on & (gap <= film);
-        f_cap = -(C->cap_coef * r_eff * C->tension);
-        f_sb = BULK_SELECT(sb_acts, f_sb, zero);
-        f_cap = BULK_SELECT(cap_acts, f_cap, zero);
+        bulk_film_terms(C, films, &gap, &r_eff, &v_n, &f_sb, &f_cap);
     }
     wetdem_v4d f_n = (zero + f_sb) + f_cap;
     /* the class: 0 beyond the gap test's reach, else the flags of a pair apart within its range
@@ -212,10 +222,119 @@ bulk_four(const struct wetdem_many_bulk_in* in, const struct bulk_constants* C,
     *(wetdem_v4d*)&out->force[2][k] = zero + f_n * nz;
 }
 
+/* What the contact core (bulk_lean_force) reads of four lanes, and what it gives. */
+struct bulk_lanes {
+    wetdem_v4d n[3], gap, v_n; /* unit normal (into i), gap [m], normal velocity [m/s] */
+    wetdem_v4d r_i, r_j;       /* radii [m] (r_j unused for a wall) */
+    wetdem_v4d r_eff, m_eff;   /* R* [m], m* [kg] */
+    wetdem_v4d k, damping;     /* Hertz stiffness factor, damping factor (models.h) */
+    wetdem_v4d v_t[3];         /* tangential velocity [m/s] (with mindlin) */
+    wetdem_v4d s[3];           /* the Mindlin spring [m] (with mindlin): in, then out */
+    wetdem_v4d term[3];        /* sb and capillary terms in term[1], term[2] [N] */
+    /* out: the force on i [N], the torques on i and j [N m], all ones where all are finite */
+    wetdem_v4d force[3], ti[3], tj[3];
+    wetdem_v4i finite;
+};
+
+/* lean_force of sim_many_force.c lane by lane (this file's header): lanes in solid contact
+ * (gap < 0) get hertz and mindlin, the others (a wall apart: `apart`) only the film terms, a
+ * zero spring (mindlin resets it apart) and zero torques. `wall`: no torque on j. */
+static inline __attribute__((always_inline)) void
+bulk_lean_force(const struct wetdem_many_bulk_in* in, const struct bulk_constants* C,
+                struct bulk_lanes* L, bool apart, bool wall)
+{
+    const wetdem_v4d zero = C->zero;
+    wetdem_v4i touch = L->gap < zero;
+    wetdem_v4d overlap = -L->gap, root = overlap;
+    bulk_sqrt(&root);
+    wetdem_v4d f_el = L->k * overlap * root; /* hertz_elastic_k */
+    L->term[0] = zero;
+    if (in->hertz_form >= 0) { /* hertz_total of hertz_damping_from */
+        wetdem_v4d quarter = root;
+        bulk_sqrt(&quarter);
+        wetdem_v4d sum = f_el + L->damping * quarter * L->v_n;
+        L->term[0] = in->hertz_form == 1 ? sum : BULK_SELECT(sum > zero, sum, zero);
+        if (apart)
+            L->term[0] = BULK_SELECT(touch, L->term[0], zero);
+    }
+    wetdem_v4d ft[3] = {zero, zero, zero};
+    for (int c = 0; c < 3; c++)
+        L->ti[c] = L->tj[c] = zero;
+    if (in->mindlin) {
+        const wetdem_v4d *n = L->n, *v_t = L->v_t;
+        wetdem_v4d* s = L->s;
+        /* mindlin_spring: the spring rotated into the plane (rotate_into_plane), advanced */
+        wetdem_v4d len = s[0] * s[0] + s[1] * s[1] + s[2] * s[2];
+        bulk_sqrt(&len);
+        wetdem_v4d sn = -(s[0] * n[0] + s[1] * n[1] + s[2] * n[2]);
+        wetdem_v4d p[3] = {s[0] + sn * n[0], s[1] + sn * n[1], s[2] + sn * n[2]};
+        wetdem_v4d plen = p[0] * p[0] + p[1] * p[1] + p[2] * p[2];
+        bulk_sqrt(&plen);
+        wetdem_v4i some = plen > zero;
+        wetdem_v4d ratio = len / BULK_SELECT(some, plen, C->one);
+        const wetdem_v4d dt = BULK_SPLAT(in->dt);
+        for (int c = 0; c < 3; c++)
+            s[c] = BULK_SELECT(some, p[c] * ratio, zero) + dt * v_t[c];
+        wetdem_v4d k_t = L->r_eff * overlap;
+        bulk_sqrt(&k_t);
+        k_t = BULK_SPLAT(8.0 * in->g_star) * k_t; /* tangential_stiffness */
+        wetdem_v4d gamma_t = L->m_eff * k_t;
+        bulk_sqrt(&gamma_t);
+        gamma_t = BULK_SPLAT(in->tangential_factor) * gamma_t; /* tangential_damping */
+        wetdem_v4d mk = -k_t, mg = -gamma_t;
+        for (int c = 0; c < 3; c++)
+            ft[c] = s[c] * mk + mg * v_t[c];
+        wetdem_v4d f_total = ft[0] * ft[0] + ft[1] * ft[1] + ft[2] * ft[2];
+        bulk_sqrt(&f_total);
+        const wetdem_v4i magnitude = {INT64_MAX, INT64_MAX, INT64_MAX, INT64_MAX};
+        wetdem_v4d f_max = BULK_SPLAT(in->mu) * (wetdem_v4d)((wetdem_v4i)f_el & magnitude);
+        wetdem_v4i slide = f_total > f_max;
+        if (apart)
+            slide &= touch;
+        if (slide[0] | slide[1] | slide[2] | slide[3]) { /* capped, the spring set to match */
+            wetdem_v4d cap = f_max / BULK_SELECT(slide, f_total, C->one);
+            wetdem_v4i stiff = k_t > zero;
+            wetdem_v4d inv_k = BULK_SPLAT(-1.0) / BULK_SELECT(stiff, k_t, C->one);
+            for (int c = 0; c < 3; c++) {
+                wetdem_v4d capped = ft[c] * cap;
+                wetdem_v4d back = BULK_SELECT(stiff, (capped + gamma_t * v_t[c]) * inv_k, zero);
+                ft[c] = BULK_SELECT(slide, capped, ft[c]);
+                s[c] = BULK_SELECT(slide, back, s[c]);
+            }
+        }
+        /* the torques, -R n x F_t (lean_force: from zero, so +0 + ...) */
+        wetdem_v4d cr[3] = {n[1] * ft[2] - n[2] * ft[1], n[2] * ft[0] - n[0] * ft[2],
+                            n[0] * ft[1] - n[1] * ft[0]};
+        wetdem_v4d mri = -L->r_i, mrj = -L->r_j;
+        for (int c = 0; c < 3; c++) {
+            L->ti[c] = zero + mri * cr[c];
+            if (!wall)
+                L->tj[c] = zero + mrj * cr[c];
+            ft[c] = zero + ft[c];
+            if (apart) {
+                L->ti[c] = BULK_SELECT(touch, L->ti[c], zero);
+                ft[c] = BULK_SELECT(touch, ft[c], zero);
+                s[c] = BULK_SELECT(touch, s[c], zero);
+            }
+        }
+    }
+    /* the normal terms in model order (chosen by value, not indexed: an indexed member would
+       keep all of L in memory) */
+    wetdem_v4d f_n = zero;
+    for (int m = 0; m < in->n_normal; m++)
+        f_n += in->normal[m] == 0 ? L->term[0] : in->normal[m] == 1 ? L->term[1] : L->term[2];
+    wetdem_v4i finite = BULK_FINITE(f_n);
+    for (int c = 0; c < 3; c++) {
+        L->force[c] = ft[c] + f_n * L->n[c];
+        finite &= BULK_FINITE(L->force[c]) & BULK_FINITE(L->ti[c]) & BULK_FINITE(L->tj[c]);
+    }
+    L->finite = finite;
+}
+
 /* The out entries at[0..4) (candidates list[at[l]]) in solid contact, with the geometry and
- * film terms bulk_four gave them: lean_contact and lean_force lane by lane (the header); each
- * lane with a finite result gets its force, torques and flags (cls) and its spring stored,
- * the others keep class 1. Lanes may repeat an entry (they compute and store the same). */
+ * film terms bulk_four gave them: lean_contact, then lean_force (bulk_lean_force); each lane
+ * with a finite result gets its force, torques and flags (cls) and its spring stored, the
+ * others keep class 1. Lanes may repeat an entry (they compute and store the same). */
 static inline __attribute__((always_inline)) void
 bulk_contacts(const struct wetdem_many_bulk_in* in, const struct bulk_constants* C,
               const uint32_t* list, const uint32_t at[4], struct wetdem_many_bulk_out* out,
@@ -228,29 +347,21 @@ bulk_contacts(const struct wetdem_many_bulk_in* in, const struct bulk_constants*
         i[l] = in->pairs[q[l]].i;
         j[l] = out->j[at[l]];
     }
-    wetdem_v4d gap = BULK_GATHER(out->gap, at), v_n = BULK_GATHER(out->v_n, at);
-    wetdem_v4d nx = BULK_GATHER(out->n[0], at), ny = BULK_GATHER(out->n[1], at),
-               nz = BULK_GATHER(out->n[2], at);
-    wetdem_v4d r_a = {in->xr[i[0]].r, in->xr[i[1]].r, in->xr[i[2]].r, in->xr[i[3]].r};
-    wetdem_v4d r_b = {in->xr[j[0]].r, in->xr[j[1]].r, in->xr[j[2]].r, in->xr[j[3]].r};
-    wetdem_v4d pc[4]; /* R*, m*, k, damping factor */
+    struct bulk_lanes L; /* (set field by field: an initializer would zero all of it first) */
+    for (int c = 0; c < 3; c++)
+        L.n[c] = BULK_GATHER(out->n[c], at);
+    L.gap = BULK_GATHER(out->gap, at);
+    L.v_n = BULK_GATHER(out->v_n, at);
+    L.r_i = (wetdem_v4d){in->xr[i[0]].r, in->xr[i[1]].r, in->xr[i[2]].r, in->xr[i[3]].r};
+    L.r_j = (wetdem_v4d){in->xr[j[0]].r, in->xr[j[1]].r, in->xr[j[2]].r, in->xr[j[3]].r};
+    wetdem_v4d pc[4]; /* the pair constants: R*, m*, k, damping factor */
     bulk_columns(in->cache[q[0]], in->cache[q[1]], in->cache[q[2]], in->cache[q[3]], pc);
-    wetdem_v4d overlap = -gap, root = overlap;
-    bulk_sqrt(&root);
-    wetdem_v4d f_el = pc[2] * overlap * root; /* hertz_elastic_k */
-    wetdem_v4d term[3] = {zero, zero, zero};  /* hertz, sb, capillary */
-    if (in->hertz_form >= 0) {                /* hertz_total of hertz_damping_from */
-        wetdem_v4d quarter = root;
-        bulk_sqrt(&quarter);
-        wetdem_v4d sum = f_el + pc[3] * quarter * v_n;
-        term[0] = in->hertz_form == 1 ? sum : BULK_SELECT(sum > zero, sum, zero);
-    }
-    if (films) {
-        term[1] = BULK_GATHER(out->f_sb, at);
-        term[2] = BULK_GATHER(out->f_cap, at);
-    }
-    wetdem_v4d ft[3] = {zero, zero, zero}, ti[3] = {zero, zero, zero}, tj[3] = {zero, zero, zero};
-    wetdem_v4d s[3];
+    L.r_eff = pc[0];
+    L.m_eff = pc[1];
+    L.k = pc[2];
+    L.damping = pc[3];
+    L.term[1] = films ? BULK_GATHER(out->f_sb, at) : zero;
+    L.term[2] = films ? BULK_GATHER(out->f_cap, at) : zero;
     if (in->mindlin) {
         /* the contact points' velocities (velocity, spin: columns at the record's start and at
            its third double) and the tangential velocity, vec3_reject */
@@ -260,98 +371,57 @@ bulk_contacts(const struct wetdem_many_bulk_in* in, const struct bulk_constants*
         bulk_columns(&vw[i[0]][0].z, &vw[i[1]][0].z, &vw[i[2]][0].z, &vw[i[3]][0].z, a1);
         bulk_columns(&vw[j[0]][0].x, &vw[j[1]][0].x, &vw[j[2]][0].x, &vw[j[3]][0].x, b0);
         bulk_columns(&vw[j[0]][0].z, &vw[j[1]][0].z, &vw[j[2]][0].z, &vw[j[3]][0].z, b1);
-        wetdem_v4d mra = -r_a, ax = nx * mra, ay = ny * mra, az = nz * mra; /* n (-R_i) */
-        wetdem_v4d bx = nx * r_b, by = ny * r_b, bz = nz * r_b;             /* n R_j */
-        wetdem_v4d wa_x = a1[1], wa_y = a1[2], wa_z = a1[3], wb_x = b1[1], wb_y = b1[2],
-                   wb_z = b1[3];
-        wetdem_v4d va_x = a0[0] + (wa_y * az - wa_z * ay), va_y = a0[1] + (wa_z * ax - wa_x * az),
-                   va_z = a0[2] + (wa_x * ay - wa_y * ax);
-        wetdem_v4d vb_x = b0[0] + (wb_y * bz - wb_z * by), vb_y = b0[1] + (wb_z * bx - wb_x * bz),
-                   vb_z = b0[2] + (wb_x * by - wb_y * bx);
-        wetdem_v4d rx = va_x - vb_x, ry = va_y - vb_y, rz = va_z - vb_z;
-        wetdem_v4d rn = -(rx * nx + ry * ny + rz * nz);
-        wetdem_v4d vt_x = rx + rn * nx, vt_y = ry + rn * ny, vt_z = rz + rn * nz;
-        /* mindlin_spring: the spring rotated into the plane (rotate_into_plane), advanced */
-        for (int c = 0; c < 3; c++)
-            s[c] = (wetdem_v4d){in->history[q[0] * in->len + in->spring_off + c],
-                                in->history[q[1] * in->len + in->spring_off + c],
-                                in->history[q[2] * in->len + in->spring_off + c],
-                                in->history[q[3] * in->len + in->spring_off + c]};
-        wetdem_v4d len = s[0] * s[0] + s[1] * s[1] + s[2] * s[2];
-        bulk_sqrt(&len);
-        wetdem_v4d sn = -(s[0] * nx + s[1] * ny + s[2] * nz);
-        wetdem_v4d px = s[0] + sn * nx, py = s[1] + sn * ny, pz = s[2] + sn * nz;
-        wetdem_v4d plen = px * px + py * py + pz * pz;
-        bulk_sqrt(&plen);
-        wetdem_v4i some = plen > zero;
-        wetdem_v4d ratio = len / BULK_SELECT(some, plen, C->one);
-        s[0] = BULK_SELECT(some, px * ratio, zero) + BULK_SPLAT(in->dt) * vt_x;
-        s[1] = BULK_SELECT(some, py * ratio, zero) + BULK_SPLAT(in->dt) * vt_y;
-        s[2] = BULK_SELECT(some, pz * ratio, zero) + BULK_SPLAT(in->dt) * vt_z;
-        wetdem_v4d k_t = pc[0] * overlap;
-        bulk_sqrt(&k_t);
-        k_t = BULK_SPLAT(8.0 * in->g_star) * k_t; /* tangential_stiffness */
-        wetdem_v4d gamma_t = pc[1] * k_t;
-        bulk_sqrt(&gamma_t);
-        gamma_t = BULK_SPLAT(in->tangential_factor) * gamma_t; /* tangential_damping */
-        wetdem_v4d mk = -k_t, mg = -gamma_t;
-        ft[0] = s[0] * mk + mg * vt_x;
-        ft[1] = s[1] * mk + mg * vt_y;
-        ft[2] = s[2] * mk + mg * vt_z;
-        wetdem_v4d f_total = ft[0] * ft[0] + ft[1] * ft[1] + ft[2] * ft[2];
-        bulk_sqrt(&f_total);
-        const wetdem_v4i magnitude = {INT64_MAX, INT64_MAX, INT64_MAX, INT64_MAX};
-        wetdem_v4d f_max = BULK_SPLAT(in->mu) * (wetdem_v4d)((wetdem_v4i)f_el & magnitude);
-        wetdem_v4i slide = f_total > f_max;
-        if (slide[0] | slide[1] | slide[2] | slide[3]) { /* capped, the spring set to match */
-            wetdem_v4d cap = f_max / BULK_SELECT(slide, f_total, C->one);
-            wetdem_v4i stiff = k_t > zero;
-            wetdem_v4d inv_k = BULK_SPLAT(-1.0) / BULK_SELECT(stiff, k_t, C->one);
-            for (int c = 0; c < 3; c++) {
-                wetdem_v4d vt = c == 0 ? vt_x : c == 1 ? vt_y : vt_z;
-                wetdem_v4d capped = ft[c] * cap;
-                wetdem_v4d back = BULK_SELECT(stiff, (capped + gamma_t * vt) * inv_k, zero);
-                ft[c] = BULK_SELECT(slide, capped, ft[c]);
-                s[c] = BULK_SELECT(slide, back, s[c]);
-            }
+        const wetdem_v4d* n = L.n;
+        wetdem_v4d mra = -L.r_i, a[3] = {n[0] * mra, n[1] * mra, n[2] * mra}; /* n (-R_i) */
+        wetdem_v4d b[3] = {n[0] * L.r_j, n[1] * L.r_j, n[2] * L.r_j};         /* n R_j */
+        wetdem_v4d rel[3] = {
+            (a0[0] + (a1[2] * a[2] - a1[3] * a[1])) - (b0[0] + (b1[2] * b[2] - b1[3] * b[1])),
+            (a0[1] + (a1[3] * a[0] - a1[1] * a[2])) - (b0[1] + (b1[3] * b[0] - b1[1] * b[2])),
+            (a0[2] + (a1[1] * a[1] - a1[2] * a[0])) - (b0[2] + (b1[1] * b[1] - b1[2] * b[0]))};
+        wetdem_v4d rn = -(rel[0] * n[0] + rel[1] * n[1] + rel[2] * n[2]);
+        for (int c = 0; c < 3; c++) {
+            L.v_t[c] = rel[c] + rn * n[c];
+            L.s[c] = (wetdem_v4d){in->history[q[0] * in->len + in->spring_off + c],
+                                  in->history[q[1] * in->len + in->spring_off + c],
+                                  in->history[q[2] * in->len + in->spring_off + c],
+                                  in->history[q[3] * in->len + in->spring_off + c]};
         }
-        /* the torques, -R n x F_t (lean_force: from zero, so +0 + ...) */
-        wetdem_v4d cx = ny * ft[2] - nz * ft[1], cy = nz * ft[0] - nx * ft[2],
-                   cz = nx * ft[1] - ny * ft[0];
-        wetdem_v4d mrb = -r_b;
-        ti[0] = zero + mra * cx;
-        ti[1] = zero + mra * cy;
-        ti[2] = zero + mra * cz;
-        tj[0] = zero + mrb * cx;
-        tj[1] = zero + mrb * cy;
-        tj[2] = zero + mrb * cz;
-        for (int c = 0; c < 3; c++)
-            ft[c] = zero + ft[c];
     }
-    wetdem_v4d f_n = zero;
-    for (int m = 0; m < in->n_normal; m++)
-        f_n += term[in->normal[m]];
-    wetdem_v4d force[3] = {ft[0] + f_n * nx, ft[1] + f_n * ny, ft[2] + f_n * nz};
-    wetdem_v4i finite = BULK_FINITE(f_n);
-    for (int c = 0; c < 3; c++)
-        finite &= BULK_FINITE(force[c]) & BULK_FINITE(ti[c]) & BULK_FINITE(tj[c]);
-    const wetdem_v4d film = C->film;
+    bulk_lean_force(in, C, &L, false, false);
     wetdem_v4i flags =
         (WETDEM_MANY_ACTIVE | WETDEM_MANY_DIRTY | WETDEM_MANY_CONTACT | WETDEM_MANY_SPRING) |
-        (C->bridge_on & (gap < film) & WETDEM_MANY_BRIDGE);
+        (C->bridge_on & (L.gap < C->film) & WETDEM_MANY_BRIDGE);
     for (int l = 0; l < 4; l++) {
-        if (!finite[l])
+        if (!L.finite[l])
             continue; /* the scalar kernel evaluates it again, from the unchanged spring */
         size_t k = at[l];
         out->cls[k] = flags[l];
         for (int c = 0; c < 3; c++) {
-            out->force[c][k] = force[c][l];
-            out->torque_i[c][k] = ti[c][l];
-            out->torque_j[c][k] = tj[c][l];
+            out->force[c][k] = L.force[c][l];
+            out->torque_i[c][k] = L.ti[c][l];
+            out->torque_j[c][k] = L.tj[c][l];
             if (in->mindlin)
-                in->history[q[l] * in->len + in->spring_off + c] = s[c][l];
+                in->history[q[l] * in->len + in->spring_off + c] = L.s[c][l];
         }
     }
+}
+
+/* The constants of a call (struct bulk_constants). */
+static inline __attribute__((always_inline)) struct bulk_constants
+bulk_constants_of(const struct wetdem_many_bulk_in* in)
+{
+    return (struct bulk_constants){.zero = BULK_SPLAT(0.0),
+                                   .one = BULK_SPLAT(1.0),
+                                   .film = BULK_SPLAT(in->film),
+                                   .h_min = BULK_SPLAT(in->film_h_min),
+                                   .range = BULK_SPLAT(in->range),
+                                   .sb_coef = BULK_SPLAT(in->sb_coef),
+                                   .cap_coef = BULK_SPLAT(in->cap_coef),
+                                   .tension = BULK_SPLAT(in->surface_tension),
+                                   .sb_on = BULK_UNIFORM(in->sb && in->film > 0),
+                                   .nc = BULK_UNIFORM(in->sb_nc),
+                                   .cap_on = BULK_UNIFORM(in->capillary && in->film > 0),
+                                   .bridge_on = BULK_UNIFORM(in->film > 0)};
 }
 
 /* Candidates list[0..n) (1 <= n <= WETDEM_MANY_BULK_MAX, in any particles): their geometry,
@@ -361,18 +431,7 @@ bulk_contacts(const struct wetdem_many_bulk_in* in, const struct bulk_constants*
 void WETDEM_MANY_BULK_NAME(const struct wetdem_many_bulk_in* in, const uint32_t* list, size_t n,
                            size_t j_end, struct wetdem_many_bulk_out* out)
 {
-    const struct bulk_constants C = {.zero = BULK_SPLAT(0.0),
-                                     .one = BULK_SPLAT(1.0),
-                                     .film = BULK_SPLAT(in->film),
-                                     .h_min = BULK_SPLAT(in->film_h_min),
-                                     .range = BULK_SPLAT(in->range),
-                                     .sb_coef = BULK_SPLAT(in->sb_coef),
-                                     .cap_coef = BULK_SPLAT(in->cap_coef),
-                                     .tension = BULK_SPLAT(in->surface_tension),
-                                     .sb_on = BULK_UNIFORM(in->sb && in->film > 0),
-                                     .nc = BULK_UNIFORM(in->sb_nc),
-                                     .cap_on = BULK_UNIFORM(in->capillary && in->film > 0),
-                                     .bridge_on = BULK_UNIFORM(in->film > 0)};
+    const struct bulk_constants C = bulk_constants_of(in);
     bool films = (in->sb || in->capillary) && in->film > 0;
     bool both = in->sb && in->capillary && in->film > 0 && !in->sb_nc; /* the usual case */
     size_t k = 0;
@@ -406,6 +465,114 @@ void WETDEM_MANY_BULK_NAME(const struct wetdem_many_bulk_in* in, const uint32_t*
             bulk_contacts(in, &C, list, at + g, out, true);
         else
             bulk_contacts(in, &C, list, at + g, out, false);
+}
+
+/* Particle-wall entries e = k..k+4 (with `tail`, those before n, the last one repeated):
+ * eval_walls_of's gap, then lean_wall and lean_force lane by lane (walls apart get the film
+ * terms only and a zero spring), with R* = R, m* = m_eff and the Hertz constants of the
+ * particle's radius and mass. Lanes beyond the reach or the range get class 0; lanes with a
+ * finite result their flags (and their spring stored), the others class 1. */
+static inline __attribute__((always_inline)) void
+bulk_walls_four(const struct wetdem_many_bulk_in* in, const struct bulk_constants* C,
+                const uint32_t* part, const unsigned char* wall, size_t n,
+                struct wetdem_many_bulk_out* out, size_t k, bool tail, enum bulk_films films)
+{
+    const wetdem_v4d zero = C->zero;
+    uint32_t i[4], w[4];
+    for (int l = 0; l < 4; l++) {
+        size_t e = !tail || k + l < n ? k + l : n - 1;
+        i[l] = part[e];
+        w[l] = wall[e];
+    }
+    const struct wetdem_celllist_item* xr = in->xr;
+    const struct wetdem_wall* W = in->walls;
+    wetdem_v4d x[4]; /* position and radius */
+    bulk_columns(&xr[i[0]].x, &xr[i[1]].x, &xr[i[2]].x, &xr[i[3]].x, x);
+    struct bulk_lanes L;
+    L.n[0] = (wetdem_v4d){W[w[0]].normal.x, W[w[1]].normal.x, W[w[2]].normal.x, W[w[3]].normal.x};
+    L.n[1] = (wetdem_v4d){W[w[0]].normal.y, W[w[1]].normal.y, W[w[2]].normal.y, W[w[3]].normal.y};
+    L.n[2] = (wetdem_v4d){W[w[0]].normal.z, W[w[1]].normal.z, W[w[2]].normal.z, W[w[3]].normal.z};
+    wetdem_v4d d[3] = {
+        x[0] - (wetdem_v4d){W[w[0]].point.x, W[w[1]].point.x, W[w[2]].point.x, W[w[3]].point.x},
+        x[1] - (wetdem_v4d){W[w[0]].point.y, W[w[1]].point.y, W[w[2]].point.y, W[w[3]].point.y},
+        x[2] - (wetdem_v4d){W[w[0]].point.z, W[w[1]].point.z, W[w[2]].point.z, W[w[3]].point.z}};
+    const wetdem_v4d* nv = L.n;
+    L.gap = (d[0] * nv[0] + d[1] * nv[1] + d[2] * nv[2]) - x[3];
+    wetdem_v4i within = (L.gap <= BULK_SPLAT(in->reach)) & ~(L.gap > C->range);
+    const struct wetdem_vec3(*vw)[2] = in->vw;
+    wetdem_v4d a0[4], a1[4]; /* v_x v_y v_z w_x, v_z w_x w_y w_z */
+    bulk_columns(&vw[i[0]][0].x, &vw[i[1]][0].x, &vw[i[2]][0].x, &vw[i[3]][0].x, a0);
+    L.v_n = -(a0[0] * nv[0] + a0[1] * nv[1] + a0[2] * nv[2]);
+    L.r_i = L.r_eff = x[3];
+    L.r_j = zero;
+    L.m_eff = BULK_GATHER(in->m_eff, i);
+    wetdem_v4d root = x[3];
+    bulk_sqrt(&root);
+    L.k = BULK_SPLAT((4.0 / 3.0) * in->e_star) * root; /* hertz_stiffness */
+    L.damping = zero;
+    if (in->hertz_form >= 0) { /* hertz_damping_factor */
+        wetdem_v4d mk = L.m_eff * L.k;
+        bulk_sqrt(&mk);
+        L.damping = BULK_SPLAT(in->hertz_coef) * mk;
+    }
+    size_t spring[4];
+    if (in->mindlin) {
+        bulk_columns(&vw[i[0]][0].z, &vw[i[1]][0].z, &vw[i[2]][0].z, &vw[i[3]][0].z, a1);
+        wetdem_v4d mr = -x[3], a[3] = {nv[0] * mr, nv[1] * mr, nv[2] * mr}; /* n (-R) */
+        wetdem_v4d va[3] = {a0[0] + (a1[2] * a[2] - a1[3] * a[1]),
+                            a0[1] + (a1[3] * a[0] - a1[1] * a[2]),
+                            a0[2] + (a1[1] * a[1] - a1[2] * a[0])};
+        wetdem_v4d vn = -(va[0] * nv[0] + va[1] * nv[1] + va[2] * nv[2]);
+        for (int l = 0; l < 4; l++)
+            spring[l] = (i[l] * in->n_walls + w[l]) * in->len + in->spring_off;
+        for (int c = 0; c < 3; c++) {
+            L.v_t[c] = va[c] + vn * nv[c];
+            L.s[c] = (wetdem_v4d){in->wall_history[spring[0] + c], in->wall_history[spring[1] + c],
+                                  in->wall_history[spring[2] + c], in->wall_history[spring[3] + c]};
+        }
+    }
+    L.term[1] = L.term[2] = zero;
+    if (films != BULK_DRY)
+        bulk_film_terms(C, films, &L.gap, &L.r_eff, &L.v_n, &L.term[1], &L.term[2]);
+    bulk_lean_force(in, C, &L, true, true);
+    wetdem_v4i touch = L.gap < zero;
+    wetdem_v4i flags = (WETDEM_MANY_ACTIVE | WETDEM_MANY_DIRTY) |
+                       (touch & (WETDEM_MANY_CONTACT | WETDEM_MANY_SPRING)) |
+                       (C->bridge_on & (L.gap < C->film) & WETDEM_MANY_BRIDGE);
+    wetdem_v4i done = within & L.finite;
+    *(wetdem_v4i*)&out->cls[k] = within & ((done & (flags - 1)) | 1);
+    for (int c = 0; c < 3; c++) {
+        *(wetdem_v4d*)&out->force[c][k] = L.force[c];
+        *(wetdem_v4d*)&out->torque_i[c][k] = L.ti[c];
+    }
+    for (int l = 0; in->mindlin && l < 4; l++)
+        if (done[l])
+            for (int c = 0; c < 3; c++)
+                in->wall_history[spring[l] + c] = L.s[c][l];
+}
+
+/* Particle-wall pairs (part[e], wall[e]), e < n (1 <= n <= WETDEM_MANY_BULK_MAX), four at a
+ * time (bulk_walls_four) into out's entries 0..n). */
+void WETDEM_MANY_BULK_WALLS_NAME(const struct wetdem_many_bulk_in* in, const uint32_t* part,
+                                 const unsigned char* wall, size_t n,
+                                 struct wetdem_many_bulk_out* out)
+{
+    const struct bulk_constants C = bulk_constants_of(in);
+    bool films = (in->sb || in->capillary) && in->film > 0;
+    bool both = in->sb && in->capillary && in->film > 0 && !in->sb_nc;
+    enum bulk_films kind = both ? BULK_BOTH : films ? BULK_ANY : BULK_DRY;
+    size_t k = 0;
+    if (kind == BULK_BOTH)
+        for (; k + 4 <= n; k += 4)
+            bulk_walls_four(in, &C, part, wall, n, out, k, false, BULK_BOTH);
+    else if (kind == BULK_DRY)
+        for (; k + 4 <= n; k += 4)
+            bulk_walls_four(in, &C, part, wall, n, out, k, false, BULK_DRY);
+    else
+        for (; k + 4 <= n; k += 4)
+            bulk_walls_four(in, &C, part, wall, n, out, k, false, BULK_ANY);
+    if (k < n)
+        bulk_walls_four(in, &C, part, wall, n, out, k, true, kind);
 }
 
 #endif

@@ -35,6 +35,7 @@
 #include <string.h>
 
 #include "integrator.h"
+#include "contact.h"
 #include "many.h"
 #include "models.h"
 #include "vec3.h"
@@ -97,6 +98,7 @@ void wetdem_sim_many_free(struct wetdem_sim* sim)
     free(m->contacts);
     free(m->xr);
     free(m->inv);
+    free(m->m_eff);
     free(m->vw);
     free(m->fixed);
     free(m->thread_work);
@@ -253,6 +255,7 @@ static int size_particle_arrays(struct wetdem_sim* sim)
                   {(void**)&m->contacts, sizeof *m->contacts},
                   {(void**)&m->xr, sizeof *m->xr},
                   {(void**)&m->inv, sizeof *m->inv},
+                  {(void**)&m->m_eff, sizeof *m->m_eff},
                   {(void**)&m->vw, sizeof *m->vw},
                   {(void**)&m->fixed, sizeof *m->fixed},
                   {(void**)&m->wall_dirty, sizeof *m->wall_dirty}};
@@ -472,6 +475,7 @@ int wetdem_sim_many_prepare(struct wetdem_sim* sim)
         m->fixed[k] = p->is_fixed;
         m->inv[k][0] = 1.0 / p->mass;
         m->inv[k][1] = 1.0 / (0.4 * p->mass * p->radius * p->radius);
+        m->m_eff[k] = contact_effective_mass(p);
         m->wall_dirty[k] = ~(uint64_t)0; /* histories may have been restored or changed */
     }
     bool track = m->max_disp_valid && m->cl.n_builds > 0 && m->cl.n_at_build == sim->n_particles;

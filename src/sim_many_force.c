@@ -758,8 +758,10 @@ struct pass {
     bool fused;    /* skip, and the block's candidates are tested and evaluated in one loop */
     bool maintain; /* each tested candidate gets its skip time anew */
     bool zeroed;   /* the sums start from zero already (many.h sums_zeroed) */
-    /* four pairs at a time (many_bulk.h) for the lean kernel's common case, or NULL */
+    /* four pairs at a time (many_bulk.h) for the lean kernel's common case, or NULL; and the
+       particle-wall pairs so (with at most 64 walls) */
     wetdem_many_bulk_fn* bulk;
+    wetdem_many_bulk_walls_fn* bulk_walls;
     struct wetdem_many_bulk_in bulk_in;
 };
 
@@ -1197,6 +1199,89 @@ static inline void start_sum(const struct wetdem_sim* sim, size_t k, bool walls,
     m->contacts[k] = n_contacts;
 }
 
+/* The sums of the particles with walls list[lo..hi) (wall_list), started with their walls as
+ * start_sum does: the particle-wall pairs within range evaluated four at a time (many_bulk.h
+ * bulk_walls) in batches of whole particles, what eval_walls_of does with each result (a class
+ * 1 pair through eval_wall, the scalar kernel). */
+static void start_sums_four_at_a_time(const struct pass* P, size_t lo, size_t hi,
+                                      struct failure* fail)
+{
+    struct wetdem_many* m = P->m;
+    const struct wetdem_sim* sim = P->sim;
+    const uint32_t* list = m->wall_list;
+    size_t len = sim->history_len, nw = sim->n_walls;
+    double range = P->bulk_in.range; /* of the one material pair */
+    uint32_t part[WETDEM_MANY_BULK_MAX];
+    unsigned char wall[WETDEM_MANY_BULK_MAX];
+    struct wetdem_many_bulk_out bo;
+    uint64_t n_within = 0;
+    for (size_t s = lo; s < hi;) {
+        /* the pairs within the reach and the range of list[s..s_end), whole particles (the
+           first always fits: at most 64 walls); those beyond get what eval_walls_of and
+           eval_wall give them (no flags, a fresh history where it may have been used) */
+        size_t n = 0, s_end = s;
+        for (; s_end < hi; s_end++) {
+            size_t i = list[s_end];
+            uint64_t mask = m->wall_mask[i];
+            size_t count = 0;
+            for (uint64_t b = mask; b; b &= b - 1)
+                count++;
+            if (n + count > WETDEM_MANY_BULK_MAX)
+                break;
+            struct wetdem_vec3 pos = vec3(m->xr[i].x, m->xr[i].y, m->xr[i].z);
+            for (size_t w = next_wall(&mask); w < nw; w = next_wall(&mask)) {
+                const struct wetdem_wall* wl = &sim->walls[w];
+                double gap = vec3_dot(vec3_sub(pos, wl->point), wl->normal) - m->xr[i].r;
+                if (gap <= m->reach && !(gap > range)) {
+                    part[n] = (uint32_t)i;
+                    wall[n++] = (unsigned char)w;
+                    continue;
+                }
+                uint64_t bit = (uint64_t)1 << w;
+                if (len && (m->wall_dirty[i] & bit))
+                    wetdem_sim_history_init(sim, m->wall_history + (i * nw + w) * len);
+                m->wall_dirty[i] &= ~bit;
+            }
+        }
+        if (n)
+            P->bulk_walls(&P->bulk_in, part, wall, n, &bo);
+        size_t e = 0;
+        for (; s < s_end; s++) {
+            size_t i = list[s];
+            struct wetdem_vec3 f = vec3(0, 0, 0), t = vec3(0, 0, 0);
+            uint32_t n_contacts = 0;
+            for (; e < n && part[e] == i; e++) {
+                size_t w = wall[e];
+                uint64_t bit = (uint64_t)1 << w;
+                double* hist = len ? m->wall_history + (i * nw + w) * len : NULL;
+                bool dirty = m->wall_dirty[i] & bit;
+                long long cls = bo.cls[e];
+                struct wetdem_many_pair_out o;
+                unsigned char flags;
+                if (cls == 1)
+                    flags = eval_wall(sim, i, w, hist, dirty, &o, fail);
+                else {
+                    flags = (unsigned char)cls; /* (within the range: not 0) */
+                    o.force = vec3(bo.force[0][e], bo.force[1][e], bo.force[2][e]);
+                    o.torque_i = vec3(bo.torque_i[0][e], bo.torque_i[1][e], bo.torque_i[2][e]);
+                    n_within += flags != 0;
+                }
+                m->wall_dirty[i] = flags ? m->wall_dirty[i] | bit : m->wall_dirty[i] & ~bit;
+                if (!(flags & WETDEM_MANY_ACTIVE))
+                    continue;
+                f = vec3_add(f, o.force);
+                t = vec3_add(t, o.torque_i);
+                n_contacts += (flags & WETDEM_MANY_CONTACT) ? 1 : 0;
+            }
+            m->force[i] = f;
+            m->torque[i] = t;
+            m->contacts[i] = n_contacts;
+        }
+    }
+#pragma omp atomic
+    m->bulk_walls += n_within;
+}
+
 /* Phase 2, start of block b: each particle's sum begins with its walls (wall order), then the
  * reactions of the cross pairs (k, i) from earlier blocks, in increasing k. */
 static void start_sums_of_block(const struct pass* P, size_t b, struct failure* fail)
@@ -1216,8 +1301,14 @@ static void start_sums_of_block(const struct pass* P, size_t b, struct failure* 
             else
                 hi = mid;
         }
-        for (size_t s = lo; s < m->n_wall_list && list[s] < end; s++)
-            start_sum(sim, list[s], true, fail);
+        size_t hi_s = lo;
+        while (hi_s < m->n_wall_list && list[hi_s] < end)
+            hi_s++;
+        if (P->bulk_walls)
+            start_sums_four_at_a_time(P, lo, hi_s, fail);
+        else
+            for (size_t s = lo; s < hi_s; s++)
+                start_sum(sim, list[s], true, fail);
     } else
         for (size_t k = begin; k < end; k++)
             start_sum(sim, k, wall_mask[k] || every_wall, fail);
@@ -1665,6 +1756,16 @@ int wetdem_sim_many_forces(struct wetdem_sim* sim, bool kick)
             .mu = L->mindlin_lub ? x->friction_lub : x->friction_dry,
             .tangential_factor = x->mindlin_damping};
         memcpy(P.bulk_in.normal, L->normal, sizeof P.bulk_in.normal);
+        if (sim->n_walls <= 64) { /* (the wall masks) */
+            P.bulk_walls = wetdem_many_bulk_walls_choose(m->bulk_mode == 2);
+            P.bulk_in.walls = sim->walls;
+            P.bulk_in.n_walls = sim->n_walls;
+            P.bulk_in.wall_history = m->wall_history;
+            P.bulk_in.m_eff = m->m_eff;
+            P.bulk_in.reach = m->reach;
+            P.bulk_in.e_star = x->e_star;
+            P.bulk_in.hertz_coef = L->hertz_form >= 0 ? x->hertz_damping[L->hertz_form] : 0.0;
+        }
     }
     m->bulk_passes += P.bulk != NULL;
     /* one region: cross pairs, a barrier, then each block on its own */

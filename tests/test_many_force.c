@@ -632,6 +632,7 @@ static struct wetdem_sim* wet_pile(const char* const* models, int n_models, bool
  * and without mindlin (whose springs are reset apart, and rotated, advanced and capped in
  * contact) and capillary, in either model order, with both treatments of sb below h_min',
  * without film models (dry: contacts only), with either hertz damping form and without hertz,
+ * particle-wall pairs apart and in contact too,
  * on 1 and 2 threads (cross pairs, whose lanes are left out), several calls, each compared:
  * particles, pairs and flags (contacts, bridges). */
 static void test_many_four_at_a_time_change_no_result(void** state)
@@ -688,6 +689,9 @@ static void test_many_four_at_a_time_change_no_result(void** state)
             if (threads == 1)
                 assert_true(sims[2]->many->bulk_contacts == m->bulk_contacts);
             assert_int_equal(sims[1]->many->bulk_contacts, 0);
+            /* and the particles' walls, on the box's six walls */
+            assert_true(m->bulk_walls > 1000 && sims[2]->many->bulk_walls == m->bulk_walls);
+            assert_int_equal(sims[1]->many->bulk_walls, 0);
             size_t contacts = 0, apart = 0; /* both kinds were met at the end */
             for (size_t q = 0; q < m->cl.n_pairs; q++) {
                 contacts += (m->flags[q] & WETDEM_MANY_CONTACT) != 0;
