@@ -39,6 +39,8 @@
 #define PARALLEL_MIN 512
 /* Most runs of particles searched against one cell: 26 distinct neighbours at worst. */
 #define MAX_RUNS 27
+/* Blocks of cells per thread in the pair search (fewer leave a thread idle at the end) */
+#define SCAN_CHUNKS 8
 
 static void set_msg(char* msg, size_t n, const char* fmt, ...)
     __attribute__((format(printf, 3, 4)));
@@ -94,6 +96,7 @@ void wetdem_celllist_clear(struct wetdem_celllist* cl)
     free(cl->scratch);
     free(cl->scratch_cap);
     free(cl->scratch_used);
+    free(cl->counts);
     memset(cl, 0, sizeof *cl);
 }
 
@@ -169,33 +172,52 @@ static size_t cell_index(const struct wetdem_celllist* cl, int x, int y, int z)
     return ((size_t)z * (size_t)cl->n_cells[1] + (size_t)y) * (size_t)cl->n_cells[0] + (size_t)x;
 }
 
-/* Counting sort of the particles into cells (cell_start, cell_items; items in index order). */
+/* Counting sort of the particles into cells (cell_start, cell_items; items in index order),
+ * in parallel: thread t of nt takes the particles [n t / nt, n (t + 1) / nt), counts them per
+ * cell, and places them after the same cell's particles of the threads before it, so each
+ * cell lists its particles in index order whatever the thread count. */
 static int bin_particles(struct wetdem_celllist* cl, const struct wetdem_particle* p, size_t n)
 {
     size_t n_cells = (size_t)cl->n_cells[0] * (size_t)cl->n_cells[1] * (size_t)cl->n_cells[2];
+    int nt = n >= PARALLEL_MIN ? omp_get_max_threads() : 1;
     if (reserve((void**)&cl->cell_start, &cl->cells_cap, n_cells + 1, sizeof(size_t)) ||
         reserve((void**)&cl->cell_items, &cl->items_cap, n, sizeof(uint32_t)) ||
         reserve((void**)&cl->cell_of, &cl->cell_of_cap, n, sizeof(uint32_t)) ||
-        reserve((void**)&cl->sorted, &cl->sorted_cap, n, sizeof *cl->sorted))
+        reserve((void**)&cl->sorted, &cl->sorted_cap, n, sizeof *cl->sorted) ||
+        reserve((void**)&cl->counts, &cl->counts_cap, (size_t)nt * n_cells, sizeof(size_t)))
         return WETDEM_ERR_NOMEM;
-    memset(cl->cell_start, 0, (n_cells + 1) * sizeof(size_t));
-    for (size_t i = 0; i < n; i++) {
-        size_t c = cell_index(cl, cell_coord(cl, p[i].pos.x, 0), cell_coord(cl, p[i].pos.y, 1),
-                              cell_coord(cl, p[i].pos.z, 2));
-        cl->cell_of[i] = (uint32_t)c;
-        cl->cell_start[c + 1]++;
+#pragma omp parallel num_threads(nt)
+    {
+        size_t t = (size_t)omp_get_thread_num(), team = (size_t)omp_get_num_threads();
+        size_t lo = n * t / team, hi = n * (t + 1) / team, *count = cl->counts + t * n_cells;
+        memset(count, 0, n_cells * sizeof *count);
+        for (size_t i = lo; i < hi; i++) {
+            size_t c = cell_index(cl, cell_coord(cl, p[i].pos.x, 0), cell_coord(cl, p[i].pos.y, 1),
+                                  cell_coord(cl, p[i].pos.z, 2));
+            cl->cell_of[i] = (uint32_t)c;
+            count[c]++;
+        }
+#pragma omp barrier
+#pragma omp single
+        { /* each thread's first place in each cell */
+            size_t run = 0;
+            for (size_t c = 0; c < n_cells; c++) {
+                cl->cell_start[c] = run;
+                for (size_t u = 0; u < team; u++) {
+                    size_t k = cl->counts[u * n_cells + c];
+                    cl->counts[u * n_cells + c] = run;
+                    run += k;
+                }
+            }
+            cl->cell_start[n_cells] = run;
+        }
+        for (size_t i = lo; i < hi; i++) {
+            size_t s = count[cl->cell_of[i]]++;
+            cl->cell_items[s] = (uint32_t)i;
+            cl->sorted[s] =
+                (struct wetdem_celllist_item){p[i].pos.x, p[i].pos.y, p[i].pos.z, p[i].radius};
+        }
     }
-    for (size_t c = 0; c < n_cells; c++)
-        cl->cell_start[c + 1] += cl->cell_start[c];
-    for (size_t i = 0; i < n; i++) {
-        size_t s = cl->cell_start[cl->cell_of[i]]++;
-        cl->cell_items[s] = (uint32_t)i;
-        cl->sorted[s] =
-            (struct wetdem_celllist_item){p[i].pos.x, p[i].pos.y, p[i].pos.z, p[i].radius};
-    }
-    for (size_t c = n_cells; c > 0; c--) /* undo the shift left by the fill */
-        cl->cell_start[c] = cl->cell_start[c - 1];
-    cl->cell_start[0] = 0;
     return WETDEM_OK;
 }
 
@@ -357,10 +379,17 @@ static int stencil_runs(const struct wetdem_celllist* cl, const struct scan* sc,
     return 6;
 }
 
-/* Searches cell (x, y, z) against itself and its half stencil; appends to the buffer of
- * thread t (grown as needed). Returns WETDEM_OK or WETDEM_ERR_NOMEM. */
-static int scan_cell(struct wetdem_celllist* cl, const struct scan* sc, int x, int y, int z,
-                     bool distinct, int t)
+/* A thread's pair buffer during the search, in the thread's own memory (the arrays of
+ * struct wetdem_celllist that hold it share cache lines between threads). */
+struct pair_buffer {
+    struct wetdem_celllist_pair* pairs;
+    size_t cap, used;
+};
+
+/* Searches cell (x, y, z) against itself and its half stencil; appends to the buffer b (grown
+ * as needed). Returns WETDEM_OK or WETDEM_ERR_NOMEM. */
+static int scan_cell(const struct wetdem_celllist* cl, const struct scan* sc, int x, int y, int z,
+                     bool distinct, struct pair_buffer* b)
 {
     size_t c = cell_index(cl, x, y, z), a0 = cl->cell_start[c], a1 = cl->cell_start[c + 1];
     struct run runs[MAX_RUNS + 1];
@@ -368,18 +397,17 @@ static int scan_cell(struct wetdem_celllist* cl, const struct scan* sc, int x, i
     size_t others = 0, na = a1 - a0;
     for (int r = 1; r < m; r++)
         others += runs[r].hi - runs[r].lo;
-    size_t used = cl->scratch_used[t], need = used + na * (na - 1) / 2 + na * others;
-    if (need > cl->scratch_cap[t] &&
-        reserve((void**)&cl->scratch[t], &cl->scratch_cap[t], need, sizeof **cl->scratch))
+    size_t used = b->used, need = used + na * (na - 1) / 2 + na * others;
+    if (need > b->cap && reserve((void**)&b->pairs, &b->cap, need, sizeof *b->pairs))
         return WETDEM_ERR_NOMEM;
     bool image = cl->box.periodic[0] || cl->box.periodic[1] || cl->box.periodic[2];
-    struct wetdem_celllist_pair* out = cl->scratch[t];
+    struct wetdem_celllist_pair* out = b->pairs;
     for (size_t s = a0; s < a1; s++) {
         runs[0] = (struct run){s + 1, a1};
         used +=
             image ? scan_image(sc, s, runs, m, out + used) : scan_plain(sc, s, runs, m, out + used);
     }
-    cl->scratch_used[t] = used;
+    b->used = used;
     return WETDEM_OK;
 }
 
@@ -397,16 +425,18 @@ static size_t block_start(const struct wetdem_celllist* cl, size_t n_cells, size
     return t == 0 ? 0 : (t == nt ? n_cells : lo);
 }
 
-/* Scans the cells [c0, c1) into the buffer of thread t. */
+/* Scans the cells [c0, c1) into the buffer of thread t (kept in a local while it runs). */
 static int scan_block(struct wetdem_celllist* cl, const struct scan* sc, size_t c0, size_t c1,
                       bool distinct, int t)
 {
     int nx = cl->n_cells[0], ny = cl->n_cells[1];
     int x = (int)(c0 % (size_t)nx), y = (int)(c0 / (size_t)nx % (size_t)ny);
     int z = (int)(c0 / ((size_t)nx * (size_t)ny));
-    for (size_t c = c0; c < c1; c++) {
-        if (cl->cell_start[c + 1] > cl->cell_start[c] && scan_cell(cl, sc, x, y, z, distinct, t))
-            return WETDEM_ERR_NOMEM;
+    struct pair_buffer b = {cl->scratch[t], cl->scratch_cap[t], cl->scratch_used[t]};
+    int st = WETDEM_OK;
+    for (size_t c = c0; c < c1 && st == WETDEM_OK; c++) {
+        if (cl->cell_start[c + 1] > cl->cell_start[c])
+            st = scan_cell(cl, sc, x, y, z, distinct, &b);
         if (++x == nx) {
             x = 0;
             if (++y == ny) {
@@ -415,7 +445,10 @@ static int scan_block(struct wetdem_celllist* cl, const struct scan* sc, size_t 
             }
         }
     }
-    return WETDEM_OK;
+    cl->scratch[t] = b.pairs;
+    cl->scratch_cap[t] = b.cap;
+    cl->scratch_used[t] = b.used;
+    return st;
 }
 
 /* Checks the particles; r_max [m] is the largest radius, [lo, hi] the bounding box [m]. */
@@ -427,19 +460,30 @@ static int check_input(const struct wetdem_particle* p, size_t n, double* r_max,
                 UINT32_MAX - 1);
         return WETDEM_ERR_INVALID;
     }
+    /* in parallel: min and max are exact, so the same for any thread count; the first bad
+       particle is the lowest index of one */
     double r = 0, l[3] = {INFINITY, INFINITY, INFINITY}, h[3] = {-INFINITY, -INFINITY, -INFINITY};
+    size_t bad = SIZE_MAX;
+#pragma omp parallel for schedule(static) reduction(max                                            \
+                                                    : r, h[:3])                                    \
+    reduction(min                                                                                  \
+              : l[:3], bad) if (n >= PARALLEL_MIN)
     for (size_t i = 0; i < n; i++) {
         double x[3] = {p[i].pos.x, p[i].pos.y, p[i].pos.z};
         if (!vec3_is_finite(p[i].pos) || !(p[i].radius > 0 && isfinite(p[i].radius))) {
-            set_msg(msg, msg_size, "particle %zu has a non-finite position or a bad radius %g m", i,
-                    p[i].radius);
-            return WETDEM_ERR_INVALID;
+            bad = i < bad ? i : bad;
+            continue;
         }
         r = p[i].radius > r ? p[i].radius : r;
         for (int k = 0; k < 3; k++) {
             l[k] = x[k] < l[k] ? x[k] : l[k];
             h[k] = x[k] > h[k] ? x[k] : h[k];
         }
+    }
+    if (bad != SIZE_MAX) {
+        set_msg(msg, msg_size, "particle %zu has a non-finite position or a bad radius %g m", bad,
+                p[bad].radius);
+        return WETDEM_ERR_INVALID;
     }
     *r_max = r;
     memcpy(lo, l, sizeof l);
@@ -485,34 +529,79 @@ static void sort_segment(struct wetdem_celllist_pair* q, size_t len)
     }
 }
 
-/* Counting sort of the thread buffers by i into pairs / first_pair, then each segment by j. */
+/* Chunks of the particle range over which the prefix sum of the pair counts is shared. */
+#define GATHER_CHUNKS 64
+
+/* Counting sort of the nt thread buffers by i into pairs / first_pair, then each segment by
+ * j, in parallel: the buffers are counted per i on their own, the prefix sum over i (each
+ * buffer's first place in each segment, buffers in order) runs in chunks of i, and each
+ * buffer is scattered on its own. Segments are sorted by j, so the list does not depend on
+ * which buffer held a pair. */
 static int gather_pairs(struct wetdem_celllist* cl, size_t n, int nt)
 {
-    size_t total = 0;
+    size_t total = 0, nb = (size_t)nt;
     for (int t = 0; t < nt; t++)
         total += cl->scratch_used[t];
     if (reserve((void**)&cl->first_pair, &cl->first_cap, n + 2, sizeof(size_t)) ||
-        reserve((void**)&cl->pairs, &cl->pairs_cap, total ? total : 1, sizeof *cl->pairs))
+        reserve((void**)&cl->pairs, &cl->pairs_cap, total ? total : 1, sizeof *cl->pairs) ||
+        reserve((void**)&cl->counts, &cl->counts_cap, nb * (n ? n : 1), sizeof(size_t)))
         return WETDEM_ERR_NOMEM;
-    size_t* start = cl->first_pair; /* counts at i + 2, so the scatter leaves starts at i */
-    memset(start, 0, (n + 2) * sizeof *start);
-    for (int t = 0; t < nt; t++)
-        for (size_t q = 0; q < cl->scratch_used[t]; q++)
-            start[cl->scratch[t][q].i + 2]++;
-    for (size_t i = 2; i < n + 2; i++)
-        start[i] += start[i - 1];
-    for (int t = 0; t < nt; t++)
-        for (size_t q = 0; q < cl->scratch_used[t]; q++)
-            cl->pairs[start[cl->scratch[t][q].i + 1]++] = cl->scratch[t][q];
-#pragma omp parallel for schedule(static) if (n >= PARALLEL_MIN)
-    for (size_t i = 0; i < n; i++)
-        sort_segment(cl->pairs + start[i], start[i + 1] - start[i]);
+    size_t* start = cl->first_pair;
+    size_t chunk_start[GATHER_CHUNKS + 1];
+    size_t n_chunks = n < GATHER_CHUNKS ? 1 : GATHER_CHUNKS;
+#pragma omp parallel num_threads(nt) if (n >= PARALLEL_MIN)
+    {
+#pragma omp for schedule(static)
+        for (size_t b = 0; b < nb; b++) { /* counts of buffer b per i */
+            size_t* count = cl->counts + b * n;
+            memset(count, 0, n * sizeof *count);
+            for (size_t q = 0; q < cl->scratch_used[b]; q++)
+                count[cl->scratch[b][q].i]++;
+        }
+#pragma omp for schedule(static)
+        for (size_t k = 0; k < n_chunks; k++) { /* pairs of each chunk of i */
+            size_t sum = 0;
+            for (size_t i = n * k / n_chunks; i < n * (k + 1) / n_chunks; i++)
+                for (size_t b = 0; b < nb; b++)
+                    sum += cl->counts[b * n + i];
+            chunk_start[k + 1] = sum;
+        }
+#pragma omp single
+        {
+            chunk_start[0] = 0;
+            for (size_t k = 0; k < n_chunks; k++)
+                chunk_start[k + 1] += chunk_start[k];
+        }
+#pragma omp for schedule(static)
+        for (size_t k = 0; k < n_chunks; k++) { /* segment starts, and each buffer's place */
+            size_t run = chunk_start[k];
+            for (size_t i = n * k / n_chunks; i < n * (k + 1) / n_chunks; i++) {
+                start[i] = run;
+                for (size_t b = 0; b < nb; b++) {
+                    size_t c = cl->counts[b * n + i];
+                    cl->counts[b * n + i] = run;
+                    run += c;
+                }
+            }
+        }
+#pragma omp for schedule(static)
+        for (size_t b = 0; b < nb; b++) { /* each buffer into its places */
+            size_t* place = cl->counts + b * n;
+            for (size_t q = 0; q < cl->scratch_used[b]; q++)
+                cl->pairs[place[cl->scratch[b][q].i]++] = cl->scratch[b][q];
+        }
+#pragma omp for schedule(static)
+        for (size_t i = 0; i < n; i++)
+            sort_segment(cl->pairs + start[i], (i + 1 < n ? start[i + 1] : total) - start[i]);
+    }
+    start[n] = start[n + 1] = total;
     cl->n_pairs = total;
     return WETDEM_OK;
 }
 
-/* Finds the pairs: threads scan contiguous blocks of cells into their own buffers, which are
- * then sorted into the list (the same list for any thread count). */
+/* Finds the pairs: threads scan contiguous blocks of cells (SCAN_CHUNKS per thread, taken as
+ * they come: packings are denser in places) into their own buffers, which are then sorted into
+ * the list by (i, j): the same list for any thread count and any share of the blocks. */
 static int fill_pairs(struct wetdem_celllist* cl, size_t n)
 {
     int max_threads = n >= PARALLEL_MIN ? omp_get_max_threads() : 1, used_threads = 1;
@@ -531,14 +620,18 @@ static int fill_pairs(struct wetdem_celllist* cl, size_t n)
 #pragma omp parallel num_threads(max_threads)
     {
         int t = omp_get_thread_num(), nt = omp_get_num_threads();
+        int chunks = nt > 1 ? SCAN_CHUNKS * nt : 1;
 #pragma omp single
         used_threads = nt;
         cl->scratch_used[t] = 0;
-        if (scan_block(cl, &sc, block_start(cl, n_cells, n, t, nt),
-                       block_start(cl, n_cells, n, t + 1, nt), distinct, t)) {
+#pragma omp barrier
+#pragma omp for schedule(dynamic, 1)
+        for (int k = 0; k < chunks; k++)
+            if (scan_block(cl, &sc, block_start(cl, n_cells, n, k, chunks),
+                           block_start(cl, n_cells, n, k + 1, chunks), distinct, t)) {
 #pragma omp atomic write
-            nomem = true;
-        }
+                nomem = true;
+            }
     }
     return nomem ? WETDEM_ERR_NOMEM : gather_pairs(cl, n, used_threads);
 }
@@ -558,6 +651,7 @@ int wetdem_celllist_build(struct wetdem_celllist* cl, const struct wetdem_partic
         set_msg(msg, msg_size, "out of memory building the neighbour list of %zu particles", n);
         return WETDEM_ERR_NOMEM;
     }
+#pragma omp parallel for schedule(static) if (n >= PARALLEL_MIN)
     for (size_t i = 0; i < n; i++)
         cl->pos_at_build[i] = p[i].pos;
     cl->n_at_build = n;

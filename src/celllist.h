@@ -72,6 +72,8 @@ struct wetdem_celllist {
     size_t* scratch_cap;
     size_t* scratch_used;
     int n_scratch;
+    size_t* counts; /* per-thread counts of the parallel counting sorts (cells, pairs) */
+    size_t counts_cap;
     /* state at the last build */
     struct wetdem_vec3* pos_at_build;
     size_t n_at_build, at_build_cap;

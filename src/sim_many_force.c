@@ -1014,21 +1014,30 @@ static void partition_blocks(struct wetdem_many* m, size_t n, size_t nb)
     }
     if (timed)
         memcpy(old_blk, m->blk, (nb + 1) * sizeof *old_blk);
+        /* work[i]: the unscaled estimate (in parallel: it reads every candidate's flags) */
+#pragma omp parallel for schedule(static) if (wetdem_many_parallel(m, n))
+    for (size_t i = 0; i < n; i++)
+        m->work[i] = particle_work(m, i);
+    double factor[WETDEM_MANY_MAX_BLOCKS]; /* of each timed block (a division once per block) */
+    for (size_t b = 0; b < nb; b++)
+        factor[b] = timed ? scale[b] / mean : 1.0;
     double total = 0;
-    for (size_t i = 0, b = 0; i < n; i++) { /* work[i]: the unscaled estimate */
+    for (size_t i = 0, b = 0; i < n; i++) {
         while (timed && b + 1 < nb && i >= old_blk[b + 1])
             b++;
-        m->work[i] = particle_work(m, i);
-        total += m->work[i] * (timed ? scale[b] / mean : 1.0);
+        total += m->work[i] * factor[b];
     }
     double sum = 0;
     size_t b = 1;
+    double next = total * (double)b / (double)nb;       /* the share at which cut b falls */
     for (size_t i = 0, old = 0; i < n && b < nb; i++) { /* the cuts, on the scaled estimates */
         while (timed && old + 1 < nb && i >= old_blk[old + 1])
             old++;
-        sum += m->work[i] * (timed ? scale[old] / mean : 1.0);
-        while (b < nb && sum >= total * (double)b / (double)nb)
+        sum += m->work[i] * factor[old];
+        while (b < nb && sum >= next) {
             m->blk[b++] = i + 1;
+            next = total * (double)b / (double)nb;
+        }
     }
     m->blk[0] = 0;
     while (b <= nb)
@@ -1130,10 +1139,20 @@ static int index_blocks(struct wetdem_sim* sim, size_t nb)
                                "too many candidate pairs for the force pass: %zu (limit %u)", np,
                                UINT32_MAX);
     partition_blocks(m, n, nb);
-    size_t nc = 0; /* pairs (i, j > i) leave i's block when j is at or beyond its end */
-    for (size_t b = 0; nb > 1 && b < nb; b++)
+    /* pairs (i, j > i) leave i's block when j is at or beyond its end: counted and listed by
+       block, the blocks in parallel (each block's entries at its offset, in pair order) */
+    size_t count[WETDEM_MANY_MAX_BLOCKS + 1] = {0};
+    bool parallel = nb > 1 && wetdem_many_parallel(m, n);
+#pragma omp parallel for schedule(static) if (parallel)
+    for (size_t b = 0; b < (nb > 1 ? nb : 0); b++) {
+        size_t c = 0; /* (stored once: neighbouring counts share a cache line) */
         for (size_t q = m->cl.first_pair[m->blk[b]]; q < m->cl.first_pair[m->blk[b + 1]]; q++)
-            nc += m->cl.pairs[q].j >= m->blk[b + 1];
+            c += m->cl.pairs[q].j >= m->blk[b + 1];
+        count[b + 1] = c;
+    }
+    for (size_t b = 0; b < nb; b++)
+        count[b + 1] += count[b];
+    size_t nc = count[nb];
     if (!reserve((void**)&m->cross_q, &m->cross_q_cap, nc, sizeof *m->cross_q) ||
         !reserve((void**)&m->cross_in, &m->cross_in_cap, nc, sizeof *m->cross_in) ||
         !reserve((void**)&m->cross_out, &m->cross_out_cap, nc, sizeof *m->cross_out) ||
@@ -1143,20 +1162,20 @@ static int index_blocks(struct wetdem_sim* sim, size_t nb)
     size_t* first_out = m->cross_first;         /* by block of the first particle */
     size_t* first_in = m->cross_first + nb + 1; /* by block of the second particle */
     memset(m->cross_first, 0, 2 * (nb + 1) * sizeof *m->cross_first);
-    size_t e = 0;
-    for (size_t bi = 0; nb > 1 && bi < nb; bi++)
-        for (size_t q = m->cl.first_pair[m->blk[bi]]; q < m->cl.first_pair[m->blk[bi + 1]]; q++) {
-            size_t j = m->cl.pairs[q].j;
-            if (j < m->blk[bi + 1])
-                continue;
-            m->cross_q[e] = (uint32_t)q;
-            m->cross_in[e] = (uint32_t)e;
-            first_out[bi + 1]++;
-            first_in[block_of(m->blk, nb, j) + 1]++;
-            e++;
-        }
+#pragma omp parallel for schedule(static) if (parallel)
+    for (size_t bi = 0; bi < (nb > 1 ? nb : 0); bi++) {
+        size_t e = count[bi];
+        for (size_t q = m->cl.first_pair[m->blk[bi]]; q < m->cl.first_pair[m->blk[bi + 1]]; q++)
+            if (m->cl.pairs[q].j >= m->blk[bi + 1]) {
+                m->cross_q[e] = (uint32_t)q;
+                m->cross_in[e] = (uint32_t)e;
+                e++;
+            }
+    }
+    for (size_t e = 0; e < nc; e++)
+        first_in[block_of(m->blk, nb, m->cl.pairs[m->cross_q[e]].j) + 1]++;
     for (size_t b = 0; b < nb; b++) {
-        first_out[b + 1] += first_out[b];
+        first_out[b + 1] = count[b + 1];
         first_in[b + 1] += first_in[b];
     }
     if (nc > 1 && sort_cross_in(m, nc) != WETDEM_OK)

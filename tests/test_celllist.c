@@ -207,6 +207,37 @@ static void test_celllist_rejects_too_small_periodic_box(void** state)
     free(p);
 }
 
+/* The check of the particles runs in parallel: the message names the first bad particle, and
+ * the bounding box (and so the grid and the list) is the same, for any thread count. */
+static void test_celllist_first_bad_particle_for_any_thread_count(void** state)
+{
+    (void)state;
+    size_t n = 3000;
+    struct wetdem_particle* p = random_spheres(n, 60e-3, 0.5e-3, 1.5e-3, 11);
+    struct wetdem_celllist_box box = {{0, 0, 0}, {60e-3, 60e-3, 60e-3}, {false, false, false}};
+    int saved = omp_get_max_threads();
+    for (int threads = 1; threads <= 4; threads++) {
+        omp_set_num_threads(threads);
+        struct wetdem_celllist cl;
+        char msg[256] = "";
+        CHECK_OK(wetdem_celllist_init(&cl, &box, 0.4e-3, 0.2e-3, msg, sizeof msg));
+        p[2900].radius = -1e-3; /* in the last thread's share */
+        p[1700].pos.y = NAN;    /* the first bad one */
+        CHECK_STATUS(wetdem_celllist_build(&cl, p, n, msg, sizeof msg), WETDEM_ERR_INVALID);
+        CHECK_CONTAINS(msg, "particle 1700 has a non-finite position");
+        p[1700].pos.y = 1e-3;
+        CHECK_STATUS(wetdem_celllist_build(&cl, p, n, msg, sizeof msg), WETDEM_ERR_INVALID);
+        CHECK_CONTAINS(msg, "particle 2900 has a non-finite position or a bad radius -0.001 m");
+        p[2900].radius = 1e-3;
+        CHECK_OK(wetdem_celllist_build(&cl, p, n, msg, sizeof msg));
+        assert_int_equal(cl.n_cells[0], 16); /* the box of the spheres, 60 mm / d_cut 3.6 mm */
+        check_against_brute_force(&cl, p, n);
+        wetdem_celllist_clear(&cl);
+    }
+    omp_set_num_threads(saved);
+    free(p);
+}
+
 static void test_celllist_same_list_for_any_thread_count(void** state)
 {
     (void)state;
@@ -338,6 +369,7 @@ int main(void)
         cmocka_unit_test(test_celllist_unwrapped_positions),
         cmocka_unit_test(test_celllist_polydisperse_long_reach),
         cmocka_unit_test(test_celllist_rejects_too_small_periodic_box),
+        cmocka_unit_test(test_celllist_first_bad_particle_for_any_thread_count),
         cmocka_unit_test(test_celllist_same_list_for_any_thread_count),
         cmocka_unit_test(test_celllist_never_misses_beyond_contact_pairs),
         cmocka_unit_test(test_celllist_remap_history_keeps_common_pairs),
