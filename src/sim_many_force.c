@@ -991,6 +991,18 @@ static double particle_work(const struct wetdem_many* m, size_t i)
     return 4.5 + (double)(q1 - q0) + 20.0 * (double)active + 12.0 * (double)walls;
 }
 
+/* Block of particle k (blk: nb + 1 starts). */
+static size_t block_of(const size_t* blk, size_t nb, size_t k)
+{
+    size_t b = 0;
+    while (b + 1 < nb && k >= blk[b + 1])
+        b++;
+    return b;
+}
+
+/* Chunks of the particles whose work sums place the block cuts (partition_blocks). */
+#define PARTITION_CHUNKS 256
+
 /* Block starts blk[0..nb]: contiguous blocks of about equal estimated work, so that the
  * threads finish together (the result does not depend on the boundaries). When the blocks of
  * the same count were timed, the estimate of each particle is scaled by its old block's time
@@ -1014,34 +1026,52 @@ static void partition_blocks(struct wetdem_many* m, size_t n, size_t nb)
     }
     if (timed)
         memcpy(old_blk, m->blk, (nb + 1) * sizeof *old_blk);
-        /* work[i]: the unscaled estimate (in parallel: it reads every candidate's flags) */
-#pragma omp parallel for schedule(static) if (wetdem_many_parallel(m, n))
-    for (size_t i = 0; i < n; i++)
-        m->work[i] = particle_work(m, i);
     double factor[WETDEM_MANY_MAX_BLOCKS]; /* of each timed block (a division once per block) */
     for (size_t b = 0; b < nb; b++)
         factor[b] = timed ? scale[b] / mean : 1.0;
-    double total = 0;
-    for (size_t i = 0, b = 0; i < n; i++) {
-        while (timed && b + 1 < nb && i >= old_blk[b + 1])
-            b++;
-        total += m->work[i] * factor[b];
-    }
-    double sum = 0;
-    size_t b = 1;
-    double next = total * (double)b / (double)nb;       /* the share at which cut b falls */
-    for (size_t i = 0, old = 0; i < n && b < nb; i++) { /* the cuts, on the scaled estimates */
-        while (timed && old + 1 < nb && i >= old_blk[old + 1])
-            old++;
-        sum += m->work[i] * factor[old];
-        while (b < nb && sum >= next) {
-            m->blk[b++] = i + 1;
-            next = total * (double)b / (double)nb;
+    /* work[i], the unscaled estimate, and the scaled sums of PARTITION_CHUNKS chunks of the
+       particles, in parallel (it reads every candidate's flags); then the cuts from the chunk
+       sums, each found by a scan of its chunk. The chunks do not depend on the thread count,
+       so neither do the cuts (which change no result anyway: only the balance). */
+    size_t n_chunks = n < PARTITION_CHUNKS ? 1 : PARTITION_CHUNKS;
+    double chunk_sum[PARTITION_CHUNKS + 1];
+#pragma omp parallel for schedule(static) if (wetdem_many_parallel(m, n))
+    for (size_t k = 0; k < n_chunks; k++) {
+        size_t lo = n * k / n_chunks, hi = n * (k + 1) / n_chunks;
+        size_t old = timed ? block_of(old_blk, nb, lo) : 0;
+        double sum = 0;
+        for (size_t i = lo; i < hi; i++) {
+            while (timed && old + 1 < nb && i >= old_blk[old + 1])
+                old++;
+            m->work[i] = particle_work(m, i);
+            sum += m->work[i] * factor[old];
         }
+        chunk_sum[k + 1] = sum;
     }
+    chunk_sum[0] = 0;
+    for (size_t k = 0; k < n_chunks; k++)
+        chunk_sum[k + 1] += chunk_sum[k];
+    double total = chunk_sum[n_chunks];
+    size_t b = 1, k = 0;
     m->blk[0] = 0;
-    while (b <= nb)
-        m->blk[b++] = n;
+    for (; b < nb; b++) { /* cut b: after the particle at which the sum reaches b/nb of it */
+        double target = total * (double)b / (double)nb;
+        while (k + 1 < n_chunks && chunk_sum[k + 1] < target)
+            k++;
+        size_t lo = n * k / n_chunks, hi = n * (k + 1) / n_chunks, i = lo;
+        size_t old = timed ? block_of(old_blk, nb, lo) : 0;
+        double sum = chunk_sum[k];
+        for (; i < hi; i++) {
+            while (timed && old + 1 < nb && i >= old_blk[old + 1])
+                old++;
+            sum += m->work[i] * factor[old];
+            if (sum >= target)
+                break;
+        }
+        size_t cut = i < hi ? i + 1 : hi;
+        m->blk[b] = cut > m->blk[b - 1] ? cut : m->blk[b - 1];
+    }
+    m->blk[nb] = n;
     if (m->block_jitter) { /* tests: arbitrary increasing cuts, new at every re-cut */
         uint64_t r = m->block_jitter =
             m->block_jitter * 6364136223846793005u + 1442695040888963407u;
@@ -1051,11 +1081,13 @@ static void partition_blocks(struct wetdem_many* m, size_t n, size_t nb)
             m->blk[b] = lo + (size_t)((r >> 33) % (hi - lo + 1));
         }
     }
-    for (b = 0; b < nb; b++) { /* the estimate of each new block, for the next feedback */
-        m->block_est[b] = 0;
-        for (size_t i = m->blk[b]; i < m->blk[b + 1]; i++)
-            m->block_est[b] += m->work[i];
-        m->block_time[b] = 0;
+#pragma omp parallel for schedule(static) if (wetdem_many_parallel(m, n))
+    for (size_t c = 0; c < nb; c++) { /* the estimate of each new block, for the next feedback */
+        double est = 0;
+        for (size_t i = m->blk[c]; i < m->blk[c + 1]; i++)
+            est += m->work[i];
+        m->block_est[c] = est;
+        m->block_time[c] = 0;
     }
 }
 
@@ -1071,15 +1103,6 @@ static bool blocks_unbalanced(const struct wetdem_many* m)
         hi = fmax(hi, m->block_time[b]);
     }
     return hi > 1.1 * lo;
-}
-
-/* Block of particle k (blk: nb + 1 starts). */
-static size_t block_of(const size_t* blk, size_t nb, size_t k)
-{
-    size_t b = 0;
-    while (b + 1 < nb && k >= blk[b + 1])
-        b++;
-    return b;
 }
 
 /* A cross entry e with its pair (i, j), for sorting by (j, i). */
