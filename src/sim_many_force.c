@@ -1220,8 +1220,46 @@ static int index_blocks(struct wetdem_sim* sim, size_t nb)
 static void cross_pairs_share(const struct pass* P, size_t t, size_t nt, struct failure* fail)
 {
     struct wetdem_many* m = P->m;
-    size_t n = m->cross_first[m->n_blocks];
-    for (size_t e = n * t / nt; e < n * (t + 1) / nt; e++) {
+    size_t n = m->cross_first[m->n_blocks], e_begin = n * t / nt, e_end = n * (t + 1) / nt;
+    if (P->bulk) { /* four at a time: what eval_candidate does with each result */
+        uint32_t q_of[WETDEM_MANY_BULK_MAX], e_of[WETDEM_MANY_BULK_MAX];
+        struct wetdem_many_bulk_out bo;
+        for (size_t e = e_begin; e < e_end;) {
+            size_t n_w = 0; /* the next candidates whose skip time has come */
+            for (; e < e_end && n_w < WETDEM_MANY_BULK_MAX; e++) {
+                q_of[n_w] = m->cross_q[e];
+                e_of[n_w] = (uint32_t)e;
+                n_w += !skipped(P, m->cross_q[e]);
+            }
+            if (!n_w)
+                continue;
+            P->bulk(&P->bulk_in, q_of, n_w, SIZE_MAX, &bo); /* (no particle is being updated) */
+            for (size_t k = 0; k < n_w; k++) {
+                size_t q = q_of[k];
+                struct wetdem_many_pair_out* o = &m->cross_out[e_of[k]];
+                long long cls = bo.cls[k];
+                if (P->maintain) /* within_reach's */
+                    set_skip_time(P, q, bo.r2[k]);
+                if (!cls) {
+                    if (P->flags[q])
+                        leave_range(P, q);
+                } else if (cls & WETDEM_MANY_CONTACT) { /* its spring stored */
+                    P->flags[q] = (unsigned char)cls;
+                    o->force = vec3(bo.force[0][k], bo.force[1][k], bo.force[2][k]);
+                    o->torque_i = vec3(bo.torque_i[0][k], bo.torque_i[1][k], bo.torque_i[2][k]);
+                    o->torque_j = vec3(bo.torque_j[0][k], bo.torque_j[1][k], bo.torque_j[2][k]);
+                } else if (cls != 1) { /* apart, finite (no torques: adds_torque) */
+                    reset_spring_apart(&m->lean, P->flags[q], P->history + q * P->len);
+                    P->flags[q] = (unsigned char)cls;
+                    o->force = vec3(bo.force[0][k], bo.force[1][k], bo.force[2][k]);
+                } else
+                    near_candidate(P, q, P->pairs[q].i, P->pairs[q].j, vec3(0, 0, 0), m->mix, o,
+                                   fail, &bo, k);
+            }
+        }
+        return;
+    }
+    for (size_t e = e_begin; e < e_end; e++) {
         size_t q = m->cross_q[e];
         eval_candidate(P, q, P->pairs[q].i, P->pairs[q].j, &m->cross_out[e], fail);
     }
