@@ -173,9 +173,10 @@ struct wetdem_many {
        candidate rejected at clock c with |d| - far = g > 0 cannot pass the test while the
        clock is below c + g/2, its skip_until; until then it is not tested (its result would be
        the same: a rejection). The times are kept (skip_on) from each list build, and again
-       32 passes after they were dropped (skip_off_passes), for as long as at least half of
-       the candidates are skipped (in a flowing system few are, and keeping the times costs
-       more than the skips save). They are usable (skip_ready) when the previous pass kept
+       32 passes after they were dropped (skip_off_passes), for as long as at least an eighth
+       of the candidates are skipped (in a flowing system few are, and keeping the times costs
+       more than the skips save; with half, as before, a wet packing lost them too often:
+       5 % more instructions on the benchmark's shared state). They are usable (skip_ready) when the previous pass kept
        them and every step since had a bound; a list build, a call, particles loaded anew, a
        step without a bound and a restart of the clock clear it. */
     float* skip_until; /* [m], rounded down */
