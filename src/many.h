@@ -198,6 +198,7 @@ struct wetdem_many {
     unsigned skip_off_passes;
     bool no_skip;             /* tests: test every candidate at every pass */
     bool skip_always;         /* tests: keep the times whatever share is skipped */
+    unsigned skip_share;      /* tests: keep them while 1/skip_share are skipped (0: 1/8) */
     double clock_limit;       /* tests: restart the skip clock beyond this [m] (0: the skin) */
     uint64_t clock_restarts;  /* restarts of the skip clock (tests) */
     uint64_t pass_candidates; /* candidates of the latest pass's gap tests */

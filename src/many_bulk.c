@@ -6,25 +6,24 @@
 #define WETDEM_MANY_BULK_WALLS_NAME wetdem_many_bulk_walls_base
 #include "many_bulk.h"
 
-wetdem_many_bulk_fn* wetdem_many_bulk_choose(bool base_only)
+/* Whether the AVX2 versions run here (never with `base_only`). */
+static bool avx2_usable(bool base_only)
 {
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
     /* (libgcc's check includes the operating system's support of the AVX registers) */
-    if (!base_only && __builtin_cpu_supports("avx2"))
-        return wetdem_many_bulk_avx2;
+    return !base_only && __builtin_cpu_supports("avx2");
 #else
     (void)base_only;
+    return false;
 #endif
-    return wetdem_many_bulk_base;
+}
+
+wetdem_many_bulk_fn* wetdem_many_bulk_choose(bool base_only)
+{
+    return avx2_usable(base_only) ? wetdem_many_bulk_avx2 : wetdem_many_bulk_base;
 }
 
 wetdem_many_bulk_walls_fn* wetdem_many_bulk_walls_choose(bool base_only)
 {
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
-    if (!base_only && __builtin_cpu_supports("avx2"))
-        return wetdem_many_bulk_walls_avx2;
-#else
-    (void)base_only;
-#endif
-    return wetdem_many_bulk_walls_base;
+    return avx2_usable(base_only) ? wetdem_many_bulk_walls_avx2 : wetdem_many_bulk_walls_base;
 }

@@ -1864,7 +1864,8 @@ int wetdem_sim_many_forces(struct wetdem_sim* sim, bool kick)
     m->blocks_passes++;
     m->sums_zeroed = 0;
     m->skipped_tests += m->pass_skipped;
-    if (skip && 8 * m->pass_skipped < m->pass_candidates && !m->skip_always) /* (many.h) */
+    uint64_t share = m->skip_share ? m->skip_share : 8; /* (many.h) */
+    if (skip && share * m->pass_skipped < m->pass_candidates && !m->skip_always)
         m->skip_on = false; /* for 32 passes or until the next list build (many.h) */
     m->skip_ready = m->skip_on && fail.status == WETDEM_OK; /* every candidate has its time */
     m->fuse_on = 4 * m->pass_near >= 3 * (m->pass_candidates - m->pass_skipped); /* (many.h) */

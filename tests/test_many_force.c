@@ -469,8 +469,9 @@ static void same_run(const struct wetdem_sim* a, const struct wetdem_sim* b)
 /* The gap test skips a candidate until the skip clock (the sum of every step's bound on the
  * displacements, many.h) says it may have come within reach; a skipped candidate would have
  * been rejected, so runs with and without skipping are bit-identical: in a flowing gas with
- * the skip times kept at every pass, with the default choice (which drops them there after
- * the first passes of a list, as too few candidates are skipped), and the same spheres from
+ * the skip times kept at every pass, with the default choice (here with the times dropped
+ * unless half of the candidates are skipped, which drops them after the first passes of a
+ * list, as too few candidates are), and the same spheres from
  * rest; and with the candidates whose time has come tested and evaluated in one loop (fused,
  * where those within range keep their old times, many.h) instead of a gap test and the kernels
  * over its list. Between calls the user may move particles: the run then tests every candidate
@@ -487,7 +488,8 @@ static void test_many_skipped_candidates_change_no_result(void** state)
     struct wetdem_sim* test_all = wet_gas(false, false);
     struct wetdem_sim* fused = wet_gas(false, false);
     skip->many->skip_always = true;
-    skip->many->fuse_mode = 1; /* the gap test, then the kernels over its list */
+    skip->many->fuse_mode = 1;        /* the gap test, then the kernels over its list */
+    by_default->many->skip_share = 2; /* dropped unless half are skipped: in this gas, often */
     test_all->many->no_skip = true;
     fused->many->skip_always = true;
     fused->many->fuse_mode = 2; /* tested and evaluated in one loop whenever the times are usable */
