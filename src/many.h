@@ -127,7 +127,7 @@ typedef void wetdem_many_bulk_walls_fn(const struct wetdem_many_bulk_in* in, con
                                        struct wetdem_many_bulk_out* out);
 /* many_bulk.c: the baseline version; many_bulk_avx2.c: the AVX2 one (x86-64 with GCC). */
 wetdem_many_bulk_fn wetdem_many_bulk_base, wetdem_many_bulk_avx2;
-wetdem_many_bulk_walls_fn wetdem_many_bulk_walls_base, wetdem_many_bulk_walls_avx2;
+wetdem_many_bulk_walls_fn wetdem_many_bulk_base_walls, wetdem_many_bulk_avx2_walls;
 /* The versions for this processor (AVX2 where it has it), or the baseline with `base_only`. */
 wetdem_many_bulk_fn* wetdem_many_bulk_choose(bool base_only);
 wetdem_many_bulk_walls_fn* wetdem_many_bulk_walls_choose(bool base_only);

@@ -3,7 +3,7 @@
  * x86-64, plain C elsewhere), and the choice of the version for the processor.
  */
 #define WETDEM_MANY_BULK_NAME wetdem_many_bulk_base
-#define WETDEM_MANY_BULK_WALLS_NAME wetdem_many_bulk_walls_base
+#define WETDEM_MANY_BULK_WALLS_NAME wetdem_many_bulk_base_walls
 #include "many_bulk.h"
 
 /* Whether the AVX2 versions run here (never with `base_only`). */
@@ -25,5 +25,5 @@ wetdem_many_bulk_fn* wetdem_many_bulk_choose(bool base_only)
 
 wetdem_many_bulk_walls_fn* wetdem_many_bulk_walls_choose(bool base_only)
 {
-    return avx2_usable(base_only) ? wetdem_many_bulk_walls_avx2 : wetdem_many_bulk_walls_base;
+    return avx2_usable(base_only) ? wetdem_many_bulk_avx2_walls : wetdem_many_bulk_base_walls;
 }

@@ -9,5 +9,5 @@
 #pragma GCC target("avx2")
 #endif
 #define WETDEM_MANY_BULK_NAME wetdem_many_bulk_avx2
-#define WETDEM_MANY_BULK_WALLS_NAME wetdem_many_bulk_walls_avx2
+#define WETDEM_MANY_BULK_WALLS_NAME wetdem_many_bulk_avx2_walls
 #include "many_bulk.h"
