@@ -1341,7 +1341,9 @@ static void start_sums_four_at_a_time(const struct pass* P, size_t lo, size_t hi
                 if (cls == 1)
                     flags = eval_wall(sim, i, w, hist, dirty, &o, fail);
                 else {
-                    flags = (unsigned char)cls; /* (within the range: not 0) */
+                    flags = (unsigned char)cls;  /* (within the range, as tested: not 0) */
+                    if (!flags && hist && dirty) /* (kept for safety, as eval_wall does) */
+                        wetdem_sim_history_init(sim, hist);
                     o.force = vec3(bo.force[0][e], bo.force[1][e], bo.force[2][e]);
                     o.torque_i = vec3(bo.torque_i[0][e], bo.torque_i[1][e], bo.torque_i[2][e]);
                     n_within += flags != 0;
