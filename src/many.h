@@ -53,6 +53,10 @@ struct wetdem_many_pair_out {
  * does not depend on the thread count either way. */
 #define WETDEM_MANY_PARALLEL_MIN 512
 
+/* The skip times are kept while at least 1/WETDEM_MANY_SKIP_SHARE of the candidates are
+ * skipped (struct wetdem_many, skip_until). */
+#define WETDEM_MANY_SKIP_SHARE 8
+
 /* Most threads (blocks) of the force pass. */
 #define WETDEM_MANY_MAX_BLOCKS 256
 
@@ -79,10 +83,9 @@ struct wetdem_many_bulk_in {
     double cap_coef;                /* 8 pi */
     double surface_tension;         /* [N/m] */
     bool sb, sb_nc, capillary;      /* sb and capillary enabled; sb's "nc" treatment below h_min' */
-    /* solid contacts (gap < 0) four at a time too (many_bulk.h bulk_contacts), with the lean
+    /* then the solid contacts (gap < 0) among them (many_bulk.h bulk_contacts), with the lean
        kernel's plan: hertz (form 0 exact, 1 tsuji, -1 absent), mindlin, the normal forces in
        model order (0 hertz, 1 sb, 2 capillary) */
-    bool contacts;
     int hertz_form;
     bool mindlin;
     int n_normal;
@@ -98,14 +101,13 @@ struct wetdem_many_bulk_in {
     size_t n_walls;
     double* wall_history; /* n_walls x len doubles per particle */
     const double* m_eff;  /* per particle: its mass against a wall [kg] (contact.h) */
-    double reach;         /* the start-up reach of the pass [m] */
     double e_star;        /* E* [Pa] */
     double hertz_coef;    /* the damping coefficient of hertz's form [-] */
 };
 struct wetdem_many_bulk_out { /* by component, each entry 32-byte aligned */
     /* 0: beyond the gap test's reach (|x_i - x_j|^2 > pair_lim2); 1: within it, for the scalar
-       kernel; else its flags: apart within the range with a finite force, or (with `contacts`
-       in the input) in solid contact with a finite force and torques, its spring stored */
+       kernel; else its flags: apart within the range with a finite force, or in solid contact
+       with a finite force and torques, its spring stored */
     long long cls[WETDEM_MANY_BULK_MAX] __attribute__((aligned(32)));
     uint32_t j[WETDEM_MANY_BULK_MAX];                               /* the pair's second particle */
     double r2[WETDEM_MANY_BULK_MAX] __attribute__((aligned(32)));   /* |x_i - x_j|^2 [m^2] */
@@ -120,10 +122,10 @@ struct wetdem_many_bulk_out { /* by component, each entry 32-byte aligned */
 };
 typedef void wetdem_many_bulk_fn(const struct wetdem_many_bulk_in* in, const uint32_t* list,
                                  size_t n, size_t j_end, struct wetdem_many_bulk_out* out);
-/* Particle-wall pairs (part[e], wall[e]), e < n <= WETDEM_MANY_BULK_MAX: cls (0 beyond the
- * reach or the range, 1 for the scalar kernel, else the flags), force and torque_i. */
+/* Particle-wall pairs (part[e], wall[e]) within the range, at gap[e] [m] (e < n <=
+ * WETDEM_MANY_BULK_MAX): cls (1 for the scalar kernel, else the flags), force and torque_i. */
 typedef void wetdem_many_bulk_walls_fn(const struct wetdem_many_bulk_in* in, const uint32_t* part,
-                                       const unsigned char* wall, size_t n,
+                                       const unsigned char* wall, const double* gap, size_t n,
                                        struct wetdem_many_bulk_out* out);
 /* many_bulk.c: the baseline version; many_bulk_avx2.c: the AVX2 one (x86-64 with GCC). */
 wetdem_many_bulk_fn wetdem_many_bulk_base, wetdem_many_bulk_avx2;
@@ -198,7 +200,8 @@ struct wetdem_many {
     unsigned skip_off_passes;
     bool no_skip;             /* tests: test every candidate at every pass */
     bool skip_always;         /* tests: keep the times whatever share is skipped */
-    unsigned skip_share;      /* tests: keep them while 1/skip_share are skipped (0: 1/8) */
+    unsigned skip_share;      /* tests: keep them while 1/skip_share are skipped (0: the
+                                 default, 1/WETDEM_MANY_SKIP_SHARE) */
     double clock_limit;       /* tests: restart the skip clock beyond this [m] (0: the skin) */
     uint64_t clock_restarts;  /* restarts of the skip clock (tests) */
     uint64_t pass_candidates; /* candidates of the latest pass's gap tests */

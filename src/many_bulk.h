@@ -14,8 +14,8 @@
  *   capillary (force_capillary.c; Punch 2023 Eq. 15):  F_cap = -8 pi R* sigma,
  *   each for gap <= delta and +0 where it does not act;
  *   apart: f_n = (+0 + F_sb) + F_cap,  force = +0 + f_n n.
- * With `contacts` in the input, the candidates in solid contact (gap < 0) are then evaluated
- * four at a time as well (bulk_contacts): lean_contact and lean_force of sim_many_force.c for
+ * The candidates in solid contact (gap < 0) are then evaluated four at a time as well
+ * (bulk_contacts): lean_contact and lean_force of sim_many_force.c for
  * hertz and mindlin, lane by lane, with R*, m*, k and the damping factor from the pair
  * constants (Hertz: Nijssen 2023 Eq. 2 and the Tsuji damping, force_hertz.c; Mindlin: the
  * spring of force_mindlin.c, mindlin.h):
@@ -406,6 +406,14 @@ bulk_contacts(const struct wetdem_many_bulk_in* in, const struct bulk_constants*
     }
 }
 
+/* The film models of a call's input (enum bulk_films). */
+static inline enum bulk_films bulk_films_of(const struct wetdem_many_bulk_in* in)
+{
+    if (in->sb && in->capillary && in->film > 0 && !in->sb_nc) /* the usual case */
+        return BULK_BOTH;
+    return (in->sb || in->capillary) && in->film > 0 ? BULK_ANY : BULK_DRY;
+}
+
 /* The constants of a call (struct bulk_constants). */
 static inline __attribute__((always_inline)) struct bulk_constants
 bulk_constants_of(const struct wetdem_many_bulk_in* in)
@@ -426,28 +434,25 @@ bulk_constants_of(const struct wetdem_many_bulk_in* in)
 
 /* Candidates list[0..n) (1 <= n <= WETDEM_MANY_BULK_MAX, in any particles): their geometry,
  * and the force apart of the film models, into out's entries 0..n); those whose second
- * particle is at or past j_end are left out (their entries but j are not used). With
- * `contacts`, then those in solid contact (bulk_contacts). */
+ * particle is at or past j_end are left out (their entries but j are not used). Then those in
+ * solid contact (bulk_contacts). */
 void WETDEM_MANY_BULK_NAME(const struct wetdem_many_bulk_in* in, const uint32_t* list, size_t n,
                            size_t j_end, struct wetdem_many_bulk_out* out)
 {
     const struct bulk_constants C = bulk_constants_of(in);
-    bool films = (in->sb || in->capillary) && in->film > 0;
-    bool both = in->sb && in->capillary && in->film > 0 && !in->sb_nc; /* the usual case */
-    size_t k = 0;
-    if (both)
+    enum bulk_films films = bulk_films_of(in);
+    size_t k = 0; /* (each kind of films in its own loop, its masks constants there) */
+    if (films == BULK_BOTH)
         for (; k + 4 <= n; k += 4)
             bulk_four(in, &C, list, n, j_end, out, k, false, BULK_BOTH);
-    else if (!films)
+    else if (films == BULK_DRY)
         for (; k + 4 <= n; k += 4)
             bulk_four(in, &C, list, n, j_end, out, k, false, BULK_DRY);
     else
         for (; k + 4 <= n; k += 4)
             bulk_four(in, &C, list, n, j_end, out, k, false, BULK_ANY);
     if (k < n)
-        bulk_four(in, &C, list, n, j_end, out, k, true, films ? BULK_ANY : BULK_DRY);
-    if (!in->contacts)
-        return;
+        bulk_four(in, &C, list, n, j_end, out, k, true, films == BULK_DRY ? BULK_DRY : BULK_ANY);
     /* the entries in solid contact (class 1 with gap < 0, of this thread's particles), four at
        a time, the last group filled up with its last entry */
     uint32_t at[WETDEM_MANY_BULK_MAX + 3];
@@ -461,52 +466,46 @@ void WETDEM_MANY_BULK_NAME(const struct wetdem_many_bulk_in* in, const uint32_t*
     for (size_t r = n_at; r % 4; r++)
         at[r] = at[n_at - 1];
     for (size_t g = 0; g < n_at; g += 4)
-        if (films)
+        if (films != BULK_DRY)
             bulk_contacts(in, &C, list, at + g, out, true);
         else
             bulk_contacts(in, &C, list, at + g, out, false);
 }
 
-/* Particle-wall entries e = k..k+4 (with `tail`, those before n, the last one repeated):
- * eval_walls_of's gap, then lean_wall and lean_force lane by lane (walls apart get the film
- * terms only and a zero spring), with R* = R, m* = m_eff and the Hertz constants of the
- * particle's radius and mass. Lanes beyond the reach or the range get class 0; lanes with a
- * finite result their flags (and their spring stored), the others class 1. */
+/* Particle-wall entries e = k..k+4 within the range at gap[e] (eval_walls_of's; with `tail`,
+ * those before n, the last one repeated): lean_wall and lean_force lane by lane (walls apart
+ * get the film terms only and a zero spring), with R* = R, m* = m_eff and the Hertz constants
+ * of the particle's radius and mass. Lanes with a finite result get their flags (and their
+ * spring stored), the others class 1. */
 static inline __attribute__((always_inline)) void
 bulk_walls_four(const struct wetdem_many_bulk_in* in, const struct bulk_constants* C,
-                const uint32_t* part, const unsigned char* wall, size_t n,
+                const uint32_t* part, const unsigned char* wall, const double* gap, size_t n,
                 struct wetdem_many_bulk_out* out, size_t k, bool tail, enum bulk_films films)
 {
     const wetdem_v4d zero = C->zero;
-    uint32_t i[4], w[4];
+    uint32_t i[4], w[4], e[4];
     for (int l = 0; l < 4; l++) {
-        size_t e = !tail || k + l < n ? k + l : n - 1;
-        i[l] = part[e];
-        w[l] = wall[e];
+        e[l] = (uint32_t)(!tail || k + l < n ? k + l : n - 1);
+        i[l] = part[e[l]];
+        w[l] = wall[e[l]];
     }
     const struct wetdem_celllist_item* xr = in->xr;
     const struct wetdem_wall* W = in->walls;
-    wetdem_v4d x[4]; /* position and radius */
-    bulk_columns(&xr[i[0]].x, &xr[i[1]].x, &xr[i[2]].x, &xr[i[3]].x, x);
     struct bulk_lanes L;
     L.n[0] = (wetdem_v4d){W[w[0]].normal.x, W[w[1]].normal.x, W[w[2]].normal.x, W[w[3]].normal.x};
     L.n[1] = (wetdem_v4d){W[w[0]].normal.y, W[w[1]].normal.y, W[w[2]].normal.y, W[w[3]].normal.y};
     L.n[2] = (wetdem_v4d){W[w[0]].normal.z, W[w[1]].normal.z, W[w[2]].normal.z, W[w[3]].normal.z};
-    wetdem_v4d d[3] = {
-        x[0] - (wetdem_v4d){W[w[0]].point.x, W[w[1]].point.x, W[w[2]].point.x, W[w[3]].point.x},
-        x[1] - (wetdem_v4d){W[w[0]].point.y, W[w[1]].point.y, W[w[2]].point.y, W[w[3]].point.y},
-        x[2] - (wetdem_v4d){W[w[0]].point.z, W[w[1]].point.z, W[w[2]].point.z, W[w[3]].point.z}};
     const wetdem_v4d* nv = L.n;
-    L.gap = (d[0] * nv[0] + d[1] * nv[1] + d[2] * nv[2]) - x[3];
-    wetdem_v4i within = (L.gap <= BULK_SPLAT(in->reach)) & ~(L.gap > C->range);
+    L.gap = BULK_GATHER(gap, e);
+    const wetdem_v4d radius = {xr[i[0]].r, xr[i[1]].r, xr[i[2]].r, xr[i[3]].r};
     const struct wetdem_vec3(*vw)[2] = in->vw;
     wetdem_v4d a0[4], a1[4]; /* v_x v_y v_z w_x, v_z w_x w_y w_z */
     bulk_columns(&vw[i[0]][0].x, &vw[i[1]][0].x, &vw[i[2]][0].x, &vw[i[3]][0].x, a0);
     L.v_n = -(a0[0] * nv[0] + a0[1] * nv[1] + a0[2] * nv[2]);
-    L.r_i = L.r_eff = x[3];
+    L.r_i = L.r_eff = radius;
     L.r_j = zero;
     L.m_eff = BULK_GATHER(in->m_eff, i);
-    wetdem_v4d root = x[3];
+    wetdem_v4d root = radius;
     bulk_sqrt(&root);
     L.k = BULK_SPLAT((4.0 / 3.0) * in->e_star) * root; /* hertz_stiffness */
     L.damping = zero;
@@ -518,7 +517,7 @@ bulk_walls_four(const struct wetdem_many_bulk_in* in, const struct bulk_constant
     size_t spring[4];
     if (in->mindlin) {
         bulk_columns(&vw[i[0]][0].z, &vw[i[1]][0].z, &vw[i[2]][0].z, &vw[i[3]][0].z, a1);
-        wetdem_v4d mr = -x[3], a[3] = {nv[0] * mr, nv[1] * mr, nv[2] * mr}; /* n (-R) */
+        wetdem_v4d mr = -radius, a[3] = {nv[0] * mr, nv[1] * mr, nv[2] * mr}; /* n (-R) */
         wetdem_v4d va[3] = {a0[0] + (a1[2] * a[2] - a1[3] * a[1]),
                             a0[1] + (a1[3] * a[0] - a1[1] * a[2]),
                             a0[2] + (a1[1] * a[1] - a1[2] * a[0])};
@@ -539,8 +538,8 @@ bulk_walls_four(const struct wetdem_many_bulk_in* in, const struct bulk_constant
     wetdem_v4i flags = (WETDEM_MANY_ACTIVE | WETDEM_MANY_DIRTY) |
                        (touch & (WETDEM_MANY_CONTACT | WETDEM_MANY_SPRING)) |
                        (C->bridge_on & (L.gap < C->film) & WETDEM_MANY_BRIDGE);
-    wetdem_v4i done = within & L.finite;
-    *(wetdem_v4i*)&out->cls[k] = within & ((done & (flags - 1)) | 1);
+    wetdem_v4i done = L.finite;
+    *(wetdem_v4i*)&out->cls[k] = (done & (flags - 1)) | 1;
     for (int c = 0; c < 3; c++) {
         *(wetdem_v4d*)&out->force[c][k] = L.force[c];
         *(wetdem_v4d*)&out->torque_i[c][k] = L.ti[c];
@@ -551,28 +550,26 @@ bulk_walls_four(const struct wetdem_many_bulk_in* in, const struct bulk_constant
                 in->wall_history[spring[l] + c] = L.s[c][l];
 }
 
-/* Particle-wall pairs (part[e], wall[e]), e < n (1 <= n <= WETDEM_MANY_BULK_MAX), four at a
- * time (bulk_walls_four) into out's entries 0..n). */
+/* Particle-wall pairs (part[e], wall[e]) within the range at gap[e], e < n (1 <= n <=
+ * WETDEM_MANY_BULK_MAX), four at a time (bulk_walls_four) into out's entries 0..n). */
 void WETDEM_MANY_BULK_WALLS_NAME(const struct wetdem_many_bulk_in* in, const uint32_t* part,
-                                 const unsigned char* wall, size_t n,
+                                 const unsigned char* wall, const double* gap, size_t n,
                                  struct wetdem_many_bulk_out* out)
 {
     const struct bulk_constants C = bulk_constants_of(in);
-    bool films = (in->sb || in->capillary) && in->film > 0;
-    bool both = in->sb && in->capillary && in->film > 0 && !in->sb_nc;
-    enum bulk_films kind = both ? BULK_BOTH : films ? BULK_ANY : BULK_DRY;
-    size_t k = 0;
-    if (kind == BULK_BOTH)
+    enum bulk_films films = bulk_films_of(in);
+    size_t k = 0; /* (each kind of films in its own loop, as for the pairs) */
+    if (films == BULK_BOTH)
         for (; k + 4 <= n; k += 4)
-            bulk_walls_four(in, &C, part, wall, n, out, k, false, BULK_BOTH);
-    else if (kind == BULK_DRY)
+            bulk_walls_four(in, &C, part, wall, gap, n, out, k, false, BULK_BOTH);
+    else if (films == BULK_DRY)
         for (; k + 4 <= n; k += 4)
-            bulk_walls_four(in, &C, part, wall, n, out, k, false, BULK_DRY);
+            bulk_walls_four(in, &C, part, wall, gap, n, out, k, false, BULK_DRY);
     else
         for (; k + 4 <= n; k += 4)
-            bulk_walls_four(in, &C, part, wall, n, out, k, false, BULK_ANY);
+            bulk_walls_four(in, &C, part, wall, gap, n, out, k, false, BULK_ANY);
     if (k < n)
-        bulk_walls_four(in, &C, part, wall, n, out, k, true, kind);
+        bulk_walls_four(in, &C, part, wall, gap, n, out, k, true, films);
 }
 
 #endif

@@ -765,6 +765,17 @@ struct pass {
     struct wetdem_many_bulk_in bulk_in;
 };
 
+/* The force and torques of entry k of four-at-a-time results (those of a contact; a pair
+ * apart has no torques there). */
+static inline struct wetdem_many_pair_out bulk_pair_out(const struct wetdem_many_bulk_out* bo,
+                                                        size_t k)
+{
+    return (struct wetdem_many_pair_out){
+        .force = vec3(bo->force[0][k], bo->force[1][k], bo->force[2][k]),
+        .torque_i = vec3(bo->torque_i[0][k], bo->torque_i[1][k], bo->torque_i[2][k]),
+        .torque_j = vec3(bo->torque_j[0][k], bo->torque_j[1][k], bo->torque_j[2][k])};
+}
+
 /* Candidate q = (i, j, d = x_i - x_j) that passed the gap test: its kernel. Returns its flags.
  * Inlined into its two loops (cross pairs, pairs of a block): with the pairs apart on their
  * own short path (lean_apart), the call cost more than the spills it used to save. */
@@ -1245,9 +1256,7 @@ static void cross_pairs_share(const struct pass* P, size_t t, size_t nt, struct 
                         leave_range(P, q);
                 } else if (cls & WETDEM_MANY_CONTACT) { /* its spring stored */
                     P->flags[q] = (unsigned char)cls;
-                    o->force = vec3(bo.force[0][k], bo.force[1][k], bo.force[2][k]);
-                    o->torque_i = vec3(bo.torque_i[0][k], bo.torque_i[1][k], bo.torque_i[2][k]);
-                    o->torque_j = vec3(bo.torque_j[0][k], bo.torque_j[1][k], bo.torque_j[2][k]);
+                    *o = bulk_pair_out(&bo, k);
                 } else if (cls != 1) { /* apart, finite (no torques: adds_torque) */
                     reset_spring_apart(&m->lean, P->flags[q], P->history + q * P->len);
                     P->flags[q] = (unsigned char)cls;
@@ -1293,6 +1302,7 @@ static void start_sums_four_at_a_time(const struct pass* P, size_t lo, size_t hi
     double range = P->bulk_in.range; /* of the one material pair */
     uint32_t part[WETDEM_MANY_BULK_MAX];
     unsigned char wall[WETDEM_MANY_BULK_MAX];
+    double gap_of[WETDEM_MANY_BULK_MAX];
     struct wetdem_many_bulk_out bo;
     uint64_t n_within = 0;
     for (size_t s = lo; s < hi;) {
@@ -1314,6 +1324,7 @@ static void start_sums_four_at_a_time(const struct pass* P, size_t lo, size_t hi
                 double gap = vec3_dot(vec3_sub(pos, wl->point), wl->normal) - m->xr[i].r;
                 if (gap <= m->reach && !(gap > range)) {
                     part[n] = (uint32_t)i;
+                    gap_of[n] = gap;
                     wall[n++] = (unsigned char)w;
                     continue;
                 }
@@ -1324,7 +1335,7 @@ static void start_sums_four_at_a_time(const struct pass* P, size_t lo, size_t hi
             }
         }
         if (n)
-            P->bulk_walls(&P->bulk_in, part, wall, n, &bo);
+            P->bulk_walls(&P->bulk_in, part, wall, gap_of, n, &bo);
         size_t e = 0;
         for (; s < s_end; s++) {
             size_t i = list[s];
@@ -1341,12 +1352,10 @@ static void start_sums_four_at_a_time(const struct pass* P, size_t lo, size_t hi
                 if (cls == 1)
                     flags = eval_wall(sim, i, w, hist, dirty, &o, fail);
                 else {
-                    flags = (unsigned char)cls;  /* (within the range, as tested: not 0) */
-                    if (!flags && hist && dirty) /* (kept for safety, as eval_wall does) */
-                        wetdem_sim_history_init(sim, hist);
+                    flags = (unsigned char)cls; /* (within the range: never 0) */
                     o.force = vec3(bo.force[0][e], bo.force[1][e], bo.force[2][e]);
                     o.torque_i = vec3(bo.torque_i[0][e], bo.torque_i[1][e], bo.torque_i[2][e]);
-                    n_within += flags != 0;
+                    n_within++;
                 }
                 m->wall_dirty[i] = flags ? m->wall_dirty[i] | bit : m->wall_dirty[i] & ~bit;
                 if (!(flags & WETDEM_MANY_ACTIVE))
@@ -1617,10 +1626,7 @@ pairs_of_block_as(const struct pass* P, size_t b, bool kick, struct wetdem_vec3 
                 if (cls & WETDEM_MANY_CONTACT) { /* in solid contact, evaluated four at a time
                                                     (spring stored): what add_pair does then */
                     P->flags[q] = (unsigned char)cls;
-                    struct wetdem_many_pair_out o = {
-                        .force = vec3(bo.force[0][k], bo.force[1][k], bo.force[2][k]),
-                        .torque_i = vec3(bo.torque_i[0][k], bo.torque_i[1][k], bo.torque_i[2][k]),
-                        .torque_j = vec3(bo.torque_j[0][k], bo.torque_j[1][k], bo.torque_j[2][k])};
+                    struct wetdem_many_pair_out o = bulk_pair_out(&bo, k);
                     add_pair(P, j, (unsigned char)cls, &o, &f, &t, &n_contacts);
                     n_bulk_contacts++;
                     continue;
@@ -1825,7 +1831,6 @@ int wetdem_sim_many_forces(struct wetdem_sim* sim, bool kick)
             .sb = m->lean.sb,
             .sb_nc = (int)m->lean.sb_below == THIN_FILM_BELOW_NC,
             .capillary = m->lean.capillary,
-            .contacts = true,
             .hertz_form = L->hertz_form,
             .mindlin = L->mindlin,
             .n_normal = L->n_normal,
@@ -1844,7 +1849,6 @@ int wetdem_sim_many_forces(struct wetdem_sim* sim, bool kick)
             P.bulk_in.n_walls = sim->n_walls;
             P.bulk_in.wall_history = m->wall_history;
             P.bulk_in.m_eff = m->m_eff;
-            P.bulk_in.reach = m->reach;
             P.bulk_in.e_star = x->e_star;
             P.bulk_in.hertz_coef = L->hertz_form >= 0 ? x->hertz_damping[L->hertz_form] : 0.0;
         }
@@ -1866,7 +1870,7 @@ int wetdem_sim_many_forces(struct wetdem_sim* sim, bool kick)
     m->blocks_passes++;
     m->sums_zeroed = 0;
     m->skipped_tests += m->pass_skipped;
-    uint64_t share = m->skip_share ? m->skip_share : 8; /* (many.h) */
+    uint64_t share = m->skip_share ? m->skip_share : WETDEM_MANY_SKIP_SHARE;
     if (skip && share * m->pass_skipped < m->pass_candidates && !m->skip_always)
         m->skip_on = false; /* for 32 passes or until the next list build (many.h) */
     m->skip_ready = m->skip_on && fail.status == WETDEM_OK; /* every candidate has its time */
