@@ -55,6 +55,8 @@
 typedef double wetdem_v4d __attribute__((vector_size(32)));
 typedef long long wetdem_v4i __attribute__((vector_size(32)));
 
+/* The next loop over the four lanes written out (GCC would keep it a loop at -O2). */
+#define BULK_UNROLL _Pragma("GCC unroll 4")
 /* All ones in every lane where b, else zeros. */
 #define BULK_UNIFORM(b)                                                                            \
     ((wetdem_v4i){-(long long)(b), -(long long)(b), -(long long)(b), -(long long)(b)})
@@ -166,6 +168,7 @@ bulk_four(const struct wetdem_many_bulk_in* in, const struct bulk_constants* C,
     const struct wetdem_vec3(*vw)[2] = in->vw;
     const wetdem_v4d zero = C->zero, one = C->one, film = C->film;
     uint32_t q[4], i[4], j[4];
+    BULK_UNROLL
     for (int l = 0; l < 4; l++) {
         q[l] = list[!tail || k + l < n ? k + l : n - 1];
         i[l] = in->pairs[q[l]].i;
@@ -342,6 +345,7 @@ bulk_contacts(const struct wetdem_many_bulk_in* in, const struct bulk_constants*
 {
     const wetdem_v4d zero = C->zero;
     uint32_t q[4], i[4], j[4];
+    BULK_UNROLL
     for (int l = 0; l < 4; l++) {
         q[l] = list[at[l]];
         i[l] = in->pairs[q[l]].i;
@@ -484,6 +488,7 @@ bulk_walls_four(const struct wetdem_many_bulk_in* in, const struct bulk_constant
 {
     const wetdem_v4d zero = C->zero;
     uint32_t i[4], w[4], e[4];
+    BULK_UNROLL
     for (int l = 0; l < 4; l++) {
         e[l] = (uint32_t)(!tail || k + l < n ? k + l : n - 1);
         i[l] = part[e[l]];
@@ -522,6 +527,7 @@ bulk_walls_four(const struct wetdem_many_bulk_in* in, const struct bulk_constant
                             a0[1] + (a1[3] * a[0] - a1[1] * a[2]),
                             a0[2] + (a1[1] * a[1] - a1[2] * a[0])};
         wetdem_v4d vn = -(va[0] * nv[0] + va[1] * nv[1] + va[2] * nv[2]);
+        BULK_UNROLL
         for (int l = 0; l < 4; l++)
             spring[l] = (i[l] * in->n_walls + w[l]) * in->len + in->spring_off;
         for (int c = 0; c < 3; c++) {

@@ -1545,6 +1545,118 @@ add_pair(const struct pass* P, size_t j, unsigned char fl, const struct wetdem_m
     }
 }
 
+/* Particle i of a block after its listed pairs (with running sums f, t and n_contacts): its
+ * cross pairs from phase 1 (from *e, j order), then its own sums into the totals (the
+ * reactions of earlier particles are there already) and the closing half kick. */
+static inline __attribute__((always_inline)) void
+close_particle(const struct pass* P, size_t i, size_t* e, size_t e_end, struct wetdem_vec3 f,
+               struct wetdem_vec3 t, uint32_t n_contacts, bool kick, struct wetdem_vec3 g)
+{
+    struct wetdem_many* m = P->m;
+    for (; *e < e_end && P->pairs[m->cross_q[*e]].i == i; ++*e) { /* its cross pairs, j order */
+        unsigned char fl = P->flags[m->cross_q[*e]];
+        if (!(fl & WETDEM_MANY_ACTIVE))
+            continue;
+        f = vec3_add(f, m->cross_out[*e].force);
+        if (adds_torque(P->lean, fl))
+            t = vec3_add(t, m->cross_out[*e].torque_i);
+        n_contacts += (fl & WETDEM_MANY_CONTACT) ? 1 : 0;
+    }
+    m->force[i] = vec3_add(m->force[i], f);
+    m->torque[i] = vec3_add(m->torque[i], t);
+    m->contacts[i] += n_contacts;
+    if (kick)
+        wetdem_many_close_kick(m, i, g);
+}
+
+/* Particle i of a block without listed pairs: close_particle from zero sums if it has cross
+ * pairs, else only the closing half kick (nothing to add: adding +0 would change no sum). */
+static inline __attribute__((always_inline)) void
+close_unlisted(const struct pass* P, size_t i, size_t* e, size_t e_end, bool kick,
+               struct wetdem_vec3 g)
+{
+    if (*e < e_end && P->pairs[P->m->cross_q[*e]].i == i)
+        close_particle(P, i, e, e_end, vec3(0, 0, 0), vec3(0, 0, 0), 0, kick, g);
+    else if (kick)
+        wetdem_many_close_kick(P->m, i, g);
+}
+
+/* Phase 2 of block b with four pairs at a time (pairs_of_block_as): the listed candidates
+ * list[0..n_list) are evaluated WETDEM_MANY_BULK_MAX at a time (P->bulk) and their results
+ * taken in list order, in one loop over the results rather than one per particle; a particle
+ * is closed (close_particle, close_unlisted for those between) when the first result of a
+ * later one comes, the last ones after the loop. The same operations in the same order as the
+ * loop per particle: each particle's pairs in list order, then its cross pairs, its sums and
+ * its kick; the evaluation of a batch reads only particles at or after its first pair's first
+ * particle, none of which has been closed. Returns the number within range; *n_bulk_contacts
+ * gets those in solid contact evaluated four at a time. */
+static inline __attribute__((always_inline)) uint64_t
+consume_four_at_a_time(const struct pass* P, const struct pass* P_out, size_t b,
+                       const uint32_t* list, size_t n_list, bool kick, struct wetdem_vec3 g,
+                       struct failure* fail, bool fused, uint64_t* n_bulk_contacts)
+{
+    struct wetdem_many* m = P->m;
+    const struct wetdem_celllist_pair* pairs = P->pairs;
+    const unsigned char* flags = P->flags;
+    size_t end_block = m->blk[b + 1];
+    size_t e = m->cross_first[b], e_end = m->cross_first[b + 1]; /* the block's cross pairs */
+    size_t next = m->blk[b];      /* the first particle not closed */
+    size_t i = SIZE_MAX;          /* the particle of the current results, once there is one */
+    struct wetdem_vec3 f = vec3(0, 0, 0), t = vec3(0, 0, 0);
+    uint32_t n_contacts = 0;
+    uint64_t n_near = 0, n_contact_results = 0;
+    struct wetdem_many_bulk_out bo;
+    for (size_t h = 0; h < n_list;) {
+        size_t n_w = n_list - h < WETDEM_MANY_BULK_MAX ? n_list - h : WETDEM_MANY_BULK_MAX;
+        P->bulk(&P->bulk_in, list + h, n_w, end_block, &bo);
+        for (size_t k = 0; k < n_w; k++) {
+            size_t q = list[h + k], j = bo.j[k];
+            if (pairs[q].i != i) { /* the first result of a later particle */
+                if (i != SIZE_MAX)
+                    close_particle(P, i, &e, e_end, f, t, n_contacts, kick, g);
+                for (i = pairs[q].i; next < i; next++)
+                    close_unlisted(P, next, &e, e_end, kick, g);
+                next = i + 1;
+                f = t = vec3(0, 0, 0);
+                n_contacts = 0;
+            }
+            if (j >= end_block) /* a cross pair: tested and evaluated in phase 1 */
+                continue;
+            long long cls = bo.cls[k];
+            if (!cls) { /* beyond (in two loops the test gave it its time and listed it for its
+                           flags) */
+                beyond_reach(P, P_out, q, bo.r2[k], fused);
+                continue;
+            }
+            n_near++;
+            if (cls & WETDEM_MANY_CONTACT) { /* in solid contact, evaluated four at a time
+                                                (spring stored): what add_pair does then */
+                P->flags[q] = (unsigned char)cls;
+                struct wetdem_many_pair_out o = bulk_pair_out(&bo, k);
+                add_pair(P, j, (unsigned char)cls, &o, &f, &t, &n_contacts);
+                n_contact_results++;
+                continue;
+            }
+            if (cls != 1) { /* apart, finite: what near_candidate and add_pair do then */
+                reset_spring_apart(&m->lean, flags[q], P->history + q * P->len);
+                P->flags[q] = (unsigned char)cls; /* (no contact: no counts, no torques) */
+                add_reaction_pair(m, j, vec3(bo.force[0][k], bo.force[1][k], bo.force[2][k]), &f);
+                continue;
+            }
+            struct wetdem_many_pair_out o;
+            unsigned char fl = near_candidate(P, q, i, j, vec3(0, 0, 0), m->mix, &o, fail, &bo, k);
+            add_pair(P, j, fl, &o, &f, &t, &n_contacts);
+        }
+        h += n_w;
+    }
+    if (i != SIZE_MAX)
+        close_particle(P, i, &e, e_end, f, t, n_contacts, kick, g);
+    for (; next < end_block; next++)
+        close_unlisted(P, next, &e, e_end, kick, g);
+    *n_bulk_contacts = n_contact_results;
+    return n_near;
+}
+
 /* Phase 2 of block b: every particle i in index order; its pairs within the block are
  * evaluated and their reactions added to the second particle at once (so each particle
  * receives its reactions in increasing i), its cross pairs are read from phase 1; the sum of
@@ -1566,10 +1678,7 @@ pairs_of_block_as(const struct pass* P, size_t b, bool kick, struct wetdem_vec3 
     const struct wetdem_celllist_pair* pairs = P->pairs;
     size_t begin_block = m->blk[b], end_block = m->blk[b + 1];
     size_t e = m->cross_first[b], e_end = m->cross_first[b + 1]; /* the block's cross pairs */
-    const unsigned char* flags = P->flags;
     bool single = common || P->nm == 1, periodic = !common && P->periodic;
-    struct wetdem_many_bulk_out bo; /* results of list[bulk_begin, bulk_end) */
-    size_t bulk_begin = 0, bulk_end = 0;
     /* 1. the candidates to test (fused), or the gap test of every candidate of the block whose
           second particle is in the block, in one flat loop without branches on its outcome:
           the pairs within range, and those with flags (they may have just left it), are listed
@@ -1589,61 +1698,17 @@ pairs_of_block_as(const struct pass* P, size_t b, bool kick, struct wetdem_vec3 
                 : gap_test(P, q_begin, q_end, end_block, list, near, periodic, false, &n_skipped);
     /* 2. every particle in index order: its listed pairs (reactions to the second particle at
           once), its cross pairs from phase 1, then its own sum and the closing half kick */
-    size_t h = 0;
-    for (size_t i = begin_block; i < end_block; i++) {
-        bool own = h < n_list && pairs[list[h]].i == i;
-        bool cross = e < e_end && pairs[m->cross_q[e]].i == i;
-        if (!own && !cross) { /* nothing to add (adding +0 would change no sum) */
-            if (kick)
-                wetdem_many_close_kick(m, i, g);
+    if (bulk)
+        n_near = consume_four_at_a_time(P, P_out, b, list, n_list, kick, g, fail, fused,
+                                        &n_bulk_contacts);
+    for (size_t i = begin_block, h = 0; !bulk && i < end_block; i++) {
+        if (!(h < n_list && pairs[list[h]].i == i)) { /* no listed pairs */
+            close_unlisted(P, i, &e, e_end, kick, g);
             continue;
         }
         struct wetdem_vec3 f = vec3(0, 0, 0), t = vec3(0, 0, 0);
         uint32_t n_contacts = 0;
-        if (bulk) /* its candidates, from the results of up to WETDEM_MANY_BULK_MAX at a time */
-            for (size_t q_next = m->cl.first_pair[i + 1];; h++) { /* i's come before q_next */
-                if (h == bulk_end) {                              /* the next candidates' results */
-                    if (h == n_list)
-                        break;
-                    size_t n_w =
-                        n_list - h < WETDEM_MANY_BULK_MAX ? n_list - h : WETDEM_MANY_BULK_MAX;
-                    P->bulk(&P->bulk_in, list + h, n_w, end_block, &bo);
-                    bulk_begin = h;
-                    bulk_end = h + n_w;
-                }
-                size_t k = h - bulk_begin, q = list[h], j = bo.j[k];
-                if (q >= q_next) /* a later particle's */
-                    break;
-                if (j >= end_block) /* a cross pair: tested and evaluated in phase 1 */
-                    continue;
-                long long cls = bo.cls[k];
-                if (!cls) { /* beyond (in two loops the test gave it its time and listed it for
-                               its flags) */
-                    beyond_reach(P, P_out, q, bo.r2[k], fused);
-                    continue;
-                }
-                n_near++;
-                if (cls & WETDEM_MANY_CONTACT) { /* in solid contact, evaluated four at a time
-                                                    (spring stored): what add_pair does then */
-                    P->flags[q] = (unsigned char)cls;
-                    struct wetdem_many_pair_out o = bulk_pair_out(&bo, k);
-                    add_pair(P, j, (unsigned char)cls, &o, &f, &t, &n_contacts);
-                    n_bulk_contacts++;
-                    continue;
-                }
-                if (cls != 1) { /* apart, finite: what near_candidate and add_pair do then */
-                    reset_spring_apart(&m->lean, flags[q], P->history + q * P->len);
-                    P->flags[q] = (unsigned char)cls; /* (no contact: no counts, no torques) */
-                    add_reaction_pair(m, j, vec3(bo.force[0][k], bo.force[1][k], bo.force[2][k]),
-                                      &f);
-                    continue;
-                }
-                struct wetdem_many_pair_out o;
-                unsigned char fl =
-                    near_candidate(P, q, i, j, vec3(0, 0, 0), m->mix, &o, fail, &bo, k);
-                add_pair(P, j, fl, &o, &f, &t, &n_contacts);
-            }
-        for (; !bulk && h < n_list && pairs[list[h]].i == i; h++) {
+        for (; h < n_list && pairs[list[h]].i == i; h++) {
             size_t q = list[h], j = pairs[q].j;
             struct wetdem_vec3 d;
             const struct wetdem_many_mix* x;
@@ -1670,20 +1735,7 @@ pairs_of_block_as(const struct pass* P, size_t b, bool kick, struct wetdem_vec3 
             unsigned char fl = near_candidate(P, q, i, j, d, x, &o, fail, NULL, 0);
             add_pair(P, j, fl, &o, &f, &t, &n_contacts);
         }
-        for (; e < e_end && pairs[m->cross_q[e]].i == i; e++) { /* its cross pairs, j order */
-            unsigned char fl = flags[m->cross_q[e]];
-            if (!(fl & WETDEM_MANY_ACTIVE))
-                continue;
-            f = vec3_add(f, m->cross_out[e].force);
-            if (adds_torque(P->lean, fl))
-                t = vec3_add(t, m->cross_out[e].torque_i);
-            n_contacts += (fl & WETDEM_MANY_CONTACT) ? 1 : 0;
-        }
-        m->force[i] = vec3_add(m->force[i], f);
-        m->torque[i] = vec3_add(m->torque[i], t);
-        m->contacts[i] += n_contacts;
-        if (kick)
-            wetdem_many_close_kick(m, i, g);
+        close_particle(P, i, &e, e_end, f, t, n_contacts, kick, g);
     }
 #pragma omp atomic
     m->pass_skipped += n_skipped;
