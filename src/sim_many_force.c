@@ -1571,9 +1571,9 @@ close_particle(const struct pass* P, size_t i, size_t* e, size_t e_end, struct w
 
 /* Particle i of a block without listed pairs: close_particle from zero sums if it has cross
  * pairs, else only the closing half kick (nothing to add: adding +0 would change no sum). */
-static inline __attribute__((always_inline)) void
-close_unlisted(const struct pass* P, size_t i, size_t* e, size_t e_end, bool kick,
-               struct wetdem_vec3 g)
+static inline __attribute__((always_inline)) void close_unlisted(const struct pass* P, size_t i,
+                                                                 size_t* e, size_t e_end, bool kick,
+                                                                 struct wetdem_vec3 g)
 {
     if (*e < e_end && P->pairs[P->m->cross_q[*e]].i == i)
         close_particle(P, i, e, e_end, vec3(0, 0, 0), vec3(0, 0, 0), 0, kick, g);
@@ -1597,14 +1597,21 @@ consume_four_at_a_time(const struct pass* P, const struct pass* P_out, size_t b,
 {
     struct wetdem_many* m = P->m;
     const struct wetdem_celllist_pair* pairs = P->pairs;
-    const unsigned char* flags = P->flags;
     size_t end_block = m->blk[b + 1];
     size_t e = m->cross_first[b], e_end = m->cross_first[b + 1]; /* the block's cross pairs */
-    size_t next = m->blk[b];      /* the first particle not closed */
-    size_t i = SIZE_MAX;          /* the particle of the current results, once there is one */
+    size_t next = m->blk[b];                                     /* the first particle not closed */
+    size_t i = SIZE_MAX; /* the particle of the current results, once there is one */
     struct wetdem_vec3 f = vec3(0, 0, 0), t = vec3(0, 0, 0);
     uint32_t n_contacts = 0;
     uint64_t n_near = 0, n_contact_results = 0;
+    /* the arrays written per result, in locals: a store through the byte flags could change
+       any field of *m, which would be loaded again after every one */
+    struct wetdem_vec3 *force = m->force, *torque = m->torque;
+    uint32_t* contacts = m->contacts;
+    unsigned char* flags = P->flags;
+    double* history = P->history;
+    size_t len = P->len, spring_off = m->lean.mindlin_off;
+    bool spring_reset = m->lean.mindlin;
     struct wetdem_many_bulk_out bo;
     for (size_t h = 0; h < n_list;) {
         size_t n_w = n_list - h < WETDEM_MANY_BULK_MAX ? n_list - h : WETDEM_MANY_BULK_MAX;
@@ -1629,18 +1636,24 @@ consume_four_at_a_time(const struct pass* P, const struct pass* P_out, size_t b,
                 continue;
             }
             n_near++;
-            if (cls & WETDEM_MANY_CONTACT) { /* in solid contact, evaluated four at a time
-                                                (spring stored): what add_pair does then */
-                P->flags[q] = (unsigned char)cls;
-                struct wetdem_many_pair_out o = bulk_pair_out(&bo, k);
-                add_pair(P, j, (unsigned char)cls, &o, &f, &t, &n_contacts);
-                n_contact_results++;
-                continue;
-            }
-            if (cls != 1) { /* apart, finite: what near_candidate and add_pair do then */
-                reset_spring_apart(&m->lean, flags[q], P->history + q * P->len);
-                P->flags[q] = (unsigned char)cls; /* (no contact: no counts, no torques) */
-                add_reaction_pair(m, j, vec3(bo.force[0][k], bo.force[1][k], bo.force[2][k]), &f);
+            if (cls != 1) { /* evaluated four at a time: what near_candidate and add_pair do */
+                struct wetdem_vec3 force_k = vec3(bo.force[0][k], bo.force[1][k], bo.force[2][k]);
+                unsigned char was = flags[q];
+                flags[q] = (unsigned char)cls;
+                f = vec3_add(f, force_k); /* add_reaction_pair */
+                force[j] = vec3_sub(force[j], force_k);
+                if (cls & WETDEM_MANY_CONTACT) { /* in solid contact (spring stored) */
+                    struct wetdem_many_pair_out o = bulk_pair_out(&bo, k);
+                    n_contacts++;
+                    contacts[j]++;
+                    t = vec3_add(t, o.torque_i);
+                    torque[j] = vec3_add(torque[j], o.torque_j);
+                    n_contact_results++;
+                } else if (spring_reset && (was & WETDEM_MANY_SPRING)) {
+                    /* apart (no counts, no torques): reset_spring_apart, from the flags before */
+                    double* spring = history + q * len + spring_off;
+                    spring[0] = spring[1] = spring[2] = 0.0;
+                }
                 continue;
             }
             struct wetdem_many_pair_out o;
