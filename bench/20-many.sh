@@ -69,7 +69,8 @@ command -v liggghts >/dev/null && command -v mpirun >/dev/null && have_lg=true
 deck=$root/bench/liggghts
 
 # wetdem run: protocol variant threads steps [many_bench args] -> "rate kb psteps_per_cpu_s
-# contacts bridges"
+# contacts bridges kick_s forces_s" (the last two: wall time of the timed steps' kicks and
+# drifts, and of their force passes)
 run_wd() {
   local proto=$1 variant=$2 t=$3 steps=$4 flag=""
   shift 4
@@ -80,7 +81,8 @@ run_wd() {
   echo "$(echo "$line" | field psteps_per_s) $(echo "$line" | field maxrss_kb)" \
        "$(awk -v n="$N" -v s="$steps" -v c="$(echo "$line" | field cpu_seconds)" \
           'BEGIN{printf "%.4g", n*s/c}')" \
-       "$(echo "$line" | field contacts) $(echo "$line" | field bridges)"
+       "$(echo "$line" | field contacts) $(echo "$line" | field bridges)" \
+       "$(echo "$line" | field kick_s) $(echo "$line" | field forces_s)"
 }
 
 # LIGGGHTS run: variant ranks data nsettle nsteps dt -> "rate kb cpu_seconds"
@@ -105,16 +107,17 @@ run_lg() {
 measure() {
   local proto=$1 variant=$2 t=$3 data=$4 nsettle=$5 nsteps=$6 dt=$7
   shift 7
-  local wbest="0 0 0 - -" lbest="0 0 0" c0=0 rep
+  local wbest="0 0 0 - - 0 0" lbest="0 0 0" c0=0 rep
   if $have_lg && [ "$t" = 1 ]; then
     c0=$(run_lg "$variant" 1 "$data" "$nsettle" 0 "$dt" | awk '{print $3}')
   fi
   for rep in $(seq "$REPEAT"); do
     local w l
     w=$(run_wd "$proto" "$variant" "$t" "$nsteps" --dt "$dt" "$@")
-    wbest=$(printf '%s\n%s\n' "$wbest" "$w" | awk 'NR == 1 {r = $1; k = $2; c = $3; x = $4; y = $5}
-      NR == 2 {if ($1 > r) {r = $1; k = $2; x = $4; y = $5}; if ($3 > c) c = $3}
-      END {print r, k, c, x, y}')
+    wbest=$(printf '%s\n%s\n' "$wbest" "$w" | awk 'NR == 1 {r = $1; k = $2; c = $3; x = $4; y = $5
+        a = $6; b = $7}
+      NR == 2 {if ($1 > r) {r = $1; k = $2; x = $4; y = $5; a = $6; b = $7}; if ($3 > c) c = $3}
+      END {print r, k, c, x, y, a, b}')
     $have_lg || continue
     l=$(run_lg "$variant" "$t" "$data" "$nsettle" "$nsteps" "$dt" | awk -v c0="$c0" -v t="$t" \
         -v n="$N" -v s="$nsteps" '{print $1, $2, (t == 1 && $3 > c0) ? n * s / ($3 - c0) : 0}')
@@ -200,7 +203,7 @@ echo "load average after the run: $(cut -d' ' -f1-3 /proc/loadavg), $(nproc) cor
 awk -v n="$N" -v wb="$base_kb" -v lb="$lg_base" -v steps="$STEPS" -v same="$SAME_STEPS" \
     -v fsteps="$FROZEN_STEPS" -v fdt="$FROZEN_DT" -v isteps="$INSTR_STEPS" '
   /^(full|same|frozen) / { k = $1 " " $2 " " $3 " " $4; rate[k] = $5; kb[k] = $6; cpu[k] = $7
-                    con[k] = $8; bri[k] = $9 }
+                    con[k] = $8; bri[k] = $9; kick[k] = $10; frc[k] = $11 }
   /^instr / { ins[$2 " " $3 " " $4] = $5 }
   function r(a, b) { return (b > 0) ? a / b : 0 }
   END {
@@ -241,6 +244,16 @@ awk -v n="$N" -v wb="$base_kb" -v lb="$lg_base" -v steps="$STEPS" -v same="$SAME
       note = p == 1 ? " (different final states)" : " (target <= 1.3)"
       if (p == 2) note = " (the wet run ends with more contacts)"
       printf "%s\n", note
+      nsteps = p == 1 ? steps : (p == 2 ? same : fsteps) # ns per particle-step of a phase:
+      printf "  wetdem phases [ns per particle-step], 1 thread / 2 threads (speed-up):"
+      for (v = 1; v <= 2; v++) {
+        kind = v == 1 ? "dry" : "wet"; a = w kind " 1"; b = w kind " 2"
+        printf "%s %s kick-drift %.1f / %.1f (%.2fx), forces %.1f / %.1f (%.2fx)",
+               v == 1 ? "" : ";", kind, 1e9 * kick[a] / (n * nsteps), 1e9 * kick[b] / (n * nsteps),
+               r(kick[a], kick[b]), 1e9 * frc[a] / (n * nsteps), 1e9 * frc[b] / (n * nsteps),
+               r(frc[a], frc[b])
+      }
+      printf "\n"
     }
     if (length(ins) > 0)
       printf "instructions per particle-step (callgrind, 1 thread, %d steps minus 0):\n", isteps

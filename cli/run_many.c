@@ -249,6 +249,13 @@ static void summary_text(FILE* f, const struct cli_many_setup* su, const struct 
             wetdem_sim_time(su->sim), s->step, s->dt, o->wall, omp_get_max_threads());
     fprintf(f, "contacts           %zu\nliquid bridges     %zu\n", s->contacts, s->bridges);
     fprintf(f, "agglomerates       %zu  (mean size %.3g)\n", s->agglomerates, s->mean_agglomerate);
+    double phase[4] = {s->seconds_kick, s->seconds_forces, s->seconds_lists, s->seconds_output};
+    const char* name[4] = {"kick-drift", "forces", "neighbour lists", "output"};
+    fprintf(f, "wall time by phase");
+    for (int k = 0; k < 4; k++)
+        fprintf(f, "%s %s %.3g s (%.0f %%)", k ? "," : "", name[k], phase[k],
+                o->wall > 0 ? 100 * phase[k] / o->wall : 0.0);
+    fprintf(f, "\n");
     if (!o->has_budget)
         return;
     const struct wetdem_energy_budget* b = &o->budget;

@@ -586,6 +586,10 @@ struct wetdem_many_stats {
     unsigned long long list_builds; /* neighbour-list builds so far */
     double dt;                      /* step [s] */
     unsigned long long step;        /* steps since the start of the many run */
+    /* wall-clock time by phase of the many run in this process [s] (a restart starts them at
+       zero): kicks and drifts, force passes (less their neighbour-list builds), the builds
+       (with the history carried over), and each step's outputs and observer calls */
+    double seconds_kick, seconds_forces, seconds_lists, seconds_output;
 };
 WETDEM_API int wetdem_sim_many_stats(const struct wetdem_sim* sim, struct wetdem_many_stats* s);
 

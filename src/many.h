@@ -151,6 +151,9 @@ struct wetdem_many {
     double t0;     /* time of step 0 [s] */
     uint64_t step; /* steps since t0 */
     bool started;
+    /* wall time by phase in this process [s] (wetdem_many_stats): kicks and drifts, force
+       passes (less their list builds), neighbour-list builds, outputs and observers */
+    double seconds_kick, seconds_forces, seconds_lists, seconds_output;
     double* history; /* cl.n_pairs x history_len, aligned with cl.pairs */
     size_t history_cap;
     double* wall_history; /* n_particles x n_walls x history_len */

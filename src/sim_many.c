@@ -384,8 +384,13 @@ static double coordinate_max(const struct wetdem_sim* sim)
     return x_max;
 }
 
+static double wall_seconds(void)
+{
+    return omp_get_wtime();
+}
+
 /* Rebuilds the cell list and carries the histories of surviving pairs over. */
-static int rebuild(struct wetdem_sim* sim)
+static int rebuild_lists(struct wetdem_sim* sim)
 {
     struct wetdem_many* m = sim->many;
     size_t len = sim->history_len, n_old = m->cl.n_pairs;
@@ -418,6 +423,15 @@ static int rebuild(struct wetdem_sim* sim)
                           fresh);
     m->blocks_ready = false; /* the force pass indexes the new list */
     return update_wall_masks(sim);
+}
+
+/* rebuild_lists, its time added to the lists' phase. */
+static int rebuild(struct wetdem_sim* sim)
+{
+    double t0 = wall_seconds();
+    int st = rebuild_lists(sim);
+    sim->many->seconds_lists += wall_seconds() - t0;
+    return st;
 }
 
 int wetdem_sim_many_prepare(struct wetdem_sim* sim)
@@ -682,8 +696,10 @@ static int forces_and_work(struct wetdem_sim* sim, bool kick)
             return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory");
         m->thread_work_cap = need;
     }
+    double t0 = wall_seconds(), lists0 = m->seconds_lists; /* (a build may come first) */
     int st = wetdem_sim_many_forces(sim, kick);
     collect_work(m, n_threads);
+    m->seconds_forces += (wall_seconds() - t0) - (m->seconds_lists - lists0);
     return st;
 }
 
@@ -725,6 +741,18 @@ void wetdem_sim_many_energies(const struct wetdem_sim* sim, double* kinetic, dou
 }
 
 /* First call of a many run: step size, pair list, forces and the energy at t0. */
+/* The outputs due (wetdem_sim_many_outputs; `final`: those of a call's end), then with
+ * `observe` the observer if due; their time added to the output phase. */
+static int timed_outputs(struct wetdem_sim* sim, bool final, bool observe)
+{
+    double t0 = wall_seconds();
+    int st = wetdem_sim_many_outputs(sim, final);
+    if (st == WETDEM_OK && observe)
+        st = wetdem_sim_observe_due(sim);
+    sim->many->seconds_output += wall_seconds() - t0;
+    return st;
+}
+
 static int start(struct wetdem_sim* sim)
 {
     struct wetdem_many* m = sim->many;
@@ -739,12 +767,7 @@ static int start(struct wetdem_sim* sim)
     m->started = true;
     memset(&m->energy, 0, sizeof m->energy);
     wetdem_sim_many_energies(sim, &m->energy.k0, &m->energy.u0, &m->energy.el0);
-    return wetdem_sim_many_outputs(sim, false);
-}
-
-static double wall_seconds(void)
-{
-    return omp_get_wtime();
+    return timed_outputs(sim, false, false);
 }
 
 /* Stop flag, progress callback. Returns WETDEM_EVENT to stop (checkpoint written). */
@@ -791,7 +814,9 @@ static bool state_read_after(const struct wetdem_sim* sim, uint64_t step, unsign
 static int one_step(struct wetdem_sim* sim, bool defer)
 {
     struct wetdem_many* m = sim->many;
+    double t0 = wall_seconds();
     kick_drift(sim, m->dt);
+    m->seconds_kick += wall_seconds() - t0;
     m->step++;
     sim->engine.time = m->t0 + (double)m->step * m->dt; /* no accumulated round-off */
     sim->engine.t_committed = sim->engine.time;
@@ -802,9 +827,7 @@ static int one_step(struct wetdem_sim* sim, bool defer)
     if (!defer) /* the state is read after this step */
         sync_records(sim);
     sim->engine.stats.steps++;
-    st = wetdem_sim_many_outputs(sim, false);
-    if (st == WETDEM_OK)
-        st = wetdem_sim_observe_due(sim);
+    st = timed_outputs(sim, false, true);
     return st;
 }
 
@@ -829,7 +852,7 @@ int wetdem_sim_many_integrate(struct wetdem_sim* sim, double t_end)
     }
     sync_records(sim); /* done after the last step; here for a step that failed */
     if (st == WETDEM_OK)
-        st = wetdem_sim_many_outputs(sim, true);
+        st = timed_outputs(sim, true, false);
     if (st >= 0 && sim->engine.observer && !(sim->engine.last_observed == sim->engine.time)) {
         int so = wetdem_sim_observe(sim);
         st = so != WETDEM_OK ? so : st;

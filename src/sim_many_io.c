@@ -93,6 +93,10 @@ int wetdem_sim_many_stats(const struct wetdem_sim* sim, struct wetdem_many_stats
     s->list_builds = m->cl.n_builds;
     s->dt = m->dt;
     s->step = m->step;
+    s->seconds_kick = m->seconds_kick;
+    s->seconds_forces = m->seconds_forces;
+    s->seconds_lists = m->seconds_lists;
+    s->seconds_output = m->seconds_output;
     return WETDEM_OK;
 }
 

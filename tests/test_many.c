@@ -5,6 +5,7 @@
  * start-up reach bound is enforced, agglomerates by union-find, VTK/CSV outputs, lists rebuilt
  * at the same steps with the displacement bound, callbacks see the current state.
  */
+#include <math.h>
 #include <omp.h>
 #include <stdlib.h>
 #include <sys/stat.h>
@@ -93,6 +94,40 @@ static void test_many_same_result_for_any_thread_count(void** state)
     assert_int_equal(s.step, 500);           /* 1 ms / 2 us */
     wetdem_sim_free(a);
     wetdem_sim_free(b);
+}
+
+/* The wall time by phase (wetdem_many_stats): the phases are disjoint intervals inside the
+ * integrate calls, so their sum cannot exceed the calls' own elapsed time; the force passes
+ * and the first list build take measurable time, and a second call only adds to them. The
+ * 1e-5 s slack covers the rounding of the differences of clock readings: seconds since boot
+ * (< 1e7 s), so each difference is off by at most an ulp, 2e-9 s, and a step takes at most
+ * four, 1e-5 s over the 1000 steps of the two calls. */
+static void test_many_phase_times_add_up(void** state)
+{
+    (void)state;
+    struct wetdem_sim* sim = wet_box(150, true);
+    double t0 = omp_get_wtime();
+    CHECK_OK(wetdem_sim_integrate(sim, 1e-3));
+    double elapsed = omp_get_wtime() - t0;
+    struct wetdem_many_stats a, b;
+    CHECK_OK(wetdem_sim_many_stats(sim, &a));
+    double phase[4] = {a.seconds_kick, a.seconds_forces, a.seconds_lists, a.seconds_output};
+    double sum = 0;
+    for (int k = 0; k < 4; k++) {
+        assert_true(isfinite(phase[k]) && phase[k] >= 0);
+        sum += phase[k];
+    }
+    assert_true(sum <= elapsed + 1e-5);
+    assert_true(a.seconds_kick > 0 && a.seconds_forces > 0 && a.seconds_lists > 0);
+    t0 = omp_get_wtime();
+    CHECK_OK(wetdem_sim_integrate(sim, 2e-3));
+    elapsed += omp_get_wtime() - t0;
+    CHECK_OK(wetdem_sim_many_stats(sim, &b));
+    assert_true(b.seconds_kick > a.seconds_kick && b.seconds_forces > a.seconds_forces);
+    assert_true(b.seconds_lists >= a.seconds_lists && b.seconds_output >= a.seconds_output);
+    assert_true(b.seconds_kick + b.seconds_forces + b.seconds_lists + b.seconds_output <=
+                elapsed + 1e-5);
+    wetdem_sim_free(sim);
 }
 
 static void test_many_restart_is_bit_identical(void** state)
@@ -492,6 +527,7 @@ int main(void)
         cmocka_unit_test(test_many_writes_vtk_and_csv),
         cmocka_unit_test(test_many_restart_continues_outputs),
         cmocka_unit_test(test_many_rejects_bad_settings),
+        cmocka_unit_test(test_many_phase_times_add_up),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
