@@ -740,7 +740,6 @@ void wetdem_sim_many_energies(const struct wetdem_sim* sim, double* kinetic, dou
     *elastic = el;
 }
 
-/* First call of a many run: step size, pair list, forces and the energy at t0. */
 /* The outputs due (wetdem_sim_many_outputs; `final`: those of a call's end), then with
  * `observe` the observer if due; their time added to the output phase. */
 static int timed_outputs(struct wetdem_sim* sim, bool final, bool observe)
@@ -753,6 +752,7 @@ static int timed_outputs(struct wetdem_sim* sim, bool final, bool observe)
     return st;
 }
 
+/* First call of a many run: step size, pair list, forces and the energy at t0. */
 static int start(struct wetdem_sim* sim)
 {
     struct wetdem_many* m = sim->many;

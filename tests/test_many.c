@@ -3,7 +3,8 @@
  * independent of the thread count, checkpoint + restart bit-identical to an uninterrupted run,
  * the energy budget closes, agreement with the few-body engine on a binary collision, the
  * start-up reach bound is enforced, agglomerates by union-find, VTK/CSV outputs, lists rebuilt
- * at the same steps with the displacement bound, callbacks see the current state.
+ * at the same steps with the displacement bound, callbacks see the current state, the wall time
+ * by phase adds up.
  */
 #include <math.h>
 #include <omp.h>
