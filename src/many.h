@@ -181,9 +181,10 @@ struct wetdem_many {
        32 passes after they were dropped (skip_off_passes), for as long as at least an eighth
        of the candidates are skipped (in a flowing system few are, and keeping the times costs
        more than the skips save; with half, as before, a wet packing lost them too often:
-       5 % more instructions on the benchmark's shared state). They are usable (skip_ready) when the previous pass kept
-       them and every step since had a bound; a list build, a call, particles loaded anew, a
-       step without a bound and a restart of the clock clear it. */
+       5 % more instructions on the benchmark's shared state). They are usable (skip_ready)
+       when the previous pass kept them and every step since had a bound; a list build, a
+       call, particles loaded anew, a step without a bound and a restart of the clock clear
+       it. */
     float* skip_until; /* [m], rounded down */
     size_t skip_until_cap;
     /* The constants of the skip times, per list build (sim_many_force.c pair_constants and

@@ -827,8 +827,7 @@ static int one_step(struct wetdem_sim* sim, bool defer)
     if (!defer) /* the state is read after this step */
         sync_records(sim);
     sim->engine.stats.steps++;
-    st = timed_outputs(sim, false, true);
-    return st;
+    return timed_outputs(sim, false, true);
 }
 
 int wetdem_sim_many_integrate(struct wetdem_sim* sim, double t_end)

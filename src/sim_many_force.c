@@ -747,6 +747,10 @@ struct pass {
     const struct wetdem_celllist_item* xr;
     const struct wetdem_celllist_pair* pairs;
     unsigned char* flags;
+    /* the sums the pairs add to (m's: here so that a block's copy of the pass holds them, not
+       loaded from m again after every byte store to flags) */
+    struct wetdem_vec3 *force, *torque;
+    uint32_t* contacts;
     const double* lim2; /* pair_lim2 */
     float* skip_until;  /* many.h: the gap test's skip clock */
     double clock;       /* drift_clock */
@@ -814,6 +818,19 @@ static void leave_range(const struct pass* P, size_t q)
     if (P->flags[q] & WETDEM_MANY_DIRTY && P->len)
         wetdem_sim_history_init(P->sim, P->history + q * P->len);
     P->flags[q] = 0;
+}
+
+/* Candidate q's four-at-a-time result of class cls > 1 (its flags; many.h): the flags
+ * stored and, apart, Mindlin's spring reset from the flags before (reset_spring_apart; in
+ * solid contact the vector kernel stored the spring). What near_candidate does with the pair's
+ * state; its force and torques are the result's (bulk_pair_out; apart, no torques). */
+static inline __attribute__((always_inline)) void bulk_flags(const struct pass* P, size_t q,
+                                                             long long cls)
+{
+    unsigned char was = P->flags[q];
+    P->flags[q] = (unsigned char)cls;
+    if (!(cls & WETDEM_MANY_CONTACT))
+        reset_spring_apart(&P->m->lean, was, P->history + q * P->len);
 }
 
 /* Pair (i, j): d = x_i - x_j (minimum image when `periodic`) into *d and the pair's mixed
@@ -940,6 +957,34 @@ static unsigned char eval_wall(const struct wetdem_sim* sim, size_t i, size_t w,
     return flags;
 }
 
+/* Particle i's pair with wall w beyond its range: a fresh history where it may have been used
+ * (its dirty bit; every wall past the 64th counts as used), no dirty bit. */
+static void wall_beyond(const struct wetdem_sim* sim, size_t i, size_t w)
+{
+    struct wetdem_many* m = sim->many;
+    size_t len = sim->history_len;
+    uint64_t bit = w < 64 ? (uint64_t)1 << w : 0;
+    if (len && (w >= 64 || (m->wall_dirty[i] & bit)))
+        wetdem_sim_history_init(sim, m->wall_history + (i * sim->n_walls + w) * len);
+    m->wall_dirty[i] &= ~bit;
+}
+
+/* Particle i's pair with wall w evaluated with flags fl and output o: its dirty bit, and when
+ * active its force, torque and contact into *f, *t, *n_contacts. */
+static inline void add_wall_result(const struct wetdem_many* m, size_t i, size_t w,
+                                   unsigned char fl, const struct wetdem_many_pair_out* o,
+                                   struct wetdem_vec3* f, struct wetdem_vec3* t,
+                                   uint32_t* n_contacts)
+{
+    uint64_t bit = w < 64 ? (uint64_t)1 << w : 0;
+    m->wall_dirty[i] = fl ? m->wall_dirty[i] | bit : m->wall_dirty[i] & ~bit;
+    if (!(fl & WETDEM_MANY_ACTIVE))
+        return;
+    *f = vec3_add(*f, o->force);
+    *t = vec3_add(*t, o->torque_i);
+    *n_contacts += (fl & WETDEM_MANY_CONTACT) ? 1 : 0;
+}
+
 /* Wall forces on particle i, added to *f, *t, *n_contacts in wall order. */
 static void eval_walls_of(const struct wetdem_sim* sim, size_t i, struct wetdem_vec3* f,
                           struct wetdem_vec3* t, uint32_t* n_contacts, struct failure* fail)
@@ -956,21 +1001,15 @@ static void eval_walls_of(const struct wetdem_sim* sim, size_t i, struct wetdem_
             continue;
         const struct wetdem_wall* wall = &sim->walls[w];
         double gap = vec3_dot(vec3_sub(pos, wall->point), wall->normal) - radius;
-        double* hist = len ? m->wall_history + (i * nw + w) * len : NULL;
-        uint64_t bit = w < 64 ? (uint64_t)1 << w : 0;
-        bool dirty = w >= 64 || (m->wall_dirty[i] & bit);
-        struct wetdem_many_pair_out o;
-        unsigned char flags = 0;
-        if (gap <= m->reach)
-            flags = eval_wall(sim, i, w, hist, dirty, &o, fail);
-        else if (hist && dirty)
-            wetdem_sim_history_init(sim, hist);
-        m->wall_dirty[i] = flags ? m->wall_dirty[i] | bit : m->wall_dirty[i] & ~bit;
-        if (!(flags & WETDEM_MANY_ACTIVE))
+        if (gap > m->reach) {
+            wall_beyond(sim, i, w);
             continue;
-        *f = vec3_add(*f, o.force);
-        *t = vec3_add(*t, o.torque_i);
-        *n_contacts += (flags & WETDEM_MANY_CONTACT) ? 1 : 0;
+        }
+        double* hist = len ? m->wall_history + (i * nw + w) * len : NULL;
+        bool dirty = w >= 64 || (m->wall_dirty[i] >> w & 1);
+        struct wetdem_many_pair_out o;
+        unsigned char flags = eval_wall(sim, i, w, hist, dirty, &o, fail);
+        add_wall_result(m, i, w, flags, &o, f, t, n_contacts);
     }
 }
 
@@ -1254,16 +1293,16 @@ static void cross_pairs_share(const struct pass* P, size_t t, size_t nt, struct 
                 if (!cls) {
                     if (P->flags[q])
                         leave_range(P, q);
-                } else if (cls & WETDEM_MANY_CONTACT) { /* its spring stored */
-                    P->flags[q] = (unsigned char)cls;
-                    *o = bulk_pair_out(&bo, k);
-                } else if (cls != 1) { /* apart, finite (no torques: adds_torque) */
-                    reset_spring_apart(&m->lean, P->flags[q], P->history + q * P->len);
-                    P->flags[q] = (unsigned char)cls;
-                    o->force = vec3(bo.force[0][k], bo.force[1][k], bo.force[2][k]);
-                } else
+                } else if (cls == 1)
                     near_candidate(P, q, P->pairs[q].i, P->pairs[q].j, vec3(0, 0, 0), m->mix, o,
                                    fail, &bo, k);
+                else {
+                    bulk_flags(P, q, cls);
+                    if (cls & WETDEM_MANY_CONTACT)
+                        *o = bulk_pair_out(&bo, k);
+                    else
+                        o->force = vec3(bo.force[0][k], bo.force[1][k], bo.force[2][k]);
+                }
             }
         }
         return;
@@ -1326,12 +1365,8 @@ static void start_sums_four_at_a_time(const struct pass* P, size_t lo, size_t hi
                     part[n] = (uint32_t)i;
                     gap_of[n] = gap;
                     wall[n++] = (unsigned char)w;
-                    continue;
-                }
-                uint64_t bit = (uint64_t)1 << w;
-                if (len && (m->wall_dirty[i] & bit))
-                    wetdem_sim_history_init(sim, m->wall_history + (i * nw + w) * len);
-                m->wall_dirty[i] &= ~bit;
+                } else
+                    wall_beyond(sim, i, w); /* (within the reach, flags 0 from eval_wall) */
             }
         }
         if (n)
@@ -1343,26 +1378,19 @@ static void start_sums_four_at_a_time(const struct pass* P, size_t lo, size_t hi
             uint32_t n_contacts = 0;
             for (; e < n && part[e] == i; e++) {
                 size_t w = wall[e];
-                uint64_t bit = (uint64_t)1 << w;
-                double* hist = len ? m->wall_history + (i * nw + w) * len : NULL;
-                bool dirty = m->wall_dirty[i] & bit;
                 long long cls = bo.cls[e];
                 struct wetdem_many_pair_out o;
                 unsigned char flags;
                 if (cls == 1)
-                    flags = eval_wall(sim, i, w, hist, dirty, &o, fail);
+                    flags = eval_wall(sim, i, w, len ? m->wall_history + (i * nw + w) * len : NULL,
+                                      m->wall_dirty[i] >> w & 1, &o, fail);
                 else {
                     flags = (unsigned char)cls; /* (within the range: never 0) */
                     o.force = vec3(bo.force[0][e], bo.force[1][e], bo.force[2][e]);
                     o.torque_i = vec3(bo.torque_i[0][e], bo.torque_i[1][e], bo.torque_i[2][e]);
                     n_within++;
                 }
-                m->wall_dirty[i] = flags ? m->wall_dirty[i] | bit : m->wall_dirty[i] & ~bit;
-                if (!(flags & WETDEM_MANY_ACTIVE))
-                    continue;
-                f = vec3_add(f, o.force);
-                t = vec3_add(t, o.torque_i);
-                n_contacts += (flags & WETDEM_MANY_CONTACT) ? 1 : 0;
+                add_wall_result(m, i, w, flags, &o, &f, &t, &n_contacts);
             }
             m->force[i] = f;
             m->torque[i] = t;
@@ -1509,10 +1537,10 @@ gap_test(const struct pass* P, size_t q_begin, size_t q_end, size_t end_block,
 
 /* A pair's force on i into i's running sum f, and its reaction at once into j's force. */
 static inline __attribute__((always_inline)) void
-add_reaction_pair(struct wetdem_many* m, size_t j, struct wetdem_vec3 force, struct wetdem_vec3* f)
+add_reaction_pair(const struct pass* P, size_t j, struct wetdem_vec3 force, struct wetdem_vec3* f)
 {
     *f = vec3_add(*f, force);
-    m->force[j] = vec3_sub(m->force[j], force);
+    P->force[j] = vec3_sub(P->force[j], force);
 }
 
 /* Candidate q beyond the gap test's reach (squared distance r2 [m^2]): in one loop (`fused`)
@@ -1534,14 +1562,13 @@ add_pair(const struct pass* P, size_t j, unsigned char fl, const struct wetdem_m
 {
     if (!(fl & WETDEM_MANY_ACTIVE))
         return;
-    struct wetdem_many* m = P->m;
     uint32_t c = (fl & WETDEM_MANY_CONTACT) ? 1 : 0;
-    add_reaction_pair(m, j, o->force, f);
+    add_reaction_pair(P, j, o->force, f);
     *n_contacts += c;
-    m->contacts[j] += c;
+    P->contacts[j] += c;
     if (adds_torque(P->lean, fl)) {
         *t = vec3_add(*t, o->torque_i);
-        m->torque[j] = vec3_add(m->torque[j], o->torque_j);
+        P->torque[j] = vec3_add(P->torque[j], o->torque_j);
     }
 }
 
@@ -1604,14 +1631,6 @@ consume_four_at_a_time(const struct pass* P, const struct pass* P_out, size_t b,
     struct wetdem_vec3 f = vec3(0, 0, 0), t = vec3(0, 0, 0);
     uint32_t n_contacts = 0;
     uint64_t n_near = 0, n_contact_results = 0;
-    /* the arrays written per result, in locals: a store through the byte flags could change
-       any field of *m, which would be loaded again after every one */
-    struct wetdem_vec3 *force = m->force, *torque = m->torque;
-    uint32_t* contacts = m->contacts;
-    unsigned char* flags = P->flags;
-    double* history = P->history;
-    size_t len = P->len, spring_off = m->lean.mindlin_off;
-    bool spring_reset = m->lean.mindlin;
     struct wetdem_many_bulk_out bo;
     for (size_t h = 0; h < n_list;) {
         size_t n_w = n_list - h < WETDEM_MANY_BULK_MAX ? n_list - h : WETDEM_MANY_BULK_MAX;
@@ -1636,23 +1655,17 @@ consume_four_at_a_time(const struct pass* P, const struct pass* P_out, size_t b,
                 continue;
             }
             n_near++;
-            if (cls != 1) { /* evaluated four at a time: what near_candidate and add_pair do */
+            if (cls != 1) { /* evaluated four at a time: what add_pair does with the result */
+                bulk_flags(P, q, cls);
                 struct wetdem_vec3 force_k = vec3(bo.force[0][k], bo.force[1][k], bo.force[2][k]);
-                unsigned char was = flags[q];
-                flags[q] = (unsigned char)cls;
-                f = vec3_add(f, force_k); /* add_reaction_pair */
-                force[j] = vec3_sub(force[j], force_k);
-                if (cls & WETDEM_MANY_CONTACT) { /* in solid contact (spring stored) */
+                add_reaction_pair(P, j, force_k, &f);
+                if (cls & WETDEM_MANY_CONTACT) { /* (apart: no counts, no torques) */
                     struct wetdem_many_pair_out o = bulk_pair_out(&bo, k);
                     n_contacts++;
-                    contacts[j]++;
+                    P->contacts[j]++;
                     t = vec3_add(t, o.torque_i);
-                    torque[j] = vec3_add(torque[j], o.torque_j);
+                    P->torque[j] = vec3_add(P->torque[j], o.torque_j);
                     n_contact_results++;
-                } else if (spring_reset && (was & WETDEM_MANY_SPRING)) {
-                    /* apart (no counts, no torques): reset_spring_apart, from the flags before */
-                    double* spring = history + q * len + spring_off;
-                    spring[0] = spring[1] = spring[2] = 0.0;
                 }
                 continue;
             }
@@ -1859,6 +1872,9 @@ int wetdem_sim_many_forces(struct wetdem_sim* sim, bool kick)
     m->fused_passes += fused;
     struct pass P = {.sim = sim,
                      .m = m,
+                     .force = m->force,
+                     .torque = m->torque,
+                     .contacts = m->contacts,
                      .p = sim->particles,
                      .xr = m->xr,
                      .pairs = m->cl.pairs,
