@@ -109,7 +109,7 @@ struct wetdem_many_bulk_out { /* by component, each entry 32-byte aligned */
        kernel; else its flags: apart within the range with a finite force, or in solid contact
        with a finite force and torques, its spring stored */
     long long cls[WETDEM_MANY_BULK_MAX] __attribute__((aligned(32)));
-    uint32_t j[WETDEM_MANY_BULK_MAX];                               /* the pair's second particle */
+    uint32_t i[WETDEM_MANY_BULK_MAX], j[WETDEM_MANY_BULK_MAX];      /* the pair's particles */
     double r2[WETDEM_MANY_BULK_MAX] __attribute__((aligned(32)));   /* |x_i - x_j|^2 [m^2] */
     double gap[WETDEM_MANY_BULK_MAX] __attribute__((aligned(32)));  /* [m] */
     double n[3][WETDEM_MANY_BULK_MAX] __attribute__((aligned(32))); /* unit normal, j to i */
@@ -117,8 +117,10 @@ struct wetdem_many_bulk_out { /* by component, each entry 32-byte aligned */
     double f_sb[WETDEM_MANY_BULK_MAX] __attribute__((aligned(32))); /* its sb term [N] */
     double f_cap[WETDEM_MANY_BULK_MAX] __attribute__((aligned(32)));    /* its capillary term [N] */
     double force[3][WETDEM_MANY_BULK_MAX] __attribute__((aligned(32))); /* its force on i [N] */
-    /* in solid contact (cls has WETDEM_MANY_CONTACT): the torques on i and j [N m] */
-    double torque_i[3][WETDEM_MANY_BULK_MAX], torque_j[3][WETDEM_MANY_BULK_MAX];
+    /* in solid contact (cls has WETDEM_MANY_CONTACT): the torques on i and j [N m]; the one
+       on i is +0 for the other pairs evaluated */
+    double torque_i[3][WETDEM_MANY_BULK_MAX] __attribute__((aligned(32)));
+    double torque_j[3][WETDEM_MANY_BULK_MAX] __attribute__((aligned(32)));
 };
 typedef void wetdem_many_bulk_fn(const struct wetdem_many_bulk_in* in, const uint32_t* list,
                                  size_t n, size_t j_end, struct wetdem_many_bulk_out* out);

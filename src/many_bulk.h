@@ -160,7 +160,7 @@ bulk_film_terms(const struct bulk_constants* C, enum bulk_films films, const wet
 static inline __attribute__((always_inline)) void
 bulk_four(const struct wetdem_many_bulk_in* in, const struct bulk_constants* C,
           const uint32_t* list, size_t n, size_t j_end, struct wetdem_many_bulk_out* out, size_t k,
-          bool tail, enum bulk_films films)
+          bool tail, enum bulk_films films, uint32_t* at, size_t* n_at)
 {
     bool dry = films == BULK_DRY;
     const wetdem_v4i bridge_on = films == BULK_BOTH ? (wetdem_v4i){-1, -1, -1, -1} : C->bridge_on;
@@ -168,14 +168,17 @@ bulk_four(const struct wetdem_many_bulk_in* in, const struct bulk_constants* C,
     const struct wetdem_vec3(*vw)[2] = in->vw;
     const wetdem_v4d zero = C->zero, one = C->one, film = C->film;
     uint32_t q[4], i[4], j[4];
+    wetdem_v4i own; /* all ones in the lanes of this thread's pairs (and, with tail, before n) */
     BULK_UNROLL
     for (int l = 0; l < 4; l++) {
         q[l] = list[!tail || k + l < n ? k + l : n - 1];
         i[l] = in->pairs[q[l]].i;
         j[l] = in->pairs[q[l]].j;
+        out->i[k + l] = i[l];
         out->j[k + l] = j[l];
         /* a second particle at or past j_end belongs to another thread, which may be updating
            it: the lane reads its first particle instead (and is not used) */
+        own[l] = -(long long)(j[l] < j_end && (!tail || k + l < n));
         j[l] = j[l] < j_end ? j[l] : i[l];
     }
     wetdem_v4d pi[4], pj[4], vi[4], vj[4];
@@ -212,6 +215,14 @@ bulk_four(const struct wetdem_many_bulk_in* in, const struct bulk_constants* C,
     wetdem_v4i apart_flags =
         (WETDEM_MANY_ACTIVE | WETDEM_MANY_DIRTY) | (bridge_on & (gap < film) & WETDEM_MANY_BRIDGE);
     *(wetdem_v4i*)&out->cls[k] = near & ((fast & (apart_flags - 1)) | 1);
+    /* this thread's lanes in solid contact (class 1 with gap < 0) onto the list for
+       bulk_contacts, without a branch */
+    wetdem_v4i contact = near & (gap < zero) & own;
+    BULK_UNROLL
+    for (int l = 0; l < 4; l++) {
+        at[*n_at] = (uint32_t)(k + l);
+        *n_at += (size_t)(contact[l] & 1);
+    }
     *(wetdem_v4d*)&out->r2[k] = r2; /* (out has room for the lanes past n) */
     *(wetdem_v4d*)&out->gap[k] = gap;
     *(wetdem_v4d*)&out->n[0][k] = nx;
@@ -223,6 +234,8 @@ bulk_four(const struct wetdem_many_bulk_in* in, const struct bulk_constants* C,
     *(wetdem_v4d*)&out->force[0][k] = zero + f_n * nx;
     *(wetdem_v4d*)&out->force[1][k] = zero + f_n * ny;
     *(wetdem_v4d*)&out->force[2][k] = zero + f_n * nz;
+    for (int c = 0; c < 3; c++) /* (+0 apart: the results' sums add it without a test) */
+        *(wetdem_v4d*)&out->torque_i[c][k] = zero;
 }
 
 /* What the contact core (bulk_lean_force) reads of four lanes, and what it gives. */
@@ -445,26 +458,24 @@ void WETDEM_MANY_BULK_NAME(const struct wetdem_many_bulk_in* in, const uint32_t*
 {
     const struct bulk_constants C = bulk_constants_of(in);
     enum bulk_films films = bulk_films_of(in);
+    /* the entries in solid contact (class 1 with gap < 0, of this thread's particles), listed
+       by bulk_four, for bulk_contacts four at a time, the last group filled up with its last
+       entry */
+    uint32_t at[WETDEM_MANY_BULK_MAX + 3];
+    size_t n_at = 0;
     size_t k = 0; /* (each kind of films in its own loop, its masks constants there) */
     if (films == BULK_BOTH)
         for (; k + 4 <= n; k += 4)
-            bulk_four(in, &C, list, n, j_end, out, k, false, BULK_BOTH);
+            bulk_four(in, &C, list, n, j_end, out, k, false, BULK_BOTH, at, &n_at);
     else if (films == BULK_DRY)
         for (; k + 4 <= n; k += 4)
-            bulk_four(in, &C, list, n, j_end, out, k, false, BULK_DRY);
+            bulk_four(in, &C, list, n, j_end, out, k, false, BULK_DRY, at, &n_at);
     else
         for (; k + 4 <= n; k += 4)
-            bulk_four(in, &C, list, n, j_end, out, k, false, BULK_ANY);
+            bulk_four(in, &C, list, n, j_end, out, k, false, BULK_ANY, at, &n_at);
     if (k < n)
-        bulk_four(in, &C, list, n, j_end, out, k, true, films == BULK_DRY ? BULK_DRY : BULK_ANY);
-    /* the entries in solid contact (class 1 with gap < 0, of this thread's particles), four at
-       a time, the last group filled up with its last entry */
-    uint32_t at[WETDEM_MANY_BULK_MAX + 3];
-    size_t n_at = 0;
-    for (k = 0; k < n; k++) {
-        at[n_at] = (uint32_t)k;
-        n_at += out->cls[k] == 1 && out->gap[k] < 0.0 && out->j[k] < j_end;
-    }
+        bulk_four(in, &C, list, n, j_end, out, k, true, films == BULK_DRY ? BULK_DRY : BULK_ANY,
+                  at, &n_at);
     if (!n_at)
         return;
     for (size_t r = n_at; r % 4; r++)

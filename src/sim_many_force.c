@@ -829,7 +829,8 @@ static inline __attribute__((always_inline)) void bulk_flags(const struct pass* 
 {
     unsigned char was = P->flags[q];
     P->flags[q] = (unsigned char)cls;
-    if (!(cls & WETDEM_MANY_CONTACT))
+    if (was & ~cls & WETDEM_MANY_SPRING) /* (apart now: cls has the bit in solid contact; one
+                                            test, rarely true, for the two of before) */
         reset_spring_apart(&P->m->lean, was, P->history + q * P->len);
 }
 
@@ -1608,14 +1609,76 @@ static inline __attribute__((always_inline)) void close_unlisted(const struct pa
         wetdem_many_close_kick(P->m, i, g);
 }
 
+/* The running sums of a particle's listed pairs in three pairs of lanes, (f_x, f_y),
+ * (f_z, t_x), (t_y, t_z) (each lane's addition the one of the vec3 sums; its count of contacts
+ * goes to the total at once, in any order the same integer); and what a batch of four-at-a-time results keeps of each particle it reaches
+ * (consume_four_at_a_time): slot 0 the one carried from the batch before, slot s > 0 the s-th
+ * new particle. */
+typedef double lanes2 __attribute__((vector_size(16)));
+typedef unsigned long long mask2 __attribute__((vector_size(16)));
+struct running_sums {
+    lanes2 a, b, c;
+};
+struct batch_sums {
+    struct running_sums s[WETDEM_MANY_BULK_MAX + 1];
+    uint32_t particle[WETDEM_MANY_BULK_MAX + 2]; /* the slot's particle; the one after the
+                                                    last used slot: none (UINT32_MAX) */
+};
+
+static inline __attribute__((always_inline)) struct wetdem_vec3
+running_force(const struct running_sums* r)
+{
+    return vec3(r->a[0], r->a[1], r->b[0]);
+}
+static inline __attribute__((always_inline)) struct wetdem_vec3
+running_torque(const struct running_sums* r)
+{
+    return vec3(r->b[1], r->c[0], r->c[1]);
+}
+
+/* Closes the particles next .. stop - 1 of a batch (close_particle) with the sums of the
+ * batch's slots from_slot .. to_slot - 1 (their particles in order among them). Without cross
+ * pairs among them (always on one thread), the slots' sums are added, then every particle
+ * gets its kick: no branch on whether a particle has pairs. */
+static inline __attribute__((always_inline)) void
+close_batch(const struct pass* P, const struct batch_sums* B, size_t from_slot, size_t to_slot,
+            size_t next, size_t stop, size_t* e, size_t e_end, bool kick, struct wetdem_vec3 g)
+{
+    struct wetdem_many* m = P->m;
+    if (*e < e_end && P->pairs[m->cross_q[*e]].i < stop) { /* cross pairs: particle by particle */
+        for (size_t p = next, s = from_slot; p < stop; p++) {
+            if (s < to_slot && B->particle[s] == p) {
+                close_particle(P, p, e, e_end, running_force(&B->s[s]),
+                               running_torque(&B->s[s]), 0, kick, g);
+                s++;
+            } else
+                close_unlisted(P, p, e, e_end, kick, g);
+        }
+        return;
+    }
+    for (size_t s = from_slot; s < to_slot; s++) { /* (their sums, then the kicks) */
+        size_t p = B->particle[s];
+        m->force[p] = vec3_add(m->force[p], running_force(&B->s[s]));
+        m->torque[p] = vec3_add(m->torque[p], running_torque(&B->s[s]));
+    }
+    for (size_t p = next; kick && p < stop; p++)
+        wetdem_many_close_kick(m, p, g);
+}
+
 /* Phase 2 of block b with four pairs at a time (pairs_of_block_as): the listed candidates
  * list[0..n_list) are evaluated WETDEM_MANY_BULK_MAX at a time (P->bulk) and their results
- * taken in list order, in one loop over the results rather than one per particle; a particle
- * is closed (close_particle, close_unlisted for those between) when the first result of a
- * later one comes, the last ones after the loop. The same operations in the same order as the
- * loop per particle: each particle's pairs in list order, then its cross pairs, its sums and
- * its kick; the evaluation of a batch reads only particles at or after its first pair's first
- * particle, none of which has been closed. Returns the number within range; *n_bulk_contacts
+ * taken in list order, in one loop over the results rather than one per particle. Each result
+ * adds to the running sums of its first particle (restarted from +0 at the first result of a
+ * particle, without a branch: in a wet packing the particles' numbers of pairs follow no
+ * pattern, and a branch there was mispredicted at about every other particle), which are kept
+ * in the batch's slot of that particle; after the batch, the particles before the last one
+ * (whose pairs may go on in the next batch) are closed (close_batch), the last ones after the
+ * loop. The same operations in the same order as the loop per particle: each particle's pairs
+ * in list order, then its cross pairs, its sums and its kick; the evaluation of a batch reads
+ * only particles at or after its first pair's first particle, none of which has been closed,
+ * and no reaction goes to a closed particle (j > i). A result in solid contact adds its torques
+ * (+0 apart: the vector kernel's) and its count without a test; the torque on j goes to a
+ * scratch sum instead where it is apart. Returns the number within range; *n_bulk_contacts
  * gets those in solid contact evaluated four at a time. */
 static inline __attribute__((always_inline)) uint64_t
 consume_four_at_a_time(const struct pass* P, const struct pass* P_out, size_t b,
@@ -1623,61 +1686,84 @@ consume_four_at_a_time(const struct pass* P, const struct pass* P_out, size_t b,
                        struct failure* fail, bool fused, uint64_t* n_bulk_contacts)
 {
     struct wetdem_many* m = P->m;
-    const struct wetdem_celllist_pair* pairs = P->pairs;
     size_t end_block = m->blk[b + 1];
     size_t e = m->cross_first[b], e_end = m->cross_first[b + 1]; /* the block's cross pairs */
     size_t next = m->blk[b];                                     /* the first particle not closed */
-    size_t i = SIZE_MAX; /* the particle of the current results, once there is one */
-    struct wetdem_vec3 f = vec3(0, 0, 0), t = vec3(0, 0, 0);
-    uint32_t n_contacts = 0;
+    uint32_t i = UINT32_MAX; /* the particle of the current results, once there is one */
+    struct running_sums r = {{0, 0}, {0, 0}, {0, 0}};
     uint64_t n_near = 0, n_contact_results = 0;
     struct wetdem_many_bulk_out bo;
+    struct batch_sums B;
     for (size_t h = 0; h < n_list;) {
         size_t n_w = n_list - h < WETDEM_MANY_BULK_MAX ? n_list - h : WETDEM_MANY_BULK_MAX;
         P->bulk(&P->bulk_in, list + h, n_w, end_block, &bo);
+        /* 1. in list order, each result's state, its reactions on j and its counts of
+              contacts; what it adds to i's force and torque is left in its entry (+0 for
+              those that do not act) */
         for (size_t k = 0; k < n_w; k++) {
             size_t q = list[h + k], j = bo.j[k];
-            if (pairs[q].i != i) { /* the first result of a later particle */
-                if (i != SIZE_MAX)
-                    close_particle(P, i, &e, e_end, f, t, n_contacts, kick, g);
-                for (i = pairs[q].i; next < i; next++)
-                    close_unlisted(P, next, &e, e_end, kick, g);
-                next = i + 1;
-                f = t = vec3(0, 0, 0);
-                n_contacts = 0;
-            }
-            if (j >= end_block) /* a cross pair: tested and evaluated in phase 1 */
-                continue;
             long long cls = bo.cls[k];
-            if (!cls) { /* beyond (in two loops the test gave it its time and listed it for its
-                           flags) */
-                beyond_reach(P, P_out, q, bo.r2[k], fused);
-                continue;
-            }
-            n_near++;
-            if (cls != 1) { /* evaluated four at a time: what add_pair does with the result */
+            if (j < end_block && cls > 1) { /* evaluated four at a time: add_pair's j side */
+                n_near++;
                 bulk_flags(P, q, cls);
-                struct wetdem_vec3 force_k = vec3(bo.force[0][k], bo.force[1][k], bo.force[2][k]);
-                add_reaction_pair(P, j, force_k, &f);
-                if (cls & WETDEM_MANY_CONTACT) { /* (apart: no counts, no torques) */
-                    struct wetdem_many_pair_out o = bulk_pair_out(&bo, k);
-                    n_contacts++;
+                P->force[j] = vec3_sub(P->force[j], vec3(bo.force[0][k], bo.force[1][k],
+                                                         bo.force[2][k]));
+                if (cls & WETDEM_MANY_CONTACT) { /* (apart: no counts, and +0 torques) */
+                    P->torque[j] = vec3_add(P->torque[j], vec3(bo.torque_j[0][k],
+                                                               bo.torque_j[1][k],
+                                                               bo.torque_j[2][k]));
                     P->contacts[j]++;
-                    t = vec3_add(t, o.torque_i);
-                    P->torque[j] = vec3_add(P->torque[j], o.torque_j);
+                    P->contacts[bo.i[k]]++;
                     n_contact_results++;
                 }
                 continue;
             }
-            struct wetdem_many_pair_out o;
-            unsigned char fl = near_candidate(P, q, i, j, vec3(0, 0, 0), m->mix, &o, fail, &bo, k);
-            add_pair(P, j, fl, &o, &f, &t, &n_contacts);
+            struct wetdem_vec3 f = vec3(0, 0, 0), t = vec3(0, 0, 0);
+            if (j >= end_block) /* a cross pair: tested and evaluated in phase 1 */
+                ;
+            else if (!cls) /* beyond (in two loops the test gave it its time and listed it
+                              for its flags) */
+                beyond_reach(P, P_out, q, bo.r2[k], fused);
+            else {
+                n_near++;
+                struct wetdem_many_pair_out o;
+                unsigned char fl =
+                    near_candidate(P, q, bo.i[k], j, vec3(0, 0, 0), m->mix, &o, fail, &bo, k);
+                add_pair(P, j, fl, &o, &f, &t, &P->contacts[bo.i[k]]); /* (f, t from +0: o's
+                                                                          or +0) */
+            }
+            bo.force[0][k] = f.x;
+            bo.force[1][k] = f.y;
+            bo.force[2][k] = f.z;
+            bo.torque_i[0][k] = t.x;
+            bo.torque_i[1][k] = t.y;
+            bo.torque_i[2][k] = t.z;
+        }
+        /* 2. the running sums of the first particles, in list order, each restarted from +0
+              at a new particle without a branch (a sum from +0 is never -0) */
+        size_t slot = 0; /* slot 0: the particle carried from the batch before (none at first) */
+        B.particle[0] = i;
+        B.s[0] = r;
+        for (size_t k = 0; k < n_w; k++) {
+            uint32_t first = bo.i[k];
+            size_t fresh = first != i;
+            slot += fresh;
+            i = first;
+            unsigned long long keep = (unsigned long long)fresh - 1;
+            mask2 keep2 = {keep, keep};
+            r.a = (lanes2)((mask2)r.a & keep2) + (lanes2){bo.force[0][k], bo.force[1][k]};
+            r.b = (lanes2)((mask2)r.b & keep2) + (lanes2){bo.force[2][k], bo.torque_i[0][k]};
+            r.c = (lanes2)((mask2)r.c & keep2) + (lanes2){bo.torque_i[1][k], bo.torque_i[2][k]};
+            B.particle[slot] = i;
+            B.s[slot] = r;
         }
         h += n_w;
+        /* the particles before the last one, or at the end all of the block */
+        size_t from = B.particle[0] == UINT32_MAX ? 1 : 0, stop = h < n_list ? i : end_block;
+        close_batch(P, &B, from, h < n_list ? slot : slot + 1, next, stop, &e, e_end, kick, g);
+        next = stop;
     }
-    if (i != SIZE_MAX)
-        close_particle(P, i, &e, e_end, f, t, n_contacts, kick, g);
-    for (; next < end_block; next++)
+    for (; next < end_block; next++) /* (no listed candidates) */
         close_unlisted(P, next, &e, e_end, kick, g);
     *n_bulk_contacts = n_contact_results;
     return n_near;
