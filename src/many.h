@@ -109,12 +109,12 @@ struct wetdem_many_bulk_out { /* by component, each entry 32-byte aligned */
        kernel; else its flags: apart within the range with a finite force, or in solid contact
        with a finite force and torques, its spring stored */
     long long cls[WETDEM_MANY_BULK_MAX] __attribute__((aligned(32)));
-    uint32_t i[WETDEM_MANY_BULK_MAX], j[WETDEM_MANY_BULK_MAX];      /* the pair's particles */
-    double r2[WETDEM_MANY_BULK_MAX] __attribute__((aligned(32)));   /* |x_i - x_j|^2 [m^2] */
-    double gap[WETDEM_MANY_BULK_MAX] __attribute__((aligned(32)));  /* [m] */
-    double n[3][WETDEM_MANY_BULK_MAX] __attribute__((aligned(32))); /* unit normal, j to i */
-    double v_n[WETDEM_MANY_BULK_MAX] __attribute__((aligned(32)));  /* [m/s] */
-    double f_sb[WETDEM_MANY_BULK_MAX] __attribute__((aligned(32))); /* its sb term [N] */
+    uint32_t i[WETDEM_MANY_BULK_MAX], j[WETDEM_MANY_BULK_MAX];          /* the pair's particles */
+    double r2[WETDEM_MANY_BULK_MAX] __attribute__((aligned(32)));       /* |x_i - x_j|^2 [m^2] */
+    double gap[WETDEM_MANY_BULK_MAX] __attribute__((aligned(32)));      /* [m] */
+    double n[3][WETDEM_MANY_BULK_MAX] __attribute__((aligned(32)));     /* unit normal, j to i */
+    double v_n[WETDEM_MANY_BULK_MAX] __attribute__((aligned(32)));      /* [m/s] */
+    double f_sb[WETDEM_MANY_BULK_MAX] __attribute__((aligned(32)));     /* its sb term [N] */
     double f_cap[WETDEM_MANY_BULK_MAX] __attribute__((aligned(32)));    /* its capillary term [N] */
     double force[3][WETDEM_MANY_BULK_MAX] __attribute__((aligned(32))); /* its force on i [N] */
     /* in solid contact (cls has WETDEM_MANY_CONTACT): the torques on i and j [N m]; the one

@@ -474,8 +474,8 @@ void WETDEM_MANY_BULK_NAME(const struct wetdem_many_bulk_in* in, const uint32_t*
         for (; k + 4 <= n; k += 4)
             bulk_four(in, &C, list, n, j_end, out, k, false, BULK_ANY, at, &n_at);
     if (k < n)
-        bulk_four(in, &C, list, n, j_end, out, k, true, films == BULK_DRY ? BULK_DRY : BULK_ANY,
-                  at, &n_at);
+        bulk_four(in, &C, list, n, j_end, out, k, true, films == BULK_DRY ? BULK_DRY : BULK_ANY, at,
+                  &n_at);
     if (!n_at)
         return;
     for (size_t r = n_at; r % 4; r++)

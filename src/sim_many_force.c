@@ -1609,11 +1609,11 @@ static inline __attribute__((always_inline)) void close_unlisted(const struct pa
         wetdem_many_close_kick(P->m, i, g);
 }
 
-/* The running sums of a particle's listed pairs in three pairs of lanes, (f_x, f_y),
- * (f_z, t_x), (t_y, t_z) (each lane's addition the one of the vec3 sums; its count of contacts
- * goes to the total at once, in any order the same integer); and what a batch of four-at-a-time results keeps of each particle it reaches
- * (consume_four_at_a_time): slot 0 the one carried from the batch before, slot s > 0 the s-th
- * new particle. */
+/* The running force and torque of a particle's listed pairs in three pairs of lanes,
+ * (f_x, f_y), (f_z, t_x), (t_y, t_z), each lane's addition the one of the vec3 sums (its count
+ * of contacts goes to the total at once: an integer, the same in any order); and what a batch
+ * of four-at-a-time results keeps of each particle it reaches (consume_four_at_a_time): slot 0
+ * the one carried from the batch before, slot s > 0 the s-th particle that begins in it. */
 typedef double lanes2 __attribute__((vector_size(16)));
 typedef unsigned long long mask2 __attribute__((vector_size(16)));
 struct running_sums {
@@ -1621,8 +1621,8 @@ struct running_sums {
 };
 struct batch_sums {
     struct running_sums s[WETDEM_MANY_BULK_MAX + 1];
-    uint32_t particle[WETDEM_MANY_BULK_MAX + 2]; /* the slot's particle; the one after the
-                                                    last used slot: none (UINT32_MAX) */
+    uint32_t particle[WETDEM_MANY_BULK_MAX + 1]; /* the slot's particle (slot 0: UINT32_MAX
+                                                    before the first batch) */
 };
 
 static inline __attribute__((always_inline)) struct wetdem_vec3
@@ -1637,9 +1637,10 @@ running_torque(const struct running_sums* r)
 }
 
 /* Closes the particles next .. stop - 1 of a batch (close_particle) with the sums of the
- * batch's slots from_slot .. to_slot - 1 (their particles in order among them). Without cross
- * pairs among them (always on one thread), the slots' sums are added, then every particle
- * gets its kick: no branch on whether a particle has pairs. */
+ * batch's slots from_slot .. to_slot - 1 (their particles in order among them, the others
+ * without listed pairs). Without cross pairs among them (always on one thread), the slots'
+ * sums are added, then every particle gets its kick: no branch on whether a particle has
+ * pairs. */
 static inline __attribute__((always_inline)) void
 close_batch(const struct pass* P, const struct batch_sums* B, size_t from_slot, size_t to_slot,
             size_t next, size_t stop, size_t* e, size_t e_end, bool kick, struct wetdem_vec3 g)
@@ -1648,8 +1649,8 @@ close_batch(const struct pass* P, const struct batch_sums* B, size_t from_slot, 
     if (*e < e_end && P->pairs[m->cross_q[*e]].i < stop) { /* cross pairs: particle by particle */
         for (size_t p = next, s = from_slot; p < stop; p++) {
             if (s < to_slot && B->particle[s] == p) {
-                close_particle(P, p, e, e_end, running_force(&B->s[s]),
-                               running_torque(&B->s[s]), 0, kick, g);
+                close_particle(P, p, e, e_end, running_force(&B->s[s]), running_torque(&B->s[s]), 0,
+                               kick, g);
                 s++;
             } else
                 close_unlisted(P, p, e, e_end, kick, g);
@@ -1676,10 +1677,10 @@ close_batch(const struct pass* P, const struct batch_sums* B, size_t from_slot, 
  * loop. The same operations in the same order as the loop per particle: each particle's pairs
  * in list order, then its cross pairs, its sums and its kick; the evaluation of a batch reads
  * only particles at or after its first pair's first particle, none of which has been closed,
- * and no reaction goes to a closed particle (j > i). A result in solid contact adds its torques
- * (+0 apart: the vector kernel's) and its count without a test; the torque on j goes to a
- * scratch sum instead where it is apart. Returns the number within range; *n_bulk_contacts
- * gets those in solid contact evaluated four at a time. */
+ * and no reaction goes to a closed particle (j > i). Every result adds its torque on i to the
+ * running sum (+0 apart: the vector kernel's, or +0 where it does not act); the torque on j
+ * and the counts are added in solid contact only. Returns the number within range;
+ * *n_bulk_contacts gets those in solid contact evaluated four at a time. */
 static inline __attribute__((always_inline)) uint64_t
 consume_four_at_a_time(const struct pass* P, const struct pass* P_out, size_t b,
                        const uint32_t* list, size_t n_list, bool kick, struct wetdem_vec3 g,
@@ -1706,11 +1707,10 @@ consume_four_at_a_time(const struct pass* P, const struct pass* P_out, size_t b,
             if (j < end_block && cls > 1) { /* evaluated four at a time: add_pair's j side */
                 n_near++;
                 bulk_flags(P, q, cls);
-                P->force[j] = vec3_sub(P->force[j], vec3(bo.force[0][k], bo.force[1][k],
-                                                         bo.force[2][k]));
+                P->force[j] =
+                    vec3_sub(P->force[j], vec3(bo.force[0][k], bo.force[1][k], bo.force[2][k]));
                 if (cls & WETDEM_MANY_CONTACT) { /* (apart: no counts, and +0 torques) */
-                    P->torque[j] = vec3_add(P->torque[j], vec3(bo.torque_j[0][k],
-                                                               bo.torque_j[1][k],
+                    P->torque[j] = vec3_add(P->torque[j], vec3(bo.torque_j[0][k], bo.torque_j[1][k],
                                                                bo.torque_j[2][k]));
                     P->contacts[j]++;
                     P->contacts[bo.i[k]]++;
