@@ -770,7 +770,7 @@ struct pass {
 };
 
 /* The force and torques of entry k of four-at-a-time results (those of a contact; a pair
- * apart has no torques there). */
+ * apart has +0 for its torque on i there, and no torque on j). */
 static inline struct wetdem_many_pair_out bulk_pair_out(const struct wetdem_many_bulk_out* bo,
                                                         size_t k)
 {
