@@ -69,6 +69,16 @@ struct wetdem_many_pair_out {
                                   kept across rebuilds and restarts; the lean kernel resets the
                                   spring of a pair apart only then (else it is zero already) */
 
+/* The set bits of a 4-bit mask, in order: its lanes (then zeros) and their number; for the
+ * compaction of four lanes without a branch per lane (sim_many_force.c due_candidates,
+ * many_bulk.h bulk_four). */
+static const uint32_t wetdem_many_mask_lanes[16][4] = {
+    {0, 0, 0, 0}, {0, 0, 0, 0}, {1, 0, 0, 0}, {0, 1, 0, 0}, {2, 0, 0, 0}, {0, 2, 0, 0},
+    {1, 2, 0, 0}, {0, 1, 2, 0}, {3, 0, 0, 0}, {0, 3, 0, 0}, {1, 3, 0, 0}, {0, 1, 3, 0},
+    {2, 3, 0, 0}, {0, 2, 3, 0}, {1, 2, 3, 0}, {0, 1, 2, 3}};
+static const unsigned char wetdem_many_mask_count[16] = {0, 1, 1, 2, 1, 2, 2, 3,
+                                                         1, 2, 2, 3, 2, 3, 3, 4};
+
 /* Four pairs at a time (many_bulk.h): what the bulk evaluation of a block's listed
  * candidates reads, and what it gives per candidate. For the lean kernel with a film model in
  * the common case (one material pair, no periodic axis). */

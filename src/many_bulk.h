@@ -170,16 +170,44 @@ bulk_four(const struct wetdem_many_bulk_in* in, const struct bulk_constants* C,
     uint32_t q[4], i[4], j[4];
     wetdem_v4i own; /* all ones in the lanes of this thread's pairs (and, with tail, before n) */
     BULK_UNROLL
-    for (int l = 0; l < 4; l++) {
+    for (int l = 0; l < 4; l++)
         q[l] = list[!tail || k + l < n ? k + l : n - 1];
-        i[l] = in->pairs[q[l]].i;
-        j[l] = in->pairs[q[l]].j;
-        out->i[k + l] = i[l];
-        out->j[k + l] = j[l];
-        /* a second particle at or past j_end belongs to another thread, which may be updating
-           it: the lane reads its first particle instead (and is not used) */
-        own[l] = -(long long)(j[l] < j_end && (!tail || k + l < n));
-        j[l] = j[l] < j_end ? j[l] : i[l];
+#if defined(__SSE2__)
+    if (!tail && j_end <= INT32_MAX) { /* the same, four lanes at once */
+        __m128i p01 = _mm_unpacklo_epi64(_mm_loadl_epi64((const __m128i*)&in->pairs[q[0]]),
+                                         _mm_loadl_epi64((const __m128i*)&in->pairs[q[1]]));
+        __m128i p23 = _mm_unpacklo_epi64(_mm_loadl_epi64((const __m128i*)&in->pairs[q[2]]),
+                                         _mm_loadl_epi64((const __m128i*)&in->pairs[q[3]]));
+        __m128i iv = _mm_castps_si128(
+            _mm_shuffle_ps(_mm_castsi128_ps(p01), _mm_castsi128_ps(p23), _MM_SHUFFLE(2, 0, 2, 0)));
+        __m128i jv = _mm_castps_si128(
+            _mm_shuffle_ps(_mm_castsi128_ps(p01), _mm_castsi128_ps(p23), _MM_SHUFFLE(3, 1, 3, 1)));
+        _mm_storeu_si128((__m128i*)(void*)&out->i[k], iv);
+        _mm_storeu_si128((__m128i*)(void*)&out->j[k], jv);
+        /* (indices below 2^31: a signed comparison) */
+        __m128i mine = _mm_cmplt_epi32(jv, _mm_set1_epi32((int)j_end));
+        __m128i js = _mm_or_si128(_mm_and_si128(mine, jv), _mm_andnot_si128(mine, iv));
+        _mm_storeu_si128((__m128i*)(void*)i, iv);
+        _mm_storeu_si128((__m128i*)(void*)j, js);
+        union {
+            wetdem_v4i v;
+            __m128i h[2];
+        } u = {.h = {_mm_unpacklo_epi32(mine, mine), _mm_unpackhi_epi32(mine, mine)}};
+        own = u.v;
+    } else
+#endif
+    {
+        BULK_UNROLL
+        for (int l = 0; l < 4; l++) {
+            i[l] = in->pairs[q[l]].i;
+            j[l] = in->pairs[q[l]].j;
+            out->i[k + l] = i[l];
+            out->j[k + l] = j[l];
+            /* a second particle at or past j_end belongs to another thread, which may be
+               updating it: the lane reads its first particle instead (and is not used) */
+            own[l] = -(long long)(j[l] < j_end && (!tail || k + l < n));
+            j[l] = j[l] < j_end ? j[l] : i[l];
+        }
     }
     wetdem_v4d pi[4], pj[4], vi[4], vj[4];
     bulk_columns(&xr[i[0]].x, &xr[i[1]].x, &xr[i[2]].x, &xr[i[3]].x, pi);
@@ -218,11 +246,23 @@ bulk_four(const struct wetdem_many_bulk_in* in, const struct bulk_constants* C,
     /* this thread's lanes in solid contact (class 1 with gap < 0) onto the list for
        bulk_contacts, without a branch */
     wetdem_v4i contact = near & (gap < zero) & own;
+#if defined(__AVX__)
+    { /* their offsets from a table by the 4-bit mask, four written, `count` of them kept */
+        int mask = _mm256_movemask_pd((__m256d)contact);
+        _mm_storeu_si128(
+            (__m128i*)(void*)(at + *n_at),
+            _mm_add_epi32(
+                _mm_set1_epi32((int)k),
+                _mm_loadu_si128((const __m128i*)(const void*)wetdem_many_mask_lanes[mask])));
+        *n_at += wetdem_many_mask_count[mask];
+    }
+#else
     BULK_UNROLL
     for (int l = 0; l < 4; l++) {
         at[*n_at] = (uint32_t)(k + l);
         *n_at += (size_t)(contact[l] & 1);
     }
+#endif
     *(wetdem_v4d*)&out->r2[k] = r2; /* (out has room for the lanes past n) */
     *(wetdem_v4d*)&out->gap[k] = gap;
     *(wetdem_v4d*)&out->n[0][k] = nx;

@@ -1485,11 +1485,8 @@ due_candidates(const struct pass* P, size_t q_begin, size_t q_end, uint32_t* res
        below (not less: due, as is a NaN), the due lanes' offsets taken from a table by the
        4-bit mask and written as four indices, of which the first `count` are kept; the
        write stays within the candidates read so far plus three (n_test <= q - q_begin) */
-    static const uint32_t lanes[16][4] = {{0, 0, 0, 0}, {0, 0, 0, 0}, {1, 0, 0, 0}, {0, 1, 0, 0},
-                                          {2, 0, 0, 0}, {0, 2, 0, 0}, {1, 2, 0, 0}, {0, 1, 2, 0},
-                                          {3, 0, 0, 0}, {0, 3, 0, 0}, {1, 3, 0, 0}, {0, 1, 3, 0},
-                                          {2, 3, 0, 0}, {0, 2, 3, 0}, {1, 2, 3, 0}, {0, 1, 2, 3}};
-    static const unsigned char count[16] = {0, 1, 1, 2, 1, 2, 2, 3, 1, 2, 2, 3, 2, 3, 3, 4};
+    const uint32_t(*lanes)[4] = wetdem_many_mask_lanes;
+    const unsigned char* count = wetdem_many_mask_count;
     __m128d c = _mm_set1_pd(clock);
     for (; q_end - q >= 4; q += 4) {
         __m128 u = _mm_loadu_ps(until + q);
@@ -1698,9 +1695,13 @@ consume_four_at_a_time(const struct pass* P, const struct pass* P_out, size_t b,
     for (size_t h = 0; h < n_list;) {
         size_t n_w = n_list - h < WETDEM_MANY_BULK_MAX ? n_list - h : WETDEM_MANY_BULK_MAX;
         P->bulk(&P->bulk_in, list + h, n_w, end_block, &bo);
-        /* 1. in list order, each result's state, its reactions on j and its counts of
-              contacts; what it adds to i's force and torque is left in its entry (+0 for
-              those that do not act) */
+        /* in list order, each result's state, its reactions on j and its counts of contacts,
+           then what it adds to i's force and torque (its entry's: the slower paths write it
+           there, +0 for those that do not act) into the running sums of the first particles,
+           restarted from +0 at a new particle without a branch (a sum from +0 is never -0) */
+        size_t slot = 0; /* slot 0: the particle carried from the batch before (none at first) */
+        B.particle[0] = i;
+        B.s[0] = r;
         for (size_t k = 0; k < n_w; k++) {
             size_t q = list[h + k], j = bo.j[k];
             long long cls = bo.cls[k];
@@ -1716,35 +1717,27 @@ consume_four_at_a_time(const struct pass* P, const struct pass* P_out, size_t b,
                     P->contacts[bo.i[k]]++;
                     n_contact_results++;
                 }
-                continue;
+            } else {
+                struct wetdem_vec3 f = vec3(0, 0, 0), t = vec3(0, 0, 0);
+                if (j >= end_block) /* a cross pair: tested and evaluated in phase 1 */
+                    ;
+                else if (!cls) /* beyond (in two loops the test gave it its time and listed it
+                                  for its flags) */
+                    beyond_reach(P, P_out, q, bo.r2[k], fused);
+                else {
+                    n_near++;
+                    struct wetdem_many_pair_out o;
+                    unsigned char fl =
+                        near_candidate(P, q, bo.i[k], j, vec3(0, 0, 0), m->mix, &o, fail, &bo, k);
+                    add_pair(P, j, fl, &o, &f, &t, &P->contacts[bo.i[k]]);
+                }
+                bo.force[0][k] = f.x;
+                bo.force[1][k] = f.y;
+                bo.force[2][k] = f.z;
+                bo.torque_i[0][k] = t.x;
+                bo.torque_i[1][k] = t.y;
+                bo.torque_i[2][k] = t.z;
             }
-            struct wetdem_vec3 f = vec3(0, 0, 0), t = vec3(0, 0, 0);
-            if (j >= end_block) /* a cross pair: tested and evaluated in phase 1 */
-                ;
-            else if (!cls) /* beyond (in two loops the test gave it its time and listed it
-                              for its flags) */
-                beyond_reach(P, P_out, q, bo.r2[k], fused);
-            else {
-                n_near++;
-                struct wetdem_many_pair_out o;
-                unsigned char fl =
-                    near_candidate(P, q, bo.i[k], j, vec3(0, 0, 0), m->mix, &o, fail, &bo, k);
-                add_pair(P, j, fl, &o, &f, &t, &P->contacts[bo.i[k]]); /* (f, t from +0: o's
-                                                                          or +0) */
-            }
-            bo.force[0][k] = f.x;
-            bo.force[1][k] = f.y;
-            bo.force[2][k] = f.z;
-            bo.torque_i[0][k] = t.x;
-            bo.torque_i[1][k] = t.y;
-            bo.torque_i[2][k] = t.z;
-        }
-        /* 2. the running sums of the first particles, in list order, each restarted from +0
-              at a new particle without a branch (a sum from +0 is never -0) */
-        size_t slot = 0; /* slot 0: the particle carried from the batch before (none at first) */
-        B.particle[0] = i;
-        B.s[0] = r;
-        for (size_t k = 0; k < n_w; k++) {
             uint32_t first = bo.i[k];
             size_t fresh = first != i;
             slot += fresh;
