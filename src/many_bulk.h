@@ -292,6 +292,18 @@ struct bulk_lanes {
     wetdem_v4i finite;
 };
 
+/* The normal terms of L in model order into *f_n (chosen by value, not indexed: an indexed
+ * member would keep all of L in memory). */
+static inline __attribute__((always_inline)) void
+bulk_normal_sum(const struct wetdem_many_bulk_in* in, const struct bulk_constants* C,
+                const struct bulk_lanes* L, wetdem_v4d* f_n)
+{
+    wetdem_v4d sum = C->zero;
+    for (int m = 0; m < in->n_normal; m++)
+        sum += in->normal[m] == 0 ? L->term[0] : in->normal[m] == 1 ? L->term[1] : L->term[2];
+    *f_n = sum;
+}
+
 /* lean_force of sim_many_force.c lane by lane (this file's header): lanes in solid contact
  * (gap < 0) get hertz and mindlin, the others (a wall apart: `apart`) only the film terms, a
  * zero spring (mindlin resets it apart) and zero torques. `wall`: no torque on j. */
@@ -374,11 +386,8 @@ bulk_lean_force(const struct wetdem_many_bulk_in* in, const struct bulk_constant
             }
         }
     }
-    /* the normal terms in model order (chosen by value, not indexed: an indexed member would
-       keep all of L in memory) */
-    wetdem_v4d f_n = zero;
-    for (int m = 0; m < in->n_normal; m++)
-        f_n += in->normal[m] == 0 ? L->term[0] : in->normal[m] == 1 ? L->term[1] : L->term[2];
+    wetdem_v4d f_n;
+    bulk_normal_sum(in, C, L, &f_n);
     wetdem_v4i finite = BULK_FINITE(f_n);
     for (int c = 0; c < 3; c++) {
         L->force[c] = ft[c] + f_n * L->n[c];
@@ -527,21 +536,23 @@ void WETDEM_MANY_BULK_NAME(const struct wetdem_many_bulk_in* in, const uint32_t*
             bulk_contacts(in, &C, list, at + g, out, false);
 }
 
-/* Particle-wall entries e = k..k+4 within the range at gap[e] (eval_walls_of's; with `tail`,
- * those before n, the last one repeated): lean_wall and lean_force lane by lane (walls apart
- * get the film terms only and a zero spring), with R* = R, m* = m_eff and the Hertz constants
- * of the particle's radius and mass. Lanes with a finite result get their flags (and their
- * spring stored), the others class 1. */
+/* Particle-wall entries e = idx[k..k+4) within the range at gap[e] (eval_walls_of's; with
+ * `tail`, those before n, the last one repeated): lean_wall and lean_force lane by lane (walls
+ * apart get the film terms only and a zero spring), with R* = R, m* = m_eff and the Hertz
+ * constants of the particle's radius and mass; `touching`: all of them at gap < 0, else none
+ * (then only what lean_force gives a pair apart: the film terms, +0 torques, a zero spring).
+ * Lanes with a finite result get their flags (and their spring stored), the others class 1. */
 static inline __attribute__((always_inline)) void
 bulk_walls_four(const struct wetdem_many_bulk_in* in, const struct bulk_constants* C,
-                const uint32_t* part, const unsigned char* wall, const double* gap, size_t n,
-                struct wetdem_many_bulk_out* out, size_t k, bool tail, enum bulk_films films)
+                const uint32_t* part, const unsigned char* wall, const double* gap,
+                const uint32_t* idx, size_t n, struct wetdem_many_bulk_out* out, size_t k,
+                bool tail, enum bulk_films films, bool touching)
 {
     const wetdem_v4d zero = C->zero;
     uint32_t i[4], w[4], e[4];
     BULK_UNROLL
     for (int l = 0; l < 4; l++) {
-        e[l] = (uint32_t)(!tail || k + l < n ? k + l : n - 1);
+        e[l] = idx[!tail || k + l < n ? k + l : n - 1];
         i[l] = part[e[l]];
         w[l] = wall[e[l]];
     }
@@ -560,73 +571,111 @@ bulk_walls_four(const struct wetdem_many_bulk_in* in, const struct bulk_constant
     L.v_n = -(a0[0] * nv[0] + a0[1] * nv[1] + a0[2] * nv[2]);
     L.r_i = L.r_eff = radius;
     L.r_j = zero;
-    L.m_eff = BULK_GATHER(in->m_eff, i);
-    wetdem_v4d root = radius;
-    bulk_sqrt(&root);
-    L.k = BULK_SPLAT((4.0 / 3.0) * in->e_star) * root; /* hertz_stiffness */
-    L.damping = zero;
-    if (in->hertz_form >= 0) { /* hertz_damping_factor */
-        wetdem_v4d mk = L.m_eff * L.k;
-        bulk_sqrt(&mk);
-        L.damping = BULK_SPLAT(in->hertz_coef) * mk;
-    }
     size_t spring[4];
-    if (in->mindlin) {
-        bulk_columns(&vw[i[0]][0].z, &vw[i[1]][0].z, &vw[i[2]][0].z, &vw[i[3]][0].z, a1);
-        wetdem_v4d mr = -radius, a[3] = {nv[0] * mr, nv[1] * mr, nv[2] * mr}; /* n (-R) */
-        wetdem_v4d va[3] = {a0[0] + (a1[2] * a[2] - a1[3] * a[1]),
-                            a0[1] + (a1[3] * a[0] - a1[1] * a[2]),
-                            a0[2] + (a1[1] * a[1] - a1[2] * a[0])};
-        wetdem_v4d vn = -(va[0] * nv[0] + va[1] * nv[1] + va[2] * nv[2]);
-        BULK_UNROLL
-        for (int l = 0; l < 4; l++)
-            spring[l] = (i[l] * in->n_walls + w[l]) * in->len + in->spring_off;
-        for (int c = 0; c < 3; c++) {
-            L.v_t[c] = va[c] + vn * nv[c];
-            L.s[c] = (wetdem_v4d){in->wall_history[spring[0] + c], in->wall_history[spring[1] + c],
-                                  in->wall_history[spring[2] + c], in->wall_history[spring[3] + c]};
-        }
-    }
+    BULK_UNROLL
+    for (int l = 0; l < 4; l++)
+        spring[l] = (i[l] * in->n_walls + w[l]) * in->len + in->spring_off;
     L.term[1] = L.term[2] = zero;
     if (films != BULK_DRY)
         bulk_film_terms(C, films, &L.gap, &L.r_eff, &L.v_n, &L.term[1], &L.term[2]);
-    bulk_lean_force(in, C, &L, true, true);
-    wetdem_v4i touch = L.gap < zero;
+    if (touching) {
+        L.m_eff = BULK_GATHER(in->m_eff, i);
+        wetdem_v4d root = radius;
+        bulk_sqrt(&root);
+        L.k = BULK_SPLAT((4.0 / 3.0) * in->e_star) * root; /* hertz_stiffness */
+        L.damping = zero;
+        if (in->hertz_form >= 0) { /* hertz_damping_factor */
+            wetdem_v4d mk = L.m_eff * L.k;
+            bulk_sqrt(&mk);
+            L.damping = BULK_SPLAT(in->hertz_coef) * mk;
+        }
+        if (in->mindlin) {
+            bulk_columns(&vw[i[0]][0].z, &vw[i[1]][0].z, &vw[i[2]][0].z, &vw[i[3]][0].z, a1);
+            wetdem_v4d mr = -radius, a[3] = {nv[0] * mr, nv[1] * mr, nv[2] * mr}; /* n (-R) */
+            wetdem_v4d va[3] = {a0[0] + (a1[2] * a[2] - a1[3] * a[1]),
+                                a0[1] + (a1[3] * a[0] - a1[1] * a[2]),
+                                a0[2] + (a1[1] * a[1] - a1[2] * a[0])};
+            wetdem_v4d vn = -(va[0] * nv[0] + va[1] * nv[1] + va[2] * nv[2]);
+            for (int c = 0; c < 3; c++) {
+                L.v_t[c] = va[c] + vn * nv[c];
+                L.s[c] =
+                    (wetdem_v4d){in->wall_history[spring[0] + c], in->wall_history[spring[1] + c],
+                                 in->wall_history[spring[2] + c], in->wall_history[spring[3] + c]};
+            }
+        }
+        bulk_lean_force(in, C, &L, false, true); /* (every lane touches: no masks needed) */
+    } else { /* bulk_lean_force's result where no lane touches */
+        L.term[0] = zero;
+        wetdem_v4d f_n;
+        bulk_normal_sum(in, C, &L, &f_n);
+        L.finite = BULK_FINITE(f_n);
+        for (int c = 0; c < 3; c++) {
+            L.force[c] = zero + f_n * nv[c];
+            L.ti[c] = L.s[c] = zero;
+            L.finite &= BULK_FINITE(L.force[c]);
+        }
+    }
     wetdem_v4i flags = (WETDEM_MANY_ACTIVE | WETDEM_MANY_DIRTY) |
-                       (touch & (WETDEM_MANY_CONTACT | WETDEM_MANY_SPRING)) |
+                       (BULK_UNIFORM(touching) & (WETDEM_MANY_CONTACT | WETDEM_MANY_SPRING)) |
                        (C->bridge_on & (L.gap < C->film) & WETDEM_MANY_BRIDGE);
-    wetdem_v4i done = L.finite;
-    *(wetdem_v4i*)&out->cls[k] = (done & (flags - 1)) | 1;
-    for (int c = 0; c < 3; c++) {
-        *(wetdem_v4d*)&out->force[c][k] = L.force[c];
-        *(wetdem_v4d*)&out->torque_i[c][k] = L.ti[c];
+    wetdem_v4i cls = (L.finite & (flags - 1)) | 1;
+    BULK_UNROLL
+    for (int l = 0; l < 4; l++) { /* (lanes that repeat an entry store the same) */
+        out->cls[e[l]] = cls[l];
+        for (int c = 0; c < 3; c++) {
+            out->force[c][e[l]] = L.force[c][l];
+            out->torque_i[c][e[l]] = L.ti[c][l];
+        }
     }
     for (int l = 0; in->mindlin && l < 4; l++)
-        if (done[l])
+        if (L.finite[l])
             for (int c = 0; c < 3; c++)
                 in->wall_history[spring[l] + c] = L.s[c][l];
 }
 
+/* The entries idx[0..n) (touching or not) four at a time, each kind of films in its own loop
+ * (its masks constants there), as for the pairs. */
+static inline __attribute__((always_inline)) void
+bulk_walls_of(const struct wetdem_many_bulk_in* in, const struct bulk_constants* C,
+              const uint32_t* part, const unsigned char* wall, const double* gap,
+              const uint32_t* idx, size_t n, struct wetdem_many_bulk_out* out, bool touching)
+{
+    enum bulk_films films = bulk_films_of(in);
+    size_t k = 0;
+    if (films == BULK_BOTH)
+        for (; k + 4 <= n; k += 4)
+            bulk_walls_four(in, C, part, wall, gap, idx, n, out, k, false, BULK_BOTH, touching);
+    else if (films == BULK_DRY)
+        for (; k + 4 <= n; k += 4)
+            bulk_walls_four(in, C, part, wall, gap, idx, n, out, k, false, BULK_DRY, touching);
+    else
+        for (; k + 4 <= n; k += 4)
+            bulk_walls_four(in, C, part, wall, gap, idx, n, out, k, false, BULK_ANY, touching);
+    if (k < n)
+        bulk_walls_four(in, C, part, wall, gap, idx, n, out, k, true, films, touching);
+}
+
 /* Particle-wall pairs (part[e], wall[e]) within the range at gap[e], e < n (1 <= n <=
- * WETDEM_MANY_BULK_MAX), four at a time (bulk_walls_four) into out's entries 0..n). */
+ * WETDEM_MANY_BULK_MAX), into out's entries 0..n): those in solid contact (gap < 0) four at a
+ * time, then the others (apart within the films, or a gap that is not a number: what
+ * lean_force does with them), without the contact terms (bulk_walls_four). */
 void WETDEM_MANY_BULK_WALLS_NAME(const struct wetdem_many_bulk_in* in, const uint32_t* part,
                                  const unsigned char* wall, const double* gap, size_t n,
                                  struct wetdem_many_bulk_out* out)
 {
     const struct bulk_constants C = bulk_constants_of(in);
-    enum bulk_films films = bulk_films_of(in);
-    size_t k = 0; /* (each kind of films in its own loop, as for the pairs) */
-    if (films == BULK_BOTH)
-        for (; k + 4 <= n; k += 4)
-            bulk_walls_four(in, &C, part, wall, gap, n, out, k, false, BULK_BOTH);
-    else if (films == BULK_DRY)
-        for (; k + 4 <= n; k += 4)
-            bulk_walls_four(in, &C, part, wall, gap, n, out, k, false, BULK_DRY);
-    else
-        for (; k + 4 <= n; k += 4)
-            bulk_walls_four(in, &C, part, wall, gap, n, out, k, false, BULK_ANY);
-    if (k < n)
-        bulk_walls_four(in, &C, part, wall, gap, n, out, k, true, films);
+    uint32_t idx[2][WETDEM_MANY_BULK_MAX];
+    size_t count[2] = {0, 0};        /* touching, apart */
+    for (size_t e = 0; e < n; e++) { /* (without a branch on the gap) */
+        size_t apart = !(gap[e] < 0);
+        idx[0][count[0]] = idx[1][count[1]] = (uint32_t)e;
+        count[0] += 1 - apart;
+        count[1] += apart;
+    }
+    if (count[0])
+        bulk_walls_of(in, &C, part, wall, gap, idx[0], count[0], out, true);
+    if (count[1])
+        bulk_walls_of(in, &C, part, wall, gap, idx[1], count[1], out, false);
 }
 
 #endif
