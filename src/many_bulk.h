@@ -173,7 +173,7 @@ bulk_four(const struct wetdem_many_bulk_in* in, const struct bulk_constants* C,
     for (int l = 0; l < 4; l++)
         q[l] = list[!tail || k + l < n ? k + l : n - 1];
 #if defined(__SSE2__)
-    if (!tail && j_end <= INT32_MAX) { /* the same, four lanes at once */
+    if (!tail && j_end <= UINT32_MAX) { /* the same, four lanes at once */
         __m128i p01 = _mm_unpacklo_epi64(_mm_loadl_epi64((const __m128i*)&in->pairs[q[0]]),
                                          _mm_loadl_epi64((const __m128i*)&in->pairs[q[1]]));
         __m128i p23 = _mm_unpacklo_epi64(_mm_loadl_epi64((const __m128i*)&in->pairs[q[2]]),
@@ -184,8 +184,10 @@ bulk_four(const struct wetdem_many_bulk_in* in, const struct bulk_constants* C,
             _mm_shuffle_ps(_mm_castsi128_ps(p01), _mm_castsi128_ps(p23), _MM_SHUFFLE(3, 1, 3, 1)));
         _mm_storeu_si128((__m128i*)(void*)&out->i[k], iv);
         _mm_storeu_si128((__m128i*)(void*)&out->j[k], jv);
-        /* (indices below 2^31: a signed comparison) */
-        __m128i mine = _mm_cmplt_epi32(jv, _mm_set1_epi32((int)j_end));
+        /* j < j_end unsigned: a signed comparison of both less 2^31 */
+        const __m128i bias = _mm_set1_epi32(INT32_MIN);
+        __m128i mine = _mm_cmplt_epi32(_mm_xor_si128(jv, bias),
+                                       _mm_xor_si128(_mm_set1_epi32((int)(uint32_t)j_end), bias));
         __m128i js = _mm_or_si128(_mm_and_si128(mine, jv), _mm_andnot_si128(mine, iv));
         _mm_storeu_si128((__m128i*)(void*)i, iv);
         _mm_storeu_si128((__m128i*)(void*)j, js);
@@ -247,7 +249,8 @@ bulk_four(const struct wetdem_many_bulk_in* in, const struct bulk_constants* C,
        bulk_contacts, without a branch */
     wetdem_v4i contact = near & (gap < zero) & own;
 #if defined(__AVX__)
-    { /* their offsets from a table by the 4-bit mask, four written, `count` of them kept */
+    { /* their offsets from a table by the 4-bit mask, four written (within at's room: *n_at
+         <= k), `count` of them kept */
         int mask = _mm256_movemask_pd((__m256d)contact);
         _mm_storeu_si128(
             (__m128i*)(void*)(at + *n_at),
@@ -304,15 +307,14 @@ bulk_normal_sum(const struct wetdem_many_bulk_in* in, const struct bulk_constant
     *f_n = sum;
 }
 
-/* lean_force of sim_many_force.c lane by lane (this file's header): lanes in solid contact
- * (gap < 0) get hertz and mindlin, the others (a wall apart: `apart`) only the film terms, a
- * zero spring (mindlin resets it apart) and zero torques. `wall`: no torque on j. */
+/* lean_force of sim_many_force.c lane by lane (this file's header) for four lanes in solid
+ * contact (gap < 0): hertz, mindlin and the normal terms. `wall`: no torque on j. (A wall
+ * apart gets the film terms alone: bulk_walls_four.) */
 static inline __attribute__((always_inline)) void
 bulk_lean_force(const struct wetdem_many_bulk_in* in, const struct bulk_constants* C,
-                struct bulk_lanes* L, bool apart, bool wall)
+                struct bulk_lanes* L, bool wall)
 {
     const wetdem_v4d zero = C->zero;
-    wetdem_v4i touch = L->gap < zero;
     wetdem_v4d overlap = -L->gap, root = overlap;
     bulk_sqrt(&root);
     wetdem_v4d f_el = L->k * overlap * root; /* hertz_elastic_k */
@@ -322,8 +324,6 @@ bulk_lean_force(const struct wetdem_many_bulk_in* in, const struct bulk_constant
         bulk_sqrt(&quarter);
         wetdem_v4d sum = f_el + L->damping * quarter * L->v_n;
         L->term[0] = in->hertz_form == 1 ? sum : BULK_SELECT(sum > zero, sum, zero);
-        if (apart)
-            L->term[0] = BULK_SELECT(touch, L->term[0], zero);
     }
     wetdem_v4d ft[3] = {zero, zero, zero};
     for (int c = 0; c < 3; c++)
@@ -357,8 +357,6 @@ bulk_lean_force(const struct wetdem_many_bulk_in* in, const struct bulk_constant
         const wetdem_v4i magnitude = {INT64_MAX, INT64_MAX, INT64_MAX, INT64_MAX};
         wetdem_v4d f_max = BULK_SPLAT(in->mu) * (wetdem_v4d)((wetdem_v4i)f_el & magnitude);
         wetdem_v4i slide = f_total > f_max;
-        if (apart)
-            slide &= touch;
         if (slide[0] | slide[1] | slide[2] | slide[3]) { /* capped, the spring set to match */
             wetdem_v4d cap = f_max / BULK_SELECT(slide, f_total, C->one);
             wetdem_v4i stiff = k_t > zero;
@@ -379,11 +377,6 @@ bulk_lean_force(const struct wetdem_many_bulk_in* in, const struct bulk_constant
             if (!wall)
                 L->tj[c] = zero + mrj * cr[c];
             ft[c] = zero + ft[c];
-            if (apart) {
-                L->ti[c] = BULK_SELECT(touch, L->ti[c], zero);
-                ft[c] = BULK_SELECT(touch, ft[c], zero);
-                s[c] = BULK_SELECT(touch, s[c], zero);
-            }
         }
     }
     wetdem_v4d f_n;
@@ -453,7 +446,7 @@ bulk_contacts(const struct wetdem_many_bulk_in* in, const struct bulk_constants*
                                   in->history[q[3] * in->len + in->spring_off + c]};
         }
     }
-    bulk_lean_force(in, C, &L, false, false);
+    bulk_lean_force(in, C, &L, false);
     wetdem_v4i flags =
         (WETDEM_MANY_ACTIVE | WETDEM_MANY_DIRTY | WETDEM_MANY_CONTACT | WETDEM_MANY_SPRING) |
         (C->bridge_on & (L.gap < C->film) & WETDEM_MANY_BRIDGE);
@@ -603,8 +596,8 @@ bulk_walls_four(const struct wetdem_many_bulk_in* in, const struct bulk_constant
                                  in->wall_history[spring[2] + c], in->wall_history[spring[3] + c]};
             }
         }
-        bulk_lean_force(in, C, &L, false, true); /* (every lane touches: no masks needed) */
-    } else { /* bulk_lean_force's result where no lane touches */
+        bulk_lean_force(in, C, &L, true);
+    } else { /* what lean_force gives a pair apart: no contact terms, +0 torques */
         L.term[0] = zero;
         wetdem_v4d f_n;
         bulk_normal_sum(in, C, &L, &f_n);
