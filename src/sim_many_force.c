@@ -1367,7 +1367,7 @@ static void start_sums_four_at_a_time(const struct pass* P, size_t lo, size_t hi
                     gap_of[n] = gap;
                     wall[n++] = (unsigned char)w;
                 } else
-                    wall_beyond(sim, i, w); /* (within the reach, flags 0 from eval_wall) */
+                    wall_beyond(sim, i, w); /* (also within the reach: eval_wall's flags 0) */
             }
         }
         if (n)

@@ -474,9 +474,10 @@ static void same_run(const struct wetdem_sim* a, const struct wetdem_sim* b)
  * list, as too few candidates are), and the same spheres from rest; and with the candidates
  * whose time has come tested and evaluated in one loop (fused, where those within range keep
  * their old times, many.h) instead of a gap test and the kernels over its list. Between calls
- * the user may move particles: the run then tests every candidate at its first pass. Here the first particle of the nearest skipped candidate is moved,
- * between calls, to within its reach (less than skin/2: no list rebuild); the runs with
- * skipping must see it at once. Last, the clock is restarted often. */
+ * the user may move particles: the run then tests every candidate at its first pass. Here the
+ * first particle of the nearest skipped candidate is moved, between calls, to within its
+ * reach (less than skin/2: no list rebuild); the runs with skipping must see it at once. Last,
+ * the clock is restarted often. */
 static void test_many_skipped_candidates_change_no_result(void** state)
 {
     (void)state;
