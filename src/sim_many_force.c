@@ -1587,9 +1587,9 @@ close_particle(const struct pass* P, size_t i, size_t* e, size_t e_end, struct w
             t = vec3_add(t, m->cross_out[*e].torque_i);
         n_contacts += (fl & WETDEM_MANY_CONTACT) ? 1 : 0;
     }
-    m->force[i] = vec3_add(m->force[i], f);
-    m->torque[i] = vec3_add(m->torque[i], t);
-    m->contacts[i] += n_contacts;
+    P->force[i] = vec3_add(P->force[i], f);
+    P->torque[i] = vec3_add(P->torque[i], t);
+    P->contacts[i] += n_contacts;
     if (kick)
         wetdem_many_close_kick(m, i, g);
 }
@@ -1656,8 +1656,8 @@ close_batch(const struct pass* P, const struct batch_sums* B, size_t from_slot, 
     }
     for (size_t s = from_slot; s < to_slot; s++) { /* (their sums, then the kicks) */
         size_t p = B->particle[s];
-        m->force[p] = vec3_add(m->force[p], running_force(&B->s[s]));
-        m->torque[p] = vec3_add(m->torque[p], running_torque(&B->s[s]));
+        P->force[p] = vec3_add(P->force[p], running_force(&B->s[s]));
+        P->torque[p] = vec3_add(P->torque[p], running_torque(&B->s[s]));
     }
     for (size_t p = next; kick && p < stop; p++)
         wetdem_many_close_kick(m, p, g);
