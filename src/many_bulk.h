@@ -191,11 +191,16 @@ bulk_four(const struct wetdem_many_bulk_in* in, const struct bulk_constants* C,
         __m128i js = _mm_or_si128(_mm_and_si128(mine, jv), _mm_andnot_si128(mine, iv));
         _mm_storeu_si128((__m128i*)(void*)i, iv);
         _mm_storeu_si128((__m128i*)(void*)j, js);
+#if defined(__AVX2__) /* (sign-extended in a register: two halves stored and read back as
+                          one vector would stall the load on its two stores) */
+        own = (wetdem_v4i)_mm256_cvtepi32_epi64(mine);
+#else
         union {
             wetdem_v4i v;
             __m128i h[2];
         } u = {.h = {_mm_unpacklo_epi32(mine, mine), _mm_unpackhi_epi32(mine, mine)}};
         own = u.v;
+#endif
     } else
 #endif
     {

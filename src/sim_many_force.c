@@ -828,6 +828,8 @@ static inline __attribute__((always_inline)) void bulk_flags(const struct pass* 
                                                              long long cls)
 {
     unsigned char was = P->flags[q];
+    if (was == (unsigned char)cls) /* (most pairs keep their flags from step to step) */
+        return;
     P->flags[q] = (unsigned char)cls;
     if (was & ~cls & WETDEM_MANY_SPRING) /* (apart now: cls has the bit in solid contact; one
                                             test, rarely true, for the two of before) */
