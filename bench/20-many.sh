@@ -21,8 +21,12 @@
 # other guests, CPU time leaves out the time the host took away, and wall time does not), memory
 # per particle ((max RSS - RSS of a 1-particle run) / N) and the ratios against the targets:
 # >= 2x LIGGGHTS per core dry and wet, >= 1.8x speed-up on 2 threads, wet <= 1.3x dry.
-# Then, with valgrind, the load-independent measure: instructions per particle-step of both
-# codes on the shared state (same-state and frozen protocols, callgrind, one thread).
+# With the frozen protocol, the floor of the wet cost: bench/bridge_floor.c's bare loop over the
+# same state's bridges apart (their sb and capillary forces onto both spheres, nothing else),
+# best of REPEAT rounds of FROZEN_STEPS steps, and the wet / dry cost it alone would add to the
+# dry run. Then, with valgrind, the load-independent measure: instructions per particle-step of
+# both codes on the shared state (same-state and frozen protocols, callgrind, one thread), and
+# the floor's instructions per bridge apart.
 #
 # Usage: bench/20-many.sh [WETDEM_CLI]    (make bench passes the CLI; it is not needed here)
 # Environment: N (20000), SETTLE (500), STEPS (1500), STATE (3000), SAME_STEPS (300),
@@ -54,6 +58,7 @@ res="$out/results.txt"
 
 cc -std=c11 -D_DEFAULT_SOURCE -O2 -fopenmp -Iinclude bench/many_bench.c build/libwetdem.a \
    -lsundials_cvode -lsundials_nvecserial -lgsl -lgslcblas -linih -lm -o "$out/many_bench"
+cc -std=c11 -D_DEFAULT_SOURCE -O2 bench/bridge_floor.c -lm -o "$out/bridge_floor"
 "$out/many_bench" --n "$N" --data "$out/system.data"
 "$out/many_bench" --n 1 --data "$out/one.data"
 
@@ -158,6 +163,11 @@ for variant in dry wet; do
       --state-in "$out/state.data" --settle 0 --steps "$FROZEN_STEPS"
   done
 done
+# the floor: the bare loop over the bridges apart of the same state (bench/bridge_floor.c),
+# best of REPEAT rounds of FROZEN_STEPS steps -> "floor bridges_apart scalar_ns vector_ns"
+"$out/bridge_floor" --state-in "$out/state.data" --steps "$FROZEN_STEPS" --repeat "$REPEAT" |
+  awk '{for (k = 2; k <= NF; k++) {split($k, a, "="); v[a[1]] = a[2]}
+        print "floor", v["bridges_apart"], v["scalar_ns"], v["vector_ns"]}' | tee -a "$res" >&2
 $have_lg || echo "20-many: liggghts or mpirun not installed: LIGGGHTS half skipped" \
   "(scripts/install-deps bench)"
 
@@ -192,6 +202,15 @@ if [ "$INSTR_STEPS" -gt 0 ] && command -v valgrind >/dev/null; then
       done
     done
   done
+  fl=()
+  for s in 0 "$INSTR_STEPS"; do # the floor's, per bridge apart (its fastest version)
+    fl+=("$(valgrind --tool=callgrind --callgrind-out-file=/dev/null "$out/bridge_floor" \
+      --state-in "$out/state.data" --steps "$s" --repeat 1 --kernel vector 2>&1 |
+      sed -n 's/.*Collected : //p')")
+  done
+  nb=$(awk '/^floor /{print $2}' "$res")
+  [ "${nb:-0}" -gt 0 ] && echo "instr floor $(( (fl[1] - fl[0]) / (nb * INSTR_STEPS) ))" |
+    tee -a "$res" >&2
 else
   echo "20-many: valgrind not installed or INSTR_STEPS=0: instruction counts skipped" >&2
 fi
@@ -204,7 +223,9 @@ awk -v n="$N" -v wb="$base_kb" -v lb="$lg_base" -v steps="$STEPS" -v same="$SAME
     -v fsteps="$FROZEN_STEPS" -v fdt="$FROZEN_DT" -v isteps="$INSTR_STEPS" '
   /^(full|same|frozen) / { k = $1 " " $2 " " $3 " " $4; rate[k] = $5; kb[k] = $6; cpu[k] = $7
                     con[k] = $8; bri[k] = $9; kick[k] = $10; frc[k] = $11 }
+  /^instr floor / { floor_ins = $3; next }
   /^instr / { ins[$2 " " $3 " " $4] = $5 }
+  /^floor / { floor_nb = $2; floor_ns = ($4 > 0 && $4 < $3) ? $4 : $3; floor_one = $3 }
   function r(a, b) { return (b > 0) ? a / b : 0 }
   END {
     printf "\n%-5s %-9s %-4s %7s %12s %14s %14s %9s %9s\n", "proto", "code", "kind", "threads",
@@ -244,6 +265,11 @@ awk -v n="$N" -v wb="$base_kb" -v lb="$lg_base" -v steps="$STEPS" -v same="$SAME
       note = p == 1 ? " (different final states)" : " (target <= 1.3)"
       if (p == 2) note = " (the wet run ends with more contacts)"
       printf "%s\n", note
+      if (p == 3 && floor_nb > 0 && rate[w "dry 1"] > 0)
+        printf "  the floor (bench/bridge_floor.c: the bare loop over the %d bridges apart of this" \
+               " state, no engine): %.1f ns per bridge-step (one pair at a time %.1f); on top of" \
+               " the dry run it alone gives a wet / dry cost of %.2fx\n", floor_nb, floor_ns,
+               floor_one, 1 + floor_nb * floor_ns * 1e-9 * rate[w "dry 1"] / n
       nsteps = p == 1 ? steps : (p == 2 ? same : fsteps) # ns per particle-step of a phase:
       printf "  wetdem phases [ns per particle-step], 1 thread / 2 threads (speed-up):"
       for (v = 1; v <= 2; v++) {
@@ -266,6 +292,9 @@ awk -v n="$N" -v wb="$base_kb" -v lb="$lg_base" -v steps="$STEPS" -v same="$SAME
         printf "; LIGGGHTS dry %d, wet %d (%.2fx); LIGGGHTS / wetdem dry %.2fx, wet %.2fx",
                ins[l "dry"], ins[l "wet"], r(ins[l "wet"], ins[l "dry"]),
                r(ins[l "dry"], ins[w "dry"]), r(ins[l "wet"], ins[w "wet"])
+      if (p == 3 && floor_ins > 0 && floor_nb > 0)
+        printf "; the floor %d per bridge apart, on top of the dry step %.2fx", floor_ins,
+               1 + floor_nb * floor_ins / (n * ins[w "dry"])
       printf "\n"
     }
   }' "$res" | tee "$out/summary.txt"

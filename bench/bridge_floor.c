@@ -1,0 +1,375 @@
+/*
+ * bridge_floor.c — the floor of the wet models' cost in bench/20-many.sh: the bare loop over
+ * the liquid bridges apart of a benchmark state, with nothing of an engine around it.
+ *
+ * For every pair apart within the films of a state written by many_bench --state-out
+ * (0 <= gap < delta, delta = 40 um: the two 20 um films of the benchmark's material), each
+ * step computes what wetdem's wet variant adds for such a pair and nothing else: the distance,
+ * the unit normal n (j to i), the normal velocity v_n = -(v_i - v_j) . n, R* = R_i R_j /
+ * (R_i + R_j), the thin-film force of sb (force_sb.c; Punch 2023 Eq. 7 with the corrected
+ * bracket, SPEC section 6)
+ *   F_sb = 6 pi mu R*^2 v_n / h [1 - h/delta]^2 for h = gap >= h_min' (1 um, the default
+ *   minimum separation), else 0,
+ * the capillary force (force_capillary.c; Punch 2023 Eq. 15) F_cap = -8 pi R* sigma, and adds
+ * (F_sb + F_cap) n to i and subtracts it from j. The positions and velocities stay those of the
+ * state. Not kept, unlike wetdem: the pair list from the cell list and its gap test, the pairs
+ * beyond the films and those in contact, each pair's flags (the bridge counts), the order of the
+ * sums that makes results independent of the thread count, the walls, the film terms of the
+ * contacts. Any engine pays at least this for the bridges apart, so on top of the dry run it
+ * bounds the wet / dry cost from below.
+ *
+ * Two versions of the loop, the same operations in the same order: one pair at a time, and four
+ * pairs at a time in vector units (AVX2 where the processor has it, as wetdem's kernel; else
+ * only the first runs). Their force sums must agree bit for bit, or the program fails.
+ *
+ * Usage: bridge_floor --state-in FILE [--steps S] [--repeat R] [--kernel scalar|vector|both]
+ * Prints one line: "floor n=.. bridges_apart=.. steps=.. scalar_ns=.. vector_ns=.." (ns per
+ * bridge-step, best of R rounds of S steps; 0 for a version not run).
+ */
+#include <math.h>
+#include <stdbool.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#define FILM 40e-6     /* delta of a pair [m]: 2 x 20 um */
+#define H_MIN 1e-6     /* h_min' [m] */
+#define VISCOSITY 0.01 /* [Pa s] */
+#define TENSION 0.02   /* [N/m] */
+#define MAX_ATOMS 10000000
+
+struct sphere { /* one 32-byte record, as wetdem's position records */
+    double x, y, z, r;
+};
+struct motion { /* velocity and spin, as wetdem's */
+    double vx, vy, vz, wx, wy, wz;
+};
+struct state {
+    size_t n;
+    struct sphere* s;
+    struct motion* v;
+};
+struct bridges {
+    size_t n;
+    uint32_t *i, *j; /* i < j, in (i, j) order */
+};
+
+static double now(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+static void fail(const char* what, const char* path)
+{
+    fprintf(stderr, "bridge_floor: %s%s%s\n", what, path ? ": " : "", path ? path : "");
+    exit(1);
+}
+
+/* The atoms and velocities of a data file written by many_bench (ids 1..n). */
+static struct state read_state(const char* path)
+{
+    FILE* f = fopen(path, "r");
+    if (!f)
+        fail("cannot read", path);
+    char line[512];
+    size_t n = 0, seen = 0;
+    int section = 0; /* 1 atoms, 2 velocities */
+    struct state st = {0};
+    while (fgets(line, sizeof line, f)) {
+        size_t id;
+        double a[6];
+        if (sscanf(line, "%zu atoms", &id) == 1 && !st.s) {
+            if (id < 1 || id > MAX_ATOMS)
+                fail("atom count out of range", path);
+            n = id;
+            st.s = calloc(n, sizeof *st.s);
+            st.v = calloc(n, sizeof *st.v);
+            if (!st.s || !st.v)
+                fail("out of memory", NULL);
+        } else if (!strncmp(line, "Atoms", 5))
+            section = 1;
+        else if (!strncmp(line, "Velocities", 10))
+            section = 2;
+        else if (section == 1 && st.s &&
+                 sscanf(line, "%zu %*d %lf %*f %lf %lf %lf", &id, &a[0], &a[1], &a[2], &a[3]) ==
+                     5 &&
+                 id >= 1 && id <= n) {
+            st.s[id - 1] = (struct sphere){a[1], a[2], a[3], 0.5 * a[0]};
+            seen++;
+        } else if (section == 2 && st.v &&
+                   sscanf(line, "%zu %lf %lf %lf %lf %lf %lf", &id, &a[0], &a[1], &a[2], &a[3],
+                          &a[4], &a[5]) == 7 &&
+                   id >= 1 && id <= n)
+            st.v[id - 1] = (struct motion){a[0], a[1], a[2], a[3], a[4], a[5]};
+    }
+    fclose(f);
+    if (!n || seen != n)
+        fail("not a complete many_bench data file", path);
+    st.n = n;
+    return st;
+}
+
+static double gap_of(const struct state* st, size_t i, size_t j)
+{
+    const struct sphere *a = &st->s[i], *b = &st->s[j];
+    double dx = a->x - b->x, dy = a->y - b->y, dz = a->z - b->z;
+    return sqrt(dx * dx + dy * dy + dz * dz) - a->r - b->r;
+}
+
+/* The pairs apart within the films, (i, j) order, from a cell grid of the largest diameter
+ * plus the film (each pair once: cells compared with those after them). */
+static struct bridges find_bridges(const struct state* st)
+{
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY},
+           r_max = 0;
+    for (size_t k = 0; k < st->n; k++) {
+        double p[3] = {st->s[k].x, st->s[k].y, st->s[k].z};
+        for (int c = 0; c < 3; c++) {
+            lo[c] = p[c] < lo[c] ? p[c] : lo[c];
+            hi[c] = p[c] > hi[c] ? p[c] : hi[c];
+        }
+        r_max = st->s[k].r > r_max ? st->s[k].r : r_max;
+    }
+    double h = 2 * r_max + FILM;
+    size_t dim[3], cells = 1;
+    for (int c = 0; c < 3; c++) {
+        dim[c] = (size_t)((hi[c] - lo[c]) / h) + 1;
+        cells *= dim[c];
+    }
+    size_t *start = calloc(cells + 1, sizeof *start), *item = malloc(st->n * sizeof *item),
+           *cell = malloc(st->n * sizeof *cell);
+    if (!start || !item || !cell)
+        fail("out of memory", NULL);
+    for (size_t k = 0; k < st->n; k++) {
+        size_t c[3];
+        double p[3] = {st->s[k].x, st->s[k].y, st->s[k].z};
+        for (int a = 0; a < 3; a++) {
+            c[a] = (size_t)((p[a] - lo[a]) / h);
+            c[a] = c[a] < dim[a] ? c[a] : dim[a] - 1;
+        }
+        cell[k] = (c[2] * dim[1] + c[1]) * dim[0] + c[0];
+        start[cell[k] + 1]++;
+    }
+    for (size_t c = 0; c < cells; c++)
+        start[c + 1] += start[c];
+    size_t* fill = malloc(cells * sizeof *fill);
+    if (!fill)
+        fail("out of memory", NULL);
+    memcpy(fill, start, cells * sizeof *fill);
+    for (size_t k = 0; k < st->n; k++)
+        item[fill[cell[k]]++] = k;
+    /* per particle i, its partners j > i, collected then sorted by j */
+    size_t cap = 16 * st->n, count = 0;
+    struct bridges b = {0, malloc(cap * sizeof *b.i), malloc(cap * sizeof *b.j)};
+    uint32_t* mine = malloc(st->n * sizeof *mine);
+    if (!b.i || !b.j || !mine)
+        fail("out of memory", NULL);
+    for (size_t i = 0; i < st->n; i++) {
+        size_t m = 0, c = cell[i];
+        long cx = (long)(c % dim[0]), cy = (long)(c / dim[0] % dim[1]),
+             cz = (long)(c / (dim[0] * dim[1]));
+        for (long dz = -1; dz <= 1; dz++)
+            for (long dy = -1; dy <= 1; dy++)
+                for (long dx = -1; dx <= 1; dx++) {
+                    long x = cx + dx, y = cy + dy, z = cz + dz;
+                    if (x < 0 || y < 0 || z < 0 || x >= (long)dim[0] || y >= (long)dim[1] ||
+                        z >= (long)dim[2])
+                        continue;
+                    size_t d = ((size_t)z * dim[1] + (size_t)y) * dim[0] + (size_t)x;
+                    for (size_t t = start[d]; t < start[d + 1]; t++) {
+                        size_t j = item[t];
+                        double g = j > i ? gap_of(st, i, j) : -1;
+                        if (g >= 0 && g < FILM)
+                            mine[m++] = (uint32_t)j;
+                    }
+                }
+        for (size_t a = 1; a < m; a++) /* (few partners: insertion sort) */
+            for (size_t z = a; z > 0 && mine[z - 1] > mine[z]; z--) {
+                uint32_t t = mine[z];
+                mine[z] = mine[z - 1];
+                mine[z - 1] = t;
+            }
+        for (size_t a = 0; a < m; a++) {
+            if (count == cap)
+                fail("more bridges than 16 per particle", NULL);
+            b.i[count] = (uint32_t)i;
+            b.j[count++] = mine[a];
+        }
+    }
+    b.n = count;
+    free(start);
+    free(item);
+    free(cell);
+    free(fill);
+    free(mine);
+    return b;
+}
+
+/* One step, one pair at a time: force[k] gets the bridges' sum (3 doubles per particle). */
+static void step_scalar(const struct state* st, const struct bridges* b, double (*force)[3])
+{
+    const double sb = 6.0 * M_PI * VISCOSITY, cap = 8.0 * M_PI;
+    for (size_t q = 0; q < b->n; q++) {
+        size_t i = b->i[q], j = b->j[q];
+        const struct sphere *a = &st->s[i], *c = &st->s[j];
+        const struct motion *va = &st->v[i], *vc = &st->v[j];
+        double dx = a->x - c->x, dy = a->y - c->y, dz = a->z - c->z;
+        double dist = sqrt(dx * dx + dy * dy + dz * dz), inv = 1.0 / dist;
+        double nx = dx * inv, ny = dy * inv, nz = dz * inv;
+        double gap = dist - a->r - c->r, r_eff = a->r * c->r / (a->r + c->r);
+        double v_n = -((va->vx - vc->vx) * nx + (va->vy - vc->vy) * ny + (va->vz - vc->vz) * nz);
+        double bracket = 1.0 - gap / FILM;
+        double f_sb = gap >= H_MIN ? sb * r_eff * r_eff * v_n / gap * bracket * bracket : 0.0;
+        double f_n = f_sb + -(cap * r_eff * TENSION);
+        double fx = f_n * nx, fy = f_n * ny, fz = f_n * nz;
+        force[i][0] += fx;
+        force[i][1] += fy;
+        force[i][2] += fz;
+        force[j][0] -= fx;
+        force[j][1] -= fy;
+        force[j][2] -= fz;
+    }
+}
+
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+#define FLOOR_VECTOR 1
+#include <immintrin.h>
+typedef double v4d __attribute__((vector_size(32)));
+typedef long long v4i __attribute__((vector_size(32)));
+
+/* The first four doubles at p0..p3 as columns: c[k] lane l = p_l[k] (two unpacks and two
+ * lane permutes per pair of columns, as wetdem's kernel reads its records). */
+__attribute__((target("avx2"))) static inline void
+columns(const double* p0, const double* p1, const double* p2, const double* p3, v4d c[4])
+{
+    __m256d a0 = _mm256_loadu_pd(p0), a1 = _mm256_loadu_pd(p1), a2 = _mm256_loadu_pd(p2),
+            a3 = _mm256_loadu_pd(p3);
+    __m256d t0 = _mm256_unpacklo_pd(a0, a1), t1 = _mm256_unpackhi_pd(a0, a1);
+    __m256d t2 = _mm256_unpacklo_pd(a2, a3), t3 = _mm256_unpackhi_pd(a2, a3);
+    c[0] = (v4d)_mm256_permute2f128_pd(t0, t2, 0x20);
+    c[1] = (v4d)_mm256_permute2f128_pd(t1, t3, 0x20);
+    c[2] = (v4d)_mm256_permute2f128_pd(t0, t2, 0x31);
+    c[3] = (v4d)_mm256_permute2f128_pd(t1, t3, 0x31);
+}
+
+/* The same, four pairs at a time (the pairs past the last multiple of four one at a time). */
+__attribute__((target("avx2"))) static void step_vector(const struct state* st,
+                                                        const struct bridges* b, double (*force)[3])
+{
+    const v4d sb = {6.0 * M_PI * VISCOSITY, 6.0 * M_PI * VISCOSITY, 6.0 * M_PI * VISCOSITY,
+                    6.0 * M_PI * VISCOSITY},
+              cap = {8.0 * M_PI, 8.0 * M_PI, 8.0 * M_PI, 8.0 * M_PI},
+              tension = {TENSION, TENSION, TENSION, TENSION}, film = {FILM, FILM, FILM, FILM},
+              h_min = {H_MIN, H_MIN, H_MIN, H_MIN}, one = {1, 1, 1, 1}, zero = {0, 0, 0, 0};
+    size_t q = 0;
+    for (; q + 4 <= b->n; q += 4) {
+        const uint32_t *I = b->i + q, *J = b->j + q;
+        v4d p[2][4], v[2][4];
+        for (int s = 0; s < 2; s++) { /* s = 0: the first particles, 1: the second */
+            const uint32_t* K = s ? J : I;
+            columns(&st->s[K[0]].x, &st->s[K[1]].x, &st->s[K[2]].x, &st->s[K[3]].x, p[s]);
+            columns(&st->v[K[0]].vx, &st->v[K[1]].vx, &st->v[K[2]].vx, &st->v[K[3]].vx, v[s]);
+        }
+        v4d dx = p[0][0] - p[1][0], dy = p[0][1] - p[1][1], dz = p[0][2] - p[1][2];
+        v4d dist = dx * dx + dy * dy + dz * dz;
+        dist = (v4d)_mm256_sqrt_pd((__m256d)dist);
+        v4d inv = one / dist, nx = dx * inv, ny = dy * inv, nz = dz * inv;
+        v4d gap = dist - p[0][3] - p[1][3], r_eff = p[0][3] * p[1][3] / (p[0][3] + p[1][3]);
+        v4d v_n = -((v[0][0] - v[1][0]) * nx + (v[0][1] - v[1][1]) * ny + (v[0][2] - v[1][2]) * nz);
+        v4d bracket = one - gap / film;
+        v4d f_sb = sb * r_eff * r_eff * v_n / gap * bracket * bracket;
+        v4i acts = gap >= h_min;
+        f_sb = (v4d)(((v4i)f_sb & acts) | ((v4i)zero & ~acts));
+        v4d f_n = f_sb + -(cap * r_eff * tension);
+        double f[3][4] __attribute__((aligned(32))); /* (stored, then read lane by lane) */
+        *(v4d*)f[0] = f_n * nx;
+        *(v4d*)f[1] = f_n * ny;
+        *(v4d*)f[2] = f_n * nz;
+#pragma GCC unroll 4
+        for (int l = 0; l < 4; l++) {
+            double *a = force[I[l]], *c = force[J[l]];
+            a[0] += f[0][l];
+            a[1] += f[1][l];
+            a[2] += f[2][l];
+            c[0] -= f[0][l];
+            c[1] -= f[1][l];
+            c[2] -= f[2][l];
+        }
+    }
+    struct bridges rest = {b->n - q, b->i + q, b->j + q};
+    step_scalar(st, &rest, force);
+}
+#endif
+
+/* Best ns per bridge-step of `rounds` rounds of `steps` steps of one version; the sums of its
+ * last round into force. */
+static double timed(void (*step)(const struct state*, const struct bridges*, double (*)[3]),
+                    const struct state* st, const struct bridges* b, int steps, int rounds,
+                    double (*force)[3])
+{
+    double best = INFINITY;
+    for (int r = 0; r < rounds; r++) {
+        memset(force, 0, st->n * sizeof *force);
+        double t0 = now();
+        for (int s = 0; s < steps; s++)
+            step(st, b, force);
+        double t = now() - t0;
+        best = t < best ? t : best;
+    }
+    return b->n && steps ? 1e9 * best / ((double)steps * (double)b->n) : 0.0;
+}
+
+int main(int argc, char** argv)
+{
+    const char *path = NULL, *kernel = "both";
+    int steps = 300, rounds = 5;
+    for (int k = 1; k < argc; k++) {
+        if (!strcmp(argv[k], "--state-in") && k + 1 < argc)
+            path = argv[++k];
+        else if (!strcmp(argv[k], "--steps") && k + 1 < argc)
+            steps = atoi(argv[++k]);
+        else if (!strcmp(argv[k], "--repeat") && k + 1 < argc)
+            rounds = atoi(argv[++k]);
+        else if (!strcmp(argv[k], "--kernel") && k + 1 < argc)
+            kernel = argv[++k];
+        else {
+            fprintf(stderr, "usage: bridge_floor --state-in FILE [--steps S] [--repeat R] "
+                            "[--kernel scalar|vector|both]\n");
+            return 2;
+        }
+    }
+    bool scalar = strcmp(kernel, "vector") != 0, vector = strcmp(kernel, "scalar") != 0;
+    if (!path || steps < 0 || rounds < 1 || (!scalar && !vector && strcmp(kernel, "both"))) {
+        fprintf(stderr, "bridge_floor: --state-in FILE is needed; --steps >= 0, --repeat >= 1, "
+                        "--kernel scalar, vector or both\n");
+        return 2;
+    }
+    struct state st = read_state(path);
+    struct bridges b = find_bridges(&st);
+    double(*f_scalar)[3] = calloc(st.n, sizeof *f_scalar),
+    (*f_vector)[3] = calloc(st.n, sizeof *f_vector);
+    if (!f_scalar || !f_vector)
+        fail("out of memory", NULL);
+    double ns_scalar = scalar ? timed(step_scalar, &st, &b, steps, rounds, f_scalar) : 0.0;
+    double ns_vector = 0.0;
+#ifdef FLOOR_VECTOR
+    if (vector && __builtin_cpu_supports("avx2")) {
+        ns_vector = timed(step_vector, &st, &b, steps, rounds, f_vector);
+        if (scalar && memcmp(f_scalar, f_vector, st.n * sizeof *f_scalar))
+            fail("the two versions' sums differ", NULL);
+    }
+#endif
+    printf("floor n=%zu bridges_apart=%zu steps=%d scalar_ns=%.2f vector_ns=%.2f\n", st.n, b.n,
+           steps, ns_scalar, ns_vector);
+    free(f_scalar);
+    free(f_vector);
+    free(b.i);
+    free(b.j);
+    free(st.s);
+    free(st.v);
+    return 0;
+}
