@@ -34,6 +34,7 @@
 #include <string.h>
 #include <time.h>
 
+/* the wet variant of bench/many_bench.c (change them together) */
 #define FILM 40e-6     /* delta of a pair [m]: 2 x 20 um */
 #define H_MIN 1e-6     /* h_min' [m] */
 #define VISCOSITY 0.01 /* [Pa s] */

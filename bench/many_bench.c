@@ -6,7 +6,8 @@
  * nu = 0.3, e = 0.5, mu = 0.5) on a 20 x 20 x (n/400) lattice of spacing 2.05 mm with Gaussian
  * velocities (sigma 0.1 m/s, seed 1), settling in a closed box under gravity.
  *   dry: hertz + mindlin;  wet: hertz + mindlin + sb (thin-film viscous, 20 um films,
- *   mu_f = 0.01 Pa s) + capillary (sigma = 0.02 N/m).
+ *   mu_f = 0.01 Pa s) + capillary (sigma = 0.02 N/m). bench/bridge_floor.c, the floor of the
+ *   wet cost, repeats these film, viscosity and tension values: change them together.
  * dt = 1e-5 s (as the LIGGGHTS decks; --dt changes it, e.g. 1e-9 s for the frozen-configuration
  * protocol of bench/20-many.sh). The first `settle` steps are not timed.
  *

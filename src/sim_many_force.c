@@ -820,10 +820,11 @@ static void leave_range(const struct pass* P, size_t q)
     P->flags[q] = 0;
 }
 
-/* Candidate q's four-at-a-time result of class cls > 1 (its flags; many.h): the flags
- * stored and, apart, Mindlin's spring reset from the flags before (reset_spring_apart; in
- * solid contact the vector kernel stored the spring). What near_candidate does with the pair's
- * state; its force and torques are the result's (bulk_pair_out; apart, no torques). */
+/* Candidate q's four-at-a-time result of class cls > 1 (its flags; many.h): the flags stored
+ * where they change and, apart, Mindlin's spring reset from the flags before
+ * (reset_spring_apart; in solid contact the vector kernel stored the spring). What
+ * near_candidate does with the pair's state; its force and torques are the result's
+ * (bulk_pair_out; apart, no torques). */
 static inline __attribute__((always_inline)) void bulk_flags(const struct pass* P, size_t q,
                                                              long long cls)
 {
