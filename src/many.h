@@ -283,6 +283,11 @@ struct wetdem_many {
     bool blocks_refined;    /* re-indexed since the list build, with flags from a pass */
     double block_est[WETDEM_MANY_MAX_BLOCKS];  /* estimated work of each block */
     double block_time[WETDEM_MANY_MAX_BLOCKS]; /* its time in the passes since [s] */
+    /* the kick-drift pass's ranges (sim_many.c kick_ranges): thread t updates the particles
+       kick_cut[t] .. kick_cut[t + 1], cut by the speed each range was updated at (smoothed) */
+    size_t kick_cut[WETDEM_MANY_MAX_BLOCKS + 1];
+    double kick_speed[WETDEM_MANY_MAX_BLOCKS]; /* [particles/s]; 0 before a measurement */
+    size_t kick_threads, kick_n;               /* the ranges' count, and the particles */
     double* work;                              /* per particle: scratch of the partition */
     size_t work_cap;
     bool blocks_ready;
@@ -295,6 +300,7 @@ struct wetdem_many {
     bool fused;                   /* every enabled model has a fused kernel */
     bool generic_only;            /* tests: never use the fused kernel */
     uint64_t block_jitter; /* tests: non-zero cuts the force-pass blocks at random (a seed) */
+    uint64_t kick_jitter;  /* tests: non-zero cuts the kick-drift ranges at random (a seed) */
     size_t parallel_min;   /* tests: fewest particles for parallel loops (0: default
                                     WETDEM_MANY_PARALLEL_MIN) */
     bool periodic_any;     /* some axis is periodic */

@@ -599,6 +599,64 @@ static double max_displacement2(const struct wetdem_sim* sim)
     return worst;
 }
 
+/* The ranges of the kick-drift pass on nt threads (1 <= nt <= WETDEM_MANY_MAX_BLOCKS):
+ * contiguous, in proportion to the speed at which each was updated in the passes before
+ * (kick_speeds), so that a thread the machine slows down (a virtual core shared with other
+ * guests, which here ran the same work at half speed for whole runs) does less of the pass;
+ * equal before the first measurement and when the thread count or the particles change; none
+ * below an eighth of an equal share, so that every range keeps being measured. Each
+ * particle's update is its own, so the cuts change no result (tests/test_many_force.c). */
+static void kick_ranges(struct wetdem_many* m, size_t n, size_t nt)
+{
+    if (m->kick_threads != nt || m->kick_n != n) {
+        m->kick_threads = nt;
+        m->kick_n = n;
+        for (size_t t = 0; t < nt; t++)
+            m->kick_speed[t] = 0;
+    }
+    double total = 0;
+    bool measured = true;
+    for (size_t t = 0; t < nt; t++) {
+        total += m->kick_speed[t];
+        measured = measured && m->kick_speed[t] > 0;
+    }
+    size_t least = n / (8 * nt);
+    double sum = 0;
+    m->kick_cut[0] = 0;
+    for (size_t t = 1; t < nt; t++) {
+        sum += measured ? m->kick_speed[t - 1] / total : 1.0 / (double)nt;
+        size_t cut = (size_t)((double)n * sum), lo = m->kick_cut[t - 1] + least,
+               hi = n - (nt - t) * least;
+        cut = cut < lo ? lo : cut;
+        m->kick_cut[t] = cut > hi ? hi : cut;
+    }
+    m->kick_cut[nt] = n;
+    if (m->kick_jitter) { /* tests: arbitrary increasing cuts, new at every pass */
+        uint64_t r = m->kick_jitter = m->kick_jitter * 6364136223846793005u + 1442695040888963407u;
+        for (size_t t = 1; t < nt; t++) {
+            r = r * 6364136223846793005u + 1442695040888963407u;
+            m->kick_cut[t] =
+                m->kick_cut[t - 1] + (size_t)((r >> 33) % (n - m->kick_cut[t - 1] + 1));
+        }
+    }
+}
+
+/* Each range's speed [particles/s] from its time in the pass (seconds), smoothed over the
+ * passes; one measurement moves it by at most a factor of two (a thread descheduled for one
+ * step does not empty its range). */
+static void kick_speeds(struct wetdem_many* m, size_t nt, const double* seconds)
+{
+    for (size_t t = 0; t < nt; t++) {
+        size_t count = m->kick_cut[t + 1] - m->kick_cut[t];
+        if (!count || !(seconds[t] > 0))
+            continue;
+        double speed = (double)count / seconds[t], old = m->kick_speed[t];
+        if (old > 0)
+            speed = 0.75 * old + 0.25 * fmin(fmax(speed, 0.5 * old), 2.0 * old);
+        m->kick_speed[t] = speed;
+    }
+}
+
 /* Half kick and drift of every particle (preceded by the previous step's closing half kick if
  * it was deferred). The rebuild criterion (largest displacement since the last neighbour-list
  * build > skin/2) is decided without reading the positions at the build at every step: the
@@ -632,14 +690,27 @@ static void kick_drift(struct wetdem_sim* sim, double h)
     const struct wetdem_celllist_box* box = &m->cl.box;
     size_t n = sim->n_particles;
     double v2_max = 0; /* max is exact: the same for any thread count */
-#pragma omp parallel for schedule(static) reduction(max : v2_max) if (wetdem_many_parallel(m, n))
-    for (size_t k = 0; k < n; k++) {
-        const struct kick_arrays A = arrays; /* (a copy of the thread's own: in registers) */
-        if (!fixed[k])
-            kick_drift_one(&A, box, k, g, h, periodic, pending, &v2_max);
-        A.force[k] = A.torque[k] = vec3(0, 0, 0);
-        contacts[k] = 0;
+    size_t nt = wetdem_many_parallel(m, n) ? (size_t)omp_get_max_threads() : 1;
+    nt = nt < WETDEM_MANY_MAX_BLOCKS ? nt : WETDEM_MANY_MAX_BLOCKS;
+    kick_ranges(m, n, nt);
+    double seconds[WETDEM_MANY_MAX_BLOCKS];
+#pragma omp parallel num_threads((int)nt) reduction(max : v2_max) if (nt > 1)
+    { /* (range r on thread r; on fewer threads than asked, each takes every got-th range) */
+        size_t got = (size_t)omp_get_num_threads();
+        for (size_t r = (size_t)omp_get_thread_num(); r < nt; r += got) {
+            double t0 = omp_get_wtime();
+            for (size_t k = m->kick_cut[r]; k < m->kick_cut[r + 1]; k++) {
+                const struct kick_arrays A = arrays; /* (the thread's own copy: in registers) */
+                if (!fixed[k])
+                    kick_drift_one(&A, box, k, g, h, periodic, pending, &v2_max);
+                A.force[k] = A.torque[k] = vec3(0, 0, 0);
+                contacts[k] = 0;
+            }
+            seconds[r] = omp_get_wtime() - t0;
+        }
     }
+    if (nt > 1)
+        kick_speeds(m, nt, seconds);
     m->sums_zeroed = sim->n_particles;
     m->records_stale = true;
     m->max_disp_valid = track;

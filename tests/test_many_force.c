@@ -432,10 +432,12 @@ static void test_many_lean_constants_follow_changed_particles(void** state)
     wetdem_sim_free(generic);
 }
 
-/* The force pass's blocks may be cut anywhere (they are balanced by timing, which varies from
- * run to run): the sum order of every particle does not depend on them, so runs with blocks
- * cut at random, re-cut at every list build, equal the run on one thread bit for bit. */
-static void test_many_block_cuts_do_not_change_the_result(void** state)
+/* The force pass's blocks and the kick-drift pass's ranges may be cut anywhere (both are
+ * balanced by timing, which varies from run to run): the sum order of every particle does not
+ * depend on the blocks, and each particle's kick and drift is its own, so runs with blocks cut
+ * at random, re-cut at every list build, and ranges cut at random at every pass equal the run
+ * on one thread bit for bit. */
+static void test_many_block_and_kick_cuts_do_not_change_the_result(void** state)
 {
     (void)state;
     int saved = omp_get_max_threads();
@@ -445,14 +447,43 @@ static void test_many_block_cuts_do_not_change_the_result(void** state)
     for (int threads = 2; threads <= 4; threads++) {
         struct wetdem_sim* cut = wet_gas(false, false);
         cut->many->block_jitter = (uint64_t)threads * 977;
+        cut->many->kick_jitter = (uint64_t)threads * 131;
         omp_set_num_threads(threads);
         CHECK_OK(wetdem_sim_integrate(cut, 0.6e-3));
         assert_true(cut->many->n_blocks == (size_t)threads);
+        assert_true(cut->many->kick_threads == (size_t)threads); /* (the ranges were used) */
         test_check_same_particles(one, cut);
         wetdem_sim_free(cut);
     }
     omp_set_num_threads(saved);
     wetdem_sim_free(one);
+}
+
+/* The kick-drift pass gives each thread a share of the particles in proportion to the speed at
+ * which it updated its range before: with thread 1 measured three times as fast as thread 0,
+ * the next pass cuts at a quarter of the particles; with a thread measured as stopped, no range
+ * falls below an eighth of an equal share. */
+static void test_many_kick_ranges_follow_the_threads_speed(void** state)
+{
+    (void)state;
+    int saved = omp_get_max_threads();
+    omp_set_num_threads(2);
+    struct wetdem_sim* sim = wet_gas(false, false);
+    CHECK_OK(wetdem_sim_integrate(sim, 2e-6)); /* (set-up and a first pass) */
+    struct wetdem_many* m = sim->many;
+    size_t n = sim->n_particles;
+    assert_true(m->kick_threads == 2 && m->kick_n == n);
+    m->kick_speed[0] = 1e6;
+    m->kick_speed[1] = 3e6;
+    CHECK_OK(wetdem_sim_integrate(sim, 4e-6));
+    assert_int_equal(m->kick_cut[1], (size_t)((double)n * 0.25)); /* the speeds' share */
+    m->kick_speed[0] = 1e-30;
+    m->kick_speed[1] = 1e6;
+    CHECK_OK(wetdem_sim_integrate(sim, 6e-6));
+    assert_int_equal(m->kick_cut[1], n / 16); /* the least range */
+    assert_int_equal(m->kick_cut[2], n);
+    wetdem_sim_free(sim);
+    omp_set_num_threads(saved);
 }
 
 /* Runs a and b are bit-identical: particles, and every candidate pair's flags (contact,
@@ -721,7 +752,8 @@ int main(void)
         cmocka_unit_test(test_many_lean_run_any_model_order),
         cmocka_unit_test(test_many_lean_springs_across_rebuilds),
         cmocka_unit_test(test_many_lean_constants_follow_changed_particles),
-        cmocka_unit_test(test_many_block_cuts_do_not_change_the_result),
+        cmocka_unit_test(test_many_block_and_kick_cuts_do_not_change_the_result),
+        cmocka_unit_test(test_many_kick_ranges_follow_the_threads_speed),
         cmocka_unit_test(test_many_skipped_candidates_change_no_result),
         cmocka_unit_test(test_many_four_at_a_time_change_no_result),
     };
