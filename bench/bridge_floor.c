@@ -121,79 +121,92 @@ static double gap_of(const struct state* st, size_t i, size_t j)
     return sqrt(dx * dx + dy * dy + dz * dz) - a->r - b->r;
 }
 
-/* The pairs apart within the films, (i, j) order, from a cell grid of the largest diameter
- * plus the film (each pair once: cells compared with those after them). */
+/* The cell grid of find_bridges: particles item[start[c] .. start[c + 1]) in cell c of
+ * dim[0] x dim[1] x dim[2] cells of side h from lo. */
+struct grid {
+    double lo[3], h;
+    size_t dim[3];
+    size_t *start, *item, *cell; /* cell: each particle's */
+};
+
+/* Appends to mine[*m] the partners j > i of particle i apart within the films in cell (x, y, z),
+ * if it is in the grid. */
+static void partners_in_cell(const struct state* st, const struct grid* g, size_t i, long x, long y,
+                             long z, uint32_t* mine, size_t* m)
+{
+    if (x < 0 || y < 0 || z < 0 || x >= (long)g->dim[0] || y >= (long)g->dim[1] ||
+        z >= (long)g->dim[2])
+        return;
+    size_t d = ((size_t)z * g->dim[1] + (size_t)y) * g->dim[0] + (size_t)x;
+    for (size_t t = g->start[d]; t < g->start[d + 1]; t++) {
+        size_t j = g->item[t];
+        if (j <= i)
+            continue;
+        double gap = gap_of(st, i, j);
+        if (gap >= 0 && gap < FILM)
+            mine[(*m)++] = (uint32_t)j;
+    }
+}
+
+static int by_index(const void* a, const void* b)
+{
+    uint32_t x = *(const uint32_t*)a, y = *(const uint32_t*)b;
+    return (x > y) - (x < y);
+}
+
+/* The pairs apart within the films, (i, j) order: for each particle i, the partners j > i in
+ * its cell and the 26 around it (cells of the largest diameter plus the film), sorted. */
 static struct bridges find_bridges(const struct state* st)
 {
-    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY},
-           r_max = 0;
+    struct grid g = {.lo = {INFINITY, INFINITY, INFINITY}};
+    double hi[3] = {-INFINITY, -INFINITY, -INFINITY}, r_max = 0;
     for (size_t k = 0; k < st->n; k++) {
         double p[3] = {st->s[k].x, st->s[k].y, st->s[k].z};
         for (int c = 0; c < 3; c++) {
-            lo[c] = p[c] < lo[c] ? p[c] : lo[c];
+            g.lo[c] = p[c] < g.lo[c] ? p[c] : g.lo[c];
             hi[c] = p[c] > hi[c] ? p[c] : hi[c];
         }
         r_max = st->s[k].r > r_max ? st->s[k].r : r_max;
     }
-    double h = 2 * r_max + FILM;
-    size_t dim[3], cells = 1;
+    g.h = 2 * r_max + FILM;
+    size_t cells = 1;
     for (int c = 0; c < 3; c++) {
-        dim[c] = (size_t)((hi[c] - lo[c]) / h) + 1;
-        cells *= dim[c];
+        g.dim[c] = (size_t)((hi[c] - g.lo[c]) / g.h) + 1;
+        cells *= g.dim[c];
     }
-    size_t *start = calloc(cells + 1, sizeof *start), *item = malloc(st->n * sizeof *item),
-           *cell = malloc(st->n * sizeof *cell);
-    if (!start || !item || !cell)
+    g.start = calloc(cells + 1, sizeof *g.start);
+    g.item = malloc(st->n * sizeof *g.item);
+    g.cell = malloc(st->n * sizeof *g.cell);
+    size_t* fill = malloc(cells * sizeof *fill);
+    if (!g.start || !g.item || !g.cell || !fill)
         fail("out of memory", NULL);
-    for (size_t k = 0; k < st->n; k++) {
-        size_t c[3];
+    for (size_t k = 0; k < st->n; k++) { /* counting sort of the particles into cells */
         double p[3] = {st->s[k].x, st->s[k].y, st->s[k].z};
+        size_t c[3];
         for (int a = 0; a < 3; a++) {
-            c[a] = (size_t)((p[a] - lo[a]) / h);
-            c[a] = c[a] < dim[a] ? c[a] : dim[a] - 1;
+            c[a] = (size_t)((p[a] - g.lo[a]) / g.h);
+            c[a] = c[a] < g.dim[a] ? c[a] : g.dim[a] - 1;
         }
-        cell[k] = (c[2] * dim[1] + c[1]) * dim[0] + c[0];
-        start[cell[k] + 1]++;
+        g.cell[k] = (c[2] * g.dim[1] + c[1]) * g.dim[0] + c[0];
+        g.start[g.cell[k] + 1]++;
     }
     for (size_t c = 0; c < cells; c++)
-        start[c + 1] += start[c];
-    size_t* fill = malloc(cells * sizeof *fill);
-    if (!fill)
-        fail("out of memory", NULL);
-    memcpy(fill, start, cells * sizeof *fill);
+        g.start[c + 1] += g.start[c];
+    memcpy(fill, g.start, cells * sizeof *fill);
     for (size_t k = 0; k < st->n; k++)
-        item[fill[cell[k]]++] = k;
-    /* per particle i, its partners j > i, collected then sorted by j */
+        g.item[fill[g.cell[k]]++] = k;
     size_t cap = 16 * st->n, count = 0;
     struct bridges b = {0, malloc(cap * sizeof *b.i), malloc(cap * sizeof *b.j)};
     uint32_t* mine = malloc(st->n * sizeof *mine);
     if (!b.i || !b.j || !mine)
         fail("out of memory", NULL);
     for (size_t i = 0; i < st->n; i++) {
-        size_t m = 0, c = cell[i];
-        long cx = (long)(c % dim[0]), cy = (long)(c / dim[0] % dim[1]),
-             cz = (long)(c / (dim[0] * dim[1]));
-        for (long dz = -1; dz <= 1; dz++)
-            for (long dy = -1; dy <= 1; dy++)
-                for (long dx = -1; dx <= 1; dx++) {
-                    long x = cx + dx, y = cy + dy, z = cz + dz;
-                    if (x < 0 || y < 0 || z < 0 || x >= (long)dim[0] || y >= (long)dim[1] ||
-                        z >= (long)dim[2])
-                        continue;
-                    size_t d = ((size_t)z * dim[1] + (size_t)y) * dim[0] + (size_t)x;
-                    for (size_t t = start[d]; t < start[d + 1]; t++) {
-                        size_t j = item[t];
-                        double g = j > i ? gap_of(st, i, j) : -1;
-                        if (g >= 0 && g < FILM)
-                            mine[m++] = (uint32_t)j;
-                    }
-                }
-        for (size_t a = 1; a < m; a++) /* (few partners: insertion sort) */
-            for (size_t z = a; z > 0 && mine[z - 1] > mine[z]; z--) {
-                uint32_t t = mine[z];
-                mine[z] = mine[z - 1];
-                mine[z - 1] = t;
-            }
+        size_t m = 0, c = g.cell[i];
+        long x = (long)(c % g.dim[0]), y = (long)(c / g.dim[0] % g.dim[1]),
+             z = (long)(c / (g.dim[0] * g.dim[1]));
+        for (int a = 0; a < 27; a++)
+            partners_in_cell(st, &g, i, x + a % 3 - 1, y + a / 3 % 3 - 1, z + a / 9 - 1, mine, &m);
+        qsort(mine, m, sizeof *mine, by_index);
         for (size_t a = 0; a < m; a++) {
             if (count == cap)
                 fail("more bridges than 16 per particle", NULL);
@@ -202,9 +215,9 @@ static struct bridges find_bridges(const struct state* st)
         }
     }
     b.n = count;
-    free(start);
-    free(item);
-    free(cell);
+    free(g.start);
+    free(g.item);
+    free(g.cell);
     free(fill);
     free(mine);
     return b;
