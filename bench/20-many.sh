@@ -28,10 +28,15 @@
 # both codes on the shared state (same-state and frozen protocols, callgrind, one thread), and
 # the floor's instructions per bridge apart.
 #
+# Then PAIRS pairs of a one-thread and a two-thread run back to back per protocol and variant
+# (LIGGGHTS: the frozen protocol), each pair's speed-up and their median: a measure of the
+# two-thread speed-up that a host whose speed drifts between runs spoils less than the best of
+# runs taken minutes apart.
+#
 # Usage: bench/20-many.sh [WETDEM_CLI]    (make bench passes the CLI; it is not needed here)
 # Environment: N (20000), SETTLE (500), STEPS (1500), STATE (3000), SAME_STEPS (300),
-# FROZEN_STEPS (300), FROZEN_DT (1e-9), REPEAT (3), INSTR_STEPS (100; 0 skips the instruction
-# counts) — about 10-20 minutes on 2 cores;
+# FROZEN_STEPS (300), FROZEN_DT (1e-9), REPEAT (3), PAIRS (5; 0 skips the pairs), INSTR_STEPS
+# (100; 0 skips the instruction counts) — about 12-22 minutes on 2 cores;
 # OMP_WAIT_POLICY and GOMP_SPINCOUNT (default: GOMP_SPINCOUNT=20000, a waiting thread spins
 # briefly, about a step's time, then sleeps; fully active threads collapse when the host takes
 # a core, fully passive ones pay a wake-up at every parallel region, 5-8 % on 2 threads here).
@@ -163,6 +168,48 @@ for variant in dry wet; do
       --state-in "$out/state.data" --settle 0 --steps "$FROZEN_STEPS"
   done
 done
+# ---- paired two-thread speed-ups ----
+# PAIRS pairs of runs, each pair a one-thread and a two-thread run back to back (every other
+# pair in the other order, so that a drift of the host's speed favours neither side): each
+# pair's speed-up, and their median, least and largest. The best-of-REPEAT speed-ups above
+# compare the best one-thread run with the best two-thread run, taken minutes apart; on a host
+# whose speed moves by up to 2x between consecutive runs (and whose one-thread runs are at
+# times much faster than their neighbours) the two runs of a pair see about the same load.
+# wetdem in every protocol, LIGGGHTS (1 and 2 ranks) in the frozen one.
+# Arguments: protocol variant code data nsettle nsteps dt [many_bench args] -> "pair ..." line
+paired() {
+  local proto=$1 variant=$2 code=$3 data=$4 nsettle=$5 nsteps=$6 dt=$7 k t one two
+  shift 7
+  local ratios=()
+  for k in $(seq "$PAIRS"); do
+    one=0 two=0
+    for t in $( ((k % 2)) && echo 1 2 || echo 2 1); do
+      local rate
+      if [ "$code" = wetdem ]; then
+        rate=$(run_wd "$proto" "$variant" "$t" "$nsteps" --dt "$dt" "$@" | awk '{print $1}')
+      else
+        rate=$(run_lg "$variant" "$t" "$data" "$nsettle" "$nsteps" "$dt" | awk '{print $1}')
+      fi
+      if [ "$t" = 1 ]; then one=$rate; else two=$rate; fi
+    done
+    ratios+=("$(awk -v a="$one" -v b="$two" 'BEGIN{printf "%.3f", (a > 0 ? b / a : 0)}')")
+  done
+  echo "pair $proto $code $variant ${ratios[*]}" | tee -a "$res" >&2
+}
+PAIRS=${PAIRS:-5}
+if [ "$PAIRS" -gt 0 ]; then
+  for variant in dry wet; do
+    paired full "$variant" wetdem "$out/system.data" "$SETTLE" "$STEPS" 1e-5 \
+      --n "$N" --settle "$SETTLE" --steps "$STEPS"
+    paired same "$variant" wetdem "$out/state.data" 0 "$SAME_STEPS" 1e-5 \
+      --state-in "$out/state.data" --settle 0 --steps "$SAME_STEPS"
+    paired frozen "$variant" wetdem "$out/state.data" 0 "$FROZEN_STEPS" "$FROZEN_DT" \
+      --state-in "$out/state.data" --settle 0 --steps "$FROZEN_STEPS"
+    $have_lg && paired frozen "$variant" liggghts "$out/state.data" 0 "$FROZEN_STEPS" \
+      "$FROZEN_DT"
+  done
+fi
+
 # the floor: the bare loop over the bridges apart of the same state (bench/bridge_floor.c),
 # best of REPEAT rounds of FROZEN_STEPS steps -> "floor bridges_apart scalar_ns vector_ns"
 "$out/bridge_floor" --state-in "$out/state.data" --steps "$FROZEN_STEPS" --repeat "$REPEAT" |
@@ -223,6 +270,14 @@ awk -v n="$N" -v wb="$base_kb" -v lb="$lg_base" -v steps="$STEPS" -v same="$SAME
     -v fsteps="$FROZEN_STEPS" -v fdt="$FROZEN_DT" -v isteps="$INSTR_STEPS" '
   /^(full|same|frozen) / { k = $1 " " $2 " " $3 " " $4; rate[k] = $5; kb[k] = $6; cpu[k] = $7
                     con[k] = $8; bri[k] = $9; kick[k] = $10; frc[k] = $11 }
+  /^pair / { k = $2 " " $3 " " $4; m = 0; delete pv
+              for (f = 5; f <= NF; f++) pv[++m] = $f
+              for (a = 2; a <= m; a++) for (b = a; b > 1 && pv[b - 1] > pv[b]; b--) {
+                x = pv[b]; pv[b] = pv[b - 1]; pv[b - 1] = x }
+              pmed[k] = m % 2 ? pv[(m + 1) / 2] : (pv[m / 2] + pv[m / 2 + 1]) / 2
+              plo[k] = pv[1]; phi[k] = pv[m]; pn[k] = m; pok[k] = 0
+              for (a = 1; a <= m; a++) pok[k] += pv[a] >= 1.8
+              next }
   /^instr floor / { floor_ins = $3; next }
   /^instr / { ins[$2 " " $3 " " $4] = $5 }
   /^floor / { floor_nb = $2; floor_ns = ($4 > 0 && $4 < $3) ? $4 : $3; floor_one = $3 }
@@ -254,7 +309,15 @@ awk -v n="$N" -v wb="$base_kb" -v lb="$lg_base" -v steps="$STEPS" -v same="$SAME
         printf "  %s: wetdem 2-thread speed-up       %.2fx (target >= 1.8)", kind,
                r(rate[w " 2"], rate[w " 1"])
         if (rate[l " 2"] > 0) printf "; LIGGGHTS 2 ranks %.2fx", r(rate[l " 2"], rate[l " 1"])
-        printf "\n"
+        printf " (best of each)\n"
+        for (c = 1; c <= 2; c++) {
+          pk = proto " " (c == 1 ? "wetdem" : "liggghts") " " kind
+          if (pk in pmed)
+            printf "  %s: %s speed-up, %d pairs back to back: median %.2fx" \
+                   " (%.2f-%.2f; %d of %d at >= 1.8)\n", kind,
+                   c == 1 ? "wetdem 2-thread" : "LIGGGHTS 2-rank", pn[pk], pmed[pk], plo[pk],
+                   phi[pk], pok[pk], pn[pk]
+        }
       }
       w = proto " wetdem "; l = proto " liggghts "
       printf "  cost wet / dry (1 thread): wetdem %.2fx wall, %.2fx CPU", r(rate[w "dry 1"],
