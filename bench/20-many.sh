@@ -28,10 +28,10 @@
 # both codes on the shared state (same-state and frozen protocols, callgrind, one thread), and
 # the floor's instructions per bridge apart.
 #
-# Then PAIRS pairs of a one-thread and a two-thread run back to back per protocol and variant
-# (LIGGGHTS: the frozen protocol), each pair's speed-up and their median: a measure of the
-# two-thread speed-up that a host whose speed drifts between runs spoils less than the best of
-# runs taken minutes apart.
+# After the three protocols (before the floor), PAIRS pairs of a one-thread and a two-thread
+# run back to back per protocol and variant (LIGGGHTS: the frozen protocol), each pair's
+# speed-up and their median: a measure of the two-thread speed-up that a host whose speed
+# drifts between runs spoils less than the best of runs taken minutes apart.
 #
 # Usage: bench/20-many.sh [WETDEM_CLI]    (make bench passes the CLI; it is not needed here)
 # Environment: N (20000), SETTLE (500), STEPS (1500), STATE (3000), SAME_STEPS (300),
