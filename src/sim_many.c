@@ -7,9 +7,11 @@
  *     v' = v + a(t) dt/2,  w' = w + alpha(t) dt/2,  x(t + dt) = x + v' dt
  *     F, T at x(t + dt) with the predicted velocities v* = v' + a(t) dt/2 (and w*)
  *     v(t + dt) = v' + a(t + dt) dt/2,  w(t + dt) = w' + alpha(t + dt) dt/2
- * with a = F/m + g, alpha = T/I, I = (2/5) m R^2. Steps are whole: a run to t_end takes
- * ceil((t_end - t)/dt) steps, so runs split into pieces (checkpoint and restart) follow the
- * same time grid t0 + k dt as one run and give bit-identical states.
+ * with a = F/m + g, alpha = T/I, I = (2/5) m R^2. Between steps whose state nothing reads, the
+ * force pass applies the last line and the next step's first one to each block of particles
+ * once their forces are complete (one_step), with the same arithmetic. Steps are whole: a run
+ * to t_end takes ceil((t_end - t)/dt) steps, so runs split into pieces (checkpoint and
+ * restart) follow the same time grid t0 + k dt as one run and give bit-identical states.
  *
  * Pairs: the cell list (celllist.h, Eq. 1 there) lists every pair with gap < reach + skin,
  * where reach is the largest model range of any pair, bounded at start-up from the largest
@@ -552,10 +554,9 @@ struct kick_arrays {
 /* Half kick and drift of particle k; its velocities become the predicted ones v' + a dt/2,
  * and *v2_max the larger of itself and |v'|^2 of the half-step velocity. Every value is formed
  * in a local and stored once. */
-static inline void kick_drift_one(const struct kick_arrays* A,
-                                  const struct wetdem_celllist_box* box, size_t k,
-                                  struct wetdem_vec3 g, double h, bool periodic, bool pending,
-                                  double* v2_max)
+static inline __attribute__((always_inline)) void
+kick_drift_one(const struct kick_arrays* A, const struct wetdem_celllist_box* box, size_t k,
+               struct wetdem_vec3 g, double h, bool periodic, bool pending, double* v2_max)
 {
     double half = 0.5 * h;
     struct wetdem_vec3 a = vec3_axpy(g, A->inv[k][0], A->force[k]);
@@ -577,6 +578,38 @@ static inline void kick_drift_one(const struct kick_arrays* A,
     A->xr[k].z = x.z;
     A->vw[k][0] = vec3_axpy(vh, half, a);
     A->vw[k][1] = vec3_axpy(wh, half, alpha);
+}
+
+/* The arrays of the kick-drift arithmetic. */
+static struct kick_arrays kick_arrays_of(struct wetdem_many* m)
+{
+    return (struct kick_arrays){.force = m->force,
+                                .torque = m->torque,
+                                .vh = m->vh,
+                                .wh = m->wh,
+                                .inv = (const double(*)[2])m->inv,
+                                .xr = m->xr,
+                                .vw = m->vw};
+}
+
+void wetdem_sim_many_drift_range(struct wetdem_sim* sim, size_t lo, size_t hi, double* v2_max)
+{
+    struct wetdem_many* m = sim->many;
+    struct wetdem_vec3 g = gravity(sim);
+    bool periodic = m->cl.box.periodic[0] || m->cl.box.periodic[1] || m->cl.box.periodic[2];
+    const struct kick_arrays arrays = kick_arrays_of(m);
+    const unsigned char* fixed = m->fixed;
+    uint32_t* contacts = m->contacts;
+    const struct wetdem_celllist_box* box = &m->cl.box;
+    double v2 = *v2_max;
+    for (size_t k = lo; k < hi; k++) {
+        const struct kick_arrays A = arrays; /* (in registers, as in kick_drift) */
+        if (!fixed[k])
+            kick_drift_one(&A, box, k, g, m->dt, periodic, true, &v2);
+        A.force[k] = A.torque[k] = vec3(0, 0, 0);
+        contacts[k] = 0;
+    }
+    *v2_max = v2;
 }
 
 /* Largest squared displacement of any particle since the last neighbour-list build [m^2]. */
@@ -657,60 +690,23 @@ static void kick_speeds(struct wetdem_many* m, size_t nt, const double* seconds)
     }
 }
 
-/* Half kick and drift of every particle (preceded by the previous step's closing half kick if
- * it was deferred). The rebuild criterion (largest displacement since the last neighbour-list
- * build > skin/2) is decided without reading the positions at the build at every step: the
- * pass bounds this step's displacement of every particle by h max|v'| plus the round-off of
- * the drift (16 eps max|x|, eps = DBL_EPSILON; the drift x + h v' and the periodic wrap each
- * round by at most eps|x| per component), and adds it to m->disp_bound, an upper bound of
- * the largest displacement since the build. Only when that bound exceeds skin/2 (less a
- * relative 1e-6 for the round-off of the sum) are the displacements measured, and the bound
- * reset to the measured one. Where the measurement is skipped, the true displacement is below
- * skin/2 and the measured one would not have triggered a rebuild either: the lists are
- * rebuilt at the same steps, so the results are those of a measurement at every step. */
-static void kick_drift(struct wetdem_sim* sim, double h)
+/* After the drift of every particle (by the kick-drift pass or inside the force pass), with
+ * v2_max the largest |v'|^2 of the half-step velocities and h the step: the state of the
+ * pass and the rebuild criterion. The criterion (largest displacement since the last
+ * neighbour-list build > skin/2) is decided without reading the positions at the build at
+ * every step: this step's displacement of every particle is bounded by h max|v'| plus the
+ * round-off of the drift (16 eps max|x|, eps = DBL_EPSILON; the drift x + h v' and the
+ * periodic wrap each round by at most eps|x| per component) and added to m->disp_bound, an
+ * upper bound of the largest displacement since the build. Only when that bound exceeds
+ * skin/2 (less a relative 1e-6 for the round-off of the sum) are the displacements measured,
+ * and the bound reset to the measured one. Where the measurement is skipped, the true
+ * displacement is below skin/2 and the measured one would not have triggered a rebuild
+ * either: the lists are rebuilt at the same steps, so the results are those of a measurement
+ * at every step. */
+static void after_drift(struct wetdem_sim* sim, double h, double v2_max)
 {
     struct wetdem_many* m = sim->many;
-    bool pending = m->kick_pending;
-    m->kick_pending = false;
-    struct wetdem_vec3 g = gravity(sim);
     bool track = m->cl.n_builds > 0 && m->cl.n_at_build == sim->n_particles;
-    bool periodic = m->cl.box.periodic[0] || m->cl.box.periodic[1] || m->cl.box.periodic[2];
-    /* the force pass's sums start here, from zero, while the lines are in cache (the force
-       pass then starts only the particles with walls) */
-    const struct kick_arrays arrays = {.force = m->force,
-                                       .torque = m->torque,
-                                       .vh = m->vh,
-                                       .wh = m->wh,
-                                       .inv = (const double(*)[2])m->inv,
-                                       .xr = m->xr,
-                                       .vw = m->vw};
-    const unsigned char* fixed = m->fixed;
-    uint32_t* contacts = m->contacts;
-    const struct wetdem_celllist_box* box = &m->cl.box;
-    size_t n = sim->n_particles;
-    double v2_max = 0; /* max is exact: the same for any thread count */
-    size_t nt = wetdem_many_parallel(m, n) ? (size_t)omp_get_max_threads() : 1;
-    nt = nt < WETDEM_MANY_MAX_BLOCKS ? nt : WETDEM_MANY_MAX_BLOCKS;
-    kick_ranges(m, n, nt);
-    double seconds[WETDEM_MANY_MAX_BLOCKS];
-#pragma omp parallel num_threads((int)nt) reduction(max : v2_max) if (nt > 1)
-    { /* (range r on thread r; on fewer threads than asked, each takes every got-th range) */
-        size_t got = (size_t)omp_get_num_threads();
-        for (size_t r = (size_t)omp_get_thread_num(); r < nt; r += got) {
-            double t0 = omp_get_wtime();
-            for (size_t k = m->kick_cut[r]; k < m->kick_cut[r + 1]; k++) {
-                const struct kick_arrays A = arrays; /* (the thread's own copy: in registers) */
-                if (!fixed[k])
-                    kick_drift_one(&A, box, k, g, h, periodic, pending, &v2_max);
-                A.force[k] = A.torque[k] = vec3(0, 0, 0);
-                contacts[k] = 0;
-            }
-            seconds[r] = omp_get_wtime() - t0;
-        }
-    }
-    if (nt > 1)
-        kick_speeds(m, nt, seconds);
     m->sums_zeroed = sim->n_particles;
     m->records_stale = true;
     m->max_disp_valid = track;
@@ -741,6 +737,47 @@ static void kick_drift(struct wetdem_sim* sim, double h)
     }
 }
 
+/* Half kick and drift of every particle (preceded by the previous step's closing half kick if
+ * it was deferred), then after_drift. */
+static void kick_drift(struct wetdem_sim* sim, double h)
+{
+    struct wetdem_many* m = sim->many;
+    bool pending = m->kick_pending;
+    m->kick_pending = false;
+    struct wetdem_vec3 g = gravity(sim);
+    bool periodic = m->cl.box.periodic[0] || m->cl.box.periodic[1] || m->cl.box.periodic[2];
+    /* the force pass's sums start here, from zero, while the lines are in cache (the force
+       pass then starts only the particles with walls) */
+    const struct kick_arrays arrays = kick_arrays_of(m);
+    const unsigned char* fixed = m->fixed;
+    uint32_t* contacts = m->contacts;
+    const struct wetdem_celllist_box* box = &m->cl.box;
+    size_t n = sim->n_particles;
+    double v2_max = 0; /* max is exact: the same for any thread count */
+    size_t nt = wetdem_many_parallel(m, n) ? (size_t)omp_get_max_threads() : 1;
+    nt = nt < WETDEM_MANY_MAX_BLOCKS ? nt : WETDEM_MANY_MAX_BLOCKS;
+    kick_ranges(m, n, nt);
+    double seconds[WETDEM_MANY_MAX_BLOCKS];
+#pragma omp parallel num_threads((int)nt) reduction(max : v2_max) if (nt > 1)
+    { /* (range r on thread r; on fewer threads than asked, each takes every got-th range) */
+        size_t got = (size_t)omp_get_num_threads();
+        for (size_t r = (size_t)omp_get_thread_num(); r < nt; r += got) {
+            double t0 = omp_get_wtime();
+            for (size_t k = m->kick_cut[r]; k < m->kick_cut[r + 1]; k++) {
+                const struct kick_arrays A = arrays; /* (the thread's own copy: in registers) */
+                if (!fixed[k])
+                    kick_drift_one(&A, box, k, g, h, periodic, pending, &v2_max);
+                A.force[k] = A.torque[k] = vec3(0, 0, 0);
+                contacts[k] = 0;
+            }
+            seconds[r] = omp_get_wtime() - t0;
+        }
+    }
+    if (nt > 1)
+        kick_speeds(m, nt, seconds);
+    after_drift(sim, h, v2_max);
+}
+
 /* The deferred closing half kick of every particle, before anything reads the state. */
 static void finish_kick(struct wetdem_sim* sim)
 {
@@ -768,9 +805,12 @@ static int forces_and_work(struct wetdem_sim* sim, bool kick)
         m->thread_work_cap = need;
     }
     double t0 = wall_seconds(), lists0 = m->seconds_lists; /* (a build may come first) */
+    m->drift_seconds = 0;
     int st = wetdem_sim_many_forces(sim, kick);
     collect_work(m, n_threads);
-    m->seconds_forces += (wall_seconds() - t0) - (m->seconds_lists - lists0);
+    /* (the next step's kicks and drifts, where the pass applied them, count as theirs) */
+    m->seconds_forces += (wall_seconds() - t0) - (m->seconds_lists - lists0) - m->drift_seconds;
+    m->seconds_kick += m->drift_seconds;
     return st;
 }
 
@@ -841,6 +881,8 @@ static int start(struct wetdem_sim* sim)
     return timed_outputs(sim, false, false);
 }
 
+static int one_step(struct wetdem_sim* sim, bool defer);
+
 /* Stop flag, progress callback. Returns WETDEM_EVENT to stop (checkpoint written). */
 static int poll_stop(struct wetdem_sim* sim, unsigned long long done, unsigned long long total,
                      double t_start)
@@ -852,6 +894,11 @@ static int poll_stop(struct wetdem_sim* sim, unsigned long long done, unsigned l
         stop = m->set.progress(done, total, wall_seconds() - t_start, m->set.progress_ctx) != 0;
     if (!stop)
         return WETDEM_OK;
+    if (m->drifted) { /* raised during a pass that began the next step: that step finished */
+        int st = one_step(sim, false);
+        if (st != WETDEM_OK)
+            return st;
+    }
     finish_kick(sim); /* a stop flag raised during a deferred step */
     sync_records(sim);
     if (m->checkpoint_path) {
@@ -879,22 +926,46 @@ static bool state_read_after(const struct wetdem_sim* sim, uint64_t step, unsign
            (m->checkpoint_path && s->checkpoint_every && step >= m->next_checkpoint_step);
 }
 
-/* One step. When nothing reads the state before the next step (`defer`), the closing half
- * kick is left to the next step's kick-drift pass, with the same arithmetic: one pass over the
- * particles less per step. */
+/* The largest |v'|^2 of the drift the latest force pass applied (drift_v2 of its blocks; max
+ * is exact, so the same for any blocks). */
+static double drift_v2_max(const struct wetdem_many* m)
+{
+    double v2 = 0;
+    for (size_t b = 0; b < WETDEM_MANY_MAX_BLOCKS; b++)
+        v2 = m->drift_v2[b] > v2 ? m->drift_v2[b] : v2;
+    return v2;
+}
+
+/* One step. When nothing reads the state before the next step (`defer`), the force pass
+ * begins the next step: each block, once the forces on its particles are complete, applies
+ * the closing half kick, the next half kick and the drift to them (many.h drift_in_pass), the
+ * arithmetic of the kick-drift pass, so that the next step starts at its force pass. On two
+ * threads this spares a parallel region and its wait per step, and each thread updates the
+ * particles whose forces it summed. Not when a stop is already asked for, so that a stop
+ * raised before a step ends the run at that step; one raised during the pass ends it after the
+ * next (poll_stop). */
 static int one_step(struct wetdem_sim* sim, bool defer)
 {
     struct wetdem_many* m = sim->many;
     double t0 = wall_seconds();
-    kick_drift(sim, m->dt);
+    if (m->drifted) { /* begun by the previous pass */
+        m->drifted = false;
+        after_drift(sim, m->dt, drift_v2_max(m));
+    } else
+        kick_drift(sim, m->dt);
     m->seconds_kick += wall_seconds() - t0;
     m->step++;
     sim->engine.time = m->t0 + (double)m->step * m->dt; /* no accumulated round-off */
     sim->engine.t_committed = sim->engine.time;
+    m->drift_in_pass = defer && !m->no_drift_in_pass && !(m->set.stop_flag && *m->set.stop_flag);
     int st = forces_and_work(sim, !defer); /* else the closing half kick is in the gather */
+    m->drifted = m->drift_in_pass;
+    m->drift_in_pass = false;
+    if (m->stop_during_step && m->step == m->stop_during_step && m->set.stop_flag)
+        *m->set.stop_flag = 1; /* (tests) */
     if (st != WETDEM_OK)
         return st;
-    m->kick_pending = defer;
+    m->kick_pending = defer && !m->drifted;
     if (!defer) /* the state is read after this step */
         sync_records(sim);
     sim->engine.stats.steps++;

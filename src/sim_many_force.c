@@ -20,7 +20,10 @@
  *      for i in index order: its listed pairs (the exact test h > range decides), each
  *      reaction -F added to j at once; its cross pairs from step 1; the sum S_i of its own
  *      pairs in j order added last (a particle with no pairs adds nothing: +0 would change no
- *      sum); the closing half kick of velocity Verlet (sim_many.c).
+ *      sum); the closing half kick of velocity Verlet (sim_many.c). When nothing reads the
+ *      state before the next step, the block then applies to its particles, whose forces are
+ *      complete, the closing half kick, the next step's half kick and its drift instead
+ *      (sim_many.c one_step, many.h drift_in_pass).
  * So particle k always sums walls, then -F of every pair (i, k) in increasing i, then S_k: an
  * order set by particle indices only, whatever the blocks, so states are bit-identical for any
  * number of threads and, because pairs out of range add nothing, for any time at which the
@@ -2017,7 +2020,17 @@ int wetdem_sim_many_forces(struct wetdem_sim* sim, bool kick)
         }
     }
     m->bulk_passes += P.bulk != NULL;
-    /* one region: cross pairs, a barrier, then each block on its own */
+    /* the next step's kicks and drifts (many.h drift_in_pass; never with the closing kick
+       here, which they include) */
+    bool drift = m->drift_in_pass && !kick;
+    for (size_t b = 0; drift && b < WETDEM_MANY_MAX_BLOCKS; b++)
+        m->drift_v2[b] = 0;
+        /* one region: cross pairs, a barrier, then each block on its own, and with `drift` the
+       kicks and drifts of its particles, whose forces are then complete: the cross pairs were
+       evaluated before the barrier, the block's own pairs and the reactions they give are
+       summed, and no other block reads the block's particles after the barrier (its lanes of
+       cross pairs read their first particle instead). Their time counts as the block's, so
+       the blocks are balanced with them. */
 #pragma omp parallel if (parallel)
     {
         size_t t = (size_t)omp_get_thread_num(), nt = (size_t)omp_get_num_threads();
@@ -2027,9 +2040,16 @@ int wetdem_sim_many_forces(struct wetdem_sim* sim, bool kick)
             double t0 = omp_get_wtime();
             start_sums_of_block(&P, b, &fail);
             pairs_of_block(&P, b, kick, g, &fail);
+            if (drift) {
+                double t1 = omp_get_wtime();
+                wetdem_sim_many_drift_range(sim, m->blk[b], m->blk[b + 1], &m->drift_v2[b]);
+                if (t == 0) /* (the phases' wall time, as the master thread sees it) */
+                    m->drift_seconds += omp_get_wtime() - t1;
+            }
             m->block_time[b] += omp_get_wtime() - t0;
         }
     }
+    m->drift_passes += drift;
     m->blocks_passes++;
     m->sums_zeroed = 0;
     m->skipped_tests += m->pass_skipped;

@@ -303,6 +303,37 @@ static void test_many_stop_flag_writes_a_checkpoint(void** state)
     wetdem_sim_free(sim);
 }
 
+/* A stop raised while a force pass also began the next step (many.h drift_in_pass: the step's
+ * state is read by nothing) ends the run after that next step, with a checkpoint from which
+ * the run goes on bit for bit as if never stopped. */
+static void test_many_stop_during_a_drifting_step_loses_nothing(void** state)
+{
+    (void)state;
+    char path[] = "/tmp/wetdem_test_many_stop_drift_XXXXXX";
+    close(mkstemp(path));
+    remove(path);
+    struct wetdem_sim* whole = wet_box(60, true);
+    CHECK_OK(wetdem_sim_integrate(whole, 200 * 2e-6));
+    struct wetdem_sim* sim = wet_box(60, true);
+    struct wetdem_many_settings s = box_settings();
+    s.checkpoint_path = path;
+    s.stop_flag = &stop_now;
+    CHECK_OK(wetdem_sim_set_many(sim, &s));
+    sim->many->stop_during_step = 37;
+    CHECK_STATUS(wetdem_sim_integrate(sim, 200 * 2e-6), WETDEM_EVENT);
+    stop_now = 0;
+    assert_true(sim->many->drift_passes >= 36);        /* steps 1-37 began their next steps */
+    CHECK_REL(wetdem_sim_time(sim), 38 * 2e-6, 1e-12); /* step 38, under way, was finished */
+    struct wetdem_sim* resumed = wet_box(60, true);
+    CHECK_OK(wetdem_sim_read_checkpoint(resumed, path));
+    CHECK_OK(wetdem_sim_integrate(resumed, 200 * 2e-6));
+    test_check_same_particles(whole, resumed);
+    remove(path);
+    wetdem_sim_free(whole);
+    wetdem_sim_free(sim);
+    wetdem_sim_free(resumed);
+}
+
 /* Work-energy balance. Velocity Verlet changes the kinetic energy through each force by
  * dt F.v(t + dt) per step; the budget uses the predicted velocity, O(dt^2) from it, so the
  * balance error is second order in dt. At dt = 2 us (~1/60 of the Hertz contact time of
@@ -518,6 +549,7 @@ int main(void)
         cmocka_unit_test(test_many_same_result_for_any_thread_count),
         cmocka_unit_test(test_many_restart_is_bit_identical),
         cmocka_unit_test(test_many_stop_flag_writes_a_checkpoint),
+        cmocka_unit_test(test_many_stop_during_a_drifting_step_loses_nothing),
         cmocka_unit_test(test_many_deferred_kick_is_bit_identical),
         cmocka_unit_test(test_many_displacement_bound_rebuilds_at_the_same_steps),
         cmocka_unit_test(test_many_callbacks_see_the_current_state),

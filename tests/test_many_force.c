@@ -660,6 +660,42 @@ static struct wetdem_sim* wet_pile(const char* const* models, int n_models, bool
     return sim;
 }
 
+/* The next step's kicks and drifts applied by the force pass, block by block (many.h
+ * drift_in_pass), are the kick-drift pass's arithmetic on complete forces: runs with them and
+ * runs with the kick-drift pass at every step are bit-identical, on 1 to 3 threads, in several
+ * calls (each ends with a step whose state is read, so without them), with a fixed particle,
+ * in a periodic gas of two materials (the scalar kernel) and in a closed box of one (four pairs
+ * at a time). */
+static void test_many_drift_in_the_force_pass_changes_no_result(void** state)
+{
+    (void)state;
+    static const char* const all[] = {"hertz", "mindlin", "sb", "capillary"};
+    int saved = omp_get_max_threads();
+    for (int fixture = 0; fixture < 2; fixture++)
+        for (int threads = 1; threads <= 3; threads++) {
+            omp_set_num_threads(threads);
+            struct wetdem_sim* sims[2];
+            for (int k = 0; k < 2; k++) {
+                sims[k] = fixture ? wet_pile(all, 4, false, 0, 0) : wet_gas(false, false);
+                wetdem_sim_particles(sims[k], NULL)[3].is_fixed = true;
+                sims[k]->many->no_drift_in_pass = k == 1;
+            }
+            for (int call = 1; call <= 4; call++) {
+                for (int k = 0; k < 2; k++)
+                    CHECK_OK(wetdem_sim_integrate(sims[k], call * 0.15e-3));
+                same_run(sims[0], sims[1]);
+            }
+            uint64_t steps = sims[0]->engine.stats.steps;
+            assert_true(sims[0]->many->drift_passes == steps - 4); /* all but each call's last */
+            assert_int_equal(sims[1]->many->drift_passes, 0);
+            if (fixture)
+                assert_true(sims[0]->many->bulk_passes > 0);
+            for (int k = 0; k < 2; k++)
+                wetdem_sim_free(sims[k]);
+        }
+    omp_set_num_threads(saved);
+}
+
 /* Four pairs at a time (many_bulk.h) in AVX2 where the processor has it and in the baseline
  * instruction set give runs bit-identical to the scalar kernel's, in one loop and in two, with
  * and without mindlin (whose springs are reset apart, and rotated, advanced and capped in
@@ -753,6 +789,7 @@ int main(void)
         cmocka_unit_test(test_many_lean_springs_across_rebuilds),
         cmocka_unit_test(test_many_lean_constants_follow_changed_particles),
         cmocka_unit_test(test_many_block_and_kick_cuts_do_not_change_the_result),
+        cmocka_unit_test(test_many_drift_in_the_force_pass_changes_no_result),
         cmocka_unit_test(test_many_kick_ranges_follow_the_threads_speed),
         cmocka_unit_test(test_many_skipped_candidates_change_no_result),
         cmocka_unit_test(test_many_four_at_a_time_change_no_result),
