@@ -251,31 +251,32 @@ struct wetdem_many {
                                     set when a run (re)starts (sim_many.c prepare) */
     uint32_t* wall_list;  /* particles with a non-zero wall_mask (or all if > 64 walls) */
     size_t n_wall_list, wall_list_cap;
-    bool kick_pending; /* the latest step's closing half kick is still to be applied
+    bool kick_pending;      /* the latest step's closing half kick is still to be applied
                                     (sim_many.c one_step); never true outside a run */
+    size_t sums_zeroed;     /* the kick-drift pass set force, torque and contacts of this many
+                                    particles to zero (0: not); the next force pass then starts
+                                    only the sums of the particles with walls */
+    double disp_bound;      /* upper bound of the largest displacement since the build [m]
+                                    (sim_many.c kick_drift; 0 at a build, INFINITY when a call
+                                    starts) */
+    double x_build_max;     /* the largest |coordinate| at the build [m] */
+    uint64_t disp_measures; /* displacement measurements so far (tests) */
+    double max_disp2;       /* largest squared displacement since the build [m^2], */
+    bool max_disp_valid;    /* measured during the latest drift */
     /* The next step's kick and drift inside the force pass (sim_many.c one_step): when nothing
        reads the state after a step, each block of the pass, once its sums are complete,
        applies to its particles the closing half kick, the next half kick and the drift, as
        the kick-drift pass would (sim_many_force.c). drift_in_pass asks it of a pass; drifted:
-       the latest pass did it, so the next step starts at its force pass; drift_v2[b] the
-       largest |v'|^2 of block b's drift; drift_seconds the master thread's time in them. */
-    bool drift_in_pass, drifted;
+       the latest pass did it, so the next step starts at its force pass (also after a failed
+       pass, whose state is that of the next step begun); drift_v2[b] the largest |v'|^2 of
+       block b's drift; drift_seconds the master thread's time in them; drift_passes the
+       passes that did so (tests). Tests: no_drift_in_pass keeps the kick-drift pass at every
+       step; a non-zero stop_during_step raises the stop flag during that step's force pass,
+       as a signal arriving then would. */
+    bool drift_in_pass, drifted, no_drift_in_pass;
     double drift_v2[WETDEM_MANY_MAX_BLOCKS];
     double drift_seconds;
-    uint64_t drift_passes;     /* passes that did so (tests) */
-    bool no_drift_in_pass;     /* tests: the kick-drift pass at every step */
-    uint64_t stop_during_step; /* tests: non-zero raises the stop flag during that step's force
-                                  pass, as a signal arriving then would */
-    size_t sums_zeroed;        /* the kick-drift pass set force, torque and contacts of this many
-                                    particles to zero (0: not); the next force pass then starts
-                                    only the sums of the particles with walls */
-    double disp_bound;         /* upper bound of the largest displacement since the build [m]
-                                    (sim_many.c kick_drift; 0 at a build, INFINITY when a call
-                                    starts) */
-    double x_build_max;        /* the largest |coordinate| at the build [m] */
-    uint64_t disp_measures;    /* displacement measurements so far (tests) */
-    double max_disp2;          /* largest squared displacement since the build [m^2], */
-    bool max_disp_valid;       /* measured during the latest drift */
+    uint64_t drift_passes, stop_during_step;
     /* blocks of the force pass (sim_many_force.c), one per thread: particles blk[b] ..
        blk[b+1]; the pairs crossing blocks (first particle in an earlier block), in pair order
        (cross_q, with their results cross_out), grouped by the block of the first particle

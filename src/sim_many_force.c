@@ -2023,9 +2023,8 @@ int wetdem_sim_many_forces(struct wetdem_sim* sim, bool kick)
     /* the next step's kicks and drifts (many.h drift_in_pass; never with the closing kick
        here, which they include) */
     bool drift = m->drift_in_pass && !kick;
-    for (size_t b = 0; drift && b < WETDEM_MANY_MAX_BLOCKS; b++)
-        m->drift_v2[b] = 0;
-        /* one region: cross pairs, a barrier, then each block on its own, and with `drift` the
+    memset(m->drift_v2, 0, sizeof m->drift_v2);
+    /* one region: cross pairs, a barrier, then each block on its own, and with `drift` the
        kicks and drifts of its particles, whose forces are then complete: the cross pairs were
        evaluated before the barrier, the block's own pairs and the reactions they give are
        summed, and no other block reads the block's particles after the barrier (its lanes of
