@@ -280,19 +280,27 @@ static void test_many_callbacks_see_the_current_state(void** state)
     wetdem_sim_free(stepped);
 }
 
-static void test_many_stop_flag_writes_a_checkpoint(void** state)
+/* A wet box of 60 spheres that writes its checkpoint to `path` (a fresh name from the
+ * template, no file yet) when stop_now is raised, with `progress` called every 10 steps. */
+static struct wetdem_sim* stoppable_box(char* path, wetdem_progress_fn progress)
 {
-    (void)state;
-    char path[] = "/tmp/wetdem_test_many_stop_XXXXXX";
     close(mkstemp(path));
     remove(path);
     struct wetdem_sim* sim = wet_box(60, true);
     struct wetdem_many_settings s = box_settings();
     s.checkpoint_path = path;
     s.stop_flag = &stop_now;
-    s.progress = stop_after;
+    s.progress = progress;
     s.progress_every = 10;
     CHECK_OK(wetdem_sim_set_many(sim, &s));
+    return sim;
+}
+
+static void test_many_stop_flag_writes_a_checkpoint(void** state)
+{
+    (void)state;
+    char path[] = "/tmp/wetdem_test_many_stop_XXXXXX";
+    struct wetdem_sim* sim = stoppable_box(path, stop_after);
     CHECK_STATUS(wetdem_sim_integrate(sim, 1e-3), WETDEM_EVENT);
     CHECK_CONTAINS(wetdem_sim_errmsg(sim), "checkpoint");
     /* the flag is set inside step 100's progress call and seen at step 101 */
@@ -310,15 +318,9 @@ static void test_many_stop_during_a_drifting_step_loses_nothing(void** state)
 {
     (void)state;
     char path[] = "/tmp/wetdem_test_many_stop_drift_XXXXXX";
-    close(mkstemp(path));
-    remove(path);
     struct wetdem_sim* whole = wet_box(60, true);
     CHECK_OK(wetdem_sim_integrate(whole, 200 * 2e-6));
-    struct wetdem_sim* sim = wet_box(60, true);
-    struct wetdem_many_settings s = box_settings();
-    s.checkpoint_path = path;
-    s.stop_flag = &stop_now;
-    CHECK_OK(wetdem_sim_set_many(sim, &s));
+    struct wetdem_sim* sim = stoppable_box(path, NULL); /* (no progress calls) */
     sim->many->stop_during_step = 37;
     CHECK_STATUS(wetdem_sim_integrate(sim, 200 * 2e-6), WETDEM_EVENT);
     stop_now = 0;
