@@ -263,17 +263,14 @@ struct wetdem_many {
     uint64_t disp_measures; /* displacement measurements so far (tests) */
     double max_disp2;       /* largest squared displacement since the build [m^2], */
     bool max_disp_valid;    /* measured during the latest drift */
-    /* The next step's kick and drift inside the force pass (sim_many.c one_step): when nothing
-       reads the state after a step, each block of the pass, once its sums are complete,
-       applies to its particles the closing half kick, the next half kick and the drift, as
-       the kick-drift pass would (sim_many_force.c). drift_in_pass asks it of a pass; drifted:
-       the latest pass did it, so the next step starts at its force pass (also after a failed
-       pass, whose state is that of the next step begun); drift_v2[b] the largest |v'|^2 of
-       block b's drift; drift_seconds the master thread's time in them; drift_passes the
-       passes that did so (tests). Tests: no_drift_in_pass keeps the kick-drift pass at every
-       step; a non-zero stop_during_step raises the stop flag during that step's force pass,
-       as a signal arriving then would. */
-    bool drift_in_pass, drifted, no_drift_in_pass;
+    /* The next step's kick and drift inside the force pass (WETDEM_MANY_END_STEP, sim_many.c
+       one_step): drifted, the latest pass did them, so the next step starts at its force pass
+       (also after a failed pass, whose state is that of the next step begun); drift_v2[b] the
+       largest |v'|^2 of block b's drift (b < n_blocks); drift_seconds the master thread's time
+       in them; drift_passes the passes that did so (tests). Tests: no_drift_in_pass keeps the
+       kick-drift pass at every step; a non-zero stop_during_step raises the stop flag during
+       that step's force pass, as a signal arriving then would. */
+    bool drifted, no_drift_in_pass;
     double drift_v2[WETDEM_MANY_MAX_BLOCKS];
     double drift_seconds;
     uint64_t drift_passes, stop_during_step;
@@ -380,8 +377,8 @@ static inline void wetdem_many_close_kick(struct wetdem_many* m, size_t k, struc
 /* wetdem_sim_many_free and wetdem_sim_many_integrate: sim.h. */
 /* Closing half kick of the deferred step, half kick and drift of particles lo .. hi - 1, their
  * force, torque and contacts zeroed for the next pass (the kick-drift pass's arithmetic);
- * *v2_max becomes the larger of itself and their largest |v'|^2. */
-void wetdem_sim_many_drift_range(struct wetdem_sim* sim, size_t lo, size_t hi, double* v2_max);
+ * returns their largest |v'|^2. */
+double wetdem_sim_many_drift_range(struct wetdem_sim* sim, size_t lo, size_t hi);
 /* Kinetic (translational + rotational), gravitational potential and Hertz elastic energy at
  * the current state [J]. */
 void wetdem_sim_many_energies(const struct wetdem_sim* sim, double* kinetic, double* potential,
@@ -406,9 +403,16 @@ void wetdem_sim_many_contact(const struct wetdem_sim* sim, size_t i, size_t j, b
 int wetdem_sim_many_eval_fused(const struct wetdem_sim* sim, struct wetdem_contact* c,
                                const struct wetdem_many_mix* x, double* history,
                                struct wetdem_pair_force* out, struct wetdem_pair_force* per_model);
+/* What a force pass does with each particle once its force is complete. */
+enum wetdem_many_end {
+    WETDEM_MANY_END_NONE, /* nothing: the closing half kick is left to the next step */
+    WETDEM_MANY_END_KICK, /* the closing half kick v = v' + a dt/2 */
+    WETDEM_MANY_END_STEP  /* the closing half kick, the next step's half kick and its drift
+                             (wetdem_sim_many_drift_range), block by block */
+};
 /* Forces, torques and contact counts of every particle at the current state, histories
- * committed; with `kick`, also the closing half kick v = v' + a dt/2 of each particle. */
-int wetdem_sim_many_forces(struct wetdem_sim* sim, bool kick);
+ * committed, then `end` for each particle. */
+int wetdem_sim_many_forces(struct wetdem_sim* sim, enum wetdem_many_end end);
 
 /* sim_many_io.c */
 /* Writes the outputs due at the current step (VTK, CSV, periodic checkpoint). */

@@ -580,36 +580,41 @@ kick_drift_one(const struct kick_arrays* A, const struct wetdem_celllist_box* bo
     A->vw[k][1] = vec3_axpy(wh, half, alpha);
 }
 
-/* The arrays of the kick-drift arithmetic. */
-static struct kick_arrays kick_arrays_of(struct wetdem_many* m)
+/* Particles lo .. hi - 1 of the engine's arrays: half kick and drift (kick_drift_one, after
+ * the deferred closing half kick when `pending`) where not fixed, and force, torque and
+ * contact count zeroed for the next force pass while their lines are in cache (that pass then
+ * starts only the sums of the particles with walls); *v2_max as kick_drift_one's. */
+static inline __attribute__((always_inline)) void kick_drift_range(struct wetdem_many* m, size_t lo,
+                                                                   size_t hi, struct wetdem_vec3 g,
+                                                                   bool pending, double* v2_max)
 {
-    return (struct kick_arrays){.force = m->force,
-                                .torque = m->torque,
-                                .vh = m->vh,
-                                .wh = m->wh,
-                                .inv = (const double(*)[2])m->inv,
-                                .xr = m->xr,
-                                .vw = m->vw};
-}
-
-void wetdem_sim_many_drift_range(struct wetdem_sim* sim, size_t lo, size_t hi, double* v2_max)
-{
-    struct wetdem_many* m = sim->many;
-    struct wetdem_vec3 g = gravity(sim);
-    bool periodic = m->cl.box.periodic[0] || m->cl.box.periodic[1] || m->cl.box.periodic[2];
-    const struct kick_arrays arrays = kick_arrays_of(m);
+    const struct kick_arrays arrays = {.force = m->force,
+                                       .torque = m->torque,
+                                       .vh = m->vh,
+                                       .wh = m->wh,
+                                       .inv = (const double(*)[2])m->inv,
+                                       .xr = m->xr,
+                                       .vw = m->vw};
     const unsigned char* fixed = m->fixed;
     uint32_t* contacts = m->contacts;
     const struct wetdem_celllist_box* box = &m->cl.box;
-    double v2 = *v2_max;
+    bool periodic = box->periodic[0] || box->periodic[1] || box->periodic[2];
+    double h = m->dt, v2 = *v2_max;
     for (size_t k = lo; k < hi; k++) {
-        const struct kick_arrays A = arrays; /* (in registers, as in kick_drift) */
+        const struct kick_arrays A = arrays; /* (the thread's own copy: in registers) */
         if (!fixed[k])
-            kick_drift_one(&A, box, k, g, m->dt, periodic, true, &v2);
+            kick_drift_one(&A, box, k, g, h, periodic, pending, &v2);
         A.force[k] = A.torque[k] = vec3(0, 0, 0);
         contacts[k] = 0;
     }
     *v2_max = v2;
+}
+
+double wetdem_sim_many_drift_range(struct wetdem_sim* sim, size_t lo, size_t hi)
+{
+    double v2 = 0;
+    kick_drift_range(sim->many, lo, hi, gravity(sim), true, &v2);
+    return v2;
 }
 
 /* Largest squared displacement of any particle since the last neighbour-list build [m^2]. */
@@ -739,19 +744,12 @@ static void after_drift(struct wetdem_sim* sim, double h, double v2_max)
 
 /* Half kick and drift of every particle (preceded by the previous step's closing half kick if
  * it was deferred), then after_drift. */
-static void kick_drift(struct wetdem_sim* sim, double h)
+static void kick_drift(struct wetdem_sim* sim)
 {
     struct wetdem_many* m = sim->many;
     bool pending = m->kick_pending;
     m->kick_pending = false;
     struct wetdem_vec3 g = gravity(sim);
-    bool periodic = m->cl.box.periodic[0] || m->cl.box.periodic[1] || m->cl.box.periodic[2];
-    /* the force pass's sums start here, from zero, while the lines are in cache (the force
-       pass then starts only the particles with walls) */
-    const struct kick_arrays arrays = kick_arrays_of(m);
-    const unsigned char* fixed = m->fixed;
-    uint32_t* contacts = m->contacts;
-    const struct wetdem_celllist_box* box = &m->cl.box;
     size_t n = sim->n_particles;
     double v2_max = 0; /* max is exact: the same for any thread count */
     size_t nt = wetdem_many_parallel(m, n) ? (size_t)omp_get_max_threads() : 1;
@@ -763,19 +761,13 @@ static void kick_drift(struct wetdem_sim* sim, double h)
         size_t got = (size_t)omp_get_num_threads();
         for (size_t r = (size_t)omp_get_thread_num(); r < nt; r += got) {
             double t0 = omp_get_wtime();
-            for (size_t k = m->kick_cut[r]; k < m->kick_cut[r + 1]; k++) {
-                const struct kick_arrays A = arrays; /* (the thread's own copy: in registers) */
-                if (!fixed[k])
-                    kick_drift_one(&A, box, k, g, h, periodic, pending, &v2_max);
-                A.force[k] = A.torque[k] = vec3(0, 0, 0);
-                contacts[k] = 0;
-            }
+            kick_drift_range(m, m->kick_cut[r], m->kick_cut[r + 1], g, pending, &v2_max);
             seconds[r] = omp_get_wtime() - t0;
         }
     }
     if (nt > 1)
         kick_speeds(m, nt, seconds);
-    after_drift(sim, h, v2_max);
+    after_drift(sim, m->dt, v2_max);
 }
 
 /* The deferred closing half kick of every particle, before anything reads the state. */
@@ -791,8 +783,8 @@ static void finish_kick(struct wetdem_sim* sim)
         wetdem_many_close_kick(m, k, g);
 }
 
-/* Forces at the current state (with the closing half kick when `kick`), work collected. */
-static int forces_and_work(struct wetdem_sim* sim, bool kick)
+/* Forces at the current state, then `end` for each particle (many.h), work collected. */
+static int forces_and_work(struct wetdem_sim* sim, enum wetdem_many_end end)
 {
     struct wetdem_many* m = sim->many;
     int n_threads = omp_get_max_threads();
@@ -806,7 +798,7 @@ static int forces_and_work(struct wetdem_sim* sim, bool kick)
     }
     double t0 = wall_seconds(), lists0 = m->seconds_lists; /* (a build may come first) */
     m->drift_seconds = 0;
-    int st = wetdem_sim_many_forces(sim, kick);
+    int st = wetdem_sim_many_forces(sim, end);
     collect_work(m, n_threads);
     /* (the next step's kicks and drifts, where the pass applied them, count as theirs) */
     m->seconds_forces += (wall_seconds() - t0) - (m->seconds_lists - lists0) - m->drift_seconds;
@@ -872,7 +864,7 @@ static int start(struct wetdem_sim* sim)
         return st;
     m->t0 = sim->engine.time;
     m->step = 0;
-    st = forces_and_work(sim, false);
+    st = forces_and_work(sim, WETDEM_MANY_END_NONE);
     if (st != WETDEM_OK)
         return st;
     m->started = true;
@@ -931,14 +923,14 @@ static bool state_read_after(const struct wetdem_sim* sim, uint64_t step, unsign
 static double drift_v2_max(const struct wetdem_many* m)
 {
     double v2 = 0;
-    for (size_t b = 0; b < WETDEM_MANY_MAX_BLOCKS; b++)
+    for (size_t b = 0; b < m->n_blocks; b++)
         v2 = m->drift_v2[b] > v2 ? m->drift_v2[b] : v2;
     return v2;
 }
 
 /* One step. When nothing reads the state before the next step (`defer`), the force pass
  * begins the next step: each block, once the forces on its particles are complete, applies
- * the closing half kick, the next half kick and the drift to them (many.h drift_in_pass), the
+ * the closing half kick, the next half kick and the drift to them (WETDEM_MANY_END_STEP), the
  * arithmetic of the kick-drift pass, so that the next step starts at its force pass. On two
  * threads this spares a parallel region and its wait per step, and each thread updates the
  * particles whose forces it summed. Not when a stop is already asked for, so that a stop
@@ -952,15 +944,16 @@ static int one_step(struct wetdem_sim* sim, bool defer)
         m->drifted = false;
         after_drift(sim, m->dt, drift_v2_max(m));
     } else
-        kick_drift(sim, m->dt);
+        kick_drift(sim);
     m->seconds_kick += wall_seconds() - t0;
     m->step++;
     sim->engine.time = m->t0 + (double)m->step * m->dt; /* no accumulated round-off */
     sim->engine.t_committed = sim->engine.time;
-    m->drift_in_pass = defer && !m->no_drift_in_pass && !(m->set.stop_flag && *m->set.stop_flag);
-    int st = forces_and_work(sim, !defer); /* else the closing half kick is in the gather */
-    m->drifted = m->drift_in_pass;
-    m->drift_in_pass = false;
+    bool step = defer && !m->no_drift_in_pass && !(m->set.stop_flag && *m->set.stop_flag);
+    int st = forces_and_work(sim, !defer ? WETDEM_MANY_END_KICK
+                                  : step ? WETDEM_MANY_END_STEP
+                                         : WETDEM_MANY_END_NONE);
+    m->drifted = step;
     if (m->stop_during_step && m->step == m->stop_during_step && m->set.stop_flag)
         *m->set.stop_flag = 1; /* (tests) */
     if (st != WETDEM_OK)

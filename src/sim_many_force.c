@@ -23,7 +23,7 @@
  *      sum); the closing half kick of velocity Verlet (sim_many.c). When nothing reads the
  *      state before the next step, the block then applies to its particles, whose forces are
  *      complete, the closing half kick, the next step's half kick and its drift instead
- *      (sim_many.c one_step, many.h drift_in_pass).
+ *      (sim_many.c one_step, many.h WETDEM_MANY_END_STEP).
  * So particle k always sums walls, then -F of every pair (i, k) in increasing i, then S_k: an
  * order set by particle indices only, whatever the blocks, so states are bit-identical for any
  * number of threads and, because pairs out of range add nothing, for any time at which the
@@ -1926,8 +1926,9 @@ static int pair_constants(struct wetdem_sim* sim)
     return WETDEM_OK;
 }
 
-int wetdem_sim_many_forces(struct wetdem_sim* sim, bool kick)
+int wetdem_sim_many_forces(struct wetdem_sim* sim, enum wetdem_many_end end)
 {
+    bool kick = end == WETDEM_MANY_END_KICK, drift = end == WETDEM_MANY_END_STEP;
     struct wetdem_many* m = sim->many;
     int st = wetdem_sim_many_prepare(sim);
     if (st != WETDEM_OK)
@@ -2020,10 +2021,6 @@ int wetdem_sim_many_forces(struct wetdem_sim* sim, bool kick)
         }
     }
     m->bulk_passes += P.bulk != NULL;
-    /* the next step's kicks and drifts (many.h drift_in_pass; never with the closing kick
-       here, which they include) */
-    bool drift = m->drift_in_pass && !kick;
-    memset(m->drift_v2, 0, sizeof m->drift_v2);
     /* one region: cross pairs, a barrier, then each block on its own, and with `drift` the
        kicks and drifts of its particles, whose forces are then complete: the cross pairs were
        evaluated before the barrier, the block's own pairs and the reactions they give are
@@ -2041,7 +2038,7 @@ int wetdem_sim_many_forces(struct wetdem_sim* sim, bool kick)
             pairs_of_block(&P, b, kick, g, &fail);
             if (drift) {
                 double t1 = omp_get_wtime();
-                wetdem_sim_many_drift_range(sim, m->blk[b], m->blk[b + 1], &m->drift_v2[b]);
+                m->drift_v2[b] = wetdem_sim_many_drift_range(sim, m->blk[b], m->blk[b + 1]);
                 if (t == 0) /* (the phases' wall time, as the master thread sees it) */
                     m->drift_seconds += omp_get_wtime() - t1;
             }

@@ -311,9 +311,9 @@ static void test_many_stop_flag_writes_a_checkpoint(void** state)
     wetdem_sim_free(sim);
 }
 
-/* A stop raised while a force pass also began the next step (many.h drift_in_pass: the step's
- * state is read by nothing) ends the run after that next step, with a checkpoint from which
- * the run goes on bit for bit as if never stopped. */
+/* A stop raised while a force pass also began the next step (many.h WETDEM_MANY_END_STEP:
+ * the step's state is read by nothing) ends the run after that next step, with a checkpoint
+ * from which the run goes on bit for bit as if never stopped. */
 static void test_many_stop_during_a_drifting_step_loses_nothing(void** state)
 {
     (void)state;

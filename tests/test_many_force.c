@@ -661,7 +661,7 @@ static struct wetdem_sim* wet_pile(const char* const* models, int n_models, bool
 }
 
 /* The next step's kicks and drifts applied by the force pass, block by block (many.h
- * drift_in_pass), are the kick-drift pass's arithmetic on complete forces: runs with them and
+ * WETDEM_MANY_END_STEP), are the kick-drift pass's arithmetic on complete forces: runs with them and
  * runs with the kick-drift pass at every step are bit-identical, on 1 to 3 threads, in several
  * calls (each ends with a step whose state is read, so without them), with a fixed particle,
  * in a periodic gas of two materials (the scalar kernel) and in a closed box of one (four pairs
