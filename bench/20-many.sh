@@ -263,6 +263,10 @@ else
 fi
 
 # ---- report ----
+# the processor, as the kernel reports it (a virtual machine's host may change between runs)
+echo "processor: $(sed -n 's/^model name[[:space:]]*: //p' /proc/cpuinfo | sort -u | head -n 1)," \
+     "second-level cache $(getconf LEVEL2_CACHE_SIZE 2>/dev/null || echo '?') bytes," \
+     "AVX-512 $(grep -qw avx512f /proc/cpuinfo && echo yes || echo no)" | tee -a "$res"
 echo "load average after the run: $(cut -d' ' -f1-3 /proc/loadavg), $(nproc) cores;" \
      "time taken by the host (steal) during the run: $(awk -v a="$steal0" -v b="$(steal_s)" \
      'BEGIN{printf "%.1f", b - a}') s" | tee -a "$res"
