@@ -139,12 +139,23 @@ typedef void wetdem_many_bulk_fn(const struct wetdem_many_bulk_in* in, const uin
 typedef void wetdem_many_bulk_walls_fn(const struct wetdem_many_bulk_in* in, const uint32_t* part,
                                        const unsigned char* wall, const double* gap, size_t n,
                                        struct wetdem_many_bulk_out* out);
-/* many_bulk.c: the baseline version; many_bulk_avx2.c: the AVX2 one (x86-64 with GCC). */
-wetdem_many_bulk_fn wetdem_many_bulk_base, wetdem_many_bulk_avx2;
-wetdem_many_bulk_walls_fn wetdem_many_bulk_base_walls, wetdem_many_bulk_avx2_walls;
-/* The versions for this processor (AVX2 where it has it), or the baseline with `base_only`. */
-wetdem_many_bulk_fn* wetdem_many_bulk_choose(bool base_only);
-wetdem_many_bulk_walls_fn* wetdem_many_bulk_walls_choose(bool base_only);
+/* many_bulk.c: the baseline version; many_bulk_avx2.c: the AVX2 one; many_bulk_avx512.c: the
+   same in the AVX-512 encoding (both x86-64 with GCC). */
+wetdem_many_bulk_fn wetdem_many_bulk_base, wetdem_many_bulk_avx2, wetdem_many_bulk_avx512;
+wetdem_many_bulk_walls_fn wetdem_many_bulk_base_walls, wetdem_many_bulk_avx2_walls,
+    wetdem_many_bulk_avx512_walls;
+/* The versions by instruction set; BEST: the last of them that the processor runs. */
+enum wetdem_many_bulk_isa {
+    WETDEM_MANY_BULK_BEST,
+    WETDEM_MANY_BULK_BASE,
+    WETDEM_MANY_BULK_AVX2,
+    WETDEM_MANY_BULK_AVX512
+};
+/* Whether the processor (and its operating system) runs version `isa` (BEST and BASE always). */
+bool wetdem_many_bulk_usable(enum wetdem_many_bulk_isa isa);
+/* Version `isa` where usable, else the baseline one. */
+wetdem_many_bulk_fn* wetdem_many_bulk_choose(enum wetdem_many_bulk_isa isa);
+wetdem_many_bulk_walls_fn* wetdem_many_bulk_walls_choose(enum wetdem_many_bulk_isa isa);
 
 /* Energy bookkeeping (sim_many.c accumulates, sim_many_io.c reports). */
 struct wetdem_many_energy {
@@ -233,8 +244,9 @@ struct wetdem_many {
     uint64_t pass_near;         /* in-block candidates of the latest pass within range */
     bool fuse_on;               /* the next pass with usable skip times runs fused */
     int fuse_mode;              /* tests: 0 decided as above, 1 never fused, 2 always fused */
-    int bulk_mode;              /* tests: four pairs at a time (many_bulk.h) where it applies (0),
-                              never (1), or in the baseline instruction set only (2) */
+    int bulk_mode;              /* tests: four pairs at a time (many_bulk.h) where it applies in
+                                   the processor's best version (0), never (1), or in version
+                                   enum wetdem_many_bulk_isa bulk_mode - 1 (2 and up) */
     uint64_t fused_passes;      /* passes run fused (tests) */
     uint64_t bulk_passes;       /* passes with four pairs at a time (tests) */
     uint64_t bulk_contacts;     /* solid contacts evaluated four at a time (tests) */

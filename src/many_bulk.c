@@ -6,24 +6,47 @@
 #define WETDEM_MANY_BULK_WALLS_NAME wetdem_many_bulk_base_walls
 #include "many_bulk.h"
 
-/* Whether the AVX2 versions run here (never with `base_only`). */
-static bool avx2_usable(bool base_only)
+/* Whether the processor (and its operating system: libgcc's check includes the state of the
+ * wider registers) runs version `isa`. */
+bool wetdem_many_bulk_usable(enum wetdem_many_bulk_isa isa)
 {
+    switch (isa) {
+    case WETDEM_MANY_BULK_BEST:
+    case WETDEM_MANY_BULK_BASE: return true;
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
-    /* (libgcc's check includes the operating system's support of the AVX registers) */
-    return !base_only && __builtin_cpu_supports("avx2");
-#else
-    (void)base_only;
-    return false;
+    case WETDEM_MANY_BULK_AVX2: return __builtin_cpu_supports("avx2");
+    case WETDEM_MANY_BULK_AVX512:
+        return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("avx512f") &&
+               __builtin_cpu_supports("avx512vl") && __builtin_cpu_supports("avx512dq");
 #endif
+    default: return false;
+    }
 }
 
-wetdem_many_bulk_fn* wetdem_many_bulk_choose(bool base_only)
+/* The version that runs: `isa` where usable, BEST the widest usable one, else the baseline. */
+static enum wetdem_many_bulk_isa version_of(enum wetdem_many_bulk_isa isa)
 {
-    return avx2_usable(base_only) ? wetdem_many_bulk_avx2 : wetdem_many_bulk_base;
+    if (isa == WETDEM_MANY_BULK_BEST)
+        return wetdem_many_bulk_usable(WETDEM_MANY_BULK_AVX512) ? WETDEM_MANY_BULK_AVX512
+               : wetdem_many_bulk_usable(WETDEM_MANY_BULK_AVX2) ? WETDEM_MANY_BULK_AVX2
+                                                                : WETDEM_MANY_BULK_BASE;
+    return wetdem_many_bulk_usable(isa) ? isa : WETDEM_MANY_BULK_BASE;
 }
 
-wetdem_many_bulk_walls_fn* wetdem_many_bulk_walls_choose(bool base_only)
+wetdem_many_bulk_fn* wetdem_many_bulk_choose(enum wetdem_many_bulk_isa isa)
 {
-    return avx2_usable(base_only) ? wetdem_many_bulk_avx2_walls : wetdem_many_bulk_base_walls;
+    switch (version_of(isa)) {
+    case WETDEM_MANY_BULK_AVX512: return wetdem_many_bulk_avx512;
+    case WETDEM_MANY_BULK_AVX2: return wetdem_many_bulk_avx2;
+    default: return wetdem_many_bulk_base;
+    }
+}
+
+wetdem_many_bulk_walls_fn* wetdem_many_bulk_walls_choose(enum wetdem_many_bulk_isa isa)
+{
+    switch (version_of(isa)) {
+    case WETDEM_MANY_BULK_AVX512: return wetdem_many_bulk_avx512_walls;
+    case WETDEM_MANY_BULK_AVX2: return wetdem_many_bulk_avx2_walls;
+    default: return wetdem_many_bulk_base_walls;
+    }
 }

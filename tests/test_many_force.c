@@ -619,8 +619,10 @@ static void test_many_skipped_candidates_change_no_result(void** state)
 /* A wet pile settling in a closed box, one material and no periodic axis (the case where the
  * pass evaluates four pairs at a time, many_bulk.h), with the skip times always kept, the pass
  * in one loop, two or as chosen (many.h fuse_mode 2, 1, 0), and the given choice of the
- * four-at-a-time version (many.h bulk_mode: 0 the processor's, 1 never, 2 the baseline
- * instruction set). */
+ * four-at-a-time version (many.h bulk_mode: 0 the processor's best, 1 never, 2 and up the
+ * version bulk_mode - 1 of enum wetdem_many_bulk_isa). */
+#define N_BULK_MODES (2 + WETDEM_MANY_BULK_AVX512) /* many.h bulk_mode 0 .. 4 */
+
 static struct wetdem_sim* wet_pile(const char* const* models, int n_models, bool nc, int fuse_mode,
                                    int bulk_mode)
 {
@@ -697,8 +699,9 @@ static void test_many_drift_in_the_force_pass_changes_no_result(void** state)
     omp_set_num_threads(saved);
 }
 
-/* Four pairs at a time (many_bulk.h) in AVX2 where the processor has it and in the baseline
- * instruction set give runs bit-identical to the scalar kernel's, in one loop and in two, with
+/* Four pairs at a time (many_bulk.h) in every version the processor runs (the baseline
+ * instruction set, AVX2, its AVX-512 encoding, and the one chosen by default) give runs
+ * bit-identical to the scalar kernel's, in one loop and in two, with
  * and without mindlin (whose springs are reset apart, and rotated, advanced and capped in
  * contact) and capillary, in either model order, with both treatments of sb below h_min',
  * without film models (dry: contacts only), with either hertz damping form and without hertz,
@@ -729,9 +732,12 @@ static void test_many_four_at_a_time_change_no_result(void** state)
     for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++)
         for (int threads = 1; threads <= 2; threads++) {
             omp_set_num_threads(threads);
-            struct wetdem_sim* sims[3];
-            for (int mode = 0; mode < 3; mode++) /* the processor's, never, the baseline */
-            {
+            /* bulk_mode (many.h): the processor's best, never (the scalar kernel), then each
+               version of enum wetdem_many_bulk_isa from the baseline on, where it runs */
+            struct wetdem_sim* sims[N_BULK_MODES] = {NULL};
+            for (int mode = 0; mode < N_BULK_MODES; mode++) {
+                if (mode >= 2 && !wetdem_many_bulk_usable((enum wetdem_many_bulk_isa)(mode - 1)))
+                    continue;
                 sims[mode] = wet_pile(cases[c].models, cases[c].n_models, cases[c].nc,
                                       cases[c].fuse_mode, mode);
                 if (cases[c].damping)
@@ -739,10 +745,12 @@ static void test_many_four_at_a_time_change_no_result(void** state)
                         wetdem_sim_set_param_str(sims[mode], "hertz.damping", cases[c].damping));
             }
             for (int call = 1; call <= 8; call++) {
-                for (int mode = 0; mode < 3; mode++)
-                    CHECK_OK(wetdem_sim_integrate(sims[mode], call * 1e-3));
-                same_run(sims[0], sims[1]);
-                same_run(sims[2], sims[1]);
+                for (int mode = 0; mode < N_BULK_MODES; mode++)
+                    if (sims[mode])
+                        CHECK_OK(wetdem_sim_integrate(sims[mode], call * 1e-3));
+                for (int mode = 0; mode < N_BULK_MODES; mode++)
+                    if (sims[mode] && mode != 1)
+                        same_run(sims[mode], sims[1]);
             }
             const struct wetdem_many* m = sims[0]->many;
             uint64_t passes = sims[0]->engine.stats.force_evals;
@@ -751,18 +759,24 @@ static void test_many_four_at_a_time_change_no_result(void** state)
                 assert_true(m->fused_passes > passes / 2);
             if (cases[c].fuse_mode == 1)
                 assert_int_equal(m->fused_passes, 0);
-            assert_true(sims[2]->many->bulk_passes == m->bulk_passes);
             assert_int_equal(sims[1]->many->bulk_passes, 0);
-            /* contacts four at a time (counted in the blocks' passes, not in the cross pairs';
-               on two threads the blocks follow measured times, so the two runs may cut them
-               apart) */
-            assert_true(m->bulk_contacts > 1000 && sims[2]->many->bulk_contacts > 1000);
-            if (threads == 1)
-                assert_true(sims[2]->many->bulk_contacts == m->bulk_contacts);
             assert_int_equal(sims[1]->many->bulk_contacts, 0);
-            /* and the particles' walls, on the box's six walls */
-            assert_true(m->bulk_walls > 1000 && sims[2]->many->bulk_walls == m->bulk_walls);
             assert_int_equal(sims[1]->many->bulk_walls, 0);
+            assert_true(m->bulk_contacts > 1000 && m->bulk_walls > 1000);
+            for (int mode = 2; mode < N_BULK_MODES; mode++) {
+                if (!sims[mode])
+                    continue;
+                const struct wetdem_many* v = sims[mode]->many;
+                assert_true(v->bulk_passes == m->bulk_passes);
+                /* contacts four at a time (counted in the blocks' passes, not in the cross
+                   pairs'; on two threads the blocks follow measured times, so two runs may cut
+                   them apart) */
+                assert_true(v->bulk_contacts > 1000);
+                if (threads == 1)
+                    assert_true(v->bulk_contacts == m->bulk_contacts);
+                /* and the particles' walls, on the box's six walls */
+                assert_true(v->bulk_walls == m->bulk_walls);
+            }
             size_t contacts = 0, apart = 0; /* both kinds were met at the end */
             for (size_t q = 0; q < m->cl.n_pairs; q++) {
                 contacts += (m->flags[q] & WETDEM_MANY_CONTACT) != 0;
@@ -772,7 +786,7 @@ static void test_many_four_at_a_time_change_no_result(void** state)
                during the run are counted above) */
             bool films = cases[c].models != dry && cases[c].models != hertz_only;
             assert_true(contacts > (films ? 10u : 0u) && (apart > 10) == films);
-            for (int mode = 0; mode < 3; mode++)
+            for (int mode = 0; mode < N_BULK_MODES; mode++)
                 wetdem_sim_free(sims[mode]);
         }
     omp_set_num_threads(saved);
