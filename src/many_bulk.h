@@ -31,9 +31,9 @@
  * IEEE 754 addition, multiplication, division and square root are correctly rounded lane by
  * lane, and the build has no contraction into fused multiply-adds (-ffp-contract=off), so every
  * value is bit-identical to the scalar kernel's (tests/test_many_force.c compares whole runs
- * of every version the processor runs with the scalar kernel). The scalar loop takes a pair apart within range
- * with a finite force as it is (its class), and gives the others to the scalar kernel with this
- * geometry and, in solid contact, these film terms.
+ * of every version the processor runs with the scalar kernel). The scalar loop takes a pair
+ * apart within range with a finite force as it is (its class), and gives the others to the
+ * scalar kernel with this geometry and, in solid contact, these film terms.
  *
  * Included by many_bulk.c (the baseline instruction set: SSE2 on x86-64, plain C elsewhere),
  * many_bulk_avx2.c (AVX2) and many_bulk_avx512.c (the same in the AVX-512 encoding), the last
