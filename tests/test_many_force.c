@@ -792,6 +792,38 @@ static void test_many_four_at_a_time_change_no_result(void** state)
     omp_set_num_threads(saved);
 }
 
+/* The choice of the four-at-a-time version (many.h): each version where the processor runs
+ * it, else the baseline (never an instruction the processor lacks); by default the widest
+ * usable one; AVX-512 usable only with AVX2. */
+static void test_many_bulk_version_choice(void** state)
+{
+    (void)state;
+    assert_true(wetdem_many_bulk_usable(WETDEM_MANY_BULK_BEST));
+    assert_true(wetdem_many_bulk_usable(WETDEM_MANY_BULK_BASE));
+    bool avx2 = wetdem_many_bulk_usable(WETDEM_MANY_BULK_AVX2),
+         avx512 = wetdem_many_bulk_usable(WETDEM_MANY_BULK_AVX512);
+    assert_true(!avx512 || avx2);
+    assert_true(wetdem_many_bulk_choose(WETDEM_MANY_BULK_BASE) == wetdem_many_bulk_base);
+    assert_true(wetdem_many_bulk_choose(WETDEM_MANY_BULK_AVX2) ==
+                (avx2 ? wetdem_many_bulk_avx2 : wetdem_many_bulk_base));
+    assert_true(wetdem_many_bulk_choose(WETDEM_MANY_BULK_AVX512) ==
+                (avx512 ? wetdem_many_bulk_avx512 : wetdem_many_bulk_base));
+    assert_true(wetdem_many_bulk_choose(WETDEM_MANY_BULK_BEST) == (avx512 ? wetdem_many_bulk_avx512
+                                                                   : avx2 ? wetdem_many_bulk_avx2
+                                                                          : wetdem_many_bulk_base));
+    assert_true(wetdem_many_bulk_walls_choose(WETDEM_MANY_BULK_BASE) ==
+                wetdem_many_bulk_base_walls);
+    assert_true(wetdem_many_bulk_walls_choose(WETDEM_MANY_BULK_BEST) ==
+                (avx512 ? wetdem_many_bulk_avx512_walls
+                 : avx2 ? wetdem_many_bulk_avx2_walls
+                        : wetdem_many_bulk_base_walls));
+    assert_true(wetdem_many_bulk_walls_choose(WETDEM_MANY_BULK_AVX512) ==
+                (avx512 ? wetdem_many_bulk_avx512_walls : wetdem_many_bulk_base_walls));
+    /* what the processor says it has, for the record of the run */
+    print_message("four-at-a-time versions usable here: baseline%s%s\n", avx2 ? ", AVX2" : "",
+                  avx512 ? ", AVX-512" : "");
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -808,6 +840,7 @@ int main(void)
         cmocka_unit_test(test_many_kick_ranges_follow_the_threads_speed),
         cmocka_unit_test(test_many_skipped_candidates_change_no_result),
         cmocka_unit_test(test_many_four_at_a_time_change_no_result),
+        cmocka_unit_test(test_many_bulk_version_choice),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
