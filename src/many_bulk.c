@@ -33,20 +33,22 @@ static enum wetdem_many_bulk_isa version_of(enum wetdem_many_bulk_isa isa)
     return wetdem_many_bulk_usable(isa) ? isa : WETDEM_MANY_BULK_BASE;
 }
 
+/* The functions of each version (BEST is resolved by version_of). */
+static const struct {
+    wetdem_many_bulk_fn* pairs;
+    wetdem_many_bulk_walls_fn* walls;
+} versions[] = {
+    [WETDEM_MANY_BULK_BASE] = {wetdem_many_bulk_base, wetdem_many_bulk_base_walls},
+    [WETDEM_MANY_BULK_AVX2] = {wetdem_many_bulk_avx2, wetdem_many_bulk_avx2_walls},
+    [WETDEM_MANY_BULK_AVX512] = {wetdem_many_bulk_avx512, wetdem_many_bulk_avx512_walls},
+};
+
 wetdem_many_bulk_fn* wetdem_many_bulk_choose(enum wetdem_many_bulk_isa isa)
 {
-    switch (version_of(isa)) {
-    case WETDEM_MANY_BULK_AVX512: return wetdem_many_bulk_avx512;
-    case WETDEM_MANY_BULK_AVX2: return wetdem_many_bulk_avx2;
-    default: return wetdem_many_bulk_base;
-    }
+    return versions[version_of(isa)].pairs;
 }
 
 wetdem_many_bulk_walls_fn* wetdem_many_bulk_walls_choose(enum wetdem_many_bulk_isa isa)
 {
-    switch (version_of(isa)) {
-    case WETDEM_MANY_BULK_AVX512: return wetdem_many_bulk_avx512_walls;
-    case WETDEM_MANY_BULK_AVX2: return wetdem_many_bulk_avx2_walls;
-    default: return wetdem_many_bulk_base_walls;
-    }
+    return versions[version_of(isa)].walls;
 }

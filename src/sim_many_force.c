@@ -1980,13 +1980,10 @@ int wetdem_sim_many_forces(struct wetdem_sim* sim, enum wetdem_many_end end)
                      .zeroed = m->sums_zeroed == n};
     /* four pairs at a time for the lean kernel in the common case: the geometry and film
        terms of every listed candidate, then the solid contacts among them */
-    if (P.lean && P.nm == 1 && !P.periodic && m->bulk_mode != 1) {
+    if (P.lean && P.nm == 1 && !P.periodic && !m->bulk_off) {
         const struct wetdem_many_mix* x = m->mix;
         const struct wetdem_many_lean* L = &m->lean;
-        enum wetdem_many_bulk_isa isa = m->bulk_mode >= 2
-                                            ? (enum wetdem_many_bulk_isa)(m->bulk_mode - 1)
-                                            : WETDEM_MANY_BULK_BEST;
-        P.bulk = wetdem_many_bulk_choose(isa);
+        P.bulk = wetdem_many_bulk_choose(m->bulk_isa);
         P.bulk_in = (struct wetdem_many_bulk_in){
             .xr = m->xr,
             .vw = (const struct wetdem_vec3(*)[2])m->vw,
@@ -2014,7 +2011,7 @@ int wetdem_sim_many_forces(struct wetdem_sim* sim, enum wetdem_many_end end)
             .tangential_factor = x->mindlin_damping};
         memcpy(P.bulk_in.normal, L->normal, sizeof P.bulk_in.normal);
         if (sim->n_walls <= 64) { /* (the wall masks) */
-            P.bulk_walls = wetdem_many_bulk_walls_choose(isa);
+            P.bulk_walls = wetdem_many_bulk_walls_choose(m->bulk_isa);
             P.bulk_in.walls = sim->walls;
             P.bulk_in.n_walls = sim->n_walls;
             P.bulk_in.wall_history = m->wall_history;

@@ -619,12 +619,10 @@ static void test_many_skipped_candidates_change_no_result(void** state)
 /* A wet pile settling in a closed box, one material and no periodic axis (the case where the
  * pass evaluates four pairs at a time, many_bulk.h), with the skip times always kept, the pass
  * in one loop, two or as chosen (many.h fuse_mode 2, 1, 0), and the given choice of the
- * four-at-a-time version (many.h bulk_mode: 0 the processor's best, 1 never, 2 and up the
- * version bulk_mode - 1 of enum wetdem_many_bulk_isa). */
-#define N_BULK_MODES (2 + WETDEM_MANY_BULK_AVX512) /* many.h bulk_mode 0 .. 4 */
-
+ * four-at-a-time version: never (`bulk_off`, the scalar kernel), or version `isa` (many.h
+ * bulk_off, bulk_isa). */
 static struct wetdem_sim* wet_pile(const char* const* models, int n_models, bool nc, int fuse_mode,
-                                   int bulk_mode)
+                                   bool bulk_off, enum wetdem_many_bulk_isa isa)
 {
     struct wetdem_sim* sim = materials_sim(models, n_models, false);
     if (nc)
@@ -659,7 +657,8 @@ static struct wetdem_sim* wet_pile(const char* const* models, int n_models, bool
     sim->many->parallel_min = 1; /* run the parallel loops even for this small system */
     sim->many->skip_always = true;
     sim->many->fuse_mode = fuse_mode;
-    sim->many->bulk_mode = bulk_mode;
+    sim->many->bulk_off = bulk_off;
+    sim->many->bulk_isa = isa;
     return sim;
 }
 
@@ -679,7 +678,8 @@ static void test_many_drift_in_the_force_pass_changes_no_result(void** state)
             omp_set_num_threads(threads);
             struct wetdem_sim* sims[2];
             for (int k = 0; k < 2; k++) {
-                sims[k] = fixture ? wet_pile(all, 4, false, 0, 0) : wet_gas(false, false);
+                sims[k] = fixture ? wet_pile(all, 4, false, 0, false, WETDEM_MANY_BULK_BEST)
+                                  : wet_gas(false, false);
                 wetdem_sim_particles(sims[k], NULL)[3].is_fixed = true;
                 sims[k]->many->no_drift_in_pass = k == 1;
             }
@@ -732,50 +732,53 @@ static void test_many_four_at_a_time_change_no_result(void** state)
     for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++)
         for (int threads = 1; threads <= 2; threads++) {
             omp_set_num_threads(threads);
-            /* bulk_mode (many.h): the processor's best, never (the scalar kernel), then each
-               version of enum wetdem_many_bulk_isa from the baseline on, where it runs */
-            struct wetdem_sim* sims[N_BULK_MODES] = {NULL};
-            for (int mode = 0; mode < N_BULK_MODES; mode++) {
-                if (mode >= 2 && !wetdem_many_bulk_usable((enum wetdem_many_bulk_isa)(mode - 1)))
+            /* the scalar kernel, then every version the processor runs (BEST: its default) */
+            struct wetdem_sim* scalar = NULL;
+            struct wetdem_sim* sims[WETDEM_MANY_BULK_AVX512 + 1] = {NULL};
+            const int n_isa = WETDEM_MANY_BULK_AVX512 + 1;
+            for (int v = -1; v < n_isa; v++) {
+                enum wetdem_many_bulk_isa isa =
+                    v < 0 ? WETDEM_MANY_BULK_BEST : (enum wetdem_many_bulk_isa)v;
+                if (!wetdem_many_bulk_usable(isa))
                     continue;
-                sims[mode] = wet_pile(cases[c].models, cases[c].n_models, cases[c].nc,
-                                      cases[c].fuse_mode, mode);
+                struct wetdem_sim* sim = wet_pile(cases[c].models, cases[c].n_models, cases[c].nc,
+                                                  cases[c].fuse_mode, v < 0, isa);
                 if (cases[c].damping)
-                    CHECK_OK(
-                        wetdem_sim_set_param_str(sims[mode], "hertz.damping", cases[c].damping));
+                    CHECK_OK(wetdem_sim_set_param_str(sim, "hertz.damping", cases[c].damping));
+                *(v < 0 ? &scalar : &sims[v]) = sim;
             }
             for (int call = 1; call <= 8; call++) {
-                for (int mode = 0; mode < N_BULK_MODES; mode++)
-                    if (sims[mode])
-                        CHECK_OK(wetdem_sim_integrate(sims[mode], call * 1e-3));
-                for (int mode = 0; mode < N_BULK_MODES; mode++)
-                    if (sims[mode] && mode != 1)
-                        same_run(sims[mode], sims[1]);
+                CHECK_OK(wetdem_sim_integrate(scalar, call * 1e-3));
+                for (int v = 0; v < n_isa; v++)
+                    if (sims[v]) {
+                        CHECK_OK(wetdem_sim_integrate(sims[v], call * 1e-3));
+                        same_run(sims[v], scalar);
+                    }
             }
-            const struct wetdem_many* m = sims[0]->many;
-            uint64_t passes = sims[0]->engine.stats.force_evals;
+            const struct wetdem_many* m = sims[WETDEM_MANY_BULK_BEST]->many;
+            uint64_t passes = sims[WETDEM_MANY_BULK_BEST]->engine.stats.force_evals;
             assert_true(m->bulk_passes == passes); /* every pass */
             if (cases[c].fuse_mode == 2)
                 assert_true(m->fused_passes > passes / 2);
             if (cases[c].fuse_mode == 1)
                 assert_int_equal(m->fused_passes, 0);
-            assert_int_equal(sims[1]->many->bulk_passes, 0);
-            assert_int_equal(sims[1]->many->bulk_contacts, 0);
-            assert_int_equal(sims[1]->many->bulk_walls, 0);
+            assert_int_equal(scalar->many->bulk_passes, 0);
+            assert_int_equal(scalar->many->bulk_contacts, 0);
+            assert_int_equal(scalar->many->bulk_walls, 0);
             assert_true(m->bulk_contacts > 1000 && m->bulk_walls > 1000);
-            for (int mode = 2; mode < N_BULK_MODES; mode++) {
-                if (!sims[mode])
+            for (int v = 0; v < n_isa; v++) {
+                if (!sims[v])
                     continue;
-                const struct wetdem_many* v = sims[mode]->many;
-                assert_true(v->bulk_passes == m->bulk_passes);
+                const struct wetdem_many* u = sims[v]->many;
+                assert_true(u->bulk_passes == m->bulk_passes);
                 /* contacts four at a time (counted in the blocks' passes, not in the cross
                    pairs'; on two threads the blocks follow measured times, so two runs may cut
                    them apart) */
-                assert_true(v->bulk_contacts > 1000);
+                assert_true(u->bulk_contacts > 1000);
                 if (threads == 1)
-                    assert_true(v->bulk_contacts == m->bulk_contacts);
+                    assert_true(u->bulk_contacts == m->bulk_contacts);
                 /* and the particles' walls, on the box's six walls */
-                assert_true(v->bulk_walls == m->bulk_walls);
+                assert_true(u->bulk_walls == m->bulk_walls);
             }
             size_t contacts = 0, apart = 0; /* both kinds were met at the end */
             for (size_t q = 0; q < m->cl.n_pairs; q++) {
@@ -786,8 +789,9 @@ static void test_many_four_at_a_time_change_no_result(void** state)
                during the run are counted above) */
             bool films = cases[c].models != dry && cases[c].models != hertz_only;
             assert_true(contacts > (films ? 10u : 0u) && (apart > 10) == films);
-            for (int mode = 0; mode < N_BULK_MODES; mode++)
-                wetdem_sim_free(sims[mode]);
+            wetdem_sim_free(scalar);
+            for (int v = 0; v < n_isa; v++)
+                wetdem_sim_free(sims[v]);
         }
     omp_set_num_threads(saved);
 }
