@@ -245,14 +245,15 @@ struct wetdem_many {
     bool fuse_on;       /* the next pass with usable skip times runs fused */
     int fuse_mode;      /* tests: 0 decided as above, 1 never fused, 2 always fused */
     bool bulk_off;      /* tests: never four pairs at a time (many_bulk.h) */
-    enum wetdem_many_bulk_isa bulk_isa; /* tests: its version where it applies (default BEST) */
-    uint64_t fused_passes;              /* passes run fused (tests) */
-    uint64_t bulk_passes;               /* passes with four pairs at a time (tests) */
-    uint64_t bulk_contacts;             /* solid contacts evaluated four at a time (tests) */
-    uint64_t bulk_walls;                /* particle-wall pairs within range evaluated so (tests) */
-    uint64_t pair_consts_build;         /* the list build they were computed for */
-    bool pair_consts_ready;             /* cleared when the kernel is set up */
-    unsigned char* old_flags;           /* flags of the previous list, for remapping */
+    /* tests: the version of four pairs at a time where it applies (default BEST) */
+    enum wetdem_many_bulk_isa bulk_isa;
+    uint64_t fused_passes;      /* passes run fused (tests) */
+    uint64_t bulk_passes;       /* passes with four pairs at a time (tests) */
+    uint64_t bulk_contacts;     /* solid contacts evaluated four at a time (tests) */
+    uint64_t bulk_walls;        /* particle-wall pairs within range evaluated so (tests) */
+    uint64_t pair_consts_build; /* the list build they were computed for */
+    bool pair_consts_ready;     /* cleared when the kernel is set up */
+    unsigned char* old_flags;   /* flags of the previous list, for remapping */
     size_t old_flags_cap;
     uint64_t* wall_mask; /* per particle: bit w set if wall w is within reach + skin
                                     at the last build (walls >= 64 are always evaluated) */
