@@ -1559,10 +1559,12 @@ beyond_reach(const struct pass* P, const struct pass* P_out, size_t q, double r2
 }
 
 /* Pair q = (i, j) of block b, with result o and flags fl: into particle i's running sums
- * (f, t, n_contacts), and its reaction at once into j's sums. */
+ * (f, t, n_contacts), and its reaction at once into j's sums but for the torque on j, which
+ * the caller adds (o->torque_j, where the pair is active and adds_torque). */
 static inline __attribute__((always_inline)) void
-add_pair(const struct pass* P, size_t j, unsigned char fl, const struct wetdem_many_pair_out* o,
-         struct wetdem_vec3* f, struct wetdem_vec3* t, uint32_t* n_contacts)
+add_pair_but_torque_j(const struct pass* P, size_t j, unsigned char fl,
+                      const struct wetdem_many_pair_out* o, struct wetdem_vec3* f,
+                      struct wetdem_vec3* t, uint32_t* n_contacts)
 {
     if (!(fl & WETDEM_MANY_ACTIVE))
         return;
@@ -1570,10 +1572,18 @@ add_pair(const struct pass* P, size_t j, unsigned char fl, const struct wetdem_m
     add_reaction_pair(P, j, o->force, f);
     *n_contacts += c;
     P->contacts[j] += c;
-    if (adds_torque(P->lean, fl)) {
+    if (adds_torque(P->lean, fl))
         *t = vec3_add(*t, o->torque_i);
+}
+
+/* The same with the torque on j added at once. */
+static inline __attribute__((always_inline)) void
+add_pair(const struct pass* P, size_t j, unsigned char fl, const struct wetdem_many_pair_out* o,
+         struct wetdem_vec3* f, struct wetdem_vec3* t, uint32_t* n_contacts)
+{
+    add_pair_but_torque_j(P, j, fl, o, f, t, n_contacts);
+    if ((fl & WETDEM_MANY_ACTIVE) && adds_torque(P->lean, fl))
         P->torque[j] = vec3_add(P->torque[j], o->torque_j);
-    }
 }
 
 /* Particle i of a block after its listed pairs (with running sums f, t and n_contacts): its
@@ -1682,12 +1692,16 @@ close_batch(const struct pass* P, const struct batch_sums* B, size_t from_slot, 
  * only particles at or after its first pair's first particle, none of which has been closed,
  * and no reaction goes to a closed particle (j > i). Every result adds its torque on i to the
  * running sum (+0 apart: the vector kernel's, or +0 where it does not act); the torque on j
- * and the counts are added in solid contact only. Returns the number within range;
- * *n_bulk_contacts gets those in solid contact evaluated four at a time. */
+ * and the counts are added in solid contact only: with `defer` (a pass with films, where
+ * contacts and bridges apart alternate without a pattern and a branch on which one a result
+ * is was mispredicted often) after the batch's loop, in a loop over its contacts in list
+ * order (the torques on j get no other addition in between, so the same sums), else at once.
+ * Returns the number within range; *n_bulk_contacts gets those in solid contact evaluated
+ * four at a time. */
 static inline __attribute__((always_inline)) uint64_t
 consume_four_at_a_time(const struct pass* P, const struct pass* P_out, size_t b,
                        const uint32_t* list, size_t n_list, bool kick, struct wetdem_vec3 g,
-                       struct failure* fail, bool fused, uint64_t* n_bulk_contacts)
+                       struct failure* fail, bool fused, bool defer, uint64_t* n_bulk_contacts)
 {
     struct wetdem_many* m = P->m;
     size_t end_block = m->blk[b + 1];
@@ -1698,6 +1712,7 @@ consume_four_at_a_time(const struct pass* P, const struct pass* P_out, size_t b,
     uint64_t n_near = 0, n_contact_results = 0;
     struct wetdem_many_bulk_out bo;
     struct batch_sums B;
+    uint32_t torque_at[WETDEM_MANY_BULK_MAX];
     for (size_t h = 0; h < n_list;) {
         size_t n_w = n_list - h < WETDEM_MANY_BULK_MAX ? n_list - h : WETDEM_MANY_BULK_MAX;
         P->bulk(&P->bulk_in, list + h, n_w, end_block, &bo);
@@ -1708,6 +1723,7 @@ consume_four_at_a_time(const struct pass* P, const struct pass* P_out, size_t b,
         size_t slot = 0; /* slot 0: the particle carried from the batch before (none at first) */
         B.particle[0] = i;
         B.s[0] = r;
+        size_t n_torque = 0; /* the entries whose torque on j is added after the loop */
         for (size_t k = 0; k < n_w; k++) {
             size_t q = list[h + k], j = bo.j[k];
             long long cls = bo.cls[k];
@@ -1716,7 +1732,10 @@ consume_four_at_a_time(const struct pass* P, const struct pass* P_out, size_t b,
                 bulk_flags(P, q, cls);
                 P->force[j] =
                     vec3_sub(P->force[j], vec3(bo.force[0][k], bo.force[1][k], bo.force[2][k]));
-                if (cls & WETDEM_MANY_CONTACT) { /* (apart: no counts, and +0 torques) */
+                if (defer) { /* (apart: no counts, and +0 torques) */
+                    torque_at[n_torque] = (uint32_t)k;
+                    n_torque += (size_t)((cls & WETDEM_MANY_CONTACT) != 0);
+                } else if (cls & WETDEM_MANY_CONTACT) {
                     P->torque[j] = vec3_add(P->torque[j], vec3(bo.torque_j[0][k], bo.torque_j[1][k],
                                                                bo.torque_j[2][k]));
                     P->contacts[j]++;
@@ -1735,7 +1754,17 @@ consume_four_at_a_time(const struct pass* P, const struct pass* P_out, size_t b,
                     struct wetdem_many_pair_out o;
                     unsigned char fl =
                         near_candidate(P, q, bo.i[k], j, vec3(0, 0, 0), m->mix, &o, fail, &bo, k);
-                    add_pair(P, j, fl, &o, &f, &t, &P->contacts[bo.i[k]]);
+                    if (!defer)
+                        add_pair(P, j, fl, &o, &f, &t, &P->contacts[bo.i[k]]);
+                    else
+                        add_pair_but_torque_j(P, j, fl, &o, &f, &t, &P->contacts[bo.i[k]]);
+                    if (defer && (fl & WETDEM_MANY_ACTIVE) && adds_torque(P->lean, fl)) {
+                        bo.cls[k] = 0; /* (its counts are added) */
+                        bo.torque_j[0][k] = o.torque_j.x;
+                        bo.torque_j[1][k] = o.torque_j.y;
+                        bo.torque_j[2][k] = o.torque_j.z;
+                        torque_at[n_torque++] = (uint32_t)k;
+                    }
                 }
                 bo.force[0][k] = f.x;
                 bo.force[1][k] = f.y;
@@ -1756,6 +1785,19 @@ consume_four_at_a_time(const struct pass* P, const struct pass* P_out, size_t b,
             B.particle[slot] = i;
             B.s[slot] = r;
         }
+        /* the torques on j, in list order (the only additions to them in the loop), and the
+           counts of the contacts evaluated four at a time, apart from the loop over all
+           results: in a wet packing, whether a result is a contact follows no pattern */
+        for (size_t c = 0; c < n_torque; c++) {
+            size_t k = torque_at[c], j = bo.j[k];
+            P->torque[j] = vec3_add(P->torque[j],
+                                    vec3(bo.torque_j[0][k], bo.torque_j[1][k], bo.torque_j[2][k]));
+            if (bo.cls[k]) {
+                P->contacts[j]++;
+                P->contacts[bo.i[k]]++;
+                n_contact_results++;
+            }
+        }
         h += n_w;
         /* the particles before the last one, or at the end all of the block */
         size_t from = B.particle[0] == UINT32_MAX ? 1 : 0, stop = h < n_list ? i : end_block;
@@ -1775,10 +1817,11 @@ consume_four_at_a_time(const struct pass* P, const struct pass* P_out, size_t b,
  * (`fused` false): the gap test of the block's candidates (gap_test), then the kernels over
  * the list of those within range; one loop (`fused`, with usable skip times only): the
  * candidates whose time has come, each tested and, within range, evaluated at once, with the
- * geometry of the test (many.h fuse_on). The same kernels run in the same order. */
+ * geometry of the test (many.h fuse_on). The same kernels run in the same order. `defer`: as
+ * consume_four_at_a_time's (with `bulk`). */
 static inline __attribute__((always_inline)) void
 pairs_of_block_as(const struct pass* P, size_t b, bool kick, struct wetdem_vec3 g,
-                  struct failure* fail, bool fused, bool common, bool bulk)
+                  struct failure* fail, bool fused, bool common, bool bulk, bool defer)
 {
     /* a private copy of the pass, whose fields no store of the loop can change (as those of
        *P could, through the byte stores of flags and hit lists): kept in registers, not
@@ -1810,7 +1853,7 @@ pairs_of_block_as(const struct pass* P, size_t b, bool kick, struct wetdem_vec3 
     /* 2. every particle in index order: its listed pairs (reactions to the second particle at
           once), its cross pairs from phase 1, then its own sum and the closing half kick */
     if (bulk)
-        n_near = consume_four_at_a_time(P, P_out, b, list, n_list, kick, g, fail, fused,
+        n_near = consume_four_at_a_time(P, P_out, b, list, n_list, kick, g, fail, fused, defer,
                                         &n_bulk_contacts);
     for (size_t i = begin_block, h = 0; !bulk && i < end_block; i++) {
         if (!(h < n_list && pairs[list[h]].i == i)) { /* no listed pairs */
@@ -1861,22 +1904,29 @@ pairs_of_block_as(const struct pass* P, size_t b, bool kick, struct wetdem_vec3 
 }
 
 /* Phase 2 of block b (pairs_of_block_as), compiled apart for the one-loop pass in the common
- * case (one material pair, no periodic axis) with and without four pairs at a time, the
- * one-loop pass in general, and two loops. */
+ * case (one material pair, no periodic axis) with and without four pairs at a time (with and
+ * without films), the one-loop pass in general, and two loops (in the common case with and
+ * without four pairs at a time and films). */
 static void pairs_of_block(const struct pass* P, size_t b, bool kick, struct wetdem_vec3 g,
                            struct failure* fail)
 {
     bool common = P->nm == 1 && !P->periodic; /* one material pair, no periodic axis */
-    if (P->fused && common && P->bulk)
-        pairs_of_block_as(P, b, kick, g, fail, true, true, true);
+    /* films: contacts and bridges apart mixed in the results (consume_four_at_a_time) */
+    bool films = P->bulk_in.film > 0 && (P->bulk_in.sb || P->bulk_in.capillary);
+    if (P->fused && common && P->bulk && films)
+        pairs_of_block_as(P, b, kick, g, fail, true, true, true, true);
+    else if (P->fused && common && P->bulk)
+        pairs_of_block_as(P, b, kick, g, fail, true, true, true, false);
     else if (P->fused && common)
-        pairs_of_block_as(P, b, kick, g, fail, true, true, false);
+        pairs_of_block_as(P, b, kick, g, fail, true, true, false, false);
     else if (P->fused)
-        pairs_of_block_as(P, b, kick, g, fail, true, false, false);
+        pairs_of_block_as(P, b, kick, g, fail, true, false, false, false);
+    else if (common && P->bulk && films)
+        pairs_of_block_as(P, b, kick, g, fail, false, true, true, true);
     else if (common && P->bulk)
-        pairs_of_block_as(P, b, kick, g, fail, false, true, true);
+        pairs_of_block_as(P, b, kick, g, fail, false, true, true, false);
     else
-        pairs_of_block_as(P, b, kick, g, fail, false, false, false);
+        pairs_of_block_as(P, b, kick, g, fail, false, false, false, false);
 }
 
 /* The constants of every candidate pair (many.h: pair_lim2, and pair_cache for the lean

@@ -487,8 +487,9 @@ static void test_many_kick_ranges_follow_the_threads_speed(void** state)
     omp_set_num_threads(saved);
 }
 
-/* Runs a and b are bit-identical: particles, and every candidate pair's flags (contact,
- * bridge: what the statistics count) over the same list. */
+/* Runs a and b are bit-identical: particles, every candidate pair's flags (contact, bridge:
+ * what the statistics count) over the same list, and each particle's count of contacts (the
+ * VTK files' and, with the walls, the statistics'). */
 static void same_run(const struct wetdem_sim* a, const struct wetdem_sim* b)
 {
     test_check_same_particles(a, b);
@@ -496,6 +497,8 @@ static void same_run(const struct wetdem_sim* a, const struct wetdem_sim* b)
     assert_memory_equal(a->many->cl.pairs, b->many->cl.pairs,
                         a->many->cl.n_pairs * sizeof *a->many->cl.pairs);
     assert_memory_equal(a->many->flags, b->many->flags, a->many->cl.n_pairs);
+    assert_memory_equal(a->many->contacts, b->many->contacts,
+                        a->n_particles * sizeof *a->many->contacts);
 }
 
 /* The gap test skips a candidate until the skip clock (the sum of every step's bound on the
