@@ -1559,12 +1559,10 @@ beyond_reach(const struct pass* P, const struct pass* P_out, size_t q, double r2
 }
 
 /* Pair q = (i, j) of block b, with result o and flags fl: into particle i's running sums
- * (f, t, n_contacts), and its reaction at once into j's sums but for the torque on j, which
- * the caller adds (o->torque_j, where the pair is active and adds_torque). */
+ * (f, t, n_contacts), and its reaction at once into j's sums. */
 static inline __attribute__((always_inline)) void
-add_pair_but_torque_j(const struct pass* P, size_t j, unsigned char fl,
-                      const struct wetdem_many_pair_out* o, struct wetdem_vec3* f,
-                      struct wetdem_vec3* t, uint32_t* n_contacts)
+add_pair(const struct pass* P, size_t j, unsigned char fl, const struct wetdem_many_pair_out* o,
+         struct wetdem_vec3* f, struct wetdem_vec3* t, uint32_t* n_contacts)
 {
     if (!(fl & WETDEM_MANY_ACTIVE))
         return;
@@ -1572,18 +1570,10 @@ add_pair_but_torque_j(const struct pass* P, size_t j, unsigned char fl,
     add_reaction_pair(P, j, o->force, f);
     *n_contacts += c;
     P->contacts[j] += c;
-    if (adds_torque(P->lean, fl))
+    if (adds_torque(P->lean, fl)) {
         *t = vec3_add(*t, o->torque_i);
-}
-
-/* The same with the torque on j added at once. */
-static inline __attribute__((always_inline)) void
-add_pair(const struct pass* P, size_t j, unsigned char fl, const struct wetdem_many_pair_out* o,
-         struct wetdem_vec3* f, struct wetdem_vec3* t, uint32_t* n_contacts)
-{
-    add_pair_but_torque_j(P, j, fl, o, f, t, n_contacts);
-    if ((fl & WETDEM_MANY_ACTIVE) && adds_torque(P->lean, fl))
         P->torque[j] = vec3_add(P->torque[j], o->torque_j);
+    }
 }
 
 /* Particle i of a block after its listed pairs (with running sums f, t and n_contacts): its
@@ -1695,7 +1685,7 @@ close_batch(const struct pass* P, const struct batch_sums* B, size_t from_slot, 
  * and the counts are added in solid contact only: with `defer` (a pass with films, where
  * contacts and bridges apart alternate without a pattern and a branch on which one a result
  * is was mispredicted often) after the batch's loop, in a loop over its contacts in list
- * order (the torques on j get no other addition in between, so the same sums), else at once.
+ * order (the same sums: see there), else at once.
  * Returns the number within range; *n_bulk_contacts gets those in solid contact evaluated
  * four at a time. */
 static inline __attribute__((always_inline)) uint64_t
@@ -1723,7 +1713,7 @@ consume_four_at_a_time(const struct pass* P, const struct pass* P_out, size_t b,
         size_t slot = 0; /* slot 0: the particle carried from the batch before (none at first) */
         B.particle[0] = i;
         B.s[0] = r;
-        size_t n_torque = 0; /* the entries whose torque on j is added after the loop */
+        size_t n_torque = 0; /* with defer: the contacts, whose torque on j waits */
         for (size_t k = 0; k < n_w; k++) {
             size_t q = list[h + k], j = bo.j[k];
             long long cls = bo.cls[k];
@@ -1754,17 +1744,7 @@ consume_four_at_a_time(const struct pass* P, const struct pass* P_out, size_t b,
                     struct wetdem_many_pair_out o;
                     unsigned char fl =
                         near_candidate(P, q, bo.i[k], j, vec3(0, 0, 0), m->mix, &o, fail, &bo, k);
-                    if (!defer)
-                        add_pair(P, j, fl, &o, &f, &t, &P->contacts[bo.i[k]]);
-                    else
-                        add_pair_but_torque_j(P, j, fl, &o, &f, &t, &P->contacts[bo.i[k]]);
-                    if (defer && (fl & WETDEM_MANY_ACTIVE) && adds_torque(P->lean, fl)) {
-                        bo.cls[k] = 0; /* (its counts are added) */
-                        bo.torque_j[0][k] = o.torque_j.x;
-                        bo.torque_j[1][k] = o.torque_j.y;
-                        bo.torque_j[2][k] = o.torque_j.z;
-                        torque_at[n_torque++] = (uint32_t)k;
-                    }
+                    add_pair(P, j, fl, &o, &f, &t, &P->contacts[bo.i[k]]);
                 }
                 bo.force[0][k] = f.x;
                 bo.force[1][k] = f.y;
@@ -1785,19 +1765,19 @@ consume_four_at_a_time(const struct pass* P, const struct pass* P_out, size_t b,
             B.particle[slot] = i;
             B.s[slot] = r;
         }
-        /* the torques on j, in list order (the only additions to them in the loop), and the
-           counts of the contacts evaluated four at a time, apart from the loop over all
-           results: in a wet packing, whether a result is a contact follows no pattern */
+        /* the torques on j of the contacts evaluated four at a time, in list order, and their
+           counts, apart from the loop over all results: in a wet packing, whether a result is
+           a contact follows no pattern. The loop adds no other torque on j but that of a
+           contact the scalar kernel takes over, whose result is not finite (bulk_contacts
+           leaves it only those) and fails the pass: no run goes on with its sums. */
         for (size_t c = 0; c < n_torque; c++) {
             size_t k = torque_at[c], j = bo.j[k];
             P->torque[j] = vec3_add(P->torque[j],
                                     vec3(bo.torque_j[0][k], bo.torque_j[1][k], bo.torque_j[2][k]));
-            if (bo.cls[k]) {
-                P->contacts[j]++;
-                P->contacts[bo.i[k]]++;
-                n_contact_results++;
-            }
+            P->contacts[j]++;
+            P->contacts[bo.i[k]]++;
         }
+        n_contact_results += n_torque;
         h += n_w;
         /* the particles before the last one, or at the end all of the block */
         size_t from = B.particle[0] == UINT32_MAX ? 1 : 0, stop = h < n_list ? i : end_block;
