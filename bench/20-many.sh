@@ -28,14 +28,17 @@
 # both codes on the shared state (same-state and frozen protocols, callgrind, one thread), and
 # the floor's instructions per bridge apart.
 #
-# After the three protocols (before the floor), PAIRS pairs of a one-thread and a two-thread
+# After the three protocols, the frozen protocol's wet / dry cost for each film thickness of
+# FILMS (wetdem, one thread): the cost against the number of pairs within the films.
+# Then (before the floor), PAIRS pairs of a one-thread and a two-thread
 # run back to back per protocol and variant (LIGGGHTS: the frozen protocol), each pair's
 # speed-up and their median: a measure of the two-thread speed-up that a host whose speed
 # drifts between runs spoils less than the best of runs taken minutes apart.
 #
 # Usage: bench/20-many.sh [WETDEM_CLI]    (make bench passes the CLI; it is not needed here)
 # Environment: N (20000), SETTLE (500), STEPS (1500), STATE (3000), SAME_STEPS (300),
-# FROZEN_STEPS (300), FROZEN_DT (1e-9), REPEAT (3), PAIRS (5; 0 skips the pairs), INSTR_STEPS
+# FROZEN_STEPS (300), FROZEN_DT (1e-9), REPEAT (3), FILMS ("3.2e-6 10e-6 20e-6"; "" skips the
+# film sweep), PAIRS (5; 0 skips the pairs), INSTR_STEPS
 # (100; 0 skips the instruction counts) — about 12-22 minutes on 2 cores;
 # OMP_WAIT_POLICY and GOMP_SPINCOUNT (default: GOMP_SPINCOUNT=20000, a waiting thread spins
 # briefly, about a step's time, then sleeps; fully active threads collapse when the host takes
@@ -168,6 +171,34 @@ for variant in dry wet; do
       --state-in "$out/state.data" --settle 0 --steps "$FROZEN_STEPS"
   done
 done
+# ---- the wet cost against the film thickness ----
+# The frozen protocol's wet / dry cost for each film thickness of FILMS (per sphere [m]; the
+# benchmark's wet variant has 20e-6): REPEAT rounds, each a dry run and then a wet run per film,
+# back to back on one thread; the best of each -> "film M wet_rate dry_rate contacts bridges".
+# More film, more pairs within the films (bridges apart) besides the same contacts: the cost
+# against that number, and where the target holds (many_bench.c: 3 delta / R of liquid).
+FILMS=${FILMS-"3.2e-6 10e-6 20e-6"}
+if [ -n "$FILMS" ]; then
+  film_dry=0
+  declare -A film_wet film_line
+  for rep in $(seq "$REPEAT"); do
+    r=$(run_wd film dry 1 "$FROZEN_STEPS" --dt "$FROZEN_DT" --state-in "$out/state.data" \
+        --settle 0 --steps "$FROZEN_STEPS" | awk '{print $1}')
+    film_dry=$(awk -v a="$film_dry" -v b="$r" 'BEGIN{print (b > a) ? b : a}')
+    for f in $FILMS; do
+      line=$(run_wd film wet 1 "$FROZEN_STEPS" --dt "$FROZEN_DT" --state-in "$out/state.data" \
+             --settle 0 --steps "$FROZEN_STEPS" --film "$f")
+      r=$(echo "$line" | awk '{print $1}')
+      if awk -v a="${film_wet[$f]:-0}" -v b="$r" 'BEGIN{exit !(b > a)}'; then
+        film_wet[$f]=$r
+        film_line[$f]=$(echo "$line" | awk '{print $4, $5}')
+      fi
+    done
+  done
+  for f in $FILMS; do
+    echo "film $f ${film_wet[$f]} $film_dry ${film_line[$f]}" | tee -a "$res" >&2
+  done
+fi
 # ---- paired two-thread speed-ups ----
 # PAIRS pairs of runs, each pair a one-thread and a two-thread run back to back (every other
 # pair in the other order, so that a drift of the host's speed favours neither side): each
@@ -282,6 +313,8 @@ awk -v n="$N" -v wb="$base_kb" -v lb="$lg_base" -v steps="$STEPS" -v same="$SAME
               plo[k] = pv[1]; phi[k] = pv[m]; pn[k] = m; pok[k] = 0
               for (a = 1; a <= m; a++) pok[k] += pv[a] >= 1.8
               next }
+  /^film / { nfilm++; fm[nfilm] = $2; fw[nfilm] = $3; fd[nfilm] = $4; fc[nfilm] = $5
+             fb[nfilm] = $6; next }
   /^instr floor / { floor_ins = $3; next }
   /^instr / { ins[$2 " " $3 " " $4] = $5 }
   /^floor / { floor_nb = $2; floor_ns = ($4 > 0 && $4 < $3) ? $4 : $3; floor_one = $3 }
@@ -337,6 +370,15 @@ awk -v n="$N" -v wb="$base_kb" -v lb="$lg_base" -v steps="$STEPS" -v same="$SAME
                " state, no engine): %.1f ns per bridge-step (one pair at a time %.1f); on top of" \
                " the dry run it alone gives a wet / dry cost of %.2fx\n", floor_nb, floor_ns,
                floor_one, 1 + floor_nb * floor_ns * 1e-9 * rate[w "dry 1"] / n
+      if (p == 3 && nfilm > 0) { # (liquid: 3 delta / R of the mean radius, 0.95 mm)
+        printf "  cost wet / dry against the film thickness (dry and wet back to back, best of" \
+               " each; target <= 1.3):"
+        for (f = 1; f <= nfilm; f++)
+          printf "%s %g um films (%.1f %% liquid) %.2fx, %d pairs within the films (%d contacts)",
+                 f == 1 ? "" : ";", fm[f] * 1e6, 300 * fm[f] / 0.95e-3, r(fd[f], fw[f]), fb[f],
+                 fc[f]
+        printf "\n"
+      }
       nsteps = p == 1 ? steps : (p == 2 ? same : fsteps) # ns per particle-step of a phase:
       printf "  wetdem phases [ns per particle-step], 1 thread / 2 threads (speed-up):"
       for (v = 1; v <= 2; v++) {

@@ -8,6 +8,10 @@
  *   dry: hertz + mindlin;  wet: hertz + mindlin + sb (thin-film viscous, 20 um films,
  *   mu_f = 0.01 Pa s) + capillary (sigma = 0.02 N/m). bench/bridge_floor.c, the floor of the
  *   wet cost, repeats these film, viscosity and tension values: change them together.
+ *   --film changes the wet spheres' film thickness (bench/20-many.sh's film sweep: the wet cost
+ *   against the number of pairs within the films); a thin film on a sphere of radius R holds
+ *   3 delta / R of its volume in liquid, so 20 um on R ~ 0.95 mm is about 6 %, and 3.2 um 1 %,
+ *   the liquid content of the LIGGGHTS deck.
  * dt = 1e-5 s (as the LIGGGHTS decks; --dt changes it, e.g. 1e-9 s for the frozen-configuration
  * protocol of bench/20-many.sh). The first `settle` steps are not timed.
  *
@@ -17,13 +21,14 @@
  * so wetdem dry, wetdem wet and both LIGGGHTS variants run the same configuration. Contact
  * histories are not carried over, in either code.
  *
- * Usage: many_bench [--wet] [--n N] [--settle S] [--steps S] [--dt DT] [--data FILE] [--budget]
- *                   [--state-in FILE] [--state-out FILE]
+ * Usage: many_bench [--wet] [--film M] [--n N] [--settle S] [--steps S] [--dt DT] [--data FILE]
+ *                   [--budget] [--state-in FILE] [--state-out FILE]
  * Prints one line: "wetdem <dry|wet> n=.. threads=.. steps=.. seconds=.. cpu_seconds=..
  * psteps_per_s=..
- * maxrss_kb=.. contacts=.. bridges=.. pairs=.. builds=.. kick_s=.. forces_s=.. lists_s=.." (the
- * last three: the timed steps' wall time in kicks and drifts, force passes and list builds,
- * wetdem_many_stats). Uses only the public API.
+ * maxrss_kb=.. contacts=.. bridges=.. pairs=.. builds=.. kick_s=.. forces_s=.. lists_s=.. film=.."
+ * (kick_s, forces_s, lists_s: the timed steps' wall time in kicks and drifts, force passes and
+ * list builds, wetdem_many_stats; film: the wet spheres' film thickness, 0 dry). Uses only the
+ * public API.
  */
 #include <omp.h>
 #include <sys/resource.h>
@@ -146,7 +151,7 @@ static void read_data(const char* path, struct wetdem_sim* sim)
     }
 }
 
-static void setup(struct wetdem_sim* sim, bool wet, size_t n, double hi[3])
+static void setup(struct wetdem_sim* sim, bool wet, double film, size_t n, double hi[3])
 {
     struct wetdem_material m = {.density = 2500,
                                 .youngs_modulus = 1e7,
@@ -155,7 +160,7 @@ static void setup(struct wetdem_sim* sim, bool wet, size_t n, double hi[3])
                                 .friction_dry = 0.5,
                                 .friction_lub = 0.5,
                                 .roughness = 0,
-                                .film = wet ? 20e-6 : 0};
+                                .film = wet ? film : 0};
     int st = wetdem_sim_add_material(sim, &m);
     if (st < 0)
         die(sim, st, "material");
@@ -201,7 +206,7 @@ int main(int argc, char** argv)
     const char* data = NULL;
     const char* state_in = NULL;
     const char* state_out = NULL;
-    double dt = 1e-5;
+    double dt = 1e-5, film = 20e-6; /* film: the wet spheres' film thickness [m] */
     for (int k = 1; k < argc; k++) {
         if (!strcmp(argv[k], "--wet"))
             wet = true;
@@ -221,10 +226,13 @@ int main(int argc, char** argv)
             state_out = argv[++k];
         else if (!strcmp(argv[k], "--dt") && k + 1 < argc && (dt = strtod(argv[++k], NULL)) > 0)
             continue;
+        else if (!strcmp(argv[k], "--film") && k + 1 < argc &&
+                 (film = strtod(argv[++k], NULL)) > 0 && film < 1e-3)
+            continue;
         else {
-            fprintf(stderr, "usage: many_bench [--wet] [--budget] [--n N] [--settle S] "
-                            "[--steps S] [--dt DT] [--data FILE] [--state-in FILE] "
-                            "[--state-out FILE]\n");
+            fprintf(stderr, "usage: many_bench [--wet] [--film M (0 < M < 1e-3 m)] [--budget] "
+                            "[--n N] [--settle S] [--steps S] [--dt DT] [--data FILE] "
+                            "[--state-in FILE] [--state-out FILE]\n");
             return 2;
         }
     }
@@ -234,7 +242,7 @@ int main(int argc, char** argv)
     }
     struct wetdem_sim* sim = wetdem_sim_create();
     double hi[3];
-    setup(sim, wet, n, hi);
+    setup(sim, wet, film, n, hi);
     if (state_in)
         read_data(state_in, sim);
     if (data) {
@@ -256,11 +264,11 @@ int main(int argc, char** argv)
         write_data(state_out, sim, hi);
     printf("wetdem %s n=%zu threads=%d steps=%lu seconds=%.3f cpu_seconds=%.3f psteps_per_s=%.4g "
            "maxrss_kb=%ld contacts=%zu bridges=%zu pairs=%zu builds=%llu kick_s=%.6f "
-           "forces_s=%.6f lists_s=%.6f\n",
+           "forces_s=%.6f lists_s=%.6f film=%g\n",
            wet ? "wet" : "dry", n, omp_get_max_threads(), steps, secs, cpu,
            (double)n * (double)steps / secs, max_rss_kb(), s.contacts, s.bridges, s.candidate_pairs,
            s.list_builds, s.seconds_kick - s0.seconds_kick, s.seconds_forces - s0.seconds_forces,
-           s.seconds_lists - s0.seconds_lists);
+           s.seconds_lists - s0.seconds_lists, wet ? film : 0.0);
     if (budget) {
         struct wetdem_energy_budget b;
         wetdem_sim_energy_budget(sim, &b);
