@@ -155,6 +155,12 @@ enum wetdem_many_bulk_isa {
 bool wetdem_many_bulk_usable(enum wetdem_many_bulk_isa isa);
 /* Version `isa` where usable, else the baseline one. */
 wetdem_many_bulk_fn* wetdem_many_bulk_choose(enum wetdem_many_bulk_isa isa);
+/* Whether a film model acts in a four-at-a-time pass with input in: then its results mix
+ * contacts and bridges apart (many_bulk.h bulk_films_of, sim_many_force.c pairs_of_block). */
+static inline bool wetdem_many_bulk_films(const struct wetdem_many_bulk_in* in)
+{
+    return (in->sb || in->capillary) && in->film > 0;
+}
 wetdem_many_bulk_walls_fn* wetdem_many_bulk_walls_choose(enum wetdem_many_bulk_isa isa);
 
 /* Energy bookkeeping (sim_many.c accumulates, sim_many_io.c reports). */

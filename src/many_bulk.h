@@ -476,7 +476,7 @@ static inline enum bulk_films bulk_films_of(const struct wetdem_many_bulk_in* in
 {
     if (in->sb && in->capillary && in->film > 0 && !in->sb_nc) /* the usual case */
         return BULK_BOTH;
-    return (in->sb || in->capillary) && in->film > 0 ? BULK_ANY : BULK_DRY;
+    return wetdem_many_bulk_films(in) ? BULK_ANY : BULK_DRY;
 }
 
 /* The constants of a call (struct bulk_constants). */

@@ -1892,7 +1892,7 @@ static void pairs_of_block(const struct pass* P, size_t b, bool kick, struct wet
 {
     bool common = P->nm == 1 && !P->periodic; /* one material pair, no periodic axis */
     /* films: contacts and bridges apart mixed in the results (consume_four_at_a_time) */
-    bool films = P->bulk_in.film > 0 && (P->bulk_in.sb || P->bulk_in.capillary);
+    bool films = wetdem_many_bulk_films(&P->bulk_in);
     if (P->fused && common && P->bulk && films)
         pairs_of_block_as(P, b, kick, g, fail, true, true, true, true);
     else if (P->fused && common && P->bulk)
