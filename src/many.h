@@ -269,6 +269,11 @@ struct wetdem_many {
                                     set when a run (re)starts (sim_many.c prepare) */
     uint32_t* wall_list;  /* particles with a non-zero wall_mask (or all if > 64 walls) */
     size_t n_wall_list, wall_list_cap;
+    /* with at most 64 walls: the bits of the masks as a flat list of particle-wall pairs, in
+       particle order and, for each particle, in wall order (e < n_wall_entries) */
+    uint32_t* wall_entry_part;
+    unsigned char* wall_entry_wall;
+    size_t n_wall_entries, wall_entry_part_cap, wall_entry_wall_cap;
     bool kick_pending;      /* the latest step's closing half kick is still to be applied
                                     (sim_many.c one_step); never true outside a run */
     size_t sums_zeroed;     /* the kick-drift pass set force, torque and contacts of this many

@@ -93,6 +93,8 @@ void wetdem_sim_many_free(struct wetdem_sim* sim)
     free(m->wall_mask);
     free(m->wall_dirty);
     free(m->wall_list);
+    free(m->wall_entry_part);
+    free(m->wall_entry_wall);
     free(m->force);
     free(m->torque);
     free(m->vh);
@@ -322,9 +324,27 @@ static int update_wall_masks(struct wetdem_sim* sim)
     if (grow((void**)&m->wall_list, &m->wall_list_cap, n ? n : 1, sizeof *m->wall_list))
         return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory for %zu particles", n);
     m->n_wall_list = 0;
-    for (size_t i = 0; i < n; i++)
+    size_t n_entries = 0;
+    for (size_t i = 0; i < n; i++) {
         if (m->wall_mask[i] || nw > 64)
             m->wall_list[m->n_wall_list++] = (uint32_t)i;
+        for (uint64_t mask = m->wall_mask[i]; mask; mask &= mask - 1)
+            n_entries++;
+    }
+    if (grow((void**)&m->wall_entry_part, &m->wall_entry_part_cap, n_entries ? n_entries : 1,
+             sizeof *m->wall_entry_part) ||
+        grow((void**)&m->wall_entry_wall, &m->wall_entry_wall_cap, n_entries ? n_entries : 1,
+             sizeof *m->wall_entry_wall))
+        return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory for %zu particle-wall pairs",
+                               n_entries);
+    m->n_wall_entries = 0;
+    for (size_t s = 0; s < m->n_wall_list && nw <= 64; s++) {
+        size_t i = m->wall_list[s];
+        for (uint64_t mask = m->wall_mask[i]; mask; mask &= mask - 1) {
+            m->wall_entry_part[m->n_wall_entries] = (uint32_t)i;
+            m->wall_entry_wall[m->n_wall_entries++] = (unsigned char)__builtin_ctzll(mask);
+        }
+    }
     return WETDEM_OK;
 }
 

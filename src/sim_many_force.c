@@ -1320,6 +1320,47 @@ static void cross_pairs_share(const struct pass* P, size_t t, size_t nt, struct 
     }
 }
 
+/* The running force and torque of a particle's listed pairs (or of its walls) in three pairs
+ * of lanes, (f_x, f_y), (f_z, t_x), (t_y, t_z), each lane's addition the one of the vec3 sums
+ * (its count of contacts goes to the total at once: an integer, the same in any order); the
+ * sums restarted from +0 without a branch (running_add); and what a batch
+ * of four-at-a-time results keeps of each particle it reaches (consume_four_at_a_time): slot 0
+ * the one carried from the batch before, slot s > 0 the s-th particle that begins in it. */
+typedef double lanes2 __attribute__((vector_size(16)));
+typedef unsigned long long mask2 __attribute__((vector_size(16)));
+struct running_sums {
+    lanes2 a, b, c;
+};
+struct batch_sums {
+    struct running_sums s[WETDEM_MANY_BULK_MAX + 1];
+    uint32_t particle[WETDEM_MANY_BULK_MAX + 1]; /* the slot's particle (slot 0: UINT32_MAX
+                                                    before the first batch) */
+};
+
+static inline __attribute__((always_inline)) struct wetdem_vec3
+running_force(const struct running_sums* r)
+{
+    return vec3(r->a[0], r->a[1], r->b[0]);
+}
+static inline __attribute__((always_inline)) struct wetdem_vec3
+running_torque(const struct running_sums* r)
+{
+    return vec3(r->b[1], r->c[0], r->c[1]);
+}
+
+/* *r plus force (f_x, f_y, f_z) and torque (t_x, t_y, t_z) in ft[0..6), restarted from +0
+ * first when `fresh` (a new particle): the lanes masked to +0, the sum +0 + ft as a fresh
+ * vec3 sum's (and a sum from +0 is never -0, so the masked restart changes no bit). */
+static inline __attribute__((always_inline)) void running_add(struct running_sums* r, bool fresh,
+                                                              const double ft[6])
+{
+    unsigned long long keep = (unsigned long long)fresh - 1;
+    mask2 keep2 = {keep, keep};
+    r->a = (lanes2)((mask2)r->a & keep2) + (lanes2){ft[0], ft[1]};
+    r->b = (lanes2)((mask2)r->b & keep2) + (lanes2){ft[2], ft[3]};
+    r->c = (lanes2)((mask2)r->c & keep2) + (lanes2){ft[4], ft[5]};
+}
+
 /* The start of particle k's sum: its walls (wall order) when it has some within reach. */
 static inline void start_sum(const struct wetdem_sim* sim, size_t k, bool walls,
                              struct failure* fail)
@@ -1334,78 +1375,103 @@ static inline void start_sum(const struct wetdem_sim* sim, size_t k, bool walls,
     m->contacts[k] = n_contacts;
 }
 
-/* The sums of the particles with walls list[lo..hi) (wall_list), started with their walls as
- * start_sum does: the particle-wall pairs within range evaluated four at a time (many_bulk.h
- * bulk_walls) in batches of whole particles, what eval_walls_of does with each result (a class
- * 1 pair through eval_wall, the scalar kernel). */
+/* The sums of the particles whose particle-wall pairs are the entries lo..hi of the flat list
+ * (many.h wall_entry_part, wall_entry_wall; whole particles), started with their walls as
+ * start_sum does: the pairs within the reach and the range evaluated four at a time
+ * (many_bulk.h bulk_walls) in batches of whole particles, what eval_walls_of does with each
+ * result (a class 1 pair through eval_wall, the scalar kernel). In flat loops over the entries
+ * without branches on the outcome, whose patterns follow no rule in a packing (how many walls a
+ * particle has, which of them are within range): every entry is written to the batch's list
+ * and kept by its test; one beyond gets wall_beyond only where its history may have been used
+ * (its dirty bit: otherwise wall_beyond changes nothing); the results are summed in entry
+ * order into running sums restarted at each particle (running_add), which are stored after
+ * every entry. The particles without a pair within range keep the zero sums the kick-drift
+ * pass gave them (start_sums_of_block calls this only then), which is what start_sum gives
+ * them. */
 static void start_sums_four_at_a_time(const struct pass* P, size_t lo, size_t hi,
                                       struct failure* fail)
 {
     struct wetdem_many* m = P->m;
     const struct wetdem_sim* sim = P->sim;
-    const uint32_t* list = m->wall_list;
+    const uint32_t* part_of = m->wall_entry_part;
+    const unsigned char* wall_of = m->wall_entry_wall;
     size_t len = sim->history_len, nw = sim->n_walls;
-    double range = P->bulk_in.range; /* of the one material pair */
+    double range = P->bulk_in.range, reach = m->reach; /* (of the one material pair) */
     uint32_t part[WETDEM_MANY_BULK_MAX];
     unsigned char wall[WETDEM_MANY_BULK_MAX];
     double gap_of[WETDEM_MANY_BULK_MAX];
     struct wetdem_many_bulk_out bo;
     uint64_t n_within = 0;
     for (size_t s = lo; s < hi;) {
-        /* the pairs within the reach and the range of list[s..s_end), whole particles (the
-           first always fits: at most 64 walls); those beyond get what eval_walls_of and
-           eval_wall give them (no flags, a fresh history where it may have been used) */
-        size_t n = 0, s_end = s;
-        for (; s_end < hi; s_end++) {
-            size_t i = list[s_end];
-            uint64_t mask = m->wall_mask[i];
-            size_t count = 0;
-            for (uint64_t b = mask; b; b &= b - 1)
-                count++;
-            if (n + count > WETDEM_MANY_BULK_MAX)
-                break;
+        /* a batch of whole particles: cut before the first entry of a particle that goes on
+           past WETDEM_MANY_BULK_MAX entries (each has at most 64, one a wall) */
+        size_t s_end = hi - s > WETDEM_MANY_BULK_MAX ? s + WETDEM_MANY_BULK_MAX : hi;
+        while (s_end < hi && s_end - 1 > s && part_of[s_end] == part_of[s_end - 1])
+            s_end--;
+        size_t n = 0;
+        for (size_t e = s; e < s_end; e++) {
+            size_t i = part_of[e], w = wall_of[e];
+            const struct wetdem_wall* wl = &sim->walls[w];
             struct wetdem_vec3 pos = vec3(m->xr[i].x, m->xr[i].y, m->xr[i].z);
-            for (size_t w = next_wall(&mask); w < nw; w = next_wall(&mask)) {
-                const struct wetdem_wall* wl = &sim->walls[w];
-                double gap = vec3_dot(vec3_sub(pos, wl->point), wl->normal) - m->xr[i].r;
-                if (gap <= m->reach && !(gap > range)) {
-                    part[n] = (uint32_t)i;
-                    gap_of[n] = gap;
-                    wall[n++] = (unsigned char)w;
-                } else
-                    wall_beyond(sim, i, w); /* (also within the reach: eval_wall's flags 0) */
-            }
+            double gap = vec3_dot(vec3_sub(pos, wl->point), wl->normal) - m->xr[i].r;
+            size_t within = (size_t)(gap <= reach) & (size_t) !(gap > range);
+            part[n] = (uint32_t)i;
+            gap_of[n] = gap;
+            wall[n] = (unsigned char)w;
+            n += within;
+            if (!within && (m->wall_dirty[i] >> w & 1))
+                wall_beyond(sim, i, w); /* (also within the reach: eval_wall's flags 0) */
         }
         if (n)
             P->bulk_walls(&P->bulk_in, part, wall, gap_of, n, &bo);
-        size_t e = 0;
-        for (; s < s_end; s++) {
-            size_t i = list[s];
-            struct wetdem_vec3 f = vec3(0, 0, 0), t = vec3(0, 0, 0);
-            uint32_t n_contacts = 0;
-            for (; e < n && part[e] == i; e++) {
-                size_t w = wall[e];
-                long long cls = bo.cls[e];
+        struct running_sums r = {{0, 0}, {0, 0}, {0, 0}};
+        uint32_t prev = UINT32_MAX, n_contacts = 0;
+        for (size_t e = 0; e < n; e++) {
+            size_t i = part[e], w = wall[e];
+            unsigned char flags = (unsigned char)bo.cls[e]; /* (within the range: never 0) */
+            double ft[6] = {bo.force[0][e],    bo.force[1][e],    bo.force[2][e],
+                            bo.torque_i[0][e], bo.torque_i[1][e], bo.torque_i[2][e]};
+            if (bo.cls[e] == 1) { /* the scalar kernel; inactive, it adds +0 */
                 struct wetdem_many_pair_out o;
-                unsigned char flags;
-                if (cls == 1)
-                    flags = eval_wall(sim, i, w, len ? m->wall_history + (i * nw + w) * len : NULL,
-                                      m->wall_dirty[i] >> w & 1, &o, fail);
-                else {
-                    flags = (unsigned char)cls; /* (within the range: never 0) */
-                    o.force = vec3(bo.force[0][e], bo.force[1][e], bo.force[2][e]);
-                    o.torque_i = vec3(bo.torque_i[0][e], bo.torque_i[1][e], bo.torque_i[2][e]);
-                    n_within++;
-                }
-                add_wall_result(m, i, w, flags, &o, &f, &t, &n_contacts);
-            }
-            m->force[i] = f;
-            m->torque[i] = t;
+                flags = eval_wall(sim, i, w, len ? m->wall_history + (i * nw + w) * len : NULL,
+                                  m->wall_dirty[i] >> w & 1, &o, fail);
+                bool active = flags & WETDEM_MANY_ACTIVE;
+                double v[6] = {o.force.x,    o.force.y,    o.force.z,
+                               o.torque_i.x, o.torque_i.y, o.torque_i.z};
+                for (int c = 0; c < 6; c++)
+                    ft[c] = active ? v[c] : 0.0;
+            } else
+                n_within++;
+            uint64_t bit = (uint64_t)1 << w;
+            m->wall_dirty[i] = flags ? m->wall_dirty[i] | bit : m->wall_dirty[i] & ~bit;
+            bool fresh = i != prev;
+            prev = (uint32_t)i;
+            running_add(&r, fresh, ft);
+            n_contacts =
+                (fresh ? 0 : n_contacts) + ((flags & (WETDEM_MANY_ACTIVE | WETDEM_MANY_CONTACT)) ==
+                                            (WETDEM_MANY_ACTIVE | WETDEM_MANY_CONTACT));
+            m->force[i] = running_force(&r);
+            m->torque[i] = running_torque(&r);
             m->contacts[i] = n_contacts;
         }
+        s = s_end;
     }
 #pragma omp atomic
     m->bulk_walls += n_within;
+}
+
+/* The first index s < n with a[s] >= key in the sorted a[0..n), else n. */
+static size_t first_not_below(const uint32_t* a, size_t n, size_t key)
+{
+    size_t lo = 0, hi = n;
+    while (lo < hi) {
+        size_t mid = lo + (hi - lo) / 2;
+        if (a[mid] < key)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return lo;
 }
 
 /* Phase 2, start of block b: each particle's sum begins with its walls (wall order), then the
@@ -1417,24 +1483,15 @@ static void start_sums_of_block(const struct pass* P, size_t b, struct failure* 
     const uint64_t* wall_mask = m->wall_mask;
     bool every_wall = sim->n_walls > 64;
     size_t begin = m->blk[b], end = m->blk[b + 1];
-    if (P->zeroed) { /* the others are zero already: the particles with walls (wall_list) */
-        const uint32_t* list = m->wall_list;
-        size_t lo = 0, hi = m->n_wall_list; /* the first entry >= begin */
-        while (lo < hi) {
-            size_t mid = lo + (hi - lo) / 2;
-            if (list[mid] < begin)
-                lo = mid + 1;
-            else
-                hi = mid;
-        }
-        size_t hi_s = lo;
-        while (hi_s < m->n_wall_list && list[hi_s] < end)
-            hi_s++;
-        if (P->bulk_walls)
-            start_sums_four_at_a_time(P, lo, hi_s, fail);
+    if (P->zeroed) {       /* the others are zero already: the particles with walls */
+        if (P->bulk_walls) /* their entries in the flat list */
+            start_sums_four_at_a_time(
+                P, first_not_below(m->wall_entry_part, m->n_wall_entries, begin),
+                first_not_below(m->wall_entry_part, m->n_wall_entries, end), fail);
         else
-            for (size_t s = lo; s < hi_s; s++)
-                start_sum(sim, list[s], true, fail);
+            for (size_t s = first_not_below(m->wall_list, m->n_wall_list, begin);
+                 s < m->n_wall_list && m->wall_list[s] < end; s++)
+                start_sum(sim, m->wall_list[s], true, fail);
     } else
         for (size_t k = begin; k < end; k++)
             start_sum(sim, k, wall_mask[k] || every_wall, fail);
@@ -1610,33 +1667,6 @@ static inline __attribute__((always_inline)) void close_unlisted(const struct pa
         close_particle(P, i, e, e_end, vec3(0, 0, 0), vec3(0, 0, 0), 0, kick, g);
     else if (kick)
         wetdem_many_close_kick(P->m, i, g);
-}
-
-/* The running force and torque of a particle's listed pairs in three pairs of lanes,
- * (f_x, f_y), (f_z, t_x), (t_y, t_z), each lane's addition the one of the vec3 sums (its count
- * of contacts goes to the total at once: an integer, the same in any order); and what a batch
- * of four-at-a-time results keeps of each particle it reaches (consume_four_at_a_time): slot 0
- * the one carried from the batch before, slot s > 0 the s-th particle that begins in it. */
-typedef double lanes2 __attribute__((vector_size(16)));
-typedef unsigned long long mask2 __attribute__((vector_size(16)));
-struct running_sums {
-    lanes2 a, b, c;
-};
-struct batch_sums {
-    struct running_sums s[WETDEM_MANY_BULK_MAX + 1];
-    uint32_t particle[WETDEM_MANY_BULK_MAX + 1]; /* the slot's particle (slot 0: UINT32_MAX
-                                                    before the first batch) */
-};
-
-static inline __attribute__((always_inline)) struct wetdem_vec3
-running_force(const struct running_sums* r)
-{
-    return vec3(r->a[0], r->a[1], r->b[0]);
-}
-static inline __attribute__((always_inline)) struct wetdem_vec3
-running_torque(const struct running_sums* r)
-{
-    return vec3(r->b[1], r->c[0], r->c[1]);
 }
 
 /* Closes the particles next .. stop - 1 of a batch (close_particle) with the sums of the
