@@ -33,7 +33,8 @@
 # Then (before the floor), PAIRS pairs of a one-thread and a two-thread
 # run back to back per protocol and variant (LIGGGHTS: the frozen protocol), each pair's
 # speed-up and their median: a measure of the two-thread speed-up that a host whose speed
-# drifts between runs spoils less than the best of runs taken minutes apart.
+# drifts between runs spoils less than the best of runs taken minutes apart; and PAIRS pairs of
+# a frozen dry and wet run on one thread back to back, the same for the wet / dry cost.
 #
 # Usage: bench/20-many.sh [WETDEM_CLI]    (make bench passes the CLI; it is not needed here)
 # Environment: N (20000), SETTLE (500), STEPS (1500), STATE (3000), SAME_STEPS (300),
@@ -227,8 +228,26 @@ paired() {
   done
   echo "pair $proto $code $variant ${ratios[*]}" | tee -a "$res" >&2
 }
+# The same for the frozen protocol's wet / dry cost on one thread: PAIRS pairs of a dry and a
+# wet run back to back (every other pair in the other order) -> "costpair frozen r1 r2 ..."
+# (each dry rate over its wet rate). The best-of-REPEAT cost above compares runs taken minutes
+# apart, between LIGGGHTS runs; a pair's two runs see about the same machine.
+paired_cost() {
+  local k v dry wet ratios=()
+  for k in $(seq "$PAIRS"); do
+    for v in $( ((k % 2)) && echo dry wet || echo wet dry); do
+      local rate
+      rate=$(run_wd frozen "$v" 1 "$FROZEN_STEPS" --dt "$FROZEN_DT" --state-in \
+             "$out/state.data" --settle 0 --steps "$FROZEN_STEPS" | awk '{print $1}')
+      if [ "$v" = dry ]; then dry=$rate; else wet=$rate; fi
+    done
+    ratios+=("$(awk -v a="$dry" -v b="$wet" 'BEGIN{printf "%.3f", (b > 0 ? a / b : 0)}')")
+  done
+  echo "costpair frozen ${ratios[*]}" | tee -a "$res" >&2
+}
 PAIRS=${PAIRS:-5}
 if [ "$PAIRS" -gt 0 ]; then
+  paired_cost
   for variant in dry wet; do
     paired full "$variant" wetdem "$out/system.data" "$SETTLE" "$STEPS" 1e-5 \
       --n "$N" --settle "$SETTLE" --steps "$STEPS"
@@ -313,6 +332,14 @@ awk -v n="$N" -v wb="$base_kb" -v lb="$lg_base" -v steps="$STEPS" -v same="$SAME
               plo[k] = pv[1]; phi[k] = pv[m]; pn[k] = m; pok[k] = 0
               for (a = 1; a <= m; a++) pok[k] += pv[a] >= 1.8
               next }
+  /^costpair / { m = 0; delete cv
+                 for (f = 3; f <= NF; f++) cv[++m] = $f
+                 for (a = 2; a <= m; a++) for (b = a; b > 1 && cv[b - 1] > cv[b]; b--) {
+                   x = cv[b]; cv[b] = cv[b - 1]; cv[b - 1] = x }
+                 cmed = m % 2 ? cv[(m + 1) / 2] : (cv[m / 2] + cv[m / 2 + 1]) / 2
+                 clo = cv[1]; chi = cv[m]; cn = m; cok = 0
+                 for (a = 1; a <= m; a++) cok += cv[a] <= 1.3
+                 next }
   /^film / { nfilm++; fm[nfilm] = $2; fw[nfilm] = $3; fd[nfilm] = $4; fc[nfilm] = $5
              fb[nfilm] = $6; next }
   /^instr floor / { floor_ins = $3; next }
@@ -365,6 +392,9 @@ awk -v n="$N" -v wb="$base_kb" -v lb="$lg_base" -v steps="$STEPS" -v same="$SAME
       note = p == 1 ? " (different final states)" : " (target <= 1.3)"
       if (p == 2) note = " (the wet run ends with more contacts)"
       printf "%s\n", note
+      if (p == 3 && cn > 0)
+        printf "  cost wet / dry (1 thread), %d pairs of a dry and a wet run back to back: median" \
+               " %.2fx (%.2f-%.2f; %d of %d at <= 1.3)\n", cn, cmed, clo, chi, cok, cn
       if (p == 3 && floor_nb > 0 && rate[w "dry 1"] > 0)
         printf "  the floor (bench/bridge_floor.c: the bare loop over the %d bridges apart of this" \
                " state, no engine): %.1f ns per bridge-step (one pair at a time %.1f); on top of" \
