@@ -1404,7 +1404,7 @@ static void start_sums_four_at_a_time(const struct pass* P, size_t lo, size_t hi
     uint64_t n_within = 0;
     for (size_t s = lo; s < hi;) {
         /* a batch of whole particles: cut before the first entry of a particle that goes on
-           past WETDEM_MANY_BULK_MAX entries (each has at most 64, one a wall) */
+           past WETDEM_MANY_BULK_MAX entries (a particle has at most 64, one per wall) */
         size_t s_end = hi - s > WETDEM_MANY_BULK_MAX ? s + WETDEM_MANY_BULK_MAX : hi;
         while (s_end < hi && s_end - 1 > s && part_of[s_end] == part_of[s_end - 1])
             s_end--;
@@ -1435,11 +1435,13 @@ static void start_sums_four_at_a_time(const struct pass* P, size_t lo, size_t hi
                 struct wetdem_many_pair_out o;
                 flags = eval_wall(sim, i, w, len ? m->wall_history + (i * nw + w) * len : NULL,
                                   m->wall_dirty[i] >> w & 1, &o, fail);
-                bool active = flags & WETDEM_MANY_ACTIVE;
-                double v[6] = {o.force.x,    o.force.y,    o.force.z,
-                               o.torque_i.x, o.torque_i.y, o.torque_i.z};
-                for (int c = 0; c < 6; c++)
-                    ft[c] = active ? v[c] : 0.0;
+                bool active = flags & WETDEM_MANY_ACTIVE; /* (else o is not written) */
+                ft[0] = active ? o.force.x : 0.0;
+                ft[1] = active ? o.force.y : 0.0;
+                ft[2] = active ? o.force.z : 0.0;
+                ft[3] = active ? o.torque_i.x : 0.0;
+                ft[4] = active ? o.torque_i.y : 0.0;
+                ft[5] = active ? o.torque_i.z : 0.0;
             } else
                 n_within++;
             uint64_t bit = (uint64_t)1 << w;
