@@ -94,7 +94,7 @@ run_wd() {
   echo "$proto $line" >> "$out/wetdem.log"
   echo "$(echo "$line" | field psteps_per_s) $(echo "$line" | field maxrss_kb)" \
        "$(awk -v n="$N" -v s="$steps" -v c="$(echo "$line" | field cpu_seconds)" \
-          'BEGIN{printf "%.4g", c > 0 ? n * s / c : 0}')" \
+          'BEGIN{printf "%.4g", (c > 0 ? n * s / c : 0)}')" \
        "$(echo "$line" | field contacts) $(echo "$line" | field bridges)" \
        "$(echo "$line" | field kick_s) $(echo "$line" | field forces_s)"
 }
