@@ -976,6 +976,14 @@ static void wall_beyond(const struct wetdem_sim* sim, size_t i, size_t w)
     m->wall_dirty[i] &= ~bit;
 }
 
+/* Particle i's dirty bit of wall w after an evaluation with flags fl: set with any flags
+ * (its history may differ from a fresh one), else cleared (walls past the 64th have none). */
+static inline void set_wall_dirty(const struct wetdem_many* m, size_t i, size_t w, unsigned char fl)
+{
+    uint64_t bit = w < 64 ? (uint64_t)1 << w : 0;
+    m->wall_dirty[i] = fl ? m->wall_dirty[i] | bit : m->wall_dirty[i] & ~bit;
+}
+
 /* Particle i's pair with wall w evaluated with flags fl and output o: its dirty bit, and when
  * active its force, torque and contact into *f, *t, *n_contacts. */
 static inline void add_wall_result(const struct wetdem_many* m, size_t i, size_t w,
@@ -983,8 +991,7 @@ static inline void add_wall_result(const struct wetdem_many* m, size_t i, size_t
                                    struct wetdem_vec3* f, struct wetdem_vec3* t,
                                    uint32_t* n_contacts)
 {
-    uint64_t bit = w < 64 ? (uint64_t)1 << w : 0;
-    m->wall_dirty[i] = fl ? m->wall_dirty[i] | bit : m->wall_dirty[i] & ~bit;
+    set_wall_dirty(m, i, w, fl);
     if (!(fl & WETDEM_MANY_ACTIVE))
         return;
     *f = vec3_add(*f, o->force);
@@ -1444,8 +1451,7 @@ static void start_sums_four_at_a_time(const struct pass* P, size_t lo, size_t hi
                 ft[5] = active ? o.torque_i.z : 0.0;
             } else
                 n_within++;
-            uint64_t bit = (uint64_t)1 << w;
-            m->wall_dirty[i] = flags ? m->wall_dirty[i] | bit : m->wall_dirty[i] & ~bit;
+            set_wall_dirty(m, i, w, flags);
             bool fresh = i != prev;
             prev = (uint32_t)i;
             running_add(&r, fresh, ft);
@@ -1789,11 +1795,9 @@ consume_four_at_a_time(const struct pass* P, const struct pass* P_out, size_t b,
             size_t fresh = first != i;
             slot += fresh;
             i = first;
-            unsigned long long keep = (unsigned long long)fresh - 1;
-            mask2 keep2 = {keep, keep};
-            r.a = (lanes2)((mask2)r.a & keep2) + (lanes2){bo.force[0][k], bo.force[1][k]};
-            r.b = (lanes2)((mask2)r.b & keep2) + (lanes2){bo.force[2][k], bo.torque_i[0][k]};
-            r.c = (lanes2)((mask2)r.c & keep2) + (lanes2){bo.torque_i[1][k], bo.torque_i[2][k]};
+            const double ft[6] = {bo.force[0][k],    bo.force[1][k],    bo.force[2][k],
+                                  bo.torque_i[0][k], bo.torque_i[1][k], bo.torque_i[2][k]};
+            running_add(&r, fresh, ft);
             B.particle[slot] = i;
             B.s[slot] = r;
         }
