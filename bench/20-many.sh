@@ -324,22 +324,19 @@ awk -v n="$N" -v wb="$base_kb" -v lb="$lg_base" -v steps="$STEPS" -v same="$SAME
     -v fsteps="$FROZEN_STEPS" -v fdt="$FROZEN_DT" -v isteps="$INSTR_STEPS" '
   /^(full|same|frozen) / { k = $1 " " $2 " " $3 " " $4; rate[k] = $5; kb[k] = $6; cpu[k] = $7
                     con[k] = $8; bri[k] = $9; kick[k] = $10; frc[k] = $11 }
-  /^pair / { k = $2 " " $3 " " $4; m = 0; delete pv
-              for (f = 5; f <= NF; f++) pv[++m] = $f
-              for (a = 2; a <= m; a++) for (b = a; b > 1 && pv[b - 1] > pv[b]; b--) {
-                x = pv[b]; pv[b] = pv[b - 1]; pv[b - 1] = x }
-              pmed[k] = m % 2 ? pv[(m + 1) / 2] : (pv[m / 2] + pv[m / 2 + 1]) / 2
-              plo[k] = pv[1]; phi[k] = pv[m]; pn[k] = m; pok[k] = 0
-              for (a = 1; a <= m; a++) pok[k] += pv[a] >= 1.8
-              next }
-  /^costpair / { m = 0; delete cv
-                 for (f = 3; f <= NF; f++) cv[++m] = $f
-                 for (a = 2; a <= m; a++) for (b = a; b > 1 && cv[b - 1] > cv[b]; b--) {
-                   x = cv[b]; cv[b] = cv[b - 1]; cv[b - 1] = x }
-                 cmed = m % 2 ? cv[(m + 1) / 2] : (cv[m / 2] + cv[m / 2 + 1]) / 2
-                 clo = cv[1]; chi = cv[m]; cn = m; cok = 0
-                 for (a = 1; a <= m; a++) cok += cv[a] <= 1.3
-                 next }
+  # the values $first.. of a pair line: their median, range, count and how many reach bound
+  # (at or above it with at_least, else at or below)
+  function pair_stats(k, first, bound, at_least,   m, f, a, b, x, v) {
+    m = 0
+    for (f = first; f <= NF; f++) v[++m] = $f
+    for (a = 2; a <= m; a++) for (b = a; b > 1 && v[b - 1] > v[b]; b--) {
+      x = v[b]; v[b] = v[b - 1]; v[b - 1] = x }
+    pmed[k] = m % 2 ? v[(m + 1) / 2] : (v[m / 2] + v[m / 2 + 1]) / 2
+    plo[k] = v[1]; phi[k] = v[m]; pn[k] = m; pok[k] = 0
+    for (a = 1; a <= m; a++) pok[k] += at_least ? v[a] >= bound : v[a] <= bound
+  }
+  /^pair / { pair_stats($2 " " $3 " " $4, 5, 1.8, 1); next }
+  /^costpair / { pair_stats("cost " $2, 3, 1.3, 0); next }
   /^film / { nfilm++; fm[nfilm] = $2; fw[nfilm] = $3; fd[nfilm] = $4; fc[nfilm] = $5
              fb[nfilm] = $6; next }
   /^instr floor / { floor_ins = $3; next }
@@ -392,10 +389,11 @@ awk -v n="$N" -v wb="$base_kb" -v lb="$lg_base" -v steps="$STEPS" -v same="$SAME
       note = p == 1 ? " (different final states)" : " (best of each, between LIGGGHTS runs)"
       if (p == 2) note = " (the wet run ends with more contacts)"
       printf "%s\n", note
-      if (p == 3 && cn > 0)
+      ck = "cost " proto
+      if (ck in pmed)
         printf "  cost wet / dry (1 thread), %d pairs of a dry and a wet run back to back: median" \
-               " %.2fx (%.2f-%.2f; %d of %d at <= 1.3; target <= 1.3)\n", cn, cmed, clo, chi,
-               cok, cn
+               " %.2fx (%.2f-%.2f; %d of %d at <= 1.3; target <= 1.3)\n", pn[ck], pmed[ck],
+               plo[ck], phi[ck], pok[ck], pn[ck]
       if (p == 3 && floor_nb > 0 && rate[w "dry 1"] > 0)
         printf "  the floor (bench/bridge_floor.c: the bare loop over the %d bridges apart of this" \
                " state, no engine): %.1f ns per bridge-step (one pair at a time %.1f); on top of" \
