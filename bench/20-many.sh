@@ -44,7 +44,8 @@
 # OMP_WAIT_POLICY and GOMP_SPINCOUNT (default: GOMP_SPINCOUNT=20000, a waiting thread spins
 # briefly, about a step's time, then sleeps; fully active threads collapse when the host takes
 # a core, fully passive ones pay a wake-up at every parallel region, 5-8 % on 2 threads here).
-# Results go to build/bench/many/ (logs, results.txt, summary.txt). The ratios are printed, not
+# Results go to build/bench/many/ (logs, results.txt, summary.txt, the figure many_bench.png:
+# bench/many_figure.py). The ratios are printed, not
 # enforced: the machine may be shared, which the load average printed with the results shows.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
@@ -436,3 +437,12 @@ awk -v n="$N" -v wb="$base_kb" -v lb="$lg_base" -v steps="$STEPS" -v same="$SAME
       printf "\n"
     }
   }' "$res" | tee "$out/summary.txt"
+
+# ---- figure ----
+# The three targets in one figure (bench/many_figure.py; matplotlib from Debian, which make
+# bench installs): $out/many_bench.png. docs/figures/many_bench.png is a copy of a run's.
+if /usr/bin/python3 -c "import matplotlib" 2>/dev/null; then
+  /usr/bin/python3 bench/many_figure.py --results "$res" --out "$out/many_bench.png" --n "$N"
+else
+  echo "20-many: python3-matplotlib not installed: figure skipped (scripts/install-deps bench)" >&2
+fi
