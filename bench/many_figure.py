@@ -20,28 +20,28 @@ import argparse
 import os
 import sys
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "figures"))
+from common import np, plt  # noqa: E402  (matplotlib without a display)
 
 PROTOCOLS = ("full", "same", "frozen")
 VARIANTS = ("dry", "wet")
 COLOURS = {"dry": "#4c72b0", "wet": "#dd8452", "liggghts": "#8c8c8c"}
-FILM_OF_BENCHMARK = 20e-6  # [m] the wet variant's film per sphere (bench/many_bench.c)
 
 
 def read_results(path):
-    """The lines of a results file, by kind: rates, pairs, cost pairs, films, floor."""
-    r = {"rate": {}, "pair": {}, "costpair": None, "film": [], "floor": None}
+    """The lines of a results file, by kind: rates, pairs within the films of wetdem's runs,
+    pairs of runs, cost pairs, films, floor."""
+    r = {"rate": {}, "within": {}, "pair": {}, "costpair": None, "film": [], "floor": None}
     with open(path) as f:
         for line in f:
             w = line.split()
             if not w:
                 continue
             if w[0] in PROTOCOLS and len(w) >= 5:  # proto code variant threads rate ...
-                r["rate"][(w[0], w[1], w[2], int(w[3]))] = float(w[4])
+                key = (w[0], w[1], w[2], int(w[3]))
+                r["rate"][key] = float(w[4])
+                if len(w) >= 9 and w[8].isdigit():  # ... kb cpu contacts bridges (wetdem)
+                    r["within"][key] = int(w[8])
             elif w[0] == "pair":  # pair proto code variant ratios...
                 r["pair"][(w[1], w[2], w[3])] = [float(x) for x in w[4:]]
             elif w[0] == "costpair":  # costpair frozen ratios...
@@ -84,12 +84,13 @@ def per_core(ax, r):
 def two_threads(ax, r):
     groups = [(p, "wetdem", v) for p in PROTOCOLS for v in VARIANTS]
     groups += [("frozen", "liggghts", v) for v in VARIANTS]
-    labels, lows = [], [1.8]
+    labels, lows, drew = [], [1.8], False
     for g, key in enumerate(groups):
         vals = r["pair"].get(key)
         labels.append(f"{key[0]}\n{'LIGGGHTS' + chr(10) if key[1] == 'liggghts' else ''}{key[2]}")
         if not vals:
             continue
+        drew = True
         med, lo, hi = np.median(vals), min(vals), max(vals)
         lows.append(lo)
         colour = COLOURS["liggghts"] if key[1] == "liggghts" else COLOURS[key[2]]
@@ -102,7 +103,7 @@ def two_threads(ax, r):
     ax.set_title("2 threads: median and range of the pairs")
     ax.set_ylim(bottom=min(lows) - 0.05)
     ax.legend(fontsize=8, loc="lower right")
-    if len(lows) == 1:
+    if not drew:
         note(ax, "no pairs of runs in this results file (PAIRS=0)")
 
 
@@ -117,8 +118,8 @@ def wet_cost(ax, r, n):
         for f, c in zip(films, cost):
             ax.annotate(f"{f[0] * 1e6:g} um: {c:.2f}", (f[4], c), textcoords="offset points",
                         xytext=(-6, 7), ha="right", fontsize=7)
-    bench = [f for f in films if abs(f[0] - FILM_OF_BENCHMARK) < 1e-9]
-    within_bench = bench[0][4] if bench else None
+    # the pairs within the films of the benchmark's wet variant (its frozen run's bridges)
+    within_bench = r["within"].get(("frozen", "wetdem", "wet", 1))
     if r["costpair"] and within_bench:
         drew = True
         v = r["costpair"]
