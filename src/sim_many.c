@@ -328,8 +328,7 @@ static int update_wall_masks(struct wetdem_sim* sim)
     for (size_t i = 0; i < n; i++) {
         if (m->wall_mask[i] || nw > 64)
             m->wall_list[m->n_wall_list++] = (uint32_t)i;
-        for (uint64_t mask = m->wall_mask[i]; mask; mask &= mask - 1)
-            n_entries++;
+        n_entries += (size_t)__builtin_popcountll(m->wall_mask[i]);
     }
     if (grow((void**)&m->wall_entry_part, &m->wall_entry_part_cap, n_entries ? n_entries : 1,
              sizeof *m->wall_entry_part) ||
