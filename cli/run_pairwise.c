@@ -69,7 +69,8 @@ static const struct cli_key_desc pairwise_keys[] = {
         "Longest simulated time."),
     NUM("rtol", "-", "1e-9", 1e-14, 1e-3, false, false, "Relative tolerance of CVODE."),
     NUM("rest_speed_ratio", "-", "1e-3", 0, 1, false, true,
-        "Contacts slower than this times v_n0 are held at h_min (resting contact)."),
+        "Contacts slower than this times v_n0 are held at h_min (resting contact); without "
+        "v_n0 > 0, times the largest initial sphere speed."),
     NUM("stop_when_separated", "-", "1", 0, 1, false, false,
         "1: stop once every pair is apart and receding; 0: run to t_end."),
     NUM("ref_i", "-", "1", 1, 8, false, false,
@@ -259,7 +260,7 @@ static void sweep_header(FILE* f, const struct wetdem_pairwise_config* cfg)
 
 static double star(const struct wetdem_pairwise_result* r, double t)
 {
-    return r->v_10 * t / (4.0 * r->a_ref);
+    return wetdem_pairwise_t_star(r, t);
 }
 
 /* One sweep row. A failed run writes its status, the steps and events it took, and "nan" or
@@ -292,8 +293,11 @@ static void summary_text(FILE* f, const struct wetdem_pairwise_result* r)
     if (r->separated_sphere >= 0)
         fprintf(f, " (sphere %d left)", r->separated_sphere + 1);
     fprintf(f, "\ntime               %.6g s  (t* = %.6g, t-hat = %.6g)\n", r->time,
-            star(r, r->time), r->v_n0 * r->time / r->delta_ref);
-    fprintf(f, "v_n0               %.6g m/s  (delta_12 = %.6g m)\n", r->v_n0, r->delta_ref);
+            star(r, r->time), wetdem_pairwise_t_hat(r, r->time));
+    fprintf(f, "v_n0               %.6g m/s  (delta_12 = %.6g m)%s\n", r->v_n0, r->delta_ref,
+            r->v_n0 > 0.0 ? ""
+                          : "; the reference pair does not approach at t = 0, so t-hat and e_w "
+                            "have no scale (nan)");
     fprintf(f, "events             %zu  (steps %llu, rhs %llu)\n", r->n_events, r->steps,
             r->rhs_evals);
     fprintf(f, "pair  e_w[-]     e_own[-]   contacts  mechanism\n");

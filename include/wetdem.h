@@ -673,7 +673,8 @@ struct wetdem_pairwise_config {
     double gravity_x, gravity_y; /* [m/s^2] */
     double t_end;                /* longest simulated time [s] > 0 */
     double rtol;                 /* relative tolerance of the integrator, (0, 1e-3]; 1e-9 */
-    double rest_speed_ratio;     /* contacts slower than this x v_n0 become resting [-]; 1e-3 */
+    double rest_speed_ratio;     /* contacts slower than this x v_n0 (without v_n0 > 0: x the
+                                    largest initial sphere speed) become resting [-]; 1e-3 */
     bool stop_when_separated;    /* stop once every pair is apart and receding (default true) */
     size_t ref_i, ref_j;         /* reference pair for v_n0, delta_12, t-hat, t* (default 0, 1) */
     size_t max_events;           /* event budget (default 100000) */
@@ -693,8 +694,8 @@ enum wetdem_pairwise_event_kind {
 struct wetdem_pairwise_event {
     enum wetdem_pairwise_event_kind kind;
     double time;   /* [s] */
-    double t_hat;  /* v_n0 t / delta_12 [-] (Davis Eq. 19) */
-    double t_star; /* v_10 t / 4a [-] */
+    double t_hat;  /* v_n0 t / delta_12 [-] (Davis Eq. 19); NAN without v_n0 > 0 */
+    double t_star; /* v_10 t / 4a [-]; NAN without v_10 > 0 */
     size_t i, j;   /* pair */
     size_t k, l;   /* partner change: the pair that left the tracked set; else = i, j */
     double gap;    /* h at the event [m] */
@@ -716,7 +717,8 @@ struct wetdem_pairwise_pair_result {
     unsigned n_contacts; /* hard-sphere impulses */
     double v_n_in;       /* normal approach speed when the films first overlapped [m/s] */
     double v_n_out;      /* normal separation speed at the last film separation [m/s] */
-    double e_wet;        /* Eq. 40: v_n_out / v_n0 (0 if bound, NAN if films never met) [-] */
+    double e_wet;        /* Eq. 40: v_n_out / v_n0 (0 if bound, NAN if films never met or
+                            v_n0 <= 0) [-] */
     double e_wet_own;    /* v_n_out / v_n_in (NAN if v_n_in <= 0 or films never met) [-] */
     double t_start;      /* first film overlap [s] (NAN if none) */
     double t_end;        /* last film separation [s] (NAN if none) */
@@ -735,7 +737,9 @@ struct wetdem_pairwise_result {
     int separated_sphere; /* PA with one sphere alone: its index; else -1 */
     struct wetdem_pairwise_sphere final[WETDEM_PAIRWISE_MAX_SPHERES]; /* state at the end */
     double time;                                                      /* time reached [s] */
-    double v_n0;      /* normal approach speed of the reference pair at t = 0 [m/s] */
+    double v_n0;      /* normal approach speed of the reference pair at t = 0 [m/s]: the
+                         scale of t-hat and e_wet, which are NAN when it is <= 0 (a pair at
+                         rest or receding, as in a cluster relaxing from rest) */
     double delta_ref; /* delta_12 of the reference pair [m] */
     double v_10;      /* speed of sphere ref_i at t = 0 [m/s] */
     double a_ref;     /* reduced radius a of the reference pair [m] */
@@ -803,6 +807,10 @@ WETDEM_API int wetdem_pairwise_run(struct wetdem_pairwise* pw,
 /* Borrowed view of the last run's event log; *n receives the count. */
 WETDEM_API const struct wetdem_pairwise_event*
 wetdem_pairwise_events(const struct wetdem_pairwise* pw, size_t* n);
+/* The scaled times of a run's time t [s]: t-hat = v_n0 t / delta_12 (Davis Eq. 19) and
+ * t* = v_10 t / 4a, NAN when their speed (res->v_n0, res->v_10) is not positive. */
+WETDEM_API double wetdem_pairwise_t_hat(const struct wetdem_pairwise_result* res, double t);
+WETDEM_API double wetdem_pairwise_t_star(const struct wetdem_pairwise_result* res, double t);
 /* Index of pair (i, j), i != j < n, in the per-pair arrays: (0,1), (0,2), ..., (1,2), ... */
 WETDEM_API size_t wetdem_pairwise_pair_index(size_t n, size_t i, size_t j);
 /* "film_start", "contact", "rest_start", "rest_end", "film_end", "partner_change". */

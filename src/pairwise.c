@@ -62,7 +62,7 @@ struct wetdem_pairwise {
     struct wetdem_pairwise_result* res;
     bool approaching[PW_PMAX];
     int reversal[PW_PMAX];
-    double v_ref, rest_speed, v_scale;
+    double rest_speed, v_scale;
     bool done;
 };
 
@@ -367,15 +367,24 @@ static bool interpolate(struct wetdem_pairwise* pw, double t, double* y)
 
 /* ---------------------------------------------------------------------- event log ---- */
 
+double wetdem_pairwise_t_hat(const struct wetdem_pairwise_result* res, double t)
+{
+    return (res->v_n0 > 0.0 && res->delta_ref > 0.0) ? res->v_n0 * t / res->delta_ref : NAN;
+}
+
+double wetdem_pairwise_t_star(const struct wetdem_pairwise_result* res, double t)
+{
+    return (res->v_10 > 0.0 && res->a_ref > 0.0) ? res->v_10 * t / (4.0 * res->a_ref) : NAN;
+}
+
 static double t_hat(const struct wetdem_pairwise* pw, double t)
 {
-    const struct wetdem_pairwise_result* r = pw->res;
-    return (r->v_n0 > 0.0 && r->delta_ref > 0.0) ? r->v_n0 * t / r->delta_ref : NAN;
+    return wetdem_pairwise_t_hat(pw->res, t);
 }
 
 static double t_star(const struct wetdem_pairwise* pw, double t)
 {
-    return pw->res->v_10 * t / (4.0 * pw->res->a_ref);
+    return wetdem_pairwise_t_star(pw->res, t);
 }
 
 static int log_event(struct wetdem_pairwise* pw, enum wetdem_pairwise_event_kind kind, size_t p,
@@ -783,7 +792,8 @@ static void classify(struct wetdem_pairwise* pw)
             r->bound ? WETDEM_OUTCOME_STICK
                      : (pw->reversal[p] == REV_IMPULSE ? WETDEM_OUTCOME_BOUNCE
                                                        : WETDEM_OUTCOME_STICK_ROTATE_SEPARATE);
-        r->e_wet = r->bound ? 0.0 : r->v_n_out / pw->v_ref;
+        /* (without an approach of the reference pair at t = 0, e_ij,w has no scale) */
+        r->e_wet = r->bound ? 0.0 : res->v_n0 > 0.0 ? r->v_n_out / res->v_n0 : NAN;
         r->e_wet_own = (r->bound ? 0.0 : r->v_n_out) / r->v_n_in;
         if (!(r->v_n_in > 0.0))
             r->e_wet_own = NAN;
@@ -839,8 +849,8 @@ static void initial_state(struct wetdem_pairwise* pw)
     for (size_t i = 0; i < sys->n; i++)
         v = fmax(v, fmax(hypot(k.ux[i], k.uy[i]), hypot(k.vx[i], k.vy[i])));
     pw->v_scale = v > 0.0 ? v : 1e-6;
-    pw->v_ref = res->v_n0 > 0.0 ? res->v_n0 : pw->v_scale;
-    pw->rest_speed = cfg->rest_speed_ratio * pw->v_ref;
+    /* (without an approach of the reference pair, the largest initial speed: Sec. 7) */
+    pw->rest_speed = cfg->rest_speed_ratio * (res->v_n0 > 0.0 ? res->v_n0 : pw->v_scale);
     memset(&pw->md, 0, sizeof pw->md);
     for (size_t p = 0; p < sys->n_pairs; p++) {
         struct wetdem_pairwise_pair_result* r = &res->pairs[p];

@@ -661,6 +661,59 @@ static void test_pairwise_outcome_full_agglomeration(void** state)
         assert_true(r.pairs[p].bound);
 }
 
+/* The scales of the outputs (docs/derivations/pairwise.md Sec. 9): e_ij,w = v_n_out / v_n0 and
+ * t-hat = v_n0 t / delta_12 with v_n0 the reference pair's approach speed at t = 0, t* =
+ * v_10 t / 4a with v_10 the speed of sphere ref_i. The head-on collision of head_on() with a
+ * third sphere at rest far off the line (its films never meet the others'): with the
+ * colliding pair as reference, e_w is v_n_out / v_n0 and t-hat v_n0 t / delta_12 (the same
+ * operations: exact); with a reference pair that does not approach (sphere 0 moves along x,
+ * sphere 2 lies on the y axis: v_n0 = 0) they have no scale and are NaN, while e_own keeps
+ * its own scale and the collision is the same (the third sphere exerts no force; 1e-6
+ * allows for the integrator, rtol 1e-9, taking other steps with a larger state); with an
+ * unmoving ref_i, t* is NaN too. */
+static void test_pairwise_scales_of_the_reference_pair(void** state)
+{
+    (void)state;
+    struct wetdem_pairwise_config two = head_on(10.0, 100e-6, 0.5), c = two;
+    c.n_spheres = 3;
+    c.spheres[2] = (struct wetdem_pairwise_sphere){
+        .radius = 2e-3, .mass = c.spheres[0].mass, .film = 50e-6, .y = 20e-3};
+    struct wetdem_pairwise_result r2, r;
+    struct wetdem_pairwise* pw;
+    CHECK_OK(run(&two, &r2, NULL));
+    CHECK_OK(run(&c, &r, &pw));
+    const struct wetdem_pairwise_pair_result* p = &r.pairs[wetdem_pairwise_pair_index(3, 0, 1)];
+    assert_true(p->films_met && !p->bound && r.v_n0 == 0.5);
+    assert_true(p->e_wet == p->v_n_out / r.v_n0);
+    CHECK_REL(p->e_wet_own, r2.pairs[0].e_wet_own, 1e-6);
+    const struct wetdem_pairwise_event* ev = find_event(pw, WETDEM_PAIRWISE_CONTACT, 0);
+    assert_non_null(ev);
+    assert_true(ev->t_hat == r.v_n0 * ev->time / r.delta_ref);
+    assert_true(ev->t_star == r.v_10 * ev->time / (4.0 * r.a_ref));
+    wetdem_pairwise_free(pw);
+
+    c.ref_i = 0;
+    c.ref_j = 2;
+    CHECK_OK(run(&c, &r, &pw));
+    p = &r.pairs[wetdem_pairwise_pair_index(3, 0, 1)];
+    assert_true(r.v_n0 == 0.0 && p->films_met && !p->bound);
+    assert_true(isnan(p->e_wet));
+    CHECK_REL(p->e_wet_own, r2.pairs[0].e_wet_own, 1e-6);
+    ev = find_event(pw, WETDEM_PAIRWISE_CONTACT, 0);
+    assert_non_null(ev);
+    assert_true(isnan(ev->t_hat) && isnan(wetdem_pairwise_t_hat(&r, r.time)));
+    assert_true(ev->t_star == r.v_10 * ev->time / (4.0 * r.a_ref) && ev->t_star > 0.0);
+    wetdem_pairwise_free(pw);
+
+    c.ref_i = 2; /* an unmoving first sphere: no v_10 either */
+    c.ref_j = 0;
+    CHECK_OK(run(&c, &r, &pw));
+    ev = find_event(pw, WETDEM_PAIRWISE_CONTACT, 0);
+    assert_non_null(ev);
+    assert_true(r.v_10 == 0.0 && isnan(ev->t_star) && isnan(wetdem_pairwise_t_star(&r, r.time)));
+    wetdem_pairwise_free(pw);
+}
+
 /* Two spheres: bounce (reversed by the impulse), stick-rotate-separate (no contact: the
  * doublet turns and the centrifugal force pulls it apart, St_n = 1.2 at 60 deg without
  * capillarity) and stick (head-on below the critical Stokes number, above). */
@@ -870,6 +923,7 @@ int main(void)
         cmocka_unit_test(test_pairwise_outcome_full_separation),
         cmocka_unit_test(test_pairwise_outcome_partial),
         cmocka_unit_test(test_pairwise_outcome_full_agglomeration),
+        cmocka_unit_test(test_pairwise_scales_of_the_reference_pair),
         cmocka_unit_test(test_pairwise_two_sphere_mechanisms),
         cmocka_unit_test(test_pairwise_tree_change_keeps_spheres),
         cmocka_unit_test(test_pairwise_partner_change_logged),
