@@ -7,6 +7,7 @@
  * computed as 10^(log10 A + (log10 B - log10 A) k/(N - 1)) so that decades come out as the
  * round numbers they are; k = 0..N-1, with x_0 = A and x_{N-1} = B returned exactly.
  */
+#include <ctype.h>
 #include <errno.h>
 #include <math.h>
 #include <stdarg.h>
@@ -27,16 +28,42 @@ void cli_error(const char* fmt, ...)
     va_end(ap);
 }
 
-int cli_parse_double(const char* text, const char* what, double* out)
+int cli_number(const char* text, double* out)
 {
+    /* [+-] digits [. digits] [(e|E) [+-] digits], with at least one digit before the exponent */
+    const char* p = text;
+    size_t mantissa = 0;
+    p += *p == '+' || *p == '-';
+    for (; isdigit((unsigned char)*p); p++)
+        mantissa++;
+    if (*p == '.')
+        for (p++; isdigit((unsigned char)*p); p++)
+            mantissa++;
+    if (mantissa && (*p == 'e' || *p == 'E')) {
+        p++;
+        p += *p == '+' || *p == '-';
+        if (!isdigit((unsigned char)*p))
+            return -1;
+        while (isdigit((unsigned char)*p))
+            p++;
+    }
+    if (!mantissa || *p != '\0')
+        return -1;
     char* end = NULL;
     errno = 0;
     double v = strtod(text, &end);
-    if (end == text || *end != '\0' || !isfinite(v) || errno == ERANGE) {
+    if (end != p || errno == ERANGE || !isfinite(v))
+        return -1;
+    *out = v;
+    return 0;
+}
+
+int cli_parse_double(const char* text, const char* what, double* out)
+{
+    if (cli_number(text, out) != 0) {
         cli_error("%s: '%s' is not a finite number", what, text);
         return CLI_EXIT_USAGE;
     }
-    *out = v;
     return CLI_EXIT_OK;
 }
 

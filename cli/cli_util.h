@@ -27,7 +27,13 @@ struct cli_range {
 /* Prints "wetdem: " followed by the printf-style message and a newline to stderr. */
 void cli_error(const char* fmt, ...) __attribute__((format(printf, 1, 2)));
 
-/* Parses `text` as one finite number (the whole string, no trailing characters). `what`
+/* Parses the whole of `text` as one finite number in plain decimal or exponent notation
+ * ("6.35e-3", "-2", "+.5E4": the syntax docs/scenarios.md gives; not hexadecimal, "inf" or
+ * "nan", which strtod would also take, nor a value beyond the range of a double). 0 and *out
+ * set, or -1. */
+int cli_number(const char* text, double* out);
+
+/* Parses `text` as one finite number (cli_number). `what`
  * names the option in the error message, e.g. "--speed". Returns CLI_EXIT_OK and sets *out,
  * or prints an error and returns CLI_EXIT_USAGE. */
 int cli_parse_double(const char* text, const char* what, double* out);

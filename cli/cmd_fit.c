@@ -18,6 +18,7 @@
  * built serially beforehand, so results do not depend on the thread count.
  * Exit codes: 0 ok, 1 runtime error or no convergence, 2 bad options, data or scenario.
  */
+#include <ctype.h>
 #include <errno.h>
 #include <math.h>
 #include <omp.h>
@@ -193,10 +194,9 @@ static int read_value(const char* path, long line, char** f, int n, const int co
         return CLI_EXIT_USAGE;
     }
     const char* t = f[col[c]];
-    char* end;
-    errno = 0;
-    *v = strtod(t, &end);
-    bool ok = end != t && *end == '\0' && isfinite(*v) && errno != ERANGE;
+    while (isspace((unsigned char)*t)) /* (a space after the comma) */
+        t++;
+    bool ok = cli_number(t, v) == 0;
     const char* why = "a finite number";
     if (ok && c == COL_STOKES && !(*v > 0))
         ok = false, why = "a Stokes number > 0";

@@ -214,13 +214,7 @@ const char* cli_scenario_text(const struct cli_scenario* sc, const char* section
 
 int cli_parse_number_text(const char* text, double* out)
 {
-    char* end = NULL;
-    errno = 0;
-    double v = strtod(text, &end);
-    if (end == text || *end != '\0' || errno == ERANGE || !isfinite(v))
-        return -1;
-    *out = v;
-    return 0;
+    return cli_number(text, out);
 }
 
 /* Checks a number against a descriptor; on failure prints the message and returns 2. */
@@ -229,8 +223,10 @@ static int check_number(const struct cli_scenario* sc, const struct cli_entry* e
 {
     double v;
     if (cli_parse_number_text(e->value, &v) != 0) {
-        cli_scenario_error(sc, e, "not a finite number%s%s%s", d->unit[0] ? " [" : "", d->unit,
-                           d->unit[0] ? "]" : "");
+        cli_scenario_error(sc, e,
+                           "not a finite number%s%s%s (decimal or exponent notation, "
+                           "e.g. 6.35e-3)",
+                           d->unit[0] ? " [" : "", d->unit, d->unit[0] ? "]" : "");
         return CLI_EXIT_USAGE;
     }
     char msg[512];

@@ -167,6 +167,12 @@ static void test_scenario_bad_files_exit_2_with_line(void** state)
         {"key", "[collision]\nstokse = 5\n", ":2:", "did you mean 'stokes'"},
         {"nan", "[collision]\n\nstokes = nan\n", ":3:", "not a finite number"},
         {"inf", "[collision]\nspeed = inf\n", ":2:", "not a finite number"},
+        /* only decimal or exponent notation (docs/scenarios.md): strtod alone would read 16
+           here, and 1e-400 would underflow to 0 */
+        {"hex", "[collision]\nspeed = 0x10\n", ":2:", "decimal or exponent notation"},
+        {"comma", "[collision]\nspeed = 0,5\n", ":2:", "not a finite number"},
+        {"underflow", "[collision]\nspeed = 1e-400\n", ":2:", "not a finite number"},
+        {"exponent", "[collision]\nspeed = 5e\n", ":2:", "not a finite number"},
         {"radius", "[collision]\nstokes = 5\nstriker_radius = -0.01\n", ":3:", "out of range"},
         {"angle", "[collision]\nstokes = 5\nangle_deg = 90\n", ":3:", "valid [0, 90)"},
         {"duplicate", "[collision]\nstokes = 5\nstokes = 6\n", ":3:", "given twice"},
