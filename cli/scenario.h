@@ -157,6 +157,10 @@ double cli_stokes_speed(double stokes_n, double viscosity, double m_eff, double 
 /* ---- internal: building blocks of the soft-engine and many-particle builders
  * (scenario_build.c, used by scenario_many.c) ---- */
 
+/* An [integrator] key p that no parameter matches, if it is close to `name` (as "nam"):
+ * reported with that hint and CLI_EXIT_USAGE returned; else CLI_EXIT_OK (nothing printed). */
+int cli_scenario_integrator_name_typo(const struct cli_scenario* sc, const struct cli_entry* p);
+
 /* Prints the library's message of sim against entry e (or against [section] when e is NULL)
  * and returns CLI_EXIT_USAGE. */
 int cli_scenario_lib_error(const struct cli_scenario* sc, const struct cli_entry* e,

@@ -63,9 +63,16 @@ int cli_scenario_material_section(const struct cli_scenario* sc, const char* sec
     const struct cli_entry* p = cli_scenario_find(sc, section, "preset");
     wetdem_param_init_defaults(wetdem_material_params(), m);
     if (p && wetdem_material_preset(p->value, m) != WETDEM_OK) {
-        const char* hint = wetdem_param_suggest(p->value, wetdem_material_preset_names());
-        cli_scenario_error(sc, p, "unknown material preset%s%s%s", hint ? " (did you mean '" : "",
-                           hint ? hint : "", hint ? "'?)" : "");
+        const char* const* names = wetdem_material_preset_names();
+        const char* hint = wetdem_param_suggest(p->value, names);
+        char list[512] = "";
+        for (size_t k = 0, used = 0; !hint && names[k] && used < sizeof list; k++)
+            used +=
+                (size_t)snprintf(list + used, sizeof list - used, "%s%s", k ? ", " : "", names[k]);
+        if (hint)
+            cli_scenario_error(sc, p, "unknown material preset (did you mean '%s'?)", hint);
+        else
+            cli_scenario_error(sc, p, "unknown material preset; the presets are %s", list);
         return CLI_EXIT_USAGE;
     }
     const struct wetdem_param_desc* d = wetdem_material_params();
@@ -222,6 +229,15 @@ static bool other_integrator_has(const char* chosen, const char* key)
     return found;
 }
 
+int cli_scenario_integrator_name_typo(const struct cli_scenario* sc, const struct cli_entry* p)
+{
+    static const char* const name_key[] = {"name", NULL};
+    if (strcmp(p->section, "integrator") != 0 || !wetdem_param_suggest(p->key, name_key))
+        return CLI_EXIT_OK;
+    cli_scenario_error(sc, p, "unknown key '%s' in [integrator] (did you mean 'name'?)", p->key);
+    return CLI_EXIT_USAGE;
+}
+
 /* [integrator] name and parameters ("<name>.<key>"), [sim] settings ("sim.<key>").
  * Parameters of an integrator other than the chosen one are skipped, so a file tuned for
  * cvode also runs with --set integrator.name=verlet; a key no integrator has is an error. */
@@ -247,7 +263,9 @@ static int build_integrator(const struct cli_scenario* sc, struct wetdem_sim* si
             other_integrator_has(name, p->key))
             continue; /* a parameter of the integrator not chosen (e.g. --set name=verlet) */
         if (wetdem_sim_set_param_str(sim, full, p->value) != WETDEM_OK)
-            return cli_scenario_lib_error(sc, p, p->section, sim);
+            return cli_scenario_integrator_name_typo(sc, p) != CLI_EXIT_OK
+                       ? CLI_EXIT_USAGE
+                       : cli_scenario_lib_error(sc, p, p->section, sim);
     }
     return CLI_EXIT_OK;
 }

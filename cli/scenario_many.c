@@ -227,7 +227,9 @@ static int build_settings(const struct cli_scenario* sc, struct wetdem_sim* sim)
         char full[2 * CLI_NAME_MAX];
         snprintf(full, sizeof full, "%s.%s", integ ? "verlet" : "sim", p->key);
         if (wetdem_sim_set_param_str(sim, full, p->value) != WETDEM_OK)
-            return cli_scenario_lib_error(sc, p, p->section, sim);
+            return cli_scenario_integrator_name_typo(sc, p) != CLI_EXIT_OK
+                       ? CLI_EXIT_USAGE
+                       : cli_scenario_lib_error(sc, p, p->section, sim);
     }
     return CLI_EXIT_OK;
 }
