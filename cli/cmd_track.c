@@ -202,10 +202,11 @@ int cmd_track(int argc, char** argv)
     }
     struct wetdem_track_summary s;
     int st = wetdem_track_read_csv(t, c.input);
-    if (st == WETDEM_OK)
+    bool read = st == WETDEM_OK; /* (the reader's messages name the file and line already) */
+    if (read)
         st = wetdem_track_analyse(t, &c.opt, &s);
     if (st != WETDEM_OK) {
-        cli_error("track: %s", wetdem_track_errmsg(t));
+        cli_error("track: %s%s%s", read ? c.input : "", read ? ": " : "", wetdem_track_errmsg(t));
         wetdem_track_free(t);
         return st == WETDEM_ERR_NOMEM ? CLI_EXIT_RUNTIME : CLI_EXIT_USAGE;
     }

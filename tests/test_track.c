@@ -721,6 +721,15 @@ static void test_track_cli_exits_2_with_line_number(void** state)
     remove(path);
     assert_int_equal(rc, 2);
     CHECK_CONTAINS(out, ":3: sphere 1: frame 2 follows frame 0");
+    /* a track that reads but cannot be analysed (sphere 2 one frame short): the file named */
+    path = write_temp("frame,sphere,x1,y1,x2,y2,x3,y3\n0,1,1,1,2,2,3,3\n1,1,1,1,2,2,3,3\n"
+                      "0,2,9,9,8,8,7,7\n");
+    rc = test_run_cli_into(args, out, sizeof out);
+    remove(path);
+    assert_int_equal(rc, 2);
+    char expect[600];
+    snprintf(expect, sizeof expect, "track: %s: sphere 1 covers frames 0 to 1", path);
+    CHECK_CONTAINS(out, expect);
     /* --help anywhere prints the usage and succeeds, also before the required options. */
     assert_int_equal(test_run_cli_into("track --help", out, sizeof out), 0);
     CHECK_CONTAINS(out, "usage: wetdem track DOTS.csv --fps F --pixel-size S");
