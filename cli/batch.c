@@ -55,8 +55,15 @@ static int build_all(const struct cli_scenario* base, struct cli_batch* b)
             rest /= b->range[d].n;
         }
         int rc = build_point(base, b, p);
-        if (rc != CLI_EXIT_OK)
+        if (rc != CLI_EXIT_OK) { /* (the message above is about the file with these values) */
+            char at[600];
+            int used = 0;
+            for (int d = 0; d < b->n_keys && used < (int)sizeof at; d++)
+                used += snprintf(at + used, sizeof at - (size_t)used, "%s%s = %.17g", d ? ", " : "",
+                                 b->key[d], p->value[d]);
+            cli_error("%s: at point %zu of %zu of the values: %s", b->cmd, k + 1, b->n_pts, at);
             return rc;
+        }
     }
     return CLI_EXIT_OK;
 }

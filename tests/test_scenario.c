@@ -345,6 +345,7 @@ static void test_scenario_sweep_order_and_threads(void** state)
     struct test_run r = run_cli(cmd);
     assert_int_equal(r.code, 2);
     CHECK_CONTAINS(r.out, "angle_deg");
+    CHECK_CONTAINS(r.out, "sweep: at point 3 of 3 of the values: collision.angle_deg = 120");
     free(r.out);
     assert_false(exists(tmpdir, "sweep.csv"));
     /* --out into a directory that does not exist yet: it is created, the table written whole */
