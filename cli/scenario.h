@@ -171,6 +171,9 @@ int cli_scenario_build_fluid(const struct cli_scenario* sc, struct wetdem_sim* s
  * given; checked with wetdem_material_validate. Returns an exit code. */
 int cli_scenario_material_section(const struct cli_scenario* sc, const char* section,
                                   struct wetdem_material* m);
+/* Every [material.NAME] section checked as cli_scenario_material_section does, also those no
+ * sphere uses (a mistake there is one too): an exit code, the message printed. */
+int cli_scenario_check_materials(const struct cli_scenario* sc);
 /* Every [model.NAME] key as the parameter NAME.key of sim's enabled model NAME (an error when
  * NAME is not enabled). Returns an exit code. */
 int cli_scenario_set_model_params(const struct cli_scenario* sc, struct wetdem_sim* sim);

@@ -89,6 +89,19 @@ int cli_scenario_material_section(const struct cli_scenario* sc, const char* sec
     return CLI_EXIT_OK;
 }
 
+int cli_scenario_check_materials(const struct cli_scenario* sc)
+{
+    for (size_t k = 0; k < sc->n_sections; k++) {
+        struct wetdem_material m;
+        int rc = strncmp(sc->sections[k].name, "material.", 9) == 0
+                     ? cli_scenario_material_section(sc, sc->sections[k].name, &m)
+                     : CLI_EXIT_OK;
+        if (rc != CLI_EXIT_OK)
+            return rc;
+    }
+    return CLI_EXIT_OK;
+}
+
 int cli_scenario_set_model_params(const struct cli_scenario* sc, struct wetdem_sim* sim)
 {
     for (size_t k = 0; k < sc->n_entries; k++) {
@@ -357,6 +370,7 @@ int cli_scenario_build(const struct cli_scenario* sc, struct cli_setup* su)
     struct wetdem_material mi, mj;
     int rc;
     if ((rc = cli_scenario_build_fluid(sc, su->sim)) != CLI_EXIT_OK ||
+        (rc = cli_scenario_check_materials(sc)) != CLI_EXIT_OK ||
         (rc = build_materials(sc, su, &mi, &mj)) != CLI_EXIT_OK ||
         (rc = build_models(sc, su->sim)) != CLI_EXIT_OK ||
         (rc = build_integrator(sc, su->sim)) != CLI_EXIT_OK ||

@@ -671,6 +671,7 @@ int cli_many_build(const struct cli_scenario* sc, struct cli_many_setup* su)
     unsigned faces = 0;
     int rc;
     if ((rc = cli_scenario_build_fluid(sc, su->sim)) != CLI_EXIT_OK ||
+        (rc = cli_scenario_check_materials(sc)) != CLI_EXIT_OK ||
         (rc = build_models(sc, su->sim)) != CLI_EXIT_OK ||
         (rc = build_settings(sc, su->sim)) != CLI_EXIT_OK ||
         (rc = build_box(sc, su)) != CLI_EXIT_OK ||
