@@ -175,6 +175,9 @@ static void test_scenario_bad_files_exit_2_with_line(void** state)
         {"exponent", "[collision]\nspeed = 5e\n", ":2:", "not a finite number"},
         {"preset", "[collision]\nstokes = 5\nstriker = m\n[material.m]\npreset = zzz\n",
          ":5:", "the presets are steel1, steel2"},
+        /* a material no sphere uses is checked all the same */
+        {"unused", "[collision]\nstokes = 5\n[material.spare]\npreset = zzz\n",
+         ":4:", "unknown material preset"},
         {"integrator", "[collision]\nstokes = 5\n[integrator]\nnam = cvode\n",
          ":4:", "unknown key 'nam' in [integrator] (did you mean 'name'?)"},
         {"radius", "[collision]\nstokes = 5\nstriker_radius = -0.01\n", ":3:", "out of range"},
