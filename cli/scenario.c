@@ -25,8 +25,6 @@
 #include "cli_util.h"
 #include "scenario.h"
 
-#define LINE_MAX_CHARS 200 /* inih's INI_MAX_LINE: 196 characters + "\r\n\0" + 1 */
-
 /* ---- small string helpers ---- */
 
 static void copy_text(char* dst, size_t n, const char* src)
@@ -422,6 +420,9 @@ struct reader {
     int line;
     int n_errors;
     bool out_of_memory;
+    int read_errno; /* a read error (e.g. EISDIR: the path is a directory), else 0 */
+    char* buf;      /* the physical line (getline) */
+    size_t cap;
 };
 
 /* Records a "[name]" header line (inih reports malformed ones itself). */
@@ -446,24 +447,51 @@ static void note_section(struct reader* r, const char* text)
         r->out_of_memory = true;
 }
 
-/* inih reader: one line per call, counted; an over-long line is reported and skipped. */
+/* The length of line s without its comment: a whole-line comment (';' or '#' first) or an
+ * inline one (' ;' or ' #': the character after white space), and the white space before. */
+static size_t without_comment(const char* s, size_t len)
+{
+    size_t k = 0;
+    while (k < len && isspace((unsigned char)s[k]))
+        k++;
+    if (k < len && (s[k] == ';' || s[k] == '#'))
+        return 0;
+    for (; k < len; k++)
+        if ((s[k] == ';' || s[k] == '#') && k > 0 && isspace((unsigned char)s[k - 1]))
+            break;
+    while (k > 0 && isspace((unsigned char)s[k - 1]))
+        k--;
+    return k;
+}
+
+/* inih reader: one line per call, counted, given to inih without its comment (inih's lines
+ * hold num - 1 characters, which long comments would exceed); a line longer than that
+ * without its comment is reported and skipped. */
 static char* read_line(char* str, int num, void* stream)
 {
     struct reader* r = stream;
-    if (!fgets(str, num, r->f))
+    ssize_t got = getline(&r->buf, &r->cap, r->f);
+    if (got < 0) {
+        if (ferror(r->f))
+            r->read_errno = errno ? errno : EIO;
         return NULL;
-    r->line++;
-    size_t len = strlen(str);
-    if (len > 0 && str[len - 1] != '\n' && !feof(r->f)) {
-        int c;
-        while ((c = fgetc(r->f)) != EOF && c != '\n')
-            ;
-        fprintf(stderr, "%s:%d: line longer than %d characters\n", r->sc->file, r->line,
-                LINE_MAX_CHARS - 4);
-        r->n_errors++;
-        str[0] = '\0';
-        return str;
     }
+    r->line++;
+    const char* text = r->buf;
+    if (r->line == 1 && got >= 3 && memcmp(text, "\xef\xbb\xbf", 3) == 0) { /* a UTF-8 BOM */
+        text += 3;
+        got -= 3;
+    }
+    size_t len = without_comment(text, (size_t)got);
+    if (len + 2 > (size_t)num) { /* (room for "\n" and the terminating '\0') */
+        fprintf(stderr, "%s:%d: line longer than %d characters without its comment\n", r->sc->file,
+                r->line, num - 2);
+        r->n_errors++;
+        len = 0;
+    }
+    memcpy(str, text, len);
+    str[len] = '\n';
+    str[len + 1] = '\0';
     note_section(r, str);
     return str;
 }
@@ -501,9 +529,14 @@ int cli_scenario_load(const char* path, struct cli_scenario* sc)
     }
     int bad_line = ini_parse_stream(read_line, &r, on_pair, &r);
     fclose(r.f);
-    if (r.out_of_memory || bad_line == -2) {
+    free(r.buf);
+    if (r.read_errno == ENOMEM || r.out_of_memory || bad_line == -2) {
         cli_error("%s: out of memory reading the scenario", path);
         return CLI_EXIT_RUNTIME;
+    }
+    if (r.read_errno) {
+        cli_error("%s: cannot read scenario file: %s", path, strerror(r.read_errno));
+        return CLI_EXIT_USAGE;
     }
     int rc = r.n_errors ? CLI_EXIT_USAGE : CLI_EXIT_OK;
     if (bad_line > 0) {
@@ -602,5 +635,11 @@ int cli_load_with_overrides(const char* file, const char* const* sets, int n_set
     int rc = cli_scenario_load(file, sc);
     for (int k = 0; rc == CLI_EXIT_OK && k < n_sets; k++)
         rc = cli_scenario_override(sc, sets[k]);
+    if (rc == CLI_EXIT_OK && sc->n_sections == 0 && sc->n_entries == 0) { /* (no --set) */
+        cli_error("%s: no [section] in the file: a scenario has [section] headers and "
+                  "'key = value' lines (docs/scenarios.md)",
+                  file);
+        rc = CLI_EXIT_USAGE;
+    }
     return rc;
 }

@@ -192,6 +192,17 @@ static void test_scenario_bad_files_exit_2_with_line(void** state)
         {"notenabled", "[collision]\nstokes = 5\n[model.nijssen]\ncutoff_ratio = 2\n",
          ":4:", "not enabled"},
         {"nospeed", "[collision]\nstriker = delrin\n", ":1:", "speed > 0"},
+        /* a value of 300 characters (a comment of any length is fine: see below) */
+        {"long",
+         "[collision]\nstokes = 5\nstriker = "
+         "aaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaa"
+         "a"
+         "aaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaa"
+         "a"
+         "aaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaa"
+         "a"
+         "aaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaa\n",
+         ":3:", "line longer than 198 characters without its comment"},
         /* two spheres of radius 1 mm 1.5 mm apart overlap: reported at the second section, with
          * the spheres counted from 1 in file order as the CLI and output columns count them */
         {"overlap",
@@ -216,6 +227,38 @@ static void test_scenario_bad_files_exit_2_with_line(void** state)
     struct test_run r = run_cli("run /nonexistent/scenario.ini");
     assert_int_equal(r.code, 2);
     CHECK_CONTAINS(r.out, "cannot open scenario file");
+    free(r.out);
+    r = run_cli("run /tmp --check"); /* a directory opens, but does not read */
+    assert_int_equal(r.code, 2);
+    CHECK_CONTAINS(r.out, "/tmp: cannot read scenario file");
+    free(r.out);
+    char args[700];
+    snprintf(args, sizeof args, "run '%s' --check", write_file("bad_empty.ini", "; nothing\n"));
+    r = run_cli(args);
+    assert_int_equal(r.code, 2);
+    CHECK_CONTAINS(r.out, "no [section] in the file");
+    free(r.out);
+}
+
+/* What a file written elsewhere brings, accepted: a UTF-8 byte-order mark, CR LF line ends and
+ * comments longer than a line may be (whole-line and inline, ';' and '#'); the values are
+ * those without them. */
+static void test_scenario_boms_crlf_and_long_comments(void** state)
+{
+    (void)state;
+    char text[4096], comment[1200];
+    memset(comment, 'c', sizeof comment - 1);
+    comment[sizeof comment - 1] = '\0';
+    snprintf(text, sizeof text,
+             "\xef\xbb\xbf; %s\r\n[collision]   ; %s\r\nstokes = 7.5 # %s\r\nstriker = "
+             "glass\r\n",
+             comment, comment, comment);
+    char args[700];
+    snprintf(args, sizeof args, "run '%s' --check", write_file("windows.ini", text));
+    struct test_run r = run_cli(args);
+    if (r.code != 0)
+        fail_msg("exit %d\n%s", r.code, r.out);
+    CHECK_CONTAINS(r.out, "stokes_n      7.5 -");
     free(r.out);
 }
 
@@ -484,6 +527,7 @@ int main(void)
         cmocka_unit_test(test_scenario_stokes_gives_speed),
         cmocka_unit_test(test_scenario_set_overrides),
         cmocka_unit_test(test_scenario_bad_files_exit_2_with_line),
+        cmocka_unit_test(test_scenario_boms_crlf_and_long_comments),
         cmocka_unit_test(test_scenario_docs_list_every_key),
         cmocka_unit_test(test_scenario_run_writes_files_or_nothing),
         cmocka_unit_test(test_scenario_sweep_order_and_threads),
