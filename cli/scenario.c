@@ -482,6 +482,12 @@ static char* read_line(char* str, int num, void* stream)
         text += 3;
         got -= 3;
     }
+    if (memchr(text, '\0', (size_t)got)) { /* a binary file: one message, not one a line */
+        fprintf(stderr, "%s:%d: a NUL byte: not a text (INI) scenario file\n", r->sc->file,
+                r->line);
+        r->n_errors++;
+        return NULL;
+    }
     size_t len = without_comment(text, (size_t)got);
     if (len + 2 > (size_t)num) { /* (room for "\n" and the terminating '\0') */
         fprintf(stderr, "%s:%d: line longer than %d characters without its comment\n", r->sc->file,
@@ -527,6 +533,15 @@ int cli_scenario_load(const char* path, struct cli_scenario* sc)
         cli_error("%s: cannot open scenario file: %s", path, strerror(errno));
         return CLI_EXIT_USAGE;
     }
+    char head[4096]; /* a binary file: said so at once, not as a malformed line after another */
+    size_t n_head = fread(head, 1, sizeof head, r.f);
+    if (memchr(head, '\0', n_head)) {
+        fclose(r.f);
+        cli_error("%s: a NUL byte in its first %zu bytes: not a text (INI) scenario file", path,
+                  n_head);
+        return CLI_EXIT_USAGE;
+    }
+    rewind(r.f);
     int bad_line = ini_parse_stream(read_line, &r, on_pair, &r);
     fclose(r.f);
     free(r.buf);

@@ -228,6 +228,11 @@ static void test_scenario_bad_files_exit_2_with_line(void** state)
     assert_int_equal(r.code, 2);
     CHECK_CONTAINS(r.out, "cannot open scenario file");
     free(r.out);
+    r = run_cli("run build/libwetdem.a --check"); /* a binary file: one message */
+    assert_int_equal(r.code, 2);
+    CHECK_CONTAINS(r.out, "build/libwetdem.a: a NUL byte in its first 4096 bytes: not a text");
+    assert_null(strchr(strchr(r.out, '\n') + 1, '\n')); /* (that line only) */
+    free(r.out);
     r = run_cli("run /tmp --check"); /* a directory opens, but does not read */
     assert_int_equal(r.code, 2);
     CHECK_CONTAINS(r.out, "/tmp: cannot read scenario file");
