@@ -237,6 +237,11 @@ static int read_data(const char* path, struct point** out, size_t* n_out)
     bool have_header = false;
     size_t n = 0;
     for (long line = 1; rc == CLI_EXIT_OK && fgets(buf, sizeof buf, fp); line++) {
+        if (!strchr(buf, '\n') && !feof(fp)) { /* (its rest would be read as another line) */
+            cli_error("%s:%ld: line longer than %zu characters", path, line, sizeof buf - 2);
+            rc = CLI_EXIT_USAGE;
+            break;
+        }
         char* s = buf + strspn(buf, " \t");
         if (*s == '#' || *s == '\n' || *s == '\r' || *s == '\0')
             continue;
@@ -250,6 +255,10 @@ static int read_data(const char* path, struct point** out, size_t* n_out)
         } else {
             rc = read_row(path, line, f, nf, col, &pts[n++]);
         }
+    }
+    if (rc == CLI_EXIT_OK && ferror(fp)) { /* (e.g. a directory: it opens, but does not read) */
+        cli_error("%s: cannot read data file: %s", path, strerror(errno));
+        rc = CLI_EXIT_USAGE;
     }
     fclose(fp);
     if (rc == CLI_EXIT_OK && n == 0) {

@@ -326,6 +326,8 @@ int wetdem_track_read_csv(struct wetdem_track* track, const char* path)
         if (st != WETDEM_OK)
             st = located(track, st, path, line);
     }
+    if (st == WETDEM_OK && ferror(fp)) /* (e.g. a directory: it opens, but does not read) */
+        st = fail(track, WETDEM_ERR_IO, "%s: cannot read: %s", path, strerror(errno));
     fclose(fp);
     if (st == WETDEM_OK && track->n_spheres == 0)
         st = fail(track, WETDEM_ERR_PARSE, "%s: no data rows", path);

@@ -270,6 +270,17 @@ static void test_fit_cli_rejects_bad_input(void** state)
     expect_cli(args, 2, ":2: 1 columns, but column e_n is number 2");
     temp_csv(bad, "bad", "stokes,e_n\n2,0.5\n");
     expect_cli(args, 2, ":1: the header must name columns stokes_n and e_n");
+    /* a line longer than the reader's buffer is an error, not read as two lines */
+    static char long_line[6000];
+    int used = snprintf(long_line, sizeof long_line, "# ");
+    memset(long_line + used, 'x', 5000);
+    snprintf(long_line + used + 5000, sizeof long_line - (size_t)used - 5000,
+             "\nstokes_n,e_n\n2,0.5\n3,0.6\n");
+    temp_csv(bad, "bad", long_line);
+    expect_cli(args, 2, ":1: line longer than 4094 characters");
+    snprintf(args, sizeof args, "fit %s --data /tmp --fit glass.p_gt", ini);
+    expect_cli(args, 2, "/tmp: cannot read data file: Is a directory");
+    snprintf(args, sizeof args, "fit %s --data %s --fit glass.p_gt", ini, bad);
     snprintf(args, sizeof args, "fit %s --data %s --fit glass.p_g", ini, good);
     expect_cli(args, 2, "unknown key 'p_g' in [model.glass] (did you mean 'p_gt'?)");
     snprintf(args, sizeof args, "fit %s --data %s --fit glas.p_gt", ini, good);

@@ -650,6 +650,12 @@ static void expect_read_error(const char* text, int status, const char* needle)
 static void test_track_rejects_malformed_files(void** state)
 {
     (void)state;
+    { /* a directory opens, but does not read */
+        struct wetdem_track* t = wetdem_track_create();
+        CHECK_STATUS(wetdem_track_read_csv(t, "/tmp"), WETDEM_ERR_IO);
+        CHECK_CONTAINS(wetdem_track_errmsg(t), "/tmp: cannot read: Is a directory");
+        wetdem_track_free(t);
+    }
     const char* head = "frame,sphere,x1,y1,x2,y2,x3,y3\n";
     char buf[512];
     snprintf(buf, sizeof buf, "%s0,1,1,1,2,2,3,3\n1,1,1,1,2,2,3\n", head);
