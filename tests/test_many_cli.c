@@ -11,7 +11,8 @@
  *   - SIGINT sent to a running CLI writes a checkpoint, exits 130 and prints the command that
  *     resumes it; resuming gives the uninterrupted run's files byte for byte;
  *   - progress goes to stderr only when it is a terminal, with an estimate of the time left;
- *   - the example scenarios check, and the summary's energy budget adds up.
+ *   - the example scenarios check, and the summary's energy budget adds up; a run whose budget
+ *     does not close (a step too long for the contacts) says so and exits 1.
  *
  * The runs use one OpenMP thread (results are bit-identical for a given thread count, and one
  * thread is the fastest for 150 spheres on a shared machine) and the passive wait policy.
@@ -384,6 +385,14 @@ static void test_many_cli_examples_and_budget(void** state)
     assert_true(v[4] > 0);                              /* damping and films took energy */
     CHECK_CONTAINS(js, ", \"energy_J\": {\"input\": "); /* fields separated as JSON wants */
     free(js);
+    /* a step too long for the contacts (20 us, about a sixth of the contact time): the budget
+       closes to only 0.09 (2e-4 at 2 us), the run says so and exits 1, its files written */
+    assert_int_equal(run_cli("run budget.ini --set run.steps=300 --set run.dt=2e-5 --out long"), 1);
+    char* err = stderr_text();
+    CHECK_CONTAINS(err, "the energy budget does not close (error 0.09");
+    CHECK_CONTAINS(err, "the step dt = 2e-05 s is too long for these contacts; halve it");
+    free(err);
+    assert_true(exists("long/summary.json") && exists("long/global.csv"));
 }
 
 static int setup(void** state)
