@@ -44,6 +44,17 @@ static int build_point(const struct cli_scenario* base, const struct cli_batch* 
     return rc;
 }
 
+/* "KEY = VALUE[, KEY2 = VALUE2]" of point p into buf. */
+static void point_values(const struct cli_batch* b, const struct cli_batch_point* p, char* buf,
+                         size_t n)
+{
+    size_t used = 0;
+    buf[0] = '\0';
+    for (int d = 0; d < b->n_keys && used < n; d++)
+        used += (size_t)snprintf(buf + used, n - used, "%s%s = %.12g", d ? ", " : "", b->key[d],
+                                 p->value[d]);
+}
+
 /* Builds every point (serially: every input error is reported before anything runs). */
 static int build_all(const struct cli_scenario* base, struct cli_batch* b)
 {
@@ -56,11 +67,8 @@ static int build_all(const struct cli_scenario* base, struct cli_batch* b)
         }
         int rc = build_point(base, b, p);
         if (rc != CLI_EXIT_OK) { /* (the message above is about the file with these values) */
-            char at[600];
-            int used = 0;
-            for (int d = 0; d < b->n_keys && used < (int)sizeof at; d++)
-                used += snprintf(at + used, sizeof at - (size_t)used, "%s%s = %.17g", d ? ", " : "",
-                                 b->key[d], p->value[d]);
+            char at[1024];
+            point_values(b, p, at, sizeof at);
             cli_error("%s: at point %zu of %zu of the values: %s", b->cmd, k + 1, b->n_pts, at);
             return rc;
         }
@@ -224,14 +232,15 @@ int cli_batch_report_failures(const struct cli_batch* b, int rc)
 {
     for (size_t k = 0; k < b->n_pts; k++) {
         const struct cli_batch_point* p = &b->pts[k];
-        if (p->status >= 0)
+        char where[1100];
+        size_t used = (size_t)snprintf(where, sizeof where, "%s: ", b->cmd);
+        point_values(b, p, where + used, sizeof where - used);
+        if (p->status >= 0) { /* (a pairwise point's result is zero: no energy ratio) */
+            if (b->engine == CLI_ENGINE_SOFT && cli_energy_grew(&p->res, where))
+                rc = CLI_EXIT_RUNTIME;
             continue;
-        char where[1024];
-        size_t used = 0;
-        for (int d = 0; d < b->n_keys && used < sizeof where; d++)
-            used += (size_t)snprintf(where + used, sizeof where - used, "%s%s = %.12g",
-                                     d ? ", " : "", b->key[d], p->value[d]);
-        cli_error("%s: %s: %s (%s)", b->cmd, where, p->errmsg, wetdem_status_name(p->status));
+        }
+        cli_error("%s: %s (%s)", where, p->errmsg, wetdem_status_name(p->status));
         rc = CLI_EXIT_RUNTIME;
     }
     return rc;

@@ -53,6 +53,10 @@ size_t cli_result_fields(const struct cli_setup* su, const struct wetdem_collisi
                    r->e_t);
     out[n++] = num("e_n_observed", "-", "e_n at observe_time after the first interaction",
                    r->e_n_observed);
+    out[n++] = num("energy_ratio", "-",
+                   "kinetic energy of the relative motion and spins at the end over that at "
+                   "t = 0 (at most 1; nan with gravity)",
+                   r->energy_ratio);
     out[n++] = num("angle_in", "deg",
                    "impact angle to the line of centres at contact of the straight-line approach",
                    r->angle_in * RAD2DEG);
@@ -96,6 +100,17 @@ size_t cli_result_fields(const struct cli_setup* su, const struct wetdem_collisi
     out[n++] = count("root_evals", "evaluations of the event functions", r->stats.root_evals);
     out[n++] = count("events", "events located", r->stats.events);
     return n;
+}
+
+bool cli_energy_grew(const struct wetdem_collision_result* r, const char* what)
+{
+    if (!(isfinite(r->energy_ratio) && r->energy_ratio > 1.01))
+        return false;
+    cli_error("%s: the collision ends with %.4g times the kinetic energy it began with, which "
+              "the models cannot give: the step is too long for the contact; halve [integrator] "
+              "dt_fraction (or dt), or use name = cvode",
+              what, r->energy_ratio);
+    return true;
 }
 
 void cli_setup_capture(struct cli_setup* su)

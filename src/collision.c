@@ -25,7 +25,11 @@
  *     relative velocity against the straight-line contact normal; lubrication slows the
  *     normal approach before contact, so the velocity at the actual first contact is more
  *     oblique than this, as in the experiments, which measure the approach before impact),
- *   angle_out = atan2(|dv_f,t|, dv_f . n_f).
+ *   angle_out = atan2(|dv_f,t|, dv_f . n_f),
+ *   energy_ratio = E_f / E_0,  E = m* |dv|^2 / 2 + I_i |w_i|^2 / 2 + I_j |w_j|^2 / 2 (the
+ *     kinetic energy of the two-body motion about its centre of mass, m* = m_i for a wall or
+ *     a fixed target, and of the spins, I = 2/5 m R^2): at most 1 for the passive models of
+ *     the catalogue, so a value above it measures the integration's error (NAN with gravity).
  * Outcome: stick if not separated by t_end; stick-rotate-separate if separated after the
  * line of centres turned by more than 5 degrees, after the approach was first arrested (the
  * first minimum of the gap), in steps with the gap below h_close (a doublet rotating in near contact: a prompt bounce turns it by a few
@@ -326,7 +330,27 @@ static struct wetdem_vec3 contact_slip(const struct wetdem_sim* sim, struct wetd
 /* The initial state that the restitution coefficients refer to. */
 struct initial {
     struct wetdem_vec3 dv, slip, n; /* relative velocity, contact slip [m/s], normal */
+    double energy;                  /* kinetic energy of the relative motion and spins [J] */
 };
+
+/* Kinetic energy of the relative motion, m* |dv|^2 / 2 (the two-body motion's in the frame
+ * of the centre of mass; a wall or a fixed target has infinite mass), and of both spins,
+ * I w^2 / 2 with I = 2/5 m R^2 (solid spheres, as the integrator's). */
+static double collision_energy(const struct wetdem_sim* sim)
+{
+    const struct wetdem_particle* a = &sim->particles[0];
+    bool other = !sim->n_walls && !sim->particles[1].is_fixed;
+    double m_eff =
+        other ? a->mass * sim->particles[1].mass / (a->mass + sim->particles[1].mass) : a->mass;
+    struct wetdem_vec3 dv = relative_velocity(sim);
+    double e = 0.5 * m_eff * vec3_dot(dv, dv) +
+               0.2 * a->mass * a->radius * a->radius * vec3_dot(a->omega, a->omega);
+    if (other) {
+        const struct wetdem_particle* b = &sim->particles[1];
+        e += 0.2 * b->mass * b->radius * b->radius * vec3_dot(b->omega, b->omega);
+    }
+    return e;
+}
 
 /* Contact time, contact/h_min flags and the last interaction end, from the event log. */
 static void scan_log(const struct wetdem_sim* sim, bool in_contact,
@@ -403,6 +427,9 @@ static void analyse(const struct wetdem_sim* sim, const struct setup* su, const 
     r->t_final = sim->engine.time;
     r->interaction_duration =
         tr->interacting ? (separated ? t_last_end : sim->engine.time) - tr->t_first : 0.0;
+    double g = fabs(sim->settings.gravity_x) + fabs(sim->settings.gravity_y) +
+               fabs(sim->settings.gravity_z);
+    r->energy_ratio = in->energy > 0 && g == 0 ? collision_energy(sim) / in->energy : NAN;
     r->rotation_angle = tr->rotation;
     r->rotation_close = tr->rotation_close;
     r->close_gap = su->h_close;
@@ -429,7 +456,8 @@ int wetdem_collision_run(struct wetdem_sim* sim, const struct wetdem_collision_s
         return st;
     struct tracker tr;
     start_tracker(sim, &su, spec, &tr);
-    struct initial in = {.dv = relative_velocity(sim), .n = vec3(1, 0, 0)};
+    struct initial in = {
+        .dv = relative_velocity(sim), .n = vec3(1, 0, 0), .energy = collision_energy(sim)};
     in.slip = contact_slip(sim, in.n);
     bool in_contact = tr.gap_prev < 0;
     st = run(sim, spec, &tr);

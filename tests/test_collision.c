@@ -64,6 +64,8 @@ static void test_collision_hertz_undamped(void** state)
         struct wetdem_collision_result r;
         CHECK_OK(wetdem_collision_run(sim, &s, &r));
         CHECK_ABS(r.e, 1.0, q ? 1e-6 : 1e-4);
+        /* head-on without spin the energy is m* |dv|^2 / 2: its ratio is e^2 to rounding */
+        CHECK_REL(r.energy_ratio, r.e * r.e, 1e-12);
         CHECK_REL(r.contact_duration, t_c, 5e-3);
         assert_true(r.separated && r.solid_contact);
         assert_int_equal(r.outcome, WETDEM_OUTCOME_BOUNCE);
@@ -89,6 +91,7 @@ static void test_collision_hertz_damped(void** state)
         CHECK_OK(wetdem_collision_run(sim, &s, &r));
         CHECK_REL(r.e, 0.9, 5e-3);
         CHECK_REL(r.e_n, 0.9, 5e-3);
+        CHECK_REL(r.energy_ratio, r.e * r.e, 1e-12);
         wetdem_sim_free(sim);
     }
 }
@@ -125,6 +128,12 @@ static void test_collision_momentum(void** state)
         double p0 = hypot(p0x, p0y);
         CHECK_ABS(px, p0x, 1e-12 * p0);
         CHECK_ABS(py, p0y, 1e-12 * p0);
+        /* lubrication, damping and friction take energy (spin included): well below 1 */
+        assert_true(r.energy_ratio > 0 && r.energy_ratio < 0.99);
+        /* with gravity the kinetic energy is not the measure (the potential changes): NAN */
+        CHECK_OK(wetdem_sim_set_param(sim, "sim.gravity_z", -9.81));
+        CHECK_OK(wetdem_collision_run(sim, &s, &r));
+        assert_true(isnan(r.energy_ratio));
         wetdem_sim_free(sim);
     }
 }

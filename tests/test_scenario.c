@@ -245,6 +245,27 @@ static void test_scenario_bad_files_exit_2_with_line(void** state)
     free(r.out);
 }
 
+/* A collision whose step is too long for its contact ends with more kinetic energy than it
+ * began with (dry Hertz at half the Hertz time per step: 3x): the run says so and exits 1,
+ * and so does a sweep for each such point; at the default step it does not. */
+static void test_scenario_energy_gain_is_an_error(void** state)
+{
+    (void)state;
+    struct test_run r = run_cli("run examples/scenarios/dry_hertz.ini");
+    assert_int_equal(r.code, 0);
+    free(r.out);
+    r = run_cli("run examples/scenarios/dry_hertz.ini --set integrator.dt_fraction=0.5");
+    assert_int_equal(r.code, 1);
+    CHECK_CONTAINS(r.out, "times the kinetic energy it began with");
+    CHECK_CONTAINS(r.out, "halve [integrator] dt_fraction");
+    free(r.out);
+    r = run_cli("sweep examples/scenarios/dry_hertz.ini --set integrator.dt_fraction=0.5 "
+                "--param collision.speed --values 0.5:1:2");
+    assert_int_equal(r.code, 1);
+    CHECK_CONTAINS(r.out, "sweep: collision.speed = 1: the collision ends with");
+    free(r.out);
+}
+
 /* What a file written elsewhere brings, accepted: a UTF-8 byte-order mark, CR LF line ends and
  * comments longer than a line may be (whole-line and inline, ';' and '#'); the values are
  * those without them. */
@@ -533,6 +554,7 @@ int main(void)
         cmocka_unit_test(test_scenario_set_overrides),
         cmocka_unit_test(test_scenario_bad_files_exit_2_with_line),
         cmocka_unit_test(test_scenario_boms_crlf_and_long_comments),
+        cmocka_unit_test(test_scenario_energy_gain_is_an_error),
         cmocka_unit_test(test_scenario_docs_list_every_key),
         cmocka_unit_test(test_scenario_run_writes_files_or_nothing),
         cmocka_unit_test(test_scenario_sweep_order_and_threads),
