@@ -235,9 +235,12 @@ int cli_batch_report_failures(const struct cli_batch* b, int rc)
         char where[1100];
         size_t used = (size_t)snprintf(where, sizeof where, "%s: ", b->cmd);
         point_values(b, p, where + used, sizeof where - used);
+        char why[300];
         if (p->status >= 0) { /* (a pairwise point's result is zero: no energy ratio) */
-            if (b->engine == CLI_ENGINE_SOFT && cli_energy_grew(&p->res, where))
+            if (b->engine == CLI_ENGINE_SOFT && cli_energy_grew(&p->res, why, sizeof why)) {
+                cli_error("%s: the collision %s", where, why);
                 rc = CLI_EXIT_RUNTIME;
+            }
             continue;
         }
         cli_error("%s: %s (%s)", where, p->errmsg, wetdem_status_name(p->status));

@@ -26,6 +26,7 @@
 #include <string.h>
 
 #include "cli_util.h"
+#include "output_csv.h"
 #include "scenario.h"
 
 #define MAX_SETS 256
@@ -316,7 +317,8 @@ static int simulate(const struct fit_ctx* c, const double* params, const struct 
 {
     struct cli_setup* su = calloc(n, sizeof *su);
     int* status = calloc(n, sizeof *status);
-    int st = (su && status) ? WETDEM_OK : WETDEM_ERR_NOMEM;
+    double* ratio = calloc(n, sizeof *ratio); /* each collision's energy_ratio */
+    int st = (su && status && ratio) ? WETDEM_OK : WETDEM_ERR_NOMEM;
     size_t built = 0;
     for (; st == WETDEM_OK && built < n; built++)
         if (build_point(c, params, &pts[built], &su[built]) != CLI_EXIT_OK) {
@@ -332,18 +334,26 @@ static int simulate(const struct fit_ctx* c, const double* params, const struct 
             e_n[k] = reported_e_n(&su[k], &r);
             omega[k] = sqrt(r.omega_i.x * r.omega_i.x + r.omega_i.y * r.omega_i.y +
                             r.omega_i.z * r.omega_i.z);
+            ratio[k] = r.energy_ratio;
         }
-        for (size_t k = 0; k < n && st == WETDEM_OK; k++)
+        for (size_t k = 0; k < n && st == WETDEM_OK; k++) { /* (the first failure, in order) */
+            char why[300];
+            struct wetdem_collision_result r = {.energy_ratio = ratio[k]};
             if (status[k] < 0) {
                 st = WETDEM_ERR_CALLBACK;
                 snprintf(msg, msg_size, "collision at St_n = %g failed: %s", pts[k].stokes,
                          wetdem_sim_errmsg(su[k].sim));
+            } else if (cli_energy_grew(&r, why, sizeof why)) { /* (as run and sweep report it) */
+                st = WETDEM_ERR_CALLBACK;
+                snprintf(msg, msg_size, "the collision at St_n = %g %s", pts[k].stokes, why);
             }
+        }
     }
     for (size_t k = 0; su && k < built; k++)
         cli_setup_free(&su[k]);
     free(su);
     free(status);
+    free(ratio);
     return st;
 }
 

@@ -189,10 +189,11 @@ static int run_soft(const struct cli_scenario* sc, struct cli_setup* su, const s
         cli_summary_text(stdout, sc, su, &res);
     if (a->out_dir && rc == CLI_EXIT_OK && !a->json)
         printf("files in %s/\n", a->out_dir);
-    char what[1100];
-    snprintf(what, sizeof what, "run %s", sc->file);
-    if (rc == CLI_EXIT_OK && cli_energy_grew(&res, what))
+    char why[300];
+    if (rc == CLI_EXIT_OK && cli_energy_grew(&res, why, sizeof why)) {
+        cli_error("run %s: the collision %s", sc->file, why);
         rc = CLI_EXIT_RUNTIME;
+    }
     return rc;
 }
 

@@ -278,6 +278,12 @@ static void test_fit_cli_rejects_bad_input(void** state)
              "\nstokes_n,e_n\n2,0.5\n3,0.6\n");
     temp_csv(bad, "bad", long_line);
     expect_cli(args, 2, ":1: line longer than 4094 characters");
+    /* collisions whose step is too long for the contact gain energy: the fit stops there */
+    snprintf(args, sizeof args,
+             "fit %s --data %s --fit glass.p_gt --init 4e6 --set integrator.name=verlet "
+             "--set integrator.dt_fraction=0.6",
+             ini, good);
+    expect_cli(args, 1, "times the kinetic energy it began with");
     snprintf(args, sizeof args, "fit %s --data /tmp --fit glass.p_gt", ini);
     expect_cli(args, 2, "/tmp: cannot read data file: Is a directory");
     snprintf(args, sizeof args, "fit %s --data %s --fit glass.p_gt", ini, bad);
