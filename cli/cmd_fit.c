@@ -185,15 +185,11 @@ static int read_header(const char* path, long line, char** f, int n, int col[N_C
     return CLI_EXIT_OK;
 }
 
-/* Reads column c of a row into *v with its range check. */
-static int read_value(const char* path, long line, char** f, int n, const int col[N_COLS], int c,
+/* Reads column c of a row (with the header's number of columns) into *v with its range
+ * check. */
+static int read_value(const char* path, long line, char** f, const int col[N_COLS], int c,
                       double* v)
 {
-    if (col[c] >= n) {
-        cli_error("%s:%ld: %d columns, but column %s is number %d", path, line, n, col_names[c],
-                  col[c] + 1);
-        return CLI_EXIT_USAGE;
-    }
     const char* t = f[col[c]];
     while (isspace((unsigned char)*t)) /* (a space after the comma) */
         t++;
@@ -203,6 +199,12 @@ static int read_value(const char* path, long line, char** f, int n, const int co
         ok = false, why = "a Stokes number > 0";
     if (ok && c == COL_ANGLE && !(*v >= 0 && *v < 90))
         ok = false, why = "an angle in [0, 90) deg";
+    /* a coefficient of restitution: at most 1 for these models, above it by the scatter of a
+       measurement only (Punch's repeated experiments scatter by about 0.02) */
+    if (ok && c == COL_EN && !(*v >= 0 && *v < 1.5))
+        ok = false, why = "a restitution coefficient in [0, 1.5)";
+    if (ok && c == COL_OMEGA && !(*v >= 0))
+        ok = false, why = "a spin magnitude >= 0 rad/s";
     if (!ok) {
         cli_error("%s:%ld: column %s: '%s' is not %s", path, line, col_names[c], t, why);
         return CLI_EXIT_USAGE;
@@ -210,18 +212,22 @@ static int read_value(const char* path, long line, char** f, int n, const int co
     return CLI_EXIT_OK;
 }
 
-static int read_row(const char* path, long line, char** f, int n, const int col[N_COLS],
-                    struct point* p)
+static int read_row(const char* path, long line, char** f, int n, int n_header,
+                    const int col[N_COLS], struct point* p)
 {
-    int rc = read_value(path, line, f, n, col, COL_STOKES, &p->stokes);
+    if (n != n_header) { /* (a value too many or too few: the columns would shift) */
+        cli_error("%s:%ld: %d columns, but the header has %d", path, line, n, n_header);
+        return CLI_EXIT_USAGE;
+    }
+    int rc = read_value(path, line, f, col, COL_STOKES, &p->stokes);
     if (rc == CLI_EXIT_OK)
-        rc = read_value(path, line, f, n, col, COL_EN, &p->e_n);
+        rc = read_value(path, line, f, col, COL_EN, &p->e_n);
     p->has_angle = col[COL_ANGLE] >= 0;
     p->omega = NAN;
     if (rc == CLI_EXIT_OK && p->has_angle)
-        rc = read_value(path, line, f, n, col, COL_ANGLE, &p->angle_deg);
+        rc = read_value(path, line, f, col, COL_ANGLE, &p->angle_deg);
     if (rc == CLI_EXIT_OK && col[COL_OMEGA] >= 0)
-        rc = read_value(path, line, f, n, col, COL_OMEGA, &p->omega);
+        rc = read_value(path, line, f, col, COL_OMEGA, &p->omega);
     return rc;
 }
 
@@ -236,6 +242,7 @@ static int read_data(const char* path, struct point** out, size_t* n_out)
     char buf[4096], *f[64];
     int col[N_COLS], rc = pts ? CLI_EXIT_OK : CLI_EXIT_RUNTIME;
     bool have_header = false;
+    int n_header = 0;
     size_t n = 0;
     for (long line = 1; rc == CLI_EXIT_OK && fgets(buf, sizeof buf, fp); line++) {
         if (!strchr(buf, '\n') && !feof(fp)) { /* (its rest would be read as another line) */
@@ -250,11 +257,12 @@ static int read_data(const char* path, struct point** out, size_t* n_out)
         if (!have_header) {
             rc = read_header(path, line, f, nf, col);
             have_header = true;
+            n_header = nf;
         } else if (n == MAX_POINTS) {
             cli_error("%s:%ld: more than %d data rows", path, line, MAX_POINTS);
             rc = CLI_EXIT_USAGE;
         } else {
-            rc = read_row(path, line, f, nf, col, &pts[n++]);
+            rc = read_row(path, line, f, nf, n_header, col, &pts[n++]);
         }
     }
     if (rc == CLI_EXIT_OK && ferror(fp)) { /* (e.g. a directory: it opens, but does not read) */

@@ -267,7 +267,12 @@ static void test_fit_cli_rejects_bad_input(void** state)
     snprintf(args, sizeof args, "fit %s --data %s --fit glass.p_gt", ini, bad);
     expect_cli(args, 2, ":4: column e_n: 'abc' is not a finite number");
     temp_csv(bad, "bad", "stokes_n,e_n\n2\n");
-    expect_cli(args, 2, ":2: 1 columns, but column e_n is number 2");
+    expect_cli(args, 2, ":2: 1 columns, but the header has 2");
+    temp_csv(bad, "bad", "stokes_n,e_n\n2,0.5,7\n"); /* a value too many would shift nothing */
+    expect_cli(args, 2, ":2: 3 columns, but the header has 2");
+    temp_csv(bad, "bad", "stokes_n,e_n\n2,99999999999\n");
+    expect_cli(args, 2,
+               ":2: column e_n: '99999999999' is not a restitution coefficient in [0, 1.5)");
     temp_csv(bad, "bad", "stokes,e_n\n2,0.5\n");
     expect_cli(args, 2, ":1: the header must name columns stokes_n and e_n");
     /* a line longer than the reader's buffer is an error, not read as two lines */
