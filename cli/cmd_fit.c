@@ -331,7 +331,10 @@ static int simulate(const struct fit_ctx* c, const double* params, const struct 
     for (; st == WETDEM_OK && built < n; built++)
         if (build_point(c, params, &pts[built], &su[built]) != CLI_EXIT_OK) {
             st = WETDEM_ERR_INVALID;
-            snprintf(msg, msg_size, "the scenario was rejected at St_n = %g with %s = %g%s",
+            snprintf(msg, msg_size,
+                     "the scenario was rejected at St_n = %g with %s = %g%s (the message "
+                     "above): an --init value outside the key's range, or a fit that left it "
+                     "(the data may not determine the key)",
                      pts[built].stokes, c->keys[0], params[0], c->n_keys > 1 ? ", ..." : "");
         }
     if (st == WETDEM_OK) {
