@@ -237,7 +237,8 @@ int cli_batch_report_failures(const struct cli_batch* b, int rc)
         point_values(b, p, where + used, sizeof where - used);
         char why[300];
         if (p->status >= 0) { /* (a pairwise point's result is zero: no energy ratio) */
-            if (b->engine == CLI_ENGINE_SOFT && cli_energy_grew(&p->res, why, sizeof why)) {
+            if (b->engine == CLI_ENGINE_SOFT &&
+                cli_energy_grew(p->res.energy_ratio, why, sizeof why)) {
                 cli_error("%s: the collision %s", where, why);
                 rc = CLI_EXIT_RUNTIME;
             }

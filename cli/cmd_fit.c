@@ -349,12 +349,12 @@ static int simulate(const struct fit_ctx* c, const double* params, const struct 
         }
         for (size_t k = 0; k < n && st == WETDEM_OK; k++) { /* (the first failure, in order) */
             char why[300];
-            struct wetdem_collision_result r = {.energy_ratio = ratio[k]};
             if (status[k] < 0) {
                 st = WETDEM_ERR_CALLBACK;
                 snprintf(msg, msg_size, "collision at St_n = %g failed: %s", pts[k].stokes,
                          wetdem_sim_errmsg(su[k].sim));
-            } else if (cli_energy_grew(&r, why, sizeof why)) { /* (as run and sweep report it) */
+            } else if (cli_energy_grew(ratio[k], why,
+                                       sizeof why)) { /* (as run and sweep report it) */
                 st = WETDEM_ERR_CALLBACK;
                 snprintf(msg, msg_size, "the collision at St_n = %g %s", pts[k].stokes, why);
             }
@@ -537,7 +537,7 @@ static int initial_value(const struct fit_ctx* c, size_t j, double* v)
     char section[CLI_NAME_MAX];
     snprintf(section, sizeof section, "%.*s", (int)(dot - full), full);
     const struct cli_entry* e = cli_scenario_find(c->base, section, dot + 1);
-    if (e && cli_parse_number_text(e->value, v) == 0)
+    if (e && cli_number(e->value, v) == 0)
         return CLI_EXIT_OK;
     if (preset_value(c->base, section, dot + 1, v) || model_value(c->base, section, dot + 1, v))
         return CLI_EXIT_OK;

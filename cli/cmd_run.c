@@ -190,7 +190,7 @@ static int run_soft(const struct cli_scenario* sc, struct cli_setup* su, const s
     if (a->out_dir && rc == CLI_EXIT_OK && !a->json)
         printf("files in %s/\n", a->out_dir);
     char why[300];
-    if (rc == CLI_EXIT_OK && cli_energy_grew(&res, why, sizeof why)) {
+    if (rc == CLI_EXIT_OK && cli_energy_grew(res.energy_ratio, why, sizeof why)) {
         cli_error("run %s: the collision %s", sc->file, why);
         rc = CLI_EXIT_RUNTIME;
     }

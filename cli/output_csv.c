@@ -102,15 +102,15 @@ size_t cli_result_fields(const struct cli_setup* su, const struct wetdem_collisi
     return n;
 }
 
-bool cli_energy_grew(const struct wetdem_collision_result* r, char* msg, size_t n)
+bool cli_energy_grew(double energy_ratio, char* msg, size_t n)
 {
-    if (!(isfinite(r->energy_ratio) && r->energy_ratio > 1.01))
+    if (!(isfinite(energy_ratio) && energy_ratio > 1.01))
         return false;
     snprintf(msg, n,
              "ends with %.4g times the kinetic energy it began with, which the models cannot "
              "give: the step is too long for the contact; halve [integrator] dt_fraction (or "
              "dt), or use name = cvode",
-             r->energy_ratio);
+             energy_ratio);
     return true;
 }
 

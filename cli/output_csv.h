@@ -36,10 +36,10 @@ size_t cli_result_fields(const struct cli_setup* su, const struct wetdem_collisi
                          struct cli_field* out);
 
 /* Whether a collision ended with more kinetic energy than it began with, beyond what the
- * integration's error allows (energy_ratio above 1.01; the passive models give at most 1,
+ * integration's error allows (its energy_ratio above 1.01; the passive models give at most 1,
  * Verlet at its default step 1 - 8e-5 for an elastic impact): its step was too long for the
  * contact. Then writes into msg[n] which ratio and what to change ("ends with ..."). */
-bool cli_energy_grew(const struct wetdem_collision_result* r, char* msg, size_t n);
+bool cli_energy_grew(double energy_ratio, char* msg, size_t n);
 
 /* Records what the result struct lacks from the final state of su->sim: the striker's own
  * speed and the angle of its velocity to the line of centres, theta_i,1 of Nijssen Fig. 1c,

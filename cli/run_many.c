@@ -245,7 +245,9 @@ struct outcome {
 static double closure_ratio(const struct wetdem_energy_budget* b)
 {
     double scale = fmax(fabs(b->input), fabs(b->work_total));
-    return scale > 0 || !isfinite(b->balance_error) ? fabs(b->balance_error) / scale : 0.0;
+    if (!isfinite(b->balance_error) || !isfinite(scale))
+        return NAN;
+    return scale > 0 ? fabs(b->balance_error) / scale : 0.0;
 }
 
 /* Beyond this ratio the integration is not what the budget's O(dt^2) error allows: the step is

@@ -258,11 +258,6 @@ static void sweep_header(FILE* f, const struct wetdem_pairwise_config* cfg)
                     i + 1, j + 1, i + 1, j + 1, i + 1, j + 1, i + 1, j + 1, i + 1, j + 1);
 }
 
-static double star(const struct wetdem_pairwise_result* r, double t)
-{
-    return wetdem_pairwise_t_star(r, t);
-}
-
 /* One sweep row. A failed run writes its status, the steps and events it took, and "nan" or
  * "none" for every result (the row keeps the header's columns). */
 static void sweep_row(FILE* f, int status, const struct wetdem_pairwise_config* cfg,
@@ -279,11 +274,11 @@ static void sweep_row(FILE* f, int status, const struct wetdem_pairwise_config* 
     }
     fprintf(f, "%s,%s,%d,%.12g,%.12g,%zu,%llu", wetdem_status_name(status),
             wetdem_pairwise_outcome_name(r->outcome), r->separated_sphere + 1, r->time,
-            star(r, r->time), r->n_events, r->steps);
+            wetdem_pairwise_t_star(r, r->time), r->n_events, r->steps);
     for (size_t p = 0; p < r->n_pairs; p++) {
         const struct wetdem_pairwise_pair_result* q = &r->pairs[p];
         fprintf(f, ",%.12g,%.12g,%u,%s,%.12g", q->e_wet, q->e_wet_own, q->n_contacts,
-                mechanism_name(q->mechanism), star(r, q->t_end));
+                mechanism_name(q->mechanism), wetdem_pairwise_t_star(r, q->t_end));
     }
 }
 
@@ -293,7 +288,7 @@ static void summary_text(FILE* f, const struct wetdem_pairwise_result* r)
     if (r->separated_sphere >= 0)
         fprintf(f, " (sphere %d left)", r->separated_sphere + 1);
     fprintf(f, "\ntime               %.6g s  (t* = %.6g, t-hat = %.6g)\n", r->time,
-            star(r, r->time), wetdem_pairwise_t_hat(r, r->time));
+            wetdem_pairwise_t_star(r, r->time), wetdem_pairwise_t_hat(r, r->time));
     fprintf(f, "v_n0               %.6g m/s  (delta_12 = %.6g m)%s\n", r->v_n0, r->delta_ref,
             r->v_n0 > 0.0 ? ""
                           : "; the reference pair does not approach at t = 0, so t-hat and e_w "

@@ -210,17 +210,12 @@ const char* cli_scenario_text(const struct cli_scenario* sc, const char* section
 
 /* ---- value checks ---- */
 
-int cli_parse_number_text(const char* text, double* out)
-{
-    return cli_number(text, out);
-}
-
 /* Checks a number against a descriptor; on failure prints the message and returns 2. */
 static int check_number(const struct cli_scenario* sc, const struct cli_entry* e,
                         const struct wetdem_param_desc* d)
 {
     double v;
-    if (cli_parse_number_text(e->value, &v) != 0) {
+    if (cli_number(e->value, &v) != 0) {
         cli_scenario_error(sc, e,
                            "not a finite number%s%s%s (decimal or exponent notation, "
                            "e.g. 6.35e-3)",

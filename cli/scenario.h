@@ -195,8 +195,6 @@ const char* cli_model_suggestion(const char* word);
 void cli_section_suggestion(const char* name, char* msg, size_t n);
 /* Whether s is a non-empty name of letters, digits, '_' and '-'. */
 bool cli_is_name(const char* s);
-/* Parses a whole string as one finite number. 0 or -1. */
-int cli_parse_number_text(const char* text, double* out);
 /* A numeric or choice key descriptor as a library parameter descriptor (for range text). */
 struct wetdem_param_desc cli_key_as_param(const struct cli_key_desc* k);
 

@@ -377,16 +377,6 @@ double wetdem_pairwise_t_star(const struct wetdem_pairwise_result* res, double t
     return (res->v_10 > 0.0 && res->a_ref > 0.0) ? res->v_10 * t / (4.0 * res->a_ref) : NAN;
 }
 
-static double t_hat(const struct wetdem_pairwise* pw, double t)
-{
-    return wetdem_pairwise_t_hat(pw->res, t);
-}
-
-static double t_star(const struct wetdem_pairwise* pw, double t)
-{
-    return wetdem_pairwise_t_star(pw->res, t);
-}
-
 static int log_event(struct wetdem_pairwise* pw, enum wetdem_pairwise_event_kind kind, size_t p,
                      size_t p_old, double gap, double v_n)
 {
@@ -405,8 +395,8 @@ static int log_event(struct wetdem_pairwise* pw, enum wetdem_pairwise_event_kind
     pw->events[pw->n_events++] = (struct wetdem_pairwise_event){
         .kind = kind,
         .time = pw->t,
-        .t_hat = t_hat(pw, pw->t),
-        .t_star = t_star(pw, pw->t),
+        .t_hat = wetdem_pairwise_t_hat(pw->res, pw->t),
+        .t_star = wetdem_pairwise_t_star(pw->res, pw->t),
         .i = pw->sys.pi[p],
         .j = pw->sys.pj[p],
         .k = pw->sys.pi[p_old],
@@ -424,8 +414,8 @@ static void fill_frame(const struct wetdem_pairwise* pw, const struct wetdem_pai
 {
     memset(fr, 0, sizeof *fr);
     fr->time = t;
-    fr->t_hat = t_hat(pw, t);
-    fr->t_star = t_star(pw, t);
+    fr->t_hat = wetdem_pairwise_t_hat(pw->res, t);
+    fr->t_star = wetdem_pairwise_t_star(pw->res, t);
     fr->n_spheres = pw->sys.n;
     fr->n_pairs = pw->sys.n_pairs;
     for (size_t i = 0; i < pw->sys.n; i++) {

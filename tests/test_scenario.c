@@ -244,6 +244,19 @@ static void test_scenario_bad_files_exit_2_with_line(void** state)
     CHECK_CONTAINS(r.out, "build/libwetdem.a: a NUL byte in its first 4096 bytes: not a text");
     assert_null(strchr(strchr(r.out, '\n') + 1, '\n')); /* (that line only) */
     free(r.out);
+    { /* a NUL byte past the first 4 KiB: refused at its line */
+        char path[600], args2[700];
+        snprintf(path, sizeof path, "%s/late_nul.ini", tmpdir);
+        FILE* f = fopen(path, "wb");
+        assert_non_null(f);
+        fputs("[collision]\nstokes = 5\n", f);
+        for (int k = 0; k < 100; k++) /* lines 3..102, 5,000 bytes */
+            fprintf(f, "; %047d\n", k);
+        fwrite("speed\0= 1\n", 1, 11, f);
+        fclose(f);
+        snprintf(args2, sizeof args2, "run '%s' --check", path);
+        expect_run(args2, 2, "late_nul.ini:103: a NUL byte: not a text (INI) scenario file");
+    }
     /* a directory opens, but does not read */
     expect_run("run /tmp --check", 2, "/tmp: cannot read scenario file");
     char args[700];
