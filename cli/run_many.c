@@ -260,8 +260,9 @@ static void summary_text(FILE* f, const struct cli_many_setup* su, const struct 
     const struct wetdem_many_stats* s = &o->stats;
     fprintf(f, "particles          %zu  (walls %zu)\n", wetdem_sim_n_particles(su->sim),
             wetdem_sim_n_walls(su->sim));
-    fprintf(f, "time               %.6g s  (step %llu, dt = %.4g s, %.3g s wall, %d threads)\n",
-            wetdem_sim_time(su->sim), s->step, s->dt, o->wall, omp_get_max_threads());
+    fprintf(f, "time               %.6g s  (step %llu, dt = %.4g s, %.3g s wall, %d thread%s)\n",
+            wetdem_sim_time(su->sim), s->step, s->dt, o->wall, s->threads,
+            s->threads == 1 ? "" : "s");
     fprintf(f, "contacts           %zu\nliquid bridges     %zu\n", s->contacts, s->bridges);
     fprintf(f, "agglomerates       %zu  (mean size %.3g)\n", s->agglomerates, s->mean_agglomerate);
     double phase[4] = {s->seconds_kick, s->seconds_forces, s->seconds_lists, s->seconds_output};

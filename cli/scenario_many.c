@@ -117,7 +117,8 @@ static const struct cli_key_desc run_keys[] = {
     NUM("skin", "m", "0 (0.1 x smallest radius)", 0, 1, false, false,
         "Verlet skin of the neighbour lists."),
     WORD("energy_budget", CLI_VALUE_CHOICE, "yes", yes_no,
-         "Accumulate the work of every model on particle pairs and walls (about 10 % slower)."),
+         "Accumulate the work of every model on particle pairs and walls, and check that the "
+         "budget closes (10-75 % slower: docs/many.md)."),
     {0},
 };
 

@@ -536,7 +536,8 @@ struct wetdem_many_settings {
     struct wetdem_vec3 box_lo, box_hi;   /* periodic box [m] (read on periodic axes only) */
     double dt;                           /* step [s] >= 0; 0: verlet.dt, or verlet.dt_fraction
                                             x the Hertz contact time of the smallest spheres */
-    bool energy_budget;                  /* accumulate the work of every model (costs ~10 %) */
+    bool energy_budget;                  /* accumulate the work of every model (costs 10-75 %:
+                                            docs/many.md, "Energy budget") */
     const char* output_prefix;           /* <prefix>_NNNNNN.vtk, <prefix>.vtk.series and
                                             <prefix>.csv; NULL: no files (copied) */
     unsigned long long vtk_every;        /* steps between VTK files; 0: none */
@@ -575,7 +576,8 @@ struct wetdem_energy_budget {
     double balance_error; /* (kinetic + potential) - (their start values) - work_total: zero
                              up to the O(dt^2) integration error */
 };
-/* Fills *b (many.energy_budget must be on). WETDEM_OK, or WETDEM_ERR_INVALID before a run. */
+/* Fills *b. WETDEM_OK, or WETDEM_ERR_INVALID before a run or when many.energy_budget is off
+ * (no work is summed then, so no budget can close). */
 WETDEM_API int wetdem_sim_energy_budget(const struct wetdem_sim* sim,
                                         struct wetdem_energy_budget* b);
 
@@ -593,6 +595,8 @@ struct wetdem_many_stats {
        zero): kicks and drifts, force passes (less their neighbour-list builds), the builds
        (with the history carried over), and each step's outputs and observer calls */
     double seconds_kick, seconds_forces, seconds_lists, seconds_output;
+    int threads; /* OpenMP threads the run's loops use: OMP_NUM_THREADS, or 1 for fewer than 512
+                    particles (waking the threads would cost more than the work) */
 };
 WETDEM_API int wetdem_sim_many_stats(const struct wetdem_sim* sim, struct wetdem_many_stats* s);
 

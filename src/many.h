@@ -100,6 +100,8 @@ struct wetdem_many_bulk_in {
     bool mindlin;
     int n_normal;
     unsigned char normal[WETDEM_MAX_MODELS];
+    bool contacts_scalar;     /* leave them to the scalar kernel (class 1): with an energy
+                                 budget, which needs each model's terms */
     const double (*cache)[4]; /* pair_cache: R* [m], m* [kg], Hertz k, damping factor */
     double* history;          /* the pair histories, len doubles each; the Mindlin spring at */
     size_t len, spring_off;   /* spring_off of them [m] */
@@ -357,8 +359,12 @@ struct wetdem_many {
     double* m_eff;        /* per particle: contact_effective_mass (the mass, infinite if fixed) */
     size_t particle_cap;
     struct wetdem_many_energy energy;
-    double* thread_work; /* per thread: 2 x WETDEM_MAX_MODELS accumulators */
-    size_t thread_work_cap;
+    /* with an energy budget, the work of a force pass, model by model (n_models doubles per
+       entry), summed in an order that does not depend on the blocks (sim_many_force.c
+       collect_pass_work): per particle i of its pairs (i, j) and of its walls, and per cross
+       pair, with its chunk sums */
+    double *pair_work, *wall_work, *cross_work, *chunk_work;
+    size_t pair_work_cap, wall_work_cap, cross_work_cap, chunk_work_cap;
     /* outputs */
     uint64_t vtk_files, csv_rows;
     uint64_t next_vtk_step, next_csv_step, next_checkpoint_step;

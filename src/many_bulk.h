@@ -500,7 +500,7 @@ bulk_constants_of(const struct wetdem_many_bulk_in* in)
 /* Candidates list[0..n) (1 <= n <= WETDEM_MANY_BULK_MAX, in any particles): their geometry,
  * and the force apart of the film models, into out's entries 0..n); those whose second
  * particle is at or past j_end are left out (their entries but j are not used). Then those in
- * solid contact (bulk_contacts). */
+ * solid contact (bulk_contacts), unless in->contacts_scalar. */
 void WETDEM_MANY_BULK_NAME(const struct wetdem_many_bulk_in* in, const uint32_t* list, size_t n,
                            size_t j_end, struct wetdem_many_bulk_out* out)
 {
@@ -524,7 +524,7 @@ void WETDEM_MANY_BULK_NAME(const struct wetdem_many_bulk_in* in, const uint32_t*
     if (k < n)
         bulk_four(in, &C, list, n, j_end, out, k, true, films == BULK_DRY ? BULK_DRY : BULK_ANY, at,
                   &n_at);
-    if (!n_at)
+    if (!n_at || in->contacts_scalar)
         return;
     for (size_t r = n_at; r % 4; r++)
         at[r] = at[n_at - 1];

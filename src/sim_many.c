@@ -105,7 +105,10 @@ void wetdem_sim_many_free(struct wetdem_sim* sim)
     free(m->m_eff);
     free(m->vw);
     free(m->fixed);
-    free(m->thread_work);
+    free(m->pair_work);
+    free(m->wall_work);
+    free(m->cross_work);
+    free(m->chunk_work);
     free(m->mix);
     free(m->blk);
     free(m->cross_first);
@@ -526,18 +529,6 @@ int wetdem_sim_many_prepare(struct wetdem_sim* sim)
 
 /* ---- forces: sim_many_force.c ---- */
 
-/* Sums the per-thread work accumulators into the budget in thread order and clears them. */
-static void collect_work(struct wetdem_many* m, int n_threads)
-{
-    for (int t = 0; t < n_threads; t++)
-        for (int k = 0; k < WETDEM_MAX_MODELS; k++) {
-            double* w = m->thread_work + (size_t)t * 2 * WETDEM_MAX_MODELS;
-            m->energy.work_pair[k] += w[k];
-            m->energy.work_wall[k] += w[WETDEM_MAX_MODELS + k];
-            w[k] = w[WETDEM_MAX_MODELS + k] = 0;
-        }
-}
-
 /* ---- integration ---- */
 
 static struct wetdem_vec3 gravity(const struct wetdem_sim* sim)
@@ -802,23 +793,14 @@ static void finish_kick(struct wetdem_sim* sim)
         wetdem_many_close_kick(m, k, g);
 }
 
-/* Forces at the current state, then `end` for each particle (many.h), work collected. */
+/* Forces at the current state, then `end` for each particle (many.h), work collected (by the
+ * force pass). */
 static int forces_and_work(struct wetdem_sim* sim, enum wetdem_many_end end)
 {
     struct wetdem_many* m = sim->many;
-    int n_threads = omp_get_max_threads();
-    size_t need = (size_t)n_threads * 2 * WETDEM_MAX_MODELS;
-    if (need > m->thread_work_cap) {
-        free(m->thread_work);
-        m->thread_work = calloc(need, sizeof(double));
-        if (!m->thread_work)
-            return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory");
-        m->thread_work_cap = need;
-    }
     double t0 = wall_seconds(), lists0 = m->seconds_lists; /* (a build may come first) */
     m->drift_seconds = 0;
     int st = wetdem_sim_many_forces(sim, end);
-    collect_work(m, n_threads);
     /* (the next step's kicks and drifts, where the pass applied them, count as theirs) */
     m->seconds_forces += (wall_seconds() - t0) - (m->seconds_lists - lists0) - m->drift_seconds;
     m->seconds_kick += m->drift_seconds;
@@ -1017,7 +999,7 @@ int wetdem_sim_energy_budget(const struct wetdem_sim* sim, struct wetdem_energy_
 {
     memset(b, 0, sizeof *b);
     const struct wetdem_many* m = sim->many;
-    if (!m || !m->started)
+    if (!m || !m->started || !m->set.energy_budget) /* (without it, no work was summed) */
         return WETDEM_ERR_INVALID;
     wetdem_sim_many_energies(sim, &b->kinetic, &b->potential, &b->elastic);
     b->input = m->energy.k0 + m->energy.u0 + m->energy.el0;

@@ -52,12 +52,15 @@
  * and the dropped 0 + y change nothing. The range of these models is the film thickness delta_ab
  * (0 for the contact models), a property of the material pair.
  *
- * Lean kernel: for the same model sets without an energy budget (and, with sb, a constant
- * h_min), the force is computed straight from the two particles (or particle and wall),
- * without a contact record or the switch, by the same definitions (models.h: Hertz stiffness,
- * elastic and damping parts; mindlin.h: the tangential spring) in the same order, so it is
- * bit-identical to the fused kernel and the generic path (tests/test_many_force.c). Pairs
- * apart (gap >= 0, liquid bridges) take a short path with the film terms only (lean_apart).
+ * Lean kernel: for the same model sets (with sb, only with a constant h_min), the force is
+ * computed straight from the two particles (or particle and wall), without a contact record
+ * or the switch, by the same definitions (models.h: Hertz stiffness, elastic and damping
+ * parts; mindlin.h: the tangential spring) in the same order, so it is bit-identical to the
+ * fused kernel and the generic path (tests/test_many_force.c). Pairs apart (gap >= 0, liquid
+ * bridges) take a short path with the film terms only (lean_apart). With an energy budget it
+ * also gives each model's terms (struct lean_terms), whose work is summed as the fused
+ * kernel's per-model records are (add_model_work: the same records, the same operations, so
+ * the same bits); four pairs at a time (many_bulk.h) then stay off.
  */
 #include <omp.h>
 #include <stdlib.h>
@@ -374,6 +377,15 @@ struct lean_geometry {
     bool wall;
 };
 
+/* Each model's part of a lean result, for the energy budget: the normal terms of hertz, sb
+ * and capillary (+0 where a model does not act), mindlin's tangential force and torques, and
+ * the unit normal. */
+struct lean_terms {
+    double term[3]; /* hertz, sb, capillary [N] */
+    struct wetdem_vec3 f_tan, t_i, t_j, n;
+    bool contact; /* in solid contact (else the mindlin record is zero) */
+};
+
 /* The normal forces of the film models at gap `gap` [m] (R* = r_eff [m], v_n [m/s]), as
  * force_sb.c and force_capillary.c compute them, into term[1] (sb) and term[2] (capillary);
  * the terms of models that do not act are left as they are (+0). */
@@ -394,14 +406,15 @@ static inline __attribute__((always_inline)) void film_terms(const struct wetdem
 /* Force of pair g with mixed properties x: the operations of wetdem_sim_many_eval_fused and
  * eval_pair in the same order on the quantities the enabled models read, so force, torques,
  * history and flags are bit-identical to theirs (tests/test_many_force.c). The film terms are
- * film_terms', or film[0] and film[1] when film is not NULL. The sum of the
+ * film_terms', or film[0] and film[1] when film is not NULL; each model's part into *terms
+ * when terms is not NULL. The sum of the
  * normal forces starts at +0 and adds the models in model order; a model that does not act
  * adds +0, which changes no sum that is not -0 (and a sum from +0 never is). Needs
  * g->gap <= x->range. Returns WETDEM_OK or WETDEM_ERR_NUMERIC (non-finite force). */
 static inline __attribute__((always_inline)) int
 lean_force(const struct wetdem_many* m, const struct lean_geometry* g,
            const struct wetdem_many_mix* x, double* hist, unsigned char* flags,
-           struct wetdem_many_pair_out* o, const double* film)
+           struct wetdem_many_pair_out* o, const double* film, struct lean_terms* terms)
 {
     const struct wetdem_many_lean* L = &m->lean;
     double gap = g->gap, r_eff = g->r_eff, v_n = g->v_n, overlap = -gap;
@@ -439,6 +452,9 @@ lean_force(const struct wetdem_many* m, const struct lean_geometry* g,
     o->force = vec3_axpy(f_tan, f_n, n);
     o->torque_i = t_i;
     o->torque_j = t_j;
+    if (terms)
+        *terms =
+            (struct lean_terms){{term[0], term[1], term[2]}, f_tan, t_i, t_j, n, overlap > 0.0};
     *flags = WETDEM_MANY_ACTIVE | WETDEM_MANY_DIRTY |
              (gap < 0 ? WETDEM_MANY_CONTACT | WETDEM_MANY_SPRING : 0) |
              (x->film > 0 && gap < x->film ? WETDEM_MANY_BRIDGE : 0);
@@ -476,14 +492,16 @@ apart_result(const struct wetdem_many_lean* L, const struct wetdem_many_mix* x, 
 
 /* Pair apart (gap >= 0) within its range: the operations of lean_force for that case, where
  * only the film models act, along the normal n. The normal sum is lean_force's: hertz adds +0
- * there, which changes no sum from +0, and the other two commute. */
+ * there, which changes no sum from +0, and the other two commute. *terms as lean_force's. */
 static inline __attribute__((always_inline)) int
 lean_apart(const struct wetdem_many_lean* L, const struct wetdem_many_mix* x, struct wetdem_vec3 n,
            double gap, double r_eff, double v_n, unsigned char was, double* hist,
-           unsigned char* flags, struct wetdem_many_pair_out* o)
+           unsigned char* flags, struct wetdem_many_pair_out* o, struct lean_terms* terms)
 {
     double term[3] = {0.0, 0.0, 0.0};
     film_terms(L, x, gap, r_eff, v_n, term);
+    if (terms)
+        *terms = (struct lean_terms){.term = {0.0, term[1], term[2]}, .n = n};
     double f_n = 0.0 + term[1] + term[2];
     return apart_result(L, x, gap, f_n, vec3_axpy(vec3(0, 0, 0), f_n, n), was, hist, flags, o);
 }
@@ -507,11 +525,12 @@ lean_pair_start(const struct wetdem_many* m, size_t ia, size_t ib, struct wetdem
 
 /* Pair (ia, ib) in solid contact (gap < 0) with the start of its geometry (lean_pair_start)
  * and its constants `cache` (pair_cache): the rest of the geometry, then lean_force (with the
- * film terms `film`, or NULL). */
+ * film terms `film`, or NULL, and *terms). */
 static inline __attribute__((always_inline)) int
 lean_contact(const struct wetdem_many* m, size_t ia, size_t ib, struct wetdem_vec3 n, double gap,
              double v_n, const struct wetdem_many_mix* x, double* hist, const double* cache,
-             unsigned char* flags, struct wetdem_many_pair_out* o, const double* film)
+             unsigned char* flags, struct wetdem_many_pair_out* o, const double* film,
+             struct lean_terms* terms)
 {
     double r_a = m->xr[ia].r, r_b = m->xr[ib].r;
     const struct wetdem_vec3 *vw_a = m->vw[ia], *vw_b = m->vw[ib]; /* velocity, spin */
@@ -531,16 +550,18 @@ lean_contact(const struct wetdem_many* m, size_t ia, size_t ib, struct wetdem_ve
         struct wetdem_vec3 vb = vec3_add(vw_b[0], vec3_cross(vw_b[1], vec3_scale(n, r_b)));
         g.v_t = vec3_reject(vec3_sub(va, vb), n);
     }
-    return lean_force(m, &g, x, hist, flags, o, film);
+    return lean_force(m, &g, x, hist, flags, o, film, terms);
 }
 
 /* Pair (ia, ib) with d = x_a - x_b (minimum image): lean_pair_start, then lean_apart or
  * lean_contact; *flags = 0 beyond the range. With bulk results (bo, not NULL), the start of
- * the geometry and the force apart are candidate k's there (the same bits). */
+ * the geometry and the force apart are candidate k's there (the same bits). Each model's part
+ * into *terms when terms is not NULL. */
 static inline __attribute__((always_inline)) int
 lean_pair(const struct wetdem_many* m, size_t ia, size_t ib, struct wetdem_vec3 d,
           const struct wetdem_many_mix* x, double* hist, const double* cache, unsigned char* flags,
-          struct wetdem_many_pair_out* o, const struct wetdem_many_bulk_out* bo, size_t k)
+          struct wetdem_many_pair_out* o, const struct wetdem_many_bulk_out* bo, size_t k,
+          struct lean_terms* terms)
 {
     unsigned char was = *flags; /* of the previous evaluation */
     double gap, v_n, film[2];
@@ -552,30 +573,33 @@ lean_pair(const struct wetdem_many* m, size_t ia, size_t ib, struct wetdem_vec3 
             return WETDEM_OK;
         n = vec3(bo->n[0][k], bo->n[1][k], bo->n[2][k]);
         v_n = bo->v_n[k];
-        if (!(gap < 0.0))
+        if (!(gap < 0.0)) {
+            if (terms)
+                *terms = (struct lean_terms){.term = {0.0, bo->f_sb[k], bo->f_cap[k]}, .n = n};
             return apart_result(&m->lean, x, gap, (0.0 + bo->f_sb[k]) + bo->f_cap[k],
                                 vec3(bo->force[0][k], bo->force[1][k], bo->force[2][k]), was, hist,
                                 flags, o);
+        }
         film[0] = bo->f_sb[k];
         film[1] = bo->f_cap[k];
     } else {
         if (!lean_pair_start(m, ia, ib, d, x, &gap, &n, &v_n))
             return WETDEM_OK;
         if (!(gap < 0.0))
-            return lean_apart(&m->lean, x, n, gap, cache[0], v_n, was, hist, flags, o);
+            return lean_apart(&m->lean, x, n, gap, cache[0], v_n, was, hist, flags, o, terms);
     }
-    return lean_contact(m, ia, ib, n, gap, v_n, x, hist, cache, flags, o, bo ? film : NULL);
+    return lean_contact(m, ia, ib, n, gap, v_n, x, hist, cache, flags, o, bo ? film : NULL, terms);
 }
 
 /* Particle a and plane wall w: the geometry of wall_contact_from, then lean_force (walls
  * apart are too few for a path of their own to pay); *flags = 0 beyond the range. */
 static int lean_wall(const struct wetdem_many* m, const struct wetdem_particle* a,
                      const struct wetdem_wall* w, const struct wetdem_many_mix* x, double* hist,
-                     unsigned char* flags, struct wetdem_many_pair_out* o)
+                     unsigned char* flags, struct wetdem_many_pair_out* o, struct lean_terms* terms)
     __attribute__((noinline));
 static int lean_wall(const struct wetdem_many* m, const struct wetdem_particle* a,
                      const struct wetdem_wall* w, const struct wetdem_many_mix* x, double* hist,
-                     unsigned char* flags, struct wetdem_many_pair_out* o)
+                     unsigned char* flags, struct wetdem_many_pair_out* o, struct lean_terms* terms)
 {
     double dist = vec3_dot(vec3_sub(a->pos, w->point), w->normal);
     struct lean_geometry g = {.n = w->normal,
@@ -599,7 +623,7 @@ static int lean_wall(const struct wetdem_many* m, const struct wetdem_particle* 
             vec3_add(a->vel, vec3_cross(a->omega, vec3_scale(w->normal, -a->radius)));
         g.v_t = vec3_reject(va, g.n);
     }
-    return lean_force(m, &g, x, hist, flags, o, NULL);
+    return lean_force(m, &g, x, hist, flags, o, NULL, terms);
 }
 
 /* ---- the pair pass ---- */
@@ -607,7 +631,7 @@ static int lean_wall(const struct wetdem_many* m, const struct wetdem_particle* 
 /* Whether the lean kernel evaluates the pairs (else the fused kernel or the generic models). */
 static bool lean_active(const struct wetdem_many* m)
 {
-    return m->lean.on && !m->set.energy_budget;
+    return m->lean.on;
 }
 
 /* Whether the result of a particle pair with flags fl has torques to add (`lean`: the lean
@@ -651,31 +675,73 @@ static int report_failure(struct wetdem_sim* sim, const struct failure* f)
                                                            : wetdem_status_name(f->status));
 }
 
-/* This thread's work accumulators (pair or wall contacts), NULL without an energy budget. */
-static double* thread_work(const struct wetdem_many* m, int wall)
+/* The work accumulators (sim->n_models doubles) of entry `index` of the pass's per-particle
+ * or per-cross-pair work `base` (many.h; collect_pass_work), NULL without an energy budget. */
+static inline double* work_slot(const struct wetdem_sim* sim, double* base, size_t index)
 {
-    if (!m->set.energy_budget)
-        return NULL;
-    return m->thread_work + (size_t)omp_get_thread_num() * 2 * WETDEM_MAX_MODELS +
-           (size_t)wall * WETDEM_MAX_MODELS;
+    return sim->many->set.energy_budget ? base + index * sim->n_models : NULL;
 }
 
-/* Adds dt x the power of each model's force on the pair to work[model]. */
-static void add_work(const struct wetdem_sim* sim, const struct wetdem_contact* c,
-                     const struct wetdem_pair_force* per_model, double* work)
+/* The same for the pass's pairs: the pass holds `base` only with a budget (else NULL), in a
+ * block's copy kept in a register. */
+static inline double* pass_work_slot(double* base, size_t n_models, size_t index)
+{
+    return base ? base + index * n_models : NULL;
+}
+
+/* Adds dt x the power of each model's force on pair (i, j) (particle i and a wall when
+ * `wall`; unit normal n, j to i) to work[model], from the models' records per_model[0..
+ * n_models). */
+static void add_model_work(const struct wetdem_many* m, size_t i, size_t j, bool wall,
+                           struct wetdem_vec3 n, const struct wetdem_pair_force* per_model,
+                           size_t n_models, double* work)
+{
+    struct wetdem_vec3 dv = m->vw[i][0], wi = m->vw[i][1], wj = vec3(0, 0, 0);
+    if (!wall) {
+        dv = vec3_sub(dv, m->vw[j][0]);
+        wj = m->vw[j][1];
+    }
+    for (size_t k = 0; k < n_models; k++) {
+        const struct wetdem_pair_force* f = &per_model[k];
+        struct wetdem_vec3 fi = vec3_axpy(f->f_tan, f->f_normal, n);
+        double p =
+            vec3_dot(fi, dv) + vec3_dot(f->torque_i, wi) + (wall ? 0.0 : vec3_dot(f->torque_j, wj));
+        work[k] += m->dt * p;
+    }
+}
+
+/* The work of a lean result with terms t (lean_force): what add_model_work gives for the
+ * records the fused kernel makes (fused_model: from zero, a normal model adds its term F,
+ * mindlin its tangential force and torques), without them: such a record's force on i is
+ * 0 + F n (axpy from zero), which is F n but for the sign of a zero component, and its zero
+ * torques add +-0 to the power; neither changes a power that is not zero, and a zero power
+ * changes no work sum (which starts at +0 and so is never -0). So the models whose records are
+ * zero are left out, and the sums are the fused kernel's bit for bit (tests/test_many_force.c
+ * compares whole runs' budgets). */
+static inline __attribute__((always_inline)) void add_lean_work(const struct wetdem_sim* sim,
+                                                                size_t i, size_t j, bool wall,
+                                                                const struct lean_terms* t,
+                                                                double* work)
 {
     const struct wetdem_many* m = sim->many;
-    struct wetdem_vec3 dv = m->vw[c->i][0], wi = m->vw[c->i][1], wj = vec3(0, 0, 0);
-    if (!c->is_wall) {
-        dv = vec3_sub(dv, m->vw[c->j][0]);
-        wj = m->vw[c->j][1];
-    }
+    struct wetdem_vec3 dv = m->vw[i][0];
+    if (!wall)
+        dv = vec3_sub(dv, m->vw[j][0]);
     for (size_t k = 0; k < sim->n_models; k++) {
-        const struct wetdem_pair_force* f = &per_model[k];
-        struct wetdem_vec3 fi = vec3_axpy(f->f_tan, f->f_normal, c->normal);
-        double p = vec3_dot(fi, dv) + vec3_dot(f->torque_i, wi) +
-                   (c->is_wall ? 0.0 : vec3_dot(f->torque_j, wj));
-        work[k] += sim->many->dt * p;
+        double p;
+        if (m->kind[k] == FUSED_MINDLIN) {
+            if (!t->contact)
+                continue;
+            p = vec3_dot(t->f_tan, dv) + vec3_dot(t->t_i, m->vw[i][1]);
+            if (!wall)
+                p += vec3_dot(t->t_j, m->vw[j][1]);
+        } else {
+            double f = t->term[m->kind[k] == FUSED_HERTZ ? 0 : m->kind[k] == FUSED_SB ? 1 : 2];
+            if (f == 0.0)
+                continue;
+            p = vec3_dot(vec3_scale(t->n, f), dv);
+        }
+        work[k] += m->dt * p;
     }
 }
 
@@ -719,14 +785,15 @@ static int eval_pair(const struct wetdem_sim* sim, struct wetdem_contact* c,
           vec3_is_finite(f.torque_j)))
         return WETDEM_ERR_NUMERIC;
     if (pm)
-        add_work(sim, c, per_model, work);
+        add_model_work(m, c->i, c->j, c->is_wall, c->normal, per_model, sim->n_models, work);
     return WETDEM_OK;
 }
 
-/* Pair q within reach of the cheap test (d = x_i - x_j): its contact and force into *o. */
+/* Pair q within reach of the cheap test (d = x_i - x_j): its contact and force into *o, its
+ * work into work[] (NULL: none). */
 static void eval_near_pair(const struct wetdem_sim* sim, size_t q, struct wetdem_vec3 d,
                            const struct wetdem_many_mix* x, struct wetdem_many_pair_out* o,
-                           struct failure* fail)
+                           struct failure* fail, double* work)
 {
     const struct wetdem_many* m = sim->many;
     size_t i = m->cl.pairs[q].i, j = m->cl.pairs[q].j, len = sim->history_len;
@@ -737,7 +804,7 @@ static void eval_near_pair(const struct wetdem_sim* sim, size_t q, struct wetdem
     c.j = j;
     double range = contact_range(sim, &c, x);
     double* hist = len ? m->history + q * len : NULL;
-    int st = eval_pair(sim, &c, x, range, hist, o, &m->flags[q], thread_work(m, 0));
+    int st = eval_pair(sim, &c, x, range, hist, o, &m->flags[q], work);
     if (st != WETDEM_OK)
         note_failure(fail, q, st, false, &c, range);
 }
@@ -770,6 +837,10 @@ struct pass {
     wetdem_many_bulk_fn* bulk;
     wetdem_many_bulk_walls_fn* bulk_walls;
     struct wetdem_many_bulk_in bulk_in;
+    /* with an energy budget, the work entries of the particles and of the cross pairs (many.h),
+       else NULL; n_models doubles each */
+    double *pair_work, *cross_work;
+    size_t n_models;
 };
 
 /* The force and torques of entry k of four-at-a-time results (those of a contact; a pair
@@ -783,35 +854,55 @@ static inline struct wetdem_many_pair_out bulk_pair_out(const struct wetdem_many
         .torque_j = vec3(bo->torque_j[0][k], bo->torque_j[1][k], bo->torque_j[2][k])};
 }
 
-/* Candidate q = (i, j, d = x_i - x_j) that passed the gap test: its kernel. Returns its flags.
+/* Candidate q = (i, j, d = x_i - x_j) that passed the gap test: its kernel, its work into
+ * work[] (work_slot: NULL without a budget). Returns its flags.
  * Inlined into its two loops (cross pairs, pairs of a block): with the pairs apart on their
  * own short path (lean_apart), the call cost more than the spills it used to save. */
 static unsigned char near_candidate(const struct pass* P, size_t q, size_t i, size_t j,
                                     struct wetdem_vec3 d, const struct wetdem_many_mix* x,
                                     struct wetdem_many_pair_out* o, struct failure* fail,
-                                    const struct wetdem_many_bulk_out* bo, size_t k)
+                                    const struct wetdem_many_bulk_out* bo, size_t k, double* work)
     __attribute__((always_inline));
 static inline unsigned char near_candidate(const struct pass* P, size_t q, size_t i, size_t j,
                                            struct wetdem_vec3 d, const struct wetdem_many_mix* x,
                                            struct wetdem_many_pair_out* o, struct failure* fail,
-                                           const struct wetdem_many_bulk_out* bo, size_t k)
+                                           const struct wetdem_many_bulk_out* bo, size_t k,
+                                           double* work)
 {
     unsigned char* fl = &P->flags[q];
     if (!P->lean) {
-        eval_near_pair(P->sim, q, d, x, o, fail);
+        eval_near_pair(P->sim, q, d, x, o, fail, work);
         return *fl;
     }
     unsigned char was = *fl;
     double* hist = P->history + q * P->len;
-    int st = lean_pair(P->m, i, j, d, x, hist, P->m->pair_cache[q], fl, o, bo, k);
+    struct lean_terms terms, *budget = work ? &terms : NULL;
+    int st = lean_pair(P->m, i, j, d, x, hist, P->m->pair_cache[q], fl, o, bo, k, budget);
     if (!*fl && (was & WETDEM_MANY_DIRTY) && P->len)
         wetdem_sim_history_init(P->sim, hist);
+    if (budget && *fl && st == WETDEM_OK) /* (as eval_pair: a force within range, finite) */
+        add_lean_work(P->sim, i, j, false, budget, work);
     if (st != WETDEM_OK) {
         struct wetdem_contact c = {.gap = bo ? bo->gap[k]
                                              : vec3_norm(d) - P->p[i].radius - P->p[j].radius};
         note_failure(fail, q, st, false, &c, x->range);
     }
     return *fl;
+}
+
+/* With an energy budget (work not NULL), the work of candidate k of four-at-a-time results bo,
+ * pair (i, j), into work[],
+ * apart within its range (the solid contacts are the scalar kernel's then:
+ * contacts_scalar): the film terms and normal there, lean_pair's with these results. */
+static inline __attribute__((always_inline)) void
+bulk_apart_work(const struct pass* P, const struct wetdem_many_bulk_out* bo, size_t k, size_t i,
+                size_t j, double* work)
+{
+    if (!work)
+        return;
+    struct lean_terms t = {.term = {0.0, bo->f_sb[k], bo->f_cap[k]},
+                           .n = vec3(bo->n[0][k], bo->n[1][k], bo->n[2][k])};
+    add_lean_work(P->sim, i, j, false, &t, work);
 }
 
 /* Pair q, which had flags, has left its range: fresh history, no flags. */
@@ -906,14 +997,14 @@ static inline __attribute__((always_inline)) bool skipped(const struct pass* P, 
  * force and torques where they include WETDEM_MANY_ACTIVE. */
 static inline __attribute__((always_inline)) unsigned char
 eval_candidate(const struct pass* P, size_t q, size_t i, size_t j, struct wetdem_many_pair_out* o,
-               struct failure* fail)
+               struct failure* fail, double* work)
 {
     struct wetdem_vec3 d;
     const struct wetdem_many_mix* x;
     if (skipped(P, q))
         return 0;
     if (within_reach(P, q, i, j, P->periodic, P->nm == 1, P->maintain, &d, &x))
-        return near_candidate(P, q, i, j, d, x, o, fail, NULL, 0);
+        return near_candidate(P, q, i, j, d, x, o, fail, NULL, 0, work);
     if (P->flags[q])
         leave_range(P, q);
     return 0;
@@ -940,11 +1031,15 @@ static unsigned char eval_wall(const struct wetdem_sim* sim, size_t i, size_t w,
     const struct wetdem_particle* a = &state;
     const struct wetdem_wall* wall = &sim->walls[w];
     const struct wetdem_many_mix* x = wetdem_sim_many_mix(sim, a->material, wall->material);
+    double* work = work_slot(sim, m->wall_work, i);
     unsigned char flags;
     if (lean_active(m)) {
-        int st = lean_wall(m, a, wall, x, hist, &flags, o);
+        struct lean_terms terms, *budget = work ? &terms : NULL;
+        int st = lean_wall(m, a, wall, x, hist, &flags, o, budget);
         if (!flags && hist && dirty) /* reset beyond the range, as eval_pair does */
             wetdem_sim_history_init(sim, hist);
+        if (budget && flags && st == WETDEM_OK)
+            add_lean_work(sim, i, w, true, budget, work);
         if (st != WETDEM_OK) {
             struct wetdem_contact c = {
                 .gap = vec3_dot(vec3_sub(a->pos, wall->point), wall->normal) - a->radius};
@@ -958,7 +1053,7 @@ static unsigned char eval_wall(const struct wetdem_sim* sim, size_t i, size_t w,
     c.j = w;
     double range = contact_range(sim, &c, x);
     flags = WETDEM_MANY_DIRTY; /* eval_pair resets the history beyond the range */
-    int st = eval_pair(sim, &c, x, range, hist, o, &flags, thread_work(m, 1));
+    int st = eval_pair(sim, &c, x, range, hist, o, &flags, work);
     if (st != WETDEM_OK)
         note_failure(fail, i * sim->n_walls + w, st, true, &c, range);
     return flags;
@@ -1309,9 +1404,12 @@ static void cross_pairs_share(const struct pass* P, size_t t, size_t nt, struct 
                         leave_range(P, q);
                 } else if (cls == 1)
                     near_candidate(P, q, P->pairs[q].i, P->pairs[q].j, vec3(0, 0, 0), m->mix, o,
-                                   fail, &bo, k);
+                                   fail, &bo, k,
+                                   pass_work_slot(P->cross_work, P->n_models, e_of[k]));
                 else {
                     bulk_flags(P, q, cls);
+                    bulk_apart_work(P, &bo, k, P->pairs[q].i, P->pairs[q].j,
+                                    pass_work_slot(P->cross_work, P->n_models, e_of[k]));
                     if (cls & WETDEM_MANY_CONTACT)
                         *o = bulk_pair_out(&bo, k);
                     else
@@ -1323,7 +1421,8 @@ static void cross_pairs_share(const struct pass* P, size_t t, size_t nt, struct 
     }
     for (size_t e = e_begin; e < e_end; e++) {
         size_t q = m->cross_q[e];
-        eval_candidate(P, q, P->pairs[q].i, P->pairs[q].j, &m->cross_out[e], fail);
+        eval_candidate(P, q, P->pairs[q].i, P->pairs[q].j, &m->cross_out[e], fail,
+                       pass_work_slot(P->cross_work, P->n_models, e));
     }
 }
 
@@ -1723,13 +1822,15 @@ close_batch(const struct pass* P, const struct batch_sums* B, size_t from_slot, 
  * and the counts are added in solid contact only: with `defer` (a pass with films, where
  * contacts and bridges apart alternate without a pattern and a branch on which one a result
  * is was mispredicted often) after the batch's loop, in a loop over its contacts in list
- * order (the same sums: see there), else at once.
+ * order (the same sums: see there), else at once. `budget`: P->pair_work is set (an energy
+ * budget), each result's work goes there.
  * Returns the number within range; *n_bulk_contacts gets those in solid contact evaluated
  * four at a time. */
 static inline __attribute__((always_inline)) uint64_t
 consume_four_at_a_time(const struct pass* P, const struct pass* P_out, size_t b,
                        const uint32_t* list, size_t n_list, bool kick, struct wetdem_vec3 g,
-                       struct failure* fail, bool fused, bool defer, uint64_t* n_bulk_contacts)
+                       struct failure* fail, bool fused, bool defer, bool budget,
+                       uint64_t* n_bulk_contacts)
 {
     struct wetdem_many* m = P->m;
     size_t end_block = m->blk[b + 1];
@@ -1758,6 +1859,8 @@ consume_four_at_a_time(const struct pass* P, const struct pass* P_out, size_t b,
             if (j < end_block && cls > 1) { /* evaluated four at a time: add_pair's j side */
                 n_near++;
                 bulk_flags(P, q, cls);
+                bulk_apart_work(P, &bo, k, bo.i[k], j,
+                                budget ? pass_work_slot(P->pair_work, P->n_models, bo.i[k]) : NULL);
                 P->force[j] =
                     vec3_sub(P->force[j], vec3(bo.force[0][k], bo.force[1][k], bo.force[2][k]));
                 if (defer) { /* (apart: no counts, and +0 torques) */
@@ -1780,8 +1883,9 @@ consume_four_at_a_time(const struct pass* P, const struct pass* P_out, size_t b,
                 else {
                     n_near++;
                     struct wetdem_many_pair_out o;
-                    unsigned char fl =
-                        near_candidate(P, q, bo.i[k], j, vec3(0, 0, 0), m->mix, &o, fail, &bo, k);
+                    unsigned char fl = near_candidate(
+                        P, q, bo.i[k], j, vec3(0, 0, 0), m->mix, &o, fail, &bo, k,
+                        budget ? pass_work_slot(P->pair_work, P->n_models, bo.i[k]) : NULL);
                     add_pair(P, j, fl, &o, &f, &t, &P->contacts[bo.i[k]]);
                 }
                 bo.force[0][k] = f.x;
@@ -1868,9 +1972,12 @@ pairs_of_block_as(const struct pass* P, size_t b, bool kick, struct wetdem_vec3 
                 : gap_test(P, q_begin, q_end, end_block, list, near, periodic, false, &n_skipped);
     /* 2. every particle in index order: its listed pairs (reactions to the second particle at
           once), its cross pairs from phase 1, then its own sum and the closing half kick */
-    if (bulk)
+    if (bulk && P->pair_work) /* (the budget's code apart: none of it in the loop without) */
         n_near = consume_four_at_a_time(P, P_out, b, list, n_list, kick, g, fail, fused, defer,
-                                        &n_bulk_contacts);
+                                        true, &n_bulk_contacts);
+    else if (bulk)
+        n_near = consume_four_at_a_time(P, P_out, b, list, n_list, kick, g, fail, fused, defer,
+                                        false, &n_bulk_contacts);
     for (size_t i = begin_block, h = 0; !bulk && i < end_block; i++) {
         if (!(h < n_list && pairs[list[h]].i == i)) { /* no listed pairs */
             close_unlisted(P, i, &e, e_end, kick, g);
@@ -1902,7 +2009,8 @@ pairs_of_block_as(const struct pass* P, size_t b, bool kick, struct wetdem_vec3 
                 pair_delta(P, i, j, periodic, single, &d, &x);
             }
             struct wetdem_many_pair_out o;
-            unsigned char fl = near_candidate(P, q, i, j, d, x, &o, fail, NULL, 0);
+            unsigned char fl = near_candidate(P, q, i, j, d, x, &o, fail, NULL, 0,
+                                              pass_work_slot(P->pair_work, P->n_models, i));
             add_pair(P, j, fl, &o, &f, &t, &n_contacts);
         }
         close_particle(P, i, &e, e_end, f, t, n_contacts, kick, g);
@@ -1992,6 +2100,82 @@ static int pair_constants(struct wetdem_sim* sim)
     return WETDEM_OK;
 }
 
+/* Particles per chunk of the work sums (collect_pass_work): a constant, so that the sums do not
+ * depend on the thread count. */
+#define WORK_CHUNK 1024
+
+/* Grows *a to n doubles, zero where it grew (the pass's work entries are zero between passes:
+ * collect_pass_work clears them). */
+static bool reserve_zeroed(double** a, size_t* cap, size_t n)
+{
+    if (n <= *cap)
+        return true;
+    if (!reserve((void**)a, cap, n, sizeof **a))
+        return false;
+    memset(*a, 0, n * sizeof **a);
+    return true;
+}
+
+/* With an energy budget: room for the pass's work entries (many.h). */
+static int reserve_work(struct wetdem_sim* sim)
+{
+    struct wetdem_many* m = sim->many;
+    size_t nm = sim->n_models, n = sim->n_particles, nc = m->cross_first[m->n_blocks];
+    size_t chunks = (n + WORK_CHUNK - 1) / WORK_CHUNK;
+    if (!reserve_zeroed(&m->pair_work, &m->pair_work_cap, n * nm) ||
+        !reserve_zeroed(&m->wall_work, &m->wall_work_cap, n * nm) ||
+        !reserve_zeroed(&m->cross_work, &m->cross_work_cap, nc * nm) ||
+        !reserve_zeroed(&m->chunk_work, &m->chunk_work_cap, chunks * 2 * nm))
+        return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory for the energy budget");
+    return WETDEM_OK;
+}
+
+/* The work of the pass, model by model, added to the budget, its entries cleared. Each
+ * particle's entry holds the work of its pairs (i, j) evaluated in its block, in list order;
+ * its cross pairs (j in a later block: larger j, so later in the list) are added after them
+ * in list order (cross_q is sorted); so every entry is the sum of the particle's pairs in list
+ * order, whatever the blocks. The entries, pairs and walls, are then summed in particle order
+ * in chunks of WORK_CHUNK, and the chunks in order: the work does not depend on the blocks or
+ * the thread count (before, per-thread sums made it depend on the blocks, which follow
+ * measured times). */
+static void collect_pass_work(struct wetdem_sim* sim, bool parallel)
+{
+    struct wetdem_many* m = sim->many;
+    size_t nm = sim->n_models, n = sim->n_particles, nc = m->cross_first[m->n_blocks];
+    for (size_t e = 0; e < nc; e++) {
+        double *from = m->cross_work + e * nm,
+               *to = m->pair_work + m->cl.pairs[m->cross_q[e]].i * nm;
+        for (size_t k = 0; k < nm; k++) {
+            to[k] += from[k];
+            from[k] = 0.0;
+        }
+    }
+    size_t chunks = (n + WORK_CHUNK - 1) / WORK_CHUNK;
+#pragma omp parallel for schedule(static) if (parallel)
+    for (size_t c = 0; c < chunks; c++) {
+        double* s = m->chunk_work + c * 2 * nm; /* pairs, then walls */
+        for (size_t k = 0; k < 2 * nm; k++)
+            s[k] = 0.0;
+        size_t end = (c + 1) * WORK_CHUNK < n ? (c + 1) * WORK_CHUNK : n;
+        for (size_t i = c * WORK_CHUNK; i < end; i++)
+            for (size_t k = 0; k < nm; k++) {
+                s[k] += m->pair_work[i * nm + k];
+                s[nm + k] += m->wall_work[i * nm + k];
+                m->pair_work[i * nm + k] = m->wall_work[i * nm + k] = 0.0;
+            }
+    }
+    double pairs[WETDEM_MAX_MODELS] = {0}, walls[WETDEM_MAX_MODELS] = {0};
+    for (size_t c = 0; c < chunks; c++)
+        for (size_t k = 0; k < nm; k++) {
+            pairs[k] += m->chunk_work[c * 2 * nm + k];
+            walls[k] += m->chunk_work[c * 2 * nm + nm + k];
+        }
+    for (size_t k = 0; k < nm; k++) {
+        m->energy.work_pair[k] += pairs[k];
+        m->energy.work_wall[k] += walls[k];
+    }
+}
+
 int wetdem_sim_many_forces(struct wetdem_sim* sim, enum wetdem_many_end end)
 {
     bool kick = end == WETDEM_MANY_END_KICK, drift = end == WETDEM_MANY_END_STEP;
@@ -2007,6 +2191,8 @@ int wetdem_sim_many_forces(struct wetdem_sim* sim, enum wetdem_many_end end)
     if (st != WETDEM_OK)
         return st;
     st = pair_constants(sim);
+    if (st == WETDEM_OK && m->set.energy_budget)
+        st = reserve_work(sim);
     if (st != WETDEM_OK)
         return st;
     struct failure fail = {0};
@@ -2043,7 +2229,10 @@ int wetdem_sim_many_forces(struct wetdem_sim* sim, enum wetdem_many_end end)
                      .nm = (size_t)m->n_mix_materials,
                      .periodic = m->periodic_any,
                      .lean = lean_active(m),
-                     .zeroed = m->sums_zeroed == n};
+                     .zeroed = m->sums_zeroed == n,
+                     .pair_work = m->set.energy_budget ? m->pair_work : NULL,
+                     .cross_work = m->set.energy_budget ? m->cross_work : NULL,
+                     .n_models = sim->n_models};
     /* four pairs at a time for the lean kernel in the common case: the geometry and film
        terms of every listed candidate, then the solid contacts among them */
     if (P.lean && P.nm == 1 && !P.periodic && !m->bulk_off) {
@@ -2067,6 +2256,7 @@ int wetdem_sim_many_forces(struct wetdem_sim* sim, enum wetdem_many_end end)
             .hertz_form = L->hertz_form,
             .mindlin = L->mindlin,
             .n_normal = L->n_normal,
+            .contacts_scalar = m->set.energy_budget,
             .cache = (const double(*)[4])m->pair_cache,
             .history = m->history,
             .len = sim->history_len,
@@ -2076,7 +2266,8 @@ int wetdem_sim_many_forces(struct wetdem_sim* sim, enum wetdem_many_end end)
             .mu = L->mindlin_lub ? x->friction_lub : x->friction_dry,
             .tangential_factor = x->mindlin_damping};
         memcpy(P.bulk_in.normal, L->normal, sizeof P.bulk_in.normal);
-        if (sim->n_walls <= 64) { /* (the wall masks) */
+        if (sim->n_walls <= 64 && !m->set.energy_budget) { /* (the wall masks; walls four at a
+                                                               time give no terms per model) */
             P.bulk_walls = wetdem_many_bulk_walls_choose(m->bulk_isa);
             P.bulk_in.walls = sim->walls;
             P.bulk_in.n_walls = sim->n_walls;
@@ -2111,6 +2302,8 @@ int wetdem_sim_many_forces(struct wetdem_sim* sim, enum wetdem_many_end end)
             m->block_time[b] += omp_get_wtime() - t0;
         }
     }
+    if (m->set.energy_budget)
+        collect_pass_work(sim, parallel);
     m->drift_passes += drift;
     m->blocks_passes++;
     m->sums_zeroed = 0;

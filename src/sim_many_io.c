@@ -11,6 +11,7 @@
  * within its interaction range is in any valid list, and forces are added in (i, j) order, so
  * the result does not depend on when the list was built.
  */
+#include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -97,6 +98,7 @@ int wetdem_sim_many_stats(const struct wetdem_sim* sim, struct wetdem_many_stats
     s->seconds_forces = m->seconds_forces;
     s->seconds_lists = m->seconds_lists;
     s->seconds_output = m->seconds_output;
+    s->threads = wetdem_many_parallel(m, sim->n_particles) ? omp_get_max_threads() : 1;
     return WETDEM_OK;
 }
 

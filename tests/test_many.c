@@ -87,9 +87,22 @@ static void test_many_same_result_for_any_thread_count(void** state)
     CHECK_OK(wetdem_sim_integrate(a, 1e-3));
     omp_set_num_threads(3);
     CHECK_OK(wetdem_sim_integrate(b, 1e-3));
+    struct wetdem_many_stats s;
+    /* the threads the run used: the OpenMP setting, but one below the fewest particles for
+       parallel loops (here 1 for the test; the summary printed the setting for a run on one
+       thread) */
+    CHECK_OK(wetdem_sim_many_stats(b, &s));
+    assert_int_equal(s.threads, 3);
+    b->many->parallel_min = 151;
+    CHECK_OK(wetdem_sim_many_stats(b, &s));
+    assert_int_equal(s.threads, 1);
     omp_set_num_threads(saved);
     test_check_same_particles(a, b);
-    struct wetdem_many_stats s;
+    /* and the energy budget, summed in an order set by the particles only */
+    struct wetdem_energy_budget ea, eb;
+    CHECK_OK(wetdem_sim_energy_budget(a, &ea));
+    CHECK_OK(wetdem_sim_energy_budget(b, &eb));
+    assert_memory_equal(&ea, &eb, sizeof ea);
     CHECK_OK(wetdem_sim_many_stats(a, &s));
     assert_true(s.contacts + s.bridges > 0); /* the run did exercise pair forces */
     assert_int_equal(s.step, 500);           /* 1 ms / 2 us */

@@ -393,6 +393,19 @@ static void test_many_cli_examples_and_budget(void** state)
     CHECK_CONTAINS(err, "the step dt = 2e-05 s is too long for these contacts; halve it");
     free(err);
     assert_true(exists("long/summary.json") && exists("long/global.csv"));
+    /* without the budget no work is summed: the same run prints no budget and does not judge
+       one (it gave every model's work as 0 and failed on the change of kinetic energy) */
+    assert_int_equal(run_cli("run budget.ini --set run.steps=300 --set run.dt=2e-5 "
+                             "--set run.energy_budget=no --out off"),
+                     0);
+    char* off = test_read_file(tpath("out.txt"), NULL);
+    CHECK_CONTAINS(off, "contacts");
+    assert_null(strstr(off, "energy budget"));
+    assert_null(strstr(off, "closure error"));
+    free(off);
+    char* off_json = test_read_file(tpath("off/summary.json"), NULL);
+    assert_null(strstr(off_json, "balance_error"));
+    free(off_json);
 }
 
 static int setup(void** state)

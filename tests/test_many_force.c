@@ -322,8 +322,8 @@ static struct wetdem_sim* wet_gas(bool generic_only, bool budget)
     return wet_gas_of(models, generic_only, budget);
 }
 
-/* Whole runs: fused against generic (with and without the energy budget, whose per-model
- * forces go through a separate branch), on 1 and 3 threads. */
+/* Whole runs: the lean kernel against generic (with and without the energy budget, whose
+ * per-model forces go through a separate branch), on 1 and 3 threads. */
 static void test_many_fused_run_equals_generic_run(void** state)
 {
     (void)state;
@@ -340,7 +340,8 @@ static void test_many_fused_run_equals_generic_run(void** state)
         omp_set_num_threads(saved);
         assert_true(fused->many->fused);
         assert_false(generic->many->fused);
-        /* without the budget the lean kernel runs (sim_many_force.c), with it the fused one */
+        /* the lean kernel runs with and without the budget (sim_many_force.c): with it, each
+           model's work from its terms must equal the generic interface's bit for bit */
         assert_true(fused->many->lean.on);
         assert_false(generic->many->lean.on);
         test_check_same_particles(fused, generic);
@@ -349,11 +350,15 @@ static void test_many_fused_run_equals_generic_run(void** state)
         CHECK_OK(wetdem_sim_many_stats(fused, &s));
         assert_true(s.contacts > 0 && s.bridges > 0); /* contact and film branches were run */
         if (budget) {
-            struct wetdem_energy_budget bf, bg;
+            struct wetdem_energy_budget bf, bg, b3;
             CHECK_OK(wetdem_sim_energy_budget(fused, &bf));
             CHECK_OK(wetdem_sim_energy_budget(generic, &bg));
+            CHECK_OK(wetdem_sim_energy_budget(fused3, &b3));
             assert_memory_equal(bf.work_pair, bg.work_pair, sizeof bf.work_pair);
             assert_memory_equal(bf.work_wall, bg.work_wall, sizeof bf.work_wall);
+            /* (the work's sums do not depend on the blocks: the same on 3 threads) */
+            assert_memory_equal(bf.work_pair, b3.work_pair, sizeof bf.work_pair);
+            assert_memory_equal(bf.work_wall, b3.work_wall, sizeof bf.work_wall);
         }
         wetdem_sim_free(fused);
         wetdem_sim_free(generic);
@@ -799,6 +804,61 @@ static void test_many_four_at_a_time_change_no_result(void** state)
     omp_set_num_threads(saved);
 }
 
+/* With an energy budget the lean kernel gives each model's terms: four pairs at a time for
+ * the pairs apart (their work from the vector kernel's film terms), the solid contacts and the
+ * walls by the scalar kernel. Whole runs of the closed wet box, 1 and 2 threads, through that
+ * path, through the scalar kernel alone and through the generic interface: the same
+ * particles, flags and work of every model bit for bit, and the same particles as without the
+ * budget (the budget only reads the forces). The work is summed per particle in list order,
+ * then in fixed chunks of particles (sim_many_force.c collect_pass_work), so it is also the
+ * same on 1 and 2 threads, whose blocks are cut by measured times (it was not, with sums per
+ * thread). */
+static void test_many_budget_four_at_a_time_equals_generic(void** state)
+{
+    (void)state;
+    static const char* const all[] = {"hertz", "mindlin", "sb", "capillary"};
+    int saved = omp_get_max_threads();
+    struct wetdem_energy_budget one_thread;
+    for (int threads = 1; threads <= 2; threads++) {
+        omp_set_num_threads(threads);
+        struct wetdem_sim* sims[4]; /* four at a time, scalar, generic: with the budget; none */
+        for (int k = 0; k < 4; k++) {
+            sims[k] = wet_pile(all, 4, false, 0, k == 1, WETDEM_MANY_BULK_BEST);
+            sims[k]->many->set.energy_budget = k < 3;
+            sims[k]->many->generic_only = k == 2;
+        }
+        for (int call = 1; call <= 4; call++)
+            for (int k = 0; k < 4; k++)
+                CHECK_OK(wetdem_sim_integrate(sims[k], call * 1e-3));
+        const struct wetdem_many* bulk = sims[0]->many;
+        assert_true(bulk->bulk_passes == sims[0]->engine.stats.force_evals);
+        assert_int_equal(bulk->bulk_contacts, 0); /* (contacts_scalar) */
+        assert_int_equal(bulk->bulk_walls, 0);
+        assert_true(bulk->lean.on && !sims[2]->many->lean.on);
+        struct wetdem_energy_budget b[3];
+        for (int k = 0; k < 3; k++) {
+            if (k > 0)
+                same_run(sims[0], sims[k]);
+            CHECK_OK(wetdem_sim_energy_budget(sims[k], &b[k]));
+        }
+        test_check_same_particles(sims[0], sims[3]);
+        if (threads == 1)
+            one_thread = b[0];
+        assert_memory_equal(b[0].work_pair, one_thread.work_pair, sizeof b[0].work_pair);
+        assert_memory_equal(b[0].work_wall, one_thread.work_wall, sizeof b[0].work_wall);
+        for (int k = 1; k < 3; k++) {
+            assert_memory_equal(b[0].work_pair, b[k].work_pair, sizeof b[0].work_pair);
+            assert_memory_equal(b[0].work_wall, b[k].work_wall, sizeof b[0].work_wall);
+        }
+        /* every model worked on pairs and walls (the films on the walls too) */
+        for (int q = 0; q < 4; q++)
+            assert_true(b[0].work_pair[q] != 0 && b[0].work_wall[q] != 0);
+        for (int k = 0; k < 4; k++)
+            wetdem_sim_free(sims[k]);
+    }
+    omp_set_num_threads(saved);
+}
+
 /* The choice of the four-at-a-time version (many.h): each version where the processor runs
  * it, else the baseline (never an instruction the processor lacks); by default the widest
  * usable one; AVX-512 usable only with AVX2. */
@@ -847,6 +907,7 @@ int main(void)
         cmocka_unit_test(test_many_kick_ranges_follow_the_threads_speed),
         cmocka_unit_test(test_many_skipped_candidates_change_no_result),
         cmocka_unit_test(test_many_four_at_a_time_change_no_result),
+        cmocka_unit_test(test_many_budget_four_at_a_time_equals_generic),
         cmocka_unit_test(test_many_bulk_version_choice),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
