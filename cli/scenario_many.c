@@ -118,7 +118,7 @@ static const struct cli_key_desc run_keys[] = {
         "Verlet skin of the neighbour lists."),
     WORD("energy_budget", CLI_VALUE_CHOICE, "yes", yes_no,
          "Accumulate the work of every model on particle pairs and walls, and check that the "
-         "budget closes (10-75 % slower: docs/many.md)."),
+         "budget closes (about 25-50 % slower: docs/many.md)."),
     {0},
 };
 

@@ -536,8 +536,8 @@ struct wetdem_many_settings {
     struct wetdem_vec3 box_lo, box_hi;   /* periodic box [m] (read on periodic axes only) */
     double dt;                           /* step [s] >= 0; 0: verlet.dt, or verlet.dt_fraction
                                             x the Hertz contact time of the smallest spheres */
-    bool energy_budget;                  /* accumulate the work of every model (costs 10-75 %:
-                                            docs/many.md, "Energy budget") */
+    bool energy_budget;                  /* accumulate the work of every model (costs about
+                                            25-50 %: docs/many.md, "Energy budget") */
     const char* output_prefix;           /* <prefix>_NNNNNN.vtk, <prefix>.vtk.series and
                                             <prefix>.csv; NULL: no files (copied) */
     unsigned long long vtk_every;        /* steps between VTK files; 0: none */

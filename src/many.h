@@ -89,10 +89,13 @@ struct wetdem_many_bulk_in {
     const struct wetdem_celllist_pair* pairs;
     const double* lim2;             /* pair_lim2 */
     double film, film_h_min, range; /* of the material pair [m] */
-    double sb_coef;                 /* 6 pi mu [Pa s] */
-    double cap_coef;                /* 8 pi */
-    double surface_tension;         /* [N/m] */
-    bool sb, sb_nc, capillary;      /* sb and capillary enabled; sb's "nc" treatment below h_min' */
+    bool periodic;                  /* any periodic axis: d = x_i - x_j is the minimum image */
+    bool axis_periodic[3];          /* the periodic axes, of lengths box_len [m] */
+    double box_len[3];
+    double sb_coef;            /* 6 pi mu [Pa s] */
+    double cap_coef;           /* 8 pi */
+    double surface_tension;    /* [N/m] */
+    bool sb, sb_nc, capillary; /* sb and capillary enabled; sb's "nc" treatment below h_min' */
     /* then the solid contacts (gap < 0) among them (many_bulk.h bulk_contacts), with the lean
        kernel's plan: hertz (form 0 exact, 1 tsuji, -1 absent), mindlin, the normal forces in
        model order (0 hertz, 1 sb, 2 capillary) */
@@ -100,8 +103,8 @@ struct wetdem_many_bulk_in {
     bool mindlin;
     int n_normal;
     unsigned char normal[WETDEM_MAX_MODELS];
-    bool contacts_scalar;     /* leave them to the scalar kernel (class 1): with an energy
-                                 budget, which needs each model's terms */
+    bool budget;              /* an energy budget: also each model's terms (out's hertz and
+                                 f_tan) */
     const double (*cache)[4]; /* pair_cache: R* [m], m* [kg], Hertz k, damping factor */
     double* history;          /* the pair histories, len doubles each; the Mindlin spring at */
     size_t len, spring_off;   /* spring_off of them [m] */
@@ -121,13 +124,17 @@ struct wetdem_many_bulk_out { /* by component, each entry 32-byte aligned */
        kernel; else its flags: apart within the range with a finite force, or in solid contact
        with a finite force and torques, its spring stored */
     long long cls[WETDEM_MANY_BULK_MAX] __attribute__((aligned(32)));
-    uint32_t i[WETDEM_MANY_BULK_MAX], j[WETDEM_MANY_BULK_MAX];          /* the pair's particles */
-    double r2[WETDEM_MANY_BULK_MAX] __attribute__((aligned(32)));       /* |x_i - x_j|^2 [m^2] */
-    double gap[WETDEM_MANY_BULK_MAX] __attribute__((aligned(32)));      /* [m] */
-    double n[3][WETDEM_MANY_BULK_MAX] __attribute__((aligned(32)));     /* unit normal, j to i */
-    double v_n[WETDEM_MANY_BULK_MAX] __attribute__((aligned(32)));      /* [m/s] */
-    double f_sb[WETDEM_MANY_BULK_MAX] __attribute__((aligned(32)));     /* its sb term [N] */
-    double f_cap[WETDEM_MANY_BULK_MAX] __attribute__((aligned(32)));    /* its capillary term [N] */
+    uint32_t i[WETDEM_MANY_BULK_MAX], j[WETDEM_MANY_BULK_MAX];       /* the pair's particles */
+    double r2[WETDEM_MANY_BULK_MAX] __attribute__((aligned(32)));    /* |x_i - x_j|^2 [m^2] */
+    double gap[WETDEM_MANY_BULK_MAX] __attribute__((aligned(32)));   /* [m] */
+    double n[3][WETDEM_MANY_BULK_MAX] __attribute__((aligned(32)));  /* unit normal, j to i */
+    double v_n[WETDEM_MANY_BULK_MAX] __attribute__((aligned(32)));   /* [m/s] */
+    double f_sb[WETDEM_MANY_BULK_MAX] __attribute__((aligned(32)));  /* its sb term [N] */
+    double f_cap[WETDEM_MANY_BULK_MAX] __attribute__((aligned(32))); /* its capillary term [N] */
+    /* with in->budget: the hertz term [N] and mindlin's tangential force on i [N] (lean_force's
+       term[0] and f_tan), +0 apart (and so the torque on j) */
+    double hertz[WETDEM_MANY_BULK_MAX] __attribute__((aligned(32)));
+    double f_tan[3][WETDEM_MANY_BULK_MAX] __attribute__((aligned(32)));
     double force[3][WETDEM_MANY_BULK_MAX] __attribute__((aligned(32))); /* its force on i [N] */
     /* in solid contact (cls has WETDEM_MANY_CONTACT): the torques on i and j [N m]; the one
        on i is +0 for the other pairs evaluated */

@@ -1,10 +1,11 @@
 /*
  * many_bulk.h — four candidate pairs at a time in vector units (docs/many.md, "Four pairs at a
  * time"): the gap test, the geometry and the film forces of the lean kernel, for the one-loop
- * pass of a wet packing in the common case (one material pair, no periodic axis). Internal to
- * the many-particle engine.
+ * pass of a wet packing in the common case (one material pair, periodic axes or not). Internal
+ * to the many-particle engine.
  *
- * For candidate pair q = (i, j) with d = x_i - x_j, exactly the operations of
+ * For candidate pair q = (i, j) with d = x_i - x_j (on a periodic axis of length L its minimum
+ * image d - L nearbyint(d / L), celllist.h celllist_delta), exactly the operations of
  * sim_many_force.c's within_reach, lean_pair_start, film_terms and lean_apart, lane by lane:
  *   r2 = (d_x d_x + d_y d_y) + d_z d_z (the gap test: r2 <= pair_lim2),  |d| = sqrt(r2),
  *   gap = (|d| - R_i) - R_j,  n = d (1/|d|) (or (1, 0, 0) when |d| = 0),
@@ -108,6 +109,20 @@ static inline __attribute__((always_inline)) void bulk_columns(const double* p0,
 #endif
 }
 
+/* *d less len times the nearest integer (ties to even, the current rounding mode's, as
+ * nearbyint) to *d / len, lane by lane: celllist_delta's minimum image on a periodic axis. */
+static inline __attribute__((always_inline)) void bulk_minimum_image(wetdem_v4d* d, double len)
+{
+    wetdem_v4d l = BULK_SPLAT(len), r = *d / l;
+#if defined(__AVX__)
+    r = (wetdem_v4d)_mm256_round_pd((__m256d)r, _MM_FROUND_CUR_DIRECTION | _MM_FROUND_NO_EXC);
+#else
+    for (int k = 0; k < 4; k++)
+        r[k] = nearbyint(r[k]);
+#endif
+    *d -= l * r;
+}
+
 /* The lanes of v at the entries idx[0..3] of the array a. */
 #define BULK_GATHER(a, idx)                                                                        \
     ((wetdem_v4d){(a)[(idx)[0]], (a)[(idx)[1]], (a)[(idx)[2]], (a)[(idx)[3]]})
@@ -161,7 +176,7 @@ bulk_film_terms(const struct bulk_constants* C, enum bulk_films films, const wet
 static inline __attribute__((always_inline)) void
 bulk_four(const struct wetdem_many_bulk_in* in, const struct bulk_constants* C,
           const uint32_t* list, size_t n, size_t j_end, struct wetdem_many_bulk_out* out, size_t k,
-          bool tail, enum bulk_films films, uint32_t* at, size_t* n_at)
+          bool tail, enum bulk_films films, bool periodic, uint32_t* at, size_t* n_at)
 {
     bool dry = films == BULK_DRY;
     const wetdem_v4i bridge_on = films == BULK_BOTH ? (wetdem_v4i){-1, -1, -1, -1} : C->bridge_on;
@@ -226,6 +241,14 @@ bulk_four(const struct wetdem_many_bulk_in* in, const struct bulk_constants* C,
     wetdem_v4d lim2 = {in->lim2[q[0]], in->lim2[q[1]], in->lim2[q[2]], in->lim2[q[3]]};
     /* within_reach and lean_pair_start */
     wetdem_v4d dx = pi[0] - pj[0], dy = pi[1] - pj[1], dz = pi[2] - pj[2];
+    if (periodic) { /* (in->periodic, a constant of the loop) */
+        if (in->axis_periodic[0])
+            bulk_minimum_image(&dx, in->box_len[0]);
+        if (in->axis_periodic[1])
+            bulk_minimum_image(&dy, in->box_len[1]);
+        if (in->axis_periodic[2])
+            bulk_minimum_image(&dz, in->box_len[2]);
+    }
     wetdem_v4d r2 = dx * dx + dy * dy + dz * dz;
     wetdem_v4d dist = r2;
     bulk_sqrt(&dist);
@@ -285,6 +308,11 @@ bulk_four(const struct wetdem_many_bulk_in* in, const struct bulk_constants* C,
     *(wetdem_v4d*)&out->force[2][k] = zero + f_n * nz;
     for (int c = 0; c < 3; c++) /* (+0 apart: the results' sums add it without a test) */
         *(wetdem_v4d*)&out->torque_i[c][k] = zero;
+    if (in->budget) { /* the contact terms +0 apart, so the budget reads them without a test */
+        *(wetdem_v4d*)&out->hertz[k] = zero;
+        for (int c = 0; c < 3; c++)
+            *(wetdem_v4d*)&out->f_tan[c][k] = *(wetdem_v4d*)&out->torque_j[c][k] = zero;
+    }
 }
 
 /* What the contact core (bulk_lean_force) reads of four lanes, and what it gives. */
@@ -296,8 +324,9 @@ struct bulk_lanes {
     wetdem_v4d v_t[3];         /* tangential velocity [m/s] (with mindlin) */
     wetdem_v4d s[3];           /* the Mindlin spring [m] (with mindlin): in, then out */
     wetdem_v4d term[3];        /* sb and capillary terms in term[1], term[2] [N] */
-    /* out: the force on i [N], the torques on i and j [N m], all ones where all are finite */
-    wetdem_v4d force[3], ti[3], tj[3];
+    /* out: the force on i [N], the torques on i and j [N m], all ones where all are finite;
+       mindlin's part of the force, f_tan [N] */
+    wetdem_v4d force[3], ti[3], tj[3], f_tan[3];
     wetdem_v4i finite;
 };
 
@@ -388,6 +417,9 @@ bulk_lean_force(const struct wetdem_many_bulk_in* in, const struct bulk_constant
     wetdem_v4d f_n;
     bulk_normal_sum(in, C, L, &f_n);
     wetdem_v4i finite = BULK_FINITE(f_n);
+    if (in->budget) /* (only the budget reads it) */
+        for (int c = 0; c < 3; c++)
+            L->f_tan[c] = ft[c];
     for (int c = 0; c < 3; c++) {
         L->force[c] = ft[c] + f_n * L->n[c];
         finite &= BULK_FINITE(L->force[c]) & BULK_FINITE(L->ti[c]) & BULK_FINITE(L->tj[c]);
@@ -469,6 +501,12 @@ bulk_contacts(const struct wetdem_many_bulk_in* in, const struct bulk_constants*
                 in->history[q[l] * in->len + in->spring_off + c] = L.s[c][l];
         }
     }
+    for (int l = 0; in->budget && l < 4; l++) /* (the test once for the group without one) */
+        if (L.finite[l]) {
+            out->hertz[at[l]] = L.term[0][l];
+            for (int c = 0; c < 3; c++)
+                out->f_tan[c][at[l]] = L.f_tan[c][l];
+        }
 }
 
 /* The film models of a call's input (enum bulk_films). */
@@ -497,10 +535,32 @@ bulk_constants_of(const struct wetdem_many_bulk_in* in)
                                    .bridge_on = BULK_UNIFORM(in->film > 0)};
 }
 
+/* bulk_four over list[0..n), each kind of films in its own loop (its masks constants there),
+ * `periodic` (in->periodic) a constant of the loops. */
+static inline __attribute__((always_inline)) void
+bulk_groups(const struct wetdem_many_bulk_in* in, const struct bulk_constants* C,
+            const uint32_t* list, size_t n, size_t j_end, struct wetdem_many_bulk_out* out,
+            enum bulk_films films, bool periodic, uint32_t* at, size_t* n_at)
+{
+    size_t k = 0;
+    if (films == BULK_BOTH)
+        for (; k + 4 <= n; k += 4)
+            bulk_four(in, C, list, n, j_end, out, k, false, BULK_BOTH, periodic, at, n_at);
+    else if (films == BULK_DRY)
+        for (; k + 4 <= n; k += 4)
+            bulk_four(in, C, list, n, j_end, out, k, false, BULK_DRY, periodic, at, n_at);
+    else
+        for (; k + 4 <= n; k += 4)
+            bulk_four(in, C, list, n, j_end, out, k, false, BULK_ANY, periodic, at, n_at);
+    if (k < n)
+        bulk_four(in, C, list, n, j_end, out, k, true, films == BULK_DRY ? BULK_DRY : BULK_ANY,
+                  periodic, at, n_at);
+}
+
 /* Candidates list[0..n) (1 <= n <= WETDEM_MANY_BULK_MAX, in any particles): their geometry,
  * and the force apart of the film models, into out's entries 0..n); those whose second
  * particle is at or past j_end are left out (their entries but j are not used). Then those in
- * solid contact (bulk_contacts), unless in->contacts_scalar. */
+ * solid contact (bulk_contacts). */
 void WETDEM_MANY_BULK_NAME(const struct wetdem_many_bulk_in* in, const uint32_t* list, size_t n,
                            size_t j_end, struct wetdem_many_bulk_out* out)
 {
@@ -511,20 +571,11 @@ void WETDEM_MANY_BULK_NAME(const struct wetdem_many_bulk_in* in, const uint32_t*
        entry */
     uint32_t at[WETDEM_MANY_BULK_MAX + 3];
     size_t n_at = 0;
-    size_t k = 0; /* (each kind of films in its own loop, its masks constants there) */
-    if (films == BULK_BOTH)
-        for (; k + 4 <= n; k += 4)
-            bulk_four(in, &C, list, n, j_end, out, k, false, BULK_BOTH, at, &n_at);
-    else if (films == BULK_DRY)
-        for (; k + 4 <= n; k += 4)
-            bulk_four(in, &C, list, n, j_end, out, k, false, BULK_DRY, at, &n_at);
+    if (in->periodic)
+        bulk_groups(in, &C, list, n, j_end, out, films, true, at, &n_at);
     else
-        for (; k + 4 <= n; k += 4)
-            bulk_four(in, &C, list, n, j_end, out, k, false, BULK_ANY, at, &n_at);
-    if (k < n)
-        bulk_four(in, &C, list, n, j_end, out, k, true, films == BULK_DRY ? BULK_DRY : BULK_ANY, at,
-                  &n_at);
-    if (!n_at || in->contacts_scalar)
+        bulk_groups(in, &C, list, n, j_end, out, films, false, at, &n_at);
+    if (!n_at)
         return;
     for (size_t r = n_at; r % 4; r++)
         at[r] = at[n_at - 1];

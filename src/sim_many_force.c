@@ -383,7 +383,6 @@ struct lean_geometry {
 struct lean_terms {
     double term[3]; /* hertz, sb, capillary [N] */
     struct wetdem_vec3 f_tan, t_i, t_j, n;
-    bool contact; /* in solid contact (else the mindlin record is zero) */
 };
 
 /* The normal forces of the film models at gap `gap` [m] (R* = r_eff [m], v_n [m/s]), as
@@ -453,8 +452,7 @@ lean_force(const struct wetdem_many* m, const struct lean_geometry* g,
     o->torque_i = t_i;
     o->torque_j = t_j;
     if (terms)
-        *terms =
-            (struct lean_terms){{term[0], term[1], term[2]}, f_tan, t_i, t_j, n, overlap > 0.0};
+        *terms = (struct lean_terms){{term[0], term[1], term[2]}, f_tan, t_i, t_j, n};
     *flags = WETDEM_MANY_ACTIVE | WETDEM_MANY_DIRTY |
              (gap < 0 ? WETDEM_MANY_CONTACT | WETDEM_MANY_SPRING : 0) |
              (x->film > 0 && gap < x->film ? WETDEM_MANY_BRIDGE : 0);
@@ -715,9 +713,9 @@ static void add_model_work(const struct wetdem_many* m, size_t i, size_t j, bool
  * mindlin its tangential force and torques), without them: such a record's force on i is
  * 0 + F n (axpy from zero), which is F n but for the sign of a zero component, and its zero
  * torques add +-0 to the power; neither changes a power that is not zero, and a zero power
- * changes no work sum (which starts at +0 and so is never -0). So the models whose records are
- * zero are left out, and the sums are the fused kernel's bit for bit (tests/test_many_force.c
- * compares whole runs' budgets). */
+ * changes no work sum (which starts at +0 and so is never -0). So the sums are the fused
+ * kernel's bit for bit (tests/test_many_force.c compares whole runs' budgets), and a model that
+ * does not act (its terms +0: mindlin and hertz apart) needs no test: it adds a zero power. */
 static inline __attribute__((always_inline)) void add_lean_work(const struct wetdem_sim* sim,
                                                                 size_t i, size_t j, bool wall,
                                                                 const struct lean_terms* t,
@@ -730,15 +728,11 @@ static inline __attribute__((always_inline)) void add_lean_work(const struct wet
     for (size_t k = 0; k < sim->n_models; k++) {
         double p;
         if (m->kind[k] == FUSED_MINDLIN) {
-            if (!t->contact)
-                continue;
             p = vec3_dot(t->f_tan, dv) + vec3_dot(t->t_i, m->vw[i][1]);
             if (!wall)
                 p += vec3_dot(t->t_j, m->vw[j][1]);
         } else {
             double f = t->term[m->kind[k] == FUSED_HERTZ ? 0 : m->kind[k] == FUSED_SB ? 1 : 2];
-            if (f == 0.0)
-                continue;
             p = vec3_dot(vec3_scale(t->n, f), dv);
         }
         work[k] += m->dt * p;
@@ -891,16 +885,21 @@ static inline unsigned char near_candidate(const struct pass* P, size_t q, size_
 }
 
 /* With an energy budget (work not NULL), the work of candidate k of four-at-a-time results bo,
- * pair (i, j), into work[],
- * apart within its range (the solid contacts are the scalar kernel's then:
- * contacts_scalar): the film terms and normal there, lean_pair's with these results. */
+ * pair (i, j), of class > 1, into work[]: the terms lean_pair gives with these results (apart:
+ * the film terms; in solid contact also the hertz term, mindlin's force and the torques, which
+ * the vector kernel computes as lean_force does). */
 static inline __attribute__((always_inline)) void
-bulk_apart_work(const struct pass* P, const struct wetdem_many_bulk_out* bo, size_t k, size_t i,
-                size_t j, double* work)
+bulk_result_work(const struct pass* P, const struct wetdem_many_bulk_out* bo, size_t k, size_t i,
+                 size_t j, double* work)
 {
     if (!work)
         return;
-    struct lean_terms t = {.term = {0.0, bo->f_sb[k], bo->f_cap[k]},
+    /* (the contact terms are +0 apart: no test on the class, which a wet packing's results
+       follow without a pattern) */
+    struct lean_terms t = {.term = {bo->hertz[k], bo->f_sb[k], bo->f_cap[k]},
+                           .f_tan = vec3(bo->f_tan[0][k], bo->f_tan[1][k], bo->f_tan[2][k]),
+                           .t_i = vec3(bo->torque_i[0][k], bo->torque_i[1][k], bo->torque_i[2][k]),
+                           .t_j = vec3(bo->torque_j[0][k], bo->torque_j[1][k], bo->torque_j[2][k]),
                            .n = vec3(bo->n[0][k], bo->n[1][k], bo->n[2][k])};
     add_lean_work(P->sim, i, j, false, &t, work);
 }
@@ -1408,8 +1407,8 @@ static void cross_pairs_share(const struct pass* P, size_t t, size_t nt, struct 
                                    pass_work_slot(P->cross_work, P->n_models, e_of[k]));
                 else {
                     bulk_flags(P, q, cls);
-                    bulk_apart_work(P, &bo, k, P->pairs[q].i, P->pairs[q].j,
-                                    pass_work_slot(P->cross_work, P->n_models, e_of[k]));
+                    bulk_result_work(P, &bo, k, P->pairs[q].i, P->pairs[q].j,
+                                     pass_work_slot(P->cross_work, P->n_models, e_of[k]));
                     if (cls & WETDEM_MANY_CONTACT)
                         *o = bulk_pair_out(&bo, k);
                     else
@@ -1859,8 +1858,9 @@ consume_four_at_a_time(const struct pass* P, const struct pass* P_out, size_t b,
             if (j < end_block && cls > 1) { /* evaluated four at a time: add_pair's j side */
                 n_near++;
                 bulk_flags(P, q, cls);
-                bulk_apart_work(P, &bo, k, bo.i[k], j,
-                                budget ? pass_work_slot(P->pair_work, P->n_models, bo.i[k]) : NULL);
+                bulk_result_work(P, &bo, k, bo.i[k], j,
+                                 budget ? pass_work_slot(P->pair_work, P->n_models, bo.i[k])
+                                        : NULL);
                 P->force[j] =
                     vec3_sub(P->force[j], vec3(bo.force[0][k], bo.force[1][k], bo.force[2][k]));
                 if (defer) { /* (apart: no counts, and +0 torques) */
@@ -1952,7 +1952,9 @@ pairs_of_block_as(const struct pass* P, size_t b, bool kick, struct wetdem_vec3 
     const struct wetdem_celllist_pair* pairs = P->pairs;
     size_t begin_block = m->blk[b], end_block = m->blk[b + 1];
     size_t e = m->cross_first[b], e_end = m->cross_first[b + 1]; /* the block's cross pairs */
-    bool single = common || P->nm == 1, periodic = !common && P->periodic;
+    /* (common with bulk: periodic axes are the vector kernel's, known here only to the gap
+       test of two loops, once per block) */
+    bool single = common || P->nm == 1, periodic = common ? bulk && P->periodic : P->periodic;
     /* 1. the candidates to test (fused), or the gap test of every candidate of the block whose
           second particle is in the block, in one flat loop without branches on its outcome:
           the pairs within range, and those with flags (they may have just left it), are listed
@@ -2028,13 +2030,15 @@ pairs_of_block_as(const struct pass* P, size_t b, bool kick, struct wetdem_vec3 
 }
 
 /* Phase 2 of block b (pairs_of_block_as), compiled apart for the one-loop pass in the common
- * case (one material pair, no periodic axis) with and without four pairs at a time (with and
- * without films), the one-loop pass in general, and two loops (in the common case with and
- * without four pairs at a time and films). */
+ * case (one material pair, and no periodic axis or four pairs at a time) with and without four
+ * pairs at a time (with and without films), the one-loop pass in general, and two loops (in
+ * the common case with and without four pairs at a time and films). */
 static void pairs_of_block(const struct pass* P, size_t b, bool kick, struct wetdem_vec3 g,
                            struct failure* fail)
 {
-    bool common = P->nm == 1 && !P->periodic; /* one material pair, no periodic axis */
+    /* one material pair, and no periodic axis or four pairs at a time (whose kernel takes the
+       minimum image) */
+    bool common = P->nm == 1 && (!P->periodic || P->bulk);
     /* films: contacts and bridges apart mixed in the results (consume_four_at_a_time) */
     bool films = wetdem_many_bulk_films(&P->bulk_in);
     if (P->fused && common && P->bulk && films)
@@ -2235,7 +2239,7 @@ int wetdem_sim_many_forces(struct wetdem_sim* sim, enum wetdem_many_end end)
                      .n_models = sim->n_models};
     /* four pairs at a time for the lean kernel in the common case: the geometry and film
        terms of every listed candidate, then the solid contacts among them */
-    if (P.lean && P.nm == 1 && !P.periodic && !m->bulk_off) {
+    if (P.lean && P.nm == 1 && !m->bulk_off) {
         const struct wetdem_many_mix* x = m->mix;
         const struct wetdem_many_lean* L = &m->lean;
         P.bulk = wetdem_many_bulk_choose(m->bulk_isa);
@@ -2247,6 +2251,10 @@ int wetdem_sim_many_forces(struct wetdem_sim* sim, enum wetdem_many_end end)
             .film = x->film,
             .film_h_min = x->film_h_min,
             .range = x->range,
+            .periodic = P.periodic,
+            .axis_periodic = {m->cl.box.periodic[0], m->cl.box.periodic[1], m->cl.box.periodic[2]},
+            .box_len = {m->cl.box.hi[0] - m->cl.box.lo[0], m->cl.box.hi[1] - m->cl.box.lo[1],
+                        m->cl.box.hi[2] - m->cl.box.lo[2]},
             .sb_coef = 6.0 * M_PI * x->viscosity, /* the first product of film_terms' */
             .cap_coef = 8.0 * M_PI,
             .surface_tension = x->surface_tension,
@@ -2256,7 +2264,7 @@ int wetdem_sim_many_forces(struct wetdem_sim* sim, enum wetdem_many_end end)
             .hertz_form = L->hertz_form,
             .mindlin = L->mindlin,
             .n_normal = L->n_normal,
-            .contacts_scalar = m->set.energy_budget,
+            .budget = m->set.energy_budget,
             .cache = (const double(*)[4])m->pair_cache,
             .history = m->history,
             .len = sim->history_len,
