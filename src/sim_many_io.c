@@ -279,9 +279,12 @@ int wetdem_sim_many_outputs(struct wetdem_sim* sim, bool final)
 /* ---- checkpoints ---- */
 
 /* Fingerprint of everything a checkpoint must be restored into unchanged. */
-static uint64_t config_hash(const struct wetdem_sim* sim)
+/* The fingerprint of the set-up, with the energy budget on or off as `budget` (a run resumed
+ * with the budget from a checkpoint written without it would report the work since the
+ * restart against the energies since the start). */
+static uint64_t config_hash_with(const struct wetdem_sim* sim, bool budget)
 {
-    uint64_t h = wetdem_checkpoint_hash(0, "wetdem-many-1", 13);
+    uint64_t h = wetdem_checkpoint_hash(0, "wetdem-many-2", 13);
     h = wetdem_checkpoint_hash(h, sim->materials,
                                (size_t)sim->n_materials * sizeof(*sim->materials));
     h = wetdem_checkpoint_hash(h, &sim->fluid, sizeof sim->fluid);
@@ -303,9 +306,14 @@ static uint64_t config_hash(const struct wetdem_sim* sim)
     const struct wetdem_many_settings* s = &sim->many->set;
     double geo[8] = {s->skin,     s->dt,       s->box_lo.x, s->box_lo.y,
                      s->box_lo.z, s->box_hi.x, s->box_hi.y, s->box_hi.z};
-    unsigned char per[3] = {s->periodic[0], s->periodic[1], s->periodic[2]};
+    unsigned char per[4] = {s->periodic[0], s->periodic[1], s->periodic[2], budget};
     h = wetdem_checkpoint_hash(h, geo, sizeof geo);
     return wetdem_checkpoint_hash(h, per, sizeof per);
+}
+
+static uint64_t config_hash(const struct wetdem_sim* sim)
+{
+    return config_hash_with(sim, sim->many->set.energy_budget);
 }
 
 /* USER blob: dt, t0, then force and torque of every particle, then its contact count. */
@@ -398,6 +406,14 @@ static int check_restorable(struct wetdem_sim* sim, const struct wetdem_checkpoi
                             const char* path)
 {
     size_t n = ck->n_particles, nw = sim->n_walls;
+    bool budget = sim->many->set.energy_budget;
+    if (ck->config_hash != config_hash(sim) && ck->config_hash == config_hash_with(sim, !budget))
+        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
+                               "checkpoint '%s' was written with the energy budget %s: resume "
+                               "with it %s too (energy_budget = %s), or the budget would not "
+                               "cover the whole run",
+                               path, budget ? "off" : "on", budget ? "off" : "on",
+                               budget ? "no" : "yes");
     if (ck->config_hash != config_hash(sim))
         return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
                                "checkpoint '%s' was written with different materials, fluid, "

@@ -301,6 +301,7 @@ static struct wetdem_sim* stoppable_box(char* path, wetdem_progress_fn progress)
     remove(path);
     struct wetdem_sim* sim = wet_box(60, true);
     struct wetdem_many_settings s = box_settings();
+    s.energy_budget = true; /* as wet_box's, whose runs resume its checkpoints */
     s.checkpoint_path = path;
     s.stop_flag = &stop_now;
     s.progress = progress;

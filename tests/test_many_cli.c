@@ -254,6 +254,16 @@ static void test_many_cli_restart_is_bit_identical(void** state)
     CHECK_CONTAINS(err, "different materials");
     free(err);
     check_same_outputs("whole", "split", 7);
+    /* so is one written without the energy budget when the budget is on (it would count the
+       work since the restart against the energies since the start), with the key to set */
+    code = run_cli("run box.ini --set run.steps=600 --set run.energy_budget=no --out split "
+                   "--restart split/checkpoint.ckpt");
+    err = stderr_text();
+    assert_int_equal(code, 2);
+    CHECK_CONTAINS(err, "was written with the energy budget on: resume with it on too "
+                        "(energy_budget = yes)");
+    free(err);
+    check_same_outputs("whole", "split", 7);
 }
 
 /* Number of data rows in a CSV (lines starting with a digit). */
