@@ -681,6 +681,13 @@ bulk_walls_four(const struct wetdem_many_bulk_in* in, const struct bulk_constant
         if (L.finite[l])
             for (int c = 0; c < 3; c++)
                 in->wall_history[spring[l] + c] = L.s[c][l];
+    for (int l = 0; in->budget && l < 4; l++) { /* each model's terms (+0 where it does not act) */
+        out->hertz[e[l]] = L.term[0][l];
+        out->f_sb[e[l]] = L.term[1][l];
+        out->f_cap[e[l]] = L.term[2][l];
+        for (int c = 0; c < 3; c++)
+            out->f_tan[c][e[l]] = touching ? L.f_tan[c][l] : 0.0;
+    }
 }
 
 /* The entries idx[0..n) (touching or not) four at a time, each kind of films in its own loop

@@ -1492,9 +1492,12 @@ static inline void start_sum(const struct wetdem_sim* sim, size_t k, bool walls,
  * order into running sums restarted at each particle (running_add), which are stored after
  * every entry. The particles without a pair within range keep the zero sums the kick-drift
  * pass gave them (start_sums_of_block calls this only then), which is what start_sum gives
- * them. */
-static void start_sums_four_at_a_time(const struct pass* P, size_t lo, size_t hi,
-                                      struct failure* fail)
+ * them. With `budget` (an energy budget), each result's work per model into the particle's
+ * wall work, in entry order (eval_wall's for those it takes). */
+static inline __attribute__((always_inline)) void start_sums_four_at_a_time_as(const struct pass* P,
+                                                                               size_t lo, size_t hi,
+                                                                               struct failure* fail,
+                                                                               bool budget)
 {
     struct wetdem_many* m = P->m;
     const struct wetdem_sim* sim = P->sim;
@@ -1547,8 +1550,17 @@ static void start_sums_four_at_a_time(const struct pass* P, size_t lo, size_t hi
                 ft[3] = active ? o.torque_i.x : 0.0;
                 ft[4] = active ? o.torque_i.y : 0.0;
                 ft[5] = active ? o.torque_i.z : 0.0;
-            } else
+            } else {
                 n_within++;
+                if (budget) { /* (the vector kernel's terms: lean_wall's) */
+                    struct lean_terms t = {
+                        .term = {bo.hertz[e], bo.f_sb[e], bo.f_cap[e]},
+                        .f_tan = vec3(bo.f_tan[0][e], bo.f_tan[1][e], bo.f_tan[2][e]),
+                        .t_i = vec3(bo.torque_i[0][e], bo.torque_i[1][e], bo.torque_i[2][e]),
+                        .n = sim->walls[w].normal};
+                    add_lean_work(sim, i, w, true, &t, work_slot(sim, m->wall_work, i));
+                }
+            }
             set_wall_dirty(m, i, w, flags);
             bool fresh = i != prev;
             prev = (uint32_t)i;
@@ -1564,6 +1576,17 @@ static void start_sums_four_at_a_time(const struct pass* P, size_t lo, size_t hi
     }
 #pragma omp atomic
     m->bulk_walls += n_within;
+}
+
+/* start_sums_four_at_a_time_as, compiled apart with and without the energy budget (its work
+ * of each entry). */
+static void start_sums_four_at_a_time(const struct pass* P, size_t lo, size_t hi,
+                                      struct failure* fail)
+{
+    if (P->m->set.energy_budget)
+        start_sums_four_at_a_time_as(P, lo, hi, fail, true);
+    else
+        start_sums_four_at_a_time_as(P, lo, hi, fail, false);
 }
 
 /* The first index s < n with a[s] >= key in the sorted a[0..n), else n. */
@@ -2274,8 +2297,7 @@ int wetdem_sim_many_forces(struct wetdem_sim* sim, enum wetdem_many_end end)
             .mu = L->mindlin_lub ? x->friction_lub : x->friction_dry,
             .tangential_factor = x->mindlin_damping};
         memcpy(P.bulk_in.normal, L->normal, sizeof P.bulk_in.normal);
-        if (sim->n_walls <= 64 && !m->set.energy_budget) { /* (the wall masks; walls four at a
-                                                               time give no terms per model) */
+        if (sim->n_walls <= 64) { /* (the wall masks) */
             P.bulk_walls = wetdem_many_bulk_walls_choose(m->bulk_isa);
             P.bulk_in.walls = sim->walls;
             P.bulk_in.n_walls = sim->n_walls;
