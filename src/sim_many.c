@@ -22,8 +22,8 @@
  *
  * Determinism: every particle sums the forces on it in an order set by particle indices only
  * (sim_many_force.c), so positions and velocities are bit-identical for any number of
- * threads. The energy accumulators are summed per thread and are reproducible for a given
- * thread count.
+ * threads. So is the energy budget: its work is summed per particle in list order and then
+ * over fixed chunks of particles (sim_many_force.c collect_pass_work).
  *
  * Energy budget: the work of model k on a pair over one step is W = dt P(t + dt) with the
  * power P = F_i.(v*_i - v*_j) + T_i.w*_i + T_j.w*_j of that model's force at the evaluated
