@@ -89,8 +89,8 @@ struct wetdem_many_bulk_in {
     const struct wetdem_celllist_pair* pairs;
     const double* lim2;             /* pair_lim2 */
     double film, film_h_min, range; /* of the material pair [m] */
-    bool periodic;                  /* any periodic axis: d = x_i - x_j is the minimum image */
-    bool axis_periodic[3];          /* the periodic axes, of lengths box_len [m] */
+    bool axis_periodic[3];          /* the periodic axes (d = x_i - x_j is the minimum image
+                                       there), of lengths box_len [m] */
     double box_len[3];
     double sb_coef;            /* 6 pi mu [Pa s] */
     double cap_coef;           /* 8 pi */

@@ -241,7 +241,7 @@ bulk_four(const struct wetdem_many_bulk_in* in, const struct bulk_constants* C,
     wetdem_v4d lim2 = {in->lim2[q[0]], in->lim2[q[1]], in->lim2[q[2]], in->lim2[q[3]]};
     /* within_reach and lean_pair_start */
     wetdem_v4d dx = pi[0] - pj[0], dy = pi[1] - pj[1], dz = pi[2] - pj[2];
-    if (periodic) { /* (in->periodic, a constant of the loop) */
+    if (periodic) { /* (some axis is: a constant of the loop) */
         if (in->axis_periodic[0])
             bulk_minimum_image(&dx, in->box_len[0]);
         if (in->axis_periodic[1])
@@ -536,7 +536,7 @@ bulk_constants_of(const struct wetdem_many_bulk_in* in)
 }
 
 /* bulk_four over list[0..n), each kind of films in its own loop (its masks constants there),
- * `periodic` (in->periodic) a constant of the loops. */
+ * `periodic` (some axis of in is) a constant of the loops. */
 static inline __attribute__((always_inline)) void
 bulk_groups(const struct wetdem_many_bulk_in* in, const struct bulk_constants* C,
             const uint32_t* list, size_t n, size_t j_end, struct wetdem_many_bulk_out* out,
@@ -571,7 +571,7 @@ void WETDEM_MANY_BULK_NAME(const struct wetdem_many_bulk_in* in, const uint32_t*
        entry */
     uint32_t at[WETDEM_MANY_BULK_MAX + 3];
     size_t n_at = 0;
-    if (in->periodic)
+    if (in->axis_periodic[0] || in->axis_periodic[1] || in->axis_periodic[2])
         bulk_groups(in, &C, list, n, j_end, out, films, true, at, &n_at);
     else
         bulk_groups(in, &C, list, n, j_end, out, films, false, at, &n_at);

@@ -58,9 +58,8 @@
  * parts; mindlin.h: the tangential spring) in the same order, so it is bit-identical to the
  * fused kernel and the generic path (tests/test_many_force.c). Pairs apart (gap >= 0, liquid
  * bridges) take a short path with the film terms only (lean_apart). With an energy budget it
- * also gives each model's terms (struct lean_terms), whose work is summed as the fused
- * kernel's per-model records are (add_model_work: the same records, the same operations, so
- * the same bits); four pairs at a time (many_bulk.h) then stay off.
+ * (and four pairs at a time, many_bulk.h) also gives each model's terms (struct lean_terms),
+ * whose work equals that of the fused kernel's per-model records bit for bit (add_lean_work).
  */
 #include <omp.h>
 #include <stdlib.h>
@@ -626,12 +625,6 @@ static int lean_wall(const struct wetdem_many* m, const struct wetdem_particle* 
 
 /* ---- the pair pass ---- */
 
-/* Whether the lean kernel evaluates the pairs (else the fused kernel or the generic models). */
-static bool lean_active(const struct wetdem_many* m)
-{
-    return m->lean.on;
-}
-
 /* Whether the result of a particle pair with flags fl has torques to add (`lean`: the lean
  * kernel made it): lean_apart leaves them unset, as zero, for pairs apart; adding a zero
  * would change no sum (every sum starts from +0, and a sum from +0 is never -0). */
@@ -673,16 +666,10 @@ static int report_failure(struct wetdem_sim* sim, const struct failure* f)
                                                            : wetdem_status_name(f->status));
 }
 
-/* The work accumulators (sim->n_models doubles) of entry `index` of the pass's per-particle
- * or per-cross-pair work `base` (many.h; collect_pass_work), NULL without an energy budget. */
-static inline double* work_slot(const struct wetdem_sim* sim, double* base, size_t index)
-{
-    return sim->many->set.energy_budget ? base + index * sim->n_models : NULL;
-}
-
-/* The same for the pass's pairs: the pass holds `base` only with a budget (else NULL), in a
- * block's copy kept in a register. */
-static inline double* pass_work_slot(double* base, size_t n_models, size_t index)
+/* The work accumulators (n_models doubles) of entry `index` of the pass's per-particle or
+ * per-cross-pair work `base` (many.h; collect_pass_work), or NULL where base is (no energy
+ * budget). */
+static inline double* work_slot(double* base, size_t n_models, size_t index)
 {
     return base ? base + index * n_models : NULL;
 }
@@ -884,6 +871,21 @@ static inline unsigned char near_candidate(const struct pass* P, size_t q, size_
     return *fl;
 }
 
+/* The terms of entry k of four-at-a-time results bo kept for a budget (in->budget), with unit
+ * normal n: the contact terms are +0 apart, so no test on the class (which a wet packing's
+ * results follow without a pattern); a wall has no torque on j. */
+static inline __attribute__((always_inline)) struct lean_terms
+bulk_terms(const struct wetdem_many_bulk_out* bo, size_t k, struct wetdem_vec3 n, bool wall)
+{
+    return (struct lean_terms){
+        .term = {bo->hertz[k], bo->f_sb[k], bo->f_cap[k]},
+        .f_tan = vec3(bo->f_tan[0][k], bo->f_tan[1][k], bo->f_tan[2][k]),
+        .t_i = vec3(bo->torque_i[0][k], bo->torque_i[1][k], bo->torque_i[2][k]),
+        .t_j =
+            wall ? vec3(0, 0, 0) : vec3(bo->torque_j[0][k], bo->torque_j[1][k], bo->torque_j[2][k]),
+        .n = n};
+}
+
 /* With an energy budget (work not NULL), the work of candidate k of four-at-a-time results bo,
  * pair (i, j), of class > 1, into work[]: the terms lean_pair gives with these results (apart:
  * the film terms; in solid contact also the hertz term, mindlin's force and the torques, which
@@ -894,13 +896,7 @@ bulk_result_work(const struct pass* P, const struct wetdem_many_bulk_out* bo, si
 {
     if (!work)
         return;
-    /* (the contact terms are +0 apart: no test on the class, which a wet packing's results
-       follow without a pattern) */
-    struct lean_terms t = {.term = {bo->hertz[k], bo->f_sb[k], bo->f_cap[k]},
-                           .f_tan = vec3(bo->f_tan[0][k], bo->f_tan[1][k], bo->f_tan[2][k]),
-                           .t_i = vec3(bo->torque_i[0][k], bo->torque_i[1][k], bo->torque_i[2][k]),
-                           .t_j = vec3(bo->torque_j[0][k], bo->torque_j[1][k], bo->torque_j[2][k]),
-                           .n = vec3(bo->n[0][k], bo->n[1][k], bo->n[2][k])};
+    struct lean_terms t = bulk_terms(bo, k, vec3(bo->n[0][k], bo->n[1][k], bo->n[2][k]), false);
     add_lean_work(P->sim, i, j, false, &t, work);
 }
 
@@ -1030,9 +1026,9 @@ static unsigned char eval_wall(const struct wetdem_sim* sim, size_t i, size_t w,
     const struct wetdem_particle* a = &state;
     const struct wetdem_wall* wall = &sim->walls[w];
     const struct wetdem_many_mix* x = wetdem_sim_many_mix(sim, a->material, wall->material);
-    double* work = work_slot(sim, m->wall_work, i);
+    double* work = work_slot(m->set.energy_budget ? m->wall_work : NULL, sim->n_models, i);
     unsigned char flags;
-    if (lean_active(m)) {
+    if (m->lean.on) {
         struct lean_terms terms, *budget = work ? &terms : NULL;
         int st = lean_wall(m, a, wall, x, hist, &flags, o, budget);
         if (!flags && hist && dirty) /* reset beyond the range, as eval_pair does */
@@ -1403,12 +1399,11 @@ static void cross_pairs_share(const struct pass* P, size_t t, size_t nt, struct 
                         leave_range(P, q);
                 } else if (cls == 1)
                     near_candidate(P, q, P->pairs[q].i, P->pairs[q].j, vec3(0, 0, 0), m->mix, o,
-                                   fail, &bo, k,
-                                   pass_work_slot(P->cross_work, P->n_models, e_of[k]));
+                                   fail, &bo, k, work_slot(P->cross_work, P->n_models, e_of[k]));
                 else {
                     bulk_flags(P, q, cls);
                     bulk_result_work(P, &bo, k, P->pairs[q].i, P->pairs[q].j,
-                                     pass_work_slot(P->cross_work, P->n_models, e_of[k]));
+                                     work_slot(P->cross_work, P->n_models, e_of[k]));
                     if (cls & WETDEM_MANY_CONTACT)
                         *o = bulk_pair_out(&bo, k);
                     else
@@ -1421,7 +1416,7 @@ static void cross_pairs_share(const struct pass* P, size_t t, size_t nt, struct 
     for (size_t e = e_begin; e < e_end; e++) {
         size_t q = m->cross_q[e];
         eval_candidate(P, q, P->pairs[q].i, P->pairs[q].j, &m->cross_out[e], fail,
-                       pass_work_slot(P->cross_work, P->n_models, e));
+                       work_slot(P->cross_work, P->n_models, e));
     }
 }
 
@@ -1553,12 +1548,8 @@ static inline __attribute__((always_inline)) void start_sums_four_at_a_time_as(c
             } else {
                 n_within++;
                 if (budget) { /* (the vector kernel's terms: lean_wall's) */
-                    struct lean_terms t = {
-                        .term = {bo.hertz[e], bo.f_sb[e], bo.f_cap[e]},
-                        .f_tan = vec3(bo.f_tan[0][e], bo.f_tan[1][e], bo.f_tan[2][e]),
-                        .t_i = vec3(bo.torque_i[0][e], bo.torque_i[1][e], bo.torque_i[2][e]),
-                        .n = sim->walls[w].normal};
-                    add_lean_work(sim, i, w, true, &t, work_slot(sim, m->wall_work, i));
+                    struct lean_terms t = bulk_terms(&bo, e, sim->walls[w].normal, true);
+                    add_lean_work(sim, i, w, true, &t, work_slot(m->wall_work, sim->n_models, i));
                 }
             }
             set_wall_dirty(m, i, w, flags);
@@ -1882,8 +1873,7 @@ consume_four_at_a_time(const struct pass* P, const struct pass* P_out, size_t b,
                 n_near++;
                 bulk_flags(P, q, cls);
                 bulk_result_work(P, &bo, k, bo.i[k], j,
-                                 budget ? pass_work_slot(P->pair_work, P->n_models, bo.i[k])
-                                        : NULL);
+                                 budget ? work_slot(P->pair_work, P->n_models, bo.i[k]) : NULL);
                 P->force[j] =
                     vec3_sub(P->force[j], vec3(bo.force[0][k], bo.force[1][k], bo.force[2][k]));
                 if (defer) { /* (apart: no counts, and +0 torques) */
@@ -1908,7 +1898,7 @@ consume_four_at_a_time(const struct pass* P, const struct pass* P_out, size_t b,
                     struct wetdem_many_pair_out o;
                     unsigned char fl = near_candidate(
                         P, q, bo.i[k], j, vec3(0, 0, 0), m->mix, &o, fail, &bo, k,
-                        budget ? pass_work_slot(P->pair_work, P->n_models, bo.i[k]) : NULL);
+                        budget ? work_slot(P->pair_work, P->n_models, bo.i[k]) : NULL);
                     add_pair(P, j, fl, &o, &f, &t, &P->contacts[bo.i[k]]);
                 }
                 bo.force[0][k] = f.x;
@@ -2035,7 +2025,7 @@ pairs_of_block_as(const struct pass* P, size_t b, bool kick, struct wetdem_vec3 
             }
             struct wetdem_many_pair_out o;
             unsigned char fl = near_candidate(P, q, i, j, d, x, &o, fail, NULL, 0,
-                                              pass_work_slot(P->pair_work, P->n_models, i));
+                                              work_slot(P->pair_work, P->n_models, i));
             add_pair(P, j, fl, &o, &f, &t, &n_contacts);
         }
         close_particle(P, i, &e, e_end, f, t, n_contacts, kick, g);
@@ -2089,7 +2079,7 @@ static int pair_constants(struct wetdem_sim* sim)
     if (m->pair_consts_ready && m->pair_consts_build == m->cl.n_builds)
         return WETDEM_OK;
     size_t np = m->cl.n_pairs, nm = (size_t)m->n_mix_materials;
-    bool lean = lean_active(m);
+    bool lean = m->lean.on;
     int form = m->lean.hertz_form;
     if (!reserve((void**)&m->pair_lim2, &m->pair_lim2_cap, np, sizeof *m->pair_lim2) ||
         (lean && !reserve((void**)&m->pair_cache, &m->pair_cache_cap, np, sizeof *m->pair_cache)))
@@ -2255,7 +2245,7 @@ int wetdem_sim_many_forces(struct wetdem_sim* sim, enum wetdem_many_end end)
                      .len = sim->history_len,
                      .nm = (size_t)m->n_mix_materials,
                      .periodic = m->periodic_any,
-                     .lean = lean_active(m),
+                     .lean = m->lean.on,
                      .zeroed = m->sums_zeroed == n,
                      .pair_work = m->set.energy_budget ? m->pair_work : NULL,
                      .cross_work = m->set.energy_budget ? m->cross_work : NULL,
@@ -2274,7 +2264,6 @@ int wetdem_sim_many_forces(struct wetdem_sim* sim, enum wetdem_many_end end)
             .film = x->film,
             .film_h_min = x->film_h_min,
             .range = x->range,
-            .periodic = P.periodic,
             .axis_periodic = {m->cl.box.periodic[0], m->cl.box.periodic[1], m->cl.box.periodic[2]},
             .box_len = {m->cl.box.hi[0] - m->cl.box.lo[0], m->cl.box.hi[1] - m->cl.box.lo[1],
                         m->cl.box.hi[2] - m->cl.box.lo[2]},
