@@ -262,10 +262,11 @@ if [ "$PAIRS" -gt 0 ]; then
 fi
 
 # the floor: the bare loop over the bridges apart of the same state (bench/bridge_floor.c),
-# best of REPEAT rounds of FROZEN_STEPS steps -> "floor bridges_apart scalar_ns vector_ns"
+# best of REPEAT rounds of FROZEN_STEPS steps -> "floor bridges_apart scalar_ns vector_ns
+# gather_ns" (0 for a version the processor lacks)
 "$out/bridge_floor" --state-in "$out/state.data" --steps "$FROZEN_STEPS" --repeat "$REPEAT" |
   awk '{for (k = 2; k <= NF; k++) {split($k, a, "="); v[a[1]] = a[2]}
-        print "floor", v["bridges_apart"], v["scalar_ns"], v["vector_ns"]}' | tee -a "$res" >&2
+        print "floor", v["bridges_apart"], v["scalar_ns"], v["vector_ns"], v["gather_ns"] + 0}' | tee -a "$res" >&2
 $have_lg || echo "20-many: liggghts or mpirun not installed: LIGGGHTS half skipped" \
   "(scripts/install-deps bench)"
 
@@ -342,7 +343,8 @@ awk -v n="$N" -v wb="$base_kb" -v lb="$lg_base" -v steps="$STEPS" -v same="$SAME
              fb[nfilm] = $6; next }
   /^instr floor / { floor_ins = $3; next }
   /^instr / { ins[$2 " " $3 " " $4] = $5 }
-  /^floor / { floor_nb = $2; floor_ns = ($4 > 0 && $4 < $3) ? $4 : $3; floor_one = $3 }
+  /^floor / { floor_nb = $2; floor_one = $3; floor_ns = $3; floor_gather = $5 + 0
+              for (k = 4; k <= 5; k++) if ($k > 0 && $k < floor_ns) floor_ns = $k }
   function r(a, b) { return (b > 0) ? a / b : 0 }
   END {
     printf "\n%-5s %-9s %-4s %7s %12s %14s %14s %9s %9s\n", "proto", "code", "kind", "threads",
@@ -397,9 +399,10 @@ awk -v n="$N" -v wb="$base_kb" -v lb="$lg_base" -v steps="$STEPS" -v same="$SAME
                plo[ck], phi[ck], pok[ck], pn[ck]
       if (p == 3 && floor_nb > 0 && rate[w "dry 1"] > 0)
         printf "  the floor (bench/bridge_floor.c: the bare loop over the %d bridges apart of this" \
-               " state, no engine): %.1f ns per bridge-step (one pair at a time %.1f); on top of" \
+               " state, no engine): %.1f ns per bridge-step (one pair at a time %.1f; eight at a" \
+               " time by AVX-512 gathers from arrays by component %.1f); on top of" \
                " the dry run it alone gives a wet / dry cost of %.2fx\n", floor_nb, floor_ns,
-               floor_one, 1 + floor_nb * floor_ns * 1e-9 * rate[w "dry 1"] / n
+               floor_one, floor_gather, 1 + floor_nb * floor_ns * 1e-9 * rate[w "dry 1"] / n
       if (p == 3 && nfilm > 0) { # (liquid: 3 delta / R of the mean radius, 0.95 mm)
         printf "  cost wet / dry against the film thickness (dry and wet back to back, best of" \
                " each; target <= 1.3):"

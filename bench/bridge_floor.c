@@ -18,13 +18,17 @@
  * contacts. Any engine pays at least this for the bridges apart, so on top of the dry run it
  * bounds the wet / dry cost from below.
  *
- * Two versions of the loop, the same operations in the same order: one pair at a time, and four
- * pairs at a time in vector units (AVX2 where the processor has it, as wetdem's kernel; else
- * only the first runs). Their force sums must agree bit for bit, or the program fails.
+ * Three versions of the loop, the same operations in the same order: one pair at a time; four
+ * pairs at a time in vector units from the 32-byte records (AVX2 where the processor has it, as
+ * wetdem's kernel); and eight pairs at a time from arrays by component (x[], y[], ... of all
+ * spheres) with the AVX-512 gather instructions, where the processor has AVX-512F: the other
+ * layout a redesign would choose, measured on the same pairs. A version the processor lacks is
+ * not run. Their force sums must agree bit for bit, or the program fails.
  *
- * Usage: bridge_floor --state-in FILE [--steps S] [--repeat R] [--kernel scalar|vector|both]
- * Prints one line: "floor n=.. bridges_apart=.. steps=.. scalar_ns=.. vector_ns=.." (ns per
- * bridge-step, best of R rounds of S steps; 0 for a version not run).
+ * Usage: bridge_floor --state-in FILE [--steps S] [--repeat R]
+ *                     [--kernel scalar|vector|gather|both|all]   (both: scalar and vector)
+ * Prints one line: "floor n=.. bridges_apart=.. steps=.. scalar_ns=.. vector_ns=.. gather_ns=.."
+ * (ns per bridge-step, best of R rounds of S steps; 0 for a version not run).
  */
 #include <math.h>
 #include <stdbool.h>
@@ -51,6 +55,7 @@ struct state {
     size_t n;
     struct sphere* s;
     struct motion* v;
+    double* comp[7]; /* by component, for the gather version: x, y, z, r, vx, vy, vz */
 };
 struct bridges {
     size_t n;
@@ -317,6 +322,67 @@ __attribute__((target("avx2"))) static void step_vector(const struct state* st,
     struct bridges rest = {b->n - q, b->i + q, b->j + q};
     step_scalar(st, &rest, force);
 }
+
+/* The same, eight pairs at a time from the arrays by component with AVX-512 gathers (fourteen
+ * gathers of eight doubles for eight pairs; the pairs past the last multiple of eight one at a
+ * time). */
+__attribute__((target("avx512f"))) static void
+step_gather(const struct state* st, const struct bridges* b, double (*force)[3])
+{
+    const __m512d sb = _mm512_set1_pd(6.0 * M_PI * VISCOSITY), cap = _mm512_set1_pd(8.0 * M_PI),
+                  tension = _mm512_set1_pd(TENSION), film = _mm512_set1_pd(FILM),
+                  h_min = _mm512_set1_pd(H_MIN), one = _mm512_set1_pd(1.0),
+                  minus = _mm512_set1_pd(-1.0);
+    size_t q = 0;
+    for (; q + 8 <= b->n; q += 8) {
+        __m256i ij[2] = {_mm256_loadu_si256((const __m256i*)(const void*)(b->i + q)),
+                         _mm256_loadu_si256((const __m256i*)(const void*)(b->j + q))};
+        __m512d c[2][7]; /* c[s][k]: component k of the first (s = 0) or second particles */
+        for (int t = 0; t < 2; t++)
+            for (int k = 0; k < 7; k++)
+                c[t][k] = _mm512_i32gather_pd(ij[t], st->comp[k], 8);
+        __m512d dx = _mm512_sub_pd(c[0][0], c[1][0]), dy = _mm512_sub_pd(c[0][1], c[1][1]),
+                dz = _mm512_sub_pd(c[0][2], c[1][2]);
+        __m512d dist = _mm512_sqrt_pd(_mm512_add_pd(
+            _mm512_add_pd(_mm512_mul_pd(dx, dx), _mm512_mul_pd(dy, dy)), _mm512_mul_pd(dz, dz)));
+        __m512d inv = _mm512_div_pd(one, dist), nx = _mm512_mul_pd(dx, inv),
+                ny = _mm512_mul_pd(dy, inv), nz = _mm512_mul_pd(dz, inv);
+        __m512d ri = c[0][3], rj = c[1][3];
+        __m512d gap = _mm512_sub_pd(_mm512_sub_pd(dist, ri), rj),
+                r_eff = _mm512_div_pd(_mm512_mul_pd(ri, rj), _mm512_add_pd(ri, rj));
+        __m512d v_n = _mm512_mul_pd(
+            minus, _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(_mm512_sub_pd(c[0][4], c[1][4]), nx),
+                                               _mm512_mul_pd(_mm512_sub_pd(c[0][5], c[1][5]), ny)),
+                                 _mm512_mul_pd(_mm512_sub_pd(c[0][6], c[1][6]), nz)));
+        __m512d bracket = _mm512_sub_pd(one, _mm512_div_pd(gap, film));
+        __m512d f_sb = _mm512_mul_pd(
+            _mm512_mul_pd(
+                _mm512_div_pd(_mm512_mul_pd(_mm512_mul_pd(_mm512_mul_pd(sb, r_eff), r_eff), v_n),
+                              gap),
+                bracket),
+            bracket);
+        f_sb = _mm512_maskz_mov_pd(_mm512_cmp_pd_mask(gap, h_min, _CMP_GE_OQ), f_sb);
+        __m512d f_n = _mm512_add_pd(
+            f_sb, _mm512_mul_pd(minus, _mm512_mul_pd(_mm512_mul_pd(cap, r_eff), tension)));
+        double f[3][8] __attribute__((aligned(64))); /* (stored, then read lane by lane) */
+        _mm512_store_pd(f[0], _mm512_mul_pd(f_n, nx));
+        _mm512_store_pd(f[1], _mm512_mul_pd(f_n, ny));
+        _mm512_store_pd(f[2], _mm512_mul_pd(f_n, nz));
+        const uint32_t *I = b->i + q, *J = b->j + q;
+#pragma GCC unroll 8
+        for (int l = 0; l < 8; l++) {
+            double *a = force[I[l]], *e = force[J[l]];
+            a[0] += f[0][l];
+            a[1] += f[1][l];
+            a[2] += f[2][l];
+            e[0] -= f[0][l];
+            e[1] -= f[1][l];
+            e[2] -= f[2][l];
+        }
+    }
+    struct bridges rest = {b->n - q, b->i + q, b->j + q};
+    step_scalar(st, &rest, force);
+}
 #endif
 
 /* Best ns per bridge-step of `rounds` rounds of `steps` steps of one version; the sums of its
@@ -339,7 +405,7 @@ static double timed(void (*step)(const struct state*, const struct bridges*, dou
 
 int main(int argc, char** argv)
 {
-    const char *path = NULL, *kernel = "both";
+    const char *path = NULL, *kernel = "all";
     int steps = 300, rounds = 5;
     for (int k = 1; k < argc; k++) {
         if (!strcmp(argv[k], "--state-in") && k + 1 < argc)
@@ -352,14 +418,17 @@ int main(int argc, char** argv)
             kernel = argv[++k];
         else {
             fprintf(stderr, "usage: bridge_floor --state-in FILE [--steps S] [--repeat R] "
-                            "[--kernel scalar|vector|both]\n");
+                            "[--kernel scalar|vector|gather|both|all]\n");
             return 2;
         }
     }
-    bool scalar = strcmp(kernel, "vector") != 0, vector = strcmp(kernel, "scalar") != 0;
-    if (!path || steps < 0 || rounds < 1 || (!scalar && !vector && strcmp(kernel, "both"))) {
+    bool all = !strcmp(kernel, "all"), both = !strcmp(kernel, "both");
+    bool scalar = all || both || !strcmp(kernel, "scalar"),
+         vector = all || both || !strcmp(kernel, "vector"),
+         gather = all || !strcmp(kernel, "gather");
+    if (!path || steps < 0 || rounds < 1 || (!scalar && !vector && !gather)) {
         fprintf(stderr, "bridge_floor: --state-in FILE is needed; --steps >= 0, --repeat >= 1, "
-                        "--kernel scalar, vector or both\n");
+                        "--kernel scalar, vector, gather, both or all\n");
         return 2;
     }
     struct state st = read_state(path);
@@ -369,16 +438,39 @@ int main(int argc, char** argv)
     if (!f_scalar || !f_vector)
         fail("out of memory", NULL);
     double ns_scalar = scalar ? timed(step_scalar, &st, &b, steps, rounds, f_scalar) : 0.0;
-    double ns_vector = 0.0;
+    double ns_vector = 0.0, ns_gather = 0.0;
 #ifdef FLOOR_VECTOR
     if (vector && __builtin_cpu_supports("avx2")) {
         ns_vector = timed(step_vector, &st, &b, steps, rounds, f_vector);
         if (scalar && memcmp(f_scalar, f_vector, st.n * sizeof *f_scalar))
-            fail("the two versions' sums differ", NULL);
+            fail("the scalar and vector versions' sums differ", NULL);
+    }
+    if (gather && __builtin_cpu_supports("avx512f")) {
+        for (int k = 0; k < 7; k++) {
+            st.comp[k] = malloc(st.n * sizeof *st.comp[k]);
+            if (!st.comp[k])
+                fail("out of memory", NULL);
+        }
+        for (size_t k = 0; k < st.n; k++) {
+            const double c[7] = {st.s[k].x,  st.s[k].y,  st.s[k].z, st.s[k].r,
+                                 st.v[k].vx, st.v[k].vy, st.v[k].vz};
+            for (int a = 0; a < 7; a++)
+                st.comp[a][k] = c[a];
+        }
+        double(*f_gather)[3] = calloc(st.n, sizeof *f_gather);
+        if (!f_gather)
+            fail("out of memory", NULL);
+        ns_gather = timed(step_gather, &st, &b, steps, rounds, f_gather);
+        if ((scalar && memcmp(f_scalar, f_gather, st.n * sizeof *f_scalar)) ||
+            (vector && ns_vector > 0 && memcmp(f_vector, f_gather, st.n * sizeof *f_vector)))
+            fail("the gather version's sums differ from the others'", NULL);
+        free(f_gather);
+        for (int k = 0; k < 7; k++)
+            free(st.comp[k]);
     }
 #endif
-    printf("floor n=%zu bridges_apart=%zu steps=%d scalar_ns=%.2f vector_ns=%.2f\n", st.n, b.n,
-           steps, ns_scalar, ns_vector);
+    printf("floor n=%zu bridges_apart=%zu steps=%d scalar_ns=%.2f vector_ns=%.2f gather_ns=%.2f\n",
+           st.n, b.n, steps, ns_scalar, ns_vector, ns_gather);
     free(f_scalar);
     free(f_vector);
     free(b.i);

@@ -48,8 +48,8 @@ def read_results(path):
                 r["costpair"] = [float(x) for x in w[2:]]
             elif w[0] == "film":  # film thickness wet_rate dry_rate contacts within
                 r["film"].append((float(w[1]), float(w[2]), float(w[3]), int(w[4]), int(w[5])))
-            elif w[0] == "floor":  # floor bridges_apart scalar_ns vector_ns
-                ns = [float(x) for x in w[2:4] if float(x) > 0]
+            elif w[0] == "floor":  # floor bridges_apart scalar_ns vector_ns [gather_ns]
+                ns = [float(x) for x in w[2:5] if float(x) > 0]
                 r["floor"] = (int(w[1]), min(ns)) if ns else None
     return r
 
