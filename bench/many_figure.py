@@ -137,6 +137,7 @@ def wet_cost(ax, r, n):
     ax.set_xlabel("pairs within the films (frozen state)")
     ax.set_ylabel("wet / dry time per step")
     ax.set_title("cost of the wet models (frozen, 1 thread)")
+    ax.margins(x=0.18, y=0.15)  # room for the points' labels, which sit above and to the left
     ax.legend(fontsize=7, loc="upper left")
     if not drew:
         note(ax, "no film sweep or cost pairs in this results file")
