@@ -260,6 +260,23 @@ static void step_scalar(const struct state* st, const struct bridges* b, double 
 typedef double v4d __attribute__((vector_size(32)));
 typedef long long v4i __attribute__((vector_size(32)));
 
+/* Lane by lane, the forces fx, fy, fz of `lanes` pairs (I[l], J[l]) onto both spheres, in pair
+ * order as step_scalar adds them (inlined with a constant lane count, so unrolled). */
+static inline void add_lanes(double (*force)[3], const uint32_t* I, const uint32_t* J,
+                             const double* fx, const double* fy, const double* fz, int lanes)
+{
+#pragma GCC unroll 8
+    for (int l = 0; l < lanes; l++) {
+        double *a = force[I[l]], *c = force[J[l]];
+        a[0] += fx[l];
+        a[1] += fy[l];
+        a[2] += fz[l];
+        c[0] -= fx[l];
+        c[1] -= fy[l];
+        c[2] -= fz[l];
+    }
+}
+
 /* The first four doubles at p0..p3 as columns: c[k] lane l = p_l[k] (two unpacks and two
  * lane permutes per pair of columns, as wetdem's kernel reads its records). */
 __attribute__((target("avx2"))) static inline void
@@ -308,16 +325,7 @@ __attribute__((target("avx2"))) static void step_vector(const struct state* st,
         *(v4d*)f[0] = f_n * nx;
         *(v4d*)f[1] = f_n * ny;
         *(v4d*)f[2] = f_n * nz;
-#pragma GCC unroll 4
-        for (int l = 0; l < 4; l++) {
-            double *a = force[I[l]], *c = force[J[l]];
-            a[0] += f[0][l];
-            a[1] += f[1][l];
-            a[2] += f[2][l];
-            c[0] -= f[0][l];
-            c[1] -= f[1][l];
-            c[2] -= f[2][l];
-        }
+        add_lanes(force, I, J, f[0], f[1], f[2], 4);
     }
     struct bridges rest = {b->n - q, b->i + q, b->j + q};
     step_scalar(st, &rest, force);
@@ -368,17 +376,7 @@ step_gather(const struct state* st, const struct bridges* b, double (*force)[3])
         _mm512_store_pd(f[0], _mm512_mul_pd(f_n, nx));
         _mm512_store_pd(f[1], _mm512_mul_pd(f_n, ny));
         _mm512_store_pd(f[2], _mm512_mul_pd(f_n, nz));
-        const uint32_t *I = b->i + q, *J = b->j + q;
-#pragma GCC unroll 8
-        for (int l = 0; l < 8; l++) {
-            double *a = force[I[l]], *e = force[J[l]];
-            a[0] += f[0][l];
-            a[1] += f[1][l];
-            a[2] += f[2][l];
-            e[0] -= f[0][l];
-            e[1] -= f[1][l];
-            e[2] -= f[2][l];
-        }
+        add_lanes(force, b->i + q, b->j + q, f[0], f[1], f[2], 8);
     }
     struct bridges rest = {b->n - q, b->i + q, b->j + q};
     step_scalar(st, &rest, force);
