@@ -266,7 +266,8 @@ fi
 # gather_ns" (0 for a version the processor lacks)
 "$out/bridge_floor" --state-in "$out/state.data" --steps "$FROZEN_STEPS" --repeat "$REPEAT" |
   awk '{for (k = 2; k <= NF; k++) {split($k, a, "="); v[a[1]] = a[2]}
-        print "floor", v["bridges_apart"], v["scalar_ns"], v["vector_ns"], v["gather_ns"] + 0}' | tee -a "$res" >&2
+        print "floor", v["bridges_apart"], v["scalar_ns"], v["vector_ns"], v["gather_ns"] + 0}' |
+  tee -a "$res" >&2
 $have_lg || echo "20-many: liggghts or mpirun not installed: LIGGGHTS half skipped" \
   "(scripts/install-deps bench)"
 
@@ -399,10 +400,11 @@ awk -v n="$N" -v wb="$base_kb" -v lb="$lg_base" -v steps="$STEPS" -v same="$SAME
                plo[ck], phi[ck], pok[ck], pn[ck]
       if (p == 3 && floor_nb > 0 && rate[w "dry 1"] > 0)
         printf "  the floor (bench/bridge_floor.c: the bare loop over the %d bridges apart of this" \
-               " state, no engine): %.1f ns per bridge-step (one pair at a time %.1f; eight at a" \
-               " time by AVX-512 gathers from arrays by component %.1f); on top of" \
-               " the dry run it alone gives a wet / dry cost of %.2fx\n", floor_nb, floor_ns,
-               floor_one, floor_gather, 1 + floor_nb * floor_ns * 1e-9 * rate[w "dry 1"] / n
+               " state, no engine): %.1f ns per bridge-step (one pair at a time %.1f; %s); on" \
+               " top of the dry run it alone gives a wet / dry cost of %.2fx\n", floor_nb,
+               floor_ns, floor_one, (floor_gather > 0) ? sprintf("eight at a time by AVX-512" \
+               " gathers from arrays by component %.1f", floor_gather) : "no AVX-512 gathers" \
+               " on this processor", 1 + floor_nb * floor_ns * 1e-9 * rate[w "dry 1"] / n
       if (p == 3 && nfilm > 0) { # (liquid: 3 delta / R of the mean radius, 0.95 mm)
         printf "  cost wet / dry against the film thickness (dry and wet back to back, best of" \
                " each; target <= 1.3):"
