@@ -71,7 +71,7 @@ $(BUILD)/libwetdem.so: $(LIB_OBJ)
 $(BUILD)/wetdem: $(CLI_OBJ) $(BUILD)/libwetdem.a
 	$(CC) -o $@ $(CLI_OBJ) $(BUILD)/libwetdem.a $(LDLIBS)
 
-$(BUILD)/tests/%: tests/%.c tests/harness.h $(BUILD)/libwetdem.a $(BUILD)/flags.stamp
+$(BUILD)/tests/%: tests/%.c $(wildcard tests/*.h) $(BUILD)/libwetdem.a $(BUILD)/flags.stamp
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS_ALL) -Itests -o $@ $< $(BUILD)/libwetdem.a $(LDLIBS) -lcmocka
 

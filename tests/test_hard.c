@@ -8,40 +8,8 @@
 #include <stdbool.h>
 
 #include "harness.h"
+#include "test_vec.h"
 #include "models.h"
-
-static struct wetdem_vec3 v3(double x, double y, double z)
-{
-    return (struct wetdem_vec3){x, y, z};
-}
-static struct wetdem_vec3 add(struct wetdem_vec3 a, struct wetdem_vec3 b)
-{
-    return v3(a.x + b.x, a.y + b.y, a.z + b.z);
-}
-static struct wetdem_vec3 sub(struct wetdem_vec3 a, struct wetdem_vec3 b)
-{
-    return v3(a.x - b.x, a.y - b.y, a.z - b.z);
-}
-static struct wetdem_vec3 scale(struct wetdem_vec3 a, double s)
-{
-    return v3(a.x * s, a.y * s, a.z * s);
-}
-static double dot(struct wetdem_vec3 a, struct wetdem_vec3 b)
-{
-    return a.x * b.x + a.y * b.y + a.z * b.z;
-}
-static double norm(struct wetdem_vec3 a)
-{
-    return sqrt(dot(a, a));
-}
-static struct wetdem_vec3 cross(struct wetdem_vec3 a, struct wetdem_vec3 b)
-{
-    return v3(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
-}
-static struct wetdem_vec3 unit(struct wetdem_vec3 a)
-{
-    return scale(a, 1.0 / norm(a));
-}
 
 /* A solid sphere, I = 2/5 m R^2. */
 static struct wetdem_impulse_body sphere(double m, double r, struct wetdem_vec3 v,

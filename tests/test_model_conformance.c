@@ -24,6 +24,7 @@
 #include <stdlib.h>
 
 #include "harness.h"
+#include "test_vec.h"
 
 #define MAX_PARAM_DOUBLES 16
 #define MAX_HISTORY 16
@@ -76,37 +77,6 @@ static const struct motion motions[] = {
 static const double scan_gaps[] = {-3e-6, -2e-7, 0.3e-6, 0.8e-6, 1.5e-6, 5e-6,
                                    50e-6, 99e-6, 0.5e-3, 1.3e-3, 2e-3};
 #define N_GAPS (sizeof scan_gaps / sizeof scan_gaps[0])
-
-/* ---- small vector helpers (the test uses only the public header) ---- */
-
-static struct wetdem_vec3 v3(double x, double y, double z)
-{
-    return (struct wetdem_vec3){x, y, z};
-}
-static struct wetdem_vec3 add(struct wetdem_vec3 a, struct wetdem_vec3 b)
-{
-    return v3(a.x + b.x, a.y + b.y, a.z + b.z);
-}
-static struct wetdem_vec3 sub(struct wetdem_vec3 a, struct wetdem_vec3 b)
-{
-    return v3(a.x - b.x, a.y - b.y, a.z - b.z);
-}
-static struct wetdem_vec3 scale(struct wetdem_vec3 a, double s)
-{
-    return v3(a.x * s, a.y * s, a.z * s);
-}
-static double dot(struct wetdem_vec3 a, struct wetdem_vec3 b)
-{
-    return a.x * b.x + a.y * b.y + a.z * b.z;
-}
-static double norm(struct wetdem_vec3 a)
-{
-    return sqrt(dot(a, a));
-}
-static struct wetdem_vec3 cross(struct wetdem_vec3 a, struct wetdem_vec3 b)
-{
-    return v3(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
-}
 
 /* ---- model variants: defaults, plus every other word of every enumerated parameter ---- */
 
