@@ -24,10 +24,7 @@
 #include "output_csv.h"
 #include "scenario.h"
 
-#define NUM(k, u, dflt, lo, hi, lo_open, hi_open, doc)                                             \
-    {                                                                                              \
-        k, CLI_VALUE_NUMBER, u, dflt, lo, hi, lo_open, hi_open, NULL, doc                          \
-    }
+#define NUM CLI_KEY_NUMBER
 
 static const struct cli_key_desc davis_keys[] = {
     NUM("n_spheres", "-", "3", 2, 3, false, false,

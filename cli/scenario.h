@@ -67,6 +67,20 @@ struct cli_key_desc {
     const char* doc;            /* one or two sentences */
 };
 
+/* Initialisers of key descriptors for the tables of cli/scenario_keys.c, cli/scenario_many.c
+ * and cli/run_pairwise.c: a number with its unit and valid range, or a word of a kind. */
+#define CLI_KEY_NUMBER(k, u, dflt, lo, hi, lo_open, hi_open, doc)                                  \
+    {                                                                                              \
+        k, CLI_VALUE_NUMBER, u, dflt, lo, hi, lo_open, hi_open, NULL, doc                          \
+    }
+#define CLI_KEY_WORD(k, kind, dflt, choices, doc)                                                  \
+    {                                                                                              \
+        k, kind, "", dflt, 0, 0, false, false, choices, doc                                        \
+    }
+
+/* The choices of a yes/no key. */
+extern const char* const cli_yes_no[];
+
 /* Descriptor of one section. A name ending in ".*" (e.g. "material.*") is a family of
  * sections "material.NAME". keys == NULL means the keys are checked when the scenario is
  * built (e.g. [model.NAME] keys are the parameters of model NAME). */

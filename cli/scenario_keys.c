@@ -19,14 +19,8 @@ static const char* const target_choices[] = {"sphere", "wall", "fixed", NULL};
 static const char* const fluid_choices[] = {"water", "glycerol80", "silicone10", NULL};
 static const char* const engine_choices[] = {"soft", "pairwise", NULL};
 
-#define NUM(k, u, dflt, lo, hi, lo_open, hi_open, doc)                                             \
-    {                                                                                              \
-        k, CLI_VALUE_NUMBER, u, dflt, lo, hi, lo_open, hi_open, NULL, doc                          \
-    }
-#define WORD(k, kind, dflt, choices, doc)                                                          \
-    {                                                                                              \
-        k, kind, "", dflt, 0, 0, false, false, choices, doc                                        \
-    }
+#define NUM CLI_KEY_NUMBER
+#define WORD CLI_KEY_WORD
 
 static const struct cli_key_desc collision_keys[] = {
     WORD("striker", CLI_VALUE_NAME, "steel1", NULL,
@@ -95,8 +89,8 @@ static const struct cli_key_desc models_keys[] = {
     {0},
 };
 
+const char* const cli_yes_no[] = {"no", "yes", NULL};
 static const char* const cvode_methods[] = {"auto", "adams", "bdf", NULL};
-static const char* const yes_no[] = {"no", "yes", NULL};
 
 /* Keys after "name" are the integrators' parameters ("<name>.<key>" in the library); their
  * defaults are read from the library's descriptor tables when the docs are generated
@@ -133,7 +127,7 @@ static const struct cli_key_desc sim_keys[] = {
     NUM("gravity_x", "m/s^2", NULL, -1e4, 1e4, false, false, "Gravity, x component."),
     NUM("gravity_y", "m/s^2", NULL, -1e4, 1e4, false, false, "Gravity, y component."),
     NUM("gravity_z", "m/s^2", NULL, -1e4, 1e4, false, false, "Gravity, z component."),
-    WORD("stop_on_separation", CLI_VALUE_CHOICE, NULL, yes_no,
+    WORD("stop_on_separation", CLI_VALUE_CHOICE, NULL, cli_yes_no,
          "Stop once every pair that interacted has left its range and recedes (a collision "
          "run sets this itself)."),
     NUM("separation_factor", "-", NULL, 1, 1e3, false, false,

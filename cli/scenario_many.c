@@ -24,17 +24,10 @@
 #include "cli_util.h"
 #include "scenario_many.h"
 
-#define NUM(k, u, dflt, lo, hi, lo_open, hi_open, doc)                                             \
-    {                                                                                              \
-        k, CLI_VALUE_NUMBER, u, dflt, lo, hi, lo_open, hi_open, NULL, doc                          \
-    }
-#define WORD(k, kind, dflt, choices, doc)                                                          \
-    {                                                                                              \
-        k, kind, "", dflt, 0, 0, false, false, choices, doc                                        \
-    }
+#define NUM CLI_KEY_NUMBER
+#define WORD CLI_KEY_WORD
 #define MAX_MATERIALS 32
 
-static const char* const yes_no[] = {"no", "yes", NULL};
 static const char* const layouts[] = {"lattice", "random", NULL};
 static const char* const face_names[] = {"x_min", "x_max", "y_min", "y_max",
                                          "z_min", "z_max", NULL};
@@ -103,7 +96,7 @@ static const struct cli_key_desc particle_keys[] = {
     NUM("spin_y", "rad/s", "0", -1e6, 1e6, false, false, "Spin, y."),
     NUM("spin_z", "rad/s", "0", -1e6, 1e6, false, false, "Spin, z."),
     WORD("material", CLI_VALUE_NAME, "steel1", NULL, "Material, as in [insert]."),
-    WORD("fixed", CLI_VALUE_CHOICE, "no", yes_no, "yes: held in place (infinite mass)."),
+    WORD("fixed", CLI_VALUE_CHOICE, "no", cli_yes_no, "yes: held in place (infinite mass)."),
     {0},
 };
 
@@ -116,7 +109,7 @@ static const struct cli_key_desc run_keys[] = {
         "packing height. Fixed for the run."),
     NUM("skin", "m", "0 (0.1 x smallest radius)", 0, 1, false, false,
         "Verlet skin of the neighbour lists."),
-    WORD("energy_budget", CLI_VALUE_CHOICE, "yes", yes_no,
+    WORD("energy_budget", CLI_VALUE_CHOICE, "yes", cli_yes_no,
          "Accumulate the work of every model on particle pairs and walls, and check that the "
          "budget closes (about 25-50 % slower: docs/many.md)."),
     {0},
@@ -128,7 +121,7 @@ static const struct cli_key_desc dump_keys[] = {
          "in --out DIR; none disables them."),
     NUM("vtk_every", "-", "run steps / 50", 0, 1e15, false, false,
         "Steps between VTK frames (the last step is always written); 0: none."),
-    WORD("vtk_binary", CLI_VALUE_CHOICE, "yes", yes_no,
+    WORD("vtk_binary", CLI_VALUE_CHOICE, "yes", cli_yes_no,
          "yes: binary legacy VTK (exact, compact); no: ASCII with 17 digits."),
     WORD("csv", CLI_VALUE_TEXT, "global.csv", NULL,
          "CSV of global quantities (energies, contacts, liquid bridges, agglomerates, work per "
