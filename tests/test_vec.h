@@ -1,6 +1,8 @@
 /*
  * test_vec.h — small vector helpers for tests that use only the public header (wetdem.h).
- * The library's own helpers (src/vec3.h) are internal; these keep such tests independent of it.
+ * They repeat the shape of the library's internal src/vec3.h on purpose: a test that checked
+ * the library's vector algebra with that same algebra could not catch an error in it (a wrong
+ * sign in a cross product would cancel), so the tests carry their own.
  */
 #ifndef WETDEM_TEST_VEC_H
 #define WETDEM_TEST_VEC_H
