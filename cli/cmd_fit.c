@@ -677,22 +677,23 @@ static int write_fit_csv(const char* path, const struct fit_ctx* c, const double
 static int write_curve_csv(const char* path, const struct fit_ctx* c, const double* values, int m,
                            int argc, char** argv)
 {
-    double lo = INFINITY, hi = 0, angles[64];
+    double lo = INFINITY, hi = 0;
+    double* angles = malloc((c->n_pts ? c->n_pts : 1) * sizeof *angles); /* every distinct one */
     size_t n_ang = 0;
-    for (size_t i = 0; i < c->n_pts; i++) {
+    for (size_t i = 0; angles && i < c->n_pts; i++) {
         lo = fmin(lo, c->pts[i].stokes), hi = fmax(hi, c->pts[i].stokes);
         double a = point_angle(c, &c->pts[i]);
         size_t k = 0;
         while (k < n_ang && angles[k] != a)
             k++;
-        if (k == n_ang && n_ang < 64)
+        if (k == n_ang)
             angles[n_ang++] = a;
     }
     size_t n = n_ang * (size_t)m;
-    struct point* pts = calloc(n, sizeof *pts);
-    double* e = calloc(2 * n, sizeof *e);
+    struct point* pts = calloc(n ? n : 1, sizeof *pts);
+    double* e = calloc(2 * (n ? n : 1), sizeof *e);
     char msg[512] = "out of memory";
-    int st = (pts && e) ? WETDEM_OK : WETDEM_ERR_NOMEM;
+    int st = (angles && pts && e) ? WETDEM_OK : WETDEM_ERR_NOMEM;
     for (size_t k = 0; st == WETDEM_OK && k < n; k++) {
         double u = m > 1 ? (double)(k % (size_t)m) / (m - 1) : 0;
         pts[k] = (struct point){
@@ -713,6 +714,7 @@ static int write_curve_csv(const char* path, const struct fit_ctx* c, const doub
     }
     if (st != WETDEM_OK)
         cli_error("fit: curve: %s", msg);
+    free(angles);
     free(pts);
     free(e);
     return st == WETDEM_OK ? CLI_EXIT_OK : CLI_EXIT_RUNTIME;

@@ -334,6 +334,49 @@ static void test_fit_cli_reports_units_on_example(void** state)
         fail_msg("P_gt %.4g +- %.3g Pa vs 11.6e6", value, se);
 }
 
+/* The curve file holds the fitted model at every distinct angle of the data, however many:
+ * 70 angles (0, 0.5, ..., 34.5 deg), 2 curve points each, give 140 rows and 70 angles. */
+static void test_fit_cli_curve_covers_every_angle(void** state)
+{
+    (void)state;
+    const char* cli = getenv("WETDEM_CLI");
+    if (!cli)
+        skip();
+    static char data[4096];
+    int used = snprintf(data, sizeof data, "stokes_n,e_n,angle_deg\n");
+    for (int k = 0; k < 70; k++)
+        used += snprintf(data + used, sizeof data - (size_t)used, "%.2f,0.3,%.1f\n", 3 + 0.01 * k,
+                         0.5 * k);
+    char csv[96], curve[128], args[1024], out[8192];
+    temp_csv(csv, "angles", data);
+    snprintf(curve, sizeof curve, "/tmp/wetdem_fit_curve_%d.csv", (int)getpid());
+    snprintf(args, sizeof args,
+             "fit examples/fit/punch_db_c.ini --data %s --fit glass.p_gt --init 1.16e7 "
+             "--curve %s --curve-points 2",
+             csv, curve);
+    int rc = test_run_cli_into(args, out, sizeof out);
+    if (rc != 0)
+        fail_msg("wetdem %s: exit %d:\n%s", args, rc, out);
+    FILE* f = fopen(curve, "r");
+    assert_non_null(f);
+    char line[256];
+    int rows = 0, angles = 0;
+    double last = -1;
+    while (fgets(line, sizeof line, f)) {
+        double a;
+        if (line[0] == '#' || sscanf(line, "%lf,", &a) != 1)
+            continue; /* provenance and header */
+        rows++;
+        angles += a != last;
+        last = a;
+    }
+    fclose(f);
+    assert_int_equal(rows, 140);
+    assert_int_equal(angles, 70);
+    remove(csv);
+    remove(curve);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -343,6 +386,7 @@ int main(void)
         cmocka_unit_test(test_fit_recovers_glass_pressure_from_simulated_data),
         cmocka_unit_test(test_fit_cli_rejects_bad_input),
         cmocka_unit_test(test_fit_cli_reports_units_on_example),
+        cmocka_unit_test(test_fit_cli_curve_covers_every_angle),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
