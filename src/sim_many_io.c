@@ -401,6 +401,56 @@ int wetdem_sim_write_checkpoint(struct wetdem_sim* sim, const char* path)
     return st == WETDEM_OK ? st : wetdem_sim_fail(sim, st, "%s", msg);
 }
 
+/* The index of the first non-finite of x[0 .. n), or n. */
+static size_t first_non_finite(const double* x, size_t n)
+{
+    size_t k = 0;
+    while (k < n && isfinite(x[k]))
+        k++;
+    return k;
+}
+
+/* The rest of a checkpoint that a set-up cannot fingerprint: time and step size, the latest
+ * forces and torques, the energy accumulators and histories must be finite (and dt > 0), the
+ * pair keys must name particles i < j < n in increasing (i, j) order, and the wall keys the
+ * (particle, wall) grid in order, as restore_pairs copies their histories by position. The file's CRC already caught
+ * damage; this catches a file that is whole but not a state of this run. */
+static int check_restorable_values(struct wetdem_sim* sim, const struct wetdem_checkpoint* ck,
+                                   const char* path)
+{
+    size_t n = ck->n_particles, nw = sim->n_walls, np = ck->n_pairs - n * nw;
+    double dt_t0[2];
+    memcpy(dt_t0, ck->extra, sizeof dt_t0);
+    const char* bad = NULL;
+    if (!isfinite(ck->time) || first_non_finite(dt_t0, 2) < 2 || !(dt_t0[0] > 0))
+        bad = "a non-finite time or a step dt that is not > 0";
+    for (size_t k = 0; !bad && k < n; k++) {
+        double ft[6];
+        memcpy(ft, ck->extra + 16 + k * 48, sizeof ft);
+        if (first_non_finite(ft, 6) < 6)
+            bad = "a non-finite force or torque";
+    }
+    if (!bad && first_non_finite(ck->energy, ck->n_energy) < ck->n_energy)
+        bad = "a non-finite energy-budget term";
+    if (!bad && first_non_finite(ck->history, ck->n_pairs * ck->history_len) <
+                    ck->n_pairs * ck->history_len)
+        bad = "a non-finite pair history";
+    for (size_t q = 0; !bad && q < np; q++) {
+        const struct wetdem_checkpoint_pair* k = &ck->pairs[q];
+        if (k->is_wall || !(k->i < k->j && k->j < n))
+            bad = "a pair key that names no pair of its particles";
+        else if (q > 0 && (k[-1].i > k->i || (k[-1].i == k->i && k[-1].j >= k->j)))
+            bad = "pair keys out of (i, j) order"; /* restore_pairs merges them as sorted */
+    }
+    for (size_t q = 0; !bad && q < n * nw; q++) {
+        const struct wetdem_checkpoint_pair* k = &ck->pairs[np + q];
+        if (!k->is_wall || k->i != q / nw || k->j != q % nw)
+            bad = "a particle-wall key out of order";
+    }
+    return bad ? wetdem_sim_fail(sim, WETDEM_ERR_PARSE, "checkpoint '%s': %s", path, bad)
+               : WETDEM_OK;
+}
+
 /* Checks that checkpoint ck fits this sim's set-up. */
 static int check_restorable(struct wetdem_sim* sim, const struct wetdem_checkpoint* ck,
                             const char* path)
@@ -424,12 +474,22 @@ static int check_restorable(struct wetdem_sim* sim, const struct wetdem_checkpoi
         ck->n_pairs < n * nw)
         return wetdem_sim_fail(sim, WETDEM_ERR_PARSE, "checkpoint '%s': inconsistent contents",
                                path);
-    for (size_t k = 0; k < n; k++)
-        if (ck->particles[k].material < 0 || ck->particles[k].material >= sim->n_materials)
+    for (size_t k = 0; k < n; k++) {
+        const struct wetdem_particle* p = &ck->particles[k];
+        if (p->material < 0 || p->material >= sim->n_materials)
             return wetdem_sim_fail(sim, WETDEM_ERR_PARSE,
                                    "checkpoint '%s': particle %zu has material %d", path, k,
-                                   ck->particles[k].material);
-    return WETDEM_OK;
+                                   p->material);
+        /* what wetdem_sim_add_particle accepts, so that a resumed run starts from a state a
+           fresh one could have */
+        if (!vec3_is_finite(p->pos) || !vec3_is_finite(p->vel) || !vec3_is_finite(p->omega) ||
+            !(isfinite(p->radius) && p->radius > 0) || !(isfinite(p->mass) && p->mass > 0))
+            return wetdem_sim_fail(sim, WETDEM_ERR_PARSE,
+                                   "checkpoint '%s': particle %zu has a non-finite position, "
+                                   "velocity or spin, or a radius or mass that is not > 0",
+                                   path, k);
+    }
+    return check_restorable_values(sim, ck, path);
 }
 
 /* Particles, engine time and counters from ck. */

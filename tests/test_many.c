@@ -1,6 +1,7 @@
 /*
  * test_many.c — the many-particle mode (src/sim_many.c, src/sim_many_io.c): results
  * independent of the thread count, checkpoint + restart bit-identical to an uninterrupted run,
+ * checkpoints holding impossible states refused,
  * the energy budget closes, agreement with the few-body engine on a binary collision, the
  * start-up reach bound is enforced, agglomerates by union-find, VTK/CSV outputs, lists rebuilt
  * at the same steps with the displacement bound, callbacks see the current state, the wall time
@@ -12,6 +13,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "checkpoint.h"
 #include "harness.h"
 #include "many.h"
 
@@ -170,6 +172,66 @@ static void test_many_restart_is_bit_identical(void** state)
     wetdem_sim_free(first);
     wetdem_sim_free(resumed);
     wetdem_sim_free(dry);
+}
+
+/* A checkpoint that is whole (its CRC right) but holds no state a run could reach is refused
+ * on reading, naming the checkpoint and what is wrong, before anything is restored: each case
+ * rewrites one field of a good checkpoint through the checkpoint API (so the CRC is new). */
+static void test_many_restart_refuses_impossible_states(void** state)
+{
+    (void)state;
+    char good[] = "/tmp/wetdem_test_many_good_XXXXXX", bad[] = "/tmp/wetdem_test_many_bad_XXXXXX";
+    close(mkstemp(good));
+    close(mkstemp(bad));
+    struct wetdem_sim* first = wet_box(60, true);
+    CHECK_OK(wetdem_sim_integrate(first, 0.2e-3));
+    CHECK_OK(wetdem_sim_write_checkpoint(first, good));
+    wetdem_sim_free(first);
+    const char* want[] = {"particle 3 has a non-finite position, velocity or spin",
+                          "particle 5 has a non-finite position, velocity or spin",
+                          "a radius or mass that is not > 0",
+                          "a step dt that is not > 0",
+                          "a non-finite force or torque",
+                          "a non-finite energy-budget term",
+                          "a non-finite pair history",
+                          "pair keys out of (i, j) order",
+                          "a particle-wall key out of order"};
+    for (int c = 0; c < 9; c++) {
+        struct wetdem_checkpoint ck;
+        char msg[256];
+        CHECK_OK(wetdem_checkpoint_read(good, &ck, msg, sizeof msg));
+        size_t n = ck.n_particles, nw = ck.n_walls, np = ck.n_pairs - n * nw;
+        assert_true(np >= 2 && nw == 2 && ck.history_len > 0);
+        const double nan = NAN, zero = 0;
+        switch (c) {
+        case 0: ck.particles[3].vel.y = NAN; break;
+        case 1: ck.particles[5].omega.z = INFINITY; break;
+        case 2: ck.particles[7].radius = -1e-3; break;
+        case 3: memcpy(ck.extra, &zero, 8); break;                  /* dt */
+        case 4: memcpy(ck.extra + 16 + 48 * 9 + 8, &nan, 8); break; /* force y of particle 9 */
+        case 5: ck.energy[1] = -INFINITY; break;
+        case 6: ck.history[ck.history_len * np / 2] = NAN; break;
+        case 7: {
+            struct wetdem_checkpoint_pair t = ck.pairs[0];
+            ck.pairs[0] = ck.pairs[1];
+            ck.pairs[1] = t;
+            break;
+        }
+        case 8: ck.pairs[np + 1].j = 0; break;
+        }
+        CHECK_OK(wetdem_checkpoint_write(bad, &ck, msg, sizeof msg));
+        wetdem_checkpoint_clear(&ck);
+        struct wetdem_sim* resumed = wet_box(60, true);
+        CHECK_STATUS(wetdem_sim_read_checkpoint(resumed, bad), WETDEM_ERR_PARSE);
+        CHECK_CONTAINS(wetdem_sim_errmsg(resumed), bad);
+        CHECK_CONTAINS(wetdem_sim_errmsg(resumed), want[c]);
+        wetdem_sim_free(resumed);
+    }
+    struct wetdem_sim* resumed = wet_box(60, true); /* the good one is still read */
+    CHECK_OK(wetdem_sim_read_checkpoint(resumed, good));
+    wetdem_sim_free(resumed);
+    remove(good);
+    remove(bad);
 }
 
 static volatile int stop_now = 0;
@@ -564,6 +626,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_many_same_result_for_any_thread_count),
         cmocka_unit_test(test_many_restart_is_bit_identical),
+        cmocka_unit_test(test_many_restart_refuses_impossible_states),
         cmocka_unit_test(test_many_stop_flag_writes_a_checkpoint),
         cmocka_unit_test(test_many_stop_during_a_drifting_step_loses_nothing),
         cmocka_unit_test(test_many_deferred_kick_is_bit_identical),
