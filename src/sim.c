@@ -126,16 +126,22 @@ struct wetdem_fluid wetdem_sim_fluid(const struct wetdem_sim* sim)
     return sim->fluid;
 }
 
+bool wetdem_sim_particle_valid(const struct wetdem_particle* p, char* why, size_t n)
+{
+    if (!vec3_is_finite(p->pos) || !vec3_is_finite(p->vel) || !vec3_is_finite(p->omega))
+        snprintf(why, n, "position, velocity and spin must be finite");
+    else if (!(isfinite(p->radius) && p->radius > 0))
+        snprintf(why, n, "radius must be > 0 and finite, got %g m", p->radius);
+    else if (!(isfinite(p->mass) && p->mass > 0))
+        snprintf(why, n, "mass must be > 0 and finite, got %g kg", p->mass);
+    else
+        return true;
+    return false;
+}
+
 int wetdem_sim_add_particle(struct wetdem_sim* sim, struct wetdem_particle p)
 {
     size_t k = sim->n_particles;
-    if (!vec3_is_finite(p.pos) || !vec3_is_finite(p.vel) || !vec3_is_finite(p.omega))
-        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
-                               "particle %zu: position, velocity and spin must be finite", k);
-    if (!(isfinite(p.radius) && p.radius > 0))
-        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
-                               "particle %zu: radius must be > 0 and finite, got %g m", k,
-                               p.radius);
     if (p.material < 0 || p.material >= sim->n_materials)
         return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
                                "particle %zu: material %d does not exist (valid 0..%d)", k,
@@ -143,9 +149,9 @@ int wetdem_sim_add_particle(struct wetdem_sim* sim, struct wetdem_particle p)
     if (p.mass == 0)
         p.mass =
             sim->materials[p.material].density * 4.0 / 3.0 * M_PI * p.radius * p.radius * p.radius;
-    if (!(isfinite(p.mass) && p.mass > 0))
-        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
-                               "particle %zu: mass must be > 0 and finite, got %g kg", k, p.mass);
+    char why[128];
+    if (!wetdem_sim_particle_valid(&p, why, sizeof why))
+        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID, "particle %zu: %s", k, why);
     if (grow((void**)&sim->particles, &sim->particles_cap, k + 1, sizeof p) != WETDEM_OK)
         return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory adding particle %zu", k);
     sim->particles[k] = p;

@@ -356,12 +356,10 @@ static int check_run(struct wetdem_sim* sim, double t_end)
         return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
                                "the enabled models keep %zu doubles of pair history; at most %d",
                                sim->history_len, HISTORY_SCRATCH);
-    for (size_t k = 0; k < sim->n_particles; k++) {
-        const struct wetdem_particle* p = &sim->particles[k];
-        if (!vec3_is_finite(p->pos) || !vec3_is_finite(p->vel) || !vec3_is_finite(p->omega))
-            return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
-                                   "particle %zu: position, velocity and spin must be finite", k);
-    }
+    char why[128];
+    for (size_t k = 0; k < sim->n_particles; k++)
+        if (!wetdem_sim_particle_valid(&sim->particles[k], why, sizeof why))
+            return wetdem_sim_fail(sim, WETDEM_ERR_INVALID, "particle %zu: %s", k, why);
     return WETDEM_OK;
 }
 

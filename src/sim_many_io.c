@@ -401,20 +401,21 @@ int wetdem_sim_write_checkpoint(struct wetdem_sim* sim, const char* path)
     return st == WETDEM_OK ? st : wetdem_sim_fail(sim, st, "%s", msg);
 }
 
-/* The index of the first non-finite of x[0 .. n), or n. */
-static size_t first_non_finite(const double* x, size_t n)
+/* Whether x[0 .. n) are all finite. */
+static bool all_finite(const double* x, size_t n)
 {
-    size_t k = 0;
-    while (k < n && isfinite(x[k]))
-        k++;
-    return k;
+    for (size_t k = 0; k < n; k++)
+        if (!isfinite(x[k]))
+            return false;
+    return true;
 }
 
 /* The rest of a checkpoint that a set-up cannot fingerprint: time and step size, the latest
  * forces and torques, the energy accumulators and histories must be finite (and dt > 0), the
  * pair keys must name particles i < j < n in increasing (i, j) order, and the wall keys the
- * (particle, wall) grid in order, as restore_pairs copies their histories by position. The file's CRC already caught
- * damage; this catches a file that is whole but not a state of this run. */
+ * (particle, wall) grid in order, as restore_pairs copies their histories by position. The
+ * file's CRC already caught damage; this catches a file that is whole but not a state of this
+ * run. */
 static int check_restorable_values(struct wetdem_sim* sim, const struct wetdem_checkpoint* ck,
                                    const char* path)
 {
@@ -422,18 +423,17 @@ static int check_restorable_values(struct wetdem_sim* sim, const struct wetdem_c
     double dt_t0[2];
     memcpy(dt_t0, ck->extra, sizeof dt_t0);
     const char* bad = NULL;
-    if (!isfinite(ck->time) || first_non_finite(dt_t0, 2) < 2 || !(dt_t0[0] > 0))
+    if (!isfinite(ck->time) || !all_finite(dt_t0, 2) || !(dt_t0[0] > 0))
         bad = "a non-finite time or a step dt that is not > 0";
     for (size_t k = 0; !bad && k < n; k++) {
         double ft[6];
         memcpy(ft, ck->extra + 16 + k * 48, sizeof ft);
-        if (first_non_finite(ft, 6) < 6)
+        if (!all_finite(ft, 6))
             bad = "a non-finite force or torque";
     }
-    if (!bad && first_non_finite(ck->energy, ck->n_energy) < ck->n_energy)
+    if (!bad && !all_finite(ck->energy, ck->n_energy))
         bad = "a non-finite energy-budget term";
-    if (!bad && first_non_finite(ck->history, ck->n_pairs * ck->history_len) <
-                    ck->n_pairs * ck->history_len)
+    if (!bad && !all_finite(ck->history, ck->n_pairs * ck->history_len))
         bad = "a non-finite pair history";
     for (size_t q = 0; !bad && q < np; q++) {
         const struct wetdem_checkpoint_pair* k = &ck->pairs[q];
@@ -480,14 +480,10 @@ static int check_restorable(struct wetdem_sim* sim, const struct wetdem_checkpoi
             return wetdem_sim_fail(sim, WETDEM_ERR_PARSE,
                                    "checkpoint '%s': particle %zu has material %d", path, k,
                                    p->material);
-        /* what wetdem_sim_add_particle accepts, so that a resumed run starts from a state a
-           fresh one could have */
-        if (!vec3_is_finite(p->pos) || !vec3_is_finite(p->vel) || !vec3_is_finite(p->omega) ||
-            !(isfinite(p->radius) && p->radius > 0) || !(isfinite(p->mass) && p->mass > 0))
-            return wetdem_sim_fail(sim, WETDEM_ERR_PARSE,
-                                   "checkpoint '%s': particle %zu has a non-finite position, "
-                                   "velocity or spin, or a radius or mass that is not > 0",
-                                   path, k);
+        char why[128]; /* what wetdem_sim_add_particle accepts */
+        if (!wetdem_sim_particle_valid(p, why, sizeof why))
+            return wetdem_sim_fail(sim, WETDEM_ERR_PARSE, "checkpoint '%s': particle %zu: %s", path,
+                                   k, why);
     }
     return check_restorable_values(sim, ck, path);
 }

@@ -187,9 +187,9 @@ static void test_many_restart_refuses_impossible_states(void** state)
     CHECK_OK(wetdem_sim_integrate(first, 0.2e-3));
     CHECK_OK(wetdem_sim_write_checkpoint(first, good));
     wetdem_sim_free(first);
-    const char* want[] = {"particle 3 has a non-finite position, velocity or spin",
-                          "particle 5 has a non-finite position, velocity or spin",
-                          "a radius or mass that is not > 0",
+    const char* want[] = {"particle 3: position, velocity and spin must be finite",
+                          "particle 5: position, velocity and spin must be finite",
+                          "particle 7: radius must be > 0 and finite, got -0.001 m",
                           "a step dt that is not > 0",
                           "a non-finite force or torque",
                           "a non-finite energy-budget term",
