@@ -489,6 +489,19 @@ static int resume(const struct cli_many_setup* su, const struct cli_run_options*
         cli_error("--restart %s: %s", opt->restart, wetdem_sim_errmsg(su->sim));
         return CLI_EXIT_USAGE;
     }
+    /* A checkpoint this program wrote holds a budget that closed at its step (or the run that
+       wrote it said otherwise and exited 1): one that does not close here was edited, or comes
+       from such a run, and is refused before any output is touched. */
+    struct wetdem_energy_budget b;
+    double ratio = wetdem_sim_energy_budget(su->sim, &b) == WETDEM_OK ? closure_ratio(&b) : 0.0;
+    if (!(ratio <= CLOSURE_LIMIT)) {
+        cli_error("--restart %s: its energy budget does not close (error %.2g of the larger of "
+                  "input and work, above %g): the state was changed after its run wrote it, "
+                  "or its run had already failed this check; resume from a checkpoint of a run "
+                  "that passed it, or start afresh",
+                  opt->restart, ratio, CLOSURE_LIMIT);
+        return CLI_EXIT_USAGE;
+    }
     struct wetdem_many_stats s;
     wetdem_sim_many_stats(su->sim, &s);
     if (pl->csv_prefix[0]) {

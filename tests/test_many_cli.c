@@ -12,7 +12,8 @@
  *     resumes it; resuming gives the uninterrupted run's files byte for byte;
  *   - progress goes to stderr only when it is a terminal, with an estimate of the time left;
  *   - the example scenarios check, and the summary's energy budget adds up; a run whose budget
- *     does not close (a step too long for the contacts) says so and exits 1.
+ *     does not close (a step too long for the contacts) says so and exits 1, and a restart
+ *     from an edited checkpoint whose budget does not close is refused with exit 2.
  *
  * The runs use one OpenMP thread (results are bit-identical for a given thread count, and one
  * thread is the fastest for 150 spheres on a shared machine) and the passive wait policy.
@@ -26,6 +27,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "checkpoint.h"
 #include "harness.h"
 
 #define ENV "OMP_NUM_THREADS=1 OMP_WAIT_POLICY=passive"
@@ -264,6 +266,28 @@ static void test_many_cli_restart_is_bit_identical(void** state)
                         "(energy_budget = yes)");
     free(err);
     check_same_outputs("whole", "split", 7);
+    /* a checkpoint edited after it was written (every velocity tripled, CRC rewritten): its
+       state is whole and finite, but the kinetic energy it holds is not one its budget's work
+       accounts for; it is refused, exit 2, and the outputs it would continue stay as they were */
+    struct wetdem_checkpoint ck;
+    char msg[256];
+    CHECK_OK(wetdem_checkpoint_read(tpath("split/checkpoint.ckpt"), &ck, msg, sizeof msg));
+    for (size_t k = 0; k < ck.n_particles; k++) {
+        ck.particles[k].vel.x *= 3;
+        ck.particles[k].vel.y *= 3;
+        ck.particles[k].vel.z *= 3;
+    }
+    CHECK_OK(wetdem_checkpoint_write(tpath("edited.ckpt"), &ck, msg, sizeof msg));
+    wetdem_checkpoint_clear(&ck);
+    snprintf(cmd, sizeof cmd, "cp -r '%s/split' '%s/edited'", tmpdir, tmpdir);
+    assert_int_equal(system(cmd), 0);
+    code = run_cli("run box.ini --set run.steps=700 --out edited --restart edited.ckpt");
+    err = stderr_text();
+    assert_int_equal(code, 2);
+    CHECK_CONTAINS(err, "--restart edited.ckpt: its energy budget does not close (error 2.");
+    CHECK_CONTAINS(err, "the state was changed after its run wrote it");
+    free(err);
+    check_same_outputs("split", "edited", 7);
 }
 
 /* Number of data rows in a CSV (lines starting with a digit). */
