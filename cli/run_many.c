@@ -255,6 +255,15 @@ static double closure_ratio(const struct wetdem_energy_budget* b)
  * the settling example gives 9e-4 at 0.1, 0.09 at 0.2, 0.35 at 0.3 and 4.6 at 0.5). */
 #define CLOSURE_LIMIT 0.05
 
+/* Whether the budget of the run (has_budget) is beyond CLOSURE_LIMIT, also when its error is
+ * not finite; *ratio is its closure_ratio (0 without a budget). The end of a run and a restart
+ * judge by this one rule. */
+static bool budget_open(const struct wetdem_energy_budget* b, bool has_budget, double* ratio)
+{
+    *ratio = has_budget ? closure_ratio(b) : 0.0;
+    return !(*ratio <= CLOSURE_LIMIT);
+}
+
 static void summary_text(FILE* f, const struct cli_many_setup* su, const struct outcome* o)
 {
     const struct wetdem_many_stats* s = &o->stats;
@@ -489,16 +498,16 @@ static int resume(const struct cli_many_setup* su, const struct cli_run_options*
         cli_error("--restart %s: %s", opt->restart, wetdem_sim_errmsg(su->sim));
         return CLI_EXIT_USAGE;
     }
-    /* A checkpoint this program wrote holds a budget that closed at its step (or the run that
-       wrote it said otherwise and exited 1): one that does not close here was edited, or comes
-       from such a run, and is refused before any output is touched. */
+    /* The budget restored closes at the checkpoint's step unless the state was edited or its
+       run's step was too long for the contacts (which the end of that run judges too): either
+       way the run is refused before any output is touched. */
     struct wetdem_energy_budget b;
-    double ratio = wetdem_sim_energy_budget(su->sim, &b) == WETDEM_OK ? closure_ratio(&b) : 0.0;
-    if (!(ratio <= CLOSURE_LIMIT)) {
+    double ratio;
+    if (budget_open(&b, wetdem_sim_energy_budget(su->sim, &b) == WETDEM_OK, &ratio)) {
         cli_error("--restart %s: its energy budget does not close (error %.2g of the larger of "
                   "input and work, above %g): the state was changed after its run wrote it, "
-                  "or its run had already failed this check; resume from a checkpoint of a run "
-                  "that passed it, or start afresh",
+                  "or that run's step is too long for its contacts; resume from a checkpoint "
+                  "whose budget closes, or start afresh",
                   opt->restart, ratio, CLOSURE_LIMIT);
         return CLI_EXIT_USAGE;
     }
@@ -576,8 +585,8 @@ static int finish(const struct cli_scenario* sc, struct cli_many_setup* su,
         summary_text(stdout, su, &o);
     if (opt->out_dir && !opt->json && rc == CLI_EXIT_OK)
         printf("files in %s/\n", opt->out_dir);
-    double ratio = o.has_budget ? closure_ratio(&o.budget) : 0.0;
-    if (rc == CLI_EXIT_OK && !(ratio <= CLOSURE_LIMIT)) { /* (also when it is not finite) */
+    double ratio;
+    if (budget_open(&o.budget, o.has_budget, &ratio) && rc == CLI_EXIT_OK) {
         cli_error("run %s: the energy budget does not close (error %.2g of the larger of input "
                   "and work, above %g): the step dt = %.4g s is too long for these contacts; "
                   "halve it ([integrator] dt_fraction, or dt in [run] or [integrator])",
