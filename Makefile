@@ -82,7 +82,7 @@ $(BUILD)/examples/%: examples/%/main.c $(BUILD)/libwetdem.a $(BUILD)/flags.stamp
 examples: $(EX_BIN)
 
 test: all $(TEST_BIN) $(EX_BIN)
-	@WETDEM_CLI=$(abspath $(BUILD)/wetdem) tests/run-tests $(TEST_BIN) $(EX_BIN)
+	@WETDEM_CLI=$(abspath $(BUILD)/wetdem) tests/run-tests $(TEST_BIN) $(EX_BIN) tests/test_install_deps.sh
 
 # Tests again under AddressSanitizer + UndefinedBehaviorSanitizer, in a separate build tree.
 test-san:
