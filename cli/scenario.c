@@ -252,15 +252,29 @@ static int check_names(const struct cli_scenario* sc, const struct cli_entry* e,
     char buf[CLI_VALUE_MAX];
     copy_text(buf, sizeof buf, e->value);
     int count = 0;
+    const char* names[CLI_VALUE_MAX / 2];
+    const char* word = NULL; /* 'none' or 'all', which stand for the whole list */
     for (char* tok = strtok(buf, " ,\t"); tok; tok = strtok(NULL, " ,\t")) {
         if (!cli_is_name(tok)) {
             cli_scenario_error(sc, e, "'%s' is not a name (letters, digits, '_' and '-')", tok);
             return CLI_EXIT_USAGE;
         }
-        count++;
+        /* A repeated name is a slip (meant another axis, face or model), not a request. */
+        for (int k = 0; k < count; k++)
+            if (strcmp(names[k], tok) == 0) {
+                cli_scenario_error(sc, e, "'%s' is listed twice", tok);
+                return CLI_EXIT_USAGE;
+            }
+        if (strcmp(tok, "none") == 0 || strcmp(tok, "all") == 0)
+            word = tok;
+        names[count++] = tok;
     }
     if (count == 0 || (!list && count > 1)) {
         cli_scenario_error(sc, e, list ? "expected one or more names" : "expected one name");
+        return CLI_EXIT_USAGE;
+    }
+    if (word && count > 1) {
+        cli_scenario_error(sc, e, "'%s' stands for the whole list: write it alone", word);
         return CLI_EXIT_USAGE;
     }
     return CLI_EXIT_OK;

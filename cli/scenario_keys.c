@@ -352,7 +352,7 @@ static int key_row(FILE* f, const char* section, const struct cli_key_desc* k)
         struct wetdem_param_desc d = cli_key_as_param(k);
         wetdem_param_range_text(&d, range, sizeof range);
     } else if (k->kind == CLI_VALUE_NAME_LIST)
-        snprintf(range, sizeof range, "list of names");
+        snprintf(range, sizeof range, "list of names, each once");
     else if (k->kind == CLI_VALUE_TEXT)
         snprintf(range, sizeof range, "text");
     fprintf(f, "| `%s` | %s | ", k->key, k->unit[0] ? k->unit : "");

@@ -2,8 +2,9 @@
  * test_many_cli.c — many-particle runs through the command line (cli/run_many.c,
  * cli/scenario_many.c):
  *   - bad scenarios (box too small for the count, negative radius, unknown key, a wall on a
- *     periodic axis, overlapping groups, t_end and steps both, a periodic edge too short for
- *     the neighbour cells, a foreign checkpoint) exit 2 with "FILE:LINE:" at the right line
+ *     periodic axis, a name listed twice or 'none' beside other names, overlapping groups,
+ *     t_end and steps both, a periodic edge too short for the neighbour cells, a foreign
+ *     checkpoint) exit 2 with "FILE:LINE:" at the right line
  *     and write nothing, not even the --out directory;
  *   - a run split by --restart, and a run resumed from an older checkpoint after its outputs
  *     went further, give byte-identical VTK frames, series index, CSV and summary to the
@@ -135,6 +136,20 @@ static void test_many_cli_bad_inputs_exit_2_with_file_and_line(void** state)
                "[box]\nsize_x = 1e-2\nsize_y = 1e-2\nsize_z = 1e-2\nperiodic = x\n[walls]\n"
                "faces = x_min z_min\n[insert]\ncount = 5\nradius = 1e-3\n[run]\nsteps = 10\n",
                7, "wall x_min lies on axis x");
+    /* a name listed twice is a slip (meant 'x y'), and 'none' or 'all' stand alone */
+    expect_bad("twice.ini",
+               "[box]\nsize_x = 1e-2\nsize_y = 1e-2\nsize_z = 1e-2\nperiodic = x x\n"
+               "[insert]\ncount = 5\nradius = 1e-3\n[run]\nsteps = 10\n",
+               5, "'x' is listed twice");
+    expect_bad("face_twice.ini",
+               "[box]\nsize_x = 1e-2\nsize_y = 1e-2\nsize_z = 1e-2\n[walls]\n"
+               "faces = z_min, z_max z_min\n[insert]\ncount = 5\nradius = 1e-3\n[run]\n"
+               "steps = 10\n",
+               6, "'z_min' is listed twice");
+    expect_bad("none_and.ini",
+               "[box]\nsize_x = 1e-2\nsize_y = 1e-2\nsize_z = 1e-2\nperiodic = none z\n"
+               "[insert]\ncount = 5\nradius = 1e-3\n[run]\nsteps = 10\n",
+               5, "'none' stands for the whole list");
     expect_bad("overlap.ini",
                "[box]\nsize_x = 1e-2\nsize_y = 1e-2\nsize_z = 1e-2\n[particle.a]\nradius = 1e-3\n"
                "x = 5e-3\ny = 5e-3\nz = 5e-3\n[particle.b]\nradius = 1e-3\nx = 6e-3\ny = 5e-3\n"
