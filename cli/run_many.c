@@ -438,7 +438,10 @@ static void print_check_json(const struct cli_scenario* sc, const struct cli_man
         printf("%s", k ? ", " : "");
         cli_json_string(stdout, wetdem_sim_model(su->sim, k)->name);
     }
-    printf("]}\n");
+    if (isfinite(s->relaxation_time))
+        printf("], \"relaxation_time_s\": %.17g}\n", s->relaxation_time);
+    else
+        printf("], \"relaxation_time_s\": null}\n");
 }
 
 static void print_check(const struct cli_scenario* sc, const struct cli_many_setup* su,
@@ -457,8 +460,11 @@ static void print_check(const struct cli_scenario* sc, const struct cli_many_set
            su->box[2], su->many.periodic[0] ? "x" : "", su->many.periodic[1] ? "y" : "",
            su->many.periodic[2] ? "z" : "",
            su->many.periodic[0] || su->many.periodic[1] || su->many.periodic[2] ? "" : "none");
-    printf("  dt            %.6g s\n  t_end         %.6g s\n  steps         %llu\n", pl->dt,
-           pl->t_end, pl->total);
+    printf("  dt            %.6g s\n", pl->dt);
+    if (isfinite(s.relaxation_time))
+        printf("  relaxation    %.6g s  (shortest viscous relaxation time; dt stays below it)\n",
+               s.relaxation_time);
+    printf("  t_end         %.6g s\n  steps         %llu\n", pl->t_end, pl->total);
     printf("  vtk_every     %llu\n  csv_every     %llu\n  contacts      %zu  (bridges %zu) at "
            "t = 0\n  models       ",
            su->vtk_every, su->csv_every, s.contacts, s.bridges);

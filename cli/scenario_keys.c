@@ -98,11 +98,12 @@ static const char* const cvode_methods[] = {"auto", "adams", "bdf", NULL};
  * or gives it another range. */
 static const struct cli_key_desc integrator_keys[] = {
     WORD("name", CLI_VALUE_NAME, "verlet", NULL,
-         "verlet (fixed step, a fraction of the Hertz contact time) or cvode (adaptive, "
+         "verlet (fixed step, a fraction of the contact time) or cvode (adaptive, "
          "with located events). The other keys are integrator parameters, checked by the library "
          "when the scenario is built; those of an integrator not chosen are ignored."),
     NUM("dt_fraction", "-", NULL, 0, 1, true, false,
-        "verlet: time step as a fraction of the Hertz contact time (Nijssen: 0.02)."),
+        "verlet: time step as a fraction of the contact time (Hertz, or hooke's half period; "
+        "Nijssen: 0.02)."),
     NUM("dt", "s", NULL, 0, 1, false, false,
         "verlet: fixed time step; 0 derives it from dt_fraction."),
     NUM("max_steps", "-", NULL, 1, 1e12, false, false,

@@ -104,9 +104,10 @@ static const struct cli_key_desc run_keys[] = {
     NUM("t_end", "s", "give t_end or steps", 0, 1e6, true, false, "Simulated time of the run."),
     NUM("steps", "-", "give t_end or steps", 1, 1e15, false, false, "Number of time steps."),
     NUM("dt", "s", "0 ([integrator] dt, else dt_fraction)", 0, 1, false, false,
-        "Time step; 0: [integrator] dt, else dt_fraction x the Hertz contact time of the two "
+        "Time step; 0: [integrator] dt, else dt_fraction x the contact time of the two "
         "smallest spheres at twice the largest speed plus the speed gravity adds over the "
-        "packing height. Fixed for the run."),
+        "packing height, at most a quarter of the viscous relaxation time (docs/many.md). A "
+        "step at or above that time is refused. Fixed for the run."),
     NUM("skin", "m", "0 (0.1 x smallest radius)", 0, 1, false, false,
         "Verlet skin of the neighbour lists."),
     WORD("energy_budget", CLI_VALUE_CHOICE, "yes", cli_yes_no,

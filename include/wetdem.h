@@ -229,6 +229,15 @@ struct wetdem_model {
      * written (<= WETDEM_MAX_THRESHOLDS). Optional. */
     size_t (*thresholds)(const void* params, const struct wetdem_contact* c, const double* history,
                          double* gaps);
+    /* Duration of an impact [s] at approach speed c->v_n > 0 (models with a solid contact;
+     * optional). The explicit engines derive their step from the shortest. */
+    double (*contact_time)(const void* params, const struct wetdem_contact* c);
+    /* Shortest relaxation time m / c_d [s] of the motion the model damps viscously, at the
+     * smallest gap it acts at (c->h_min filled in, c->v_n the approach speed): c_d = dF/dv,
+     * m = m* for normal and (2/7) m* for tangential motion (the spins take part); INFINITY
+     * where the model damps nothing, 0 where c_d has no bound. Optional. The many-particle
+     * engine keeps its step below a quarter of the shortest (docs/many.md, Time step). */
+    double (*relaxation_time)(const void* params, const struct wetdem_contact* c);
 };
 
 /* NULL-terminated table of every built-in model. */
@@ -597,6 +606,8 @@ struct wetdem_many_stats {
     double seconds_kick, seconds_forces, seconds_lists, seconds_output;
     int threads; /* OpenMP threads the run's loops use: OMP_NUM_THREADS, or 1 for fewer than 512
                     particles (waking the threads would cost more than the work) */
+    double relaxation_time; /* shortest viscous relaxation time of the enabled models at the
+                               start [s], which dt stays below (INFINITY: nothing damps) */
 };
 WETDEM_API int wetdem_sim_many_stats(const struct wetdem_sim* sim, struct wetdem_many_stats* s);
 

@@ -50,6 +50,18 @@ static int davis_pair(const void* params, const struct wetdem_contact* c, double
     return WETDEM_OK;
 }
 
+/* (2/7) m* / k at h_min', k = 2 pi mu a ln[(2 delta - h)/h]: the sliding of two spheres
+ * free to spin responds to a tangential force F as (2/7) m* dv_t/dt = F [s]. */
+static double davis_relaxation_time(const void* params, const struct wetdem_contact* c)
+{
+    (void)params;
+    double h;
+    if (!thin_film_stiffest_gap(c, &h))
+        return INFINITY;
+    return viscous_relaxation_time(2.0 / 7.0 * c->m_eff,
+                                   davis_resistance(c->viscosity, c->r_eff, h, c->film));
+}
+
 const struct wetdem_model wetdem_force_davis = {
     .name = "davis",
     .kind = WETDEM_MODEL_FLUID,
@@ -70,4 +82,5 @@ const struct wetdem_model wetdem_force_davis = {
     .range = thin_film_range,
     .pair = davis_pair,
     .thresholds = thin_film_thresholds,
+    .relaxation_time = davis_relaxation_time,
 };

@@ -46,6 +46,16 @@ static int db_pair(const void* params, const struct wetdem_contact* c, double* h
     return WETDEM_OK;
 }
 
+/* m* / c_d at h_min', c_d = 6 pi mu a^2 / h [1 - h/(2 delta - h)]^2 [s]. */
+static double db_relaxation_time(const void* params, const struct wetdem_contact* c)
+{
+    (void)params;
+    double h;
+    if (!thin_film_stiffest_gap(c, &h))
+        return INFINITY;
+    return viscous_relaxation_time(c->m_eff, db_force(c->viscosity, c->r_eff, 1.0, h, c->film));
+}
+
 const struct wetdem_model wetdem_force_db = {
     .name = "db",
     .kind = WETDEM_MODEL_FLUID,
@@ -69,4 +79,5 @@ const struct wetdem_model wetdem_force_db = {
     .range = thin_film_range,
     .pair = db_pair,
     .thresholds = thin_film_thresholds,
+    .relaxation_time = db_relaxation_time,
 };

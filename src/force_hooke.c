@@ -53,6 +53,16 @@ static int hooke_pair(const void* params, const struct wetdem_contact* c, double
     return WETDEM_OK;
 }
 
+/* Half the damped period of the linear contact, pi / sqrt(k/m* - (gamma/(2 m*))^2) [s]: the
+ * same at every impact speed. */
+static double hooke_contact_time(const void* params, const struct wetdem_contact* c)
+{
+    double k = ((const struct hooke_params*)params)->stiffness;
+    double e = c->restitution > 0.0 && c->restitution <= 1.0 ? c->restitution : 1.0;
+    double decay = hooke_damping(k, c->m_eff, e) / (2.0 * c->m_eff);
+    return M_PI / sqrt(k / c->m_eff - decay * decay);
+}
+
 const struct wetdem_model wetdem_force_hooke = {
     .name = "hooke",
     .kind = WETDEM_MODEL_CONTACT,
@@ -73,4 +83,5 @@ const struct wetdem_model wetdem_force_hooke = {
     .range = contact_only_range,
     .pair = hooke_pair,
     .thresholds = contact_only_thresholds,
+    .contact_time = hooke_contact_time,
 };

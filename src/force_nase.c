@@ -56,6 +56,18 @@ static int nase_pair(const void* params, const struct wetdem_contact* c, double*
     return WETDEM_OK;
 }
 
+/* (2/7) m* / k at h_min', k = 6 pi mu a (8/15 ln(a/h) + 0.9588) (tangential mass as in
+ * force_davis.c) [s]. */
+static double nase_relaxation_time(const void* params, const struct wetdem_contact* c)
+{
+    (void)params;
+    double h;
+    if (!thin_film_stiffest_gap(c, &h))
+        return INFINITY;
+    return viscous_relaxation_time(2.0 / 7.0 * c->m_eff,
+                                   nase_resistance(c->viscosity, c->r_eff, h));
+}
+
 const struct wetdem_model wetdem_force_nase = {
     .name = "nase",
     .kind = WETDEM_MODEL_FLUID,
@@ -78,4 +90,5 @@ const struct wetdem_model wetdem_force_nase = {
     .range = thin_film_range,
     .pair = nase_pair,
     .thresholds = thin_film_thresholds,
+    .relaxation_time = nase_relaxation_time,
 };

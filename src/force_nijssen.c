@@ -141,6 +141,25 @@ static size_t nijssen_thresholds(const void* params, const struct wetdem_contact
     return 3;
 }
 
+/* The Hertz contact time of the contact branch at the approach speed c->v_n [s]. */
+static double nijssen_contact_time(const void* params, const struct wetdem_contact* c)
+{
+    (void)params;
+    return wetdem_force_hertz_contact_time(c->e_star, c->r_eff, c->m_eff, fmax(c->v_n, 1e-12));
+}
+
+/* m* / c_d with c_d = 6 pi mu R*^2 / h_min, the lubrication at the model's own minimum
+ * approach h_min = max(h_sigma, h_eps) for v0 = c->v_n (Eq. 8; the lever blend below h_min
+ * damps less) [s]. */
+static double nijssen_relaxation_time(const void* params, const struct wetdem_contact* c)
+{
+    (void)params;
+    double h_eps = minsep_ehd_gap(c->viscosity, fmax(c->v_n, 0.0), c->e_star, c->r_eff);
+    double h_min = fmax(c->roughness, h_eps);
+    return viscous_relaxation_time(c->m_eff,
+                                   lubrication_force(c->viscosity, c->r_eff, 1.0, h_min, h_min));
+}
+
 const struct wetdem_model wetdem_force_nijssen = {
     .name = "nijssen",
     .kind = WETDEM_MODEL_FLUID,
@@ -167,4 +186,6 @@ const struct wetdem_model wetdem_force_nijssen = {
     .range = nijssen_range,
     .pair = nijssen_pair,
     .thresholds = nijssen_thresholds,
+    .contact_time = nijssen_contact_time,
+    .relaxation_time = nijssen_relaxation_time,
 };

@@ -54,6 +54,14 @@ static size_t reynolds_thresholds(const void* params, const struct wetdem_contac
     return 3;
 }
 
+/* m* / c_d at h_min, c_d = 6 pi mu R*^2 / h_min (the law is held at h_min below it) [s]. */
+static double reynolds_relaxation_time(const void* params, const struct wetdem_contact* c)
+{
+    (void)params;
+    double c_d = reynolds_force(c->viscosity, c->r_eff, 1.0, fmax(c->h_min, 0.0));
+    return viscous_relaxation_time(c->m_eff, c_d);
+}
+
 const struct wetdem_model wetdem_force_reynolds = {
     .name = "reynolds",
     .kind = WETDEM_MODEL_FLUID,
@@ -69,4 +77,5 @@ const struct wetdem_model wetdem_force_reynolds = {
     .range = reynolds_range,
     .pair = reynolds_pair,
     .thresholds = reynolds_thresholds,
+    .relaxation_time = reynolds_relaxation_time,
 };

@@ -47,6 +47,16 @@ static int sb_pair(const void* params, const struct wetdem_contact* c, double* h
     return WETDEM_OK;
 }
 
+/* m* / c_d at h_min', c_d = 6 pi mu a^2 / h [1 - h/delta]^2 (the force per unit v_n) [s]. */
+static double sb_relaxation_time(const void* params, const struct wetdem_contact* c)
+{
+    (void)params;
+    double h;
+    if (!thin_film_stiffest_gap(c, &h))
+        return INFINITY;
+    return viscous_relaxation_time(c->m_eff, sb_force(c->viscosity, c->r_eff, 1.0, h, c->film));
+}
+
 const struct wetdem_model wetdem_force_sb = {
     .name = "sb",
     .kind = WETDEM_MODEL_FLUID,
@@ -69,4 +79,5 @@ const struct wetdem_model wetdem_force_sb = {
     .range = thin_film_range,
     .pair = sb_pair,
     .thresholds = thin_film_thresholds,
+    .relaxation_time = sb_relaxation_time,
 };

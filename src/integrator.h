@@ -88,9 +88,10 @@ struct wetdem_vec3 wetdem_sim_acceleration(const struct wetdem_sim* sim, size_t 
 /* Angular acceleration of free particle k from engine.torque [rad/s^2]. */
 struct wetdem_vec3 wetdem_sim_angular_acceleration(const struct wetdem_sim* sim, size_t k);
 /* Largest relative speed of any pair, including the speed gravity can add over the pair's gap,
- * floored by sim.speed_floor [m/s]; *t_hertz (if non-NULL) receives the smallest Hertz
- * contact time of any pair at that speed [s] (INFINITY without pairs). */
-double wetdem_sim_speed_scale(const struct wetdem_sim* sim, double* t_hertz);
+ * floored by sim.speed_floor [m/s]; *t_contact (if non-NULL) receives the shortest impact
+ * duration of any pair at its speed (wetdem_sim_contact_time: the enabled models' contact
+ * times, else Hertz's) [s] (INFINITY without pairs). */
+double wetdem_sim_speed_scale(const struct wetdem_sim* sim, double* t_contact);
 /* Smallest radius of a free particle [m] (1 if none). */
 double wetdem_sim_length_scale(const struct wetdem_sim* sim);
 /* Checks sim.stop_on_separation at the current state (engine.pair_gap/pair_vn must be

@@ -13,8 +13,9 @@
  * velocities v', which is first order for damped motion.) Position-only forces see exactly the
  * symplectic, time-reversible velocity Verlet.
  *
- * Step: verlet.dt [s] when > 0; otherwise dt = dt_fraction x the smallest Hertz contact time
- * (Johnson 1985 Sec. 11.4) over all pairs at the speed scale of wetdem_sim_speed_scale(): the
+ * Step: verlet.dt [s] when > 0; otherwise dt = dt_fraction x the shortest impact duration
+ * over all pairs (the Hertz contact time, Johnson 1985 Sec. 11.4, or hooke's half period:
+ * the enabled models' contact_time hooks) at the speed scale of wetdem_sim_speed_scale(): the
  * largest relative speed of any pair at the start of the run, raised by the speed gravity can
  * add over the pair's gap, floored by sim.speed_floor. dt is fixed for one
  * wetdem_sim_integrate() call; long runs with changing speeds are integrated in chunks.
@@ -33,7 +34,7 @@
 
 struct verlet_params {
     double dt;          /* fixed step [s]; 0: from dt_fraction */
-    double dt_fraction; /* step as a fraction of the Hertz contact time [-] */
+    double dt_fraction; /* step as a fraction of the contact time [-] */
     double max_steps;   /* most steps one integrate call may take [-] */
 };
 
@@ -42,9 +43,10 @@ _Static_assert(sizeof(struct verlet_params) <= WETDEM_INTEGRATOR_PARAMS_MAX * si
 
 #define P(field) offsetof(struct verlet_params, field)
 static const struct wetdem_param_desc verlet_params_desc[] = {
-    {"dt", "s", "Fixed time step; 0 derives it from dt_fraction and the Hertz contact time.", P(dt),
-     0.0, 0.0, 1.0, false, false, NULL},
-    {"dt_fraction", "-", "Time step as a fraction of the Hertz contact time (Nijssen: 0.02).",
+    {"dt", "s", "Fixed time step; 0 derives it from dt_fraction and the contact time.", P(dt), 0.0,
+     0.0, 1.0, false, false, NULL},
+    {"dt_fraction", "-",
+     "Time step as a fraction of the contact time (Hertz, or hooke's half period; Nijssen: 0.02).",
      P(dt_fraction), 0.02, 0.0, 1.0, true, false, NULL},
     {"max_steps", "-", "Largest number of steps one integrate call may take.", P(max_steps), 1e8,
      1.0, 1e12, false, false, NULL},
@@ -56,12 +58,12 @@ static const struct wetdem_param_desc verlet_params_desc[] = {
 static int choose_step(struct wetdem_sim* sim, const struct verlet_params* p, double t_end,
                        double* dt)
 {
-    double span = t_end - sim->engine.time, t_hertz = INFINITY;
+    double span = t_end - sim->engine.time, t_contact = INFINITY;
     if (p->dt > 0) {
         *dt = p->dt;
     } else {
-        wetdem_sim_speed_scale(sim, &t_hertz);
-        *dt = isfinite(t_hertz) ? p->dt_fraction * t_hertz : span;
+        wetdem_sim_speed_scale(sim, &t_contact);
+        *dt = isfinite(t_contact) ? p->dt_fraction * t_contact : span;
     }
     if (!(*dt > 0) || !isfinite(*dt))
         return wetdem_sim_fail(sim, WETDEM_ERR_INVALID, "verlet: step %g s is not usable", *dt);

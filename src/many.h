@@ -184,10 +184,11 @@ struct wetdem_many {
     char* output_prefix;
     char* checkpoint_path;
     struct wetdem_celllist cl;
-    double reach;  /* largest interaction gap of any pair [m] (start-up bound) */
-    double dt;     /* time step [s], fixed once the many run starts */
-    double t0;     /* time of step 0 [s] */
-    uint64_t step; /* steps since t0 */
+    double reach;           /* largest interaction gap of any pair [m] (start-up bound) */
+    double dt;              /* time step [s], fixed once the many run starts */
+    double relaxation_time; /* shortest viscous relaxation time at the start [s] (choose_dt) */
+    double t0;              /* time of step 0 [s] */
+    uint64_t step;          /* steps since t0 */
     bool started;
     /* wall time by phase in this process [s] (wetdem_many_stats): kicks and drifts, force
        passes (less their list builds), neighbour-list builds, outputs and observers */

@@ -31,6 +31,16 @@ extern const struct wetdem_model wetdem_minsep_glass;
 
 /* ---- hooks shared by the models that act only in solid contact (hertz, mindlin, hooke) ---- */
 
+/* Relaxation time m / c_d [s] of a motion of mass m [kg] damped with coefficient c_d
+ * [kg/s]: INFINITY without damping, 0 when c_d has no bound (not finite). The models'
+ * relaxation_time hooks return it. */
+static inline double viscous_relaxation_time(double m, double c_d)
+{
+    if (!(c_d > 0.0))
+        return INFINITY;
+    return isfinite(c_d) ? m / c_d : 0.0;
+}
+
 /* Range of a contact-only model [m]: 0, it acts only where the gap is negative. */
 static inline double contact_only_range(const void* params, const struct wetdem_contact* c)
 {

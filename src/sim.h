@@ -117,6 +117,18 @@ int wetdem_sim_eval_contact(const struct wetdem_sim* sim, struct wetdem_contact*
 /* Largest gap at which any enabled force model acts for this contact [m]. */
 double wetdem_sim_contact_range(const struct wetdem_sim* sim, const struct wetdem_contact* c);
 
+/* Shortest impact duration [s] of the enabled models for contact c at approach speed c->v_n:
+ * their contact_time hooks, or the Hertz contact time of c's materials when no enabled model
+ * has a solid contact (fluid forces only). */
+double wetdem_sim_contact_time(const struct wetdem_sim* sim, const struct wetdem_contact* c);
+
+/* Shortest viscous relaxation time [s] of the enabled models for contact c at approach speed
+ * c->v_n (their relaxation_time hooks; INFINITY when none damps). Fills c->h_min from the
+ * min-separation model for a fresh pair first. *which (optional) receives the model that
+ * sets it, NULL if none. */
+double wetdem_sim_relaxation_time(const struct wetdem_sim* sim, struct wetdem_contact* c,
+                                  const struct wetdem_model** which);
+
 /* Initial value of a pair's history: zeros except NAN-free defaults; writes history_len. */
 void wetdem_sim_history_init(const struct wetdem_sim* sim, double* history);
 

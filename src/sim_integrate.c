@@ -251,7 +251,7 @@ struct wetdem_vec3 wetdem_sim_angular_acceleration(const struct wetdem_sim* sim,
 
 /* ---- scales ---- */
 
-double wetdem_sim_speed_scale(const struct wetdem_sim* sim, double* t_hertz)
+double wetdem_sim_speed_scale(const struct wetdem_sim* sim, double* t_contact)
 {
     const struct wetdem_engine* e = &sim->engine;
     double g = sqrt(sim->settings.gravity_x * sim->settings.gravity_x +
@@ -269,11 +269,13 @@ double wetdem_sim_speed_scale(const struct wetdem_sim* sim, double* t_hertz)
         double v = sqrt(vec3_dot(dv, dv) + 2.0 * g * fmax(c.gap, 0.0));
         v = fmax(v, floor);
         v_max = fmax(v_max, v);
-        if (t_hertz)
-            t_min = fmin(t_min, wetdem_force_hertz_contact_time(c.e_star, c.r_eff, c.m_eff, v));
+        if (t_contact && v > 0) {
+            c.v_n = v;
+            t_min = fmin(t_min, wetdem_sim_contact_time(sim, &c));
+        }
     }
-    if (t_hertz)
-        *t_hertz = t_min;
+    if (t_contact)
+        *t_contact = t_min;
     return v_max;
 }
 

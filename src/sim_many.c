@@ -190,22 +190,74 @@ static double reach_bound(const struct wetdem_sim* sim)
     return reach;
 }
 
-/* Step [s]: many.dt, else verlet.dt, else verlet.dt_fraction x the shortest Hertz contact
- * time of two smallest spheres (or one and a wall) at the speed scale. */
+/* The pair of spheres p and q (materials a, b) at gap `gap`, p above q, at rest. */
+static void probe_spheres(const struct wetdem_sim* sim, struct wetdem_particle p,
+                          struct wetdem_particle q, int a, int b, double gap,
+                          struct wetdem_contact* c)
+{
+    q.pos = vec3(0, 0, 0);
+    p.pos = vec3(0, 0, q.radius + p.radius + gap);
+    wetdem_contact_from_particles(c, &p, &sim->materials[a], &q, &sim->materials[b], &sim->fluid);
+}
+
+/* The time scales of the step at approach speed v, over every material combination:
+ * *t_contact, the shortest impact duration of two smallest spheres or of one and a wall (the
+ * enabled models' contact times, else Hertz's); *tau, the shortest viscous relaxation time of
+ * the pairs where it is shortest (a smallest sphere with a smallest and with a largest one,
+ * and with a wall if there is one), *damper the model and *h_at the gap that set it. */
+static void step_scales(const struct wetdem_sim* sim, struct wetdem_particle small,
+                        struct wetdem_particle big, double v, double* t_contact, double* tau,
+                        const struct wetdem_model** damper, double* h_at)
+{
+    *t_contact = *tau = INFINITY;
+    *damper = NULL;
+    *h_at = 0;
+    for (int a = 0; a < sim->n_materials; a++)
+        for (int b = 0; b < sim->n_materials; b++)
+            for (int probe = 0; probe < 3; probe++) {
+                struct wetdem_contact c;
+                if (probe == 2)
+                    probe_contact(sim, small, a, b, true, 0.0, &c);
+                else
+                    probe_spheres(sim, small, probe ? big : small, a, b, 0.0, &c);
+                c.v_n = fmax(v, 1e-12);
+                if (probe != 1)
+                    *t_contact = fmin(*t_contact, wetdem_sim_contact_time(sim, &c));
+                if (probe == 2 && sim->n_walls == 0)
+                    continue;
+                const struct wetdem_model* which;
+                double t = wetdem_sim_relaxation_time(sim, &c, &which);
+                if (t < *tau) {
+                    *tau = t;
+                    *damper = which;
+                    *h_at = c.h_min;
+                }
+            }
+}
+
+/* Step [s]: many.dt, else verlet.dt, else verlet.dt_fraction x the shortest impact duration
+ * at the speed scale, and at most a quarter of the shortest viscous relaxation time tau
+ * (step_scales). Velocity Verlet with the damping evaluated at the predicted velocity is
+ * stable for dt < tau and dissipates within 3 % of the exact rate for dt <= tau/4
+ * (docs/many.md, Time step); a step given at or above tau is refused. */
 static int choose_dt(struct wetdem_sim* sim, double* dt)
 {
     struct wetdem_many* m = sim->many;
     double fixed = 0, fraction = 0.02;
     wetdem_sim_param(sim, "verlet.dt", &fixed);
     wetdem_sim_param(sim, "verlet.dt_fraction", &fraction);
-    *dt = m->set.dt > 0 ? m->set.dt : fixed;
-    if (*dt > 0)
+    double given = m->set.dt > 0 ? m->set.dt : fixed;
+    m->relaxation_time = INFINITY;
+    if (sim->n_particles == 0) {
+        *dt = given;
         return WETDEM_OK;
-    struct wetdem_particle small = sim->particles[0];
+    }
+    struct wetdem_particle small = sim->particles[0], big = sim->particles[0];
     double v = 0, lo = INFINITY, hi = -INFINITY;
     for (size_t k = 0; k < sim->n_particles; k++) {
         const struct wetdem_particle* p = &sim->particles[k];
         small = p->radius < small.radius ? *p : small;
+        big = p->radius > big.radius ? *p : big;
         v = fmax(v, 2 * vec3_norm(p->vel));
         lo = fmin(lo, fmin(p->pos.z, fmin(p->pos.x, p->pos.y)));
         hi = fmax(hi, fmax(p->pos.z, fmax(p->pos.x, p->pos.y)));
@@ -214,16 +266,29 @@ static int choose_dt(struct wetdem_sim* sim, double* dt)
     double g = sqrt(s->gravity_x * s->gravity_x + s->gravity_y * s->gravity_y +
                     s->gravity_z * s->gravity_z);
     v = fmax(s->speed_floor, v + sqrt(2 * g * fmax(hi - lo, 0.0)));
-    double t_min = INFINITY;
-    for (int a = 0; a < sim->n_materials; a++)
-        for (int b = 0; b < sim->n_materials; b++)
-            for (int wall = 0; wall < 2; wall++) {
-                struct wetdem_contact c;
-                probe_contact(sim, small, a, b, wall, 0.0, &c);
-                t_min = fmin(t_min, wetdem_force_hertz_contact_time(c.e_star, c.r_eff, c.m_eff,
-                                                                    fmax(v, 1e-12)));
-            }
-    *dt = fraction * t_min;
+    double t_contact, tau, h_at;
+    const struct wetdem_model* damper;
+    step_scales(sim, small, big, v, &t_contact, &tau, &damper, &h_at);
+    m->relaxation_time = tau;
+    if (tau == 0)
+        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
+                               "many: the viscous damping of '%s' has no bound at h_min = %g m "
+                               "(it grows as 1/h towards contact), so no step is stable: set a "
+                               "minimum separation h_min > 0",
+                               damper->name, h_at);
+    if (given > 0) {
+        if (given >= tau)
+            return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
+                                   "many: the step dt = %g s is not below the viscous "
+                                   "relaxation time %g s that '%s' sets at h_min = %g m "
+                                   "(m/c_d, for the smallest spheres): velocity Verlet is "
+                                   "unstable there; use dt <= %g s (a quarter, dissipation "
+                                   "within 3 %%), or 0 to derive it",
+                                   given, tau, damper->name, h_at, 0.25 * tau);
+        *dt = given;
+        return WETDEM_OK;
+    }
+    *dt = fmin(fraction * t_contact, 0.25 * tau);
     if (!(isfinite(*dt) && *dt > 0))
         return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
                                "many: cannot derive a time step (%g s); set many.dt or verlet.dt",

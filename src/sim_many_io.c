@@ -93,6 +93,7 @@ int wetdem_sim_many_stats(const struct wetdem_sim* sim, struct wetdem_many_stats
     s->candidate_pairs = m->cl.n_pairs;
     s->list_builds = m->cl.n_builds;
     s->dt = m->dt;
+    s->relaxation_time = m->relaxation_time;
     s->step = m->step;
     s->seconds_kick = m->seconds_kick;
     s->seconds_forces = m->seconds_forces;

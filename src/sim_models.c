@@ -326,6 +326,41 @@ double wetdem_sim_contact_range(const struct wetdem_sim* sim, const struct wetde
     return r;
 }
 
+double wetdem_sim_contact_time(const struct wetdem_sim* sim, const struct wetdem_contact* c)
+{
+    double t = INFINITY;
+    for (size_t k = 0; k < sim->n_models; k++) {
+        const struct wetdem_model_slot* s = &sim->models[k];
+        if (s->model->contact_time)
+            t = fmin(t, s->model->contact_time(s->params, c));
+    }
+    if (t < INFINITY)
+        return t;
+    return wetdem_force_hertz_contact_time(c->e_star, c->r_eff, c->m_eff, fmax(c->v_n, 1e-12));
+}
+
+double wetdem_sim_relaxation_time(const struct wetdem_sim* sim, struct wetdem_contact* c,
+                                  const struct wetdem_model** which)
+{
+    double history[64] = {0}; /* a fresh pair's min-separation record (offset 0) */
+    c->h_min = sim->minsep.model->history_len <= 64
+                   ? sim->minsep.model->min_separation(sim->minsep.params, c, history)
+                   : 0.0;
+    double t = INFINITY;
+    if (which)
+        *which = NULL;
+    for (size_t k = 0; k < sim->n_models; k++) {
+        const struct wetdem_model_slot* s = &sim->models[k];
+        double tk = s->model->relaxation_time ? s->model->relaxation_time(s->params, c) : INFINITY;
+        if (tk < t) {
+            t = tk;
+            if (which)
+                *which = s->model;
+        }
+    }
+    return t;
+}
+
 int wetdem_sim_eval_contact(const struct wetdem_sim* sim, struct wetdem_contact* c, double* history,
                             struct wetdem_pair_force* out, struct wetdem_pair_force* per_model)
 {

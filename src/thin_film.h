@@ -96,4 +96,15 @@ static inline size_t thin_film_thresholds(const void* params, const struct wetde
     return 2;
 }
 
+/* Gap [m] at which a thin-film law damps most, h_min' = min(h_min, delta) (the laws grow
+ * as the gap closes and are not evaluated below h_min'). Returns false when no film acts
+ * (delta <= 0); *h = 0 when h_min' = 0, where the damping has no bound. */
+static inline bool thin_film_stiffest_gap(const struct wetdem_contact* c, double* h)
+{
+    if (!(c->film > 0.0))
+        return false;
+    *h = fmax(thin_film_h_min(c->h_min, c->film), 0.0);
+    return true;
+}
+
 #endif

@@ -494,6 +494,10 @@ static void test_hertz_collision_through_pair_rebounds_with_e(void** state)
     e = collide(&col, v0, tc0 / 20000, &tc);
     CHECK_REL(e, 1.0, 1e-8);
     CHECK_REL(tc, tc0, 1e-6);
+    /* the contact_time hook at the impact speed: the same duration */
+    struct wetdem_contact at_speed = col.c;
+    at_speed.v_n = v0;
+    CHECK_REL(wetdem_force_hertz.contact_time(p, &at_speed), tc, 1e-6);
 }
 
 static void test_hertz_rejects_invalid_restitution(void** state)
@@ -814,6 +818,8 @@ static void test_hooke_collision_recovers_e_and_contact_time(void** state)
         double e = collide(&col, 0.3, tc0 / 2000, &tc);
         CHECK_REL(e, es[k], 1e-9);
         CHECK_REL(tc, tc0, 1e-9);
+        /* the contact_time hook (the engines' step scale) is the integrated duration */
+        CHECK_REL(wetdem_force_hooke.contact_time(p, &col.c), tc, 1e-9);
     }
 }
 

@@ -438,6 +438,61 @@ static void test_fluid_params_validated(void** state)
     wetdem_sim_free(sim);
 }
 
+/* relaxation_time, the many-particle engine's step bound (docs/many.md, Time step): m / c_d
+ * at the gap that damps most. c_d is measured from each model's own force at unit speed
+ * (normal: F_n at v_n = 1 m/s; tangential: |F_t| at |v_t| = 1 m/s) on gaps from the
+ * stiffest one (h_min' = min(h_min, delta) for the thin films, h_min for reynolds, nijssen's
+ * own h_min = max(h_sigma, h_eps) at v0 = 1 m/s) out to the film's edge or the cut-off: the
+ * hook equals m / c_d there (m = m*, or 2/7 m* for the tangential laws) to TOL_CLOSED, and
+ * no gap further out damps more. With h_min = 0 the laws have no bound near contact (0);
+ * capillary and the contact models damp nothing viscously (no hook, or INFINITY). */
+static void test_fluid_relaxation_time_is_the_stiffest_damping(void** state)
+{
+    (void)state;
+    const struct {
+        const struct wetdem_model* model;
+        bool tangential;
+    } cases[] = {{&wetdem_force_sb, false},       {&wetdem_force_db, false},
+                 {&wetdem_force_reynolds, false}, {&wetdem_force_nijssen, false},
+                 {&wetdem_force_davis, true},     {&wetdem_force_nase, true}};
+    const double m_eff = MI * MJ / (MI + MJ);
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        const struct wetdem_model* m = cases[k].model;
+        double params[8] = {0};
+        make_params(m, 0, params);
+        struct wetdem_contact c = pair_at(DELTA, 1.0);
+        assert_non_null(m->relaxation_time);
+        double tau = m->relaxation_time(params, &c);
+        double h_stiff = c.h_min; /* 1 um < delta */
+        if (m == &wetdem_force_nijssen) {
+            double h_eps = 0.37 * A_EFF * pow(c.viscosity * 1.0 / (c.e_star * A_EFF), 0.4);
+            h_stiff = fmax(c.roughness, h_eps);
+        }
+        double mass = cases[k].tangential ? 2.0 / 7.0 * m_eff : m_eff;
+        double range = m->range(params, &c);
+        bool first = true;
+        for (double g = h_stiff; g < range; g *= 1.7, first = false) {
+            struct wetdem_contact at = pair_at(g, cases[k].tangential ? 0.0 : 1.0);
+            if (cases[k].tangential)
+                at.v_t = (struct wetdem_vec3){0, 1.0, 0};
+            struct wetdem_pair_force f = eval(m, 0, at);
+            double c_d = cases[k].tangential ? vec_norm_test(f.f_tan) : f.f_normal;
+            if (first)
+                CHECK_REL(tau, mass / c_d, TOL_CLOSED);
+            else if (!(mass / c_d >= tau))
+                fail_msg("%s: gap %g m damps more (m/c_d = %g s) than relaxation_time %g s",
+                         m->name, g, mass / c_d, tau);
+        }
+        if (m != &wetdem_force_nijssen) { /* nijssen keeps its own h_min */
+            c.h_min = 0;
+            CHECK_ABS(m->relaxation_time(params, &c), 0, 0);
+        }
+    }
+    assert_null(wetdem_force_capillary.relaxation_time);
+    assert_null(wetdem_force_hertz.relaxation_time);
+    assert_null(wetdem_force_mindlin.relaxation_time);
+}
+
 /* Every fluid model documents itself (docs/models.md is generated from these strings). */
 static void test_fluid_models_documented(void** state)
 {
@@ -472,6 +527,7 @@ int main(void)
         cmocka_unit_test(test_fluid_swap_symmetry),
         cmocka_unit_test(test_fluid_thresholds),
         cmocka_unit_test(test_fluid_params_validated),
+        cmocka_unit_test(test_fluid_relaxation_time_is_the_stiffest_damping),
         cmocka_unit_test(test_fluid_models_documented),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

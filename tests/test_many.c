@@ -3,7 +3,8 @@
  * independent of the thread count, checkpoint + restart bit-identical to an uninterrupted run,
  * checkpoints holding impossible states refused,
  * the energy budget closes, agreement with the few-body engine on a binary collision, the
- * start-up reach bound is enforced, agglomerates by union-find, VTK/CSV outputs, lists rebuilt
+ * derived step follows the contact model and stays below a quarter of the viscous relaxation
+ * time (a longer given step refused), the start-up reach bound is enforced, agglomerates by union-find, VTK/CSV outputs, lists rebuilt
  * at the same steps with the displacement bound, callbacks see the current state, the wall time
  * by phase adds up.
  */
@@ -16,6 +17,7 @@
 #include "checkpoint.h"
 #include "harness.h"
 #include "many.h"
+#include "vec3.h"
 
 /* The many-particle settings of wet_box's box: periodic in x and y, dt 2 us, skin 50 um. */
 static struct wetdem_many_settings box_settings(void)
@@ -466,6 +468,128 @@ static void test_many_matches_few_body_engine(void** state)
     wetdem_sim_free(sims[1]);
 }
 
+/* Two spheres of radius 1 mm (glass-like, 2500 kg/m^3) at gap h0 = 5 um inside h_min =
+ * 10 um of one viscous model, `model`, moving at +-u along `dir` (x: approach, the normal;
+ * y: sliding). In that gap the model's damping c_d is constant, so the relative (slip)
+ * speed decays as exp(-t/tau), tau = m/c_d. */
+static struct wetdem_sim* damped_pair(const char* model, double viscosity, double u, int dir)
+{
+    struct wetdem_sim* sim = wetdem_sim_create();
+    struct wetdem_material m = {.density = 2500,
+                                .youngs_modulus = 70e9,
+                                .poisson_ratio = 0.22,
+                                .restitution = 0.9,
+                                .film = 50e-6};
+    assert_int_equal(wetdem_sim_add_material(sim, &m), 0);
+    CHECK_OK(wetdem_sim_set_param(sim, "fluid.viscosity", viscosity));
+    CHECK_OK(wetdem_sim_enable_model(sim, model));
+    CHECK_OK(wetdem_sim_enable_model(sim, "fixed"));
+    CHECK_OK(wetdem_sim_set_param(sim, "fixed.h_min", 10e-6));
+    if (strcmp(model, "davis") == 0) /* the law at h_min' below it, not zero */
+        CHECK_OK(wetdem_sim_set_param_str(sim, "davis.below_hmin", "nc"));
+    CHECK_OK(wetdem_sim_set_param(sim, "verlet.dt_fraction", 1)); /* so that tau/4 binds */
+    double x = 1e-3 + 2.5e-6;
+    struct wetdem_particle a = {.pos = {-x, 0, 0}, .radius = 1e-3};
+    struct wetdem_particle b = {.pos = {x, 0, 0}, .radius = 1e-3};
+    (dir == 0 ? &a.vel.x : &a.vel.y)[0] = u;
+    (dir == 0 ? &b.vel.x : &b.vel.y)[0] = -u;
+    CHECK_OK(wetdem_sim_add_particle(sim, a));
+    CHECK_OK(wetdem_sim_add_particle(sim, b));
+    CHECK_OK(wetdem_sim_set_many(sim, &(struct wetdem_many_settings){.skin = 1e-4}));
+    return sim;
+}
+
+/* Relative speed of the surfaces of spheres 0 and 1 at their contact point, less its part
+ * along the line of centres when `tangential` [m/s]. */
+static double surface_speed(const struct wetdem_sim* sim, bool tangential)
+{
+    const struct wetdem_particle* p = wetdem_sim_particles_const(sim, NULL);
+    struct wetdem_vec3 d = vec3_sub(p[0].pos, p[1].pos);
+    struct wetdem_vec3 n = vec3_scale(d, 1.0 / vec3_norm(d));
+    struct wetdem_vec3 u0 = vec3_add(p[0].vel, vec3_cross(p[0].omega, vec3_scale(n, -p[0].radius)));
+    struct wetdem_vec3 u1 = vec3_add(p[1].vel, vec3_cross(p[1].omega, vec3_scale(n, p[1].radius)));
+    struct wetdem_vec3 du = vec3_sub(u0, u1);
+    if (tangential)
+        return vec3_norm(vec3_reject(du, n));
+    return -vec3_dot(du, n); /* approach speed */
+}
+
+/* The step bound (docs/many.md, Time step). The derived step is a quarter of the relaxation
+ * time tau = m/c_d (normal: reynolds, c_d = 6 pi mu R*^2/h_min, m = m*; tangential: davis
+ * with its law held at h_min, c_d = 2 pi mu a ln((2 delta - h_min)/h_min), m = 2/7 m*, the
+ * spins taking part). Velocity Verlet with the damping at the predicted velocity maps the
+ * speed v and the kick u = a dt of a pure damping, lambda = dt/tau, as
+ *   u' = -lambda (v + u),   v' = v + u/2 + u'/2,
+ * from u = -lambda v at the start; its roots z = (T +- sqrt(T^2 + 2 lambda))/2, T = 1 - 3
+ * lambda/2, lie inside the unit circle only for lambda < 1 (a step given at or above tau is
+ * refused; 1.01 tau here), and at lambda = 1/4 the slow one decays at 0.9715 of the exact rate. The engine
+ * must follow that map step for step: 1e-12 for the normal pair, whose motion is exactly
+ * that linear decay; 1e-5 for the sliding one (u = 5 mm/s), which keeps 5/7 of its relative
+ * speed as the spheres roll on each other: its line of centres turns by theta ~ 2e-4 rad in
+ * 4 tau, which moves (5/7 / (2/7 e^-4)) theta^2/2 ~ 1e-6 of the slip into the normal. */
+static void test_many_step_stays_below_the_viscous_relaxation_time(void** state)
+{
+    (void)state;
+    const double m_eff = 0.5 * 2500 * 4.0 / 3.0 * M_PI * 1e-9, a = 0.5e-3, h = 10e-6;
+    const struct {
+        const char* model;
+        double mu, u;
+        int dir;
+        double tau, tol;
+    } cases[] = {
+        {"reynolds", 1.0, 0.05, 0, m_eff / (6 * M_PI * 1.0 * a * a / h), 1e-12},
+        {"davis", 10.0, 0.005, 1, 2.0 / 7.0 * m_eff / (2 * M_PI * 10.0 * a * log((200e-6 - h) / h)),
+         1e-5},
+    };
+    for (size_t k = 0; k < 2; k++) {
+        struct wetdem_sim* sim = damped_pair(cases[k].model, cases[k].mu, cases[k].u, cases[k].dir);
+        double v0 = surface_speed(sim, cases[k].dir == 1);
+        CHECK_OK(wetdem_sim_integrate(sim, 4 * cases[k].tau));
+        struct wetdem_many_stats st;
+        CHECK_OK(wetdem_sim_many_stats(sim, &st));
+        CHECK_REL(st.relaxation_time, cases[k].tau, 1e-12);
+        CHECK_REL(st.dt, 0.25 * cases[k].tau, 1e-12);
+        double lambda = st.dt / cases[k].tau, v = v0, u = -lambda * v0;
+        for (unsigned long long n = 0; n < st.step; n++) {
+            double u_next = -lambda * (v + u);
+            v += 0.5 * (u + u_next);
+            u = u_next;
+        }
+        assert_true(st.step >= 16);
+        CHECK_REL(surface_speed(sim, cases[k].dir == 1), v, cases[k].tol);
+        /* against the exact decay: slower, by less than 3 % in rate */
+        double rate = log(v / v0) / (-wetdem_sim_time(sim) / cases[k].tau);
+        assert_true(rate > 0.97 && rate < 1.0);
+        wetdem_sim_free(sim);
+
+        sim = damped_pair(cases[k].model, cases[k].mu, cases[k].u, cases[k].dir);
+        CHECK_OK(wetdem_sim_set_param(sim, "verlet.dt", 1.01 * cases[k].tau));
+        CHECK_STATUS(wetdem_sim_integrate(sim, 1e-4), WETDEM_ERR_INVALID);
+        CHECK_CONTAINS(wetdem_sim_errmsg(sim), "viscous relaxation time");
+        CHECK_CONTAINS(wetdem_sim_errmsg(sim), cases[k].model);
+        wetdem_sim_free(sim);
+    }
+}
+
+/* The derived step follows the contact model: with hooke alone it is dt_fraction x hooke's
+ * damped half period pi / sqrt(k/m* - (gamma/(2 m*))^2) of the two spheres (m* = m/2, less
+ * than against a wall), not the Hertz contact time of their material (1.3x longer here). */
+static void test_many_step_follows_the_contact_model(void** state)
+{
+    (void)state;
+    struct wetdem_sim* sim = damped_pair("hooke", 0.0, 0.05, 0);
+    CHECK_OK(wetdem_sim_set_param(sim, "verlet.dt_fraction", 0.02));
+    CHECK_OK(wetdem_sim_integrate(sim, 1e-6));
+    struct wetdem_many_stats st;
+    CHECK_OK(wetdem_sim_many_stats(sim, &st));
+    double m_eff = 0.5 * 2500 * 4.0 / 3.0 * M_PI * 1e-9, k = 1e6, l = log(0.9);
+    double gamma = -2 * l * sqrt(m_eff * k) / sqrt(l * l + M_PI * M_PI);
+    double t_c = M_PI / sqrt(k / m_eff - gamma * gamma / (4 * m_eff * m_eff));
+    CHECK_REL(st.dt, 0.02 * t_c, 1e-12);
+    assert_true(isinf(st.relaxation_time)); /* nothing damps viscously */
+    wetdem_sim_free(sim);
+}
+
 static void test_many_reach_bound_is_enforced(void** state)
 {
     (void)state;
@@ -634,6 +758,8 @@ int main(void)
         cmocka_unit_test(test_many_callbacks_see_the_current_state),
         cmocka_unit_test(test_many_energy_budget_closes),
         cmocka_unit_test(test_many_matches_few_body_engine),
+        cmocka_unit_test(test_many_step_stays_below_the_viscous_relaxation_time),
+        cmocka_unit_test(test_many_step_follows_the_contact_model),
         cmocka_unit_test(test_many_reach_bound_is_enforced),
         cmocka_unit_test(test_many_agglomerates_by_union_find),
         cmocka_unit_test(test_many_writes_vtk_and_csv),

@@ -540,7 +540,9 @@ static void test_scenario_map_and_check_of_other_engines(void** state)
     CHECK_REL(json_value(r.out, "t_end_s"), 0.04, 0.0);
     double dt = json_value(r.out, "dt_s"), steps = json_value(r.out, "steps");
     assert_true(dt > 0 && (steps - 1) * dt < 0.04 && 0.04 <= steps * dt * (1 + 1e-12));
-    CHECK_CONTAINS(r.out, "\"models\": [\"hertz\", \"mindlin\", \"sb\", \"capillary\"]}");
+    CHECK_CONTAINS(r.out, "\"models\": [\"hertz\", \"mindlin\", \"sb\", \"capillary\"], ");
+    /* the step stays below a quarter of the films' viscous relaxation time */
+    assert_true(json_value(r.out, "relaxation_time_s") >= 4 * dt);
     free(r.out);
     /* pairwise --check resolves Davis's groups without running (no outcome line). Run length
      * t_end = t*_end 4a / v_10 with v_10 = v_n0 / cos(beta): 20 x 4 x 2e-3 m / (1 m/s /
