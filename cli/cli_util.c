@@ -183,6 +183,36 @@ static void parent_dir(const char* path, char* dir, size_t n)
         dir[0] = '\0';
 }
 
+int cli_check_output_file(const char* what, const char* option, const char* path)
+{
+    struct stat st;
+    if (!path)
+        return CLI_EXIT_OK;
+    if (!path[0]) {
+        cli_error("%s: %s needs a file name", what, option);
+        return CLI_EXIT_USAGE;
+    }
+    if (stat(path, &st) == 0 && S_ISDIR(st.st_mode)) {
+        cli_error("%s: %s %s is a directory; give a file name in it, e.g. %s/%s.csv", what, option,
+                  path, path, what);
+        return CLI_EXIT_USAGE;
+    }
+    /* the directories on the way are made when the file is written: none may be a file */
+    char prefix[1024];
+    snprintf(prefix, sizeof prefix, "%s", path);
+    for (char* slash = strchr(prefix + 1, '/'); slash; slash = strchr(slash + 1, '/')) {
+        *slash = '\0';
+        bool not_dir = stat(prefix, &st) == 0 && !S_ISDIR(st.st_mode);
+        *slash = '/';
+        if (not_dir) {
+            *slash = '\0';
+            cli_error("%s: %s %s: %s is not a directory", what, option, path, prefix);
+            return CLI_EXIT_USAGE;
+        }
+    }
+    return CLI_EXIT_OK;
+}
+
 int cli_write_output(const char* path, const char* what, void (*write)(FILE* f, const void* ctx),
                      const void* ctx)
 {

@@ -139,7 +139,8 @@ static int parse_args(int argc, char** argv, struct fit_args* a)
         usage(stderr);
         return CLI_EXIT_USAGE;
     }
-    return CLI_EXIT_OK;
+    int rc = cli_check_output_file("fit", "--out", a->out);
+    return rc == CLI_EXIT_OK ? cli_check_output_file("fit", "--curve", a->curve) : rc;
 }
 
 /* ---- data file ---------------------------------------------------------------------------- */

@@ -83,7 +83,7 @@ static int parse_args(int argc, char** argv, struct sweep_args* a)
         usage(stderr);
         return CLI_EXIT_USAGE;
     }
-    return CLI_EXIT_OK;
+    return cli_check_output_file("sweep", "--out", a->out);
 }
 
 /* The table with the sweep's trailer: for the soft engine, the integrator counts summed over

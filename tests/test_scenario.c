@@ -10,6 +10,8 @@
  *   - docs/scenarios.md contains the key tables `wetdem docs-scenarios` generates;
  *   - `run --out` writes trajectory, events and summary with unit headers, and nothing at all
  *     when the input is bad or the run fails;
+ *   - output paths that cannot be what they name (run --out a file or empty; sweep, map and
+ *     fit --out or --curve a directory, empty or under a file) exit 2 before anything runs;
  *   - `sweep` rows come in input order and are bit-identical with 1 and 2 threads, for the
  *     soft engine and for the pairwise engine (whose runs are in the parallel phase too);
  *   - a failed pairwise point reports the engine's status in the status column and exits 1;
@@ -379,6 +381,36 @@ static void test_scenario_run_writes_files_or_nothing(void** state)
     CHECK_CONTAINS(head, "time [s],event [word]");
 }
 
+/* Output paths that cannot be what they name are refused while the arguments are read, with
+ * exit 2, before any collision is run: run --out that is a file or empty; sweep, map and fit
+ * --out (and fit --curve) that is a directory, empty, or under a file. */
+static void test_scenario_bad_output_paths_exit_2(void** state)
+{
+    (void)state;
+    const char* file = write_file("plain.txt", "not a directory\n");
+    char args[1400];
+    snprintf(args, sizeof args, "run examples/scenarios/dry_hertz.ini --out '%s'", file);
+    expect_run(args, 2, "exists and is not a directory");
+    expect_run("run examples/scenarios/dry_hertz.ini --out ''", 2, "--out needs a directory name");
+    const char* sweep = "sweep examples/scenarios/dry_hertz.ini --param collision.speed --values "
+                        "0.5:1:2";
+    snprintf(args, sizeof args, "%s --out '%s'", sweep, tmpdir);
+    expect_run(args, 2, "is a directory; give a file name in it");
+    snprintf(args, sizeof args, "%s --out ''", sweep);
+    expect_run(args, 2, "--out needs a file name");
+    snprintf(args, sizeof args, "%s --out '%s/x.csv'", sweep, file);
+    expect_run(args, 2, "plain.txt is not a directory");
+    snprintf(args, sizeof args,
+             "map examples/scenarios/dry_hertz.ini --param collision.speed --values 0.5:1:2 "
+             "--param2 collision.angle_deg --values2 0:30:2 --out '%s'",
+             tmpdir);
+    expect_run(args, 2, "map: --out");
+    snprintf(args, sizeof args,
+             "fit examples/scenarios/dry_hertz.ini --data '%s' --fit hertz.damping --curve '%s'",
+             file, tmpdir);
+    expect_run(args, 2, "fit: --curve");
+}
+
 /* Data lines (not starting with '#') of a sweep. */
 static char* data_lines(const char* text)
 {
@@ -572,6 +604,7 @@ int main(void)
         cmocka_unit_test(test_scenario_energy_gain_is_an_error),
         cmocka_unit_test(test_scenario_docs_list_every_key),
         cmocka_unit_test(test_scenario_run_writes_files_or_nothing),
+        cmocka_unit_test(test_scenario_bad_output_paths_exit_2),
         cmocka_unit_test(test_scenario_sweep_order_and_threads),
         cmocka_unit_test(test_scenario_sweep_pairwise_threads_and_status),
         cmocka_unit_test(test_scenario_map_and_check_of_other_engines),
