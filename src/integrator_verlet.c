@@ -173,7 +173,7 @@ static int verlet_integrate(struct wetdem_sim* sim, const void* params, double t
 
 const struct wetdem_integrator wetdem_integrator_verlet = {
     .name = "verlet",
-    .summary = "velocity Verlet, fixed step = dt_fraction x Hertz contact time",
+    .summary = "velocity Verlet, fixed step = dt_fraction x contact time (Hertz, or hooke)",
     .params = verlet_params_desc,
     .params_size = sizeof(struct verlet_params),
     .integrate = verlet_integrate,
