@@ -256,11 +256,11 @@ static int place_one(const struct wetdem_insert_spec* s, gsl_rng* rng, struct gr
         solid += 4.0 / 3.0 * M_PI * out[q].radius * out[q].radius * out[q].radius;
     return wetdem_status_fail(
         msg, n, WETDEM_ERR_INVALID,
-        "insert: placed %zu of %zu spheres; sphere %zu (radius %g m) found no free "
-        "place in %zu random trials. The requested volume fraction %.3f is too close to "
-        "the random-insertion limit (~%.2f): use layout = lattice, a larger region or "
-        "fewer spheres",
-        placed, s->n, i, out[i].radius, attempts, solid / vol, RSA_JAMMING);
+        "insert: placed %zu of %zu spheres (the largest first); the next, of radius %g m, "
+        "found no free place in %zu random trials. The requested volume fraction %.3f is "
+        "too close to the random-insertion limit (~%.2f): use layout = lattice, a larger "
+        "region or fewer spheres",
+        placed, s->n, out[i].radius, attempts, solid / vol, RSA_JAMMING);
 }
 
 static int place_random(const struct wetdem_insert_spec* s, gsl_rng* rng, double r_max,

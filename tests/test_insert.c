@@ -151,6 +151,8 @@ static void test_insert_random_reports_jamming(void** state)
     CHECK_STATUS(wetdem_insert_particles(&s, p, msg, sizeof msg), WETDEM_ERR_INVALID);
     CHECK_CONTAINS(msg, "random-insertion limit");
     CHECK_CONTAINS(msg, "lattice");
+    CHECK_CONTAINS(msg, "of 2000 spheres (the largest first); the next, of radius 0.001 m");
+    CHECK_CONTAINS(msg, "volume fraction 1.047"); /* 2000 x 4/3 pi (1 mm)^3 / (20 mm)^3 */
     free(p);
 }
 
