@@ -607,7 +607,8 @@ struct wetdem_many_stats {
     int threads; /* OpenMP threads the run's loops use: OMP_NUM_THREADS, or 1 for fewer than 512
                     particles (waking the threads would cost more than the work) */
     double relaxation_time; /* shortest viscous relaxation time of the enabled models at the
-                               start [s], which dt stays below (INFINITY: nothing damps) */
+                               start, or at the restored state after a checkpoint [s], which
+                               dt stays below (INFINITY: nothing damps) */
 };
 WETDEM_API int wetdem_sim_many_stats(const struct wetdem_sim* sim, struct wetdem_many_stats* s);
 

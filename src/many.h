@@ -186,7 +186,8 @@ struct wetdem_many {
     struct wetdem_celllist cl;
     double reach;           /* largest interaction gap of any pair [m] (start-up bound) */
     double dt;              /* time step [s], fixed once the many run starts */
-    double relaxation_time; /* shortest viscous relaxation time at the start [s] (choose_dt) */
+    double relaxation_time; /* shortest viscous relaxation time at the start [s] (choose_dt),
+                               or when the run was restored from a checkpoint */
     double t0;              /* time of step 0 [s] */
     uint64_t step;          /* steps since t0 */
     bool started;
@@ -423,6 +424,9 @@ void wetdem_sim_many_energies(const struct wetdem_sim* sim, double* kinetic, dou
 /* Makes sure the pair list, histories and per-particle arrays fit the current particles
  * (builds the cell list when needed). */
 int wetdem_sim_many_prepare(struct wetdem_sim* sim);
+/* The shortest viscous relaxation time of the enabled models for the current particles [s]
+ * (what the step is held below; INFINITY when nothing damps), as at the start of a run. */
+double wetdem_sim_many_relaxation_time(const struct wetdem_sim* sim);
 
 /* sim_many_force.c */
 /* Builds the material-pair table and chooses the kernel (fused or generic); needs m->reach

@@ -240,6 +240,39 @@ static void step_scales(const struct wetdem_sim* sim, struct wetdem_particle sma
  * (step_scales). Velocity Verlet with the damping evaluated at the predicted velocity is
  * stable for dt < tau and dissipates within 3 % of the exact rate for dt <= tau/4
  * (docs/many.md, Time step); a step given at or above tau is refused. */
+/* The speed scale of the step [m/s]: twice the largest particle speed plus what gravity adds
+ * over the height of the packing, floored by sim.speed_floor; *small and *big receive a
+ * smallest and a largest sphere. Needs at least one particle. */
+static double start_speed(const struct wetdem_sim* sim, struct wetdem_particle* small,
+                          struct wetdem_particle* big)
+{
+    *small = *big = sim->particles[0];
+    double v = 0, lo = INFINITY, hi = -INFINITY;
+    for (size_t k = 0; k < sim->n_particles; k++) {
+        const struct wetdem_particle* p = &sim->particles[k];
+        *small = p->radius < small->radius ? *p : *small;
+        *big = p->radius > big->radius ? *p : *big;
+        v = fmax(v, 2 * vec3_norm(p->vel));
+        lo = fmin(lo, fmin(p->pos.z, fmin(p->pos.x, p->pos.y)));
+        hi = fmax(hi, fmax(p->pos.z, fmax(p->pos.x, p->pos.y)));
+    }
+    const struct wetdem_sim_settings* s = &sim->settings;
+    double g = sqrt(s->gravity_x * s->gravity_x + s->gravity_y * s->gravity_y +
+                    s->gravity_z * s->gravity_z);
+    return fmax(s->speed_floor, v + sqrt(2 * g * fmax(hi - lo, 0.0)));
+}
+
+double wetdem_sim_many_relaxation_time(const struct wetdem_sim* sim)
+{
+    if (sim->n_particles == 0)
+        return INFINITY;
+    struct wetdem_particle small, big;
+    double v = start_speed(sim, &small, &big), t_contact, tau, h_at;
+    const struct wetdem_model* damper;
+    step_scales(sim, small, big, v, &t_contact, &tau, &damper, &h_at);
+    return tau;
+}
+
 static int choose_dt(struct wetdem_sim* sim, double* dt)
 {
     struct wetdem_many* m = sim->many;
@@ -252,21 +285,8 @@ static int choose_dt(struct wetdem_sim* sim, double* dt)
         *dt = given;
         return WETDEM_OK;
     }
-    struct wetdem_particle small = sim->particles[0], big = sim->particles[0];
-    double v = 0, lo = INFINITY, hi = -INFINITY;
-    for (size_t k = 0; k < sim->n_particles; k++) {
-        const struct wetdem_particle* p = &sim->particles[k];
-        small = p->radius < small.radius ? *p : small;
-        big = p->radius > big.radius ? *p : big;
-        v = fmax(v, 2 * vec3_norm(p->vel));
-        lo = fmin(lo, fmin(p->pos.z, fmin(p->pos.x, p->pos.y)));
-        hi = fmax(hi, fmax(p->pos.z, fmax(p->pos.x, p->pos.y)));
-    }
-    const struct wetdem_sim_settings* s = &sim->settings;
-    double g = sqrt(s->gravity_x * s->gravity_x + s->gravity_y * s->gravity_y +
-                    s->gravity_z * s->gravity_z);
-    v = fmax(s->speed_floor, v + sqrt(2 * g * fmax(hi - lo, 0.0)));
-    double t_contact, tau, h_at;
+    struct wetdem_particle small, big;
+    double v = start_speed(sim, &small, &big), t_contact, tau, h_at;
     const struct wetdem_model* damper;
     step_scales(sim, small, big, v, &t_contact, &tau, &damper, &h_at);
     m->relaxation_time = tau;

@@ -509,6 +509,7 @@ static int restore_state(struct wetdem_sim* sim, const struct wetdem_checkpoint*
     m->step = ck->step;
     memcpy(&m->dt, ck->extra, 8);
     memcpy(&m->t0, ck->extra + 8, 8);
+    m->relaxation_time = wetdem_sim_many_relaxation_time(sim); /* not in the checkpoint */
     m->energy.k0 = ck->energy[0];
     m->energy.u0 = ck->energy[1];
     m->energy.el0 = ck->energy[2];

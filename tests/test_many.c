@@ -165,6 +165,12 @@ static void test_many_restart_is_bit_identical(void** state)
     CHECK_ABS(wetdem_sim_time(resumed), 0.5e-3, 1e-18);
     CHECK_OK(wetdem_sim_integrate(resumed, 1.2e-3));
     test_check_same_particles(whole, resumed);
+    /* the relaxation time (not in the checkpoint) is that of the run: h_min is fixed here */
+    struct wetdem_many_stats s_whole, s_resumed;
+    CHECK_OK(wetdem_sim_many_stats(whole, &s_whole));
+    CHECK_OK(wetdem_sim_many_stats(resumed, &s_resumed));
+    assert_true(isfinite(s_whole.relaxation_time) && s_whole.relaxation_time > s_whole.dt);
+    CHECK_ABS(s_resumed.relaxation_time, s_whole.relaxation_time, 0);
     /* a sim set up differently refuses the checkpoint */
     struct wetdem_sim* dry = wet_box(150, false);
     CHECK_STATUS(wetdem_sim_read_checkpoint(dry, path), WETDEM_ERR_INVALID);
