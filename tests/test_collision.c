@@ -1,8 +1,8 @@
 /*
  * test_collision.c — binary collisions on the soft engine (wetdem_collision_run) and their
  * analysis (STYLE §6.9.4): dry undamped Hertz (e = 1, Hertz contact time), damped Hertz
- * (e = e_dry), the Verlet step from hooke's own contact time, momentum conservation, e falling with viscosity, lubrication acting on a wall,
- * Verlet and CVODE agreeing, i <-> j symmetry, determinism, clones, outcome classes, the
+ * (e = e_dry), the Verlet step from hooke's own contact time, momentum conservation, e
+ * falling with viscosity, lubrication acting on a wall, Verlet and CVODE agreeing, i <-> j symmetry, determinism, clones, outcome classes, the
  * Stokes-number speed, the observation window, and input validation.
  */
 #include "harness.h"
