@@ -173,10 +173,17 @@ static inline bool wetdem_many_bulk_films(const struct wetdem_many_bulk_in* in)
 wetdem_many_bulk_walls_fn* wetdem_many_bulk_walls_choose(enum wetdem_many_bulk_isa isa);
 
 /* Energy bookkeeping (sim_many.c accumulates, sim_many_io.c reports). */
+/* The work is summed by the trapezoid rule over the force passes, dt (P_0/2 + P_1 + ... +
+ * P_{N-1} + P_N/2) with P_n the power of the forces of pass n: each force changes the kinetic
+ * energy through two half kicks, and the forces of the first and of the latest pass have given
+ * only one. work_* hold dt (P_0/2 + P_1 + ... + P_N) and last_* the latest pass's dt P_N, of
+ * which wetdem_sim_energy_budget takes half off (sim_many.c). */
 struct wetdem_many_energy {
     double k0, u0, el0;                  /* kinetic, potential, elastic at the start [J] */
     double work_pair[WETDEM_MAX_MODELS]; /* work of model k on particle pairs [J] */
     double work_wall[WETDEM_MAX_MODELS]; /* work of model k on particle-wall pairs [J] */
+    double last_pair[WETDEM_MAX_MODELS]; /* the latest pass's part of work_pair [J] */
+    double last_wall[WETDEM_MAX_MODELS]; /* the latest pass's part of work_wall [J] */
 };
 
 struct wetdem_many {

@@ -954,7 +954,15 @@ static int start(struct wetdem_sim* sim)
     if (st != WETDEM_OK)
         return st;
     m->started = true;
+    /* the forces at t0 give the first half kick only: half their dt P (trapezoid rule) */
+    struct wetdem_many_energy first = m->energy;
     memset(&m->energy, 0, sizeof m->energy);
+    for (size_t k = 0; k < WETDEM_MAX_MODELS; k++) {
+        m->energy.work_pair[k] = 0.5 * first.last_pair[k];
+        m->energy.work_wall[k] = 0.5 * first.last_wall[k];
+        m->energy.last_pair[k] = first.last_pair[k];
+        m->energy.last_wall[k] = first.last_wall[k];
+    }
     wetdem_sim_many_energies(sim, &m->energy.k0, &m->energy.u0, &m->energy.el0);
     return timed_outputs(sim, false, false);
 }
@@ -1089,9 +1097,10 @@ int wetdem_sim_energy_budget(const struct wetdem_sim* sim, struct wetdem_energy_
     wetdem_sim_many_energies(sim, &b->kinetic, &b->potential, &b->elastic);
     b->input = m->energy.k0 + m->energy.u0 + m->energy.el0;
     double work = 0;
+    /* the latest forces have given their first half kick only (trapezoid rule, many.h) */
     for (size_t k = 0; k < sim->n_models && k < WETDEM_ENERGY_MAX_MODELS; k++) {
-        b->work_pair[k] = m->energy.work_pair[k];
-        b->work_wall[k] = m->energy.work_wall[k];
+        b->work_pair[k] = m->energy.work_pair[k] - 0.5 * m->energy.last_pair[k];
+        b->work_wall[k] = m->energy.work_wall[k] - 0.5 * m->energy.last_wall[k];
         work += b->work_pair[k] + b->work_wall[k];
     }
     b->n_models = sim->n_models;

@@ -2190,6 +2190,8 @@ static void collect_pass_work(struct wetdem_sim* sim, bool parallel)
     for (size_t k = 0; k < nm; k++) {
         m->energy.work_pair[k] += pairs[k];
         m->energy.work_wall[k] += walls[k];
+        m->energy.last_pair[k] = pairs[k];
+        m->energy.last_wall[k] = walls[k];
     }
 }
 

@@ -24,6 +24,11 @@
 
 #define CSV_SUFFIX ".csv"
 #define SERIES_SUFFIX ".vtk.series"
+/* Energy-budget accumulators of a checkpoint: k0, u0, el0, then per model the work on pairs
+ * and on walls and the latest pass's part of each (many.h); checkpoints written before the
+ * latest-pass terms were kept have only the first three groups. */
+#define N_ENERGY (3 + 4 * WETDEM_MAX_MODELS)
+#define N_ENERGY_RIGHT_SUM (3 + 2 * WETDEM_MAX_MODELS)
 
 /* ---- agglomerates ---- */
 
@@ -332,7 +337,7 @@ static int fill_checkpoint(struct wetdem_sim* sim, struct wetdem_checkpoint* ck)
     ck->history = malloc((total * len > 0 ? total * len : 1) * sizeof(double));
     ck->walls = malloc((nw ? nw : 1) * sizeof *ck->walls);
     ck->extra = malloc(blob_size(n));
-    ck->energy = malloc((3 + 2 * WETDEM_MAX_MODELS) * sizeof(double));
+    ck->energy = malloc(N_ENERGY * sizeof(double));
     if (!ck->pairs || !ck->history || !ck->walls || !ck->extra || !ck->energy)
         return WETDEM_ERR_NOMEM;
     for (size_t q = 0; q < np; q++)
@@ -362,6 +367,8 @@ static int fill_checkpoint(struct wetdem_sim* sim, struct wetdem_checkpoint* ck)
     e[2] = m->energy.el0;
     memcpy(e + 3, m->energy.work_pair, sizeof m->energy.work_pair);
     memcpy(e + 3 + WETDEM_MAX_MODELS, m->energy.work_wall, sizeof m->energy.work_wall);
+    memcpy(e + 3 + 2 * WETDEM_MAX_MODELS, m->energy.last_pair, sizeof m->energy.last_pair);
+    memcpy(e + 3 + 3 * WETDEM_MAX_MODELS, m->energy.last_wall, sizeof m->energy.last_wall);
     *ck = (struct wetdem_checkpoint){
         .time = sim->engine.time,
         .step = m->step,
@@ -376,7 +383,7 @@ static int fill_checkpoint(struct wetdem_sim* sim, struct wetdem_checkpoint* ck)
         .history_len = len,
         .stats = sim->engine.stats,
         .energy = ck->energy,
-        .n_energy = 3 + 2 * WETDEM_MAX_MODELS,
+        .n_energy = N_ENERGY,
         .extra = ck->extra,
         .extra_size = blob_size(n),
         .output = {m->vtk_files, m->csv_rows, m->next_vtk_step, m->next_csv_step}};
@@ -471,8 +478,8 @@ static int check_restorable(struct wetdem_sim* sim, const struct wetdem_checkpoi
                                "models, parameters, walls or many settings",
                                path);
     if (ck->n_walls != nw || ck->history_len != sim->history_len ||
-        ck->extra_size != blob_size(n) || ck->n_energy != 3 + 2 * WETDEM_MAX_MODELS ||
-        ck->n_pairs < n * nw)
+        ck->extra_size != blob_size(n) ||
+        (ck->n_energy != N_ENERGY && ck->n_energy != N_ENERGY_RIGHT_SUM) || ck->n_pairs < n * nw)
         return wetdem_sim_fail(sim, WETDEM_ERR_PARSE, "checkpoint '%s': inconsistent contents",
                                path);
     for (size_t k = 0; k < n; k++) {
@@ -515,6 +522,16 @@ static int restore_state(struct wetdem_sim* sim, const struct wetdem_checkpoint*
     m->energy.el0 = ck->energy[2];
     memcpy(m->energy.work_pair, ck->energy + 3, sizeof m->energy.work_pair);
     memcpy(m->energy.work_wall, ck->energy + 3 + WETDEM_MAX_MODELS, sizeof m->energy.work_wall);
+    /* a checkpoint of the right-sum accounting (no latest-pass terms) keeps reporting as it
+       did: its work was summed without the first half and is reported whole */
+    memset(m->energy.last_pair, 0, sizeof m->energy.last_pair);
+    memset(m->energy.last_wall, 0, sizeof m->energy.last_wall);
+    if (ck->n_energy == N_ENERGY) {
+        memcpy(m->energy.last_pair, ck->energy + 3 + 2 * WETDEM_MAX_MODELS,
+               sizeof m->energy.last_pair);
+        memcpy(m->energy.last_wall, ck->energy + 3 + 3 * WETDEM_MAX_MODELS,
+               sizeof m->energy.last_wall);
+    }
     for (size_t k = 0; k < m->n_series; k++)
         free(m->vtk_names[k]);
     m->n_series = 0;

@@ -1,12 +1,13 @@
 /*
  * test_many.c — the many-particle mode (src/sim_many.c, src/sim_many_io.c): results
  * independent of the thread count, checkpoint + restart bit-identical to an uninterrupted run,
- * checkpoints holding impossible states refused,
- * the energy budget closes, agreement with the few-body engine on a binary collision, the
- * derived step follows the contact model and stays below a quarter of the viscous relaxation
- * time (a longer given step refused), the start-up reach bound is enforced, agglomerates by union-find, VTK/CSV outputs, lists rebuilt
- * at the same steps with the displacement bound, callbacks see the current state, the wall time
- * by phase adds up.
+ * checkpoints holding impossible states refused (and one of the earlier budget accounting
+ * read), the energy budget closes, to second order from a moving start (trapezoid rule),
+ * agreement with the few-body engine on a binary collision, the derived step follows the
+ * contact model and stays below a quarter of the viscous relaxation time (a longer given step
+ * refused), the start-up reach bound is enforced, agglomerates by union-find, VTK/CSV
+ * outputs, lists rebuilt at the same steps with the displacement bound, callbacks see the
+ * current state, the wall time by phase adds up.
  */
 #include <math.h>
 #include <omp.h>
@@ -237,6 +238,33 @@ static void test_many_restart_refuses_impossible_states(void** state)
     }
     struct wetdem_sim* resumed = wet_box(60, true); /* the good one is still read */
     CHECK_OK(wetdem_sim_read_checkpoint(resumed, good));
+    struct wetdem_energy_budget b_good;
+    CHECK_OK(wetdem_sim_energy_budget(resumed, &b_good));
+    wetdem_sim_free(resumed);
+    /* a checkpoint of the earlier accounting (work summed whole, no latest-pass terms: the
+     * first 3 + 2 WETDEM_MAX_MODELS accumulators) is read, and reports its sums whole */
+    struct wetdem_checkpoint ck;
+    char msg[256];
+    CHECK_OK(wetdem_checkpoint_read(good, &ck, msg, sizeof msg));
+    double sums[WETDEM_MAX_MODELS][2], last[WETDEM_MAX_MODELS][2];
+    for (int k = 0; k < WETDEM_MAX_MODELS; k++)
+        for (int w = 0; w < 2; w++) {
+            sums[k][w] = ck.energy[3 + w * WETDEM_MAX_MODELS + k];
+            last[k][w] = ck.energy[3 + (2 + w) * WETDEM_MAX_MODELS + k];
+        }
+    ck.n_energy = 3 + 2 * WETDEM_MAX_MODELS;
+    CHECK_OK(wetdem_checkpoint_write(bad, &ck, msg, sizeof msg));
+    wetdem_checkpoint_clear(&ck);
+    resumed = wet_box(60, true);
+    CHECK_OK(wetdem_sim_read_checkpoint(resumed, bad));
+    struct wetdem_energy_budget b_old;
+    CHECK_OK(wetdem_sim_energy_budget(resumed, &b_old));
+    for (size_t k = 0; k < b_good.n_models; k++) {
+        CHECK_ABS(b_old.work_pair[k], sums[k][0], 0);
+        CHECK_ABS(b_old.work_wall[k], sums[k][1], 0);
+        CHECK_ABS(b_good.work_pair[k], sums[k][0] - 0.5 * last[k][0], 0);
+        CHECK_ABS(b_good.work_wall[k], sums[k][1] - 0.5 * last[k][1], 0);
+    }
     wetdem_sim_free(resumed);
     remove(good);
     remove(bad);
@@ -577,6 +605,40 @@ static void test_many_step_stays_below_the_viscous_relaxation_time(void** state)
     }
 }
 
+/* The budget sums the work by the trapezoid rule over the force passes: the forces at the
+ * start and the latest ones have given one half kick each. A pair whose relative motion decays
+ * in a constant viscous damping from a moving start (damped_pair: reynolds, tau = m* / c_d)
+ * shows it: with the whole power of the first or last pass (a right or left sum), the
+ * closure error was first order, 0.1 of the work at dt = tau/10; now it is second order, the
+ * ratio of the errors at dt = tau/10 and tau/20 is 4 (3.6 to 4.4: the O(dt^3) terms), and
+ * each is below 0.3 (dt/tau)^2 of the work (measured 0.22). */
+static void test_many_energy_budget_is_second_order_from_a_moving_start(void** state)
+{
+    (void)state;
+    const double m_eff = 0.5 * 2500 * 4.0 / 3.0 * M_PI * 1e-9;
+    const double tau = m_eff / (6 * M_PI * 1.0 * 0.5e-3 * 0.5e-3 / 10e-6);
+    double err[2];
+    for (int k = 0; k < 2; k++) {
+        double lambda = k ? 0.05 : 0.1;
+        struct wetdem_sim* sim = damped_pair("reynolds", 1.0, 0.05, 0);
+        CHECK_OK(wetdem_sim_set_param(sim, "verlet.dt", lambda * tau));
+        CHECK_OK(wetdem_sim_set_many(
+            sim, &(struct wetdem_many_settings){.skin = 1e-4, .energy_budget = true}));
+        CHECK_OK(wetdem_sim_integrate(sim, 4 * tau));
+        struct wetdem_energy_budget b;
+        CHECK_OK(wetdem_sim_energy_budget(sim, &b));
+        assert_true(b.work_total < 0 && b.kinetic < 0.01 * b.input);
+        err[k] = fabs(b.balance_error) / fabs(b.work_total);
+        if (!(err[k] < 0.3 * lambda * lambda))
+            fail_msg("dt = %g tau: closure %g of the work, above 0.3 (dt/tau)^2", lambda, err[k]);
+        wetdem_sim_free(sim);
+    }
+    double order = err[0] / err[1];
+    if (!(order > 3.6 && order < 4.4))
+        fail_msg("closure %g at tau/10 and %g at tau/20: ratio %g, not second order", err[0],
+                 err[1], order);
+}
+
 /* The derived step follows the contact model: with hooke alone it is dt_fraction x hooke's
  * damped half period pi / sqrt(k/m* - (gamma/(2 m*))^2) of the two spheres (m* = m/2, less
  * than against a wall), not the Hertz contact time of their material (1.3x longer here). */
@@ -763,6 +825,7 @@ int main(void)
         cmocka_unit_test(test_many_displacement_bound_rebuilds_at_the_same_steps),
         cmocka_unit_test(test_many_callbacks_see_the_current_state),
         cmocka_unit_test(test_many_energy_budget_closes),
+        cmocka_unit_test(test_many_energy_budget_is_second_order_from_a_moving_start),
         cmocka_unit_test(test_many_matches_few_body_engine),
         cmocka_unit_test(test_many_step_stays_below_the_viscous_relaxation_time),
         cmocka_unit_test(test_many_step_follows_the_contact_model),
