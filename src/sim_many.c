@@ -235,11 +235,6 @@ static void step_scales(const struct wetdem_sim* sim, struct wetdem_particle sma
             }
 }
 
-/* Step [s]: many.dt, else verlet.dt, else verlet.dt_fraction x the shortest impact duration
- * at the speed scale, and at most a quarter of the shortest viscous relaxation time tau
- * (step_scales). Velocity Verlet with the damping evaluated at the predicted velocity is
- * stable for dt < tau and dissipates within 3 % of the exact rate for dt <= tau/4
- * (docs/many.md, Time step); a step given at or above tau is refused. */
 /* The speed scale of the step [m/s]: twice the largest particle speed plus what gravity adds
  * over the height of the packing, floored by sim.speed_floor; *small and *big receive a
  * smallest and a largest sphere. Needs at least one particle. */
@@ -273,6 +268,12 @@ double wetdem_sim_many_relaxation_time(const struct wetdem_sim* sim)
     return tau;
 }
 
+/* Step [s]: many.dt, else verlet.dt, else verlet.dt_fraction x the shortest impact duration
+ * at the speed scale, and at most a quarter of the shortest viscous relaxation time tau
+ * (step_scales). Velocity Verlet with the damping evaluated at the predicted velocity is
+ * stable for dt < tau and dissipates within 3 % of the exact rate for dt <= tau/4
+ * (docs/many.md, Time step); a step given at or above tau is refused. Without particles the
+ * step must be given. */
 static int choose_dt(struct wetdem_sim* sim, double* dt)
 {
     struct wetdem_many* m = sim->many;
@@ -283,7 +284,10 @@ static int choose_dt(struct wetdem_sim* sim, double* dt)
     m->relaxation_time = INFINITY;
     if (sim->n_particles == 0) {
         *dt = given;
-        return WETDEM_OK;
+        return given > 0 ? WETDEM_OK
+                         : wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
+                                           "many: no particles to derive the time step from: "
+                                           "add particles, or set many.dt or verlet.dt");
     }
     struct wetdem_particle small, big;
     double v = start_speed(sim, &small, &big), t_contact, tau, h_at;

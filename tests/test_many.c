@@ -811,6 +811,17 @@ static void test_many_rejects_bad_settings(void** state)
     CHECK_STATUS(wetdem_sim_insert(sim, &spec), WETDEM_ERR_INVALID);
     CHECK_CONTAINS(wetdem_sim_errmsg(sim), "insert.material 3");
     wetdem_sim_free(sim);
+    /* no particles: no step can be derived (a given one runs the empty box) */
+    sim = wetdem_sim_create();
+    CHECK_OK(wetdem_sim_set_many(sim, &(struct wetdem_many_settings){.skin = 1e-4}));
+    CHECK_STATUS(wetdem_sim_integrate(sim, 1e-3), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(wetdem_sim_errmsg(sim), "no particles to derive the time step from");
+    wetdem_sim_free(sim);
+    sim = wetdem_sim_create();
+    CHECK_OK(wetdem_sim_set_many(sim, &(struct wetdem_many_settings){.skin = 1e-4, .dt = 1e-4}));
+    CHECK_OK(wetdem_sim_integrate(sim, 1e-3));
+    CHECK_REL(wetdem_sim_time(sim), 1e-3, 1e-12);
+    wetdem_sim_free(sim);
 }
 
 int main(void)
