@@ -305,9 +305,9 @@ static int choose_dt(struct wetdem_sim* sim, double* dt)
             return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
                                    "many: the step dt = %g s is not below the viscous "
                                    "relaxation time %g s that '%s' sets at h_min = %g m "
-                                   "(m/c_d, for the smallest spheres): velocity Verlet is "
-                                   "unstable there; use dt <= %g s (a quarter, dissipation "
-                                   "within 3 %%), or 0 to derive it",
+                                   "(m/c_d, shortest over the smallest spheres' pairs): "
+                                   "velocity Verlet is unstable there; use dt <= %g s (a "
+                                   "quarter, dissipation within 3 %%), or 0 to derive it",
                                    given, tau, damper->name, h_at, 0.25 * tau);
         *dt = given;
         return WETDEM_OK;
