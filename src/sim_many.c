@@ -200,11 +200,12 @@ static void probe_spheres(const struct wetdem_sim* sim, struct wetdem_particle p
     wetdem_contact_from_particles(c, &p, &sim->materials[a], &q, &sim->materials[b], &sim->fluid);
 }
 
-/* The time scales of the step at approach speed v, over every material combination:
- * *t_contact, the shortest impact duration of two smallest spheres or of one and a wall (the
- * enabled models' contact times, else Hertz's); *tau, the shortest viscous relaxation time of
- * the pairs where it is shortest (a smallest sphere with a smallest and with a largest one,
- * and with a wall if there is one), *damper the model and *h_at the gap that set it. */
+/* The time scales of the step at approach speed v: *t_contact, the shortest impact duration
+ * of two smallest spheres or of one and a wall over every material combination (the enabled
+ * models' contact times, else Hertz's); *tau, the shortest viscous relaxation time of the
+ * pairs where it is shortest (a smallest sphere with a smallest and with a largest one, and
+ * with a wall if there is one), over the materials the particles and walls carry (a material
+ * no sphere uses must not refuse a step), *damper the model and *h_at the gap that set it. */
 static void step_scales(const struct wetdem_sim* sim, struct wetdem_particle small,
                         struct wetdem_particle big, double v, double* t_contact, double* tau,
                         const struct wetdem_model** damper, double* h_at)
@@ -212,6 +213,12 @@ static void step_scales(const struct wetdem_sim* sim, struct wetdem_particle sma
     *t_contact = *tau = INFINITY;
     *damper = NULL;
     *h_at = 0;
+    /* bit 1: a particle's material, bit 2: a wall's (all of them if there is no memory) */
+    unsigned char* used = calloc((size_t)sim->n_materials + 1, 1);
+    for (size_t k = 0; used && k < sim->n_particles; k++)
+        used[sim->particles[k].material] |= 1;
+    for (size_t w = 0; used && w < sim->n_walls; w++)
+        used[sim->walls[w].material] |= 2;
     for (int a = 0; a < sim->n_materials; a++)
         for (int b = 0; b < sim->n_materials; b++)
             for (int probe = 0; probe < 3; probe++) {
@@ -225,6 +232,8 @@ static void step_scales(const struct wetdem_sim* sim, struct wetdem_particle sma
                     *t_contact = fmin(*t_contact, wetdem_sim_contact_time(sim, &c));
                 if (probe == 2 && sim->n_walls == 0)
                     continue;
+                if (used && !((used[a] & 1) && (used[b] & (probe == 2 ? 2 : 1))))
+                    continue;
                 const struct wetdem_model* which;
                 double t = wetdem_sim_relaxation_time(sim, &c, &which);
                 if (t < *tau) {
@@ -233,6 +242,7 @@ static void step_scales(const struct wetdem_sim* sim, struct wetdem_particle sma
                     *h_at = c.h_min;
                 }
             }
+    free(used);
 }
 
 /* The speed scale of the step [m/s]: twice the largest particle speed plus what gravity adds

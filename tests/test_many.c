@@ -596,6 +596,20 @@ static void test_many_step_stays_below_the_viscous_relaxation_time(void** state)
         assert_true(rate > 0.97 && rate < 1.0);
         wetdem_sim_free(sim);
 
+        /* a material no sphere carries changes nothing: a pair of spheres with its 1 mm films
+           (delta = 2 mm) would give davis ln((2 delta - h)/h) = ln(399) against ln(19), tau/2 */
+        sim = damped_pair(cases[k].model, cases[k].mu, cases[k].u, cases[k].dir);
+        struct wetdem_material thick = {.density = 2500,
+                                        .youngs_modulus = 70e9,
+                                        .poisson_ratio = 0.22,
+                                        .restitution = 0.9,
+                                        .film = 1e-3};
+        assert_int_equal(wetdem_sim_add_material(sim, &thick), 1);
+        CHECK_OK(wetdem_sim_integrate(sim, cases[k].tau));
+        CHECK_OK(wetdem_sim_many_stats(sim, &st));
+        CHECK_REL(st.relaxation_time, cases[k].tau, 1e-12);
+        wetdem_sim_free(sim);
+
         sim = damped_pair(cases[k].model, cases[k].mu, cases[k].u, cases[k].dir);
         CHECK_OK(wetdem_sim_set_param(sim, "verlet.dt", 1.01 * cases[k].tau));
         CHECK_STATUS(wetdem_sim_integrate(sim, 1e-4), WETDEM_ERR_INVALID);
