@@ -272,6 +272,11 @@ static void summary_text(FILE* f, const struct cli_many_setup* su, const struct 
     fprintf(f, "time               %.6g s  (step %llu, dt = %.4g s, %.3g s wall, %d thread%s)\n",
             wetdem_sim_time(su->sim), s->step, s->dt, o->wall, s->threads,
             s->threads == 1 ? "" : "s");
+    if (s->dt == 0.25 * s->relaxation_time)
+        fprintf(f,
+                "                   (dt held at a quarter of the viscous relaxation time "
+                "%.4g s: docs/many.md, Time step)\n",
+                s->relaxation_time);
     fprintf(f, "contacts           %zu\nliquid bridges     %zu\n", s->contacts, s->bridges);
     fprintf(f, "agglomerates       %zu  (mean size %.3g)\n", s->agglomerates, s->mean_agglomerate);
     double phase[4] = {s->seconds_kick, s->seconds_forces, s->seconds_lists, s->seconds_output};
@@ -462,8 +467,9 @@ static void print_check(const struct cli_scenario* sc, const struct cli_many_set
            su->many.periodic[0] || su->many.periodic[1] || su->many.periodic[2] ? "" : "none");
     printf("  dt            %.6g s\n", pl->dt);
     if (isfinite(s.relaxation_time))
-        printf("  relaxation    %.6g s  (shortest viscous relaxation time; dt stays below it)\n",
-               s.relaxation_time);
+        printf("  relaxation    %.6g s  (shortest viscous relaxation time; dt %s)\n",
+               s.relaxation_time,
+               pl->dt == 0.25 * s.relaxation_time ? "held at a quarter of it" : "stays below it");
     printf("  t_end         %.6g s\n  steps         %llu\n", pl->t_end, pl->total);
     printf("  vtk_every     %llu\n  csv_every     %llu\n  contacts      %zu  (bridges %zu) at "
            "t = 0\n  models       ",

@@ -576,6 +576,20 @@ static void test_scenario_map_and_check_of_other_engines(void** state)
     /* the step stays below a quarter of the films' viscous relaxation time */
     assert_true(json_value(r.out, "relaxation_time_s") >= 4 * dt);
     free(r.out);
+    /* in a 100 times more viscous liquid the quarter binds, and --check says so: the
+       settling example's tau = m/c_d (a smallest sphere on the floor) scales as 1/mu */
+    r = run_cli("run examples/scenarios/many_settling.ini --check");
+    assert_int_equal(r.code, 0);
+    double tau = check_value(r.out, "relaxation    ");
+    CHECK_CONTAINS(r.out, "dt stays below it");
+    free(r.out);
+    r = run_cli("run examples/scenarios/many_settling.ini --check --set fluid.viscosity=1");
+    assert_int_equal(r.code, 0);
+    /* 1e-5: --check prints 6 digits */
+    CHECK_REL(check_value(r.out, "relaxation    "), tau / 100, 1e-5);
+    CHECK_REL(check_value(r.out, "dt            "), tau / 400, 1e-5);
+    CHECK_CONTAINS(r.out, "dt held at a quarter of it");
+    free(r.out);
     /* pairwise --check resolves Davis's groups without running (no outcome line). Run length
      * t_end = t*_end 4a / v_10 with v_10 = v_n0 / cos(beta): 20 x 4 x 2e-3 m / (1 m/s /
      * cos 30 deg) = 0.0692820323 s; film delta = h_a 4a = 0.01 x 8e-3 m / 2 per sphere = 2e-5 m
