@@ -375,14 +375,6 @@ static int hertz_pair(const void* params, const struct wetdem_contact* c, double
     return WETDEM_OK;
 }
 
-/* The Hertz contact time at the approach speed c->v_n [s] (speeds below 1e-12 m/s count as
- * 1e-12: the time grows without bound as the speed vanishes). */
-static double hertz_contact_time(const void* params, const struct wetdem_contact* c)
-{
-    (void)params;
-    return wetdem_force_hertz_contact_time(c->e_star, c->r_eff, c->m_eff, fmax(c->v_n, 1e-12));
-}
-
 const struct wetdem_model wetdem_force_hertz = {
     .name = "hertz",
     .kind = WETDEM_MODEL_CONTACT,
@@ -412,5 +404,5 @@ const struct wetdem_model wetdem_force_hertz = {
     .range = contact_only_range,
     .pair = hertz_pair,
     .thresholds = contact_only_thresholds,
-    .contact_time = hertz_contact_time,
+    .contact_time = hertz_contact_time_hook,
 };

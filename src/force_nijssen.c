@@ -141,13 +141,6 @@ static size_t nijssen_thresholds(const void* params, const struct wetdem_contact
     return 3;
 }
 
-/* The Hertz contact time of the contact branch at the approach speed c->v_n [s]. */
-static double nijssen_contact_time(const void* params, const struct wetdem_contact* c)
-{
-    (void)params;
-    return wetdem_force_hertz_contact_time(c->e_star, c->r_eff, c->m_eff, fmax(c->v_n, 1e-12));
-}
-
 /* m* / c_d with c_d = 6 pi mu R*^2 / h_min, the lubrication at the model's own minimum
  * approach h_min = max(h_sigma, h_eps) for v0 = c->v_n (Eq. 8; the lever blend below h_min
  * damps less) [s]. */
@@ -186,6 +179,6 @@ const struct wetdem_model wetdem_force_nijssen = {
     .range = nijssen_range,
     .pair = nijssen_pair,
     .thresholds = nijssen_thresholds,
-    .contact_time = nijssen_contact_time,
+    .contact_time = hertz_contact_time_hook, /* of the contact branch */
     .relaxation_time = nijssen_relaxation_time,
 };

@@ -126,6 +126,14 @@ double wetdem_force_hertz_total(double f_el, double f_damp, int form);
 /* force_hertz.c: duration of an undamped head-on Hertz collision at impact speed v [s]:
  * 2.868266... (m*^2 / (E*^2 R* v))^(1/5) (Hertz theory; Johnson 1985 Sec. 11.4). */
 double wetdem_force_hertz_contact_time(double e_star, double r_eff, double m_eff, double v);
+/* The contact_time hook of the models with a Hertz contact (hertz, nijssen): the Hertz
+ * contact time at the approach speed c->v_n [s] (speeds below 1e-12 m/s count as 1e-12: the
+ * time grows without bound as the speed vanishes). */
+static inline double hertz_contact_time_hook(const void* params, const struct wetdem_contact* c)
+{
+    (void)params;
+    return wetdem_force_hertz_contact_time(c->e_star, c->r_eff, c->m_eff, fmax(c->v_n, 1e-12));
+}
 /* force_mindlin.c: Mindlin tangential spring with Coulomb limit. spring (3 doubles of history:
  * the elastic tangential displacement [m]) is rotated into the current tangent plane and
  * advanced by v_t dt; stiffness k_t = 8 G* sqrt(R* delta); Tsuji damping from `restitution`

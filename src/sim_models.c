@@ -336,7 +336,7 @@ double wetdem_sim_contact_time(const struct wetdem_sim* sim, const struct wetdem
     }
     if (t < INFINITY)
         return t;
-    return wetdem_force_hertz_contact_time(c->e_star, c->r_eff, c->m_eff, fmax(c->v_n, 1e-12));
+    return hertz_contact_time_hook(NULL, c); /* fluid forces only: the materials' */
 }
 
 double wetdem_sim_relaxation_time(const struct wetdem_sim* sim, struct wetdem_contact* c,
