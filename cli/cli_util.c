@@ -183,18 +183,21 @@ static void parent_dir(const char* path, char* dir, size_t n)
         dir[0] = '\0';
 }
 
-int cli_check_output_file(const char* what, const char* option, const char* path)
+int cli_check_output_path(const char* what, const char* option, const char* path, bool is_dir)
 {
     struct stat st;
     if (!path)
         return CLI_EXIT_OK;
     if (!path[0]) {
-        cli_error("%s: %s needs a file name", what, option);
+        cli_error("%s: %s needs a %s name", what, option, is_dir ? "directory" : "file");
         return CLI_EXIT_USAGE;
     }
-    if (stat(path, &st) == 0 && S_ISDIR(st.st_mode)) {
-        cli_error("%s: %s %s is a directory; give a file name in it, e.g. %s/%s.csv", what, option,
-                  path, path, what);
+    if (stat(path, &st) == 0 && !S_ISDIR(st.st_mode) != !is_dir) {
+        if (is_dir)
+            cli_error("%s: %s %s exists and is not a directory", what, option, path);
+        else
+            cli_error("%s: %s %s is a directory; give a file name in it, e.g. %s/%s.csv", what,
+                      option, path, path, what);
         return CLI_EXIT_USAGE;
     }
     /* the directories on the way are made when the file is written: none may be a file */

@@ -63,10 +63,11 @@ void cli_print_provenance(FILE* f, int argc, char** argv);
 
 /* mkdir -p: creates dir and its parents. 0, or -1 with errno set. */
 int cli_make_dirs(const char* dir);
-/* Checks, when the arguments are read, that an output file given as `option` of command
- * `what` can be one: a name, and not that of a directory. NULL (stdout) passes. Returns
- * CLI_EXIT_OK or CLI_EXIT_USAGE after printing why. */
-int cli_check_output_file(const char* what, const char* option, const char* path);
+/* Checks, when the arguments are read, that an output path given as `option` of command
+ * `what` can be what it names, a file (is_dir false) or a directory made if missing: a
+ * name, not that of a directory (of a file) that exists, and no file on the way. NULL
+ * (stdout, no output) passes. Returns CLI_EXIT_OK or CLI_EXIT_USAGE after printing why. */
+int cli_check_output_path(const char* what, const char* option, const char* path, bool is_dir);
 
 /* Writes a table with write(f, ctx): to stdout when path is NULL, otherwise to path (its
  * directory is created when missing) under a temporary name renamed only when everything was

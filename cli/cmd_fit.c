@@ -139,8 +139,8 @@ static int parse_args(int argc, char** argv, struct fit_args* a)
         usage(stderr);
         return CLI_EXIT_USAGE;
     }
-    int rc = cli_check_output_file("fit", "--out", a->out);
-    return rc == CLI_EXIT_OK ? cli_check_output_file("fit", "--curve", a->curve) : rc;
+    int rc = cli_check_output_path("fit", "--out", a->out, false);
+    return rc == CLI_EXIT_OK ? cli_check_output_path("fit", "--curve", a->curve, false) : rc;
 }
 
 /* ---- data file ---------------------------------------------------------------------------- */

@@ -86,7 +86,7 @@ static int parse_args(int argc, char** argv, struct map_args* a)
         cli_error("map: --param and --param2 are both '%s'", a->key[0]);
         return CLI_EXIT_USAGE;
     }
-    return cli_check_output_file("map", "--out", a->out);
+    return cli_check_output_path("map", "--out", a->out, false);
 }
 
 /* The table with the map's trailer. */

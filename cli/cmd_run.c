@@ -15,7 +15,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 #include <unistd.h>
 
 #include "cli_util.h"
@@ -79,18 +78,8 @@ static int parse_args(int argc, char** argv, struct run_args* a)
         usage(stderr);
         return CLI_EXIT_USAGE;
     }
-    /* --out names a directory, made if missing: refuse at once what cannot be one, before
-     * anything is built or written */
-    struct stat st;
-    if (a->out_dir && !a->out_dir[0]) {
-        cli_error("run: --out needs a directory name");
-        return CLI_EXIT_USAGE;
-    }
-    if (a->out_dir && stat(a->out_dir, &st) == 0 && !S_ISDIR(st.st_mode)) {
-        cli_error("run: --out %s exists and is not a directory", a->out_dir);
-        return CLI_EXIT_USAGE;
-    }
-    return CLI_EXIT_OK;
+    /* before anything is built or written */
+    return cli_check_output_path("run", "--out", a->out_dir, true);
 }
 
 /* One output file: final name and the temporary name it is written under. */

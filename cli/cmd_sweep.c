@@ -83,7 +83,7 @@ static int parse_args(int argc, char** argv, struct sweep_args* a)
         usage(stderr);
         return CLI_EXIT_USAGE;
     }
-    return cli_check_output_file("sweep", "--out", a->out);
+    return cli_check_output_path("sweep", "--out", a->out, false);
 }
 
 /* The table with the sweep's trailer: for the soft engine, the integrator counts summed over

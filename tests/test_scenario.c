@@ -382,8 +382,8 @@ static void test_scenario_run_writes_files_or_nothing(void** state)
 }
 
 /* Output paths that cannot be what they name are refused while the arguments are read, with
- * exit 2, before any collision is run: run --out that is a file or empty; sweep, map and fit
- * --out (and fit --curve) that is a directory, empty, or under a file. */
+ * exit 2, before any collision is run: run --out that is a file, empty or under a file;
+ * sweep, map and fit --out (and fit --curve) that is a directory, empty, or under a file. */
 static void test_scenario_bad_output_paths_exit_2(void** state)
 {
     (void)state;
@@ -392,6 +392,8 @@ static void test_scenario_bad_output_paths_exit_2(void** state)
     snprintf(args, sizeof args, "run examples/scenarios/dry_hertz.ini --out '%s'", file);
     expect_run(args, 2, "exists and is not a directory");
     expect_run("run examples/scenarios/dry_hertz.ini --out ''", 2, "--out needs a directory name");
+    snprintf(args, sizeof args, "run examples/scenarios/dry_hertz.ini --out '%s/sub'", file);
+    expect_run(args, 2, "plain.txt is not a directory");
     const char* sweep = "sweep examples/scenarios/dry_hertz.ini --param collision.speed --values "
                         "0.5:1:2";
     snprintf(args, sizeof args, "%s --out '%s'", sweep, tmpdir);
