@@ -264,6 +264,13 @@ static bool budget_open(const struct wetdem_energy_budget* b, bool has_budget, d
     return !(*ratio <= CLOSURE_LIMIT);
 }
 
+/* Whether the run's step is the quarter of the viscous relaxation time the library holds a
+ * derived step to (docs/many.md, Time step). */
+static bool dt_held_by_relaxation(const struct wetdem_many_stats* s)
+{
+    return s->dt == 0.25 * s->relaxation_time;
+}
+
 static void summary_text(FILE* f, const struct cli_many_setup* su, const struct outcome* o)
 {
     const struct wetdem_many_stats* s = &o->stats;
@@ -272,7 +279,7 @@ static void summary_text(FILE* f, const struct cli_many_setup* su, const struct 
     fprintf(f, "time               %.6g s  (step %llu, dt = %.4g s, %.3g s wall, %d thread%s)\n",
             wetdem_sim_time(su->sim), s->step, s->dt, o->wall, s->threads,
             s->threads == 1 ? "" : "s");
-    if (s->dt == 0.25 * s->relaxation_time)
+    if (dt_held_by_relaxation(s))
         fprintf(f,
                 "                   (dt held at a quarter of the viscous relaxation time "
                 "%.4g s: docs/many.md, Time step)\n",
@@ -469,7 +476,7 @@ static void print_check(const struct cli_scenario* sc, const struct cli_many_set
     if (isfinite(s.relaxation_time))
         printf("  relaxation    %.6g s  (shortest viscous relaxation time; dt %s)\n",
                s.relaxation_time,
-               pl->dt == 0.25 * s.relaxation_time ? "held at a quarter of it" : "stays below it");
+               dt_held_by_relaxation(&s) ? "held at a quarter of it" : "stays below it");
     printf("  t_end         %.6g s\n  steps         %llu\n", pl->t_end, pl->total);
     printf("  vtk_every     %llu\n  csv_every     %llu\n  contacts      %zu  (bridges %zu) at "
            "t = 0\n  models       ",
