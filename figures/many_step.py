@@ -21,23 +21,7 @@ import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from common import FIGURES, ROOT, np, plt  # noqa: E402
-
-failures = []
-
-
-def check(ok, text):
-    print(f"  [{'ok' if ok else 'FAIL'}] {text}")
-    if not ok:
-        failures.append(text)
-
-
-def read_global(path):
-    """global.csv as {column: array}."""
-    with open(path) as f:
-        lines = [ln.strip() for ln in f if not ln.startswith("#") and ln.strip()]
-    names = lines[0].split(",")
-    rows = np.array([[float(x) for x in ln.split(",")] for ln in lines[1:]])
-    return {n: rows[:, k] for k, n in enumerate(names)}
+from many_figs import check, failures, read_global  # noqa: E402  (the many pieces' checks)
 
 
 def map_speed(lam, steps):
