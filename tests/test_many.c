@@ -506,14 +506,22 @@ static void test_many_matches_few_body_engine(void** state)
  * 10 um of one viscous model, `model`, moving at +-u along `dir` (x: approach, the normal;
  * y: sliding). In that gap the model's damping c_d is constant, so the relative (slip)
  * speed decays as exp(-t/tau), tau = m/c_d. */
+#define PAIR_M_EFF (0.5 * 2500 * 4.0 / 3.0 * M_PI * 1e-9) /* m* of two such spheres [kg] */
+
+/* The pair's glass-like material with films `film` [m]. */
+static struct wetdem_material pair_material(double film)
+{
+    return (struct wetdem_material){.density = 2500,
+                                    .youngs_modulus = 70e9,
+                                    .poisson_ratio = 0.22,
+                                    .restitution = 0.9,
+                                    .film = film};
+}
+
 static struct wetdem_sim* damped_pair(const char* model, double viscosity, double u, int dir)
 {
     struct wetdem_sim* sim = wetdem_sim_create();
-    struct wetdem_material m = {.density = 2500,
-                                .youngs_modulus = 70e9,
-                                .poisson_ratio = 0.22,
-                                .restitution = 0.9,
-                                .film = 50e-6};
+    struct wetdem_material m = pair_material(50e-6);
     assert_int_equal(wetdem_sim_add_material(sim, &m), 0);
     CHECK_OK(wetdem_sim_set_param(sim, "fluid.viscosity", viscosity));
     CHECK_OK(wetdem_sim_enable_model(sim, model));
@@ -564,7 +572,7 @@ static double surface_speed(const struct wetdem_sim* sim, bool tangential)
 static void test_many_step_stays_below_the_viscous_relaxation_time(void** state)
 {
     (void)state;
-    const double m_eff = 0.5 * 2500 * 4.0 / 3.0 * M_PI * 1e-9, a = 0.5e-3, h = 10e-6;
+    const double m_eff = PAIR_M_EFF, a = 0.5e-3, h = 10e-6;
     const struct {
         const char* model;
         double mu, u;
@@ -597,18 +605,17 @@ static void test_many_step_stays_below_the_viscous_relaxation_time(void** state)
         wetdem_sim_free(sim);
 
         /* a material no sphere carries changes nothing: a pair of spheres with its 1 mm films
-           (delta = 2 mm) would give davis ln((2 delta - h)/h) = ln(399) against ln(19), tau/2 */
-        sim = damped_pair(cases[k].model, cases[k].mu, cases[k].u, cases[k].dir);
-        struct wetdem_material thick = {.density = 2500,
-                                        .youngs_modulus = 70e9,
-                                        .poisson_ratio = 0.22,
-                                        .restitution = 0.9,
-                                        .film = 1e-3};
-        assert_int_equal(wetdem_sim_add_material(sim, &thick), 1);
-        CHECK_OK(wetdem_sim_integrate(sim, cases[k].tau));
-        CHECK_OK(wetdem_sim_many_stats(sim, &st));
-        CHECK_REL(st.relaxation_time, cases[k].tau, 1e-12);
-        wetdem_sim_free(sim);
+           (delta = 2 mm) would give davis ln((2 delta - h)/h) = ln(399) against ln(19), tau/2
+           (reynolds does not depend on the films: the sliding case only) */
+        if (cases[k].dir == 1) {
+            sim = damped_pair(cases[k].model, cases[k].mu, cases[k].u, cases[k].dir);
+            struct wetdem_material thick = pair_material(1e-3);
+            assert_int_equal(wetdem_sim_add_material(sim, &thick), 1);
+            CHECK_OK(wetdem_sim_integrate(sim, cases[k].tau));
+            CHECK_OK(wetdem_sim_many_stats(sim, &st));
+            CHECK_REL(st.relaxation_time, cases[k].tau, 1e-12);
+            wetdem_sim_free(sim);
+        }
 
         sim = damped_pair(cases[k].model, cases[k].mu, cases[k].u, cases[k].dir);
         CHECK_OK(wetdem_sim_set_param(sim, "verlet.dt", 1.01 * cases[k].tau));
@@ -629,7 +636,7 @@ static void test_many_step_stays_below_the_viscous_relaxation_time(void** state)
 static void test_many_energy_budget_is_second_order_from_a_moving_start(void** state)
 {
     (void)state;
-    const double m_eff = 0.5 * 2500 * 4.0 / 3.0 * M_PI * 1e-9;
+    const double m_eff = PAIR_M_EFF;
     const double tau = m_eff / (6 * M_PI * 1.0 * 0.5e-3 * 0.5e-3 / 10e-6);
     double err[2];
     for (int k = 0; k < 2; k++) {
@@ -664,7 +671,7 @@ static void test_many_step_follows_the_contact_model(void** state)
     CHECK_OK(wetdem_sim_integrate(sim, 1e-6));
     struct wetdem_many_stats st;
     CHECK_OK(wetdem_sim_many_stats(sim, &st));
-    double m_eff = 0.5 * 2500 * 4.0 / 3.0 * M_PI * 1e-9, k = 1e6, l = log(0.9);
+    double m_eff = PAIR_M_EFF, k = 1e6, l = log(0.9);
     double gamma = -2 * l * sqrt(m_eff * k) / sqrt(l * l + M_PI * M_PI);
     double t_c = M_PI / sqrt(k / m_eff - gamma * gamma / (4 * m_eff * m_eff));
     CHECK_REL(st.dt, 0.02 * t_c, 1e-12);
