@@ -116,9 +116,9 @@ static int place_lattice(const struct wetdem_insert_spec* s, double r_max,
         return wetdem_status_fail(
             msg, n, WETDEM_ERR_INVALID,
             "insert: the region holds at most %.0f spheres (%zu x %zu x %zu) on a "
-            "lattice of spacing 2 radius_max + gap = %g m, but count = %zu; enlarge "
-            "the region or reduce count, radius_max (%g m) or gap (%g m)",
-            sites, m[0], m[1], m[2], 2 * r_max + s->gap, s->n, r_max, s->gap);
+            "lattice of spacing 2 r + gap = %g m (r = %g m, the largest radius drawn), but "
+            "count = %zu; enlarge the region or reduce count, radius_max or gap (%g m)",
+            sites, m[0], m[1], m[2], 2 * r_max + s->gap, r_max, s->n, s->gap);
     for (size_t i = 0; i < s->n; i++) {
         size_t c[3] = {i % m[0], (i / m[0]) % m[1], i / (m[0] * m[1])};
         for (int k = 0; k < 3; k++)

@@ -253,6 +253,29 @@ static void test_cli_forces_bad_input(void** state)
     }
 }
 
+/* `wetdem run` rejects a bad option before it reads the scenario: exit code 2, the option
+ * named, a hint for a near-miss spelling and a note for an option left without its value. */
+static void test_cli_run_bad_arguments(void** state)
+{
+    (void)state;
+    static const struct {
+        const char *args, *message;
+    } cases[] = {
+        {"run none.ini --otu d", "unexpected argument '--otu' (did you mean '--out'?)"},
+        {"run none.ini --jsno", "(did you mean '--json'?)"},
+        {"run none.ini --restrat c.ckpt", "(did you mean '--restart'?)"},
+        {"run none.ini --out", "unexpected argument '--out' (needs a value)"},
+        {"run none.ini --zzzzzzzz", "unexpected argument '--zzzzzzzz'\nusage: wetdem run"},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        struct test_run r = run_cli(cases[k].args, true);
+        if (r.code != 2)
+            fail_msg("'%s' exited %d, expected 2:\n%s", cases[k].args, r.code, r.out);
+        CHECK_CONTAINS(r.out, cases[k].message);
+        free(r.out);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -264,6 +287,7 @@ int main(void)
         cmocka_unit_test(test_cli_forces_matches_reynolds_closed_form),
         cmocka_unit_test(test_cli_forces_log_gaps_are_decades),
         cmocka_unit_test(test_cli_forces_bad_input),
+        cmocka_unit_test(test_cli_run_bad_arguments),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

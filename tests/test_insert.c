@@ -122,6 +122,8 @@ static void test_insert_lattice_capacity_by_hand(void** state)
     s.n = 65;
     CHECK_STATUS(wetdem_insert_particles(&s, p, msg, sizeof msg), WETDEM_ERR_INVALID);
     CHECK_CONTAINS(msg, "at most 64 spheres");
+    /* a = 2 r + gap = 2 x 1 mm + 0.1 mm; r is the largest radius drawn, not the key */
+    CHECK_CONTAINS(msg, "spacing 2 r + gap = 0.0021 m (r = 0.001 m, the largest radius drawn)");
     s.n = 64;
     CHECK_OK(wetdem_insert_particles(&s, p, msg, sizeof msg));
     check_inside(&s, p);
