@@ -266,6 +266,13 @@ bool cli_wants_help(int argc, char** argv)
     return false;
 }
 
+const char* cli_option_hint(const char* arg, const char* const* options, char* buf, size_t n)
+{
+    const char* hint = arg[0] == '-' ? wetdem_param_suggest(arg, options) : NULL;
+    snprintf(buf, n, "%s%s%s", hint ? " (did you mean '" : "", hint ? hint : "", hint ? "'?)" : "");
+    return buf;
+}
+
 void cli_param_default_text(const struct wetdem_param_desc* d, char* buf, size_t n)
 {
     if (d->choices) {

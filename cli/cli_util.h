@@ -55,6 +55,11 @@ int cli_apply_set(struct wetdem_sim* sim, const char* key_value);
  * prints its usage to stdout and exits 0, whatever else is on the line. */
 bool cli_wants_help(int argc, char** argv);
 
+/* " (did you mean 'NAME'?)" for the name among `options` (NULL-terminated) closest to a
+ * misspelt option `arg` (wetdem_param_suggest), written into buf; "" when arg does not start
+ * with '-' or nothing is close. Returns buf, for use as a "%s" argument. */
+const char* cli_option_hint(const char* arg, const char* const* options, char* buf, size_t n);
+
 /* Writes the '#' provenance lines that start every CSV the CLI prints:
  *     # wetdem <version> (git <hash>)
  *     # command: wetdem <argv[0]> <argv[1]> ...

@@ -127,7 +127,12 @@ static int parse_args(int argc, char** argv, struct fit_args* a)
             if (rc == CLI_EXIT_OK)
                 *(s[2] == 'm' ? &a->max_iter : &a->curve_points) = (int)x;
         } else {
-            cli_error("fit: unknown option '%s'", s);
+            static const char* const options[] = {
+                "--data",        "--fit",     "--init",     "--out",          "--curve", "--set",
+                "--omega-scale", "--fd-step", "--max-iter", "--curve-points", NULL};
+            char hint[64];
+            cli_error("fit: unknown option '%s'%s", s,
+                      cli_option_hint(s, options, hint, sizeof hint));
             usage(stderr);
             return CLI_EXIT_USAGE;
         }

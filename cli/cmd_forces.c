@@ -113,7 +113,12 @@ static int parse_args(int argc, char** argv, struct forces_opts* o)
             const char* val = option_value(argc, argv, &k);
             rc = val ? parse_valued(a, val, o) : CLI_EXIT_USAGE;
         } else if (a[0] == '-' && a[1] == '-') {
-            cli_error("forces: unknown option '%s' (see 'wetdem forces --help')", a);
+            static const char* const options[] = {"--preset", "--fluid", "--radius", "--speed",
+                                                  "--slip",   "--gaps",  "--model",  "--set",
+                                                  "--log",    NULL};
+            char hint[64];
+            cli_error("forces: unknown option '%s'%s (see 'wetdem forces --help')", a,
+                      cli_option_hint(a, options, hint, sizeof hint));
             rc = CLI_EXIT_USAGE;
         } else if (o->n_models < MAX_ITEMS) {
             o->models[o->n_models++] = a;

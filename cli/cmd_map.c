@@ -72,7 +72,12 @@ static int parse_args(int argc, char** argv, struct map_args* a)
         else if (s[0] != '-' && !a->file)
             a->file = s;
         else {
-            cli_error("map: unexpected argument '%s'", s);
+            static const char* const options[] = {"--param",   "--values", "--param2",
+                                                  "--values2", "--out",    "--set",
+                                                  "--log",     "--log2",   NULL};
+            char hint[64];
+            cli_error("map: unexpected argument '%s'%s", s,
+                      cli_option_hint(s, options, hint, sizeof hint));
             usage(stderr);
             return CLI_EXIT_USAGE;
         }

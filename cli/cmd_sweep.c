@@ -73,7 +73,11 @@ static int parse_args(int argc, char** argv, struct sweep_args* a)
         else if (s[0] != '-' && !a->file)
             a->file = s;
         else {
-            cli_error("sweep: unexpected argument '%s'", s);
+            static const char* const options[] = {"--param", "--values", "--out",
+                                                  "--set",   "--log",    NULL};
+            char hint[64];
+            cli_error("sweep: unexpected argument '%s'%s", s,
+                      cli_option_hint(s, options, hint, sizeof hint));
             usage(stderr);
             return CLI_EXIT_USAGE;
         }

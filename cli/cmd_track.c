@@ -71,7 +71,13 @@ static int parse_option(struct track_cli* c, const char* name, const char* value
         c->frames_path = value;
         return CLI_EXIT_OK;
     }
-    cli_error("track: unknown option '%s'\n%s", name, usage);
+    static const char* const options[] = {"--fps",    "--pixel-size", "--threshold", "--radius",
+                                          "--mass",   "--viscosity",  "--window",    "--order",
+                                          "--offset", "--fit-frames", "--striker",   "--frames",
+                                          "--json",   "--y-down",     NULL};
+    char hint[64];
+    cli_error("track: unknown option '%s'%s\n%s", name,
+              cli_option_hint(name, options, hint, sizeof hint), usage);
     return CLI_EXIT_USAGE;
 }
 

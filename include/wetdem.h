@@ -131,8 +131,9 @@ WETDEM_API int wetdem_param_validate(const struct wetdem_param_desc* d, double v
 WETDEM_API void wetdem_param_range_text(const struct wetdem_param_desc* d, char* buf, size_t n);
 /* Index of `word` among d->choices, or -1. */
 WETDEM_API int wetdem_param_choice_index(const struct wetdem_param_desc* d, const char* word);
-/* The closest of `candidates` (NULL-terminated) to `word` by edit distance, or NULL when
- * nothing is close enough to be a plausible typo. */
+/* The closest of `candidates` (NULL-terminated) to `word` by edit distance (insertions,
+ * deletions, substitutions and swaps of adjacent letters count 1; ties go to the first), or
+ * NULL when nothing is close enough to be a plausible typo. */
 WETDEM_API const char* wetdem_param_suggest(const char* word, const char* const* candidates);
 
 /* ======================================================================================== */

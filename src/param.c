@@ -1,7 +1,8 @@
 /*
  * param.c — parameter descriptors: defaults, validation with a message naming the parameter,
  * its value and valid range, enumerated choices, and "did you mean" suggestions by edit
- * distance (Levenshtein, with a threshold of one third of the word length, at least 2).
+ * distance (optimal string alignment: Levenshtein with swaps of adjacent letters; threshold one
+ * third of the word length, at least 2).
  */
 #include <math.h>
 #include <stdio.h>
@@ -81,7 +82,9 @@ int wetdem_param_choice_index(const struct wetdem_param_desc* d, const char* wor
     return -1;
 }
 
-/* Levenshtein distance of two short strings (truncated to 63 characters). */
+/* Edit distance of two short strings (truncated to 63 characters): insertions, deletions,
+ * substitutions and swaps of two adjacent letters each count 1 (the optimal string alignment
+ * distance), so that "lgo2" is 1 from "log2" and 2 from "log". */
 static size_t edit_distance(const char* a, const char* b)
 {
     size_t la = strlen(a), lb = strlen(b);
@@ -89,25 +92,27 @@ static size_t edit_distance(const char* a, const char* b)
         la = 63;
     if (lb > 63)
         lb = 63;
-    size_t row[64];
+    size_t rows[3][64]; /* distances for prefixes of a of length i - 2, i - 1 and i */
     for (size_t j = 0; j <= lb; j++)
-        row[j] = j;
+        rows[1][j] = j;
     for (size_t i = 1; i <= la; i++) {
-        size_t diag = row[0];
-        row[0] = i;
+        size_t *before = rows[0], *prev = rows[1], *cur = rows[2];
+        cur[0] = i;
         for (size_t j = 1; j <= lb; j++) {
-            size_t up = row[j];
-            size_t cost = a[i - 1] == b[j - 1] ? 0 : 1;
-            size_t best = diag + cost;
-            if (up + 1 < best)
-                best = up + 1;
-            if (row[j - 1] + 1 < best)
-                best = row[j - 1] + 1;
-            row[j] = best;
-            diag = up;
+            size_t best = prev[j - 1] + (a[i - 1] == b[j - 1] ? 0 : 1);
+            if (prev[j] + 1 < best)
+                best = prev[j] + 1;
+            if (cur[j - 1] + 1 < best)
+                best = cur[j - 1] + 1;
+            if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1] &&
+                before[j - 2] + 1 < best)
+                best = before[j - 2] + 1;
+            cur[j] = best;
         }
+        memcpy(rows[0], rows[1], sizeof rows[0]);
+        memcpy(rows[1], rows[2], sizeof rows[1]);
     }
-    return row[lb];
+    return rows[1][lb];
 }
 
 const char* wetdem_param_suggest(const char* word, const char* const* candidates)

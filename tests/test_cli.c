@@ -253,19 +253,29 @@ static void test_cli_forces_bad_input(void** state)
     }
 }
 
-/* `wetdem run` rejects a bad option before it reads the scenario: exit code 2, the option
- * named, a hint for a near-miss spelling and a note for an option left without its value. */
-static void test_cli_run_bad_arguments(void** state)
+/* Every command rejects a bad option before it reads a file: exit code 2, the option named,
+ * a hint for a near-miss spelling (one or two letters off, as wetdem_param_suggest measures
+ * it), none for a word far from every option, and a note for an option left without its
+ * value. */
+static void test_cli_bad_options_get_hints(void** state)
 {
     (void)state;
     static const struct {
         const char *args, *message;
     } cases[] = {
-        {"run none.ini --otu d", "unexpected argument '--otu' (did you mean '--out'?)"},
+        {"run none.ini --otu d", "run: unexpected argument '--otu' (did you mean '--out'?)"},
         {"run none.ini --jsno", "(did you mean '--json'?)"},
         {"run none.ini --restrat c.ckpt", "(did you mean '--restart'?)"},
         {"run none.ini --out", "unexpected argument '--out' (needs a value)"},
         {"run none.ini --zzzzzzzz", "unexpected argument '--zzzzzzzz'\nusage: wetdem run"},
+        {"sweep none.ini --parma a",
+         "sweep: unexpected argument '--parma' (did you mean '--param'?)"},
+        {"map none.ini --lgo2", "map: unexpected argument '--lgo2' (did you mean '--log2'?)"},
+        {"fit none.ini --dat d.csv", "fit: unknown option '--dat' (did you mean '--data'?)"},
+        {"fit none.ini --zzzzzzzz 1", "fit: unknown option '--zzzzzzzz'\n"},
+        {"forces --model reynolds --radus 1",
+         "unknown option '--radus' (did you mean '--radius'?)"},
+        {"track dots.csv --fsp 30", "track: unknown option '--fsp' (did you mean '--fps'?)"},
     };
     for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
         struct test_run r = run_cli(cases[k].args, true);
@@ -287,7 +297,7 @@ int main(void)
         cmocka_unit_test(test_cli_forces_matches_reynolds_closed_form),
         cmocka_unit_test(test_cli_forces_log_gaps_are_decades),
         cmocka_unit_test(test_cli_forces_bad_input),
-        cmocka_unit_test(test_cli_run_bad_arguments),
+        cmocka_unit_test(test_cli_bad_options_get_hints),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -211,6 +211,14 @@ static void test_params_suggest_threshold(void** state)
     assert_string_equal(wetdem_param_suggest("viscosoty", names), "viscosity");
     /* Far from every name: no hint rather than a misleading one. */
     assert_null(wetdem_param_suggest("gravity_x", names));
+    /* Two letters swapped count as one edit: "lgo2" is 1 from "log2" but 2 from "log", which
+     * plain Levenshtein ties at 2 and so resolved to the first listed. */
+    static const char* const flags[] = {"--log", "--log2", NULL};
+    assert_string_equal(wetdem_param_suggest("--lgo2", flags), "--log2");
+    assert_string_equal(wetdem_param_suggest("--lgo", flags), "--log");
+    /* "dnesity": one swap (distance 1); "ytisned" reverses it and stays without a hint. */
+    assert_string_equal(wetdem_param_suggest("dnesity", names), "density");
+    assert_null(wetdem_param_suggest("ytisned", names));
 }
 
 /* One material preset checked field by field against a seed table row. */
