@@ -513,8 +513,18 @@ static int set_outputs(struct cli_many_setup* su, const struct cli_run_options* 
 static int resume(const struct cli_many_setup* su, const struct cli_run_options* opt,
                   const struct plan* pl, struct series* vtk)
 {
+    size_t n_scenario = wetdem_sim_n_particles(su->sim);
     if (wetdem_sim_read_checkpoint(su->sim, opt->restart) != WETDEM_OK) {
         cli_error("--restart %s: %s", opt->restart, wetdem_sim_errmsg(su->sim));
+        return CLI_EXIT_USAGE;
+    }
+    /* The checkpoint's spheres replace the scenario's, so a changed [insert] count or a
+       [particle.NAME] added or removed would otherwise go unnoticed. */
+    if (wetdem_sim_n_particles(su->sim) != n_scenario) {
+        cli_error("--restart %s: the checkpoint holds %zu spheres but the scenario places %zu "
+                  "([insert] count, [particle.NAME]): resume with the scenario of the run that "
+                  "wrote it",
+                  opt->restart, wetdem_sim_n_particles(su->sim), n_scenario);
         return CLI_EXIT_USAGE;
     }
     /* The budget restored closes at the checkpoint's step unless the state was edited or its
@@ -532,6 +542,14 @@ static int resume(const struct cli_many_setup* su, const struct cli_run_options*
     }
     struct wetdem_many_stats s;
     wetdem_sim_many_stats(su->sim, &s);
+    if (s.step >= pl->total) {
+        cli_error("--restart %s: the checkpoint is at step %llu (t = %.9g s), and this run ends "
+                  "at step %llu ([run] t_end = %.9g s): the run that wrote it had reached its "
+                  "end; raise t_end (--set run.t_end=...) or steps to continue it",
+                  opt->restart, (unsigned long long)s.step, wetdem_sim_time(su->sim), pl->total,
+                  pl->t_end);
+        return CLI_EXIT_USAGE;
+    }
     if (pl->csv_prefix[0]) {
         char path[PATH_CHARS + 8];
         snprintf(path, sizeof path, "%s.csv", pl->csv_prefix);

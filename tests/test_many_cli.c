@@ -281,6 +281,24 @@ static void test_many_cli_restart_is_bit_identical(void** state)
                         "(energy_budget = yes)");
     free(err);
     check_same_outputs("whole", "split", 7);
+    /* one holding another number of spheres than the scenario places (the checkpoint's would
+       replace them unnoticed), and the final checkpoint of a run resumed with the same end
+       (nothing to run: the message says how to extend it); both exit 2 before any output is
+       touched */
+    code = run_cli("run box.ini --set run.steps=900 --set insert.count=151 --out split "
+                   "--restart split/checkpoint.ckpt");
+    err = stderr_text();
+    assert_int_equal(code, 2);
+    CHECK_CONTAINS(err, "the checkpoint holds 150 spheres but the scenario places 151");
+    free(err);
+    code = run_cli("run box.ini --set run.steps=600 --out split --restart split/checkpoint.ckpt");
+    err = stderr_text();
+    assert_int_equal(code, 2);
+    CHECK_CONTAINS(err, "the checkpoint is at step 600 (t = 0.0012 s), and this run ends at step "
+                        "600");
+    CHECK_CONTAINS(err, "raise t_end (--set run.t_end=...) or steps to continue it");
+    free(err);
+    check_same_outputs("whole", "split", 7);
     /* a checkpoint edited after it was written (every velocity tripled, CRC rewritten): its
        state is whole and finite, but the kinetic energy it holds is not one its budget's work
        accounts for; it is refused, exit 2, and the outputs it would continue stay as they were */
