@@ -1,7 +1,7 @@
 /*
  * batch.c — the batch of independent collisions behind `wetdem sweep` and `wetdem map` (see
- * batch.h): load and check the scenario, build every point serially, run the points in
- * parallel, write the table in input order, report the failed runs.
+ * batch.h): load and check the scenario, check every point serially by building it, build
+ * and run the points in parallel, write the table in input order, report the failed runs.
  *
  * Engines: soft (a CSV row of every field of struct wetdem_collision_result, cli/output_csv.c)
  * and pairwise (the row of cli_run_pairwise, whose status column is the engine's status).
@@ -15,32 +15,37 @@
 #include "batch.h"
 #include "output_csv.h"
 
-/* The scenario of point p: base with every key set; then the soft engine's set-up, or the
- * pairwise engine's configuration checked without running (its header mode builds and
- * validates it). Returns an exit code. */
+/* What a batch holds per point while it runs (with the row's text, about 1 kB): its set-up is
+ * built when it runs, not kept, or maps of millions of collisions would not fit in memory. */
+_Static_assert(sizeof(struct cli_batch_point) <= 1024, "a batch point holds only its results");
+
+/* The scenario of point p into *sc: base with every key set; then, for the soft engine, its
+ * set-up into *su, or for the pairwise engine its configuration checked without running (its
+ * header mode builds and validates it). Touches only *sc and *su, so points are built
+ * concurrently. Returns an exit code; free *sc and *su in every case. */
 static int build_point(const struct cli_scenario* base, const struct cli_batch* b,
-                       struct cli_batch_point* p)
+                       const struct cli_batch_point* p, struct cli_scenario* sc,
+                       struct cli_setup* su)
 {
-    int rc = cli_scenario_copy(base, &p->sc);
+    memset(su, 0, sizeof *su);
+    int rc = cli_scenario_copy(base, sc);
     for (int d = 0; d < b->n_keys && rc == CLI_EXIT_OK; d++) {
         char set[512];
         snprintf(set, sizeof set, "%s=%.17g", b->key[d], p->value[d]);
-        rc = cli_scenario_override(&p->sc, set);
+        rc = cli_scenario_override(sc, set);
     }
     if (rc == CLI_EXIT_OK && b->engine == CLI_ENGINE_SOFT)
-        rc = cli_scenario_build(&p->sc, &p->su);
+        rc = cli_scenario_build(sc, su);
     if (rc == CLI_EXIT_OK && b->engine == CLI_ENGINE_PAIRWISE) {
         char* text = NULL;
         size_t len = 0;
         FILE* f = open_memstream(&text, &len);
         struct cli_run_options opt = {.sweep_row = f, .sweep_header = true};
-        rc = f ? cli_run_pairwise(&p->sc, &opt) : CLI_EXIT_RUNTIME;
+        rc = f ? cli_run_pairwise(sc, &opt) : CLI_EXIT_RUNTIME;
         if (f)
             fclose(f);
         free(text);
     }
-    if (b->engine == CLI_ENGINE_SOFT)
-        cli_scenario_free(&p->sc); /* the set-up holds everything the run needs */
     return rc;
 }
 
@@ -55,7 +60,9 @@ static void point_values(const struct cli_batch* b, const struct cli_batch_point
                                  p->value[d]);
 }
 
-/* Builds every point (serially: every input error is reported before anything runs). */
+/* Checks every point by building it (serially: every input error is reported before anything
+ * runs), then releases it: a point holds only its values and results, and is built again when
+ * it runs, so a batch of millions of collisions needs about 1 kB each rather than its set-up. */
 static int build_all(const struct cli_scenario* base, struct cli_batch* b)
 {
     for (size_t k = 0; k < b->n_pts; k++) {
@@ -65,7 +72,11 @@ static int build_all(const struct cli_scenario* base, struct cli_batch* b)
             p->value[d] = cli_range_value(&b->range[d], rest % b->range[d].n);
             rest /= b->range[d].n;
         }
-        int rc = build_point(base, b, p);
+        struct cli_scenario sc;
+        struct cli_setup su;
+        int rc = build_point(base, b, p, &sc, &su);
+        cli_scenario_free(&sc);
+        cli_setup_free(&su);
         if (rc != CLI_EXIT_OK) { /* (the message above is about the file with these values) */
             char at[1024];
             point_values(b, p, at, sizeof at);
@@ -76,32 +87,36 @@ static int build_all(const struct cli_scenario* base, struct cli_batch* b)
     return CLI_EXIT_OK;
 }
 
-/* Runs one built point and keeps its status and CSV fields; releases its set-up. Touches
- * only *p, so points run concurrently. */
-static void run_point(struct cli_batch_point* p, enum cli_engine engine)
+/* Builds and runs one point (checked by build_all) and keeps its status and CSV fields.
+ * Touches only *p, so points run concurrently. */
+static void run_point(const struct cli_scenario* base, const struct cli_batch* b,
+                      struct cli_batch_point* p)
 {
+    struct cli_scenario sc;
+    struct cli_setup su;
     size_t len = 0;
-    FILE* f = open_memstream(&p->row, &len);
     p->status = WETDEM_ERR_NOMEM; /* kept when the engine could not start */
     snprintf(p->errmsg, sizeof p->errmsg, "out of memory");
-    if (f && engine == CLI_ENGINE_PAIRWISE) {
+    bool built = build_point(base, b, p, &sc, &su) == CLI_EXIT_OK;
+    FILE* f = built ? open_memstream(&p->row, &len) : NULL;
+    if (f && b->engine == CLI_ENGINE_PAIRWISE) {
         struct cli_run_options opt = {.sweep_row = f,
                                       .status_out = &p->status,
                                       .errmsg_out = p->errmsg,
                                       .errmsg_size = sizeof p->errmsg};
-        cli_run_pairwise(&p->sc, &opt);
+        cli_run_pairwise(&sc, &opt);
     } else if (f) {
-        p->status = wetdem_collision_run(p->su.sim, &p->su.spec, &p->res);
+        p->status = wetdem_collision_run(su.sim, &su.spec, &p->res);
         if (p->status < 0)
-            snprintf(p->errmsg, sizeof p->errmsg, "%s", wetdem_sim_errmsg(p->su.sim));
+            snprintf(p->errmsg, sizeof p->errmsg, "%s", wetdem_sim_errmsg(su.sim));
         else
-            cli_setup_capture(&p->su);
-        cli_csv_result_row(f, &p->su, &p->res);
+            cli_setup_capture(&su);
+        cli_csv_result_row(f, &su, &p->res);
     }
     if (f)
         fclose(f);
-    cli_scenario_free(&p->sc);
-    cli_setup_free(&p->su); /* the row holds all that is reported */
+    cli_scenario_free(&sc);
+    cli_setup_free(&su); /* the row holds all that is reported */
 }
 
 static void show_progress(const char* cmd, size_t done, size_t n, double t0)
@@ -116,14 +131,14 @@ static void show_progress(const char* cmd, size_t done, size_t n, double t0)
 
 /* Runs every point in parallel (dynamic scheduling: run times differ by orders of
  * magnitude across a batch). */
-static void run_all(struct cli_batch* b)
+static void run_all(const struct cli_scenario* base, struct cli_batch* b)
 {
     bool show = b->progress && isatty(STDERR_FILENO);
     double t0 = omp_get_wtime(), last = 0;
     size_t done = 0, n = b->n_pts;
 #pragma omp parallel for schedule(dynamic, 1)
     for (size_t k = 0; k < n; k++) {
-        run_point(&b->pts[k], b->engine);
+        run_point(base, b, &b->pts[k]);
 #pragma omp critical(batch_progress)
         {
             done++;
@@ -195,11 +210,11 @@ int cli_batch_run(struct cli_batch* b)
     double t0 = omp_get_wtime();
     if (rc == CLI_EXIT_OK)
         rc = build_all(&sc, b);
-    cli_scenario_free(&sc);
     if (rc == CLI_EXIT_OK) {
-        run_all(b);
+        run_all(&sc, b);
         b->wall = omp_get_wtime() - t0;
     }
+    cli_scenario_free(&sc);
     return rc;
 }
 
@@ -252,11 +267,8 @@ int cli_batch_report_failures(const struct cli_batch* b, int rc)
 
 void cli_batch_free(struct cli_batch* b)
 {
-    for (size_t k = 0; b->pts && k < b->n_pts; k++) {
-        cli_scenario_free(&b->pts[k].sc);
-        cli_setup_free(&b->pts[k].su);
+    for (size_t k = 0; b->pts && k < b->n_pts; k++)
         free(b->pts[k].row);
-    }
     free(b->pts);
     free(b->header);
     b->pts = NULL;

@@ -6,7 +6,8 @@
  * Each point is the scenario with `--set KEY=value` for each key (values printed with %.17g,
  * so the same bits as `wetdem run FILE --set KEY=value`, and coupled keys stay right). Every
  * point is built (soft engine) or its configuration checked (pairwise engine) before any runs,
- * so every input error is reported before anything runs; the runs share nothing and are
+ * so every input error is reported before anything runs, and built again when it runs (a
+ * point keeps only its values and results: about 1 kB); the runs share nothing and are
  * distributed over OpenMP threads with dynamic scheduling (run times differ by orders of
  * magnitude across a batch); each keeps its engine's CSV fields, and the table is written
  * after all finished, so its data rows are bit-identical for any thread count.
@@ -22,11 +23,10 @@
 
 #define CLI_BATCH_MAX_KEYS 2
 
-/* One point: its set-up, and after the run its status and CSV fields. */
+/* One point: its values, and after the run its status and CSV fields (its scenario and
+ * set-up live only while it is checked and while it runs). */
 struct cli_batch_point {
     double value[CLI_BATCH_MAX_KEYS];   /* the keys' values at this point [their units] */
-    struct cli_scenario sc;             /* pairwise engine: the point's scenario until run */
-    struct cli_setup su;                /* soft engine: the built simulation until run */
     struct wetdem_collision_result res; /* soft engine: the run's result (zero for pairwise) */
     int status;                         /* the run's status (the pairwise engine's own) */
     char errmsg[256];                   /* the engine's message of a failed run */

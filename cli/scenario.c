@@ -111,21 +111,24 @@ void cli_scenario_free(struct cli_scenario* sc)
 
 int cli_scenario_copy(const struct cli_scenario* src, struct cli_scenario* dst)
 {
+    /* entries and section marks are plain values: copied whole (a batch copies one per point) */
     memset(dst, 0, sizeof *dst);
     copy_text(dst->file, sizeof dst->file, src->file);
-    for (size_t k = 0; k < src->n_entries; k++) {
-        const struct cli_entry* e = &src->entries[k];
-        if (push_entry(dst, e->section, e->key, e->value, e->line) != 0)
-            goto fail;
+    size_t n_e = src->n_entries, n_s = src->n_sections;
+    dst->entries = malloc((n_e ? n_e : 1) * sizeof *dst->entries);
+    dst->sections = malloc((n_s ? n_s : 1) * sizeof *dst->sections);
+    if (!dst->entries || !dst->sections) {
+        cli_scenario_free(dst);
+        cli_error("out of memory copying a scenario");
+        return CLI_EXIT_RUNTIME;
     }
-    for (size_t k = 0; k < src->n_sections; k++)
-        if (push_section(dst, src->sections[k].name, src->sections[k].line) != 0)
-            goto fail;
+    if (n_e)
+        memcpy(dst->entries, src->entries, n_e * sizeof *dst->entries);
+    if (n_s)
+        memcpy(dst->sections, src->sections, n_s * sizeof *dst->sections);
+    dst->n_entries = dst->entries_cap = n_e;
+    dst->n_sections = dst->sections_cap = n_s;
     return CLI_EXIT_OK;
-fail:
-    cli_scenario_free(dst);
-    cli_error("out of memory copying a scenario");
-    return CLI_EXIT_RUNTIME;
 }
 
 /* ---- messages ---- */
@@ -254,7 +257,8 @@ static int check_names(const struct cli_scenario* sc, const struct cli_entry* e,
     int count = 0;
     const char* names[CLI_VALUE_MAX / 2];
     const char* word = NULL; /* 'none' or 'all', which stand for the whole list */
-    for (char* tok = strtok(buf, " ,\t"); tok; tok = strtok(NULL, " ,\t")) {
+    char* save = NULL;
+    for (char* tok = strtok_r(buf, " ,\t", &save); tok; tok = strtok_r(NULL, " ,\t", &save)) {
         if (!cli_is_name(tok)) {
             cli_scenario_error(sc, e, "'%s' is not a name (letters, digits, '_' and '-')", tok);
             return CLI_EXIT_USAGE;

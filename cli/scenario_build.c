@@ -189,7 +189,8 @@ static int enable_forces(const struct cli_scenario* sc, struct wetdem_sim* sim)
     const struct cli_entry* e = cli_scenario_find(sc, "models", "force");
     char buf[CLI_VALUE_MAX];
     snprintf(buf, sizeof buf, "%s", e ? e->value : "hertz");
-    for (char* tok = strtok(buf, " ,\t"); tok; tok = strtok(NULL, " ,\t")) {
+    char* save = NULL;
+    for (char* tok = strtok_r(buf, " ,\t", &save); tok; tok = strtok_r(NULL, " ,\t", &save)) {
         const struct wetdem_model* m = wetdem_model_find(tok);
         if (m && m->kind == WETDEM_MODEL_MIN_SEPARATION) {
             cli_scenario_error(sc, e,

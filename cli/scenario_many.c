@@ -185,7 +185,8 @@ static int build_models(const struct cli_scenario* sc, struct wetdem_sim* sim)
     const struct cli_entry* e = cli_scenario_find(sc, "models", "force");
     char buf[CLI_VALUE_MAX];
     snprintf(buf, sizeof buf, "%s", e ? e->value : "hertz");
-    for (char* tok = strtok(buf, " ,\t"); tok; tok = strtok(NULL, " ,\t")) {
+    char* save = NULL;
+    for (char* tok = strtok_r(buf, " ,\t", &save); tok; tok = strtok_r(NULL, " ,\t", &save)) {
         const struct wetdem_model* m = wetdem_model_find(tok);
         if (m && m->kind != WETDEM_MODEL_CONTACT && m->kind != WETDEM_MODEL_FLUID) {
             cli_scenario_error(sc, e,
@@ -298,7 +299,8 @@ static int build_box(const struct cli_scenario* sc, struct cli_many_setup* su)
     const struct cli_entry* e = cli_scenario_find(sc, "box", "periodic");
     char buf[CLI_VALUE_MAX];
     snprintf(buf, sizeof buf, "%s", e ? e->value : "none");
-    for (char* tok = strtok(buf, " ,\t"); tok; tok = strtok(NULL, " ,\t")) {
+    char* save = NULL;
+    for (char* tok = strtok_r(buf, " ,\t", &save); tok; tok = strtok_r(NULL, " ,\t", &save)) {
         if (strcmp(tok, "none") == 0)
             continue;
         if (strlen(tok) != 1 || !strchr("xyz", tok[0])) {
@@ -318,7 +320,8 @@ static int wall_faces(const struct cli_scenario* sc, const struct cli_many_setup
     char buf[CLI_VALUE_MAX];
     snprintf(buf, sizeof buf, "%s", e ? e->value : "all");
     *faces = 0;
-    for (char* tok = strtok(buf, " ,\t"); tok; tok = strtok(NULL, " ,\t")) {
+    char* save = NULL;
+    for (char* tok = strtok_r(buf, " ,\t", &save); tok; tok = strtok_r(NULL, " ,\t", &save)) {
         if (strcmp(tok, "none") == 0)
             continue;
         if (strcmp(tok, "all") == 0) {
@@ -383,8 +386,8 @@ static int build_walls(const struct cli_scenario* sc, struct cli_many_setup* su,
 static int insert_error(const struct cli_scenario* sc, const char* section, const char* msg)
 {
     const char* key = NULL;
+    char k[CLI_NAME_MAX];
     if (strncmp(msg, "insert.", 7) == 0) {
-        static char k[CLI_NAME_MAX];
         size_t n = strcspn(msg + 7, " ");
         snprintf(k, sizeof k, "%.*s", (int)(n < sizeof k ? n : sizeof k - 1), msg + 7);
         key = k;

@@ -56,8 +56,6 @@ void wetdem_param_range_text(const struct wetdem_param_desc* d, char* buf, size_
 int wetdem_param_validate(const struct wetdem_param_desc* d, double value, char* msg,
                           size_t msg_size)
 {
-    char range[160];
-    wetdem_param_range_text(d, range, sizeof range);
     bool ok = isfinite(value);
     if (ok && d->choices) {
         double idx = floor(value);
@@ -68,9 +66,12 @@ int wetdem_param_validate(const struct wetdem_param_desc* d, double value, char*
     }
     if (ok)
         return WETDEM_OK;
-    if (msg && msg_size)
+    if (msg && msg_size) { /* (the range's text only now: builds check every parameter) */
+        char range[160];
+        wetdem_param_range_text(d, range, sizeof range);
         snprintf(msg, msg_size, "%s = %g [%s] is out of range: valid %s", d->name, value, d->unit,
                  range);
+    }
     return WETDEM_ERR_INVALID;
 }
 

@@ -490,6 +490,39 @@ static void csv_field(const char* line, int col, char* out, size_t n)
     snprintf(out, n, "%.*s", (int)(len < n ? len : n - 1), line);
 }
 
+/* Each point of a sweep is built afresh from the scenario when it runs (a point keeps only its
+ * values and results): its row is the collision `wetdem run FILE --set KEY=value` gives. The
+ * sweep prints 12 significant digits, so 1e-11 relative; e_n of the wet case changes by 1e-3
+ * between the speeds, so a row of the wrong point fails. */
+static void test_scenario_sweep_point_equals_run(void** state)
+{
+    (void)state;
+    const char* args = "sweep examples/scenarios/nijssen_head_on.ini --param collision.stokes "
+                       "--values 20:80:4";
+    struct test_run sw = test_run_cli("OMP_NUM_THREADS=2", args, false);
+    assert_int_equal(sw.code, 0);
+    char* rows = data_lines(sw.out);
+    const char* line = strchr(rows, '\n') + 1; /* after the header */
+    for (int k = 0; k < 4; k++) {
+        double stokes = 20 + 20 * k;
+        char cmd[256], e_sweep[64];
+        snprintf(cmd, sizeof cmd,
+                 "run examples/scenarios/nijssen_head_on.ini --json --set collision.stokes=%g",
+                 stokes);
+        struct test_run r = test_run_cli("", cmd, false);
+        assert_int_equal(r.code, 0);
+        const char* e = strstr(r.out, "\"e_n\": ");
+        assert_non_null(e);
+        CHECK_REL(strtod(line, NULL), stokes, 0.0);
+        csv_field(line, 6, e_sweep, sizeof e_sweep); /* stokes, status, speed, St, v_n0, e, e_n */
+        CHECK_REL(strtod(e_sweep, NULL), strtod(e + 7, NULL), 1e-11);
+        free(r.out);
+        line = strchr(line, '\n') + 1;
+    }
+    free(rows);
+    free(sw.out);
+}
+
 static void test_scenario_sweep_pairwise_threads_and_status(void** state)
 {
     (void)state;
@@ -622,6 +655,7 @@ int main(void)
         cmocka_unit_test(test_scenario_run_writes_files_or_nothing),
         cmocka_unit_test(test_scenario_bad_output_paths_exit_2),
         cmocka_unit_test(test_scenario_sweep_order_and_threads),
+        cmocka_unit_test(test_scenario_sweep_point_equals_run),
         cmocka_unit_test(test_scenario_sweep_pairwise_threads_and_status),
         cmocka_unit_test(test_scenario_map_and_check_of_other_engines),
     };
