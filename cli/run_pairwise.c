@@ -25,10 +25,11 @@
 #include "scenario.h"
 
 #define NUM CLI_KEY_NUMBER
+#define COUNT CLI_KEY_COUNT
 
 static const struct cli_key_desc davis_keys[] = {
-    NUM("n_spheres", "-", "3", 2, 3, false, false,
-        "2: striker and target only (oblique two-sphere collision); 3: Davis Fig. 3."),
+    COUNT("n_spheres", "3", 2, 3,
+          "2: striker and target only (oblique two-sphere collision); 3: Davis Fig. 3."),
     NUM("stokes", "-", "2", 0, 1e9, true, false,
         "Normal Stokes number St_n = m v_n0/(6 pi mu a^2)."),
     NUM("capillary", "-", "1000", 0, 1e12, false, false,
@@ -68,12 +69,11 @@ static const struct cli_key_desc pairwise_keys[] = {
     NUM("rest_speed_ratio", "-", "1e-3", 0, 1, false, true,
         "Contacts slower than this times v_n0 are held at h_min (resting contact); without "
         "v_n0 > 0, times the largest initial sphere speed."),
-    NUM("stop_when_separated", "-", "1", 0, 1, false, false,
-        "1: stop once every pair is apart and receding; 0: run to t_end."),
-    NUM("ref_i", "-", "1", 1, 8, false, false,
-        "Reference pair (v_n0, delta_12, t-hat, t*): first."),
-    NUM("ref_j", "-", "2", 1, 8, false, false, "Reference pair: second sphere."),
-    NUM("max_events", "-", "100000", 1, 1e9, false, false, "Event budget of one run."),
+    COUNT("stop_when_separated", "1", 0, 1,
+          "1: stop once every pair is apart and receding; 0: run to t_end."),
+    COUNT("ref_i", "1", 1, 8, "Reference pair (v_n0, delta_12, t-hat, t*): first."),
+    COUNT("ref_j", "2", 1, 8, "Reference pair: second sphere."),
+    COUNT("max_events", "100000", 1, 1e9, "Event budget of one run."),
     {0},
 };
 

@@ -296,6 +296,7 @@ struct wetdem_param_desc cli_key_as_param(const struct cli_key_desc* k)
     d.min_open = k->min_open;
     d.max_open = k->max_open;
     d.choices = k->kind == CLI_VALUE_CHOICE ? k->choices : NULL;
+    d.integer = k->integer;
     return d;
 }
 

@@ -65,17 +65,23 @@ struct cli_key_desc {
     bool min_open, max_open;    /* exclude the bound */
     const char* const* choices; /* CLI_VALUE_CHOICE: NULL-terminated words */
     const char* doc;            /* one or two sentences */
+    bool integer;               /* numbers: whole numbers only (counts, steps, indices) */
 };
 
 /* Initialisers of key descriptors for the tables of cli/scenario_keys.c, cli/scenario_many.c
  * and cli/run_pairwise.c: a number with its unit and valid range, or a word of a kind. */
 #define CLI_KEY_NUMBER(k, u, dflt, lo, hi, lo_open, hi_open, doc)                                  \
     {                                                                                              \
-        k, CLI_VALUE_NUMBER, u, dflt, lo, hi, lo_open, hi_open, NULL, doc                          \
+        k, CLI_VALUE_NUMBER, u, dflt, lo, hi, lo_open, hi_open, NULL, doc, false                   \
+    }
+/* A whole number in [lo, hi] without a unit: a count, a number of steps, an index. */
+#define CLI_KEY_COUNT(k, dflt, lo, hi, doc)                                                        \
+    {                                                                                              \
+        k, CLI_VALUE_NUMBER, "-", dflt, lo, hi, false, false, NULL, doc, true                      \
     }
 #define CLI_KEY_WORD(k, kind, dflt, choices, doc)                                                  \
     {                                                                                              \
-        k, kind, "", dflt, 0, 0, false, false, choices, doc                                        \
+        k, kind, "", dflt, 0, 0, false, false, choices, doc, false                                 \
     }
 
 /* The choices of a yes/no key. */

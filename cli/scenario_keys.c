@@ -20,6 +20,7 @@ static const char* const fluid_choices[] = {"water", "glycerol80", "silicone10",
 static const char* const engine_choices[] = {"soft", "pairwise", NULL};
 
 #define NUM CLI_KEY_NUMBER
+#define COUNT CLI_KEY_COUNT
 #define WORD CLI_KEY_WORD
 
 static const struct cli_key_desc collision_keys[] = {
@@ -106,8 +107,7 @@ static const struct cli_key_desc integrator_keys[] = {
         "Nijssen: 0.02)."),
     NUM("dt", "s", NULL, 0, 1, false, false,
         "verlet: fixed time step; 0 derives it from dt_fraction."),
-    NUM("max_steps", "-", NULL, 1, 1e12, false, false,
-        "verlet and cvode: most steps one integration may take."),
+    COUNT("max_steps", NULL, 1, 1e12, "verlet and cvode: most steps one integration may take."),
     NUM("rtol", "-", NULL, 1e-14, 1e-2, false, false, "cvode: relative tolerance."),
     NUM("atol", "-", NULL, 1e-16, 1e-2, false, false,
         "cvode: absolute tolerance in units of the length, speed and spin scales."),
@@ -115,10 +115,9 @@ static const struct cli_key_desc integrator_keys[] = {
          "cvode: auto (Adams, switching to BDF for the rest of the run once a stretch without "
          "events turns stiff, e.g. a resting lubricated contact), adams (non-stiff) or bdf "
          "(stiff, dense Newton)."),
-    NUM("stiff_steps", "-", NULL, 10, 1e9, false, false,
-        "cvode, method auto: Adams steps without an event after which BDF takes over."),
-    NUM("max_order", "-", NULL, 1, 12, false, false,
-        "cvode: largest order of the method (BDF uses at most 5)."),
+    COUNT("stiff_steps", NULL, 10, 1e9,
+          "cvode, method auto: Adams steps without an event after which BDF takes over."),
+    COUNT("max_order", NULL, 1, 12, "cvode: largest order of the method (BDF uses at most 5)."),
     NUM("max_step", "s", NULL, 0, 1e6, false, false,
         "cvode: largest step; 0 uses 0.1 x smallest radius / speed scale."),
     {0},

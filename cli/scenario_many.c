@@ -25,6 +25,7 @@
 #include "scenario_many.h"
 
 #define NUM CLI_KEY_NUMBER
+#define COUNT CLI_KEY_COUNT
 #define WORD CLI_KEY_WORD
 #define MAX_MATERIALS 32
 
@@ -57,7 +58,7 @@ static const struct cli_key_desc insert_keys[] = {
          "lattice: simple cubic lattice of spacing 2 radius_max + gap, bottom layers first; "
          "random: random sequential addition without overlap (jams near a volume fraction of "
          "0.38)."),
-    NUM("count", "-", "required", 1, 1e8, false, false, "Number of spheres."),
+    COUNT("count", "required", 1, 1e8, "Number of spheres."),
     NUM("radius", "m", "required unless radius_min/max", 0, 1, true, false,
         "Radius of equal spheres."),
     NUM("radius_min", "m", "none", 0, 1, true, false,
@@ -65,8 +66,8 @@ static const struct cli_key_desc insert_keys[] = {
     NUM("radius_max", "m", "none", 0, 1, true, false, "Polydisperse: largest radius."),
     NUM("gap", "m", "0", 0, 1, false, false,
         "Least surface gap between spheres and to the region's faces."),
-    NUM("seed", "-", "1", 0, 4294967295.0, false, false,
-        "Seed of the generator (mt19937): the same seed gives the same spheres."),
+    COUNT("seed", "1", 0, 4294967295.0,
+          "Seed of the generator (mt19937): the same seed gives the same spheres."),
     WORD("material", CLI_VALUE_NAME, "steel1", NULL,
          "Material: a preset (steel1, steel2, glass, delrin, punch_steel, punch_steel_coated) "
          "or NAME of a [material.NAME] section."),
@@ -102,7 +103,7 @@ static const struct cli_key_desc particle_keys[] = {
 
 static const struct cli_key_desc run_keys[] = {
     NUM("t_end", "s", "give t_end or steps", 0, 1e6, true, false, "Simulated time of the run."),
-    NUM("steps", "-", "give t_end or steps", 1, 1e15, false, false, "Number of time steps."),
+    COUNT("steps", "give t_end or steps", 1, 1e15, "Number of time steps."),
     NUM("dt", "s", "0 ([integrator] dt, else dt_fraction)", 0, 1, false, false,
         "Time step; 0: [integrator] dt, else dt_fraction x the contact time of the two "
         "smallest spheres at twice the largest speed plus the speed gravity adds over the "
@@ -120,20 +121,19 @@ static const struct cli_key_desc dump_keys[] = {
     WORD("vtk", CLI_VALUE_TEXT, "particles", NULL,
          "Prefix of the VTK files PREFIX_NNNNNN.vtk and of the ParaView index PREFIX.vtk.series "
          "in --out DIR; none disables them."),
-    NUM("vtk_every", "-", "run steps / 50", 0, 1e15, false, false,
-        "Steps between VTK frames (the last step is always written); 0: none."),
+    COUNT("vtk_every", "run steps / 50", 0, 1e15,
+          "Steps between VTK frames (the last step is always written); 0: none."),
     WORD("vtk_binary", CLI_VALUE_CHOICE, "yes", cli_yes_no,
          "yes: binary legacy VTK (exact, compact); no: ASCII with 17 digits."),
     WORD("csv", CLI_VALUE_TEXT, "global.csv", NULL,
          "CSV of global quantities (energies, contacts, liquid bridges, agglomerates, work per "
          "model) in --out DIR, ending in .csv; none disables it."),
-    NUM("csv_every", "-", "run steps / 500", 0, 1e15, false, false,
-        "Steps between CSV rows; 0: none."),
+    COUNT("csv_every", "run steps / 500", 0, 1e15, "Steps between CSV rows; 0: none."),
     WORD("checkpoint", CLI_VALUE_TEXT, "checkpoint.ckpt", NULL,
          "Checkpoint in --out DIR, written atomically every checkpoint_every steps, when "
          "interrupted (SIGINT, SIGTERM) and at the end; none disables it."),
-    NUM("checkpoint_every", "-", "0 (interruption and end only)", 0, 1e15, false, false,
-        "Steps between periodic checkpoints."),
+    COUNT("checkpoint_every", "0 (interruption and end only)", 0, 1e15,
+          "Steps between periodic checkpoints."),
     WORD("summary", CLI_VALUE_TEXT, "summary.json", NULL,
          "Summary and energy budget (JSON) in --out DIR; none disables it."),
     {0},

@@ -114,6 +114,7 @@ struct wetdem_param_desc {
     double min, max;            /* valid closed range [min, max]; see *_open flags */
     bool min_open, max_open;    /* exclude the bound itself */
     const char* const* choices; /* NULL-terminated words, or NULL for a number */
+    bool integer;               /* a count or an order: whole numbers only */
 };
 
 /* Number of descriptors in a {0}-terminated table. */

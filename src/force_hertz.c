@@ -41,7 +41,7 @@ static const struct wetdem_param_desc hertz_params_desc[] = {
      "Normal damping: exact (force clipped at zero, coefficient that rebounds with exactly "
      "e_dry under the clipped law) or tsuji (LIGGGHTS model hertz: Tsuji coefficient, force "
      "not clipped, which also rebounds with exactly e_dry but pulls at the end of unloading).",
-     offsetof(struct hertz_params, damping), 0, 0, 1, false, false, damping_choices},
+     offsetof(struct hertz_params, damping), 0, 0, 1, false, false, damping_choices, false},
     {0},
 };
 

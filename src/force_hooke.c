@@ -27,7 +27,7 @@ struct hooke_params {
 
 static const struct wetdem_param_desc hooke_params_desc[] = {
     {"stiffness", "N/m", "Normal spring constant k of the linear contact.",
-     offsetof(struct hooke_params, stiffness), 1e6, 0, 1e15, true, false, NULL},
+     offsetof(struct hooke_params, stiffness), 1e6, 0, 1e15, true, false, NULL, false},
     {0},
 };
 

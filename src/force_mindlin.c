@@ -46,7 +46,7 @@ static const struct wetdem_param_desc mindlin_params_desc[] = {
     {"friction", "-",
      "Which Coulomb coefficient of the pair limits the tangential force: dry "
      "(material friction_dry) or lubricated (material friction_lub).",
-     offsetof(struct mindlin_params, friction), 0, 0, 1, false, false, friction_choices},
+     offsetof(struct mindlin_params, friction), 0, 0, 1, false, false, friction_choices, false},
     {0},
 };
 

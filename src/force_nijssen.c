@@ -46,11 +46,12 @@ struct nijssen_params {
 
 static const struct wetdem_param_desc nijssen_params_desc[] = {
     {"cutoff_ratio", "-", "Cut-off gap h_co as a multiple of R* (Nijssen: 1).",
-     offsetof(struct nijssen_params, cutoff_ratio), 1.0, 0, 100, true, false, NULL},
+     offsetof(struct nijssen_params, cutoff_ratio), 1.0, 0, 100, true, false, NULL, false},
     {"damping", "-",
      "Hertz damping from e_dry: exact = rebound with exactly e_dry, tsuji = the LIGGGHTS "
      "coefficient; both on the contact branch clipped at zero (unlike hertz.damping = tsuji).",
-     offsetof(struct nijssen_params, damping), 0, 0, 1, false, false, nijssen_damping_choices},
+     offsetof(struct nijssen_params, damping), 0, 0, 1, false, false, nijssen_damping_choices,
+     false},
     {0},
 };
 

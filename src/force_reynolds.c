@@ -19,7 +19,7 @@ struct reynolds_params {
 
 static const struct wetdem_param_desc reynolds_params_desc[] = {
     {"cutoff_ratio", "-", "Cut-off gap h_co as a multiple of R*.",
-     offsetof(struct reynolds_params, cutoff_ratio), 1.0, 0, 100, true, false, NULL},
+     offsetof(struct reynolds_params, cutoff_ratio), 1.0, 0, 100, true, false, NULL, false},
     {0},
 };
 

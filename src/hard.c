@@ -39,7 +39,7 @@ static const struct wetdem_param_desc hard_params_desc[] = {
     {"friction", "-",
      "Which Coulomb coefficient of the pair the engine passes to the impulse: dry "
      "(material friction_dry) or lubricated (material friction_lub, Davis's mu_f).",
-     offsetof(struct hard_params, friction), 1, 0, 1, false, false, friction_choices},
+     offsetof(struct hard_params, friction), 1, 0, 1, false, false, friction_choices, false},
     {0},
 };
 

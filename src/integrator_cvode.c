@@ -62,27 +62,27 @@ _Static_assert(sizeof(struct cvode_params) <= WETDEM_INTEGRATOR_PARAMS_MAX * siz
 #define P(field) offsetof(struct cvode_params, field)
 static const struct wetdem_param_desc cvode_params_desc[] = {
     {"rtol", "-", "Relative tolerance of CVODE's local error test.", P(rtol), 1e-8, 1e-14, 1e-2,
-     false, false, NULL},
+     false, false, NULL, false},
     {"atol", "-",
      "Absolute tolerance in units of the length scale (positions), speed scale (velocities) "
      "and their ratio (spins).",
-     P(atol), 1e-9, 1e-16, 1e-2, false, false, NULL},
+     P(atol), 1e-9, 1e-16, 1e-2, false, false, NULL, false},
     {"max_steps", "-", "Largest number of steps one integrate call may take.", P(max_steps), 1e7,
-     1.0, 1e12, false, false, NULL},
+     1.0, 1e12, false, false, NULL, true},
     {"method", "-",
      "adams (non-stiff, functional iteration), bdf (stiff, dense Newton) or auto (adams, "
      "switching to bdf when a stretch without events takes stiff_steps steps).",
-     P(method), 0, 0, 2, false, false, method_choices},
+     P(method), 0, 0, 2, false, false, method_choices, false},
     {"max_step", "s", "Largest step; 0 uses 0.1 x smallest radius / speed scale.", P(max_step), 0,
-     0, 1e6, false, false, NULL},
+     0, 1e6, false, false, NULL, false},
     {"stiff_steps", "-",
      "auto: Adams steps without an event after which the problem counts as stiff (e.g. a "
      "resting lubricated contact) and BDF takes over for the rest of the run.",
-     P(stiff_steps), 500, 10, 1e9, false, false, NULL},
+     P(stiff_steps), 500, 10, 1e9, false, false, NULL, true},
     {"max_order", "-",
      "Largest order of the method (BDF uses at most 5). 5 was measured fastest for binary "
      "collisions: higher Adams orders cost O(q^2) vector operations per step.",
-     P(max_order), 5, 1, 12, false, false, NULL},
+     P(max_order), 5, 1, 12, false, false, NULL, true},
     {0},
 };
 #undef P

@@ -44,12 +44,12 @@ _Static_assert(sizeof(struct verlet_params) <= WETDEM_INTEGRATOR_PARAMS_MAX * si
 #define P(field) offsetof(struct verlet_params, field)
 static const struct wetdem_param_desc verlet_params_desc[] = {
     {"dt", "s", "Fixed time step; 0 derives it from dt_fraction and the contact time.", P(dt), 0.0,
-     0.0, 1.0, false, false, NULL},
+     0.0, 1.0, false, false, NULL, false},
     {"dt_fraction", "-",
      "Time step as a fraction of the contact time (Hertz, or hooke's half period; Nijssen: 0.02).",
-     P(dt_fraction), 0.02, 0.0, 1.0, true, false, NULL},
+     P(dt_fraction), 0.02, 0.0, 1.0, true, false, NULL, false},
     {"max_steps", "-", "Largest number of steps one integrate call may take.", P(max_steps), 1e8,
-     1.0, 1e12, false, false, NULL},
+     1.0, 1e12, false, false, NULL, true},
     {0},
 };
 #undef P

@@ -121,21 +121,22 @@ int wetdem_fluid_preset(const char* name, struct wetdem_fluid* f)
 
 #define MAT(field) offsetof(struct wetdem_material, field)
 static const struct wetdem_param_desc material_params[] = {
-    {"density", "kg/m^3", "Solid density.", MAT(density), 7780, 0, INFINITY, true, true, NULL},
+    {"density", "kg/m^3", "Solid density.", MAT(density), 7780, 0, INFINITY, true, true, NULL,
+     false},
     {"youngs_modulus", "Pa", "Young's modulus E.", MAT(youngs_modulus), 190e9, 0, INFINITY, true,
-     true, NULL},
+     true, NULL, false},
     {"poisson_ratio", "-", "Poisson's ratio nu.", MAT(poisson_ratio), 0.27, -1, 0.5, true, true,
-     NULL},
+     NULL, false},
     {"restitution", "-", "Dry coefficient of restitution e_dry.", MAT(restitution), 0.97, 0, 1,
-     true, false, NULL},
+     true, false, NULL, false},
     {"friction_dry", "-", "Coulomb friction coefficient of dry contact.", MAT(friction_dry), 0.11,
-     0, 10, false, false, NULL},
+     0, 10, false, false, NULL, false},
     {"friction_lub", "-", "Coulomb friction coefficient of lubricated contact.", MAT(friction_lub),
-     0.02, 0, 10, false, false, NULL},
+     0.02, 0, 10, false, false, NULL, false},
     {"roughness", "m", "Mean asperity height sigma (Nijssen Eq. 3).", MAT(roughness), 0, 0, 1e-2,
-     false, false, NULL},
+     false, false, NULL, false},
     {"film", "m", "Liquid film thickness on this sphere (delta_i).", MAT(film), 0, 0, 1, false,
-     false, NULL},
+     false, NULL, false},
     {0},
 };
 #undef MAT
@@ -143,10 +144,10 @@ static const struct wetdem_param_desc material_params[] = {
 #define FLU(field) offsetof(struct wetdem_fluid, field)
 static const struct wetdem_param_desc fluid_params[] = {
     {"viscosity", "Pa s", "Dynamic viscosity mu of the liquid.", FLU(viscosity), 1e-3, 0, 1e6,
-     false, false, NULL},
+     false, false, NULL, false},
     {"surface_tension", "N/m", "Surface tension sigma of the liquid.", FLU(surface_tension), 0.072,
-     0, 10, false, false, NULL},
-    {"density", "kg/m^3", "Liquid density.", FLU(density), 998, 0, 1e5, false, false, NULL},
+     0, 10, false, false, NULL, false},
+    {"density", "kg/m^3", "Liquid density.", FLU(density), 998, 0, 1e5, false, false, NULL, false},
     {0},
 };
 #undef FLU

@@ -55,7 +55,8 @@ struct minsep_speed_params {
         "reset_ratio", "-",                                                                        \
             "Gap, as a multiple of R*, beyond which the pair's largest approach speed is "         \
             "forgotten.",                                                                          \
-            offsetof(struct minsep_speed_params, reset_ratio), 1.0, 0, 100, true, false, NULL      \
+            offsetof(struct minsep_speed_params, reset_ratio), 1.0, 0, 100, true, false, NULL,     \
+            false                                                                                  \
     }
 
 /* h_eps [m] of the pair of contact c with v0 its largest approach speed during the current

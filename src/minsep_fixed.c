@@ -13,7 +13,7 @@ struct minsep_fixed_params {
 
 static const struct wetdem_param_desc fixed_params[] = {
     {"h_min", "m", "Minimum separation of the surfaces.",
-     offsetof(struct minsep_fixed_params, h_min), 1e-6, 0, 1e-1, false, false, NULL},
+     offsetof(struct minsep_fixed_params, h_min), 1e-6, 0, 1e-1, false, false, NULL, false},
     {0},
 };
 

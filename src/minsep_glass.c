@@ -38,12 +38,12 @@ struct minsep_glass_params {
 
 static const struct wetdem_param_desc glass_params[] = {
     {"p_gt", "Pa", "Glass-transition pressure of the liquid (Punch Fig. 8d: 11.6 MPa).",
-     offsetof(struct minsep_glass_params, p_gt), 11.6e6, 0, 1e12, true, false, NULL},
+     offsetof(struct minsep_glass_params, p_gt), 11.6e6, 0, 1e12, true, false, NULL, false},
     {"speed", "-",
      "Normal speed setting h_min: max = largest approach speed since the films overlapped, "
      "initial = approach speed at film overlap, current = instantaneous |v_n|.",
      offsetof(struct minsep_glass_params, speed), GLASS_SPEED_MAX, 0, 2, false, false,
-     glass_speed_choices},
+     glass_speed_choices, false},
     {0},
 };
 

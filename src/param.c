@@ -49,8 +49,12 @@ void wetdem_param_range_text(const struct wetdem_param_desc* d, char* buf, size_
             used += (size_t)snprintf(buf + used, n - used, "%s %s", k ? "," : "", d->choices[k]);
         return;
     }
-    snprintf(buf, n, "%c%.6g, %.6g%c", d->min_open ? '(' : '[', d->min, d->max,
-             d->max_open ? ')' : ']');
+    if (d->integer) /* whole numbers up to 10 digits in full: [0, 4294967295], not 4.29497e+09 */
+        snprintf(buf, n, "integer in %c%.10g, %.10g%c", d->min_open ? '(' : '[', d->min, d->max,
+                 d->max_open ? ')' : ']');
+    else
+        snprintf(buf, n, "%c%.6g, %.6g%c", d->min_open ? '(' : '[', d->min, d->max,
+                 d->max_open ? ')' : ']');
 }
 
 int wetdem_param_validate(const struct wetdem_param_desc* d, double value, char* msg,
@@ -64,13 +68,18 @@ int wetdem_param_validate(const struct wetdem_param_desc* d, double value, char*
         ok = (d->min_open ? value > d->min : value >= d->min) &&
              (d->max_open ? value < d->max : value <= d->max);
     }
-    if (ok)
+    bool whole = !d->integer || value == floor(value); /* 100.5 steps: a slip, not 100 */
+    if (ok && whole)
         return WETDEM_OK;
     if (msg && msg_size) { /* (the range's text only now: builds check every parameter) */
         char range[160];
         wetdem_param_range_text(d, range, sizeof range);
-        snprintf(msg, msg_size, "%s = %g [%s] is out of range: valid %s", d->name, value, d->unit,
-                 range);
+        if (ok) /* in range but not whole; all its digits, so 1e6 + 0.5 is not shown as 1e+06 */
+            snprintf(msg, msg_size, "%s = %.15g [%s] is not a whole number: valid %s", d->name,
+                     value, d->unit, range);
+        else
+            snprintf(msg, msg_size, "%s = %g [%s] is out of range: valid %s", d->name, value,
+                     d->unit, range);
     }
     return WETDEM_ERR_INVALID;
 }

@@ -22,21 +22,21 @@ static const char* const yes_no[] = {"no", "yes", NULL};
 #define SET(field) offsetof(struct wetdem_sim_settings, field)
 static const struct wetdem_param_desc settings_params[] = {
     {"gravity_x", "m/s^2", "Gravitational acceleration, x component.", SET(gravity_x), 0, -1e4, 1e4,
-     false, false, NULL},
+     false, false, NULL, false},
     {"gravity_y", "m/s^2", "Gravitational acceleration, y component.", SET(gravity_y), 0, -1e4, 1e4,
-     false, false, NULL},
+     false, false, NULL, false},
     {"gravity_z", "m/s^2", "Gravitational acceleration, z component.", SET(gravity_z), 0, -1e4, 1e4,
-     false, false, NULL},
+     false, false, NULL, false},
     {"stop_on_separation", "-",
      "Stop integrating (status WETDEM_EVENT) once every pair that interacted has left its "
      "interaction range and recedes.",
-     SET(stop_on_separation), 0, 0, 1, false, false, yes_no},
+     SET(stop_on_separation), 0, 0, 1, false, false, yes_no, false},
     {"separation_factor", "-",
      "A pair counts as separated when its gap exceeds this multiple of its interaction range.",
-     SET(separation_factor), 1, 1, 1e3, false, false, NULL},
+     SET(separation_factor), 1, 1, 1e3, false, false, NULL, false},
     {"speed_floor", "m/s",
      "Smallest relative speed used to derive the Verlet step and the CVODE tolerance scales.",
-     SET(speed_floor), 1e-3, 0, 1e3, true, false, NULL},
+     SET(speed_floor), 1e-3, 0, 1e3, true, false, NULL, false},
     {0},
 };
 #undef SET

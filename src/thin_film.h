@@ -44,7 +44,7 @@ static const char* const thin_film_below_choices[] = {"c", "nc", NULL};
         "below_hmin", "-",                                                                         \
             "Below h_min: c = force zero (Punch Eq. 12), nc = law evaluated at h_min (Eq. 13).",   \
             offsetof(type, below_hmin), THIN_FILM_BELOW_C, 0, 1, false, false,                     \
-            thin_film_below_choices                                                                \
+            thin_film_below_choices, false                                                         \
     }
 
 /* h_min capped at the film thickness (Punch Eq. 14 cap) [m]. */

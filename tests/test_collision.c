@@ -343,7 +343,7 @@ static int glue_pair(const void* params, const struct wetdem_contact* c, double*
 }
 
 static const struct wetdem_param_desc glue_desc[] = {
-    {"tau", "s", "decay", offsetof(struct glue_params, tau), 0, 0, 1e3, false, false, NULL},
+    {"tau", "s", "decay", offsetof(struct glue_params, tau), 0, 0, 1e3, false, false, NULL, false},
     {0},
 };
 

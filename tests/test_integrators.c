@@ -22,10 +22,12 @@ struct spring_params {
 };
 
 static const struct wetdem_param_desc spring_desc[] = {
-    {"k", "N/m", "stiffness", offsetof(struct spring_params, k), 0, 0, 1e12, false, false, NULL},
-    {"c", "N s/m", "damping", offsetof(struct spring_params, c), 0, 0, 1e12, false, false, NULL},
+    {"k", "N/m", "stiffness", offsetof(struct spring_params, k), 0, 0, 1e12, false, false, NULL,
+     false},
+    {"c", "N s/m", "damping", offsetof(struct spring_params, c), 0, 0, 1e12, false, false, NULL,
+     false},
     {"torque", "N m", "torque", offsetof(struct spring_params, torque), 0, -1, 1, false, false,
-     NULL},
+     NULL, false},
     {0},
 };
 

@@ -128,6 +128,11 @@ static void test_many_cli_bad_inputs_exit_2_with_file_and_line(void** state)
                "[box]\nsize_x = 1e-2\nsize_y = 1e-2\nsize_z = 1e-2\n[insert]\ncount = 5\n"
                "radius = -1e-3\n[run]\nsteps = 10\n",
                7, "radius");
+    /* a count given as 5.5 is refused, not truncated to 5 (line 6: count) */
+    expect_bad("fraction.ini",
+               "[box]\nsize_x = 1e-2\nsize_y = 1e-2\nsize_z = 1e-2\n[insert]\ncount = 5.5\n"
+               "radius = 1e-3\n[run]\nsteps = 10\n",
+               6, "count = 5.5 [-] is not a whole number: valid integer in [1, 100000000]");
     expect_bad("typo.ini",
                "[box]\nsize_x = 1e-2\nsize_y = 1e-2\nsize_z = 1e-2\n[insert]\ncuont = 5\n"
                "radius = 1e-3\n[run]\nsteps = 10\n",

@@ -182,9 +182,9 @@ static void test_params_range_text_and_message(void** state)
     (void)state;
     static const char* const words[] = {"c", "nc", NULL};
     const struct wetdem_param_desc d[] = {
-        {"ratio", "-", "doc", 0, 0.5, 0, 1, true, false, NULL},
-        {"speed", "m/s", "doc", 0, 0, -1, 1e6, false, true, NULL},
-        {"mode", "-", "doc", 0, 0, 0, 1, false, false, words},
+        {"ratio", "-", "doc", 0, 0.5, 0, 1, true, false, NULL, false},
+        {"speed", "m/s", "doc", 0, 0, -1, 1e6, false, true, NULL, false},
+        {"mode", "-", "doc", 0, 0, 0, 1, false, false, words, false},
     };
     char buf[160];
     wetdem_param_range_text(&d[0], buf, sizeof buf);
@@ -201,6 +201,36 @@ static void test_params_range_text_and_message(void** state)
     CHECK_OK(wetdem_param_validate(&d[1], -1.0, NULL, 0));
     assert_int_equal(wetdem_param_choice_index(&d[2], "nc"), 1);
     assert_int_equal(wetdem_param_choice_index(&d[2], "x"), -1);
+}
+
+/* A count (integer = true) takes whole numbers only: 100.5 steps is refused, not truncated to
+ * 100; the value is printed in all its digits, and its range in full up to 10 digits. */
+static void test_params_integer_counts(void** state)
+{
+    (void)state;
+    const struct wetdem_param_desc seed = {"seed",       "-",   "doc", 0,    1,   0,
+                                           4294967295.0, false, false, NULL, true};
+    char buf[160], msg[256];
+    wetdem_param_range_text(&seed, buf, sizeof buf);
+    assert_string_equal(buf, "integer in [0, 4294967295]");
+    CHECK_OK(wetdem_param_validate(&seed, 4294967295.0, msg, sizeof msg));
+    CHECK_OK(wetdem_param_validate(&seed, 0.0, msg, sizeof msg));
+    CHECK_STATUS(wetdem_param_validate(&seed, 1e6 + 0.5, msg, sizeof msg), WETDEM_ERR_INVALID);
+    assert_string_equal(msg, "seed = 1000000.5 [-] is not a whole number: valid integer in "
+                             "[0, 4294967295]");
+    CHECK_STATUS(wetdem_param_validate(&seed, -1.0, msg, sizeof msg), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(msg, "seed = -1 [-] is out of range");
+    /* the library's own counts: an integrator's step budget and order */
+    struct wetdem_sim* sim = wetdem_sim_create();
+    CHECK_OK(wetdem_sim_set_integrator(sim, "cvode"));
+    CHECK_OK(wetdem_sim_set_param(sim, "cvode.max_order", 4));
+    CHECK_STATUS(wetdem_sim_set_param(sim, "cvode.max_order", 2.5), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(wetdem_sim_errmsg(sim), "max_order = 2.5 [-] is not a whole number");
+    CHECK_STATUS(wetdem_sim_set_param(sim, "cvode.max_steps", 100.5), WETDEM_ERR_INVALID);
+    double order = 0;
+    CHECK_OK(wetdem_sim_param(sim, "cvode.max_order", &order));
+    CHECK_REL(order, 4.0, 0.0); /* the refused value left the old one */
+    wetdem_sim_free(sim);
 }
 
 static void test_params_suggest_threshold(void** state)
@@ -361,6 +391,7 @@ int main(void)
         cmocka_unit_test(test_params_choice_by_word),
         cmocka_unit_test(test_params_range_text_and_message),
         cmocka_unit_test(test_params_suggest_threshold),
+        cmocka_unit_test(test_params_integer_counts),
         cmocka_unit_test(test_params_presets_match_seed_tables),
         cmocka_unit_test(test_params_mass_from_density),
         cmocka_unit_test(test_params_public_settings_and_integrator_tables),
