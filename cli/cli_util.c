@@ -269,7 +269,11 @@ bool cli_wants_help(int argc, char** argv)
 const char* cli_option_hint(const char* arg, const char* const* options, char* buf, size_t n)
 {
     const char* hint = arg[0] == '-' ? wetdem_param_suggest(arg, options) : NULL;
-    snprintf(buf, n, "%s%s%s", hint ? " (did you mean '" : "", hint ? hint : "", hint ? "'?)" : "");
+    if (hint && strcmp(hint, arg) == 0) /* a known option that reached here: its value is missing */
+        snprintf(buf, n, " (needs a value)");
+    else
+        snprintf(buf, n, "%s%s%s", hint ? " (did you mean '" : "", hint ? hint : "",
+                 hint ? "'?)" : "");
     return buf;
 }
 

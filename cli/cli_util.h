@@ -56,8 +56,9 @@ int cli_apply_set(struct wetdem_sim* sim, const char* key_value);
 bool cli_wants_help(int argc, char** argv);
 
 /* " (did you mean 'NAME'?)" for the name among `options` (NULL-terminated) closest to a
- * misspelt option `arg` (wetdem_param_suggest), written into buf; "" when arg does not start
- * with '-' or nothing is close. Returns buf, for use as a "%s" argument. */
+ * misspelt option `arg` (wetdem_param_suggest), written into buf; " (needs a value)" when arg
+ * is one of them (a command's parser rejects a known option only when its value is missing);
+ * "" when arg does not start with '-' or nothing is close. Returns buf, for "%s". */
 const char* cli_option_hint(const char* arg, const char* const* options, char* buf, size_t n);
 
 /* Writes the '#' provenance lines that start every CSV the CLI prints:

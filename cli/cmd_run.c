@@ -69,13 +69,12 @@ static int parse_args(int argc, char** argv, struct run_args* a)
                                                   "--json", "--check", NULL};
             bool takes_value =
                 strcmp(s, "--set") == 0 || strcmp(s, "--out") == 0 || strcmp(s, "--restart") == 0;
-            char hint[64] = "";
+            char hint[64];
             if (takes_value && has_next)
                 cli_error("run: more than %d --set options", MAX_SETS);
             else
                 cli_error("run: unexpected argument '%s'%s", s,
-                          takes_value ? " (needs a value)"
-                                      : cli_option_hint(s, options, hint, sizeof hint));
+                          cli_option_hint(s, options, hint, sizeof hint));
             usage(stderr);
             return CLI_EXIT_USAGE;
         }

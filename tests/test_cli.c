@@ -271,6 +271,8 @@ static void test_cli_bad_options_get_hints(void** state)
         {"sweep none.ini --parma a",
          "sweep: unexpected argument '--parma' (did you mean '--param'?)"},
         {"map none.ini --lgo2", "map: unexpected argument '--lgo2' (did you mean '--log2'?)"},
+        {"sweep none.ini --values 1:2:3 --param", "unexpected argument '--param' (needs a value)"},
+        {"map none.ini --param2", "map: unexpected argument '--param2' (needs a value)"},
         {"fit none.ini --dat d.csv", "fit: unknown option '--dat' (did you mean '--data'?)"},
         {"fit none.ini --zzzzzzzz 1", "fit: unknown option '--zzzzzzzz'\n"},
         {"forces --model reynolds --radus 1",
