@@ -85,6 +85,7 @@ static int parse_args(int argc, char** argv, struct track_cli* c)
 {
     memset(c, 0, sizeof *c);
     wetdem_track_options_init(&c->opt);
+    c->opt.fps = c->opt.pixel_size = NAN; /* not given (0 given is the library's to refuse) */
     for (int k = 1; k < argc; k++) {
         const char* a = argv[k];
         if (strcmp(a, "--json") == 0) {
@@ -106,8 +107,13 @@ static int parse_args(int argc, char** argv, struct track_cli* c)
             return CLI_EXIT_USAGE;
         }
     }
-    if (!c->input || c->opt.fps == 0 || c->opt.pixel_size == 0) {
-        cli_error("track: DOTS.csv, --fps and --pixel-size are required\n%s", usage);
+    const char* missing = !c->input                  ? "DOTS.csv"
+                          : isnan(c->opt.fps)        ? "--fps"
+                          : isnan(c->opt.pixel_size) ? "--pixel-size"
+                                                     : NULL;
+    if (missing) {
+        cli_error("track: %s is missing (DOTS.csv, --fps and --pixel-size are required)\n%s",
+                  missing, usage);
         return CLI_EXIT_USAGE;
     }
     return CLI_EXIT_OK;

@@ -743,6 +743,15 @@ static void test_track_cli_exits_2_with_line_number(void** state)
     CHECK_CONTAINS(out, "--frames FILE");
     assert_int_equal(test_run_cli_into("track dots.csv --fps", out, sizeof out), 2);
     CHECK_CONTAINS(out, "option --fps needs a value");
+    /* a missing option is named; a given but invalid one gets its own message (--fps 0 was
+       reported as missing) */
+    assert_int_equal(test_run_cli_into("track dots.csv --fps 5000", out, sizeof out), 2);
+    CHECK_CONTAINS(out, "track: --pixel-size is missing");
+    path = write_temp("frame,sphere,x1,y1,x2,y2,x3,y3\n0,1,1,1,2,2,3,3\n");
+    snprintf(args, sizeof args, "track %s --fps 0 --pixel-size 175e-6", path);
+    assert_int_equal(test_run_cli_into(args, out, sizeof out), 2);
+    remove(path);
+    CHECK_CONTAINS(out, "fps = 0: must be a frame rate > 0 [1/s]");
 }
 
 int main(void)
