@@ -134,8 +134,15 @@ static int parse_args(int argc, char** argv, struct forces_opts* o)
 /* Checks the numbers that the library cannot check for us (it never sees them alone). */
 static int check_opts(const struct forces_opts* o)
 {
-    if (!(o->radius > 0)) {
-        cli_error("forces: --radius = %g m is out of range: valid (0, inf)", o->radius);
+    /* the ranges of the scenario keys striker_radius and speed (docs/scenarios.md) */
+    if (!(o->radius > 0 && o->radius <= 1)) {
+        cli_error("forces: --radius = %g m is out of range: valid (0, 1]", o->radius);
+        return CLI_EXIT_USAGE;
+    }
+    if (!(fabs(o->speed) <= 1e3) || !(fabs(o->slip) <= 1e3)) {
+        cli_error("forces: --%s = %g m/s is out of range: valid [-1000, 1000]",
+                  fabs(o->speed) <= 1e3 ? "slip" : "speed",
+                  fabs(o->speed) <= 1e3 ? o->slip : o->speed);
         return CLI_EXIT_USAGE;
     }
     double lo = fmin(o->gaps.first, o->gaps.last);
