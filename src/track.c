@@ -459,12 +459,21 @@ static int check_options(struct wetdem_track* t, const struct wetdem_track_optio
     if (o->fit_frames != 0 && (o->fit_frames < TRACK_MIN_FIT || o->fit_frames > 1000000))
         return fail(t, WETDEM_ERR_INVALID, "fit_frames = %d: must be 0 (all) or in [%d, 1000000]",
                     o->fit_frames, TRACK_MIN_FIT);
-    const double phys[3] = {o->radius, o->mass, o->viscosity};
-    const char* names[3] = {"radius", "mass", "viscosity"};
-    for (int k = 0; k < 3; k++)
-        if (!(isfinite(phys[k]) && phys[k] >= 0))
-            return fail(t, WETDEM_ERR_INVALID, "%s = %g: must be >= 0 (0: not given)", names[k],
-                        phys[k]);
+    /* St_n's inputs, within the ranges of the scenario keys of a sphere (docs/scenarios.md) */
+    const double phys[3] = {o->radius, o->mass, o->viscosity}, top[3] = {1, 1e6, 1e9};
+    const char *names[3] = {"radius", "mass", "viscosity"}, *units[3] = {"m", "kg", "Pa s"};
+    int given = 0;
+    for (int k = 0; k < 3; k++) {
+        if (!(isfinite(phys[k]) && phys[k] >= 0 && phys[k] <= top[k]))
+            return fail(t, WETDEM_ERR_INVALID, "%s = %g: must be in (0, %g] %s, or 0: not given",
+                        names[k], phys[k], top[k], units[k]);
+        given += phys[k] > 0;
+    }
+    if (given == 1 || given == 2) /* St_n would be NaN without a word */
+        return fail(t, WETDEM_ERR_INVALID,
+                    "radius, mass and viscosity = %g m, %g kg, %g Pa s: the Stokes number needs "
+                    "all three (or none)",
+                    o->radius, o->mass, o->viscosity);
     return WETDEM_OK;
 }
 

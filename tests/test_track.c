@@ -697,6 +697,18 @@ static void test_track_rejects_short_or_mismatched_tracks(void** state)
     o.window = 4;
     CHECK_STATUS(wetdem_track_analyse(t, &o, &s), WETDEM_ERR_INVALID);
     CHECK_CONTAINS(wetdem_track_errmsg(t), "window = 4");
+    o.window = 7;
+    /* St_n's inputs: within the scenario keys' ranges, and all three or none (two of them gave
+       St_n = NaN without a word, a radius of 1e300 m gave St_n = 0) */
+    o.radius = 1e300;
+    o.mass = 0.068;
+    o.viscosity = 10;
+    CHECK_STATUS(wetdem_track_analyse(t, &o, &s), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(wetdem_track_errmsg(t), "radius = 1e+300: must be in (0, 1] m, or 0");
+    o.radius = 12.7e-3;
+    o.viscosity = 0;
+    CHECK_STATUS(wetdem_track_analyse(t, &o, &s), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(wetdem_track_errmsg(t), "the Stokes number needs all three (or none)");
     wetdem_track_free(t);
     /* Two resting spheres: no collision, and the message says why. */
     t = wetdem_track_create();
