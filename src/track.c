@@ -442,10 +442,13 @@ void wetdem_track_options_init(struct wetdem_track_options* opt)
 
 static int check_options(struct wetdem_track* t, const struct wetdem_track_options* o)
 {
-    if (!(isfinite(o->fps) && o->fps > 0))
-        return fail(t, WETDEM_ERR_INVALID, "fps = %g: must be a frame rate > 0 [1/s]", o->fps);
-    if (!(isfinite(o->pixel_size) && o->pixel_size > 0))
-        return fail(t, WETDEM_ERR_INVALID, "pixel_size = %g: must be > 0 [m/pixel]", o->pixel_size);
+    /* a camera's range, with room: 1e9 frames/s, 1 m a pixel (Punch: 5000, 175e-6) */
+    if (!(o->fps > 0 && o->fps <= 1e9))
+        return fail(t, WETDEM_ERR_INVALID, "fps = %g: must be a frame rate in (0, 1e9] [1/s]",
+                    o->fps);
+    if (!(o->pixel_size > 0 && o->pixel_size <= 1))
+        return fail(t, WETDEM_ERR_INVALID, "pixel_size = %g: must be in (0, 1] [m/pixel]",
+                    o->pixel_size);
     if (o->window < 1 || o->window % 2 == 0 || o->window > 1001)
         return fail(t, WETDEM_ERR_INVALID, "window = %d: must be odd, in [1, 1001] frames",
                     o->window);

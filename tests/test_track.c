@@ -698,6 +698,10 @@ static void test_track_rejects_short_or_mismatched_tracks(void** state)
     CHECK_STATUS(wetdem_track_analyse(t, &o, &s), WETDEM_ERR_INVALID);
     CHECK_CONTAINS(wetdem_track_errmsg(t), "window = 4");
     o.window = 7;
+    o.pixel_size = 1e300; /* (it made the first frames' speeds look like the collision) */
+    CHECK_STATUS(wetdem_track_analyse(t, &o, &s), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(wetdem_track_errmsg(t), "pixel_size = 1e+300: must be in (0, 1] [m/pixel]");
+    o.pixel_size = 175e-6;
     /* St_n's inputs: within the scenario keys' ranges, and all three or none (two of them gave
        St_n = NaN without a word, a radius of 1e300 m gave St_n = 0) */
     o.radius = 1e300;
@@ -763,7 +767,7 @@ static void test_track_cli_exits_2_with_line_number(void** state)
     snprintf(args, sizeof args, "track %s --fps 0 --pixel-size 175e-6", path);
     assert_int_equal(test_run_cli_into(args, out, sizeof out), 2);
     remove(path);
-    CHECK_CONTAINS(out, "fps = 0: must be a frame rate > 0 [1/s]");
+    CHECK_CONTAINS(out, "fps = 0: must be a frame rate in (0, 1e9] [1/s]");
 }
 
 int main(void)
