@@ -577,7 +577,8 @@ static int initial_values(const struct fit_args* a, const struct fit_ctx* c, dou
     char buf[1024];
     snprintf(buf, sizeof buf, "%s", a->init);
     size_t n = 0;
-    for (char* tok = strtok(buf, ","); tok; tok = strtok(NULL, ",")) {
+    char* save = NULL;
+    for (char* tok = strtok_r(buf, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
         if (n == c->n_keys) {
             cli_error("fit: --init has more values than --fit has keys (%zu)", c->n_keys);
             return CLI_EXIT_USAGE;
@@ -588,6 +589,24 @@ static int initial_values(const struct fit_args* a, const struct fit_ctx* c, dou
     if (n != c->n_keys) {
         cli_error("fit: --init has %zu values for %zu keys", n, c->n_keys);
         return CLI_EXIT_USAGE;
+    }
+    /* Each value as given, against its key's range, before the fit (which works on its
+       logarithm and would report exp(log(v)) at the first collision instead). */
+    for (size_t j = 0; j < n; j++) {
+        struct cli_scenario probe;
+        char set[2 * CLI_NAME_MAX + 40];
+        int len = snprintf(set, sizeof set, "%s=%.15g", c->keys[j], init[j]);
+        if (strtod(strchr(set, '=') + 1, NULL) != init[j] || len >= (int)sizeof set)
+            snprintf(set, sizeof set, "%s=%.17g", c->keys[j], init[j]); /* the same bits */
+        if (cli_scenario_copy(c->base, &probe) != CLI_EXIT_OK)
+            return CLI_EXIT_RUNTIME;
+        int rc = cli_scenario_override(&probe, set);
+        cli_scenario_free(&probe);
+        if (rc != CLI_EXIT_OK) {
+            cli_error("fit: --init: %g is not a valid initial value of %s (the message above)",
+                      init[j], c->keys[j]);
+            return CLI_EXIT_USAGE;
+        }
     }
     return CLI_EXIT_OK;
 }

@@ -306,6 +306,13 @@ static void test_fit_cli_rejects_bad_input(void** state)
     expect_cli(args, 2,
                "has 2 data rows (2 residuals) for 2 parameters: need more "
                "residuals than parameters, at least 3 rows");
+    /* an initial value outside the key's range, named as given before the fit starts (the
+       fit works on its logarithm and reported exp(log(1e300)) at its first collision) */
+    snprintf(args, sizeof args, "fit %s --data %s --fit glass.p_gt --init 1e300", ini, good);
+    expect_cli(args, 2,
+               "--init: 1e+300 is not a valid initial value of model.glass.p_gt (the message "
+               "above)");
+    expect_cli(args, 2, "--set model.glass.p_gt=1e+300: p_gt = 1e+300 [Pa] is out of range");
     remove(good);
     remove(bad);
 }
