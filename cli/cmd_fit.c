@@ -534,6 +534,20 @@ static bool model_value(const struct cli_scenario* sc, const char* section, cons
     return st == WETDEM_OK;
 }
 
+/* Whether `key=value` is accepted as an override of the base scenario (the checker prints
+ * why not). Returns its exit code. */
+static int probe_override(const struct fit_ctx* c, const char* key, const char* value)
+{
+    struct cli_scenario probe;
+    char set[2 * CLI_NAME_MAX + 64];
+    snprintf(set, sizeof set, "%s=%s", key, value);
+    if (cli_scenario_copy(c->base, &probe) != CLI_EXIT_OK)
+        return CLI_EXIT_RUNTIME;
+    int rc = cli_scenario_override(&probe, set);
+    cli_scenario_free(&probe);
+    return rc;
+}
+
 /* Initial value of key j: the scenario's value, its preset's, or the model's current value.
  * An unknown key gets the scenario checker's message (with a suggestion). */
 static int initial_value(const struct fit_ctx* c, size_t j, double* v)
@@ -554,13 +568,9 @@ static int initial_value(const struct fit_ctx* c, size_t j, double* v)
         return CLI_EXIT_USAGE;
     }
     /* Not settable here (e.g. a model the scenario does not enable): the checker says why. */
-    struct cli_scenario probe;
-    char set[2 * CLI_NAME_MAX + 8];
-    snprintf(set, sizeof set, "%s=1", full);
-    if (cli_scenario_copy(c->base, &probe) != CLI_EXIT_OK)
-        return CLI_EXIT_RUNTIME;
-    int rc = cli_scenario_override(&probe, set);
-    cli_scenario_free(&probe);
+    int rc = probe_override(c, full, "1");
+    if (rc == CLI_EXIT_RUNTIME)
+        return rc;
     if (rc == CLI_EXIT_OK)
         cli_error("fit: %s has no numeric value in %s; give it with --init", full, c->base->file);
     return CLI_EXIT_USAGE;
@@ -583,30 +593,21 @@ static int initial_values(const struct fit_args* a, const struct fit_ctx* c, dou
             cli_error("fit: --init has more values than --fit has keys (%zu)", c->n_keys);
             return CLI_EXIT_USAGE;
         }
-        if (cli_parse_double(tok, "--init", &init[n++]) != CLI_EXIT_OK)
+        if (cli_parse_double(tok, "--init", &init[n]) != CLI_EXIT_OK)
             return CLI_EXIT_USAGE;
+        /* the value as given, against its key's range, before the fit (which works on its
+           logarithm and would report exp(log(v)) at the first collision instead) */
+        int rc = probe_override(c, c->keys[n], tok);
+        if (rc != CLI_EXIT_OK) {
+            cli_error("fit: --init: %s is not a valid initial value of %s (the message above)", tok,
+                      c->keys[n]);
+            return rc;
+        }
+        n++;
     }
     if (n != c->n_keys) {
         cli_error("fit: --init has %zu values for %zu keys", n, c->n_keys);
         return CLI_EXIT_USAGE;
-    }
-    /* Each value as given, against its key's range, before the fit (which works on its
-       logarithm and would report exp(log(v)) at the first collision instead). */
-    for (size_t j = 0; j < n; j++) {
-        struct cli_scenario probe;
-        char set[2 * CLI_NAME_MAX + 40];
-        int len = snprintf(set, sizeof set, "%s=%.15g", c->keys[j], init[j]);
-        if (strtod(strchr(set, '=') + 1, NULL) != init[j] || len >= (int)sizeof set)
-            snprintf(set, sizeof set, "%s=%.17g", c->keys[j], init[j]); /* the same bits */
-        if (cli_scenario_copy(c->base, &probe) != CLI_EXIT_OK)
-            return CLI_EXIT_RUNTIME;
-        int rc = cli_scenario_override(&probe, set);
-        cli_scenario_free(&probe);
-        if (rc != CLI_EXIT_OK) {
-            cli_error("fit: --init: %g is not a valid initial value of %s (the message above)",
-                      init[j], c->keys[j]);
-            return CLI_EXIT_USAGE;
-        }
     }
     return CLI_EXIT_OK;
 }

@@ -139,12 +139,13 @@ static int check_opts(const struct forces_opts* o)
         cli_error("forces: --radius = %g m is out of range: valid (0, 1]", o->radius);
         return CLI_EXIT_USAGE;
     }
-    if (!(fabs(o->speed) <= 1e3) || !(fabs(o->slip) <= 1e3)) {
-        cli_error("forces: --%s = %g m/s is out of range: valid [-1000, 1000]",
-                  fabs(o->speed) <= 1e3 ? "slip" : "speed",
-                  fabs(o->speed) <= 1e3 ? o->slip : o->speed);
-        return CLI_EXIT_USAGE;
-    }
+    const double speeds[2] = {o->speed, o->slip};
+    for (int k = 0; k < 2; k++)
+        if (!(fabs(speeds[k]) <= 1e3)) {
+            cli_error("forces: --%s = %g m/s is out of range: valid [-1000, 1000]",
+                      k ? "slip" : "speed", speeds[k]);
+            return CLI_EXIT_USAGE;
+        }
     double lo = fmin(o->gaps.first, o->gaps.last);
     if (!(lo > -o->radius)) {
         cli_error("forces: --gaps: gap %g m is out of range: overlaps must stay below the "

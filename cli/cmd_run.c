@@ -67,10 +67,8 @@ static int parse_args(int argc, char** argv, struct run_args* a)
         else {
             static const char* const options[] = {"--set",  "--out",   "--restart",
                                                   "--json", "--check", NULL};
-            bool takes_value =
-                strcmp(s, "--set") == 0 || strcmp(s, "--out") == 0 || strcmp(s, "--restart") == 0;
             char hint[64];
-            if (takes_value && has_next)
+            if (strcmp(s, "--set") == 0 && has_next) /* the only option refused with a value */
                 cli_error("run: more than %d --set options", MAX_SETS);
             else
                 cli_error("run: unexpected argument '%s'%s", s,

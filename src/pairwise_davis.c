@@ -90,9 +90,6 @@ static int davis_validate(const struct wetdem_pairwise_davis* d, char* msg, size
         if (wetdem_param_validate(p, v, msg, n) != WETDEM_OK)
             return WETDEM_ERR_INVALID;
     }
-    if (d->n_spheres != 2 && d->n_spheres != 3)
-        return wetdem_status_fail(msg, n, WETDEM_ERR_INVALID, "n_spheres = %g: must be 2 or 3",
-                                  d->n_spheres);
     if (d->n_spheres == 3) {
         if (d->d23 + d->d13 < 1.0 || d->d13 - d->d23 < -1.0 || d->d23 - d->d13 < -1.0)
             return wetdem_status_fail(

@@ -49,12 +49,9 @@ void wetdem_param_range_text(const struct wetdem_param_desc* d, char* buf, size_
             used += (size_t)snprintf(buf + used, n - used, "%s %s", k ? "," : "", d->choices[k]);
         return;
     }
-    if (d->integer) /* whole numbers up to 10 digits in full: [0, 4294967295], not 4.29497e+09 */
-        snprintf(buf, n, "integer in %c%.10g, %.10g%c", d->min_open ? '(' : '[', d->min, d->max,
-                 d->max_open ? ')' : ']');
-    else
-        snprintf(buf, n, "%c%.6g, %.6g%c", d->min_open ? '(' : '[', d->min, d->max,
-                 d->max_open ? ')' : ']');
+    int digits = d->integer ? 10 : 6; /* counts in full: [0, 4294967295], not 4.29497e+09 */
+    snprintf(buf, n, "%s%c%.*g, %.*g%c", d->integer ? "integer in " : "", d->min_open ? '(' : '[',
+             digits, d->min, digits, d->max, d->max_open ? ')' : ']');
 }
 
 int wetdem_param_validate(const struct wetdem_param_desc* d, double value, char* msg,

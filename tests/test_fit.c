@@ -310,9 +310,9 @@ static void test_fit_cli_rejects_bad_input(void** state)
        fit works on its logarithm and reported exp(log(1e300)) at its first collision) */
     snprintf(args, sizeof args, "fit %s --data %s --fit glass.p_gt --init 1e300", ini, good);
     expect_cli(args, 2,
-               "--init: 1e+300 is not a valid initial value of model.glass.p_gt (the message "
+               "--init: 1e300 is not a valid initial value of model.glass.p_gt (the message "
                "above)");
-    expect_cli(args, 2, "--set model.glass.p_gt=1e+300: p_gt = 1e+300 [Pa] is out of range");
+    expect_cli(args, 2, "--set model.glass.p_gt=1e300: p_gt = 1e+300 [Pa] is out of range");
     remove(good);
     remove(bad);
 }
