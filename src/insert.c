@@ -9,8 +9,10 @@
  * x fastest, then y, then z (bottom layers first, as for settling).
  * Random: spheres are tried at uniform positions (centres >= R_i + gap from non-periodic faces)
  * in order of decreasing radius and accepted when |x_i - x_j| >= R_i + R_j + gap for every
- * accepted j (minimum image on periodic axes), found with a grid of cells of edge
- * 2 R_max + gap. Random sequential addition of equal spheres jams near a volume fraction of
+ * accepted j (minimum image on periodic axes), found with a grid of cells of edge at least
+ * 2 R_max + gap (merged pairwise along the finest axis while there are more than
+ * INSERT_CELLS_PER_SPHERE cells per sphere, so that a sparse region costs no more memory than
+ * a dense one). Random sequential addition of equal spheres jams near a volume fraction of
  * 0.38 (Widom 1966; Talbot et al. 2000), which bounds what the random layout can reach.
  */
 #include <gsl/gsl_randist.h>
@@ -150,23 +152,37 @@ static size_t grid_index(const struct grid* g, int cx, int cy, int cz)
     return ((size_t)cz * (size_t)g->nc[1] + (size_t)cy) * (size_t)g->nc[0] + (size_t)cx;
 }
 
+size_t wetdem_insert_grid_shape(const struct wetdem_insert_spec* s, double edge, int nc[3])
+{
+    for (int k = 0; k < 3; k++) {
+        double m = floor((axis(s->hi, k) - axis(s->lo, k)) / edge);
+        nc[k] = m < 1 ? 1 : (m > 1024 ? 1024 : (int)m);
+    }
+    /* A sparse region (few spheres, large box) would otherwise get up to 1024^3 cells: 8 GB
+     * of heads for ten spheres. Merging cells pairwise along the finest axis keeps every edge
+     * >= `edge`, so the search stays exact and the positions do not depend on the grid. */
+    double cap = INSERT_CELLS_PER_SPHERE * (double)s->n + 27;
+    while ((double)nc[0] * nc[1] * nc[2] > cap) {
+        int k = nc[0] >= nc[1] && nc[0] >= nc[2] ? 0 : (nc[1] >= nc[2] ? 1 : 2);
+        nc[k] /= 2;
+    }
+    return (size_t)nc[0] * (size_t)nc[1] * (size_t)nc[2];
+}
+
 static int grid_init(struct grid* g, const struct wetdem_insert_spec* s, double edge)
 {
-    double cells = 1;
+    size_t cells = wetdem_insert_grid_shape(s, edge, g->nc);
     for (int k = 0; k < 3; k++) {
         g->lo[k] = axis(s->lo, k);
         g->len[k] = axis(s->hi, k) - g->lo[k];
         g->periodic[k] = s->periodic[k];
-        double m = floor(g->len[k] / edge);
-        g->nc[k] = m < 1 ? 1 : (m > 1024 ? 1024 : (int)m);
         g->cell[k] = g->len[k] / g->nc[k];
-        cells *= g->nc[k];
     }
-    g->head = malloc((size_t)cells * sizeof *g->head);
+    g->head = malloc(cells * sizeof *g->head);
     g->next = malloc(s->n * sizeof *g->next);
     if (!g->head || !g->next)
         return WETDEM_ERR_NOMEM;
-    for (size_t c = 0; c < (size_t)cells; c++)
+    for (size_t c = 0; c < cells; c++)
         g->head[c] = -1;
     return WETDEM_OK;
 }

@@ -18,4 +18,11 @@
 int wetdem_insert_particles(const struct wetdem_insert_spec* spec, struct wetdem_particle* out,
                             char* msg, size_t msg_size);
 
+/* Cells per sphere above which the random layout's search grid is coarsened. */
+#define INSERT_CELLS_PER_SPHERE 8
+
+/* Shape nc[3] of the random layout's search grid for cells of edge >= edge [m] (at most 1024
+ * per axis and INSERT_CELLS_PER_SPHERE n + 27 in all); returns the number of cells. */
+size_t wetdem_insert_grid_shape(const struct wetdem_insert_spec* spec, double edge, int nc[3]);
+
 #endif

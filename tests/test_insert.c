@@ -158,6 +158,43 @@ static void test_insert_random_reports_jamming(void** state)
     free(p);
 }
 
+static void test_insert_sparse_region_gets_a_coarse_exact_grid(void** state)
+{
+    (void)state;
+    /* Ten spheres of R = 50 um in a 1 m cube: cells of edge 2 R + gap = 0.2 mm would be
+     * 1024^3 (8 GB of heads). The grid must stay within 8 cells a sphere (+ 27) with every
+     * cell edge still >= 2 R + gap, which is what keeps the search exact. */
+    struct wetdem_insert_spec s = base_spec(WETDEM_INSERT_RANDOM, 10);
+    s.hi = vec3(1, 1, 1);
+    s.radius_min = s.radius_max = 50e-6;
+    double edge = 2 * s.radius_max + s.gap;
+    int nc[3];
+    size_t cells = wetdem_insert_grid_shape(&s, edge, nc);
+    assert_true(cells <= INSERT_CELLS_PER_SPHERE * s.n + 27);
+    assert_true(cells == (size_t)nc[0] * nc[1] * nc[2]);
+    for (int k = 0; k < 3; k++)
+        assert_true(nc[k] >= 1 && 1.0 / nc[k] >= edge);
+    struct wetdem_particle p10[10];
+    CHECK_OK(wetdem_insert_particles(&s, p10, NULL, 0));
+    check_inside(&s, p10);
+
+    /* 3000 spheres of R = 10 mm in a periodic 1 m cube: 49^3 cells of edge 2 R + gap =
+     * 20.05 mm coarsened to 24^3 of 41.7 mm. The k-th sphere's trial lands within 2 R + gap
+     * of an accepted one with probability k (4/3 pi (20.05 mm)^3) / 1 m^3, about 150 rejected
+     * trials over the run, many in a neighbouring cell or through the wrap, so a grid that
+     * missed a neighbour would let the brute-force check find an overlap. */
+    s = base_spec(WETDEM_INSERT_RANDOM, 3000);
+    s.hi = vec3(1, 1, 1);
+    s.radius_min = s.radius_max = 10e-3;
+    s.periodic[0] = s.periodic[1] = s.periodic[2] = true;
+    cells = wetdem_insert_grid_shape(&s, 2 * s.radius_max + s.gap, nc);
+    assert_true(nc[0] == 24 && nc[1] == 24 && nc[2] == 24);
+    struct wetdem_particle* p = calloc(s.n, sizeof *p);
+    CHECK_OK(wetdem_insert_particles(&s, p, NULL, 0));
+    assert_true(worst_gap_excess(&s, p) >= 0);
+    free(p);
+}
+
 static void test_insert_given_radii_and_velocity_statistics(void** state)
 {
     (void)state;
@@ -218,6 +255,7 @@ int main(void)
         cmocka_unit_test(test_insert_lattice_capacity_by_hand),
         cmocka_unit_test(test_insert_lattice_polydisperse_no_overlap),
         cmocka_unit_test(test_insert_random_reports_jamming),
+        cmocka_unit_test(test_insert_sparse_region_gets_a_coarse_exact_grid),
         cmocka_unit_test(test_insert_given_radii_and_velocity_statistics),
         cmocka_unit_test(test_insert_rejects_bad_spec),
     };
