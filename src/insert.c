@@ -89,21 +89,24 @@ static double draw_radii(const struct wetdem_insert_spec* s, gsl_rng* rng,
     return r_max;
 }
 
-/* Sites along axis k of the lattice: count, first site and spacing [m]. */
+/* Sites along axis k of the lattice: count, first site and spacing [m]. The count is capped
+ * at n, which no row needs more than: it then fits a size_t however fine the lattice, and
+ * the sites that are filled (and the spacing) are those of the whole row. */
 static size_t lattice_axis(const struct wetdem_insert_spec* s, int k, double r_max, double* first,
                            double* step)
 {
-    double lo = axis(s->lo, k), len = axis(s->hi, k) - lo, a = 2 * r_max + s->gap;
+    double lo = axis(s->lo, k), len = axis(s->hi, k) - lo, a = 2 * r_max + s->gap, m;
     if (s->periodic[k]) {
-        double m = floor(len / a);
+        m = floor(len / a);
         *step = m > 0 ? len / m : 0;
         *first = lo + 0.5 * *step;
-        return (size_t)m;
+    } else {
+        double room = len - 2 * s->gap - 2 * r_max;
+        m = room < 0 ? 0 : floor(room / a) + 1;
+        *first = lo + s->gap + r_max;
+        *step = a;
     }
-    double room = len - 2 * s->gap - 2 * r_max;
-    *first = lo + s->gap + r_max;
-    *step = a;
-    return room < 0 ? 0 : (size_t)floor(room / a) + 1;
+    return m < (double)s->n ? (size_t)m : s->n;
 }
 
 static int place_lattice(const struct wetdem_insert_spec* s, double r_max,
@@ -122,7 +125,7 @@ static int place_lattice(const struct wetdem_insert_spec* s, double r_max,
             "count = %zu; enlarge the region or reduce count, radius_max or gap (%g m)",
             sites, m[0], m[1], m[2], 2 * r_max + s->gap, r_max, s->n, s->gap);
     for (size_t i = 0; i < s->n; i++) {
-        size_t c[3] = {i % m[0], (i / m[0]) % m[1], i / (m[0] * m[1])};
+        size_t c[3] = {i % m[0], (i / m[0]) % m[1], i / m[0] / m[1]};
         for (int k = 0; k < 3; k++)
             set_axis(&out[i].pos, k, first[k] + (double)c[k] * step[k]);
     }

@@ -129,6 +129,26 @@ static void test_insert_lattice_capacity_by_hand(void** state)
     check_inside(&s, p);
 }
 
+static void test_insert_lattice_with_more_sites_than_a_size_t_holds(void** state)
+{
+    (void)state;
+    /* A periodic 1 m cube and R = 1 / (2 (2^32 + 0.5)) m: 2^32 sites an axis, 2^96 in all.
+     * Products of the site counts wrap a size_t (2^64 = 0), which must neither divide by
+     * zero nor lose the spacing: the spheres lie along x, 1 / 2^32 m apart. */
+    struct wetdem_insert_spec s = base_spec(WETDEM_INSERT_LATTICE, 4);
+    s.hi = vec3(1, 1, 1);
+    s.gap = 0;
+    s.radius_min = s.radius_max = 1 / (2 * (4294967296.0 + 0.5));
+    s.periodic[0] = s.periodic[1] = s.periodic[2] = true;
+    struct wetdem_particle p[4];
+    CHECK_OK(wetdem_insert_particles(&s, p, NULL, 0));
+    double step = 1 / 4294967296.0; /* exact in binary, as is every site below */
+    for (size_t i = 0; i < 4; i++) {
+        assert_true(p[i].pos.x == (0.5 + (double)i) * step);
+        assert_true(p[i].pos.y == 0.5 * step && p[i].pos.z == 0.5 * step);
+    }
+}
+
 static void test_insert_lattice_polydisperse_no_overlap(void** state)
 {
     (void)state;
@@ -253,6 +273,7 @@ int main(void)
         cmocka_unit_test(test_insert_random_has_no_overlap),
         cmocka_unit_test(test_insert_random_periodic_respects_images),
         cmocka_unit_test(test_insert_lattice_capacity_by_hand),
+        cmocka_unit_test(test_insert_lattice_with_more_sites_than_a_size_t_holds),
         cmocka_unit_test(test_insert_lattice_polydisperse_no_overlap),
         cmocka_unit_test(test_insert_random_reports_jamming),
         cmocka_unit_test(test_insert_sparse_region_gets_a_coarse_exact_grid),
