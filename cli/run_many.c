@@ -424,6 +424,13 @@ static int dry_start(const struct cli_scenario* sc, struct cli_many_setup* su, s
     /* the library takes ceil((t_end - t)/dt) steps on the grid t = k dt */
     pl->t_end = su->steps ? (double)su->steps * s.dt : su->t_end;
     double span = pl->t_end / s.dt;
+    if (!su->steps && span > WETDEM_MANY_MAX_STEPS) {
+        cli_scenario_error(sc, cli_scenario_find(sc, "run", "t_end"),
+                           "takes %.3g steps of dt = %g s, more than %g: raise "
+                           "[run] dt or lower t_end",
+                           span, s.dt, WETDEM_MANY_MAX_STEPS);
+        return CLI_EXIT_USAGE;
+    }
     pl->total = su->steps ? su->steps : (unsigned long long)ceil(span - 1e-9);
     if (!su->vtk_every_given)
         su->vtk_every = pl->total / 50 > 0 ? pl->total / 50 : 1;

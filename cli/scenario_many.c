@@ -102,7 +102,8 @@ static const struct cli_key_desc particle_keys[] = {
 };
 
 static const struct cli_key_desc run_keys[] = {
-    NUM("t_end", "s", "give t_end or steps", 0, 1e6, true, false, "Simulated time of the run."),
+    NUM("t_end", "s", "give t_end or steps", 0, 1e6, true, false,
+        "Simulated time of the run, at most 1e15 steps of dt."),
     COUNT("steps", "give t_end or steps", 1, 1e15, "Number of time steps."),
     NUM("dt", "s", "0 ([integrator] dt, else dt_fraction)", 0, 1, false, false,
         "Time step; 0: [integrator] dt, else dt_fraction x the contact time of the two "

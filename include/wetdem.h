@@ -563,6 +563,10 @@ struct wetdem_many_settings {
     unsigned long long progress_every; /* steps between progress calls; 0: 1000 */
 };
 
+/* Most steps one wetdem_sim_integrate() call of a many-particle run takes: a longer call is
+ * refused (a 2-core machine does some 1e7 particle-steps a second). */
+#define WETDEM_MANY_MAX_STEPS 1e15
+
 /* Switches sim to the many-particle mode: wetdem_sim_integrate() then runs velocity Verlet
  * over cell lists (no event location), with walls, gravity, periodic axes, OpenMP, outputs and
  * checkpoints as set. NULL switches back. Returns WETDEM_OK or WETDEM_ERR_INVALID. */

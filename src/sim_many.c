@@ -1082,9 +1082,14 @@ int wetdem_sim_many_integrate(struct wetdem_sim* sim, double t_end)
     int st = m->started ? wetdem_sim_many_prepare(sim) : start(sim);
     if (st != WETDEM_OK)
         return st;
+    double span = (t_end - sim->engine.time) / m->dt;
+    if (span > WETDEM_MANY_MAX_STEPS) /* also keeps the step count below 2^64 */
+        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
+                               "reaching t_end = %g s from t = %g s takes %.3g steps of dt = %g s, "
+                               "more than %g: raise dt or lower t_end",
+                               t_end, sim->engine.time, span, m->dt, WETDEM_MANY_MAX_STEPS);
     if (sim->engine.observer && !(sim->engine.last_observed == sim->engine.time))
         st = wetdem_sim_observe(sim);
-    double span = (t_end - sim->engine.time) / m->dt;
     unsigned long long total = span > 1e-9 ? (unsigned long long)ceil(span - 1e-9) : 0;
     double t_start = wall_seconds();
     for (unsigned long long k = 1; st == WETDEM_OK && k <= total; k++) {

@@ -840,6 +840,11 @@ static void test_many_rejects_bad_settings(void** state)
     wetdem_sim_free(sim);
     sim = wetdem_sim_create();
     CHECK_OK(wetdem_sim_set_many(sim, &(struct wetdem_many_settings){.skin = 1e-4, .dt = 1e-4}));
+    /* 1e30 s / 1e-4 s = 1e34 steps: refused without a step taken. Before, a count beyond
+     * 2^64 was cast to an integer (undefined; 0 on x86) and the call returned OK at once. */
+    CHECK_STATUS(wetdem_sim_integrate(sim, 1e30), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(wetdem_sim_errmsg(sim), "takes 1e+34 steps of dt = 0.0001 s, more than 1e+15");
+    assert_true(wetdem_sim_time(sim) == 0);
     CHECK_OK(wetdem_sim_integrate(sim, 1e-3));
     CHECK_REL(wetdem_sim_time(sim), 1e-3, 1e-12);
     wetdem_sim_free(sim);

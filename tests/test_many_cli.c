@@ -170,6 +170,11 @@ static void test_many_cli_bad_inputs_exit_2_with_file_and_line(void** state)
                "[insert]\ncount = 1\nradius = 1e-3\n[material.steel1]\npreset = steel1\n"
                "film = 20e-6\n[models]\nforce = hertz sb\n[run]\nsteps = 10\n",
                1, "[box]");
+    /* 1e6 s in steps of 1e-20 s: 1e26 steps is refused at t_end, not cast to a wrong count */
+    expect_bad("too_long.ini",
+               "[box]\nsize_x = 1e-2\nsize_y = 1e-2\nsize_z = 1e-2\n[insert]\ncount = 5\n"
+               "radius = 1e-3\n[run]\nt_end = 1e6\ndt = 1e-20\n",
+               9, "t_end = 1e6: takes 1e+26 steps of dt = 1e-20 s, more than 1e+15");
     expect_bad("mixed.ini",
                "[collision]\nspeed = 1\n[box]\nsize_x = 1e-2\nsize_y = 1e-2\nsize_z = 1e-2\n"
                "[insert]\ncount = 1\nradius = 1e-3\n[run]\nsteps = 10\n",
