@@ -18,8 +18,10 @@
  * key (scenario.h error convention).
  */
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "cli_util.h"
 #include "scenario_many.h"
@@ -432,6 +434,38 @@ static int insert_radii(const struct cli_scenario* sc, const char* section,
     return CLI_EXIT_OK;
 }
 
+/* Progress of a random insertion, on stderr when it is a terminal: near the random-insertion
+ * limit a million spheres take some 20 s. The line is redrawn at most twice a second and
+ * cleared at the end. No time left is shown: the trials per sphere grow as the region fills. */
+struct insert_progress {
+    const char* section;
+    double last_print; /* [s] of wall time */
+    bool shown;        /* a line is on the terminal */
+};
+
+static void clear_insert_progress(struct insert_progress* p)
+{
+    if (p->shown)
+        fprintf(stderr, "\r%100s\r", "");
+    p->shown = false;
+}
+
+static int on_insert_progress(unsigned long long done, unsigned long long total, double elapsed,
+                              void* ctx)
+{
+    struct insert_progress* p = ctx;
+    if (!(elapsed - p->last_print >= 0.5 || done == total))
+        return 0;
+    p->last_print = elapsed;
+    fprintf(stderr, "\rwetdem: [%s] %llu/%llu spheres placed (%5.1f %%), %.0f s elapsed   ",
+            p->section, done, total, 100.0 * (double)done / (double)total, elapsed);
+    p->shown = true;
+    if (done == total)
+        clear_insert_progress(p);
+    fflush(stderr);
+    return 0;
+}
+
 static int build_insert(const struct cli_scenario* sc, struct cli_many_setup* su,
                         struct materials* mt, const char* section)
 {
@@ -467,7 +501,13 @@ static int build_insert(const struct cli_scenario* sc, struct cli_many_setup* su
                         cli_scenario_text(sc, section, "material", "steel1"), &s.material);
     if (rc != CLI_EXIT_OK)
         return rc;
+    struct insert_progress prog = {.section = section};
+    if (isatty(STDERR_FILENO)) {
+        s.progress = on_insert_progress;
+        s.progress_ctx = &prog;
+    }
     int st = wetdem_sim_insert(su->sim, &s);
+    clear_insert_progress(&prog); /* before a message: the insertion may fail part way */
     if (st == WETDEM_ERR_NOMEM) {
         cli_error("%s: out of memory inserting %zu spheres", sc->file, s.n);
         return CLI_EXIT_RUNTIME;

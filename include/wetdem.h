@@ -651,10 +651,18 @@ struct wetdem_insert_spec {
     int material;                /* material index given to every sphere */
     unsigned long seed;          /* seed of the gsl_rng mt19937 generator */
     size_t max_attempts;         /* random layout: trials per sphere; 0 means 10000 */
+    wetdem_progress_fn progress; /* optional, random layout: called with the spheres placed,
+                                    n and the wall time since the start [s] after every
+                                    WETDEM_INSERT_PROGRESS_EVERY spheres and the last; a
+                                    non-zero return stops the insertion (WETDEM_EVENT, no
+                                    sphere inserted) */
+    void* progress_ctx;
 };
+#define WETDEM_INSERT_PROGRESS_EVERY 1000
 /* Inserts spec->n spheres into sim (mass from the material density). Returns WETDEM_OK,
  * WETDEM_ERR_INVALID (bad spec, or the region cannot hold them: the message says how many
- * fit and what to change) or WETDEM_ERR_NOMEM. */
+ * fit and what to change), WETDEM_ERR_NOMEM, or WETDEM_EVENT when the progress callback
+ * stopped it (nothing is inserted unless WETDEM_OK). */
 WETDEM_API int wetdem_sim_insert(struct wetdem_sim* sim, const struct wetdem_insert_spec* spec);
 
 /* ======================================================================================== */

@@ -13,10 +13,12 @@
  * 2 R_max + gap (merged pairwise along the finest axis while there are more than
  * INSERT_CELLS_PER_SPHERE cells per sphere, so that a sparse region costs no more memory than
  * a dense one). Random sequential addition of equal spheres jams near a volume fraction of
- * 0.38 (Widom 1966; Talbot et al. 2000), which bounds what the random layout can reach.
+ * 0.38 (Widom 1966; Talbot et al. 2000), which bounds what the random layout can reach; the
+ * trials per sphere grow near it, so the random layout reports its progress (spec->progress).
  */
 #include <gsl/gsl_randist.h>
 #include <gsl/gsl_rng.h>
+#include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -304,8 +306,16 @@ static int place_random(const struct wetdem_insert_spec* s, gsl_rng* rng, double
             order[2 * i + 1] = (double)i;
         }
         qsort(order, s->n, 2 * sizeof *order, by_radius_desc);
-        for (size_t q = 0; q < s->n && st == WETDEM_OK; q++)
+        double t0 = omp_get_wtime();
+        for (size_t q = 0; q < s->n && st == WETDEM_OK; q++) {
             st = place_one(s, rng, &g, out, (size_t)order[2 * q + 1], q, msg, n);
+            size_t done = q + 1;
+            bool due = done % WETDEM_INSERT_PROGRESS_EVERY == 0 || done == s->n;
+            if (st == WETDEM_OK && s->progress && due &&
+                s->progress(done, s->n, omp_get_wtime() - t0, s->progress_ctx) != 0)
+                st = wetdem_status_fail(msg, n, WETDEM_EVENT,
+                                        "insert: stopped after %zu of %zu spheres", done, s->n);
+        }
     }
     free(order);
     free(g.head);

@@ -14,7 +14,8 @@
 /* Fills out[0 .. spec->n-1] (caller memory): positions, radii, velocities (spins 0, mass 0 so
  * that the simulation fills it from the material density, material). Returns WETDEM_OK,
  * WETDEM_ERR_INVALID (bad spec, or the region cannot hold the spheres: the message says how
- * many fit and what to change) or WETDEM_ERR_NOMEM; the message goes to msg (may be NULL). */
+ * many fit and what to change), WETDEM_ERR_NOMEM or WETDEM_EVENT (stopped by spec->progress);
+ * the message goes to msg (may be NULL). */
 int wetdem_insert_particles(const struct wetdem_insert_spec* spec, struct wetdem_particle* out,
                             char* msg, size_t msg_size);
 

@@ -215,6 +215,72 @@ static void test_insert_sparse_region_gets_a_coarse_exact_grid(void** state)
     free(p);
 }
 
+struct progress_log {
+    unsigned long long done[8], total[8];
+    double elapsed[8];
+    int calls;
+    unsigned long long stop_at; /* non-zero: stop when this many are placed */
+};
+
+static int log_progress(unsigned long long done, unsigned long long total, double elapsed,
+                        void* ctx)
+{
+    struct progress_log* log = ctx;
+    if (log->calls < 8) {
+        log->done[log->calls] = done;
+        log->total[log->calls] = total;
+        log->elapsed[log->calls] = elapsed;
+    }
+    log->calls++;
+    return log->stop_at && done >= log->stop_at;
+}
+
+static void test_insert_random_reports_progress_and_can_stop(void** state)
+{
+    (void)state;
+    /* 2500 spheres: calls after 1000, 2000 and 2500, with total 2500 and a clock that does
+     * not run backwards; the callback leaves the spheres as they are without it. */
+    struct wetdem_insert_spec s = base_spec(WETDEM_INSERT_RANDOM, 2500);
+    s.hi = vec3(0.1, 0.1, 0.1);
+    struct wetdem_particle* plain = calloc(s.n, sizeof *plain);
+    struct wetdem_particle* seen = calloc(s.n, sizeof *seen);
+    CHECK_OK(wetdem_insert_particles(&s, plain, NULL, 0));
+    struct progress_log log = {.calls = 0};
+    s.progress = log_progress;
+    s.progress_ctx = &log;
+    CHECK_OK(wetdem_insert_particles(&s, seen, NULL, 0));
+    assert_int_equal(log.calls, 3);
+    const unsigned long long want[3] = {1000, 2000, 2500};
+    for (int k = 0; k < 3; k++) {
+        assert_true(log.done[k] == want[k] && log.total[k] == 2500);
+        assert_true(log.elapsed[k] >= (k ? log.elapsed[k - 1] : 0));
+    }
+    for (size_t i = 0; i < s.n; i++) /* field by field: padding bytes may differ */
+        assert_true(plain[i].radius == seen[i].radius && plain[i].pos.x == seen[i].pos.x &&
+                    plain[i].pos.y == seen[i].pos.y && plain[i].pos.z == seen[i].pos.z &&
+                    plain[i].vel.x == seen[i].vel.x && plain[i].vel.z == seen[i].vel.z);
+
+    /* a non-zero return stops it: WETDEM_EVENT, and the simulation gains no sphere */
+    log = (struct progress_log){.stop_at = 2000};
+    char msg[256] = "";
+    CHECK_STATUS(wetdem_insert_particles(&s, seen, msg, sizeof msg), WETDEM_EVENT);
+    CHECK_CONTAINS(msg, "insert: stopped after 2000 of 2500 spheres");
+    assert_int_equal(log.calls, 2);
+    struct wetdem_sim* sim = wetdem_sim_create();
+    struct wetdem_material m = {.density = 2500,
+                                .youngs_modulus = 1e7,
+                                .poisson_ratio = 0.3,
+                                .restitution = 0.6,
+                                .friction_dry = 0.4};
+    assert_int_equal(wetdem_sim_add_material(sim, &m), 0);
+    log = (struct progress_log){.stop_at = 1000};
+    CHECK_STATUS(wetdem_sim_insert(sim, &s), WETDEM_EVENT);
+    assert_int_equal(wetdem_sim_n_particles(sim), 0);
+    wetdem_sim_free(sim);
+    free(plain);
+    free(seen);
+}
+
 static void test_insert_given_radii_and_velocity_statistics(void** state)
 {
     (void)state;
@@ -277,6 +343,7 @@ int main(void)
         cmocka_unit_test(test_insert_lattice_polydisperse_no_overlap),
         cmocka_unit_test(test_insert_random_reports_jamming),
         cmocka_unit_test(test_insert_sparse_region_gets_a_coarse_exact_grid),
+        cmocka_unit_test(test_insert_random_reports_progress_and_can_stop),
         cmocka_unit_test(test_insert_given_radii_and_velocity_statistics),
         cmocka_unit_test(test_insert_rejects_bad_spec),
     };

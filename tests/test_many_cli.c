@@ -389,7 +389,8 @@ static void test_many_cli_sigint_writes_a_checkpoint_and_resumes(void** state)
     check_same_outputs("ref", "sig", 7); /* frames at 0, 2000, ..., 12000 */
 }
 
-/* Progress: nothing on stderr when it is a file; a line with the time left on a terminal. */
+/* Progress: nothing on stderr when it is a file; on a terminal, the spheres placed by the
+ * random insertion and then a line with the time left. */
 static void test_many_cli_progress_only_on_a_terminal(void** state)
 {
     (void)state;
@@ -422,6 +423,9 @@ static void test_many_cli_progress_only_on_a_terminal(void** state)
     assert_true(WIFEXITED(status) && WEXITSTATUS(status) == 0);
     CHECK_CONTAINS(buf, "step 200/200 (100.0 %)");
     CHECK_CONTAINS(buf, "s left");
+    /* the random insertion's count, before the steps (and not on a file, above) */
+    CHECK_CONTAINS(buf, "wetdem: [insert] 150/150 spheres placed (100.0 %)");
+    assert_true(strstr(buf, "spheres placed") < strstr(buf, "step 200/200"));
 }
 
 /* The shipped examples check; the summary's budget: input = kinetic + potential + elastic +
