@@ -10,7 +10,8 @@
  * every face of a non-periodic axis), with normals into the box. A wall on a periodic axis
  * would cut the periodic images and is refused. Insertion groups ([insert], [insert.NAME])
  * and single spheres ([particle.NAME]) are added in file order; each group is free of
- * overlaps by construction (src/insert.c) and the groups are checked against each other here
+ * overlaps by construction (src/insert.c; a random group also keeps clear of the spheres
+ * added before it) and the groups are checked against each other here
  * (|x_i - x_j| >= R_i + R_j with the minimum image on periodic axes), as is every centre being
  * inside the box and every sphere inside the walls.
  *
@@ -149,7 +150,8 @@ const struct cli_section_desc cli_many_sections[] = {
      insert_keys},
     {"insert.*",
      "Many-particle run: another insertion group NAME with the keys of [insert]; groups and "
-     "particles are added in file order and must not overlap.",
+     "particles are added in file order and must not overlap (a random group keeps clear of "
+     "the spheres before it: put larger spheres first).",
      insert_keys},
     {"particle.*", "Many-particle run: one sphere NAME placed explicitly.", particle_keys},
     {"run", "Many-particle run: length, time step, neighbour-list skin, energy budget.", run_keys},

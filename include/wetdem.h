@@ -659,7 +659,9 @@ struct wetdem_insert_spec {
     void* progress_ctx;
 };
 #define WETDEM_INSERT_PROGRESS_EVERY 1000
-/* Inserts spec->n spheres into sim (mass from the material density). Returns WETDEM_OK,
+/* Inserts spec->n spheres into sim (mass from the material density). The random layout keeps
+ * spec->gap clear of the spheres already in sim too (minimum image on the region's periodic
+ * axes), so groups can share a region; the lattice does not look at them. Returns WETDEM_OK,
  * WETDEM_ERR_INVALID (bad spec, or the region cannot hold them: the message says how many
  * fit and what to change), WETDEM_ERR_NOMEM, or WETDEM_EVENT when the progress callback
  * stopped it (nothing is inserted unless WETDEM_OK). */

@@ -9,12 +9,14 @@
  * x fastest, then y, then z (bottom layers first, as for settling).
  * Random: spheres are tried at uniform positions (centres >= R_i + gap from non-periodic faces)
  * in order of decreasing radius and accepted when |x_i - x_j| >= R_i + R_j + gap for every
- * accepted j (minimum image on periodic axes), found with a grid of cells of edge at least
- * 2 R_max + gap (merged pairwise along the finest axis while there are more than
- * INSERT_CELLS_PER_SPHERE cells per sphere, so that a sparse region costs no more memory than
- * a dense one). Random sequential addition of equal spheres jams near a volume fraction of
- * 0.38 (Widom 1966; Talbot et al. 2000), which bounds what the random layout can reach; the
- * trials per sphere grow near it, so the random layout reports its progress (spec->progress).
+ * accepted j and every sphere already in the simulation that can reach the region (minimum
+ * image on the region's periodic axes). They are found with a grid of cells of edge at least
+ * R_max + max(R_max, R of those spheres) + gap, merged pairwise along the finest axis while
+ * there are more than INSERT_CELLS_PER_SPHERE cells per sphere, so that a sparse region costs
+ * no more memory than a dense one. Random sequential addition of equal spheres jams near a
+ * volume fraction of 0.38 (Widom 1966; Talbot et al. 2000), which bounds what the random
+ * layout can reach; the trials per sphere grow near it, so it reports its progress
+ * (spec->progress).
  */
 #include <gsl/gsl_randist.h>
 #include <gsl/gsl_rng.h>
@@ -136,12 +138,20 @@ static int place_lattice(const struct wetdem_insert_spec* s, double r_max,
 
 /* ---- random sequential addition on a grid ---- */
 
+/* A sphere the random layout must keep clear of: one already in the simulation or one it
+ * placed. */
+struct ball {
+    double x[3], r;
+};
+
 struct grid {
     int nc[3];
     double lo[3], cell[3], len[3];
     bool periodic[3];
-    long* head; /* first sphere of each cell, -1 if none */
-    long* next; /* next sphere of the same cell */
+    long* head;         /* first ball of each cell, -1 if none */
+    long* next;         /* next ball of the same cell */
+    struct ball* balls; /* the spheres binned so far */
+    size_t n_balls;
 };
 
 static int cell_of(const struct grid* g, double x, int k)
@@ -157,7 +167,8 @@ static size_t grid_index(const struct grid* g, int cx, int cy, int cz)
     return ((size_t)cz * (size_t)g->nc[1] + (size_t)cy) * (size_t)g->nc[0] + (size_t)cx;
 }
 
-size_t wetdem_insert_grid_shape(const struct wetdem_insert_spec* s, double edge, int nc[3])
+size_t wetdem_insert_grid_shape(const struct wetdem_insert_spec* s, size_t n_balls, double edge,
+                                int nc[3])
 {
     for (int k = 0; k < 3; k++) {
         double m = floor((axis(s->hi, k) - axis(s->lo, k)) / edge);
@@ -166,7 +177,7 @@ size_t wetdem_insert_grid_shape(const struct wetdem_insert_spec* s, double edge,
     /* A sparse region (few spheres, large box) would otherwise get up to 1024^3 cells: 8 GB
      * of heads for ten spheres. Merging cells pairwise along the finest axis keeps every edge
      * >= `edge`, so the search stays exact and the positions do not depend on the grid. */
-    double cap = INSERT_CELLS_PER_SPHERE * (double)s->n + 27;
+    double cap = INSERT_CELLS_PER_SPHERE * (double)n_balls + 27;
     while ((double)nc[0] * nc[1] * nc[2] > cap) {
         int k = nc[0] >= nc[1] && nc[0] >= nc[2] ? 0 : (nc[1] >= nc[2] ? 1 : 2);
         nc[k] /= 2;
@@ -174,9 +185,37 @@ size_t wetdem_insert_grid_shape(const struct wetdem_insert_spec* s, double edge,
     return (size_t)nc[0] * (size_t)nc[1] * (size_t)nc[2];
 }
 
-static int grid_init(struct grid* g, const struct wetdem_insert_spec* s, double edge)
+static void grid_add(struct grid* g, struct ball b)
 {
-    size_t cells = wetdem_insert_grid_shape(s, edge, g->nc);
+    size_t c = grid_index(g, cell_of(g, b.x[0], 0), cell_of(g, b.x[1], 1), cell_of(g, b.x[2], 2));
+    g->balls[g->n_balls] = b;
+    g->next[g->n_balls] = g->head[c];
+    g->head[c] = (long)g->n_balls++;
+}
+
+/* Whether an existing sphere can reach a new one (radius <= r_max): on every axis on which the
+ * region does not wrap, its centre lies within r + r_max + gap of the region. */
+static bool can_reach(const struct wetdem_insert_spec* s, const struct wetdem_particle* q,
+                      double r_max)
+{
+    double reach = q->radius + r_max + s->gap;
+    for (int k = 0; k < 3; k++) {
+        double x = axis(q->pos, k);
+        if (!s->periodic[k] && (x < axis(s->lo, k) - reach || x > axis(s->hi, k) + reach))
+            return false;
+    }
+    return true;
+}
+
+/* Grid of cells of edge >= `edge` over the region, holding the existing spheres that can
+ * reach the new ones, with room for those. */
+static int grid_init(struct grid* g, const struct wetdem_insert_spec* s, double edge, double r_max,
+                     const struct wetdem_particle* existing, size_t n_existing)
+{
+    size_t near = 0;
+    for (size_t q = 0; q < n_existing; q++)
+        near += can_reach(s, &existing[q], r_max);
+    size_t cells = wetdem_insert_grid_shape(s, s->n + near, edge, g->nc);
     for (int k = 0; k < 3; k++) {
         g->lo[k] = axis(s->lo, k);
         g->len[k] = axis(s->hi, k) - g->lo[k];
@@ -184,11 +223,16 @@ static int grid_init(struct grid* g, const struct wetdem_insert_spec* s, double 
         g->cell[k] = g->len[k] / g->nc[k];
     }
     g->head = malloc(cells * sizeof *g->head);
-    g->next = malloc(s->n * sizeof *g->next);
-    if (!g->head || !g->next)
+    g->next = malloc((s->n + near) * sizeof *g->next);
+    g->balls = malloc((s->n + near) * sizeof *g->balls);
+    if (!g->head || !g->next || !g->balls)
         return WETDEM_ERR_NOMEM;
     for (size_t c = 0; c < cells; c++)
         g->head[c] = -1;
+    for (size_t q = 0; q < n_existing; q++)
+        if (can_reach(s, &existing[q], r_max))
+            grid_add(g, (struct ball){{existing[q].pos.x, existing[q].pos.y, existing[q].pos.z},
+                                      existing[q].radius});
     return WETDEM_OK;
 }
 
@@ -205,8 +249,7 @@ static int around(const struct grid* g, int c, int k, int out[3])
     return m;
 }
 
-static bool is_free(const struct grid* g, const struct wetdem_particle* p, struct wetdem_vec3 x,
-                    double r, double gap)
+static bool is_free(const struct grid* g, struct wetdem_vec3 x, double r, double gap)
 {
     int ax[3][3], m[3];
     for (int k = 0; k < 3; k++)
@@ -216,9 +259,10 @@ static bool is_free(const struct grid* g, const struct wetdem_particle* p, struc
             for (int c = 0; c < m[0]; c++)
                 for (long j = g->head[grid_index(g, ax[0][c], ax[1][b], ax[2][a])]; j >= 0;
                      j = g->next[j]) {
-                    double d[3], lim = r + p[j].radius + gap;
+                    const struct ball* q = &g->balls[j];
+                    double d[3], lim = r + q->r + gap;
                     for (int k = 0; k < 3; k++) {
-                        d[k] = axis(x, k) - axis(p[j].pos, k);
+                        d[k] = axis(x, k) - q->x[k];
                         if (g->periodic[k])
                             d[k] -= g->len[k] * nearbyint(d[k] / g->len[k]);
                     }
@@ -252,8 +296,27 @@ static int by_radius_desc(const void* a, const void* b)
     return x[0] != y[0] ? (x[0] < y[0] ? 1 : -1) : (x[1] > y[1]) - (x[1] < y[1]);
 }
 
+/* Volume fraction of the region that the new spheres and the binned existing ones whose
+ * centres lie in it would fill [-]. */
+static double requested_fraction(const struct wetdem_insert_spec* s, const struct grid* g,
+                                 const struct wetdem_particle* out, size_t n_existing_binned)
+{
+    double solid = 0;
+    for (size_t q = 0; q < s->n; q++)
+        solid += 4.0 / 3.0 * M_PI * out[q].radius * out[q].radius * out[q].radius;
+    for (size_t q = 0; q < n_existing_binned; q++) {
+        const struct ball* b = &g->balls[q];
+        bool inside = true;
+        for (int k = 0; k < 3; k++)
+            inside = inside && b->x[k] >= g->lo[k] && b->x[k] <= g->lo[k] + g->len[k];
+        solid += inside ? 4.0 / 3.0 * M_PI * b->r * b->r * b->r : 0;
+    }
+    return solid / (g->len[0] * g->len[1] * g->len[2]);
+}
+
 static int place_one(const struct wetdem_insert_spec* s, gsl_rng* rng, struct grid* g,
-                     struct wetdem_particle* out, size_t i, size_t placed, char* msg, size_t n)
+                     struct wetdem_particle* out, size_t i, size_t placed, size_t n_existing_binned,
+                     char* msg, size_t n)
 {
     size_t attempts = s->max_attempts ? s->max_attempts : DEFAULT_ATTEMPTS;
     for (size_t t = 0; t < attempts; t++) {
@@ -264,27 +327,32 @@ static int place_one(const struct wetdem_insert_spec* s, gsl_rng* rng, struct gr
                 "insert: sphere %zu of radius %g m plus gap %g m does not fit in the "
                 "region",
                 i, out[i].radius, s->gap);
-        if (!is_free(g, out, x, out[i].radius, s->gap))
+        if (!is_free(g, x, out[i].radius, s->gap))
             continue;
         out[i].pos = x;
-        size_t c = grid_index(g, cell_of(g, x.x, 0), cell_of(g, x.y, 1), cell_of(g, x.z, 2));
-        g->next[i] = g->head[c];
-        g->head[c] = (long)i;
+        grid_add(g, (struct ball){{x.x, x.y, x.z}, out[i].radius});
         return WETDEM_OK;
     }
-    double vol = g->len[0] * g->len[1] * g->len[2], solid = 0;
-    for (size_t q = 0; q < s->n; q++)
-        solid += 4.0 / 3.0 * M_PI * out[q].radius * out[q].radius * out[q].radius;
+    if (n_existing_binned)
+        return wetdem_status_fail(
+            msg, n, WETDEM_ERR_INVALID,
+            "insert: placed %zu of %zu spheres (the largest first); the next, of radius %g m, "
+            "found no free place in %zu random trials among them and the %zu spheres already "
+            "there (volume fraction %.3f with them): insert the groups of larger spheres "
+            "first (groups go in file order), or use a larger region or fewer spheres",
+            placed, s->n, out[i].radius, attempts, n_existing_binned,
+            requested_fraction(s, g, out, n_existing_binned));
     return wetdem_status_fail(
         msg, n, WETDEM_ERR_INVALID,
         "insert: placed %zu of %zu spheres (the largest first); the next, of radius %g m, "
         "found no free place in %zu random trials. The requested volume fraction %.3f is "
         "too close to the random-insertion limit (~%.2f): use layout = lattice, a larger "
         "region or fewer spheres",
-        placed, s->n, out[i].radius, attempts, solid / vol, RSA_JAMMING);
+        placed, s->n, out[i].radius, attempts, requested_fraction(s, g, out, 0), RSA_JAMMING);
 }
 
 static int place_random(const struct wetdem_insert_spec* s, gsl_rng* rng, double r_max,
+                        const struct wetdem_particle* existing, size_t n_existing,
                         struct wetdem_particle* out, char* msg, size_t n)
 {
     for (int k = 0; k < 3; k++)
@@ -294,9 +362,16 @@ static int place_random(const struct wetdem_insert_spec* s, gsl_rng* rng, double
                 "insert: periodic length along %c (%g m) is below 2 radius_max + gap "
                 "= %g m: a sphere would touch its own image",
                 "xyz"[k], axis(s->hi, k) - axis(s->lo, k), 2 * r_max + s->gap);
+    /* a new sphere (<= r_max) meets a binned one (<= r_far) within r_max + r_far + gap */
+    double r_far = r_max;
+    for (size_t q = 0; q < n_existing; q++)
+        if (can_reach(s, &existing[q], r_max))
+            r_far = fmax(r_far, existing[q].radius);
     struct grid g = {0};
     double* order = malloc(2 * s->n * sizeof *order);
-    int st = order ? grid_init(&g, s, 2 * r_max + s->gap) : WETDEM_ERR_NOMEM;
+    int st = order ? grid_init(&g, s, r_max + r_far + s->gap, r_max, existing, n_existing)
+                   : WETDEM_ERR_NOMEM;
+    size_t binned = g.n_balls;
     if (st != WETDEM_OK) {
         st = wetdem_status_fail(msg, n, WETDEM_ERR_NOMEM, "insert: out of memory for %zu spheres",
                                 s->n);
@@ -308,7 +383,7 @@ static int place_random(const struct wetdem_insert_spec* s, gsl_rng* rng, double
         qsort(order, s->n, 2 * sizeof *order, by_radius_desc);
         double t0 = omp_get_wtime();
         for (size_t q = 0; q < s->n && st == WETDEM_OK; q++) {
-            st = place_one(s, rng, &g, out, (size_t)order[2 * q + 1], q, msg, n);
+            st = place_one(s, rng, &g, out, (size_t)order[2 * q + 1], q, binned, msg, n);
             size_t done = q + 1;
             bool due = done % WETDEM_INSERT_PROGRESS_EVERY == 0 || done == s->n;
             if (st == WETDEM_OK && s->progress && due &&
@@ -320,11 +395,19 @@ static int place_random(const struct wetdem_insert_spec* s, gsl_rng* rng, double
     free(order);
     free(g.head);
     free(g.next);
+    free(g.balls);
     return st;
 }
 
 int wetdem_insert_particles(const struct wetdem_insert_spec* spec, struct wetdem_particle* out,
                             char* msg, size_t msg_size)
+{
+    return wetdem_insert_particles_among(spec, NULL, 0, out, msg, msg_size);
+}
+
+int wetdem_insert_particles_among(const struct wetdem_insert_spec* spec,
+                                  const struct wetdem_particle* existing, size_t n_existing,
+                                  struct wetdem_particle* out, char* msg, size_t msg_size)
 {
     int st = check_spec(spec, msg, msg_size);
     if (st != WETDEM_OK)
@@ -334,8 +417,9 @@ int wetdem_insert_particles(const struct wetdem_insert_spec* spec, struct wetdem
         return wetdem_status_fail(msg, msg_size, WETDEM_ERR_NOMEM, "insert: out of memory");
     gsl_rng_set(rng, spec->seed);
     double r_max = draw_radii(spec, rng, out);
-    st = spec->layout == WETDEM_INSERT_LATTICE ? place_lattice(spec, r_max, out, msg, msg_size)
-                                               : place_random(spec, rng, r_max, out, msg, msg_size);
+    st = spec->layout == WETDEM_INSERT_LATTICE
+             ? place_lattice(spec, r_max, out, msg, msg_size)
+             : place_random(spec, rng, r_max, existing, n_existing, out, msg, msg_size);
     for (size_t i = 0; st == WETDEM_OK && i < spec->n; i++) {
         double sd = spec->velocity_sigma;
         out[i].vel = vec3(spec->velocity.x + gsl_ran_gaussian_ziggurat(rng, sd),

@@ -19,11 +19,19 @@
 int wetdem_insert_particles(const struct wetdem_insert_spec* spec, struct wetdem_particle* out,
                             char* msg, size_t msg_size);
 
+/* The same, and the random layout also keeps spec->gap clear of existing[0 .. n_existing-1]
+ * (minimum image on the region's periodic axes). The lattice does not look at them. */
+int wetdem_insert_particles_among(const struct wetdem_insert_spec* spec,
+                                  const struct wetdem_particle* existing, size_t n_existing,
+                                  struct wetdem_particle* out, char* msg, size_t msg_size);
+
 /* Cells per sphere above which the random layout's search grid is coarsened. */
 #define INSERT_CELLS_PER_SPHERE 8
 
-/* Shape nc[3] of the random layout's search grid for cells of edge >= edge [m] (at most 1024
- * per axis and INSERT_CELLS_PER_SPHERE n + 27 in all); returns the number of cells. */
-size_t wetdem_insert_grid_shape(const struct wetdem_insert_spec* spec, double edge, int nc[3]);
+/* Shape nc[3] of the random layout's search grid for n_balls spheres in cells of edge >= edge
+ * [m] (at most 1024 per axis and INSERT_CELLS_PER_SPHERE n_balls + 27 in all); returns the
+ * number of cells. */
+size_t wetdem_insert_grid_shape(const struct wetdem_insert_spec* spec, size_t n_balls, double edge,
+                                int nc[3]);
 
 #endif

@@ -620,7 +620,8 @@ int wetdem_sim_insert(struct wetdem_sim* sim, const struct wetdem_insert_spec* s
     if (!p)
         return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory for %zu particles", spec->n);
     char msg[768];
-    int st = wetdem_insert_particles(spec, p, msg, sizeof msg);
+    int st =
+        wetdem_insert_particles_among(spec, sim->particles, sim->n_particles, p, msg, sizeof msg);
     if (st != WETDEM_OK)
         st = wetdem_sim_fail(sim, st, "%s", msg);
     for (size_t k = 0; st == WETDEM_OK && k < spec->n; k++)

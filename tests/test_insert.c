@@ -189,7 +189,7 @@ static void test_insert_sparse_region_gets_a_coarse_exact_grid(void** state)
     s.radius_min = s.radius_max = 50e-6;
     double edge = 2 * s.radius_max + s.gap;
     int nc[3];
-    size_t cells = wetdem_insert_grid_shape(&s, edge, nc);
+    size_t cells = wetdem_insert_grid_shape(&s, s.n, edge, nc);
     assert_true(cells <= INSERT_CELLS_PER_SPHERE * s.n + 27);
     assert_true(cells == (size_t)nc[0] * nc[1] * nc[2]);
     for (int k = 0; k < 3; k++)
@@ -207,12 +207,82 @@ static void test_insert_sparse_region_gets_a_coarse_exact_grid(void** state)
     s.hi = vec3(1, 1, 1);
     s.radius_min = s.radius_max = 10e-3;
     s.periodic[0] = s.periodic[1] = s.periodic[2] = true;
-    cells = wetdem_insert_grid_shape(&s, 2 * s.radius_max + s.gap, nc);
+    cells = wetdem_insert_grid_shape(&s, s.n, 2 * s.radius_max + s.gap, nc);
     assert_true(nc[0] == 24 && nc[1] == 24 && nc[2] == 24);
     struct wetdem_particle* p = calloc(s.n, sizeof *p);
     CHECK_OK(wetdem_insert_particles(&s, p, NULL, 0));
     assert_true(worst_gap_excess(&s, p) >= 0);
     free(p);
+}
+
+/* Smallest gap between a sphere of a and one of b minus gap (>= 0: clear), minimum image on
+ * the axes periodic in s [m]. */
+static double worst_gap_between(const struct wetdem_insert_spec* s, const struct wetdem_particle* a,
+                                size_t na, const struct wetdem_particle* b, size_t nb)
+{
+    double worst = INFINITY, len[3] = {s->hi.x - s->lo.x, s->hi.y - s->lo.y, s->hi.z - s->lo.z};
+    for (size_t i = 0; i < na; i++)
+        for (size_t j = 0; j < nb; j++) {
+            double d[3] = {a[i].pos.x - b[j].pos.x, a[i].pos.y - b[j].pos.y,
+                           a[i].pos.z - b[j].pos.z};
+            for (int k = 0; k < 3; k++)
+                if (s->periodic[k])
+                    d[k] -= len[k] * round(d[k] / len[k]);
+            double h = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) - a[i].radius - b[j].radius;
+            worst = fmin(worst, h - s->gap);
+        }
+    return worst;
+}
+
+static void test_insert_random_keeps_clear_of_existing_spheres(void** state)
+{
+    (void)state;
+    /* 40 spheres of R = 2 mm first, then 3000 of 0.2-0.3 mm in the same periodic 30 mm cube
+     * (volume fractions 0.050 and 0.007). Drawn alone, about 3000 x 40 x 4/3 pi (2.35 mm)^3 /
+     * (30 mm)^3 = 240 of the small spheres would land on a big one; none may. */
+    struct wetdem_insert_spec big = base_spec(WETDEM_INSERT_RANDOM, 40);
+    big.hi = vec3(30e-3, 30e-3, 30e-3);
+    big.periodic[0] = big.periodic[1] = big.periodic[2] = true;
+    big.radius_min = big.radius_max = 2e-3;
+    struct wetdem_insert_spec small = big;
+    small.n = 3000;
+    small.radius_min = 0.2e-3;
+    small.radius_max = 0.3e-3;
+    small.seed = 43;
+    struct wetdem_particle pb[40], *ps = calloc(small.n, sizeof *ps);
+    CHECK_OK(wetdem_insert_particles(&big, pb, NULL, 0));
+    CHECK_OK(wetdem_insert_particles(&small, ps, NULL, 0));
+    assert_true(worst_gap_between(&small, ps, small.n, pb, 40) < 0); /* alone: they overlap */
+    CHECK_OK(wetdem_insert_particles_among(&small, pb, 40, ps, NULL, 0));
+    assert_true(worst_gap_between(&small, ps, small.n, pb, 40) >= 0);
+    assert_true(worst_gap_excess(&small, ps) >= 0);
+
+    /* the same through the simulation, which passes its spheres; the small ones first leave
+     * no hole for a big one, and the message says to insert the larger spheres first */
+    struct wetdem_sim* sim = wetdem_sim_create();
+    struct wetdem_material m = {
+        .density = 2500, .youngs_modulus = 1e7, .poisson_ratio = 0.3, .restitution = 0.6};
+    assert_int_equal(wetdem_sim_add_material(sim, &m), 0);
+    CHECK_OK(wetdem_sim_insert(sim, &big));
+    CHECK_OK(wetdem_sim_insert(sim, &small));
+    size_t n;
+    const struct wetdem_particle* all = wetdem_sim_particles_const(sim, &n);
+    assert_int_equal(n, 3040);
+    assert_true(worst_gap_between(&small, all + 40, small.n, all, 40) >= 0);
+    wetdem_sim_free(sim);
+    sim = wetdem_sim_create();
+    assert_int_equal(wetdem_sim_add_material(sim, &m), 0);
+    /* 20000 of 0.3 mm: a big sphere's centre needs no small centre within 2.35 mm, where
+     * 20000 x 4/3 pi (2.35 mm)^3 / (30 mm)^3 = 40 are expected (a chance of e^-40) */
+    small.n = 20000;
+    small.radius_min = small.radius_max = 0.3e-3;
+    CHECK_OK(wetdem_sim_insert(sim, &small));
+    big.max_attempts = 200;
+    CHECK_STATUS(wetdem_sim_insert(sim, &big), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(wetdem_sim_errmsg(sim), "the 20000 spheres already there");
+    CHECK_CONTAINS(wetdem_sim_errmsg(sim), "insert the groups of larger spheres first");
+    wetdem_sim_free(sim);
+    free(ps);
 }
 
 struct progress_log {
@@ -344,6 +414,7 @@ int main(void)
         cmocka_unit_test(test_insert_random_reports_jamming),
         cmocka_unit_test(test_insert_sparse_region_gets_a_coarse_exact_grid),
         cmocka_unit_test(test_insert_random_reports_progress_and_can_stop),
+        cmocka_unit_test(test_insert_random_keeps_clear_of_existing_spheres),
         cmocka_unit_test(test_insert_given_radii_and_velocity_statistics),
         cmocka_unit_test(test_insert_rejects_bad_spec),
     };

@@ -428,6 +428,35 @@ static void test_many_cli_progress_only_on_a_terminal(void** state)
     assert_true(strstr(buf, "spheres placed") < strstr(buf, "step 200/200"));
 }
 
+/* Two random groups in one box: the later one keeps clear of the earlier (else the CLI's own
+ * check between groups, tested above, refuses the file); smaller spheres first leave no room
+ * for larger ones, and the message says so. */
+static void test_many_cli_random_groups_share_the_box(void** state)
+{
+    (void)state;
+    const char* box = "[box]\nsize_x = 10e-3\nsize_y = 10e-3\nsize_z = 10e-3\nperiodic = x y z\n"
+                      "[run]\nsteps = 10\n";
+    /* 8 of R = 1.5 mm (volume fraction 0.11), then 400 of 0.3 mm (0.045): drawn alone, some
+     * 400 x 8 x 4/3 pi (1.8 mm)^3 / (10 mm)^3 = 78 small spheres would land on a big one */
+    char text[1024];
+    snprintf(text, sizeof text,
+             "%s[insert.big]\ncount = 8\nradius = 1.5e-3\nseed = 1\n"
+             "[insert.small]\ncount = 400\nradius = 0.3e-3\nseed = 2\n",
+             box);
+    write_text("groups.ini", text);
+    assert_int_equal(run_cli("run groups.ini --check"), 0);
+    char* out = test_read_file(tpath("out.txt"), NULL);
+    CHECK_CONTAINS(out, "particles     408");
+    free(out);
+    /* 1500 of 0.3 mm first (0.17): a big sphere's centre needs none of theirs within 1.8 mm,
+     * where 1500 x 4/3 pi (1.8 mm)^3 / (10 mm)^3 = 37 are expected (a chance of e^-37) */
+    snprintf(text, sizeof text,
+             "%s[insert.small]\ncount = 1500\nradius = 0.3e-3\nseed = 2\n"
+             "[insert.big]\ncount = 8\nradius = 1.5e-3\nseed = 1\n",
+             box);
+    expect_bad("groups_bad.ini", text, 13, "insert the groups of larger spheres first");
+}
+
 /* The shipped examples check; the summary's budget: input = kinetic + potential + elastic +
  * dissipated exactly as defined, and the closure error small against the energies. */
 static void test_many_cli_examples_and_budget(void** state)
@@ -511,6 +540,7 @@ int main(void)
         cmocka_unit_test(test_many_cli_restart_is_bit_identical),
         cmocka_unit_test(test_many_cli_sigint_writes_a_checkpoint_and_resumes),
         cmocka_unit_test(test_many_cli_progress_only_on_a_terminal),
+        cmocka_unit_test(test_many_cli_random_groups_share_the_box),
         cmocka_unit_test(test_many_cli_examples_and_budget),
     };
     return cmocka_run_group_tests(tests, setup, getenv("WETDEM_KEEP_TMP") ? NULL : teardown);
