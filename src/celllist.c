@@ -648,7 +648,10 @@ int wetdem_celllist_build(struct wetdem_celllist* cl, const struct wetdem_partic
         return st;
     if (bin_particles(cl, p, n) != WETDEM_OK || fill_pairs(cl, n) != WETDEM_OK ||
         reserve((void**)&cl->pos_at_build, &cl->at_build_cap, n, sizeof *cl->pos_at_build)) {
-        set_msg(msg, msg_size, "out of memory building the neighbour list of %zu particles", n);
+        set_msg(msg, msg_size,
+                "out of memory building the neighbour list of %zu particles, the pairs with a "
+                "gap below reach + skin = %g + %g m: a smaller skin shortens it",
+                n, cl->reach, cl->skin);
         return WETDEM_ERR_NOMEM;
     }
 #pragma omp parallel for schedule(static) if (n >= PARALLEL_MIN)
