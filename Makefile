@@ -87,8 +87,8 @@ test: all $(TEST_BIN) $(EX_BIN)
 # Tests again under AddressSanitizer + UndefinedBehaviorSanitizer, in a separate build tree.
 test-san:
 	$(MAKE) test BUILD=build-san OPT=-O1 \
-	  EXTRA_CFLAGS="-fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer" \
-	  LDLIBS="$(LDLIBS) -fsanitize=address,undefined"
+	  EXTRA_CFLAGS="-fsanitize=address,undefined,float-cast-overflow -fno-sanitize-recover=all -fno-omit-frame-pointer" \
+	  LDLIBS="$(LDLIBS) -fsanitize=address,undefined,float-cast-overflow"
 
 check-prefix: all
 	@tools/check-prefix $(BUILD)
