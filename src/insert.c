@@ -42,7 +42,10 @@ static void set_axis(struct wetdem_vec3* v, int k, double x)
     *(k == 0 ? &v->x : (k == 1 ? &v->y : &v->z)) = x;
 }
 
-static int check_spec(const struct wetdem_insert_spec* s, char* msg, size_t n)
+static int lattice_capacity(const struct wetdem_insert_spec* s, double r, const char* what,
+                            char* msg, size_t n);
+
+int wetdem_insert_check(const struct wetdem_insert_spec* s, char* msg, size_t n)
 {
     if (s->layout != WETDEM_INSERT_LATTICE && s->layout != WETDEM_INSERT_RANDOM)
         return wetdem_status_fail(msg, n, WETDEM_ERR_INVALID,
@@ -70,11 +73,32 @@ static int check_spec(const struct wetdem_insert_spec* s, char* msg, size_t n)
             msg, n, WETDEM_ERR_INVALID,
             "insert velocity: mean must be finite and sigma >= 0 m/s, got sigma %g",
             s->velocity_sigma);
-    for (size_t i = 0; s->radii && i < s->n; i++)
+    /* the least volume the spheres can fill [m^3] */
+    double least = s->radii ? 0 : (double)s->n * 4.0 / 3.0 * M_PI * pow(s->radius_min, 3);
+    for (size_t i = 0; s->radii && i < s->n; i++) {
         if (!(isfinite(s->radii[i]) && s->radii[i] > 0))
             return wetdem_status_fail(msg, n, WETDEM_ERR_INVALID,
                                       "insert radii: radius %zu must be finite and > 0 m, got %g",
                                       i, s->radii[i]);
+        least += 4.0 / 3.0 * M_PI * pow(s->radii[i], 3);
+    }
+    if (s->layout == WETDEM_INSERT_LATTICE) { /* the most sites the radii drawn can leave */
+        double r = s->radius_min;
+        for (size_t i = 0; s->radii && i < s->n; i++)
+            r = i ? fmax(r, s->radii[i]) : s->radii[i];
+        const char* what = s->radii ? "the largest radius given"
+                           : s->radius_min == s->radius_max
+                               ? "the largest radius drawn"
+                               : "radius_min, the least the largest radius drawn can be";
+        return lattice_capacity(s, r, what, msg, n);
+    }
+    double region = (s->hi.x - s->lo.x) * (s->hi.y - s->lo.y) * (s->hi.z - s->lo.z);
+    if (least > region) /* before any memory is taken for the spheres */
+        return wetdem_status_fail(
+            msg, n, WETDEM_ERR_INVALID,
+            "insert: count = %zu spheres fill at least %.3g m^3, %.3g times the region's "
+            "%.3g m^3: reduce count or the radii, or enlarge the region",
+            s->n, least, least / region, region);
     return WETDEM_OK;
 }
 
@@ -113,6 +137,26 @@ static size_t lattice_axis(const struct wetdem_insert_spec* s, int k, double r_m
     return m < (double)s->n ? (size_t)m : s->n;
 }
 
+/* WETDEM_OK if the lattice for spheres of largest radius r has at least n sites; `what` says
+ * what r is. */
+static int lattice_capacity(const struct wetdem_insert_spec* s, double r, const char* what,
+                            char* msg, size_t n)
+{
+    double first, step;
+    size_t m[3];
+    for (int k = 0; k < 3; k++)
+        m[k] = lattice_axis(s, k, r, &first, &step);
+    double sites = (double)m[0] * (double)m[1] * (double)m[2];
+    if (sites >= (double)s->n)
+        return WETDEM_OK;
+    return wetdem_status_fail(
+        msg, n, WETDEM_ERR_INVALID,
+        "insert: the region holds at most %.0f spheres (%zu x %zu x %zu) on a lattice of "
+        "spacing 2 r + gap = %g m (r = %g m, %s), but count = %zu; enlarge the region or "
+        "reduce count, radius_max or gap (%g m)",
+        sites, m[0], m[1], m[2], 2 * r + s->gap, r, what, s->n, s->gap);
+}
+
 static int place_lattice(const struct wetdem_insert_spec* s, double r_max,
                          struct wetdem_particle* out, char* msg, size_t n)
 {
@@ -120,14 +164,9 @@ static int place_lattice(const struct wetdem_insert_spec* s, double r_max,
     size_t m[3];
     for (int k = 0; k < 3; k++)
         m[k] = lattice_axis(s, k, r_max, &first[k], &step[k]);
-    double sites = (double)m[0] * (double)m[1] * (double)m[2];
-    if (sites < (double)s->n)
-        return wetdem_status_fail(
-            msg, n, WETDEM_ERR_INVALID,
-            "insert: the region holds at most %.0f spheres (%zu x %zu x %zu) on a "
-            "lattice of spacing 2 r + gap = %g m (r = %g m, the largest radius drawn), but "
-            "count = %zu; enlarge the region or reduce count, radius_max or gap (%g m)",
-            sites, m[0], m[1], m[2], 2 * r_max + s->gap, r_max, s->n, s->gap);
+    int st = lattice_capacity(s, r_max, "the largest radius drawn", msg, n);
+    if (st != WETDEM_OK)
+        return st;
     for (size_t i = 0; i < s->n; i++) {
         size_t c[3] = {i % m[0], (i / m[0]) % m[1], i / m[0] / m[1]};
         for (int k = 0; k < 3; k++)
@@ -409,7 +448,7 @@ int wetdem_insert_particles_among(const struct wetdem_insert_spec* spec,
                                   const struct wetdem_particle* existing, size_t n_existing,
                                   struct wetdem_particle* out, char* msg, size_t msg_size)
 {
-    int st = check_spec(spec, msg, msg_size);
+    int st = wetdem_insert_check(spec, msg, msg_size);
     if (st != WETDEM_OK)
         return st;
     gsl_rng* rng = gsl_rng_alloc(gsl_rng_mt19937);

@@ -11,6 +11,11 @@
 
 /* struct wetdem_insert_spec and enum wetdem_insert_layout are public (wetdem.h). */
 
+/* Checks spec without drawing anything: layout, count, region, radii, gap, velocities, and
+ * that the spheres' least volume fits the region's. Returns WETDEM_OK or WETDEM_ERR_INVALID
+ * (message in msg). */
+int wetdem_insert_check(const struct wetdem_insert_spec* spec, char* msg, size_t msg_size);
+
 /* Fills out[0 .. spec->n-1] (caller memory): positions, radii, velocities (spins 0, mass 0 so
  * that the simulation fills it from the material density, material). Returns WETDEM_OK,
  * WETDEM_ERR_INVALID (bad spec, or the region cannot hold the spheres: the message says how

@@ -616,10 +616,12 @@ int wetdem_sim_insert(struct wetdem_sim* sim, const struct wetdem_insert_spec* s
         return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
                                "insert.material %d does not exist (valid 0..%d)", spec->material,
                                sim->n_materials - 1);
+    char msg[768];
+    if (wetdem_insert_check(spec, msg, sizeof msg) != WETDEM_OK) /* before taking memory */
+        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID, "%s", msg);
     struct wetdem_particle* p = malloc((spec->n ? spec->n : 1) * sizeof *p);
     if (!p)
         return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory for %zu particles", spec->n);
-    char msg[768];
     int st =
         wetdem_insert_particles_among(spec, sim->particles, sim->n_particles, p, msg, sizeof msg);
     if (st != WETDEM_OK)

@@ -164,8 +164,9 @@ static void test_insert_lattice_polydisperse_no_overlap(void** state)
 static void test_insert_random_reports_jamming(void** state)
 {
     (void)state;
-    /* 2000 spheres of R = 1 mm in a 20 mm cube: 8.4e-6 m^3 of spheres in 8e-6 m^3 (> 1). */
-    struct wetdem_insert_spec s = base_spec(WETDEM_INSERT_RANDOM, 2000);
+    /* 1000 spheres of R = 1 mm in a 20 mm cube: 4.19e-6 m^3 of spheres in 8e-6 m^3 (0.524),
+     * beyond the random-insertion limit of 0.38 (and the 0.52 of the simple cubic lattice). */
+    struct wetdem_insert_spec s = base_spec(WETDEM_INSERT_RANDOM, 1000);
     s.radius_min = s.radius_max = 1e-3;
     s.max_attempts = 200;
     struct wetdem_particle* p = calloc(s.n, sizeof *p);
@@ -173,8 +174,8 @@ static void test_insert_random_reports_jamming(void** state)
     CHECK_STATUS(wetdem_insert_particles(&s, p, msg, sizeof msg), WETDEM_ERR_INVALID);
     CHECK_CONTAINS(msg, "random-insertion limit");
     CHECK_CONTAINS(msg, "lattice");
-    CHECK_CONTAINS(msg, "of 2000 spheres (the largest first); the next, of radius 0.001 m");
-    CHECK_CONTAINS(msg, "volume fraction 1.047"); /* 2000 x 4/3 pi (1 mm)^3 / (20 mm)^3 */
+    CHECK_CONTAINS(msg, "of 1000 spheres (the largest first); the next, of radius 0.001 m");
+    CHECK_CONTAINS(msg, "volume fraction 0.524"); /* 1000 x 4/3 pi (1 mm)^3 / (20 mm)^3 */
     free(p);
 }
 
@@ -400,6 +401,36 @@ static void test_insert_rejects_bad_spec(void** state)
     s.hi.x = 1.5e-3; /* thinner than one sphere */
     CHECK_STATUS(wetdem_insert_particles(&s, p, msg, sizeof msg), WETDEM_ERR_INVALID);
     CHECK_CONTAINS(msg, "does not fit");
+
+    /* 10^8 spheres of R >= 0.5 mm in a 20 mm cube: at least 10^8 x 4/3 pi (0.5 mm)^3 =
+     * 0.0524 m^3, 6545 times the 8e-6 m^3 region. Refused before the 10^8 particles are
+     * allocated: the simulation gives this message, not the random layout's "placed ..." */
+    s = base_spec(WETDEM_INSERT_RANDOM, 100000000);
+    CHECK_STATUS(wetdem_insert_check(&s, msg, sizeof msg), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(msg, "count = 100000000 spheres fill at least 0.0524 m^3, 6.54e+03 times");
+    struct wetdem_sim* sim = wetdem_sim_create();
+    struct wetdem_material m = {
+        .density = 2500, .youngs_modulus = 1e7, .poisson_ratio = 0.3, .restitution = 0.6};
+    assert_int_equal(wetdem_sim_add_material(sim, &m), 0);
+    CHECK_STATUS(wetdem_sim_insert(sim, &s), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(wetdem_sim_errmsg(sim), "times the region's 8e-06 m^3");
+    wetdem_sim_free(sim);
+    /* the lattice: for spheres of radius_min = 0.5 mm at 1.05 mm spacing an axis has
+     * floor((20 - 2 x 0.05 - 2 x 0.5) / 1.05) + 1 = 19 sites, and 19^3 = 6859 is the most
+     * any draw of radii in [0.5, 1] mm leaves */
+    s = base_spec(WETDEM_INSERT_LATTICE, 100000000);
+    CHECK_STATUS(wetdem_insert_check(&s, msg, sizeof msg), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(msg, "holds at most 6859 spheres (19 x 19 x 19)");
+    CHECK_CONTAINS(msg, "radius_min, the least the largest radius drawn can be");
+    /* given radii count exactly: 4 of 13 mm fill 3.68e-5 m^3 > 8e-6 m^3; 4 of 7 mm do not */
+    double radii[4] = {13e-3, 13e-3, 13e-3, 13e-3};
+    s = base_spec(WETDEM_INSERT_RANDOM, 4);
+    s.radii = radii;
+    CHECK_STATUS(wetdem_insert_check(&s, msg, sizeof msg), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(msg, "4.6 times");
+    for (int k = 0; k < 4; k++)
+        radii[k] = 7e-3;
+    CHECK_OK(wetdem_insert_check(&s, msg, sizeof msg));
 }
 
 int main(void)
