@@ -304,6 +304,12 @@ static int choose_dt(struct wetdem_sim* sim, double* dt)
     const struct wetdem_model* damper;
     step_scales(sim, small, big, v, &t_contact, &tau, &damper, &h_at);
     m->relaxation_time = tau;
+    if (tau == 0 && h_at > 0) /* m/c_d underflowed to 0: a mass near the least double */
+        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
+                               "many: the viscous relaxation time m/c_d of '%s' at h_min = %g m "
+                               "is 0 s, since the smallest sphere's mass is %g kg: no step is "
+                               "stable; check the material's density and the radii",
+                               damper->name, h_at, small.mass);
     if (tau == 0)
         return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
                                "many: the viscous damping of '%s' has no bound at h_min = %g m "
@@ -323,10 +329,15 @@ static int choose_dt(struct wetdem_sim* sim, double* dt)
         return WETDEM_OK;
     }
     *dt = fmin(fraction * t_contact, 0.25 * tau);
-    if (!(isfinite(*dt) && *dt > 0))
+    /* a contact time of 0 or inf (a density or modulus near the ends of the double range)
+     * resolves no contact, even where the relaxation time gives a finite step */
+    if (!(isfinite(*dt) && *dt > 0 && isfinite(t_contact) && t_contact > 0))
         return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
-                               "many: cannot derive a time step (%g s); set many.dt or verlet.dt",
-                               *dt);
+                               "many: cannot derive a time step from the contact time %g s of "
+                               "the smallest spheres (mass %g kg) and the relaxation time %g s: "
+                               "check the materials' density and youngs_modulus, or set "
+                               "many.dt or verlet.dt",
+                               t_contact, small.mass, tau);
     return WETDEM_OK;
 }
 

@@ -175,6 +175,19 @@ static void test_many_cli_bad_inputs_exit_2_with_file_and_line(void** state)
                "[box]\nsize_x = 1e-2\nsize_y = 1e-2\nsize_z = 1e-2\n[insert]\ncount = 5\n"
                "radius = 1e-3\n[run]\nt_end = 1e6\ndt = 1e-20\n",
                9, "t_end = 1e6: takes 1e+26 steps of dt = 1e-20 s, more than 1e+15");
+    /* a density of 1e-300 kg/m^3 makes m/c_d underflow to 0 though h_min > 0: the message
+     * names the mass, not a missing h_min; 1e300 makes the Hertz contact time infinite, and
+     * a step of a quarter of the relaxation time (2e291 s) would send the spheres to inf */
+    scenario("light.ini", "steps = 5\n");
+    assert_int_equal(run_cli("run light.ini --set material.wet.density=1e-300"), 2);
+    char* msg = stderr_text();
+    CHECK_CONTAINS(msg, "is 0 s, since the smallest sphere's mass is");
+    CHECK_CONTAINS(msg, "check the material's density and the radii");
+    free(msg);
+    assert_int_equal(run_cli("run light.ini --set material.wet.density=1e300 --set run.dt=0"), 2);
+    msg = stderr_text();
+    CHECK_CONTAINS(msg, "cannot derive a time step from the contact time inf s");
+    free(msg);
     expect_bad("mixed.ini",
                "[collision]\nspeed = 1\n[box]\nsize_x = 1e-2\nsize_y = 1e-2\nsize_z = 1e-2\n"
                "[insert]\ncount = 1\nradius = 1e-3\n[run]\nsteps = 10\n",
