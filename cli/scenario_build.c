@@ -297,6 +297,24 @@ static int build_kinematics(const struct cli_scenario* sc, struct cli_setup* su,
     double m_i = mi->density * 4.0 / 3.0 * PI * pow(s->radius_i, 3);
     double m_j = mj->density * 4.0 / 3.0 * PI * pow(s->radius_j, 3);
     bool free_target = !s->target_is_wall && !s->target_is_fixed;
+    const char* mass_key = !(isfinite(m_i) && m_i > 0)                  ? "striker_radius"
+                           : free_target && !(isfinite(m_j) && m_j > 0) ? "target_radius"
+                                                                        : NULL;
+    if (mass_key) { /* a radius or density near the ends of the double range */
+        const struct cli_entry* e = cli_scenario_find(sc, "collision", mass_key);
+        double m = mass_key[0] == 's' ? m_i : m_j;
+        if (e)
+            cli_scenario_error(sc, e,
+                               "gives a mass density x 4/3 pi R^3 = %g kg, not a positive finite "
+                               "number: check the radius and the material's density",
+                               m);
+        else
+            cli_scenario_section_error(sc, "collision",
+                                       "the %s's mass density x 4/3 pi R^3 = %g kg is not a "
+                                       "positive finite number: check its radius and density",
+                                       mass_key[0] == 's' ? "striker" : "target", m);
+        return CLI_EXIT_USAGE;
+    }
     su->m_eff = free_target ? m_i * m_j / (m_i + m_j) : m_i;
     su->r_eff =
         s->target_is_wall ? s->radius_i : s->radius_i * s->radius_j / (s->radius_i + s->radius_j);
@@ -320,8 +338,9 @@ static int build_kinematics(const struct cli_scenario* sc, struct cli_setup* su,
     }
     if (stokes > 0)
         speed = cli_stokes_speed(stokes, mu, su->m_eff, su->r_eff, s->angle);
-    if (!(speed <= 1e3)) {
-        cli_scenario_error(sc, es, "the derived impact speed %g m/s exceeds 1e3 m/s", speed);
+    if (!(speed > 0 && speed <= 1e3)) {
+        cli_scenario_error(sc, es, "the derived impact speed %g m/s is outside (0, 1e3] m/s",
+                           speed);
         return CLI_EXIT_USAGE;
     }
     su->impact_speed = speed;
@@ -335,8 +354,23 @@ static int build_kinematics(const struct cli_scenario* sc, struct cli_setup* su,
     s->initial_gap = cli_scenario_number(sc, "collision", "initial_gap", 0);
     double t_cross = fmax(su->r_eff, s->initial_gap) / v_n;
     s->t_end = cli_scenario_number(sc, "collision", "t_end", 0);
-    if (s->t_end == 0)
+    bool t_end_auto = s->t_end == 0;
+    if (t_end_auto)
         s->t_end = cli_scenario_number(sc, "collision", "t_end_crossings", 20) * t_cross;
+    if (!(s->t_end >= WETDEM_MIN_SPAN)) { /* a radius near the least double, say */
+        if (t_end_auto)
+            cli_scenario_section_error(sc, "collision",
+                                       "the automatic t_end = %g s (t_end_crossings x "
+                                       "max(R*, initial_gap) / v_n) is below %g s, the "
+                                       "shortest run CVODE integrates: give t_end",
+                                       s->t_end, WETDEM_MIN_SPAN);
+        else
+            cli_scenario_error(sc, cli_scenario_find(sc, "collision", "t_end"),
+                               "is below %g s, the shortest run CVODE integrates: give 0 "
+                               "(automatic) or a longer time",
+                               WETDEM_MIN_SPAN);
+        return CLI_EXIT_USAGE;
+    }
     s->observe_time = cli_scenario_number(sc, "collision", "observe_time", 0);
     s->rebound_gap_factor = cli_scenario_number(sc, "collision", "rebound_gap_factor", 1);
     s->close_gap = cli_scenario_number(sc, "collision", "close_gap", 0);

@@ -394,6 +394,10 @@ WETDEM_API const struct wetdem_param_desc* wetdem_integrator_params(const char* 
 /* One-line summary of integrator `name` (static text), or NULL for an unknown name. */
 WETDEM_API const char* wetdem_integrator_summary(const char* name);
 
+/* Shortest span t_end - t [s] that CVODE integrates (the cvode integrator and the pairwise
+ * engine): below about 1e-160 s its step selection fails, so a shorter span is refused. */
+#define WETDEM_MIN_SPAN 1e-150
+
 /* Advances the simulation to time t_end [s]. Returns WETDEM_OK at t_end, WETDEM_EVENT when a
  * stop condition fired (sim.stop_on_separation), or a negative status (message in errmsg). */
 WETDEM_API int wetdem_sim_integrate(struct wetdem_sim* sim, double t_end);

@@ -392,6 +392,11 @@ static int cvode_integrate(struct wetdem_sim* sim, const void* params, double t_
     const struct cvode_params* p = params;
     if (!(t_end > sim->engine.time))
         return WETDEM_OK;
+    if (t_end - sim->engine.time < WETDEM_MIN_SPAN)
+        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
+                               "cvode: t_end - t = %g s is shorter than the %g s that CVODE "
+                               "integrates; give a longer t_end",
+                               t_end - sim->engine.time, WETDEM_MIN_SPAN);
     struct run r = {.sim = sim};
     r.free_index = malloc((sim->n_particles ? sim->n_particles : 1) * sizeof *r.free_index);
     if (!r.free_index)

@@ -71,10 +71,12 @@ static int fail(struct wetdem_pairwise* pw, int status, const char* fmt, ...)
 
 static int fail(struct wetdem_pairwise* pw, int status, const char* fmt, ...)
 {
+    char text[sizeof pw->errmsg]; /* the arguments may include the current message */
     va_list ap;
     va_start(ap, fmt);
-    vsnprintf(pw->errmsg, sizeof pw->errmsg, fmt, ap);
+    vsnprintf(text, sizeof text, fmt, ap);
     va_end(ap);
+    memcpy(pw->errmsg, text, sizeof text);
     return status;
 }
 
@@ -227,9 +229,11 @@ static int validate_scalars(const struct wetdem_pairwise_config* c, char* msg, s
         return wetdem_status_fail(msg, n, WETDEM_ERR_INVALID,
                                   "gravity = (%g, %g) m/s^2: must be finite", c->gravity_x,
                                   c->gravity_y);
-    if (!(c->t_end > 0.0) || !isfinite(c->t_end))
-        return wetdem_status_fail(msg, n, WETDEM_ERR_INVALID, "t_end = %g s: must be in (0, inf)",
-                                  c->t_end);
+    if (!(c->t_end >= WETDEM_MIN_SPAN) || !isfinite(c->t_end))
+        return wetdem_status_fail(msg, n, WETDEM_ERR_INVALID,
+                                  "t_end = %g s: must be in [%g, inf), the shortest span CVODE "
+                                  "integrates",
+                                  c->t_end, WETDEM_MIN_SPAN);
     if (!(c->rtol >= 1e-14 && c->rtol <= 1e-3))
         return wetdem_status_fail(msg, n, WETDEM_ERR_INVALID, "rtol = %g: must be in [1e-14, 1e-3]",
                                   c->rtol);

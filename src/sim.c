@@ -15,10 +15,12 @@ int wetdem_sim_fail(struct wetdem_sim* sim, int status, const char* fmt, ...)
 {
     if (!sim)
         return status;
+    char text[sizeof sim->errmsg]; /* the arguments may include the current message */
     va_list ap;
     va_start(ap, fmt);
-    vsnprintf(sim->errmsg, sizeof sim->errmsg, fmt, ap);
+    vsnprintf(text, sizeof text, fmt, ap);
     va_end(ap);
+    memcpy(sim->errmsg, text, sizeof text);
     return status;
 }
 

@@ -14,6 +14,7 @@
 #include <string.h>
 
 #include "integrator_cvode_nvec.h"
+#include "sim.h"
 
 struct spring_params {
     double k;      /* [N/m] */
@@ -112,6 +113,32 @@ static void test_integrators_free_flight(void** state)
         CHECK_REL(p.vel.x, 0.3, 1e-14);
         wetdem_sim_free(sim);
     }
+}
+
+/* A span below WETDEM_MIN_SPAN: CVODE's own check failed ("tstop is behind t"); it is
+ * refused with the span in the message and the state untouched. */
+static void test_integrators_shortest_span(void** state)
+{
+    (void)state;
+    struct wetdem_sim* sim = make_sim("cvode", 0.5, 0.3, false, NULL);
+    CHECK_STATUS(wetdem_sim_integrate(sim, 1e-300), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(wetdem_sim_errmsg(sim), "t_end - t = 1e-300 s is shorter than the 1e-150 s");
+    assert_true(wetdem_sim_time(sim) == 0);
+    CHECK_OK(wetdem_sim_integrate(sim, 1e-150)); /* at the bound: integrated */
+    assert_true(wetdem_sim_time(sim) == 1e-150);
+    wetdem_sim_free(sim);
+}
+
+/* A failure message may quote the one before it (wetdem_sim_fail formats into its own
+ * buffer first: formatting into the message it reads garbled both) */
+static void test_integrators_message_quotes_the_last(void** state)
+{
+    (void)state;
+    struct wetdem_sim* sim = make_sim("cvode", 0.5, 0.3, false, NULL);
+    wetdem_sim_fail(sim, WETDEM_ERR_STEP, "inner %d", 7);
+    wetdem_sim_fail(sim, WETDEM_ERR_STEP, "outer (%s)", wetdem_sim_errmsg(sim));
+    assert_string_equal(wetdem_sim_errmsg(sim), "outer (inner 7)");
+    wetdem_sim_free(sim);
 }
 
 /* Constant force: gravity g = -9.81 z: z = v0 t + g t^2/2, v = g t; constant torque tau on a
@@ -477,6 +504,8 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_integrators_free_flight),
         cmocka_unit_test(test_integrators_constant_force),
+        cmocka_unit_test(test_integrators_shortest_span),
+        cmocka_unit_test(test_integrators_message_quotes_the_last),
         cmocka_unit_test(test_integrators_oscillators),
         cmocka_unit_test(test_integrators_verlet_order_two),
         cmocka_unit_test(test_integrators_verlet_reversible),

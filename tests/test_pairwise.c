@@ -867,6 +867,10 @@ static void test_pairwise_config_rejected(void** state)
     CHECK_STATUS(wetdem_pairwise_config_validate(&b, msg, sizeof msg), WETDEM_ERR_INVALID);
     CHECK_CONTAINS(msg, "restitution = 0: must be in (0, 1]");
     b = c;
+    b.t_end = 1e-300; /* CVODE failed with "tstop is behind t" below about 1e-160 s */
+    CHECK_STATUS(wetdem_pairwise_config_validate(&b, msg, sizeof msg), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(msg, "t_end = 1e-300 s: must be in [1e-150, inf)");
+    b = c;
     b.spheres[0].vx = NAN;
     struct wetdem_pairwise* pw = wetdem_pairwise_create();
     struct wetdem_pairwise_result r;

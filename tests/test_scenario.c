@@ -205,6 +205,11 @@ static void test_scenario_bad_files_exit_2_with_line(void** state)
         {"notenabled", "[collision]\nstokes = 5\n[model.nijssen]\ncutoff_ratio = 2\n",
          ":4:", "not enabled"},
         {"nospeed", "[collision]\nstriker = delrin\n", ":1:", "speed > 0"},
+        /* below the shortest span CVODE integrates (it failed with "tstop is behind t") */
+        {"t_end", "[collision]\nspeed = 0.1\nt_end = 1e-300\n", ":3:", "is below 1e-150 s"},
+        /* R = 1e-300 m: 4/3 pi R^3 underflows to a mass of 0 (a NaN impact speed before) */
+        {"massless", "[collision]\nstokes = 5\nstriker_radius = 1e-300\n[fluid]\nviscosity = 0.1\n",
+         ":3:", "gives a mass density x 4/3 pi R^3 = 0 kg, not a positive finite number"},
         /* a value of 300 characters (a comment of any length is fine: see below) */
         {"long",
          "[collision]\nstokes = 5\nstriker = "
