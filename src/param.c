@@ -6,6 +6,7 @@
  */
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "wetdem.h"
@@ -54,6 +55,17 @@ void wetdem_param_range_text(const struct wetdem_param_desc* d, char* buf, size_
              digits, d->min, digits, d->max, d->max_open ? ')' : ']');
 }
 
+/* The fewest significant digits (at least 6) that read back as value, so that a value just
+ * outside a range is not printed as its end: -1.000000000001, not -1, for (-1, 0.5). */
+static void shortest_text(double value, char* buf, size_t n)
+{
+    for (int digits = 6; digits <= 17; digits++) {
+        snprintf(buf, n, "%.*g", digits, value);
+        if (strtod(buf, NULL) == value)
+            return;
+    }
+}
+
 int wetdem_param_validate(const struct wetdem_param_desc* d, double value, char* msg,
                           size_t msg_size)
 {
@@ -69,14 +81,11 @@ int wetdem_param_validate(const struct wetdem_param_desc* d, double value, char*
     if (ok && whole)
         return WETDEM_OK;
     if (msg && msg_size) { /* (the range's text only now: builds check every parameter) */
-        char range[160];
+        char range[160], text[32];
         wetdem_param_range_text(d, range, sizeof range);
-        if (ok) /* in range but not whole; all its digits, so 1e6 + 0.5 is not shown as 1e+06 */
-            snprintf(msg, msg_size, "%s = %.15g [%s] is not a whole number: valid %s", d->name,
-                     value, d->unit, range);
-        else
-            snprintf(msg, msg_size, "%s = %g [%s] is out of range: valid %s", d->name, value,
-                     d->unit, range);
+        shortest_text(value, text, sizeof text); /* 1e6 + 0.5 is not shown as 1e+06 */
+        snprintf(msg, msg_size, "%s = %s [%s] is %s: valid %s", d->name, text, d->unit,
+                 ok ? "not a whole number" : "out of range", range);
     }
     return WETDEM_ERR_INVALID;
 }

@@ -197,6 +197,12 @@ static void test_params_range_text_and_message(void** state)
     CHECK_STATUS(wetdem_param_validate(&d[0], 0.0, msg, sizeof msg), WETDEM_ERR_INVALID);
     assert_string_equal(msg, "ratio = 0 [-] is out of range: valid (0, 1]");
     CHECK_OK(wetdem_param_validate(&d[0], 1.0, msg, sizeof msg));
+    /* just outside: as many digits as tell it from the end (%g printed "1 ... valid (0, 1]") */
+    CHECK_STATUS(wetdem_param_validate(&d[0], 1.000000000001, msg, sizeof msg), WETDEM_ERR_INVALID);
+    assert_string_equal(msg, "ratio = 1.000000000001 [-] is out of range: valid (0, 1]");
+    CHECK_STATUS(wetdem_param_validate(&d[0], nextafter(1.0, 2.0), msg, sizeof msg),
+                 WETDEM_ERR_INVALID);
+    assert_string_equal(msg, "ratio = 1.0000000000000002 [-] is out of range: valid (0, 1]");
     CHECK_STATUS(wetdem_param_validate(&d[1], 1e6, NULL, 0), WETDEM_ERR_INVALID);
     CHECK_OK(wetdem_param_validate(&d[1], -1.0, NULL, 0));
     assert_int_equal(wetdem_param_choice_index(&d[2], "nc"), 1);
