@@ -14,6 +14,7 @@
  *   cut-off h_co = R* of Nijssen crossed twenty times over); trajectory interval
  *   max(R*, initial_gap) / (500 v_n).
  */
+#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -341,6 +342,13 @@ static int build_kinematics(const struct cli_scenario* sc, struct cli_setup* su,
     if (!(speed > 0 && speed <= 1e3)) {
         cli_scenario_error(sc, es, "the derived impact speed %g m/s is outside (0, 1e3] m/s",
                            speed);
+        return CLI_EXIT_USAGE;
+    }
+    if (!(0.5 * su->m_eff * speed * speed >= DBL_MIN)) { /* e = |dv_f|/|dv_0| would be 0/0 */
+        cli_scenario_error(sc, ev ? ev : es,
+                           "gives an impact speed of %g m/s, whose kinetic energy m* v^2 / 2 "
+                           "= %g J underflows a double: e and energy_ratio would be 0/0",
+                           speed, 0.5 * su->m_eff * speed * speed);
         return CLI_EXIT_USAGE;
     }
     su->impact_speed = speed;

@@ -37,6 +37,7 @@
  * thickness delta_ij when it has films (overlapping films are the bridge that holds the
  * doublet, Punch; Davis), else 0.01 R* (immersed pairs).
  */
+#include <float.h>
 #include <math.h>
 #include <string.h>
 
@@ -459,6 +460,12 @@ int wetdem_collision_run(struct wetdem_sim* sim, const struct wetdem_collision_s
     struct initial in = {
         .dv = relative_velocity(sim), .n = vec3(1, 0, 0), .energy = collision_energy(sim)};
     in.slip = contact_slip(sim, in.n);
+    if (!(vec3_norm(in.dv) > 0 && in.energy >= DBL_MIN)) /* e and energy_ratio divide by them */
+        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
+                               "collision: the relative speed %g m/s is too small: |dv|^2 or the "
+                               "kinetic energy %g J underflows, so e and energy_ratio would be "
+                               "0/0; give a larger speed",
+                               spec->speed, in.energy);
     bool in_contact = tr.gap_prev < 0;
     st = run(sim, spec, &tr);
     if (st < 0)

@@ -622,6 +622,10 @@ static void test_collision_bad_spec(void** state)
     s.radius_i = -1;
     CHECK_STATUS(wetdem_collision_run(sim, &s, &r), WETDEM_ERR_INVALID);
     CHECK_CONTAINS(wetdem_sim_errmsg(sim), "radius");
+    /* 1e-300 m/s: |dv|^2 = 1e-600 underflows to 0, and e = |dv_f| / |dv_0| was 0/0 = NaN */
+    s = head_on(mat, 1e-300, 1.0);
+    CHECK_STATUS(wetdem_collision_run(sim, &s, &r), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(wetdem_sim_errmsg(sim), "the relative speed 1e-300 m/s is too small");
     wetdem_sim_free(sim);
 }
 

@@ -205,6 +205,8 @@ static void test_scenario_bad_files_exit_2_with_line(void** state)
         {"notenabled", "[collision]\nstokes = 5\n[model.nijssen]\ncutoff_ratio = 2\n",
          ":4:", "not enabled"},
         {"nospeed", "[collision]\nstriker = delrin\n", ":1:", "speed > 0"},
+        /* the squared speed underflows: e = |dv_f| / |dv_0| would be 0/0 */
+        {"slow", "[collision]\nspeed = 1e-300\n", ":2:", "= 0 J underflows a double"},
         /* below the shortest span CVODE integrates (it failed with "tstop is behind t") */
         {"t_end", "[collision]\nspeed = 0.1\nt_end = 1e-300\n", ":3:", "is below 1e-150 s"},
         /* R = 1e-300 m: 4/3 pi R^3 underflows to a mass of 0 (a NaN impact speed before) */
