@@ -157,6 +157,10 @@ static int run_soft(const struct cli_scenario* sc, struct cli_setup* su, const s
 {
     struct out_file traj, events, summary;
     int rc = CLI_EXIT_OK;
+    if (a->out_dir && su->trajectory_file[0] &&
+        (rc = cli_scenario_check_trajectory(sc, "collision", su->spec.t_end,
+                                            su->trajectory_interval)) != CLI_EXIT_OK)
+        return rc; /* before the directory is made */
     if (a->out_dir && cli_make_dirs(a->out_dir) != 0) {
         cli_error("run: cannot create directory %s: %s", a->out_dir, strerror(errno));
         return CLI_EXIT_RUNTIME;

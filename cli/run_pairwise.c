@@ -429,27 +429,37 @@ static int open_out(const char* dir, const char* name, FILE** f, char* path, siz
     return CLI_EXIT_OK;
 }
 
-/* The run with files in opt->out_dir (trajectory during the run, events and summary after). */
+/* The run with files in opt->out_dir (trajectory during the run, events and summary after).
+ * *ran: whether the run took place (not when the trajectory is refused or no directory). */
 static int run_with_files(const struct cli_scenario* sc, const struct cli_run_options* opt,
                           const struct wetdem_pairwise_config* cfg, struct wetdem_pairwise* pw,
-                          struct wetdem_pairwise_result* r, int* status)
+                          struct wetdem_pairwise_result* r, int* status, bool* ran)
 {
     char path[1200];
     FILE *ft = NULL, *fe = NULL, *fs = NULL;
+    double dt = cli_scenario_number(sc, "output", "trajectory_interval", 0.0);
+    dt = dt > 0.0 ? dt : cfg->t_end / 2000.0;
+    bool traj = strcmp(cli_scenario_text(sc, "output", "trajectory", "trajectory.csv"), "none");
+    int rc =
+        traj ? cli_scenario_check_trajectory(
+                   sc, cli_scenario_has_section(sc, "davis") ? "davis" : "pairwise", cfg->t_end, dt)
+             : CLI_EXIT_OK;
+    if (rc != CLI_EXIT_OK)
+        return rc; /* before the directory is made */
     if (cli_make_dirs(opt->out_dir) != 0) {
         cli_error("run: cannot create directory %s", opt->out_dir);
         return CLI_EXIT_RUNTIME;
     }
-    int rc = open_out(opt->out_dir, cli_scenario_text(sc, "output", "trajectory", "trajectory.csv"),
-                      &ft, path, sizeof path);
+    rc = open_out(opt->out_dir, cli_scenario_text(sc, "output", "trajectory", "trajectory.csv"),
+                  &ft, path, sizeof path);
     struct traj t = {ft};
     if (ft) {
         cli_print_provenance(ft, opt->argc, opt->argv);
         trajectory_header(ft, cfg->n_spheres);
-        double dt = cli_scenario_number(sc, "output", "trajectory_interval", 0.0);
-        wetdem_pairwise_set_observer(pw, dt > 0.0 ? dt : cfg->t_end / 2000.0, write_frame, &t);
+        wetdem_pairwise_set_observer(pw, dt, write_frame, &t);
     }
     *status = wetdem_pairwise_run(pw, cfg, r);
+    *ran = true;
     if (ft && fclose(ft) != 0)
         rc = CLI_EXIT_RUNTIME;
     if (rc == CLI_EXIT_OK)
@@ -491,10 +501,16 @@ int cli_run_pairwise(const struct cli_scenario* sc, const struct cli_run_options
         return CLI_EXIT_RUNTIME;
     }
     int status = WETDEM_OK;
-    if (opt->out_dir)
-        rc = run_with_files(sc, opt, &cfg, pw, &r, &status);
-    else
+    if (opt->out_dir) {
+        bool ran = false;
+        rc = run_with_files(sc, opt, &cfg, pw, &r, &status, &ran);
+        if (!ran) { /* refused, or no directory: no result to report */
+            wetdem_pairwise_free(pw);
+            return rc;
+        }
+    } else {
         status = wetdem_pairwise_run(pw, &cfg, &r);
+    }
     if (opt->status_out)
         *opt->status_out = status;
     if (opt->errmsg_out && opt->errmsg_size > 0)

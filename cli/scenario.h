@@ -181,6 +181,15 @@ double cli_stokes_speed(double stokes_n, double viscosity, double m_eff, double 
  * reported with that hint and CLI_EXIT_USAGE returned; else CLI_EXIT_OK (nothing printed). */
 int cli_scenario_integrator_name_typo(const struct cli_scenario* sc, const struct cli_entry* p);
 
+/* Most rows a trajectory file may get: about 2 GB of CSV. */
+#define CLI_MAX_TRAJECTORY_ROWS 1e7
+
+/* A trajectory of t_end / interval rows [s / s]: CLI_EXIT_OK if at most
+ * CLI_MAX_TRAJECTORY_ROWS, else the message at [output] trajectory_interval (or at [output],
+ * else at [run_section], when the interval is automatic) and CLI_EXIT_USAGE. */
+int cli_scenario_check_trajectory(const struct cli_scenario* sc, const char* run_section,
+                                  double t_end, double interval);
+
 /* Prints the library's message of sim against entry e (or against [section] when e is NULL)
  * and returns CLI_EXIT_USAGE. */
 int cli_scenario_lib_error(const struct cli_scenario* sc, const struct cli_entry* e,

@@ -394,6 +394,24 @@ static void output_name(const struct cli_scenario* sc, const char* key, const ch
     snprintf(out, CLI_VALUE_MAX, "%s", strcmp(v, "none") == 0 ? "" : v);
 }
 
+int cli_scenario_check_trajectory(const struct cli_scenario* sc, const char* run_section,
+                                  double t_end, double interval)
+{
+    double rows = t_end / interval;
+    if (rows <= CLI_MAX_TRAJECTORY_ROWS)
+        return CLI_EXIT_OK;
+    const struct cli_entry* e = cli_scenario_find(sc, "output", "trajectory_interval");
+    const char* fmt = "a trajectory row every %g s over t_end = %g s makes %.3g rows, more than "
+                      "%g: raise trajectory_interval, or set trajectory = none";
+    if (e && strtod(e->value, NULL) > 0)
+        cli_scenario_error(sc, e, fmt, interval, t_end, rows, CLI_MAX_TRAJECTORY_ROWS);
+    else
+        cli_scenario_section_error(sc,
+                                   cli_scenario_has_section(sc, "output") ? "output" : run_section,
+                                   fmt, interval, t_end, rows, CLI_MAX_TRAJECTORY_ROWS);
+    return CLI_EXIT_USAGE;
+}
+
 int cli_scenario_engine(const struct cli_scenario* sc, enum cli_engine* engine)
 {
     const char* t = cli_scenario_text(sc, "engine", "type", "soft");

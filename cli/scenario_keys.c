@@ -145,7 +145,8 @@ static const struct cli_key_desc output_keys[] = {
     WORD("summary", CLI_VALUE_TEXT, "summary.json", NULL,
          "Summary file (JSON) in the --out directory; 'none' disables it."),
     NUM("trajectory_interval", "s", "0 (auto)", 0, 1e6, false, false,
-        "Time between trajectory rows; 0: max(R*, initial_gap) / (500 v_n)."),
+        "Time between trajectory rows; 0: max(R*, initial_gap) / (500 v_n), or t_end / 2000 "
+        "for the pairwise engine. At most 1e7 rows (t_end / interval)."),
     {0},
 };
 

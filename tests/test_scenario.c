@@ -418,6 +418,28 @@ static void test_scenario_bad_output_paths_exit_2(void** state)
              "fit examples/scenarios/dry_hertz.ini --data '%s' --fit hertz.damping --curve '%s'",
              file, tmpdir);
     expect_run(args, 2, "fit: --curve");
+    /* a directory that cannot be made: the pairwise engine reported a result it never
+     * computed (a crash) */
+    expect_run("run examples/scenarios/davis_three.ini --out /proc/wetdem_no/out", 1,
+               "cannot create directory /proc/wetdem_no/out");
+    expect_run("run examples/scenarios/dry_hertz.ini --out /proc/wetdem_no/out", 1,
+               "cannot create directory /proc/wetdem_no/out");
+    /* a trajectory row every 1e-12 s: 6.9e10 rows (some 14 TB) for Davis's three spheres,
+     * 1e9 for the dry impact, refused before the directory is made */
+    snprintf(args, sizeof args,
+             "run examples/scenarios/davis_three.ini --set output.trajectory_interval=1e-12 "
+             "--out '%s/traj_pw'",
+             tmpdir);
+    expect_run(args, 2,
+               "a trajectory row every 1e-12 s over t_end = 0.069282 s makes 6.93e+10 "
+               "rows, more than 1e+07");
+    assert_false(exists(tmpdir, "traj_pw"));
+    snprintf(args, sizeof args,
+             "run examples/scenarios/dry_hertz.ini --set output.trajectory_interval=1e-12 "
+             "--out '%s/traj_soft'",
+             tmpdir);
+    expect_run(args, 2, "rows, more than 1e+07: raise trajectory_interval");
+    assert_false(exists(tmpdir, "traj_soft"));
 }
 
 /* Data lines (not starting with '#') of a sweep. */
