@@ -46,9 +46,11 @@ static const struct cli_key_desc davis_keys[] = {
     NUM("restitution", "-", "1", 0, 1, true, false, "Dry coefficient of restitution e_dry."),
     NUM("friction", "-", "0", 0, 10, false, false, "Friction coefficient mu_f of the impulse."),
     NUM("t_star_end", "-", "20", 0, 1e9, true, false, "Run length in t* = v_10 t/4a."),
-    NUM("a", "m", "1e-3", 0, 1, true, false, "Reduced radius a (sphere radius 2a); a unit only."),
-    NUM("viscosity", "Pa s", "1", 0, 1e9, true, false, "Film viscosity mu; a unit only."),
-    NUM("speed_n0", "m/s", "1", 0, 1e3, true, false, "Normal impact speed v_n0; a unit only."),
+    NUM("a", "m", "1e-3", 1e-6, 1, false, false,
+        "Reduced radius a (sphere radius 2a); a unit only (the range keeps the dimensional run "
+        "within CVODE's reach)."),
+    NUM("viscosity", "Pa s", "1", 1e-6, 1e9, false, false, "Film viscosity mu; a unit only."),
+    NUM("speed_n0", "m/s", "1", 1e-6, 1e3, false, false, "Normal impact speed v_n0; a unit only."),
     {0},
 };
 

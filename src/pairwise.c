@@ -204,6 +204,21 @@ static int validate_sphere(const struct wetdem_pairwise_sphere* s, size_t i, cha
         if (!isfinite(v[k]))
             return wetdem_status_fail(msg, n, WETDEM_ERR_INVALID,
                                       "spheres[%zu].%s = %g: must be finite", i, names[k], v[k]);
+    /* the spin equation divides by I, and the tolerances scale with the speeds: a radius or
+     * mass near the least double, or a speed whose square underflows, leaves CVODE nothing
+     * to work with (it failed at the first right-hand side) */
+    double inertia = 0.4 * s->mass * s->radius * s->radius;
+    if (!(inertia >= DBL_MIN && isfinite(inertia)))
+        return wetdem_status_fail(msg, n, WETDEM_ERR_INVALID,
+                                  "spheres[%zu]: mass %g kg and radius %g m give a moment of "
+                                  "inertia 2/5 m a^2 = %g kg m^2 outside the normal doubles",
+                                  i, s->mass, s->radius, inertia);
+    double speed = hypot(s->vx, s->vy), energy = 0.5 * s->mass * speed * speed;
+    if (speed > 0.0 && !(energy >= DBL_MIN))
+        return wetdem_status_fail(msg, n, WETDEM_ERR_INVALID,
+                                  "spheres[%zu]: speed %g m/s is too small: its kinetic energy "
+                                  "1/2 m v^2 = %g J underflows; give 0 or a larger speed",
+                                  i, speed, energy);
     return WETDEM_OK;
 }
 

@@ -866,6 +866,20 @@ static void test_pairwise_config_rejected(void** state)
     b.restitution = 0.0;
     CHECK_STATUS(wetdem_pairwise_config_validate(&b, msg, sizeof msg), WETDEM_ERR_INVALID);
     CHECK_CONTAINS(msg, "restitution = 0: must be in (0, 1]");
+    /* CVODE failed at its first right-hand side: I = 2/5 m a^2 underflows, or the speed's
+     * square does (the tolerances scale with it) */
+    b = c;
+    b.spheres[0].radius = 1e-300;
+    CHECK_STATUS(wetdem_pairwise_config_validate(&b, msg, sizeof msg), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(msg, "spheres[0]: mass");
+    CHECK_CONTAINS(msg, "moment of inertia 2/5 m a^2 = 0 kg m^2 outside the normal doubles");
+    b = c;
+    b.spheres[0].vx = 1e-300;
+    b.spheres[0].vy = 0;
+    CHECK_STATUS(wetdem_pairwise_config_validate(&b, msg, sizeof msg), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(msg, "spheres[0]: speed 1e-300 m/s is too small");
+    b.spheres[0].vx = 0; /* at rest is fine */
+    CHECK_OK(wetdem_pairwise_config_validate(&b, msg, sizeof msg));
     b = c;
     b.t_end = 1e-300; /* CVODE failed with "tstop is behind t" below about 1e-160 s */
     CHECK_STATUS(wetdem_pairwise_config_validate(&b, msg, sizeof msg), WETDEM_ERR_INVALID);
