@@ -640,6 +640,43 @@ static int finish(const struct cli_scenario* sc, struct cli_many_setup* su,
     return rc;
 }
 
+#define MAX_VTK_FRAMES 1e5 /* files in one directory, each N x 100 B or so */
+#define MAX_CSV_ROWS 1e7   /* about 2 GB of global quantities */
+
+/* Refuses output intervals that would flood --out: more than MAX_VTK_FRAMES VTK files or
+ * MAX_CSV_ROWS CSV rows over the run (exit 2 at the interval's key). */
+static int check_output_volume(const struct cli_scenario* sc, const struct cli_many_setup* su,
+                               const struct plan* pl)
+{
+    const struct {
+        bool on;
+        unsigned long long every;
+        double most;
+        const char *key, *what, *off;
+    } out[2] = {
+        {su->vtk_prefix[0] && su->vtk_every, su->vtk_every, MAX_VTK_FRAMES, "vtk_every",
+         "VTK files", "vtk = none"},
+        {su->csv_name[0] && su->csv_every, su->csv_every, MAX_CSV_ROWS, "csv_every", "CSV rows",
+         "csv = none"},
+    };
+    for (int k = 0; k < 2; k++) {
+        double count = out[k].on ? (double)(pl->total / out[k].every) + 1 : 0;
+        if (count <= out[k].most)
+            continue;
+        char text[300];
+        snprintf(text, sizeof text,
+                 "writes %.3g %s over the run's %llu steps, more than %g: raise %s, or set %s",
+                 count, out[k].what, pl->total, out[k].most, out[k].key, out[k].off);
+        const struct cli_entry* e = cli_scenario_find(sc, "dump", out[k].key);
+        if (e)
+            cli_scenario_error(sc, e, "%s", text);
+        else /* (the default intervals give 51 frames and 501 rows) */
+            cli_scenario_section_error(sc, "dump", "%s = %llu %s", out[k].key, out[k].every, text);
+        return CLI_EXIT_USAGE;
+    }
+    return CLI_EXIT_OK;
+}
+
 /* Fresh start or restart, first frame, the stepping and the end. */
 static int run(const struct cli_scenario* sc, struct cli_many_setup* su,
                const struct cli_run_options* opt, struct plan* pl, struct series* vtk)
@@ -684,6 +721,8 @@ int cli_run_many(const struct cli_scenario* sc, const struct cli_run_options* op
         return rc;
     struct plan pl = {0};
     rc = dry_start(sc, &su, &pl);
+    if (rc == CLI_EXIT_OK && opt->out_dir && !opt->check)
+        rc = check_output_volume(sc, &su, &pl);
     if (rc == CLI_EXIT_OK && opt->check) {
         print_check(sc, &su, &pl, opt->json);
     } else if (rc == CLI_EXIT_OK) {

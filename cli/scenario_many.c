@@ -126,13 +126,15 @@ static const struct cli_key_desc dump_keys[] = {
          "Prefix of the VTK files PREFIX_NNNNNN.vtk and of the ParaView index PREFIX.vtk.series "
          "in --out DIR; none disables them."),
     COUNT("vtk_every", "run steps / 50", 0, 1e15,
-          "Steps between VTK frames (the last step is always written); 0: none."),
+          "Steps between VTK frames (the last step is always written); 0: none. At most 1e5 "
+          "files a run."),
     WORD("vtk_binary", CLI_VALUE_CHOICE, "yes", cli_yes_no,
          "yes: binary legacy VTK (exact, compact); no: ASCII with 17 digits."),
     WORD("csv", CLI_VALUE_TEXT, "global.csv", NULL,
          "CSV of global quantities (energies, contacts, liquid bridges, agglomerates, work per "
          "model) in --out DIR, ending in .csv; none disables it."),
-    COUNT("csv_every", "run steps / 500", 0, 1e15, "Steps between CSV rows; 0: none."),
+    COUNT("csv_every", "run steps / 500", 0, 1e15,
+          "Steps between CSV rows; 0: none. At most 1e7 rows a run."),
     WORD("checkpoint", CLI_VALUE_TEXT, "checkpoint.ckpt", NULL,
          "Checkpoint in --out DIR, written atomically every checkpoint_every steps, when "
          "interrupted (SIGINT, SIGTERM) and at the end; none disables it."),

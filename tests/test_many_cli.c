@@ -175,6 +175,15 @@ static void test_many_cli_bad_inputs_exit_2_with_file_and_line(void** state)
                "[box]\nsize_x = 1e-2\nsize_y = 1e-2\nsize_z = 1e-2\n[insert]\ncount = 5\n"
                "radius = 1e-3\n[run]\nt_end = 1e6\ndt = 1e-20\n",
                9, "t_end = 1e6: takes 1e+26 steps of dt = 1e-20 s, more than 1e+15");
+    /* a VTK file every step of 2e5, a CSV row every step of 2e7: refused before --out */
+    expect_bad("vtk_flood.ini",
+               "[box]\nsize_x = 1e-2\nsize_y = 1e-2\nsize_z = 1e-2\n[insert]\ncount = 5\n"
+               "radius = 1e-3\n[run]\nsteps = 200000\n[dump]\nvtk_every = 1\n",
+               11, "writes 2e+05 VTK files over the run's 200000 steps, more than 100000");
+    expect_bad("csv_flood.ini",
+               "[box]\nsize_x = 1e-2\nsize_y = 1e-2\nsize_z = 1e-2\n[insert]\ncount = 5\n"
+               "radius = 1e-3\n[run]\nsteps = 20000000\n[dump]\ncsv_every = 1\n",
+               11, "writes 2e+07 CSV rows over the run's 20000000 steps, more than 1e+07");
     /* a density of 1e-300 kg/m^3 makes m/c_d underflow to 0 though h_min > 0: the message
      * names the mass, not a missing h_min; 1e300 makes the Hertz contact time infinite, and
      * a step of a quarter of the relaxation time (2e291 s) would send the spheres to inf */
