@@ -148,9 +148,15 @@ int wetdem_sim_add_particle(struct wetdem_sim* sim, struct wetdem_particle p)
         return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
                                "particle %zu: material %d does not exist (valid 0..%d)", k,
                                p.material, sim->n_materials - 1);
-    if (p.mass == 0)
-        p.mass =
-            sim->materials[p.material].density * 4.0 / 3.0 * M_PI * p.radius * p.radius * p.radius;
+    double density = sim->materials[p.material].density;
+    if (p.mass == 0) {
+        p.mass = density * 4.0 / 3.0 * M_PI * p.radius * p.radius * p.radius;
+        if (isfinite(p.radius) && p.radius > 0 && !(isfinite(p.mass) && p.mass > 0))
+            return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
+                                   "particle %zu: its mass density x 4/3 pi R^3 = %g kg (density "
+                                   "%g kg/m^3, R = %g m) is not a positive finite number",
+                                   k, p.mass, density, p.radius);
+    }
     char why[128];
     if (!wetdem_sim_particle_valid(&p, why, sizeof why))
         return wetdem_sim_fail(sim, WETDEM_ERR_INVALID, "particle %zu: %s", k, why);

@@ -848,6 +848,16 @@ static void test_many_rejects_bad_settings(void** state)
     CHECK_OK(wetdem_sim_integrate(sim, 1e-3));
     CHECK_REL(wetdem_sim_time(sim), 1e-3, 1e-12);
     wetdem_sim_free(sim);
+    /* a mass taken from the density that underflows: named as such, with its factors */
+    sim = wetdem_sim_create();
+    struct wetdem_material m = {
+        .density = 2500, .youngs_modulus = 1e7, .poisson_ratio = 0.3, .restitution = 0.6};
+    assert_int_equal(wetdem_sim_add_material(sim, &m), 0);
+    CHECK_STATUS(wetdem_sim_add_particle(sim, (struct wetdem_particle){.radius = 1e-300}),
+                 WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(wetdem_sim_errmsg(sim), "particle 0: its mass density x 4/3 pi R^3 = 0 kg "
+                                           "(density 2500 kg/m^3, R = 1e-300 m)");
+    wetdem_sim_free(sim);
 }
 
 int main(void)
