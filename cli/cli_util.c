@@ -73,8 +73,9 @@ static int parse_count(const char* text, const char* what, size_t* n)
     char* end = NULL;
     errno = 0;
     long long v = strtoll(text, &end, 10);
-    if (end == text || *end != '\0' || errno == ERANGE || v < 1 || v > 10000000) {
-        cli_error("%s: count N = '%s' must be an integer in [1, 10000000]", what, text);
+    if (end == text || *end != '\0' || errno == ERANGE || v < 1 || v > CLI_MAX_BATCH_POINTS) {
+        cli_error("%s: count N = '%s' must be an integer in [1, %.0f]", what, text,
+                  CLI_MAX_BATCH_POINTS);
         return CLI_EXIT_USAGE;
     }
     *n = (size_t)v;

@@ -18,6 +18,9 @@
 #include "cli.h"
 
 /* A sequence of n values from first to last, evenly spaced (or geometrically when is_log). */
+/* Most points of a sweep (--values N) or a map (N x N2): 1e7 points of some 0.8 kB. */
+#define CLI_MAX_BATCH_POINTS 1e7
+
 struct cli_range {
     double first, last; /* end points, both included */
     size_t n;           /* number of values, >= 1 */

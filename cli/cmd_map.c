@@ -123,6 +123,12 @@ int cmd_map(int argc, char** argv)
         rc = cli_parse_range(a.values[d], a.is_log[d], d ? "--values2" : "--values", &b.range[d]);
     if (rc != CLI_EXIT_OK)
         return rc;
+    double points = (double)b.range[0].n * (double)b.range[1].n;
+    if (points > CLI_MAX_BATCH_POINTS) { /* as a sweep's N: some 0.8 kB of memory a point */
+        cli_error("map: --values x --values2 = %zu x %zu = %.3g points, more than %.0f",
+                  b.range[0].n, b.range[1].n, points, CLI_MAX_BATCH_POINTS);
+        return CLI_EXIT_USAGE;
+    }
     rc = cli_batch_run(&b);
     if (rc == CLI_EXIT_OK) {
         struct map_table t = {&b, argc, argv};

@@ -625,6 +625,19 @@ static void test_scenario_map_and_check_of_other_engines(void** state)
     CHECK_CONTAINS(r.out, "many-particle scenario runs with 'wetdem run'");
     free(r.out);
     assert_false(exists(tmpdir, "map.csv"));
+    /* 1e5 x 1e5 points: refused as input (it was "out of memory", exit 1), as is a sweep of
+     * more than 1e7 */
+    snprintf(cmd, sizeof cmd,
+             "map examples/scenarios/dry_hertz.ini --param collision.speed --values 0.1:1:100000 "
+             "--param2 collision.angle_deg --values2 0:30:100000 --out '%s/map.csv'",
+             tmpdir);
+    expect_run(cmd, 2,
+               "map: --values x --values2 = 100000 x 100000 = 1e+10 points, more than "
+               "10000000");
+    assert_false(exists(tmpdir, "map.csv"));
+    expect_run("sweep examples/scenarios/dry_hertz.ini --param collision.speed --values "
+               "0.1:1:10000001",
+               2, "--values: count N = '10000001' must be an integer in [1, 10000000]");
     /* many-particle --check --json: one JSON object, no text form. The cradle runs
      * t_end = 0.04 s in steps = ceil(t_end / dt) of the library's dt, so
      * (steps - 1) dt < t_end <= steps dt. */
