@@ -661,6 +661,28 @@ static void test_pairwise_outcome_full_agglomeration(void** state)
         assert_true(r.pairs[p].bound);
 }
 
+/* Davis's Fig. 3 (St 2, Ca 1000, 30 deg) run to t* = 4e4: the three spheres close into a
+ * triangle held at h_min at t* = 15.5 and spin at 75 rad/s, so the angles of the lines of
+ * centres grow by some 14000 rad. CVODE's difference-quotient Jacobian perturbs a component
+ * by about 1.5e-8 of its size: unwrapped, the angles' perturbation moved a gap by half of h_min
+ * and the Newton iteration failed near t* = 3e4 (t = 103.7 s). Wrapped, the run ends FA, with
+ * the five events of the short run and every gap held at h_min: the held pairs' drift is of
+ * order 1e-14 m, and 1e-6 h_min (4e-13 m) leaves it room. */
+static void test_pairwise_long_spinning_cluster(void** state)
+{
+    (void)state;
+    struct wetdem_pairwise_config c = davis(2.0, 1000.0, 30.0, 4e4);
+    struct wetdem_pairwise_result r;
+    CHECK_OK(run(&c, &r, NULL));
+    assert_int_equal(r.outcome, WETDEM_PAIRWISE_FA);
+    assert_int_equal(r.n_events, 5);
+    CHECK_REL(r.time, c.t_end, 1e-12);
+    for (size_t p = 0; p < 3; p++) {
+        assert_true(r.pairs[p].bound);
+        assert_true(r.pairs[p].min_gap >= c.h_min * (1 - 1e-6));
+    }
+}
+
 /* The scales of the outputs (docs/derivations/pairwise.md Sec. 9): e_ij,w = v_n_out / v_n0 and
  * t-hat = v_n0 t / delta_12 with v_n0 the reference pair's approach speed at t = 0, t* =
  * v_10 t / 4a with v_10 the speed of sphere ref_i. The head-on collision of head_on() with a
@@ -941,6 +963,7 @@ int main(void)
         cmocka_unit_test(test_pairwise_outcome_full_separation),
         cmocka_unit_test(test_pairwise_outcome_partial),
         cmocka_unit_test(test_pairwise_outcome_full_agglomeration),
+        cmocka_unit_test(test_pairwise_long_spinning_cluster),
         cmocka_unit_test(test_pairwise_scales_of_the_reference_pair),
         cmocka_unit_test(test_pairwise_two_sphere_mechanisms),
         cmocka_unit_test(test_pairwise_tree_change_keeps_spheres),
