@@ -281,25 +281,43 @@ static void sweep_row(FILE* f, int status, const struct wetdem_pairwise_config* 
     }
 }
 
+/* %g of v, or "n/a" for a coefficient that is undefined (NaN) */
+static void format_or_na(double v, char* buf, size_t n)
+{
+    if (isfinite(v))
+        snprintf(buf, n, "%.6g", v);
+    else
+        snprintf(buf, n, "n/a");
+}
+
 static void summary_text(FILE* f, const struct wetdem_pairwise_result* r)
 {
     fprintf(f, "outcome            %s", wetdem_pairwise_outcome_name(r->outcome));
     if (r->separated_sphere >= 0)
         fprintf(f, " (sphere %d left)", r->separated_sphere + 1);
-    fprintf(f, "\ntime               %.6g s  (t* = %.6g, t-hat = %.6g)\n", r->time,
-            wetdem_pairwise_t_star(r, r->time), wetdem_pairwise_t_hat(r, r->time));
+    char t_star[32], t_hat[32];
+    format_or_na(wetdem_pairwise_t_star(r, r->time), t_star, sizeof t_star);
+    format_or_na(wetdem_pairwise_t_hat(r, r->time), t_hat, sizeof t_hat);
+    fprintf(f, "\ntime               %.6g s  (t* = %s, t-hat = %s)\n", r->time, t_star, t_hat);
     fprintf(f, "v_n0               %.6g m/s  (delta_12 = %.6g m)%s\n", r->v_n0, r->delta_ref,
             r->v_n0 > 0.0 ? ""
                           : "; the reference pair does not approach at t = 0, so t-hat and e_w "
-                            "have no scale (nan)");
+                            "have no scale (n/a)");
     fprintf(f, "events             %zu  (steps %llu, rhs %llu)\n", r->n_events, r->steps,
             r->rhs_evals);
     fprintf(f, "pair  e_w[-]     e_own[-]   contacts  mechanism\n");
+    bool undefined = false;
     for (size_t p = 0; p < r->n_pairs; p++) {
         const struct wetdem_pairwise_pair_result* q = &r->pairs[p];
-        fprintf(f, "%zu-%zu   %-10.6g %-10.6g %-9u %s\n", q->i + 1, q->j + 1, q->e_wet,
-                q->e_wet_own, q->n_contacts, mechanism_name(q->mechanism));
+        char e_w[32], e_own[32];
+        format_or_na(q->e_wet, e_w, sizeof e_w);
+        format_or_na(q->e_wet_own, e_own, sizeof e_own);
+        undefined = undefined || !isfinite(q->e_wet) || !isfinite(q->e_wet_own);
+        fprintf(f, "%zu-%zu   %-10s %-10s %-9u %s\n", q->i + 1, q->j + 1, e_w, e_own, q->n_contacts,
+                mechanism_name(q->mechanism));
     }
+    if (undefined) /* (NaN in the CSV and null in the JSON) */
+        fprintf(f, "n/a: the pair's films never met, or it did not approach when they did\n");
 }
 
 static void json_number(FILE* f, double v)

@@ -638,6 +638,16 @@ static void test_scenario_map_and_check_of_other_engines(void** state)
     expect_run("sweep examples/scenarios/dry_hertz.ini --param collision.speed --values "
                "0.1:1:10000001",
                2, "--values: count N = '10000001' must be an integer in [1, 10000000]");
+    /* the pairwise text summary: a coefficient without a scale reads n/a, not nan (pair 2-3
+     * of Davis's Fig. 3 rests with its films just touching: it never approached) */
+    expect_run("run examples/scenarios/davis_three.ini", 0,
+               "2-3   0          n/a        0         stick\n"
+               "n/a: the pair's films never met, or it did not approach when they did");
+    /* spheres 2 and 3 of the unequal example as the reference pair: they do not approach at
+     * t = 0 and sphere 2 rests, so t* and t-hat have no scale either */
+    expect_run("run examples/scenarios/davis_unequal.ini --set pairwise.ref_i=2 --set "
+               "pairwise.ref_j=3",
+               0, "time               0.05 s  (t* = n/a, t-hat = n/a)");
     /* many-particle --check --json: one JSON object, no text form. The cradle runs
      * t_end = 0.04 s in steps = ceil(t_end / dt) of the library's dt, so
      * (steps - 1) dt < t_end <= steps dt. */
