@@ -246,15 +246,20 @@ static bool can_reach(const struct wetdem_insert_spec* s, const struct wetdem_pa
     return true;
 }
 
-/* Grid of cells of edge >= `edge` over the region, holding the existing spheres that can
- * reach the new ones, with room for those. */
-static int grid_init(struct grid* g, const struct wetdem_insert_spec* s, double edge, double r_max,
+/* Grid over the region holding the existing spheres that can reach the new ones, with room
+ * for those. A new sphere (<= r_max) meets a binned one (<= r_far) within r_max + r_far + gap:
+ * the cells are at least that wide. */
+static int grid_init(struct grid* g, const struct wetdem_insert_spec* s, double r_max,
                      const struct wetdem_particle* existing, size_t n_existing)
 {
     size_t near = 0;
+    double r_far = r_max;
     for (size_t q = 0; q < n_existing; q++)
-        near += can_reach(s, &existing[q], r_max);
-    size_t cells = wetdem_insert_grid_shape(s, s->n + near, edge, g->nc);
+        if (can_reach(s, &existing[q], r_max)) {
+            near++;
+            r_far = fmax(r_far, existing[q].radius);
+        }
+    size_t cells = wetdem_insert_grid_shape(s, s->n + near, r_max + r_far + s->gap, g->nc);
     for (int k = 0; k < 3; k++) {
         g->lo[k] = axis(s->lo, k);
         g->len[k] = axis(s->hi, k) - g->lo[k];
@@ -401,15 +406,9 @@ static int place_random(const struct wetdem_insert_spec* s, gsl_rng* rng, double
                 "insert: periodic length along %c (%g m) is below 2 radius_max + gap "
                 "= %g m: a sphere would touch its own image",
                 "xyz"[k], axis(s->hi, k) - axis(s->lo, k), 2 * r_max + s->gap);
-    /* a new sphere (<= r_max) meets a binned one (<= r_far) within r_max + r_far + gap */
-    double r_far = r_max;
-    for (size_t q = 0; q < n_existing; q++)
-        if (can_reach(s, &existing[q], r_max))
-            r_far = fmax(r_far, existing[q].radius);
     struct grid g = {0};
     double* order = malloc(2 * s->n * sizeof *order);
-    int st = order ? grid_init(&g, s, r_max + r_far + s->gap, r_max, existing, n_existing)
-                   : WETDEM_ERR_NOMEM;
+    int st = order ? grid_init(&g, s, r_max, existing, n_existing) : WETDEM_ERR_NOMEM;
     size_t binned = g.n_balls;
     if (st != WETDEM_OK) {
         st = wetdem_status_fail(msg, n, WETDEM_ERR_NOMEM, "insert: out of memory for %zu spheres",
@@ -441,24 +440,22 @@ static int place_random(const struct wetdem_insert_spec* s, gsl_rng* rng, double
 int wetdem_insert_particles(const struct wetdem_insert_spec* spec, struct wetdem_particle* out,
                             char* msg, size_t msg_size)
 {
-    return wetdem_insert_particles_among(spec, NULL, 0, out, msg, msg_size);
+    int st = wetdem_insert_check(spec, msg, msg_size);
+    return st != WETDEM_OK ? st : wetdem_insert_particles_among(spec, NULL, 0, out, msg, msg_size);
 }
 
 int wetdem_insert_particles_among(const struct wetdem_insert_spec* spec,
                                   const struct wetdem_particle* existing, size_t n_existing,
                                   struct wetdem_particle* out, char* msg, size_t msg_size)
 {
-    int st = wetdem_insert_check(spec, msg, msg_size);
-    if (st != WETDEM_OK)
-        return st;
     gsl_rng* rng = gsl_rng_alloc(gsl_rng_mt19937);
     if (!rng)
         return wetdem_status_fail(msg, msg_size, WETDEM_ERR_NOMEM, "insert: out of memory");
     gsl_rng_set(rng, spec->seed);
     double r_max = draw_radii(spec, rng, out);
-    st = spec->layout == WETDEM_INSERT_LATTICE
-             ? place_lattice(spec, r_max, out, msg, msg_size)
-             : place_random(spec, rng, r_max, existing, n_existing, out, msg, msg_size);
+    int st = spec->layout == WETDEM_INSERT_LATTICE
+                 ? place_lattice(spec, r_max, out, msg, msg_size)
+                 : place_random(spec, rng, r_max, existing, n_existing, out, msg, msg_size);
     for (size_t i = 0; st == WETDEM_OK && i < spec->n; i++) {
         double sd = spec->velocity_sigma;
         out[i].vel = vec3(spec->velocity.x + gsl_ran_gaussian_ziggurat(rng, sd),

@@ -24,8 +24,9 @@ int wetdem_insert_check(const struct wetdem_insert_spec* spec, char* msg, size_t
 int wetdem_insert_particles(const struct wetdem_insert_spec* spec, struct wetdem_particle* out,
                             char* msg, size_t msg_size);
 
-/* The same, and the random layout also keeps spec->gap clear of existing[0 .. n_existing-1]
- * (minimum image on the region's periodic axes). The lattice does not look at them. */
+/* The same for a spec that wetdem_insert_check accepted (it is not checked again), and the
+ * random layout also keeps spec->gap clear of existing[0 .. n_existing-1] (minimum image on the
+ * region's periodic axes). The lattice does not look at them. */
 int wetdem_insert_particles_among(const struct wetdem_insert_spec* spec,
                                   const struct wetdem_particle* existing, size_t n_existing,
                                   struct wetdem_particle* out, char* msg, size_t msg_size);

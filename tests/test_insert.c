@@ -24,20 +24,26 @@ static struct wetdem_insert_spec base_spec(enum wetdem_insert_layout layout, siz
     };
 }
 
+/* Gap of spheres a and b minus the required gap (>= 0: clear), minimum image on the axes
+ * periodic in s [m]. */
+static double gap_excess(const struct wetdem_insert_spec* s, const struct wetdem_particle* a,
+                         const struct wetdem_particle* b)
+{
+    double len[3] = {s->hi.x - s->lo.x, s->hi.y - s->lo.y, s->hi.z - s->lo.z};
+    double d[3] = {a->pos.x - b->pos.x, a->pos.y - b->pos.y, a->pos.z - b->pos.z};
+    for (int k = 0; k < 3; k++)
+        if (s->periodic[k])
+            d[k] -= len[k] * round(d[k] / len[k]);
+    return sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) - a->radius - b->radius - s->gap;
+}
+
 /* Smallest gap over all pairs minus the required gap (>= 0 when nothing overlaps) [m]. */
 static double worst_gap_excess(const struct wetdem_insert_spec* s, const struct wetdem_particle* p)
 {
-    double worst = INFINITY, len[3] = {s->hi.x - s->lo.x, s->hi.y - s->lo.y, s->hi.z - s->lo.z};
+    double worst = INFINITY;
     for (size_t i = 0; i < s->n; i++)
-        for (size_t j = i + 1; j < s->n; j++) {
-            double d[3] = {p[i].pos.x - p[j].pos.x, p[i].pos.y - p[j].pos.y,
-                           p[i].pos.z - p[j].pos.z};
-            for (int k = 0; k < 3; k++)
-                if (s->periodic[k])
-                    d[k] -= len[k] * round(d[k] / len[k]);
-            double gap = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) - p[i].radius - p[j].radius;
-            worst = fmin(worst, gap - s->gap);
-        }
+        for (size_t j = i + 1; j < s->n; j++)
+            worst = fmin(worst, gap_excess(s, &p[i], &p[j]));
     return worst;
 }
 
@@ -216,22 +222,14 @@ static void test_insert_sparse_region_gets_a_coarse_exact_grid(void** state)
     free(p);
 }
 
-/* Smallest gap between a sphere of a and one of b minus gap (>= 0: clear), minimum image on
- * the axes periodic in s [m]. */
+/* Smallest gap between a sphere of a and one of b minus gap (>= 0: clear) [m]. */
 static double worst_gap_between(const struct wetdem_insert_spec* s, const struct wetdem_particle* a,
                                 size_t na, const struct wetdem_particle* b, size_t nb)
 {
-    double worst = INFINITY, len[3] = {s->hi.x - s->lo.x, s->hi.y - s->lo.y, s->hi.z - s->lo.z};
+    double worst = INFINITY;
     for (size_t i = 0; i < na; i++)
-        for (size_t j = 0; j < nb; j++) {
-            double d[3] = {a[i].pos.x - b[j].pos.x, a[i].pos.y - b[j].pos.y,
-                           a[i].pos.z - b[j].pos.z};
-            for (int k = 0; k < 3; k++)
-                if (s->periodic[k])
-                    d[k] -= len[k] * round(d[k] / len[k]);
-            double h = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) - a[i].radius - b[j].radius;
-            worst = fmin(worst, h - s->gap);
-        }
+        for (size_t j = 0; j < nb; j++)
+            worst = fmin(worst, gap_excess(s, &a[i], &b[j]));
     return worst;
 }
 

@@ -76,6 +76,17 @@ static char* stderr_text(void)
     return s;
 }
 
+/* Runs args, expects exit `code` and `needle` on stderr; returns stderr (caller frees). */
+static char* expect_exit(const char* args, int code, const char* needle)
+{
+    int got = run_cli(args);
+    char* err = stderr_text();
+    if (got != code)
+        fail_msg("%s: exit %d, expected %d\n%s", args, got, code, err);
+    CHECK_CONTAINS(err, needle);
+    return err;
+}
+
 /* A wet granular box: 150 spheres, periodic in x and y, floor and lid, gravity. */
 static const char* const base =
     "[box]\nsize_x = 6e-3\nsize_y = 6e-3\nsize_z = 8e-3\nperiodic = x y\n"
@@ -188,25 +199,20 @@ static void test_many_cli_bad_inputs_exit_2_with_file_and_line(void** state)
      * names the mass, not a missing h_min; 1e300 makes the Hertz contact time infinite, and
      * a step of a quarter of the relaxation time (2e291 s) would send the spheres to inf */
     scenario("light.ini", "steps = 5\n");
-    assert_int_equal(run_cli("run light.ini --set material.wet.density=1e-300"), 2);
-    char* msg = stderr_text();
-    CHECK_CONTAINS(msg, "is 0 s, since the smallest sphere's mass is");
+    char* msg = expect_exit("run light.ini --set material.wet.density=1e-300", 2,
+                            "is 0 s, since the smallest sphere's mass is");
     CHECK_CONTAINS(msg, "check the material's density and the radii");
     free(msg);
-    assert_int_equal(run_cli("run light.ini --set material.wet.density=1e300 --set run.dt=0"), 2);
-    msg = stderr_text();
-    CHECK_CONTAINS(msg, "cannot derive a time step from the contact time inf s");
-    free(msg);
+    free(expect_exit("run light.ini --set material.wet.density=1e300 --set run.dt=0", 2,
+                     "cannot derive a time step from the contact time inf s"));
     expect_bad("mixed.ini",
                "[collision]\nspeed = 1\n[box]\nsize_x = 1e-2\nsize_y = 1e-2\nsize_z = 1e-2\n"
                "[insert]\ncount = 1\nradius = 1e-3\n[run]\nsteps = 10\n",
                1, "not both");
     /* sweeps vary binary collisions; a many-particle file is refused, not misread */
     scenario("sweep.ini", "");
-    assert_int_equal(run_cli("sweep sweep.ini --param run.dt --values 1e-6:2e-6:2"), 2);
-    char* err = stderr_text();
-    CHECK_CONTAINS(err, "runs with 'wetdem run'");
-    free(err);
+    free(expect_exit("sweep sweep.ini --param run.dt --values 1e-6:2e-6:2", 2,
+                     "runs with 'wetdem run'"));
 }
 
 /* Removes field `col` (0-based) from every comma-separated line of text, in place. */
