@@ -251,11 +251,7 @@ int cli_write_output(const char* path, const char* what, void (*write)(FILE* f, 
 void cli_print_double(FILE* f, double v)
 {
     char buf[40];
-    for (int digits = 15; digits <= 17; digits++) {
-        snprintf(buf, sizeof buf, "%.*g", digits, v);
-        if (strtod(buf, NULL) == v || digits == 17)
-            break;
-    }
+    wetdem_param_format_value(v, 15, buf, sizeof buf);
     fputs(buf, f);
 }
 

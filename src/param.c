@@ -55,11 +55,9 @@ void wetdem_param_range_text(const struct wetdem_param_desc* d, char* buf, size_
              digits, d->min, digits, d->max, d->max_open ? ')' : ']');
 }
 
-/* The fewest significant digits (at least 6) that read back as value, so that a value just
- * outside a range is not printed as its end: -1.000000000001, not -1, for (-1, 0.5). */
-static void shortest_text(double value, char* buf, size_t n)
+void wetdem_param_format_value(double value, int min_digits, char* buf, size_t n)
 {
-    for (int digits = 6; digits <= 17; digits++) {
+    for (int digits = min_digits < 1 ? 1 : min_digits; digits <= 17; digits++) {
         snprintf(buf, n, "%.*g", digits, value);
         if (strtod(buf, NULL) == value)
             return;
@@ -83,7 +81,9 @@ int wetdem_param_validate(const struct wetdem_param_desc* d, double value, char*
     if (msg && msg_size) { /* (the range's text only now: builds check every parameter) */
         char range[160], text[32];
         wetdem_param_range_text(d, range, sizeof range);
-        shortest_text(value, text, sizeof text); /* 1e6 + 0.5 is not shown as 1e+06 */
+        /* a value just past a range's end is not printed as the end (-1.000000000001, not -1,
+         * for (-1, 0.5)), nor 1e6 + 0.5 as 1e+06 */
+        wetdem_param_format_value(value, 6, text, sizeof text);
         snprintf(msg, msg_size, "%s = %s [%s] is %s: valid %s", d->name, text, d->unit,
                  ok ? "not a whole number" : "out of range", range);
     }

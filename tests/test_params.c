@@ -203,6 +203,13 @@ static void test_params_range_text_and_message(void** state)
     CHECK_STATUS(wetdem_param_validate(&d[0], nextafter(1.0, 2.0), msg, sizeof msg),
                  WETDEM_ERR_INVALID);
     assert_string_equal(msg, "ratio = 1.0000000000000002 [-] is out of range: valid (0, 1]");
+    /* the formatter both messages and the CLI's CSV use: fewest digits from the minimum up */
+    wetdem_param_format_value(0.1, 15, buf, sizeof buf);
+    assert_string_equal(buf, "0.1");
+    wetdem_param_format_value(0.1 + 0.2, 15, buf, sizeof buf); /* 0.30000000000000004 */
+    assert_true(strtod(buf, NULL) == 0.1 + 0.2 && strlen(buf) == 19);
+    wetdem_param_format_value(2.5, 1, buf, sizeof buf);
+    assert_string_equal(buf, "2.5");
     CHECK_STATUS(wetdem_param_validate(&d[1], 1e6, NULL, 0), WETDEM_ERR_INVALID);
     CHECK_OK(wetdem_param_validate(&d[1], -1.0, NULL, 0));
     assert_int_equal(wetdem_param_choice_index(&d[2], "nc"), 1);
