@@ -298,12 +298,13 @@ static int build_kinematics(const struct cli_scenario* sc, struct cli_setup* su,
     double m_i = mi->density * 4.0 / 3.0 * PI * pow(s->radius_i, 3);
     double m_j = mj->density * 4.0 / 3.0 * PI * pow(s->radius_j, 3);
     bool free_target = !s->target_is_wall && !s->target_is_fixed;
-    const char* mass_key = !(isfinite(m_i) && m_i > 0)                  ? "striker_radius"
-                           : free_target && !(isfinite(m_j) && m_j > 0) ? "target_radius"
-                                                                        : NULL;
-    if (mass_key) { /* a radius or density near the ends of the double range */
-        const struct cli_entry* e = cli_scenario_find(sc, "collision", mass_key);
-        double m = mass_key[0] == 's' ? m_i : m_j;
+    bool striker_ok = isfinite(m_i) && m_i > 0, target_ok = isfinite(m_j) && m_j > 0;
+    /* a radius or density near the ends of the double range */
+    if (!striker_ok || (free_target && !target_ok)) {
+        const char* who = striker_ok ? "target" : "striker";
+        const struct cli_entry* e =
+            cli_scenario_find(sc, "collision", striker_ok ? "target_radius" : "striker_radius");
+        double m = striker_ok ? m_j : m_i;
         if (e)
             cli_scenario_error(sc, e,
                                "gives a mass density x 4/3 pi R^3 = %g kg, not a positive finite "
@@ -313,7 +314,7 @@ static int build_kinematics(const struct cli_scenario* sc, struct cli_setup* su,
             cli_scenario_section_error(sc, "collision",
                                        "the %s's mass density x 4/3 pi R^3 = %g kg is not a "
                                        "positive finite number: check its radius and density",
-                                       mass_key[0] == 's' ? "striker" : "target", m);
+                                       who, m);
         return CLI_EXIT_USAGE;
     }
     su->m_eff = free_target ? m_i * m_j / (m_i + m_j) : m_i;
