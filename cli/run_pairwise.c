@@ -318,6 +318,17 @@ static void summary_text(FILE* f, const struct wetdem_pairwise_result* r)
     }
     if (undefined) /* (NaN in the CSV and null in the JSON) */
         fprintf(f, "n/a: the pair's films never met, or it did not approach when they did\n");
+    const struct wetdem_pairwise_energy* e = &r->energy;
+    if (!isfinite(e->residual))
+        return; /* (not computed: energy_budget = false) */
+    fprintf(f, "energy [J]         initial %.6g = kinetic %.6g + capillary %.6g + gravity %.6g\n",
+            e->initial, e->kinetic, e->capillary, e->gravity);
+    fprintf(f,
+            "                   + dissipated: viscous normal %.6g, tangential %.6g, "
+            "contact %.6g\n",
+            e->viscous_normal, e->viscous_tangential, e->contact);
+    fprintf(f, "                   + residual %.3g (%.2g of the largest term)\n", e->residual,
+            e->residual / wetdem_pairwise_energy_scale(e));
 }
 
 static void json_number(FILE* f, double v)
@@ -351,7 +362,24 @@ static void summary_json(FILE* f, const struct wetdem_pairwise_result* r)
         json_number(f, q->e_wet_own);
         fputs("}", f);
     }
-    fputs("]}\n", f);
+    const struct wetdem_pairwise_energy* e = &r->energy;
+    const struct {
+        const char* key;
+        double value;
+    } energy[] = {{"initial", e->initial},
+                  {"kinetic", e->kinetic},
+                  {"capillary", e->capillary},
+                  {"gravity", e->gravity},
+                  {"viscous_normal", e->viscous_normal},
+                  {"viscous_tangential", e->viscous_tangential},
+                  {"contact", e->contact},
+                  {"residual", e->residual}};
+    fputs("], \"energy_J\": {", f);
+    for (size_t k = 0; k < sizeof energy / sizeof energy[0]; k++) {
+        fprintf(f, "%s\"%s\": ", k ? ", " : "", energy[k].key);
+        json_number(f, energy[k].value);
+    }
+    fputs("}}\n", f);
 }
 
 /* `run --check`: the resolved configuration, without running. */
@@ -521,6 +549,7 @@ int cli_run_pairwise(const struct cli_scenario* sc, const struct cli_run_options
         return CLI_EXIT_RUNTIME;
     }
     int status = WETDEM_OK;
+    cfg.energy_budget = !opt->sweep_row; /* (a sweep's rows carry no energies) */
     if (opt->out_dir) {
         bool ran = false;
         rc = run_with_files(sc, opt, &cfg, pw, &r, &status, &ran);

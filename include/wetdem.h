@@ -720,6 +720,8 @@ struct wetdem_pairwise_config {
     bool stop_when_separated;    /* stop once every pair is apart and receding (default true) */
     size_t ref_i, ref_j;         /* reference pair for v_n0, delta_12, t-hat, t* (default 0, 1) */
     size_t max_events;           /* event budget (default 100000) */
+    bool energy_budget;          /* integrate the viscous work for result.energy (default
+                                    true; about a third more time); false: energy is NAN */
 };
 
 /* What happened, in the event log of a pairwise run. */
@@ -770,6 +772,25 @@ struct wetdem_pairwise_pair_result {
                            -1 if the films never met */
 };
 
+/* Energy budget of a pairwise run [J]. The mechanical energy is the kinetic energy
+ * (translation and spin) plus two potentials: the capillary suction's, sum over the pairs
+ * whose films overlap of 8 pi a sigma (h - delta) <= 0 (zero where the films meet, so it is
+ * continuous), and gravity's, -sum m g . x. Its loss is the work of the viscous film forces
+ * (integrated along the run) and of the impulses:
+ *     initial = kinetic + capillary + gravity + viscous_normal + viscous_tangential
+ *               + contact + residual,
+ * where the residual is the integration error (docs/derivations/pairwise.md, Sec. 11). */
+struct wetdem_pairwise_energy {
+    double initial;            /* mechanical energy at t = 0, before any impulse [J] */
+    double kinetic;            /* kinetic energy at the end [J] */
+    double capillary;          /* capillary potential at the end, <= 0 [J] */
+    double gravity;            /* gravity's potential -sum m g . x at the end [J] */
+    double viscous_normal;     /* dissipated by the viscous part of Eq. 3, >= 0 [J] */
+    double viscous_tangential; /* dissipated by Eq. 4, >= 0 [J] */
+    double contact;            /* lost in impulses: e_dry < 1, friction, rest contacts [J] */
+    double residual;           /* initial less all the others [J] */
+};
+
 /* Summary of a pairwise run. */
 struct wetdem_pairwise_result {
     size_t n_spheres, n_pairs;
@@ -787,6 +808,7 @@ struct wetdem_pairwise_result {
     double a_ref;     /* reduced radius a of the reference pair [m] */
     size_t n_events;
     unsigned long long steps, rhs_evals, guard_evals;
+    struct wetdem_pairwise_energy energy;
 };
 
 /* State of every sphere at one output time, handed to the observer. */
@@ -859,6 +881,9 @@ WETDEM_API size_t wetdem_pairwise_pair_index(size_t n, size_t i, size_t j);
 WETDEM_API const char* wetdem_pairwise_event_name(enum wetdem_pairwise_event_kind kind);
 /* "FA", "PA", "FS". */
 WETDEM_API const char* wetdem_pairwise_outcome_name(enum wetdem_pairwise_outcome outcome);
+/* Largest magnitude among the terms of an energy budget [J] (DBL_MIN if all are zero): the
+ * scale its residual is judged against. */
+WETDEM_API double wetdem_pairwise_energy_scale(const struct wetdem_pairwise_energy* e);
 
 /* Fills *d with Davis's defaults (St_n 2, Ca 1000, h_a 0.01, h_m 0.01, beta 30 deg,
  * d_23 = d_13 = 1, h_23,0 = 1, theta_23,0 = 0, e_dry 1, mu_f 0, t* 20). */

@@ -133,6 +133,19 @@ bool wetdem_pairwise_rhs_hold_set(const struct wetdem_pairwise_system* sys,
 bool wetdem_pairwise_rhs_eval(const struct wetdem_pairwise_system* sys,
                               const struct wetdem_pairwise_mode* md, const double* y, double* dydt);
 
+/* Mechanical energy of state k [J]: kinetic (translation and spin), the capillary potential
+ * sum over film pairs of 8 pi a sigma (h - delta) (<= 0) and gravity's -sum m g . x. */
+void wetdem_pairwise_rhs_energy(const struct wetdem_pairwise_system* sys,
+                                const struct wetdem_pairwise_mode* md,
+                                const struct wetdem_pairwise_kin* k, double* kinetic,
+                                double* capillary, double* gravity);
+/* Power dissipated by the film forces at state k [W], >= 0: the viscous part of Eq. 3 times
+ * v_n and Eq. 4 times v_s, summed over the film pairs. */
+void wetdem_pairwise_rhs_dissipation(const struct wetdem_pairwise_system* sys,
+                                     const struct wetdem_pairwise_mode* md,
+                                     const struct wetdem_pairwise_kin* k, double* normal,
+                                     double* tangential);
+
 /* ---- pairwise_jump.c ---- */
 
 /* Applies the hard-sphere impulse of pair p at state k (through wetdem_hard_impulse(),

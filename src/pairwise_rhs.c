@@ -26,6 +26,13 @@
  * Resting contact (an extension, docs/derivations/pairwise.md): a pair held at h = h_min
  * carries an extra normal force lambda (> 0 compressive) chosen so that dv_n/dt = 0 for every
  * held pair; the small linear system A lambda = -b is solved by Gaussian elimination.
+ * Energy (docs/derivations/pairwise.md Sec. 11): the film forces of pair p do work at the rate
+ * -(F_n v_n + F_t v_s) on the two spheres (translation and spin), so with the capillary
+ * potential U = 8 pi a sigma (h - delta) <= 0 of each film pair and gravity's -sum m g . x,
+ *     d/dt (kinetic + U + gravity) = -sum_p [F_visc,n v_n + F_t v_s] <= 0,
+ *     F_visc,n v_n = 6 pi mu a^2 v_n^2 [1 - h/(2 delta - h)]^2 / h,
+ *     F_t v_s = 2 pi mu a v_s^2 ln[(2 delta - h)/h];
+ * the constraint force of a held pair does no work (v_n = 0).
  * Validity: thin films delta << a, low Reynolds number, motion in a plane.
  */
 #include <math.h>
@@ -325,4 +332,42 @@ bool wetdem_pairwise_rhs_eval(const struct wetdem_pairwise_system* sys,
         if (a < 5 * sys->n && !isfinite(dydt[a]))
             return false;
     return true;
+}
+
+void wetdem_pairwise_rhs_energy(const struct wetdem_pairwise_system* sys,
+                                const struct wetdem_pairwise_mode* md,
+                                const struct wetdem_pairwise_kin* k, double* kinetic,
+                                double* capillary, double* gravity)
+{
+    double ke = 0.0, u_c = 0.0, u_g = 0.0;
+    for (size_t i = 0; i < sys->n; i++) {
+        ke += 0.5 * sys->m[i] * (k->vx[i] * k->vx[i] + k->vy[i] * k->vy[i]) +
+              0.5 * sys->inertia[i] * k->w[i] * k->w[i];
+        u_g -= sys->m[i] * (sys->gx * k->x[i] + sys->gy * k->y[i]);
+    }
+    for (size_t p = 0; p < sys->n_pairs; p++)
+        if (md->film[p])
+            u_c += 8.0 * M_PI * sys->a_eff[p] * sys->sigma * (k->h[p] - sys->delta[p]);
+    *kinetic = ke;
+    *capillary = u_c;
+    *gravity = u_g;
+}
+
+void wetdem_pairwise_rhs_dissipation(const struct wetdem_pairwise_system* sys,
+                                     const struct wetdem_pairwise_mode* md,
+                                     const struct wetdem_pairwise_kin* k, double* normal,
+                                     double* tangential)
+{
+    double pn = 0.0, pt = 0.0;
+    for (size_t p = 0; p < sys->n_pairs; p++) {
+        if (!md->film[p])
+            continue;
+        double h = k->h[p], v_n = k->v_n[p], v_s = -k->r[p] * k->omega_lc[p] + k->v_w[p];
+        pn += v_n *
+              wetdem_pairwise_rhs_normal_force(sys->mu, 0.0, sys->a_eff[p], sys->delta[p], h, v_n);
+        pt += v_s *
+              wetdem_pairwise_rhs_tangential_force(sys->mu, sys->a_eff[p], sys->delta[p], h, v_s);
+    }
+    *normal = pn;
+    *tangential = pt;
 }

@@ -89,6 +89,21 @@ static int run(const struct wetdem_pairwise_config* c, struct wetdem_pairwise_re
     return st;
 }
 
+/* n equal film-coated spheres (1 mm, 50 um films) at the origin, for the caller to place. */
+static struct wetdem_pairwise_config cluster(size_t n)
+{
+    struct wetdem_pairwise_config c;
+    wetdem_pairwise_config_init(&c);
+    c.n_spheres = n;
+    c.viscosity = 1.0;
+    c.surface_tension = 0.02;
+    c.h_min = 1e-6;
+    c.t_end = 2e-3;
+    for (size_t i = 0; i < n; i++)
+        c.spheres[i] = (struct wetdem_pairwise_sphere){.radius = 1e-3, .mass = 3e-5, .film = 50e-6};
+    return c;
+}
+
 /* ------------------------------------------------------------- closed-form head-on ---- */
 
 static double analytic_inverse_speed(double h, void* params)
@@ -402,6 +417,142 @@ static void test_pairwise_dry_elastic_energy(void** state)
     assert_int_equal(r.outcome, WETDEM_PAIRWISE_FS);
 }
 
+/* ------------------------------------------------------------------ energy budget ---- */
+
+/* The split of the head-on collision's losses against the closed form (Sec. 5): the relative
+ * motion, of kinetic energy (1/2) m* v0^2, reaches h_min at v_c = v0 (1 - I(h_m)/St), the
+ * impulse takes (1/2) m* v_c^2 (1 - e_dry^2), and the pair leaves the films at e_w v0 with
+ * e_w = e_dry (1 - I/St) - I/St; the film's viscous force took the rest, on the way in and
+ * out. The centre of mass keeps its kinetic energy. The impulse's share is exact given v_c
+ * (1e-6 as for v_c itself in test_pairwise_headon_matches_closed_form); the viscous share is
+ * integrated by three-point Gauss-Legendre on the dense output of steps taken to rtol 1e-11,
+ * whose error is far below the 1e-6 allowed. */
+static void test_pairwise_energy_headon_closed_form(void** state)
+{
+    (void)state;
+    const double st = 10.0, film = 100e-6, v0 = 0.5;
+    struct wetdem_pairwise_config c = head_on(st, film, v0);
+    c.rtol = 1e-11;
+    struct wetdem_pairwise_result r;
+    CHECK_OK(run(&c, &r, NULL));
+    double m0 = c.spheres[0].mass, m1 = c.spheres[1].mass, ms = m0 * m1 / (m0 + m1);
+    double i_m = closed_form_integral(0.01), v_c = v0 * (1.0 - i_m / st);
+    double e_w = c.restitution * (1.0 - i_m / st) - i_m / st;
+    double contact = 0.5 * ms * v_c * v_c * (1.0 - c.restitution * c.restitution);
+    double lost = 0.5 * ms * v0 * v0 * (1.0 - e_w * e_w);
+    const struct wetdem_pairwise_energy* e = &r.energy;
+    CHECK_REL(e->initial, 0.5 * m0 * v0 * v0, 1e-15);
+    CHECK_REL(e->contact, contact, 1e-6);
+    CHECK_REL(e->viscous_normal, lost - contact, 1e-6);
+    assert_true(e->viscous_tangential == 0.0 && e->capillary == 0.0 && e->gravity == 0.0);
+    CHECK_ABS(e->residual, 0.0, 1e-6 * e->initial);
+    /* the residual's scale: the largest term, here the initial energy; never zero */
+    assert_true(wetdem_pairwise_energy_scale(e) == e->initial);
+    struct wetdem_pairwise_energy none = {0};
+    assert_true(wetdem_pairwise_energy_scale(&none) == DBL_MIN);
+}
+
+/* The budget closes on Davis's three spheres, whatever dissipates: the Fig. 3 case (St 2,
+ * Ca 1000), a capillary well 150 times deeper than the impact's kinetic energy (Ca 0.01:
+ * 1800 elastic impulses inside it, and sphere 3 thrown out, PA, with more kinetic energy
+ * than the system started with), and the same with e_dry = 0.6 and friction 0.3. Every term
+ * is computed independently (potentials and kinetic energy from the state, the viscous work
+ * integrated, the impulses' losses from the energy before and after them), so a force
+ * missing from the equations of motion, a wrong sign of a coupling term or a force that
+ * does work it should not would leave a residual of the size of that work. At rtol 1e-9 the
+ * residual is 1e-7 to 6e-7 of the largest term (the sum of the steps' local errors); 1e-5
+ * allows for other compilers' rounding. With e_dry = 1 and no friction an impulse loses
+ * nothing but rounding; only a contact slower than the rest speed is plastic (Sec. 7) and
+ * takes at most (1/2) m* v_rest^2, so the contact losses lie between -1e-12 of the largest
+ * term (rounding over 1800 impulses of energies up to it, 1e-16 each) and that bound times
+ * the number of rest contacts. */
+static void test_pairwise_energy_budget_closes(void** state)
+{
+    (void)state;
+    const double ca[3] = {1000.0, 0.01, 0.01}, e_dry[3] = {1.0, 1.0, 0.6},
+                 mu_f[3] = {0.0, 0.0, 0.3};
+    for (int k = 0; k < 3; k++) {
+        struct wetdem_pairwise_config c = davis(2.0, ca[k], 30.0, 20.0);
+        c.restitution = e_dry[k];
+        c.friction = mu_f[k];
+        struct wetdem_pairwise_result r;
+        struct wetdem_pairwise* pw;
+        CHECK_OK(run(&c, &r, &pw));
+        const struct wetdem_pairwise_energy* e = &r.energy;
+        double scale = wetdem_pairwise_energy_scale(e);
+        CHECK_ABS(e->residual, 0.0, 1e-5 * scale);
+        assert_true(e->viscous_normal > 0.0 && e->viscous_tangential > 0.0);
+        assert_true(e->capillary <= 0.0 && e->gravity == 0.0);
+        size_t n_rest = 0;
+        while (find_event(pw, WETDEM_PAIRWISE_REST_START, n_rest))
+            n_rest++;
+        wetdem_pairwise_free(pw);
+        double v_rest = c.rest_speed_ratio * r.v_n0, m_eff = 0.5 * c.spheres[0].mass;
+        if (mu_f[k] == 0.0 && e_dry[k] == 1.0) {
+            assert_true(e->contact >= -1e-12 * scale);
+            assert_true(e->contact <=
+                        (double)n_rest * 0.5 * m_eff * v_rest * v_rest * 1.000001 + 1e-12 * scale);
+        } else {
+            assert_true(e->contact > 1e-3 * scale);
+        }
+        if (k == 1) {
+            assert_int_equal(r.outcome, WETDEM_PAIRWISE_PA);
+            assert_int_equal(r.separated_sphere, 2);
+            assert_true(e->kinetic > e->initial);
+            assert_true(r.pairs[0].n_contacts > 1000);
+        }
+    }
+}
+
+/* The budget reads CVODE's dense output and changes nothing: with it switched off the run
+ * takes the same steps to the same bits, and reports NAN energies. */
+static void test_pairwise_energy_budget_leaves_run_unchanged(void** state)
+{
+    (void)state;
+    struct wetdem_pairwise_config c = davis(2.0, 0.01, 30.0, 20.0), d = c;
+    d.energy_budget = false;
+    struct wetdem_pairwise_result r, s;
+    CHECK_OK(run(&c, &r, NULL));
+    CHECK_OK(run(&d, &s, NULL));
+    assert_true(r.steps == s.steps && r.rhs_evals == s.rhs_evals && r.n_events == s.n_events);
+    assert_memory_equal(r.final, s.final, sizeof r.final);
+    assert_true(r.time == s.time && r.outcome == s.outcome);
+    assert_true(isfinite(r.energy.residual) && isnan(s.energy.residual) &&
+                isnan(s.energy.viscous_normal) && isnan(s.energy.initial));
+}
+
+/* With gravity the potential -sum m g . x enters the budget. Two spheres with their films
+ * overlapping, one moving towards the other, fall together under g = (3, -9.81) m/s^2 while
+ * suction and viscous forces act between them and they end bound. Gravity's change is minus
+ * its work, sum m g . (x_end - x_0), which the final positions give (1e-12: a difference of
+ * sums of the same products); the residual is as small as without gravity. */
+static void test_pairwise_energy_with_gravity(void** state)
+{
+    (void)state;
+    struct wetdem_pairwise_config c = cluster(2);
+    c.spheres[1].x = 2e-3 + 100e-6;
+    c.spheres[0].vx = 0.05;
+    c.gravity_x = 3.0;
+    c.gravity_y = -9.81;
+    c.restitution = 0.7;
+    c.t_end = 0.02;
+    c.stop_when_separated = false;
+    struct wetdem_pairwise_result r;
+    CHECK_OK(run(&c, &r, NULL));
+    const struct wetdem_pairwise_energy* e = &r.energy;
+    double work = 0.0;
+    for (size_t i = 0; i < 2; i++)
+        work += c.spheres[i].mass * (c.gravity_x * (r.final[i].x - c.spheres[i].x) +
+                                     c.gravity_y * (r.final[i].y - c.spheres[i].y));
+    double g0 = 0.0;
+    for (size_t i = 0; i < 2; i++)
+        g0 -= c.spheres[i].mass * (c.gravity_x * c.spheres[i].x + c.gravity_y * c.spheres[i].y);
+    CHECK_REL(e->gravity - g0, -work, 1e-12);
+    assert_true(e->gravity < g0 && e->viscous_normal > 0.0 && e->capillary < 0.0);
+    assert_true(r.pairs[0].bound);
+    CHECK_ABS(e->residual, 0.0, 1e-5 * wetdem_pairwise_energy_scale(e));
+}
+
 /* Relabelling: the same physical collision with the spheres numbered (2, 0, 1) gives the same
  * final state and the same e_ij,w per physical pair. Different anchor and tracked pairs, so
  * agreement is to the integration tolerance: 1e-7 of the sphere radius and the speed. */
@@ -592,20 +743,6 @@ static void test_pairwise_forces_match_models(void** state)
 }
 
 /* ----------------------------------------------------------------------- outcomes ---- */
-
-static struct wetdem_pairwise_config cluster(size_t n)
-{
-    struct wetdem_pairwise_config c;
-    wetdem_pairwise_config_init(&c);
-    c.n_spheres = n;
-    c.viscosity = 1.0;
-    c.surface_tension = 0.02;
-    c.h_min = 1e-6;
-    c.t_end = 2e-3;
-    for (size_t i = 0; i < n; i++)
-        c.spheres[i] = (struct wetdem_pairwise_sphere){.radius = 1e-3, .mass = 3e-5, .film = 50e-6};
-    return c;
-}
 
 /* FS: nothing overlaps and everything recedes: the run stops at once. */
 static void test_pairwise_outcome_full_separation(void** state)
@@ -956,6 +1093,10 @@ int main(void)
         cmocka_unit_test(test_pairwise_jump_conserves_momentum),
         cmocka_unit_test(test_pairwise_run_conserves_momentum),
         cmocka_unit_test(test_pairwise_dry_elastic_energy),
+        cmocka_unit_test(test_pairwise_energy_headon_closed_form),
+        cmocka_unit_test(test_pairwise_energy_budget_closes),
+        cmocka_unit_test(test_pairwise_energy_budget_leaves_run_unchanged),
+        cmocka_unit_test(test_pairwise_energy_with_gravity),
         cmocka_unit_test(test_pairwise_relabelling_symmetry),
         cmocka_unit_test(test_pairwise_deterministic),
         cmocka_unit_test(test_pairwise_positions_match_cartesian),

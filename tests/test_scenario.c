@@ -643,6 +643,22 @@ static void test_scenario_map_and_check_of_other_engines(void** state)
     expect_run("run examples/scenarios/davis_three.ini", 0,
                "2-3   0          n/a        0         stick\n"
                "n/a: the pair's films never met, or it did not approach when they did");
+    /* the pairwise energy budget in the JSON summary: its terms add up to the initial energy
+     * (1e-11: they are printed with 12 digits) with a residual of at most 1e-5 of it (the
+     * library's test_pairwise_energy_budget_closes), and the text summary shows it */
+    r = run_cli("run examples/scenarios/davis_three.ini --json");
+    assert_int_equal(r.code, 0);
+    const char* terms[] = {"kinetic",        "capillary",          "gravity",
+                           "viscous_normal", "viscous_tangential", "contact",
+                           "residual"};
+    double e0 = json_value(r.out, "initial"), sum = 0.0;
+    for (size_t k = 0; k < sizeof terms / sizeof terms[0]; k++)
+        sum += json_value(r.out, terms[k]);
+    CHECK_REL(sum, e0, 1e-11);
+    assert_true(e0 > 0.0 && fabs(json_value(r.out, "residual")) <= 1e-5 * e0);
+    free(r.out);
+    expect_run("run examples/scenarios/davis_three.ini", 0,
+               "energy [J]         initial 5.02655e-05");
     /* spheres 2 and 3 of the unequal example as the reference pair: they do not approach at
      * t = 0 and sphere 2 rests, so t* and t-hat have no scale either */
     expect_run("run examples/scenarios/davis_unequal.ini --set pairwise.ref_i=2 --set "
