@@ -433,6 +433,9 @@ static int write_frame(const struct wetdem_pairwise_frame* fr, void* ctx)
     }
     for (size_t p = 0; p < fr->n_pairs; p++)
         fprintf(t->f, ",%.12g,%.12g", fr->gap[p], fr->v_n[p]);
+    const struct wetdem_pairwise_energy* e = &fr->energy;
+    fprintf(t->f, ",%.12g,%.12g,%.12g,%.12g,%.12g,%.12g,%.12g", e->kinetic, e->capillary,
+            e->gravity, e->viscous_normal, e->viscous_tangential, e->contact, e->residual);
     fputc('\n', t->f);
     return ferror(t->f) ? -1 : 0;
 }
@@ -446,6 +449,9 @@ static void trajectory_header(FILE* f, size_t n)
     for (size_t i = 1; i <= n; i++)
         for (size_t j = i + 1; j <= n; j++)
             fprintf(f, ",h_%zu%zu [m],v_n_%zu%zu [m/s]", i, j, i, j);
+    fputs(",kinetic [J],capillary [J],gravity [J],viscous_normal [J],viscous_tangential [J],"
+          "contact [J],energy_residual [J]",
+          f);
     fputc('\n', f);
 }
 

@@ -262,6 +262,47 @@ def fig_gaps():
     check("partner_change" in list(ev["event"]), "St 2: the striker meets sphere 3 and a partner change is logged")
 
 
+def fig_energy():
+    """The energy budget over time (docs/derivations/pairwise.md Sec. 11), each term over the
+    initial energy E0: kinetic, capillary potential, the viscous work so far and the
+    impulses' losses, whose sum with the residual is E0 at every row."""
+    import json
+    fig, ax = plt.subplots(1, 2, figsize=(12, 4.2))
+    terms = [("kinetic", "kinetic"), ("capillary", "capillary potential"),
+             ("viscous_normal", "viscous work, normal"),
+             ("viscous_tangential", "viscous work, tangential"), ("contact", "impulses")]
+    for a, name, title in zip(ax, ["fig3", "deepwell"],
+                              ["St 2, Ca 1000 (Fig. 3: FA)",
+                               "St 2, Ca 0.01: a well 150 E0 deep, e_dry = 1"]):
+        t = read_csv(os.path.join(DATA, "energy_" + name, "trajectory.csv"))
+        e0 = t["kinetic"][0] + t["capillary"][0] + t["gravity"][0]
+        scale = np.max([np.abs(t[k]) for k, _ in terms] + [np.full(len(t["kinetic"]), abs(e0))],
+                       axis=0)
+        worst = np.max(np.abs(t["energy_residual"]) / scale)
+        for key, label in terms:
+            a.plot(t["t_star"], t[key] / e0, label=label)
+        a.axhline(0, color="k", lw=0.5)
+        a.set(xlabel=r"$t^* = v_{10} t / 4a$", ylabel="energy / $E_0$",
+              title=f"{title}\nlargest |residual| {worst:.1e} of the largest term")
+        a.set_yscale("symlog", linthresh=1e-2)
+        a.set_xscale("symlog", linthresh=1e-3)
+        a.set_xlim(0, t["t_star"][-1])
+        a.legend(fontsize=8)
+        check(worst <= 1e-5, f"{name}: the energy budget closes at every output row "
+              f"(largest residual {worst:.1e} <= 1e-5 of the largest term)")
+        mono = all(np.all(np.diff(t[k]) >= 0) for k in ("viscous_normal", "viscous_tangential"))
+        check(mono, f"{name}: the viscous work never decreases")
+        if name == "deepwell":
+            with open(os.path.join(DATA, "energy_deepwell", "summary.json")) as f:
+                summary = json.load(f)
+            check(summary["outcome"] == "PA" and t["kinetic"][-1] > e0,
+                  f"deep well: the well's energy throws sphere 3 out (PA, outcome "
+                  f"{summary['outcome']}), ending with {t['kinetic'][-1] / e0:.1f} E0 of kinetic energy")
+    fig.tight_layout()
+    fig.savefig(os.path.join(FIGURES, "davis_energy.png"), dpi=120)
+    plt.close(fig)
+
+
 def main():
     os.makedirs(FIGURES, exist_ok=True)
     fig_restitution()
@@ -269,6 +310,7 @@ def main():
     fig_map()
     fig_snapshots()
     fig_gaps()
+    fig_energy()
     if failures:
         print(f"{len(failures)} check(s) failed")
         sys.exit(1)

@@ -818,6 +818,8 @@ struct wetdem_pairwise_frame {
     struct wetdem_pairwise_sphere spheres[WETDEM_PAIRWISE_MAX_SPHERES];
     double gap[WETDEM_PAIRWISE_MAX_PAIRS]; /* h of every pair [m] */
     double v_n[WETDEM_PAIRWISE_MAX_PAIRS]; /* normal approach speed of every pair [m/s] */
+    struct wetdem_pairwise_energy energy;  /* the budget from t = 0 to this time (NAN without
+                                              config.energy_budget) */
 };
 /* Observer: called at t = 0, every `interval` seconds and at the end; non-zero stops the run
  * with WETDEM_ERR_CALLBACK. */

@@ -427,6 +427,83 @@ static int log_event(struct wetdem_pairwise* pw, enum wetdem_pairwise_event_kind
     return WETDEM_OK;
 }
 
+/* ------------------------------------------------------------------ energy budget ---- */
+
+/* Mechanical energy of state y in the current mode [J] (NAN if y is outside the domain). */
+static double mechanical_energy(const struct wetdem_pairwise* pw, const double* y)
+{
+    struct wetdem_pairwise_kin k;
+    double ke, u_c, u_g;
+    if (!wetdem_pairwise_state_kin(&pw->sys, &pw->md, y, &k))
+        return NAN;
+    wetdem_pairwise_rhs_energy(&pw->sys, &pw->md, &k, &ke, &u_c, &u_g);
+    return ke + u_c + u_g;
+}
+
+/* The film forces' dissipation over [t_lo, t_hi] inside the last step [J]: three-point
+ * Gauss-Legendre on CVODE's dense output, exact for a power that is a polynomial of degree 5
+ * in t, as accurate as the interpolant elsewhere. It reads the solution without changing
+ * it, so the run's trajectory does not depend on the budget. */
+static int step_dissipation(struct wetdem_pairwise* pw, double t_lo, double t_hi, double* normal,
+                            double* tangential)
+{
+    static const double node[3] = {-0.77459666924148337704, 0.0, 0.77459666924148337704};
+    static const double weight[3] = {5.0 / 9.0, 8.0 / 9.0, 5.0 / 9.0};
+    double half = 0.5 * (t_hi - t_lo), mid = 0.5 * (t_lo + t_hi);
+    double e_n = 0.0, e_t = 0.0;
+    *normal = *tangential = 0.0;
+    if (!(half > 0.0))
+        return WETDEM_OK;
+    for (int g = 0; g < 3; g++) {
+        double y[PW_YMAX], p_n, p_t, t = mid + half * node[g];
+        struct wetdem_pairwise_kin k;
+        if (!interpolate(pw, t, y) || !wetdem_pairwise_state_kin(&pw->sys, &pw->md, y, &k))
+            return fail(pw, WETDEM_ERR_STEP, "dense output failed at t = %g s", t);
+        wetdem_pairwise_rhs_dissipation(&pw->sys, &pw->md, &k, &p_n, &p_t);
+        e_n += weight[g] * p_n;
+        e_t += weight[g] * p_t;
+    }
+    *normal = half * e_n;
+    *tangential = half * e_t;
+    return WETDEM_OK;
+}
+
+/* Adds the dissipation over [t_lo, t_hi] of the last step to the run's budget. */
+static int dissipate(struct wetdem_pairwise* pw, double t_lo, double t_hi)
+{
+    double e_n, e_t;
+    int st = pw->cfg.energy_budget ? step_dissipation(pw, t_lo, t_hi, &e_n, &e_t) : WETDEM_OK;
+    if (st == WETDEM_OK && pw->cfg.energy_budget) {
+        pw->res->energy.viscous_normal += e_n;
+        pw->res->energy.viscous_tangential += e_t;
+    }
+    return st;
+}
+
+double wetdem_pairwise_energy_scale(const struct wetdem_pairwise_energy* e)
+{
+    double terms[] = {e->initial, e->kinetic,        e->capillary,
+                      e->gravity, e->viscous_normal, e->viscous_tangential,
+                      e->contact};
+    double s = DBL_MIN;
+    for (size_t k = 0; k < sizeof terms / sizeof terms[0]; k++)
+        s = fmax(s, fabs(terms[k]));
+    return s;
+}
+
+/* The budget at state k: the energies there and the residual, given the losses so far in e. */
+static void close_budget(const struct wetdem_pairwise* pw, const struct wetdem_pairwise_kin* k,
+                         struct wetdem_pairwise_energy* e)
+{
+    if (!pw->cfg.energy_budget) {
+        *e = (struct wetdem_pairwise_energy){NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN};
+        return;
+    }
+    wetdem_pairwise_rhs_energy(&pw->sys, &pw->md, k, &e->kinetic, &e->capillary, &e->gravity);
+    e->residual = e->initial - (e->kinetic + e->capillary + e->gravity + e->viscous_normal +
+                                e->viscous_tangential + e->contact);
+}
+
 /* ------------------------------------------------------------------------- output ---- */
 
 static void fill_frame(const struct wetdem_pairwise* pw, const struct wetdem_pairwise_kin* k,
@@ -452,12 +529,24 @@ static void fill_frame(const struct wetdem_pairwise* pw, const struct wetdem_pai
     }
 }
 
+/* Frame at time t, state y, inside the last step from pw->t (or at pw->t itself). Its
+ * budget is the run's so far plus the dissipation from pw->t to t. */
 static int emit(struct wetdem_pairwise* pw, double t, const double* y)
 {
     struct wetdem_pairwise_kin k;
     struct wetdem_pairwise_frame fr;
     wetdem_pairwise_state_kin(&pw->sys, &pw->md, y, &k);
     fill_frame(pw, &k, t, &fr);
+    fr.energy = pw->res->energy;
+    if (pw->cfg.energy_budget && t > pw->t) {
+        double e_n, e_t;
+        int st = step_dissipation(pw, pw->t, t, &e_n, &e_t);
+        if (st != WETDEM_OK)
+            return st;
+        fr.energy.viscous_normal += e_n;
+        fr.energy.viscous_tangential += e_t;
+    }
+    close_budget(pw, &k, &fr.energy);
     if (pw->obs(&fr, pw->obs_ctx) != 0)
         return fail(pw, WETDEM_ERR_CALLBACK, "observer returned non-zero at t = %g s", t);
     return WETDEM_OK;
@@ -748,47 +837,6 @@ static int process_events(struct wetdem_pairwise* pw)
     return fail(pw, WETDEM_ERR_STEP, "events do not settle at t = %g s", pw->t);
 }
 
-/* ------------------------------------------------------------------ energy budget ---- */
-
-/* Mechanical energy of state y in the current mode [J] (NAN if y is outside the domain). */
-static double mechanical_energy(const struct wetdem_pairwise* pw, const double* y)
-{
-    struct wetdem_pairwise_kin k;
-    double ke, u_c, u_g;
-    if (!wetdem_pairwise_state_kin(&pw->sys, &pw->md, y, &k))
-        return NAN;
-    wetdem_pairwise_rhs_energy(&pw->sys, &pw->md, &k, &ke, &u_c, &u_g);
-    return ke + u_c + u_g;
-}
-
-/* Adds the film forces' dissipation over [t_lo, t_hi] of the last step: three-point
- * Gauss-Legendre on CVODE's dense output, exact for a power that is a polynomial of degree 5
- * in t, as accurate as the interpolant elsewhere. It reads the solution without changing
- * it, so the run's trajectory does not depend on the budget. */
-static int dissipate(struct wetdem_pairwise* pw, double t_lo, double t_hi)
-{
-    if (!pw->cfg.energy_budget)
-        return WETDEM_OK;
-    static const double node[3] = {-0.77459666924148337704, 0.0, 0.77459666924148337704};
-    static const double weight[3] = {5.0 / 9.0, 8.0 / 9.0, 5.0 / 9.0};
-    double half = 0.5 * (t_hi - t_lo), mid = 0.5 * (t_lo + t_hi);
-    if (!(half > 0.0))
-        return WETDEM_OK;
-    double e_n = 0.0, e_t = 0.0;
-    for (int g = 0; g < 3; g++) {
-        double y[PW_YMAX], p_n, p_t, t = mid + half * node[g];
-        struct wetdem_pairwise_kin k;
-        if (!interpolate(pw, t, y) || !wetdem_pairwise_state_kin(&pw->sys, &pw->md, y, &k))
-            return fail(pw, WETDEM_ERR_STEP, "dense output failed at t = %g s", t);
-        wetdem_pairwise_rhs_dissipation(&pw->sys, &pw->md, &k, &p_n, &p_t);
-        e_n += weight[g] * p_n;
-        e_t += weight[g] * p_t;
-    }
-    pw->res->energy.viscous_normal += half * e_n;
-    pw->res->energy.viscous_tangential += half * e_t;
-    return WETDEM_OK;
-}
-
 /* process_events, with the mechanical energy its impulses take counted as contact losses
  * (a film switching on or off at h = delta changes no energy; the tree's repacking only
  * rounds). */
@@ -801,30 +849,6 @@ static int process_events_counted(struct wetdem_pairwise* pw)
     if (st == WETDEM_OK)
         pw->res->energy.contact += before - mechanical_energy(pw, pw->y);
     return st;
-}
-
-double wetdem_pairwise_energy_scale(const struct wetdem_pairwise_energy* e)
-{
-    double terms[] = {e->initial, e->kinetic,        e->capillary,
-                      e->gravity, e->viscous_normal, e->viscous_tangential,
-                      e->contact};
-    double s = DBL_MIN;
-    for (size_t k = 0; k < sizeof terms / sizeof terms[0]; k++)
-        s = fmax(s, fabs(terms[k]));
-    return s;
-}
-
-/* The energies at the end and the residual of the budget. */
-static void close_budget(struct wetdem_pairwise* pw, const struct wetdem_pairwise_kin* k)
-{
-    struct wetdem_pairwise_energy* e = &pw->res->energy;
-    if (!pw->cfg.energy_budget) {
-        *e = (struct wetdem_pairwise_energy){NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN};
-        return;
-    }
-    wetdem_pairwise_rhs_energy(&pw->sys, &pw->md, k, &e->kinetic, &e->capillary, &e->gravity);
-    e->residual = e->initial - (e->kinetic + e->capillary + e->gravity + e->viscous_normal +
-                                e->viscous_tangential + e->contact);
 }
 
 /* ------------------------------------------------------------------- bookkeeping ---- */
@@ -1047,7 +1071,7 @@ static void finish(struct wetdem_pairwise* pw)
     }
     res->time = pw->t;
     res->n_events = pw->n_events;
-    close_budget(pw, &k);
+    close_budget(pw, &k, &res->energy);
     classify(pw);
 }
 

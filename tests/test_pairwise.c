@@ -521,6 +521,47 @@ static void test_pairwise_energy_budget_leaves_run_unchanged(void** state)
                 isnan(s.energy.viscous_normal) && isnan(s.energy.initial));
 }
 
+/* The budget at every output time (the observer's frames): the run's losses so far plus the
+ * dissipation from the step's start to the frame, so the viscous work never decreases, the
+ * residual stays as small as at the end (1e-5 of the largest term, as above) and the last
+ * frame's budget is the result's, bit for bit (the same sums at the same state). Run on the
+ * deep-well case, whose frames fall among 1800 impulses. */
+struct frame_budget {
+    size_t n;
+    double worst, last_n, last_t;
+    bool monotone;
+    struct wetdem_pairwise_energy last;
+};
+
+static int check_frame_budget(const struct wetdem_pairwise_frame* fr, void* ctx)
+{
+    struct frame_budget* b = ctx;
+    const struct wetdem_pairwise_energy* e = &fr->energy;
+    b->worst = fmax(b->worst, fabs(e->residual) / wetdem_pairwise_energy_scale(e));
+    b->monotone =
+        b->monotone && e->viscous_normal >= b->last_n && e->viscous_tangential >= b->last_t;
+    b->last_n = e->viscous_normal;
+    b->last_t = e->viscous_tangential;
+    b->last = *e;
+    b->n++;
+    return 0;
+}
+
+static void test_pairwise_energy_budget_at_every_frame(void** state)
+{
+    (void)state;
+    struct wetdem_pairwise_config c = davis(2.0, 0.01, 30.0, 20.0);
+    struct wetdem_pairwise* pw = wetdem_pairwise_create();
+    struct frame_budget b = {.monotone = true};
+    wetdem_pairwise_set_observer(pw, c.t_end / 500.0, check_frame_budget, &b);
+    struct wetdem_pairwise_result r;
+    CHECK_OK(wetdem_pairwise_run(pw, &c, &r));
+    wetdem_pairwise_free(pw);
+    assert_true(b.n >= 500 && b.monotone);
+    assert_true(b.worst <= 1e-5);
+    assert_memory_equal(&b.last, &r.energy, sizeof r.energy);
+}
+
 /* With gravity the potential -sum m g . x enters the budget. Two spheres with their films
  * overlapping, one moving towards the other, fall together under g = (3, -9.81) m/s^2 while
  * suction and viscous forces act between them and they end bound. Gravity's change is minus
@@ -1096,6 +1137,7 @@ int main(void)
         cmocka_unit_test(test_pairwise_energy_headon_closed_form),
         cmocka_unit_test(test_pairwise_energy_budget_closes),
         cmocka_unit_test(test_pairwise_energy_budget_leaves_run_unchanged),
+        cmocka_unit_test(test_pairwise_energy_budget_at_every_frame),
         cmocka_unit_test(test_pairwise_energy_with_gravity),
         cmocka_unit_test(test_pairwise_relabelling_symmetry),
         cmocka_unit_test(test_pairwise_deterministic),
