@@ -775,7 +775,7 @@ struct wetdem_pairwise_pair_result {
 /* Energy budget of a pairwise run [J]. The mechanical energy is the kinetic energy
  * (translation and spin) plus two potentials: the capillary suction's, sum over the pairs
  * whose films overlap of 8 pi a sigma (h - delta) <= 0 (zero where the films meet, so it is
- * continuous), and gravity's, -sum m g . x. Its loss is the work of the viscous film forces
+ * continuous), and gravity's, -sum m g . (x - x_0) from the start. Its loss is the work of the viscous film forces
  * (integrated along the run) and of the impulses:
  *     initial = kinetic + capillary + gravity + viscous_normal + viscous_tangential
  *               + contact + residual,
@@ -784,7 +784,7 @@ struct wetdem_pairwise_energy {
     double initial;            /* mechanical energy at t = 0, before any impulse [J] */
     double kinetic;            /* kinetic energy at the end [J] */
     double capillary;          /* capillary potential at the end, <= 0 [J] */
-    double gravity;            /* gravity's potential -sum m g . x at the end [J] */
+    double gravity;            /* gravity's potential -sum m g . (x - x_0) at the end [J] */
     double viscous_normal;     /* dissipated by the viscous part of Eq. 3, >= 0 [J] */
     double viscous_tangential; /* dissipated by Eq. 4, >= 0 [J] */
     double contact;            /* lost in impulses: e_dry < 1, friction, rest contacts [J] */

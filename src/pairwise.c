@@ -63,6 +63,7 @@ struct wetdem_pairwise {
     bool approaching[PW_PMAX];
     int reversal[PW_PMAX];
     double rest_speed, v_scale;
+    double gravity_ref; /* -sum m g . x at t = 0 [J]: gravity's potential is taken from it */
     bool done;
 };
 
@@ -429,15 +430,25 @@ static int log_event(struct wetdem_pairwise* pw, enum wetdem_pairwise_event_kind
 
 /* ------------------------------------------------------------------ energy budget ---- */
 
-/* Mechanical energy of state y in the current mode [J] (NAN if y is outside the domain). */
-static double mechanical_energy(const struct wetdem_pairwise* pw, const double* y)
+/* Kinetic energy, capillary potential and -sum m g . x of state y in the current mode [J];
+ * false if y is outside the domain. */
+static bool energy_parts(const struct wetdem_pairwise* pw, const double* y, double* kinetic,
+                         double* capillary, double* gravity)
 {
     struct wetdem_pairwise_kin k;
-    double ke, u_c, u_g;
     if (!wetdem_pairwise_state_kin(&pw->sys, &pw->md, y, &k))
-        return NAN;
-    wetdem_pairwise_rhs_energy(&pw->sys, &pw->md, &k, &ke, &u_c, &u_g);
-    return ke + u_c + u_g;
+        return false;
+    wetdem_pairwise_rhs_energy(&pw->sys, &pw->md, &k, kinetic, capillary, gravity);
+    return true;
+}
+
+/* Mechanical energy of state y [J] (NAN outside the domain), gravity's potential taken from
+ * its value at t = 0: it then measures the work done alone, and a far origin of the positions
+ * adds no large constant that would round the other terms away. */
+static double mechanical_energy(const struct wetdem_pairwise* pw, const double* y)
+{
+    double ke, u_c, u_g;
+    return energy_parts(pw, y, &ke, &u_c, &u_g) ? ke + u_c + (u_g - pw->gravity_ref) : NAN;
 }
 
 /* The film forces' dissipation over [t_lo, t_hi] inside the last step [J]: three-point
@@ -500,6 +511,7 @@ static void close_budget(const struct wetdem_pairwise* pw, const struct wetdem_p
         return;
     }
     wetdem_pairwise_rhs_energy(&pw->sys, &pw->md, k, &e->kinetic, &e->capillary, &e->gravity);
+    e->gravity -= pw->gravity_ref;
     e->residual = e->initial - (e->kinetic + e->capillary + e->gravity + e->viscous_normal +
                                 e->viscous_tangential + e->contact);
 }
@@ -1090,6 +1102,9 @@ int wetdem_pairwise_run(struct wetdem_pairwise* pw, const struct wetdem_pairwise
     pw->n_out = 0;
     pw->done = false;
     initial_state(pw);
+    double ke0, u_c0;
+    if (!energy_parts(pw, pw->y, &ke0, &u_c0, &pw->gravity_ref))
+        pw->gravity_ref = NAN;
     res->energy.initial = mechanical_energy(pw, pw->y);
     if ((st = setup_cvode(pw)) != WETDEM_OK || (st = process_events_counted(pw)) != WETDEM_OK ||
         (st = restart(pw)) != WETDEM_OK)

@@ -133,8 +133,9 @@ bool wetdem_pairwise_rhs_hold_set(const struct wetdem_pairwise_system* sys,
 bool wetdem_pairwise_rhs_eval(const struct wetdem_pairwise_system* sys,
                               const struct wetdem_pairwise_mode* md, const double* y, double* dydt);
 
-/* Mechanical energy of state k [J]: kinetic (translation and spin), the capillary potential
- * sum over film pairs of 8 pi a sigma (h - delta) (<= 0) and gravity's -sum m g . x. */
+/* Parts of the mechanical energy of state k [J]: kinetic (translation and spin), the
+ * capillary potential sum over film pairs of 8 pi a sigma (h - delta) (<= 0) and gravity's
+ * -sum m g . x (the driver takes it from its value at t = 0). */
 void wetdem_pairwise_rhs_energy(const struct wetdem_pairwise_system* sys,
                                 const struct wetdem_pairwise_mode* md,
                                 const struct wetdem_pairwise_kin* k, double* kinetic,
