@@ -321,14 +321,15 @@ static void summary_text(FILE* f, const struct wetdem_pairwise_result* r)
     const struct wetdem_pairwise_energy* e = &r->energy;
     if (!isfinite(e->residual))
         return; /* (not computed: energy_budget = false) */
-    fprintf(f, "energy [J]         initial %.6g = kinetic %.6g + capillary %.6g + gravity %.6g\n",
-            e->initial, e->kinetic, e->capillary, e->gravity);
-    fprintf(f,
-            "                   + dissipated: viscous normal %.6g, tangential %.6g, "
-            "contact %.6g\n",
-            e->viscous_normal, e->viscous_tangential, e->contact);
-    fprintf(f, "                   + residual %.3g (%.2g of the largest term)\n", e->residual,
-            e->residual / wetdem_pairwise_energy_scale(e));
+    fprintf(f, "energy [J]         initial %.6g\n", e->initial);
+    fprintf(f, "  kinetic          %-13.6g at the end\n", e->kinetic);
+    fprintf(f, "  capillary        %-13.6g potential at the end\n", e->capillary);
+    fprintf(f, "  gravity          %-13.6g potential at the end, from the start\n", e->gravity);
+    fprintf(f, "  viscous normal   %-13.6g dissipated\n", e->viscous_normal);
+    fprintf(f, "  viscous tangent  %-13.6g dissipated\n", e->viscous_tangential);
+    fprintf(f, "  contact          %-13.6g lost in impulses\n", e->contact);
+    fprintf(f, "  residual         %-13.3g %.2g of the largest term (integration error)\n",
+            e->residual, e->residual / wetdem_pairwise_energy_scale(e));
 }
 
 static void json_number(FILE* f, double v)
