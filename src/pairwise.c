@@ -36,6 +36,9 @@ enum { REV_NONE = 0, REV_IMPULSE = 1, REV_FILM = 2 };
 enum { G_FILM = 0, G_CONTACT = 1, G_RELEASE = 2, G_KINDS = 3 };
 
 #define PW_MAX_STEPS 20000000ULL
+/* Steps in a row whose event lies at the step's start and logs nothing before the run is
+ * stopped as stalled: a located event that changes nothing is met again by the next step. */
+#define PW_MAX_STALLED 1000u
 
 struct wetdem_pairwise {
     char errmsg[1024];
@@ -63,6 +66,7 @@ struct wetdem_pairwise {
     bool approaching[PW_PMAX];
     int reversal[PW_PMAX];
     double rest_speed, v_scale;
+    unsigned stalled;   /* consecutive steps whose events came at their start, none logged */
     double gravity_ref; /* -sum m g . x at t = 0 [J]: gravity's potential is taken from it */
     bool done;
 };
@@ -797,8 +801,14 @@ static int on_contact(struct wetdem_pairwise* pw, size_t p)
     if (!current_kin(pw, &k))
         return WETDEM_ERR_NUMERIC;
     double v_n = k.v_n[p];
-    if (!(v_n > 0.0))
-        return WETDEM_OK; /* grazing: nothing to reverse */
+    /* Receding at the rest speed or faster: a graze, nothing to reverse. Slower, the pair
+     * is at h_min and at rest to within the rest speed, and the contact problem decides
+     * whether it is held: a deep capillary well turns such a pair round within a step
+     * (10^6 m/s^2 at Ca = 0.01), and at rtol 1e-5 CVODE's steps start one rounding below
+     * h_min, so leaving it free would locate the same crossing at the step's start again,
+     * each time, with time standing still. */
+    if (!(v_n > 0.0) && !(-v_n < pw->rest_speed))
+        return WETDEM_OK;
     pw->approaching[p] = false;
     pw->reversal[p] = REV_IMPULSE;
     if (v_n < pw->rest_speed)
@@ -1049,9 +1059,18 @@ static int advance(struct wetdem_pairwise* pw)
         pw->t = t_ev;
         if (!interpolate(pw, t_ev, pw->y))
             return fail(pw, WETDEM_ERR_STEP, "dense output failed at t = %g s", t_ev);
+        size_t n_logged = pw->n_events;
         if ((st = process_events_counted(pw)) != WETDEM_OK || (st = restart(pw)) != WETDEM_OK)
             return st;
+        pw->stalled = (t_ev == t_lo && pw->n_events == n_logged) ? pw->stalled + 1 : 0;
+        if (pw->stalled >= PW_MAX_STALLED)
+            return fail(pw, WETDEM_ERR_STEP,
+                        "time stands still at t = %g s: %u steps in a row met an event at their "
+                        "start that changed nothing (a pair grazing at h_min; with "
+                        "rest_speed_ratio = %g, try a larger one or a smaller rtol)",
+                        t_lo, pw->stalled, pw->cfg.rest_speed_ratio);
     } else {
+        pw->stalled = 0;
         int st = emit_until(pw, t);
         if (st != WETDEM_OK || (st = dissipate(pw, t_lo, t)) != WETDEM_OK)
             return st;
@@ -1101,6 +1120,7 @@ int wetdem_pairwise_run(struct wetdem_pairwise* pw, const struct wetdem_pairwise
     pw->t = 0.0;
     pw->n_out = 0;
     pw->done = false;
+    pw->stalled = 0;
     initial_state(pw);
     double ke0, u_c0;
     if (!energy_parts(pw, pw->y, &ke0, &u_c0, &pw->gravity_ref))

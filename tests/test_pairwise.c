@@ -504,6 +504,61 @@ static void test_pairwise_energy_budget_closes(void** state)
     }
 }
 
+/* The residual is the sum of the steps' local errors, which CVODE keeps to about rtol each,
+ * so it shrinks with the tolerance, and every tolerance of the valid range finishes: at
+ * Ca = 0.01 (sphere 1 held in the deep well of sphere 2) from rtol 1e-3 down, two decades at
+ * a time, 5.0e-2, 1.7e-3, 3.8e-5 and 5.3e-7 of the largest term (29 to 72 times less each),
+ * and at Ca = 1000 6.8e-3 to 1.1e-7 from 1e-3 to 1e-9, not monotonically in between (1e-6
+ * gives 2.4e-5, 1e-5 1.4e-5). Required: 10 times less for every two decades at Ca = 0.01, and
+ * 1e4 times less over the six decades in both. The outcome is PA at every tolerance. Until
+ * slow receding pairs at h_min went to the contact problem, rtol 1e-5 and above made the
+ * Ca = 0.01 run stand still at t = 3e-5 s for 20 million steps. */
+static void test_pairwise_energy_residual_shrinks_with_rtol(void** state)
+{
+    (void)state;
+    const double ca[2] = {0.01, 1000.0};
+    for (int k = 0; k < 2; k++) {
+        double prev = NAN, first = NAN;
+        for (double rtol = 1e-3; rtol > 1e-10; rtol *= 1e-2) {
+            struct wetdem_pairwise_config c = davis(2.0, ca[k], 30.0, 20.0);
+            c.rtol = rtol;
+            struct wetdem_pairwise_result r;
+            CHECK_OK(run(&c, &r, NULL));
+            double rel = fabs(r.energy.residual) / wetdem_pairwise_energy_scale(&r.energy);
+            if (k == 0) {
+                assert_int_equal(r.outcome, WETDEM_PAIRWISE_PA);
+                if (!isnan(prev) && !(rel < 0.1 * prev))
+                    fail_msg("Ca %g rtol %g: residual %.3g of the largest term, rtol %g %.3g",
+                             ca[k], rtol, rel, rtol * 1e2, prev);
+            }
+            prev = rel;
+            if (isnan(first))
+                first = rel;
+        }
+        if (!(prev < 1e-4 * first))
+            fail_msg("Ca %g: residual %.3g at rtol 1e-9 against %.3g at 1e-3", ca[k], prev, first);
+    }
+}
+
+/* A located contact that changes nothing would be met again at the start of every step:
+ * with resting contacts switched off (rest_speed_ratio = 0) the Ca = 0.01 run at rtol 1e-5
+ * does that at t = 3e-5 s, and is stopped after 1000 such steps with a message saying why,
+ * not after 20 million. */
+static void test_pairwise_stall_is_reported(void** state)
+{
+    (void)state;
+    struct wetdem_pairwise_config c = davis(2.0, 0.01, 30.0, 20.0);
+    c.rtol = 1e-5;
+    c.rest_speed_ratio = 0.0;
+    struct wetdem_pairwise_result r;
+    struct wetdem_pairwise* pw = wetdem_pairwise_create();
+    assert_int_equal(wetdem_pairwise_run(pw, &c, &r), WETDEM_ERR_STEP);
+    CHECK_CONTAINS(wetdem_pairwise_errmsg(pw), "time stands still at t = ");
+    CHECK_CONTAINS(wetdem_pairwise_errmsg(pw), "rest_speed_ratio = 0");
+    assert_true(r.steps < 100000);
+    wetdem_pairwise_free(pw);
+}
+
 /* The budget reads CVODE's dense output and changes nothing: with it switched off the run
  * takes the same steps to the same bits, and reports NAN energies. */
 static void test_pairwise_energy_budget_leaves_run_unchanged(void** state)
@@ -1151,6 +1206,8 @@ int main(void)
         cmocka_unit_test(test_pairwise_dry_elastic_energy),
         cmocka_unit_test(test_pairwise_energy_headon_closed_form),
         cmocka_unit_test(test_pairwise_energy_budget_closes),
+        cmocka_unit_test(test_pairwise_energy_residual_shrinks_with_rtol),
+        cmocka_unit_test(test_pairwise_stall_is_reported),
         cmocka_unit_test(test_pairwise_energy_budget_leaves_run_unchanged),
         cmocka_unit_test(test_pairwise_energy_budget_at_every_frame),
         cmocka_unit_test(test_pairwise_energy_with_gravity),
