@@ -179,7 +179,8 @@ static int check_engine(const struct cli_scenario* sc, struct cli_batch* b)
         cli_error("%s %s: engine 'pairwise' is not in this build", b->cmd, b->file);
         rc = CLI_EXIT_RUNTIME;
     }
-    if (rc == CLI_EXIT_OK && cli_scenario_is_many && cli_scenario_is_many(sc)) {
+    if (rc == CLI_EXIT_OK && b->engine == CLI_ENGINE_SOFT && cli_scenario_is_many &&
+        cli_scenario_is_many(sc)) { /* (a pairwise scenario's stray [box] is its own error) */
         cli_error("%s %s: a many-particle scenario runs with 'wetdem run' (one run per "
                   "file); %s",
                   b->cmd, b->file, b->many_note);

@@ -218,8 +218,12 @@ static int report_gap(const struct cli_scenario* sc, const char* msg)
 /* Builds and checks the configuration; exit code. */
 static int build_config(const struct cli_scenario* sc, struct wetdem_pairwise_config* cfg)
 {
+    static const char* const reads[] = {"engine", "davis", "pairwise", "sphere.*", "output", NULL};
+    int rc = cli_scenario_check_read(sc, "the pairwise engine", reads);
+    if (rc != CLI_EXIT_OK)
+        return rc;
     bool davis = cli_scenario_has_section(sc, "davis");
-    int rc = davis ? from_davis(sc, cfg) : from_spheres(sc, cfg);
+    rc = davis ? from_davis(sc, cfg) : from_spheres(sc, cfg);
     if (rc != CLI_EXIT_OK)
         return rc;
     run_settings(sc, cfg);

@@ -197,6 +197,52 @@ bool cli_scenario_has_section(const struct cli_scenario* sc, const char* section
     return false;
 }
 
+/* Whether section `name` is among `reads` (exact names, or "family.*" for "family.NAME"). */
+static bool section_read(const char* name, const char* const* reads)
+{
+    for (size_t k = 0; reads[k]; k++) {
+        const char* star = strstr(reads[k], ".*");
+        if (star ? strncmp(name, reads[k], (size_t)(star - reads[k]) + 1) == 0
+                 : strcmp(name, reads[k]) == 0)
+            return true;
+    }
+    return false;
+}
+
+int cli_scenario_check_read(const struct cli_scenario* sc, const char* reader,
+                            const char* const* reads)
+{
+    const char* name = NULL;
+    const struct cli_entry* set = NULL;
+    for (size_t k = 0; k < sc->n_sections && !name; k++)
+        if (!section_read(sc->sections[k].name, reads))
+            name = sc->sections[k].name;
+    for (size_t k = 0; k < sc->n_entries && !name; k++)
+        if (!section_read(sc->entries[k].section, reads)) {
+            name = sc->entries[k].section;
+            set = sc->entries[k].line == 0 ? &sc->entries[k] : NULL;
+        }
+    if (!name)
+        return CLI_EXIT_OK;
+    char list[512];
+    size_t used = 0;
+    for (size_t k = 0; reads[k] && used < sizeof list; k++) {
+        const char* star = strstr(reads[k], ".*");
+        int len = star ? (int)(star - reads[k]) : (int)strlen(reads[k]);
+        used += (size_t)snprintf(list + used, sizeof list - used, "%s[%.*s%s]",
+                                 k == 0         ? ""
+                                 : reads[k + 1] ? ", "
+                                                : " and ",
+                                 len, reads[k], star ? ".NAME" : "");
+    }
+    if (set)
+        cli_scenario_error(sc, set, "[%s] is not read by %s, which reads %s", name, reader, list);
+    else
+        cli_scenario_section_error(sc, name, "not read by %s, which reads %s: remove it", reader,
+                                   list);
+    return CLI_EXIT_USAGE;
+}
+
 double cli_scenario_number(const struct cli_scenario* sc, const char* section, const char* key,
                            double def)
 {

@@ -125,6 +125,13 @@ const struct cli_entry* cli_scenario_find(const struct cli_scenario* sc, const c
                                           const char* key);
 /* Whether the scenario has a [section] header or any key in it. */
 bool cli_scenario_has_section(const struct cli_scenario* sc, const char* section);
+/* Checks that every section of sc (in the file or from --set) is one of `reads`, the
+ * NULL-terminated sections that `reader` (e.g. "the pairwise engine") reads, a "family.*"
+ * standing for every [family.NAME]: a section no engine of the scenario reads would be
+ * ignored without a word. Prints the first other one at its line, with the list, and returns
+ * CLI_EXIT_USAGE; CLI_EXIT_OK when there is none. */
+int cli_scenario_check_read(const struct cli_scenario* sc, const char* reader,
+                            const char* const* reads);
 /* Reads a number (default `def` when absent). The value was checked when loaded; this only
  * converts. */
 double cli_scenario_number(const struct cli_scenario* sc, const char* section, const char* key,

@@ -422,8 +422,12 @@ int cli_scenario_engine(const struct cli_scenario* sc, enum cli_engine* engine)
 
 int cli_scenario_build(const struct cli_scenario* sc, struct cli_setup* su)
 {
+    static const char* const reads[] = {"engine",  "collision",  "material.*", "fluid",  "models",
+                                        "model.*", "integrator", "sim",        "output", NULL};
     memset(su, 0, sizeof *su);
     cli_scenario_engine(sc, &su->engine);
+    if (cli_scenario_check_read(sc, "a binary collision", reads) != CLI_EXIT_OK)
+        return CLI_EXIT_USAGE;
     su->sim = wetdem_sim_create();
     if (!su->sim) {
         cli_error("out of memory creating a simulation");

@@ -704,6 +704,11 @@ int cli_many_build(const struct cli_scenario* sc, struct cli_many_setup* su)
                                    "[run], ...), not both");
         return CLI_EXIT_USAGE;
     }
+    static const char* const reads[] = {
+        "engine",     "box",   "walls",  "insert",  "insert.*",   "particle.*", "run", "dump",
+        "material.*", "fluid", "models", "model.*", "integrator", "sim",        NULL};
+    if (cli_scenario_check_read(sc, "a many-particle run", reads) != CLI_EXIT_OK)
+        return CLI_EXIT_USAGE;
     su->sim = wetdem_sim_create();
     if (!su->sim) {
         cli_error("out of memory creating a simulation");

@@ -225,6 +225,17 @@ static void test_scenario_bad_files_exit_2_with_line(void** state)
          ":3:", "line longer than 198 characters without its comment"},
         /* two spheres of radius 1 mm 1.5 mm apart overlap: reported at the second section, with
          * the spheres counted from 1 in file order as the CLI and output columns count them */
+        /* a section the scenario's engine does not read would be ignored without a word: the
+         * pairwise engine takes its tolerance from [pairwise] rtol, not from [integrator];
+         * a binary collision reads no [davis]; a many-particle run writes what [dump] names */
+        {"unread_pairwise",
+         "[engine]\ntype = pairwise\n[davis]\nstokes = 2\n[integrator]\nrtol = 1e-6\n", ":5:",
+         "[integrator]: not read by the pairwise engine, which reads [engine], [davis], "
+         "[pairwise], [sphere.NAME] and [output]"},
+        {"unread_binary", "[collision]\nstokes = 5\n\n[davis]\nstokes = 2\n",
+         ":4:", "[davis]: not read by a binary collision"},
+        {"unread_many", "[box]\nsize_x = 1e-2\n[output]\ntrajectory = none\n",
+         ":3:", "[output]: not read by a many-particle run"},
         {"overlap",
          "[engine]\ntype = pairwise\n[pairwise]\nh_min = 1e-6\nt_end = 1\n[sphere.a]\nradius = "
          "1e-3\nmass = 1e-5\n"
@@ -268,6 +279,12 @@ static void test_scenario_bad_files_exit_2_with_line(void** state)
     }
     /* a directory opens, but does not read */
     expect_run("run /tmp --check", 2, "/tmp: cannot read scenario file");
+    /* the same for a --set of such a section, and for sweeps and maps of the pairwise engine */
+    expect_run("run examples/scenarios/davis_three.ini --set integrator.rtol=1e-6 --check", 2,
+               "--set integrator.rtol=1e-6: [integrator] is not read by the pairwise engine");
+    expect_run("sweep examples/scenarios/davis_three.ini --set box.size_x=1 --param davis.stokes "
+               "--values 1:2:2 --out /dev/null",
+               2, "[box] is not read by the pairwise engine");
     char args[700];
     snprintf(args, sizeof args, "run '%s' --check", write_file("bad_empty.ini", "; nothing\n"));
     expect_run(args, 2, "no [section] in the file");
