@@ -407,8 +407,11 @@ static int log_event(struct wetdem_pairwise* pw, enum wetdem_pairwise_event_kind
 {
     if (pw->n_events >= pw->cfg.max_events)
         return fail(pw, WETDEM_ERR_MAX_STEPS,
-                    "event budget max_events = %zu exhausted at t = %g s (chattering contact?)",
-                    pw->cfg.max_events, pw->t);
+                    "event budget max_events = %zu exhausted at t = %g s, the next a %s of "
+                    "spheres %zu and %zu at %g m/s (a pair bouncing in a deep capillary well, "
+                    "or chattering: raise max_events, or lower the restitution)",
+                    pw->cfg.max_events, pw->t, wetdem_pairwise_event_name(kind), pw->sys.pi[p] + 1,
+                    pw->sys.pj[p] + 1, v_n);
     if (pw->n_events == pw->events_cap) {
         size_t cap = pw->events_cap ? 2 * pw->events_cap : 64;
         void* mem = realloc(pw->events, cap * sizeof *pw->events);
