@@ -67,7 +67,8 @@ static const struct cli_key_desc pairwise_keys[] = {
     NUM("gravity_y", "m/s^2", "0", -1e3, 1e3, false, false, "Gravity, y."),
     NUM("t_end", "s", "from [davis] t_star_end, else required", 0, 1e9, true, false,
         "Longest simulated time."),
-    NUM("rtol", "-", "1e-9", 1e-14, 1e-3, false, false, "Relative tolerance of CVODE."),
+    NUM("rtol", "-", "1e-9", 1e-14, 1e-5, false, false,
+        "Relative tolerance of CVODE (above 1e-5 its speeds are too coarse for the rest speed)."),
     NUM("rest_speed_ratio", "-", "1e-3", 0, 1, false, true,
         "Contacts slower than this times v_n0 are held at h_min (resting contact); without "
         "v_n0 > 0, times the largest initial sphere speed."),
