@@ -108,8 +108,9 @@ bool cli_energy_grew(double energy_ratio, char* msg, size_t n)
         return false;
     snprintf(msg, n,
              "ends with %.4g times the kinetic energy it began with, which the models cannot "
-             "give: the step is too long for the contact; halve [integrator] dt_fraction (or "
-             "dt), or use name = cvode",
+             "give: the integration is too coarse for the contact; with [integrator] name = "
+             "verlet halve dt_fraction (or dt), or use name = cvode; with cvode lower rtol and "
+             "atol",
              energy_ratio);
     return true;
 }

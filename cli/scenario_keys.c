@@ -108,8 +108,8 @@ static const struct cli_key_desc integrator_keys[] = {
     NUM("dt", "s", NULL, 0, 1, false, false,
         "verlet: fixed time step; 0 derives it from dt_fraction."),
     COUNT("max_steps", NULL, 1, 1e12, "verlet and cvode: most steps one integration may take."),
-    NUM("rtol", "-", NULL, 1e-14, 1e-2, false, false, "cvode: relative tolerance."),
-    NUM("atol", "-", NULL, 1e-16, 1e-2, false, false,
+    NUM("rtol", "-", NULL, 1e-14, 1e-4, false, false, "cvode: relative tolerance."),
+    NUM("atol", "-", NULL, 1e-16, 1e-4, false, false,
         "cvode: absolute tolerance in units of the length, speed and spin scales."),
     WORD("method", CLI_VALUE_CHOICE, NULL, cvode_methods,
          "cvode: auto (Adams, switching to BDF for the rest of the run once a stretch without "

@@ -145,7 +145,7 @@ static void test_cli_describe_lists_parameters_with_units(void** state)
         free(r.out);
     }
     r = run_cli("describe cvode", false);
-    CHECK_CONTAINS(r.out, "rtol [-]  default 1e-08, valid [1e-14, 0.01]");
+    CHECK_CONTAINS(r.out, "rtol [-]  default 1e-08, valid [1e-14, 0.0001]");
     CHECK_CONTAINS(r.out, "method [-]  default auto, valid one of: auto, adams, bdf");
     free(r.out);
     r = run_cli("describe presets", false);
