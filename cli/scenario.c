@@ -197,15 +197,19 @@ bool cli_scenario_has_section(const struct cli_scenario* sc, const char* section
     return false;
 }
 
-/* Whether section `name` is among `reads` (exact names, or "family.*" for "family.NAME"). */
+bool cli_section_matches(const char* name, const char* pattern)
+{
+    const char* star = strstr(pattern, ".*");
+    return star ? strncmp(name, pattern, (size_t)(star - pattern) + 1) == 0
+                : strcmp(name, pattern) == 0;
+}
+
+/* Whether section `name` matches one of the NULL-terminated `reads`. */
 static bool section_read(const char* name, const char* const* reads)
 {
-    for (size_t k = 0; reads[k]; k++) {
-        const char* star = strstr(reads[k], ".*");
-        if (star ? strncmp(name, reads[k], (size_t)(star - reads[k]) + 1) == 0
-                 : strcmp(name, reads[k]) == 0)
+    for (size_t k = 0; reads[k]; k++)
+        if (cli_section_matches(name, reads[k]))
             return true;
-    }
     return false;
 }
 

@@ -125,6 +125,8 @@ const struct cli_entry* cli_scenario_find(const struct cli_scenario* sc, const c
                                           const char* key);
 /* Whether the scenario has a [section] header or any key in it. */
 bool cli_scenario_has_section(const struct cli_scenario* sc, const char* section);
+/* Whether section `name` is `pattern`, or of its family when pattern is "family.*". */
+bool cli_section_matches(const char* name, const char* pattern);
 /* Checks that every section of sc (in the file or from --set) is one of `reads`, the
  * NULL-terminated sections that `reader` (e.g. "the pairwise engine") reads, a "family.*"
  * standing for every [family.NAME]: a section no engine of the scenario reads would be

@@ -164,12 +164,9 @@ const struct cli_section_desc cli_many_sections[] = {
 /* Whether a section name belongs to the many-particle sections. */
 static bool is_many_section(const char* name)
 {
-    for (size_t k = 0; cli_many_sections[k].name; k++) {
-        const char* s = cli_many_sections[k].name;
-        const char* star = strstr(s, ".*");
-        if (star ? strncmp(name, s, (size_t)(star - s) + 1) == 0 : strcmp(name, s) == 0)
+    for (size_t k = 0; cli_many_sections[k].name; k++)
+        if (cli_section_matches(name, cli_many_sections[k].name))
             return true;
-    }
     return false;
 }
 

@@ -66,7 +66,6 @@ struct wetdem_pairwise {
     bool approaching[PW_PMAX];
     int reversal[PW_PMAX];
     double rest_speed, v_scale;
-    double v_round;     /* rounding of a relative speed: 64 DBL_EPSILON v_scale [m/s] */
     unsigned stalled;   /* consecutive steps whose events came at their start, none logged */
     double gravity_ref; /* -sum m g . x at t = 0 [J]: gravity's potential is taken from it */
     bool done;
@@ -257,7 +256,7 @@ static int validate_scalars(const struct wetdem_pairwise_config* c, char* msg, s
                                   "integrates",
                                   c->t_end, WETDEM_MIN_SPAN);
     /* Above 1e-5 CVODE's tolerance on the speeds, rtol v_scale, comes within a factor 100 of
-     * the rest speed (1e-3 v_n0) and contacts at h_min can chatter: at 1e-4 three of the 400
+     * the rest speed (1e-3 v_n0) and contacts at h_min can chatter: at 1e-4 two of the 400
      * runs of a Davis St x angle map at Ca = 0.01 (spheres in a line) used up the event
      * budget; at 1e-5 none of the 800 of that map at Ca 0.01 and 1000 did. */
     if (!(c->rtol >= 1e-14 && c->rtol <= 1e-5))
@@ -598,12 +597,13 @@ static int emit_until(struct wetdem_pairwise* pw, double t_hi)
 
 /* --------------------------------------------------------------------------- guards ---- */
 
-/* A contact is met at h = h_min (1 - CONTACT_SLACK), and then set to h_min: a pair the
- * contact problem leaves free at h_min (it will separate) is thus not met again by the
- * rounding of its gap, 1e-16 of it, while it starts to move away. Without the slack, at rtol
- * 1e-3, where CVODE takes speeds of 1e-14 m/s for zero, three spheres in a line (Davis,
- * angle 0, Ca 0.01) met such a pair every 2e-16 s. The slack is 4e-19 m at h_min = 4e-7 m,
- * an interpenetration far below any of the model's lengths. */
+/* A contact is met at h = h_min (1 - CONTACT_SLACK), and then set to h_min, so that a pair
+ * at h_min is not met again by the rounding of its gap (1e-16 of it): neither one the
+ * contact problem leaves free there (it separates), nor one whose next step starts one
+ * rounding below h_min. Without the slack, at Ca = 0.01 in Davis's set-up, where suction
+ * turns a pair at h_min round within 1e-13 s, the default example stood still at
+ * t = 3e-5 s at rtol 1e-5, and three spheres in a line met such a pair every 2e-16 s at
+ * 1e-3. The slack is 4e-19 m at h_min = 4e-7 m, far below any of the model's lengths. */
 #define CONTACT_SLACK 1e-12
 
 /* Guard values of every pair at state y: g[G_KINDS * p + kind], >= 0 while the mode holds. */
@@ -622,10 +622,7 @@ static bool guards(struct wetdem_pairwise* pw, const double* y, double* g)
         gp[G_FILM] =
             !has_film ? 1.0 : (pw->md.film[p] ? sys->delta[p] - k.h[p] : k.h[p] - sys->delta[p]);
         gp[G_CONTACT] = pw->md.resting[p] ? 1.0 : k.h[p] - sys->h_min * (1.0 - CONTACT_SLACK);
-        /* at h_min and approaching: now (an approach at the rounding of the speeds, left
-         * after a pair the contact problem did not hold, is none: met again at once, it
-         * would be met for ever at the same time) */
-        if (!(gp[G_CONTACT] > 0.0) && k.v_n[p] > pw->v_round)
+        if (!(gp[G_CONTACT] > 0.0) && k.v_n[p] > 0.0) /* at h_min and approaching: now */
             gp[G_CONTACT] = fmin(gp[G_CONTACT], -DBL_MIN);
         gp[G_RELEASE] = 1.0;
         any_rest = any_rest || pw->md.resting[p];
@@ -820,14 +817,8 @@ static int on_contact(struct wetdem_pairwise* pw, size_t p)
     if (!current_kin(pw, &k))
         return WETDEM_ERR_NUMERIC;
     double v_n = k.v_n[p];
-    /* Receding at the rest speed or faster: a graze, nothing to reverse. Slower, the pair
-     * is at h_min and at rest to within the rest speed, and the contact problem decides
-     * whether it is held: a deep capillary well turns such a pair round within a step
-     * (10^6 m/s^2 at Ca = 0.01), and at rtol 1e-5 CVODE's steps start one rounding below
-     * h_min, so leaving it free would locate the same crossing at the step's start again,
-     * each time, with time standing still. */
-    if (!(v_n > 0.0) && !(-v_n < pw->rest_speed))
-        return WETDEM_OK;
+    if (!(v_n > 0.0))
+        return WETDEM_OK; /* grazing: nothing to reverse */
     pw->approaching[p] = false;
     pw->reversal[p] = REV_IMPULSE;
     if (v_n < pw->rest_speed)
@@ -1003,7 +994,6 @@ static void initial_state(struct wetdem_pairwise* pw)
     for (size_t i = 0; i < sys->n; i++)
         v = fmax(v, fmax(hypot(k.ux[i], k.uy[i]), hypot(k.vx[i], k.vy[i])));
     pw->v_scale = v > 0.0 ? v : 1e-6;
-    pw->v_round = 64.0 * DBL_EPSILON * pw->v_scale;
     /* (without an approach of the reference pair, the largest initial speed: Sec. 7) */
     pw->rest_speed = cfg->rest_speed_ratio * (res->v_n0 > 0.0 ? res->v_n0 : pw->v_scale);
     memset(&pw->md, 0, sizeof pw->md);

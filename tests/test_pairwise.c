@@ -511,9 +511,9 @@ static void test_pairwise_energy_budget_closes(void** state)
  * (45 to 72 times less each), and at Ca = 1000 1.4e-5 to 5.0e-10 from 1e-5 to 1e-11, not
  * evenly in between (1e-7 gives 2.2e-6, 1e-6 2.4e-5). Required: 10 times less for every two
  * decades at Ca = 0.01, and 1e3 times less over the six decades in both (an order of at
- * least one half). The outcome is PA at every tolerance. Until slow receding pairs at h_min
- * went to the contact problem, rtol 1e-5 made the Ca = 0.01 run stand still at t = 3e-5 s
- * for 20 million steps. */
+ * least one half). The outcome is PA at every tolerance. Until contacts were met at
+ * h_min (1 - 1e-12), rtol 1e-5 made the Ca = 0.01 run stand still at t = 3e-5 s for 20
+ * million steps. */
 static void test_pairwise_energy_residual_shrinks_with_rtol(void** state)
 {
     (void)state;
