@@ -279,7 +279,7 @@ static void test_scenario_bad_files_exit_2_with_line(void** state)
     }
     /* a directory opens, but does not read */
     expect_run("run /tmp --check", 2, "/tmp: cannot read scenario file");
-    /* the same for a --set of such a section, and for sweeps and maps of the pairwise engine */
+    /* the same for a --set of such a section, and for a sweep of the pairwise engine */
     expect_run("run examples/scenarios/davis_three.ini --set integrator.rtol=1e-6 --check", 2,
                "--set integrator.rtol=1e-6: [integrator] is not read by the pairwise engine");
     expect_run("sweep examples/scenarios/davis_three.ini --set box.size_x=1 --param davis.stokes "
