@@ -837,7 +837,9 @@ static int on_release(struct wetdem_pairwise* pw, size_t p, const struct wetdem_
         return fail(pw, WETDEM_ERR_NUMERIC, "singular resting-contact problem at t = %g s", pw->t);
     hold[p] = false;
     pw->approaching[p] = false;
-    pw->reversal[p] = REV_IMPULSE;
+    /* the held pair had v_n = 0: what now pulls it apart is the film and centrifugal forces,
+     * not an impulse (a later contact marks REV_IMPULSE again) */
+    pw->reversal[p] = REV_FILM;
     return set_held(pw, hold, PW_PMAX, k, 0.0);
 }
 

@@ -774,42 +774,37 @@ static int cart_rhs(double t, const double* s, double* ds, void* params)
     return GSL_SUCCESS;
 }
 
-/* Sphere positions recovered from the pair variables (Eqs. 37-38) agree with an rk8pd
- * integration of the Cartesian equations (1)-(2), (16) with the same film forces. Case: three
- * spheres, St_n = 0.5, no capillarity (forces continuous at h = delta), no contact; compared
- * at t* = 2 after the striker has pushed the doublet and turned with it. Both integrations run
- * at ~1e-11; 1e-8 of the radius leaves room for the film switch-on (a kink in the force)
- * that rk8pd crosses without locating it. */
-static void test_pairwise_positions_match_cartesian(void** state)
+/* The pairwise run of c against an rk8pd integration of the Cartesian equations (1)-(2), (16)
+ * with the same film forces (cart_rhs), at c.t_end: positions to 1e-8 of the first radius,
+ * velocities and surface speeds of spin to 1e-8 of the scale `v`. Both integrations run at
+ * ~1e-11; 1e-8 leaves room for a film switch-on (a kink in the force) that rk8pd crosses
+ * without locating it. */
+static void check_against_cartesian(const struct wetdem_pairwise_config* c, double v)
 {
-    (void)state;
-    struct wetdem_pairwise_config c = davis(0.5, 0.0, 30.0, 2.0);
-    c.stop_when_separated = false;
-    c.rtol = 1e-11;
     struct wetdem_pairwise_result r;
-    CHECK_OK(run(&c, &r, NULL));
+    CHECK_OK(run(c, &r, NULL));
     for (size_t p = 0; p < 3; p++)
         assert_int_equal(r.pairs[p].n_contacts, 0);
-    struct cart cp = {.mu = c.viscosity, .sigma = c.surface_tension};
+    struct cart cp = {.mu = c->viscosity, .sigma = c->surface_tension};
     double s[15];
     for (int i = 0; i < 3; i++) {
-        const struct wetdem_pairwise_sphere* q = &c.spheres[i];
+        const struct wetdem_pairwise_sphere* q = &c->spheres[i];
         cp.a[i] = q->radius;
         cp.m[i] = q->mass;
         cp.inertia[i] = 0.4 * q->mass * q->radius * q->radius;
         for (int j = 0; j < 3; j++)
-            cp.delta[i][j] = q->film + c.spheres[j].film;
-        double v[5] = {q->x, q->y, q->vx, q->vy, q->omega};
-        memcpy(s + 5 * i, v, sizeof v);
+            cp.delta[i][j] = q->film + c->spheres[j].film;
+        double y[5] = {q->x, q->y, q->vx, q->vy, q->omega};
+        memcpy(s + 5 * i, y, sizeof y);
     }
     gsl_odeiv2_system sys = {cart_rhs, NULL, 15, &cp};
     gsl_odeiv2_driver* drv =
         gsl_odeiv2_driver_alloc_y_new(&sys, gsl_odeiv2_step_rk8pd, 1e-9, 1e-13, 1e-11);
     double t = 0.0;
-    assert_int_equal(gsl_odeiv2_driver_apply(drv, &t, c.t_end, s), GSL_SUCCESS);
+    assert_int_equal(gsl_odeiv2_driver_apply(drv, &t, c->t_end, s), GSL_SUCCESS);
     gsl_odeiv2_driver_free(drv);
-    CHECK_REL(r.time, c.t_end, 1e-15);
-    double a = c.spheres[0].radius, v = c.spheres[0].vx;
+    CHECK_REL(r.time, c->t_end, 1e-15);
+    double a = c->spheres[0].radius;
     for (int i = 0; i < 3; i++) {
         CHECK_ABS(r.final[i].x, s[5 * i], 1e-8 * a);
         CHECK_ABS(r.final[i].y, s[5 * i + 1], 1e-8 * a);
@@ -817,6 +812,55 @@ static void test_pairwise_positions_match_cartesian(void** state)
         CHECK_ABS(r.final[i].vy, s[5 * i + 3], 1e-8 * v);
         CHECK_ABS(r.final[i].omega * a, s[5 * i + 4] * a, 1e-8 * v);
     }
+}
+
+/* Sphere positions recovered from the pair variables (Eqs. 37-38) agree with the Cartesian
+ * equations. Case: three spheres, St_n = 0.5, no capillarity (forces continuous at
+ * h = delta), no contact; compared at t* = 2 after the striker has pushed the doublet and
+ * turned with it. */
+static void test_pairwise_positions_match_cartesian(void** state)
+{
+    (void)state;
+    struct wetdem_pairwise_config c = davis(0.5, 0.0, 30.0, 2.0);
+    c.stop_when_separated = false;
+    c.rtol = 1e-11;
+    check_against_cartesian(&c, c.spheres[0].vx);
+}
+
+/* The same for three unequal spheres (radii, masses and films all different) whose films all
+ * overlap, so that one of the three pairs is not tracked and every coupling term carries its
+ * own mass and inertia weight (m_j / M, a_i^2 / I_i): with equal spheres a weight of the wrong
+ * sphere gives the same numbers, here it moves the spheres by ~1e-2 of a radius. Spins and
+ * capillary suction on; no pair reaches h_min or leaves its films within t_end. */
+static void test_pairwise_unequal_triangle_matches_cartesian(void** state)
+{
+    (void)state;
+    struct wetdem_pairwise_config c = cluster(3);
+    const double a[3] = {1.0e-3, 1.3e-3, 0.8e-3}, film[3] = {40e-6, 55e-6, 30e-6};
+    const double gap01 = 60e-6, gap02 = 45e-6, gap12 = 50e-6;
+    for (int i = 0; i < 3; i++)
+        c.spheres[i] =
+            (struct wetdem_pairwise_sphere){.radius = a[i],
+                                            .mass = 2500.0 * 4.0 / 3.0 * M_PI * a[i] * a[i] * a[i],
+                                            .film = film[i]};
+    /* sphere 1 on the x axis, sphere 2 where its gaps to 0 and 1 are gap02 and gap12 */
+    double d01 = a[0] + a[1] + gap01, d02 = a[0] + a[2] + gap02, d12 = a[1] + a[2] + gap12;
+    double x2 = (d01 * d01 + d02 * d02 - d12 * d12) / (2.0 * d01);
+    c.spheres[1].x = d01;
+    c.spheres[2].x = x2;
+    c.spheres[2].y = sqrt(d02 * d02 - x2 * x2);
+    c.spheres[0].vx = 0.02;
+    c.spheres[0].vy = -0.01;
+    c.spheres[1].vy = 0.03;
+    c.spheres[2].vx = -0.01;
+    c.spheres[0].omega = 20.0;
+    c.spheres[2].omega = -35.0;
+    c.viscosity = 0.05;
+    c.surface_tension = 0.01;
+    c.t_end = 4e-4;
+    c.stop_when_separated = false;
+    c.rtol = 1e-11;
+    check_against_cartesian(&c, 0.03);
 }
 
 /* ------------------------------------------------- kernels vs the soft engine's models */
@@ -1017,6 +1061,31 @@ static void test_pairwise_two_sphere_mechanisms(void** state)
     CHECK_OK(run(&c, &r, NULL));
     assert_int_equal(r.pairs[0].mechanism, WETDEM_OUTCOME_BOUNCE);
     assert_int_equal(r.pairs[0].n_contacts, 1);
+}
+
+/* A pair held at h_min (resting contact, v_n = 0) and then let go separates through the film
+ * and centrifugal forces with no impulse after the release: stick-rotate-separate, not bounce.
+ * Three spheres, Davis's Table I at St_n = 3.7253, 45 deg: pair 1-2 has three contacts, is held
+ * at t* = 0.051, released at t* = 0.074 and leaves its films at t* = 2.77. */
+static void test_pairwise_released_pair_is_not_a_bounce(void** state)
+{
+    (void)state;
+    struct wetdem_pairwise_config c = davis(3.7252902984619, 1000.0, 45.0, 30.0);
+    struct wetdem_pairwise_result r;
+    struct wetdem_pairwise* pw;
+    CHECK_OK(run(&c, &r, &pw));
+    const struct wetdem_pairwise_event* rest_end = find_event(pw, WETDEM_PAIRWISE_REST_END, 0);
+    assert_non_null(rest_end);
+    assert_true(rest_end->i == 0 && rest_end->j == 1);
+    size_t n;
+    const struct wetdem_pairwise_event* ev = wetdem_pairwise_events(pw, &n);
+    for (size_t k = 0; k < n; k++) /* no impulse on the pair after its release */
+        assert_false(ev[k].kind == WETDEM_PAIRWISE_CONTACT && ev[k].i == 0 && ev[k].j == 1 &&
+                     ev[k].time > rest_end->time);
+    assert_false(r.pairs[0].bound);
+    assert_true(r.pairs[0].n_contacts > 0 && r.pairs[0].e_wet > 0.0);
+    assert_int_equal(r.pairs[0].mechanism, WETDEM_OUTCOME_STICK_ROTATE_SEPARATE);
+    wetdem_pairwise_free(pw);
 }
 
 /* ------------------------------------------------------------- tree and partner change */
@@ -1220,6 +1289,7 @@ int main(void)
         cmocka_unit_test(test_pairwise_relabelling_symmetry),
         cmocka_unit_test(test_pairwise_deterministic),
         cmocka_unit_test(test_pairwise_positions_match_cartesian),
+        cmocka_unit_test(test_pairwise_unequal_triangle_matches_cartesian),
         cmocka_unit_test(test_pairwise_forces_match_models),
         cmocka_unit_test(test_pairwise_outcome_full_separation),
         cmocka_unit_test(test_pairwise_outcome_partial),
@@ -1227,6 +1297,7 @@ int main(void)
         cmocka_unit_test(test_pairwise_long_spinning_cluster),
         cmocka_unit_test(test_pairwise_scales_of_the_reference_pair),
         cmocka_unit_test(test_pairwise_two_sphere_mechanisms),
+        cmocka_unit_test(test_pairwise_released_pair_is_not_a_bounce),
         cmocka_unit_test(test_pairwise_tree_change_keeps_spheres),
         cmocka_unit_test(test_pairwise_partner_change_logged),
         cmocka_unit_test(test_pairwise_davis_builder),
