@@ -152,11 +152,13 @@ const struct wetdem_model wetdem_hard_model = {
            "point (including spin): if the impulse m_t |u_t| that stops the slip, with "
            "1/m_t = 1/m_i + 1/m_j + R_i^2/I_i + R_j^2/I_j, is at most mu J_n, the surfaces "
            "leave rolling without slip (sticking); otherwise the tangential impulse is "
-           "mu J_n against the slip (sliding) and the slip keeps its direction. Linear and "
-           "angular momentum are conserved. For equal solid spheres m_t = 2 m*/7 (Davis's "
-           "A33-A36). Walls: mass and radius INFINITY. mu is the pair's dry or lubricated "
-           "coefficient (parameter friction; Davis uses the lubricated one). Valid when the "
-           "solid contact time is far shorter than the other time scales of the collision.",
+           "mu J_n against the slip (sliding) and the slip keeps its direction. Linear "
+           "momentum is conserved, and angular momentum for touching spheres (at a gap h, "
+           "with the lever arms R_i and R_j, it changes by h n x J_t). For equal solid "
+           "spheres m_t = 2 m*/7 (Davis's A33-A36). Walls: mass and radius INFINITY. mu is "
+           "the pair's dry or lubricated coefficient (parameter friction; Davis uses the "
+           "lubricated one). Valid when the solid contact time is far shorter than the "
+           "other time scales of the collision.",
     .equations = "Davis 2023 Appendix A, Eqs. A1-A3 (normal), A8-A11 (sliding; A11 with I_j "
                  "for omega_j), A30-A36 (arrest of slip), generalised to unequal spheres in "
                  "3-D in docs/derivations/contact.md",
