@@ -110,7 +110,7 @@ static void run_point(const struct cli_scenario* base, const struct cli_batch* b
         if (p->status < 0)
             snprintf(p->errmsg, sizeof p->errmsg, "%s", wetdem_sim_errmsg(su.sim));
         else
-            cli_setup_capture(&su);
+            cli_setup_capture(&su, &p->res);
         cli_csv_result_row(f, &su, &p->res);
     }
     if (f)

@@ -178,7 +178,7 @@ static int run_soft(const struct cli_scenario* sc, struct cli_setup* su, const s
         close_out(&traj, false);
         return CLI_EXIT_RUNTIME;
     }
-    cli_setup_capture(su);
+    cli_setup_capture(su, &res);
     if (open_out(&events, a->out_dir, su->events_file) != 0 ||
         open_out(&summary, a->out_dir, su->summary_file) != 0) {
         close_out(&traj, false);

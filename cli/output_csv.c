@@ -115,27 +115,17 @@ bool cli_energy_grew(double energy_ratio, char* msg, size_t n)
     return true;
 }
 
-void cli_setup_capture(struct cli_setup* su)
+void cli_setup_capture(struct cli_setup* su, const struct wetdem_collision_result* r)
 {
     size_t n = 0;
     const struct wetdem_particle* p = wetdem_sim_particles_const(su->sim, &n);
     su->striker_speed_out = NAN;
     su->striker_angle_out = NAN;
-    if (n < 1 || (!su->spec.target_is_wall && n < 2))
+    if (n < 1)
         return;
-    double nx = 1, ny = 0, nz = 0; /* the wall x = 0 has normal +x (wetdem_collision_run) */
-    if (!su->spec.target_is_wall) {
-        nx = p[0].pos.x - p[1].pos.x;
-        ny = p[0].pos.y - p[1].pos.y;
-        nz = p[0].pos.z - p[1].pos.z;
-        double d = sqrt(nx * nx + ny * ny + nz * nz);
-        nx /= d;
-        ny /= d;
-        nz /= d;
-    }
-    const struct wetdem_vec3 v = p[0].vel;
-    double vn = v.x * nx + v.y * ny + v.z * nz;
-    double tx = v.x - vn * nx, ty = v.y - vn * ny, tz = v.z - vn * nz;
+    const struct wetdem_vec3 v = p[0].vel, nf = r->normal_out;
+    double vn = v.x * nf.x + v.y * nf.y + v.z * nf.z;
+    double tx = v.x - vn * nf.x, ty = v.y - vn * nf.y, tz = v.z - vn * nf.z;
     su->striker_speed_out = sqrt(v.x * v.x + v.y * v.y + v.z * v.z);
     su->striker_angle_out = atan2(sqrt(tx * tx + ty * ty + tz * tz), fabs(vn));
 }

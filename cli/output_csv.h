@@ -43,8 +43,9 @@ bool cli_energy_grew(double energy_ratio, char* msg, size_t n);
 
 /* Records what the result struct lacks from the final state of su->sim: the striker's own
  * speed and the angle of its velocity to the line of centres, theta_i,1 of Nijssen Fig. 1c,
- * atan2(|v_t|, |v . n|) in [0, pi/2] (n: the final line of centres, or the wall normal). */
-void cli_setup_capture(struct cli_setup* su);
+ * atan2(|v_t|, |v . n|) in [0, pi/2] (n: the rebound normal r->normal_out, the line of
+ * centres at the start of the final separation; the wall normal against a wall). */
+void cli_setup_capture(struct cli_setup* su, const struct wetdem_collision_result* r);
 
 /* CSV header "name [unit],..." of the result fields (no newline). */
 void cli_csv_result_header(FILE* f);

@@ -166,7 +166,7 @@ struct cli_setup {
     char summary_file[CLI_VALUE_MAX];
     /* filled by cli_setup_capture() after the run: */
     double striker_speed_out; /* |v_i| at the end [m/s] */
-    double striker_angle_out; /* angle of v_i to the final line of centres [rad] */
+    double striker_angle_out; /* angle of v_i to the rebound normal n_f [rad] */
 };
 
 /* Reads [engine] type only. CLI_EXIT_OK or CLI_EXIT_USAGE. */

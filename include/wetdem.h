@@ -490,16 +490,21 @@ struct wetdem_collision_spec {
 };
 
 struct wetdem_collision_result {
-    double stokes_n;            /* normal Stokes number of the impact [-] */
-    double speed_n0;            /* normal impact speed U cos(angle) [m/s] */
-    double e;                   /* Nijssen: |dv_1|/|dv_0| of the relative velocity [-] */
-    double e_n;                 /* normal restitution -v_f.n_f / v_0.n_0 (Punch Eq. 3) [-] */
-    double e_t;                 /* tangential restitution of the contact-point velocity [-]
+    double stokes_n;               /* normal Stokes number of the impact [-] */
+    double speed_n0;               /* normal impact speed U cos(angle) [m/s] */
+    double e;                      /* Nijssen: |dv_1|/|dv_0| of the relative velocity [-] */
+    double e_n;                    /* normal restitution -v_f.n_f / v_0.n_0 (Punch Eq. 3) [-],
+                                   n_f = normal_out */
+    double e_t;                    /* tangential restitution of the contact-point velocity [-]
                                    (-1 smooth, +1 reversed; NAN without initial slip) */
-    double e_n_observed;        /* e_n evaluated at observe_time (NAN if not requested) */
-    double angle_in, angle_out; /* impact angle of the straight-line approach (= spec angle)
+    double e_n_observed;           /* e_n evaluated at observe_time (NAN if not requested) */
+    double angle_in, angle_out;    /* impact angle of the straight-line approach (= spec angle)
                                    and rebound angle of the relative velocity, to the normal
                                    [rad] */
+    struct wetdem_vec3 normal_out; /* n_f: the unit line of centres (from j to i) that the
+                                      rebound is referred to, at the last local minimum of the
+                                      gap (the start of the final separation); at the end if
+                                      the gap had none */
     struct wetdem_vec3 omega_i, omega_j; /* final spins [rad/s] */
     double contact_duration;             /* total time with gap < 0 [s] */
     double interaction_duration;         /* time from first interaction to separation [s] */

@@ -15,7 +15,14 @@
  *   St_n = m* v_n0 / (6 pi mu R*^2),  v_n0 = U cos(theta).
  * Runs to separation (gap >= rebound_gap_factor x range, receding) or t_end.
  * With the relative velocity of centres dv = v_i - v_j, n0 = +x (the contact normal of the
- * straight-line approach) and n_f the normal at the final state:
+ * straight-line approach, which defines theta and v_n0) and n_f the rebound normal: the line of
+ * centres at the last local minimum of the gap, where the final separation starts (the middle
+ * of a bounce's contact; where a doublet that turned lets go), at the end if the gap had none.
+ * Punch Eq. 3 takes n_f "at the time of final relative velocity": with thin films that is
+ * within a degree of it, but the line of centres keeps turning after the spheres part (by tens
+ * of degrees over nijssen's cut-off R*), and a normal taken at the end of the run would make
+ * the results depend on where the run stops (rebound_gap_factor) and give e_n > 1 for an
+ * elastic frictionless impact. Velocities are taken at the end (separation or t_end):
  *   e   = |dv_f| / |dv_0|                                   (Nijssen; Yang & Hunt)
  *   e_n = -(dv_f . n_f) / (dv_0 . n0)                        (Punch Eq. 3)
  *   e_t = -(u_f . t_f) / |u_0|,  u = tangential part of the contact-point velocity
@@ -74,6 +81,9 @@ struct tracker {
     double observe_span; /* spec->observe_time [s] */
     bool observed;
     struct wetdem_vec3 n_obs, dv_obs;
+    bool turned;               /* the gap has had a local minimum */
+    struct wetdem_vec3 n_turn; /* the line of centres at the last one: the normal the rebound
+                                  is referred to (n_f of e_n, e_t, angle_out) */
 };
 
 static struct wetdem_vec3 relative_velocity(const struct wetdem_sim* sim)
@@ -88,12 +98,14 @@ static void pair_contact(const struct wetdem_sim* sim, struct wetdem_contact* c)
 }
 
 /* Smallest value of the cubic Hermite interpolant of the gap over a step in which the
- * approach speed changed sign (h' = -v_n at both ends) [m]. */
-static double hermite_min(double dt, double h0, double vn0, double h1, double vn1)
+ * approach speed changed sign (h' = -v_n at both ends) [m], and in *at where in the step it
+ * lies (fraction of the step, 0 at its start). */
+static double hermite_min(double dt, double h0, double vn0, double h1, double vn1, double* at)
 {
     double m0 = -vn0 * dt, m1 = -vn1 * dt;
     double a = 6 * h0 + 3 * m0 - 6 * h1 + 3 * m1, b = -6 * h0 - 4 * m0 + 6 * h1 - 2 * m1;
     double roots[2] = {-1, -1}, best = fmin(h0, h1);
+    *at = h1 <= h0 ? 1.0 : 0.0;
     if (fabs(a) > 1e-300) {
         double disc = b * b - 4 * a * m0;
         if (disc >= 0) {
@@ -109,7 +121,10 @@ static double hermite_min(double dt, double h0, double vn0, double h1, double vn
             continue;
         double p = (2 * s * s * s - 3 * s * s + 1) * h0 + (s * s * s - 2 * s * s + s) * m0 +
                    (-2 * s * s * s + 3 * s * s) * h1 + (s * s * s - s * s) * m1;
-        best = fmin(best, p);
+        if (p < best) {
+            best = p;
+            *at = s;
+        }
     }
     return best;
 }
@@ -135,7 +150,7 @@ static void observe_in_step(struct tracker* tr, double t, struct wetdem_vec3 n,
         return;
     double s = t > tr->t_prev ? (tr->t_observe - tr->t_prev) / (t - tr->t_prev) : 1.0;
     s = fmin(fmax(s, 0.0), 1.0);
-    tr->n_obs = vec3_add(vec3_scale(tr->n_prev, 1 - s), vec3_scale(n, s));
+    tr->n_obs = tr->turned ? tr->n_turn : vec3_add(vec3_scale(tr->n_prev, 1 - s), vec3_scale(n, s));
     tr->dv_obs = vec3_add(vec3_scale(tr->dv_prev, 1 - s), vec3_scale(dv, s));
     tr->observed = true;
 }
@@ -150,8 +165,13 @@ static int monitor(struct wetdem_sim* sim, void* ctx)
     scan_events(sim, tr);
     double low = c.gap;
     bool turned_back = tr->vn_prev > 0 && c.v_n <= 0; /* a local minimum of the gap */
-    if (turned_back)
-        low = fmin(low, hermite_min(t - tr->t_prev, tr->gap_prev, tr->vn_prev, c.gap, c.v_n));
+    if (turned_back) {
+        double at;
+        low = fmin(low, hermite_min(t - tr->t_prev, tr->gap_prev, tr->vn_prev, c.gap, c.v_n, &at));
+        struct wetdem_vec3 n = vec3_add(vec3_scale(tr->n_prev, 1 - at), vec3_scale(c.normal, at));
+        tr->n_turn = vec3_scale(n, 1.0 / vec3_norm(n));
+        tr->turned = true;
+    }
     tr->min_gap = fmin(tr->min_gap, low);
     if (tr->interacting) {
         double turn =
@@ -385,12 +405,13 @@ static void restitution(const struct wetdem_sim* sim, const struct initial* in,
 {
     struct wetdem_contact c;
     pair_contact(sim, &c);
-    struct wetdem_vec3 dvf = relative_velocity(sim), nf = c.normal;
+    struct wetdem_vec3 dvf = relative_velocity(sim), nf = tr->turned ? tr->n_turn : c.normal;
     double dn0 = vec3_dot(in->dv, in->n), dnf = vec3_dot(dvf, nf);
     r->e = vec3_norm(dvf) / vec3_norm(in->dv);
     r->e_n = dn0 < 0 ? -dnf / dn0 : NAN;
     r->angle_in = atan2(vec3_norm(vec3_reject(in->dv, in->n)), -dn0);
     r->angle_out = atan2(vec3_norm(vec3_reject(dvf, nf)), dnf);
+    r->normal_out = nf;
     double u0 = vec3_norm(in->slip);
     r->e_t = NAN;
     if (u0 > 1e-12 * vec3_norm(in->dv)) {

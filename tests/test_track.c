@@ -470,31 +470,33 @@ static void sim_pose(const struct sim_record* r, double fps, int k, double t, do
  * interaction range), after it they fly apart freely, so the before/after velocities and
  * spins are the first and last recorded states. The impact angle, v_n0 and St_n refer to the
  * line of centres n_c at contact of the undisturbed straight-line approach (Punch Eq. 16,
- * "the moment before collision"), e_n = (u_f . n_f)/v_n0 to the relative velocity u_f and
- * line of centres n_f of the final, separated state (Punch Eq. 3 fully resolved).
+ * "the moment before collision"), e_n = (u_f . n_f)/v_n0 to the final, separated relative
+ * velocity u_f and the rebound normal n_f (Punch Eq. 3 fully resolved; n_f the result's
+ * normal_out, the line of centres at the closest approach).
  * The tracker takes the line of centres at its collision frame k (Eq. 16) and, for e_n, at
  * k + offset; meanwhile the line turns at v_t/d (tangential relative speed over the centre
  * distance), so the angle is off by delta_0 = (v_t0/d) |t_k - t_c| and v_n = |u| cos(angle)
  * by the relative tan(angle) delta: bias(e_n) = e_n (tan(theta_0) delta_0 + tan(theta_f)
- * delta_f) with delta_f = (v_tf/d) |t_k+offset - t_final|, bias(St_n) = St_n tan(theta_0)
- * delta_0 (first order; the path's deflection by the film before k is ~10 um, 4e-4 rad).
+ * delta_f) with delta_f the angle between n_f and the simulated line of centres at frame
+ * k + offset, bias(St_n) = St_n tan(theta_0) delta_0 (first order; the path's deflection by
+ * the film before k is ~10 um, 4e-4 rad).
  * Eq. 23's small-angle bias (track.c header): omega^2 dt |D2 + D3|/6 on the velocities and
  * omega (omega dt)^2/6 on the spin. */
 static void simulated_truth(const struct sim_record* r, const struct synth* y,
-                            const struct wetdem_track_options* o, long frame_k, double want[N_OUT],
-                            double bias[N_OUT])
+                            const struct wetdem_track_options* o,
+                            const struct wetdem_collision_result* res, long frame_k,
+                            double want[N_OUT], double bias[N_OUT])
 {
     const double* q0 = r->q + 1;
     const double* qf = r->q + SIM_COLS * (r->n - 1) + 1;
     double d = 2 * y->radius, u0[2] = {q0[2] - q0[8], q0[3] - q0[9]};
-    double uf[2] = {qf[2] - qf[8], qf[3] - qf[9]}, df[2] = {qf[0] - qf[6], qf[1] - qf[7]};
+    double uf[2] = {qf[2] - qf[8], qf[3] - qf[9]}, nf[2] = {res->normal_out.x, res->normal_out.y};
     /* Straight-line contact: |x0 + u0 t| = d, the smaller root. */
     double x0[2] = {q0[0] - q0[6], q0[1] - q0[7]};
     double a = u0[0] * u0[0] + u0[1] * u0[1], b = x0[0] * u0[0] + x0[1] * u0[1];
     double c = x0[0] * x0[0] + x0[1] * x0[1] - d * d;
     double t_c = (-b - sqrt(b * b - a * c)) / a;
     double nc[2] = {(x0[0] + u0[0] * t_c) / d, (x0[1] + u0[1] * t_c) / d};
-    double lf = hypot(df[0], df[1]), nf[2] = {df[0] / lf, df[1] / lf};
     double vn0 = -(u0[0] * nc[0] + u0[1] * nc[1]), vt0 = fabs(u0[0] * nc[1] - u0[1] * nc[0]);
     double vnf = uf[0] * nf[0] + uf[1] * nf[1], vtf = fabs(uf[0] * nf[1] - uf[1] * nf[0]);
     double mass = 7960 * 4.0 / 3.0 * M_PI * pow(y->radius, 3), r_eff = y->radius / 2;
@@ -511,8 +513,12 @@ static void simulated_truth(const struct sim_record* r, const struct synth* y,
                        (mass / 2) * vn0 / (6 * M_PI * 10.0 * r_eff * r_eff)};
     memcpy(want, v, sizeof v);
     double dt = 1 / y->fps, t_k = (double)(frame_k - SIM_PRE) * dt;
-    double t_final = qf[-1], delta0 = vt0 / d * fabs(t_k - t_c);
-    double deltaf = vtf / lf * fabs(t_k + o->offset * dt - t_final);
+    double delta0 = vt0 / d * fabs(t_k - t_c);
+    double pos_i[2], pos_j[2], vel[2], yaw;
+    sim_pose(r, y->fps, 0, t_k + o->offset * dt, pos_i, vel, &yaw);
+    sim_pose(r, y->fps, 1, t_k + o->offset * dt, pos_j, vel, &yaw);
+    double lx = pos_i[0] - pos_j[0], ly = pos_i[1] - pos_j[1];
+    double deltaf = fabs(atan2(lx * nf[1] - ly * nf[0], lx * nf[0] + ly * nf[1]));
     double sum_d = 2 * y->radius * sin(y->beta) * cos(y->dphi / 2); /* |D2 + D3| */
     for (int k = 0; k < 2; k++) {
         double w = k == 0 ? qf[4] : qf[10];
@@ -547,7 +553,7 @@ static void check_noise_free(const struct synth* y, const struct wetdem_track_op
     struct wetdem_track_summary s;
     render_simulated(y, rec, NULL, 0, dots);
     CHECK_OK(analyse_dots(dots, o, got, &s));
-    simulated_truth(rec, y, o, s.collision_frame, want, bias);
+    simulated_truth(rec, y, o, res, s.collision_frame, want, bias);
     /* The values taken from the record are the ones wetdem_collision_run reports (same
      * definitions; round-off of the recorded states only). */
     CHECK_REL(want[8], res->e_n, 1e-9);
@@ -592,7 +598,7 @@ static void check_simulated_recovery(double stokes, double angle, unsigned long 
     gsl_rng_free(rng);
     CHECK_OK(analyse_dots(dots, &o, got, &s));
     noise_sigma(dots, &o, sigma_px, got, sigma);
-    simulated_truth(&rec, &y, &o, s.collision_frame, want, bias);
+    simulated_truth(&rec, &y, &o, &res, s.collision_frame, want, bias);
     /* The fit after the collision starts at the interval from frame k + window (k: the
      * collision frame); the bias bounds assume the simulated interaction has ended by then
      * (free flight): here it ends 1 ms (5 frames) after the first interaction. */
@@ -605,9 +611,11 @@ static void check_simulated_recovery(double stokes, double angle, unsigned long 
                      "%.3g + bias %.3g",
                      angle * 180 / M_PI, q, got[q], want[q], fabs(got[q] - want[q]), 4 * sigma[q],
                      bias[q]);
-    /* The tolerances stay meaningful: e_n within +-0.03 (4 sigma + bias) of the simulated
-     * 0.70, the spins (-5.8 rad/s) to better than 2 rad/s, the angle to 1.5 degrees. */
-    assert_true(4 * sigma[8] + bias[8] < 0.03);
+    /* The tolerances stay meaningful: e_n within +-0.04 (4 sigma + bias) of the simulated
+     * 0.70 (the bias, ~0.02, is the line of centres' turn of ~0.02 rad from the closest
+     * approach, where the simulation takes n_f, to frame k + offset, where the tracker takes
+     * it), the spins (-5.8 rad/s) to better than 2 rad/s, the angle to 1.5 degrees. */
+    assert_true(4 * sigma[8] + bias[8] < 0.04);
     assert_true(4 * sigma[4] + bias[4] < 2 && 4 * sigma[7] + bias[7] < 2);
     assert_true(4 * sigma[9] + bias[9] < 1.5 * M_PI / 180);
     free(dots);
