@@ -84,8 +84,11 @@ def checks(table):
     c = common.Checks("Fig. 3")
     for m, (stc, e30, e100, e1000, emax) in table.items():
         c.check(stc > 1.0, f"{m}: no rebound at St = 1 (St_c = {stc:.3g})")
-        c.check(5.0 <= stc <= 40.0, f"{m}: critical St {stc:.3g} within the 5-40 of the "
-                "experiments (Nijssen Sec. 2: 5 <= St_c <= 20, scatter below St = 20)")
+        # The experiments give 5 <= St_c <= 20 (Nijssen Sec. 2); the model's own threshold,
+        # (1 + e_dry)/e_dry ln(h_co/h_min) from lubrication in and out (docs/validation.md,
+        # Fig. 3), is 17-24 for these materials, so 5-40 is accepted.
+        c.check(5.0 <= stc <= 40.0, f"{m}: critical St {stc:.3g} within 5-40 (experiments "
+                "5-20; the model's lubrication threshold for these materials 17-24)")
         c.check(emax > 0.85, f"{m}: e saturates towards e_dry = 0.97 at high St "
                 f"(e = {emax:.3f} at the largest St)")
     c.check(table["steel1"][0] >= table["delrin"][0],

@@ -15,14 +15,15 @@
  *   St_n = m* v_n0 / (6 pi mu R*^2),  v_n0 = U cos(theta).
  * Runs to separation (gap >= rebound_gap_factor x range, receding) or t_end.
  * With the relative velocity of centres dv = v_i - v_j, n0 = +x (the contact normal of the
- * straight-line approach, which defines theta and v_n0) and n_f the rebound normal: the line of
- * centres at the last local minimum of the gap, where the final separation starts (the middle
- * of a bounce's contact; where a doublet that turned lets go), at the end if the gap had none.
- * Punch Eq. 3 takes n_f "at the time of final relative velocity": with thin films that is
- * within a degree of it, but the line of centres keeps turning after the spheres part (by tens
- * of degrees over nijssen's cut-off R*), and a normal taken at the end of the run would make
- * the results depend on where the run stops (rebound_gap_factor) and give e_n > 1 for an
- * elastic frictionless impact. Velocities are taken at the end (separation or t_end):
+ * straight-line approach, which defines theta and v_n0) and n_f the rebound normal, the line of
+ * centres where the final separation starts: for a bounce at the last local minimum of the gap
+ * (the middle of the contact), for stick-rotate-separate where the doublet leaves near contact
+ * (the gap rises through h_close, below), for a pair that has not separated at the end.
+ * Punch Eq. 3 takes n_f "at the time of final relative velocity", for its thin films within a
+ * degree of this; but the line of centres keeps turning after the spheres part (by tens of
+ * degrees over nijssen's cut-off R*), and a normal taken at the end of the run made the results
+ * depend on where the run stops (rebound_gap_factor) and gave e_n > 1 for an elastic
+ * frictionless impact. Velocities are taken at the end (separation or t_end):
  *   e   = |dv_f| / |dv_0|                                   (Nijssen; Yang & Hunt)
  *   e_n = -(dv_f . n_f) / (dv_0 . n0)                        (Punch Eq. 3)
  *   e_t = -(u_f . t_f) / |u_0|,  u = tangential part of the contact-point velocity
@@ -81,10 +82,29 @@ struct tracker {
     double observe_span; /* spec->observe_time [s] */
     bool observed;
     struct wetdem_vec3 n_obs, dv_obs;
-    bool turned;               /* the gap has had a local minimum */
-    struct wetdem_vec3 n_turn; /* the line of centres at the last one: the normal the rebound
-                                  is referred to (n_f of e_n, e_t, angle_out) */
+    bool turned;                /* the gap has had a local minimum */
+    struct wetdem_vec3 n_turn;  /* the line of centres at the last one */
+    bool left_close;            /* the gap has risen through h_close */
+    struct wetdem_vec3 n_leave; /* the line of centres the last time it did */
 };
+
+/* The rebound normal n_f, given the line of centres `now` (docs/engines.md, "Collision
+ * analysis"): where the pair last turned as a doublet in near contact (stick-rotate-separate),
+ * the line where it left near contact; else the line at the last local minimum of the gap;
+ * `now` when there was neither. */
+static struct wetdem_vec3 rebound_normal(const struct tracker* tr, struct wetdem_vec3 now)
+{
+    if (tr->rotation_close > SRS_ANGLE)
+        return tr->left_close ? tr->n_leave : now;
+    return tr->turned ? tr->n_turn : now;
+}
+
+/* The unit vector along (1 - s) a + s b. */
+static struct wetdem_vec3 unit_between(struct wetdem_vec3 a, struct wetdem_vec3 b, double s)
+{
+    struct wetdem_vec3 n = vec3_add(vec3_scale(a, 1 - s), vec3_scale(b, s));
+    return vec3_scale(n, 1.0 / vec3_norm(n));
+}
 
 static struct wetdem_vec3 relative_velocity(const struct wetdem_sim* sim)
 {
@@ -150,7 +170,7 @@ static void observe_in_step(struct tracker* tr, double t, struct wetdem_vec3 n,
         return;
     double s = t > tr->t_prev ? (tr->t_observe - tr->t_prev) / (t - tr->t_prev) : 1.0;
     s = fmin(fmax(s, 0.0), 1.0);
-    tr->n_obs = tr->turned ? tr->n_turn : vec3_add(vec3_scale(tr->n_prev, 1 - s), vec3_scale(n, s));
+    tr->n_obs = rebound_normal(tr, unit_between(tr->n_prev, n, s));
     tr->dv_obs = vec3_add(vec3_scale(tr->dv_prev, 1 - s), vec3_scale(dv, s));
     tr->observed = true;
 }
@@ -168,9 +188,13 @@ static int monitor(struct wetdem_sim* sim, void* ctx)
     if (turned_back) {
         double at;
         low = fmin(low, hermite_min(t - tr->t_prev, tr->gap_prev, tr->vn_prev, c.gap, c.v_n, &at));
-        struct wetdem_vec3 n = vec3_add(vec3_scale(tr->n_prev, 1 - at), vec3_scale(c.normal, at));
-        tr->n_turn = vec3_scale(n, 1.0 / vec3_norm(n));
+        tr->n_turn = unit_between(tr->n_prev, c.normal, at);
         tr->turned = true;
+    }
+    if (tr->gap_prev < tr->h_close && c.gap >= tr->h_close) {
+        tr->n_leave = unit_between(tr->n_prev, c.normal,
+                                   (tr->h_close - tr->gap_prev) / (c.gap - tr->gap_prev));
+        tr->left_close = true;
     }
     tr->min_gap = fmin(tr->min_gap, low);
     if (tr->interacting) {
@@ -399,13 +423,15 @@ static void scan_log(const struct wetdem_sim* sim, bool in_contact,
     r->contact_duration = total;
 }
 
-/* Restitution coefficients and angles from the initial and final states. */
+/* Restitution coefficients and angles from the initial and final states (a pair that has not
+ * separated: the line of centres at the end). */
 static void restitution(const struct wetdem_sim* sim, const struct initial* in,
-                        const struct tracker* tr, struct wetdem_collision_result* r)
+                        const struct tracker* tr, bool separated, struct wetdem_collision_result* r)
 {
     struct wetdem_contact c;
     pair_contact(sim, &c);
-    struct wetdem_vec3 dvf = relative_velocity(sim), nf = tr->turned ? tr->n_turn : c.normal;
+    struct wetdem_vec3 dvf = relative_velocity(sim);
+    struct wetdem_vec3 nf = separated ? rebound_normal(tr, c.normal) : c.normal;
     double dn0 = vec3_dot(in->dv, in->n), dnf = vec3_dot(dvf, nf);
     r->e = vec3_norm(dvf) / vec3_norm(in->dv);
     r->e_n = dn0 < 0 ? -dnf / dn0 : NAN;
@@ -436,7 +462,7 @@ static void analyse(const struct wetdem_sim* sim, const struct setup* su, const 
     r->speed_n0 = su->speed_n0;
     r->stokes_n =
         mu > 0 ? su->m_eff * su->speed_n0 / (6 * M_PI * mu * su->r_eff * su->r_eff) : INFINITY;
-    restitution(sim, in, tr, r);
+    restitution(sim, in, tr, separated, r);
     r->omega_i = sim->particles[0].omega;
     r->omega_j = sim->n_walls ? vec3(0, 0, 0) : sim->particles[1].omega;
     double t_last_end;

@@ -582,6 +582,12 @@ static void test_collision_outcome_with_films(void** state)
     assert_true(r.separated);
     assert_true(r.rotation_close > 30 * M_PI / 180); /* measured ~49 degrees */
     assert_int_equal(r.outcome, WETDEM_OUTCOME_STICK_ROTATE_SEPARATE);
+    /* the rebound normal is where the films part, after the turn (not the closest approach,
+     * before it, against which the leaving pair's velocity points inwards: e_n was -0.86),
+     * and e_n lies in Punch's elongated region of 0.06-0.1 (measured 0.081) */
+    double turned = acos(r.normal_out.x); /* n0 = +x */
+    assert_true(turned > r.rotation_close && turned < r.rotation_angle + 1e-9);
+    assert_true(r.e_n > 0.06 && r.e_n < 0.1);
     s.stokes = 3.5;
     s.t_end = 0.2;
     CHECK_OK(wetdem_collision_run(sim, &s, &r));
