@@ -17,10 +17,14 @@
  * checkpoint time are dropped, as are CSV rows after the checkpoint step (a run resumed from
  * an older periodic checkpoint then rewrites them identically).
  *
- * Interruption: SIGINT and SIGTERM set a volatile flag that the library reads every step as
- * its stop flag; it writes the checkpoint and returns, and the run exits with 128 + signal
- * number (130, 143) after printing the command that resumes it. A second signal kills as
- * usual (SA_RESETHAND); the checkpoint written before is intact (written atomically).
+ * Interruption: the first SIGINT or SIGTERM sets a volatile flag that the library reads every
+ * step as its stop flag; it writes the checkpoint and returns, and the run exits with 128 +
+ * signal number (130, 143) after printing the command that resumes it. A repeat within
+ * SIGNAL_GRACE_S of the first is the same request delivered twice (GNU timeout signals the
+ * process and then its process group; a terminal's Ctrl-C reaches the whole foreground group)
+ * and is ignored, so it cannot lose the checkpoint being written. A second signal after the
+ * grace period, or a third, stops the run at once by that signal, without a new checkpoint;
+ * the previous one is intact (written atomically) and the partial temporary file is removed.
  *
  * Progress with an estimate of the time left goes to stderr, only when stderr is a terminal,
  * at most twice a second.
@@ -32,6 +36,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "cli_util.h"
@@ -40,11 +45,86 @@
 
 #define PATH_CHARS 2048
 
-static volatile sig_atomic_t stop_signal = 0;
+/* ----------------------------------------------------------------------- signals --- */
+
+/* A repeat of SIGINT/SIGTERM sooner than this after the first is taken as the same request
+ * [s]: duplicates arrive within milliseconds, and a person pressing Ctrl-C again to stop at
+ * once presses it later (or three times). */
+#define SIGNAL_GRACE_S 1.0
+
+static volatile sig_atomic_t stop_signal = 0; /* the first signal: checkpoint and stop */
+static volatile sig_atomic_t signal_count = 0;
+static struct timespec first_signal_time;
+/* Set before the handlers are installed (the handler may only call async-signal-safe
+ * functions): the temporary file of a checkpoint being written, removed on a forced stop, and
+ * the notice printed on the first signal. */
+static char checkpoint_tmp[PATH_CHARS + 8];
+static char stop_notice[PATH_CHARS + 200];
+
+static void say(const char* text)
+{
+    ssize_t unused = write(STDERR_FILENO, text, strlen(text));
+    (void)unused;
+}
 
 static void on_signal(int sig)
 {
-    stop_signal = sig;
+    struct timespec now;
+    clock_gettime(CLOCK_MONOTONIC, &now);
+    if (signal_count == 0) {
+        first_signal_time = now;
+        signal_count = 1;
+        stop_signal = sig;
+        say(stop_notice);
+        return;
+    }
+    double since = (double)(now.tv_sec - first_signal_time.tv_sec) +
+                   1e-9 * (double)(now.tv_nsec - first_signal_time.tv_nsec);
+    if (signal_count == 1 && since < SIGNAL_GRACE_S) {
+        signal_count = 2; /* the same request again: the next one stops at once */
+        return;
+    }
+    say("\nwetdem: stopped at once by a repeated signal, without a new checkpoint\n");
+    if (checkpoint_tmp[0])
+        unlink(checkpoint_tmp);
+    /* die by the signal, as the caller asked: default action, raised again (delivered when
+       this handler returns) */
+    struct sigaction dfl = {.sa_handler = SIG_DFL};
+    sigemptyset(&dfl.sa_mask);
+    sigaction(sig, &dfl, NULL);
+    raise(sig);
+}
+
+struct saved_handlers {
+    struct sigaction sigint, sigterm;
+};
+
+/* Installs on_signal for SIGINT and SIGTERM (each blocks both while it runs, so the count is
+ * never updated twice at once), with the notice and the temporary checkpoint path set. */
+static void signals_install(const char* checkpoint, bool tty, struct saved_handlers* saved)
+{
+    stop_signal = 0;
+    signal_count = 0;
+    checkpoint_tmp[0] = '\0';
+    if (checkpoint[0])
+        snprintf(checkpoint_tmp, sizeof checkpoint_tmp, "%s.tmp", checkpoint);
+    snprintf(stop_notice, sizeof stop_notice,
+             "%swetdem: stopping after this step%s; a second signal %g s or more after this "
+             "one, or a third, stops at once%s\n",
+             tty ? "\n" : "", checkpoint[0] ? " to write the checkpoint" : "", SIGNAL_GRACE_S,
+             checkpoint[0] ? " without it" : "");
+    struct sigaction sa = {.sa_handler = on_signal};
+    sigemptyset(&sa.sa_mask);
+    sigaddset(&sa.sa_mask, SIGINT);
+    sigaddset(&sa.sa_mask, SIGTERM);
+    sigaction(SIGINT, &sa, &saved->sigint);
+    sigaction(SIGTERM, &sa, &saved->sigterm);
+}
+
+static void signals_restore(const struct saved_handlers* saved)
+{
+    sigaction(SIGINT, &saved->sigint, NULL);
+    sigaction(SIGTERM, &saved->sigterm, NULL);
 }
 
 /* ------------------------------------------------------------------- VTK time series --- */
@@ -569,20 +649,6 @@ static int resume(const struct cli_many_setup* su, const struct cli_run_options*
     return CLI_EXIT_OK;
 }
 
-/* The stepping, between signal handlers. Returns the library status. */
-static int integrate_with_signals(struct wetdem_sim* sim, double t_end)
-{
-    struct sigaction sa = {.sa_handler = on_signal, .sa_flags = SA_RESETHAND}, old_int, old_term;
-    sigemptyset(&sa.sa_mask);
-    stop_signal = 0;
-    sigaction(SIGINT, &sa, &old_int);
-    sigaction(SIGTERM, &sa, &old_term);
-    int st = wetdem_sim_integrate(sim, t_end);
-    sigaction(SIGINT, &old_int, NULL);
-    sigaction(SIGTERM, &old_term, NULL);
-    return st;
-}
-
 /* After the stepping: interrupted, failed or done (last frame, final checkpoint, summary). */
 static int finish(const struct cli_scenario* sc, struct cli_many_setup* su,
                   const struct cli_run_options* opt, const struct plan* pl, struct progress* prog,
@@ -695,6 +761,9 @@ static int run(const struct cli_scenario* sc, struct cli_many_setup* su,
         cli_error("run: cannot create directory %s: %s", opt->out_dir, strerror(errno));
         return CLI_EXIT_RUNTIME;
     }
+    /* from the first output on, until every file is written: a signal asks for a stop */
+    struct saved_handlers saved;
+    signals_install(pl->checkpoint, prog.tty, &saved);
     double t0 = omp_get_wtime();
     int st = opt->restart ? WETDEM_OK : wetdem_sim_integrate(su->sim, wetdem_sim_time(su->sim));
     struct wetdem_many_stats s;
@@ -705,8 +774,13 @@ static int run(const struct cli_scenario* sc, struct cli_many_setup* su,
     if (st == WETDEM_OK && frame_due && series_add(vtk, su->sim, s.step) != WETDEM_OK)
         prog.status = WETDEM_ERR_IO;
     if (st == WETDEM_OK && prog.status == WETDEM_OK)
-        st = integrate_with_signals(su->sim, pl->t_end);
-    return finish(sc, su, opt, pl, &prog, st, omp_get_wtime() - t0);
+        st = wetdem_sim_integrate(su->sim, pl->t_end);
+    rc = finish(sc, su, opt, pl, &prog, st, omp_get_wtime() - t0);
+    /* after a signal the handlers stay until the process exits: a duplicate arriving after the
+       files are written would otherwise kill it, and turn exit 130 into death by signal */
+    if (!signal_count)
+        signals_restore(&saved);
+    return rc;
 }
 
 int cli_run_many(const struct cli_scenario* sc, const struct cli_run_options* opt)

@@ -9,8 +9,9 @@
  *   - a run split by --restart, and a run resumed from an older checkpoint after its outputs
  *     went further, give byte-identical VTK frames, series index, CSV and summary to the
  *     uninterrupted run;
- *   - SIGINT sent to a running CLI writes a checkpoint, exits 130 and prints the command that
- *     resumes it; resuming gives the uninterrupted run's files byte for byte;
+ *   - SIGINT sent to a running CLI, once or twice back to back, writes a checkpoint, exits 130
+ *     and prints the command that resumes it; resuming gives the uninterrupted run's files
+ *     byte for byte;
  *   - progress goes to stderr only when it is a terminal, with an estimate of the time left;
  *   - the example scenarios check, and the summary's energy budget adds up; a run whose budget
  *     does not close (a step too long for the contacts) says so and exits 1, and a restart
@@ -387,34 +388,81 @@ static pid_t spawn_cli(const char* args)
     return pid;
 }
 
+/* Whether signal sig is pending for process pid, not yet delivered (/proc/PID/status: SigPnd
+ * for the thread, ShdPnd for the process). */
+static bool signal_pending(pid_t pid, int sig)
+{
+    char path[64], line[256];
+    snprintf(path, sizeof path, "/proc/%d/status", (int)pid);
+    FILE* f = fopen(path, "r");
+    bool pending = false;
+    while (f && fgets(line, sizeof line, f)) {
+        unsigned long long mask;
+        if ((sscanf(line, "SigPnd: %llx", &mask) == 1 ||
+             sscanf(line, "ShdPnd: %llx", &mask) == 1) &&
+            (mask >> (sig - 1)) & 1u)
+            pending = true;
+    }
+    if (f)
+        fclose(f);
+    return pending;
+}
+
+/* Starts `args`, waits until it is stepping (5 rows in tmpdir/csv), then sends it `count`
+ * SIGINTs back to back, each as soon as the one before has been delivered (two sent while
+ * neither is delivered would merge into one). Returns its wait status. */
+static int interrupt_cli(const char* args, const char* csv, int count)
+{
+    pid_t pid = spawn_cli(args);
+    struct timespec nap = {0, 1000000}, blink = {0, 20000};
+    for (int k = 0; k < 60000 && csv_rows(tpath(csv)) < 5; k++)
+        nanosleep(&nap, NULL);
+    for (int n = 0; n < count; n++) {
+        for (int k = 0; n > 0 && k < 50000 && signal_pending(pid, SIGINT); k++)
+            nanosleep(&blink, NULL);
+        kill(pid, SIGINT);
+    }
+    int status;
+    assert_int_equal(waitpid(pid, &status, 0), pid);
+    return status;
+}
+
+/* SIGINT: the checkpoint, exit 130 and the command that resumes; resuming gives the files of
+ * the uninterrupted run. Two SIGINTs back to back, as GNU timeout sends them (to the process,
+ * then to its group), are one request: the run still writes its checkpoint and exits 130 (the
+ * second killed it at once). */
 static void test_many_cli_sigint_writes_a_checkpoint_and_resumes(void** state)
 {
     (void)state;
     scenario("long.ini", "[dump]\nvtk_every = 2000\ncsv_every = 10\n");
-    const char* args = "run long.ini --set run.steps=12000 --out sig";
-    pid_t pid = spawn_cli(args);
-    /* wait until the run is stepping (5 CSV rows: step 40), then interrupt it */
-    struct timespec nap = {0, 1000000};
-    for (int k = 0; k < 60000 && csv_rows(tpath("sig/global.csv")) < 5; k++)
-        nanosleep(&nap, NULL);
-    kill(pid, SIGINT);
-    int status;
-    assert_int_equal(waitpid(pid, &status, 0), pid);
-    char* err = stderr_text();
-    if (!WIFEXITED(status) || WEXITSTATUS(status) != 130)
-        fail_msg("interrupted run: status %d, expected exit 130 (the run must outlast the "
-                 "wait for 5 CSV rows)\n%s",
-                 status, err);
-    CHECK_CONTAINS(err, "interrupted by SIGINT");
-    CHECK_CONTAINS(err, "resume with: wetdem run long.ini --set run.steps=12000 --out sig "
-                        "--restart sig/checkpoint.ckpt");
-    free(err);
-    assert_true(exists("sig/checkpoint.ckpt"));
-    assert_int_equal(run_cli("run long.ini --set run.steps=12000 --out sig --restart "
-                             "sig/checkpoint.ckpt"),
-                     0);
     assert_int_equal(run_cli("run long.ini --set run.steps=12000 --out ref"), 0);
-    check_same_outputs("ref", "sig", 7); /* frames at 0, 2000, ..., 12000 */
+    const char* dirs[2] = {"sig", "sig2"};
+    for (int k = 0; k < 2; k++) {
+        char args[200], csv[64], resume[300];
+        snprintf(args, sizeof args, "run long.ini --set run.steps=12000 --out %s", dirs[k]);
+        snprintf(csv, sizeof csv, "%s/global.csv", dirs[k]);
+        int status = interrupt_cli(args, csv, k + 1);
+        char* err = stderr_text();
+        if (!WIFEXITED(status) || WEXITSTATUS(status) != 130)
+            fail_msg("%d SIGINT: status %d, expected exit 130 (the run must outlast the wait "
+                     "for 5 CSV rows)\n%s",
+                     k + 1, status, err);
+        CHECK_CONTAINS(err, "stopping after this step to write the checkpoint");
+        CHECK_CONTAINS(err, "interrupted by SIGINT");
+        snprintf(resume, sizeof resume,
+                 "resume with: wetdem run long.ini --set run.steps=12000 --out %s --restart "
+                 "%s/checkpoint.ckpt",
+                 dirs[k], dirs[k]);
+        CHECK_CONTAINS(err, resume);
+        free(err);
+        snprintf(args, sizeof args, "%s/checkpoint.ckpt", dirs[k]);
+        assert_true(exists(args));
+        snprintf(args, sizeof args,
+                 "run long.ini --set run.steps=12000 --out %s --restart %s/checkpoint.ckpt",
+                 dirs[k], dirs[k]);
+        assert_int_equal(run_cli(args), 0);
+        check_same_outputs("ref", dirs[k], 7); /* frames at 0, 2000, ..., 12000 */
+    }
 }
 
 /* Progress: nothing on stderr when it is a file; on a terminal, the spheres placed by the
