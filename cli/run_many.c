@@ -9,13 +9,15 @@
  *
  * Outputs in DIR: PREFIX_NNNNNN.vtk frames every vtk_every steps (and the last step) with the
  * ParaView index PREFIX.vtk.series, the library's CSV of global quantities every csv_every
- * steps, the checkpoint (atomic; every checkpoint_every steps, on SIGINT/SIGTERM and at the
- * end) and summary.json with the energy budget. The VTK frames are written here, from the
- * progress callback (called after every step with the state at the end of the step), rather
- * than by the library, so that the frame numbering and the series index continue across
- * restarts: on --restart the existing index is read back and the entries after the
- * checkpoint time are dropped, as are CSV rows after the checkpoint step (a run resumed from
- * an older periodic checkpoint then rewrites them identically).
+ * steps (and a row of the last step, added here), the checkpoint (atomic; every
+ * checkpoint_every steps, on SIGINT/SIGTERM and at the end) and summary.json with the energy
+ * budget. The VTK frames are written here, from the progress callback (called after every
+ * step with the state at the end of the step), rather than by the library, so that the frame
+ * numbering and the series index continue across restarts: on --restart the existing index
+ * is read back and the entries after the checkpoint time are dropped, as are CSV rows after
+ * the checkpoint step (a run resumed from an older periodic checkpoint then rewrites them
+ * identically), and the last frame and row of the run that wrote the checkpoint when they lie
+ * off the output grid.
  *
  * Interruption: the first SIGINT or SIGTERM sets a volatile flag that the library reads every
  * step as its stop flag; it writes the checkpoint and returns, and the run exits with 128 +
@@ -197,9 +199,20 @@ static int series_add(struct series* s, struct wetdem_sim* sim, unsigned long lo
     return series_write(s) == 0 ? WETDEM_OK : WETDEM_ERR_IO;
 }
 
-/* On restart: the frames of the existing index up to time t (entries in order, named as this
- * run names them); the rest are dropped and will be written again. */
-static void series_resume(struct series* s, double t, unsigned long long step, double dt)
+/* The step of frame k, from its time on the grid t = k dt, given the time t at step `step`. */
+static unsigned long long frame_step(const struct series* s, size_t k, double t,
+                                     unsigned long long step, double dt)
+{
+    return step - (unsigned long long)llround((t - s->times[k]) / dt);
+}
+
+/* On restart: the frames of the existing index up to time t, the checkpoint's (entries in
+ * order, named as this run names them); the rest are dropped and will be written again. A
+ * frame at t itself is kept only on the grid of `every`: off it, it is the last frame that
+ * the run which wrote the checkpoint added at its end, which the uninterrupted run does not
+ * have. */
+static void series_resume(struct series* s, double t, unsigned long long step, double dt,
+                          unsigned long long every)
 {
     char path[PATH_CHARS + CLI_VALUE_MAX + 40];
     snprintf(path, sizeof path, "%s/%s.vtk.series", s->dir, s->prefix);
@@ -218,16 +231,77 @@ static void series_resume(struct series* s, double t, unsigned long long step, d
     }
     if (f)
         fclose(f);
-    /* the step of the last kept frame, from its time on the grid t = k dt */
-    s->last_step = s->n ? step - (unsigned long long)llround((t - s->times[s->n - 1]) / dt) : 0;
+    if (s->n && frame_step(s, s->n - 1, t, step, dt) == step && every && step % every != 0)
+        s->n--;
+    s->last_step = s->n ? frame_step(s, s->n - 1, t, step, dt) : 0;
 }
 
-/* ------------------------------------------------------------------ CSV on restart --- */
+/* ----------------------------------------------------------- CSV: last row, restart --- */
+
+/* The step (second column) of the last data row of the CSV at path, read from the file's
+ * tail. false when the file is missing or its tail holds no data row. */
+static bool csv_last_step(const char* path, unsigned long long* step)
+{
+    FILE* f = fopen(path, "rb");
+    if (!f)
+        return false;
+    char tail[8192];
+    long size = fseek(f, 0, SEEK_END) == 0 ? ftell(f) : -1;
+    long from = size > (long)sizeof tail - 1 ? size - (long)sizeof tail + 1 : 0;
+    size_t n = size >= 0 && fseek(f, from, SEEK_SET) == 0 ? fread(tail, 1, sizeof tail - 1, f) : 0;
+    fclose(f);
+    tail[n] = '\0';
+    bool found = false;
+    for (char* line = tail; line && *line;
+         line = strchr(line, '\n') ? strchr(line, '\n') + 1 : NULL) {
+        const char* comma = strchr(line, ',');
+        bool whole = line != tail || from == 0; /* the first line of a tail may be cut */
+        if (whole && line[0] >= '0' && line[0] <= '9' && comma) {
+            *step = strtoull(comma + 1, NULL, 10);
+            found = true;
+        }
+    }
+    return found;
+}
+
+/* Appends the state at the end of the run (finished or interrupted) to the CSV as its last
+ * row, unless the library's rows, every csv_every steps, ended there. The row has the
+ * library's columns and format (src/sim_many_io.c, write_csv_row; tests/test_many_cli.c
+ * compares the two), so the CSV ends at the state summary.json reports. The energies come
+ * from the energy budget, the API's only way to them: without it the CSV keeps to its grid.
+ * WETDEM status. */
+static int csv_final_row(const char* csv_prefix, struct wetdem_sim* sim)
+{
+    struct wetdem_many_stats s;
+    struct wetdem_energy_budget b;
+    char path[PATH_CHARS + 8];
+    snprintf(path, sizeof path, "%s.csv", csv_prefix);
+    unsigned long long last;
+    if (!csv_prefix[0] || wetdem_sim_many_stats(sim, &s) != WETDEM_OK ||
+        wetdem_sim_energy_budget(sim, &b) != WETDEM_OK || !csv_last_step(path, &last) ||
+        last >= s.step)
+        return WETDEM_OK;
+    FILE* f = fopen(path, "a");
+    if (!f)
+        return WETDEM_ERR_IO;
+    fprintf(f, "%.9g,%llu,%.9g,%.9g,%.9g,%zu,%zu,%zu,%.6g,%zu", wetdem_sim_time(sim), s.step,
+            b.kinetic, b.potential, b.elastic, s.contacts, s.bridges, s.agglomerates,
+            s.mean_agglomerate, s.candidate_pairs);
+    for (size_t q = 0; q < b.n_models && q < WETDEM_ENERGY_MAX_MODELS; q++)
+        fprintf(f, ",%.9g", b.work_pair[q] + b.work_wall[q]);
+    fprintf(f, ",%.9g,%.3g\n", b.dissipated, b.balance_error);
+    bool ok = !ferror(f);
+    ok = fclose(f) == 0 && ok;
+    return ok ? WETDEM_OK : WETDEM_ERR_IO;
+}
 
 /* Keeps the comment and header lines of the CSV and the rows up to `step` (second column),
- * rewriting the file atomically when rows are dropped. CLI exit code; a missing file is an
- * input error (the rows before the checkpoint would be lost). */
-static int csv_resume(const char* path, unsigned long long step, const char* out_dir)
+ * rewriting the file atomically when rows are dropped. A row at `step` itself is kept only on
+ * the grid of `every`: off it, it is the last row that the run which wrote the checkpoint
+ * added at its end (csv_final_row), which the uninterrupted run does not have. CLI exit
+ * code; a missing file is an input error (the rows before the checkpoint would be lost). */
+static int csv_resume(const char* path, unsigned long long step, unsigned long long every,
+                      const char* out_dir)
 {
     FILE* f = fopen(path, "r");
     if (!f) {
@@ -244,7 +318,8 @@ static int csv_resume(const char* path, unsigned long long step, const char* out
     while (g && fgets(line, sizeof line, f)) {
         const char* comma = strchr(line, ',');
         bool data = line[0] >= '0' && line[0] <= '9' && comma;
-        if (data && strtoull(comma + 1, NULL, 10) > step) {
+        unsigned long long row = data ? strtoull(comma + 1, NULL, 10) : 0;
+        if (data && (row > step || (row == step && every && step % every != 0))) {
             dropped = true;
             continue;
         }
@@ -640,12 +715,12 @@ static int resume(const struct cli_many_setup* su, const struct cli_run_options*
     if (pl->csv_prefix[0]) {
         char path[PATH_CHARS + 8];
         snprintf(path, sizeof path, "%s.csv", pl->csv_prefix);
-        int rc = csv_resume(path, s.step, opt->out_dir);
+        int rc = csv_resume(path, s.step, su->csv_every, opt->out_dir);
         if (rc != CLI_EXIT_OK)
             return rc;
     }
     if (vtk)
-        series_resume(vtk, wetdem_sim_time(su->sim), s.step, pl->dt);
+        series_resume(vtk, wetdem_sim_time(su->sim), s.step, pl->dt, su->vtk_every);
     return CLI_EXIT_OK;
 }
 
@@ -663,6 +738,10 @@ static int finish(const struct cli_scenario* sc, struct cli_many_setup* su,
     }
     if (st < 0) {
         cli_error("run %s: %s (%s)", sc->file, wetdem_sim_errmsg(su->sim), wetdem_status_name(st));
+        return CLI_EXIT_RUNTIME;
+    }
+    if (csv_final_row(pl->csv_prefix, su->sim) != WETDEM_OK) {
+        cli_error("run %s: cannot append the last row to %s.csv", sc->file, pl->csv_prefix);
         return CLI_EXIT_RUNTIME;
     }
     if (st == WETDEM_EVENT) {

@@ -6,12 +6,13 @@
  *     t_end and steps both, a periodic edge too short for the neighbour cells, a foreign
  *     checkpoint) exit 2 with "FILE:LINE:" at the right line
  *     and write nothing, not even the --out directory;
- *   - a run split by --restart, and a run resumed from an older checkpoint after its outputs
- *     went further, give byte-identical VTK frames, series index, CSV and summary to the
- *     uninterrupted run;
+ *   - a run split by --restart (at a step on the output grid and off it), and a run resumed
+ *     from an older checkpoint after its outputs went further, give byte-identical VTK frames,
+ *     series index, CSV and summary to the uninterrupted run;
  *   - SIGINT sent to a running CLI, once or twice back to back, writes a checkpoint, exits 130
  *     and prints the command that resumes it; resuming gives the uninterrupted run's files
  *     byte for byte;
+ *   - the CSV ends with a row of the last step, in the library's format;
  *   - progress goes to stderr only when it is a terminal, with an estimate of the time left;
  *   - the example scenarios check, and the summary's energy budget adds up; a run whose budget
  *     does not close (a step too long for the contacts) says so and exits 1, and a restart
@@ -241,6 +242,33 @@ static void drop_column(char* text, int col)
     *w = '\0';
 }
 
+/* The last line of tmpdir/name (caller frees), without its newline. */
+static char* last_line(const char* name)
+{
+    char* t = test_read_file(tpath(name), NULL);
+    if (!t)
+        fail_msg("%s is missing", name);
+    size_t n = strlen(t);
+    while (n > 0 && t[n - 1] == '\n')
+        t[--n] = '\0';
+    const char* nl = strrchr(t, '\n');
+    char* line = strdup(nl ? nl + 1 : t);
+    free(t);
+    return line;
+}
+
+/* The step (second column) of the last row of the CSV tmpdir/name. */
+static unsigned long long csv_last_step(const char* name)
+{
+    char* line = last_line(name);
+    const char* comma = strchr(line, ',');
+    if (!comma)
+        fail_msg("%s: last line '%s' is not a row", name, line);
+    unsigned long long step = strtoull(comma + 1, NULL, 10);
+    free(line);
+    return step;
+}
+
 /* The files of two --out directories are byte-identical, except the CSV column
  * candidate_pairs: the size of the neighbour list depends on when the list was last built,
  * and a restart builds it afresh (the forces do not depend on it: every pair within range is
@@ -294,6 +322,15 @@ static void test_many_cli_restart_is_bit_identical(void** state)
     if (code != 0)
         fail_msg("restart: exit %d\n%s", code, stderr_text());
     check_same_outputs("whole", "split", 7);
+    /* split off the CSV grid: the first run's CSV ends with a row of its last step, 305, which
+       the uninterrupted run does not have; the resumed run drops it (and keeps the row of 300) */
+    assert_int_equal(run_cli("run box.ini --set run.steps=305 --out split305"), 0);
+    assert_int_equal(csv_last_step("split305/global.csv"), 305);
+    code = run_cli("run box.ini --set run.steps=600 --out split305 --restart "
+                   "split305/checkpoint.ckpt");
+    if (code != 0)
+        fail_msg("restart at 305: exit %d\n%s", code, stderr_text());
+    check_same_outputs("whole", "split305", 7);
     /* a crash after step 300: the outputs went on to 600, the checkpoint is the older one */
     assert_int_equal(run_cli("run box.ini --set run.steps=300 --out crash"), 0);
     char cmd[1200];
@@ -427,10 +464,20 @@ static int interrupt_cli(const char* args, const char* csv, int count)
     return status;
 }
 
-/* SIGINT: the checkpoint, exit 130 and the command that resumes; resuming gives the files of
- * the uninterrupted run. Two SIGINTs back to back, as GNU timeout sends them (to the process,
- * then to its group), are one request: the run still writes its checkpoint and exits 130 (the
- * second killed it at once). */
+/* The step "(step N of" of the interruption message on stderr. */
+static unsigned long long interrupted_step(const char* err)
+{
+    const char* p = strstr(err, "(step ");
+    if (!p)
+        fail_msg("no step in the interruption message:\n%s", err);
+    return strtoull(p + 6, NULL, 10);
+}
+
+/* SIGINT: the checkpoint, exit 130, the command that resumes, and the CSV ending at the step
+ * of the checkpoint; resuming gives the files of the uninterrupted run (the CSV without that
+ * last row, off its grid of 10 steps unless the stop fell on it). Two SIGINTs back to back,
+ * as GNU timeout sends them (to the process, then to its group), are one request: the run
+ * still writes its checkpoint and exits 130 (the second killed it at once). */
 static void test_many_cli_sigint_writes_a_checkpoint_and_resumes(void** state)
 {
     (void)state;
@@ -454,6 +501,7 @@ static void test_many_cli_sigint_writes_a_checkpoint_and_resumes(void** state)
                  "%s/checkpoint.ckpt",
                  dirs[k], dirs[k]);
         CHECK_CONTAINS(err, resume);
+        assert_int_equal(csv_last_step(csv), interrupted_step(err));
         free(err);
         snprintf(args, sizeof args, "%s/checkpoint.ckpt", dirs[k]);
         assert_true(exists(args));
@@ -463,6 +511,44 @@ static void test_many_cli_sigint_writes_a_checkpoint_and_resumes(void** state)
         assert_int_equal(run_cli(args), 0);
         check_same_outputs("ref", dirs[k], 7); /* frames at 0, 2000, ..., 12000 */
     }
+}
+
+/* The CSV ends with the state of the last step, also off its grid of csv_every steps, and that
+ * row agrees with summary.json; it is the row the library writes on its grid, byte for byte. */
+static void test_many_cli_csv_ends_at_the_last_step(void** state)
+{
+    (void)state;
+    scenario("tail.ini", "[dump]\nvtk_every = 100\ncsv_every = 20\n");
+    assert_int_equal(run_cli("run tail.ini --set run.steps=610 --out tail"), 0);
+    assert_int_equal(csv_last_step("tail/global.csv"), 610);
+    char* row = last_line("tail/global.csv");
+    double t, kinetic, potential, elastic;
+    unsigned long long step;
+    assert_int_equal(sscanf(row, "%lf,%llu,%lf,%lf,%lf", &t, &step, &kinetic, &potential, &elastic),
+                     5);
+    free(row);
+    char* js = test_read_file(tpath("tail/summary.json"), NULL);
+    CHECK_CONTAINS(js, "\"step\": 610, ");
+    const char* keys[4] = {"\"time_s\": ", "\"kinetic\": ", "\"potential\": ", "\"elastic\": "};
+    double csv_values[4] = {t, kinetic, potential, elastic};
+    for (int k = 0; k < 4; k++) {
+        const char* p = strstr(js, keys[k]);
+        if (!p)
+            fail_msg("%s missing in %s", keys[k], js);
+        double v = strtod(p + strlen(keys[k]), NULL);
+        CHECK_ABS(csv_values[k], v, 1e-8 * fabs(v)); /* the CSV has 9 digits */
+    }
+    free(js);
+    /* 600 steps: the library's row of step 600 (every 20), and the CLI's (every 7: 595, 600) */
+    assert_int_equal(run_cli("run tail.ini --set run.steps=600 --out grid"), 0);
+    assert_int_equal(run_cli("run tail.ini --set run.steps=600 --set dump.csv_every=7 --out off"),
+                     0);
+    char* a = last_line("grid/global.csv");
+    char* b = last_line("off/global.csv");
+    assert_string_equal(a, b);
+    free(a);
+    free(b);
+    assert_int_equal(csv_rows(tpath("off/global.csv")), 600 / 7 + 2); /* 0, 7, ..., 595, 600 */
 }
 
 /* Progress: nothing on stderr when it is a file; on a terminal, the spheres placed by the
@@ -615,6 +701,7 @@ int main(void)
         cmocka_unit_test(test_many_cli_bad_inputs_exit_2_with_file_and_line),
         cmocka_unit_test(test_many_cli_restart_is_bit_identical),
         cmocka_unit_test(test_many_cli_sigint_writes_a_checkpoint_and_resumes),
+        cmocka_unit_test(test_many_cli_csv_ends_at_the_last_step),
         cmocka_unit_test(test_many_cli_progress_only_on_a_terminal),
         cmocka_unit_test(test_many_cli_random_groups_share_the_box),
         cmocka_unit_test(test_many_cli_examples_and_budget),
