@@ -17,7 +17,7 @@
  * is read back and the entries after the checkpoint time are dropped, as are CSV rows after
  * the checkpoint step (a run resumed from an older periodic checkpoint then rewrites them
  * identically), and the last frame and row of the run that wrote the checkpoint when they lie
- * off the output grid.
+ * off the output grid. A fresh run first removes the frames an earlier run left in DIR.
  *
  * Interruption: the first SIGINT or SIGTERM sets a volatile flag that the library reads every
  * step as its stop flag; it writes the checkpoint and returns, and the run exits with 128 +
@@ -31,6 +31,8 @@
  * Progress with an estimate of the time left goes to stderr, only when stderr is a terminal,
  * at most twice a second.
  */
+#include <ctype.h>
+#include <dirent.h>
 #include <errno.h>
 #include <math.h>
 #include <omp.h>
@@ -142,6 +144,41 @@ struct series {
 static void frame_name(const struct series* s, size_t k, char* buf, size_t n)
 {
     snprintf(buf, n, "%s_%06zu.vtk", s->prefix, k);
+}
+
+/* Whether `name` is a frame of this series, as frame_name() writes it: PREFIX_, six or more
+ * digits, .vtk. */
+static bool is_frame_name(const struct series* s, const char* name)
+{
+    size_t lp = strlen(s->prefix), n = strlen(name);
+    if (n < lp + 1 + 6 + 4 || strncmp(name, s->prefix, lp) != 0 || name[lp] != '_' ||
+        strcmp(name + n - 4, ".vtk") != 0)
+        return false;
+    for (size_t k = lp + 1; k < n - 4; k++)
+        if (!isdigit((unsigned char)name[k]))
+            return false;
+    return true;
+}
+
+/* A fresh run replaces the run in its directory: removes the frames an earlier run left there
+ * (the files named as this series names its frames, and no other file), which the new index
+ * would not list and a shorter run would not overwrite. 0, or -1 with errno set. */
+static int series_clear(const struct series* s)
+{
+    DIR* d = opendir(s->dir);
+    if (!d)
+        return -1;
+    int rc = 0;
+    for (struct dirent* e = readdir(d); e && rc == 0; e = readdir(d)) {
+        char path[PATH_CHARS + 300];
+        snprintf(path, sizeof path, "%s/%s", s->dir, e->d_name);
+        if (is_frame_name(s, e->d_name) && unlink(path) != 0 && errno != ENOENT)
+            rc = -1;
+    }
+    int err = errno;
+    closedir(d);
+    errno = err;
+    return rc;
 }
 
 /* Writes the .vtk.series index (temporary file, then rename). 0 or -1. */
@@ -838,6 +875,11 @@ static int run(const struct cli_scenario* sc, struct cli_many_setup* su,
         return rc;
     if (opt->out_dir && cli_make_dirs(opt->out_dir) != 0) {
         cli_error("run: cannot create directory %s: %s", opt->out_dir, strerror(errno));
+        return CLI_EXIT_RUNTIME;
+    }
+    if (vtk && !opt->restart && series_clear(vtk) != 0) {
+        cli_error("run: cannot remove the frames %s_NNNNNN.vtk of an earlier run in %s: %s",
+                  vtk->prefix, vtk->dir, strerror(errno));
         return CLI_EXIT_RUNTIME;
     }
     /* from the first output on, until every file is written: a signal asks for a stop */

@@ -13,6 +13,7 @@
  *     and prints the command that resumes it; resuming gives the uninterrupted run's files
  *     byte for byte;
  *   - the CSV ends with a row of the last step, in the library's format;
+ *   - a fresh run into a used --out removes the earlier run's frames, and no other file;
  *   - progress goes to stderr only when it is a terminal, with an estimate of the time left;
  *   - the example scenarios check, and the summary's energy budget adds up; a run whose budget
  *     does not close (a step too long for the contacts) says so and exits 1, and a restart
@@ -551,6 +552,35 @@ static void test_many_cli_csv_ends_at_the_last_step(void** state)
     assert_int_equal(csv_rows(tpath("off/global.csv")), 600 / 7 + 2); /* 0, 7, ..., 595, 600 */
 }
 
+/* A fresh run into a used --out replaces the earlier run's frames: none of a longer run is
+ * left beside the new index, and files not named as frames stay; a resumed run keeps the
+ * frames it continues. */
+static void test_many_cli_fresh_run_replaces_earlier_frames(void** state)
+{
+    (void)state;
+    scenario("frames.ini", "[dump]\nvtk_every = 100\ncsv_every = 20\n");
+    assert_int_equal(run_cli("run frames.ini --set run.steps=600 --out reuse"), 0);
+    const char* keep[] = {"reuse/particles_notes.vtk", "reuse/other_000005.vtk",
+                          "reuse/particles_000005.vtk.bak", "reuse/particles_00005.vtk"};
+    for (size_t k = 0; k < 4; k++)
+        write_text(keep[k], "not a frame of this run\n");
+    assert_int_equal(run_cli("run frames.ini --set run.steps=200 --out reuse"), 0);
+    for (int k = 0; k <= 6; k++) {
+        char name[64];
+        snprintf(name, sizeof name, "reuse/particles_%06d.vtk", k);
+        if (exists(name) != (k <= 2))
+            fail_msg("%s %s", name, k <= 2 ? "is missing" : "of the earlier run is left");
+    }
+    for (size_t k = 0; k < 4; k++)
+        if (!exists(keep[k]))
+            fail_msg("%s, not a frame, was removed", keep[k]);
+    assert_int_equal(run_cli("run frames.ini --set run.steps=400 --out reuse --restart "
+                             "reuse/checkpoint.ckpt"),
+                     0);
+    assert_int_equal(run_cli("run frames.ini --set run.steps=400 --out whole400"), 0);
+    check_same_outputs("whole400", "reuse", 5);
+}
+
 /* Progress: nothing on stderr when it is a file; on a terminal, the spheres placed by the
  * random insertion and then a line with the time left. */
 static void test_many_cli_progress_only_on_a_terminal(void** state)
@@ -702,6 +732,7 @@ int main(void)
         cmocka_unit_test(test_many_cli_restart_is_bit_identical),
         cmocka_unit_test(test_many_cli_sigint_writes_a_checkpoint_and_resumes),
         cmocka_unit_test(test_many_cli_csv_ends_at_the_last_step),
+        cmocka_unit_test(test_many_cli_fresh_run_replaces_earlier_frames),
         cmocka_unit_test(test_many_cli_progress_only_on_a_terminal),
         cmocka_unit_test(test_many_cli_random_groups_share_the_box),
         cmocka_unit_test(test_many_cli_examples_and_budget),
