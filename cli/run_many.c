@@ -477,7 +477,11 @@ static void summary_text(FILE* f, const struct cli_many_setup* su, const struct 
                 "%.4g s: docs/many.md, Time step)\n",
                 s->relaxation_time);
     fprintf(f, "contacts           %zu\nliquid bridges     %zu\n", s->contacts, s->bridges);
-    fprintf(f, "agglomerates       %zu  (mean size %.3g)\n", s->agglomerates, s->mean_agglomerate);
+    /* a mean of whole sizes: "2000", not %g's "2e+03"; below 1000 four digits at most */
+    fprintf(f,
+            s->mean_agglomerate < 999.5 ? "agglomerates       %zu  (mean size %.4g)\n"
+                                        : "agglomerates       %zu  (mean size %.0f)\n",
+            s->agglomerates, s->mean_agglomerate);
     double phase[4] = {s->seconds_kick, s->seconds_forces, s->seconds_lists, s->seconds_output};
     const char* name[4] = {"kick-drift", "forces", "neighbour lists", "output"};
     fprintf(f, "wall time by phase");

@@ -14,6 +14,7 @@
  *     byte for byte;
  *   - the CSV ends with a row of the last step, in the library's format;
  *   - a fresh run into a used --out removes the earlier run's frames, and no other file;
+ *   - the summary prints a large mean agglomerate size as a whole number;
  *   - progress goes to stderr only when it is a terminal, with an estimate of the time left;
  *   - the example scenarios check, and the summary's energy budget adds up; a run whose budget
  *     does not close (a step too long for the contacts) says so and exits 1, and a restart
@@ -581,6 +582,24 @@ static void test_many_cli_fresh_run_replaces_earlier_frames(void** state)
     check_same_outputs("whole400", "reuse", 5);
 }
 
+/* The summary gives a large mean agglomerate size as a whole number: 1000 wet spheres on a
+ * lattice 10 um apart, every neighbour held by a bridge, are one agglomerate of 1000 (%.3g
+ * printed 1e+03). */
+static void test_many_cli_summary_mean_size_readable(void** state)
+{
+    (void)state;
+    write_text("agglomerate.ini",
+               "[box]\nsize_x = 9.2e-3\nsize_y = 9.2e-3\nsize_z = 9.2e-3\n[material.wet]\n"
+               "density = 2500\nyoungs_modulus = 1e7\nfilm = 20e-6\n[fluid]\nviscosity = 0.01\n"
+               "surface_tension = 0.02\n[models]\nforce = hertz sb capillary\n[insert]\n"
+               "layout = lattice\ncount = 1000\nradius = 0.45e-3\ngap = 10e-6\nmaterial = wet\n"
+               "[run]\nsteps = 1\n");
+    assert_int_equal(run_cli("run agglomerate.ini"), 0);
+    char* out = test_read_file(tpath("out.txt"), NULL);
+    CHECK_CONTAINS(out, "agglomerates       1  (mean size 1000)\n");
+    free(out);
+}
+
 /* Progress: nothing on stderr when it is a file; on a terminal, the spheres placed by the
  * random insertion and then a line with the time left. */
 static void test_many_cli_progress_only_on_a_terminal(void** state)
@@ -733,6 +752,7 @@ int main(void)
         cmocka_unit_test(test_many_cli_sigint_writes_a_checkpoint_and_resumes),
         cmocka_unit_test(test_many_cli_csv_ends_at_the_last_step),
         cmocka_unit_test(test_many_cli_fresh_run_replaces_earlier_frames),
+        cmocka_unit_test(test_many_cli_summary_mean_size_readable),
         cmocka_unit_test(test_many_cli_progress_only_on_a_terminal),
         cmocka_unit_test(test_many_cli_random_groups_share_the_box),
         cmocka_unit_test(test_many_cli_examples_and_budget),
