@@ -553,11 +553,20 @@ static double axis_delta(const struct cli_many_setup* su, int k, double a, doubl
     return d;
 }
 
-/* Spheres [from, n) (one group) against the spheres before them, and each inside the box:
- * its centre in [0, size], and the whole sphere inside on an axis with walls. */
+/* A group of spheres: its section and the index of its first sphere. */
+struct group {
+    const char* section;
+    size_t from;
+};
+
+/* Spheres [from, n) of the latest of groups[0 .. n_groups) against the spheres of the groups
+ * before it, and each inside the box: its centre in [0, size], and the whole sphere inside on
+ * an axis with walls. */
 static int check_group(const struct cli_scenario* sc, const struct cli_many_setup* su,
-                       const char* section, size_t from, unsigned faces)
+                       const struct group* groups, size_t n_groups, unsigned faces)
 {
+    const char* section = groups[n_groups - 1].section;
+    size_t from = groups[n_groups - 1].from;
     size_t n;
     const struct wetdem_particle* p = wetdem_sim_particles_const(su->sim, &n);
     for (size_t i = from; i < n; i++) {
@@ -580,11 +589,15 @@ static int check_group(const struct cli_scenario* sc, const struct cli_many_setu
                            axis_delta(su, 2, p[i].pos.z, p[j].pos.z)};
             double gap = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) - p[i].radius - p[j].radius;
             if (gap < 0) {
+                size_t g = n_groups - 1;
+                while (g > 0 && groups[g].from > j)
+                    g--;
                 cli_scenario_section_error(sc, section,
-                                           "sphere %zu of [%s] overlaps sphere %zu "
-                                           "of an earlier group by %g m: move or shrink one of "
-                                           "the groups (they are inserted in file order)",
-                                           i - from + 1, section, j + 1, -gap);
+                                           "sphere %zu of [%s] overlaps sphere %zu of [%s] by %g "
+                                           "m: move or shrink one of the groups (they are "
+                                           "inserted in file order)",
+                                           i - from + 1, section, j - groups[g].from + 1,
+                                           groups[g].section, -gap);
                 return CLI_EXIT_USAGE;
             }
         }
@@ -598,20 +611,29 @@ static int build_spheres(const struct cli_scenario* sc, struct cli_many_setup* s
                          struct materials* mt, unsigned faces, const char** first)
 {
     *first = NULL;
+    struct group* groups = malloc((sc->n_sections ? sc->n_sections : 1) * sizeof *groups);
+    if (!groups) {
+        cli_error("out of memory");
+        return CLI_EXIT_RUNTIME;
+    }
+    size_t n_groups = 0;
     for (size_t s = 0; s < sc->n_sections; s++) {
         const char* name = sc->sections[s].name;
         bool ins = strcmp(name, "insert") == 0 || strncmp(name, "insert.", 7) == 0;
         if (!ins && strncmp(name, "particle.", 9) != 0)
             continue;
-        size_t from = wetdem_sim_n_particles(su->sim);
+        groups[n_groups++] = (struct group){name, wetdem_sim_n_particles(su->sim)};
         int rc = ins ? build_insert(sc, su, mt, name) : build_particle(sc, su, mt, name);
         if (rc == CLI_EXIT_OK)
-            rc = check_group(sc, su, name, from, faces);
-        if (rc != CLI_EXIT_OK)
+            rc = check_group(sc, su, groups, n_groups, faces);
+        if (rc != CLI_EXIT_OK) {
+            free(groups);
             return rc;
+        }
         if (!*first)
             *first = cli_scenario_text(sc, name, "material", "steel1");
     }
+    free(groups);
     if (!*first) {
         cli_scenario_section_error(sc, "box",
                                    "no spheres: add an [insert] section (or "

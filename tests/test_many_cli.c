@@ -174,7 +174,14 @@ static void test_many_cli_bad_inputs_exit_2_with_file_and_line(void** state)
                "[box]\nsize_x = 1e-2\nsize_y = 1e-2\nsize_z = 1e-2\n[particle.a]\nradius = 1e-3\n"
                "x = 5e-3\ny = 5e-3\nz = 5e-3\n[particle.b]\nradius = 1e-3\nx = 6e-3\ny = 5e-3\n"
                "z = 5e-3\n[run]\nsteps = 10\n",
-               10, "overlaps sphere 1");
+               10, "sphere 1 of [particle.b] overlaps sphere 1 of [particle.a] by 0.001 m");
+    /* the group overlapped is named, not counted over all the groups before */
+    expect_bad("overlap3.ini",
+               "[box]\nsize_x = 1e-2\nsize_y = 1e-2\nsize_z = 1e-2\n[particle.a]\nradius = 1e-3\n"
+               "x = 2e-3\ny = 5e-3\nz = 5e-3\n[particle.b]\nradius = 1e-3\nx = 5e-3\ny = 5e-3\n"
+               "z = 5e-3\n[particle.c]\nradius = 1e-3\nx = 6e-3\ny = 5e-3\nz = 5e-3\n[run]\n"
+               "steps = 10\n",
+               15, "sphere 1 of [particle.c] overlaps sphere 1 of [particle.b] by 0.001 m");
     expect_bad("both.ini",
                "[box]\nsize_x = 1e-2\nsize_y = 1e-2\nsize_z = 1e-2\n[insert]\ncount = 5\n"
                "radius = 1e-3\n[run]\nt_end = 1e-3\nsteps = 10\n",
