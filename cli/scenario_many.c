@@ -195,19 +195,18 @@ static int build_models(const struct cli_scenario* sc, struct wetdem_sim* sim)
     for (char* tok = strtok_r(buf, " ,\t", &save); tok; tok = strtok_r(NULL, " ,\t", &save)) {
         const struct wetdem_model* m = wetdem_model_find(tok);
         if (m && m->kind != WETDEM_MODEL_CONTACT && m->kind != WETDEM_MODEL_FLUID) {
+            const char* kind = wetdem_model_kind_name(m->kind);
             cli_scenario_error(sc, e,
-                               "'%s' is a %s model: the many-particle mode sums force "
+                               "'%s' is %s %s model: the many-particle mode sums force "
                                "models (contact and fluid) only",
-                               tok, wetdem_model_kind_name(m->kind));
+                               tok, cli_article(kind), kind);
             return CLI_EXIT_USAGE;
         }
         if (wetdem_sim_enable_model(sim, tok) != WETDEM_OK)
             return cli_scenario_lib_error(sc, e, "models", sim);
     }
-    const struct cli_entry* ms = cli_scenario_find(sc, "models", "min_separation");
-    if (ms && wetdem_sim_enable_model(sim, ms->value) != WETDEM_OK)
-        return cli_scenario_lib_error(sc, ms, "models", sim);
-    return cli_scenario_set_model_params(sc, sim);
+    int rc = cli_scenario_enable_min_separation(sc, sim);
+    return rc == CLI_EXIT_OK ? cli_scenario_set_model_params(sc, sim) : rc;
 }
 
 /* [integrator] (the many mode steps with velocity Verlet: verlet.dt and verlet.dt_fraction

@@ -3,7 +3,8 @@
  * registry model listed), `describe` (parameters with units and ranges of every model, the
  * simulation settings and both integrators; unknown names give a hint and exit 2), `forces` (CSV provenance and columns; one value checked against the closed
  * form of the reynolds model, F = 6 pi mu R*^2 v_n / h), bad input (exit 2, message), and
- * `--help`/`-h` of every subcommand listed by `wetdem --help` (usage on stdout, exit 0).
+ * `--help`/`-h` of every subcommand listed by `wetdem --help` (usage on stdout, exit 0), and
+ * the choice of models: a model of the wrong kind named with its kind.
  *
  * The CLI path comes from the environment variable WETDEM_CLI (set by `make test`), falling
  * back to build/wetdem relative to the working directory (the repository root).
@@ -292,6 +293,34 @@ static void test_cli_bad_options_get_hints(void** state)
     }
 }
 
+/* Models chosen where they do not belong are named with their kind ("an impulse model"); a
+ * minimum-separation slot holding a force model is refused in both engines (the many-particle
+ * one summed it as a force). */
+static void test_cli_model_of_the_wrong_kind(void** state)
+{
+    (void)state;
+    static const struct {
+        const char *args, *message;
+        int code;
+    } cases[] = {
+        {"run examples/scenarios/nijssen_head_on.ini --set models.min_separation=hard --check",
+         "'hard' is an impulse model, not a minimum-separation model", 2},
+        {"run examples/scenarios/many_settling.ini --set models.force=hard --check",
+         "'hard' is an impulse model: the many-particle mode sums force models", 2},
+        /* (the many-particle engine summed nijssen as a force, the run valid) */
+        {"run examples/scenarios/many_settling.ini --set models.min_separation=nijssen --check",
+         "'nijssen' is a fluid model, not a minimum-separation model", 2},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        struct test_run r = run_cli(cases[k].args, true);
+        if (r.code != cases[k].code)
+            fail_msg("'%s' exited %d, expected %d:\n%s", cases[k].args, r.code, cases[k].code,
+                     r.out);
+        CHECK_CONTAINS(r.out, cases[k].message);
+        free(r.out);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -304,6 +333,7 @@ int main(void)
         cmocka_unit_test(test_cli_forces_log_gaps_are_decades),
         cmocka_unit_test(test_cli_forces_bad_input),
         cmocka_unit_test(test_cli_bad_options_get_hints),
+        cmocka_unit_test(test_cli_model_of_the_wrong_kind),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
