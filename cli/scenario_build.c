@@ -103,8 +103,17 @@ int cli_scenario_check_materials(const struct cli_scenario* sc)
     return CLI_EXIT_OK;
 }
 
+/* Whether [models] force or min_separation was given by --set (line 0). */
+static bool models_chosen_by_set(const struct cli_scenario* sc)
+{
+    const struct cli_entry* force = cli_scenario_find(sc, "models", "force");
+    const struct cli_entry* ms = cli_scenario_find(sc, "models", "min_separation");
+    return (force && force->line == 0) || (ms && ms->line == 0);
+}
+
 int cli_scenario_set_model_params(const struct cli_scenario* sc, struct wetdem_sim* sim)
 {
+    bool switched = models_chosen_by_set(sc);
     for (size_t k = 0; k < sc->n_entries; k++) {
         const struct cli_entry* p = &sc->entries[k];
         if (strncmp(p->section, "model.", 6) != 0)
@@ -112,7 +121,10 @@ int cli_scenario_set_model_params(const struct cli_scenario* sc, struct wetdem_s
         char name[2 * CLI_NAME_MAX];
         snprintf(name, sizeof name, "%s.%s", p->section + 6, p->key);
         double v;
-        if (wetdem_sim_param(sim, name, &v) != WETDEM_OK) {
+        bool enabled = wetdem_sim_param(sim, name, &v) == WETDEM_OK;
+        if (!enabled && switched && p->line > 0)
+            continue; /* the file's section of a model that a --set of [models] left out */
+        if (!enabled) {
             cli_scenario_error(sc, p,
                                "model '%s' is not enabled by [models] force or "
                                "min_separation, so it has no parameters to set",
