@@ -11,7 +11,7 @@
  *     series index, CSV and summary to the uninterrupted run;
  *   - SIGINT sent to a running CLI, once or twice back to back, writes a checkpoint, exits 130
  *     and prints the command that resumes it; resuming gives the uninterrupted run's files
- *     byte for byte;
+ *     byte for byte; a third stops it at once, the earlier checkpoint intact;
  *   - the CSV ends with a row of the last step, in the library's format;
  *   - a fresh run into a used --out removes the earlier run's frames, and no other file;
  *   - the summary prints a large mean agglomerate size as a whole number;
@@ -522,6 +522,35 @@ static void test_many_cli_sigint_writes_a_checkpoint_and_resumes(void** state)
     }
 }
 
+/* A third SIGINT, sent while the run is still stopping after the first (20000 spheres: a step
+ * and a checkpoint take milliseconds, the signals microseconds), stops it at once by the
+ * signal: no new checkpoint, the periodic one before intact, no temporary file left. */
+static void test_many_cli_third_signal_stops_at_once(void** state)
+{
+    (void)state;
+    write_text("slow.ini",
+               "[box]\nsize_x = 28e-3\nsize_y = 28e-3\nsize_z = 28e-3\n[material.wet]\n"
+               "density = 2500\nyoungs_modulus = 1e7\nfilm = 20e-6\n[fluid]\nviscosity = 0.01\n"
+               "surface_tension = 0.02\n[models]\nforce = hertz sb capillary\n[insert]\n"
+               "layout = lattice\ncount = 20000\nradius = 0.45e-3\ngap = 10e-6\nmaterial = wet\n"
+               "velocity_sigma = 0.01\n[run]\nsteps = 100000\n[dump]\nvtk_every = 100000\n"
+               "csv_every = 1\ncheckpoint_every = 2\n");
+    int status = interrupt_cli("run slow.ini --out slow", "slow/global.csv", 3);
+    char* err = stderr_text();
+    if (!WIFSIGNALED(status) || WTERMSIG(status) != SIGINT)
+        fail_msg("3 SIGINT: status %d, expected death by SIGINT\n%s", status, err);
+    CHECK_CONTAINS(err, "stopped at once by a repeated signal, without a new checkpoint");
+    assert_null(strstr(err, "interrupted by SIGINT"));
+    free(err);
+    assert_false(exists("slow/checkpoint.ckpt.tmp"));
+    struct wetdem_checkpoint ck;
+    char msg[256];
+    CHECK_OK(wetdem_checkpoint_read(tpath("slow/checkpoint.ckpt"), &ck, msg, sizeof msg));
+    assert_int_equal(ck.n_particles, 20000);
+    assert_int_equal(ck.step % 2, 0); /* a periodic one */
+    wetdem_checkpoint_clear(&ck);
+}
+
 /* The CSV ends with the state of the last step, also off its grid of csv_every steps, and that
  * row agrees with summary.json; it is the row the library writes on its grid, byte for byte. */
 static void test_many_cli_csv_ends_at_the_last_step(void** state)
@@ -757,6 +786,7 @@ int main(void)
         cmocka_unit_test(test_many_cli_bad_inputs_exit_2_with_file_and_line),
         cmocka_unit_test(test_many_cli_restart_is_bit_identical),
         cmocka_unit_test(test_many_cli_sigint_writes_a_checkpoint_and_resumes),
+        cmocka_unit_test(test_many_cli_third_signal_stops_at_once),
         cmocka_unit_test(test_many_cli_csv_ends_at_the_last_step),
         cmocka_unit_test(test_many_cli_fresh_run_replaces_earlier_frames),
         cmocka_unit_test(test_many_cli_summary_mean_size_readable),
