@@ -248,6 +248,11 @@ int cli_write_output(const char* path, const char* what, void (*write)(FILE* f, 
     return CLI_EXIT_OK;
 }
 
+const char* cli_article(const char* word)
+{
+    return word[0] && strchr("aeiouAEIOU", word[0]) ? "an" : "a";
+}
+
 void cli_print_double(FILE* f, double v)
 {
     char buf[40];

@@ -89,6 +89,10 @@ int cli_write_output(const char* path, const char* what, void (*write)(FILE* f, 
  * v, so CSV output is both exact and readable ("1e-05", not "1.0000000000000001e-05"). */
 void cli_print_double(FILE* f, double v);
 
+/* "an" before a word that starts with a vowel letter ("an impulse model"), else "a"
+ * ("a fluid model", "a min-separation model"). */
+const char* cli_article(const char* word);
+
 /* Writes the default of a parameter as text: the chosen word for an enumeration, otherwise
  * the number in %g format. */
 void cli_param_default_text(const struct wetdem_param_desc* d, char* buf, size_t n);

@@ -9,22 +9,30 @@
  *
  * Outputs in DIR: PREFIX_NNNNNN.vtk frames every vtk_every steps (and the last step) with the
  * ParaView index PREFIX.vtk.series, the library's CSV of global quantities every csv_every
- * steps, the checkpoint (atomic; every checkpoint_every steps, on SIGINT/SIGTERM and at the
- * end) and summary.json with the energy budget. The VTK frames are written here, from the
- * progress callback (called after every step with the state at the end of the step), rather
- * than by the library, so that the frame numbering and the series index continue across
- * restarts: on --restart the existing index is read back and the entries after the
- * checkpoint time are dropped, as are CSV rows after the checkpoint step (a run resumed from
- * an older periodic checkpoint then rewrites them identically).
+ * steps (and a row of the last step, added here), the checkpoint (atomic; every
+ * checkpoint_every steps, on SIGINT/SIGTERM and at the end) and summary.json with the energy
+ * budget. The VTK frames are written here, from the progress callback (called after every
+ * step with the state at the end of the step), rather than by the library, so that the frame
+ * numbering and the series index continue across restarts: on --restart the existing index
+ * is read back and the entries after the checkpoint time are dropped, as are CSV rows after
+ * the checkpoint step (a run resumed from an older periodic checkpoint then rewrites them
+ * identically), and the last frame and row of the run that wrote the checkpoint when they lie
+ * off the output grid. A fresh run first removes the frames an earlier run left in DIR.
  *
- * Interruption: SIGINT and SIGTERM set a volatile flag that the library reads every step as
- * its stop flag; it writes the checkpoint and returns, and the run exits with 128 + signal
- * number (130, 143) after printing the command that resumes it. A second signal kills as
- * usual (SA_RESETHAND); the checkpoint written before is intact (written atomically).
+ * Interruption: the first SIGINT or SIGTERM sets a volatile flag that the library reads every
+ * step as its stop flag; it writes the checkpoint and returns, and the run exits with 128 +
+ * signal number (130, 143) after printing the command that resumes it. A repeat within
+ * SIGNAL_GRACE_S of the first is the same request delivered twice (GNU timeout signals the
+ * process and then its process group; a terminal's Ctrl-C reaches the whole foreground group)
+ * and is ignored, so it cannot lose the checkpoint being written. A second signal after the
+ * grace period, or a third, stops the run at once by that signal, without a new checkpoint;
+ * the previous one is intact (written atomically) and the partial temporary file is removed.
  *
  * Progress with an estimate of the time left goes to stderr, only when stderr is a terminal,
  * at most twice a second.
  */
+#include <ctype.h>
+#include <dirent.h>
 #include <errno.h>
 #include <math.h>
 #include <omp.h>
@@ -32,6 +40,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "cli_util.h"
@@ -40,11 +49,86 @@
 
 #define PATH_CHARS 2048
 
-static volatile sig_atomic_t stop_signal = 0;
+/* ----------------------------------------------------------------------- signals --- */
+
+/* A repeat of SIGINT/SIGTERM sooner than this after the first is taken as the same request
+ * [s]: duplicates arrive within milliseconds, and a person pressing Ctrl-C again to stop at
+ * once presses it later (or three times). */
+#define SIGNAL_GRACE_S 1.0
+
+static volatile sig_atomic_t stop_signal = 0; /* the first signal: checkpoint and stop */
+static volatile sig_atomic_t signal_count = 0;
+static struct timespec first_signal_time;
+/* Set before the handlers are installed (the handler may only call async-signal-safe
+ * functions): the temporary file of a checkpoint being written, removed on a forced stop, and
+ * the notice printed on the first signal. */
+static char checkpoint_tmp[PATH_CHARS + 8];
+static char stop_notice[PATH_CHARS + 200];
+
+static void say(const char* text)
+{
+    ssize_t unused = write(STDERR_FILENO, text, strlen(text));
+    (void)unused;
+}
 
 static void on_signal(int sig)
 {
-    stop_signal = sig;
+    struct timespec now;
+    clock_gettime(CLOCK_MONOTONIC, &now);
+    if (signal_count == 0) {
+        first_signal_time = now;
+        signal_count = 1;
+        stop_signal = sig;
+        say(stop_notice);
+        return;
+    }
+    double since = (double)(now.tv_sec - first_signal_time.tv_sec) +
+                   1e-9 * (double)(now.tv_nsec - first_signal_time.tv_nsec);
+    if (signal_count == 1 && since < SIGNAL_GRACE_S) {
+        signal_count = 2; /* the same request again: the next one stops at once */
+        return;
+    }
+    say("\nwetdem: stopped at once by a repeated signal, without a new checkpoint\n");
+    if (checkpoint_tmp[0])
+        unlink(checkpoint_tmp);
+    /* die by the signal, as the caller asked: default action, raised again (delivered when
+       this handler returns) */
+    struct sigaction dfl = {.sa_handler = SIG_DFL};
+    sigemptyset(&dfl.sa_mask);
+    sigaction(sig, &dfl, NULL);
+    raise(sig);
+}
+
+struct saved_handlers {
+    struct sigaction sigint, sigterm;
+};
+
+/* Installs on_signal for SIGINT and SIGTERM (each blocks both while it runs, so the count is
+ * never updated twice at once), with the notice and the temporary checkpoint path set. */
+static void signals_install(const char* checkpoint, bool tty, struct saved_handlers* saved)
+{
+    stop_signal = 0;
+    signal_count = 0;
+    checkpoint_tmp[0] = '\0';
+    if (checkpoint[0])
+        snprintf(checkpoint_tmp, sizeof checkpoint_tmp, "%s.tmp", checkpoint);
+    snprintf(stop_notice, sizeof stop_notice,
+             "%swetdem: stopping after this step%s; a second signal %g s or more after this "
+             "one, or a third, stops at once%s\n",
+             tty ? "\n" : "", checkpoint[0] ? " to write the checkpoint" : "", SIGNAL_GRACE_S,
+             checkpoint[0] ? " without it" : "");
+    struct sigaction sa = {.sa_handler = on_signal};
+    sigemptyset(&sa.sa_mask);
+    sigaddset(&sa.sa_mask, SIGINT);
+    sigaddset(&sa.sa_mask, SIGTERM);
+    sigaction(SIGINT, &sa, &saved->sigint);
+    sigaction(SIGTERM, &sa, &saved->sigterm);
+}
+
+static void signals_restore(const struct saved_handlers* saved)
+{
+    sigaction(SIGINT, &saved->sigint, NULL);
+    sigaction(SIGTERM, &saved->sigterm, NULL);
 }
 
 /* ------------------------------------------------------------------- VTK time series --- */
@@ -60,6 +144,41 @@ struct series {
 static void frame_name(const struct series* s, size_t k, char* buf, size_t n)
 {
     snprintf(buf, n, "%s_%06zu.vtk", s->prefix, k);
+}
+
+/* Whether `name` is a frame of this series, as frame_name() writes it: PREFIX_, six or more
+ * digits, .vtk. */
+static bool is_frame_name(const struct series* s, const char* name)
+{
+    size_t lp = strlen(s->prefix), n = strlen(name);
+    if (n < lp + 1 + 6 + 4 || strncmp(name, s->prefix, lp) != 0 || name[lp] != '_' ||
+        strcmp(name + n - 4, ".vtk") != 0)
+        return false;
+    for (size_t k = lp + 1; k < n - 4; k++)
+        if (!isdigit((unsigned char)name[k]))
+            return false;
+    return true;
+}
+
+/* A fresh run replaces the run in its directory: removes the frames an earlier run left there
+ * (the files named as this series names its frames, and no other file), which the new index
+ * would not list and a shorter run would not overwrite. 0, or -1 with errno set. */
+static int series_clear(const struct series* s)
+{
+    DIR* d = opendir(s->dir);
+    if (!d)
+        return -1;
+    int rc = 0;
+    for (struct dirent* e = readdir(d); e && rc == 0; e = readdir(d)) {
+        char path[PATH_CHARS + 300];
+        snprintf(path, sizeof path, "%s/%s", s->dir, e->d_name);
+        if (is_frame_name(s, e->d_name) && unlink(path) != 0 && errno != ENOENT)
+            rc = -1;
+    }
+    int err = errno;
+    closedir(d);
+    errno = err;
+    return rc;
 }
 
 /* Writes the .vtk.series index (temporary file, then rename). 0 or -1. */
@@ -117,9 +236,20 @@ static int series_add(struct series* s, struct wetdem_sim* sim, unsigned long lo
     return series_write(s) == 0 ? WETDEM_OK : WETDEM_ERR_IO;
 }
 
-/* On restart: the frames of the existing index up to time t (entries in order, named as this
- * run names them); the rest are dropped and will be written again. */
-static void series_resume(struct series* s, double t, unsigned long long step, double dt)
+/* The step of frame k, from its time on the grid t = k dt, given the time t at step `step`. */
+static unsigned long long frame_step(const struct series* s, size_t k, double t,
+                                     unsigned long long step, double dt)
+{
+    return step - (unsigned long long)llround((t - s->times[k]) / dt);
+}
+
+/* On restart: the frames of the existing index up to time t, the checkpoint's (entries in
+ * order, named as this run names them); the rest are dropped and will be written again. A
+ * frame at t itself is kept only on the grid of `every`: off it, it is the last frame that
+ * the run which wrote the checkpoint added at its end, which the uninterrupted run does not
+ * have. */
+static void series_resume(struct series* s, double t, unsigned long long step, double dt,
+                          unsigned long long every)
 {
     char path[PATH_CHARS + CLI_VALUE_MAX + 40];
     snprintf(path, sizeof path, "%s/%s.vtk.series", s->dir, s->prefix);
@@ -138,16 +268,77 @@ static void series_resume(struct series* s, double t, unsigned long long step, d
     }
     if (f)
         fclose(f);
-    /* the step of the last kept frame, from its time on the grid t = k dt */
-    s->last_step = s->n ? step - (unsigned long long)llround((t - s->times[s->n - 1]) / dt) : 0;
+    if (s->n && frame_step(s, s->n - 1, t, step, dt) == step && every && step % every != 0)
+        s->n--;
+    s->last_step = s->n ? frame_step(s, s->n - 1, t, step, dt) : 0;
 }
 
-/* ------------------------------------------------------------------ CSV on restart --- */
+/* ----------------------------------------------------------- CSV: last row, restart --- */
+
+/* The step (second column) of the last data row of the CSV at path, read from the file's
+ * tail. false when the file is missing or its tail holds no data row. */
+static bool csv_last_step(const char* path, unsigned long long* step)
+{
+    FILE* f = fopen(path, "rb");
+    if (!f)
+        return false;
+    char tail[8192];
+    long size = fseek(f, 0, SEEK_END) == 0 ? ftell(f) : -1;
+    long from = size > (long)sizeof tail - 1 ? size - (long)sizeof tail + 1 : 0;
+    size_t n = size >= 0 && fseek(f, from, SEEK_SET) == 0 ? fread(tail, 1, sizeof tail - 1, f) : 0;
+    fclose(f);
+    tail[n] = '\0';
+    bool found = false;
+    for (char* line = tail; line && *line;
+         line = strchr(line, '\n') ? strchr(line, '\n') + 1 : NULL) {
+        const char* comma = strchr(line, ',');
+        bool whole = line != tail || from == 0; /* the first line of a tail may be cut */
+        if (whole && line[0] >= '0' && line[0] <= '9' && comma) {
+            *step = strtoull(comma + 1, NULL, 10);
+            found = true;
+        }
+    }
+    return found;
+}
+
+/* Appends the state at the end of the run (finished or interrupted) to the CSV as its last
+ * row, unless the library's rows, every csv_every steps, ended there. The row has the
+ * library's columns and format (src/sim_many_io.c, write_csv_row; tests/test_many_cli.c
+ * compares the two), so the CSV ends at the state summary.json reports. The energies come
+ * from the energy budget, the API's only way to them: without it the CSV keeps to its grid.
+ * WETDEM status. */
+static int csv_final_row(const char* csv_prefix, struct wetdem_sim* sim)
+{
+    struct wetdem_many_stats s;
+    struct wetdem_energy_budget b;
+    char path[PATH_CHARS + 8];
+    snprintf(path, sizeof path, "%s.csv", csv_prefix);
+    unsigned long long last;
+    if (!csv_prefix[0] || wetdem_sim_many_stats(sim, &s) != WETDEM_OK ||
+        wetdem_sim_energy_budget(sim, &b) != WETDEM_OK || !csv_last_step(path, &last) ||
+        last >= s.step)
+        return WETDEM_OK;
+    FILE* f = fopen(path, "a");
+    if (!f)
+        return WETDEM_ERR_IO;
+    fprintf(f, "%.9g,%llu,%.9g,%.9g,%.9g,%zu,%zu,%zu,%.6g,%zu", wetdem_sim_time(sim), s.step,
+            b.kinetic, b.potential, b.elastic, s.contacts, s.bridges, s.agglomerates,
+            s.mean_agglomerate, s.candidate_pairs);
+    for (size_t q = 0; q < b.n_models && q < WETDEM_ENERGY_MAX_MODELS; q++)
+        fprintf(f, ",%.9g", b.work_pair[q] + b.work_wall[q]);
+    fprintf(f, ",%.9g,%.3g\n", b.dissipated, b.balance_error);
+    bool ok = !ferror(f);
+    ok = fclose(f) == 0 && ok;
+    return ok ? WETDEM_OK : WETDEM_ERR_IO;
+}
 
 /* Keeps the comment and header lines of the CSV and the rows up to `step` (second column),
- * rewriting the file atomically when rows are dropped. CLI exit code; a missing file is an
- * input error (the rows before the checkpoint would be lost). */
-static int csv_resume(const char* path, unsigned long long step, const char* out_dir)
+ * rewriting the file atomically when rows are dropped. A row at `step` itself is kept only on
+ * the grid of `every`: off it, it is the last row that the run which wrote the checkpoint
+ * added at its end (csv_final_row), which the uninterrupted run does not have. CLI exit
+ * code; a missing file is an input error (the rows before the checkpoint would be lost). */
+static int csv_resume(const char* path, unsigned long long step, unsigned long long every,
+                      const char* out_dir)
 {
     FILE* f = fopen(path, "r");
     if (!f) {
@@ -164,7 +355,8 @@ static int csv_resume(const char* path, unsigned long long step, const char* out
     while (g && fgets(line, sizeof line, f)) {
         const char* comma = strchr(line, ',');
         bool data = line[0] >= '0' && line[0] <= '9' && comma;
-        if (data && strtoull(comma + 1, NULL, 10) > step) {
+        unsigned long long row = data ? strtoull(comma + 1, NULL, 10) : 0;
+        if (data && (row > step || (row == step && every && step % every != 0))) {
             dropped = true;
             continue;
         }
@@ -285,7 +477,11 @@ static void summary_text(FILE* f, const struct cli_many_setup* su, const struct 
                 "%.4g s: docs/many.md, Time step)\n",
                 s->relaxation_time);
     fprintf(f, "contacts           %zu\nliquid bridges     %zu\n", s->contacts, s->bridges);
-    fprintf(f, "agglomerates       %zu  (mean size %.3g)\n", s->agglomerates, s->mean_agglomerate);
+    /* a mean of whole sizes: "2000", not %g's "2e+03"; below 1000 four digits at most */
+    fprintf(f,
+            s->mean_agglomerate < 999.5 ? "agglomerates       %zu  (mean size %.4g)\n"
+                                        : "agglomerates       %zu  (mean size %.0f)\n",
+            s->agglomerates, s->mean_agglomerate);
     double phase[4] = {s->seconds_kick, s->seconds_forces, s->seconds_lists, s->seconds_output};
     const char* name[4] = {"kick-drift", "forces", "neighbour lists", "output"};
     fprintf(f, "wall time by phase");
@@ -560,27 +756,13 @@ static int resume(const struct cli_many_setup* su, const struct cli_run_options*
     if (pl->csv_prefix[0]) {
         char path[PATH_CHARS + 8];
         snprintf(path, sizeof path, "%s.csv", pl->csv_prefix);
-        int rc = csv_resume(path, s.step, opt->out_dir);
+        int rc = csv_resume(path, s.step, su->csv_every, opt->out_dir);
         if (rc != CLI_EXIT_OK)
             return rc;
     }
     if (vtk)
-        series_resume(vtk, wetdem_sim_time(su->sim), s.step, pl->dt);
+        series_resume(vtk, wetdem_sim_time(su->sim), s.step, pl->dt, su->vtk_every);
     return CLI_EXIT_OK;
-}
-
-/* The stepping, between signal handlers. Returns the library status. */
-static int integrate_with_signals(struct wetdem_sim* sim, double t_end)
-{
-    struct sigaction sa = {.sa_handler = on_signal, .sa_flags = SA_RESETHAND}, old_int, old_term;
-    sigemptyset(&sa.sa_mask);
-    stop_signal = 0;
-    sigaction(SIGINT, &sa, &old_int);
-    sigaction(SIGTERM, &sa, &old_term);
-    int st = wetdem_sim_integrate(sim, t_end);
-    sigaction(SIGINT, &old_int, NULL);
-    sigaction(SIGTERM, &old_term, NULL);
-    return st;
 }
 
 /* After the stepping: interrupted, failed or done (last frame, final checkpoint, summary). */
@@ -597,6 +779,10 @@ static int finish(const struct cli_scenario* sc, struct cli_many_setup* su,
     }
     if (st < 0) {
         cli_error("run %s: %s (%s)", sc->file, wetdem_sim_errmsg(su->sim), wetdem_status_name(st));
+        return CLI_EXIT_RUNTIME;
+    }
+    if (csv_final_row(pl->csv_prefix, su->sim) != WETDEM_OK) {
+        cli_error("run %s: cannot append the last row to %s.csv", sc->file, pl->csv_prefix);
         return CLI_EXIT_RUNTIME;
     }
     if (st == WETDEM_EVENT) {
@@ -695,6 +881,14 @@ static int run(const struct cli_scenario* sc, struct cli_many_setup* su,
         cli_error("run: cannot create directory %s: %s", opt->out_dir, strerror(errno));
         return CLI_EXIT_RUNTIME;
     }
+    if (vtk && !opt->restart && series_clear(vtk) != 0) {
+        cli_error("run: cannot remove the frames %s_NNNNNN.vtk of an earlier run in %s: %s",
+                  vtk->prefix, vtk->dir, strerror(errno));
+        return CLI_EXIT_RUNTIME;
+    }
+    /* from the first output on, until every file is written: a signal asks for a stop */
+    struct saved_handlers saved;
+    signals_install(pl->checkpoint, prog.tty, &saved);
     double t0 = omp_get_wtime();
     int st = opt->restart ? WETDEM_OK : wetdem_sim_integrate(su->sim, wetdem_sim_time(su->sim));
     struct wetdem_many_stats s;
@@ -705,8 +899,13 @@ static int run(const struct cli_scenario* sc, struct cli_many_setup* su,
     if (st == WETDEM_OK && frame_due && series_add(vtk, su->sim, s.step) != WETDEM_OK)
         prog.status = WETDEM_ERR_IO;
     if (st == WETDEM_OK && prog.status == WETDEM_OK)
-        st = integrate_with_signals(su->sim, pl->t_end);
-    return finish(sc, su, opt, pl, &prog, st, omp_get_wtime() - t0);
+        st = wetdem_sim_integrate(su->sim, pl->t_end);
+    rc = finish(sc, su, opt, pl, &prog, st, omp_get_wtime() - t0);
+    /* after a signal the handlers stay until the process exits: a duplicate arriving after the
+       files are written would otherwise kill it, and turn exit 130 into death by signal */
+    if (!signal_count)
+        signals_restore(&saved);
+    return rc;
 }
 
 int cli_run_many(const struct cli_scenario* sc, const struct cli_run_options* opt)

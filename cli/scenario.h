@@ -212,8 +212,14 @@ int cli_scenario_material_section(const struct cli_scenario* sc, const char* sec
 /* Every [material.NAME] section checked as cli_scenario_material_section does, also those no
  * sphere uses (a mistake there is one too): an exit code, the message printed. */
 int cli_scenario_check_materials(const struct cli_scenario* sc);
-/* Every [model.NAME] key as the parameter NAME.key of sim's enabled model NAME (an error when
- * NAME is not enabled). Returns an exit code. */
+/* [models] min_separation, when given: enables that model, which must be a minimum-separation
+ * one (a force model named there would otherwise be summed as a force). Returns an exit
+ * code. */
+int cli_scenario_enable_min_separation(const struct cli_scenario* sc, struct wetdem_sim* sim);
+/* Every [model.NAME] key as the parameter NAME.key of sim's enabled model NAME. A key of a
+ * model that is not enabled is an error (it would be ignored without a word), except a key of
+ * the file when [models] force or min_separation came from --set: the file may hold the
+ * parameters of the model the --set switched away from. Returns an exit code. */
 int cli_scenario_set_model_params(const struct cli_scenario* sc, struct wetdem_sim* sim);
 
 /* ---- internal: section lookup (scenario_keys.c), shared by scenario*.c ---- */

@@ -103,8 +103,17 @@ int cli_scenario_check_materials(const struct cli_scenario* sc)
     return CLI_EXIT_OK;
 }
 
+/* Whether [models] force or min_separation was given by --set (line 0). */
+static bool models_chosen_by_set(const struct cli_scenario* sc)
+{
+    const struct cli_entry* force = cli_scenario_find(sc, "models", "force");
+    const struct cli_entry* ms = cli_scenario_find(sc, "models", "min_separation");
+    return (force && force->line == 0) || (ms && ms->line == 0);
+}
+
 int cli_scenario_set_model_params(const struct cli_scenario* sc, struct wetdem_sim* sim)
 {
+    bool switched = models_chosen_by_set(sc);
     for (size_t k = 0; k < sc->n_entries; k++) {
         const struct cli_entry* p = &sc->entries[k];
         if (strncmp(p->section, "model.", 6) != 0)
@@ -112,7 +121,10 @@ int cli_scenario_set_model_params(const struct cli_scenario* sc, struct wetdem_s
         char name[2 * CLI_NAME_MAX];
         snprintf(name, sizeof name, "%s.%s", p->section + 6, p->key);
         double v;
-        if (wetdem_sim_param(sim, name, &v) != WETDEM_OK) {
+        bool enabled = wetdem_sim_param(sim, name, &v) == WETDEM_OK;
+        if (!enabled && switched && p->line > 0)
+            continue; /* the file's section of a model that a --set of [models] left out */
+        if (!enabled) {
             cli_scenario_error(sc, p,
                                "model '%s' is not enabled by [models] force or "
                                "min_separation, so it has no parameters to set",
@@ -206,24 +218,30 @@ static int enable_forces(const struct cli_scenario* sc, struct wetdem_sim* sim)
     return CLI_EXIT_OK;
 }
 
+int cli_scenario_enable_min_separation(const struct cli_scenario* sc, struct wetdem_sim* sim)
+{
+    const struct cli_entry* e = cli_scenario_find(sc, "models", "min_separation");
+    if (!e)
+        return CLI_EXIT_OK;
+    const struct wetdem_model* m = wetdem_model_find(e->value);
+    if (m && m->kind != WETDEM_MODEL_MIN_SEPARATION) {
+        const char* kind = wetdem_model_kind_name(m->kind);
+        cli_scenario_error(sc, e, "'%s' is %s %s model, not a minimum-separation model", e->value,
+                           cli_article(kind), kind);
+        return CLI_EXIT_USAGE;
+    }
+    if (wetdem_sim_enable_model(sim, e->value) != WETDEM_OK)
+        return cli_scenario_lib_error(sc, e, "models", sim);
+    return CLI_EXIT_OK;
+}
+
 static int build_models(const struct cli_scenario* sc, struct wetdem_sim* sim)
 {
     wetdem_sim_clear_models(sim);
     int rc = enable_forces(sc, sim);
-    if (rc != CLI_EXIT_OK)
-        return rc;
-    const struct cli_entry* e = cli_scenario_find(sc, "models", "min_separation");
-    if (e) {
-        const struct wetdem_model* m = wetdem_model_find(e->value);
-        if (m && m->kind != WETDEM_MODEL_MIN_SEPARATION) {
-            cli_scenario_error(sc, e, "'%s' is a %s model, not a minimum-separation model",
-                               e->value, wetdem_model_kind_name(m->kind));
-            return CLI_EXIT_USAGE;
-        }
-        if (wetdem_sim_enable_model(sim, e->value) != WETDEM_OK)
-            return cli_scenario_lib_error(sc, e, "models", sim);
-    }
-    return cli_scenario_set_model_params(sc, sim);
+    if (rc == CLI_EXIT_OK)
+        rc = cli_scenario_enable_min_separation(sc, sim);
+    return rc == CLI_EXIT_OK ? cli_scenario_set_model_params(sc, sim) : rc;
 }
 
 /* Whether an integrator other than `chosen` has the parameter `key`. */

@@ -170,7 +170,10 @@ static const struct cli_section_desc sections[] = {
      "Parameters of model NAME, which [models] must enable; each key is set as 'NAME.key'. "
      "The keys are the model's parameters, listed with unit, default and range in "
      "docs/models.md (generated from the same descriptor tables the library checks values "
-     "against), e.g. [model.nijssen] cutoff_ratio = 1, [model.glass] p_gt = 11.6e6.",
+     "against), e.g. [model.nijssen] cutoff_ratio = 1, [model.glass] p_gt = 11.6e6. When "
+     "--set chooses [models] force or min_separation, the file's sections of the models it "
+     "leaves out are ignored (so --set models.min_separation=ehd works on a file with "
+     "[model.fixed]); a --set of a parameter of a model not enabled is still an error.",
      NULL},
     {"integrator", "Time integrator and its parameters.", integrator_keys},
     {"sim", "Simulation settings, set as 'sim.<key>'; other keys are checked by the library.",

@@ -124,7 +124,8 @@ static const struct cli_key_desc run_keys[] = {
 static const struct cli_key_desc dump_keys[] = {
     WORD("vtk", CLI_VALUE_TEXT, "particles", NULL,
          "Prefix of the VTK files PREFIX_NNNNNN.vtk and of the ParaView index PREFIX.vtk.series "
-         "in --out DIR; none disables them."),
+         "in --out DIR; none disables them. A fresh run (no --restart) first removes the "
+         "PREFIX_NNNNNN.vtk files of an earlier run from DIR."),
     COUNT("vtk_every", "run steps / 50", 0, 1e15,
           "Steps between VTK frames (the last step is always written); 0: none. At most 1e5 "
           "files a run."),
@@ -134,7 +135,8 @@ static const struct cli_key_desc dump_keys[] = {
          "CSV of global quantities (energies, contacts, liquid bridges, agglomerates, work per "
          "model) in --out DIR, ending in .csv; none disables it."),
     COUNT("csv_every", "run steps / 500", 0, 1e15,
-          "Steps between CSV rows; 0: none. At most 1e7 rows a run."),
+          "Steps between CSV rows (the last step is always written, with energy_budget on); "
+          "0: none. At most 1e7 rows a run."),
     WORD("checkpoint", CLI_VALUE_TEXT, "checkpoint.ckpt", NULL,
          "Checkpoint in --out DIR, written atomically every checkpoint_every steps, when "
          "interrupted (SIGINT, SIGTERM) and at the end; none disables it."),
@@ -193,19 +195,18 @@ static int build_models(const struct cli_scenario* sc, struct wetdem_sim* sim)
     for (char* tok = strtok_r(buf, " ,\t", &save); tok; tok = strtok_r(NULL, " ,\t", &save)) {
         const struct wetdem_model* m = wetdem_model_find(tok);
         if (m && m->kind != WETDEM_MODEL_CONTACT && m->kind != WETDEM_MODEL_FLUID) {
+            const char* kind = wetdem_model_kind_name(m->kind);
             cli_scenario_error(sc, e,
-                               "'%s' is a %s model: the many-particle mode sums force "
+                               "'%s' is %s %s model: the many-particle mode sums force "
                                "models (contact and fluid) only",
-                               tok, wetdem_model_kind_name(m->kind));
+                               tok, cli_article(kind), kind);
             return CLI_EXIT_USAGE;
         }
         if (wetdem_sim_enable_model(sim, tok) != WETDEM_OK)
             return cli_scenario_lib_error(sc, e, "models", sim);
     }
-    const struct cli_entry* ms = cli_scenario_find(sc, "models", "min_separation");
-    if (ms && wetdem_sim_enable_model(sim, ms->value) != WETDEM_OK)
-        return cli_scenario_lib_error(sc, ms, "models", sim);
-    return cli_scenario_set_model_params(sc, sim);
+    int rc = cli_scenario_enable_min_separation(sc, sim);
+    return rc == CLI_EXIT_OK ? cli_scenario_set_model_params(sc, sim) : rc;
 }
 
 /* [integrator] (the many mode steps with velocity Verlet: verlet.dt and verlet.dt_fraction
@@ -551,11 +552,20 @@ static double axis_delta(const struct cli_many_setup* su, int k, double a, doubl
     return d;
 }
 
-/* Spheres [from, n) (one group) against the spheres before them, and each inside the box:
- * its centre in [0, size], and the whole sphere inside on an axis with walls. */
+/* A group of spheres: its section and the index of its first sphere. */
+struct group {
+    const char* section;
+    size_t from;
+};
+
+/* Spheres [from, n) of the latest of groups[0 .. n_groups) against the spheres of the groups
+ * before it, and each inside the box: its centre in [0, size], and the whole sphere inside on
+ * an axis with walls. */
 static int check_group(const struct cli_scenario* sc, const struct cli_many_setup* su,
-                       const char* section, size_t from, unsigned faces)
+                       const struct group* groups, size_t n_groups, unsigned faces)
 {
+    const char* section = groups[n_groups - 1].section;
+    size_t from = groups[n_groups - 1].from;
     size_t n;
     const struct wetdem_particle* p = wetdem_sim_particles_const(su->sim, &n);
     for (size_t i = from; i < n; i++) {
@@ -578,11 +588,15 @@ static int check_group(const struct cli_scenario* sc, const struct cli_many_setu
                            axis_delta(su, 2, p[i].pos.z, p[j].pos.z)};
             double gap = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) - p[i].radius - p[j].radius;
             if (gap < 0) {
+                size_t g = n_groups - 1;
+                while (g > 0 && groups[g].from > j)
+                    g--;
                 cli_scenario_section_error(sc, section,
-                                           "sphere %zu of [%s] overlaps sphere %zu "
-                                           "of an earlier group by %g m: move or shrink one of "
-                                           "the groups (they are inserted in file order)",
-                                           i - from + 1, section, j + 1, -gap);
+                                           "sphere %zu of [%s] overlaps sphere %zu of [%s] by %g "
+                                           "m: move or shrink one of the groups (they are "
+                                           "inserted in file order)",
+                                           i - from + 1, section, j - groups[g].from + 1,
+                                           groups[g].section, -gap);
                 return CLI_EXIT_USAGE;
             }
         }
@@ -596,20 +610,29 @@ static int build_spheres(const struct cli_scenario* sc, struct cli_many_setup* s
                          struct materials* mt, unsigned faces, const char** first)
 {
     *first = NULL;
+    struct group* groups = malloc((sc->n_sections ? sc->n_sections : 1) * sizeof *groups);
+    if (!groups) {
+        cli_error("out of memory");
+        return CLI_EXIT_RUNTIME;
+    }
+    size_t n_groups = 0;
     for (size_t s = 0; s < sc->n_sections; s++) {
         const char* name = sc->sections[s].name;
         bool ins = strcmp(name, "insert") == 0 || strncmp(name, "insert.", 7) == 0;
         if (!ins && strncmp(name, "particle.", 9) != 0)
             continue;
-        size_t from = wetdem_sim_n_particles(su->sim);
+        groups[n_groups++] = (struct group){name, wetdem_sim_n_particles(su->sim)};
         int rc = ins ? build_insert(sc, su, mt, name) : build_particle(sc, su, mt, name);
         if (rc == CLI_EXIT_OK)
-            rc = check_group(sc, su, name, from, faces);
-        if (rc != CLI_EXIT_OK)
+            rc = check_group(sc, su, groups, n_groups, faces);
+        if (rc != CLI_EXIT_OK) {
+            free(groups);
             return rc;
+        }
         if (!*first)
             *first = cli_scenario_text(sc, name, "material", "steel1");
     }
+    free(groups);
     if (!*first) {
         cli_scenario_section_error(sc, "box",
                                    "no spheres: add an [insert] section (or "

@@ -3,11 +3,15 @@
  * registry model listed), `describe` (parameters with units and ranges of every model, the
  * simulation settings and both integrators; unknown names give a hint and exit 2), `forces` (CSV provenance and columns; one value checked against the closed
  * form of the reynolds model, F = 6 pi mu R*^2 v_n / h), bad input (exit 2, message), and
- * `--help`/`-h` of every subcommand listed by `wetdem --help` (usage on stdout, exit 0).
+ * `--help`/`-h` of every subcommand listed by `wetdem --help` (usage on stdout, exit 0), and
+ * the choice of models: a model of the wrong kind named with its kind, and [model.NAME]
+ * sections of models that a --set of [models] left out.
  *
  * The CLI path comes from the environment variable WETDEM_CLI (set by `make test`), falling
  * back to build/wetdem relative to the working directory (the repository root).
  */
+#include <unistd.h>
+
 #include "harness.h"
 
 /* Runs "$WETDEM_CLI args"; stderr is merged into out when with_stderr, discarded otherwise. */
@@ -292,6 +296,94 @@ static void test_cli_bad_options_get_hints(void** state)
     }
 }
 
+/* Models chosen where they do not belong are named with their kind ("an impulse model"); a
+ * minimum-separation slot holding a force model is refused in both engines (the many-particle
+ * one summed it as a force). */
+static void test_cli_model_of_the_wrong_kind(void** state)
+{
+    (void)state;
+    static const struct {
+        const char *args, *message;
+        int code;
+    } cases[] = {
+        {"run examples/scenarios/nijssen_head_on.ini --set models.min_separation=hard --check",
+         "'hard' is an impulse model, not a minimum-separation model", 2},
+        {"run examples/scenarios/many_settling.ini --set models.force=hard --check",
+         "'hard' is an impulse model: the many-particle mode sums force models", 2},
+        /* (the many-particle engine summed nijssen as a force, the run valid) */
+        {"run examples/scenarios/many_settling.ini --set models.min_separation=nijssen --check",
+         "'nijssen' is a fluid model, not a minimum-separation model", 2},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        struct test_run r = run_cli(cases[k].args, true);
+        if (r.code != cases[k].code)
+            fail_msg("'%s' exited %d, expected %d:\n%s", cases[k].args, r.code, cases[k].code,
+                     r.out);
+        CHECK_CONTAINS(r.out, cases[k].message);
+        free(r.out);
+    }
+}
+
+/* Writes text to a new temporary file; returns its path (static buffer). */
+static const char* temp_scenario(const char* text)
+{
+    static char path[64];
+    snprintf(path, sizeof path, "/tmp/wetdem_test_cli_XXXXXX");
+    int fd = mkstemp(path);
+    assert_true(fd >= 0);
+    FILE* f = fdopen(fd, "w");
+    assert_non_null(f);
+    fputs(text, f);
+    fclose(f);
+    return path;
+}
+
+/* A [model.NAME] section of the file for a model that a --set of [models] switched away from
+ * is ignored, so one file serves both choices (the files below hold [model.fixed] and
+ * [model.glass], for the models they choose); a --set of such a parameter, a section the
+ * file's own choice leaves unused, and a section of no model at all remain errors. */
+static void test_cli_unused_model_sections(void** state)
+{
+    (void)state;
+    static const struct {
+        const char *args, *message;
+        int code;
+    } cases[] = {
+        {"run examples/scenarios/many_settling.ini --set models.min_separation=ehd --check",
+         "is valid (many-particle run)", 0},
+        {"run examples/scenarios/punch_oblique.ini --set models.min_separation=roughness --check",
+         "is valid", 0},
+        {"run examples/scenarios/many_settling.ini --set models.min_separation=ehd "
+         "--set model.fixed.h_min=2e-6 --check",
+         "--set model.fixed.h_min=2e-6: model 'fixed' is not enabled", 2},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        struct test_run r = run_cli(cases[k].args, true);
+        if (r.code != cases[k].code)
+            fail_msg("'%s' exited %d, expected %d:\n%s", cases[k].args, r.code, cases[k].code,
+                     r.out);
+        CHECK_CONTAINS(r.out, cases[k].message);
+        free(r.out);
+    }
+    char args[256];
+    const char* unused = temp_scenario("[collision]\nstokes = 50\n[models]\nmin_separation = ehd\n"
+                                       "[model.fixed]\nh_min = 1e-6\n");
+    snprintf(args, sizeof args, "run %s --check", unused);
+    struct test_run r = run_cli(args, true);
+    assert_int_equal(r.code, 2);
+    CHECK_CONTAINS(r.out, ":6: [model.fixed] h_min = 1e-6: model 'fixed' is not enabled");
+    free(r.out);
+    remove(unused);
+    const char* stray = temp_scenario("[collision]\nstokes = 50\n[model.fixd]\nh_min = 1e-6\n");
+    snprintf(args, sizeof args, "run %s --set models.min_separation=ehd --check", stray);
+    r = run_cli(args, true);
+    assert_int_equal(r.code, 2);
+    CHECK_CONTAINS(r.out, ":3: unknown section [model.fixd]: 'fixd' is not a model; did you mean "
+                          "[model.fixed]?");
+    free(r.out);
+    remove(stray);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -304,6 +396,8 @@ int main(void)
         cmocka_unit_test(test_cli_forces_log_gaps_are_decades),
         cmocka_unit_test(test_cli_forces_bad_input),
         cmocka_unit_test(test_cli_bad_options_get_hints),
+        cmocka_unit_test(test_cli_model_of_the_wrong_kind),
+        cmocka_unit_test(test_cli_unused_model_sections),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -6,11 +6,15 @@
  *     t_end and steps both, a periodic edge too short for the neighbour cells, a foreign
  *     checkpoint) exit 2 with "FILE:LINE:" at the right line
  *     and write nothing, not even the --out directory;
- *   - a run split by --restart, and a run resumed from an older checkpoint after its outputs
- *     went further, give byte-identical VTK frames, series index, CSV and summary to the
- *     uninterrupted run;
- *   - SIGINT sent to a running CLI writes a checkpoint, exits 130 and prints the command that
- *     resumes it; resuming gives the uninterrupted run's files byte for byte;
+ *   - a run split by --restart (at a step on the output grid and off it), and a run resumed
+ *     from an older checkpoint after its outputs went further, give byte-identical VTK frames,
+ *     series index, CSV and summary to the uninterrupted run;
+ *   - SIGINT sent to a running CLI, once or twice back to back, writes a checkpoint, exits 130
+ *     and prints the command that resumes it; resuming gives the uninterrupted run's files
+ *     byte for byte; a third stops it at once, the earlier checkpoint intact;
+ *   - the CSV ends with a row of the last step, in the library's format;
+ *   - a fresh run into a used --out removes the earlier run's frames, and no other file;
+ *   - the summary prints a large mean agglomerate size as a whole number;
  *   - progress goes to stderr only when it is a terminal, with an estimate of the time left;
  *   - the example scenarios check, and the summary's energy budget adds up; a run whose budget
  *     does not close (a step too long for the contacts) says so and exits 1, and a restart
@@ -170,7 +174,14 @@ static void test_many_cli_bad_inputs_exit_2_with_file_and_line(void** state)
                "[box]\nsize_x = 1e-2\nsize_y = 1e-2\nsize_z = 1e-2\n[particle.a]\nradius = 1e-3\n"
                "x = 5e-3\ny = 5e-3\nz = 5e-3\n[particle.b]\nradius = 1e-3\nx = 6e-3\ny = 5e-3\n"
                "z = 5e-3\n[run]\nsteps = 10\n",
-               10, "overlaps sphere 1");
+               10, "sphere 1 of [particle.b] overlaps sphere 1 of [particle.a] by 0.001 m");
+    /* the group overlapped is named, not counted over all the groups before */
+    expect_bad("overlap3.ini",
+               "[box]\nsize_x = 1e-2\nsize_y = 1e-2\nsize_z = 1e-2\n[particle.a]\nradius = 1e-3\n"
+               "x = 2e-3\ny = 5e-3\nz = 5e-3\n[particle.b]\nradius = 1e-3\nx = 5e-3\ny = 5e-3\n"
+               "z = 5e-3\n[particle.c]\nradius = 1e-3\nx = 6e-3\ny = 5e-3\nz = 5e-3\n[run]\n"
+               "steps = 10\n",
+               15, "sphere 1 of [particle.c] overlaps sphere 1 of [particle.b] by 0.001 m");
     expect_bad("both.ini",
                "[box]\nsize_x = 1e-2\nsize_y = 1e-2\nsize_z = 1e-2\n[insert]\ncount = 5\n"
                "radius = 1e-3\n[run]\nt_end = 1e-3\nsteps = 10\n",
@@ -240,6 +251,33 @@ static void drop_column(char* text, int col)
     *w = '\0';
 }
 
+/* The last line of tmpdir/name (caller frees), without its newline. */
+static char* last_line(const char* name)
+{
+    char* t = test_read_file(tpath(name), NULL);
+    if (!t)
+        fail_msg("%s is missing", name);
+    size_t n = strlen(t);
+    while (n > 0 && t[n - 1] == '\n')
+        t[--n] = '\0';
+    const char* nl = strrchr(t, '\n');
+    char* line = strdup(nl ? nl + 1 : t);
+    free(t);
+    return line;
+}
+
+/* The step (second column) of the last row of the CSV tmpdir/name. */
+static unsigned long long csv_last_step(const char* name)
+{
+    char* line = last_line(name);
+    const char* comma = strchr(line, ',');
+    if (!comma)
+        fail_msg("%s: last line '%s' is not a row", name, line);
+    unsigned long long step = strtoull(comma + 1, NULL, 10);
+    free(line);
+    return step;
+}
+
 /* The files of two --out directories are byte-identical, except the CSV column
  * candidate_pairs: the size of the neighbour list depends on when the list was last built,
  * and a restart builds it afresh (the forces do not depend on it: every pair within range is
@@ -293,6 +331,15 @@ static void test_many_cli_restart_is_bit_identical(void** state)
     if (code != 0)
         fail_msg("restart: exit %d\n%s", code, stderr_text());
     check_same_outputs("whole", "split", 7);
+    /* split off the CSV grid: the first run's CSV ends with a row of its last step, 305, which
+       the uninterrupted run does not have; the resumed run drops it (and keeps the row of 300) */
+    assert_int_equal(run_cli("run box.ini --set run.steps=305 --out split305"), 0);
+    assert_int_equal(csv_last_step("split305/global.csv"), 305);
+    code = run_cli("run box.ini --set run.steps=600 --out split305 --restart "
+                   "split305/checkpoint.ckpt");
+    if (code != 0)
+        fail_msg("restart at 305: exit %d\n%s", code, stderr_text());
+    check_same_outputs("whole", "split305", 7);
     /* a crash after step 300: the outputs went on to 600, the checkpoint is the older one */
     assert_int_equal(run_cli("run box.ini --set run.steps=300 --out crash"), 0);
     char cmd[1200];
@@ -387,34 +434,206 @@ static pid_t spawn_cli(const char* args)
     return pid;
 }
 
+/* Whether signal sig is pending for process pid, not yet delivered (/proc/PID/status: SigPnd
+ * for the thread, ShdPnd for the process). */
+static bool signal_pending(pid_t pid, int sig)
+{
+    char path[64], line[256];
+    snprintf(path, sizeof path, "/proc/%d/status", (int)pid);
+    FILE* f = fopen(path, "r");
+    bool pending = false;
+    while (f && fgets(line, sizeof line, f)) {
+        unsigned long long mask;
+        if ((sscanf(line, "SigPnd: %llx", &mask) == 1 ||
+             sscanf(line, "ShdPnd: %llx", &mask) == 1) &&
+            (mask >> (sig - 1)) & 1u)
+            pending = true;
+    }
+    if (f)
+        fclose(f);
+    return pending;
+}
+
+/* Starts `args`, waits until it is stepping (5 rows in tmpdir/csv), then sends it `count`
+ * SIGINTs back to back, each as soon as the one before has been delivered (two sent while
+ * neither is delivered would merge into one). Returns its wait status. */
+static int interrupt_cli(const char* args, const char* csv, int count)
+{
+    pid_t pid = spawn_cli(args);
+    struct timespec nap = {0, 1000000}, blink = {0, 20000};
+    for (int k = 0; k < 60000 && csv_rows(tpath(csv)) < 5; k++)
+        nanosleep(&nap, NULL);
+    for (int n = 0; n < count; n++) {
+        for (int k = 0; n > 0 && k < 50000 && signal_pending(pid, SIGINT); k++)
+            nanosleep(&blink, NULL);
+        kill(pid, SIGINT);
+    }
+    int status;
+    assert_int_equal(waitpid(pid, &status, 0), pid);
+    return status;
+}
+
+/* The step "(step N of" of the interruption message on stderr. */
+static unsigned long long interrupted_step(const char* err)
+{
+    const char* p = strstr(err, "(step ");
+    if (!p)
+        fail_msg("no step in the interruption message:\n%s", err);
+    return strtoull(p + 6, NULL, 10);
+}
+
+/* SIGINT: the checkpoint, exit 130, the command that resumes, and the CSV ending at the step
+ * of the checkpoint; resuming gives the files of the uninterrupted run (the CSV without that
+ * last row, off its grid of 10 steps unless the stop fell on it). Two SIGINTs back to back,
+ * as GNU timeout sends them (to the process, then to its group), are one request: the run
+ * still writes its checkpoint and exits 130 (the second killed it at once). */
 static void test_many_cli_sigint_writes_a_checkpoint_and_resumes(void** state)
 {
     (void)state;
     scenario("long.ini", "[dump]\nvtk_every = 2000\ncsv_every = 10\n");
-    const char* args = "run long.ini --set run.steps=12000 --out sig";
-    pid_t pid = spawn_cli(args);
-    /* wait until the run is stepping (5 CSV rows: step 40), then interrupt it */
-    struct timespec nap = {0, 1000000};
-    for (int k = 0; k < 60000 && csv_rows(tpath("sig/global.csv")) < 5; k++)
-        nanosleep(&nap, NULL);
-    kill(pid, SIGINT);
-    int status;
-    assert_int_equal(waitpid(pid, &status, 0), pid);
-    char* err = stderr_text();
-    if (!WIFEXITED(status) || WEXITSTATUS(status) != 130)
-        fail_msg("interrupted run: status %d, expected exit 130 (the run must outlast the "
-                 "wait for 5 CSV rows)\n%s",
-                 status, err);
-    CHECK_CONTAINS(err, "interrupted by SIGINT");
-    CHECK_CONTAINS(err, "resume with: wetdem run long.ini --set run.steps=12000 --out sig "
-                        "--restart sig/checkpoint.ckpt");
-    free(err);
-    assert_true(exists("sig/checkpoint.ckpt"));
-    assert_int_equal(run_cli("run long.ini --set run.steps=12000 --out sig --restart "
-                             "sig/checkpoint.ckpt"),
-                     0);
     assert_int_equal(run_cli("run long.ini --set run.steps=12000 --out ref"), 0);
-    check_same_outputs("ref", "sig", 7); /* frames at 0, 2000, ..., 12000 */
+    const char* dirs[2] = {"sig", "sig2"};
+    for (int k = 0; k < 2; k++) {
+        char args[200], csv[64], resume[300];
+        snprintf(args, sizeof args, "run long.ini --set run.steps=12000 --out %s", dirs[k]);
+        snprintf(csv, sizeof csv, "%s/global.csv", dirs[k]);
+        int status = interrupt_cli(args, csv, k + 1);
+        char* err = stderr_text();
+        if (!WIFEXITED(status) || WEXITSTATUS(status) != 130)
+            fail_msg("%d SIGINT: status %d, expected exit 130 (the run must outlast the wait "
+                     "for 5 CSV rows)\n%s",
+                     k + 1, status, err);
+        CHECK_CONTAINS(err, "stopping after this step to write the checkpoint");
+        CHECK_CONTAINS(err, "interrupted by SIGINT");
+        snprintf(resume, sizeof resume,
+                 "resume with: wetdem run long.ini --set run.steps=12000 --out %s --restart "
+                 "%s/checkpoint.ckpt",
+                 dirs[k], dirs[k]);
+        CHECK_CONTAINS(err, resume);
+        assert_int_equal(csv_last_step(csv), interrupted_step(err));
+        free(err);
+        snprintf(args, sizeof args, "%s/checkpoint.ckpt", dirs[k]);
+        assert_true(exists(args));
+        snprintf(args, sizeof args,
+                 "run long.ini --set run.steps=12000 --out %s --restart %s/checkpoint.ckpt",
+                 dirs[k], dirs[k]);
+        assert_int_equal(run_cli(args), 0);
+        check_same_outputs("ref", dirs[k], 7); /* frames at 0, 2000, ..., 12000 */
+    }
+}
+
+/* A third SIGINT, sent while the run is still stopping after the first (20000 spheres: a step
+ * and a checkpoint take milliseconds, the signals microseconds), stops it at once by the
+ * signal: no new checkpoint, the periodic one before intact, no temporary file left. */
+static void test_many_cli_third_signal_stops_at_once(void** state)
+{
+    (void)state;
+    write_text("slow.ini",
+               "[box]\nsize_x = 28e-3\nsize_y = 28e-3\nsize_z = 28e-3\n[material.wet]\n"
+               "density = 2500\nyoungs_modulus = 1e7\nfilm = 20e-6\n[fluid]\nviscosity = 0.01\n"
+               "surface_tension = 0.02\n[models]\nforce = hertz sb capillary\n[insert]\n"
+               "layout = lattice\ncount = 20000\nradius = 0.45e-3\ngap = 10e-6\nmaterial = wet\n"
+               "velocity_sigma = 0.01\n[run]\nsteps = 100000\n[dump]\nvtk_every = 100000\n"
+               "csv_every = 1\ncheckpoint_every = 2\n");
+    int status = interrupt_cli("run slow.ini --out slow", "slow/global.csv", 3);
+    char* err = stderr_text();
+    if (!WIFSIGNALED(status) || WTERMSIG(status) != SIGINT)
+        fail_msg("3 SIGINT: status %d, expected death by SIGINT\n%s", status, err);
+    CHECK_CONTAINS(err, "stopped at once by a repeated signal, without a new checkpoint");
+    assert_null(strstr(err, "interrupted by SIGINT"));
+    free(err);
+    assert_false(exists("slow/checkpoint.ckpt.tmp"));
+    struct wetdem_checkpoint ck;
+    char msg[256];
+    CHECK_OK(wetdem_checkpoint_read(tpath("slow/checkpoint.ckpt"), &ck, msg, sizeof msg));
+    assert_int_equal(ck.n_particles, 20000);
+    assert_int_equal(ck.step % 2, 0); /* a periodic one */
+    wetdem_checkpoint_clear(&ck);
+}
+
+/* The CSV ends with the state of the last step, also off its grid of csv_every steps, and that
+ * row agrees with summary.json; it is the row the library writes on its grid, byte for byte. */
+static void test_many_cli_csv_ends_at_the_last_step(void** state)
+{
+    (void)state;
+    scenario("tail.ini", "[dump]\nvtk_every = 100\ncsv_every = 20\n");
+    assert_int_equal(run_cli("run tail.ini --set run.steps=610 --out tail"), 0);
+    assert_int_equal(csv_last_step("tail/global.csv"), 610);
+    char* row = last_line("tail/global.csv");
+    double t, kinetic, potential, elastic;
+    unsigned long long step;
+    assert_int_equal(sscanf(row, "%lf,%llu,%lf,%lf,%lf", &t, &step, &kinetic, &potential, &elastic),
+                     5);
+    free(row);
+    char* js = test_read_file(tpath("tail/summary.json"), NULL);
+    CHECK_CONTAINS(js, "\"step\": 610, ");
+    const char* keys[4] = {"\"time_s\": ", "\"kinetic\": ", "\"potential\": ", "\"elastic\": "};
+    double csv_values[4] = {t, kinetic, potential, elastic};
+    for (int k = 0; k < 4; k++) {
+        const char* p = strstr(js, keys[k]);
+        if (!p)
+            fail_msg("%s missing in %s", keys[k], js);
+        double v = strtod(p + strlen(keys[k]), NULL);
+        CHECK_ABS(csv_values[k], v, 1e-8 * fabs(v)); /* the CSV has 9 digits */
+    }
+    free(js);
+    /* 600 steps: the library's row of step 600 (every 20), and the CLI's (every 7: 595, 600) */
+    assert_int_equal(run_cli("run tail.ini --set run.steps=600 --out grid"), 0);
+    assert_int_equal(run_cli("run tail.ini --set run.steps=600 --set dump.csv_every=7 --out off"),
+                     0);
+    char* a = last_line("grid/global.csv");
+    char* b = last_line("off/global.csv");
+    assert_string_equal(a, b);
+    free(a);
+    free(b);
+    assert_int_equal(csv_rows(tpath("off/global.csv")), 600 / 7 + 2); /* 0, 7, ..., 595, 600 */
+}
+
+/* A fresh run into a used --out replaces the earlier run's frames: none of a longer run is
+ * left beside the new index, and files not named as frames stay; a resumed run keeps the
+ * frames it continues. */
+static void test_many_cli_fresh_run_replaces_earlier_frames(void** state)
+{
+    (void)state;
+    scenario("frames.ini", "[dump]\nvtk_every = 100\ncsv_every = 20\n");
+    assert_int_equal(run_cli("run frames.ini --set run.steps=600 --out reuse"), 0);
+    const char* keep[] = {"reuse/particles_notes.vtk", "reuse/other_000005.vtk",
+                          "reuse/particles_000005.vtk.bak", "reuse/particles_00005.vtk"};
+    for (size_t k = 0; k < 4; k++)
+        write_text(keep[k], "not a frame of this run\n");
+    assert_int_equal(run_cli("run frames.ini --set run.steps=200 --out reuse"), 0);
+    for (int k = 0; k <= 6; k++) {
+        char name[64];
+        snprintf(name, sizeof name, "reuse/particles_%06d.vtk", k);
+        if (exists(name) != (k <= 2))
+            fail_msg("%s %s", name, k <= 2 ? "is missing" : "of the earlier run is left");
+    }
+    for (size_t k = 0; k < 4; k++)
+        if (!exists(keep[k]))
+            fail_msg("%s, not a frame, was removed", keep[k]);
+    assert_int_equal(run_cli("run frames.ini --set run.steps=400 --out reuse --restart "
+                             "reuse/checkpoint.ckpt"),
+                     0);
+    assert_int_equal(run_cli("run frames.ini --set run.steps=400 --out whole400"), 0);
+    check_same_outputs("whole400", "reuse", 5);
+}
+
+/* The summary gives a large mean agglomerate size as a whole number: 1000 wet spheres on a
+ * lattice 10 um apart, every neighbour held by a bridge, are one agglomerate of 1000 (%.3g
+ * printed 1e+03). */
+static void test_many_cli_summary_mean_size_readable(void** state)
+{
+    (void)state;
+    write_text("agglomerate.ini",
+               "[box]\nsize_x = 9.2e-3\nsize_y = 9.2e-3\nsize_z = 9.2e-3\n[material.wet]\n"
+               "density = 2500\nyoungs_modulus = 1e7\nfilm = 20e-6\n[fluid]\nviscosity = 0.01\n"
+               "surface_tension = 0.02\n[models]\nforce = hertz sb capillary\n[insert]\n"
+               "layout = lattice\ncount = 1000\nradius = 0.45e-3\ngap = 10e-6\nmaterial = wet\n"
+               "[run]\nsteps = 1\n");
+    assert_int_equal(run_cli("run agglomerate.ini"), 0);
+    char* out = test_read_file(tpath("out.txt"), NULL);
+    CHECK_CONTAINS(out, "agglomerates       1  (mean size 1000)\n");
+    free(out);
 }
 
 /* Progress: nothing on stderr when it is a file; on a terminal, the spheres placed by the
@@ -567,6 +786,10 @@ int main(void)
         cmocka_unit_test(test_many_cli_bad_inputs_exit_2_with_file_and_line),
         cmocka_unit_test(test_many_cli_restart_is_bit_identical),
         cmocka_unit_test(test_many_cli_sigint_writes_a_checkpoint_and_resumes),
+        cmocka_unit_test(test_many_cli_third_signal_stops_at_once),
+        cmocka_unit_test(test_many_cli_csv_ends_at_the_last_step),
+        cmocka_unit_test(test_many_cli_fresh_run_replaces_earlier_frames),
+        cmocka_unit_test(test_many_cli_summary_mean_size_readable),
         cmocka_unit_test(test_many_cli_progress_only_on_a_terminal),
         cmocka_unit_test(test_many_cli_random_groups_share_the_box),
         cmocka_unit_test(test_many_cli_examples_and_budget),
