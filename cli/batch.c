@@ -244,8 +244,31 @@ void cli_batch_write_table(FILE* f, const struct cli_batch* b, int argc, char** 
     }
 }
 
+/* One line for the points whose fixed step did not resolve h_min (information). */
+static void report_unresolved_hmin(const struct cli_batch* b)
+{
+    size_t n = 0, worst = 0;
+    for (size_t k = 0; b->engine == CLI_ENGINE_SOFT && k < b->n_pts; k++) {
+        char why[600];
+        if (b->pts[k].status < 0 || !cli_hmin_unresolved(&b->pts[k].res, why, sizeof why))
+            continue;
+        if (n++ == 0 ||
+            b->pts[k].res.stats.hmin_step_ratio > b->pts[worst].res.stats.hmin_step_ratio)
+            worst = k;
+    }
+    if (n == 0)
+        return;
+    char where[1100], why[600];
+    point_values(b, &b->pts[worst], where, sizeof where);
+    cli_hmin_unresolved(&b->pts[worst].res, why, sizeof why);
+    cli_error("warning: %s: in %zu of %zu collisions (column hmin_step_ratio) the step does not "
+              "resolve h_min; the worst, at %s: %s",
+              b->cmd, n, b->n_pts, where, why);
+}
+
 int cli_batch_report_failures(const struct cli_batch* b, int rc)
 {
+    report_unresolved_hmin(b);
     for (size_t k = 0; k < b->n_pts; k++) {
         const struct cli_batch_point* p = &b->pts[k];
         char where[1100];

@@ -197,11 +197,13 @@ static int run_soft(const struct cli_scenario* sc, struct cli_setup* su, const s
         cli_summary_text(stdout, sc, su, &res);
     if (a->out_dir && rc == CLI_EXIT_OK && !a->json)
         printf("files in %s/\n", a->out_dir);
-    char why[300];
+    char why[600];
     if (rc == CLI_EXIT_OK && cli_energy_grew(res.energy_ratio, why, sizeof why)) {
         cli_error("run %s: the collision %s", sc->file, why);
         rc = CLI_EXIT_RUNTIME;
     }
+    if (rc == CLI_EXIT_OK && cli_hmin_unresolved(&res, why, sizeof why))
+        cli_error("warning: run %s: %s", sc->file, why);
     return rc;
 }
 

@@ -99,6 +99,11 @@ size_t cli_result_fields(const struct cli_setup* su, const struct wetdem_collisi
     out[n++] = count("pair_evals", "evaluations of one pair's models", r->stats.pair_evals);
     out[n++] = count("root_evals", "evaluations of the event functions", r->stats.root_evals);
     out[n++] = count("events", "events located", r->stats.events);
+    out[n++] = num("hmin_step_ratio", "-",
+                   "verlet: largest gap change of a step that crossed h_min (or another branch "
+                   "gap of the force laws), over that gap; above 0.1 h_min is not resolved "
+                   "(0 with cvode)",
+                   r->stats.hmin_step_ratio);
     return n;
 }
 
@@ -112,6 +117,29 @@ bool cli_energy_grew(double energy_ratio, char* msg, size_t n)
              "verlet halve dt_fraction (or dt), or use name = cvode; with cvode lower rtol and "
              "atol",
              energy_ratio);
+    return true;
+}
+
+bool cli_hmin_unresolved(const struct wetdem_collision_result* r, char* msg, size_t n)
+{
+    double ratio = r->stats.hmin_step_ratio;
+    if (!(ratio > WETDEM_HMIN_STEP_RATIO_MAX))
+        return false;
+    int used = snprintf(msg, n,
+                        "the verlet step moved the gap by %.3g h_min in a step that crossed "
+                        "h_min (it is resolved at %g or less), so the result changes in jumps, "
+                        "not smoothly, with h_min",
+                        ratio, WETDEM_HMIN_STEP_RATIO_MAX);
+    double bound = ratio / r->stokes_n;
+    if (used > 0 && (size_t)used < n && isfinite(bound))
+        used += snprintf(msg + used, n - (size_t)used,
+                         "; where a law switches there (below_hmin = c) e_n can be off by up "
+                         "to about %.2g (hmin_step_ratio / St_n)",
+                         bound);
+    if (used > 0 && (size_t)used < n)
+        snprintf(msg + used, n - (size_t)used,
+                 "; set [integrator] hmin_fraction = 0.1 (or a lower dt_fraction), or use "
+                 "name = cvode (docs/engines.md, \"Steps and h_min\")");
     return true;
 }
 

@@ -41,6 +41,11 @@ size_t cli_result_fields(const struct cli_setup* su, const struct wetdem_collisi
  * contact. Then writes into msg[n] which ratio and what to change ("ends with ..."). */
 bool cli_energy_grew(double energy_ratio, char* msg, size_t n);
 
+/* Whether a collision's fixed step did not resolve h_min (its stats.hmin_step_ratio above
+ * WETDEM_HMIN_STEP_RATIO_MAX): information, not an error. Then writes into msg[n] how far the
+ * step moved the gap, the e_n error it can cause and what to change ("the verlet step ..."). */
+bool cli_hmin_unresolved(const struct wetdem_collision_result* r, char* msg, size_t n);
+
 /* Records what the result struct lacks from the final state of su->sim: the striker's own
  * speed and the angle of its velocity to the line of centres, theta_i,1 of Nijssen Fig. 1c,
  * atan2(|v_t|, |v . n|) in [0, pi/2] (n: the rebound normal r->normal_out, the line of

@@ -415,7 +415,17 @@ struct wetdem_stats {
     unsigned long long pair_evals;     /* evaluations of one pair's models */
     unsigned long long root_evals;     /* evaluations of the event functions */
     unsigned long long events;         /* events located */
+    /* Fixed-step integrators (verlet): the largest change of a pair's gap over one step that
+     * crossed a branch gap h_k of its force laws inside their range (0 < h_k < range: h_min
+     * and the like, docs/engines.md "Events"), as a multiple of h_k [-]. 0 when no step
+     * crossed one, and always with cvode, which locates every crossing. Above
+     * WETDEM_HMIN_STEP_RATIO_MAX the step does not resolve h_min: the result moves in steps,
+     * not smoothly, with h_min (docs/engines.md, "Steps and h_min"). */
+    double hmin_step_ratio;
 };
+/* Largest hmin_step_ratio (struct wetdem_stats) at which a fixed step counts as resolving
+ * h_min: the gap moves at most a tenth of h_min in the step that crosses it [-]. */
+#define WETDEM_HMIN_STEP_RATIO_MAX 0.1
 WETDEM_API struct wetdem_stats wetdem_sim_stats(const struct wetdem_sim* sim);
 
 /* Located crossings of a pair's gap through a branch boundary of the force law. */

@@ -283,6 +283,36 @@ static void sort_crossings(struct crossing* x, size_t n)
     }
 }
 
+double wetdem_event_smallest_branch_gap(const struct wetdem_sim* sim)
+{
+    const struct wetdem_engine* e = &sim->engine;
+    double h_min = INFINITY;
+    for (size_t q = 0; q < e->n_slots; q++) {
+        if (e->slots[q].source != WETDEM_EVENT_SOURCE_MODEL)
+            continue;
+        double h_k = e->pair_gap[e->slots[q].pair] - e->g_prev[q];
+        if (h_k > 0.0)
+            h_min = fmin(h_min, h_k);
+    }
+    return h_min;
+}
+
+/* Keeps in stats.hmin_step_ratio the gap change of the step just taken, as a multiple of
+ * the branch gap h_k of model slot q that it crossed (h_k = gap - g at the step's end). A
+ * fixed step samples the force law only at its ends: with a change of the order of h_k it
+ * never sees the law between h_k and a few h_k, where the thin-film and lubrication laws
+ * (~1/h) change most and where they switch (c: to zero, nc: to the value at h_min). */
+static void note_branch_step(struct wetdem_engine* e, size_t q)
+{
+    size_t p = e->slots[q].pair;
+    double h_k = e->pair_gap[p] - e->g_new[q];
+    if (!(h_k > 0.0))
+        return;
+    double ratio = fabs(e->pair_gap[p] - e->pair_gap_prev[p]) / h_k;
+    if (ratio > e->stats.hmin_step_ratio)
+        e->stats.hmin_step_ratio = ratio;
+}
+
 int wetdem_event_detect(struct wetdem_sim* sim, double t0, double h)
 {
     struct wetdem_engine* e = &sim->engine;
@@ -301,6 +331,8 @@ int wetdem_event_detect(struct wetdem_sim* sim, double t0, double h)
             continue;
         double theta = a / (a - b);
         x[n++] = (struct crossing){t0 + theta * h, theta, q, b > 0 ? 1 : -1};
+        if (e->slots[q].source == WETDEM_EVENT_SOURCE_MODEL)
+            note_branch_step(e, q);
     }
     sort_crossings(x, n);
     int st = WETDEM_OK;

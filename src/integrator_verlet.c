@@ -19,12 +19,18 @@
  * largest relative speed of any pair at the start of the run, raised by the speed gravity can
  * add over the pair's gap, floored by sim.speed_floor. dt is fixed for one
  * wetdem_sim_integrate() call; long runs with changing speeds are integrated in chunks.
- * Without pairs the run is one step (exact for free flight and constant force). The last
- * step is shortened to land on t_end.
+ * With verlet.hmin_fraction > 0 the step is also held at or below hmin_fraction x h_min / v,
+ * h_min the smallest branch gap of the force laws inside their range at the start (the
+ * thin-film and lubrication laws switch there, docs/engines.md "Steps and h_min") and v that
+ * speed scale. Without pairs the run is one step (exact for free flight and constant force).
+ * The last step is shortened to land on t_end.
  *
  * Pair histories are committed at every step (c->dt = dt). Events: the event functions are
  * compared before and after every step and crossings are placed by linear interpolation of
- * g (time error O(dt^2) relative to the step, docs/engines.md).
+ * g (time error O(dt^2) relative to the step, docs/engines.md). The forces are not: they are
+ * sampled at the step ends only, so where a law switches at h_min the switch falls on a step
+ * end, not where the gap crosses h_min; stats.hmin_step_ratio records how far such steps move
+ * the gap, relative to h_min.
  */
 #include <math.h>
 #include <stdlib.h>
@@ -33,9 +39,10 @@
 #include "vec3.h"
 
 struct verlet_params {
-    double dt;          /* fixed step [s]; 0: from dt_fraction */
-    double dt_fraction; /* step as a fraction of the contact time [-] */
-    double max_steps;   /* most steps one integrate call may take [-] */
+    double dt;            /* fixed step [s]; 0: from dt_fraction */
+    double dt_fraction;   /* step as a fraction of the contact time [-] */
+    double max_steps;     /* most steps one integrate call may take [-] */
+    double hmin_fraction; /* > 0: gap change per step at most this fraction of h_min [-] */
 };
 
 _Static_assert(sizeof(struct verlet_params) <= WETDEM_INTEGRATOR_PARAMS_MAX * sizeof(double),
@@ -50,6 +57,11 @@ static const struct wetdem_param_desc verlet_params_desc[] = {
      P(dt_fraction), 0.02, 0.0, 1.0, true, false, NULL, false},
     {"max_steps", "-", "Largest number of steps one integrate call may take.", P(max_steps), 1e8,
      1.0, 1e12, false, false, NULL, true},
+    {"hmin_fraction", "-",
+     "When > 0, the step is also held at or below hmin_fraction x h_min / v (h_min: the "
+     "smallest branch gap of the force laws inside their range, v: the speed scale), so that "
+     "the gap moves at most that fraction of h_min per step; 0: off (dt_fraction alone).",
+     P(hmin_fraction), 0.0, 0.0, 1.0, false, false, NULL, false},
     {0},
 };
 #undef P
@@ -58,20 +70,30 @@ static const struct wetdem_param_desc verlet_params_desc[] = {
 static int choose_step(struct wetdem_sim* sim, const struct verlet_params* p, double t_end,
                        double* dt)
 {
-    double span = t_end - sim->engine.time, t_contact = INFINITY;
+    double span = t_end - sim->engine.time, t_contact = INFINITY, v = 0.0;
     if (p->dt > 0) {
         *dt = p->dt;
     } else {
-        wetdem_sim_speed_scale(sim, &t_contact);
+        v = wetdem_sim_speed_scale(sim, &t_contact);
         *dt = isfinite(t_contact) ? p->dt_fraction * t_contact : span;
+    }
+    bool held = false; /* by hmin_fraction */
+    double h_min = p->hmin_fraction > 0 ? wetdem_event_smallest_branch_gap(sim) : INFINITY;
+    if (isfinite(h_min)) {
+        if (!(v > 0))
+            v = wetdem_sim_speed_scale(sim, NULL);
+        double hold = p->hmin_fraction * h_min / v;
+        held = hold < *dt;
+        *dt = held ? hold : *dt;
     }
     if (!(*dt > 0) || !isfinite(*dt))
         return wetdem_sim_fail(sim, WETDEM_ERR_INVALID, "verlet: step %g s is not usable", *dt);
     if (span / *dt > p->max_steps)
         return wetdem_sim_fail(sim, WETDEM_ERR_MAX_STEPS,
                                "verlet: %.3g steps of %.3g s to reach t = %.9g s exceed "
-                               "verlet.max_steps = %.3g",
-                               span / *dt, *dt, t_end, p->max_steps);
+                               "verlet.max_steps = %.3g%s",
+                               span / *dt, *dt, t_end, p->max_steps,
+                               held ? " (the step is held at hmin_fraction x h_min / v)" : "");
     return WETDEM_OK;
 }
 

@@ -4,7 +4,9 @@
  * Verlet step; direction (approach gives only start events, receding only end events);
  * simultaneous thresholds in a fixed order; terminal (stop on separation) versus non-terminal
  * events; and the approach speed logged at h_min against the closed form of Reynolds
- * lubrication, for a wall and for two free spheres (lubrication acts on walls).
+ * lubrication, for a wall and for two free spheres (lubrication acts on walls); how far a
+ * Verlet step moves the gap across h_min (stats.hmin_step_ratio), the step rule
+ * verlet.hmin_fraction, and e_n of the sb law against its closed form as h_min changes.
  */
 #include "harness.h"
 
@@ -281,6 +283,141 @@ static void test_events_pair_lubrication(void** state)
     }
 }
 
+/* stats.hmin_step_ratio in free flight at 0.1 m/s, closed form: a Verlet step of 1.5 ms
+ * moves the gap by 0.15 mm, so the step that crosses h_min = 0.2 mm records 0.15/0.2 = 0.75;
+ * one of 9.5 ms records 4.75 (round-off of gaps of ~1e-3 m: 1e-12). Up to t = 17 ms, before
+ * h_min (18 ms), nothing is recorded; the range (1 mm) and contact (0) are not branch gaps
+ * inside the range and do not count. CVODE, which locates every crossing, records 0. */
+static void test_events_hmin_step_ratio(void** state)
+{
+    (void)state;
+    double dts[] = {1.5e-3, 9.5e-3}, want[] = {0.75, 4.75};
+    for (int k = 0; k < 2; k++) {
+        struct wetdem_sim* sim = wall_sim("verlet", 2e-3, -0.1, &null_model);
+        CHECK_OK(wetdem_sim_set_param(sim, "verlet.dt", dts[k]));
+        CHECK_OK(wetdem_sim_integrate(sim, 0.017));
+        assert_true(wetdem_sim_stats(sim).hmin_step_ratio == 0.0);
+        CHECK_OK(wetdem_sim_integrate(sim, 0.0285));
+        CHECK_REL(wetdem_sim_stats(sim).hmin_step_ratio, want[k], 1e-12);
+        wetdem_sim_free(sim);
+    }
+    struct wetdem_sim* sim = wall_sim("cvode", 2e-3, -0.1, &null_model);
+    CHECK_OK(wetdem_sim_integrate(sim, 0.0285));
+    assert_true(wetdem_sim_stats(sim).hmin_step_ratio == 0.0);
+    wetdem_sim_free(sim);
+}
+
+/* verlet.hmin_fraction holds the step at hmin_fraction x h_min / v: with 0.1, h_min = 0.2 mm
+ * and v = 0.1 m/s the step is 0.2 ms instead of verlet.dt = 1.5 ms, so the run to 20.5 ms
+ * takes 103 steps (the last one shortened), each moves the gap by exactly 0.1 h_min (1e-12:
+ * round-off) and the events keep their exact times. With hmin_fraction = 1 the allowance,
+ * 2 ms, is longer than verlet.dt = 0.15 ms, which stays: 137 steps, ratio 0.075. */
+static void test_events_hmin_fraction_holds_the_step(void** state)
+{
+    (void)state;
+    struct wetdem_sim* sim = wall_sim("verlet", 2e-3, -0.1, &null_model);
+    CHECK_OK(wetdem_sim_set_param(sim, "verlet.dt", 1.5e-3));
+    CHECK_OK(wetdem_sim_set_param(sim, "verlet.hmin_fraction", 0.1));
+    CHECK_OK(wetdem_sim_integrate(sim, 0.0205));
+    struct wetdem_stats s = wetdem_sim_stats(sim);
+    assert_int_equal(s.steps, 103);
+    CHECK_REL(s.hmin_step_ratio, 0.1, 1e-12);
+    enum wetdem_event_kind kinds[] = {WETDEM_EVENT_INTERACTION_START, WETDEM_EVENT_HMIN_REACHED,
+                                      WETDEM_EVENT_CONTACT_START};
+    double times[] = {0.010, 0.018, 0.020};
+    check_log(sim, kinds, times, 3, 1e-12);
+    wetdem_sim_free(sim);
+
+    sim = wall_sim("verlet", 2e-3, -0.1, &null_model);
+    CHECK_OK(wetdem_sim_set_param(sim, "verlet.dt", 1.5e-4));
+    CHECK_OK(wetdem_sim_set_param(sim, "verlet.hmin_fraction", 1));
+    CHECK_OK(wetdem_sim_integrate(sim, 0.0205));
+    s = wetdem_sim_stats(sim);
+    assert_int_equal(s.steps, 137);
+    CHECK_REL(s.hmin_step_ratio, 0.075, 1e-12);
+    wetdem_sim_free(sim);
+}
+
+/* e_n of a glass sphere (R = 6.35 mm, film 50 um on sphere and wall: delta = 100 um) hitting
+ * a wall at U = 0.05 m/s, 30 degrees, from the gap delta, in mu = 0.01 Pa s, with hertz +
+ * sb (below_hmin = c) and a fixed h_min. No model acts tangentially, so the normal motion is
+ * a head-on impact at v0 = U cos 30 = 0.0433 m/s. With K = 6 pi mu R^2 / m (m* = m against a
+ * wall), dv/dh = K (1 - h/delta)^2 / h for h_min <= h <= delta, no force between h_min and
+ * contact (c), Hertz rebounding with exactly e_dry (damping = exact), and the same law
+ * taking the same K I on the way out:
+ *     e_n = (e_dry (v0 - K I) - K I) / v0,
+ *     I = ln(delta/h_min) - 2 (1 - h_min/delta) + (1 - (h_min/delta)^2) / 2,
+ * with St_n = v0/K = 15.5: e_n = 0.19291 at h_min = 49 nm, 0.21859 at 60 nm (CVODE at
+ * rtol 1e-10 agrees to 1e-7).
+ * Verlet at its default step (2 % of the Hertz time, 1.7 us) moves the gap by ~45 nm a step
+ * and samples no gap between 38 and 61 nm: e_n is the same to the bit for both h_min, and
+ * the run says so with hmin_step_ratio > 0.1. Its error stays within the bound below
+ * (0.0022 and 0.024).
+ * With hmin_fraction = 0.1 it follows h_min. Bound: the step that crosses h_min applies the
+ * force F(h_min) <= m K v / h_min, or zero, for at most half a step too long or too short, so
+ * |dv| <= K (v dt / h_min) / 2 = K ratio / 2 per crossing; over the two crossings
+ * |d e_n| <= ratio K / v0 = ratio / St_n (about 3.4e-3 at the ratio of 0.053; errors
+ * measured: 0.9e-3 and 1.6e-3). The other steps add O(dt^2): dt = 0.1 us against a Hertz
+ * time of 85 us. */
+static double sb_wall_e_n(const char* integrator, double h_min, double hmin_fraction,
+                          struct wetdem_collision_result* r)
+{
+    struct wetdem_sim* sim = wetdem_sim_create();
+    struct wetdem_material m;
+    CHECK_OK(wetdem_material_preset("glass", &m));
+    m.film = 50e-6;
+    int mat = wetdem_sim_add_material(sim, &m);
+    assert_true(mat >= 0);
+    struct wetdem_fluid f = {.viscosity = 0.01, .surface_tension = 0.02, .density = 1000};
+    CHECK_OK(wetdem_sim_set_fluid(sim, &f));
+    CHECK_OK(wetdem_sim_enable_model(sim, "hertz"));
+    CHECK_OK(wetdem_sim_enable_model(sim, "sb"));
+    CHECK_OK(wetdem_sim_enable_model(sim, "fixed"));
+    CHECK_OK(wetdem_sim_set_param(sim, "fixed.h_min", h_min));
+    CHECK_OK(wetdem_sim_set_integrator(sim, integrator));
+    CHECK_OK(wetdem_sim_set_param(sim, "verlet.hmin_fraction", hmin_fraction));
+    CHECK_OK(wetdem_sim_set_param(sim, "cvode.rtol", 1e-10));
+    CHECK_OK(wetdem_sim_set_param(sim, "cvode.atol", 1e-11));
+    struct wetdem_collision_spec spec = {.material_i = mat,
+                                         .material_j = mat,
+                                         .radius_i = 6.35e-3,
+                                         .target_is_wall = true,
+                                         .speed = 0.05,
+                                         .angle = M_PI / 6,
+                                         .initial_gap = 100e-6,
+                                         .t_end = 0.1};
+    CHECK_OK(wetdem_collision_run(sim, &spec, r));
+    assert_true(r->separated);
+    double mass = wetdem_sim_particles_const(sim, NULL)[0].mass;
+    wetdem_sim_free(sim);
+    double delta = 100e-6, x = h_min / delta, v0 = 0.05 * cos(M_PI / 6);
+    double k = 6 * M_PI * 0.01 * 6.35e-3 * 6.35e-3 / mass;
+    double ki = k * (log(1 / x) - 2 * (1 - x) + (1 - x * x) / 2);
+    return (m.restitution * (v0 - ki) - ki) / v0;
+}
+
+static void test_events_verlet_resolves_hmin(void** state)
+{
+    (void)state;
+    double h_mins[] = {49e-9, 60e-9}, coarse[2];
+    for (int k = 0; k < 2; k++) {
+        struct wetdem_collision_result r;
+        double want = sb_wall_e_n("cvode", h_mins[k], 0, &r);
+        CHECK_ABS(r.e_n, want, 1e-7);
+        assert_true(r.stats.hmin_step_ratio == 0.0);
+
+        sb_wall_e_n("verlet", h_mins[k], 0, &r);
+        coarse[k] = r.e_n;
+        assert_true(r.stats.hmin_step_ratio > WETDEM_HMIN_STEP_RATIO_MAX);
+        CHECK_ABS(r.e_n, want, r.stats.hmin_step_ratio / r.stokes_n);
+
+        sb_wall_e_n("verlet", h_mins[k], 0.1, &r);
+        assert_true(r.stats.hmin_step_ratio <= 0.1);
+        CHECK_ABS(r.e_n, want, r.stats.hmin_step_ratio / r.stokes_n);
+    }
+    assert_true(coarse[0] == coarse[1]); /* the default step does not see h_min move */
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -291,6 +428,9 @@ int main(void)
         cmocka_unit_test(test_events_terminal),
         cmocka_unit_test(test_events_wall_lubrication_acts),
         cmocka_unit_test(test_events_pair_lubrication),
+        cmocka_unit_test(test_events_hmin_step_ratio),
+        cmocka_unit_test(test_events_hmin_fraction_holds_the_step),
+        cmocka_unit_test(test_events_verlet_resolves_hmin),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

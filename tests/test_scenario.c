@@ -16,7 +16,8 @@
  *     soft engine and for the pairwise engine (whose runs are in the parallel phase too);
  *   - a failed pairwise point reports the engine's status in the status column and exits 1;
  *   - `map` refuses many-particle scenarios (exit 2, nothing written); `run --check` of
- *     many-particle and pairwise scenarios honours --json and does not run.
+ *     many-particle and pairwise scenarios honours --json and does not run;
+ *   - a Verlet step that does not resolve h_min is reported by run and sweep (exit 0).
  */
 #include <stdlib.h>
 #include <sys/stat.h>
@@ -307,6 +308,49 @@ static void test_scenario_energy_gain_is_an_error(void** state)
     expect_run("sweep examples/scenarios/dry_hertz.ini --set integrator.dt_fraction=0.5 "
                "--param collision.speed --values 0.5:1:2",
                1, "sweep: collision.speed = 1: the collision ends with");
+}
+
+/* A Verlet step that moves the gap by more than a tenth of h_min across it is reported, not an
+ * error: a glass sphere with 50 um films hitting a wall at 0.05 m/s and 30 degrees in
+ * mu = 0.01 Pa s, with sb (below_hmin = c) and h_min = 50 nm, moves the gap by 0.917 h_min in
+ * the step that crosses it at the default step (test_events_verlet_resolves_hmin has the
+ * closed form). run warns and exits 0, a sweep warns once for all its points; with
+ * hmin_fraction = 0.1, or with cvode, nothing is said. */
+static void test_scenario_unresolved_hmin_is_reported(void** state)
+{
+    (void)state;
+    const char* file = write_file("sb_wall.ini", "[collision]\nstriker = mat\ntarget = wall\n"
+                                                 "speed = 0.05\nangle_deg = 30\n"
+                                                 "initial_gap = 1e-4\n[material.mat]\n"
+                                                 "preset = glass\nfilm = 50e-6\n[fluid]\n"
+                                                 "viscosity = 0.01\n[models]\n"
+                                                 "force = hertz sb\nmin_separation = fixed\n"
+                                                 "[model.fixed]\nh_min = 5e-8\n");
+    char args[800];
+    snprintf(args, sizeof args, "run '%s'", file);
+    expect_run(args, 0, "wetdem: warning: run ");
+    expect_run(args, 0,
+               ": the verlet step moved the gap by 0.917 h_min in a step that crossed h_min (it "
+               "is resolved at 0.1 or less), so the result changes in jumps, not smoothly, with "
+               "h_min; where a law switches there (below_hmin = c) e_n can be off by up to about "
+               "0.059 (hmin_step_ratio / St_n); set [integrator] hmin_fraction = 0.1");
+    expect_run(args, 0, "hmin_step_ratio        0.91655144");
+    const char* quiet[] = {"--set integrator.hmin_fraction=0.1", "--set integrator.name=cvode"};
+    for (int k = 0; k < 2; k++) {
+        snprintf(args, sizeof args, "run '%s' %s", file, quiet[k]);
+        struct test_run r = run_cli(args);
+        assert_int_equal(r.code, 0);
+        if (strstr(r.out, "warning"))
+            fail_msg("%s warns:\n%s", args, r.out);
+        free(r.out);
+    }
+    snprintf(args, sizeof args,
+             "sweep '%s' --param fixed.h_min --values 4.9e-8:6e-8:2 --out '%s/sb_wall.csv'", file,
+             tmpdir);
+    expect_run(args, 0,
+               "wetdem: warning: sweep: in 2 of 2 collisions (column hmin_step_ratio) the step "
+               "does not resolve h_min; the worst, at fixed.h_min = 4.9e-08: the verlet step "
+               "moved the gap by 0.935 h_min");
 }
 
 /* What a file written elsewhere brings, accepted: a UTF-8 byte-order mark, CR LF line ends and
@@ -740,6 +784,7 @@ int main(void)
         cmocka_unit_test(test_scenario_bad_files_exit_2_with_line),
         cmocka_unit_test(test_scenario_boms_crlf_and_long_comments),
         cmocka_unit_test(test_scenario_energy_gain_is_an_error),
+        cmocka_unit_test(test_scenario_unresolved_hmin_is_reported),
         cmocka_unit_test(test_scenario_docs_list_every_key),
         cmocka_unit_test(test_scenario_run_writes_files_or_nothing),
         cmocka_unit_test(test_scenario_bad_output_paths_exit_2),
