@@ -243,6 +243,19 @@ struct wetdem_model {
      * where the model damps nothing, 0 where c_d has no bound. Optional. The many-particle
      * engine keeps its step below a quarter of the shortest (docs/many.md, Time step). */
     double (*relaxation_time)(const void* params, const struct wetdem_contact* c);
+    /* The next three read the pair's state at its latest evaluation: c as pair() received it
+     * (c->h_min and c->dt not filled in), history (history_len doubles, read only) as pair()
+     * left it. All optional; the many-particle engine reports with them (docs/many.md). */
+    /* Energy stored in the conservative part of the model's solid-contact force [J]: the
+     * work that part does as the pair separates from c->gap to where it vanishes, h_min and
+     * every other branch gap held as they are now. NULL: the model stores none. */
+    double (*elastic_energy)(const void* params, const struct wetdem_contact* c,
+                             const double* history);
+    /* Whether the model exerts a solid-contact force at c. NULL: it has no solid contact. */
+    bool (*is_in_contact)(const void* params, const struct wetdem_contact* c,
+                          const double* history);
+    /* Whether the model's liquid bridge joins the pair at c. NULL: it has no bridge. */
+    bool (*is_bridged)(const void* params, const struct wetdem_contact* c, const double* history);
 };
 
 /* NULL-terminated table of every built-in model. */
