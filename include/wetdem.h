@@ -595,11 +595,13 @@ WETDEM_API int wetdem_sim_set_many(struct wetdem_sim* sim, const struct wetdem_m
 #define WETDEM_ENERGY_MAX_MODELS 16
 
 /* Energy budget of a many-particle run since its start [J]. work_* > 0 means energy given to
- * the particles, < 0 taken from them (dissipated, or stored as by the Hertz spring). */
+ * the particles, < 0 taken from them (dissipated, or stored as by a contact spring). */
 struct wetdem_energy_budget {
     double kinetic;    /* translational + rotational kinetic energy now */
     double potential;  /* gravitational potential energy now, -sum m g.x */
-    double elastic;    /* Hertz elastic energy (8/15) E* sqrt(R*) delta^(5/2) stored now */
+    double elastic;    /* energy stored now in the solid contacts of the enabled models (their
+                          elastic_energy: Hertz (8/15) E* sqrt(R*) delta^(5/2), hooke
+                          k delta^2 / 2, nijssen's blended contact; 0 for fluid forces) */
     double input;      /* kinetic + potential + elastic at the start */
     double dissipated; /* input - (kinetic + potential + elastic): lost to damping, friction,
                           viscous forces, plus what capillary bridges and tangential springs

@@ -406,6 +406,19 @@ static inline struct wetdem_particle wetdem_many_particle(const struct wetdem_si
     return p;
 }
 
+/* The committed history of candidate pair q, and of particle i with wall w (NULL without
+ * history). */
+static inline const double* wetdem_many_pair_history(const struct wetdem_sim* sim, size_t q)
+{
+    return sim->history_len ? sim->many->history + q * sim->history_len : NULL;
+}
+static inline const double* wetdem_many_wall_history(const struct wetdem_sim* sim, size_t i,
+                                                     size_t w)
+{
+    return sim->history_len ? sim->many->wall_history + (i * sim->n_walls + w) * sim->history_len
+                            : NULL;
+}
+
 /* Closing half kick of particle k with gravity g: v = v' + a dt/2, w = w' + alpha dt/2 from
  * the half-step velocities and the latest forces (the force pass, or a deferred kick before
  * the state is read; sim_many.c's kick-drift pass applies it with the same arithmetic). */
@@ -424,8 +437,9 @@ static inline void wetdem_many_close_kick(struct wetdem_many* m, size_t k, struc
  * force, torque and contacts zeroed for the next pass (the kick-drift pass's arithmetic);
  * returns their largest |v'|^2. */
 double wetdem_sim_many_drift_range(struct wetdem_sim* sim, size_t lo, size_t hi);
-/* Kinetic (translational + rotational), gravitational potential and Hertz elastic energy at
- * the current state [J]. */
+/* Kinetic (translational + rotational) and gravitational potential energy at the current
+ * state, and the elastic energy stored in the solid contacts of the enabled models at the
+ * latest evaluation (wetdem_sim_contact_elastic_energy over the pairs and walls) [J]. */
 void wetdem_sim_many_energies(const struct wetdem_sim* sim, double* kinetic, double* potential,
                               double* elastic);
 /* Makes sure the pair list, histories and per-particle arrays fit the current particles
