@@ -620,8 +620,10 @@ WETDEM_API int wetdem_sim_energy_budget(const struct wetdem_sim* sim,
 
 /* Global quantities at the latest force evaluation of a many-particle run. */
 struct wetdem_many_stats {
-    size_t contacts;                /* pairs (and particle-wall pairs) with gap < 0 */
-    size_t bridges;                 /* particle pairs with a liquid bridge (gap < film) */
+    size_t contacts;                /* particle pairs and particle-wall pairs where an enabled
+                                       model exerts a solid-contact force (is_in_contact) */
+    size_t bridges;                 /* particle pairs joined by the liquid bridge of an
+                                       enabled film model (is_bridged: h <= film) */
     size_t agglomerates;            /* clusters of >= 2 particles joined by bridges */
     double mean_agglomerate;        /* their mean number of particles (0 if none) */
     size_t candidate_pairs;         /* pairs in the neighbour list */
@@ -640,7 +642,8 @@ struct wetdem_many_stats {
 };
 WETDEM_API int wetdem_sim_many_stats(const struct wetdem_sim* sim, struct wetdem_many_stats* s);
 
-/* Writes the particles as a legacy VTK file (radius, velocity, spin, contact count). */
+/* Writes the particles as a legacy VTK file (radius, velocity, spin, contacts as in
+ * wetdem_many_stats, material, id). */
 WETDEM_API int wetdem_sim_write_vtk(struct wetdem_sim* sim, const char* path, bool binary);
 /* Writes a checkpoint of a many-particle run (atomic: temporary file, then rename).
  * Returns WETDEM_OK, WETDEM_ERR_INVALID (not in many mode) or WETDEM_ERR_IO. */

@@ -60,9 +60,11 @@ struct wetdem_many_pair_out {
 /* Most threads (blocks) of the force pass. */
 #define WETDEM_MANY_MAX_BLOCKS 256
 
-#define WETDEM_MANY_ACTIVE 1u  /* within the interaction range: force applied */
-#define WETDEM_MANY_CONTACT 2u /* gap < 0: solid contact */
-#define WETDEM_MANY_BRIDGE 4u  /* gap < film delta_ij with a fluid model: liquid bridge */
+#define WETDEM_MANY_ACTIVE 1u /* within the interaction range: force applied */
+/* The two below are the force pass's own marks of the geometry (the kernel tests compare
+ * them); the contacts and bridges reported are the models' (wetdem_sim_many_links). */
+#define WETDEM_MANY_CONTACT 2u /* gap < 0: solid overlap */
+#define WETDEM_MANY_BRIDGE 4u  /* gap < film delta_ij > 0 */
 #define WETDEM_MANY_DIRTY 8u   /* history may differ from a fresh one (reset when out of range) */
 #define WETDEM_MANY_SPRING                                                                         \
     16u /* its tangential spring may be non-zero: set in solid contact,
@@ -359,7 +361,9 @@ struct wetdem_many {
     unsigned char kind[WETDEM_MAX_MODELS]; /* fused kernel of model k */
     double kind_opt[WETDEM_MAX_MODELS];    /* its switch parameter (hertz damping form, ...) */
     struct wetdem_vec3 *force, *torque, *vh, *wh; /* per particle */
-    uint32_t* contacts; /* per particle: solid contacts at the latest evaluation */
+    uint32_t* contacts; /* per particle: solid overlaps (WETDEM_MANY_CONTACT) at the latest
+                           evaluation, kept in checkpoints; the counts reported are the
+                           models' (wetdem_sim_many_links) */
     /* The engine state of a run: per particle, position and radius (xr, also what the gap
        tests read) and velocity and spin (vw; the predicted v' + a dt/2 during a force pass).
        Loaded from the particle records when a call starts (wetdem_sim_many_prepare), and
@@ -479,8 +483,14 @@ int wetdem_sim_many_forces(struct wetdem_sim* sim, enum wetdem_many_end end);
 /* sim_many_io.c */
 /* Writes the outputs due at the current step (VTK, CSV, periodic checkpoint). */
 int wetdem_sim_many_outputs(struct wetdem_sim* sim, bool final);
-/* Number of agglomerates (clusters of >= 2 particles joined by liquid bridges) and their mean
- * size, from the latest force evaluation. */
-void wetdem_sim_many_agglomerates(const struct wetdem_sim* sim, size_t* count, double* mean);
+/* Contacts and liquid bridges at the latest force evaluation, as the enabled models define
+ * them (wetdem_sim_contact_is_in_contact, wetdem_sim_contact_is_bridged; docs/many.md,
+ * Outputs): into s, the particle pairs and particle-wall pairs in contact (contacts), the
+ * particle pairs bridged (bridges), and the clusters of >= 2 particles joined by bridges,
+ * found by union-find over the bridged pairs (agglomerates, mean_agglomerate); the other
+ * fields are left as they are. per_particle (optional, n_particles entries) receives each
+ * particle's contacts with particles and walls. WETDEM_OK or WETDEM_ERR_NOMEM. */
+int wetdem_sim_many_links(const struct wetdem_sim* sim, uint32_t* per_particle,
+                          struct wetdem_many_stats* s);
 
 #endif

@@ -5,8 +5,9 @@
  * read), the energy budget closes, to second order from a moving start (trapezoid rule),
  * agreement with the few-body engine on a binary collision, the derived step follows the
  * contact model and stays below a quarter of the viscous relaxation time (a longer given step
- * refused), the start-up reach bound is enforced, agglomerates by union-find, VTK/CSV
- * outputs, lists rebuilt at the same steps with the displacement bound, callbacks see the
+ * refused), the start-up reach bound is enforced, agglomerates by union-find, the stored
+ * energy, contacts and bridges as the enabled models define them (hand-built configurations;
+ * the same after a restart), VTK/CSV outputs, lists rebuilt at the same steps with the displacement bound, callbacks see the
  * current state, the wall time by phase adds up.
  */
 #include <math.h>
@@ -871,6 +872,71 @@ static void test_many_hooke_budget_dissipates(void** state)
     wetdem_sim_free(sim);
 }
 
+/* Contacts where an enabled model exerts a solid-contact force (nijssen's at 0 < h < h_min
+ * too), bridges where an enabled film model's bridge joins two spheres, and the agglomerates
+ * of those bridges, for the hand-built configuration: totals (walls counted once) and each
+ * sphere's contacts (what the VTK files give), for model sets with and without a contact and a
+ * film model. */
+static void test_many_contacts_and_bridges_follow_the_models(void** state)
+{
+    (void)state;
+    static const struct {
+        const char* models;
+        size_t contacts, bridges, agglomerates;
+        double mean;
+        uint32_t per[HB_N];
+    } cases[] = {
+        {"hertz mindlin sb capillary", 2, 3, 2, 2.5, {1, 1, 0, 0, 0, 1, 0, 0}},
+        {"hertz mindlin", 2, 0, 0, 0, {1, 1, 0, 0, 0, 1, 0, 0}}, /* dry: no bridge */
+        {"hooke", 2, 0, 0, 0, {1, 1, 0, 0, 0, 1, 0, 0}},
+        {"nijssen", 4, 0, 0, 0, {1, 2, 1, 0, 0, 1, 1, 0}}, /* contact below h_min, no bridge */
+        {"reynolds", 0, 0, 0, 0, {0}},                     /* no contact model */
+        {"sb capillary", 0, 3, 2, 2.5, {0}},
+        {"davis", 0, 3, 2, 2.5, {0}},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        struct wetdem_sim* sim = hand_built(cases[k].models);
+        struct wetdem_many_stats s;
+        CHECK_OK(wetdem_sim_many_stats(sim, &s));
+        uint32_t per[HB_N];
+        struct wetdem_many_stats t;
+        CHECK_OK(wetdem_sim_many_links(sim, per, &t));
+        if (s.contacts != cases[k].contacts || s.bridges != cases[k].bridges ||
+            s.agglomerates != cases[k].agglomerates || s.mean_agglomerate != cases[k].mean ||
+            memcmp(per, cases[k].per, sizeof per) != 0)
+            fail_msg("models %s: contacts %zu, bridges %zu, agglomerates %zu (mean %g), per "
+                     "sphere %u %u %u %u %u %u %u %u",
+                     cases[k].models, s.contacts, s.bridges, s.agglomerates, s.mean_agglomerate,
+                     per[0], per[1], per[2], per[3], per[4], per[5], per[6], per[7]);
+        wetdem_sim_free(sim);
+    }
+}
+
+/* The counts come from the state and the histories, so a restored checkpoint reports those of
+ * the run that wrote it before any step (the force pass's own marks are not in it). */
+static void test_many_counts_survive_a_restart(void** state)
+{
+    (void)state;
+    char path[] = "/tmp/wetdem_test_many_counts_XXXXXX";
+    close(mkstemp(path));
+    struct wetdem_sim* sim = wet_box(150, true);
+    CHECK_OK(wetdem_sim_integrate(sim, 1e-3));
+    CHECK_OK(wetdem_sim_write_checkpoint(sim, path));
+    struct wetdem_sim* resumed = wet_box(150, true);
+    CHECK_OK(wetdem_sim_read_checkpoint(resumed, path));
+    struct wetdem_many_stats a, b;
+    CHECK_OK(wetdem_sim_many_stats(sim, &a));
+    CHECK_OK(wetdem_sim_many_stats(resumed, &b));
+    assert_true(a.contacts > 0 && a.bridges > 0);
+    assert_int_equal(b.contacts, a.contacts);
+    assert_int_equal(b.bridges, a.bridges);
+    assert_int_equal(b.agglomerates, a.agglomerates);
+    CHECK_ABS(b.mean_agglomerate, a.mean_agglomerate, 0);
+    remove(path);
+    wetdem_sim_free(sim);
+    wetdem_sim_free(resumed);
+}
+
 static void test_many_writes_vtk_and_csv(void** state)
 {
     (void)state;
@@ -1031,6 +1097,8 @@ int main(void)
         cmocka_unit_test(test_many_agglomerates_by_union_find),
         cmocka_unit_test(test_many_elastic_energy_is_the_contact_models),
         cmocka_unit_test(test_many_hooke_budget_dissipates),
+        cmocka_unit_test(test_many_contacts_and_bridges_follow_the_models),
+        cmocka_unit_test(test_many_counts_survive_a_restart),
         cmocka_unit_test(test_many_writes_vtk_and_csv),
         cmocka_unit_test(test_many_restart_continues_outputs),
         cmocka_unit_test(test_many_rejects_bad_settings),
