@@ -243,6 +243,19 @@ struct wetdem_model {
      * where the model damps nothing, 0 where c_d has no bound. Optional. The many-particle
      * engine keeps its step below a quarter of the shortest (docs/many.md, Time step). */
     double (*relaxation_time)(const void* params, const struct wetdem_contact* c);
+    /* The next three read the pair's state at its latest evaluation: c as pair() received it
+     * (c->h_min and c->dt not filled in), history (history_len doubles, read only) as pair()
+     * left it. All optional; the many-particle engine reports with them (docs/many.md). */
+    /* Energy stored in the conservative part of the model's solid-contact force [J]: the
+     * work that part does as the pair separates from c->gap to where it vanishes, h_min and
+     * every other branch gap held as they are now. NULL: the model stores none. */
+    double (*elastic_energy)(const void* params, const struct wetdem_contact* c,
+                             const double* history);
+    /* Whether the model exerts a solid-contact force at c. NULL: it has no solid contact. */
+    bool (*is_in_contact)(const void* params, const struct wetdem_contact* c,
+                          const double* history);
+    /* Whether the model's liquid bridge joins the pair at c. NULL: it has no bridge. */
+    bool (*is_bridged)(const void* params, const struct wetdem_contact* c, const double* history);
 };
 
 /* NULL-terminated table of every built-in model. */
@@ -597,11 +610,13 @@ WETDEM_API int wetdem_sim_set_many(struct wetdem_sim* sim, const struct wetdem_m
 #define WETDEM_ENERGY_MAX_MODELS 16
 
 /* Energy budget of a many-particle run since its start [J]. work_* > 0 means energy given to
- * the particles, < 0 taken from them (dissipated, or stored as by the Hertz spring). */
+ * the particles, < 0 taken from them (dissipated, or stored as by a contact spring). */
 struct wetdem_energy_budget {
     double kinetic;    /* translational + rotational kinetic energy now */
     double potential;  /* gravitational potential energy now, -sum m g.x */
-    double elastic;    /* Hertz elastic energy (8/15) E* sqrt(R*) delta^(5/2) stored now */
+    double elastic;    /* energy stored now in the solid contacts of the enabled models (their
+                          elastic_energy: Hertz (8/15) E* sqrt(R*) delta^(5/2), hooke
+                          k delta^2 / 2, nijssen's blended contact; 0 for fluid forces) */
     double input;      /* kinetic + potential + elastic at the start */
     double dissipated; /* input - (kinetic + potential + elastic): lost to damping, friction,
                           viscous forces, plus what capillary bridges and tangential springs
@@ -620,8 +635,10 @@ WETDEM_API int wetdem_sim_energy_budget(const struct wetdem_sim* sim,
 
 /* Global quantities at the latest force evaluation of a many-particle run. */
 struct wetdem_many_stats {
-    size_t contacts;                /* pairs (and particle-wall pairs) with gap < 0 */
-    size_t bridges;                 /* particle pairs with a liquid bridge (gap < film) */
+    size_t contacts;                /* particle pairs and particle-wall pairs where an enabled
+                                       model exerts a solid-contact force (is_in_contact) */
+    size_t bridges;                 /* particle pairs joined by the liquid bridge of an
+                                       enabled film model (is_bridged: h <= film) */
     size_t agglomerates;            /* clusters of >= 2 particles joined by bridges */
     double mean_agglomerate;        /* their mean number of particles (0 if none) */
     size_t candidate_pairs;         /* pairs in the neighbour list */
@@ -640,7 +657,8 @@ struct wetdem_many_stats {
 };
 WETDEM_API int wetdem_sim_many_stats(const struct wetdem_sim* sim, struct wetdem_many_stats* s);
 
-/* Writes the particles as a legacy VTK file (radius, velocity, spin, contact count). */
+/* Writes the particles as a legacy VTK file (radius, velocity, spin, contacts as in
+ * wetdem_many_stats, material, id). */
 WETDEM_API int wetdem_sim_write_vtk(struct wetdem_sim* sim, const char* path, bool binary);
 /* Writes a checkpoint of a many-particle run (atomic: temporary file, then rename).
  * Returns WETDEM_OK, WETDEM_ERR_INVALID (not in many mode) or WETDEM_ERR_IO. */

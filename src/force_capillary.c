@@ -73,4 +73,5 @@ const struct wetdem_model wetdem_force_capillary = {
     .range = capillary_range,
     .pair = capillary_pair,
     .thresholds = capillary_thresholds,
+    .is_bridged = film_is_bridged,
 };

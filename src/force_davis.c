@@ -83,4 +83,5 @@ const struct wetdem_model wetdem_force_davis = {
     .pair = davis_pair,
     .thresholds = thin_film_thresholds,
     .relaxation_time = davis_relaxation_time,
+    .is_bridged = film_is_bridged,
 };

@@ -80,4 +80,5 @@ const struct wetdem_model wetdem_force_db = {
     .pair = db_pair,
     .thresholds = thin_film_thresholds,
     .relaxation_time = db_relaxation_time,
+    .is_bridged = film_is_bridged,
 };

@@ -318,6 +318,13 @@ double wetdem_force_hertz_elastic(double e_star, double r_eff, double overlap)
     return hertz_elastic_k(hertz_stiffness(e_star, r_eff), overlap);
 }
 
+double wetdem_force_hertz_energy(double e_star, double r_eff, double overlap)
+{
+    if (!(overlap > 0.0))
+        return 0.0;
+    return 8.0 / 15.0 * e_star * sqrt(r_eff) * overlap * overlap * sqrt(overlap);
+}
+
 double wetdem_force_hertz_damping_coefficient(double restitution, int form)
 {
     if (!(restitution > 0.0 && restitution <= 1.0) || (form != 0 && form != 1))
@@ -375,6 +382,16 @@ static int hertz_pair(const void* params, const struct wetdem_contact* c, double
     return WETDEM_OK;
 }
 
+/* Energy stored in the elastic part of the law, (8/15) E* sqrt(R*) delta^(5/2) [J]: the
+ * damping part is dissipative, whichever the form. */
+static double hertz_elastic_energy(const void* params, const struct wetdem_contact* c,
+                                   const double* history)
+{
+    (void)params;
+    (void)history;
+    return wetdem_force_hertz_energy(c->e_star, c->r_eff, -c->gap);
+}
+
 const struct wetdem_model wetdem_force_hertz = {
     .name = "hertz",
     .kind = WETDEM_MODEL_CONTACT,
@@ -405,4 +422,6 @@ const struct wetdem_model wetdem_force_hertz = {
     .pair = hertz_pair,
     .thresholds = contact_only_thresholds,
     .contact_time = hertz_contact_time_hook,
+    .elastic_energy = hertz_elastic_energy,
+    .is_in_contact = contact_only_is_in_contact,
 };

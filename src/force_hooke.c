@@ -63,6 +63,16 @@ static double hooke_contact_time(const void* params, const struct wetdem_contact
     return M_PI / sqrt(k / c->m_eff - decay * decay);
 }
 
+/* Energy stored in the spring, k delta^2 / 2 [J] (the dashpot stores none). */
+static double hooke_elastic_energy(const void* params, const struct wetdem_contact* c,
+                                   const double* history)
+{
+    (void)history;
+    double k = ((const struct hooke_params*)params)->stiffness;
+    double overlap = -c->gap;
+    return overlap > 0.0 ? 0.5 * k * overlap * overlap : 0.0;
+}
+
 const struct wetdem_model wetdem_force_hooke = {
     .name = "hooke",
     .kind = WETDEM_MODEL_CONTACT,
@@ -84,4 +94,6 @@ const struct wetdem_model wetdem_force_hooke = {
     .pair = hooke_pair,
     .thresholds = contact_only_thresholds,
     .contact_time = hooke_contact_time,
+    .elastic_energy = hooke_elastic_energy,
+    .is_in_contact = contact_only_is_in_contact,
 };

@@ -117,4 +117,7 @@ const struct wetdem_model wetdem_force_mindlin = {
     .range = contact_only_range,
     .pair = mindlin_pair,
     .thresholds = contact_only_thresholds,
+    /* no elastic_energy: the spring's k_t |s|^2 / 2 is no potential (k_t follows the overlap,
+       so its work depends on the path, and sliding resets s) */
+    .is_in_contact = contact_only_is_in_contact,
 };

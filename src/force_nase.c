@@ -91,4 +91,5 @@ const struct wetdem_model wetdem_force_nase = {
     .pair = nase_pair,
     .thresholds = thin_film_thresholds,
     .relaxation_time = nase_relaxation_time,
+    .is_bridged = film_is_bridged,
 };

@@ -26,7 +26,17 @@
  * v_n > 0 approaching: F_l repulsive; separating: F_l is suction (attraction).
  * History (4 doubles): [v0, tangential spring x, y, z]. Both reset when the pair leaves
  * h_co, so each encounter of a pair starts with its own v0; v0 is a property of the pair's
- * relative motion, not of either particle. Validity: immersed spheres, Reynolds lubrication
+ * relative motion, not of either particle.
+ * Stored energy (the elastic_energy hook): the work of the elastic part of the blended contact,
+ * w_c k delta^(3/2) with k = (4/3) E* sqrt(R*), from h up to h_min at the pair's h_min now
+ * (d = h_min - h):
+ *     E = 0                                                    h >= h_min
+ *       = (2/7) k d^(7/2) / h_min                              0 < h < h_min
+ *       = (2/7) k h_min^(5/2) + (2/5) k (d^(5/2) - h_min^(5/2)) h <= 0
+ * For a constant h_min this is the potential of that force, so the budget's dissipated energy
+ * is the work of the damping, lubrication and friction alone. h_min follows v0, which can grow
+ * during an encounter: E then changes without work (by the change of the integral's bounds),
+ * and the budget counts that change as dissipated (docs/many.md, Energy budget). Validity: immersed spheres, Reynolds lubrication
  * (small particle Reynolds number), St from about 1 to 10^4 (Nijssen Fig. 3).
  */
 #include <math.h>
@@ -131,6 +141,35 @@ static int nijssen_pair(const void* params, const struct wetdem_contact* c, doub
     return WETDEM_OK;
 }
 
+/* h_min = max(h_sigma, h_eps) [m] of the pair's latest evaluation: v0 as pair() recorded it. */
+static double recorded_h_min(const struct wetdem_contact* c, const double* history)
+{
+    double h_eps = minsep_ehd_gap(c->viscosity, fmax(history[HIST_V0], 0.0), c->e_star, c->r_eff);
+    return fmax(c->roughness, h_eps);
+}
+
+/* Whether the contact part of the blend acts: w_c > 0 (h < h_min) within the range. */
+static bool nijssen_is_in_contact(const void* params, const struct wetdem_contact* c,
+                                  const double* history)
+{
+    return c->gap <= nijssen_range(params, c) && c->gap < recorded_h_min(c, history);
+}
+
+/* The work of the elastic part of the blended contact, w_c (4/3) E* sqrt(R*) delta^(3/2), from
+ * the gap up to h_min at the recorded h_min [J] (header comment). */
+static double nijssen_elastic_energy(const void* params, const struct wetdem_contact* c,
+                                     const double* history)
+{
+    if (!nijssen_is_in_contact(params, c, history))
+        return 0.0;
+    double h = c->gap, h_min = recorded_h_min(c, history), d = h_min - h;
+    double k = hertz_stiffness(c->e_star, c->r_eff);
+    if (h > 0.0) /* integral of (d/h_min) k d^(3/2) */
+        return 2.0 / 7.0 * k * d * d * d * sqrt(d) / h_min;
+    double at_zero = h_min * h_min * sqrt(h_min); /* h_min^(5/2) */
+    return 2.0 / 7.0 * k * at_zero + 0.4 * k * (d * d * sqrt(d) - at_zero);
+}
+
 static size_t nijssen_thresholds(const void* params, const struct wetdem_contact* c,
                                  const double* history, double* gaps)
 {
@@ -182,4 +221,6 @@ const struct wetdem_model wetdem_force_nijssen = {
     .thresholds = nijssen_thresholds,
     .contact_time = hertz_contact_time_hook, /* of the contact branch */
     .relaxation_time = nijssen_relaxation_time,
+    .elastic_energy = nijssen_elastic_energy,
+    .is_in_contact = nijssen_is_in_contact,
 };

@@ -80,4 +80,5 @@ const struct wetdem_model wetdem_force_sb = {
     .pair = sb_pair,
     .thresholds = thin_film_thresholds,
     .relaxation_time = sb_relaxation_time,
+    .is_bridged = film_is_bridged,
 };

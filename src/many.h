@@ -60,9 +60,11 @@ struct wetdem_many_pair_out {
 /* Most threads (blocks) of the force pass. */
 #define WETDEM_MANY_MAX_BLOCKS 256
 
-#define WETDEM_MANY_ACTIVE 1u  /* within the interaction range: force applied */
-#define WETDEM_MANY_CONTACT 2u /* gap < 0: solid contact */
-#define WETDEM_MANY_BRIDGE 4u  /* gap < film delta_ij with a fluid model: liquid bridge */
+#define WETDEM_MANY_ACTIVE 1u /* within the interaction range: force applied */
+/* The two below are the force pass's own marks of the geometry (the kernel tests compare
+ * them); the contacts and bridges reported are the models' (wetdem_sim_many_links). */
+#define WETDEM_MANY_CONTACT 2u /* gap < 0: solid overlap */
+#define WETDEM_MANY_BRIDGE 4u  /* gap < film delta_ij > 0 */
 #define WETDEM_MANY_DIRTY 8u   /* history may differ from a fresh one (reset when out of range) */
 #define WETDEM_MANY_SPRING                                                                         \
     16u /* its tangential spring may be non-zero: set in solid contact,
@@ -359,7 +361,9 @@ struct wetdem_many {
     unsigned char kind[WETDEM_MAX_MODELS]; /* fused kernel of model k */
     double kind_opt[WETDEM_MAX_MODELS];    /* its switch parameter (hertz damping form, ...) */
     struct wetdem_vec3 *force, *torque, *vh, *wh; /* per particle */
-    uint32_t* contacts; /* per particle: solid contacts at the latest evaluation */
+    uint32_t* contacts; /* per particle: solid overlaps (WETDEM_MANY_CONTACT) at the latest
+                           evaluation, kept in checkpoints; the counts reported are the
+                           models' (wetdem_sim_many_links) */
     /* The engine state of a run: per particle, position and radius (xr, also what the gap
        tests read) and velocity and spin (vw; the predicted v' + a dt/2 during a force pass).
        Loaded from the particle records when a call starts (wetdem_sim_many_prepare), and
@@ -406,6 +410,19 @@ static inline struct wetdem_particle wetdem_many_particle(const struct wetdem_si
     return p;
 }
 
+/* The committed history of candidate pair q, and of particle i with wall w (NULL without
+ * history). */
+static inline const double* wetdem_many_pair_history(const struct wetdem_sim* sim, size_t q)
+{
+    return sim->history_len ? sim->many->history + q * sim->history_len : NULL;
+}
+static inline const double* wetdem_many_wall_history(const struct wetdem_sim* sim, size_t i,
+                                                     size_t w)
+{
+    return sim->history_len ? sim->many->wall_history + (i * sim->n_walls + w) * sim->history_len
+                            : NULL;
+}
+
 /* Closing half kick of particle k with gravity g: v = v' + a dt/2, w = w' + alpha dt/2 from
  * the half-step velocities and the latest forces (the force pass, or a deferred kick before
  * the state is read; sim_many.c's kick-drift pass applies it with the same arithmetic). */
@@ -424,8 +441,9 @@ static inline void wetdem_many_close_kick(struct wetdem_many* m, size_t k, struc
  * force, torque and contacts zeroed for the next pass (the kick-drift pass's arithmetic);
  * returns their largest |v'|^2. */
 double wetdem_sim_many_drift_range(struct wetdem_sim* sim, size_t lo, size_t hi);
-/* Kinetic (translational + rotational), gravitational potential and Hertz elastic energy at
- * the current state [J]. */
+/* Kinetic (translational + rotational) and gravitational potential energy at the current
+ * state, and the elastic energy stored in the solid contacts of the enabled models at the
+ * latest evaluation (wetdem_sim_contact_elastic_energy over the pairs and walls) [J]. */
 void wetdem_sim_many_energies(const struct wetdem_sim* sim, double* kinetic, double* potential,
                               double* elastic);
 /* Makes sure the pair list, histories and per-particle arrays fit the current particles
@@ -465,8 +483,14 @@ int wetdem_sim_many_forces(struct wetdem_sim* sim, enum wetdem_many_end end);
 /* sim_many_io.c */
 /* Writes the outputs due at the current step (VTK, CSV, periodic checkpoint). */
 int wetdem_sim_many_outputs(struct wetdem_sim* sim, bool final);
-/* Number of agglomerates (clusters of >= 2 particles joined by liquid bridges) and their mean
- * size, from the latest force evaluation. */
-void wetdem_sim_many_agglomerates(const struct wetdem_sim* sim, size_t* count, double* mean);
+/* Contacts and liquid bridges at the latest force evaluation, as the enabled models define
+ * them (wetdem_sim_contact_is_in_contact, wetdem_sim_contact_is_bridged; docs/many.md,
+ * Outputs): into s, the particle pairs and particle-wall pairs in contact (contacts), the
+ * particle pairs bridged (bridges), and the clusters of >= 2 particles joined by bridges,
+ * found by union-find over the bridged pairs (agglomerates, mean_agglomerate); the other
+ * fields are left as they are. per_particle (optional, n_particles entries) receives each
+ * particle's contacts with particles and walls. WETDEM_OK or WETDEM_ERR_NOMEM. */
+int wetdem_sim_many_links(const struct wetdem_sim* sim, uint32_t* per_particle,
+                          struct wetdem_many_stats* s);
 
 #endif

@@ -60,10 +60,37 @@ static inline size_t contact_only_thresholds(const void* params, const struct we
     return 1;
 }
 
+/* is_in_contact hook of a contact-only model: its force acts where the surfaces overlap,
+ * gap < 0. */
+static inline bool contact_only_is_in_contact(const void* params, const struct wetdem_contact* c,
+                                              const double* history)
+{
+    (void)params;
+    (void)history;
+    return c->gap < 0.0;
+}
+
+/* ---- hooks shared by the film models (sb, db, davis, nase, capillary) ---- */
+
+/* is_bridged hook of a film model: the liquid bridge joins the pair while the films overlap,
+ * delta = delta_i + delta_j > 0 and h <= delta, solid overlap included (the liquid surrounds
+ * the contact: force_capillary.c). */
+static inline bool film_is_bridged(const void* params, const struct wetdem_contact* c,
+                                   const double* history)
+{
+    (void)params;
+    (void)history;
+    return c->film > 0.0 && c->gap <= c->film;
+}
+
 /* ---- shared kernels (pure functions; defined in the file of the family they belong to) ---- */
 
 /* force_hertz.c: Hertz elastic normal force (4/3) E* sqrt(R*) delta^(3/2) [N]; 0 if delta <= 0. */
 double wetdem_force_hertz_elastic(double e_star, double r_eff, double overlap);
+/* force_hertz.c: energy stored in the Hertz contact, (8/15) E* sqrt(R*) delta^(5/2) [J], the
+ * integral of wetdem_force_hertz_elastic over the overlap (Johnson 1985 Eq. 4.23); 0 if
+ * delta <= 0. */
+double wetdem_force_hertz_energy(double e_star, double r_eff, double overlap);
 /* Hertz stiffness factor k = (4/3) E* sqrt(R*) [N/m^(3/2)] and the parts of the hertz law
  * written with it: the elastic force k delta^(3/2) and the damping force
  * (coefficient sqrt(m* k)) delta^(1/4) v_n [N] (delta > 0), whose first factor depends on the

@@ -129,6 +129,18 @@ double wetdem_sim_contact_time(const struct wetdem_sim* sim, const struct wetdem
 double wetdem_sim_relaxation_time(const struct wetdem_sim* sim, struct wetdem_contact* c,
                                   const struct wetdem_model** which);
 
+/* What the enabled models say of a pair at its latest evaluation (their elastic_energy,
+ * is_in_contact and is_bridged hooks, wetdem.h), from its contact c and its history as the
+ * evaluation left it (sim->history_len doubles, read only; non-NULL when history_len > 0):
+ * the energy stored in their solid contacts [J] (the sum; 0 where none stores any), whether
+ * one of them exerts a solid-contact force, whether the liquid bridge of one joins the pair. */
+double wetdem_sim_contact_elastic_energy(const struct wetdem_sim* sim,
+                                         const struct wetdem_contact* c, const double* history);
+bool wetdem_sim_contact_is_in_contact(const struct wetdem_sim* sim, const struct wetdem_contact* c,
+                                      const double* history);
+bool wetdem_sim_contact_is_bridged(const struct wetdem_sim* sim, const struct wetdem_contact* c,
+                                   const double* history);
+
 /* Initial value of a pair's history: zeros except NAN-free defaults; writes history_len. */
 void wetdem_sim_history_init(const struct wetdem_sim* sim, double* history);
 

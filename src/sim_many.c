@@ -931,23 +931,20 @@ void wetdem_sim_many_energies(const struct wetdem_sim* sim, double* kinetic, dou
              0.2 * p->mass * p->radius * p->radius * vec3_dot(p->omega, p->omega);
         u -= p->mass * vec3_dot(g, p->pos);
     }
-    /* Hertz elastic energy (8/15) E* sqrt(R*) delta^(5/2) of every overlapping pair: the
-     * integral of (4/3) E* sqrt(R*) delta^(3/2) over delta (Johnson 1985 Eq. 4.23). */
+    /* the energy stored in the solid contacts, as the enabled models define it (their
+     * elastic_energy hooks: the Hertz (8/15) E* sqrt(R*) delta^(5/2), hooke's k delta^2 / 2,
+     * nijssen's blended contact; none for fluid forces), of every pair within the list (any
+     * pair in range is in it) and every particle-wall pair */
     for (size_t q = 0; m && q < m->cl.n_pairs; q++) {
         struct wetdem_contact c;
         wetdem_sim_many_contact(sim, m->cl.pairs[q].i, m->cl.pairs[q].j, false, &c);
-        if (c.gap >= 0)
-            continue;
-        double d = -c.gap;
-        el += 8.0 / 15.0 * c.e_star * sqrt(c.r_eff) * d * d * sqrt(d);
+        el += wetdem_sim_contact_elastic_energy(sim, &c, wetdem_many_pair_history(sim, q));
     }
     for (size_t i = 0; m && i < sim->n_particles; i++)
         for (size_t w = 0; w < sim->n_walls; w++) {
             struct wetdem_contact c;
-            wetdem_sim_build_contact(sim, i, w, true, &c);
-            double d = -c.gap;
-            if (d > 0)
-                el += 8.0 / 15.0 * c.e_star * sqrt(c.r_eff) * d * d * sqrt(d);
+            wetdem_sim_many_contact(sim, i, w, true, &c);
+            el += wetdem_sim_contact_elastic_energy(sim, &c, wetdem_many_wall_history(sim, i, w));
         }
     *kinetic = k;
     *potential = u;

@@ -30,7 +30,7 @@
 #define N_ENERGY (3 + 4 * WETDEM_MAX_MODELS)
 #define N_ENERGY_RIGHT_SUM (3 + 2 * WETDEM_MAX_MODELS)
 
-/* ---- agglomerates ---- */
+/* ---- contacts, liquid bridges, agglomerates ---- */
 
 static size_t find_root(size_t* parent, size_t k)
 {
@@ -41,43 +41,77 @@ static size_t find_root(size_t* parent, size_t k)
     return k;
 }
 
-void wetdem_sim_many_agglomerates(const struct wetdem_sim* sim, size_t* count, double* mean)
+/* Joins the clusters of particles a and b (union by size; the smaller root under the larger,
+ * the lower index first on a tie). */
+static void unite(size_t* parent, size_t* size, size_t a, size_t b)
+{
+    a = find_root(parent, a);
+    b = find_root(parent, b);
+    if (a == b)
+        return;
+    if (size[a] < size[b] || (size[a] == size[b] && b < a)) {
+        size_t t = a;
+        a = b;
+        b = t;
+    }
+    parent[b] = a;
+    size[a] += size[b];
+}
+
+int wetdem_sim_many_links(const struct wetdem_sim* sim, uint32_t* per_particle,
+                          struct wetdem_many_stats* s)
 {
     const struct wetdem_many* m = sim->many;
     size_t n = sim->n_particles;
-    *count = 0;
-    *mean = 0;
+    s->contacts = s->bridges = s->agglomerates = 0;
+    s->mean_agglomerate = 0;
     size_t* parent = malloc((n ? n : 1) * 2 * sizeof *parent);
-    if (!parent || !m)
-        goto done;
+    if (!parent)
+        return WETDEM_ERR_NOMEM;
     size_t* size = parent + n;
     for (size_t k = 0; k < n; k++) {
         parent[k] = k;
         size[k] = 1;
+        if (per_particle)
+            per_particle[k] = 0;
     }
-    for (size_t q = 0; q < m->cl.n_pairs && m->flags; q++) {
-        if (!(m->flags[q] & WETDEM_MANY_BRIDGE))
-            continue;
-        size_t a = find_root(parent, m->cl.pairs[q].i), b = find_root(parent, m->cl.pairs[q].j);
-        if (a == b)
-            continue;
-        if (size[a] < size[b] || (size[a] == size[b] && b < a)) {
-            size_t t = a;
-            a = b;
-            b = t;
+    /* every pair within a model's range is in the candidate list */
+    for (size_t q = 0; q < m->cl.n_pairs; q++) {
+        size_t i = m->cl.pairs[q].i, j = m->cl.pairs[q].j;
+        struct wetdem_contact c;
+        wetdem_sim_many_contact(sim, i, j, false, &c);
+        const double* hist = wetdem_many_pair_history(sim, q);
+        if (wetdem_sim_contact_is_in_contact(sim, &c, hist)) {
+            s->contacts++;
+            if (per_particle) {
+                per_particle[i]++;
+                per_particle[j]++;
+            }
         }
-        parent[b] = a;
-        size[a] += size[b];
+        if (wetdem_sim_contact_is_bridged(sim, &c, hist)) {
+            s->bridges++;
+            unite(parent, size, i, j);
+        }
     }
+    for (size_t i = 0; i < n; i++)
+        for (size_t w = 0; w < sim->n_walls; w++) {
+            struct wetdem_contact c;
+            wetdem_sim_many_contact(sim, i, w, true, &c);
+            if (wetdem_sim_contact_is_in_contact(sim, &c, wetdem_many_wall_history(sim, i, w))) {
+                s->contacts++;
+                if (per_particle)
+                    per_particle[i]++;
+            }
+        }
     size_t members = 0;
     for (size_t k = 0; k < n; k++)
         if (parent[k] == k && size[k] >= 2) {
-            (*count)++;
+            s->agglomerates++;
             members += size[k];
         }
-    *mean = *count ? (double)members / (double)*count : 0.0;
-done:
+    s->mean_agglomerate = s->agglomerates ? (double)members / (double)s->agglomerates : 0.0;
     free(parent);
+    return WETDEM_OK;
 }
 
 int wetdem_sim_many_stats(const struct wetdem_sim* sim, struct wetdem_many_stats* s)
@@ -86,15 +120,9 @@ int wetdem_sim_many_stats(const struct wetdem_sim* sim, struct wetdem_many_stats
     const struct wetdem_many* m = sim->many;
     if (!m || !m->started)
         return WETDEM_ERR_INVALID;
-    for (size_t q = 0; q < m->cl.n_pairs; q++) {
-        s->contacts += (m->flags[q] & WETDEM_MANY_CONTACT) ? 1 : 0;
-        s->bridges += (m->flags[q] & WETDEM_MANY_BRIDGE) ? 1 : 0;
-    }
-    size_t touching = 0; /* contact counts per particle hold pairs twice, walls once */
-    for (size_t k = 0; k < sim->n_particles; k++)
-        touching += m->contacts[k];
-    s->contacts += touching - 2 * s->contacts;
-    wetdem_sim_many_agglomerates(sim, &s->agglomerates, &s->mean_agglomerate);
+    int st = wetdem_sim_many_links(sim, NULL, s);
+    if (st != WETDEM_OK)
+        return st;
     s->candidate_pairs = m->cl.n_pairs;
     s->list_builds = m->cl.n_builds;
     s->dt = m->dt;
@@ -112,10 +140,20 @@ int wetdem_sim_many_stats(const struct wetdem_sim* sim, struct wetdem_many_stats
 
 int wetdem_sim_write_vtk(struct wetdem_sim* sim, const char* path, bool binary)
 {
-    const uint32_t* contacts = sim->many && sim->many->started ? sim->many->contacts : NULL;
+    /* each particle's contacts as the enabled models define them (wetdem_sim_many_links) */
+    uint32_t* contacts = NULL;
+    if (sim->many && sim->many->started) {
+        struct wetdem_many_stats s;
+        contacts = malloc((sim->n_particles ? sim->n_particles : 1) * sizeof *contacts);
+        if (!contacts || wetdem_sim_many_links(sim, contacts, &s) != WETDEM_OK) {
+            free(contacts);
+            return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory for the contact counts");
+        }
+    }
     char msg[512];
     int st = wetdem_output_vtk_write(path, sim->particles, sim->n_particles, contacts,
                                      sim->engine.time, binary, msg, sizeof msg);
+    free(contacts);
     return st == WETDEM_OK ? st : wetdem_sim_fail(sim, st, "%s", msg);
 }
 
@@ -239,14 +277,20 @@ static int write_csv_row(struct wetdem_sim* sim)
     if (m->csv_rows == 0 || (fseek(f, 0, SEEK_END) == 0 && ftell(f) == 0))
         csv_header(sim, f);
     struct wetdem_many_stats s;
-    wetdem_sim_many_stats(sim, &s);
-    double k, u, el;
-    wetdem_sim_many_energies(sim, &k, &u, &el);
-    fprintf(f, "%.9g,%llu,%.9g,%.9g,%.9g,%zu,%zu,%zu,%.6g,%zu", sim->engine.time,
-            (unsigned long long)m->step, k, u, el, s.contacts, s.bridges, s.agglomerates,
-            s.mean_agglomerate, s.candidate_pairs);
+    st = wetdem_sim_many_stats(sim, &s);
+    if (st != WETDEM_OK) {
+        fclose(f);
+        return wetdem_sim_fail(sim, st, "out of memory for the contact counts");
+    }
+    /* the energies once: the budget has them (each pass over the pairs asks every model) */
     struct wetdem_energy_budget b;
-    if (m->set.energy_budget && wetdem_sim_energy_budget(sim, &b) == WETDEM_OK) {
+    bool budget = m->set.energy_budget && wetdem_sim_energy_budget(sim, &b) == WETDEM_OK;
+    if (!budget)
+        wetdem_sim_many_energies(sim, &b.kinetic, &b.potential, &b.elastic);
+    fprintf(f, "%.9g,%llu,%.9g,%.9g,%.9g,%zu,%zu,%zu,%.6g,%zu", sim->engine.time,
+            (unsigned long long)m->step, b.kinetic, b.potential, b.elastic, s.contacts, s.bridges,
+            s.agglomerates, s.mean_agglomerate, s.candidate_pairs);
+    if (budget) {
         for (size_t q = 0; q < sim->n_models && q < WETDEM_ENERGY_MAX_MODELS; q++)
             fprintf(f, ",%.9g", b.work_pair[q] + b.work_wall[q]);
         fprintf(f, ",%.9g,%.3g", b.dissipated, b.balance_error);

@@ -361,6 +361,47 @@ double wetdem_sim_relaxation_time(const struct wetdem_sim* sim, struct wetdem_co
     return t;
 }
 
+/* The history slice of the model in slot s, or NULL for a model without one. */
+static const double* slot_history(const struct wetdem_model_slot* s, const double* history)
+{
+    return s->model->history_len ? history + s->history_offset : NULL;
+}
+
+double wetdem_sim_contact_elastic_energy(const struct wetdem_sim* sim,
+                                         const struct wetdem_contact* c, const double* history)
+{
+    double e = 0.0;
+    for (size_t k = 0; k < sim->n_models; k++) {
+        const struct wetdem_model_slot* s = &sim->models[k];
+        if (s->model->elastic_energy)
+            e += s->model->elastic_energy(s->params, c, slot_history(s, history));
+    }
+    return e;
+}
+
+bool wetdem_sim_contact_is_in_contact(const struct wetdem_sim* sim, const struct wetdem_contact* c,
+                                      const double* history)
+{
+    for (size_t k = 0; k < sim->n_models; k++) {
+        const struct wetdem_model_slot* s = &sim->models[k];
+        if (s->model->is_in_contact &&
+            s->model->is_in_contact(s->params, c, slot_history(s, history)))
+            return true;
+    }
+    return false;
+}
+
+bool wetdem_sim_contact_is_bridged(const struct wetdem_sim* sim, const struct wetdem_contact* c,
+                                   const double* history)
+{
+    for (size_t k = 0; k < sim->n_models; k++) {
+        const struct wetdem_model_slot* s = &sim->models[k];
+        if (s->model->is_bridged && s->model->is_bridged(s->params, c, slot_history(s, history)))
+            return true;
+    }
+    return false;
+}
+
 int wetdem_sim_eval_contact(const struct wetdem_sim* sim, struct wetdem_contact* c, double* history,
                             struct wetdem_pair_force* out, struct wetdem_pair_force* per_model)
 {

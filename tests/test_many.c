@@ -5,8 +5,9 @@
  * read), the energy budget closes, to second order from a moving start (trapezoid rule),
  * agreement with the few-body engine on a binary collision, the derived step follows the
  * contact model and stays below a quarter of the viscous relaxation time (a longer given step
- * refused), the start-up reach bound is enforced, agglomerates by union-find, VTK/CSV
- * outputs, lists rebuilt at the same steps with the displacement bound, callbacks see the
+ * refused), the start-up reach bound is enforced, agglomerates by union-find, the stored
+ * energy, contacts and bridges as the enabled models define them (hand-built configurations;
+ * the same after a restart), VTK/CSV outputs, lists rebuilt at the same steps with the displacement bound, callbacks see the
  * current state, the wall time by phase adds up.
  */
 #include <math.h>
@@ -720,6 +721,222 @@ static void test_many_agglomerates_by_union_find(void** state)
     wetdem_sim_free(sim);
 }
 
+/* ---- what the outputs report, as the enabled models define it (docs/many.md, Outputs) ---- */
+
+/* Hand-built spheres of radius 1 mm (2500 kg/m^3, E 1e7 Pa, 10 um films, roughness 2 um, so
+ * delta_ij = 20 um and nijssen's h_min = h_sigma = 2 um at rest) at rest, no gravity, in a box
+ * 10 mm wide with a floor z = 0 of the same material:
+ *   0-1  overlapping by 1 um          1-2  at gap 0.5 um (0 < h < h_min, films overlap)
+ *   3-4  at gap 10 um (films overlap)  5    overlapping the floor by 1 um
+ *   6    at gap 0.5 um from the floor  7    alone
+ * with the models of `models` (space-separated), run for one step of 1 ns: the spheres move by
+ * < 1e-17 m (accelerations < 20 m/s^2), and the expected values are taken at the positions
+ * the step left anyway. */
+#define HB_N 8
+static struct wetdem_sim* hand_built(const char* models)
+{
+    struct wetdem_sim* sim = wetdem_sim_create();
+    struct wetdem_material m = {.density = 2500,
+                                .youngs_modulus = 1e7,
+                                .poisson_ratio = 0.3,
+                                .restitution = 0.5,
+                                .friction_dry = 0.4,
+                                .friction_lub = 0.1,
+                                .roughness = 2e-6,
+                                .film = 10e-6};
+    assert_int_equal(wetdem_sim_add_material(sim, &m), 0);
+    CHECK_OK(wetdem_sim_set_fluid(
+        sim, &(struct wetdem_fluid){.viscosity = 0.01, .surface_tension = 0.02, .density = 1000}));
+    char list[128];
+    snprintf(list, sizeof list, "%s", models);
+    for (char* name = strtok(list, " "); name; name = strtok(NULL, " "))
+        CHECK_OK(wetdem_sim_enable_model(sim, name));
+    if (strstr(models, "hooke"))
+        CHECK_OK(wetdem_sim_set_param(sim, "hooke.stiffness", 10));
+    double R = 1e-3, x1 = 2e-3 + 2 * R - 1e-6, x2 = x1 + 2 * R + 0.5e-6;
+    const struct wetdem_vec3 pos[HB_N] = {{2e-3, 2e-3, 5e-3},         {x1, 2e-3, 5e-3},
+                                          {x2, 2e-3, 5e-3},           {2e-3, 6e-3, 5e-3},
+                                          {4e-3 + 10e-6, 6e-3, 5e-3}, {7e-3, 2e-3, R - 1e-6},
+                                          {7e-3, 6e-3, R + 0.5e-6},   {8e-3, 8.5e-3, 8e-3}};
+    for (int k = 0; k < HB_N; k++)
+        CHECK_OK(
+            wetdem_sim_add_particle(sim, (struct wetdem_particle){.pos = pos[k], .radius = R}));
+    CHECK_OK(
+        wetdem_sim_add_wall(sim, (struct wetdem_vec3){0, 0, 0}, (struct wetdem_vec3){0, 0, 1}, 0));
+    struct wetdem_many_settings s = {.box_lo = {0, 0, 0},
+                                     .box_hi = {10e-3, 10e-3, 10e-3},
+                                     .dt = 1e-9,
+                                     .skin = 0.1e-3,
+                                     .energy_budget = true};
+    CHECK_OK(wetdem_sim_set_many(sim, &s));
+    CHECK_OK(wetdem_sim_integrate(sim, 1e-9));
+    return sim;
+}
+
+/* The contact of sphere i with sphere j >= 0, or with wall -1 - j (gap, E*, R*): the index
+ * (size_t)-1 - w of wall w in wetdem_sim_pair_force is j converted. */
+static struct wetdem_contact hb_contact(struct wetdem_sim* sim, size_t i, long j)
+{
+    struct wetdem_contact c;
+    struct wetdem_pair_force f;
+    CHECK_OK(wetdem_sim_pair_force(sim, i, (size_t)j, &c, &f));
+    return c;
+}
+
+/* The hand-built pairs in solid overlap (0-1, 5-floor) and in nijssen's blend zone (1-2,
+ * 6-floor); -1: the floor. */
+static const long hb_overlaps[2][2] = {{0, 1}, {5, -1}};
+static const long hb_blend[2][2] = {{1, 2}, {6, -1}};
+
+/* Energy stored by each model set in the hand-built configuration, by the closed forms:
+ * hertz (8/15) E* sqrt(R*) delta^(5/2) (Johnson 1985 Eq. 4.23), hooke k delta^2 / 2, nijssen's
+ * blended contact with k = (4/3) E* sqrt(R*), h_min = 2 um and d = h_min - h: (2/7) k d^(7/2) /
+ * h_min in its blend zone, (2/7) k h_min^(5/2) + (2/5) k (d^(5/2) - h_min^(5/2)) in overlap
+ * (force_nijssen.c); none for the fluid forces. */
+static double hb_expected_elastic(struct wetdem_sim* sim, const char* set)
+{
+    double e = 0, hm = 2e-6;
+    for (int b = 0; b < 2; b++) {
+        for (int o = 0; o < 2; o++) {
+            const long* q = b == 0 ? hb_overlaps[o] : hb_blend[o];
+            struct wetdem_contact c = hb_contact(sim, (size_t)q[0], q[1]);
+            double h = c.gap, k = 4.0 / 3.0 * c.e_star * sqrt(c.r_eff), d = hm - h;
+            if (strcmp(set, "nijssen") == 0)
+                e += h > 0 ? 2.0 / 7.0 * k * pow(d, 3.5) / hm
+                           : 2.0 / 7.0 * k * pow(hm, 2.5) + 0.4 * k * (pow(d, 2.5) - pow(hm, 2.5));
+            else if (b == 0 && strcmp(set, "hooke") == 0)
+                e += 0.5 * 10 * h * h;
+            else if (b == 0 && strncmp(set, "hertz", 5) == 0)
+                e += 8.0 / 15.0 * c.e_star * sqrt(c.r_eff) * pow(-h, 2.5);
+        }
+    }
+    return e;
+}
+
+/* The stored elastic energy of the budget (and of the CSV) is that of the contact models
+ * enabled: Hertz's for hertz, the spring's for hooke, nijssen's blended contact for nijssen,
+ * which holds energy at 0 < h < h_min too, and none for fluid forces alone, though spheres
+ * overlap. Tolerance 1e-12: the same closed forms, summed in another order (with pow). */
+static void test_many_elastic_energy_is_the_contact_models(void** state)
+{
+    (void)state;
+    const char* sets[] = {
+        "hertz mindlin sb capillary", "hertz", "hooke", "nijssen", "reynolds", "sb capillary"};
+    for (size_t k = 0; k < sizeof sets / sizeof sets[0]; k++) {
+        struct wetdem_sim* sim = hand_built(sets[k]);
+        struct wetdem_energy_budget b;
+        CHECK_OK(wetdem_sim_energy_budget(sim, &b));
+        double want = hb_expected_elastic(sim, sets[k]);
+        if (!(fabs(b.elastic - want) <= 1e-12 * want))
+            fail_msg("models %s: elastic %.17g J, want %.17g J", sets[k], b.elastic, want);
+        assert_true(want > 0 || strcmp(sets[k], "reynolds") == 0 ||
+                    strcmp(sets[k], "sb capillary") == 0);
+        wetdem_sim_free(sim);
+    }
+}
+
+/* The QA case of the hooke spring: a sphere (R 1 mm, 2500 kg/m^3) dropped from a gap of 50 um
+ * onto a floor, k = 10 N/m, e = 0.1, comes to rest at delta = m g / k (the damping decays as
+ * exp(-577 t / s), 1e-50 by 0.2 s). Its spring holds m^2 g^2 / (2 k) = 5.3e-10 J, and the
+ * energy dissipated is positive; with the Hertz energy counted instead (3.1e-8 J) it was
+ * negative. Tolerance 1e-9: the rest position is reached to rounding, and delta^2 doubles its
+ * relative error. */
+static void test_many_hooke_budget_dissipates(void** state)
+{
+    (void)state;
+    struct wetdem_sim* sim = wetdem_sim_create();
+    assert_int_equal(wetdem_sim_add_material(sim, &(struct wetdem_material){.density = 2500,
+                                                                            .youngs_modulus = 1e7,
+                                                                            .poisson_ratio = 0.3,
+                                                                            .restitution = 0.1}),
+                     0);
+    CHECK_OK(wetdem_sim_enable_model(sim, "hooke"));
+    CHECK_OK(wetdem_sim_set_param(sim, "hooke.stiffness", 10));
+    CHECK_OK(wetdem_sim_set_param(sim, "sim.gravity_z", -9.81));
+    CHECK_OK(wetdem_sim_add_particle(
+        sim, (struct wetdem_particle){.pos = {5e-3, 5e-3, 1.05e-3}, .radius = 1e-3}));
+    CHECK_OK(
+        wetdem_sim_add_wall(sim, (struct wetdem_vec3){0, 0, 0}, (struct wetdem_vec3){0, 0, 1}, 0));
+    CHECK_OK(wetdem_sim_set_many(sim, &(struct wetdem_many_settings){.box_lo = {0, 0, 0},
+                                                                     .box_hi = {1e-2, 1e-2, 1e-2},
+                                                                     .energy_budget = true}));
+    CHECK_OK(wetdem_sim_integrate(sim, 0.2));
+    const struct wetdem_particle* p = wetdem_sim_particles_const(sim, NULL);
+    double mg = p[0].mass * 9.81, delta = p[0].radius - p[0].pos.z;
+    struct wetdem_energy_budget b;
+    CHECK_OK(wetdem_sim_energy_budget(sim, &b));
+    CHECK_REL(delta, mg / 10, 1e-9);
+    CHECK_REL(b.elastic, 0.5 * 10 * delta * delta, 1e-12);
+    CHECK_REL(b.elastic, mg * mg / (2 * 10), 2e-9);
+    assert_true(b.dissipated > 0);
+    wetdem_sim_free(sim);
+}
+
+/* Contacts where an enabled model exerts a solid-contact force (nijssen's at 0 < h < h_min
+ * too), bridges where an enabled film model's bridge joins two spheres, and the agglomerates
+ * of those bridges, for the hand-built configuration: totals (walls counted once) and each
+ * sphere's contacts (what the VTK files give), for model sets with and without a contact and a
+ * film model. */
+static void test_many_contacts_and_bridges_follow_the_models(void** state)
+{
+    (void)state;
+    static const struct {
+        const char* models;
+        size_t contacts, bridges, agglomerates;
+        double mean;
+        uint32_t per[HB_N];
+    } cases[] = {
+        {"hertz mindlin sb capillary", 2, 3, 2, 2.5, {1, 1, 0, 0, 0, 1, 0, 0}},
+        {"hertz mindlin", 2, 0, 0, 0, {1, 1, 0, 0, 0, 1, 0, 0}}, /* dry: no bridge */
+        {"hooke", 2, 0, 0, 0, {1, 1, 0, 0, 0, 1, 0, 0}},
+        {"nijssen", 4, 0, 0, 0, {1, 2, 1, 0, 0, 1, 1, 0}}, /* contact below h_min, no bridge */
+        {"reynolds", 0, 0, 0, 0, {0}},                     /* no contact model */
+        {"sb capillary", 0, 3, 2, 2.5, {0}},
+        {"davis", 0, 3, 2, 2.5, {0}},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        struct wetdem_sim* sim = hand_built(cases[k].models);
+        struct wetdem_many_stats s;
+        CHECK_OK(wetdem_sim_many_stats(sim, &s));
+        uint32_t per[HB_N];
+        struct wetdem_many_stats t;
+        CHECK_OK(wetdem_sim_many_links(sim, per, &t));
+        if (s.contacts != cases[k].contacts || s.bridges != cases[k].bridges ||
+            s.agglomerates != cases[k].agglomerates || s.mean_agglomerate != cases[k].mean ||
+            memcmp(per, cases[k].per, sizeof per) != 0)
+            fail_msg("models %s: contacts %zu, bridges %zu, agglomerates %zu (mean %g), per "
+                     "sphere %u %u %u %u %u %u %u %u",
+                     cases[k].models, s.contacts, s.bridges, s.agglomerates, s.mean_agglomerate,
+                     per[0], per[1], per[2], per[3], per[4], per[5], per[6], per[7]);
+        wetdem_sim_free(sim);
+    }
+}
+
+/* The counts come from the state and the histories, so a restored checkpoint reports those of
+ * the run that wrote it before any step (the force pass's own marks are not in it). */
+static void test_many_counts_survive_a_restart(void** state)
+{
+    (void)state;
+    char path[] = "/tmp/wetdem_test_many_counts_XXXXXX";
+    close(mkstemp(path));
+    struct wetdem_sim* sim = wet_box(150, true);
+    CHECK_OK(wetdem_sim_integrate(sim, 1e-3));
+    CHECK_OK(wetdem_sim_write_checkpoint(sim, path));
+    struct wetdem_sim* resumed = wet_box(150, true);
+    CHECK_OK(wetdem_sim_read_checkpoint(resumed, path));
+    struct wetdem_many_stats a, b;
+    CHECK_OK(wetdem_sim_many_stats(sim, &a));
+    CHECK_OK(wetdem_sim_many_stats(resumed, &b));
+    assert_true(a.contacts > 0 && a.bridges > 0);
+    assert_int_equal(b.contacts, a.contacts);
+    assert_int_equal(b.bridges, a.bridges);
+    assert_int_equal(b.agglomerates, a.agglomerates);
+    CHECK_ABS(b.mean_agglomerate, a.mean_agglomerate, 0);
+    remove(path);
+    wetdem_sim_free(sim);
+    wetdem_sim_free(resumed);
+}
+
 static void test_many_writes_vtk_and_csv(void** state)
 {
     (void)state;
@@ -878,6 +1095,10 @@ int main(void)
         cmocka_unit_test(test_many_step_follows_the_contact_model),
         cmocka_unit_test(test_many_reach_bound_is_enforced),
         cmocka_unit_test(test_many_agglomerates_by_union_find),
+        cmocka_unit_test(test_many_elastic_energy_is_the_contact_models),
+        cmocka_unit_test(test_many_hooke_budget_dissipates),
+        cmocka_unit_test(test_many_contacts_and_bridges_follow_the_models),
+        cmocka_unit_test(test_many_counts_survive_a_restart),
         cmocka_unit_test(test_many_writes_vtk_and_csv),
         cmocka_unit_test(test_many_restart_continues_outputs),
         cmocka_unit_test(test_many_rejects_bad_settings),

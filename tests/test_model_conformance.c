@@ -706,6 +706,176 @@ static void test_conformance_viscous_laws_dissipate(void** state)
 }
 
 /* ======================================================================================== */
+/* What the engines report: stored energy, solid contact, liquid bridge                      */
+/* ======================================================================================== */
+
+/* At rest (no relative motion, no spins) and sliding only (no normal speed, no spins). */
+static const struct motion rest = {"rest", 0.0, 0.0, 0.0, {0, 0, 0}, {0, 0, 0}};
+static const struct motion slide = {"slide", 0.0, 0.2, -0.07, {0, 0, 0}, {0, 0, 0}};
+
+/* Gaps probed: overlaps, the blend zone 0 < h < h_min of nijssen (h_min = h_sigma = 1 um, or
+ * h_eps = 1.9 um for the viscous fluid) and beyond it, a film, beyond the films (100 um). */
+static const double hook_gaps[] = {-3e-6, -2e-7, 0.3e-6, 0.8e-6, 1.5e-6, 5e-6, 99e-6, 0.5e-3};
+#define N_HOOK_GAPS (sizeof hook_gaps / sizeof hook_gaps[0])
+
+/* The contact at gap h with cfg's fluid and h_min, moving as mo says. */
+static struct wetdem_contact contact_moving(const struct config* cfg, const struct motion* mo,
+                                            double h)
+{
+    struct config at = *cfg;
+    at.motion = mo;
+    return make_contact(&at, h, false);
+}
+
+/* history[] after one evaluation at gap h approaching as cfg says (nijssen records its v0). */
+static void record_history(const struct variant* v, const struct config* cfg, double h,
+                           double* history)
+{
+    memset(history, 0, MAX_HISTORY * sizeof *history);
+    struct wetdem_contact c = make_contact(cfg, h, false);
+    eval_force(v, &c, history);
+}
+
+/* The force at rest of the pair at gap h with history (copied: pair() advances it). */
+static struct wetdem_pair_force force_with(const struct variant* v, const struct wetdem_contact* c,
+                                           const double* history)
+{
+    double copy[MAX_HISTORY];
+    memcpy(copy, history, sizeof copy);
+    return eval_force(v, c, copy);
+}
+
+/* elastic_energy is the potential of the force at rest (the damping and the lubrication
+ * vanish there): -dE/dh by central differences equals F_n, with h_min as the evaluation
+ * recorded it. Step 1e-4 |h|, at least 2e-7 / 1e-4 of the distance to the nearest kink of E
+ * (0 and h_min, where dF/dh jumps), so the truncation, (eps/d)^2 times a constant below 1 for
+ * powers d^(5/2) to d^(7/2), stays below 1e-7; the cancellation of E (about |h| F) over 2 eps
+ * adds 1e-16 |h| / eps = 1e-12. Tolerance 1e-6 of F_n. */
+static void elastic_config(const struct variant* v, const struct config* cfg, void* ctx)
+{
+    size_t* n_checked = ctx;
+    if (!v->model->elastic_energy || cfg->motion != &motions[0])
+        return;
+    for (size_t g = 0; g < N_HOOK_GAPS; g++) {
+        double h = hook_gaps[g], eps = 1e-4 * fabs(h), history[MAX_HISTORY];
+        record_history(v, cfg, h, history);
+        struct wetdem_contact at = contact_moving(cfg, &rest, h);
+        struct wetdem_contact lo = contact_moving(cfg, &rest, h - eps);
+        struct wetdem_contact hi = contact_moving(cfg, &rest, h + eps);
+        double e = v->model->elastic_energy(v->params, &at, history);
+        double slope = -(v->model->elastic_energy(v->params, &hi, history) -
+                         v->model->elastic_energy(v->params, &lo, history)) /
+                       (2.0 * eps);
+        struct wetdem_pair_force f = force_with(v, &at, history);
+        if (!(fabs(slope - f.f_normal) <= 1e-6 * fabs(f.f_normal)) || !(e >= 0.0) ||
+            (e > 0.0) != (f.f_normal > 0.0))
+            fail_msg("%s [mu %g, gap %g]: stored energy %g J, -dE/dh = %.12g N, force at rest "
+                     "%.12g N",
+                     v->label, cfg->fluid->viscosity, h, e, slope, f.f_normal);
+        *n_checked += f.f_normal > 0.0;
+    }
+}
+
+static void test_conformance_elastic_energy_is_the_potential_of_the_force(void** state)
+{
+    (void)state;
+    size_t n_checked = 0;
+    assert_true(for_each_force_config(elastic_config, &n_checked) > 0);
+    /* hertz, hooke, nijssen in overlaps, nijssen in its blend zone too */
+    assert_true(n_checked >= 20);
+}
+
+/* is_in_contact says where the model exerts a solid-contact force: an elastic force at rest or
+ * a tangential one while sliding (nijssen's blend zone 0 < h < h_min included, its
+ * lubrication at rest being zero); is_bridged where the films overlap, h <= delta_ij, and
+ * nowhere without a film. Both are false beyond range(). */
+static void contact_hook_config(const struct variant* v, const struct config* cfg, void* ctx)
+{
+    size_t* n_true = ctx;
+    const struct wetdem_model* m = v->model;
+    if (cfg->motion != &motions[0])
+        return;
+    for (size_t g = 0; g < N_HOOK_GAPS; g++) {
+        double h = hook_gaps[g], history[MAX_HISTORY];
+        record_history(v, cfg, h, history);
+        struct wetdem_contact c = contact_moving(cfg, &rest, h);
+        bool beyond = h > m->range(v->params, &c);
+        if (m->is_in_contact) {
+            struct wetdem_contact sl = contact_moving(cfg, &slide, h);
+            struct wetdem_pair_force fr = force_with(v, &c, history);
+            struct wetdem_pair_force fs = force_with(v, &sl, history);
+            bool acts = fr.f_normal > 0.0 || norm(fs.f_tan) > 0.0;
+            bool says = m->is_in_contact(v->params, &c, history);
+            if (says != acts || (says && beyond))
+                fail_msg("%s [mu %g, gap %g]: is_in_contact %d, but the force at rest is %g N "
+                         "and sliding %g N",
+                         v->label, cfg->fluid->viscosity, h, says, fr.f_normal, norm(fs.f_tan));
+            *n_true += says;
+        }
+        if (m->is_bridged) {
+            bool says = m->is_bridged(v->params, &c, history);
+            if (says != (h <= c.film) || (says && beyond))
+                fail_msg("%s: is_bridged %d at gap %g with films %g m", v->label, says, h, c.film);
+            c.film = 0.0;
+            if (m->is_bridged(v->params, &c, history))
+                fail_msg("%s: bridged at gap %g without a film", v->label, h);
+            *n_true += says;
+        }
+    }
+}
+
+static void test_conformance_contact_and_bridge_hooks(void** state)
+{
+    (void)state;
+    size_t n_true = 0;
+    assert_true(for_each_force_config(contact_hook_config, &n_true) > 0);
+    assert_true(n_true > 50);
+}
+
+/* Which model has which reporting hook: a stored energy for the contacts whose elastic force
+ * has a potential (hertz, hooke, nijssen's blended contact; mindlin's spring k_t |s|^2 / 2 is
+ * none, k_t following the overlap), a solid contact for the contact models and nijssen, a
+ * liquid bridge for the film models. Every force model of the registry is listed, so that a
+ * new one decides. */
+static void test_conformance_reporting_hooks_by_model(void** state)
+{
+    (void)state;
+    static const struct {
+        const char* name;
+        bool energy, contact, bridge;
+    } want[] = {
+        {"hertz", true, true, false},      {"mindlin", false, true, false},
+        {"hooke", true, true, false},      {"nijssen", true, true, false},
+        {"reynolds", false, false, false}, {"sb", false, false, true},
+        {"db", false, false, true},        {"davis", false, false, true},
+        {"nase", false, false, true},      {"capillary", false, false, true},
+    };
+    size_t n_listed = sizeof want / sizeof want[0], n_force = 0;
+    const struct wetdem_model* const* reg = wetdem_model_registry();
+    for (size_t k = 0; reg[k]; k++) {
+        const struct wetdem_model* m = reg[k];
+        if (!is_force_model(m)) {
+            if (m->elastic_energy || m->is_in_contact || m->is_bridged)
+                fail_msg("%s: a reporting hook on a model that gives no force", m->name);
+            continue;
+        }
+        n_force++;
+        size_t w = 0;
+        while (w < n_listed && strcmp(want[w].name, m->name) != 0)
+            w++;
+        if (w == n_listed)
+            fail_msg("force model %s: say here which reporting hooks it has", m->name);
+        if ((m->elastic_energy != NULL) != want[w].energy ||
+            (m->is_in_contact != NULL) != want[w].contact ||
+            (m->is_bridged != NULL) != want[w].bridge)
+            fail_msg("%s: elastic_energy %d, is_in_contact %d, is_bridged %d; want %d %d %d",
+                     m->name, m->elastic_energy != NULL, m->is_in_contact != NULL,
+                     m->is_bridged != NULL, want[w].energy, want[w].contact, want[w].bridge);
+    }
+    assert_int_equal(n_force, n_listed);
+}
+
+/* ======================================================================================== */
 /* src/contact.c: mixing rules and kinematics                                                */
 /* ======================================================================================== */
 
@@ -973,6 +1143,9 @@ int main(void)
         cmocka_unit_test(test_conformance_continuity_at_thresholds),
         cmocka_unit_test(test_conformance_no_unreported_branch),
         cmocka_unit_test(test_conformance_viscous_laws_dissipate),
+        cmocka_unit_test(test_conformance_elastic_energy_is_the_potential_of_the_force),
+        cmocka_unit_test(test_conformance_contact_and_bridge_hooks),
+        cmocka_unit_test(test_conformance_reporting_hooks_by_model),
         cmocka_unit_test(test_conformance_contact_mixing_and_kinematics),
         cmocka_unit_test(test_conformance_wall_is_limit_of_large_fixed_sphere),
         cmocka_unit_test(test_conformance_hard_matches_davis_appendix_a_unequal),
