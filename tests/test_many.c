@@ -18,6 +18,7 @@
 #include "checkpoint.h"
 #include "harness.h"
 #include "many.h"
+#include "models.h"
 #include "vec3.h"
 
 /* The many-particle settings of wet_box's box: periodic in x and y, dt 2 us, skin 50 um. */
@@ -679,6 +680,52 @@ static void test_many_step_follows_the_contact_model(void** state)
     wetdem_sim_free(sim);
 }
 
+/* The derived step comes from the pairs that can occur (docs/many.md, Time step): a free
+ * sphere with another free one, with a fixed one, with a wall. A fixed sphere has infinite
+ * mass, so two copies of it (what "the two smallest spheres" were when a fixed sphere was the
+ * smallest) had an infinite contact time, and no step could be derived. Steel, hertz alone, a
+ * free sphere of R = 1 mm at rest with its centre 4 mm above the floor z = 0, under gravity:
+ * the speed scale is sqrt(2 g 4 mm) (the fall over the packing's height) and the step 0.02 x
+ * the Hertz contact time of the shortest pair:
+ *   - with a fixed sphere of R = 0.5 mm on the floor, and the floor: the floor's (m* = m,
+ *     R* = R; the fixed sphere's R* = R/3 gives a longer time);
+ *   - with the fixed sphere alone: that pair (m* = m, R* = 1/3 mm);
+ *   - alone (no partner at all): two copies of it (m* = m/2, R* = R/2), as if another came.
+ * 1e-12: the same formula, evaluated in the same order. */
+static void test_many_step_comes_from_the_pairs_that_occur(void** state)
+{
+    (void)state;
+    for (int k = 0; k < 3; k++) {
+        struct wetdem_sim* sim = wetdem_sim_create();
+        assert_int_equal(wetdem_sim_add_material_preset(sim, "steel1"), 0);
+        CHECK_OK(wetdem_sim_enable_model(sim, "hertz"));
+        CHECK_OK(wetdem_sim_set_param(sim, "sim.gravity_z", -9.81));
+        struct wetdem_particle ball = {.pos = {0, 0, 4e-3}, .radius = 1e-3};
+        struct wetdem_particle base = {.pos = {0, 0, 0.5e-3}, .radius = 0.5e-3, .is_fixed = true};
+        CHECK_OK(wetdem_sim_add_particle(sim, ball));
+        if (k < 2)
+            CHECK_OK(wetdem_sim_add_particle(sim, base));
+        if (k == 0)
+            CHECK_OK(wetdem_sim_add_wall(sim, (struct wetdem_vec3){0, 0, 0},
+                                         (struct wetdem_vec3){0, 0, 1}, 0));
+        CHECK_OK(wetdem_sim_set_many(sim, &(struct wetdem_many_settings){.skin = 1e-4}));
+        CHECK_OK(wetdem_sim_integrate(sim, 1e-3));
+        const struct wetdem_particle* p = wetdem_sim_particles_const(sim, NULL);
+        struct wetdem_contact c;
+        wetdem_contact_from_particles(&c, &p[0], &sim->materials[0], &p[0], &sim->materials[0],
+                                      &sim->fluid);
+        double m = p[0].mass, v = sqrt(2 * 9.81 * 4e-3);
+        double m_eff = k == 2 ? m / 2 : m, r_eff = k == 0 ? 1e-3 : k == 1 ? 1e-3 / 3 : 0.5e-3;
+        double t_c = wetdem_force_hertz_contact_time(c.e_star, r_eff, m_eff, v);
+        struct wetdem_many_stats st;
+        CHECK_OK(wetdem_sim_many_stats(sim, &st));
+        CHECK_REL(st.contact_time, t_c, 1e-12);
+        CHECK_REL(st.dt, 0.02 * t_c, 1e-12);
+        assert_true(p[0].pos.z < 4e-3); /* the free sphere falls */
+        wetdem_sim_free(sim);
+    }
+}
+
 static void test_many_reach_bound_is_enforced(void** state)
 {
     (void)state;
@@ -876,6 +923,7 @@ int main(void)
         cmocka_unit_test(test_many_matches_few_body_engine),
         cmocka_unit_test(test_many_step_stays_below_the_viscous_relaxation_time),
         cmocka_unit_test(test_many_step_follows_the_contact_model),
+        cmocka_unit_test(test_many_step_comes_from_the_pairs_that_occur),
         cmocka_unit_test(test_many_reach_bound_is_enforced),
         cmocka_unit_test(test_many_agglomerates_by_union_find),
         cmocka_unit_test(test_many_writes_vtk_and_csv),

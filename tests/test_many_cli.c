@@ -208,14 +208,19 @@ static void test_many_cli_bad_inputs_exit_2_with_file_and_line(void** state)
                11, "writes 2e+07 CSV rows over the run's 20000000 steps, more than 1e+07");
     /* a density of 1e-300 kg/m^3 makes m/c_d underflow to 0 though h_min > 0: the message
      * names the mass, not a missing h_min; 1e300 makes the Hertz contact time infinite, and
-     * a step of a quarter of the relaxation time (2e291 s) would send the spheres to inf */
+     * a step of a quarter of the relaxation time (2e291 s) would send the spheres to inf: the
+     * message names the pair that sets it (with the floor and the lid here) and the sphere */
     scenario("light.ini", "steps = 5\n");
     char* msg = expect_exit("run light.ini --set material.wet.density=1e-300", 2,
-                            "is 0 s, since the smallest sphere's mass is");
+                            "is 0 s, since the smallest free sphere's mass is");
     CHECK_CONTAINS(msg, "check the material's density and the radii");
     free(msg);
-    free(expect_exit("run light.ini --set material.wet.density=1e300 --set run.dt=0", 2,
-                     "cannot derive a time step from the contact time inf s"));
+    msg = expect_exit("run light.ini --set material.wet.density=1e300 --set run.dt=0", 2,
+                      "cannot derive a time step: the contact time of two smallest free "
+                      "spheres (the smallest free one R = 0.0004");
+    CHECK_CONTAINS(msg, ") is inf s at the speed scale ");
+    CHECK_CONTAINS(msg, "check the materials' density and youngs_modulus");
+    free(msg);
     expect_bad("mixed.ini",
                "[collision]\nspeed = 1\n[box]\nsize_x = 1e-2\nsize_y = 1e-2\nsize_z = 1e-2\n"
                "[insert]\ncount = 1\nradius = 1e-3\n[run]\nsteps = 10\n",
