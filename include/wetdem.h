@@ -637,7 +637,7 @@ struct wetdem_many_stats {
     double relaxation_time; /* shortest viscous relaxation time of the enabled models at the
                                start, or at the restored state after a checkpoint [s], which
                                dt stays below (INFINITY: nothing damps) */
-    /* shortest contact time of the pairs that can occur (the enabled models'), at the speed
+    /* shortest contact time, normal or tangential, of the pairs that can occur, at the speed
        scale, then [s]: verlet.dt_fraction multiplies it (INFINITY: no pair can touch) */
     double contact_time;
 };

@@ -195,7 +195,7 @@ struct wetdem_many {
     double dt;              /* time step [s], fixed once the many run starts */
     double relaxation_time; /* shortest viscous relaxation time at the start [s] (choose_dt),
                                or when the run was restored from a checkpoint */
-    double contact_time;    /* shortest contact time of the pairs that can occur, then [s] */
+    double contact_time;    /* shortest contact time, normal or tangential, then [s] */
     double t0;              /* time of step 0 [s] */
     uint64_t step;          /* steps since t0 */
     bool started;

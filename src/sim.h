@@ -129,6 +129,15 @@ double wetdem_sim_contact_time(const struct wetdem_sim* sim, const struct wetdem
 double wetdem_sim_relaxation_time(const struct wetdem_sim* sim, struct wetdem_contact* c,
                                   const struct wetdem_model** which);
 
+/* The time scale of the tangential oscillation of contact c [s], comparable with its normal
+ * contact time t_contact at approach speed c->v_n (c at first touch): t_contact x
+ * omega_n/omega_t, with omega^2 = k/m the enabled models' normal and tangential stiffnesses
+ * (finite differences of their forces) at the impact's largest overlap and the tangential
+ * mass (2/7) m* (both spheres spin). Below t_contact where the tangential spring (mindlin,
+ * nijssen's) is the stiffer; INFINITY where no model has one. */
+double wetdem_sim_tangential_time(const struct wetdem_sim* sim, const struct wetdem_contact* c,
+                                  double t_contact);
+
 /* Initial value of a pair's history: zeros except NAN-free defaults; writes history_len. */
 void wetdem_sim_history_init(const struct wetdem_sim* sim, double* history);
 

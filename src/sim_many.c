@@ -257,7 +257,7 @@ static void probe_pair(const struct wetdem_sim* sim, const struct step_spheres* 
 
 /* The time scales of the step at the speed scale. */
 struct step_scales {
-    double t_contact;  /* shortest contact time of the enabled models over the pairs that can
+    double t_contact;  /* shortest contact time, normal or tangential, over the pairs that can
                           occur and every material combination [s] */
     int contact_probe; /* the pair that sets it */
     double tau;        /* shortest viscous relaxation time over those pairs, for the materials
@@ -287,7 +287,8 @@ static void step_scales(const struct wetdem_sim* sim, const struct step_spheres*
                 struct wetdem_contact c;
                 probe_pair(sim, sp, probe, a, b, &c);
                 c.v_n = fmax(sp->speed, 1e-12);
-                double t = wetdem_sim_contact_time(sim, &c);
+                double t_n = wetdem_sim_contact_time(sim, &c);
+                double t = fmin(t_n, wetdem_sim_tangential_time(sim, &c, t_n));
                 if (t < s->t_contact || first) {
                     s->t_contact = t;
                     s->contact_probe = probe;
@@ -365,7 +366,7 @@ void wetdem_sim_many_time_scales(struct wetdem_sim* sim)
 }
 
 /* Step [s]: many.dt, else verlet.dt, else the shorter of verlet.dt_fraction x the shortest
- * contact time at the speed scale and a quarter of the shortest
+ * contact time (normal or tangential) at the speed scale and a quarter of the shortest
  * viscous relaxation time tau (step_scales). Velocity Verlet with the damping evaluated
  * at the predicted velocity is stable for dt < tau and dissipates within 3 % of the exact
  * rate for dt <= tau/4 (docs/many.md, Time step); a step given at or above tau is refused.
