@@ -640,6 +640,10 @@ struct wetdem_many_stats {
     /* shortest contact time, normal or tangential, of the pairs that can occur, at the speed
        scale, then [s]: verlet.dt_fraction multiplies it (INFINITY: no pair can touch) */
     double contact_time;
+    /* time in which a pair closing at the speed scale crosses the smallest gap where the
+       enabled force laws jump (h_min, below_hmin = c), then [s]: verlet.many_hmin_fraction
+       multiplies it; a longer dt crosses the jump within one step (INFINITY: none jumps) */
+    double hmin_crossing_time;
 };
 WETDEM_API int wetdem_sim_many_stats(const struct wetdem_sim* sim, struct wetdem_many_stats* s);
 

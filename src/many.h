@@ -196,6 +196,8 @@ struct wetdem_many {
     double relaxation_time; /* shortest viscous relaxation time at the start [s] (choose_dt),
                                or when the run was restored from a checkpoint */
     double contact_time;    /* shortest contact time, normal or tangential, then [s] */
+    double crossing_time;   /* time to close the smallest h_min where the force laws jump at
+                               the speed scale, then [s] (INFINITY: none jumps) */
     double t0;              /* time of step 0 [s] */
     uint64_t step;          /* steps since t0 */
     bool started;
@@ -434,7 +436,7 @@ void wetdem_sim_many_energies(const struct wetdem_sim* sim, double* kinetic, dou
 int wetdem_sim_many_prepare(struct wetdem_sim* sim);
 /* The time scales of the step for the current particles, as at the start of a run: sets
  * m->relaxation_time (what the step is held below; INFINITY when nothing damps),
- * and m->contact_time (wetdem_many_stats). */
+ * m->contact_time and m->crossing_time (wetdem_many_stats). */
 void wetdem_sim_many_time_scales(struct wetdem_sim* sim);
 
 /* sim_many_force.c */

@@ -129,6 +129,13 @@ double wetdem_sim_contact_time(const struct wetdem_sim* sim, const struct wetdem
 double wetdem_sim_relaxation_time(const struct wetdem_sim* sim, struct wetdem_contact* c,
                                   const struct wetdem_model** which);
 
+/* Smallest gap 0 < h < range [m] at which the enabled force laws of contact c (a fresh pair
+ * at approach speed c->v_n) jump: a branch gap from the models' thresholds() where the summed
+ * forces change as much across 1e-9 of it as across 1e-6 (h_min where the thin-film laws
+ * stop, below_hmin = c; not where a law is held, as reynolds', nijssen's and nc are).
+ * INFINITY if there is none. Sets h_min from the min-separation model itself. */
+double wetdem_sim_jump_gap(const struct wetdem_sim* sim, const struct wetdem_contact* c);
+
 /* The time scale of the tangential oscillation of contact c [s], comparable with its normal
  * contact time t_contact at approach speed c->v_n (c at first touch): t_contact x
  * omega_n/omega_t, with omega^2 = k/m the enabled models' normal and tangential stiffnesses

@@ -265,13 +265,14 @@ struct step_scales {
                           not refuse a step) [s] */
     const struct wetdem_model* damper; /* the model that sets tau */
     double h_at;                       /* the h_min where it does [m] */
+    double gap; /* smallest gap where the force laws jump (h_min), same pairs and materials [m] */
 };
 
 /* The time scales of the pairs of sp at its speed scale (struct step_scales). */
 static void step_scales(const struct wetdem_sim* sim, const struct step_spheres* sp,
                         struct step_scales* s)
 {
-    *s = (struct step_scales){.t_contact = INFINITY, .tau = INFINITY};
+    *s = (struct step_scales){.t_contact = INFINITY, .tau = INFINITY, .gap = INFINITY};
     /* bit 1: a particle's material, bit 2: a wall's (all of them if there is no memory) */
     unsigned char* used = calloc((size_t)sim->n_materials + 1, 1);
     for (size_t k = 0; used && k < sim->n_particles; k++)
@@ -303,6 +304,7 @@ static void step_scales(const struct wetdem_sim* sim, const struct step_spheres*
                     s->damper = which;
                     s->h_at = c.h_min;
                 }
+                s->gap = fmin(s->gap, wetdem_sim_jump_gap(sim, &c));
             }
     free(used);
 }
@@ -345,7 +347,7 @@ static void start_speed(const struct wetdem_sim* sim, struct step_spheres* sp)
 }
 
 /* The spheres and time scales of the step for the current particles, into the engine's
- * relaxation_time and contact_time too. Needs at least one particle. */
+ * relaxation_time, contact_time and crossing_time too. Needs at least one particle. */
 static void time_scales(struct wetdem_sim* sim, struct step_spheres* sp, struct step_scales* s)
 {
     struct wetdem_many* m = sim->many;
@@ -353,32 +355,35 @@ static void time_scales(struct wetdem_sim* sim, struct step_spheres* sp, struct 
     step_scales(sim, sp, s);
     m->relaxation_time = s->tau;
     m->contact_time = s->t_contact;
+    m->crossing_time = s->gap / sp->speed;
 }
 
 void wetdem_sim_many_time_scales(struct wetdem_sim* sim)
 {
     struct wetdem_many* m = sim->many;
-    m->relaxation_time = m->contact_time = INFINITY;
+    m->relaxation_time = m->contact_time = m->crossing_time = INFINITY;
     struct step_spheres sp;
     struct step_scales s;
     if (sim->n_particles > 0)
         time_scales(sim, &sp, &s);
 }
 
-/* Step [s]: many.dt, else verlet.dt, else the shorter of verlet.dt_fraction x the shortest
- * contact time (normal or tangential) at the speed scale and a quarter of the shortest
- * viscous relaxation time tau (step_scales). Velocity Verlet with the damping evaluated
- * at the predicted velocity is stable for dt < tau and dissipates within 3 % of the exact
- * rate for dt <= tau/4 (docs/many.md, Time step); a step given at or above tau is refused.
- * Without particles the step must be given. */
+/* Step [s]: many.dt, else verlet.dt, else the shortest of verlet.dt_fraction x the shortest
+ * contact time (normal or tangential) at the speed scale, a quarter of the shortest viscous
+ * relaxation time tau, and verlet.many_hmin_fraction x the time a pair closing at the speed
+ * scale takes to cross the smallest h_min where the force laws jump (step_scales). Velocity
+ * Verlet with the damping evaluated at the predicted velocity is stable for dt < tau and
+ * dissipates within 3 % of the exact rate for dt <= tau/4 (docs/many.md, Time step); a step
+ * given at or above tau is refused. Without particles the step must be given. */
 static int choose_dt(struct wetdem_sim* sim, double* dt)
 {
     struct wetdem_many* m = sim->many;
-    double fixed = 0, fraction = 0.02;
+    double fixed = 0, fraction = 0.02, many_hmin_fraction = 0.5;
     wetdem_sim_param(sim, "verlet.dt", &fixed);
     wetdem_sim_param(sim, "verlet.dt_fraction", &fraction);
+    wetdem_sim_param(sim, "verlet.many_hmin_fraction", &many_hmin_fraction);
     double given = m->set.dt > 0 ? m->set.dt : fixed;
-    m->relaxation_time = m->contact_time = INFINITY;
+    m->relaxation_time = m->contact_time = m->crossing_time = INFINITY;
     if (sim->n_particles == 0) {
         *dt = given;
         return given > 0 ? WETDEM_OK
@@ -414,7 +419,8 @@ static int choose_dt(struct wetdem_sim* sim, double* dt)
         *dt = given;
         return WETDEM_OK;
     }
-    *dt = fmin(fraction * s.t_contact, 0.25 * tau);
+    double by_gap = many_hmin_fraction > 0 ? many_hmin_fraction * m->crossing_time : INFINITY;
+    *dt = fmin(fmin(fraction * s.t_contact, 0.25 * tau), by_gap);
     /* a contact time of 0 or inf (a density or modulus near the ends of the double range)
      * resolves no contact, even where the other bounds give a finite step */
     if (!(isfinite(*dt) && *dt > 0 && isfinite(s.t_contact) && s.t_contact > 0))

@@ -100,6 +100,7 @@ int wetdem_sim_many_stats(const struct wetdem_sim* sim, struct wetdem_many_stats
     s->dt = m->dt;
     s->relaxation_time = m->relaxation_time;
     s->contact_time = m->contact_time;
+    s->hmin_crossing_time = m->crossing_time;
     s->step = m->step;
     s->seconds_kick = m->seconds_kick;
     s->seconds_forces = m->seconds_forces;

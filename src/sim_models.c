@@ -361,6 +361,52 @@ double wetdem_sim_relaxation_time(const struct wetdem_sim* sim, struct wetdem_co
     return t;
 }
 
+/* The summed normal force plus the size of the summed tangential force of the enabled models
+ * for contact c at gap h, a fresh pair [N] (NAN if a model fails). */
+static double forces_at_gap(const struct wetdem_sim* sim, struct wetdem_contact c, double h)
+{
+    struct wetdem_pair_force f;
+    c.gap = h;
+    if (wetdem_sim_eval_contact(sim, &c, NULL, &f, NULL) != WETDEM_OK)
+        return NAN;
+    return f.f_normal + vec3_norm(f.f_tan);
+}
+
+/* Change of the forces of contact c across the gap h, between h (1 + eps) and h (1 - eps) [N]. */
+static double change_across(const struct wetdem_sim* sim, const struct wetdem_contact* c, double h,
+                            double eps)
+{
+    return fabs(forces_at_gap(sim, *c, h * (1 + eps)) - forces_at_gap(sim, *c, h * (1 - eps)));
+}
+
+double wetdem_sim_jump_gap(const struct wetdem_sim* sim, const struct wetdem_contact* c)
+{
+    if (sim->history_len > 64 || sim->minsep.model->history_len > 64)
+        return INFINITY;
+    struct wetdem_contact p = *c;
+    double history[64] = {0}, gaps[WETDEM_MAX_THRESHOLDS], gap = INFINITY;
+    p.h_min = sim->minsep.model->min_separation(sim->minsep.params, &p, history);
+    double range = wetdem_sim_contact_range(sim, &p);
+    for (size_t k = 0; k < sim->n_models; k++) {
+        const struct wetdem_model_slot* s = &sim->models[k];
+        size_t n = s->model->thresholds
+                       ? s->model->thresholds(s->params, &p, history + s->history_offset, gaps)
+                       : 0;
+        for (size_t q = 0; q < n && q < WETDEM_MAX_THRESHOLDS; q++) {
+            double h = gaps[q];
+            if (!(h > 0.0 && h < range && h < gap))
+                continue;
+            /* a jump keeps its size as the interval shrinks; a law continuous at h changes
+               1000 times less from 1e-6 to 1e-9 of it (smooth), or at least 5.6 times less
+               (the steepest of the catalogue, ~(h_min - h)^1/4): the test of event.c */
+            double wide = change_across(sim, &p, h, 1e-6);
+            if (wide > 0.0 && change_across(sim, &p, h, 1e-9) >= 0.5 * wide)
+                gap = h;
+        }
+    }
+    return gap;
+}
+
 /* The normal force of the enabled models at overlap `overlap` with the surfaces at rest [N]
  * (elastic parts only: every damping and viscous term is proportional to a speed), or NAN. */
 static double force_at_rest(const struct wetdem_sim* sim, struct wetdem_contact c, double overlap)
