@@ -198,6 +198,7 @@ struct wetdem_many {
     double contact_time;    /* shortest contact time, normal or tangential, then [s] */
     double crossing_time;   /* time to close the smallest h_min where the force laws jump at
                                the speed scale, then [s] (INFINITY: none jumps) */
+    double v2_drift;        /* largest |v'|^2 of the latest drift [m^2/s^2] (after_drift) */
     double t0;              /* time of step 0 [s] */
     uint64_t step;          /* steps since t0 */
     bool started;

@@ -33,6 +33,7 @@
  */
 #include <float.h>
 #include <omp.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -555,22 +556,34 @@ static int update_wall_masks(struct wetdem_sim* sim)
 }
 
 /* Writes the engine state back to the particle records: positions, and with `motion` the
- * velocities and spins (many.h, struct wetdem_many: xr, vw). */
-static void write_back(struct wetdem_sim* sim, bool motion)
+ * velocities and spins (many.h, struct wetdem_many: xr, vw). Returns the lowest index of a
+ * particle whose state is not finite, or SIZE_MAX (with `motion`, where the records are read
+ * next: outputs, observers, callbacks, the end of a call). Finite means a finite position and
+ * finite |v|^2 + |w|^2, so that its kinetic energy is finite; checked in the same pass, on
+ * values in registers. */
+static size_t write_back(struct wetdem_sim* sim, bool motion)
 {
     struct wetdem_many* m = sim->many;
     if (!m->records_stale)
-        return;
-#pragma omp parallel for schedule(static) if (wetdem_many_parallel(m, sim->n_particles))
+        return SIZE_MAX;
+    size_t bad = SIZE_MAX; /* min is exact: the same for any thread count */
+#pragma omp parallel for schedule(static)                                                          \
+    reduction(min                                                                                  \
+              : bad) if (wetdem_many_parallel(m, sim->n_particles))
     for (size_t k = 0; k < sim->n_particles; k++) {
         struct wetdem_particle* p = &sim->particles[k];
         p->pos = vec3(m->xr[k].x, m->xr[k].y, m->xr[k].z);
         if (motion) {
             p->vel = m->vw[k][0];
             p->omega = m->vw[k][1];
+            /* 0 x inf and 0 x NaN are NaN (no -ffast-math), so the position takes part */
+            double q = vec3_dot(p->vel, p->vel) + vec3_dot(p->omega, p->omega) +
+                       0.0 * (p->pos.x + p->pos.y + p->pos.z);
+            bad = q <= DBL_MAX || k > bad ? bad : k;
         }
     }
     m->records_stale = !motion;
+    return bad;
 }
 
 /* Writes the engine's positions back to the particle records (before a list build). */
@@ -579,10 +592,11 @@ static void sync_positions(struct wetdem_sim* sim)
     write_back(sim, false);
 }
 
-/* Writes the whole engine state back to the particle records (before anything reads them). */
-static void sync_records(struct wetdem_sim* sim)
+/* Writes the whole engine state back to the particle records (before anything reads them);
+ * returns write_back's lowest index of a particle whose state is not finite, or SIZE_MAX. */
+static size_t sync_records(struct wetdem_sim* sim)
 {
-    write_back(sim, true);
+    return write_back(sim, true);
 }
 
 /* The largest of m and the magnitudes of the components of x (comparisons: no call). */
@@ -926,6 +940,7 @@ static void after_drift(struct wetdem_sim* sim, double h, double v2_max)
 {
     struct wetdem_many* m = sim->many;
     bool track = m->cl.n_builds > 0 && m->cl.n_at_build == sim->n_particles;
+    m->v2_drift = v2_max; /* (one_step stops the run where it is not finite) */
     m->sums_zeroed = sim->n_particles;
     m->records_stale = true;
     m->max_disp_valid = track;
@@ -1086,6 +1101,43 @@ static int start(struct wetdem_sim* sim)
     return timed_outputs(sim, false, false);
 }
 
+/* The lowest index of a free particle whose half-step velocity v' of the latest drift has a
+ * |v'|^2 that is not finite (after_drift found one; a fixed particle does not drift). */
+static size_t first_diverged_drift(const struct wetdem_sim* sim)
+{
+    const struct wetdem_many* m = sim->many;
+    for (size_t k = 0; k < sim->n_particles; k++)
+        if (!m->fixed[k] && !(vec3_dot(m->vh[k], m->vh[k]) <= DBL_MAX))
+            return k;
+    return 0;
+}
+
+/* Stops the run at particle k, the first whose motion is not finite: with `drift`, its
+ * half-step velocity v' (the largest |v'|^2 of the drift overflowed), else its position, or
+ * |v|^2 + |w|^2 (its kinetic energy would overflow). Returns WETDEM_ERR_NUMERIC with a message
+ * naming the step, the time and the particle; no output of that step is written, and the
+ * particle records hold the state reached. */
+static int diverged(struct wetdem_sim* sim, size_t k, bool drift)
+{
+    const struct wetdem_many* m = sim->many;
+    struct wetdem_vec3 v = drift ? m->vh[k] : m->vw[k][0], w = m->vw[k][1];
+    double ratio = m->dt / m->contact_time;
+    char hint[200];
+    if (ratio > WETDEM_MANY_CONTACT_FRACTION_MAX)
+        snprintf(hint, sizeof hint,
+                 "the step dt = %g s is %.3g x the contact time %g s, above %g x: lower it", m->dt,
+                 ratio, m->contact_time, WETDEM_MANY_CONTACT_FRACTION_MAX);
+    else
+        snprintf(hint, sizeof hint, "lower the step dt = %g s, or check the forces", m->dt);
+    return wetdem_sim_fail(sim, WETDEM_ERR_NUMERIC,
+                           "many: the motion diverged in step %llu (t = %.9g s): particle %zu "
+                           "has a %s that is not finite (x = (%g, %g, %g) m, v = (%g, %g, %g) "
+                           "m/s, w = (%g, %g, %g) rad/s); %s",
+                           (unsigned long long)m->step, sim->engine.time, k,
+                           drift ? "velocity" : "position, velocity or spin", m->xr[k].x,
+                           m->xr[k].y, m->xr[k].z, v.x, v.y, v.z, w.x, w.y, w.z, hint);
+}
+
 static int one_step(struct wetdem_sim* sim, bool defer);
 
 /* Stop flag, progress callback. Returns WETDEM_EVENT to stop (checkpoint written). */
@@ -1105,7 +1157,9 @@ static int poll_stop(struct wetdem_sim* sim, unsigned long long done, unsigned l
             return st;
     }
     finish_kick(sim); /* a stop flag raised during a deferred step */
-    sync_records(sim);
+    size_t bad = sync_records(sim);
+    if (bad != SIZE_MAX) /* (no checkpoint of a state no run can continue) */
+        return diverged(sim, bad, false);
     if (m->checkpoint_path) {
         int st = wetdem_sim_write_checkpoint(sim, m->checkpoint_path);
         if (st != WETDEM_OK)
@@ -1162,6 +1216,8 @@ static int one_step(struct wetdem_sim* sim, bool defer)
     m->step++;
     sim->engine.time = m->t0 + (double)m->step * m->dt; /* no accumulated round-off */
     sim->engine.t_committed = sim->engine.time;
+    if (!(m->v2_drift <= DBL_MAX)) /* the largest |v'|^2 of the drift: one test a step */
+        return diverged(sim, first_diverged_drift(sim), true);
     bool step = defer && !m->no_drift_in_pass && !(m->set.stop_flag && *m->set.stop_flag);
     int st = forces_and_work(sim, !defer ? WETDEM_MANY_END_KICK
                                   : step ? WETDEM_MANY_END_STEP
@@ -1172,8 +1228,9 @@ static int one_step(struct wetdem_sim* sim, bool defer)
     if (st != WETDEM_OK)
         return st;
     m->kick_pending = defer && !m->drifted;
-    if (!defer) /* the state is read after this step */
-        sync_records(sim);
+    size_t bad = defer ? SIZE_MAX : sync_records(sim); /* the state is read after this step */
+    if (bad != SIZE_MAX)
+        return diverged(sim, bad, false);
     sim->engine.stats.steps++;
     return timed_outputs(sim, false, true);
 }

@@ -9,6 +9,7 @@
  * outputs, lists rebuilt at the same steps with the displacement bound, callbacks see the
  * current state, the wall time by phase adds up.
  */
+#include <float.h>
 #include <math.h>
 #include <omp.h>
 #include <stdlib.h>
@@ -832,6 +833,53 @@ static void test_many_step_resolves_the_tangential_spring(void** state)
     wetdem_sim_free(sim);
 }
 
+/* Sums |v|^2 + |w|^2 over the particles: a progress callback that fails if a state it is shown
+ * is not finite (the divergence must stop the run before). */
+static int expect_finite_state(unsigned long long done, unsigned long long total, double elapsed,
+                               void* ctx)
+{
+    (void)total;
+    (void)elapsed;
+    size_t n;
+    const struct wetdem_particle* p = wetdem_sim_particles_const(ctx, &n);
+    for (size_t k = 0; k < n; k++)
+        if (!(vec3_dot(p[k].vel, p[k].vel) + vec3_dot(p[k].omega, p[k].omega) <= DBL_MAX &&
+              vec3_is_finite(p[k].pos)))
+            fail_msg("after step %llu particle %zu is shown a state that is not finite", done, k);
+    return 0;
+}
+
+/* A given step far above the contact time (3e-4 s for the dry gas of wet_box, whose contacts
+ * last some 4e-5 s) is taken as given, and the stats say how far above (the CLI warns above
+ * WETDEM_MANY_CONTACT_FRACTION_MAX); the motion then diverges, and the run stops at the first
+ * step whose velocities are not finite, with WETDEM_ERR_NUMERIC naming that step, its time and
+ * the particle, before any callback or output sees the state. Before, it ran to its end with
+ * an infinite kinetic energy. */
+static void test_many_divergence_stops_the_run(void** state)
+{
+    (void)state;
+    struct wetdem_sim* sim = wet_box(150, false);
+    struct wetdem_many_settings s = box_settings();
+    s.dt = 3e-4;
+    s.progress = expect_finite_state;
+    s.progress_ctx = sim;
+    s.progress_every = 1;
+    CHECK_OK(wetdem_sim_set_many(sim, &s));
+    CHECK_STATUS(wetdem_sim_integrate(sim, 0.1), WETDEM_ERR_NUMERIC);
+    const char* msg = wetdem_sim_errmsg(sim);
+    CHECK_CONTAINS(msg, "many: the motion diverged in step ");
+    CHECK_CONTAINS(msg, " s): particle ");
+    CHECK_CONTAINS(msg, "x the contact time");
+    struct wetdem_many_stats st;
+    CHECK_OK(wetdem_sim_many_stats(sim, &st));
+    assert_true(st.dt / st.contact_time > 5 * WETDEM_MANY_CONTACT_FRACTION_MAX);
+    assert_true(st.step > 1 && st.step < 333); /* stopped early */
+    char at[64];
+    snprintf(at, sizeof at, "diverged in step %llu (t = ", (unsigned long long)st.step);
+    CHECK_CONTAINS(msg, at);
+    wetdem_sim_free(sim);
+}
+
 static void test_many_reach_bound_is_enforced(void** state)
 {
     (void)state;
@@ -1032,6 +1080,7 @@ int main(void)
         cmocka_unit_test(test_many_step_comes_from_the_pairs_that_occur),
         cmocka_unit_test(test_many_step_resolves_hmin),
         cmocka_unit_test(test_many_step_resolves_the_tangential_spring),
+        cmocka_unit_test(test_many_divergence_stops_the_run),
         cmocka_unit_test(test_many_reach_bound_is_enforced),
         cmocka_unit_test(test_many_agglomerates_by_union_find),
         cmocka_unit_test(test_many_writes_vtk_and_csv),

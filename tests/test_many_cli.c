@@ -24,6 +24,7 @@
  * thread is the fastest for 150 spheres on a shared machine) and the passive wait policy.
  */
 #include <fcntl.h>
+#include <math.h>
 #include <pty.h>
 #include <signal.h>
 #include <stdlib.h>
@@ -646,7 +647,9 @@ static void test_many_cli_summary_mean_size_readable(void** state)
 static void test_many_cli_progress_only_on_a_terminal(void** state)
 {
     (void)state;
-    scenario("progress.ini", "");
+    /* (many_hmin_fraction = 0: the given step lets pairs cross h_min within a step, which the
+       run would warn about on stderr, test_many_cli_warns_about_the_step) */
+    scenario("progress.ini", "[integrator]\nmany_hmin_fraction = 0\n");
     assert_int_equal(run_cli("run progress.ini --set run.steps=200"), 0);
     char* err = stderr_text();
     assert_string_equal(err, "");
@@ -770,6 +773,78 @@ static void test_many_cli_examples_and_budget(void** state)
     free(off_json);
 }
 
+/* Counts the lines of a file that start with a digit (the rows of a CSV); *finite: whether
+ * every field of those rows is a finite number. */
+static size_t count_rows_finite(const char* name, bool* finite)
+{
+    char* text = test_read_file(tpath(name), NULL);
+    assert_non_null(text);
+    size_t rows = 0;
+    *finite = true;
+    for (char* line = strtok(text, "\n"); line; line = strtok(NULL, "\n")) {
+        if (!(line[0] >= '0' && line[0] <= '9'))
+            continue;
+        rows++;
+        for (char *p = line, *end; *p; p = *end ? end + 1 : end) {
+            double v = strtod(p, &end);
+            *finite = *finite && isfinite(v) && end != p;
+        }
+    }
+    free(text);
+    return rows;
+}
+
+/* A step that does not resolve what the run meets is warned about on stderr (the library
+ * gives the time scales in wetdem_many_stats): the base scenario's given 2 us lets a pair at
+ * its speed scale (2 m/s) travel several times h_min = 1 um in a step; many_hmin_fraction = 0 turns
+ * that bound and its warning off, and the derived step keeps to the bound. A step of 0.3 ms,
+ * some 8 x the contact time of the dry spheres, is warned about and diverges: the run stops
+ * at the first step whose motion is not finite with exit 1, naming the step, the time and
+ * the particle, and every CSV row and VTK frame written before is of a finite state (one of
+ * each for the start and every step done; no summary). Before, it ran to its end with an
+ * infinite kinetic energy. */
+static void test_many_cli_warns_about_the_step(void** state)
+{
+    (void)state;
+    scenario("warn.ini", "steps = 300\n");
+    char* err = expect_exit("run warn.ini --check", 0, "wetdem: warning: warn.ini: in one step");
+    CHECK_CONTAINS(err, "x the smallest h_min where the force laws jump");
+    assert_null(strstr(err, "contact time"));
+    free(err);
+    const char* quiet[] = {"--set integrator.many_hmin_fraction=0", "--set run.dt=0"};
+    for (int k = 0; k < 2; k++) {
+        char args[200];
+        snprintf(args, sizeof args, "run warn.ini --check %s", quiet[k]);
+        assert_int_equal(run_cli(args), 0);
+        err = stderr_text();
+        assert_string_equal(err, "");
+        free(err);
+    }
+
+    err = expect_exit("run warn.ini --set 'models.force=hertz mindlin' --set run.dt=3e-4 "
+                      "--set dump.vtk_every=1 --set dump.csv_every=1 "
+                      "--out div",
+                      1, "wetdem: warning: warn.ini: the step dt = 0.0003 s is ");
+    CHECK_CONTAINS(err, "x the contact time");
+    CHECK_CONTAINS(err, "many: the motion diverged in step ");
+    const char* at = strstr(err, "diverged in step ");
+    unsigned long long step = strtoull(at + strlen("diverged in step "), NULL, 10);
+    char where[80];
+    snprintf(where, sizeof where, "in step %llu (t = %.9g s): particle ", step, 3e-4 * step);
+    CHECK_CONTAINS(err, where);
+    free(err);
+    assert_true(step > 1 && step < 300);
+    bool finite;
+    assert_int_equal(count_rows_finite("div/global.csv", &finite), step);
+    assert_true(finite);
+    char frame[64];
+    snprintf(frame, sizeof frame, "div/particles_%06llu.vtk", step - 1);
+    assert_true(exists(frame));
+    snprintf(frame, sizeof frame, "div/particles_%06llu.vtk", step);
+    assert_false(exists(frame));
+    assert_false(exists("div/summary.json"));
+}
+
 static int setup(void** state)
 {
     (void)state;
@@ -798,6 +873,7 @@ int main(void)
         cmocka_unit_test(test_many_cli_progress_only_on_a_terminal),
         cmocka_unit_test(test_many_cli_random_groups_share_the_box),
         cmocka_unit_test(test_many_cli_examples_and_budget),
+        cmocka_unit_test(test_many_cli_warns_about_the_step),
     };
     return cmocka_run_group_tests(tests, setup, getenv("WETDEM_KEEP_TMP") ? NULL : teardown);
 }
