@@ -443,8 +443,9 @@ static double closure_ratio(const struct wetdem_energy_budget* b)
 }
 
 /* Beyond this ratio the integration is not what the budget's O(dt^2) error allows: the step is
- * too long for the contacts (the example scenarios close to 1e-4 to 7e-3, dt_fraction 0.05;
- * the settling example gives 9e-4 at 0.1, 0.09 at 0.2, 0.35 at 0.3 and 4.6 at 0.5). */
+ * too long for the contacts (the example scenarios close to 5e-5 to 3e-3, dt_fraction 0.05;
+ * the settling example gives 6e-4 at 6.6 us, 1.4e-3 at 9.7 us and 0.93 at 19 us, 0.12, 0.17
+ * and 0.33 of its contact time). */
 #define CLOSURE_LIMIT 0.05
 
 /* Whether the budget of the run (has_budget) is beyond CLOSURE_LIMIT, also when its error is
@@ -463,6 +464,45 @@ static bool dt_held_by_relaxation(const struct wetdem_many_stats* s)
     return s->dt == 0.25 * s->relaxation_time;
 }
 
+/* verlet.many_hmin_fraction of the run (the library's default if it cannot be read). */
+static double many_hmin_fraction(const struct wetdem_sim* sim)
+{
+    double f = 0.5;
+    wetdem_sim_param(sim, "verlet.many_hmin_fraction", &f);
+    return f;
+}
+
+/* Whether the run's step is the one a derived step is held to by the distance a pair at the
+ * speed scale travels per step: many_hmin_fraction x the h_min crossing time (docs/many.md). */
+static bool dt_held_by_gap(const struct wetdem_sim* sim, const struct wetdem_many_stats* s)
+{
+    return s->dt == many_hmin_fraction(sim) * s->hmin_crossing_time;
+}
+
+/* Warns on stderr when the step does not resolve what the run meets (docs/many.md, Time
+ * step): above WETDEM_MANY_CONTACT_FRACTION_MAX of the contact time, where velocity Verlet
+ * loses the contacts' restitution and then diverges; or longer than the time a pair at the
+ * speed scale takes to cross the h_min where the force laws jump, so that the jump falls
+ * within one step (unless many_hmin_fraction = 0 turned that bound off). */
+static void warn_step(const struct cli_scenario* sc, const struct cli_many_setup* su,
+                      const struct wetdem_many_stats* s)
+{
+    double ratio = s->dt / s->contact_time;
+    if (ratio > WETDEM_MANY_CONTACT_FRACTION_MAX)
+        cli_error("warning: %s: the step dt = %.4g s is %.3g x the contact time %.4g s (the "
+                  "shortest, normal or tangential, at the speed scale), above %g x: the "
+                  "contacts are not resolved, and from about 0.5 x the motion diverges; lower "
+                  "dt or dt_fraction (docs/many.md, Time step)",
+                  sc->file, s->dt, ratio, s->contact_time, WETDEM_MANY_CONTACT_FRACTION_MAX);
+    if (s->dt > s->hmin_crossing_time && many_hmin_fraction(su->sim) != 0)
+        cli_error("warning: %s: in one step dt = %.4g s a pair closing at the speed scale "
+                  "travels %.3g x the smallest h_min where the force laws jump (crossed in "
+                  "%.4g s): the jump falls within a step, which can shift a collision's "
+                  "restitution by 10 %% or more; lower dt (a derived step takes at most "
+                  "[integrator] many_hmin_fraction of it: docs/many.md, Time step)",
+                  sc->file, s->dt, s->dt / s->hmin_crossing_time, s->hmin_crossing_time);
+}
+
 static void summary_text(FILE* f, const struct cli_many_setup* su, const struct outcome* o)
 {
     const struct wetdem_many_stats* s = &o->stats;
@@ -476,6 +516,11 @@ static void summary_text(FILE* f, const struct cli_many_setup* su, const struct 
                 "                   (dt held at a quarter of the viscous relaxation time "
                 "%.4g s: docs/many.md, Time step)\n",
                 s->relaxation_time);
+    else if (dt_held_by_gap(su->sim, s))
+        fprintf(f,
+                "                   (dt held at %g of the time %.4g s a pair at the speed "
+                "scale takes to cross h_min: docs/many.md, Time step)\n",
+                many_hmin_fraction(su->sim), s->hmin_crossing_time);
     fprintf(f, "contacts           %zu\nliquid bridges     %zu\n", s->contacts, s->bridges);
     /* a mean of whole sizes: "2000", not %g's "2e+03"; below 1000 four digits at most */
     fprintf(f,
@@ -616,6 +661,7 @@ static int dry_start(const struct cli_scenario* sc, struct cli_many_setup* su, s
         return cli_many_report_start(sc, wetdem_sim_errmsg(su->sim));
     struct wetdem_many_stats s;
     wetdem_sim_many_stats(su->sim, &s);
+    warn_step(sc, su, &s);
     pl->dt = s.dt;
     /* the library takes ceil((t_end - t)/dt) steps on the grid t = k dt */
     pl->t_end = su->steps ? (double)su->steps * s.dt : su->t_end;
@@ -653,10 +699,14 @@ static void print_check_json(const struct cli_scenario* sc, const struct cli_man
         printf("%s", k ? ", " : "");
         cli_json_string(stdout, wetdem_sim_model(su->sim, k)->name);
     }
-    if (isfinite(s->relaxation_time))
-        printf("], \"relaxation_time_s\": %.17g}\n", s->relaxation_time);
-    else
-        printf("], \"relaxation_time_s\": null}\n");
+    printf("], ");
+    const char* key[3] = {"relaxation_time_s", "contact_time_s", "hmin_crossing_time_s"};
+    double value[3] = {s->relaxation_time, s->contact_time, s->hmin_crossing_time};
+    for (int k = 0; k < 3; k++) /* (INFINITY: nothing damps, touches or crosses an h_min) */
+        if (isfinite(value[k]))
+            printf("\"%s\": %.17g%s", key[k], value[k], k < 2 ? ", " : "}\n");
+        else
+            printf("\"%s\": null%s", key[k], k < 2 ? ", " : "}\n");
 }
 
 static void print_check(const struct cli_scenario* sc, const struct cli_many_setup* su,
@@ -676,10 +726,20 @@ static void print_check(const struct cli_scenario* sc, const struct cli_many_set
            su->many.periodic[2] ? "z" : "",
            su->many.periodic[0] || su->many.periodic[1] || su->many.periodic[2] ? "" : "none");
     printf("  dt            %.6g s\n", pl->dt);
+    if (isfinite(s.contact_time))
+        printf("  contact time  %.6g s  (shortest, normal or tangential, at the speed scale; "
+               "dt is %.3g of it)\n",
+               s.contact_time, pl->dt / s.contact_time);
     if (isfinite(s.relaxation_time))
         printf("  relaxation    %.6g s  (shortest viscous relaxation time; dt %s)\n",
                s.relaxation_time,
                dt_held_by_relaxation(&s) ? "held at a quarter of it" : "stays below it");
+    if (isfinite(s.hmin_crossing_time))
+        printf("  h_min crossed %.6g s  (by a pair at the speed scale; dt %s)\n",
+               s.hmin_crossing_time,
+               dt_held_by_gap(su->sim, &s)      ? "held at many_hmin_fraction of it"
+               : pl->dt <= s.hmin_crossing_time ? "stays below it"
+                                                : "exceeds it");
     printf("  t_end         %.6g s\n  steps         %llu\n", pl->t_end, pl->total);
     printf("  vtk_every     %llu\n  csv_every     %llu\n  contacts      %zu  (bridges %zu) at "
            "t = 0\n  models       ",

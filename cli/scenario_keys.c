@@ -111,6 +111,10 @@ static const struct cli_key_desc integrator_keys[] = {
         "verlet: when > 0, the step is also held at or below hmin_fraction x h_min / v, so that "
         "the gap moves at most that fraction of h_min per step (0.1 resolves it; "
         "docs/engines.md); 0: off."),
+    NUM("many_hmin_fraction", "-", NULL, 0, 1, false, false,
+        "verlet, many-particle runs: a derived step is held at or below many_hmin_fraction x "
+        "h_min / v, so that a pair closing at the speed scale moves at most that fraction of "
+        "h_min per step; 0: off, with no warning about h_min (docs/many.md, Time step)."),
     COUNT("max_steps", NULL, 1, 1e12, "verlet and cvode: most steps one integration may take."),
     NUM("rtol", "-", NULL, 1e-14, 1e-4, false, false, "cvode: relative tolerance."),
     NUM("atol", "-", NULL, 1e-16, 1e-4, false, false,

@@ -109,10 +109,13 @@ static const struct cli_key_desc run_keys[] = {
         "Simulated time of the run, at most 1e15 steps of dt."),
     COUNT("steps", "give t_end or steps", 1, 1e15, "Number of time steps."),
     NUM("dt", "s", "0 ([integrator] dt, else dt_fraction)", 0, 1, false, false,
-        "Time step; 0: [integrator] dt, else dt_fraction x the contact time of the two "
-        "smallest spheres at twice the largest speed plus the speed gravity adds over the "
-        "packing height, at most a quarter of the viscous relaxation time (docs/many.md). A "
-        "step at or above that time is refused. Fixed for the run."),
+        "Time step; 0: [integrator] dt, else dt_fraction x the shortest contact time, normal or "
+        "tangential, of the pairs that can occur (free spheres with the smallest free sphere, "
+        "fixed spheres, walls) at twice the largest speed plus the speed gravity adds over the "
+        "packing height, at most a quarter of the viscous relaxation time and the time to "
+        "travel many_hmin_fraction x h_min at that speed (docs/many.md). A step at or above the "
+        "relaxation time is refused; one above 0.1 x the contact time is warned about. Fixed "
+        "for the run."),
     NUM("skin", "m", "0 (0.1 x smallest radius)", 0, 1, false, false,
         "Verlet skin of the neighbour lists."),
     WORD("energy_budget", CLI_VALUE_CHOICE, "yes", cli_yes_no,

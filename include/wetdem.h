@@ -654,7 +654,21 @@ struct wetdem_many_stats {
     double relaxation_time; /* shortest viscous relaxation time of the enabled models at the
                                start, or at the restored state after a checkpoint [s], which
                                dt stays below (INFINITY: nothing damps) */
+    /* shortest contact time, normal or tangential, of the pairs that can occur, at the speed
+       scale, then [s]: verlet.dt_fraction multiplies it; a dt above
+       WETDEM_MANY_CONTACT_FRACTION_MAX of it does not resolve the contacts (INFINITY: no pair
+       can touch) */
+    double contact_time;
+    /* time in which a pair closing at the speed scale crosses the smallest gap where the
+       enabled force laws jump (h_min, below_hmin = c), then [s]: verlet.many_hmin_fraction
+       multiplies it; a longer dt crosses the jump within one step (INFINITY: none jumps) */
+    double hmin_crossing_time;
 };
+/* The largest step, as a fraction of wetdem_many_stats.contact_time, that resolves the
+ * contacts: velocity Verlet is unstable for a Hertz contact from about 0.5 of it, and a dry
+ * Hertz impact's restitution is off by 0.1 % at 0.1 and 0.9 % at 0.2 (docs/many.md, Time
+ * step). `wetdem run` warns above it, and above hmin_crossing_time. */
+#define WETDEM_MANY_CONTACT_FRACTION_MAX 0.1
 WETDEM_API int wetdem_sim_many_stats(const struct wetdem_sim* sim, struct wetdem_many_stats* s);
 
 /* Writes the particles as a legacy VTK file (radius, velocity, spin, contacts as in

@@ -39,10 +39,11 @@
 #include "vec3.h"
 
 struct verlet_params {
-    double dt;            /* fixed step [s]; 0: from dt_fraction */
-    double dt_fraction;   /* step as a fraction of the contact time [-] */
-    double max_steps;     /* most steps one integrate call may take [-] */
-    double hmin_fraction; /* > 0: gap change per step at most this fraction of h_min [-] */
+    double dt;                 /* fixed step [s]; 0: from dt_fraction */
+    double dt_fraction;        /* step as a fraction of the contact time [-] */
+    double max_steps;          /* most steps one integrate call may take [-] */
+    double hmin_fraction;      /* > 0: gap change per step at most this fraction of h_min [-] */
+    double many_hmin_fraction; /* many-particle mode: the same, 0.5 by default [-] */
 };
 
 _Static_assert(sizeof(struct verlet_params) <= WETDEM_INTEGRATOR_PARAMS_MAX * sizeof(double),
@@ -62,6 +63,12 @@ static const struct wetdem_param_desc verlet_params_desc[] = {
      "smallest branch gap of the force laws inside their range, v: the speed scale), so that "
      "the gap moves at most that fraction of h_min per step; 0: off (dt_fraction alone).",
      P(hmin_fraction), 0.0, 0.0, 1.0, false, false, NULL, false},
+    {"many_hmin_fraction", "-",
+     "Many-particle mode: the derived step is held at or below many_hmin_fraction x h_min / v "
+     "(h_min: the smallest gap inside the range of the force laws where they jump, v: the speed "
+     "scale; the two-body engine's hmin_fraction, on by default here); 0: off (docs/many.md, "
+     "Time step).",
+     P(many_hmin_fraction), 0.5, 0.0, 1.0, false, false, NULL, false},
     {0},
 };
 #undef P

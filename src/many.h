@@ -197,6 +197,10 @@ struct wetdem_many {
     double dt;              /* time step [s], fixed once the many run starts */
     double relaxation_time; /* shortest viscous relaxation time at the start [s] (choose_dt),
                                or when the run was restored from a checkpoint */
+    double contact_time;    /* shortest contact time, normal or tangential, then [s] */
+    double crossing_time;   /* time to close the smallest h_min where the force laws jump at
+                               the speed scale, then [s] (INFINITY: none jumps) */
+    double v2_drift;        /* largest |v'|^2 of the latest drift [m^2/s^2] (after_drift) */
     double t0;              /* time of step 0 [s] */
     uint64_t step;          /* steps since t0 */
     bool started;
@@ -449,9 +453,10 @@ void wetdem_sim_many_energies(const struct wetdem_sim* sim, double* kinetic, dou
 /* Makes sure the pair list, histories and per-particle arrays fit the current particles
  * (builds the cell list when needed). */
 int wetdem_sim_many_prepare(struct wetdem_sim* sim);
-/* The shortest viscous relaxation time of the enabled models for the current particles [s]
- * (what the step is held below; INFINITY when nothing damps), as at the start of a run. */
-double wetdem_sim_many_relaxation_time(const struct wetdem_sim* sim);
+/* The time scales of the step for the current particles, as at the start of a run: sets
+ * m->relaxation_time (what the step is held below; INFINITY when nothing damps),
+ * m->contact_time and m->crossing_time (wetdem_many_stats). */
+void wetdem_sim_many_time_scales(struct wetdem_sim* sim);
 
 /* sim_many_force.c */
 /* Builds the material-pair table and chooses the kernel (fused or generic); needs m->reach

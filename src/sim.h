@@ -140,6 +140,21 @@ bool wetdem_sim_contact_is_in_contact(const struct wetdem_sim* sim, const struct
                                       const double* history);
 bool wetdem_sim_contact_is_bridged(const struct wetdem_sim* sim, const struct wetdem_contact* c,
                                    const double* history);
+/* Smallest gap 0 < h < range [m] at which the enabled force laws of contact c (a fresh pair
+ * at approach speed c->v_n) jump: a branch gap from the models' thresholds() where the summed
+ * forces change as much across 1e-9 of it as across 1e-6 (h_min where the thin-film laws
+ * stop, below_hmin = c; not where a law is held, as reynolds', nijssen's and nc are).
+ * INFINITY if there is none. Sets h_min from the min-separation model itself. */
+double wetdem_sim_jump_gap(const struct wetdem_sim* sim, const struct wetdem_contact* c);
+
+/* The time scale of the tangential oscillation of contact c [s], comparable with its normal
+ * contact time t_contact at approach speed c->v_n (c at first touch): t_contact x
+ * omega_n/omega_t, with omega^2 = k/m the enabled models' normal and tangential stiffnesses
+ * (finite differences of their forces) at the impact's largest overlap and the tangential
+ * mass (2/7) m* (both spheres spin). Below t_contact where the tangential spring (mindlin,
+ * nijssen's) is the stiffer; INFINITY where no model has one. */
+double wetdem_sim_tangential_time(const struct wetdem_sim* sim, const struct wetdem_contact* c,
+                                  double t_contact);
 
 /* Initial value of a pair's history: zeros except NAN-free defaults; writes history_len. */
 void wetdem_sim_history_init(const struct wetdem_sim* sim, double* history);

@@ -33,6 +33,7 @@
  */
 #include <float.h>
 #include <omp.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -200,98 +201,190 @@ static void probe_spheres(const struct wetdem_sim* sim, struct wetdem_particle p
     wetdem_contact_from_particles(c, &p, &sim->materials[a], &q, &sim->materials[b], &sim->fluid);
 }
 
-/* The time scales of the step at approach speed v: *t_contact, the shortest impact duration
- * of two smallest spheres or of one and a wall over every material combination (the enabled
- * models' contact times, else Hertz's); *tau, the shortest viscous relaxation time of the
- * pairs where it is shortest (a smallest sphere with a smallest and with a largest one, and
- * with a wall if there is one), over the materials the particles and walls carry (a material
- * no sphere uses must not refuse a step), *damper the model and *h_at the gap that set it. */
-static void step_scales(const struct wetdem_sim* sim, struct wetdem_particle small,
-                        struct wetdem_particle big, double v, double* t_contact, double* tau,
-                        const struct wetdem_model** damper, double* h_at)
+/* ---- the time step (docs/many.md, Time step) ---- */
+
+/* The spheres the step is derived from: a smallest and a largest free sphere, a smallest and
+ * a largest fixed one (is_fixed: infinite mass), how many of each, and the speed scale. */
+struct step_spheres {
+    struct wetdem_particle small, big, fixed_small, fixed_big;
+    size_t n_free, n_fixed;
+    double speed; /* [m/s] */
+};
+
+/* The pairs that can occur, each probed with a smallest free sphere: with a smallest and with
+ * a largest free sphere, with a smallest and a largest fixed one (the largest has the larger
+ * R*, so the shorter contact and relaxation times; the smallest the smaller h_min), and with
+ * a wall. A fixed sphere never meets a fixed one or a wall: it does not move. */
+enum step_probe {
+    PROBE_FREE_SMALL,
+    PROBE_FREE_BIG,
+    PROBE_FIXED_SMALL,
+    PROBE_FIXED_BIG,
+    PROBE_WALL,
+    N_PROBES
+};
+
+static const char* const probe_names[N_PROBES] = {
+    "two smallest free spheres", "a smallest and a largest free sphere",
+    "a smallest free sphere and a smallest fixed one",
+    "a smallest free sphere and a largest fixed one", "a smallest free sphere and a wall"};
+
+/* Whether the pairs of `probe` can occur. When none can (a lone free sphere, or only fixed
+ * ones), the step is that of two copies of a smallest sphere, as if another could come. */
+static bool probe_occurs(const struct wetdem_sim* sim, const struct step_spheres* sp, int probe)
 {
-    *t_contact = *tau = INFINITY;
-    *damper = NULL;
-    *h_at = 0;
+    bool free_pairs = sp->n_free >= 2, fixed = sp->n_free >= 1 && sp->n_fixed >= 1,
+         wall = sp->n_free >= 1 && sim->n_walls >= 1;
+    switch (probe) {
+    case PROBE_FREE_SMALL: return free_pairs || !(fixed || wall);
+    case PROBE_FREE_BIG: return free_pairs;
+    case PROBE_FIXED_SMALL:
+    case PROBE_FIXED_BIG: return fixed;
+    default: return wall;
+    }
+}
+
+/* The contact of `probe` (materials a, b) at first touch, at rest. */
+static void probe_pair(const struct wetdem_sim* sim, const struct step_spheres* sp, int probe,
+                       int a, int b, struct wetdem_contact* c)
+{
+    const struct wetdem_particle* partner[] = {&sp->small, &sp->big, &sp->fixed_small,
+                                               &sp->fixed_big};
+    if (probe == PROBE_WALL)
+        probe_contact(sim, sp->small, a, b, true, 0.0, c);
+    else
+        probe_spheres(sim, sp->small, *partner[probe], a, b, 0.0, c);
+}
+
+/* The time scales of the step at the speed scale. */
+struct step_scales {
+    double t_contact;  /* shortest contact time, normal or tangential, over the pairs that can
+                          occur and every material combination [s] */
+    int contact_probe; /* the pair that sets it */
+    double tau;        /* shortest viscous relaxation time over those pairs, for the materials
+                          that the particles and walls carry (a material no sphere uses must
+                          not refuse a step) [s] */
+    const struct wetdem_model* damper; /* the model that sets tau */
+    double h_at;                       /* the h_min where it does [m] */
+    double gap; /* smallest gap where the force laws jump (h_min), same pairs and materials [m] */
+};
+
+/* The time scales of the pairs of sp at its speed scale (struct step_scales). */
+static void step_scales(const struct wetdem_sim* sim, const struct step_spheres* sp,
+                        struct step_scales* s)
+{
+    *s = (struct step_scales){.t_contact = INFINITY, .tau = INFINITY, .gap = INFINITY};
     /* bit 1: a particle's material, bit 2: a wall's (all of them if there is no memory) */
     unsigned char* used = calloc((size_t)sim->n_materials + 1, 1);
     for (size_t k = 0; used && k < sim->n_particles; k++)
         used[sim->particles[k].material] |= 1;
     for (size_t w = 0; used && w < sim->n_walls; w++)
         used[sim->walls[w].material] |= 2;
+    bool first = true; /* (the first pair names the contact time even where it is not finite) */
     for (int a = 0; a < sim->n_materials; a++)
         for (int b = 0; b < sim->n_materials; b++)
-            for (int probe = 0; probe < 3; probe++) {
-                struct wetdem_contact c;
-                if (probe == 2)
-                    probe_contact(sim, small, a, b, true, 0.0, &c);
-                else
-                    probe_spheres(sim, small, probe ? big : small, a, b, 0.0, &c);
-                c.v_n = fmax(v, 1e-12);
-                if (probe != 1)
-                    *t_contact = fmin(*t_contact, wetdem_sim_contact_time(sim, &c));
-                if (probe == 2 && sim->n_walls == 0)
+            for (int probe = 0; probe < N_PROBES; probe++) {
+                if (!probe_occurs(sim, sp, probe))
                     continue;
-                if (used && !((used[a] & 1) && (used[b] & (probe == 2 ? 2 : 1))))
+                struct wetdem_contact c;
+                probe_pair(sim, sp, probe, a, b, &c);
+                c.v_n = fmax(sp->speed, 1e-12);
+                double t_n = wetdem_sim_contact_time(sim, &c);
+                double t = fmin(t_n, wetdem_sim_tangential_time(sim, &c, t_n));
+                if (t < s->t_contact || first) {
+                    s->t_contact = t;
+                    s->contact_probe = probe;
+                    first = false;
+                }
+                if (used && !((used[a] & 1) && (used[b] & (probe == PROBE_WALL ? 2 : 1))))
                     continue;
                 const struct wetdem_model* which;
-                double t = wetdem_sim_relaxation_time(sim, &c, &which);
-                if (t < *tau) {
-                    *tau = t;
-                    *damper = which;
-                    *h_at = c.h_min;
+                double tau = wetdem_sim_relaxation_time(sim, &c, &which);
+                if (tau < s->tau) {
+                    s->tau = tau;
+                    s->damper = which;
+                    s->h_at = c.h_min;
                 }
+                s->gap = fmin(s->gap, wetdem_sim_jump_gap(sim, &c));
             }
     free(used);
 }
 
-/* The speed scale of the step [m/s]: twice the largest particle speed plus what gravity adds
- * over the height of the packing, floored by sim.speed_floor; *small and *big receive a
- * smallest and a largest sphere. Needs at least one particle. */
-static double start_speed(const struct wetdem_sim* sim, struct wetdem_particle* small,
-                          struct wetdem_particle* big)
+/* The spheres of struct step_spheres and the speed scale of the step [m/s]: twice the largest
+ * particle speed plus what gravity adds over the height of the packing, floored by
+ * sim.speed_floor. Without free spheres, small and big are copies of the smallest sphere,
+ * taken as free. Needs at least one particle. */
+static void start_speed(const struct wetdem_sim* sim, struct step_spheres* sp)
 {
-    *small = *big = sim->particles[0];
+    const struct wetdem_particle *small = NULL, *big = NULL, *fs = NULL, *fb = NULL;
+    const struct wetdem_particle* smallest = &sim->particles[0];
     double v = 0, lo = INFINITY, hi = -INFINITY;
+    sp->n_free = sp->n_fixed = 0;
     for (size_t k = 0; k < sim->n_particles; k++) {
         const struct wetdem_particle* p = &sim->particles[k];
-        *small = p->radius < small->radius ? *p : *small;
-        *big = p->radius > big->radius ? *p : *big;
+        smallest = p->radius < smallest->radius ? p : smallest;
+        if (p->is_fixed) {
+            fs = !fs || p->radius < fs->radius ? p : fs;
+            fb = !fb || p->radius > fb->radius ? p : fb;
+            sp->n_fixed++;
+        } else {
+            small = !small || p->radius < small->radius ? p : small;
+            big = !big || p->radius > big->radius ? p : big;
+            sp->n_free++;
+        }
         v = fmax(v, 2 * vec3_norm(p->vel));
         lo = fmin(lo, fmin(p->pos.z, fmin(p->pos.x, p->pos.y)));
         hi = fmax(hi, fmax(p->pos.z, fmax(p->pos.x, p->pos.y)));
     }
+    sp->small = small ? *small : *smallest;
+    sp->big = big ? *big : *smallest;
+    sp->small.is_fixed = sp->big.is_fixed = false;
+    sp->fixed_small = fs ? *fs : sp->small;
+    sp->fixed_big = fb ? *fb : sp->small;
     const struct wetdem_sim_settings* s = &sim->settings;
     double g = sqrt(s->gravity_x * s->gravity_x + s->gravity_y * s->gravity_y +
                     s->gravity_z * s->gravity_z);
-    return fmax(s->speed_floor, v + sqrt(2 * g * fmax(hi - lo, 0.0)));
+    sp->speed = fmax(s->speed_floor, v + sqrt(2 * g * fmax(hi - lo, 0.0)));
 }
 
-double wetdem_sim_many_relaxation_time(const struct wetdem_sim* sim)
+/* The spheres and time scales of the step for the current particles, into the engine's
+ * relaxation_time, contact_time and crossing_time too. Needs at least one particle. */
+static void time_scales(struct wetdem_sim* sim, struct step_spheres* sp, struct step_scales* s)
 {
-    if (sim->n_particles == 0)
-        return INFINITY;
-    struct wetdem_particle small, big;
-    double v = start_speed(sim, &small, &big), t_contact, tau, h_at;
-    const struct wetdem_model* damper;
-    step_scales(sim, small, big, v, &t_contact, &tau, &damper, &h_at);
-    return tau;
+    struct wetdem_many* m = sim->many;
+    start_speed(sim, sp);
+    step_scales(sim, sp, s);
+    m->relaxation_time = s->tau;
+    m->contact_time = s->t_contact;
+    m->crossing_time = s->gap / sp->speed;
 }
 
-/* Step [s]: many.dt, else verlet.dt, else verlet.dt_fraction x the shortest impact duration
- * at the speed scale, and at most a quarter of the shortest viscous relaxation time tau
- * (step_scales). Velocity Verlet with the damping evaluated at the predicted velocity is
- * stable for dt < tau and dissipates within 3 % of the exact rate for dt <= tau/4
- * (docs/many.md, Time step); a step given at or above tau is refused. Without particles the
- * step must be given. */
+void wetdem_sim_many_time_scales(struct wetdem_sim* sim)
+{
+    struct wetdem_many* m = sim->many;
+    m->relaxation_time = m->contact_time = m->crossing_time = INFINITY;
+    struct step_spheres sp;
+    struct step_scales s;
+    if (sim->n_particles > 0)
+        time_scales(sim, &sp, &s);
+}
+
+/* Step [s]: many.dt, else verlet.dt, else the shortest of verlet.dt_fraction x the shortest
+ * contact time (normal or tangential) at the speed scale, a quarter of the shortest viscous
+ * relaxation time tau, and verlet.many_hmin_fraction x the time a pair closing at the speed
+ * scale takes to cross the smallest h_min where the force laws jump (step_scales). Velocity
+ * Verlet with the damping evaluated at the predicted velocity is stable for dt < tau and
+ * dissipates within 3 % of the exact rate for dt <= tau/4 (docs/many.md, Time step); a step
+ * given at or above tau is refused. Without particles the step must be given. */
 static int choose_dt(struct wetdem_sim* sim, double* dt)
 {
     struct wetdem_many* m = sim->many;
-    double fixed = 0, fraction = 0.02;
+    double fixed = 0, fraction = 0.02, many_hmin_fraction = 0.5;
     wetdem_sim_param(sim, "verlet.dt", &fixed);
     wetdem_sim_param(sim, "verlet.dt_fraction", &fraction);
+    wetdem_sim_param(sim, "verlet.many_hmin_fraction", &many_hmin_fraction);
     double given = m->set.dt > 0 ? m->set.dt : fixed;
-    m->relaxation_time = INFINITY;
+    m->relaxation_time = m->contact_time = m->crossing_time = INFINITY;
     if (sim->n_particles == 0) {
         *dt = given;
         return given > 0 ? WETDEM_OK
@@ -299,45 +392,47 @@ static int choose_dt(struct wetdem_sim* sim, double* dt)
                                            "many: no particles to derive the time step from: "
                                            "add particles, or set many.dt or verlet.dt");
     }
-    struct wetdem_particle small, big;
-    double v = start_speed(sim, &small, &big), t_contact, tau, h_at;
-    const struct wetdem_model* damper;
-    step_scales(sim, small, big, v, &t_contact, &tau, &damper, &h_at);
-    m->relaxation_time = tau;
-    if (tau == 0 && h_at > 0) /* m/c_d underflowed to 0: a mass near the least double */
+    struct step_spheres sp;
+    struct step_scales s;
+    time_scales(sim, &sp, &s);
+    double tau = s.tau;
+    if (tau == 0 && s.h_at > 0) /* m/c_d underflowed to 0: a mass near the least double */
         return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
                                "many: the viscous relaxation time m/c_d of '%s' at h_min = %g m "
-                               "is 0 s, since the smallest sphere's mass is %g kg: no step is "
-                               "stable; check the material's density and the radii",
-                               damper->name, h_at, small.mass);
+                               "is 0 s, since the smallest free sphere's mass is %g kg: no step "
+                               "is stable; check the material's density and the radii",
+                               s.damper->name, s.h_at, sp.small.mass);
     if (tau == 0)
         return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
                                "many: the viscous damping of '%s' has no bound at h_min = %g m "
                                "(it grows as 1/h towards contact), so no step is stable: set a "
                                "minimum separation h_min > 0",
-                               damper->name, h_at);
+                               s.damper->name, s.h_at);
     if (given > 0) {
         if (given >= tau)
             return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
                                    "many: the step dt = %g s is not below the viscous "
                                    "relaxation time %g s that '%s' sets at h_min = %g m "
-                                   "(m/c_d, shortest over the smallest spheres' pairs): "
+                                   "(m/c_d, shortest over the pairs that can occur): "
                                    "velocity Verlet is unstable there; use dt <= %g s (a "
                                    "quarter, dissipation within 3 %%), or 0 to derive it",
-                                   given, tau, damper->name, h_at, 0.25 * tau);
+                                   given, tau, s.damper->name, s.h_at, 0.25 * tau);
         *dt = given;
         return WETDEM_OK;
     }
-    *dt = fmin(fraction * t_contact, 0.25 * tau);
+    double by_gap = many_hmin_fraction > 0 ? many_hmin_fraction * m->crossing_time : INFINITY;
+    *dt = fmin(fmin(fraction * s.t_contact, 0.25 * tau), by_gap);
     /* a contact time of 0 or inf (a density or modulus near the ends of the double range)
-     * resolves no contact, even where the relaxation time gives a finite step */
-    if (!(isfinite(*dt) && *dt > 0 && isfinite(t_contact) && t_contact > 0))
+     * resolves no contact, even where the other bounds give a finite step */
+    if (!(isfinite(*dt) && *dt > 0 && isfinite(s.t_contact) && s.t_contact > 0))
         return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
-                               "many: cannot derive a time step from the contact time %g s of "
-                               "the smallest spheres (mass %g kg) and the relaxation time %g s: "
-                               "check the materials' density and youngs_modulus, or set "
-                               "many.dt or verlet.dt",
-                               t_contact, small.mass, tau);
+                               "many: cannot derive a time step: the contact time of %s "
+                               "(the smallest free one R = %g m, mass %g kg) is %g s at the "
+                               "speed scale %g m/s, and the relaxation time %g s: check the "
+                               "materials' density and youngs_modulus, or set many.dt or "
+                               "verlet.dt",
+                               probe_names[s.contact_probe], sp.small.radius, sp.small.mass,
+                               s.t_contact, sp.speed, tau);
     return WETDEM_OK;
 }
 
@@ -461,22 +556,34 @@ static int update_wall_masks(struct wetdem_sim* sim)
 }
 
 /* Writes the engine state back to the particle records: positions, and with `motion` the
- * velocities and spins (many.h, struct wetdem_many: xr, vw). */
-static void write_back(struct wetdem_sim* sim, bool motion)
+ * velocities and spins (many.h, struct wetdem_many: xr, vw). Returns the lowest index of a
+ * particle whose state is not finite, or SIZE_MAX (with `motion`, where the records are read
+ * next: outputs, observers, callbacks, the end of a call). Finite means a finite position and
+ * finite |v|^2 + |w|^2, so that its kinetic energy is finite; checked in the same pass, on
+ * values in registers. */
+static size_t write_back(struct wetdem_sim* sim, bool motion)
 {
     struct wetdem_many* m = sim->many;
     if (!m->records_stale)
-        return;
-#pragma omp parallel for schedule(static) if (wetdem_many_parallel(m, sim->n_particles))
+        return SIZE_MAX;
+    size_t bad = SIZE_MAX; /* min is exact: the same for any thread count */
+#pragma omp parallel for schedule(static)                                                          \
+    reduction(min                                                                                  \
+              : bad) if (wetdem_many_parallel(m, sim->n_particles))
     for (size_t k = 0; k < sim->n_particles; k++) {
         struct wetdem_particle* p = &sim->particles[k];
         p->pos = vec3(m->xr[k].x, m->xr[k].y, m->xr[k].z);
         if (motion) {
             p->vel = m->vw[k][0];
             p->omega = m->vw[k][1];
+            /* 0 x inf and 0 x NaN are NaN (no -ffast-math), so the position takes part */
+            double q = vec3_dot(p->vel, p->vel) + vec3_dot(p->omega, p->omega) +
+                       0.0 * (p->pos.x + p->pos.y + p->pos.z);
+            bad = q <= DBL_MAX || k > bad ? bad : k;
         }
     }
     m->records_stale = !motion;
+    return bad;
 }
 
 /* Writes the engine's positions back to the particle records (before a list build). */
@@ -485,10 +592,11 @@ static void sync_positions(struct wetdem_sim* sim)
     write_back(sim, false);
 }
 
-/* Writes the whole engine state back to the particle records (before anything reads them). */
-static void sync_records(struct wetdem_sim* sim)
+/* Writes the whole engine state back to the particle records (before anything reads them);
+ * returns write_back's lowest index of a particle whose state is not finite, or SIZE_MAX. */
+static size_t sync_records(struct wetdem_sim* sim)
 {
-    write_back(sim, true);
+    return write_back(sim, true);
 }
 
 /* The largest of m and the magnitudes of the components of x (comparisons: no call). */
@@ -832,6 +940,7 @@ static void after_drift(struct wetdem_sim* sim, double h, double v2_max)
 {
     struct wetdem_many* m = sim->many;
     bool track = m->cl.n_builds > 0 && m->cl.n_at_build == sim->n_particles;
+    m->v2_drift = v2_max; /* (one_step stops the run where it is not finite) */
     m->sums_zeroed = sim->n_particles;
     m->records_stale = true;
     m->max_disp_valid = track;
@@ -989,6 +1098,43 @@ static int start(struct wetdem_sim* sim)
     return timed_outputs(sim, false, false);
 }
 
+/* The lowest index of a free particle whose half-step velocity v' of the latest drift has a
+ * |v'|^2 that is not finite (after_drift found one; a fixed particle does not drift). */
+static size_t first_diverged_drift(const struct wetdem_sim* sim)
+{
+    const struct wetdem_many* m = sim->many;
+    for (size_t k = 0; k < sim->n_particles; k++)
+        if (!m->fixed[k] && !(vec3_dot(m->vh[k], m->vh[k]) <= DBL_MAX))
+            return k;
+    return 0;
+}
+
+/* Stops the run at particle k, the first whose motion is not finite: with `drift`, its
+ * half-step velocity v' (the largest |v'|^2 of the drift overflowed), else its position, or
+ * |v|^2 + |w|^2 (its kinetic energy would overflow). Returns WETDEM_ERR_NUMERIC with a message
+ * naming the step, the time and the particle; no output of that step is written, and the
+ * particle records hold the state reached. */
+static int diverged(struct wetdem_sim* sim, size_t k, bool drift)
+{
+    const struct wetdem_many* m = sim->many;
+    struct wetdem_vec3 v = drift ? m->vh[k] : m->vw[k][0], w = m->vw[k][1];
+    double ratio = m->dt / m->contact_time;
+    char hint[200];
+    if (ratio > WETDEM_MANY_CONTACT_FRACTION_MAX)
+        snprintf(hint, sizeof hint,
+                 "the step dt = %g s is %.3g x the contact time %g s, above %g x: lower it", m->dt,
+                 ratio, m->contact_time, WETDEM_MANY_CONTACT_FRACTION_MAX);
+    else
+        snprintf(hint, sizeof hint, "lower the step dt = %g s, or check the forces", m->dt);
+    return wetdem_sim_fail(sim, WETDEM_ERR_NUMERIC,
+                           "many: the motion diverged in step %llu (t = %.9g s): particle %zu "
+                           "has a %s that is not finite (x = (%g, %g, %g) m, v = (%g, %g, %g) "
+                           "m/s, w = (%g, %g, %g) rad/s); %s",
+                           (unsigned long long)m->step, sim->engine.time, k,
+                           drift ? "velocity" : "position, velocity or spin", m->xr[k].x,
+                           m->xr[k].y, m->xr[k].z, v.x, v.y, v.z, w.x, w.y, w.z, hint);
+}
+
 static int one_step(struct wetdem_sim* sim, bool defer);
 
 /* Stop flag, progress callback. Returns WETDEM_EVENT to stop (checkpoint written). */
@@ -1008,7 +1154,9 @@ static int poll_stop(struct wetdem_sim* sim, unsigned long long done, unsigned l
             return st;
     }
     finish_kick(sim); /* a stop flag raised during a deferred step */
-    sync_records(sim);
+    size_t bad = sync_records(sim);
+    if (bad != SIZE_MAX) /* (no checkpoint of a state no run can continue) */
+        return diverged(sim, bad, false);
     if (m->checkpoint_path) {
         int st = wetdem_sim_write_checkpoint(sim, m->checkpoint_path);
         if (st != WETDEM_OK)
@@ -1065,6 +1213,8 @@ static int one_step(struct wetdem_sim* sim, bool defer)
     m->step++;
     sim->engine.time = m->t0 + (double)m->step * m->dt; /* no accumulated round-off */
     sim->engine.t_committed = sim->engine.time;
+    if (!(m->v2_drift <= DBL_MAX)) /* the largest |v'|^2 of the drift: one test a step */
+        return diverged(sim, first_diverged_drift(sim), true);
     bool step = defer && !m->no_drift_in_pass && !(m->set.stop_flag && *m->set.stop_flag);
     int st = forces_and_work(sim, !defer ? WETDEM_MANY_END_KICK
                                   : step ? WETDEM_MANY_END_STEP
@@ -1075,8 +1225,9 @@ static int one_step(struct wetdem_sim* sim, bool defer)
     if (st != WETDEM_OK)
         return st;
     m->kick_pending = defer && !m->drifted;
-    if (!defer) /* the state is read after this step */
-        sync_records(sim);
+    size_t bad = defer ? SIZE_MAX : sync_records(sim); /* the state is read after this step */
+    if (bad != SIZE_MAX)
+        return diverged(sim, bad, false);
     sim->engine.stats.steps++;
     return timed_outputs(sim, false, true);
 }

@@ -127,6 +127,8 @@ int wetdem_sim_many_stats(const struct wetdem_sim* sim, struct wetdem_many_stats
     s->list_builds = m->cl.n_builds;
     s->dt = m->dt;
     s->relaxation_time = m->relaxation_time;
+    s->contact_time = m->contact_time;
+    s->hmin_crossing_time = m->crossing_time;
     s->step = m->step;
     s->seconds_kick = m->seconds_kick;
     s->seconds_forces = m->seconds_forces;
@@ -560,7 +562,7 @@ static int restore_state(struct wetdem_sim* sim, const struct wetdem_checkpoint*
     m->step = ck->step;
     memcpy(&m->dt, ck->extra, 8);
     memcpy(&m->t0, ck->extra + 8, 8);
-    m->relaxation_time = wetdem_sim_many_relaxation_time(sim); /* not in the checkpoint */
+    wetdem_sim_many_time_scales(sim); /* not in the checkpoint */
     m->energy.k0 = ck->energy[0];
     m->energy.u0 = ck->energy[1];
     m->energy.el0 = ck->energy[2];

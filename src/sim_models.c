@@ -402,6 +402,116 @@ bool wetdem_sim_contact_is_bridged(const struct wetdem_sim* sim, const struct we
     return false;
 }
 
+/* The summed normal force plus the size of the summed tangential force of the enabled models
+ * for contact c at gap h, a fresh pair [N] (NAN if a model fails). */
+static double forces_at_gap(const struct wetdem_sim* sim, struct wetdem_contact c, double h)
+{
+    struct wetdem_pair_force f;
+    c.gap = h;
+    if (wetdem_sim_eval_contact(sim, &c, NULL, &f, NULL) != WETDEM_OK)
+        return NAN;
+    return f.f_normal + vec3_norm(f.f_tan);
+}
+
+/* Change of the forces of contact c across the gap h, between h (1 + eps) and h (1 - eps) [N]. */
+static double change_across(const struct wetdem_sim* sim, const struct wetdem_contact* c, double h,
+                            double eps)
+{
+    return fabs(forces_at_gap(sim, *c, h * (1 + eps)) - forces_at_gap(sim, *c, h * (1 - eps)));
+}
+
+double wetdem_sim_jump_gap(const struct wetdem_sim* sim, const struct wetdem_contact* c)
+{
+    if (sim->history_len > 64 || sim->minsep.model->history_len > 64)
+        return INFINITY;
+    struct wetdem_contact p = *c;
+    double history[64] = {0}, gaps[WETDEM_MAX_THRESHOLDS], gap = INFINITY;
+    p.h_min = sim->minsep.model->min_separation(sim->minsep.params, &p, history);
+    double range = wetdem_sim_contact_range(sim, &p);
+    for (size_t k = 0; k < sim->n_models; k++) {
+        const struct wetdem_model_slot* s = &sim->models[k];
+        size_t n = s->model->thresholds
+                       ? s->model->thresholds(s->params, &p, history + s->history_offset, gaps)
+                       : 0;
+        for (size_t q = 0; q < n && q < WETDEM_MAX_THRESHOLDS; q++) {
+            double h = gaps[q];
+            if (!(h > 0.0 && h < range && h < gap))
+                continue;
+            /* a jump keeps its size as the interval shrinks; a law continuous at h changes
+               1000 times less from 1e-6 to 1e-9 of it (smooth), or at least 5.6 times less
+               (the steepest of the catalogue, ~(h_min - h)^1/4): the test of event.c */
+            double wide = change_across(sim, &p, h, 1e-6);
+            if (wide > 0.0 && change_across(sim, &p, h, 1e-9) >= 0.5 * wide)
+                gap = h;
+        }
+    }
+    return gap;
+}
+
+/* The normal force of the enabled models at overlap `overlap` with the surfaces at rest [N]
+ * (elastic parts only: every damping and viscous term is proportional to a speed), or NAN. */
+static double force_at_rest(const struct wetdem_sim* sim, struct wetdem_contact c, double overlap)
+{
+    struct wetdem_pair_force f;
+    c.gap = -overlap;
+    c.v_n = 0.0;
+    c.v_t = vec3(0, 0, 0);
+    c.dt = 0.0;
+    return wetdem_sim_eval_contact(sim, &c, NULL, &f, NULL) == WETDEM_OK ? f.f_normal : NAN;
+}
+
+/* The tangential force along t of the enabled models at overlap `overlap` when a fresh
+ * tangential spring has been stretched by sliding at v_t = u t for a time dt [N], or NAN. */
+static double tangential_after(const struct wetdem_sim* sim, struct wetdem_contact c,
+                               double overlap, struct wetdem_vec3 t, double u, double dt)
+{
+    struct wetdem_pair_force f;
+    c.gap = -overlap;
+    c.v_n = 0.0;
+    c.v_t = vec3_scale(t, u);
+    c.dt = dt;
+    return wetdem_sim_eval_contact(sim, &c, NULL, &f, NULL) == WETDEM_OK ? vec3_dot(f.f_tan, t)
+                                                                         : NAN;
+}
+
+double wetdem_sim_tangential_time(const struct wetdem_sim* sim, const struct wetdem_contact* c,
+                                  double t_contact)
+{
+    if (!(isfinite(t_contact) && t_contact > 0.0 && c->v_n > 0.0) || sim->history_len > 64)
+        return INFINITY;
+    /* The largest overlap of the impact: Hertz's t_c = 2.94 delta_max / v (Johnson 1985
+     * Eq. 11.25). A linear spring's is v t_c / pi, 7 % smaller, so there the stiffnesses are
+     * taken at a slightly larger overlap than reached: conservative where they grow with it. */
+    double overlap = c->v_n * t_contact / 2.94, eps = 1e-4;
+    /* k_n = dF_n/d(delta) by a central difference: F_n ~ delta^(3/2) (hertz) or ~ delta
+     * (hooke), so the truncation error is ~eps^2 and the rounding ~1e-16/eps, both far below
+     * the accuracy a time scale needs */
+    double k_n = (force_at_rest(sim, *c, overlap * (1 + eps)) -
+                  force_at_rest(sim, *c, overlap * (1 - eps))) /
+                 (2 * eps * overlap);
+    /* k_t from a spring stretched by u dt and by 2 u dt at the same sliding speed u: the
+     * difference removes the dashpots (mindlin's, and any viscous tangential law), which
+     * depend on the speed only. u dt = 1e-6 delta keeps the spring force ~1e-6 k_t delta far
+     * below the Coulomb limit mu F_n ~ mu k_n delta for any mu above 1e-5 (below it the
+     * tangential force is negligible, and so is this bound). */
+    struct wetdem_vec3 n = c->normal;
+    struct wetdem_vec3 t = vec3_reject(fabs(n.x) < 0.9 ? vec3(1, 0, 0) : vec3(0, 1, 0), n);
+    t = vec3_scale(t, 1.0 / vec3_norm(t));
+    double u = 1e-6 * overlap;
+    double k_t = (tangential_after(sim, *c, overlap, t, u, 1.0) -
+                  tangential_after(sim, *c, overlap, t, u, 2.0)) /
+                 u;
+    if (!(k_t > 0.0 && isfinite(k_t)))
+        return INFINITY;
+    /* A tangential force F at the contact point also spins both spheres (I = 2/5 m R^2):
+     * d(v_t)/dt = F (1/m* + R_i^2/I_i + R_j^2/I_j) = (7/2) F/m*, so the tangential mass is
+     * (2/7) m* for sphere pairs, fixed spheres and walls alike. */
+    double ratio = 2.0 / 7.0 / k_t; /* 1/omega_t^2 = m_t/k_t, per kg of m* */
+    if (k_n > 0.0 && isfinite(k_n)) /* omega_n/omega_t = sqrt(k_n m_t / (k_t m*)) */
+        return t_contact * sqrt(ratio * k_n);
+    return M_PI * sqrt(ratio * c->m_eff); /* no normal spring: the tangential half period */
+}
+
 int wetdem_sim_eval_contact(const struct wetdem_sim* sim, struct wetdem_contact* c, double* history,
                             struct wetdem_pair_force* out, struct wetdem_pair_force* per_model)
 {

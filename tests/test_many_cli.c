@@ -24,6 +24,7 @@
  * thread is the fastest for 150 spheres on a shared machine) and the passive wait policy.
  */
 #include <fcntl.h>
+#include <math.h>
 #include <pty.h>
 #include <signal.h>
 #include <stdlib.h>
@@ -208,14 +209,19 @@ static void test_many_cli_bad_inputs_exit_2_with_file_and_line(void** state)
                11, "writes 2e+07 CSV rows over the run's 20000000 steps, more than 1e+07");
     /* a density of 1e-300 kg/m^3 makes m/c_d underflow to 0 though h_min > 0: the message
      * names the mass, not a missing h_min; 1e300 makes the Hertz contact time infinite, and
-     * a step of a quarter of the relaxation time (2e291 s) would send the spheres to inf */
+     * a step of a quarter of the relaxation time (2e291 s) would send the spheres to inf: the
+     * message names the pair that sets it (with the floor and the lid here) and the sphere */
     scenario("light.ini", "steps = 5\n");
     char* msg = expect_exit("run light.ini --set material.wet.density=1e-300", 2,
-                            "is 0 s, since the smallest sphere's mass is");
+                            "is 0 s, since the smallest free sphere's mass is");
     CHECK_CONTAINS(msg, "check the material's density and the radii");
     free(msg);
-    free(expect_exit("run light.ini --set material.wet.density=1e300 --set run.dt=0", 2,
-                     "cannot derive a time step from the contact time inf s"));
+    msg = expect_exit("run light.ini --set material.wet.density=1e300 --set run.dt=0", 2,
+                      "cannot derive a time step: the contact time of two smallest free "
+                      "spheres (the smallest free one R = 0.0004");
+    CHECK_CONTAINS(msg, ") is inf s at the speed scale ");
+    CHECK_CONTAINS(msg, "check the materials' density and youngs_modulus");
+    free(msg);
     expect_bad("mixed.ini",
                "[collision]\nspeed = 1\n[box]\nsize_x = 1e-2\nsize_y = 1e-2\nsize_z = 1e-2\n"
                "[insert]\ncount = 1\nradius = 1e-3\n[run]\nsteps = 10\n",
@@ -641,7 +647,9 @@ static void test_many_cli_summary_mean_size_readable(void** state)
 static void test_many_cli_progress_only_on_a_terminal(void** state)
 {
     (void)state;
-    scenario("progress.ini", "");
+    /* (many_hmin_fraction = 0: the given step lets pairs cross h_min within a step, which the
+       run would warn about on stderr, test_many_cli_warns_about_the_step) */
+    scenario("progress.ini", "[integrator]\nmany_hmin_fraction = 0\n");
     assert_int_equal(run_cli("run progress.ini --set run.steps=200"), 0);
     char* err = stderr_text();
     assert_string_equal(err, "");
@@ -765,6 +773,78 @@ static void test_many_cli_examples_and_budget(void** state)
     free(off_json);
 }
 
+/* Counts the lines of a file that start with a digit (the rows of a CSV); *finite: whether
+ * every field of those rows is a finite number. */
+static size_t count_rows_finite(const char* name, bool* finite)
+{
+    char* text = test_read_file(tpath(name), NULL);
+    assert_non_null(text);
+    size_t rows = 0;
+    *finite = true;
+    for (char* line = strtok(text, "\n"); line; line = strtok(NULL, "\n")) {
+        if (!(line[0] >= '0' && line[0] <= '9'))
+            continue;
+        rows++;
+        for (char *p = line, *end; *p; p = *end ? end + 1 : end) {
+            double v = strtod(p, &end);
+            *finite = *finite && isfinite(v) && end != p;
+        }
+    }
+    free(text);
+    return rows;
+}
+
+/* A step that does not resolve what the run meets is warned about on stderr (the library
+ * gives the time scales in wetdem_many_stats): the base scenario's given 2 us lets a pair at
+ * its speed scale (2 m/s) travel several times h_min = 1 um in a step; many_hmin_fraction = 0 turns
+ * that bound and its warning off, and the derived step keeps to the bound. A step of 0.3 ms,
+ * some 8 x the contact time of the dry spheres, is warned about and diverges: the run stops
+ * at the first step whose motion is not finite with exit 1, naming the step, the time and
+ * the particle, and every CSV row and VTK frame written before is of a finite state (one of
+ * each for the start and every step done; no summary). Before, it ran to its end with an
+ * infinite kinetic energy. */
+static void test_many_cli_warns_about_the_step(void** state)
+{
+    (void)state;
+    scenario("warn.ini", "steps = 300\n");
+    char* err = expect_exit("run warn.ini --check", 0, "wetdem: warning: warn.ini: in one step");
+    CHECK_CONTAINS(err, "x the smallest h_min where the force laws jump");
+    assert_null(strstr(err, "contact time"));
+    free(err);
+    const char* quiet[] = {"--set integrator.many_hmin_fraction=0", "--set run.dt=0"};
+    for (int k = 0; k < 2; k++) {
+        char args[200];
+        snprintf(args, sizeof args, "run warn.ini --check %s", quiet[k]);
+        assert_int_equal(run_cli(args), 0);
+        err = stderr_text();
+        assert_string_equal(err, "");
+        free(err);
+    }
+
+    err = expect_exit("run warn.ini --set 'models.force=hertz mindlin' --set run.dt=3e-4 "
+                      "--set dump.vtk_every=1 --set dump.csv_every=1 "
+                      "--out div",
+                      1, "wetdem: warning: warn.ini: the step dt = 0.0003 s is ");
+    CHECK_CONTAINS(err, "x the contact time");
+    CHECK_CONTAINS(err, "many: the motion diverged in step ");
+    const char* at = strstr(err, "diverged in step ");
+    unsigned long long step = strtoull(at + strlen("diverged in step "), NULL, 10);
+    char where[80];
+    snprintf(where, sizeof where, "in step %llu (t = %.9g s): particle ", step, 3e-4 * step);
+    CHECK_CONTAINS(err, where);
+    free(err);
+    assert_true(step > 1 && step < 300);
+    bool finite;
+    assert_int_equal(count_rows_finite("div/global.csv", &finite), step);
+    assert_true(finite);
+    char frame[64];
+    snprintf(frame, sizeof frame, "div/particles_%06llu.vtk", step - 1);
+    assert_true(exists(frame));
+    snprintf(frame, sizeof frame, "div/particles_%06llu.vtk", step);
+    assert_false(exists(frame));
+    assert_false(exists("div/summary.json"));
+}
+
 static int setup(void** state)
 {
     (void)state;
@@ -793,6 +873,7 @@ int main(void)
         cmocka_unit_test(test_many_cli_progress_only_on_a_terminal),
         cmocka_unit_test(test_many_cli_random_groups_share_the_box),
         cmocka_unit_test(test_many_cli_examples_and_budget),
+        cmocka_unit_test(test_many_cli_warns_about_the_step),
     };
     return cmocka_run_group_tests(tests, setup, getenv("WETDEM_KEEP_TMP") ? NULL : teardown);
 }
