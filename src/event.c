@@ -297,52 +297,12 @@ double wetdem_event_smallest_branch_gap(const struct wetdem_sim* sim)
     return h_min;
 }
 
-/* Sum of every model's normal force [N] and size of the tangential force [N] on pair k at
- * gap h, the rest of its state as it is now. */
-static void forces_at_gap(const struct wetdem_sim* sim, size_t k, double h, double* f_n,
-                          double* f_t)
-{
-    struct wetdem_contact c;
-    double range, scratch[64];
-    pair_state(sim, k, &c, &range, scratch);
-    c.gap = h;
-    c.dt = 0.0;
-    struct wetdem_pair_force sum = {0};
-    for (size_t m = 0; m < sim->n_models; m++) {
-        const struct wetdem_model_slot* s = &sim->models[m];
-        if (s->model->pair)
-            s->model->pair(s->params, &c, scratch + s->history_offset, &sum);
-    }
-    *f_n = sum.f_normal;
-    *f_t = sqrt(sum.f_tan.x * sum.f_tan.x + sum.f_tan.y * sum.f_tan.y + sum.f_tan.z * sum.f_tan.z);
-}
-
-/* Change of the forces of pair k across the gap h_k, between h_k (1 + eps) and h_k (1 - eps)
- * [N]: of the normal force plus that of the size of the tangential force. */
-static double change_across(const struct wetdem_sim* sim, size_t k, double h_k, double eps)
-{
-    double n_above, t_above, n_below, t_below;
-    forces_at_gap(sim, k, h_k * (1 + eps), &n_above, &t_above);
-    forces_at_gap(sim, k, h_k * (1 - eps), &n_below, &t_below);
-    return fabs(n_above - n_below) + fabs(t_above - t_below);
-}
-
-/* True when the force laws of pair k jump at the gap h_k: their change across 1e-9 h_k is at
- * least half that across 1e-6 h_k. A jump keeps its size as the interval shrinks; a law that
- * is continuous there changes by 1000 times less (smooth) or at least 5.6 times less (the
- * steepest of the catalogue, Hertz damping on an overlap shifted to h_min, ~(h_min - h)^1/4). */
-static bool laws_jump_at(const struct wetdem_sim* sim, size_t k, double h_k)
-{
-    double wide = change_across(sim, k, h_k, 1e-6);
-    return wide > 0.0 && change_across(sim, k, h_k, 1e-9) >= 0.5 * wide;
-}
-
 /* Keeps in stats.hmin_step_ratio the gap change of the step just taken, as a multiple of
  * the branch gap h_k of model slot q that it crossed (h_k = gap - g at the step's end), where
- * the force laws jump at h_k. A fixed step samples the force law only at its ends: with a
- * change of the order of h_k it puts the switch (c: to zero) at a step end, not where the gap
- * crosses h_k. Where the laws are continuous at h_k (nijssen's lever blend into contact, nc)
- * the step's error there is of second order and is not counted. */
+ * the force laws jump at h_k (wetdem_sim_laws_jump_at). A fixed step samples the force law
+ * only at its ends: with a change of the order of h_k it puts the switch (c: to zero) at a
+ * step end, not where the gap crosses h_k. Where the laws are continuous at h_k (nijssen's
+ * lever blend into contact, nc) the step's error there is of second order and is not counted. */
 static void note_branch_step(struct wetdem_sim* sim, size_t q)
 {
     struct wetdem_engine* e = &sim->engine;
@@ -351,7 +311,12 @@ static void note_branch_step(struct wetdem_sim* sim, size_t q)
     if (!(h_k > 0.0))
         return;
     double ratio = fabs(e->pair_gap[p] - e->pair_gap_prev[p]) / h_k;
-    if (ratio > e->stats.hmin_step_ratio && laws_jump_at(sim, p, h_k))
+    if (!(ratio > e->stats.hmin_step_ratio))
+        return;
+    struct wetdem_contact c;
+    double range, scratch[64];
+    pair_state(sim, p, &c, &range, scratch);
+    if (wetdem_sim_laws_jump_at(sim, &c, scratch, h_k))
         e->stats.hmin_step_ratio = ratio;
 }
 

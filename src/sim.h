@@ -140,6 +140,13 @@ bool wetdem_sim_contact_is_in_contact(const struct wetdem_sim* sim, const struct
                                       const double* history);
 bool wetdem_sim_contact_is_bridged(const struct wetdem_sim* sim, const struct wetdem_contact* c,
                                    const double* history);
+/* True when the enabled force laws of contact c (committed history `history`; NULL: a fresh
+ * pair) jump at the gap h: their change across 1e-9 h is at least half that across 1e-6 h. A
+ * jump keeps its size as the interval shrinks; a law continuous at h changes 1000 times less
+ * (smooth) or at least 5.6 times less (the steepest of the catalogue, Hertz damping on
+ * nijssen's overlap shifted to h_min, ~(h_min - h)^1/4). */
+bool wetdem_sim_laws_jump_at(const struct wetdem_sim* sim, const struct wetdem_contact* c,
+                             const double* history, double h);
 /* Smallest gap 0 < h < range [m] at which the enabled force laws of contact c (a fresh pair
  * at approach speed c->v_n) jump: a branch gap from the models' thresholds() where the summed
  * forces change as much across 1e-9 of it as across 1e-6 (h_min where the thin-film laws
