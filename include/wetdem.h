@@ -256,6 +256,12 @@ struct wetdem_model {
                           const double* history);
     /* Whether the model's liquid bridge joins the pair at c. NULL: it has no bridge. */
     bool (*is_bridged)(const void* params, const struct wetdem_contact* c, const double* history);
+    /* Min-separation models whose history is a record of the encounter (ehd, max, glass): the
+     * largest gap [m] up to which the record is kept. Beyond the force range but within this
+     * gap the engines still evaluate min_separation() on the pair's history (which updates the
+     * record) and give the force models a fresh history; beyond both, the whole history is
+     * fresh. Optional: without it the record ends with the force range. */
+    double (*record_range)(const void* params, const struct wetdem_contact* c);
 };
 
 /* NULL-terminated table of every built-in model. */

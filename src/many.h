@@ -193,7 +193,15 @@ struct wetdem_many {
     char* output_prefix;
     char* checkpoint_path;
     struct wetdem_celllist cl;
-    double reach;           /* largest interaction gap of any pair [m] (start-up bound) */
+    double reach; /* largest interaction gap of any pair [m] (start-up bound) */
+    /* With a min-separation model that keeps a record beyond the force range (its record_range
+       hook: ehd, max, glass), `record` is set and the pairs' records live up to that range
+       (sim_models.c wetdem_sim_history_beyond_range): the cell list's reach (cl.reach) is then
+       the larger of `reach` and the largest record range of two spheres, and wall_reach that
+       of `reach` and the largest record range of a sphere and a wall, so that no pair or wall
+       with a live record leaves the lists. Without it, cl.reach = wall_reach = reach. [m] */
+    bool record;
+    double wall_reach;
     double dt;              /* time step [s], fixed once the many run starts */
     double relaxation_time; /* shortest viscous relaxation time at the start [s] (choose_dt),
                                or when the run was restored from a checkpoint */
@@ -285,7 +293,7 @@ struct wetdem_many {
     bool pair_consts_ready;     /* cleared when the kernel is set up */
     unsigned char* old_flags;   /* flags of the previous list, for remapping */
     size_t old_flags_cap;
-    uint64_t* wall_mask; /* per particle: bit w set if wall w is within reach + skin
+    uint64_t* wall_mask; /* per particle: bit w set if wall w is within wall_reach + skin
                                     at the last build (walls >= 64 are always evaluated) */
     size_t wall_mask_cap;
     uint64_t* wall_dirty; /* per particle: bit w set if the history of wall w may differ

@@ -69,4 +69,11 @@ static inline double minsep_ehd_recorded_gap(const struct minsep_speed_params* p
     return minsep_ehd_gap(c->viscosity, v0, c->e_star, c->r_eff);
 }
 
+/* The gap up to which the speed record lives, reset_ratio R* [m] (the record_range hook of
+ * ehd and max: the engines keep the record there even beyond the force range). */
+static inline double minsep_speed_record_range(const void* params, const struct wetdem_contact* c)
+{
+    return ((const struct minsep_speed_params*)params)->reset_ratio * c->r_eff;
+}
+
 #endif

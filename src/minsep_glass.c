@@ -83,6 +83,13 @@ static double glass_min_separation(const void* params, const struct wetdem_conta
     return fmin(glass_gap(c->viscosity, c->r_eff, v, p->p_gt), delta);
 }
 
+/* The record lives while the films overlap: up to delta [m] (glass_min_separation's test). */
+static double glass_record_range(const void* params, const struct wetdem_contact* c)
+{
+    (void)params;
+    return fmax(c->film, 0.0);
+}
+
 const struct wetdem_model wetdem_minsep_glass = {
     .name = "glass",
     .kind = WETDEM_MODEL_MIN_SEPARATION,
@@ -100,4 +107,5 @@ const struct wetdem_model wetdem_minsep_glass = {
     .params_size = sizeof(struct minsep_glass_params),
     .history_len = 3,
     .min_separation = glass_min_separation,
+    .record_range = glass_record_range,
 };

@@ -43,4 +43,5 @@ const struct wetdem_model wetdem_minsep_max = {
     .params_size = sizeof(struct minsep_speed_params),
     .history_len = 1,
     .min_separation = max_min_separation,
+    .record_range = minsep_speed_record_range,
 };

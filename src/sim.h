@@ -163,6 +163,20 @@ double wetdem_sim_jump_gap(const struct wetdem_sim* sim, const struct wetdem_con
 double wetdem_sim_tangential_time(const struct wetdem_sim* sim, const struct wetdem_contact* c,
                                   double t_contact);
 
+/* The gap up to which the min-separation model keeps its per-pair record (its record_range
+ * hook) [m]; 0 when it keeps none. */
+double wetdem_sim_record_range(const struct wetdem_sim* sim, const struct wetdem_contact* c);
+
+/* The history of a pair beyond its force range (c->gap > wetdem_sim_contact_range), on commit:
+ * within record_range (wetdem_sim_record_range of c), the min-separation model is evaluated on
+ * the history, which keeps and updates its record (c->h_min receives its value), and the
+ * force models' slices are fresh; beyond it, the whole history is fresh, as
+ * wetdem_sim_history_init makes it. Returns whether the record is kept. Both engines call it,
+ * so a record ends at the same gap in each: reset_ratio R* for ehd and max, the films' delta
+ * for glass. */
+bool wetdem_sim_history_beyond_range(const struct wetdem_sim* sim, struct wetdem_contact* c,
+                                     double record_range, double* history);
+
 /* Initial value of a pair's history: zeros except NAN-free defaults; writes history_len. */
 void wetdem_sim_history_init(const struct wetdem_sim* sim, double* history);
 

@@ -175,8 +175,8 @@ static int eval_pair(struct wetdem_sim* sim, size_t k, double t, bool commit, bo
     struct wetdem_contact c;
     wetdem_sim_build_contact(sim, p->i, p->j, p->is_wall, &c);
     if (c.gap > wetdem_sim_contact_range(sim, &c)) {
-        if (commit && history)
-            wetdem_sim_history_init(sim, history);
+        if (commit && history) /* (a min-separation record may outlive the force range) */
+            wetdem_sim_history_beyond_range(sim, &c, wetdem_sim_record_range(sim, &c), history);
         return WETDEM_OK;
     }
     double scratch[HISTORY_SCRATCH];

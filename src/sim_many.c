@@ -18,7 +18,11 @@
  * radius and every material combination; a pair whose actual range exceeds the bound stops
  * the run with an error rather than being missed. Pair histories follow the pairs (i, j)
  * across rebuilds; pairs beyond their range get a fresh history (each encounter starts
- * afresh, as in sim_integrate.c). Particle-wall pairs are all n x n_walls pairs.
+ * afresh), except for the record of a min-separation model that keeps one beyond the force
+ * range (ehd, max: up to reset_ratio R*), which ends where it ends in sim_integrate.c
+ * (wetdem_sim_history_beyond_range); the list's reach covers that record range, so a live
+ * record is never dropped by a rebuild (many.h, record). Particle-wall pairs are all
+ * n x n_walls pairs.
  *
  * Determinism: every particle sums the forces on it in an order set by particle indices only
  * (sim_many_force.c), so positions and velocities are bit-identical for any number of
@@ -172,23 +176,30 @@ static void probe_contact(const struct wetdem_sim* sim, struct wetdem_particle p
     wetdem_contact_from_particles(c, &q, &mat[a], &p, &mat[b], &sim->fluid);
 }
 
-/* Largest range of the enabled models over every material combination, for the pair of the
- * largest spheres and for a largest sphere and a wall [m]. */
-static double reach_bound(const struct wetdem_sim* sim)
+/* The start-up bounds of the neighbour search over every material combination, for the pair
+ * of the largest spheres and for a largest sphere and a wall [m]: *reach, the largest range
+ * of the enabled models; *list_reach and *wall_reach, the larger of it and the largest record
+ * range of the min-separation model (wetdem_sim_record_range, 0 without a record) of those
+ * pairs of spheres and of those sphere-wall pairs (many.h). */
+static void reach_bound(const struct wetdem_sim* sim, double* reach, double* list_reach,
+                        double* wall_reach)
 {
     struct wetdem_particle big = {.radius = 0, .mass = 1};
     for (size_t k = 0; k < sim->n_particles; k++)
         if (sim->particles[k].radius > big.radius)
             big = sim->particles[k];
-    double reach = 0;
+    double range = 0, record[2] = {0, 0}; /* of two spheres, of a sphere and a wall */
     for (int a = 0; a < sim->n_materials; a++)
         for (int b = 0; b < sim->n_materials; b++)
             for (int wall = 0; wall < 2; wall++) {
                 struct wetdem_contact c;
                 probe_contact(sim, big, a, b, wall, 0.0, &c);
-                reach = fmax(reach, wetdem_sim_contact_range(sim, &c));
+                range = fmax(range, wetdem_sim_contact_range(sim, &c));
+                record[wall] = fmax(record[wall], wetdem_sim_record_range(sim, &c));
             }
-    return reach;
+    *reach = range;
+    *list_reach = fmax(range, record[0]);
+    *wall_reach = fmax(range, record[1]);
 }
 
 /* The pair of spheres p and q (materials a, b) at gap `gap`, p above q, at rest. */
@@ -504,7 +515,7 @@ static void swap_pair_arrays(struct wetdem_many* m)
     m->flags_cap = cap;
 }
 
-/* Walls within reach + skin of each particle at this build (Verlet criterion as for pairs);
+/* Walls within wall_reach + skin of each particle at this build (Verlet criterion as for pairs);
  * the histories of the other particle-wall pairs are reset. */
 static int update_wall_masks(struct wetdem_sim* sim)
 {
@@ -512,7 +523,7 @@ static int update_wall_masks(struct wetdem_sim* sim)
     size_t n = sim->n_particles, nw = sim->n_walls, len = sim->history_len;
     if (grow((void**)&m->wall_mask, &m->wall_mask_cap, n ? n : 1, sizeof *m->wall_mask))
         return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory for %zu particles", n);
-    double lim = m->reach + m->cl.skin;
+    double lim = m->wall_reach + m->cl.skin;
 #pragma omp parallel for schedule(static) if (wetdem_many_parallel(m, n))
     for (size_t i = 0; i < n; i++) {
         uint64_t mask = 0;
@@ -631,6 +642,23 @@ static double wall_seconds(void)
     return omp_get_wtime();
 }
 
+/* What a failed build of a cell list whose reach a min-separation record widened (many.h)
+ * adds to its message: which model and parameter set the reach; "" otherwise. */
+static const char* record_hint(const struct wetdem_sim* sim, char* buf, size_t size)
+{
+    const struct wetdem_many* m = sim->many;
+    if (!(m->cl.reach > m->reach))
+        return "";
+    const struct wetdem_model* model = sim->minsep.model;
+    bool ratio = wetdem_param_find(model->params, "reset_ratio") != NULL;
+    snprintf(buf, size,
+             " (the reach %g m is the record range of min-separation model '%s', where the "
+             "force models reach %g m%s%s%s)",
+             m->cl.reach, model->name, m->reach, ratio ? ": a smaller " : "",
+             ratio ? model->name : "", ratio ? ".reset_ratio shortens it" : "");
+    return buf;
+}
+
 /* Rebuilds the cell list and carries the histories of surviving pairs over. */
 static int rebuild_lists(struct wetdem_sim* sim)
 {
@@ -643,8 +671,10 @@ static int rebuild_lists(struct wetdem_sim* sim)
     sync_positions(sim); /* the build and the wall masks read the records */
     char msg[512];
     int st = wetdem_celllist_build(&m->cl, sim->particles, sim->n_particles, msg, sizeof msg);
-    if (st != WETDEM_OK)
-        return wetdem_sim_fail(sim, st, "%s", msg);
+    if (st != WETDEM_OK) {
+        char hint[256];
+        return wetdem_sim_fail(sim, st, "%s%s", msg, record_hint(sim, hint, sizeof hint));
+    }
     m->disp_bound = 0;  /* nothing has moved since the build (kick_drift) */
     m->drift_clock = 0; /* the gap test's skip clock starts again, its times kept anew */
     m->skip_on = !m->no_skip;
@@ -684,14 +714,17 @@ int wetdem_sim_many_prepare(struct wetdem_sim* sim)
                                "the enabled models keep %zu doubles of pair history; at most %d",
                                sim->history_len, HISTORY_MAX);
     bool fresh_set = !m->started || sim->n_particles != m->cl.n_at_build;
-    double r_min = INFINITY, reach = m->reach, skin = m->cl.skin;
+    double r_min = INFINITY, skin = m->cl.skin;
+    double reach = m->reach, list_reach = m->cl.reach, wall_reach = m->wall_reach;
     for (size_t k = 0; fresh_set && k < sim->n_particles; k++)
         r_min = fmin(r_min, sim->particles[k].radius);
-    if (fresh_set) { /* the bound is set at start-up and when particles are added */
-        reach = reach_bound(sim);
+    if (fresh_set) { /* the bounds are set at start-up and when particles are added */
+        reach_bound(sim, &reach, &list_reach, &wall_reach);
         skin = m->set.skin > 0 ? m->set.skin : 0.1 * (isfinite(r_min) ? r_min : 1.0);
+        m->reach = reach;
+        m->wall_reach = wall_reach;
     }
-    if (fresh_set && (!m->started || reach != m->reach || skin != m->cl.skin)) {
+    if (fresh_set && (!m->started || list_reach != m->cl.reach || skin != m->cl.skin)) {
         struct wetdem_celllist_box box = {
             {m->set.box_lo.x, m->set.box_lo.y, m->set.box_lo.z},
             {m->set.box_hi.x, m->set.box_hi.y, m->set.box_hi.z},
@@ -701,16 +734,16 @@ int wetdem_sim_many_prepare(struct wetdem_sim* sim)
         m->cl.pairs = NULL;
         wetdem_celllist_clear(&m->cl);
         char msg[256];
-        int st = wetdem_celllist_init(&m->cl, &box, reach, skin, msg, sizeof msg);
+        int st = wetdem_celllist_init(&m->cl, &box, list_reach, skin, msg, sizeof msg);
         m->cl.pairs = pairs;
         m->cl.n_pairs = n_pairs;
         m->cl.pairs_cap = pairs_cap;
         if (st != WETDEM_OK)
             return wetdem_sim_fail(sim, st, "%s", msg);
-        m->reach = reach;
     }
     bool refresh = fresh_set || !m->kernel_ready;
     if (refresh) {
+        m->record = sim->minsep.model->record_range != NULL; /* (the model may have changed) */
         int st = wetdem_sim_many_setup_kernel(sim);
         if (st != WETDEM_OK)
             return st;

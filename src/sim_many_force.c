@@ -130,12 +130,14 @@ static void mix_pair(const struct wetdem_sim* sim, int a, int b, struct wetdem_m
 }
 
 /* The lean kernel's plan: on for fused model sets whose restitutions are all valid (else the
- * fused kernel runs and reports the bad one) and, with sb, a constant h_min (minsep "fixed"). */
+ * fused kernel runs and reports the bad one) and, with sb, a constant h_min (minsep "fixed").
+ * Off with a min-separation record (many.h, record): the lean kernel does not evaluate the
+ * min-separation model, whose record the engine keeps beyond the force range. */
 static void plan_lean(struct wetdem_sim* sim)
 {
     struct wetdem_many* m = sim->many;
     struct wetdem_many_lean* L = &m->lean;
-    *L = (struct wetdem_many_lean){.on = m->fused, .hertz_form = -1};
+    *L = (struct wetdem_many_lean){.on = m->fused && !m->record, .hertz_form = -1};
     bool contact_models = false;
     unsigned seen = 0;
     for (size_t k = 0; k < sim->n_models; k++) {
@@ -655,6 +657,18 @@ static int report_failure(struct wetdem_sim* sim, const struct failure* f)
     size_t i = f->is_wall ? f->index / sim->n_walls : m->cl.pairs[f->index].i;
     size_t j = f->is_wall ? f->index % sim->n_walls : m->cl.pairs[f->index].j;
     const char* what = f->is_wall ? "wall " : "";
+    if (f->status == WETDEM_ERR_INVALID && m->record) { /* eval_pair's test of the record */
+        struct wetdem_contact c;
+        wetdem_sim_many_contact(sim, i, j, f->is_wall, &c);
+        double record = wetdem_sim_record_range(sim, &c);
+        double reach = f->is_wall ? m->wall_reach : m->cl.reach;
+        if (record > reach)
+            return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
+                                   "pair (%zu, %s%zu): record range %.6g m of min-separation "
+                                   "model '%s' exceeds the neighbour reach %.6g m bounded at "
+                                   "start-up",
+                                   i, what, j, record, sim->minsep.model->name, reach);
+    }
     if (f->status == WETDEM_ERR_INVALID && f->range > m->reach)
         return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
                                "pair (%zu, %s%zu): interaction range %.6g m exceeds the "
@@ -733,6 +747,24 @@ static double contact_range(const struct wetdem_sim* sim, const struct wetdem_co
     return sim->many->fused ? x->range : wetdem_sim_contact_range(sim, c);
 }
 
+/* Pair or particle-wall pair of contact c beyond its force range, with a min-separation record
+ * (many.h, record): its history as wetdem_sim_history_beyond_range leaves it, and *flags
+ * WETDEM_MANY_DIRTY while the record lives (not active: no force), else 0. Returns
+ * WETDEM_ERR_INVALID when the record range exceeds the reach of the lists (report_failure
+ * says so). Reads of c what the min-separation model reads: gap, R*, v_n, mixed properties. */
+static int record_beyond_range(const struct wetdem_sim* sim, struct wetdem_contact* c, double* hist,
+                               unsigned char* flags)
+{
+    const struct wetdem_many* m = sim->many;
+    double record = wetdem_sim_record_range(sim, c);
+    *flags = 0;
+    if (record > (c->is_wall ? m->wall_reach : m->cl.reach))
+        return WETDEM_ERR_INVALID;
+    if (wetdem_sim_history_beyond_range(sim, c, record, hist))
+        *flags = WETDEM_MANY_DIRTY;
+    return WETDEM_OK;
+}
+
 /* Evaluates contact c (materials' mixed properties x, range `range`) with history hist, advanced in place (committed every
  * step). Returns the status; *out gets force and torques (when active), *flags the flags. */
 static int eval_pair(const struct wetdem_sim* sim, struct wetdem_contact* c,
@@ -745,6 +777,8 @@ static int eval_pair(const struct wetdem_sim* sim, struct wetdem_contact* c,
     if (range > m->reach)
         return WETDEM_ERR_INVALID; /* reported by the caller: the start-up bound failed */
     if (c->gap > range) {
+        if (hist && m->record) /* the min-separation record may live on (many.h) */
+            return record_beyond_range(sim, c, hist, flags);
         if (hist && dirty)
             wetdem_sim_history_init(sim, hist);
         return WETDEM_OK;
@@ -770,6 +804,32 @@ static int eval_pair(const struct wetdem_sim* sim, struct wetdem_contact* c,
     return WETDEM_OK;
 }
 
+/* Pair q = (i, j) within the cheap test's reach (d = x_i - x_j) with a min-separation record
+ * and the fused kernel, whose range is the table's: when it lies beyond that range, its record
+ * (record_beyond_range) from only the part of the contact the min-separation model reads,
+ * computed as contact_pair_geometry does (the same bits), and true; else false (eval_pair
+ * then runs: its range check included). Most of these pairs are only within the record
+ * range, and the full contact cost them as much again. */
+static bool record_only(const struct wetdem_sim* sim, size_t q, struct wetdem_vec3 d,
+                        const struct wetdem_many_mix* x, struct failure* fail)
+{
+    struct wetdem_many* m = sim->many;
+    size_t i = m->cl.pairs[q].i, j = m->cl.pairs[q].j;
+    double dist = vec3_norm(d), r_i = m->xr[i].r, r_j = m->xr[j].r;
+    double gap = dist - r_i - r_j;
+    if (!(gap > x->range) || x->range > m->reach)
+        return false;
+    struct wetdem_contact c = {.i = i, .j = j, .gap = gap, .radius_i = r_i, .radius_j = r_j};
+    copy_mix(&c, x);
+    c.normal = dist > 0 ? vec3_scale(d, 1.0 / dist) : vec3(1, 0, 0);
+    c.r_eff = contact_reduced(r_i, r_j);
+    c.v_n = -vec3_dot(vec3_sub(m->vw[i][0], m->vw[j][0]), c.normal);
+    int st = record_beyond_range(sim, &c, m->history + q * sim->history_len, &m->flags[q]);
+    if (st != WETDEM_OK)
+        note_failure(fail, q, st, false, &c, x->range);
+    return true;
+}
+
 /* Pair q within reach of the cheap test (d = x_i - x_j): its contact and force into *o, its
  * work into work[] (NULL: none). */
 static void eval_near_pair(const struct wetdem_sim* sim, size_t q, struct wetdem_vec3 d,
@@ -778,6 +838,8 @@ static void eval_near_pair(const struct wetdem_sim* sim, size_t q, struct wetdem
 {
     const struct wetdem_many* m = sim->many;
     size_t i = m->cl.pairs[q].i, j = m->cl.pairs[q].j, len = sim->history_len;
+    if (m->record && m->fused && len && record_only(sim, q, d, x, fail))
+        return;
     struct wetdem_contact c;
     struct wetdem_particle a = wetdem_many_particle(sim, i), b = wetdem_many_particle(sim, j);
     pair_contact_from(&a, &b, d, x, &c);
@@ -960,6 +1022,27 @@ static double reach2(const struct wetdem_celllist_item* xr, size_t i, size_t j,
     return lim * lim * (1 + PREFILTER_MARGIN);
 }
 
+/* With a min-separation record (many.h, record), the gap test's bound of every candidate
+ * (pair_lim2) for the larger of r_ab and the pair's record range (for its R* and the material
+ * pair's films), up to which eval_pair still evaluates the min-separation model (the lean
+ * kernel, which would not, is off then: plan_lean). */
+static void record_limits(const struct wetdem_sim* sim)
+{
+    struct wetdem_many* m = sim->many;
+    const struct wetdem_celllist_item* xr = m->xr;
+    size_t nm = (size_t)m->n_mix_materials;
+#pragma omp parallel for schedule(static) if (wetdem_many_parallel(m, sim->n_particles))
+    for (size_t q = 0; q < m->cl.n_pairs; q++) {
+        size_t i = m->cl.pairs[q].i, j = m->cl.pairs[q].j;
+        const struct wetdem_many_mix* x =
+            &m->mix[(size_t)sim->particles[i].material * nm + (size_t)sim->particles[j].material];
+        struct wetdem_contact c = {.r_eff = contact_reduced(xr[i].r, xr[j].r)};
+        copy_mix(&c, x);
+        double lim = xr[i].r + xr[j].r + fmax(x->range, wetdem_sim_record_range(sim, &c));
+        m->pair_lim2[q] = lim * lim * (1 + PREFILTER_MARGIN);
+    }
+}
+
 /* The cheap gap test of candidate q = (i, j): pair_delta, then true when
  * |d|^2 <= (R_i + R_j + r_ab)^2 (1 + PREFILTER_MARGIN), the bound kept per pair (pair_lim2).
  * With `maintain`, sets the candidate's skip time (many.h, set_skip_time): the skip clock
@@ -1105,7 +1188,7 @@ static void eval_walls_of(const struct wetdem_sim* sim, size_t i, struct wetdem_
             continue;
         const struct wetdem_wall* wall = &sim->walls[w];
         double gap = vec3_dot(vec3_sub(pos, wall->point), wall->normal) - radius;
-        if (gap > m->reach) {
+        if (gap > m->wall_reach) {
             wall_beyond(sim, i, w);
             continue;
         }
@@ -2098,6 +2181,8 @@ static int pair_constants(struct wetdem_sim* sim)
         c[2] = hertz_stiffness(x->e_star, c[0]);
         c[3] = form >= 0 ? hertz_damping_factor(x->hertz_damping[form], c[2], c[1]) : 0.0;
     }
+    if (m->record) /* (a loop of its own: the one above is the benchmark's) */
+        record_limits(sim);
     double lim2_max = 0; /* max is exact: the same for any thread count */
 #pragma omp parallel for schedule(static)                                                          \
     reduction(max                                                                                  \

@@ -314,6 +314,26 @@ void wetdem_sim_history_init(const struct wetdem_sim* sim, double* history)
         history[k] = 0.0;
 }
 
+double wetdem_sim_record_range(const struct wetdem_sim* sim, const struct wetdem_contact* c)
+{
+    const struct wetdem_model_slot* s = &sim->minsep;
+    return s->model->record_range ? s->model->record_range(s->params, c) : 0.0;
+}
+
+bool wetdem_sim_history_beyond_range(const struct wetdem_sim* sim, struct wetdem_contact* c,
+                                     double record_range, double* history)
+{
+    const struct wetdem_model_slot* s = &sim->minsep;
+    size_t kept = 0;
+    if (s->model->record_range && c->gap <= record_range) {
+        c->h_min = s->model->min_separation(s->params, c, history); /* updates the record */
+        kept = s->model->history_len;
+    }
+    for (size_t k = kept; k < sim->history_len; k++) /* the force models': fresh */
+        history[k] = 0.0;
+    return kept > 0;
+}
+
 double wetdem_sim_contact_range(const struct wetdem_sim* sim, const struct wetdem_contact* c)
 {
     double r = 0.0;

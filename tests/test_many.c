@@ -5,9 +5,11 @@
  * read), the energy budget closes, to second order from a moving start (trapezoid rule),
  * agreement with the few-body engine on a binary collision, the derived step follows the
  * contact model and stays below a quarter of the viscous relaxation time (a longer given step
- * refused), the start-up reach bound is enforced, agglomerates by union-find, the stored
- * energy, contacts and bridges as the enabled models define them (hand-built configurations;
- * the same after a restart), VTK/CSV outputs, lists rebuilt at the same steps with the displacement bound, callbacks see the
+ * refused), the start-up reach bound is enforced, ehd's record of the largest approach speed
+ * lives to reset_ratio R* beyond the films as in the few-body engine, agglomerates by
+ * union-find, the stored energy, contacts and bridges as the enabled models define them
+ * (hand-built configurations; the same after a restart), VTK/CSV outputs, lists rebuilt at
+ * the same steps with the displacement bound, callbacks see the
  * current state, the wall time by phase adds up.
  */
 #include <float.h>
@@ -545,6 +547,100 @@ static struct wetdem_sim* damped_pair(const char* model, double viscosity, doubl
     return sim;
 }
 
+/* A sphere of R = 0.5 mm and another (R* = 0.25 mm) or a floor (R* = R), with 20 um films
+ * (delta = 40 um, the range of sb), hertz + sb and h_min from ehd with reset_ratio
+ * `ratio`, stepped by the few-body verlet integrator or, with `many`, the many-particle mode
+ * (default skin 50 um); dt = 1 ns. */
+static struct wetdem_sim* record_sim(bool many, bool wall, double ratio)
+{
+    struct wetdem_sim* sim = wetdem_sim_create();
+    struct wetdem_material m = pair_material(20e-6);
+    assert_int_equal(wetdem_sim_add_material(sim, &m), 0);
+    CHECK_OK(wetdem_sim_set_param(sim, "fluid.viscosity", 1e-3));
+    CHECK_OK(wetdem_sim_enable_model(sim, "hertz"));
+    CHECK_OK(wetdem_sim_enable_model(sim, "sb"));
+    CHECK_OK(wetdem_sim_enable_model(sim, "ehd"));
+    CHECK_OK(wetdem_sim_set_param(sim, "ehd.reset_ratio", ratio));
+    CHECK_OK(wetdem_sim_set_param(sim, "verlet.dt", 1e-9));
+    CHECK_OK(wetdem_sim_add_particle(sim, (struct wetdem_particle){.radius = 0.5e-3}));
+    if (wall)
+        CHECK_OK(wetdem_sim_add_wall(sim, vec3(0, 0, 0), vec3(0, 0, 1), 0));
+    else
+        CHECK_OK(wetdem_sim_add_particle(sim, (struct wetdem_particle){.radius = 0.5e-3}));
+    if (many)
+        CHECK_OK(wetdem_sim_set_many(sim, &(struct wetdem_many_settings){0}));
+    return sim;
+}
+
+/* Places record_sim's pair at gap `gap` [m], approaching at v_n [m/s] (< 0: receding), takes a
+ * step and returns the ehd record of the pair's history (the largest approach speed, history
+ * slot 0; 0 for a pair the many mode's list no longer holds, which is a fresh one). */
+static double record_after_step(struct wetdem_sim* sim, bool wall, double gap, double v_n)
+{
+    struct wetdem_particle* p = wetdem_sim_particles(sim, NULL);
+    double r = p[0].radius;
+    if (wall) {
+        p[0].pos = vec3(0, 0, r + gap);
+        p[0].vel = vec3(0, 0, -v_n);
+    } else {
+        p[0].pos = vec3(-(r + 0.5 * gap), 0, 0);
+        p[0].vel = vec3(0.5 * v_n, 0, 0);
+        p[1].pos = vec3(r + 0.5 * gap, 0, 0);
+        p[1].vel = vec3(-0.5 * v_n, 0, 0);
+    }
+    CHECK_OK(wetdem_sim_integrate(sim, wetdem_sim_time(sim) + 1e-9));
+    const struct wetdem_many* m = sim->many;
+    if (m && wall)
+        return m->wall_history[0];
+    for (size_t q = 0; m && q < m->cl.n_pairs; q++)
+        if (m->cl.pairs[q].i == 0 && m->cl.pairs[q].j == 1)
+            return m->history[q * sim->history_len];
+    const struct wetdem_pairs* pl = &sim->engine.pairs;
+    for (size_t k = 0; !m && k < pl->n; k++)
+        if (pl->items[k].i == 0 && pl->items[k].is_wall == wall)
+            return wetdem_pairs_history(pl, k)[0];
+    return 0.0;
+}
+
+/* ehd's h_min follows the largest approach speed of the pair's current encounter, which ends
+ * only where the gap exceeds reset_ratio R* (Nijssen's cut-off for the default 1), not where
+ * the films (sb's range, 40 um) let go. A pair approaching at 1 m/s at 30 um, moved apart to
+ * 100 and 200 um (receding, then at rest; 200 and 400 um from the floor) and back at 0.1 m/s
+ * keeps the 1 m/s when reset_ratio R* exceeds those gaps (ratio 1: 250 um, 500 um from the
+ * floor) and starts afresh from 0.1 m/s when it does not (ratio 0.3: 75 um, 150 um); beyond
+ * reset_ratio R* (600 um, 1.2 mm) the record is forgotten. The many-particle mode keeps the
+ * same record as the few-body engine, across the list rebuilds that every move (more than
+ * half the 50 um skin) forces: the list's reach covers reset_ratio R*. */
+static void test_many_speed_record_lives_to_reset_ratio_r_star(void** state)
+{
+    (void)state;
+    struct {
+        double gap, v_n, kept, fresh; /* [m], [m/s]; the record with ratio 1, with ratio 0.3 */
+    } steps[] = {{30e-6, 1.0, 1.0, 1.0}, {100e-6, -0.2, 1.0, 0.0}, {200e-6, 0.0, 1.0, 0.0},
+                 {30e-6, 0.1, 1.0, 0.1}, {600e-6, 0.0, 0.0, 0.0},  {30e-6, 0.1, 0.1, 0.1}};
+    size_t n_steps = sizeof steps / sizeof steps[0];
+    for (int wall = 0; wall < 2; wall++)
+        for (int kept = 0; kept < 2; kept++) {
+            double ratio = kept ? 1.0 : 0.3, scale = wall ? 2.0 : 1.0; /* R* = R or R/2 */
+            struct wetdem_sim* few = record_sim(false, wall, ratio);
+            struct wetdem_sim* many = record_sim(true, wall, ratio);
+            for (size_t k = 0; k < n_steps; k++) {
+                double gap = steps[k].gap < 40e-6 ? steps[k].gap : scale * steps[k].gap;
+                double want = kept ? steps[k].kept : steps[k].fresh;
+                double a = record_after_step(few, wall, gap, steps[k].v_n);
+                uint64_t builds = many->many->cl.n_builds;
+                double b = record_after_step(many, wall, gap, steps[k].v_n);
+                if (!(fabs(a - want) <= 1e-6 * want && fabs(b - want) <= 1e-6 * want))
+                    fail_msg("%s, reset_ratio %g, step %zu (gap %g m, v_n %g m/s): record %g m/s "
+                             "few-body, %g m/s many, want %g",
+                             wall ? "floor" : "pair", ratio, k, gap, steps[k].v_n, a, b, want);
+                assert_true(k == 0 || many->many->cl.n_builds > builds);
+            }
+            wetdem_sim_free(few);
+            wetdem_sim_free(many);
+        }
+}
+
 /* Relative speed of the surfaces of spheres 0 and 1 at their contact point, less its part
  * along the line of centres when `tangential` [m/s]. */
 static double surface_speed(const struct wetdem_sim* sim, bool tangential)
@@ -891,6 +987,24 @@ static void test_many_reach_bound_is_enforced(void** state)
     sim->many->reach = 10e-6; /* pretend the bound had been too small */
     CHECK_STATUS(wetdem_sim_integrate(sim, 4e-5), WETDEM_ERR_INVALID);
     CHECK_CONTAINS(wetdem_sim_errmsg(sim), "exceeds the neighbour reach");
+    wetdem_sim_free(sim);
+    /* with ehd, the list's reach is the record range reset_ratio R* of the two largest spheres
+       (R_max/2), the walls' R_max, and a pair whose record range exceeds it stops the run too */
+    sim = wet_box(150, true);
+    CHECK_OK(wetdem_sim_enable_model(sim, "ehd"));
+    CHECK_OK(wetdem_sim_integrate(sim, 2e-5));
+    size_t n;
+    const struct wetdem_particle* p = wetdem_sim_particles_const(sim, &n);
+    double r_max = 0;
+    for (size_t k = 0; k < n; k++)
+        r_max = fmax(r_max, p[k].radius);
+    CHECK_REL(sim->many->reach, 40e-6, 1e-12);
+    CHECK_REL(sim->many->cl.reach, 0.5 * r_max, 1e-12);
+    CHECK_REL(sim->many->wall_reach, r_max, 1e-12);
+    sim->many->cl.reach = 0.1e-3;
+    CHECK_STATUS(wetdem_sim_integrate(sim, 4e-5), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(wetdem_sim_errmsg(sim), "record range");
+    CHECK_CONTAINS(wetdem_sim_errmsg(sim), "'ehd' exceeds the neighbour reach 0.0001 m");
     wetdem_sim_free(sim);
 }
 
@@ -1299,6 +1413,7 @@ int main(void)
         cmocka_unit_test(test_many_step_resolves_the_tangential_spring),
         cmocka_unit_test(test_many_divergence_stops_the_run),
         cmocka_unit_test(test_many_reach_bound_is_enforced),
+        cmocka_unit_test(test_many_speed_record_lives_to_reset_ratio_r_star),
         cmocka_unit_test(test_many_agglomerates_by_union_find),
         cmocka_unit_test(test_many_elastic_energy_is_the_contact_models),
         cmocka_unit_test(test_many_hooke_budget_dissipates),

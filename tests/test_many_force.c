@@ -5,8 +5,9 @@
  * histories to the generic model interface (wetdem_sim_eval_contact) over every branch of the
  * four models, the precomputed-coefficient damping kernels it calls equal the per-call ones,
  * whole runs with the fused kernel, and with the lean kernel that computes the same forces
- * without building contacts, equal runs through the generic interface bit for bit, and all
- * stay independent of the thread count.
+ * without building contacts, equal runs through the generic interface bit for bit (also with
+ * a min-separation record kept beyond the films), and all stay independent of the thread
+ * count.
  *
  * Bit-identity is the right tolerance here: the fused kernel calls the same kernels with the
  * same arguments and adds the models in the same order, so any difference is a bug.
@@ -364,6 +365,42 @@ static void test_many_fused_run_equals_generic_run(void** state)
         wetdem_sim_free(generic);
         wetdem_sim_free(fused3);
     }
+}
+
+/* With a min-separation record (ehd, reset_ratio 1: up to R* ~ 0.22 mm, beyond the 20 um
+ * films), the fused kernel evaluates a pair beyond the films from the part of its contact the
+ * model reads (sim_many_force.c record_only), the generic path from the whole contact: whole
+ * runs end bit-identical, the particles and every pair's history and flags, also on 3
+ * threads. The lean kernel, which does not evaluate the model, is off; some pair apart beyond
+ * the films (no bridge) holds a live record. */
+static void test_many_record_beyond_the_films_equals_generic(void** state)
+{
+    (void)state;
+    int saved = omp_get_max_threads();
+    struct wetdem_sim* sims[3];
+    for (int k = 0; k < 3; k++) {
+        sims[k] = wet_gas(k == 1, false);
+        CHECK_OK(wetdem_sim_enable_model(sims[k], "ehd"));
+        omp_set_num_threads(k == 2 ? 3 : 1);
+        CHECK_OK(wetdem_sim_integrate(sims[k], 0.6e-3));
+    }
+    omp_set_num_threads(saved);
+    const struct wetdem_many *a = sims[0]->many, *b = sims[1]->many;
+    assert_true(a->fused && a->record && !a->lean.on && !b->fused);
+    size_t len = sims[0]->history_len, live = 0;
+    for (int k = 1; k < 3; k++) {
+        const struct wetdem_many* o = sims[k]->many;
+        test_check_same_particles(sims[0], sims[k]);
+        assert_int_equal(a->cl.n_pairs, o->cl.n_pairs);
+        assert_memory_equal(a->cl.pairs, o->cl.pairs, a->cl.n_pairs * sizeof a->cl.pairs[0]);
+        assert_memory_equal(a->history, o->history, a->cl.n_pairs * len * sizeof(double));
+        assert_memory_equal(a->flags, o->flags, a->cl.n_pairs);
+    }
+    for (size_t q = 0; q < a->cl.n_pairs; q++)
+        live += a->flags[q] == WETDEM_MANY_DIRTY && a->history[q * len] > 0;
+    assert_true(live > 0);
+    for (int k = 0; k < 3; k++)
+        wetdem_sim_free(sims[k]);
 }
 
 /* Runs the lean and the generic simulation to time t, checks that the first ran the lean
@@ -916,6 +953,7 @@ int main(void)
         cmocka_unit_test(test_many_precomputed_damping_is_bit_identical),
         cmocka_unit_test(test_many_unfused_set_uses_generic_path),
         cmocka_unit_test(test_many_fused_run_equals_generic_run),
+        cmocka_unit_test(test_many_record_beyond_the_films_equals_generic),
         cmocka_unit_test(test_many_lean_run_any_model_order),
         cmocka_unit_test(test_many_lean_springs_across_rebuilds),
         cmocka_unit_test(test_many_lean_constants_follow_changed_particles),

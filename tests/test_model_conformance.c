@@ -15,7 +15,8 @@
  *   - continuity at every gap thresholds() reports, except at the jumps the model's doc
  *     names (listed in documented_jump(), and checked to be real jumps);
  *   - no branch that thresholds() fails to report (a scan of the gap axis);
- * and min-separation models for swap invariance. Then the pair geometry of src/contact.c
+ * and min-separation models for swap invariance, and those with a record_range for the gap
+ * at which their own record ends being that range. Then the pair geometry of src/contact.c
  * (mixing rules, kinematics with spin lever arms, walls, fixed particles) against hand
  * arithmetic, and the hard impulse against Davis Appendix A generalised to unequal spheres
  * at a finite gap (A1, A9-A11 with I_j, A30-A33, A36) plus its energy balance.
@@ -410,6 +411,55 @@ static void test_conformance_min_separation_swap_invariant(void** state)
                 }
     }
     assert_true(n_models == 5);
+}
+
+/* Min-separation models with a record of the encounter (record_range: ehd, max, glass): the
+ * hook is theirs only; its gap is finite, >= 0 and the same for the swapped pair; and it is
+ * where the model's own record ends, which the engines rely on (they evaluate the model up to
+ * that gap beyond the force range, and give a fresh history beyond): a record of a fast
+ * approach is still there after an evaluation at record_range, and gone (the history fresh,
+ * h_min as for a fresh history) after one a relative 1e-12 beyond it. */
+static void test_conformance_record_range_is_where_the_record_ends(void** state)
+{
+    (void)state;
+    const struct wetdem_model* const* reg = wetdem_model_registry();
+    size_t n_models = 0;
+    for (size_t k = 0; reg[k]; k++) {
+        if (reg[k]->kind != WETDEM_MODEL_MIN_SEPARATION) {
+            assert_null(reg[k]->record_range);
+            continue;
+        }
+        if (!reg[k]->record_range)
+            continue;
+        n_models++;
+        struct variant vars[MAX_VARIANTS];
+        size_t nv = model_variants(reg[k], vars);
+        for (size_t v = 0; v < nv; v++) {
+            struct config cfg = {&fluids[1], 1e-6, &motions[0]};
+            struct wetdem_contact c = make_contact(&cfg, 1e-7, false);
+            struct wetdem_contact s = make_contact(&cfg, 1e-7, true);
+            double record = reg[k]->record_range(vars[v].params, &c);
+            if (!(record >= 0.0 && isfinite(record)) ||
+                !(record == reg[k]->record_range(vars[v].params, &s)))
+                fail_msg("%s: record range %g, swapped %g", vars[v].label, record,
+                         reg[k]->record_range(vars[v].params, &s));
+            for (int beyond = 0; beyond < 2; beyond++) {
+                double h[MAX_HISTORY] = {0}, fresh[MAX_HISTORY] = {0};
+                c.v_n = 2.0; /* the record: a fast approach well inside */
+                c.gap = 0.5 * record;
+                reg[k]->min_separation(vars[v].params, &c, h);
+                c.v_n = 0.1; /* then a slow one at the record range, or just beyond */
+                c.gap = beyond ? record * (1 + 1e-12) + 1e-300 : record;
+                double h_min = reg[k]->min_separation(vars[v].params, &c, h);
+                double h_fresh = reg[k]->min_separation(vars[v].params, &c, fresh);
+                bool is_fresh = !memcmp(h, fresh, reg[k]->history_len * sizeof h[0]);
+                if (beyond ? !(is_fresh && h_min == h_fresh) : is_fresh)
+                    fail_msg("%s: at %s record range %g m the record is %s", vars[v].label,
+                             beyond ? "just beyond its" : "its", record, beyond ? "kept" : "gone");
+            }
+        }
+    }
+    assert_true(n_models == 3);
 }
 
 /* ======================================================================================== */
@@ -1139,6 +1189,7 @@ int main(void)
         cmocka_unit_test(test_conformance_swap_symmetry_and_torques),
         cmocka_unit_test(test_conformance_contact_swap_is_mirror),
         cmocka_unit_test(test_conformance_min_separation_swap_invariant),
+        cmocka_unit_test(test_conformance_record_range_is_where_the_record_ends),
         cmocka_unit_test(test_conformance_zero_beyond_range),
         cmocka_unit_test(test_conformance_continuity_at_thresholds),
         cmocka_unit_test(test_conformance_no_unreported_branch),
