@@ -302,34 +302,18 @@ static bool csv_last_step(const char* path, unsigned long long* step)
 }
 
 /* Appends the state at the end of the run (finished or interrupted) to the CSV as its last
- * row, unless the library's rows, every csv_every steps, ended there. The row has the
- * library's columns and format (src/sim_many_io.c, write_csv_row; tests/test_many_cli.c
- * compares the two), so the CSV ends at the state summary.json reports. The energies come
- * from the energy budget, the API's only way to them: without it the CSV keeps to its grid.
- * WETDEM status. */
+ * row (wetdem_sim_many_write_csv_row), unless the library's rows, every csv_every steps, ended
+ * there, so the CSV ends at the state summary.json reports. WETDEM status. */
 static int csv_final_row(const char* csv_prefix, struct wetdem_sim* sim)
 {
     struct wetdem_many_stats s;
-    struct wetdem_energy_budget b;
     char path[PATH_CHARS + 8];
     snprintf(path, sizeof path, "%s.csv", csv_prefix);
     unsigned long long last;
     if (!csv_prefix[0] || wetdem_sim_many_stats(sim, &s) != WETDEM_OK ||
-        wetdem_sim_energy_budget(sim, &b) != WETDEM_OK || !csv_last_step(path, &last) ||
-        last >= s.step)
+        !csv_last_step(path, &last) || last >= s.step)
         return WETDEM_OK;
-    FILE* f = fopen(path, "a");
-    if (!f)
-        return WETDEM_ERR_IO;
-    fprintf(f, "%.9g,%llu,%.9g,%.9g,%.9g,%zu,%zu,%zu,%.6g,%zu", wetdem_sim_time(sim), s.step,
-            b.kinetic, b.potential, b.elastic, s.contacts, s.bridges, s.agglomerates,
-            s.mean_agglomerate, s.candidate_pairs);
-    for (size_t q = 0; q < b.n_models && q < WETDEM_ENERGY_MAX_MODELS; q++)
-        fprintf(f, ",%.9g", b.work_pair[q] + b.work_wall[q]);
-    fprintf(f, ",%.9g,%.3g\n", b.dissipated, b.balance_error);
-    bool ok = !ferror(f);
-    ok = fclose(f) == 0 && ok;
-    return ok ? WETDEM_OK : WETDEM_ERR_IO;
+    return wetdem_sim_many_write_csv_row(sim);
 }
 
 /* Keeps the comment and header lines of the CSV and the rows up to `step` (second column),

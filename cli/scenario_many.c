@@ -138,8 +138,8 @@ static const struct cli_key_desc dump_keys[] = {
          "CSV of global quantities (energies, contacts, liquid bridges, agglomerates, work per "
          "model) in --out DIR, ending in .csv; none disables it."),
     COUNT("csv_every", "run steps / 500", 0, 1e15,
-          "Steps between CSV rows (the last step is always written, with energy_budget on); "
-          "0: none. At most 1e7 rows a run."),
+          "Steps between CSV rows (the last step is always written); 0: none. At most 1e7 "
+          "rows a run."),
     WORD("checkpoint", CLI_VALUE_TEXT, "checkpoint.ckpt", NULL,
          "Checkpoint in --out DIR, written atomically every checkpoint_every steps, when "
          "interrupted (SIGINT, SIGTERM) and at the end; none disables it."),

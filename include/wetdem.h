@@ -677,6 +677,12 @@ struct wetdem_many_stats {
 #define WETDEM_MANY_CONTACT_FRACTION_MAX 0.1
 WETDEM_API int wetdem_sim_many_stats(const struct wetdem_sim* sim, struct wetdem_many_stats* s);
 
+/* Appends a row of the global quantities at the current state to the run's CSV
+ * (output_prefix.csv), with the columns and format of the rows written every csv_every steps:
+ * e.g. the state a run ends or is interrupted at, off that grid. WETDEM_ERR_INVALID before a
+ * run or without outputs, WETDEM_ERR_IO. */
+WETDEM_API int wetdem_sim_many_write_csv_row(struct wetdem_sim* sim);
+
 /* Writes the particles as a legacy VTK file (radius, velocity, spin, contacts as in
  * wetdem_many_stats, material, id). */
 WETDEM_API int wetdem_sim_write_vtk(struct wetdem_sim* sim, const char* path, bool binary);

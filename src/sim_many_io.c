@@ -304,6 +304,14 @@ static int write_csv_row(struct wetdem_sim* sim)
     return ok ? WETDEM_OK : wetdem_sim_fail(sim, WETDEM_ERR_IO, "cannot write '%s'", path);
 }
 
+int wetdem_sim_many_write_csv_row(struct wetdem_sim* sim)
+{
+    if (!sim || !sim->many || !sim->many->started || !sim->many->output_prefix)
+        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
+                               "many: a CSV row needs a started many-particle run with outputs");
+    return write_csv_row(sim);
+}
+
 /* Output k is due at multiples of `every` steps, once per step. */
 static bool due(uint64_t step, unsigned long long every, uint64_t* next)
 {

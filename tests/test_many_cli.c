@@ -593,6 +593,11 @@ static void test_many_cli_csv_ends_at_the_last_step(void** state)
     free(a);
     free(b);
     assert_int_equal(csv_rows(tpath("off/global.csv")), 600 / 7 + 2); /* 0, 7, ..., 595, 600 */
+    /* without the energy budget too (the row's energies then come from the state alone) */
+    assert_int_equal(run_cli("run tail.ini --set run.steps=610 --set run.energy_budget=no "
+                             "--out nobudget"),
+                     0);
+    assert_int_equal(csv_last_step("nobudget/global.csv"), 610);
 }
 
 /* A fresh run into a used --out replaces the earlier run's frames: none of a longer run is
