@@ -261,6 +261,25 @@ static void test_cli_forces_bad_input(void** state)
     }
 }
 
+/* A command line, the text its output must contain and its exit code. */
+struct cli_case {
+    const char *args, *message;
+    int code;
+};
+
+/* Runs every case and checks its exit code and message. */
+static void check_cli_cases(const struct cli_case* cases, size_t n)
+{
+    for (size_t k = 0; k < n; k++) {
+        struct test_run r = run_cli(cases[k].args, true);
+        if (r.code != cases[k].code)
+            fail_msg("'%s' exited %d, expected %d:\n%s", cases[k].args, r.code, cases[k].code,
+                     r.out);
+        CHECK_CONTAINS(r.out, cases[k].message);
+        free(r.out);
+    }
+}
+
 /* Every command rejects a bad option before it reads a file: exit code 2, the option named,
  * a hint for a near-miss spelling (one or two letters off, as wetdem_param_suggest measures
  * it), none for a word far from every option, and a note for an option left without its
@@ -268,32 +287,25 @@ static void test_cli_forces_bad_input(void** state)
 static void test_cli_bad_options_get_hints(void** state)
 {
     (void)state;
-    static const struct {
-        const char *args, *message;
-    } cases[] = {
-        {"run none.ini --otu d", "run: unexpected argument '--otu' (did you mean '--out'?)"},
-        {"run none.ini --jsno", "(did you mean '--json'?)"},
-        {"run none.ini --restrat c.ckpt", "(did you mean '--restart'?)"},
-        {"run none.ini --out", "unexpected argument '--out' (needs a value)"},
-        {"run none.ini --zzzzzzzz", "unexpected argument '--zzzzzzzz'\nusage: wetdem run"},
+    static const struct cli_case cases[] = {
+        {"run none.ini --otu d", "run: unexpected argument '--otu' (did you mean '--out'?)", 2},
+        {"run none.ini --jsno", "(did you mean '--json'?)", 2},
+        {"run none.ini --restrat c.ckpt", "(did you mean '--restart'?)", 2},
+        {"run none.ini --out", "unexpected argument '--out' (needs a value)", 2},
+        {"run none.ini --zzzzzzzz", "unexpected argument '--zzzzzzzz'\nusage: wetdem run", 2},
         {"sweep none.ini --parma a",
-         "sweep: unexpected argument '--parma' (did you mean '--param'?)"},
-        {"map none.ini --lgo2", "map: unexpected argument '--lgo2' (did you mean '--log2'?)"},
-        {"sweep none.ini --values 1:2:3 --param", "unexpected argument '--param' (needs a value)"},
-        {"map none.ini --param2", "map: unexpected argument '--param2' (needs a value)"},
-        {"fit none.ini --dat d.csv", "fit: unknown option '--dat' (did you mean '--data'?)"},
-        {"fit none.ini --zzzzzzzz 1", "fit: unknown option '--zzzzzzzz'\n"},
-        {"forces --model reynolds --radus 1",
-         "unknown option '--radus' (did you mean '--radius'?)"},
-        {"track dots.csv --fsp 30", "track: unknown option '--fsp' (did you mean '--fps'?)"},
+         "sweep: unexpected argument '--parma' (did you mean '--param'?)", 2},
+        {"map none.ini --lgo2", "map: unexpected argument '--lgo2' (did you mean '--log2'?)", 2},
+        {"sweep none.ini --values 1:2:3 --param", "unexpected argument '--param' (needs a value)",
+         2},
+        {"map none.ini --param2", "map: unexpected argument '--param2' (needs a value)", 2},
+        {"fit none.ini --dat d.csv", "fit: unknown option '--dat' (did you mean '--data'?)", 2},
+        {"fit none.ini --zzzzzzzz 1", "fit: unknown option '--zzzzzzzz'\n", 2},
+        {"forces --model reynolds --radus 1", "unknown option '--radus' (did you mean '--radius'?)",
+         2},
+        {"track dots.csv --fsp 30", "track: unknown option '--fsp' (did you mean '--fps'?)", 2},
     };
-    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
-        struct test_run r = run_cli(cases[k].args, true);
-        if (r.code != 2)
-            fail_msg("'%s' exited %d, expected 2:\n%s", cases[k].args, r.code, r.out);
-        CHECK_CONTAINS(r.out, cases[k].message);
-        free(r.out);
-    }
+    check_cli_cases(cases, sizeof cases / sizeof cases[0]);
 }
 
 /* Models chosen where they do not belong are named with their kind ("an impulse model"); a
@@ -302,10 +314,7 @@ static void test_cli_bad_options_get_hints(void** state)
 static void test_cli_model_of_the_wrong_kind(void** state)
 {
     (void)state;
-    static const struct {
-        const char *args, *message;
-        int code;
-    } cases[] = {
+    static const struct cli_case cases[] = {
         {"run examples/scenarios/nijssen_head_on.ini --set models.min_separation=hard --check",
          "'hard' is an impulse model, not a minimum-separation model", 2},
         {"run examples/scenarios/many_settling.ini --set models.force=hard --check",
@@ -314,14 +323,7 @@ static void test_cli_model_of_the_wrong_kind(void** state)
         {"run examples/scenarios/many_settling.ini --set models.min_separation=nijssen --check",
          "'nijssen' is a fluid model, not a minimum-separation model", 2},
     };
-    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
-        struct test_run r = run_cli(cases[k].args, true);
-        if (r.code != cases[k].code)
-            fail_msg("'%s' exited %d, expected %d:\n%s", cases[k].args, r.code, cases[k].code,
-                     r.out);
-        CHECK_CONTAINS(r.out, cases[k].message);
-        free(r.out);
-    }
+    check_cli_cases(cases, sizeof cases / sizeof cases[0]);
 }
 
 /* Writes text to a new temporary file; returns its path (static buffer). */
@@ -345,10 +347,7 @@ static const char* temp_scenario(const char* text)
 static void test_cli_unused_model_sections(void** state)
 {
     (void)state;
-    static const struct {
-        const char *args, *message;
-        int code;
-    } cases[] = {
+    static const struct cli_case cases[] = {
         {"run examples/scenarios/many_settling.ini --set models.min_separation=ehd --check",
          "is valid (many-particle run)", 0},
         {"run examples/scenarios/punch_oblique.ini --set models.min_separation=roughness --check",
@@ -357,14 +356,7 @@ static void test_cli_unused_model_sections(void** state)
          "--set model.fixed.h_min=2e-6 --check",
          "--set model.fixed.h_min=2e-6: model 'fixed' is not enabled", 2},
     };
-    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
-        struct test_run r = run_cli(cases[k].args, true);
-        if (r.code != cases[k].code)
-            fail_msg("'%s' exited %d, expected %d:\n%s", cases[k].args, r.code, cases[k].code,
-                     r.out);
-        CHECK_CONTAINS(r.out, cases[k].message);
-        free(r.out);
-    }
+    check_cli_cases(cases, sizeof cases / sizeof cases[0]);
     char args[256];
     const char* unused = temp_scenario("[collision]\nstokes = 50\n[models]\nmin_separation = ehd\n"
                                        "[model.fixed]\nh_min = 1e-6\n");
