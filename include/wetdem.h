@@ -518,6 +518,8 @@ struct wetdem_collision_spec {
                                    delta_ij when the pair has films, else 0.01 R* */
 };
 
+/* Result of a binary collision. e and e_n are 0 when the pair has not separated by t_end (no
+ * rebound). */
 struct wetdem_collision_result {
     double stokes_n;               /* normal Stokes number of the impact [-] */
     double speed_n0;               /* normal impact speed U cos(angle) [m/s] */

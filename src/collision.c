@@ -26,6 +26,7 @@
  * frictionless impact. Velocities are taken at the end (separation or t_end):
  *   e   = |dv_f| / |dv_0|                                   (Nijssen; Yang & Hunt)
  *   e_n = -(dv_f . n_f) / (dv_0 . n0)                        (Punch Eq. 3)
+ *   (e and e_n are 0 when the pair has not separated by t_end: no rebound)
  *   e_t = -(u_f . t_f) / |u_0|,  u = tangential part of the contact-point velocity
  *         (v_i + w_i x (-R_i n)) - (v_j + w_j x (R_j n)), t_f = u_0/|u_0| projected on the
  *         final tangent plane; -1 smooth sliding, +1 full reversal (Walton's beta)
@@ -433,8 +434,11 @@ static void restitution(const struct wetdem_sim* sim, const struct initial* in,
     struct wetdem_vec3 dvf = relative_velocity(sim);
     struct wetdem_vec3 nf = separated ? rebound_normal(tr, c.normal) : c.normal;
     double dn0 = vec3_dot(in->dv, in->n), dnf = vec3_dot(dvf, nf);
-    r->e = vec3_norm(dvf) / vec3_norm(in->dv);
-    r->e_n = dn0 < 0 ? -dnf / dn0 : NAN;
+    /* no rebound by t_end (stick, or a run too short to reach the target): 0, as the papers
+     * plot it; the ratios of the velocities at t_end would be those of a motion still under
+     * way (e = 1 and e_n = -1 for a striker still on its way in) */
+    r->e = separated ? vec3_norm(dvf) / vec3_norm(in->dv) : 0.0;
+    r->e_n = dn0 < 0 ? (separated ? -dnf / dn0 : 0.0) : NAN;
     r->angle_in = atan2(vec3_norm(vec3_reject(in->dv, in->n)), -dn0);
     r->angle_out = atan2(vec3_norm(vec3_reject(dvf, nf)), dnf);
     r->normal_out = nf;

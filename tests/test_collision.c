@@ -392,6 +392,13 @@ static void test_collision_outcomes(void** state)
         assert_false(r.separated);
         assert_int_equal(r.outcome, WETDEM_OUTCOME_STICK);
         CHECK_REL(r.t_final, 0.05, 1e-12);
+        /* no rebound: e = e_n = 0, also for a run too short to reach the target, whose
+           velocities at t_end are those of the approach (e = 1, e_n = -1 as ratios) */
+        assert_true(r.e == 0.0 && r.e_n == 0.0);
+        s.t_end = 1e-6;
+        CHECK_OK(wetdem_collision_run(sim, &s, &r));
+        assert_true(!r.separated && r.outcome == WETDEM_OUTCOME_STICK);
+        assert_true(r.e == 0.0 && r.e_n == 0.0);
         wetdem_sim_free(sim);
     }
     assert_string_equal(wetdem_outcome_name(WETDEM_OUTCOME_STICK_ROTATE_SEPARATE),
