@@ -93,9 +93,9 @@ static const char* const special_names[] = {"material", "fluid", "sim", "presets
 static void describe_integrator(const char* name)
 {
     printf("%s (integrator): %s\n\n", name, wetdem_integrator_summary(name));
-    printf("parameters (set as %s.NAME=VALUE, e.g. with --set, or in [integrator] of a "
-           "scenario):\n",
-           name);
+    printf("parameters ([integrator] keys of a scenario, --set integrator.NAME=VALUE or "
+           "%s.NAME=VALUE; %s.NAME in the library):\n",
+           name, name);
     print_table(wetdem_integrator_params(name));
 }
 

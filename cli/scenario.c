@@ -662,6 +662,9 @@ int cli_override_split(const char* text, char* section, char* key, char* value)
     if (cli_section_lookup(section, &info) != 0 && wetdem_model_find(section)) {
         memmove(section + 6, section, slen + 1); /* slen < CLI_NAME_MAX - 6 checked above */
         memcpy(section, "model.", 6);
+    } else if (wetdem_integrator_params(section)) {
+        /* the library's names of integrator parameters, cvode.rtol: [integrator] rtol */
+        copy_text(section, CLI_NAME_MAX, "integrator");
     }
     return 0;
 }

@@ -588,8 +588,10 @@ struct wetdem_many_settings {
                                             the smallest radius */
     bool periodic[3];                    /* periodic axes x, y, z */
     struct wetdem_vec3 box_lo, box_hi;   /* periodic box [m] (read on periodic axes only) */
-    double dt;                           /* step [s] >= 0; 0: verlet.dt, or verlet.dt_fraction
-                                            x the Hertz contact time of the smallest spheres */
+    double dt;                           /* step [s] >= 0; 0: verlet.dt, or derived from the
+                                            contact times of the pairs that can occur, the
+                                            viscous relaxation and h_min (docs/many.md, Time
+                                            step) */
     bool energy_budget;                  /* accumulate the work of every model (costs about
                                             25-50 %: docs/many.md, "Energy budget") */
     const char* output_prefix;           /* <prefix>_NNNNNN.vtk, <prefix>.vtk.series and

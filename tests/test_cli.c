@@ -326,6 +326,21 @@ static void test_cli_model_of_the_wrong_kind(void** state)
     check_cli_cases(cases, sizeof cases / sizeof cases[0]);
 }
 
+/* Integrator parameters by the library's names, cvode.rtol, are the [integrator] keys, as
+ * `wetdem describe cvode` says (they were refused as an unknown section [cvode]). */
+static void test_cli_integrator_names_in_set(void** state)
+{
+    (void)state;
+    static const struct cli_case cases[] = {
+        {"run examples/scenarios/nijssen_head_on.ini --set cvode.rtol=1e-9 --check", "is valid", 0},
+        {"run examples/scenarios/nijssen_head_on.ini --set verlet.dt_fraction=0.01 --check",
+         "is valid", 0},
+        {"run examples/scenarios/nijssen_head_on.ini --set cvode.rtol=1 --check",
+         "--set integrator.rtol=1: rtol = 1 [-] is out of range", 2},
+    };
+    check_cli_cases(cases, sizeof cases / sizeof cases[0]);
+}
+
 /* Writes text to a new temporary file; returns its path (static buffer). */
 static const char* temp_scenario(const char* text)
 {
@@ -390,6 +405,7 @@ int main(void)
         cmocka_unit_test(test_cli_bad_options_get_hints),
         cmocka_unit_test(test_cli_model_of_the_wrong_kind),
         cmocka_unit_test(test_cli_unused_model_sections),
+        cmocka_unit_test(test_cli_integrator_names_in_set),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
