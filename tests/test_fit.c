@@ -9,6 +9,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include <gsl/gsl_errno.h>
 #include <gsl/gsl_randist.h>
 #include <gsl/gsl_rng.h>
 
@@ -142,6 +143,180 @@ static void test_fit_rejects_bad_problems(void** state)
     pb.is_log = log_flag;
     CHECK_STATUS(wetdem_fit_run(&pb, &o, &r, NULL, msg, sizeof msg), WETDEM_ERR_INVALID);
     CHECK_CONTAINS(msg, "> 0 (log fit)");
+}
+
+/* ---- what the data do not determine, and bounds ------------------------------------------ */
+
+/* y_i = p0 x_i: p1 (when there is one) is ignored: its column of the Jacobian is zero. */
+static int ignores_second(const double* p, double* out, char* msg, size_t n, void* ctx)
+{
+    (void)msg;
+    (void)n;
+    (void)ctx;
+    for (size_t i = 0; i < 4; i++)
+        out[i] = p[0] * (double)(i + 1);
+    return WETDEM_OK;
+}
+
+/* y_i = i: no parameter matters. */
+static int constant_model(const double* p, double* out, char* msg, size_t n, void* ctx)
+{
+    (void)p, (void)msg, (void)n, (void)ctx;
+    for (size_t i = 0; i < 4; i++)
+        out[i] = (double)(i + 1);
+    return WETDEM_OK;
+}
+
+/* y_i = a b x_i: in log variables the columns of a and b are equal. */
+static int product_only(const double* p, double* out, char* msg, size_t n, void* ctx)
+{
+    (void)msg;
+    (void)n;
+    (void)ctx;
+    for (size_t i = 0; i < 4; i++)
+        out[i] = p[0] * p[1] * (double)(i + 1) + 0.01 * (double)(i % 2);
+    return WETDEM_OK;
+}
+
+static void caller_gsl_handler(const char* reason, const char* file, int line, int gsl_errno)
+{
+    (void)reason, (void)file, (void)line, (void)gsl_errno;
+}
+
+/* A parameter the predictions do not depend on gives a Jacobian column of zeros; GSL's QR of
+ * a rank-0 Jacobian called GSL's default error handler, which aborted the program. It is an
+ * error with the parameter and the value, and the caller's GSL handler is left in place. */
+static void test_fit_zero_jacobian_column_is_an_error_not_an_abort(void** state)
+{
+    (void)state;
+    const double obs[4] = {1, 2, 3, 4}, init[2] = {2, 3};
+    const char* names[2] = {"used", "flat"};
+    struct wetdem_fit_problem pb = {.n_params = 2,
+                                    .names = names,
+                                    .initial = init,
+                                    .n_data = 4,
+                                    .observed = obs,
+                                    .model = ignores_second};
+    struct wetdem_fit_options o;
+    wetdem_fit_options_init(&o);
+    struct wetdem_fit_result r;
+    char msg[512];
+    gsl_error_handler_t* before = gsl_set_error_handler(&caller_gsl_handler);
+    /* one parameter, ignored: a Jacobian of rank 0 (GSL aborted here) */
+    pb.n_params = 1;
+    pb.names = names + 1;
+    pb.initial = init + 1;
+    pb.model = constant_model;
+    CHECK_STATUS(wetdem_fit_run(&pb, &o, &r, NULL, msg, sizeof msg), WETDEM_ERR_UNDETERMINED);
+    CHECK_CONTAINS(msg,
+                   "the data do not depend on flat near 3 (its column of the Jacobian is zero");
+    assert_int_equal(r.dof, 0); /* no solution to report statistics of */
+    /* two parameters, the second ignored: rank 1 (GSL gave it a standard error of 0) */
+    pb.n_params = 2;
+    pb.names = names;
+    pb.initial = init;
+    pb.model = ignores_second;
+    CHECK_STATUS(wetdem_fit_run(&pb, &o, &r, NULL, msg, sizeof msg), WETDEM_ERR_UNDETERMINED);
+    CHECK_CONTAINS(msg,
+                   "the data do not depend on flat near 3 (its column of the Jacobian is zero");
+    assert_true(r.undetermined[1] && isinf(r.std_errors[1]));
+    /* GSL's handler is the caller's again */
+    assert_ptr_equal(gsl_set_error_handler(before), &caller_gsl_handler);
+}
+
+/* Two parameters whose columns are equal (only their product matters) have no separate
+ * values: both standard errors are infinite and the status says so (the covariance from
+ * GSL's pivoted QR set them to 0, i.e. "0 %"). */
+static void test_fit_rank_deficient_jacobian_gives_infinite_errors(void** state)
+{
+    (void)state;
+    const double obs[4] = {6.1, 12, 18.1, 24}, init[2] = {2, 2.5};
+    const char* names[2] = {"a", "b"};
+    struct wetdem_fit_problem pb = {.n_params = 2,
+                                    .names = names,
+                                    .initial = init,
+                                    .n_data = 4,
+                                    .observed = obs,
+                                    .model = product_only};
+    struct wetdem_fit_options o;
+    wetdem_fit_options_init(&o);
+    o.fd_step = 1e-5;
+    struct wetdem_fit_result r;
+    char msg[512];
+    CHECK_STATUS(wetdem_fit_run(&pb, &o, &r, NULL, msg, sizeof msg), WETDEM_ERR_UNDETERMINED);
+    CHECK_CONTAINS(msg, "the data do not determine a and b separately");
+    assert_true(r.undetermined[0] && r.undetermined[1]);
+    assert_true(isinf(r.std_errors[0]) && isinf(r.std_errors[1]));
+    assert_true(isnan(r.correlation[0][1]));
+    CHECK_REL(r.values[0] * r.values[1], 6.03, 1e-2); /* the product is what the data fix */
+}
+
+/* y_i = p x_i for p in [0, 1]: the model fails above 1, as a scenario rejects a restitution
+ * above 1; it records the largest and smallest value it was asked for. */
+struct bounded {
+    double lo_seen, hi_seen;
+};
+
+static int bounded_model(const double* p, double* out, char* msg, size_t n, void* ctx)
+{
+    struct bounded* b = ctx;
+    b->lo_seen = fmin(b->lo_seen, p[0]);
+    b->hi_seen = fmax(b->hi_seen, p[0]);
+    if (!(p[0] >= 0 && p[0] <= 1)) {
+        snprintf(msg, n, "p = %g is out of range [0, 1]", p[0]);
+        return WETDEM_ERR_INVALID;
+    }
+    for (size_t i = 0; i < 5; i++)
+        out[i] = p[0] * (double)(i + 1) / 5;
+    return WETDEM_OK;
+}
+
+/* Every evaluation, the finite-difference probes included, stays inside [lower, upper]: data
+ * made at p = 0.995 are fitted from 0.9 (the unbounded log fit probed 1.0096 and failed), and
+ * data that would need p = 1.2 leave p at the upper bound, reported as such (status OK, no
+ * standard error), not as a failed model. */
+static void test_fit_stays_inside_bounds_and_reports_a_bound(void** state)
+{
+    (void)state;
+    double obs[5];
+    const double init[1] = {0.9}, lower[1] = {0}, upper[1] = {1};
+    const char* names[1] = {"e"};
+    struct bounded b = {INFINITY, -INFINITY};
+    struct wetdem_fit_problem pb = {.n_params = 1,
+                                    .names = names,
+                                    .initial = init,
+                                    .n_data = 5,
+                                    .observed = obs,
+                                    .model = bounded_model,
+                                    .ctx = &b,
+                                    .lower = lower,
+                                    .upper = upper};
+    struct wetdem_fit_options o;
+    wetdem_fit_options_init(&o);
+    struct wetdem_fit_result r;
+    char msg[512];
+    for (size_t i = 0; i < 5; i++)
+        obs[i] = 0.995 * (double)(i + 1) / 5 + (i % 2 ? 1e-3 : -1e-3);
+    int st = wetdem_fit_run(&pb, &o, &r, NULL, msg, sizeof msg);
+    if (st != WETDEM_OK)
+        fail_msg("fit to 0.995 from 0.9: %s", msg);
+    CHECK_ABS(r.values[0], 0.995, 2e-3);
+    assert_int_equal(r.at_bound[0], 0);
+    assert_int_equal(r.transform[0], WETDEM_FIT_LOGISTIC);
+    assert_true(b.hi_seen < 1 && b.lo_seen > 0);
+    for (size_t i = 0; i < 5; i++)
+        obs[i] = 1.2 * (double)(i + 1) / 5 + (i % 2 ? 1e-3 : -1e-3);
+    st = wetdem_fit_run(&pb, &o, &r, NULL, msg, sizeof msg);
+    if (st != WETDEM_OK)
+        fail_msg("fit to 1.2 from 0.9: %s", msg);
+    assert_int_equal(r.at_bound[0], 1);
+    assert_true(r.values[0] > 0.999999 && r.values[0] <= 1 && isnan(r.std_errors[0]));
+    assert_true(b.hi_seen <= 1);
+    /* a start on a bound cannot be varied on a log scale */
+    const double on_bound[1] = {1};
+    pb.initial = on_bound;
+    CHECK_STATUS(wetdem_fit_run(&pb, &o, &r, NULL, msg, sizeof msg), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(msg, "e: initial value 1 must be finite and inside (0, 1)");
 }
 
 /* ---- P_gt from simulated restitution ----------------------------------------------------- */
@@ -390,6 +565,9 @@ int main(void)
         cmocka_unit_test(test_fit_recovers_closed_form_parameters),
         cmocka_unit_test(test_fit_standard_errors_are_calibrated),
         cmocka_unit_test(test_fit_rejects_bad_problems),
+        cmocka_unit_test(test_fit_zero_jacobian_column_is_an_error_not_an_abort),
+        cmocka_unit_test(test_fit_rank_deficient_jacobian_gives_infinite_errors),
+        cmocka_unit_test(test_fit_stays_inside_bounds_and_reports_a_bound),
         cmocka_unit_test(test_fit_recovers_glass_pressure_from_simulated_data),
         cmocka_unit_test(test_fit_cli_rejects_bad_input),
         cmocka_unit_test(test_fit_cli_reports_units_on_example),
