@@ -162,6 +162,17 @@ static void test_scenario_set_overrides(void** state)
     assert_int_equal(r.code, 2);
     CHECK_CONTAINS(r.out, "rtol");
     free(r.out);
+    /* a --set of a material the file does not define added one no sphere used (a typo), or
+       one named after a preset that started from the field defaults, not from the preset */
+    expect_run("run examples/fit/punch_db_c.ini --check --set material.strikr.roughness=1e-7", 2,
+               "--set material.strikr.roughness=1e-7: the file has no section "
+               "[material.strikr] (did you mean [material.striker]?)");
+    expect_run("sweep examples/scenarios/nijssen_head_on.ini --param collision.stokes --values "
+               "10:20:2 --set material.delrin.roughness=1e-7",
+               2, "to change preset delrin, give the file a [material.NAME] section");
+    expect_run("map examples/fit/punch_db_c.ini --param collision.stokes --values 2:3:2 --param2 "
+               "glass.p_gt --values2 1e7:2e7:2 --set material.strikr.roughness=1e-7",
+               2, "(did you mean [material.striker]?)");
 }
 
 struct bad_case {
