@@ -1050,6 +1050,10 @@ int cmd_fit(int argc, char** argv)
         rc = key_bounds(&c, init, lower, upper, is_log);
     if (rc == CLI_EXIT_OK)
         rc = check_points(&c, init);
+    if (rc == CLI_EXIT_OK) /* (before the fit runs, not after it) */
+        rc = cli_check_writable("fit", "--out", a.out);
+    if (rc == CLI_EXIT_OK)
+        rc = cli_check_writable("fit", "--curve", a.curve);
     if (rc == CLI_EXIT_OK)
         rc = run_fit(&a, &c, init, lower, upper, is_log, argc, argv);
     free(pts);
