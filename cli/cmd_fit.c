@@ -527,6 +527,20 @@ static int check_key(const char* tok, const char* section, const char* key)
     return CLI_EXIT_USAGE;
 }
 
+/* Whether `key=value` is accepted as an override of the base scenario (the checker prints
+ * why not). Returns its exit code. */
+static int probe_override(const struct fit_ctx* c, const char* key, const char* value)
+{
+    struct cli_scenario probe;
+    char set[2 * CLI_NAME_MAX + 64];
+    snprintf(set, sizeof set, "%s=%s", key, value);
+    if (cli_scenario_copy(c->base, &probe) != CLI_EXIT_OK)
+        return CLI_EXIT_RUNTIME;
+    int rc = cli_scenario_override(&probe, set);
+    cli_scenario_free(&probe);
+    return rc;
+}
+
 /* Whether the key (full name) is one the fit sets per data point, which a fit of it would
  * override: a message and CLI_EXIT_USAGE, else CLI_EXIT_OK. */
 static int check_not_per_point(const char* tok, const char* full, const struct fit_ctx* c)
@@ -575,6 +589,12 @@ static int parse_keys(const char* list, struct fit_ctx* c)
             }
         if (check_not_per_point(tok, full, c) != CLI_EXIT_OK)
             return CLI_EXIT_USAGE;
+        if (strncmp(section, "material.", 9) == 0 &&
+            !cli_scenario_has_section(c->base, section)) { /* (the override says why) */
+            int rc = probe_override(c, full, "0");
+            cli_error("fit: --fit %s: not a key of this scenario (the message above)", tok);
+            return rc == CLI_EXIT_OK ? CLI_EXIT_USAGE : rc;
+        }
         given[c->n_keys] = tok; /* (in buf, split in place) */
         c->n_keys++;
     }
@@ -647,20 +667,6 @@ static bool model_value(const struct cli_scenario* sc, const char* section, cons
     int st = wetdem_sim_param(su.sim, name, v);
     cli_setup_free(&su);
     return st == WETDEM_OK;
-}
-
-/* Whether `key=value` is accepted as an override of the base scenario (the checker prints
- * why not). Returns its exit code. */
-static int probe_override(const struct fit_ctx* c, const char* key, const char* value)
-{
-    struct cli_scenario probe;
-    char set[2 * CLI_NAME_MAX + 64];
-    snprintf(set, sizeof set, "%s=%s", key, value);
-    if (cli_scenario_copy(c->base, &probe) != CLI_EXIT_OK)
-        return CLI_EXIT_RUNTIME;
-    int rc = cli_scenario_override(&probe, set);
-    cli_scenario_free(&probe);
-    return rc;
 }
 
 /* Initial value of key j: the scenario's value, its preset's, or the model's current value.

@@ -550,6 +550,8 @@ static void test_fit_cli_refuses_keys_it_cannot_vary(void** state)
          "model.glass.p_gt is given twice (as 'glass.p_gt' and 'model.glass.p_gt')"},
         {"material.striker.restitution --init 1",
          "material.striker.restitution starts at 1, on the bound of its range (0, 1]"},
+        /* a material the file does not define (it was added, unused: a zero column) */
+        {"material.strikr.roughness --init 1e-7", "(did you mean [material.striker]?)"},
     };
     for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
         snprintf(args, sizeof args, "fit %s --data %s --fit %s", ini, csv, cases[k].fit);
