@@ -1120,7 +1120,7 @@ struct wetdem_fit_result {
                                                  in the rows of the two kinds above) */
     double cost;         /* sum of squared scaled residuals at the solution */
     double residual_std; /* s = sqrt(cost/dof), in units of the scale */
-    size_t dof;          /* n_data - n_params */
+    size_t dof;          /* n_data - n_params; 0 when the fit stopped before a solution */
     size_t iterations;
     size_t model_evals; /* calls of the model function */
     int converged_by;   /* 1 small step (xtol), 2 small gradient (gtol), 3 small cost change;

@@ -13,7 +13,9 @@
  * initial distance is reported at that bound (result.at_bound), not as an error.
  *
  * Solver: GSL gsl_multifit_nlinear, trust region with Levenberg-Marquardt steps, iterated
- * here (not by gsl_multifit_nlinear_driver, which carries on after a failed evaluation). The
+ * here (not by gsl_multifit_nlinear_driver, which carries on after a failed evaluation); a
+ * step may change a bounded variable by at most ln 10 (a longer trial counts as not lowering
+ * the cost, so the solver shortens it). The
  * Jacobian J_ij = dr_i/dq_j is taken by central differences with step h (fd_step):
  * predictions from a simulation carry integration noise of relative size ~1e-4, so the
  * default h = 1e-2 keeps the difference quotient's noise (~1e-4/h) below 1 % while its
@@ -504,7 +506,8 @@ static int solve(struct fit_ctx* c, const struct wetdem_fit_options* o, const gs
     if (gst == GSL_ENOPROG)
         return wetdem_status_fail(c->msg, sizeof c->msg, WETDEM_ERR_STEP,
                                   "the trust-region solver found no step that lowers the cost "
-                                  "from the initial values (flat or noisy predictions there?)");
+                                  "from the initial values (its predictions are flat or noisy "
+                                  "there: start nearer the value you expect)");
     if (gst != GSL_SUCCESS)
         return wetdem_status_fail(c->msg, sizeof c->msg, WETDEM_ERR_STEP,
                                   "the trust-region solver stopped: %s", gsl_strerror(gst));
