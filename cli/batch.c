@@ -3,10 +3,13 @@
  * batch.h): load and check the scenario, check every point serially by building it, build
  * and run the points in parallel, write the table in input order, report the failed runs.
  *
- * Engines: soft (a CSV row of every field of struct wetdem_collision_result, cli/output_csv.c)
- * and pairwise (the row of cli_run_pairwise, whose status column is the engine's status).
+ * Engines: soft (a CSV row of every field of struct wetdem_collision_result, cli/output_csv.c;
+ * nan and none for a failed run, status ENERGY_GREW for a run whose energy grew) and pairwise
+ * (the row of cli_run_pairwise, whose status column is the engine's status). SIGINT or
+ * SIGTERM stops starting points; the table of those that ran is still written.
  */
 #include <omp.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -107,11 +110,15 @@ static void run_point(const struct cli_scenario* base, const struct cli_batch* b
         cli_run_pairwise(&sc, &opt);
     } else if (f) {
         p->status = wetdem_collision_run(su.sim, &su.spec, &p->res);
-        if (p->status < 0)
+        if (p->status < 0) { /* (its result is all zeros: no number of it is known) */
             snprintf(p->errmsg, sizeof p->errmsg, "%s", wetdem_sim_errmsg(su.sim));
-        else
+            cli_csv_failed_row(f, &su);
+        } else {
+            char why[300];
+            p->energy_grew = cli_energy_grew(p->res.energy_ratio, why, sizeof why);
             cli_setup_capture(&su, &p->res);
-        cli_csv_result_row(f, &su, &p->res);
+            cli_csv_result_row(f, &su, &p->res);
+        }
     }
     if (f)
         fclose(f);
@@ -129,26 +136,59 @@ static void show_progress(const char* cmd, size_t done, size_t n, double t0)
         fputc('\n', stderr);
 }
 
+/* ---- SIGINT and SIGTERM: stop starting points, keep those that ran ---- */
+
+static volatile sig_atomic_t stop_signal = 0;
+
+static void on_signal(int sig)
+{
+    static const char note[] = "\nwetdem: interrupted: finishing the collisions that run, then "
+                               "writing the table of those done (again: stop at once)\n";
+    stop_signal = sig;
+    struct sigaction dfl = {.sa_handler = SIG_DFL}; /* a second signal stops at once */
+    sigemptyset(&dfl.sa_mask);
+    sigaction(sig, &dfl, NULL);
+    ssize_t ignored = write(STDERR_FILENO, note, sizeof note - 1);
+    (void)ignored;
+}
+
 /* Runs every point in parallel (dynamic scheduling: run times differ by orders of
- * magnitude across a batch). */
+ * magnitude across a batch). After SIGINT or SIGTERM the points not yet started are left
+ * out (b->interrupted, their status CLI_BATCH_NOT_RUN). */
 static void run_all(const struct cli_scenario* base, struct cli_batch* b)
 {
     bool show = b->progress && isatty(STDERR_FILENO);
     double t0 = omp_get_wtime(), last = 0;
     size_t done = 0, n = b->n_pts;
+    struct sigaction act = {.sa_handler = on_signal}, old_int, old_term;
+    sigemptyset(&act.sa_mask);
+    stop_signal = 0;
+    sigaction(SIGINT, NULL, &old_int);
+    sigaction(SIGTERM, NULL, &old_term);
+    if (old_int.sa_handler != SIG_IGN) /* (a signal ignored on entry stays ignored: nohup, &) */
+        sigaction(SIGINT, &act, NULL);
+    if (old_term.sa_handler != SIG_IGN)
+        sigaction(SIGTERM, &act, NULL);
 #pragma omp parallel for schedule(dynamic, 1)
     for (size_t k = 0; k < n; k++) {
+        if (stop_signal) {
+            b->pts[k].status = CLI_BATCH_NOT_RUN;
+            continue;
+        }
         run_point(base, b, &b->pts[k]);
 #pragma omp critical(batch_progress)
         {
             done++;
             double now = omp_get_wtime();
-            if (show && (now - last > 0.2 || done == n)) {
+            if (show && !stop_signal && (now - last > 0.2 || done == n)) {
                 show_progress(b->cmd, done, n, t0);
                 last = now;
             }
         }
     }
+    sigaction(SIGINT, &old_int, NULL);
+    sigaction(SIGTERM, &old_term, NULL);
+    b->interrupted = stop_signal;
 }
 
 /* The engine's column header into b->header (malloc'd). Exit code. */
@@ -189,6 +229,40 @@ static int check_engine(const struct cli_scenario* sc, struct cli_batch* b)
     return rc;
 }
 
+/* The keys as the scenario names them ("glass.p_gt" is [model.glass] p_gt): two names of one
+ * key, or collision.speed and collision.stokes (a --set of one replaces the other), would give
+ * rows labelled with values never used. An exit code, the message printed. */
+static int check_keys(const struct cli_batch* b)
+{
+    static const char* const options[CLI_BATCH_MAX_KEYS] = {"--param", "--param2"};
+    char full[CLI_BATCH_MAX_KEYS][2 * CLI_NAME_MAX + 2];
+    for (int d = 0; d < b->n_keys; d++) {
+        char probe[CLI_VALUE_MAX], section[CLI_NAME_MAX], key[CLI_NAME_MAX];
+        snprintf(probe, sizeof probe, "%s=0", b->key[d]);
+        if (cli_override_split(probe, section, key, NULL) != 0)
+            return CLI_EXIT_USAGE;
+        snprintf(full[d], sizeof full[d], "%s.%s", section, key);
+    }
+    if (b->n_keys < 2)
+        return CLI_EXIT_OK;
+    if (strcmp(full[0], full[1]) == 0) {
+        cli_error("%s: %s %s and %s %s name the same key, %s", b->cmd, options[0], b->key[0],
+                  options[1], b->key[1], full[0]);
+        return CLI_EXIT_USAGE;
+    }
+    bool speed[2];
+    for (int d = 0; d < 2; d++)
+        speed[d] =
+            strcmp(full[d], "collision.speed") == 0 || strcmp(full[d], "collision.stokes") == 0;
+    if (speed[0] && speed[1]) {
+        cli_error("%s: %s %s and %s %s: the impact is given by speed or by stokes, and setting "
+                  "one replaces the other, so the first would never be used",
+                  b->cmd, options[0], b->key[0], options[1], b->key[1]);
+        return CLI_EXIT_USAGE;
+    }
+    return CLI_EXIT_OK;
+}
+
 int cli_batch_run(struct cli_batch* b)
 {
     b->engine = CLI_ENGINE_SOFT;
@@ -196,10 +270,14 @@ int cli_batch_run(struct cli_batch* b)
     b->pts = NULL;
     b->n_pts = 1;
     b->wall = 0;
+    b->interrupted = 0;
     for (int d = 0; d < b->n_keys; d++)
         b->n_pts *= b->range[d].n;
     struct cli_scenario sc;
-    int rc = cli_load_with_overrides(b->file, b->sets, b->n_sets, &sc);
+    memset(&sc, 0, sizeof sc);
+    int rc = check_keys(b);
+    if (rc == CLI_EXIT_OK)
+        rc = cli_load_with_overrides(b->file, b->sets, b->n_sets, &sc);
     if (rc == CLI_EXIT_OK)
         rc = check_engine(&sc, b);
     if (rc == CLI_EXIT_OK && !(b->pts = calloc(b->n_pts, sizeof *b->pts))) {
@@ -211,6 +289,8 @@ int cli_batch_run(struct cli_batch* b)
     double t0 = omp_get_wtime();
     if (rc == CLI_EXIT_OK)
         rc = build_all(&sc, b);
+    if (rc == CLI_EXIT_OK) /* (after the input checks, which write nothing; before the runs) */
+        rc = cli_check_writable(b->cmd, "--out", b->out);
     if (rc == CLI_EXIT_OK) {
         run_all(&sc, b);
         b->wall = omp_get_wtime() - t0;
@@ -230,6 +310,38 @@ static const char* key_unit(const char* key)
     return u[0] ? u : "-";
 }
 
+/* The status word of a point: the engine's status, ENERGY_GREW for a run that succeeded with
+ * more kinetic energy at the end than at the start (its numbers are those of an integration
+ * too coarse for the contact), NOT_RUN for a point an interruption left out. */
+static const char* point_status(const struct cli_batch_point* p)
+{
+    if (p->status == CLI_BATCH_NOT_RUN)
+        return "NOT_RUN";
+    if (p->status >= 0 && p->energy_grew)
+        return "ENERGY_GREW";
+    return wetdem_status_name(p->status);
+}
+
+/* The fields of a point that did not run: "none" for the header's words, "nan" otherwise. */
+static void not_run_fields(FILE* f, const char* header)
+{
+    for (const char* col = header; col;) {
+        const char* end = strchr(col, ',');
+        size_t len = end ? (size_t)(end - col) : strlen(col);
+        bool word = len >= 6 && strncmp(col + len - 6, "[word]", 6) == 0;
+        fprintf(f, "%s%s", col == header ? "" : ",", word ? "none" : "nan");
+        col = end ? end + 1 : NULL;
+    }
+}
+
+size_t cli_batch_points_run(const struct cli_batch* b)
+{
+    size_t n = 0;
+    for (size_t k = 0; k < b->n_pts; k++)
+        n += b->pts[k].status != CLI_BATCH_NOT_RUN;
+    return n;
+}
+
 void cli_batch_write_table(FILE* f, const struct cli_batch* b, int argc, char** argv)
 {
     cli_print_provenance(f, argc, argv);
@@ -240,8 +352,16 @@ void cli_batch_write_table(FILE* f, const struct cli_batch* b, int argc, char** 
         const struct cli_batch_point* p = &b->pts[k];
         for (int d = 0; d < b->n_keys; d++)
             fprintf(f, "%.12g,", p->value[d]);
-        fprintf(f, "%s,%s\n", wetdem_status_name(p->status), p->row ? p->row : "");
+        fprintf(f, "%s,", point_status(p));
+        if (p->status == CLI_BATCH_NOT_RUN)
+            not_run_fields(f, b->header);
+        else
+            fputs(p->row ? p->row : "", f);
+        fputc('\n', f);
     }
+    if (b->interrupted)
+        fprintf(f, "# interrupted by signal %d: %zu of %zu points ran (status %s: not run)\n",
+                b->interrupted, cli_batch_points_run(b), b->n_pts, "NOT_RUN");
 }
 
 /* One line for the points whose fixed step did not resolve h_min (information). */
@@ -250,7 +370,8 @@ static void report_unresolved_hmin(const struct cli_batch* b)
     size_t n = 0, worst = 0;
     for (size_t k = 0; b->engine == CLI_ENGINE_SOFT && k < b->n_pts; k++) {
         char why[600];
-        if (b->pts[k].status < 0 || !cli_hmin_unresolved(&b->pts[k].res, why, sizeof why))
+        if (b->pts[k].status < 0 || b->pts[k].status == CLI_BATCH_NOT_RUN ||
+            !cli_hmin_unresolved(&b->pts[k].res, why, sizeof why))
             continue;
         if (n++ == 0 ||
             b->pts[k].res.stats.hmin_step_ratio > b->pts[worst].res.stats.hmin_step_ratio)
@@ -269,16 +390,23 @@ static void report_unresolved_hmin(const struct cli_batch* b)
 int cli_batch_report_failures(const struct cli_batch* b, int rc)
 {
     report_unresolved_hmin(b);
+    if (b->interrupted) {
+        cli_error("%s: interrupted by signal %d: %zu of %zu points ran; the table has every "
+                  "point, those left out with status NOT_RUN",
+                  b->cmd, b->interrupted, cli_batch_points_run(b), b->n_pts);
+        rc = 128 + b->interrupted; /* (as a program stopped by the signal, but with the table) */
+    }
     for (size_t k = 0; k < b->n_pts; k++) {
         const struct cli_batch_point* p = &b->pts[k];
         char where[1100];
         size_t used = (size_t)snprintf(where, sizeof where, "%s: ", b->cmd);
         point_values(b, p, where + used, sizeof where - used);
         char why[300];
+        if (p->status == CLI_BATCH_NOT_RUN)
+            continue;
         if (p->status >= 0) { /* (a pairwise point's result is zero: no energy ratio) */
-            if (b->engine == CLI_ENGINE_SOFT &&
-                cli_energy_grew(p->res.energy_ratio, why, sizeof why)) {
-                cli_error("%s: the collision %s", where, why);
+            if (p->energy_grew && cli_energy_grew(p->res.energy_ratio, why, sizeof why)) {
+                cli_error("%s: the collision %s (status ENERGY_GREW)", where, why);
                 rc = CLI_EXIT_RUNTIME;
             }
             continue;

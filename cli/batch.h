@@ -23,14 +23,18 @@
 
 #define CLI_BATCH_MAX_KEYS 2
 
+/* Status of a point that an interruption (SIGINT, SIGTERM) left out: no engine status. */
+#define CLI_BATCH_NOT_RUN 1000
+
 /* One point: its values, and after the run its status and CSV fields (its scenario and
  * set-up live only while it is checked and while it runs). */
 struct cli_batch_point {
     double value[CLI_BATCH_MAX_KEYS];   /* the keys' values at this point [their units] */
     struct wetdem_collision_result res; /* soft engine: the run's result (zero for pairwise) */
-    int status;                         /* the run's status (the pairwise engine's own) */
-    char errmsg[256];                   /* the engine's message of a failed run */
-    char* row;                          /* the engine's CSV fields, no newline (malloc'd) */
+    int status;       /* the run's status (the pairwise engine's own), or CLI_BATCH_NOT_RUN */
+    bool energy_grew; /* soft engine: it ran but ended with more energy (cli_energy_grew) */
+    char errmsg[256]; /* the engine's message of a failed run */
+    char* row;        /* the engine's CSV fields, no newline (malloc'd) */
 };
 
 /* A batch: the caller fills the first block, cli_batch_run() the second. */
@@ -44,27 +48,39 @@ struct cli_batch {
     int n_keys; /* 1 or 2 */
     const char* key[CLI_BATCH_MAX_KEYS];
     struct cli_range range[CLI_BATCH_MAX_KEYS];
-    bool progress; /* progress and time left on stderr when it is a terminal */
+    bool progress;   /* progress and time left on stderr when it is a terminal */
+    const char* out; /* the table's file (NULL: stdout): checked writable before the runs */
 
     enum cli_engine engine;
     char* header;                /* the engine's CSV column header, no newline (malloc'd) */
     struct cli_batch_point* pts; /* n_pts points, the first key varying slowest */
     size_t n_pts;
-    double wall; /* build and run time [s] */
+    double wall;     /* build and run time [s] */
+    int interrupted; /* the signal (SIGINT, SIGTERM) that stopped the batch early, or 0 */
 };
 
-/* Loads the file with the overrides, checks the engine, builds every point serially and runs
- * them in parallel. Returns an exit code: an input error of the file or of any point stops
- * before anything runs (message printed); a failed run is not an error here, its status is
- * in its point (see cli_batch_report_failures). Free with cli_batch_free() in every case. */
+/* Checks the keys (two names of one key, or speed and stokes, are refused), loads the file
+ * with the overrides, checks the engine, builds every point serially, checks that `out` can
+ * be written, and runs the points in parallel. Returns an exit code: an input error of the
+ * file or of any point, or an output that cannot be written, stops before anything runs
+ * (message printed, exit 2); a failed run is not an error here, its status is in its point
+ * (see cli_batch_report_failures). SIGINT or SIGTERM while the points run stops starting new
+ * ones: those that run finish, the others get CLI_BATCH_NOT_RUN and b->interrupted is set, so
+ * the caller still writes the table (a second signal stops at once, by the signal). Free
+ * with cli_batch_free() in every case. */
 int cli_batch_run(struct cli_batch* b);
 
 /* Writes the '#' provenance lines, the header "KEY [unit],...,status [word],<engine columns>"
- * and one row per point "value,...,status,<engine fields>"; the caller adds its trailer. */
+ * and one row per point "value,...,status,<engine fields>" (status: the engine's status name,
+ * ENERGY_GREW, or NOT_RUN), and after an interruption a '#' line saying so; the caller adds
+ * its trailer. */
 void cli_batch_write_table(FILE* f, const struct cli_batch* b, int argc, char** argv);
 
-/* Prints "CMD: KEY = value, ...: message (status)" for every failed run. Returns rc, or
- * CLI_EXIT_RUNTIME when any run failed. */
+/* How many points ran (all of them unless the batch was interrupted). */
+size_t cli_batch_points_run(const struct cli_batch* b);
+
+/* Prints "CMD: KEY = value, ...: message (status)" for every failed run. Returns 128 + the
+ * signal when the batch was interrupted, else rc, or CLI_EXIT_RUNTIME when any run failed. */
 int cli_batch_report_failures(const struct cli_batch* b, int rc);
 
 /* Frees the points, the header and the scenario. */

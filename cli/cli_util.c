@@ -67,13 +67,12 @@ int cli_parse_double(const char* text, const char* what, double* out)
     return CLI_EXIT_OK;
 }
 
-/* Parses the count field of a range: a decimal integer in [1, 10^7]. */
+/* Parses the count field of a range: a whole number in [1, 10^7], in decimal or exponent
+ * notation ("1e7", as every number of the command line). */
 static int parse_count(const char* text, const char* what, size_t* n)
 {
-    char* end = NULL;
-    errno = 0;
-    long long v = strtoll(text, &end, 10);
-    if (end == text || *end != '\0' || errno == ERANGE || v < 1 || v > CLI_MAX_BATCH_POINTS) {
+    double v;
+    if (cli_number(text, &v) != 0 || v != floor(v) || v < 1 || v > CLI_MAX_BATCH_POINTS) {
         cli_error("%s: count N = '%s' must be an integer in [1, %.0f]", what, text,
                   CLI_MAX_BATCH_POINTS);
         return CLI_EXIT_USAGE;
@@ -214,6 +213,28 @@ int cli_check_output_path(const char* what, const char* option, const char* path
             return CLI_EXIT_USAGE;
         }
     }
+    return CLI_EXIT_OK;
+}
+
+int cli_check_writable(const char* what, const char* option, const char* path)
+{
+    if (!path)
+        return CLI_EXIT_OK;
+    char dir[1024], tmp[1100];
+    parent_dir(path, dir, sizeof dir);
+    if (dir[0] && cli_make_dirs(dir) != 0) {
+        cli_error("%s: %s %s: cannot create directory %s: %s", what, option, path, dir,
+                  strerror(errno));
+        return CLI_EXIT_USAGE;
+    }
+    snprintf(tmp, sizeof tmp, "%s.tmp%ld", path, (long)getpid()); /* (the name written later) */
+    FILE* f = fopen(tmp, "w");
+    if (!f) {
+        cli_error("%s: %s %s cannot be written: %s", what, option, path, strerror(errno));
+        return CLI_EXIT_USAGE;
+    }
+    fclose(f);
+    remove(tmp);
     return CLI_EXIT_OK;
 }
 

@@ -78,6 +78,12 @@ int cli_make_dirs(const char* dir);
  * (stdout, no output) passes. Returns CLI_EXIT_OK or CLI_EXIT_USAGE after printing why. */
 int cli_check_output_path(const char* what, const char* option, const char* path, bool is_dir);
 
+/* Checks that a file can be written at path (NULL passes) before the work that produces it
+ * runs: makes its directory when missing and creates, then removes, the temporary file
+ * cli_write_output would write. Returns CLI_EXIT_OK, or prints "wetdem: <what>: <option>
+ * <path> cannot be written: <why>" and returns CLI_EXIT_USAGE. */
+int cli_check_writable(const char* what, const char* option, const char* path);
+
 /* Writes a table with write(f, ctx): to stdout when path is NULL, otherwise to path (its
  * directory is created when missing) under a temporary name renamed only when everything was
  * written, so a failed write leaves no half-written file. `what` names the command in the message. Returns CLI_EXIT_OK, or prints

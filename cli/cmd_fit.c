@@ -6,17 +6,23 @@
  * least squares (library: wetdem_fit_run; docs/calibration.md).
  *
  * Data CSV: a header naming the columns, then one row per measurement. Columns (a trailing
- * " [unit]" in a name is ignored, other columns are ignored): stokes_n (required), e_n
- * (required), angle_deg (optional, else the scenario's angle), omega_rad_s (optional; used
- * with --omega-scale S). Every measurement is simulated as `wetdem run FILE --set
+ * " [unit]" in a name is ignored; each column once, no other: a column the fit would not read
+ * is refused rather than ignored): stokes_n (required), e_n (required), angle_deg (optional,
+ * else the scenario's angle), omega_rad_s (optional; used with --omega-scale S). Every measurement is simulated as `wetdem run FILE --set
  * collision.stokes=St --set collision.angle_deg=angle --set KEY=value ...` would; the predicted
  * e_n is the result's e_n_observed when the scenario sets collision.observe_time (Punch
  * Fig. 9 window), its e_n otherwise, and the predicted spin is |omega_i| of the striker.
- * Residuals: e_n,sim - e_n,data, and (omega_sim - omega_data)/S.
+ * Residuals: e_n,sim - e_n,data, and (omega_sim - omega_data)/S. Keys the data set per point
+ * (collision.stokes, collision.speed, collision.angle_deg with an angle column) cannot be
+ * fitted. Each key is bounded by its valid range (the library varies the distance to the
+ * bounds on a log scale); a start on a bound is refused.
  *
  * The runs of one evaluation are independent and run in parallel (OpenMP) on simulations
  * built serially beforehand, so results do not depend on the thread count.
- * Exit codes: 0 ok, 1 runtime error or no convergence, 2 bad options, data or scenario.
+ * Exit codes: 0 ok (also with a key at a bound of its range, reported as such), 1 runtime
+ * error, no convergence, a key the data do not determine, or a collision whose result cannot
+ * be trusted (energy growth, h_min not resolved); 2 bad options, data or scenario, before any
+ * collision runs (every data point is built with the initial values first).
  */
 #include <ctype.h>
 #include <errno.h>
@@ -45,8 +51,9 @@ static void usage(FILE* f)
             "  --curve FILE   the fitted model on N Stokes numbers per angle (CSV)\n"
             "  --omega-scale S  also fit the spin; an error of S [rad/s] weighs as 1 in e_n\n"
             "  --max-iter N   trust-region iterations (50); --fd-step H Jacobian step (0.01)\n"
-            "Positive parameters are fitted as ln(value); standard errors from the Jacobian\n"
-            "scaled by the residual variance. See docs/calibration.md.\n");
+            "Each key stays inside its valid range (varied as the log of its distance to the\n"
+            "bounds); standard errors from the Jacobian scaled by the residual variance.\n"
+            "See docs/calibration.md.\n");
 }
 
 struct fit_args {
@@ -61,6 +68,7 @@ struct fit_args {
 struct point {
     double stokes, angle_deg, e_n, omega; /* omega: NAN when not measured */
     bool has_angle;
+    long line; /* line in the data file (0: a curve point) */
 };
 
 /* Everything the model function needs. */
@@ -71,6 +79,7 @@ struct fit_ctx {
     const struct point* pts;
     size_t n_pts;
     bool use_omega;
+    const char* data; /* the data file, for messages */
 };
 
 static int parse_args(int argc, char** argv, struct fit_args* a)
@@ -174,13 +183,39 @@ static int split_csv(char* line, char** f, int max, bool is_header)
 enum { COL_STOKES, COL_EN, COL_ANGLE, COL_OMEGA, N_COLS };
 static const char* const col_names[N_COLS] = {"stokes_n", "e_n", "angle_deg", "omega_rad_s"};
 
+/* Maps the header's fields to the columns: each known column at most once, no other (a column
+ * the fit would not read, e.g. per-point uncertainties, is refused rather than ignored). */
 static int read_header(const char* path, long line, char** f, int n, int col[N_COLS])
 {
-    for (int c = 0; c < N_COLS; c++) {
+    for (int c = 0; c < N_COLS; c++)
         col[c] = -1;
-        for (int k = 0; k < n; k++)
-            if (strcmp(f[k], col_names[c]) == 0)
-                col[c] = k;
+    for (int k = 0; k < n; k++) {
+        int c = 0;
+        while (c < N_COLS && strcmp(f[k], col_names[c]) != 0)
+            c++;
+        if (c < N_COLS && col[c] >= 0) {
+            cli_error("%s:%ld: column %s appears twice (columns %d and %d)", path, line, f[k],
+                      col[c] + 1, k + 1);
+            return CLI_EXIT_USAGE;
+        }
+        if (c < N_COLS) {
+            col[c] = k;
+            continue;
+        }
+        const char* names[N_COLS + 1];
+        memcpy(names, col_names, sizeof col_names);
+        names[N_COLS] = NULL;
+        const char* hint = f[k][0] ? wetdem_param_suggest(f[k], names) : NULL;
+        for (int m = 0; !hint && f[k][0] && m < N_COLS;
+             m++) /* "angle", "omega": the unit left out */
+            if (strncmp(col_names[m], f[k], strlen(f[k])) == 0)
+                hint = col_names[m];
+        cli_error("%s:%ld: column %d: unknown column '%s'%s%s%s; the columns are stokes_n and e_n "
+                  "(required), angle_deg and omega_rad_s (per-point uncertainties are not read: "
+                  "the scatter of the data about the fit sets the standard errors)",
+                  path, line, k + 1, f[k], hint ? " (did you mean '" : "", hint ? hint : "",
+                  hint ? "'?)" : "");
+        return CLI_EXIT_USAGE;
     }
     if (col[COL_STOKES] < 0 || col[COL_EN] < 0) {
         cli_error("%s:%ld: the header must name columns stokes_n and e_n (optional: angle_deg, "
@@ -201,8 +236,12 @@ static int read_value(const char* path, long line, char** f, const int col[N_COL
         t++;
     bool ok = cli_number(t, v) == 0;
     const char* why = "a finite number";
-    if (ok && c == COL_STOKES && !(*v > 0))
-        ok = false, why = "a Stokes number > 0";
+    char range[160];
+    struct wetdem_param_desc st = {.max = INFINITY}; /* (the key's range: the speed follows) */
+    cli_scenario_key_range("collision", "stokes", &st);
+    snprintf(range, sizeof range, "a Stokes number in (0, %g] ([collision] stokes)", st.max);
+    if (ok && c == COL_STOKES && !(*v > 0 && *v <= st.max))
+        ok = false, why = range;
     if (ok && c == COL_ANGLE && !(*v >= 0 && *v < 90))
         ok = false, why = "an angle in [0, 90) deg";
     /* a coefficient of restitution: at most 1 for these models, above it by the scatter of a
@@ -230,6 +269,7 @@ static int read_row(const char* path, long line, char** f, int n, int n_header,
         rc = read_value(path, line, f, col, COL_EN, &p->e_n);
     p->has_angle = col[COL_ANGLE] >= 0;
     p->omega = NAN;
+    p->line = line;
     if (rc == CLI_EXIT_OK && p->has_angle)
         rc = read_value(path, line, f, col, COL_ANGLE, &p->angle_deg);
     if (rc == CLI_EXIT_OK && col[COL_OMEGA] >= 0)
@@ -256,7 +296,10 @@ static int read_data(const char* path, struct point** out, size_t* n_out)
             rc = CLI_EXIT_USAGE;
             break;
         }
-        char* s = buf + strspn(buf, " \t");
+        char* s = buf;
+        if (line == 1 && strncmp(s, "\xEF\xBB\xBF", 3) == 0) /* a UTF-8 byte-order mark */
+            s += 3;
+        s += strspn(s, " \t");
         if (*s == '#' || *s == '\n' || *s == '\r' || *s == '\0')
             continue;
         int nf = split_csv(s, f, 64, !have_header);
@@ -325,56 +368,95 @@ static double reported_e_n(const struct cli_setup* su, const struct wetdem_colli
     return (!isfinite(e) && !r->separated) ? 0.0 : e;
 }
 
-/* Simulates n points with the given parameters into e_n[] and omega[] (|omega_i|). */
+/* "FILE:LINE (St_n = X, angle_deg = A)" of a data point, or "the point St_n = X, ..." of a
+ * curve point, into buf. */
+static void point_where(const struct fit_ctx* c, const struct point* p, char* buf, size_t n)
+{
+    char angle[64] = "";
+    if (p->has_angle)
+        snprintf(angle, sizeof angle, ", angle_deg = %g", p->angle_deg);
+    if (p->line)
+        snprintf(buf, n, "%s:%ld (St_n = %g%s)", c->data, p->line, p->stokes, angle);
+    else
+        snprintf(buf, n, "the point St_n = %g%s", p->stokes, angle);
+}
+
+/* "KEY = value, KEY2 = value2" of the fitted keys into buf. */
+static void param_values(const struct fit_ctx* c, const double* params, char* buf, size_t n)
+{
+    size_t used = 0;
+    buf[0] = '\0';
+    for (size_t j = 0; j < c->n_keys && used < n; j++)
+        used += (size_t)snprintf(buf + used, n - used, "%s%s = %.9g", j ? ", " : "", c->keys[j],
+                                 params[j]);
+}
+
+/* The first collision, in input order, that failed or whose result cannot be trusted: its
+ * message into msg and WETDEM_ERR_CALLBACK, or WETDEM_OK. */
+static int first_failure(const struct fit_ctx* c, const struct point* pts, size_t n,
+                         const struct cli_setup* su, const int* status,
+                         const struct wetdem_collision_result* res, char* msg, size_t msg_size)
+{
+    for (size_t k = 0; k < n; k++) {
+        char why[600], where[1200];
+        point_where(c, &pts[k], where, sizeof where);
+        if (status[k] < 0)
+            snprintf(msg, msg_size, "the collision of %s failed: %s", where,
+                     wetdem_sim_errmsg(su[k].sim));
+        /* (as run and sweep report them; an unresolved h_min makes e_n a step function of
+           the parameters, whose finite differences are 0 or huge) */
+        else if (cli_energy_grew(res[k].energy_ratio, why, sizeof why) ||
+                 cli_hmin_unresolved(&res[k], why, sizeof why))
+            snprintf(msg, msg_size, "the collision of %s: %s", where, why);
+        else
+            continue;
+        return WETDEM_ERR_CALLBACK;
+    }
+    return WETDEM_OK;
+}
+
+/* Simulates n points with the given parameters into e_n[] and omega[] (|omega_i|). A point
+ * the scenario rejects (the builder printed why) gives WETDEM_ERR_INVALID. */
 static int simulate(const struct fit_ctx* c, const double* params, const struct point* pts,
                     size_t n, double* e_n, double* omega, char* msg, size_t msg_size)
 {
     struct cli_setup* su = calloc(n, sizeof *su);
     int* status = calloc(n, sizeof *status);
-    double* ratio = calloc(n, sizeof *ratio); /* each collision's energy_ratio */
-    int st = (su && status && ratio) ? WETDEM_OK : WETDEM_ERR_NOMEM;
+    struct wetdem_collision_result* res = calloc(n, sizeof *res);
+    int st = (su && status && res) ? WETDEM_OK : WETDEM_ERR_NOMEM;
     size_t built = 0;
     for (; st == WETDEM_OK && built < n; built++)
         if (build_point(c, params, &pts[built], &su[built]) != CLI_EXIT_OK) {
+            char where[1200], values[600];
+            point_where(c, &pts[built], where, sizeof where);
+            param_values(c, params, values, sizeof values);
             st = WETDEM_ERR_INVALID;
-            snprintf(msg, msg_size,
-                     "the scenario was rejected at St_n = %g with %s = %g%s (the message "
-                     "above): an --init value outside the key's range, or a fit that left it "
-                     "(the data may not determine the key)",
-                     pts[built].stokes, c->keys[0], params[0], c->n_keys > 1 ? ", ..." : "");
+            snprintf(msg, msg_size, "the scenario rejects %s with %s (the message above)", where,
+                     values);
         }
     if (st == WETDEM_OK) {
 #pragma omp parallel for schedule(dynamic, 1)
         for (size_t k = 0; k < n; k++) {
-            struct wetdem_collision_result r;
-            status[k] = wetdem_collision_run(su[k].sim, &su[k].spec, &r);
-            e_n[k] = reported_e_n(&su[k], &r);
-            omega[k] = sqrt(r.omega_i.x * r.omega_i.x + r.omega_i.y * r.omega_i.y +
-                            r.omega_i.z * r.omega_i.z);
-            ratio[k] = r.energy_ratio;
+            struct wetdem_collision_result* r = &res[k];
+            status[k] = wetdem_collision_run(su[k].sim, &su[k].spec, r);
+            e_n[k] = reported_e_n(&su[k], r);
+            omega[k] = sqrt(r->omega_i.x * r->omega_i.x + r->omega_i.y * r->omega_i.y +
+                            r->omega_i.z * r->omega_i.z);
         }
-        for (size_t k = 0; k < n && st == WETDEM_OK; k++) { /* (the first failure, in order) */
-            char why[300];
-            if (status[k] < 0) {
-                st = WETDEM_ERR_CALLBACK;
-                snprintf(msg, msg_size, "collision at St_n = %g failed: %s", pts[k].stokes,
-                         wetdem_sim_errmsg(su[k].sim));
-            } else if (cli_energy_grew(ratio[k], why,
-                                       sizeof why)) { /* (as run and sweep report it) */
-                st = WETDEM_ERR_CALLBACK;
-                snprintf(msg, msg_size, "the collision at St_n = %g %s", pts[k].stokes, why);
-            }
-        }
+        st = first_failure(c, pts, n, su, status, res, msg, msg_size);
     }
     for (size_t k = 0; su && k < built; k++)
         cli_setup_free(&su[k]);
     free(su);
     free(status);
-    free(ratio);
+    free(res);
     return st;
 }
 
-/* wetdem_fit_model_fn: e_n of every point, then (with omega) |omega_i| of every point. */
+/* wetdem_fit_model_fn: e_n of every point, then (with omega) |omega_i| of every point. A
+ * point the scenario rejects is not bad input here: the data and the initial values were
+ * checked before the fit (check_points), so the fit tried values the scenario does not accept
+ * with that point (WETDEM_ERR_CALLBACK, exit 1). */
 static int fit_model(const double* params, double* predicted, char* msg, size_t msg_size, void* ctx)
 {
     const struct fit_ctx* c = ctx;
@@ -385,7 +467,7 @@ static int fit_model(const double* params, double* predicted, char* msg, size_t 
     if (st == WETDEM_OK && c->use_omega)
         memcpy(predicted + c->n_pts, omega, c->n_pts * sizeof *omega);
     free(omega);
-    return st;
+    return st == WETDEM_ERR_INVALID ? WETDEM_ERR_CALLBACK : st;
 }
 
 /* ---- parameters --------------------------------------------------------------------------- */
@@ -445,11 +527,47 @@ static int check_key(const char* tok, const char* section, const char* key)
     return CLI_EXIT_USAGE;
 }
 
-/* Splits --fit into full "section.key" names and checks each. */
+/* Whether `key=value` is accepted as an override of the base scenario (the checker prints
+ * why not). Returns its exit code. */
+static int probe_override(const struct fit_ctx* c, const char* key, const char* value)
+{
+    struct cli_scenario probe;
+    char set[2 * CLI_NAME_MAX + 64];
+    snprintf(set, sizeof set, "%s=%s", key, value);
+    if (cli_scenario_copy(c->base, &probe) != CLI_EXIT_OK)
+        return CLI_EXIT_RUNTIME;
+    int rc = cli_scenario_override(&probe, set);
+    cli_scenario_free(&probe);
+    return rc;
+}
+
+/* Whether the key (full name) is one the fit sets per data point, which a fit of it would
+ * override: a message and CLI_EXIT_USAGE, else CLI_EXIT_OK. */
+static int check_not_per_point(const char* tok, const char* full, const struct fit_ctx* c)
+{
+    const char* why = NULL;
+    if (strcmp(full, "collision.stokes") == 0)
+        why = "every data row sets it (its stokes_n), so every point would predict the same";
+    else if (strcmp(full, "collision.speed") == 0)
+        why = "every data row sets the Stokes number (stokes_n), from which the speed follows "
+              "(speed and stokes exclude each other)";
+    else if (strcmp(full, "collision.angle_deg") == 0 && c->n_pts && c->pts[0].has_angle)
+        why = "every data row sets it (the angle_deg column)";
+    if (!why)
+        return CLI_EXIT_OK;
+    cli_error("fit: --fit %s: %s cannot be fitted: %s", tok, full, why);
+    return CLI_EXIT_USAGE;
+}
+
+/* Splits --fit into full "section.key" names and checks each: a known numeric key, not one
+ * the data set per point, and not the same key twice under two names (glass.p_gt and
+ * model.glass.p_gt: the second would override the first, whose column of the Jacobian would
+ * be zero). */
 static int parse_keys(const char* list, struct fit_ctx* c)
 {
     char buf[1024];
     snprintf(buf, sizeof buf, "%s", list);
+    const char* given[WETDEM_FIT_MAX_PARAMS];
     c->n_keys = 0;
     for (char* tok = strtok(buf, ","); tok; tok = strtok(NULL, ",")) {
         if (c->n_keys == WETDEM_FIT_MAX_PARAMS) {
@@ -461,7 +579,24 @@ static int parse_keys(const char* list, struct fit_ctx* c)
         if (cli_override_split(probe, section, key, NULL) != 0 ||
             check_key(tok, section, key) != CLI_EXIT_OK)
             return CLI_EXIT_USAGE;
-        snprintf(c->keys[c->n_keys++], sizeof c->keys[0], "%s.%s", section, key);
+        char* full = c->keys[c->n_keys];
+        snprintf(full, sizeof c->keys[0], "%s.%s", section, key);
+        for (size_t j = 0; j < c->n_keys; j++)
+            if (strcmp(c->keys[j], full) == 0) {
+                cli_error("fit: --fit: %s is given twice (as '%s' and '%s'); each key once", full,
+                          given[j], tok);
+                return CLI_EXIT_USAGE;
+            }
+        if (check_not_per_point(tok, full, c) != CLI_EXIT_OK)
+            return CLI_EXIT_USAGE;
+        if (strncmp(section, "material.", 9) == 0 &&
+            !cli_scenario_has_section(c->base, section)) { /* (the override says why) */
+            int rc = probe_override(c, full, "0");
+            cli_error("fit: --fit %s: not a key of this scenario (the message above)", tok);
+            return rc == CLI_EXIT_OK ? CLI_EXIT_USAGE : rc;
+        }
+        given[c->n_keys] = tok; /* (in buf, split in place) */
+        c->n_keys++;
     }
     if (c->n_keys == 0) {
         cli_error("fit: --fit: no parameter given");
@@ -534,20 +669,6 @@ static bool model_value(const struct cli_scenario* sc, const char* section, cons
     return st == WETDEM_OK;
 }
 
-/* Whether `key=value` is accepted as an override of the base scenario (the checker prints
- * why not). Returns its exit code. */
-static int probe_override(const struct fit_ctx* c, const char* key, const char* value)
-{
-    struct cli_scenario probe;
-    char set[2 * CLI_NAME_MAX + 64];
-    snprintf(set, sizeof set, "%s=%s", key, value);
-    if (cli_scenario_copy(c->base, &probe) != CLI_EXIT_OK)
-        return CLI_EXIT_RUNTIME;
-    int rc = cli_scenario_override(&probe, set);
-    cli_scenario_free(&probe);
-    return rc;
-}
-
 /* Initial value of key j: the scenario's value, its preset's, or the model's current value.
  * An unknown key gets the scenario checker's message (with a suggestion). */
 static int initial_value(const struct fit_ctx* c, size_t j, double* v)
@@ -612,6 +733,65 @@ static int initial_values(const struct fit_args* a, const struct fit_ctx* c, dou
     return CLI_EXIT_OK;
 }
 
+/* The fit's bounds of every key, its valid range [min, max] (the library varies the distance to
+ * a bound on a log scale, so every evaluation stays inside; docs/calibration.md "Method").
+ * Keys of an unknown range are unbounded, fitted in log form when their initial value is > 0.
+ * A start on a bound of the range cannot be varied that way: refused (exit 2) with the range. */
+static int key_bounds(const struct fit_ctx* c, const double* init, double* lower, double* upper,
+                      bool* is_log)
+{
+    for (size_t j = 0; j < c->n_keys; j++) {
+        const char* full = c->keys[j];
+        const char* dot = strrchr(full, '.');
+        char section[CLI_NAME_MAX];
+        snprintf(section, sizeof section, "%.*s", (int)(dot - full), full);
+        struct wetdem_param_desc d;
+        lower[j] = -INFINITY, upper[j] = INFINITY, is_log[j] = false;
+        if (cli_scenario_key_range(section, dot + 1, &d) != 0) {
+            is_log[j] = init[j] > 0;
+            continue;
+        }
+        char range[128];
+        wetdem_param_range_text(&d, range, sizeof range);
+        if (d.integer) {
+            cli_error("fit: --fit %s: takes whole numbers only (%s), which a least-squares fit "
+                      "cannot vary",
+                      full, range);
+            return CLI_EXIT_USAGE;
+        }
+        lower[j] = d.min, upper[j] = d.max;
+        if (init[j] > d.min && init[j] < d.max)
+            continue;
+        cli_error("fit: %s starts at %g, on the bound of its range %s: the fit varies the "
+                  "distance to the bounds on a log scale (so it never leaves the range) and cannot "
+                  "start on one; give --init a value inside the range, of the size you expect",
+                  full, init[j], range);
+        return CLI_EXIT_USAGE;
+    }
+    return CLI_EXIT_OK;
+}
+
+/* Builds every data point with the initial values, serially and before any collision runs:
+ * a point the scenario rejects is bad input, named by its file and line (exit 2). */
+static int check_points(const struct fit_ctx* c, const double* init)
+{
+    for (size_t k = 0; k < c->n_pts; k++) {
+        struct cli_setup su;
+        int rc = build_point(c, init, &c->pts[k], &su);
+        if (rc == CLI_EXIT_OK) {
+            cli_setup_free(&su);
+            continue;
+        }
+        char where[1200], values[600];
+        point_where(c, &c->pts[k], where, sizeof where);
+        param_values(c, init, values, sizeof values);
+        cli_error("fit: %s: the scenario rejects this data point with %s (the message above)",
+                  where, values);
+        return rc;
+    }
+    return CLI_EXIT_OK;
+}
+
 /* ---- output ------------------------------------------------------------------------------- */
 
 static const char* const converged_words[] = {"no", "small step", "small gradient",
@@ -630,18 +810,42 @@ static void residual_stats(const double* r, size_t n, double* rms, double* max, 
     *rms = n ? sqrt(s / (double)n) : 0;
 }
 
-static void print_result(const struct fit_ctx* c, const double* init,
-                         const struct wetdem_fit_result* r, const double* pred, double omega_scale,
-                         int argc, char** argv)
+static const char* const transform_words[] = {"linear", "log", "log-upper", "logistic"};
+
+/* "KEY = value +- error UNIT (relative %)" lines, and what an infinite or NAN error means. */
+static void print_values(const struct fit_ctx* c, const struct wetdem_fit_result* r,
+                         const double* lower, const double* upper)
+{
+    for (size_t j = 0; j < c->n_keys; j++) {
+        const char* unit = key_unit(c->keys[j]);
+        printf("# %s = %.6g +- %.3g %s (%.2g %%)", c->keys[j], r->values[j], r->std_errors[j], unit,
+               100 * r->std_errors[j] / fabs(r->values[j]));
+        if (r->undetermined[j])
+            printf(": not determined by the data");
+        else if (r->at_bound[j])
+            printf(": at the %s bound %g of its range [%g, %g]: the data would take it further, "
+                   "or do not tell it from the bound (no standard error there%s)",
+                   r->at_bound[j] < 0 ? "lower" : "upper", r->at_bound[j] < 0 ? lower[j] : upper[j],
+                   lower[j], upper[j], c->n_keys > 1 ? "; the others' are with it held there" : "");
+        else if (r->std_errors[j] > fabs(r->values[j]))
+            printf(": hardly determined by the data here (a standard error above the value); a "
+                   "start nearer the value you expect may find a better minimum");
+        printf("\n");
+    }
+}
+
+static void print_result(const struct fit_ctx* c, const double* init, const double* lower,
+                         const double* upper, const struct wetdem_fit_result* r, const double* pred,
+                         double omega_scale, int argc, char** argv)
 {
     cli_print_provenance(stdout, argc, argv);
     printf("parameter,unit,value,std_error,initial,fitted_as\n");
-    for (size_t j = 0; j < c->n_keys; j++)
+    for (size_t j = 0; j < c->n_keys; j++) {
+        int t = r->transform[j] >= 0 && r->transform[j] <= 3 ? r->transform[j] : 0;
         printf("%s,%s,%.9g,%.3g,%.9g,%s\n", c->keys[j], key_unit(c->keys[j]), r->values[j],
-               r->std_errors[j], init[j], init[j] > 0 ? "log" : "linear");
-    for (size_t j = 0; j < c->n_keys; j++)
-        printf("# %s = %.6g +- %.3g %s (%.2g %%)\n", c->keys[j], r->values[j], r->std_errors[j],
-               key_unit(c->keys[j]), 100 * r->std_errors[j] / fabs(r->values[j]));
+               r->std_errors[j], init[j], transform_words[t]);
+    }
+    print_values(c, r, lower, upper);
     int by = (r->converged_by >= 0 && r->converged_by <= 3) ? r->converged_by : 0;
     printf("# cost %.6g [-], residual std s = %.4g [-]%s over %zu dof, %zu iterations, %zu model "
            "evaluations (x %zu collisions), converged: %s\n",
@@ -749,7 +953,8 @@ static int write_curve_csv(const char* path, const struct fit_ctx* c, const doub
 /* ---- command ------------------------------------------------------------------------------ */
 
 /* Problem set-up after the inputs are read: observations and scales. */
-static int run_fit(const struct fit_args* a, struct fit_ctx* c, const double* init, int argc,
+static int run_fit(const struct fit_args* a, struct fit_ctx* c, const double* init,
+                   const double* lower, const double* upper, const bool* is_log, int argc,
                    char** argv)
 {
     size_t n = c->n_pts * (c->use_omega ? 2 : 1);
@@ -776,7 +981,10 @@ static int run_fit(const struct fit_args* a, struct fit_ctx* c, const double* in
                                     .observed = obs,
                                     .scale = scale,
                                     .model = fit_model,
-                                    .ctx = c};
+                                    .ctx = c,
+                                    .is_log = is_log,
+                                    .lower = lower,
+                                    .upper = upper};
     struct wetdem_fit_options o;
     wetdem_fit_options_init(&o);
     o.max_iter = a->max_iter;
@@ -785,8 +993,13 @@ static int run_fit(const struct fit_args* a, struct fit_ctx* c, const double* in
     char msg[512] = "";
     int st = wetdem_fit_run(&pb, &o, &r, pred, msg, sizeof msg);
     int rc = CLI_EXIT_OK;
+    /* a result to show: converged, not converged, or not determining every parameter (dof 0:
+       the fit stopped before it had one, e.g. at a zero column of the Jacobian) */
+    bool has_result = st == WETDEM_OK || st == WETDEM_ERR_MAX_STEPS ||
+                      (st == WETDEM_ERR_UNDETERMINED && r.dof > 0);
+    if (has_result)
+        print_result(c, init, lower, upper, &r, pred, a->omega_scale, argc, argv);
     if (st == WETDEM_OK || st == WETDEM_ERR_MAX_STEPS) {
-        print_result(c, init, &r, pred, a->omega_scale, argc, argv);
         if (a->out)
             rc = write_fit_csv(a->out, c, pred, argc, argv);
         if (rc == CLI_EXIT_OK && a->curve)
@@ -813,7 +1026,7 @@ int cmd_fit(int argc, char** argv)
     struct cli_scenario sc;
     memset(&sc, 0, sizeof sc);
     enum cli_engine engine = CLI_ENGINE_SOFT;
-    struct fit_ctx c = {.base = &sc};
+    struct fit_ctx c = {.base = &sc, .data = a.data};
     struct point* pts = NULL;
     double init[WETDEM_FIT_MAX_PARAMS];
     rc = cli_load_with_overrides(a.file, a.sets, a.n_sets, &sc);
@@ -837,8 +1050,18 @@ int cmd_fit(int argc, char** argv)
         rc = check_counts(&a, &c);
     if (rc == CLI_EXIT_OK)
         rc = initial_values(&a, &c, init);
+    double lower[WETDEM_FIT_MAX_PARAMS], upper[WETDEM_FIT_MAX_PARAMS];
+    bool is_log[WETDEM_FIT_MAX_PARAMS];
     if (rc == CLI_EXIT_OK)
-        rc = run_fit(&a, &c, init, argc, argv);
+        rc = key_bounds(&c, init, lower, upper, is_log);
+    if (rc == CLI_EXIT_OK)
+        rc = check_points(&c, init);
+    if (rc == CLI_EXIT_OK) /* (before the fit runs, not after it) */
+        rc = cli_check_writable("fit", "--out", a.out);
+    if (rc == CLI_EXIT_OK)
+        rc = cli_check_writable("fit", "--curve", a.curve);
+    if (rc == CLI_EXIT_OK)
+        rc = run_fit(&a, &c, init, lower, upper, is_log, argc, argv);
     free(pts);
     cli_scenario_free(&sc);
     return rc;

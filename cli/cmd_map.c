@@ -11,7 +11,9 @@
  * in grid order after all finished, so the data rows are bit-identical for any thread count.
  * The trailer '#' line (runs, wall time, threads, collisions per second) is the only line
  * that varies. Engines: pairwise (the row of cli_run_pairwise) and soft (the collision row of
- * `wetdem sweep`); many-particle scenarios are refused (exit 2), as by `wetdem sweep`.
+ * `wetdem sweep`); many-particle scenarios are refused (exit 2), as by `wetdem sweep`, and
+ * so are two names of one key, or speed with stokes (cli/batch.c). Progress goes to stderr
+ * when it is a terminal; SIGINT writes the table of the points that ran (cli/batch.h).
  */
 #include <omp.h>
 #include <stdio.h>
@@ -100,8 +102,9 @@ static void write_table(FILE* f, const void* ctx)
     const struct map_table* t = ctx;
     const struct cli_batch* b = t->batch;
     cli_batch_write_table(f, b, t->argc, t->argv);
-    fprintf(f, "# totals: runs=%zu wall_time_s=%.6f threads=%d collisions_per_s=%.3f\n", b->n_pts,
-            b->wall, omp_get_max_threads(), b->wall > 0 ? (double)b->n_pts / b->wall : 0.0);
+    size_t runs = cli_batch_points_run(b);
+    fprintf(f, "# totals: runs=%zu wall_time_s=%.6f threads=%d collisions_per_s=%.3f\n", runs,
+            b->wall, omp_get_max_threads(), b->wall > 0 ? (double)runs / b->wall : 0.0);
 }
 
 int cmd_map(int argc, char** argv)
@@ -118,7 +121,9 @@ int cmd_map(int argc, char** argv)
                           .sets = a.sets,
                           .n_sets = a.n_sets,
                           .n_keys = 2,
-                          .key = {a.key[0], a.key[1]}};
+                          .key = {a.key[0], a.key[1]},
+                          .progress = true,
+                          .out = a.out};
     for (int d = 0; d < 2 && rc == CLI_EXIT_OK; d++)
         rc = cli_parse_range(a.values[d], a.is_log[d], d ? "--values2" : "--values", &b.range[d]);
     if (rc != CLI_EXIT_OK)
@@ -130,7 +135,7 @@ int cmd_map(int argc, char** argv)
         return CLI_EXIT_USAGE;
     }
     rc = cli_batch_run(&b);
-    if (rc == CLI_EXIT_OK) {
+    if (rc == CLI_EXIT_OK) { /* (also after an interruption: the points that ran) */
         struct map_table t = {&b, argc, argv};
         rc = cli_write_output(a.out, "map", write_table, &t);
         rc = cli_batch_report_failures(&b, rc);

@@ -15,7 +15,9 @@
  * are distributed over the threads, and rows are written in input order after all finished,
  * so the data rows are bit-identical for any OMP_NUM_THREADS. The trailer '#' line (totals and
  * wall time) is the only line that varies between runs. The status column is the run's
- * status (the pairwise engine's for pairwise scenarios); a failed point makes the exit code 1.
+ * status (the pairwise engine's for pairwise scenarios), ENERGY_GREW or NOT_RUN (cli/batch.h);
+ * a failed point makes the exit code 1, an interruption (SIGINT, SIGTERM) 128 + the signal
+ * after the table of the points that ran is written.
  *
  * Progress with an estimate of the time left goes to stderr only when stderr is a terminal.
  */
@@ -98,8 +100,8 @@ static void write_table(FILE* f, const void* ctx)
     const struct cli_batch* b = t->batch;
     cli_batch_write_table(f, b, t->argc, t->argv);
     if (b->engine == CLI_ENGINE_PAIRWISE) {
-        fprintf(f, "# totals: runs=%zu wall_time_s=%.6f threads=%d\n", b->n_pts, b->wall,
-                omp_get_max_threads());
+        fprintf(f, "# totals: runs=%zu wall_time_s=%.6f threads=%d\n", cli_batch_points_run(b),
+                b->wall, omp_get_max_threads());
         return;
     }
     struct wetdem_stats tot = {0};
@@ -114,8 +116,8 @@ static void write_table(FILE* f, const void* ctx)
     fprintf(f,
             "# totals: runs=%zu steps=%llu force_evals=%llu pair_evals=%llu root_evals=%llu "
             "events=%llu wall_time_s=%.6f threads=%d\n",
-            b->n_pts, tot.steps, tot.force_evals, tot.pair_evals, tot.root_evals, tot.events,
-            b->wall, omp_get_max_threads());
+            cli_batch_points_run(b), tot.steps, tot.force_evals, tot.pair_evals, tot.root_evals,
+            tot.events, b->wall, omp_get_max_threads());
 }
 
 int cmd_sweep(int argc, char** argv)
@@ -133,13 +135,14 @@ int cmd_sweep(int argc, char** argv)
                           .n_sets = a.n_sets,
                           .n_keys = 1,
                           .key = {a.key},
-                          .progress = true};
+                          .progress = true,
+                          .out = a.out};
     if (rc == CLI_EXIT_OK)
         rc = cli_parse_range(a.values, a.is_log, "--values", &b.range[0]);
     if (rc != CLI_EXIT_OK)
         return rc;
     rc = cli_batch_run(&b);
-    if (rc == CLI_EXIT_OK) {
+    if (rc == CLI_EXIT_OK) { /* (also after an interruption: the points that ran) */
         struct sweep_table t = {&b, argc, argv};
         rc = cli_write_output(a.out, "sweep", write_table, &t);
         rc = cli_batch_report_failures(&b, rc);

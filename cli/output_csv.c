@@ -195,6 +195,21 @@ void cli_csv_result_row(FILE* f, const struct cli_setup* su,
     }
 }
 
+void cli_csv_failed_row(FILE* f, const struct cli_setup* su)
+{
+    struct wetdem_collision_result r = {0};
+    struct cli_field fields[CLI_MAX_FIELDS];
+    size_t n = cli_result_fields(su, &r, fields);
+    for (size_t k = 0; k < n; k++) {
+        if (k)
+            fputc(',', f);
+        if (strcmp(fields[k].name, "impact_speed") == 0) /* (the set-up's, not a result) */
+            csv_value(f, &fields[k]);
+        else
+            fputs(fields[k].kind == CLI_FIELD_TEXT ? "none" : "nan", f);
+    }
+}
+
 void cli_summary_text(FILE* f, const struct cli_scenario* sc, const struct cli_setup* su,
                       const struct wetdem_collision_result* r)
 {

@@ -57,6 +57,10 @@ void cli_csv_result_header(FILE* f);
 /* CSV row of the result fields (no newline). */
 void cli_csv_result_row(FILE* f, const struct cli_setup* su,
                         const struct wetdem_collision_result* r);
+/* CSV row of a collision that failed (no newline): the impact speed of the set-up, then "nan"
+ * for every number, flag and count of the result and "none" for every word (the result of a
+ * failed run holds no values, and 0 or "stick" would read as results). */
+void cli_csv_failed_row(FILE* f, const struct cli_setup* su);
 /* The result as aligned "name  value  unit  meaning" lines. */
 void cli_summary_text(FILE* f, const struct cli_scenario* sc, const struct cli_setup* su,
                       const struct wetdem_collision_result* r);

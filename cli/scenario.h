@@ -242,6 +242,10 @@ bool cli_is_name(const char* s);
 /* A numeric or choice key descriptor as a library parameter descriptor (for range text). */
 struct wetdem_param_desc cli_key_as_param(const struct cli_key_desc* k);
 
+/* The valid range of a numeric key (min, max, open flags, integer) as a descriptor, from the
+ * section's key table or the library's table (material, fluid, model parameters). 0, or -1
+ * when the key is unknown or not a number. */
+int cli_scenario_key_range(const char* section, const char* key, struct wetdem_param_desc* out);
 /* Unit of a key as documented ("" if unknown or a word). */
 const char* cli_scenario_key_unit(const char* section, const char* key);
 /* Splits an override "a.b.key=value" into section and key (a model name "nijssen" becomes

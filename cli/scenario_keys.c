@@ -296,6 +296,25 @@ const char* cli_scenario_key_unit(const char* section, const char* key)
     return d ? d->unit : "";
 }
 
+int cli_scenario_key_range(const char* section, const char* key, struct wetdem_param_desc* out)
+{
+    struct cli_section_info info;
+    if (cli_section_lookup(section, &info) != 0)
+        return -1;
+    for (size_t k = 0; info.desc->keys && info.desc->keys[k].key; k++)
+        if (strcmp(info.desc->keys[k].key, key) == 0) {
+            if (info.desc->keys[k].kind != CLI_VALUE_NUMBER)
+                return -1;
+            *out = cli_key_as_param(&info.desc->keys[k]);
+            return 0;
+        }
+    const struct wetdem_param_desc* d = wetdem_param_find(info.lib_keys, key);
+    if (!d || d->choices)
+        return -1;
+    *out = *d;
+    return 0;
+}
+
 /* ---- documentation ---- */
 
 /* Writes a Markdown table cell, '|' escaped. */

@@ -82,17 +82,18 @@ struct wetdem_fluid {
 
 enum wetdem_status {
     WETDEM_OK = 0,
-    WETDEM_EVENT = 1,          /* stopped at a terminal event: information, not an error */
-    WETDEM_RETRY = 2,          /* internal: the step was too large */
-    WETDEM_ERR_NOMEM = -1,     /* out of memory */
-    WETDEM_ERR_INVALID = -2,   /* bad argument or parameter value */
-    WETDEM_ERR_NOT_FOUND = -3, /* unknown model, integrator, material or parameter name */
-    WETDEM_ERR_STEP = -4,      /* the integrator could not reach its tolerance */
-    WETDEM_ERR_MAX_STEPS = -5, /* step budget exhausted */
-    WETDEM_ERR_CALLBACK = -6,  /* a user callback returned an error */
-    WETDEM_ERR_IO = -7,        /* a file could not be read or written */
-    WETDEM_ERR_PARSE = -8,     /* a scenario or data file is malformed */
-    WETDEM_ERR_NUMERIC = -9,   /* NaN or infinity appeared in the state */
+    WETDEM_EVENT = 1,              /* stopped at a terminal event: information, not an error */
+    WETDEM_RETRY = 2,              /* internal: the step was too large */
+    WETDEM_ERR_NOMEM = -1,         /* out of memory */
+    WETDEM_ERR_INVALID = -2,       /* bad argument or parameter value */
+    WETDEM_ERR_NOT_FOUND = -3,     /* unknown model, integrator, material or parameter name */
+    WETDEM_ERR_STEP = -4,          /* the integrator could not reach its tolerance */
+    WETDEM_ERR_MAX_STEPS = -5,     /* step budget exhausted */
+    WETDEM_ERR_CALLBACK = -6,      /* a user callback returned an error */
+    WETDEM_ERR_IO = -7,            /* a file could not be read or written */
+    WETDEM_ERR_PARSE = -8,         /* a scenario or data file is malformed */
+    WETDEM_ERR_NUMERIC = -9,       /* NaN or infinity appeared in the state */
+    WETDEM_ERR_UNDETERMINED = -10, /* a fit's data do not determine a parameter */
 };
 
 /* Name of a status code, e.g. "WETDEM_ERR_INVALID"; "WETDEM_UNKNOWN" for other values. */
@@ -1071,17 +1072,26 @@ WETDEM_API const struct wetdem_track_sample* wetdem_track_samples(const struct w
 typedef int (*wetdem_fit_model_fn)(const double* params, double* predicted, char* msg,
                                    size_t msg_size, void* ctx);
 
-/* A least-squares problem: minimise sum_i ((predicted_i - observed_i)/scale_i)^2. */
+/* A least-squares problem: minimise sum_i ((predicted_i - observed_i)/scale_i)^2 over the
+ * parameters, each kept inside its range [lower_j, upper_j] by the variable the solver varies
+ * (src/fit.c, docs/calibration.md "Method"): q = p without bounds, q = ln(p - lower) with a
+ * lower bound only, q = ln(upper - p) with an upper bound only, and the logistic
+ * q = ln((p - lower)/(upper - p)) with both; so every evaluation of the model, the
+ * finite-difference probes included, lies strictly inside the range. */
 struct wetdem_fit_problem {
     size_t n_params;          /* 1..WETDEM_FIT_MAX_PARAMS */
     const char* const* names; /* parameter names for messages (may be NULL) */
-    const double* initial;    /* initial values [n_params] */
-    const bool* is_log;       /* fit ln(p) (p stays > 0) per parameter; NULL: when initial > 0 */
+    const double* initial;    /* initial values [n_params], strictly inside a finite bound */
+    const bool* is_log;       /* per parameter: a lower bound of (at least) 0, so p stays > 0
+                                 and steps are relative; NULL: for initial > 0 when lower and
+                                 upper are both NULL */
     size_t n_data;            /* > n_params (the residual variance needs a degree of freedom) */
     const double* observed;   /* [n_data] */
     const double* scale;      /* [n_data] divisor of each residual (> 0), NULL: all 1 */
     wetdem_fit_model_fn model;
     void* ctx;
+    const double* lower; /* [n_params] lower bounds (-INFINITY: none); NULL: none */
+    const double* upper; /* [n_params] upper bounds (INFINITY: none); NULL: none */
 };
 
 struct wetdem_fit_options {
@@ -1089,32 +1099,63 @@ struct wetdem_fit_options {
     double xtol;    /* step tolerance, relative in the fitted variables (1e-6) */
     double gtol;    /* gradient tolerance (1e-8) */
     double ftol;    /* cost-reduction tolerance (1e-10) */
-    double fd_step; /* central-difference step of the Jacobian in the fitted variable:
-                        relative change for log parameters, absolute x max(|p|, 1) otherwise
-                        (1e-2: larger than the integration noise of simulated predictions) */
+    double fd_step; /* central-difference step of the Jacobian in the fitted variable q: a
+                        relative change of the distance to a bound for bounded parameters,
+                        absolute x max(|p|, 1) for unbounded ones (1e-2: larger than the
+                        integration noise of simulated predictions) */
+};
+
+/* How a parameter is varied (wetdem_fit_result.transform). */
+enum wetdem_fit_transform {
+    WETDEM_FIT_LINEAR = 0,    /* q = p (no bound) */
+    WETDEM_FIT_LOG_LOWER = 1, /* q = ln(p - lower) (a lower bound only; ln p for lower = 0) */
+    WETDEM_FIT_LOG_UPPER = 2, /* q = ln(upper - p) (an upper bound only) */
+    WETDEM_FIT_LOGISTIC = 3,  /* q = ln((p - lower)/(upper - p)) (both bounds) */
 };
 
 struct wetdem_fit_result {
     double values[WETDEM_FIT_MAX_PARAMS];     /* best-fit parameters */
     double std_errors[WETDEM_FIT_MAX_PARAMS]; /* standard errors: sqrt(diag((J^T J)^-1)) s in
                                                  the fitted variable, s^2 = cost/dof, mapped to
-                                                 p by dp = p d(ln p) for log parameters */
-    double correlation[WETDEM_FIT_MAX_PARAMS][WETDEM_FIT_MAX_PARAMS]; /* of the estimates */
+                                                 p by dp = (dp/dq) dq; INFINITY for a
+                                                 parameter the data do not determine, NAN for
+                                                 one at a bound */
+    double correlation[WETDEM_FIT_MAX_PARAMS][WETDEM_FIT_MAX_PARAMS]; /* of the estimates (NAN
+                                                 in the rows of the two kinds above) */
     double cost;         /* sum of squared scaled residuals at the solution */
     double residual_std; /* s = sqrt(cost/dof), in units of the scale */
-    size_t dof;          /* n_data - n_params */
+    size_t dof;          /* n_data - n_params; 0 when the fit stopped before a solution */
     size_t iterations;
     size_t model_evals; /* calls of the model function */
-    int converged_by;   /* 1 small step (xtol), 2 small gradient (gtol), 3 small cost change */
+    int converged_by;   /* 1 small step (xtol), 2 small gradient (gtol), 3 small cost change;
+                           0 not converged */
+    int transform[WETDEM_FIT_MAX_PARAMS];     /* enum wetdem_fit_transform of each parameter */
+    int at_bound[WETDEM_FIT_MAX_PARAMS];      /* -1 at its lower bound, +1 at its upper bound:
+                                             closer to it than 1e-3 of its standard error (the
+                                             data do not tell it from the bound) and than 1e-6
+                                             of its initial distance (the fit ran towards it);
+                                             its standard error is then NAN and the others'
+                                             are those with it held there; 0 inside */
+    bool undetermined[WETDEM_FIT_MAX_PARAMS]; /* the data do not determine it (its column of
+                                                 the Jacobian is zero, or a combination of
+                                                 columns is): WETDEM_ERR_UNDETERMINED */
 };
 
 /* Fills *opt with the defaults above. */
 WETDEM_API void wetdem_fit_options_init(struct wetdem_fit_options* opt);
 /* Solves the problem with the GSL trust-region (Levenberg-Marquardt) solver and a
  * central-difference Jacobian. predicted (may be NULL) receives the predictions at the
- * solution [n_data]. Returns WETDEM_OK, WETDEM_ERR_INVALID (bad problem or options),
- * WETDEM_ERR_CALLBACK (the model failed), WETDEM_ERR_MAX_STEPS (not converged; *result holds
- * the last iterate) or WETDEM_ERR_NOMEM; msg (may be NULL) receives a message. */
+ * solution [n_data]. Returns WETDEM_OK (a parameter at a bound is reported in *result, not as
+ * an error), WETDEM_ERR_INVALID (bad problem or options, an initial value outside or on a
+ * bound), WETDEM_ERR_CALLBACK or the model's status (the model failed), WETDEM_ERR_MAX_STEPS
+ * (not converged; *result holds the last iterate), WETDEM_ERR_UNDETERMINED (the data do not
+ * depend on a parameter, or do not determine some parameters separately: *result holds the
+ * last iterate with those parameters' standard errors INFINITY), WETDEM_ERR_STEP (the solver
+ * found no step that lowers the cost) or WETDEM_ERR_NOMEM; msg (may be NULL) receives a
+ * message. GSL's error handler is switched off while the call runs and the caller's handler
+ * restored before it returns, so a GSL error never aborts the program; GSL keeps that handler
+ * in one process-wide variable, so do not change it, or rely on GSL's default handler, in
+ * another thread while a fit runs. */
 WETDEM_API int wetdem_fit_run(const struct wetdem_fit_problem* problem,
                               const struct wetdem_fit_options* opt,
                               struct wetdem_fit_result* result, double* predicted, char* msg,

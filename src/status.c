@@ -24,6 +24,7 @@ const char* wetdem_status_name(int status)
     case WETDEM_ERR_IO: return "WETDEM_ERR_IO";
     case WETDEM_ERR_PARSE: return "WETDEM_ERR_PARSE";
     case WETDEM_ERR_NUMERIC: return "WETDEM_ERR_NUMERIC";
+    case WETDEM_ERR_UNDETERMINED: return "WETDEM_ERR_UNDETERMINED";
     default: return "WETDEM_UNKNOWN";
     }
 }

@@ -9,6 +9,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include <gsl/gsl_errno.h>
 #include <gsl/gsl_randist.h>
 #include <gsl/gsl_rng.h>
 
@@ -144,6 +145,180 @@ static void test_fit_rejects_bad_problems(void** state)
     CHECK_CONTAINS(msg, "> 0 (log fit)");
 }
 
+/* ---- what the data do not determine, and bounds ------------------------------------------ */
+
+/* y_i = p0 x_i: p1 (when there is one) is ignored: its column of the Jacobian is zero. */
+static int ignores_second(const double* p, double* out, char* msg, size_t n, void* ctx)
+{
+    (void)msg;
+    (void)n;
+    (void)ctx;
+    for (size_t i = 0; i < 4; i++)
+        out[i] = p[0] * (double)(i + 1);
+    return WETDEM_OK;
+}
+
+/* y_i = i: no parameter matters. */
+static int constant_model(const double* p, double* out, char* msg, size_t n, void* ctx)
+{
+    (void)p, (void)msg, (void)n, (void)ctx;
+    for (size_t i = 0; i < 4; i++)
+        out[i] = (double)(i + 1);
+    return WETDEM_OK;
+}
+
+/* y_i = a b x_i: in log variables the columns of a and b are equal. */
+static int product_only(const double* p, double* out, char* msg, size_t n, void* ctx)
+{
+    (void)msg;
+    (void)n;
+    (void)ctx;
+    for (size_t i = 0; i < 4; i++)
+        out[i] = p[0] * p[1] * (double)(i + 1) + 0.01 * (double)(i % 2);
+    return WETDEM_OK;
+}
+
+static void caller_gsl_handler(const char* reason, const char* file, int line, int gsl_errno)
+{
+    (void)reason, (void)file, (void)line, (void)gsl_errno;
+}
+
+/* A parameter the predictions do not depend on gives a Jacobian column of zeros; GSL's QR of
+ * a rank-0 Jacobian called GSL's default error handler, which aborted the program. It is an
+ * error with the parameter and the value, and the caller's GSL handler is left in place. */
+static void test_fit_zero_jacobian_column_is_an_error_not_an_abort(void** state)
+{
+    (void)state;
+    const double obs[4] = {1, 2, 3, 4}, init[2] = {2, 3};
+    const char* names[2] = {"used", "flat"};
+    struct wetdem_fit_problem pb = {.n_params = 2,
+                                    .names = names,
+                                    .initial = init,
+                                    .n_data = 4,
+                                    .observed = obs,
+                                    .model = ignores_second};
+    struct wetdem_fit_options o;
+    wetdem_fit_options_init(&o);
+    struct wetdem_fit_result r;
+    char msg[512];
+    gsl_error_handler_t* before = gsl_set_error_handler(&caller_gsl_handler);
+    /* one parameter, ignored: a Jacobian of rank 0 (GSL aborted here) */
+    pb.n_params = 1;
+    pb.names = names + 1;
+    pb.initial = init + 1;
+    pb.model = constant_model;
+    CHECK_STATUS(wetdem_fit_run(&pb, &o, &r, NULL, msg, sizeof msg), WETDEM_ERR_UNDETERMINED);
+    CHECK_CONTAINS(msg,
+                   "the data do not depend on flat near 3 (its column of the Jacobian is zero");
+    assert_int_equal(r.dof, 0); /* no solution to report statistics of */
+    /* two parameters, the second ignored: rank 1 (GSL gave it a standard error of 0) */
+    pb.n_params = 2;
+    pb.names = names;
+    pb.initial = init;
+    pb.model = ignores_second;
+    CHECK_STATUS(wetdem_fit_run(&pb, &o, &r, NULL, msg, sizeof msg), WETDEM_ERR_UNDETERMINED);
+    CHECK_CONTAINS(msg,
+                   "the data do not depend on flat near 3 (its column of the Jacobian is zero");
+    assert_true(r.undetermined[1] && isinf(r.std_errors[1]));
+    /* GSL's handler is the caller's again */
+    assert_ptr_equal(gsl_set_error_handler(before), &caller_gsl_handler);
+}
+
+/* Two parameters whose columns are equal (only their product matters) have no separate
+ * values: both standard errors are infinite and the status says so (the covariance from
+ * GSL's pivoted QR set them to 0, i.e. "0 %"). */
+static void test_fit_rank_deficient_jacobian_gives_infinite_errors(void** state)
+{
+    (void)state;
+    const double obs[4] = {6.1, 12, 18.1, 24}, init[2] = {2, 2.5};
+    const char* names[2] = {"a", "b"};
+    struct wetdem_fit_problem pb = {.n_params = 2,
+                                    .names = names,
+                                    .initial = init,
+                                    .n_data = 4,
+                                    .observed = obs,
+                                    .model = product_only};
+    struct wetdem_fit_options o;
+    wetdem_fit_options_init(&o);
+    o.fd_step = 1e-5;
+    struct wetdem_fit_result r;
+    char msg[512];
+    CHECK_STATUS(wetdem_fit_run(&pb, &o, &r, NULL, msg, sizeof msg), WETDEM_ERR_UNDETERMINED);
+    CHECK_CONTAINS(msg, "the data do not determine a and b separately");
+    assert_true(r.undetermined[0] && r.undetermined[1]);
+    assert_true(isinf(r.std_errors[0]) && isinf(r.std_errors[1]));
+    assert_true(isnan(r.correlation[0][1]));
+    CHECK_REL(r.values[0] * r.values[1], 6.03, 1e-2); /* the product is what the data fix */
+}
+
+/* y_i = p x_i for p in [0, 1]: the model fails above 1, as a scenario rejects a restitution
+ * above 1; it records the largest and smallest value it was asked for. */
+struct bounded {
+    double lo_seen, hi_seen;
+};
+
+static int bounded_model(const double* p, double* out, char* msg, size_t n, void* ctx)
+{
+    struct bounded* b = ctx;
+    b->lo_seen = fmin(b->lo_seen, p[0]);
+    b->hi_seen = fmax(b->hi_seen, p[0]);
+    if (!(p[0] >= 0 && p[0] <= 1)) {
+        snprintf(msg, n, "p = %g is out of range [0, 1]", p[0]);
+        return WETDEM_ERR_INVALID;
+    }
+    for (size_t i = 0; i < 5; i++)
+        out[i] = p[0] * (double)(i + 1) / 5;
+    return WETDEM_OK;
+}
+
+/* Every evaluation, the finite-difference probes included, stays inside [lower, upper]: data
+ * made at p = 0.995 are fitted from 0.9 (the unbounded log fit probed 1.0096 and failed), and
+ * data that would need p = 1.2 leave p at the upper bound, reported as such (status OK, no
+ * standard error), not as a failed model. */
+static void test_fit_stays_inside_bounds_and_reports_a_bound(void** state)
+{
+    (void)state;
+    double obs[5];
+    const double init[1] = {0.9}, lower[1] = {0}, upper[1] = {1};
+    const char* names[1] = {"e"};
+    struct bounded b = {INFINITY, -INFINITY};
+    struct wetdem_fit_problem pb = {.n_params = 1,
+                                    .names = names,
+                                    .initial = init,
+                                    .n_data = 5,
+                                    .observed = obs,
+                                    .model = bounded_model,
+                                    .ctx = &b,
+                                    .lower = lower,
+                                    .upper = upper};
+    struct wetdem_fit_options o;
+    wetdem_fit_options_init(&o);
+    struct wetdem_fit_result r;
+    char msg[512];
+    for (size_t i = 0; i < 5; i++)
+        obs[i] = 0.995 * (double)(i + 1) / 5 + (i % 2 ? 1e-3 : -1e-3);
+    int st = wetdem_fit_run(&pb, &o, &r, NULL, msg, sizeof msg);
+    if (st != WETDEM_OK)
+        fail_msg("fit to 0.995 from 0.9: %s", msg);
+    CHECK_ABS(r.values[0], 0.995, 2e-3);
+    assert_int_equal(r.at_bound[0], 0);
+    assert_int_equal(r.transform[0], WETDEM_FIT_LOGISTIC);
+    assert_true(b.hi_seen < 1 && b.lo_seen > 0);
+    for (size_t i = 0; i < 5; i++)
+        obs[i] = 1.2 * (double)(i + 1) / 5 + (i % 2 ? 1e-3 : -1e-3);
+    st = wetdem_fit_run(&pb, &o, &r, NULL, msg, sizeof msg);
+    if (st != WETDEM_OK)
+        fail_msg("fit to 1.2 from 0.9: %s", msg);
+    assert_int_equal(r.at_bound[0], 1);
+    assert_true(r.values[0] > 0.999999 && r.values[0] <= 1 && isnan(r.std_errors[0]));
+    assert_true(b.hi_seen <= 1);
+    /* a start on a bound cannot be varied on a log scale */
+    const double on_bound[1] = {1};
+    pb.initial = on_bound;
+    CHECK_STATUS(wetdem_fit_run(&pb, &o, &r, NULL, msg, sizeof msg), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(msg, "e: initial value 1 must be finite and inside (0, 1)");
+}
+
 /* ---- P_gt from simulated restitution ----------------------------------------------------- */
 
 struct punch_data {
@@ -273,7 +448,7 @@ static void test_fit_cli_rejects_bad_input(void** state)
     temp_csv(bad, "bad", "stokes_n,e_n\n2,99999999999\n");
     expect_cli(args, 2,
                ":2: column e_n: '99999999999' is not a restitution coefficient in [0, 1.5)");
-    temp_csv(bad, "bad", "stokes,e_n\n2,0.5\n");
+    temp_csv(bad, "bad", "e_n,angle_deg\n0.5,0\n");
     expect_cli(args, 2, ":1: the header must name columns stokes_n and e_n");
     /* a line longer than the reader's buffer is an error, not read as two lines */
     static char long_line[6000];
@@ -315,6 +490,145 @@ static void test_fit_cli_rejects_bad_input(void** state)
     expect_cli(args, 2, "--set model.glass.p_gt=1e300: p_gt = 1e+300 [Pa] is out of range");
     remove(good);
     remove(bad);
+}
+
+/* The data file: a column named twice, a column the fit would not read (per-point
+ * uncertainties) or misspelt, are refused (the last of a name won, others were ignored); a
+ * UTF-8 byte-order mark is accepted, as in scenario files; a Stokes number beyond the key's
+ * range is named with file and line, and so is a point the scenario rejects (it blamed
+ * --init, without file or line, after the fit had started). */
+static void test_fit_cli_data_file_checks(void** state)
+{
+    (void)state;
+    if (!getenv("WETDEM_CLI"))
+        skip();
+    const char* ini = "examples/fit/punch_db_c.ini";
+    char csv[96], args[1024];
+    snprintf(args, sizeof args, "fit %s --data /tmp/wetdem_fit_data_%d.csv --fit glass.p_gt", ini,
+             (int)getpid());
+    temp_csv(csv, "data", "stokes_n,e_n,stokes_n\n2,0.5,3\n3,0.6,3\n");
+    expect_cli(args, 2, ":1: column stokes_n appears twice (columns 1 and 3)");
+    temp_csv(csv, "data", "stokes_n [-],e_n [-],sigma\n2,0.5,0.01\n3,0.6,0.01\n");
+    expect_cli(args, 2, ":1: column 3: unknown column 'sigma'; the columns are stokes_n and e_n");
+    temp_csv(csv, "data", "stokes_n,e_n,angle\n2,0.5,0\n3,0.6,0\n");
+    expect_cli(args, 2, "unknown column 'angle' (did you mean 'angle_deg'?)");
+    temp_csv(csv, "data", "\xEF\xBB\xBFstokes_n,e_n\n2,0.5\n3,abc\n"); /* read past the header */
+    expect_cli(args, 2, ":3: column e_n: 'abc' is not a finite number");
+    temp_csv(csv, "data", "stokes_n,e_n\n2,0.5\n2e9,0.6\n3,0.6\n");
+    expect_cli(args, 2, ":3: column stokes_n: '2e9' is not a Stokes number in (0, 1e+09]");
+    temp_csv(csv, "data", "stokes_n,e_n\n2,0.5\n1e8,0.6\n3,0.6\n");
+    snprintf(args, sizeof args,
+             "fit %s --data %s --fit glass.p_gt,material.striker.restitution --init 4e6,0.9", ini,
+             csv);
+    expect_cli(args, 2,
+               ".csv:3 (St_n = 1e+08): the scenario rejects this data point with model.glass.p_gt "
+               "= 4000000, material.striker.restitution = 0.9 (the message above)");
+    remove(csv);
+}
+
+/* Keys the fit cannot vary: one the data set per point (it overrode the data: every point
+ * predicted the same), the same key twice under two names, a start on a bound of the key's
+ * range (a variable on a log scale cannot start there; a linear fit from 0 probed -0.01). */
+static void test_fit_cli_refuses_keys_it_cannot_vary(void** state)
+{
+    (void)state;
+    if (!getenv("WETDEM_CLI"))
+        skip();
+    const char* ini = "examples/fit/punch_db_c.ini";
+    char csv[96], args[1024];
+    temp_csv(csv, "keys", "stokes_n,e_n,angle_deg\n2,0.5,0\n3,0.6,0\n4,0.7,0\n");
+    static const struct {
+        const char *fit, *needle;
+    } cases[] = {
+        {"collision.stokes", "collision.stokes cannot be fitted: every data row sets it"},
+        {"collision.speed --init 0.1", "collision.speed cannot be fitted: every data row sets the "
+                                       "Stokes number"},
+        {"collision.angle_deg --init 10", "every data row sets it (the angle_deg column)"},
+        {"glass.p_gt,glass.p_gt", "model.glass.p_gt is given twice (as 'glass.p_gt' and "
+                                  "'glass.p_gt')"},
+        {"glass.p_gt,model.glass.p_gt --init 4e6,5e6",
+         "model.glass.p_gt is given twice (as 'glass.p_gt' and 'model.glass.p_gt')"},
+        {"material.striker.restitution --init 1",
+         "material.striker.restitution starts at 1, on the bound of its range (0, 1]"},
+        /* a material the file does not define (it was added, unused: a zero column) */
+        {"material.strikr.roughness --init 1e-7", "(did you mean [material.striker]?)"},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        snprintf(args, sizeof args, "fit %s --data %s --fit %s", ini, csv, cases[k].fit);
+        expect_cli(args, 2, cases[k].needle);
+    }
+    /* punch_oblique ships friction_dry = 0: the fit needs a start inside the range */
+    snprintf(args, sizeof args,
+             "fit examples/scenarios/punch_oblique.ini --data %s --fit "
+             "material.striker.friction_dry",
+             csv);
+    expect_cli(args, 2, "starts at 0, on the bound of its range [0, 10]");
+    remove(csv);
+}
+
+/* What the data do not determine is an error with the key and the value, exit 1: P_gt far
+ * below the contact-bounce range (GSL aborted the program), friction in a head-on collision
+ * (with P_gt it was "0.2 +- 0"), and a Verlet step that does not resolve h_min (e_n is then a
+ * step function of P_gt: "converged" at 9.59e6 +- 0). */
+static void test_fit_cli_reports_undetermined_keys(void** state)
+{
+    (void)state;
+    if (!getenv("WETDEM_CLI"))
+        skip();
+    const char* base = "fit examples/fit/punch_db_c.ini --data examples/fit/punch_0deg.csv";
+    char args[1024];
+    snprintf(args, sizeof args, "%s --fit glass.p_gt --init 1e5", base);
+    expect_cli(args, 1,
+               "fit: the data do not depend on model.glass.p_gt near 100000 (its column of the "
+               "Jacobian is zero");
+    snprintf(args, sizeof args, "%s --fit glass.p_gt,material.striker.friction_dry --init 4e6,0.2",
+             base);
+    expect_cli(args, 1, "the data do not depend on material.striker.friction_dry near 0.2");
+    snprintf(args, sizeof args,
+             "%s --fit glass.p_gt --init 4e6 --set integrator.name=verlet --set "
+             "integrator.dt_fraction=0.2",
+             base);
+    expect_cli(args, 1, "the verlet step moved the gap by");
+}
+
+/* Parameter steps stay inside the key's range: from 1 MPa the unbounded log fit stepped P_gt
+ * to 3.1e46 Pa and stopped with "an --init value outside the key's range" (exit 2), and a
+ * dry restitution fitted from 0.9 to data simulated at 0.995 probed 1.0096. */
+static void test_fit_cli_keeps_keys_in_range(void** state)
+{
+    (void)state;
+    if (!getenv("WETDEM_CLI"))
+        skip();
+    char out[8192], csv[96], args[1024];
+    int rc = test_run_cli_into("fit examples/fit/punch_db_c.ini --data "
+                               "examples/fit/punch_0deg.csv --fit glass.p_gt --init 1e6",
+                               out, sizeof out);
+    if (rc != 0)
+        fail_msg("exit %d:\n%s", rc, out);
+    double value = 0, se = 0;
+    const char* row = strstr(out, "model.glass.p_gt,Pa,");
+    assert_non_null(row);
+    assert_int_equal(sscanf(row, "model.glass.p_gt,Pa,%lf,%lf", &value, &se), 2);
+    if (!(fabs(value - 11.6e6) < 3 * se))
+        fail_msg("P_gt %.4g +- %.3g Pa vs 11.6e6", value, se);
+    /* e_n simulated with e_dry = 0.995 (wetdem sweep examples/fit/punch_db_c.ini --param
+       collision.stokes --values 1.6:4:9 --set material.striker.restitution=0.995) */
+    temp_csv(csv, "e995",
+             "stokes_n,e_n\n1.6,0.108342\n1.9,0.393662\n2.2,0.547048\n2.5,0.644055\n"
+             "2.8,0.710375\n3.1,0.758026\n3.4,0.793505\n3.7,0.820649\n4,0.841862\n");
+    snprintf(args, sizeof args,
+             "fit examples/fit/punch_db_c.ini --data %s --fit material.striker.restitution "
+             "--init 0.9",
+             csv);
+    rc = test_run_cli_into(args, out, sizeof out);
+    if (rc != 0)
+        fail_msg("exit %d:\n%s", rc, out);
+    row = strstr(out, "material.striker.restitution,-,");
+    assert_non_null(row);
+    assert_int_equal(sscanf(row, "material.striker.restitution,-,%lf", &value), 1);
+    CHECK_ABS(value, 0.995, 1e-3);
+    CHECK_CONTAINS(out, ",0.9,logistic\n");
+    remove(csv);
 }
 
 static void test_fit_cli_reports_units_on_example(void** state)
@@ -390,8 +704,15 @@ int main(void)
         cmocka_unit_test(test_fit_recovers_closed_form_parameters),
         cmocka_unit_test(test_fit_standard_errors_are_calibrated),
         cmocka_unit_test(test_fit_rejects_bad_problems),
+        cmocka_unit_test(test_fit_zero_jacobian_column_is_an_error_not_an_abort),
+        cmocka_unit_test(test_fit_rank_deficient_jacobian_gives_infinite_errors),
+        cmocka_unit_test(test_fit_stays_inside_bounds_and_reports_a_bound),
         cmocka_unit_test(test_fit_recovers_glass_pressure_from_simulated_data),
         cmocka_unit_test(test_fit_cli_rejects_bad_input),
+        cmocka_unit_test(test_fit_cli_data_file_checks),
+        cmocka_unit_test(test_fit_cli_refuses_keys_it_cannot_vary),
+        cmocka_unit_test(test_fit_cli_reports_undetermined_keys),
+        cmocka_unit_test(test_fit_cli_keeps_keys_in_range),
         cmocka_unit_test(test_fit_cli_reports_units_on_example),
         cmocka_unit_test(test_fit_cli_curve_covers_every_angle),
     };

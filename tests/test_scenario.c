@@ -19,6 +19,7 @@
  *     many-particle and pairwise scenarios honours --json and does not run;
  *   - a Verlet step that does not resolve h_min is reported by run and sweep (exit 0).
  */
+#include <signal.h>
 #include <stdlib.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
@@ -162,6 +163,17 @@ static void test_scenario_set_overrides(void** state)
     assert_int_equal(r.code, 2);
     CHECK_CONTAINS(r.out, "rtol");
     free(r.out);
+    /* a --set of a material the file does not define added one no sphere used (a typo), or
+       one named after a preset that started from the field defaults, not from the preset */
+    expect_run("run examples/fit/punch_db_c.ini --check --set material.strikr.roughness=1e-7", 2,
+               "--set material.strikr.roughness=1e-7: the file has no section "
+               "[material.strikr] (did you mean [material.striker]?)");
+    expect_run("sweep examples/scenarios/nijssen_head_on.ini --param collision.stokes --values "
+               "10:20:2 --set material.delrin.roughness=1e-7",
+               2, "to change preset delrin, give the file a [material.NAME] section");
+    expect_run("map examples/fit/punch_db_c.ini --param collision.stokes --values 2:3:2 --param2 "
+               "glass.p_gt --values2 1e7:2e7:2 --set material.strikr.roughness=1e-7",
+               2, "(did you mean [material.striker]?)");
 }
 
 struct bad_case {
@@ -308,6 +320,10 @@ static void test_scenario_energy_gain_is_an_error(void** state)
     expect_run("sweep examples/scenarios/dry_hertz.ini --set integrator.dt_fraction=0.5 "
                "--param collision.speed --values 0.5:1:2",
                1, "sweep: collision.speed = 1: the collision ends with");
+    /* the row of such a point says so in its status column (it was WETDEM_OK, with e = 1.7) */
+    expect_run("sweep examples/scenarios/dry_hertz.ini --set integrator.dt_fraction=0.5 "
+               "--param collision.speed --values 0.5:1:2",
+               1, "\n1,ENERGY_GREW,1,");
 }
 
 /* A Verlet step that moves the gap by more than a tenth of h_min across it is reported, not an
@@ -505,6 +521,100 @@ static void test_scenario_bad_output_paths_exit_2(void** state)
              tmpdir);
     expect_run(args, 2, "rows, more than 1e+07: raise trajectory_interval");
     assert_false(exists(tmpdir, "traj_soft"));
+}
+
+/* What a batch cannot label truthfully is refused before it runs (exit 2): two names of one
+ * key, or speed and stokes, one of which replaces the other (rows were labelled with values
+ * never used); an --out that cannot be written (found after the whole batch had run). A
+ * failed collision's row has nan and none for its results (it had 0 and "stick"). The count
+ * of --values takes exponent notation, as every number does; a map shows its progress on a
+ * terminal, as a sweep does. */
+static void test_scenario_batch_keys_rows_and_outputs(void** state)
+{
+    (void)state;
+    const char* map = "map examples/fit/punch_db_c.ini --param";
+    char args[1400];
+    snprintf(args, sizeof args,
+             "%s glass.p_gt --values 1e7:2e7:2 --param2 model.glass.p_gt "
+             "--values2 1e7:2e7:2",
+             map);
+    expect_run(args, 2, "map: --param glass.p_gt and --param2 model.glass.p_gt name the same key");
+    snprintf(args, sizeof args,
+             "%s collision.stokes --values 2:3:2 --param2 collision.speed "
+             "--values2 0.1:0.2:2",
+             map);
+    expect_run(args, 2,
+               "the impact is given by speed or by stokes, and setting one replaces the "
+               "other");
+    expect_run("sweep examples/scenarios/dry_hertz.ini --param collision.speed --values 0.5:1:2 "
+               "--out /proc/wetdem_no.csv",
+               2, "sweep: --out /proc/wetdem_no.csv cannot be written");
+    snprintf(args, sizeof args,
+             "%s collision.stokes --values 2:3:2 --param2 glass.p_gt --values2 "
+             "1e7:2e7:2 --out /proc/wetdem_no.csv",
+             map);
+    expect_run(args, 2, "map: --out /proc/wetdem_no.csv cannot be written");
+    expect_run("fit examples/fit/punch_db_c.ini --data examples/fit/punch_0deg.csv --fit "
+               "glass.p_gt --out /proc/wetdem_no.csv",
+               2, "fit: --out /proc/wetdem_no.csv cannot be written");
+    expect_run("sweep examples/scenarios/nijssen_head_on.ini --param collision.stokes --values "
+               "10:1000:3 --log --set integrator.max_steps=200",
+               1, "\n10,WETDEM_ERR_MAX_STEPS,0.0025309336333,nan,nan,nan,nan,nan,");
+    expect_run("sweep examples/scenarios/nijssen_head_on.ini --param collision.stokes --values "
+               "10:1000:3 --log --set integrator.max_steps=200",
+               1, ",nan,none,nan,");
+    expect_run("sweep examples/scenarios/dry_hertz.ini --param collision.speed --values 1:2:1e1", 0,
+               "\n2,WETDEM_OK,2,");
+    /* stderr a terminal (script gives the command one): progress lines */
+    snprintf(args, sizeof args,
+             "script -qec \"'%s' %s collision.stokes --values 2:3:2 --param2 glass.p_gt "
+             "--values2 1e7:2e7:2 --out '%s/progress.csv'\" /dev/null",
+             test_cli_path(), map, tmpdir);
+    FILE* p = popen(args, "r");
+    assert_non_null(p);
+    char* out = test_slurp(p, NULL);
+    pclose(p);
+    CHECK_CONTAINS(out, "map: 4/4 done");
+    free(out);
+}
+
+/* SIGINT during a map (it lost every collision that had run): the collisions running finish,
+ * the others are left out, and the table is still written, whole and under its name, with
+ * every point (NOT_RUN for those left out) and a line saying so; exit 128 + 2. */
+static void test_scenario_interrupted_map_writes_what_ran(void** state)
+{
+    (void)state;
+    char cmd[1400];
+    snprintf(cmd, sizeof cmd, "%s/int.csv", tmpdir);
+    /* 10^4 three-sphere collisions: ~10 s on two cores, interrupted after 0.5 s */
+    pid_t pid = fork();
+    assert_true(pid >= 0);
+    if (pid == 0) {
+        signal(SIGINT, SIG_DFL);
+        freopen("/dev/null", "w", stderr);
+        execl(test_cli_path(), test_cli_path(), "map", "examples/scenarios/davis_three.ini",
+              "--param", "davis.stokes", "--values", "0.5:30:100", "--param2", "davis.angle_deg",
+              "--values2", "0:80:100", "--out", cmd, (char*)NULL);
+        _exit(127);
+    }
+    usleep(500000);
+    kill(pid, SIGINT);
+    int status = 0;
+    waitpid(pid, &status, 0);
+    assert_true(WIFEXITED(status));
+    assert_int_equal(WEXITSTATUS(status), 130);
+    snprintf(cmd, sizeof cmd, "%s/int.csv", tmpdir);
+    char* table = test_read_file(cmd, NULL);
+    assert_non_null(table);
+    CHECK_CONTAINS(table, ",NOT_RUN,none,none,nan,");
+    CHECK_CONTAINS(table, ",WETDEM_OK,");
+    CHECK_CONTAINS(table, "# interrupted by signal 2: ");
+    size_t rows = 0;
+    for (const char* line = table; line && *line;
+         line = strchr(line, '\n'), line = line ? line + 1 : NULL)
+        rows += line[0] != '#' && line[0] != '\n';
+    assert_int_equal(rows, 1 + 100 * 100); /* the header and every point */
+    free(table);
 }
 
 /* Data lines (not starting with '#') of a sweep. */
@@ -788,6 +898,8 @@ int main(void)
         cmocka_unit_test(test_scenario_docs_list_every_key),
         cmocka_unit_test(test_scenario_run_writes_files_or_nothing),
         cmocka_unit_test(test_scenario_bad_output_paths_exit_2),
+        cmocka_unit_test(test_scenario_batch_keys_rows_and_outputs),
+        cmocka_unit_test(test_scenario_interrupted_map_writes_what_ran),
         cmocka_unit_test(test_scenario_sweep_order_and_threads),
         cmocka_unit_test(test_scenario_sweep_point_equals_run),
         cmocka_unit_test(test_scenario_sweep_pairwise_threads_and_status),
