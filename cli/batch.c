@@ -17,6 +17,7 @@
 
 #include "batch.h"
 #include "output_csv.h"
+#include "signals.h"
 
 /* What a batch holds per point while it runs (with the row's text, about 1 kB): its set-up is
  * built when it runs, not kept, or maps of millions of collisions would not fit in memory. */
@@ -136,22 +137,6 @@ static void show_progress(const char* cmd, size_t done, size_t n, double t0)
         fputc('\n', stderr);
 }
 
-/* ---- SIGINT and SIGTERM: stop starting points, keep those that ran ---- */
-
-static volatile sig_atomic_t stop_signal = 0;
-
-static void on_signal(int sig)
-{
-    static const char note[] = "\nwetdem: interrupted: finishing the collisions that run, then "
-                               "writing the table of those done (again: stop at once)\n";
-    stop_signal = sig;
-    struct sigaction dfl = {.sa_handler = SIG_DFL}; /* a second signal stops at once */
-    sigemptyset(&dfl.sa_mask);
-    sigaction(sig, &dfl, NULL);
-    ssize_t ignored = write(STDERR_FILENO, note, sizeof note - 1);
-    (void)ignored;
-}
-
 /* Runs every point in parallel (dynamic scheduling: run times differ by orders of
  * magnitude across a batch). After SIGINT or SIGTERM the points not yet started are left
  * out (b->interrupted, their status CLI_BATCH_NOT_RUN). */
@@ -160,18 +145,18 @@ static void run_all(const struct cli_scenario* base, struct cli_batch* b)
     bool show = b->progress && isatty(STDERR_FILENO);
     double t0 = omp_get_wtime(), last = 0;
     size_t done = 0, n = b->n_pts;
-    struct sigaction act = {.sa_handler = on_signal}, old_int, old_term;
-    sigemptyset(&act.sa_mask);
-    stop_signal = 0;
-    sigaction(SIGINT, NULL, &old_int);
-    sigaction(SIGTERM, NULL, &old_term);
-    if (old_int.sa_handler != SIG_IGN) /* (a signal ignored on entry stays ignored: nohup, &) */
-        sigaction(SIGINT, &act, NULL);
-    if (old_term.sa_handler != SIG_IGN)
-        sigaction(SIGTERM, &act, NULL);
+    char notice[200];
+    snprintf(notice, sizeof notice,
+             "\nwetdem: interrupted: finishing the collisions that run, then writing the table "
+             "of those done (a signal %g s or more after this one, or a third: stop at once)\n",
+             CLI_SIGNAL_GRACE_S);
+    struct cli_saved_signals saved;
+    cli_signals_install(notice,
+                        "\nwetdem: stopped at once by a repeated signal, without the table\n", NULL,
+                        &saved);
 #pragma omp parallel for schedule(dynamic, 1)
     for (size_t k = 0; k < n; k++) {
-        if (stop_signal) {
+        if (cli_stop_signal) {
             b->pts[k].status = CLI_BATCH_NOT_RUN;
             continue;
         }
@@ -180,15 +165,15 @@ static void run_all(const struct cli_scenario* base, struct cli_batch* b)
         {
             done++;
             double now = omp_get_wtime();
-            if (show && !stop_signal && (now - last > 0.2 || done == n)) {
+            if (show && !cli_stop_signal && (now - last > 0.2 || done == n)) {
                 show_progress(b->cmd, done, n, t0);
                 last = now;
             }
         }
     }
-    sigaction(SIGINT, &old_int, NULL);
-    sigaction(SIGTERM, &old_term, NULL);
-    b->interrupted = stop_signal;
+    b->interrupted = cli_stop_signal;
+    if (!b->interrupted) /* (else kept, as run keeps them: see signals.h) */
+        cli_signals_restore(&saved);
 }
 
 /* The engine's column header into b->header (malloc'd). Exit code. */
@@ -390,12 +375,11 @@ static void report_unresolved_hmin(const struct cli_batch* b)
 int cli_batch_report_failures(const struct cli_batch* b, int rc)
 {
     report_unresolved_hmin(b);
-    if (b->interrupted) {
+    if (b->interrupted)
         cli_error("%s: interrupted by signal %d: %zu of %zu points ran; the table has every "
                   "point, those left out with status NOT_RUN",
                   b->cmd, b->interrupted, cli_batch_points_run(b), b->n_pts);
-        rc = 128 + b->interrupted; /* (as a program stopped by the signal, but with the table) */
-    }
+    bool failed = false;
     for (size_t k = 0; k < b->n_pts; k++) {
         const struct cli_batch_point* p = &b->pts[k];
         char where[1100];
@@ -407,14 +391,20 @@ int cli_batch_report_failures(const struct cli_batch* b, int rc)
         if (p->status >= 0) { /* (a pairwise point's result is zero: no energy ratio) */
             if (p->energy_grew && cli_energy_grew(p->res.energy_ratio, why, sizeof why)) {
                 cli_error("%s: the collision %s (status ENERGY_GREW)", where, why);
-                rc = CLI_EXIT_RUNTIME;
+                failed = true;
             }
             continue;
         }
         cli_error("%s: %s (%s)", where, p->errmsg, wetdem_status_name(p->status));
-        rc = CLI_EXIT_RUNTIME;
+        failed = true;
     }
-    return rc;
+    /* a table not written first, then the interruption (as a program stopped by the signal,
+       but with the table), then failed points */
+    if (rc != CLI_EXIT_OK)
+        return rc;
+    if (b->interrupted)
+        return 128 + b->interrupted;
+    return failed ? CLI_EXIT_RUNTIME : CLI_EXIT_OK;
 }
 
 void cli_batch_free(struct cli_batch* b)

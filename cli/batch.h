@@ -66,7 +66,8 @@ struct cli_batch {
  * (message printed, exit 2); a failed run is not an error here, its status is in its point
  * (see cli_batch_report_failures). SIGINT or SIGTERM while the points run stops starting new
  * ones: those that run finish, the others get CLI_BATCH_NOT_RUN and b->interrupted is set, so
- * the caller still writes the table (a second signal stops at once, by the signal). Free
+ * the caller still writes the table (a repeat within CLI_SIGNAL_GRACE_S is the same request;
+ * a later one, or a third, stops at once by the signal: signals.h). Free
  * with cli_batch_free() in every case. */
 int cli_batch_run(struct cli_batch* b);
 
@@ -79,8 +80,9 @@ void cli_batch_write_table(FILE* f, const struct cli_batch* b, int argc, char** 
 /* How many points ran (all of them unless the batch was interrupted). */
 size_t cli_batch_points_run(const struct cli_batch* b);
 
-/* Prints "CMD: KEY = value, ...: message (status)" for every failed run. Returns 128 + the
- * signal when the batch was interrupted, else rc, or CLI_EXIT_RUNTIME when any run failed. */
+/* Prints "CMD: KEY = value, ...: message (status)" for every failed run. Returns rc (the
+ * table's write) when it is not CLI_EXIT_OK, else 128 + the signal when the batch was
+ * interrupted, else CLI_EXIT_RUNTIME when any run failed, else CLI_EXIT_OK. */
 int cli_batch_report_failures(const struct cli_batch* b, int rc);
 
 /* Frees the points, the header and the scenario. */

@@ -22,7 +22,7 @@
  * Interruption: the first SIGINT or SIGTERM sets a volatile flag that the library reads every
  * step as its stop flag; it writes the checkpoint and returns, and the run exits with 128 +
  * signal number (130, 143) after printing the command that resumes it. A repeat within
- * SIGNAL_GRACE_S of the first is the same request delivered twice (GNU timeout signals the
+ * CLI_SIGNAL_GRACE_S of the first is the same request delivered twice (signals.c; GNU timeout signals the
  * process and then its process group; a terminal's Ctrl-C reaches the whole foreground group)
  * and is ignored, so it cannot lose the checkpoint being written. A second signal after the
  * grace period, or a third, stops the run at once by that signal, without a new checkpoint;
@@ -46,90 +46,9 @@
 #include "cli_util.h"
 #include "output_csv.h"
 #include "scenario_many.h"
+#include "signals.h"
 
 #define PATH_CHARS 2048
-
-/* ----------------------------------------------------------------------- signals --- */
-
-/* A repeat of SIGINT/SIGTERM sooner than this after the first is taken as the same request
- * [s]: duplicates arrive within milliseconds, and a person pressing Ctrl-C again to stop at
- * once presses it later (or three times). */
-#define SIGNAL_GRACE_S 1.0
-
-static volatile sig_atomic_t stop_signal = 0; /* the first signal: checkpoint and stop */
-static volatile sig_atomic_t signal_count = 0;
-static struct timespec first_signal_time;
-/* Set before the handlers are installed (the handler may only call async-signal-safe
- * functions): the temporary file of a checkpoint being written, removed on a forced stop, and
- * the notice printed on the first signal. */
-static char checkpoint_tmp[PATH_CHARS + 8];
-static char stop_notice[PATH_CHARS + 200];
-
-static void say(const char* text)
-{
-    ssize_t unused = write(STDERR_FILENO, text, strlen(text));
-    (void)unused;
-}
-
-static void on_signal(int sig)
-{
-    struct timespec now;
-    clock_gettime(CLOCK_MONOTONIC, &now);
-    if (signal_count == 0) {
-        first_signal_time = now;
-        signal_count = 1;
-        stop_signal = sig;
-        say(stop_notice);
-        return;
-    }
-    double since = (double)(now.tv_sec - first_signal_time.tv_sec) +
-                   1e-9 * (double)(now.tv_nsec - first_signal_time.tv_nsec);
-    if (signal_count == 1 && since < SIGNAL_GRACE_S) {
-        signal_count = 2; /* the same request again: the next one stops at once */
-        return;
-    }
-    say("\nwetdem: stopped at once by a repeated signal, without a new checkpoint\n");
-    if (checkpoint_tmp[0])
-        unlink(checkpoint_tmp);
-    /* die by the signal, as the caller asked: default action, raised again (delivered when
-       this handler returns) */
-    struct sigaction dfl = {.sa_handler = SIG_DFL};
-    sigemptyset(&dfl.sa_mask);
-    sigaction(sig, &dfl, NULL);
-    raise(sig);
-}
-
-struct saved_handlers {
-    struct sigaction sigint, sigterm;
-};
-
-/* Installs on_signal for SIGINT and SIGTERM (each blocks both while it runs, so the count is
- * never updated twice at once), with the notice and the temporary checkpoint path set. */
-static void signals_install(const char* checkpoint, bool tty, struct saved_handlers* saved)
-{
-    stop_signal = 0;
-    signal_count = 0;
-    checkpoint_tmp[0] = '\0';
-    if (checkpoint[0])
-        snprintf(checkpoint_tmp, sizeof checkpoint_tmp, "%s.tmp", checkpoint);
-    snprintf(stop_notice, sizeof stop_notice,
-             "%swetdem: stopping after this step%s; a second signal %g s or more after this "
-             "one, or a third, stops at once%s\n",
-             tty ? "\n" : "", checkpoint[0] ? " to write the checkpoint" : "", SIGNAL_GRACE_S,
-             checkpoint[0] ? " without it" : "");
-    struct sigaction sa = {.sa_handler = on_signal};
-    sigemptyset(&sa.sa_mask);
-    sigaddset(&sa.sa_mask, SIGINT);
-    sigaddset(&sa.sa_mask, SIGTERM);
-    sigaction(SIGINT, &sa, &saved->sigint);
-    sigaction(SIGTERM, &sa, &saved->sigterm);
-}
-
-static void signals_restore(const struct saved_handlers* saved)
-{
-    sigaction(SIGINT, &saved->sigint, NULL);
-    sigaction(SIGTERM, &saved->sigterm, NULL);
-}
 
 /* ------------------------------------------------------------------- VTK time series --- */
 
@@ -749,7 +668,7 @@ static int set_outputs(struct cli_many_setup* su, const struct cli_run_options* 
     m.vtk_every = 0; /* frames are written by on_progress */
     m.checkpoint_path = pl->checkpoint[0] ? pl->checkpoint : NULL;
     m.checkpoint_every = su->checkpoint_every;
-    m.stop_flag = &stop_signal;
+    m.stop_flag = &cli_stop_signal;
     m.progress = on_progress;
     m.progress_ctx = prog;
     m.progress_every = 1;
@@ -830,7 +749,7 @@ static int finish(const struct cli_scenario* sc, struct cli_many_setup* su,
         return CLI_EXIT_RUNTIME;
     }
     if (st == WETDEM_EVENT) {
-        int sig = stop_signal ? (int)stop_signal : SIGINT;
+        int sig = cli_stop_signal ? (int)cli_stop_signal : SIGINT;
         fprintf(stderr, "%swetdem: interrupted by %s at t = %.9g s (step %llu of %llu)",
                 prog->tty ? "\n" : "", sig == SIGTERM ? "SIGTERM" : "SIGINT",
                 wetdem_sim_time(su->sim), o.stats.step, pl->total);
@@ -931,8 +850,20 @@ static int run(const struct cli_scenario* sc, struct cli_many_setup* su,
         return CLI_EXIT_RUNTIME;
     }
     /* from the first output on, until every file is written: a signal asks for a stop */
-    struct saved_handlers saved;
-    signals_install(pl->checkpoint, prog.tty, &saved);
+    char notice[PATH_CHARS + 300], tmp[PATH_CHARS + 8] = "";
+    if (pl->checkpoint[0])
+        snprintf(tmp, sizeof tmp, "%s.tmp", pl->checkpoint);
+    snprintf(notice, sizeof notice,
+             "%swetdem: stopping after this step%s; a second signal %g s or more after this "
+             "one, or a third, stops at once%s\n",
+             prog.tty ? "\n" : "", pl->checkpoint[0] ? " to write the checkpoint" : "",
+             CLI_SIGNAL_GRACE_S, pl->checkpoint[0] ? " without it" : "");
+    struct cli_saved_signals saved;
+    cli_signals_install(notice,
+                        pl->checkpoint[0] ? "\nwetdem: stopped at once by a repeated signal, "
+                                            "without a new checkpoint\n"
+                                          : "\nwetdem: stopped at once by a repeated signal\n",
+                        tmp, &saved);
     double t0 = omp_get_wtime();
     int st = opt->restart ? WETDEM_OK : wetdem_sim_integrate(su->sim, wetdem_sim_time(su->sim));
     struct wetdem_many_stats s;
@@ -947,8 +878,8 @@ static int run(const struct cli_scenario* sc, struct cli_many_setup* su,
     rc = finish(sc, su, opt, pl, &prog, st, omp_get_wtime() - t0);
     /* after a signal the handlers stay until the process exits: a duplicate arriving after the
        files are written would otherwise kill it, and turn exit 130 into death by signal */
-    if (!signal_count)
-        signals_restore(&saved);
+    if (!cli_stop_signal)
+        cli_signals_restore(&saved);
     return rc;
 }
 

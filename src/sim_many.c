@@ -813,7 +813,8 @@ struct kick_arrays {
 };
 
 /* Half kick and drift of particle k; its velocities become the predicted ones v' + a dt/2,
- * and *v2_max the larger of itself and |v'|^2 of the half-step velocity. Every value is formed
+ * and *v2_max the larger of itself and |v'|^2 of the half-step velocity (infinite for a NaN, which
+ * a max would drop or keep depending on the order). Every value is formed
  * in a local and stored once. */
 static inline __attribute__((always_inline)) void
 kick_drift_one(const struct kick_arrays* A, const struct wetdem_celllist_box* box, size_t k,
@@ -830,6 +831,7 @@ kick_drift_one(const struct kick_arrays* A, const struct wetdem_celllist_box* bo
     struct wetdem_vec3 vh = vec3_axpy(v, half, a), wh = vec3_axpy(w, half, alpha);
     struct wetdem_vec3 x = vec3_axpy(vec3(A->xr[k].x, A->xr[k].y, A->xr[k].z), h, vh);
     double v2 = vec3_dot(vh, vh);
+    v2 = v2 == v2 ? v2 : INFINITY; /* a NaN wins no max: count it as infinite */
     *v2_max = v2 > *v2_max ? v2 : *v2_max;
     x = periodic ? wrap(box, x) : x;
     A->vh[k] = vh;

@@ -15,6 +15,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/types.h>
 #include <sys/wait.h>
 
 #include <cmocka.h>
@@ -156,6 +157,27 @@ static inline char* test_read_file(const char* path, size_t* len)
 
 /* Output of one CLI run (heap buffer, the caller frees it) and its exit code (-1 if the
  * program did not exit normally). */
+/* Whether signal sig is pending for process pid, not yet delivered (/proc/PID/status: SigPnd
+ * for the thread, ShdPnd for the process): a second signal sent while the first is pending
+ * merges with it, so a test of two signals waits for the first to be delivered. */
+static inline bool test_signal_pending(pid_t pid, int sig)
+{
+    char path[64], line[256];
+    snprintf(path, sizeof path, "/proc/%d/status", (int)pid);
+    FILE* f = fopen(path, "r");
+    bool pending = false;
+    while (f && fgets(line, sizeof line, f)) {
+        unsigned long long mask;
+        if ((sscanf(line, "SigPnd: %llx", &mask) == 1 ||
+             sscanf(line, "ShdPnd: %llx", &mask) == 1) &&
+            (mask >> (sig - 1)) & 1u)
+            pending = true;
+    }
+    if (f)
+        fclose(f);
+    return pending;
+}
+
 struct test_run {
     char* out;
     int code;

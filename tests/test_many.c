@@ -977,6 +977,41 @@ static void test_many_divergence_stops_the_run(void** state)
     wetdem_sim_free(sim);
 }
 
+/* Puts a NaN into the engine's velocity (and half-step velocity, which a deferred kick starts
+ * from) of particle 3 after step 5, as a step whose forces were not finite would leave it. */
+static int inject_nan(unsigned long long done, unsigned long long total, double elapsed, void* ctx)
+{
+    (void)total, (void)elapsed;
+    struct wetdem_sim* sim = ctx;
+    if (done == 5) {
+        sim->many->vw[3][0].x = NAN;
+        sim->many->vh[3].x = NAN;
+    }
+    return 0;
+}
+
+/* A NaN velocity stops the run at the next step as an infinite one does: the step's largest
+ * |v'|^2 is a max, which a NaN does not win (max(x, NaN) is x in one order and NaN in the
+ * other, and the threads' maxima meet in either order), so a NaN counts as infinite there.
+ * Before, the run went on with it and returned WETDEM_OK. On one thread and two. */
+static void test_many_nan_velocity_stops_the_run(void** state)
+{
+    (void)state;
+    for (int threads = 1; threads <= 2; threads++) {
+        struct wetdem_sim* sim = wet_box(150, false);
+        struct wetdem_many_settings s = box_settings();
+        s.progress = inject_nan;
+        s.progress_ctx = sim;
+        s.progress_every = 5; /* (steps 6-9 read no state: only the kick's max can stop at 6) */
+        CHECK_OK(wetdem_sim_set_many(sim, &s));
+        sim->many->parallel_min = threads == 2 ? 1 : 100000; /* (the parallel max, or none) */
+        CHECK_STATUS(wetdem_sim_integrate(sim, 4e-5), WETDEM_ERR_NUMERIC);
+        CHECK_CONTAINS(wetdem_sim_errmsg(sim), "many: the motion diverged in step 6 ");
+        CHECK_CONTAINS(wetdem_sim_errmsg(sim), "particle 3 ");
+        wetdem_sim_free(sim);
+    }
+}
+
 static void test_many_reach_bound_is_enforced(void** state)
 {
     (void)state;
@@ -1412,6 +1447,7 @@ int main(void)
         cmocka_unit_test(test_many_step_resolves_hmin),
         cmocka_unit_test(test_many_step_resolves_the_tangential_spring),
         cmocka_unit_test(test_many_divergence_stops_the_run),
+        cmocka_unit_test(test_many_nan_velocity_stops_the_run),
         cmocka_unit_test(test_many_reach_bound_is_enforced),
         cmocka_unit_test(test_many_speed_record_lives_to_reset_ratio_r_star),
         cmocka_unit_test(test_many_agglomerates_by_union_find),

@@ -440,26 +440,6 @@ static pid_t spawn_cli(const char* args)
     return pid;
 }
 
-/* Whether signal sig is pending for process pid, not yet delivered (/proc/PID/status: SigPnd
- * for the thread, ShdPnd for the process). */
-static bool signal_pending(pid_t pid, int sig)
-{
-    char path[64], line[256];
-    snprintf(path, sizeof path, "/proc/%d/status", (int)pid);
-    FILE* f = fopen(path, "r");
-    bool pending = false;
-    while (f && fgets(line, sizeof line, f)) {
-        unsigned long long mask;
-        if ((sscanf(line, "SigPnd: %llx", &mask) == 1 ||
-             sscanf(line, "ShdPnd: %llx", &mask) == 1) &&
-            (mask >> (sig - 1)) & 1u)
-            pending = true;
-    }
-    if (f)
-        fclose(f);
-    return pending;
-}
-
 /* Starts `args`, waits until it is stepping (5 rows in tmpdir/csv), then sends it `count`
  * SIGINTs back to back, each as soon as the one before has been delivered (two sent while
  * neither is delivered would merge into one). Returns its wait status. */
@@ -470,7 +450,7 @@ static int interrupt_cli(const char* args, const char* csv, int count)
     for (int k = 0; k < 60000 && csv_rows(tpath(csv)) < 5; k++)
         nanosleep(&nap, NULL);
     for (int n = 0; n < count; n++) {
-        for (int k = 0; n > 0 && k < 50000 && signal_pending(pid, SIGINT); k++)
+        for (int k = 0; n > 0 && k < 50000 && test_signal_pending(pid, SIGINT); k++)
             nanosleep(&blink, NULL);
         kill(pid, SIGINT);
     }

@@ -1,0 +1,92 @@
+/*
+ * signals.c — the CLI's handler of SIGINT and SIGTERM (signals.h): stop cleanly on the first
+ * signal, take a repeat within CLI_SIGNAL_GRACE_S as the same request, stop at once on a later
+ * one or a third.
+ */
+#include "signals.h"
+
+#include <stdatomic.h>
+#include <stdio.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+volatile sig_atomic_t cli_stop_signal = 0;
+
+static atomic_int signal_count;
+static atomic_llong first_signal_ns; /* CLOCK_MONOTONIC of the first signal; 0: not stored yet */
+/* Set before the handlers are installed (the handler reads them only) */
+static char notice_text[2400], stop_text[400];
+static char remove_path[2100];
+
+_Static_assert(ATOMIC_INT_LOCK_FREE == 2 && ATOMIC_LLONG_LOCK_FREE == 2,
+               "the signal handler needs lock-free atomics");
+
+static void say(const char* text)
+{
+    ssize_t unused = write(STDERR_FILENO, text, strlen(text));
+    (void)unused;
+}
+
+static long long monotonic_ns(void)
+{
+    struct timespec now;
+    clock_gettime(CLOCK_MONOTONIC, &now);
+    return (long long)now.tv_sec * 1000000000LL + now.tv_nsec;
+}
+
+static void on_signal(int sig)
+{
+    long long now = monotonic_ns();
+    int before = atomic_fetch_add(&signal_count, 1);
+    if (before == 0) {
+        atomic_store(&first_signal_ns, now > 0 ? now : 1);
+        cli_stop_signal = sig;
+        say(notice_text);
+        return;
+    }
+    long long first = atomic_load(&first_signal_ns);
+    if (before == 1 && (first == 0 || (double)(now - first) < 1e9 * CLI_SIGNAL_GRACE_S))
+        return; /* the same request again (first == 0: both at once) */
+    say(stop_text);
+    if (remove_path[0])
+        unlink(remove_path);
+    /* die by the signal, as the caller asked: default action, raised again (delivered when
+       this handler returns) */
+    struct sigaction dfl = {.sa_handler = SIG_DFL};
+    sigemptyset(&dfl.sa_mask);
+    sigaction(sig, &dfl, NULL);
+    raise(sig);
+}
+
+/* Installs on_signal for sig unless sig is ignored; *saved receives the previous action. */
+static void install_one(int sig, struct sigaction* saved)
+{
+    sigaction(sig, NULL, saved);
+    if (saved->sa_handler == SIG_IGN)
+        return;
+    struct sigaction sa = {.sa_handler = on_signal};
+    sigemptyset(&sa.sa_mask);
+    sigaddset(&sa.sa_mask, SIGINT);
+    sigaddset(&sa.sa_mask, SIGTERM);
+    sigaction(sig, &sa, NULL);
+}
+
+void cli_signals_install(const char* notice, const char* stop_note, const char* remove_on_stop,
+                         struct cli_saved_signals* saved)
+{
+    cli_stop_signal = 0;
+    atomic_store(&signal_count, 0);
+    atomic_store(&first_signal_ns, 0);
+    snprintf(notice_text, sizeof notice_text, "%s", notice);
+    snprintf(stop_text, sizeof stop_text, "%s", stop_note);
+    snprintf(remove_path, sizeof remove_path, "%s", remove_on_stop ? remove_on_stop : "");
+    install_one(SIGINT, &saved->sigint);
+    install_one(SIGTERM, &saved->sigterm);
+}
+
+void cli_signals_restore(const struct cli_saved_signals* saved)
+{
+    sigaction(SIGINT, &saved->sigint, NULL);
+    sigaction(SIGTERM, &saved->sigterm, NULL);
+}
