@@ -194,43 +194,15 @@ static void series_resume(struct series* s, double t, unsigned long long step, d
 
 /* ----------------------------------------------------------- CSV: last row, restart --- */
 
-/* The step (second column) of the last data row of the CSV at path, read from the file's
- * tail. false when the file is missing or its tail holds no data row. */
-static bool csv_last_step(const char* path, unsigned long long* step)
-{
-    FILE* f = fopen(path, "rb");
-    if (!f)
-        return false;
-    char tail[8192];
-    long size = fseek(f, 0, SEEK_END) == 0 ? ftell(f) : -1;
-    long from = size > (long)sizeof tail - 1 ? size - (long)sizeof tail + 1 : 0;
-    size_t n = size >= 0 && fseek(f, from, SEEK_SET) == 0 ? fread(tail, 1, sizeof tail - 1, f) : 0;
-    fclose(f);
-    tail[n] = '\0';
-    bool found = false;
-    for (char* line = tail; line && *line;
-         line = strchr(line, '\n') ? strchr(line, '\n') + 1 : NULL) {
-        const char* comma = strchr(line, ',');
-        bool whole = line != tail || from == 0; /* the first line of a tail may be cut */
-        if (whole && line[0] >= '0' && line[0] <= '9' && comma) {
-            *step = strtoull(comma + 1, NULL, 10);
-            found = true;
-        }
-    }
-    return found;
-}
-
 /* Appends the state at the end of the run (finished or interrupted) to the CSV as its last
  * row (wetdem_sim_many_write_csv_row), unless the library's rows, every csv_every steps, ended
  * there, so the CSV ends at the state summary.json reports. WETDEM status. */
-static int csv_final_row(const char* csv_prefix, struct wetdem_sim* sim)
+static int csv_final_row(const char* csv_prefix, unsigned long long csv_every,
+                         struct wetdem_sim* sim)
 {
     struct wetdem_many_stats s;
-    char path[PATH_CHARS + 8];
-    snprintf(path, sizeof path, "%s.csv", csv_prefix);
-    unsigned long long last;
-    if (!csv_prefix[0] || wetdem_sim_many_stats(sim, &s) != WETDEM_OK ||
-        !csv_last_step(path, &last) || last >= s.step)
+    if (!csv_prefix[0] || !csv_every || wetdem_sim_many_stats(sim, &s) != WETDEM_OK ||
+        s.step % csv_every == 0)
         return WETDEM_OK;
     return wetdem_sim_many_write_csv_row(sim);
 }
@@ -744,7 +716,7 @@ static int finish(const struct cli_scenario* sc, struct cli_many_setup* su,
         cli_error("run %s: %s (%s)", sc->file, wetdem_sim_errmsg(su->sim), wetdem_status_name(st));
         return CLI_EXIT_RUNTIME;
     }
-    if (csv_final_row(pl->csv_prefix, su->sim) != WETDEM_OK) {
+    if (csv_final_row(pl->csv_prefix, su->csv_every, su->sim) != WETDEM_OK) {
         cli_error("run %s: cannot append the last row to %s.csv", sc->file, pl->csv_prefix);
         return CLI_EXIT_RUNTIME;
     }

@@ -290,9 +290,15 @@ double wetdem_event_smallest_branch_gap(const struct wetdem_sim* sim)
     for (size_t q = 0; q < e->n_slots; q++) {
         if (e->slots[q].source != WETDEM_EVENT_SOURCE_MODEL)
             continue;
-        double h_k = e->pair_gap[e->slots[q].pair] - e->g_prev[q];
-        if (h_k > 0.0)
-            h_min = fmin(h_min, h_k);
+        size_t p = e->slots[q].pair;
+        double h_k = e->pair_gap[p] - e->g_prev[q];
+        if (!(h_k > 0.0 && h_k < h_min))
+            continue;
+        struct wetdem_contact c;
+        double range, scratch[64];
+        pair_state(sim, p, &c, &range, scratch);
+        if (wetdem_sim_laws_jump_at(sim, &c, scratch, h_k))
+            h_min = h_k;
     }
     return h_min;
 }

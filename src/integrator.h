@@ -68,9 +68,10 @@ void wetdem_event_values(struct wetdem_sim* sim, double* g);
  * as having interacted when its range is entered. Returns WETDEM_OK or WETDEM_ERR_NOMEM. */
 int wetdem_event_record(struct wetdem_sim* sim, size_t k, int dir, double t, double gap,
                         double v_n);
-/* Smallest threshold 0 < h_k < range of the force laws' branch boundaries (h_min and the
- * like) over every pair at the latest evaluation of the event functions (engine.g_prev
- * after wetdem_event_values at the start of a run) [m]; INFINITY when there is none. */
+/* Smallest threshold 0 < h_k < range of the force laws' branch boundaries where the laws
+ * jump (wetdem_sim_laws_jump_at: h_min of below_hmin = c; not nijssen's continuous blend)
+ * over every pair at the latest evaluation of the event functions (engine.g_prev after
+ * wetdem_event_values at the start of a run) [m]; INFINITY when there is none. */
 double wetdem_event_smallest_branch_gap(const struct wetdem_sim* sim);
 /* Verlet-style detection between two evaluated states: for every sign change of g from
  * g_prev to g_new over the step [t0, t0 + h], interpolates the crossing time and the pair's

@@ -20,9 +20,9 @@
  * add over the pair's gap, floored by sim.speed_floor. dt is fixed for one
  * wetdem_sim_integrate() call; long runs with changing speeds are integrated in chunks.
  * With verlet.hmin_fraction > 0 the step is also held at or below hmin_fraction x h_min / v,
- * h_min the smallest branch gap of the force laws inside their range at the start (the
- * thin-film and lubrication laws switch there, docs/engines.md "Steps and h_min") and v that
- * speed scale. Without pairs the run is one step (exact for free flight and constant force).
+ * h_min the smallest gap inside their range at the start where the force laws jump (the
+ * thin-film laws with below_hmin = c switch off there, docs/engines.md "Steps and h_min"; a
+ * law continuous there, as nijssen's blend, sets no bound) and v that speed scale. Without pairs the run is one step (exact for free flight and constant force).
  * The last step is shortened to land on t_end.
  *
  * Pair histories are committed at every step (c->dt = dt). Events: the event functions are
@@ -60,8 +60,9 @@ static const struct wetdem_param_desc verlet_params_desc[] = {
      1.0, 1e12, false, false, NULL, true},
     {"hmin_fraction", "-",
      "When > 0, the step is also held at or below hmin_fraction x h_min / v (h_min: the "
-     "smallest branch gap of the force laws inside their range, v: the speed scale), so that "
-     "the gap moves at most that fraction of h_min per step; 0: off (dt_fraction alone).",
+     "smallest gap inside the range of the force laws where they jump, v: the speed scale), "
+     "so that the gap moves at most that fraction of h_min per step; 0: off (dt_fraction "
+     "alone).",
      P(hmin_fraction), 0.0, 0.0, 1.0, false, false, NULL, false},
     {"many_hmin_fraction", "-",
      "Many-particle mode: the derived step is held at or below many_hmin_fraction x h_min / v "
