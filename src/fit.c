@@ -591,8 +591,8 @@ int wetdem_fit_run(const struct wetdem_fit_problem* problem, const struct wetdem
         gsl_vector_set(x0, j, c.q_jac[j]);
     }
     st = solve(&c, opt, x0, w, result);
-    result->model_evals = c.evals;
     st = report(&c, st, cov, opt, result, predicted, msg, msg_size);
+    result->model_evals = c.evals; /* (report's own evaluation at the solution included) */
 done:
     gsl_multifit_nlinear_free(w);
     gsl_matrix_free(cov);
