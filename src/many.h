@@ -201,6 +201,10 @@ struct wetdem_many {
        of `reach` and the largest record range of a sphere and a wall, so that no pair or wall
        with a live record leaves the lists. Without it, cl.reach = wall_reach = reach. [m] */
     bool record;
+    /* record and the min-separation model one of wetdem's own (ehd, max, glass), which read of
+       a contact only its gap, R*, v_n and mixed properties: a pair beyond the force range may
+       then be given that part of its contact alone (sim_many_force.c, record_only) */
+    bool record_partial;
     double wall_reach;
     double dt;              /* time step [s], fixed once the many run starts */
     double relaxation_time; /* shortest viscous relaxation time at the start [s] (choose_dt),

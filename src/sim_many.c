@@ -743,7 +743,10 @@ int wetdem_sim_many_prepare(struct wetdem_sim* sim)
     }
     bool refresh = fresh_set || !m->kernel_ready;
     if (refresh) {
-        m->record = sim->minsep.model->record_range != NULL; /* (the model may have changed) */
+        const struct wetdem_model* ms = sim->minsep.model; /* (the model may have changed) */
+        m->record = ms->record_range != NULL;
+        m->record_partial = m->record && (ms == &wetdem_minsep_ehd || ms == &wetdem_minsep_max ||
+                                          ms == &wetdem_minsep_glass);
         int st = wetdem_sim_many_setup_kernel(sim);
         if (st != WETDEM_OK)
             return st;

@@ -804,8 +804,9 @@ static int eval_pair(const struct wetdem_sim* sim, struct wetdem_contact* c,
     return WETDEM_OK;
 }
 
-/* Pair q = (i, j) within the cheap test's reach (d = x_i - x_j) with a min-separation record
- * and the fused kernel, whose range is the table's: when it lies beyond that range, its record
+/* Pair q = (i, j) within the cheap test's reach (d = x_i - x_j) with a record of one of
+ * wetdem's own min-separation models (record_partial) and the fused kernel, whose range is the
+ * table's: when it lies beyond that range, its record
  * (record_beyond_range) from only the part of the contact the min-separation model reads,
  * computed as contact_pair_geometry does (the same bits), and true; else false (eval_pair
  * then runs: its range check included). Most of these pairs are only within the record
@@ -838,7 +839,7 @@ static void eval_near_pair(const struct wetdem_sim* sim, size_t q, struct wetdem
 {
     const struct wetdem_many* m = sim->many;
     size_t i = m->cl.pairs[q].i, j = m->cl.pairs[q].j, len = sim->history_len;
-    if (m->record && m->fused && len && record_only(sim, q, d, x, fail))
+    if (m->record_partial && m->fused && len && record_only(sim, q, d, x, fail))
         return;
     struct wetdem_contact c;
     struct wetdem_particle a = wetdem_many_particle(sim, i), b = wetdem_many_particle(sim, j);

@@ -403,6 +403,61 @@ static void test_many_record_beyond_the_films_equals_generic(void** state)
         wetdem_sim_free(sims[k]);
 }
 
+/* A min-separation model of the user's own that keeps a record out to R* and reads the
+ * reduced mass, which the partial contact of the fused kernel's record_only does not fill: the
+ * largest approach momentum m* v_n of the encounter; h_min 1 um. */
+static double momentum_min_separation(const void* params, const struct wetdem_contact* c,
+                                      double* history)
+{
+    (void)params;
+    double p = c->m_eff * c->v_n;
+    history[0] = p > history[0] ? p : history[0];
+    return 1e-6;
+}
+
+static double momentum_record_range(const void* params, const struct wetdem_contact* c)
+{
+    (void)params;
+    return c->r_eff;
+}
+
+static const struct wetdem_param_desc no_params[] = {{0}};
+
+static const struct wetdem_model momentum_model = {
+    .name = "test_momentum",
+    .kind = WETDEM_MODEL_MIN_SEPARATION,
+    .summary = "h_min 1 um, a record of the largest m* v_n out to R*",
+    .doc = "",
+    .equations = "",
+    .params = no_params,
+    .history_len = 1,
+    .min_separation = momentum_min_separation,
+    .record_range = momentum_record_range,
+};
+
+/* With a min-separation model of the user's that keeps a record beyond the force range, the
+ * fused kernel gives a pair there its whole contact, as the generic path does: the runs end
+ * bit-identical, histories included (the part of the contact that suffices for wetdem's own
+ * models left m* at 0, and with it this record). */
+static void test_many_user_record_equals_generic(void** state)
+{
+    (void)state;
+    struct wetdem_sim* sims[2];
+    for (int k = 0; k < 2; k++) {
+        sims[k] = wet_gas(k == 1, false);
+        CHECK_OK(wetdem_sim_add_model(sims[k], &momentum_model, NULL));
+        CHECK_OK(wetdem_sim_integrate(sims[k], 0.6e-3));
+    }
+    const struct wetdem_many *a = sims[0]->many, *b = sims[1]->many;
+    assert_true(a->fused && a->record && !a->record_partial && !b->fused);
+    test_check_same_particles(sims[0], sims[1]);
+    assert_int_equal(a->cl.n_pairs, b->cl.n_pairs);
+    size_t len = sims[0]->history_len;
+    assert_memory_equal(a->history, b->history, a->cl.n_pairs * len * sizeof(double));
+    for (int k = 0; k < 2; k++)
+        wetdem_sim_free(sims[k]);
+}
+
 /* Runs the lean and the generic simulation to time t, checks that the first ran the lean
  * kernel and the second not, and that they end bit-identical; returns the lean run's stats. */
 static struct wetdem_many_stats lean_equals_generic(struct wetdem_sim* lean,
@@ -954,6 +1009,7 @@ int main(void)
         cmocka_unit_test(test_many_unfused_set_uses_generic_path),
         cmocka_unit_test(test_many_fused_run_equals_generic_run),
         cmocka_unit_test(test_many_record_beyond_the_films_equals_generic),
+        cmocka_unit_test(test_many_user_record_equals_generic),
         cmocka_unit_test(test_many_lean_run_any_model_order),
         cmocka_unit_test(test_many_lean_springs_across_rebuilds),
         cmocka_unit_test(test_many_lean_constants_follow_changed_particles),
