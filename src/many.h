@@ -60,11 +60,12 @@ struct wetdem_many_pair_out {
 /* Most threads (blocks) of the force pass. */
 #define WETDEM_MANY_MAX_BLOCKS 256
 
-#define WETDEM_MANY_ACTIVE 1u /* within the interaction range: force applied */
-/* The two below are the force pass's own marks of the geometry (the kernel tests compare
- * them); the contacts and bridges reported are the models' (wetdem_sim_many_links). */
-#define WETDEM_MANY_CONTACT 2u /* gap < 0: solid overlap */
-#define WETDEM_MANY_BRIDGE 4u  /* gap < film delta_ij > 0 */
+/* The flags of a candidate pair, what the force pass itself reads of its latest evaluation;
+ * the contacts and bridges reported are the models' (wetdem_sim_many_links), worked out from
+ * the state when they are reported. (4 is free: it marked gap < film, which only the reports
+ * read before they followed the models.) */
+#define WETDEM_MANY_ACTIVE 1u  /* within the interaction range: force applied */
+#define WETDEM_MANY_CONTACT 2u /* gap < 0: solid overlap (the pair's torques and spring) */
 #define WETDEM_MANY_DIRTY 8u   /* history may differ from a fresh one (reset when out of range) */
 #define WETDEM_MANY_SPRING                                                                         \
     16u /* its tangential spring may be non-zero: set in solid contact,
@@ -226,7 +227,7 @@ struct wetdem_many {
     struct wetdem_celllist_pair* old_pairs; /* previous list, for history remapping */
     double* old_history;
     size_t old_cap, old_history_cap;
-    unsigned char* flags; /* per candidate pair: MANY_ACTIVE | _CONTACT | _BRIDGE | _DIRTY
+    unsigned char* flags; /* per candidate pair: MANY_ACTIVE | _CONTACT | _DIRTY | _SPRING
                                     (a separate byte array: the gather scans it densely) */
     size_t flags_cap;
     /* constants of each candidate pair, computed once per list build and kernel set-up (the

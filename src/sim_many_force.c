@@ -455,8 +455,7 @@ lean_force(const struct wetdem_many* m, const struct lean_geometry* g,
     if (terms)
         *terms = (struct lean_terms){{term[0], term[1], term[2]}, f_tan, t_i, t_j, n};
     *flags = WETDEM_MANY_ACTIVE | WETDEM_MANY_DIRTY |
-             (gap < 0 ? WETDEM_MANY_CONTACT | WETDEM_MANY_SPRING : 0) |
-             (x->film > 0 && gap < x->film ? WETDEM_MANY_BRIDGE : 0);
+             (gap < 0 ? WETDEM_MANY_CONTACT | WETDEM_MANY_SPRING : 0);
     if (!(isfinite(f_n) && vec3_is_finite(o->force) && vec3_is_finite(t_i) && vec3_is_finite(t_j)))
         return WETDEM_ERR_NUMERIC;
     return WETDEM_OK;
@@ -478,14 +477,12 @@ reset_spring_apart(const struct wetdem_many_lean* L, unsigned char was, double* 
  * the force; the torques are zero (left unset: the callers add none, see adds_torque). The
  * force is finite when f_n is (|n| = 1). */
 static inline __attribute__((always_inline)) int
-apart_result(const struct wetdem_many_lean* L, const struct wetdem_many_mix* x, double gap,
-             double f_n, struct wetdem_vec3 force, unsigned char was, double* hist,
-             unsigned char* flags, struct wetdem_many_pair_out* o)
+apart_result(const struct wetdem_many_lean* L, double f_n, struct wetdem_vec3 force,
+             unsigned char was, double* hist, unsigned char* flags, struct wetdem_many_pair_out* o)
 {
     reset_spring_apart(L, was, hist);
     o->force = force;
-    *flags = WETDEM_MANY_ACTIVE | WETDEM_MANY_DIRTY |
-             (x->film > 0 && gap < x->film ? WETDEM_MANY_BRIDGE : 0);
+    *flags = WETDEM_MANY_ACTIVE | WETDEM_MANY_DIRTY;
     return isfinite(f_n) ? WETDEM_OK : WETDEM_ERR_NUMERIC;
 }
 
@@ -502,7 +499,7 @@ lean_apart(const struct wetdem_many_lean* L, const struct wetdem_many_mix* x, st
     if (terms)
         *terms = (struct lean_terms){.term = {0.0, term[1], term[2]}, .n = n};
     double f_n = 0.0 + term[1] + term[2];
-    return apart_result(L, x, gap, f_n, vec3_axpy(vec3(0, 0, 0), f_n, n), was, hist, flags, o);
+    return apart_result(L, f_n, vec3_axpy(vec3(0, 0, 0), f_n, n), was, hist, flags, o);
 }
 
 /* The start of pair (ia, ib)'s geometry with d = x_a - x_b (minimum image), from the engine
@@ -575,7 +572,7 @@ lean_pair(const struct wetdem_many* m, size_t ia, size_t ib, struct wetdem_vec3 
         if (!(gap < 0.0)) {
             if (terms)
                 *terms = (struct lean_terms){.term = {0.0, bo->f_sb[k], bo->f_cap[k]}, .n = n};
-            return apart_result(&m->lean, x, gap, (0.0 + bo->f_sb[k]) + bo->f_cap[k],
+            return apart_result(&m->lean, (0.0 + bo->f_sb[k]) + bo->f_cap[k],
                                 vec3(bo->force[0][k], bo->force[1][k], bo->force[2][k]), was, hist,
                                 flags, o);
         }
@@ -794,8 +791,7 @@ static int eval_pair(const struct wetdem_sim* sim, struct wetdem_contact* c,
     out->torque_i = f.torque_i;
     out->torque_j = f.torque_j;
     *flags = WETDEM_MANY_ACTIVE | WETDEM_MANY_DIRTY |
-             (c->gap < 0 ? WETDEM_MANY_CONTACT | WETDEM_MANY_SPRING : 0) |
-             (c->film > 0 && c->gap < c->film ? WETDEM_MANY_BRIDGE : 0);
+             (c->gap < 0 ? WETDEM_MANY_CONTACT | WETDEM_MANY_SPRING : 0);
     if (!(isfinite(f.f_normal) && vec3_is_finite(out->force) && vec3_is_finite(f.torque_i) &&
           vec3_is_finite(f.torque_j)))
         return WETDEM_ERR_NUMERIC;
