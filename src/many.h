@@ -60,11 +60,12 @@ struct wetdem_many_pair_out {
 /* Most threads (blocks) of the force pass. */
 #define WETDEM_MANY_MAX_BLOCKS 256
 
-#define WETDEM_MANY_ACTIVE 1u /* within the interaction range: force applied */
-/* The two below are the force pass's own marks of the geometry (the kernel tests compare
- * them); the contacts and bridges reported are the models' (wetdem_sim_many_links). */
-#define WETDEM_MANY_CONTACT 2u /* gap < 0: solid overlap */
-#define WETDEM_MANY_BRIDGE 4u  /* gap < film delta_ij > 0 */
+/* The flags of a candidate pair, what the force pass itself reads of its latest evaluation;
+ * the contacts and bridges reported are the models' (wetdem_sim_many_links), worked out from
+ * the state when they are reported. (4 is free: it marked gap < film, which only the reports
+ * read before they followed the models.) */
+#define WETDEM_MANY_ACTIVE 1u  /* within the interaction range: force applied */
+#define WETDEM_MANY_CONTACT 2u /* gap < 0: solid overlap (the pair's torques and spring) */
 #define WETDEM_MANY_DIRTY 8u   /* history may differ from a fresh one (reset when out of range) */
 #define WETDEM_MANY_SPRING                                                                         \
     16u /* its tangential spring may be non-zero: set in solid contact,
@@ -226,7 +227,7 @@ struct wetdem_many {
     struct wetdem_celllist_pair* old_pairs; /* previous list, for history remapping */
     double* old_history;
     size_t old_cap, old_history_cap;
-    unsigned char* flags; /* per candidate pair: MANY_ACTIVE | _CONTACT | _BRIDGE | _DIRTY
+    unsigned char* flags; /* per candidate pair: MANY_ACTIVE | _CONTACT | _DIRTY | _SPRING
                                     (a separate byte array: the gather scans it densely) */
     size_t flags_cap;
     /* constants of each candidate pair, computed once per list build and kernel set-up (the
@@ -312,7 +313,7 @@ struct wetdem_many {
     size_t n_wall_entries, wall_entry_part_cap, wall_entry_wall_cap;
     bool kick_pending;      /* the latest step's closing half kick is still to be applied
                                     (sim_many.c one_step); never true outside a run */
-    size_t sums_zeroed;     /* the kick-drift pass set force, torque and contacts of this many
+    size_t sums_zeroed;     /* the kick-drift pass set force and torque of this many
                                     particles to zero (0: not); the next force pass then starts
                                     only the sums of the particles with walls */
     double disp_bound;      /* upper bound of the largest displacement since the build [m]
@@ -377,9 +378,6 @@ struct wetdem_many {
     unsigned char kind[WETDEM_MAX_MODELS]; /* fused kernel of model k */
     double kind_opt[WETDEM_MAX_MODELS];    /* its switch parameter (hertz damping form, ...) */
     struct wetdem_vec3 *force, *torque, *vh, *wh; /* per particle */
-    uint32_t* contacts; /* per particle: solid overlaps (WETDEM_MANY_CONTACT) at the latest
-                           evaluation, kept in checkpoints; the counts reported are the
-                           models' (wetdem_sim_many_links) */
     /* The engine state of a run: per particle, position and radius (xr, also what the gap
        tests read) and velocity and spin (vw; the predicted v' + a dt/2 during a force pass).
        Loaded from the particle records when a call starts (wetdem_sim_many_prepare), and
@@ -454,7 +452,7 @@ static inline void wetdem_many_close_kick(struct wetdem_many* m, size_t k, struc
 /* sim_many.c */
 /* wetdem_sim_many_free and wetdem_sim_many_integrate: sim.h. */
 /* Closing half kick of the deferred step, half kick and drift of particles lo .. hi - 1, their
- * force, torque and contacts zeroed for the next pass (the kick-drift pass's arithmetic);
+ * force and torque zeroed for the next pass (the kick-drift pass's arithmetic);
  * returns their largest |v'|^2. */
 double wetdem_sim_many_drift_range(struct wetdem_sim* sim, size_t lo, size_t hi);
 /* Kinetic (translational + rotational) and gravitational potential energy at the current
@@ -493,7 +491,7 @@ enum wetdem_many_end {
     WETDEM_MANY_END_STEP  /* the closing half kick, the next step's half kick and its drift
                              (wetdem_sim_many_drift_range), block by block */
 };
-/* Forces, torques and contact counts of every particle at the current state, histories
+/* Forces and torques of every particle at the current state, histories
  * committed, then `end` for each particle. */
 int wetdem_sim_many_forces(struct wetdem_sim* sim, enum wetdem_many_end end);
 

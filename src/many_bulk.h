@@ -134,9 +134,9 @@ static inline __attribute__((always_inline)) void bulk_minimum_image(wetdem_v4d*
 /* The constants of a call, in every lane. */
 struct bulk_constants {
     wetdem_v4d zero, one, film, h_min, range, sb_coef, cap_coef, tension;
-    /* the film models that act at all (the same for every pair of the pass), the "nc"
-       treatment of sb, and whether gaps below the film are bridges */
-    wetdem_v4i sb_on, nc, cap_on, bridge_on;
+    /* the film models that act at all (the same for every pair of the pass) and the "nc"
+       treatment of sb */
+    wetdem_v4i sb_on, nc, cap_on;
 };
 
 /* The film models of a call, when known at compile time: BULK_BOTH, sb and capillary act within
@@ -179,10 +179,9 @@ bulk_four(const struct wetdem_many_bulk_in* in, const struct bulk_constants* C,
           bool tail, enum bulk_films films, bool periodic, uint32_t* at, size_t* n_at)
 {
     bool dry = films == BULK_DRY;
-    const wetdem_v4i bridge_on = films == BULK_BOTH ? (wetdem_v4i){-1, -1, -1, -1} : C->bridge_on;
     const struct wetdem_celllist_item* xr = in->xr;
     const struct wetdem_vec3(*vw)[2] = in->vw;
-    const wetdem_v4d zero = C->zero, one = C->one, film = C->film;
+    const wetdem_v4d zero = C->zero, one = C->one;
     uint32_t q[4], i[4], j[4];
     wetdem_v4i own; /* all ones in the lanes of this thread's pairs (and, with tail, before n) */
     BULK_UNROLL
@@ -268,11 +267,10 @@ bulk_four(const struct wetdem_many_bulk_in* in, const struct bulk_constants* C,
     }
     wetdem_v4d f_n = (zero + f_sb) + f_cap;
     /* the class: 0 beyond the gap test's reach, else the flags of a pair apart within its range
-       with a finite force (odd, >= 9), else 1 (the scalar kernel decides) */
+       with a finite force (ACTIVE | DIRTY, 9), else 1 (the scalar kernel decides) */
     wetdem_v4i near = r2 <= lim2;
     wetdem_v4i fast = ~(gap < zero) & ~(gap > C->range) & ((f_n - f_n) == zero);
-    wetdem_v4i apart_flags =
-        (WETDEM_MANY_ACTIVE | WETDEM_MANY_DIRTY) | (bridge_on & (gap < film) & WETDEM_MANY_BRIDGE);
+    const long long apart_flags = WETDEM_MANY_ACTIVE | WETDEM_MANY_DIRTY;
     *(wetdem_v4i*)&out->cls[k] = near & ((fast & (apart_flags - 1)) | 1);
     /* this thread's lanes in solid contact (class 1 with gap < 0) onto the list for
        bulk_contacts, without a branch */
@@ -485,14 +483,13 @@ bulk_contacts(const struct wetdem_many_bulk_in* in, const struct bulk_constants*
         }
     }
     bulk_lean_force(in, C, &L, false);
-    wetdem_v4i flags =
-        (WETDEM_MANY_ACTIVE | WETDEM_MANY_DIRTY | WETDEM_MANY_CONTACT | WETDEM_MANY_SPRING) |
-        (C->bridge_on & (L.gap < C->film) & WETDEM_MANY_BRIDGE);
+    const long long flags =
+        WETDEM_MANY_ACTIVE | WETDEM_MANY_DIRTY | WETDEM_MANY_CONTACT | WETDEM_MANY_SPRING;
     for (int l = 0; l < 4; l++) {
         if (!L.finite[l])
             continue; /* the scalar kernel evaluates it again, from the unchanged spring */
         size_t k = at[l];
-        out->cls[k] = flags[l];
+        out->cls[k] = flags;
         for (int c = 0; c < 3; c++) {
             out->force[c][k] = L.force[c][l];
             out->torque_i[c][k] = L.ti[c][l];
@@ -531,8 +528,7 @@ bulk_constants_of(const struct wetdem_many_bulk_in* in)
                                    .tension = BULK_SPLAT(in->surface_tension),
                                    .sb_on = BULK_UNIFORM(in->sb && in->film > 0),
                                    .nc = BULK_UNIFORM(in->sb_nc),
-                                   .cap_on = BULK_UNIFORM(in->capillary && in->film > 0),
-                                   .bridge_on = BULK_UNIFORM(in->film > 0)};
+                                   .cap_on = BULK_UNIFORM(in->capillary && in->film > 0)};
 }
 
 /* bulk_four over list[0..n), each kind of films in its own loop (its masks constants there),
@@ -665,9 +661,8 @@ bulk_walls_four(const struct wetdem_many_bulk_in* in, const struct bulk_constant
             L.finite &= BULK_FINITE(L.force[c]);
         }
     }
-    wetdem_v4i flags = (WETDEM_MANY_ACTIVE | WETDEM_MANY_DIRTY) |
-                       (BULK_UNIFORM(touching) & (WETDEM_MANY_CONTACT | WETDEM_MANY_SPRING)) |
-                       (C->bridge_on & (L.gap < C->film) & WETDEM_MANY_BRIDGE);
+    const long long flags = (WETDEM_MANY_ACTIVE | WETDEM_MANY_DIRTY) |
+                            (touching ? WETDEM_MANY_CONTACT | WETDEM_MANY_SPRING : 0);
     wetdem_v4i cls = (L.finite & (flags - 1)) | 1;
     BULK_UNROLL
     for (int l = 0; l < 4; l++) { /* (lanes that repeat an entry store the same) */

@@ -104,7 +104,6 @@ void wetdem_sim_many_free(struct wetdem_sim* sim)
     free(m->torque);
     free(m->vh);
     free(m->wh);
-    free(m->contacts);
     free(m->xr);
     free(m->inv);
     free(m->m_eff);
@@ -471,17 +470,12 @@ static int size_particle_arrays(struct wetdem_sim* sim)
     struct {
         void** a;
         size_t size;
-    } arrays[] = {{(void**)&m->force, sizeof *m->force},
-                  {(void**)&m->torque, sizeof *m->torque},
-                  {(void**)&m->vh, sizeof *m->vh},
-                  {(void**)&m->wh, sizeof *m->wh},
-                  {(void**)&m->contacts, sizeof *m->contacts},
-                  {(void**)&m->xr, sizeof *m->xr},
-                  {(void**)&m->inv, sizeof *m->inv},
-                  {(void**)&m->m_eff, sizeof *m->m_eff},
-                  {(void**)&m->vw, sizeof *m->vw},
-                  {(void**)&m->fixed, sizeof *m->fixed},
-                  {(void**)&m->wall_dirty, sizeof *m->wall_dirty}};
+    } arrays[] = {
+        {(void**)&m->force, sizeof *m->force}, {(void**)&m->torque, sizeof *m->torque},
+        {(void**)&m->vh, sizeof *m->vh},       {(void**)&m->wh, sizeof *m->wh},
+        {(void**)&m->xr, sizeof *m->xr},       {(void**)&m->inv, sizeof *m->inv},
+        {(void**)&m->m_eff, sizeof *m->m_eff}, {(void**)&m->vw, sizeof *m->vw},
+        {(void**)&m->fixed, sizeof *m->fixed}, {(void**)&m->wall_dirty, sizeof *m->wall_dirty}};
     size_t c = cap;
     for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++) {
         c = cap;
@@ -847,9 +841,9 @@ kick_drift_one(const struct kick_arrays* A, const struct wetdem_celllist_box* bo
 }
 
 /* Particles lo .. hi - 1 of the engine's arrays: half kick and drift (kick_drift_one, after
- * the deferred closing half kick when `pending`) where not fixed, and force, torque and
- * contact count zeroed for the next force pass while their lines are in cache (that pass then
- * starts only the sums of the particles with walls); *v2_max as kick_drift_one's. */
+ * the deferred closing half kick when `pending`) where not fixed, and force and torque zeroed
+ * for the next force pass while their lines are in cache (that pass then starts only the sums
+ * of the particles with walls); *v2_max as kick_drift_one's. */
 static inline __attribute__((always_inline)) void kick_drift_range(struct wetdem_many* m, size_t lo,
                                                                    size_t hi, struct wetdem_vec3 g,
                                                                    bool pending, double* v2_max)
@@ -862,7 +856,6 @@ static inline __attribute__((always_inline)) void kick_drift_range(struct wetdem
                                        .xr = m->xr,
                                        .vw = m->vw};
     const unsigned char* fixed = m->fixed;
-    uint32_t* contacts = m->contacts;
     const struct wetdem_celllist_box* box = &m->cl.box;
     bool periodic = box->periodic[0] || box->periodic[1] || box->periodic[2];
     double h = m->dt, v2 = *v2_max;
@@ -871,7 +864,6 @@ static inline __attribute__((always_inline)) void kick_drift_range(struct wetdem
         if (!fixed[k])
             kick_drift_one(&A, box, k, g, h, periodic, pending, &v2);
         A.force[k] = A.torque[k] = vec3(0, 0, 0);
-        contacts[k] = 0;
     }
     *v2_max = v2;
 }

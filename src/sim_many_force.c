@@ -455,8 +455,7 @@ lean_force(const struct wetdem_many* m, const struct lean_geometry* g,
     if (terms)
         *terms = (struct lean_terms){{term[0], term[1], term[2]}, f_tan, t_i, t_j, n};
     *flags = WETDEM_MANY_ACTIVE | WETDEM_MANY_DIRTY |
-             (gap < 0 ? WETDEM_MANY_CONTACT | WETDEM_MANY_SPRING : 0) |
-             (x->film > 0 && gap < x->film ? WETDEM_MANY_BRIDGE : 0);
+             (gap < 0 ? WETDEM_MANY_CONTACT | WETDEM_MANY_SPRING : 0);
     if (!(isfinite(f_n) && vec3_is_finite(o->force) && vec3_is_finite(t_i) && vec3_is_finite(t_j)))
         return WETDEM_ERR_NUMERIC;
     return WETDEM_OK;
@@ -478,14 +477,12 @@ reset_spring_apart(const struct wetdem_many_lean* L, unsigned char was, double* 
  * the force; the torques are zero (left unset: the callers add none, see adds_torque). The
  * force is finite when f_n is (|n| = 1). */
 static inline __attribute__((always_inline)) int
-apart_result(const struct wetdem_many_lean* L, const struct wetdem_many_mix* x, double gap,
-             double f_n, struct wetdem_vec3 force, unsigned char was, double* hist,
-             unsigned char* flags, struct wetdem_many_pair_out* o)
+apart_result(const struct wetdem_many_lean* L, double f_n, struct wetdem_vec3 force,
+             unsigned char was, double* hist, unsigned char* flags, struct wetdem_many_pair_out* o)
 {
     reset_spring_apart(L, was, hist);
     o->force = force;
-    *flags = WETDEM_MANY_ACTIVE | WETDEM_MANY_DIRTY |
-             (x->film > 0 && gap < x->film ? WETDEM_MANY_BRIDGE : 0);
+    *flags = WETDEM_MANY_ACTIVE | WETDEM_MANY_DIRTY;
     return isfinite(f_n) ? WETDEM_OK : WETDEM_ERR_NUMERIC;
 }
 
@@ -502,7 +499,7 @@ lean_apart(const struct wetdem_many_lean* L, const struct wetdem_many_mix* x, st
     if (terms)
         *terms = (struct lean_terms){.term = {0.0, term[1], term[2]}, .n = n};
     double f_n = 0.0 + term[1] + term[2];
-    return apart_result(L, x, gap, f_n, vec3_axpy(vec3(0, 0, 0), f_n, n), was, hist, flags, o);
+    return apart_result(L, f_n, vec3_axpy(vec3(0, 0, 0), f_n, n), was, hist, flags, o);
 }
 
 /* The start of pair (ia, ib)'s geometry with d = x_a - x_b (minimum image), from the engine
@@ -575,7 +572,7 @@ lean_pair(const struct wetdem_many* m, size_t ia, size_t ib, struct wetdem_vec3 
         if (!(gap < 0.0)) {
             if (terms)
                 *terms = (struct lean_terms){.term = {0.0, bo->f_sb[k], bo->f_cap[k]}, .n = n};
-            return apart_result(&m->lean, x, gap, (0.0 + bo->f_sb[k]) + bo->f_cap[k],
+            return apart_result(&m->lean, (0.0 + bo->f_sb[k]) + bo->f_cap[k],
                                 vec3(bo->force[0][k], bo->force[1][k], bo->force[2][k]), was, hist,
                                 flags, o);
         }
@@ -794,8 +791,7 @@ static int eval_pair(const struct wetdem_sim* sim, struct wetdem_contact* c,
     out->torque_i = f.torque_i;
     out->torque_j = f.torque_j;
     *flags = WETDEM_MANY_ACTIVE | WETDEM_MANY_DIRTY |
-             (c->gap < 0 ? WETDEM_MANY_CONTACT | WETDEM_MANY_SPRING : 0) |
-             (c->film > 0 && c->gap < c->film ? WETDEM_MANY_BRIDGE : 0);
+             (c->gap < 0 ? WETDEM_MANY_CONTACT | WETDEM_MANY_SPRING : 0);
     if (!(isfinite(f.f_normal) && vec3_is_finite(out->force) && vec3_is_finite(f.torque_i) &&
           vec3_is_finite(f.torque_j)))
         return WETDEM_ERR_NUMERIC;
@@ -864,7 +860,6 @@ struct pass {
     /* the sums the pairs add to (m's: here so that a block's copy of the pass holds them, not
        loaded from m again after every byte store to flags) */
     struct wetdem_vec3 *force, *torque;
-    uint32_t* contacts;
     const double* lim2; /* pair_lim2 */
     float* skip_until;  /* many.h: the gap test's skip clock */
     double clock;       /* drift_clock */
@@ -1159,23 +1154,21 @@ static inline void set_wall_dirty(const struct wetdem_many* m, size_t i, size_t 
 }
 
 /* Particle i's pair with wall w evaluated with flags fl and output o: its dirty bit, and when
- * active its force, torque and contact into *f, *t, *n_contacts. */
+ * active its force and torque into *f, *t. */
 static inline void add_wall_result(const struct wetdem_many* m, size_t i, size_t w,
                                    unsigned char fl, const struct wetdem_many_pair_out* o,
-                                   struct wetdem_vec3* f, struct wetdem_vec3* t,
-                                   uint32_t* n_contacts)
+                                   struct wetdem_vec3* f, struct wetdem_vec3* t)
 {
     set_wall_dirty(m, i, w, fl);
     if (!(fl & WETDEM_MANY_ACTIVE))
         return;
     *f = vec3_add(*f, o->force);
     *t = vec3_add(*t, o->torque_i);
-    *n_contacts += (fl & WETDEM_MANY_CONTACT) ? 1 : 0;
 }
 
-/* Wall forces on particle i, added to *f, *t, *n_contacts in wall order. */
+/* Wall forces on particle i, added to *f, *t in wall order. */
 static void eval_walls_of(const struct wetdem_sim* sim, size_t i, struct wetdem_vec3* f,
-                          struct wetdem_vec3* t, uint32_t* n_contacts, struct failure* fail)
+                          struct wetdem_vec3* t, struct failure* fail)
 {
     const struct wetdem_many* m = sim->many;
     size_t len = sim->history_len, nw = sim->n_walls;
@@ -1197,7 +1190,7 @@ static void eval_walls_of(const struct wetdem_sim* sim, size_t i, struct wetdem_
         bool dirty = w >= 64 || (m->wall_dirty[i] >> w & 1);
         struct wetdem_many_pair_out o;
         unsigned char flags = eval_wall(sim, i, w, hist, dirty, &o, fail);
-        add_wall_result(m, i, w, flags, &o, f, t, n_contacts);
+        add_wall_result(m, i, w, flags, &o, f, t);
     }
 }
 
@@ -1505,9 +1498,8 @@ static void cross_pairs_share(const struct pass* P, size_t t, size_t nt, struct 
 }
 
 /* The running force and torque of a particle's listed pairs (or of its walls) in three pairs
- * of lanes, (f_x, f_y), (f_z, t_x), (t_y, t_z), each lane's addition the one of the vec3 sums
- * (its count of contacts goes to the total at once: an integer, the same in any order); the
- * sums restarted from +0 without a branch (running_add); and what a batch
+ * of lanes, (f_x, f_y), (f_z, t_x), (t_y, t_z), each lane's addition the one of the vec3 sums;
+ * the sums restarted from +0 without a branch (running_add); and what a batch
  * of four-at-a-time results keeps of each particle it reaches (consume_four_at_a_time): slot 0
  * the one carried from the batch before, slot s > 0 the s-th particle that begins in it. */
 typedef double lanes2 __attribute__((vector_size(16)));
@@ -1551,12 +1543,10 @@ static inline void start_sum(const struct wetdem_sim* sim, size_t k, bool walls,
 {
     struct wetdem_many* m = sim->many;
     struct wetdem_vec3 f = vec3(0, 0, 0), t = vec3(0, 0, 0);
-    uint32_t n_contacts = 0;
     if (walls)
-        eval_walls_of(sim, k, &f, &t, &n_contacts, fail);
+        eval_walls_of(sim, k, &f, &t, fail);
     m->force[k] = f;
     m->torque[k] = t;
-    m->contacts[k] = n_contacts;
 }
 
 /* The sums of the particles whose particle-wall pairs are the entries lo..hi of the flat list
@@ -1612,7 +1602,7 @@ static inline __attribute__((always_inline)) void start_sums_four_at_a_time_as(c
         if (n)
             P->bulk_walls(&P->bulk_in, part, wall, gap_of, n, &bo);
         struct running_sums r = {{0, 0}, {0, 0}, {0, 0}};
-        uint32_t prev = UINT32_MAX, n_contacts = 0;
+        uint32_t prev = UINT32_MAX;
         for (size_t e = 0; e < n; e++) {
             size_t i = part[e], w = wall[e];
             unsigned char flags = (unsigned char)bo.cls[e]; /* (within the range: never 0) */
@@ -1640,12 +1630,8 @@ static inline __attribute__((always_inline)) void start_sums_four_at_a_time_as(c
             bool fresh = i != prev;
             prev = (uint32_t)i;
             running_add(&r, fresh, ft);
-            n_contacts =
-                (fresh ? 0 : n_contacts) + ((flags & (WETDEM_MANY_ACTIVE | WETDEM_MANY_CONTACT)) ==
-                                            (WETDEM_MANY_ACTIVE | WETDEM_MANY_CONTACT));
             m->force[i] = running_force(&r);
             m->torque[i] = running_torque(&r);
-            m->contacts[i] = n_contacts;
         }
         s = s_end;
     }
@@ -1708,7 +1694,6 @@ static void start_sums_of_block(const struct pass* P, size_t b, struct failure* 
         m->force[k] = vec3_sub(m->force[k], m->cross_out[e].force);
         if (adds_torque(P->lean, fl))
             m->torque[k] = vec3_add(m->torque[k], m->cross_out[e].torque_j);
-        m->contacts[k] += (fl & WETDEM_MANY_CONTACT) ? 1 : 0;
     }
 }
 
@@ -1820,29 +1805,26 @@ beyond_reach(const struct pass* P, const struct pass* P_out, size_t q, double r2
 }
 
 /* Pair q = (i, j) of block b, with result o and flags fl: into particle i's running sums
- * (f, t, n_contacts), and its reaction at once into j's sums. */
+ * (f, t), and its reaction at once into j's sums. */
 static inline __attribute__((always_inline)) void
 add_pair(const struct pass* P, size_t j, unsigned char fl, const struct wetdem_many_pair_out* o,
-         struct wetdem_vec3* f, struct wetdem_vec3* t, uint32_t* n_contacts)
+         struct wetdem_vec3* f, struct wetdem_vec3* t)
 {
     if (!(fl & WETDEM_MANY_ACTIVE))
         return;
-    uint32_t c = (fl & WETDEM_MANY_CONTACT) ? 1 : 0;
     add_reaction_pair(P, j, o->force, f);
-    *n_contacts += c;
-    P->contacts[j] += c;
     if (adds_torque(P->lean, fl)) {
         *t = vec3_add(*t, o->torque_i);
         P->torque[j] = vec3_add(P->torque[j], o->torque_j);
     }
 }
 
-/* Particle i of a block after its listed pairs (with running sums f, t and n_contacts): its
- * cross pairs from phase 1 (from *e, j order), then its own sums into the totals (the
- * reactions of earlier particles are there already) and the closing half kick. */
+/* Particle i of a block after its listed pairs (with running sums f and t): its cross pairs
+ * from phase 1 (from *e, j order), then its own sums into the totals (the reactions of
+ * earlier particles are there already) and the closing half kick. */
 static inline __attribute__((always_inline)) void
 close_particle(const struct pass* P, size_t i, size_t* e, size_t e_end, struct wetdem_vec3 f,
-               struct wetdem_vec3 t, uint32_t n_contacts, bool kick, struct wetdem_vec3 g)
+               struct wetdem_vec3 t, bool kick, struct wetdem_vec3 g)
 {
     struct wetdem_many* m = P->m;
     for (; *e < e_end && P->pairs[m->cross_q[*e]].i == i; ++*e) { /* its cross pairs, j order */
@@ -1852,11 +1834,9 @@ close_particle(const struct pass* P, size_t i, size_t* e, size_t e_end, struct w
         f = vec3_add(f, m->cross_out[*e].force);
         if (adds_torque(P->lean, fl))
             t = vec3_add(t, m->cross_out[*e].torque_i);
-        n_contacts += (fl & WETDEM_MANY_CONTACT) ? 1 : 0;
     }
     P->force[i] = vec3_add(P->force[i], f);
     P->torque[i] = vec3_add(P->torque[i], t);
-    P->contacts[i] += n_contacts;
     if (kick)
         wetdem_many_close_kick(m, i, g);
 }
@@ -1868,7 +1848,7 @@ static inline __attribute__((always_inline)) void close_unlisted(const struct pa
                                                                  struct wetdem_vec3 g)
 {
     if (*e < e_end && P->pairs[P->m->cross_q[*e]].i == i)
-        close_particle(P, i, e, e_end, vec3(0, 0, 0), vec3(0, 0, 0), 0, kick, g);
+        close_particle(P, i, e, e_end, vec3(0, 0, 0), vec3(0, 0, 0), kick, g);
     else if (kick)
         wetdem_many_close_kick(P->m, i, g);
 }
@@ -1886,7 +1866,7 @@ close_batch(const struct pass* P, const struct batch_sums* B, size_t from_slot, 
     if (*e < e_end && P->pairs[m->cross_q[*e]].i < stop) { /* cross pairs: particle by particle */
         for (size_t p = next, s = from_slot; p < stop; p++) {
             if (s < to_slot && B->particle[s] == p) {
-                close_particle(P, p, e, e_end, running_force(&B->s[s]), running_torque(&B->s[s]), 0,
+                close_particle(P, p, e, e_end, running_force(&B->s[s]), running_torque(&B->s[s]),
                                kick, g);
                 s++;
             } else
@@ -1916,7 +1896,7 @@ close_batch(const struct pass* P, const struct batch_sums* B, size_t from_slot, 
  * only particles at or after its first pair's first particle, none of which has been closed,
  * and no reaction goes to a closed particle (j > i). Every result adds its torque on i to the
  * running sum (+0 apart: the vector kernel's, or +0 where it does not act); the torque on j
- * and the counts are added in solid contact only: with `defer` (a pass with films, where
+ * is added in solid contact only: with `defer` (a pass with films, where
  * contacts and bridges apart alternate without a pattern and a branch on which one a result
  * is was mispredicted often) after the batch's loop, in a loop over its contacts in list
  * order (the same sums: see there), else at once. `budget`: P->pair_work is set (an energy
@@ -1942,10 +1922,10 @@ consume_four_at_a_time(const struct pass* P, const struct pass* P_out, size_t b,
     for (size_t h = 0; h < n_list;) {
         size_t n_w = n_list - h < WETDEM_MANY_BULK_MAX ? n_list - h : WETDEM_MANY_BULK_MAX;
         P->bulk(&P->bulk_in, list + h, n_w, end_block, &bo);
-        /* in list order, each result's state, its reactions on j and its counts of contacts,
-           then what it adds to i's force and torque (its entry's: the slower paths write it
-           there, +0 for those that do not act) into the running sums of the first particles,
-           restarted from +0 at a new particle without a branch (a sum from +0 is never -0) */
+        /* in list order, each result's state and its reactions on j, then what it adds to i's
+           force and torque (its entry's: the slower paths write it there, +0 for those that do
+           not act) into the running sums of the first particles, restarted from +0 at a new
+           particle without a branch (a sum from +0 is never -0) */
         size_t slot = 0; /* slot 0: the particle carried from the batch before (none at first) */
         B.particle[0] = i;
         B.s[0] = r;
@@ -1960,14 +1940,12 @@ consume_four_at_a_time(const struct pass* P, const struct pass* P_out, size_t b,
                                  budget ? work_slot(P->pair_work, P->n_models, bo.i[k]) : NULL);
                 P->force[j] =
                     vec3_sub(P->force[j], vec3(bo.force[0][k], bo.force[1][k], bo.force[2][k]));
-                if (defer) { /* (apart: no counts, and +0 torques) */
+                if (defer) { /* (apart: +0 torques) */
                     torque_at[n_torque] = (uint32_t)k;
                     n_torque += (size_t)((cls & WETDEM_MANY_CONTACT) != 0);
                 } else if (cls & WETDEM_MANY_CONTACT) {
                     P->torque[j] = vec3_add(P->torque[j], vec3(bo.torque_j[0][k], bo.torque_j[1][k],
                                                                bo.torque_j[2][k]));
-                    P->contacts[j]++;
-                    P->contacts[bo.i[k]]++;
                     n_contact_results++;
                 }
             } else {
@@ -1983,7 +1961,7 @@ consume_four_at_a_time(const struct pass* P, const struct pass* P_out, size_t b,
                     unsigned char fl = near_candidate(
                         P, q, bo.i[k], j, vec3(0, 0, 0), m->mix, &o, fail, &bo, k,
                         budget ? work_slot(P->pair_work, P->n_models, bo.i[k]) : NULL);
-                    add_pair(P, j, fl, &o, &f, &t, &P->contacts[bo.i[k]]);
+                    add_pair(P, j, fl, &o, &f, &t);
                 }
                 bo.force[0][k] = f.x;
                 bo.force[1][k] = f.y;
@@ -2002,17 +1980,15 @@ consume_four_at_a_time(const struct pass* P, const struct pass* P_out, size_t b,
             B.particle[slot] = i;
             B.s[slot] = r;
         }
-        /* the torques on j of the contacts evaluated four at a time, in list order, and their
-           counts, apart from the loop over all results: in a wet packing, whether a result is
-           a contact follows no pattern. The loop adds no other torque on j but that of a
-           contact the scalar kernel takes over, whose result is not finite (bulk_contacts
-           leaves it only those) and fails the pass: no run goes on with its sums. */
+        /* the torques on j of the contacts evaluated four at a time, in list order, apart
+           from the loop over all results: in a wet packing, whether a result is a contact
+           follows no pattern. The loop adds no other torque on j but that of a contact the
+           scalar kernel takes over, whose result is not finite (bulk_contacts leaves it only
+           those) and fails the pass: no run goes on with its sums. */
         for (size_t c = 0; c < n_torque; c++) {
             size_t k = torque_at[c], j = bo.j[k];
             P->torque[j] = vec3_add(P->torque[j],
                                     vec3(bo.torque_j[0][k], bo.torque_j[1][k], bo.torque_j[2][k]));
-            P->contacts[j]++;
-            P->contacts[bo.i[k]]++;
         }
         n_contact_results += n_torque;
         h += n_w;
@@ -2083,7 +2059,6 @@ pairs_of_block_as(const struct pass* P, size_t b, bool kick, struct wetdem_vec3 
             continue;
         }
         struct wetdem_vec3 f = vec3(0, 0, 0), t = vec3(0, 0, 0);
-        uint32_t n_contacts = 0;
         for (; h < n_list && pairs[list[h]].i == i; h++) {
             size_t q = list[h], j = pairs[q].j;
             struct wetdem_vec3 d;
@@ -2110,9 +2085,9 @@ pairs_of_block_as(const struct pass* P, size_t b, bool kick, struct wetdem_vec3 
             struct wetdem_many_pair_out o;
             unsigned char fl = near_candidate(P, q, i, j, d, x, &o, fail, NULL, 0,
                                               work_slot(P->pair_work, P->n_models, i));
-            add_pair(P, j, fl, &o, &f, &t, &n_contacts);
+            add_pair(P, j, fl, &o, &f, &t);
         }
-        close_particle(P, i, &e, e_end, f, t, n_contacts, kick, g);
+        close_particle(P, i, &e, e_end, f, t, kick, g);
     }
 #pragma omp atomic
     m->pass_skipped += n_skipped;
@@ -2317,7 +2292,6 @@ int wetdem_sim_many_forces(struct wetdem_sim* sim, enum wetdem_many_end end)
                      .m = m,
                      .force = m->force,
                      .torque = m->torque,
-                     .contacts = m->contacts,
                      .p = sim->particles,
                      .xr = m->xr,
                      .pairs = m->cl.pairs,

@@ -376,10 +376,21 @@ static uint64_t config_hash(const struct wetdem_sim* sim)
     return config_hash_with(sim, sim->many->set.energy_budget);
 }
 
-/* USER blob: dt, t0, then force and torque of every particle, then its contact count. */
+/* USER blob: dt, t0, then force and torque of every particle. */
 static size_t blob_size(size_t n)
 {
-    return 2 * sizeof(double) + n * (6 * sizeof(double) + sizeof(uint32_t));
+    return 2 * sizeof(double) + n * 6 * sizeof(double);
+}
+
+/* Whether a USER blob of `size` bytes fits n particles: blob_size(n), or that and a uint32 per
+ * particle, each one's count of solid overlaps at the latest pass, which checkpoints held while
+ * the force pass counted them. Nothing reads those counts (the reported ones are worked out
+ * from the state: wetdem_sim_many_links), so such a checkpoint resumes the same run and its
+ * counts are skipped; the sizes differ for every n > 0, so neither layout is taken for the
+ * other. */
+static bool blob_size_fits(size_t size, size_t n)
+{
+    return size == blob_size(n) || size == blob_size(n) + n * sizeof(uint32_t);
 }
 
 static int fill_checkpoint(struct wetdem_sim* sim, struct wetdem_checkpoint* ck)
@@ -413,8 +424,6 @@ static int fill_checkpoint(struct wetdem_sim* sim, struct wetdem_checkpoint* ck)
                         m->torque[k].x, m->torque[k].y, m->torque[k].z};
         memcpy(b + 16 + k * 48, ft, 48);
     }
-    if (n)
-        memcpy(b + 16 + n * 48, m->contacts, n * sizeof(uint32_t));
     double* e = ck->energy;
     e[0] = m->energy.k0;
     e[1] = m->energy.u0;
@@ -532,7 +541,7 @@ static int check_restorable(struct wetdem_sim* sim, const struct wetdem_checkpoi
                                "models, parameters, walls or many settings",
                                path);
     if (ck->n_walls != nw || ck->history_len != sim->history_len ||
-        ck->extra_size != blob_size(n) ||
+        !blob_size_fits(ck->extra_size, n) ||
         (ck->n_energy != N_ENERGY && ck->n_energy != N_ENERGY_RIGHT_SUM) || ck->n_pairs < n * nw)
         return wetdem_sim_fail(sim, WETDEM_ERR_PARSE, "checkpoint '%s': inconsistent contents",
                                path);
@@ -632,8 +641,6 @@ static int restore_pairs(struct wetdem_sim* sim, const struct wetdem_checkpoint*
         m->force[k] = vec3(ft[0], ft[1], ft[2]);
         m->torque[k] = vec3(ft[3], ft[4], ft[5]);
     }
-    if (n)
-        memcpy(m->contacts, ck->extra + 16 + n * 48, n * sizeof(uint32_t));
     for (size_t q = 0; q < m->cl.n_pairs; q++) /* histories may be stale: check on next use */
         m->flags[q] = WETDEM_MANY_DIRTY | WETDEM_MANY_SPRING;
     m->started = true;

@@ -276,6 +276,58 @@ static void test_many_restart_refuses_impossible_states(void** state)
     remove(bad);
 }
 
+/* A checkpoint of the earlier layout, whose USER section also held each particle's count of
+ * solid overlaps after the forces and torques (4 bytes a particle), is read and resumes the
+ * run bit for bit, its counts skipped (the reported ones are worked out from the state); a
+ * USER section of any other size is still refused. */
+static void test_many_restart_reads_checkpoints_with_contact_counts(void** state)
+{
+    (void)state;
+    char good[] = "/tmp/wetdem_test_many_good_XXXXXX", old[] = "/tmp/wetdem_test_many_old_XXXXXX";
+    close(mkstemp(good));
+    close(mkstemp(old));
+    struct wetdem_sim* whole = wet_box(150, true);
+    CHECK_OK(wetdem_sim_integrate(whole, 1.2e-3));
+    struct wetdem_sim* first = wet_box(150, true);
+    CHECK_OK(wetdem_sim_integrate(first, 0.5e-3));
+    CHECK_OK(wetdem_sim_write_checkpoint(first, good));
+    wetdem_sim_free(first);
+    for (int extra = 0; extra < 2; extra++) { /* the counts; then one byte more */
+        struct wetdem_checkpoint ck;
+        char msg[256];
+        CHECK_OK(wetdem_checkpoint_read(good, &ck, msg, sizeof msg));
+        size_t n = ck.n_particles, size = ck.extra_size + n * sizeof(uint32_t) + (size_t)extra;
+        assert_int_equal(ck.extra_size, 16 + 48 * n); /* dt, t0, force and torque */
+        unsigned char* blob = realloc(ck.extra, size);
+        assert_non_null(blob);
+        memset(blob + ck.extra_size, 0x5a, size - ck.extra_size); /* counts no run has */
+        ck.extra = blob;
+        ck.extra_size = size;
+        CHECK_OK(wetdem_checkpoint_write(old, &ck, msg, sizeof msg));
+        wetdem_checkpoint_clear(&ck);
+        struct wetdem_sim* resumed = wet_box(150, true);
+        if (extra) {
+            CHECK_STATUS(wetdem_sim_read_checkpoint(resumed, old), WETDEM_ERR_PARSE);
+            CHECK_CONTAINS(wetdem_sim_errmsg(resumed), "inconsistent contents");
+        } else {
+            CHECK_OK(wetdem_sim_read_checkpoint(resumed, old));
+            CHECK_OK(wetdem_sim_integrate(resumed, 1.2e-3));
+            test_check_same_particles(whole, resumed);
+            struct wetdem_many_stats a, b;
+            CHECK_OK(wetdem_sim_many_stats(whole, &a));
+            CHECK_OK(wetdem_sim_many_stats(resumed, &b));
+            assert_true(a.contacts + a.bridges > 0);
+            assert_int_equal(b.contacts, a.contacts);
+            assert_int_equal(b.bridges, a.bridges);
+            assert_int_equal(b.agglomerates, a.agglomerates);
+        }
+        wetdem_sim_free(resumed);
+    }
+    wetdem_sim_free(whole);
+    remove(good);
+    remove(old);
+}
+
 static volatile int stop_now = 0;
 
 static int stop_after(unsigned long long done, unsigned long long total, double elapsed, void* ctx)
@@ -1433,6 +1485,7 @@ int main(void)
         cmocka_unit_test(test_many_same_result_for_any_thread_count),
         cmocka_unit_test(test_many_restart_is_bit_identical),
         cmocka_unit_test(test_many_restart_refuses_impossible_states),
+        cmocka_unit_test(test_many_restart_reads_checkpoints_with_contact_counts),
         cmocka_unit_test(test_many_stop_flag_writes_a_checkpoint),
         cmocka_unit_test(test_many_stop_during_a_drifting_step_loses_nothing),
         cmocka_unit_test(test_many_deferred_kick_is_bit_identical),
