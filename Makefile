@@ -96,6 +96,8 @@ check-prefix: all
 check-docs: all
 	@$(BUILD)/wetdem docs-models > $(BUILD)/models.md && diff -u docs/models.md $(BUILD)/models.md \
 	  || { echo "docs/models.md is stale: run 'make docs'"; exit 1; }
+	@$(BUILD)/wetdem docs-cli > $(BUILD)/cli.md && diff -u docs/cli.md $(BUILD)/cli.md \
+	  || { echo "docs/cli.md is stale: run 'make docs'"; exit 1; }
 
 # Layout of every C file against .clang-format (clang-format 14, installed when missing).
 check-format:
@@ -107,6 +109,7 @@ check: test test-san check-prefix check-docs check-format
 
 docs: all
 	$(BUILD)/wetdem docs-models > docs/models.md
+	$(BUILD)/wetdem docs-cli > docs/cli.md
 
 demo: all
 	@scripts/install-deps figures

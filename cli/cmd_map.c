@@ -42,11 +42,17 @@ struct map_table {
 
 static void usage(FILE* f)
 {
-    fprintf(
-        f, "usage: wetdem map FILE --param KEY --values A:B:N --param2 KEY2 --values2 A:B:N\n"
-           "                  [--log] [--log2] [--out FILE.csv] [--set section.key=value ...]\n"
-           "A grid of independent collisions over two scenario keys (KEY slowest), in\n"
-           "parallel (OMP_NUM_THREADS); rows in grid order, bit-identical for any thread count.\n");
+    fprintf(f,
+            "usage: wetdem map FILE --param KEY --values A:B:N --param2 KEY2 --values2 A:B:N\n"
+            "                  [--log] [--log2] [--out FILE.csv] [--set section.key=value ...]\n"
+            "A grid of independent collisions over two scenario keys (KEY slowest), in\n"
+            "parallel (OMP_NUM_THREADS); rows in grid order, bit-identical for any thread count.\n"
+            "  --param KEY      first key (scenario key or model parameter, e.g. davis.stokes)\n"
+            "  --values A:B:N   its N values from A to B (both included); --log: geometric\n"
+            "  --param2 KEY2    second key, varied fastest\n"
+            "  --values2 A:B:N  its N values; --log2: geometric\n"
+            "  --out FILE.csv   write the grid there (default: stdout)\n"
+            "  --set K=V        override a scenario key or model parameter (repeatable)\n");
 }
 
 static int parse_args(int argc, char** argv, struct map_args* a)

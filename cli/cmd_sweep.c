@@ -53,7 +53,8 @@ static void usage(FILE* f)
                "Independent collisions, one per value of KEY (any scenario key, e.g.\n"
                "collision.stokes, or a model parameter), in parallel (OMP_NUM_THREADS).\n"
                "  --values A:B:N  N values from A to B (both included); --log: geometric\n"
-               "  --out FILE.csv  write the table there (default: stdout)\n");
+               "  --out FILE.csv  write the table there (default: stdout)\n"
+               "  --set K=V       override a scenario key or model parameter (repeatable)\n");
 }
 
 static int parse_args(int argc, char** argv, struct sweep_args* a)

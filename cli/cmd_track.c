@@ -19,6 +19,8 @@ static const char usage[] =
     "                    [--threshold 0.05] [--offset 5] [--fit-frames N] [--striker ID]\n"
     "                    [--y-down] [--radius R --mass M --viscosity MU] [--frames FILE]\n"
     "                    [--json]\n"
+    "Velocities, spin, collision time, impact angle, St_n and e_n of a Stokes-cradle\n"
+    "collision from tracked dots, as Punch Sec. 3.2 (docs/tracking.md).\n"
     "  DOTS.csv      rows frame,sphere,x1,y1,x2,y2,x3,y3 (pixels); dot 1 = centre dot\n"
     "  --fps         frame rate [1/s];  --pixel-size  image resolution [m/pixel]\n"
     "  --window/--order  Savitzky-Golay smoothing (odd frames > order; 1 = none)\n"

@@ -81,8 +81,9 @@ static void test_cli_every_subcommand_help(void** state)
             free(r.out);
         }
     }
-    /* models, describe, forces, run, sweep, map, fit, track, docs-models, docs-scenarios */
-    if (n_commands < 10)
+    /* models, describe, forces, run, sweep, map, fit, track, docs-models, docs-scenarios,
+     * docs-cli */
+    if (n_commands < 11)
         fail_msg("only %zu commands found in 'wetdem --help':\n%s", n_commands, help.out);
     free(help.out);
 }
