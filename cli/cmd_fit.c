@@ -880,15 +880,23 @@ static double point_angle(const struct fit_ctx* c, const struct point* p)
     return p->has_angle ? p->angle_deg : cli_scenario_number(c->base, "collision", "angle_deg", 0);
 }
 
-static int write_fit_csv(const char* path, const struct fit_ctx* c, const double* pred, int argc,
-                         char** argv)
+/* What the writers of --out and --curve print (cli_write_output). */
+struct table_ctx {
+    const struct fit_ctx* c;
+    const struct point* pts; /* the curve's points (--curve) */
+    const double* pred;      /* predictions: e_n [n], then omega [n] of --curve or with omega */
+    size_t n;                /* curve points */
+    int argc;
+    char** argv;
+};
+
+/* --out: data vs fit, one row per measurement. */
+static void fit_table(FILE* f, const void* ctx)
 {
-    FILE* f = fopen(path, "w");
-    if (!f) {
-        cli_error("fit: cannot write %s: %s", path, strerror(errno));
-        return CLI_EXIT_RUNTIME;
-    }
-    cli_print_provenance(f, argc, argv);
+    const struct table_ctx* t = ctx;
+    const struct fit_ctx* c = t->c;
+    const double* pred = t->pred;
+    cli_print_provenance(f, t->argc, t->argv);
     fprintf(f, "stokes_n [-],angle_deg [deg],e_n_data [-],e_n_fit [-],e_n_residual [-]%s\n",
             c->use_omega ? ",omega_data [rad/s],omega_fit [rad/s],omega_residual [rad/s]" : "");
     for (size_t i = 0; i < c->n_pts; i++) {
@@ -900,10 +908,29 @@ static int write_fit_csv(const char* path, const struct fit_ctx* c, const double
                     pred[c->n_pts + i] - p->omega);
         fputc('\n', f);
     }
-    return fclose(f) == 0 ? CLI_EXIT_OK : CLI_EXIT_RUNTIME;
 }
 
-/* The fitted model on `m` log-spaced Stokes numbers over the data range, per distinct angle. */
+/* --curve: the fitted model at the curve's points. */
+static void curve_table(FILE* f, const void* ctx)
+{
+    const struct table_ctx* t = ctx;
+    cli_print_provenance(f, t->argc, t->argv);
+    fprintf(f, "angle_deg [deg],stokes_n [-],e_n_fit [-],omega_fit [rad/s]\n");
+    for (size_t k = 0; k < t->n; k++)
+        fprintf(f, "%.9g,%.9g,%.9g,%.9g\n", t->pts[k].angle_deg, t->pts[k].stokes, t->pred[k],
+                t->pred[t->n + k]);
+}
+
+/* Writes --out whole or not at all (cli_write_output). Returns an exit code. */
+static int write_fit_csv(const char* path, const struct fit_ctx* c, const double* pred, int argc,
+                         char** argv)
+{
+    struct table_ctx t = {.c = c, .pred = pred, .argc = argc, .argv = argv};
+    return cli_write_output(path, "fit", fit_table, &t);
+}
+
+/* The fitted model on `m` log-spaced Stokes numbers over the data range, per distinct angle,
+ * written to path whole or not at all. Returns an exit code. */
 static int write_curve_csv(const char* path, const struct fit_ctx* c, const double* values, int m,
                            int argc, char** argv)
 {
@@ -931,23 +958,16 @@ static int write_curve_csv(const char* path, const struct fit_ctx* c, const doub
     }
     if (st == WETDEM_OK)
         st = simulate(c, values, pts, n, e, e + n, msg, sizeof msg);
-    FILE* f = st == WETDEM_OK ? fopen(path, "w") : NULL;
-    if (f) {
-        cli_print_provenance(f, argc, argv);
-        fprintf(f, "angle_deg [deg],stokes_n [-],e_n_fit [-],omega_fit [rad/s]\n");
-        for (size_t k = 0; k < n; k++)
-            fprintf(f, "%.9g,%.9g,%.9g,%.9g\n", pts[k].angle_deg, pts[k].stokes, e[k], e[n + k]);
-        st = fclose(f) == 0 ? WETDEM_OK : WETDEM_ERR_IO;
-    } else if (st == WETDEM_OK) {
-        snprintf(msg, sizeof msg, "cannot write %s: %s", path, strerror(errno));
-        st = WETDEM_ERR_IO;
-    }
-    if (st != WETDEM_OK)
+    int rc = CLI_EXIT_RUNTIME;
+    if (st == WETDEM_OK) {
+        struct table_ctx t = {.c = c, .pts = pts, .pred = e, .n = n, .argc = argc, .argv = argv};
+        rc = cli_write_output(path, "fit", curve_table, &t);
+    } else
         cli_error("fit: curve: %s", msg);
     free(angles);
     free(pts);
     free(e);
-    return st == WETDEM_OK ? CLI_EXIT_OK : CLI_EXIT_RUNTIME;
+    return rc;
 }
 
 /* ---- command ------------------------------------------------------------------------------ */

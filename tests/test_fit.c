@@ -655,6 +655,86 @@ static void test_fit_cli_reports_units_on_example(void** state)
         fail_msg("P_gt %.4g +- %.3g Pa vs 11.6e6", value, se);
 }
 
+/* Lines in the file at path (-1 when it cannot be read); *whole: it ends with a newline. */
+static int count_lines(const char* path, bool* whole)
+{
+    size_t len;
+    char* text = test_read_file(path, &len);
+    if (!text)
+        return -1;
+    int n = 0;
+    for (size_t i = 0; i < len; i++)
+        n += text[i] == '\n';
+    *whole = len > 0 && text[len - 1] == '\n';
+    free(text);
+    return n;
+}
+
+/* --out and --curve are written whole or not at all: they were written under their final
+ * names, so a write that failed midway (here: a file size limit of 1 kB) left a cut-off file
+ * there, with exit 1 (the curve, 200 points of some 6 kB; the data-vs-fit table of 72 rows,
+ * some 3.5 kB). A fit that succeeds leaves both files whole and nothing else. */
+static void test_fit_cli_writes_files_whole_or_not_at_all(void** state)
+{
+    (void)state;
+    if (!getenv("WETDEM_CLI"))
+        skip();
+    char dir[96], args[1024], fit_csv[128], curve_csv[128];
+    snprintf(dir, sizeof dir, "/tmp/wetdem_fit_out_%d", (int)getpid());
+    snprintf(fit_csv, sizeof fit_csv, "%s/fit.csv", dir);
+    snprintf(curve_csv, sizeof curve_csv, "%s/curve.csv", dir);
+    const char* fit = "fit examples/fit/punch_db_c.ini --fit glass.p_gt --init 4e6";
+    snprintf(args, sizeof args,
+             "%s --data examples/fit/punch_0deg.csv --out %s --curve %s --curve-points 200", fit,
+             fit_csv, curve_csv);
+    struct test_run r = test_run_cli("", args, true);
+    if (r.code != 0)
+        fail_msg("wetdem %s: exit %d\n%s", args, r.code, r.out);
+    free(r.out);
+    test_check_dir(dir, "curve.csv\nfit.csv\n");
+    bool whole = false;
+    assert_int_equal(count_lines(fit_csv, &whole), 2 + 1 + 9); /* provenance, header, rows */
+    assert_true(whole);
+    assert_int_equal(count_lines(curve_csv, &whole), 2 + 1 + 200);
+    assert_true(whole);
+    remove(fit_csv);
+    remove(curve_csv);
+    /* the curve cannot be written: exit 1 and no curve file; the table (0.6 kB) is whole */
+    r = test_run_cli(TEST_FILE_SIZE_LIMIT, args, true);
+    if (r.code != 1)
+        fail_msg("wetdem %s: exit %d, expected 1\n%s", args, r.code, r.out);
+    char needle[300];
+    snprintf(needle, sizeof needle, "fit: cannot write %s: File too large", curve_csv);
+    test_check_dir(dir, "fit.csv\n");
+    CHECK_CONTAINS(r.out, needle);
+    free(r.out);
+    assert_int_equal(count_lines(fit_csv, &whole), 2 + 1 + 9);
+    assert_true(whole);
+    remove(fit_csv);
+    /* the table cannot be written: exit 1, neither file (the curve is not made then) */
+    static char data[8192];
+    int used = snprintf(data, sizeof data, "stokes_n,e_n\n");
+    char* example = test_read_file("examples/fit/punch_0deg.csv", NULL);
+    assert_non_null(example);
+    const char* rows = strstr(example, "1.6,");
+    assert_non_null(rows);
+    for (int k = 0; k < 8; k++) /* each measurement 8 times: 72 rows */
+        used += snprintf(data + used, sizeof data - (size_t)used, "%s", rows);
+    free(example);
+    char csv[96];
+    temp_csv(csv, "rows72", data);
+    snprintf(args, sizeof args, "%s --data %s --out %s --curve %s", fit, csv, fit_csv, curve_csv);
+    r = test_run_cli(TEST_FILE_SIZE_LIMIT, args, true);
+    if (r.code != 1)
+        fail_msg("wetdem %s: exit %d, expected 1\n%s", args, r.code, r.out);
+    snprintf(needle, sizeof needle, "fit: cannot write %s: File too large", fit_csv);
+    test_check_dir(dir, "");
+    CHECK_CONTAINS(r.out, needle);
+    free(r.out);
+    remove(csv);
+    rmdir(dir);
+}
+
 /* The curve file holds the fitted model at every distinct angle of the data, however many:
  * 70 angles (0, 0.5, ..., 34.5 deg), 2 curve points each, give 140 rows and 70 angles. */
 static void test_fit_cli_curve_covers_every_angle(void** state)
@@ -715,6 +795,7 @@ int main(void)
         cmocka_unit_test(test_fit_cli_keeps_keys_in_range),
         cmocka_unit_test(test_fit_cli_reports_units_on_example),
         cmocka_unit_test(test_fit_cli_curve_covers_every_angle),
+        cmocka_unit_test(test_fit_cli_writes_files_whole_or_not_at_all),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
