@@ -20,9 +20,12 @@
  * The runs of one evaluation are independent and run in parallel (OpenMP) on simulations
  * built serially beforehand, so results do not depend on the thread count.
  * Exit codes: 0 ok (also with a key at a bound of its range, reported as such), 1 runtime
- * error, no convergence, a key the data do not determine, or a collision whose result cannot
- * be trusted (energy growth, h_min not resolved); 2 bad options, data or scenario, before any
- * collision runs (every data point is built with the initial values first).
+ * error, no convergence, a key the data do not determine (its column of the Jacobian zero, or
+ * numerically zero where the fit stopped, as at a start where its effect is cut off; the table
+ * is printed with standard error inf, and no --out or --curve is written), or a collision
+ * whose result cannot be trusted (energy growth, h_min not resolved); 2 bad options, data or
+ * scenario, before any collision runs (every data point is built with the initial values
+ * first).
  */
 #include <ctype.h>
 #include <errno.h>
@@ -53,6 +56,9 @@ static void usage(FILE* f)
             "  --max-iter N   trust-region iterations (50); --fd-step H Jacobian step (0.01)\n"
             "Each key stays inside its valid range (varied as the log of its distance to the\n"
             "bounds); standard errors from the Jacobian scaled by the residual variance.\n"
+            "Exit 1 when the fit does not converge or the data do not determine a key: the\n"
+            "predictions do not move with it where the fit stopped (e.g. a start where its\n"
+            "effect is cut off: start it elsewhere with --init, or leave it out of --fit).\n"
             "See docs/calibration.md.\n");
 }
 
@@ -835,8 +841,8 @@ static void print_values(const struct fit_ctx* c, const struct wetdem_fit_result
 }
 
 static void print_result(const struct fit_ctx* c, const double* init, const double* lower,
-                         const double* upper, const struct wetdem_fit_result* r, const double* pred,
-                         double omega_scale, int argc, char** argv)
+                         const double* upper, const struct wetdem_fit_result* r, int status,
+                         const double* pred, double omega_scale, int argc, char** argv)
 {
     cli_print_provenance(stdout, argc, argv);
     printf("parameter,unit,value,std_error,initial,fitted_as\n");
@@ -848,10 +854,11 @@ static void print_result(const struct fit_ctx* c, const double* init, const doub
     print_values(c, r, lower, upper);
     int by = (r->converged_by >= 0 && r->converged_by <= 3) ? r->converged_by : 0;
     printf("# cost %.6g [-], residual std s = %.4g [-]%s over %zu dof, %zu iterations, %zu model "
-           "evaluations (x %zu collisions), converged: %s\n",
+           "evaluations (x %zu collisions), converged: %s%s\n",
            r->cost, r->residual_std,
            c->use_omega ? " (spin residuals in units of --omega-scale)" : " (e_n)", r->dof,
-           r->iterations, r->model_evals, c->n_pts, converged_words[by]);
+           r->iterations, r->model_evals, c->n_pts, converged_words[by],
+           status == WETDEM_ERR_UNDETERMINED ? " (not a fit: a key is not determined)" : "");
     double* res = malloc(c->n_pts * sizeof *res);
     for (size_t part = 0; res && part < (c->use_omega ? 2u : 1u); part++) {
         for (size_t i = 0; i < c->n_pts; i++)
@@ -1018,7 +1025,7 @@ static int run_fit(const struct fit_args* a, struct fit_ctx* c, const double* in
     bool has_result = st == WETDEM_OK || st == WETDEM_ERR_MAX_STEPS ||
                       (st == WETDEM_ERR_UNDETERMINED && r.dof > 0);
     if (has_result)
-        print_result(c, init, lower, upper, &r, pred, a->omega_scale, argc, argv);
+        print_result(c, init, lower, upper, &r, st, pred, a->omega_scale, argc, argv);
     if (st == WETDEM_OK || st == WETDEM_ERR_MAX_STEPS) {
         if (a->out)
             rc = write_fit_csv(a->out, c, pred, argc, argv);
@@ -1029,6 +1036,9 @@ static int run_fit(const struct fit_args* a, struct fit_ctx* c, const double* in
         cli_error("fit: %s", msg);
         rc = st == WETDEM_ERR_INVALID ? CLI_EXIT_USAGE : CLI_EXIT_RUNTIME;
     }
+    if (st == WETDEM_ERR_UNDETERMINED)
+        cli_error("fit: --init starts a key elsewhere; a key left out of --fit is held at the "
+                  "scenario's value (or --set KEY=VALUE)");
     free(obs), free(scale), free(pred);
     return rc;
 }

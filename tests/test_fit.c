@@ -251,6 +251,62 @@ static void test_fit_rank_deficient_jacobian_gives_infinite_errors(void** state)
     CHECK_REL(r.values[0] * r.values[1], 6.03, 1e-2); /* the product is what the data fix */
 }
 
+/* y_i = 0.1 x_i + 1e-7 sin(1000 b x_i): the predictions do not depend on b beyond a jitter of
+ * 1e-7, as those of a simulation do not depend on a parameter whose effect is cut off, or does
+ * not reach them, beyond their integration noise (the Poisson ratio of the Punch striker moves
+ * e_n by 1e-8 to 1e-7, of either sign: the CLI test below). */
+static int jitter_only(const double* p, double* out, char* msg, size_t n, void* ctx)
+{
+    (void)msg, (void)n, (void)ctx;
+    for (size_t i = 0; i < 8; i++)
+        out[i] = 0.1 * (double)(i + 1) + 1e-7 * sin(1000 * p[0] * (double)(i + 1));
+    return WETDEM_OK;
+}
+
+/* A start where the predictions are flat in a parameter "converged" after a few small steps
+ * (on the small step, the difference quotients being noise) and was reported as a result,
+ * WETDEM_OK with b = 0.475 +- 251 in [0, 1]. Its column of the Jacobian is numerically zero:
+ * a factor 10 in the distance to a bound moves the residuals by 2.4e-5, under 0.1 of their
+ * scatter s = 0.011. That is WETDEM_ERR_UNDETERMINED, with the parameter, where it stopped,
+ * its start and what to do; the statistics of the last iterate stay (dof > 0, standard error
+ * inf). */
+static void test_fit_numerically_zero_column_is_undetermined(void** state)
+{
+    (void)state;
+    double obs[8];
+    const double init[1] = {0.5}, lower[1] = {0}, upper[1] = {1};
+    const char* names[1] = {"b"};
+    gsl_rng* rng = gsl_rng_alloc(gsl_rng_mt19937);
+    gsl_rng_set(rng, 11);
+    for (size_t i = 0; i < 8; i++)
+        obs[i] = 0.1 * (double)(i + 1) + gsl_ran_gaussian(rng, 0.01);
+    gsl_rng_free(rng);
+    struct wetdem_fit_problem pb = {.n_params = 1,
+                                    .names = names,
+                                    .initial = init,
+                                    .n_data = 8,
+                                    .observed = obs,
+                                    .model = jitter_only,
+                                    .lower = lower,
+                                    .upper = upper};
+    struct wetdem_fit_options o;
+    wetdem_fit_options_init(&o);
+    struct wetdem_fit_result r;
+    char msg[1024] = "";
+    int st = wetdem_fit_run(&pb, &o, &r, NULL, msg, sizeof msg);
+    if (st != WETDEM_ERR_UNDETERMINED)
+        fail_msg("status %s (b = %g +- %g): %s", wetdem_status_name(st), r.values[0],
+                 r.std_errors[0], msg);
+    CHECK_CONTAINS(msg, "the data do not determine b: where the fit stopped, at ");
+    CHECK_CONTAINS(msg, "(from the start 0.5), the predictions hardly depend on it: a factor 10 "
+                        "in its distance to the nearer bound would change the residuals by ");
+    CHECK_CONTAINS(msg, "its column of the Jacobian is numerically zero");
+    CHECK_CONTAINS(msg, "start it elsewhere, nearer the value you expect, or hold it fixed");
+    assert_true(r.undetermined[0] && isinf(r.std_errors[0]));
+    assert_int_equal(r.dof, 7);
+    assert_true(r.values[0] > 0 && r.values[0] < 1);
+}
+
 /* y_i = p x_i for p in [0, 1]: the model fails above 1, as a scenario rejects a restitution
  * above 1; it records the largest and smallest value it was asked for. */
 struct bounded {
@@ -591,6 +647,37 @@ static void test_fit_cli_reports_undetermined_keys(void** state)
     expect_cli(args, 1, "the verlet step moved the gap by");
 }
 
+/* A start where the predictions are flat in a key is not a fit: the Punch striker's Poisson
+ * ratio, from its preset's 0.35, moves e_n by 1e-8 to 1e-7 (the integration noise; the dry
+ * restitution fixes the rebound), so the fit "converged" after two steps at -0.12 +- 223,
+ * "hardly determined", with exit 0 and --out written. It is an error naming the key, where it
+ * stopped and its start, with what to do (exit 1, no --out); the table shows std_error inf. */
+static void test_fit_cli_flat_start_is_not_a_result(void** state)
+{
+    (void)state;
+    if (!getenv("WETDEM_CLI"))
+        skip();
+    char out_csv[96], args[1024];
+    snprintf(out_csv, sizeof out_csv, "/tmp/wetdem_fit_flat_%d.csv", (int)getpid());
+    snprintf(args, sizeof args,
+             "fit examples/fit/punch_db_c.ini --data examples/fit/punch_0deg.csv --fit "
+             "material.striker.poisson_ratio --out %s",
+             out_csv);
+    struct test_run r = test_run_cli("", args, true);
+    if (r.code != 1)
+        fail_msg("wetdem %s: exit %d, expected 1\n%s", args, r.code, r.out);
+    CHECK_CONTAINS(r.out, "fit: the data do not determine material.striker.poisson_ratio: where "
+                          "the fit stopped, at ");
+    CHECK_CONTAINS(r.out, "(from the start 0.35), the predictions hardly depend on it");
+    CHECK_CONTAINS(r.out, "its column of the Jacobian is numerically zero");
+    CHECK_CONTAINS(r.out, "fit: --init starts a key elsewhere; a key left out of --fit is held");
+    CHECK_CONTAINS(r.out, "material.striker.poisson_ratio,-,");
+    CHECK_CONTAINS(r.out, ",inf,0.35,logistic\n");
+    CHECK_CONTAINS(r.out, "(not a fit: a key is not determined)");
+    free(r.out);
+    assert_null(test_read_file(out_csv, NULL));
+}
+
 /* Parameter steps stay inside the key's range: from 1 MPa the unbounded log fit stepped P_gt
  * to 3.1e46 Pa and stopped with "an --init value outside the key's range" (exit 2), and a
  * dry restitution fitted from 0.9 to data simulated at 0.995 probed 1.0096. */
@@ -786,12 +873,14 @@ int main(void)
         cmocka_unit_test(test_fit_rejects_bad_problems),
         cmocka_unit_test(test_fit_zero_jacobian_column_is_an_error_not_an_abort),
         cmocka_unit_test(test_fit_rank_deficient_jacobian_gives_infinite_errors),
+        cmocka_unit_test(test_fit_numerically_zero_column_is_undetermined),
         cmocka_unit_test(test_fit_stays_inside_bounds_and_reports_a_bound),
         cmocka_unit_test(test_fit_recovers_glass_pressure_from_simulated_data),
         cmocka_unit_test(test_fit_cli_rejects_bad_input),
         cmocka_unit_test(test_fit_cli_data_file_checks),
         cmocka_unit_test(test_fit_cli_refuses_keys_it_cannot_vary),
         cmocka_unit_test(test_fit_cli_reports_undetermined_keys),
+        cmocka_unit_test(test_fit_cli_flat_start_is_not_a_result),
         cmocka_unit_test(test_fit_cli_keeps_keys_in_range),
         cmocka_unit_test(test_fit_cli_reports_units_on_example),
         cmocka_unit_test(test_fit_cli_curve_covers_every_angle),
