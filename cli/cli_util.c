@@ -1,7 +1,7 @@
 /*
  * cli_util.c — helpers shared by the CLI subcommands (see cli_util.h): messages, strict
  * parsing of numbers and "A:B:N" ranges, "--set KEY=VALUE", CSV provenance lines, tables
- * written whole (temporary file, then rename) or not at all.
+ * and --out files written whole (temporary file, then rename) or not at all.
  *
  * Range values: linear x_k = A + (B - A) k/(N - 1); geometric x_k = A (B/A)^(k/(N - 1)),
  * computed as 10^(log10 A + (log10 B - log10 A) k/(N - 1)) so that decades come out as the
@@ -238,6 +238,24 @@ int cli_check_writable(const char* what, const char* option, const char* path)
     return CLI_EXIT_OK;
 }
 
+/* Closes f, written under the name tmp; with keep, renames it to path when every write
+ * succeeded, otherwise (or without keep) removes it. 0, or -1 after printing "wetdem: <what>:
+ * cannot write <path>: <why>" when keep was asked for but the file could not be kept. */
+static int finish_file(FILE* f, const char* tmp, const char* path, const char* what, bool keep)
+{
+    bool bad = ferror(f) != 0; /* a write failed (its errno may be long gone) */
+    errno = 0;
+    int err = fclose(f) != 0 ? errno : 0; /* (flushing the rest: fails again, with the reason) */
+    if (keep && !bad && !err && rename(tmp, path) == 0)
+        return 0;
+    err = err ? err : errno;
+    remove(tmp);
+    if (!keep)
+        return 0;
+    cli_error("%s: cannot write %s: %s", what, path, err ? strerror(err) : "a write failed");
+    return -1;
+}
+
 int cli_write_output(const char* path, const char* what, void (*write)(FILE* f, const void* ctx),
                      const void* ctx)
 {
@@ -248,25 +266,43 @@ int cli_write_output(const char* path, const char* what, void (*write)(FILE* f, 
     char dir[1024];
     parent_dir(path, dir, sizeof dir);
     if (dir[0] && cli_make_dirs(dir) != 0) {
-        cli_error("%s: cannot create directory %s for %s", what, dir, path);
+        cli_error("%s: cannot create directory %s for %s: %s", what, dir, path, strerror(errno));
         return CLI_EXIT_RUNTIME;
     }
     char tmp[1100];
     snprintf(tmp, sizeof tmp, "%s.tmp%ld", path, (long)getpid());
     FILE* f = fopen(tmp, "w");
     if (!f) {
-        cli_error("%s: cannot write %s", what, tmp);
+        cli_error("%s: cannot write %s: %s", what, tmp, strerror(errno));
         return CLI_EXIT_RUNTIME;
     }
     write(f, ctx);
-    bool bad = ferror(f) != 0;
-    bad = fclose(f) != 0 || bad;
-    if (bad || rename(tmp, path) != 0) {
-        remove(tmp);
-        cli_error("%s: cannot write %s", what, path);
-        return CLI_EXIT_RUNTIME;
+    return finish_file(f, tmp, path, what, true) == 0 ? CLI_EXIT_OK : CLI_EXIT_RUNTIME;
+}
+
+int cli_out_open(struct cli_out_file* o, const char* what, const char* dir, const char* name)
+{
+    o->f = NULL;
+    o->final[0] = o->tmp[0] = '\0';
+    if (!dir || !name[0])
+        return 0;
+    snprintf(o->final, sizeof o->final, "%s/%s", dir, name);
+    snprintf(o->tmp, sizeof o->tmp, "%s/.%s.tmp%ld", dir, name, (long)getpid());
+    o->f = fopen(o->tmp, "w");
+    if (!o->f) {
+        cli_error("%s: cannot write %s: %s", what, o->tmp, strerror(errno));
+        return -1;
     }
-    return CLI_EXIT_OK;
+    return 0;
+}
+
+int cli_out_close(struct cli_out_file* o, const char* what, bool keep)
+{
+    if (!o->f)
+        return 0;
+    FILE* f = o->f;
+    o->f = NULL;
+    return finish_file(f, o->tmp, o->final, what, keep);
 }
 
 const char* cli_article(const char* word)

@@ -86,10 +86,29 @@ int cli_check_writable(const char* what, const char* option, const char* path);
 
 /* Writes a table with write(f, ctx): to stdout when path is NULL, otherwise to path (its
  * directory is created when missing) under a temporary name renamed only when everything was
- * written, so a failed write leaves no half-written file. `what` names the command in the message. Returns CLI_EXIT_OK, or prints
- * "wetdem: <what>: cannot write <file>" and returns CLI_EXIT_RUNTIME. */
+ * written, so a failed write leaves no half-written file and no temporary one. `what` names
+ * the command in the message. Returns CLI_EXIT_OK, or prints "wetdem: <what>: cannot write
+ * <file>: <why>" and returns CLI_EXIT_RUNTIME. */
 int cli_write_output(const char* path, const char* what, void (*write)(FILE* f, const void* ctx),
                      const void* ctx);
+
+/* A file written while a run goes on (a trajectory streamed row by row) or after it, in an
+ * --out directory: under the temporary name DIR/.NAME.tmpPID, renamed to DIR/NAME by
+ * cli_out_close only when the run and every write succeeded, so an interrupted or failed run
+ * leaves nothing half-written under the final name. */
+struct cli_out_file {
+    char final[1400], tmp[1400];
+    FILE* f; /* NULL: not open (no directory, or the name is empty: the file is not wanted) */
+};
+
+/* Opens the temporary file of DIR/NAME (nothing when dir is NULL or name empty: o->f NULL).
+ * 0, or -1 after printing "wetdem: <what>: cannot write <tmp>: <why>". */
+int cli_out_open(struct cli_out_file* o, const char* what, const char* dir, const char* name);
+
+/* Closes o; with keep, renames it to its final name when everything was written, otherwise
+ * (or without keep) removes the temporary file. 0, or -1 after printing "wetdem: <what>:
+ * cannot write <final>: <why>" when keep was asked for but the file could not be kept. */
+int cli_out_close(struct cli_out_file* o, const char* what, bool keep);
 
 /* Writes v to f with the fewest significant digits (15, 16 or 17) that read back as exactly
  * v, so CSV output is both exact and readable ("1e-05", not "1.0000000000000001e-05"). */

@@ -20,9 +20,12 @@
  * The runs of one evaluation are independent and run in parallel (OpenMP) on simulations
  * built serially beforehand, so results do not depend on the thread count.
  * Exit codes: 0 ok (also with a key at a bound of its range, reported as such), 1 runtime
- * error, no convergence, a key the data do not determine, or a collision whose result cannot
- * be trusted (energy growth, h_min not resolved); 2 bad options, data or scenario, before any
- * collision runs (every data point is built with the initial values first).
+ * error, no convergence, a key the data do not determine (its column of the Jacobian zero, or
+ * numerically zero where the fit stopped, as at a start where its effect is cut off; the table
+ * is printed with standard error inf, and no --out or --curve is written), or a collision
+ * whose result cannot be trusted (energy growth, h_min not resolved); 2 bad options, data or
+ * scenario, before any collision runs (every data point is built with the initial values
+ * first).
  */
 #include <ctype.h>
 #include <errno.h>
@@ -53,6 +56,9 @@ static void usage(FILE* f)
             "  --max-iter N   trust-region iterations (50); --fd-step H Jacobian step (0.01)\n"
             "Each key stays inside its valid range (varied as the log of its distance to the\n"
             "bounds); standard errors from the Jacobian scaled by the residual variance.\n"
+            "Exit 1 when the fit does not converge or the data do not determine a key: the\n"
+            "predictions do not move with it where the fit stopped (e.g. a start where its\n"
+            "effect is cut off: start it elsewhere with --init, or leave it out of --fit).\n"
             "See docs/calibration.md.\n");
 }
 
@@ -835,8 +841,8 @@ static void print_values(const struct fit_ctx* c, const struct wetdem_fit_result
 }
 
 static void print_result(const struct fit_ctx* c, const double* init, const double* lower,
-                         const double* upper, const struct wetdem_fit_result* r, const double* pred,
-                         double omega_scale, int argc, char** argv)
+                         const double* upper, const struct wetdem_fit_result* r, int status,
+                         const double* pred, double omega_scale, int argc, char** argv)
 {
     cli_print_provenance(stdout, argc, argv);
     printf("parameter,unit,value,std_error,initial,fitted_as\n");
@@ -848,10 +854,11 @@ static void print_result(const struct fit_ctx* c, const double* init, const doub
     print_values(c, r, lower, upper);
     int by = (r->converged_by >= 0 && r->converged_by <= 3) ? r->converged_by : 0;
     printf("# cost %.6g [-], residual std s = %.4g [-]%s over %zu dof, %zu iterations, %zu model "
-           "evaluations (x %zu collisions), converged: %s\n",
+           "evaluations (x %zu collisions), converged: %s%s\n",
            r->cost, r->residual_std,
            c->use_omega ? " (spin residuals in units of --omega-scale)" : " (e_n)", r->dof,
-           r->iterations, r->model_evals, c->n_pts, converged_words[by]);
+           r->iterations, r->model_evals, c->n_pts, converged_words[by],
+           status == WETDEM_ERR_UNDETERMINED ? " (not a fit: a key is not determined)" : "");
     double* res = malloc(c->n_pts * sizeof *res);
     for (size_t part = 0; res && part < (c->use_omega ? 2u : 1u); part++) {
         for (size_t i = 0; i < c->n_pts; i++)
@@ -880,15 +887,23 @@ static double point_angle(const struct fit_ctx* c, const struct point* p)
     return p->has_angle ? p->angle_deg : cli_scenario_number(c->base, "collision", "angle_deg", 0);
 }
 
-static int write_fit_csv(const char* path, const struct fit_ctx* c, const double* pred, int argc,
-                         char** argv)
+/* What the writers of --out and --curve print (cli_write_output). */
+struct table_ctx {
+    const struct fit_ctx* c;
+    const struct point* pts; /* the curve's points (--curve) */
+    const double* pred;      /* predictions: e_n [n], then omega [n] of --curve or with omega */
+    size_t n;                /* curve points */
+    int argc;
+    char** argv;
+};
+
+/* --out: data vs fit, one row per measurement. */
+static void fit_table(FILE* f, const void* ctx)
 {
-    FILE* f = fopen(path, "w");
-    if (!f) {
-        cli_error("fit: cannot write %s: %s", path, strerror(errno));
-        return CLI_EXIT_RUNTIME;
-    }
-    cli_print_provenance(f, argc, argv);
+    const struct table_ctx* t = ctx;
+    const struct fit_ctx* c = t->c;
+    const double* pred = t->pred;
+    cli_print_provenance(f, t->argc, t->argv);
     fprintf(f, "stokes_n [-],angle_deg [deg],e_n_data [-],e_n_fit [-],e_n_residual [-]%s\n",
             c->use_omega ? ",omega_data [rad/s],omega_fit [rad/s],omega_residual [rad/s]" : "");
     for (size_t i = 0; i < c->n_pts; i++) {
@@ -900,10 +915,29 @@ static int write_fit_csv(const char* path, const struct fit_ctx* c, const double
                     pred[c->n_pts + i] - p->omega);
         fputc('\n', f);
     }
-    return fclose(f) == 0 ? CLI_EXIT_OK : CLI_EXIT_RUNTIME;
 }
 
-/* The fitted model on `m` log-spaced Stokes numbers over the data range, per distinct angle. */
+/* --curve: the fitted model at the curve's points. */
+static void curve_table(FILE* f, const void* ctx)
+{
+    const struct table_ctx* t = ctx;
+    cli_print_provenance(f, t->argc, t->argv);
+    fprintf(f, "angle_deg [deg],stokes_n [-],e_n_fit [-],omega_fit [rad/s]\n");
+    for (size_t k = 0; k < t->n; k++)
+        fprintf(f, "%.9g,%.9g,%.9g,%.9g\n", t->pts[k].angle_deg, t->pts[k].stokes, t->pred[k],
+                t->pred[t->n + k]);
+}
+
+/* Writes --out whole or not at all (cli_write_output). Returns an exit code. */
+static int write_fit_csv(const char* path, const struct fit_ctx* c, const double* pred, int argc,
+                         char** argv)
+{
+    struct table_ctx t = {.c = c, .pred = pred, .argc = argc, .argv = argv};
+    return cli_write_output(path, "fit", fit_table, &t);
+}
+
+/* The fitted model on `m` log-spaced Stokes numbers over the data range, per distinct angle,
+ * written to path whole or not at all. Returns an exit code. */
 static int write_curve_csv(const char* path, const struct fit_ctx* c, const double* values, int m,
                            int argc, char** argv)
 {
@@ -931,23 +965,16 @@ static int write_curve_csv(const char* path, const struct fit_ctx* c, const doub
     }
     if (st == WETDEM_OK)
         st = simulate(c, values, pts, n, e, e + n, msg, sizeof msg);
-    FILE* f = st == WETDEM_OK ? fopen(path, "w") : NULL;
-    if (f) {
-        cli_print_provenance(f, argc, argv);
-        fprintf(f, "angle_deg [deg],stokes_n [-],e_n_fit [-],omega_fit [rad/s]\n");
-        for (size_t k = 0; k < n; k++)
-            fprintf(f, "%.9g,%.9g,%.9g,%.9g\n", pts[k].angle_deg, pts[k].stokes, e[k], e[n + k]);
-        st = fclose(f) == 0 ? WETDEM_OK : WETDEM_ERR_IO;
-    } else if (st == WETDEM_OK) {
-        snprintf(msg, sizeof msg, "cannot write %s: %s", path, strerror(errno));
-        st = WETDEM_ERR_IO;
-    }
-    if (st != WETDEM_OK)
+    int rc = CLI_EXIT_RUNTIME;
+    if (st == WETDEM_OK) {
+        struct table_ctx t = {.c = c, .pts = pts, .pred = e, .n = n, .argc = argc, .argv = argv};
+        rc = cli_write_output(path, "fit", curve_table, &t);
+    } else
         cli_error("fit: curve: %s", msg);
     free(angles);
     free(pts);
     free(e);
-    return st == WETDEM_OK ? CLI_EXIT_OK : CLI_EXIT_RUNTIME;
+    return rc;
 }
 
 /* ---- command ------------------------------------------------------------------------------ */
@@ -998,7 +1025,7 @@ static int run_fit(const struct fit_args* a, struct fit_ctx* c, const double* in
     bool has_result = st == WETDEM_OK || st == WETDEM_ERR_MAX_STEPS ||
                       (st == WETDEM_ERR_UNDETERMINED && r.dof > 0);
     if (has_result)
-        print_result(c, init, lower, upper, &r, pred, a->omega_scale, argc, argv);
+        print_result(c, init, lower, upper, &r, st, pred, a->omega_scale, argc, argv);
     if (st == WETDEM_OK || st == WETDEM_ERR_MAX_STEPS) {
         if (a->out)
             rc = write_fit_csv(a->out, c, pred, argc, argv);
@@ -1009,6 +1036,9 @@ static int run_fit(const struct fit_args* a, struct fit_ctx* c, const double* in
         cli_error("fit: %s", msg);
         rc = st == WETDEM_ERR_INVALID ? CLI_EXIT_USAGE : CLI_EXIT_RUNTIME;
     }
+    if (st == WETDEM_ERR_UNDETERMINED)
+        cli_error("fit: --init starts a key elsewhere; a key left out of --fit is held at the "
+                  "scenario's value (or --set KEY=VALUE)");
     free(obs), free(scale), free(pred);
     return rc;
 }

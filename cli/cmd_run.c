@@ -8,14 +8,14 @@
  * also handles --restart CHECKPOINT.
  *
  * Nothing half-written: the scenario is checked and the simulation built (every input check)
- * before any file is opened; files are written under temporary names and renamed only when
- * the run succeeded. Exit codes: 0 ok, 1 runtime error, 2 usage or input error.
+ * before any file is opened; files are written under temporary names (cli_out_open) and
+ * renamed only when the run succeeded and the file was written whole, removed otherwise.
+ * Exit codes: 0 ok, 1 runtime error, 2 usage or input error.
  */
 #include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 #include "cli_util.h"
 #include "output_csv.h"
@@ -85,46 +85,6 @@ static int parse_args(int argc, char** argv, struct run_args* a)
     return cli_check_output_path("run", "--out", a->out_dir, true);
 }
 
-/* One output file: final name and the temporary name it is written under. */
-struct out_file {
-    char final[1400], tmp[1400];
-    FILE* f;
-};
-
-static int open_out(struct out_file* o, const char* dir, const char* name)
-{
-    o->f = NULL;
-    o->final[0] = '\0';
-    if (!dir || !name[0])
-        return 0;
-    snprintf(o->final, sizeof o->final, "%s/%s", dir, name);
-    snprintf(o->tmp, sizeof o->tmp, "%s/.%s.tmp%ld", dir, name, (long)getpid());
-    o->f = fopen(o->tmp, "w");
-    if (!o->f) {
-        cli_error("run: cannot write %s: %s", o->tmp, strerror(errno));
-        return -1;
-    }
-    return 0;
-}
-
-/* Closes; renames on success (keep), removes the temporary file otherwise. */
-static int close_out(struct out_file* o, bool keep)
-{
-    if (!o->f)
-        return 0;
-    bool bad = ferror(o->f) != 0;
-    bad = (fclose(o->f) != 0) || bad;
-    o->f = NULL;
-    if (keep && !bad && rename(o->tmp, o->final) == 0)
-        return 0;
-    remove(o->tmp);
-    if (keep) {
-        cli_error("run: cannot write %s", o->final);
-        return -1;
-    }
-    return 0;
-}
-
 static void print_check(const struct cli_scenario* sc, const struct cli_setup* su, bool json)
 {
     const struct wetdem_collision_spec* s = &su->spec;
@@ -155,7 +115,7 @@ static void print_check(const struct cli_scenario* sc, const struct cli_setup* s
 static int run_soft(const struct cli_scenario* sc, struct cli_setup* su, const struct run_args* a,
                     int argc, char** argv)
 {
-    struct out_file traj, events, summary;
+    struct cli_out_file traj, events, summary;
     int rc = CLI_EXIT_OK;
     if (a->out_dir && su->trajectory_file[0] &&
         (rc = cli_scenario_check_trajectory(sc, "collision", su->spec.t_end,
@@ -165,7 +125,7 @@ static int run_soft(const struct cli_scenario* sc, struct cli_setup* su, const s
         cli_error("run: cannot create directory %s: %s", a->out_dir, strerror(errno));
         return CLI_EXIT_RUNTIME;
     }
-    if (open_out(&traj, a->out_dir, su->trajectory_file) != 0)
+    if (cli_out_open(&traj, "run", a->out_dir, su->trajectory_file) != 0)
         return CLI_EXIT_RUNTIME;
     struct cli_trajectory t = {
         .f = traj.f, .target_is_wall = su->spec.target_is_wall, .argc = argc, .argv = argv};
@@ -175,21 +135,27 @@ static int run_soft(const struct cli_scenario* sc, struct cli_setup* su, const s
     int st = wetdem_collision_run(su->sim, &su->spec, &res);
     if (st < 0) {
         cli_error("run %s: %s (%s)", sc->file, wetdem_sim_errmsg(su->sim), wetdem_status_name(st));
-        close_out(&traj, false);
+        if (traj.f && ferror(traj.f)) /* (what stopped the observer) */
+            cli_error("run: cannot write %s: a write failed", traj.final);
+        cli_out_close(&traj, "run", false);
         return CLI_EXIT_RUNTIME;
     }
     cli_setup_capture(su, &res);
-    if (open_out(&events, a->out_dir, su->events_file) != 0 ||
-        open_out(&summary, a->out_dir, su->summary_file) != 0) {
-        close_out(&traj, false);
-        close_out(&events, false);
+    if (cli_out_open(&events, "run", a->out_dir, su->events_file) != 0 ||
+        cli_out_open(&summary, "run", a->out_dir, su->summary_file) != 0) {
+        cli_out_close(&traj, "run", false);
+        cli_out_close(&events, "run", false);
         return CLI_EXIT_RUNTIME;
     }
     if (events.f)
         cli_events_csv(events.f, su->sim, argc, argv);
     if (summary.f)
         cli_summary_json(summary.f, sc, su, &res);
-    if (close_out(&traj, true) || close_out(&events, true) || close_out(&summary, true))
+    /* every file closed, each kept whole or removed (none left under its temporary name) */
+    bool kept = cli_out_close(&traj, "run", true) == 0;
+    kept = cli_out_close(&events, "run", true) == 0 && kept;
+    kept = cli_out_close(&summary, "run", true) == 0 && kept;
+    if (!kept)
         rc = CLI_EXIT_RUNTIME;
     if (a->json)
         cli_summary_json(stdout, sc, su, &res);

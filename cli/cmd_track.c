@@ -3,7 +3,8 @@
  * rotational velocities, collision frame, impact angle (Eq. 16), St_n (Eq. 2) and e_n (Eq. 3)
  * from the tracked positions of three painted dots per sphere (Punch 2023 Sec. 3.2, Eq. 23;
  * library: wetdem_track_*). The summary goes to stdout as "key = value" lines (or JSON with
- * --json); --frames FILE writes the per-frame velocities as CSV. docs/tracking.md.
+ * --json); --frames FILE writes the per-frame velocities as CSV, whole or not at all (under a
+ * temporary name, renamed when written; cli_write_output). docs/tracking.md.
  * Exit codes: 0 ok, 1 out of memory or unwritable output, 2 bad options or malformed track.
  */
 #include <errno.h>
@@ -121,30 +122,28 @@ static int parse_args(int argc, char** argv, struct track_cli* c)
     return CLI_EXIT_OK;
 }
 
-static int write_frames(const struct wetdem_track* t, const char* path, int argc, char** argv)
+/* What frames_table prints. */
+struct frames_ctx {
+    const struct wetdem_track* t;
+    int argc;
+    char** argv;
+};
+
+/* --frames: the per-frame velocities of every sphere. */
+static void frames_table(FILE* f, const void* ctx)
 {
-    FILE* f = fopen(path, "w");
-    if (!f) {
-        cli_error("track: cannot write '%s': %s", path, strerror(errno));
-        return CLI_EXIT_RUNTIME;
-    }
-    cli_print_provenance(f, argc, argv);
+    const struct frames_ctx* c = ctx;
+    cli_print_provenance(f, c->argc, c->argv);
     fprintf(f, "sphere,frame,time_s,vx_raw_m_s,vy_raw_m_s,omega_raw_rad_s,vx_m_s,vy_m_s,"
                "omega_rad_s,residual_m\n");
-    for (size_t k = 0; k < wetdem_track_n_spheres(t); k++) {
+    for (size_t k = 0; k < wetdem_track_n_spheres(c->t); k++) {
         size_t n;
-        const struct wetdem_track_sample* q = wetdem_track_samples(t, k, &n);
+        const struct wetdem_track_sample* q = wetdem_track_samples(c->t, k, &n);
         for (size_t i = 0; i < n; i++)
             fprintf(f, "%d,%ld,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.6g\n",
-                    wetdem_track_sphere_id(t, k), q[i].frame, q[i].time, q[i].vx_raw, q[i].vy_raw,
-                    q[i].omega_raw, q[i].vx, q[i].vy, q[i].omega, q[i].residual);
+                    wetdem_track_sphere_id(c->t, k), q[i].frame, q[i].time, q[i].vx_raw,
+                    q[i].vy_raw, q[i].omega_raw, q[i].vx, q[i].vy, q[i].omega, q[i].residual);
     }
-    int bad = ferror(f);
-    if (fclose(f) != 0 || bad) {
-        cli_error("track: error writing '%s'", path);
-        return CLI_EXIT_RUNTIME;
-    }
-    return CLI_EXIT_OK;
 }
 
 struct kv {
@@ -224,7 +223,8 @@ int cmd_track(int argc, char** argv)
         wetdem_track_free(t);
         return st == WETDEM_ERR_NOMEM ? CLI_EXIT_RUNTIME : CLI_EXIT_USAGE;
     }
-    rc = c.frames_path ? write_frames(t, c.frames_path, argc, argv) : CLI_EXIT_OK;
+    struct frames_ctx fc = {t, argc, argv};
+    rc = c.frames_path ? cli_write_output(c.frames_path, "track", frames_table, &fc) : CLI_EXIT_OK;
     if (rc == CLI_EXIT_OK) {
         if (!c.json)
             cli_print_provenance(stdout, argc, argv);

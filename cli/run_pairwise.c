@@ -474,70 +474,68 @@ static void events_csv(FILE* f, const struct wetdem_pairwise* pw)
                 ev[e].k + 1, ev[e].l + 1, ev[e].gap, ev[e].v_n);
 }
 
-/* Opens DIR/name for writing unless name is "none"; *f NULL then. Exit code. */
-static int open_out(const char* dir, const char* name, FILE** f, char* path, size_t n)
+/* The [output] name of a file in --out DIR ("" for "none": not written). */
+static const char* out_name(const struct cli_scenario* sc, const char* key, const char* def)
 {
-    *f = NULL;
-    if (strcmp(name, "none") == 0)
-        return CLI_EXIT_OK;
-    snprintf(path, n, "%s/%s", dir, name);
-    *f = fopen(path, "w");
-    if (!*f) {
-        cli_error("run: cannot write %s", path);
-        return CLI_EXIT_RUNTIME;
-    }
-    return CLI_EXIT_OK;
+    const char* name = cli_scenario_text(sc, "output", key, def);
+    return strcmp(name, "none") == 0 ? "" : name;
 }
 
-/* The run with files in opt->out_dir (trajectory during the run, events and summary after).
+/* The run with files in opt->out_dir: the trajectory written during the run, events and
+ * summary after it, each under a temporary name renamed only when the run succeeded and the
+ * file was written whole (a failed or interrupted run leaves nothing under the final names).
  * *ran: whether the run took place (not when the trajectory is refused or no directory). */
 static int run_with_files(const struct cli_scenario* sc, const struct cli_run_options* opt,
                           const struct wetdem_pairwise_config* cfg, struct wetdem_pairwise* pw,
                           struct wetdem_pairwise_result* r, int* status, bool* ran)
 {
-    char path[1200];
-    FILE *ft = NULL, *fe = NULL, *fs = NULL;
+    struct cli_out_file ft, fe, fs;
     double dt = cli_scenario_number(sc, "output", "trajectory_interval", 0.0);
     dt = dt > 0.0 ? dt : cfg->t_end / 2000.0;
-    bool traj = strcmp(cli_scenario_text(sc, "output", "trajectory", "trajectory.csv"), "none");
-    int rc =
-        traj ? cli_scenario_check_trajectory(
-                   sc, cli_scenario_has_section(sc, "davis") ? "davis" : "pairwise", cfg->t_end, dt)
-             : CLI_EXIT_OK;
+    const char* traj_name = out_name(sc, "trajectory", "trajectory.csv");
+    int rc = traj_name[0] ? cli_scenario_check_trajectory(
+                                sc, cli_scenario_has_section(sc, "davis") ? "davis" : "pairwise",
+                                cfg->t_end, dt)
+                          : CLI_EXIT_OK;
     if (rc != CLI_EXIT_OK)
         return rc; /* before the directory is made */
     if (cli_make_dirs(opt->out_dir) != 0) {
         cli_error("run: cannot create directory %s", opt->out_dir);
         return CLI_EXIT_RUNTIME;
     }
-    rc = open_out(opt->out_dir, cli_scenario_text(sc, "output", "trajectory", "trajectory.csv"),
-                  &ft, path, sizeof path);
-    struct traj t = {ft};
-    if (ft) {
-        cli_print_provenance(ft, opt->argc, opt->argv);
-        trajectory_header(ft, cfg->n_spheres);
+    if (cli_out_open(&ft, "run", opt->out_dir, traj_name) != 0)
+        return CLI_EXIT_RUNTIME;
+    struct traj t = {ft.f};
+    if (ft.f) {
+        cli_print_provenance(ft.f, opt->argc, opt->argv);
+        trajectory_header(ft.f, cfg->n_spheres);
         wetdem_pairwise_set_observer(pw, dt, write_frame, &t);
     }
     *status = wetdem_pairwise_run(pw, cfg, r);
     *ran = true;
-    if (ft && fclose(ft) != 0)
-        rc = CLI_EXIT_RUNTIME;
-    if (rc == CLI_EXIT_OK)
-        rc = open_out(opt->out_dir, cli_scenario_text(sc, "output", "events", "events.csv"), &fe,
-                      path, sizeof path);
-    if (fe) {
-        cli_print_provenance(fe, opt->argc, opt->argv);
-        events_csv(fe, pw);
-        rc = fclose(fe) != 0 ? CLI_EXIT_RUNTIME : rc;
+    if (*status != WETDEM_OK) {
+        if (ft.f && ferror(ft.f)) /* (what stopped the observer) */
+            cli_error("run: cannot write %s: a write failed", ft.final);
+        cli_out_close(&ft, "run", false);
+        return CLI_EXIT_OK; /* (the caller reports the status) */
     }
-    if (rc == CLI_EXIT_OK && *status == WETDEM_OK)
-        rc = open_out(opt->out_dir, cli_scenario_text(sc, "output", "summary", "summary.json"), &fs,
-                      path, sizeof path);
-    if (fs) {
-        summary_json(fs, r);
-        rc = fclose(fs) != 0 ? CLI_EXIT_RUNTIME : rc;
+    if (cli_out_open(&fe, "run", opt->out_dir, out_name(sc, "events", "events.csv")) != 0 ||
+        cli_out_open(&fs, "run", opt->out_dir, out_name(sc, "summary", "summary.json")) != 0) {
+        cli_out_close(&ft, "run", false);
+        cli_out_close(&fe, "run", false);
+        return CLI_EXIT_RUNTIME;
     }
-    return rc;
+    if (fe.f) {
+        cli_print_provenance(fe.f, opt->argc, opt->argv);
+        events_csv(fe.f, pw);
+    }
+    if (fs.f)
+        summary_json(fs.f, r);
+    /* every file closed, each kept whole or removed (none left under its temporary name) */
+    bool kept = cli_out_close(&ft, "run", true) == 0;
+    kept = cli_out_close(&fe, "run", true) == 0 && kept;
+    kept = cli_out_close(&fs, "run", true) == 0 && kept;
+    return kept ? CLI_EXIT_OK : CLI_EXIT_RUNTIME;
 }
 
 int cli_run_pairwise(const struct cli_scenario* sc, const struct cli_run_options* opt)

@@ -1137,8 +1137,13 @@ struct wetdem_fit_result {
                                              its standard error is then NAN and the others'
                                              are those with it held there; 0 inside */
     bool undetermined[WETDEM_FIT_MAX_PARAMS]; /* the data do not determine it (its column of
-                                                 the Jacobian is zero, or a combination of
-                                                 columns is): WETDEM_ERR_UNDETERMINED */
+                                                 the Jacobian is zero, or numerically zero at
+                                                 the solution: a factor 10 in the distance to
+                                                 a bound, or a change of its own size for an
+                                                 unbounded one, would move the residuals by
+                                                 less than 0.1 of their scatter s; or a
+                                                 combination of columns is zero):
+                                                 WETDEM_ERR_UNDETERMINED */
 };
 
 /* Fills *opt with the defaults above. */
@@ -1149,8 +1154,9 @@ WETDEM_API void wetdem_fit_options_init(struct wetdem_fit_options* opt);
  * an error), WETDEM_ERR_INVALID (bad problem or options, an initial value outside or on a
  * bound), WETDEM_ERR_CALLBACK or the model's status (the model failed), WETDEM_ERR_MAX_STEPS
  * (not converged; *result holds the last iterate), WETDEM_ERR_UNDETERMINED (the data do not
- * depend on a parameter, or do not determine some parameters separately: *result holds the
- * last iterate with those parameters' standard errors INFINITY), WETDEM_ERR_STEP (the solver
+ * depend on a parameter, exactly or beyond their scatter where the fit stopped, e.g. at a start
+ * where its effect is cut off, or do not determine some parameters separately: *result holds
+ * the last iterate with those parameters' standard errors INFINITY), WETDEM_ERR_STEP (the solver
  * found no step that lowers the cost) or WETDEM_ERR_NOMEM; msg (may be NULL) receives a
  * message. GSL's error handler is switched off while the call runs and the caller's handler
  * restored before it returns, so a GSL error never aborts the program; GSL keeps that handler

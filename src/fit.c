@@ -21,7 +21,11 @@
  * default h = 1e-2 keeps the difference quotient's noise (~1e-4/h) below 1 % while its
  * truncation error is O(h^2). A column of J that is exactly zero means the predictions do not
  * change with that parameter: the fit stops with WETDEM_ERR_UNDETERMINED (GSL's QR would
- * otherwise fail on a Jacobian of rank 0).
+ * otherwise fail on a Jacobian of rank 0). A column that is numerically zero at the solution
+ * (FLAT_FRACTION below: the predictions move with the parameter by less than their noise, as
+ * at a start where its effect is cut off) is WETDEM_ERR_UNDETERMINED too: the solver stops
+ * there at once, on a small step or gradient, and the parameter is where it started, not
+ * fitted.
  *
  * Standard errors (Gauss-Newton linearisation at the solution): cov(q) = s^2 (J^T J)^-1 with
  * the residual variance s^2 = S/(n - p), i.e. the scatter of the data about the fit sets the
@@ -62,6 +66,20 @@
  * distance to a bound. A Gauss-Newton step from where the predictions hardly change can be
  * enormous; the predictions that far away are not those the step was computed from. */
 #define Q_STEP_MAX 2.302585092994046
+
+/* A column of the Jacobian is numerically zero at the solution (the data do not determine the
+ * parameter there, though its column is not exactly zero) when moving the parameter by
+ * FLAT_STEP in its variable would change the residuals by less than FLAT_FRACTION of their
+ * scatter s: ||J_j|| FLAT_STEP < FLAT_FRACTION s. FLAT_STEP is ln 10 for a bounded or log
+ * variable (a factor 10 in the distance to the bound, the longest step the solver takes) and
+ * max(|p|, 1) for a linear one (a change of its own size, the unit of its difference step).
+ * Equivalently its standard error with the others held fixed, s/||J_j||, exceeds 10 such
+ * steps (ten decades of the distance to a bound): no estimate at all. A start where the
+ * predictions are flat in a parameter (its effect cut off) "converges" at once on the small
+ * gradient; the fit would otherwise report that start with a huge standard error as a
+ * result. */
+#define FLAT_FRACTION 0.1
+#define FLAT_STEP_LOG 2.302585092994046
 
 /* A bound is "hit" when the estimate is closer to it than this fraction of its standard
  * error (the data cannot tell it from the bound) and than AT_BOUND_TRAVEL of its initial
@@ -402,10 +420,26 @@ static void fill_errors(const struct fit_ctx* c, const gsl_matrix* cov, const bo
     }
 }
 
+/* The change of variable of parameter j whose effect on the residuals tells whether its column
+ * is numerically zero (FLAT_STEP_LOG, or max(|p|, 1) for a linear variable). */
+static double flat_step(const struct param_map* m, double q)
+{
+    return m->kind == WETDEM_FIT_LINEAR ? fmax(fabs(q), 1.0) : FLAT_STEP_LOG;
+}
+
+/* The change of the residuals (2-norm) that moving parameter j by flat_step would make, by the
+ * Jacobian at q. */
+static double flat_change(const struct fit_ctx* c, const double* q, size_t j)
+{
+    gsl_vector_const_view col = gsl_matrix_const_column(c->jac, j);
+    return gsl_blas_dnrm2(&col.vector) * flat_step(&c->map[j], q[j]);
+}
+
 /* Values, standard errors, correlations and bound flags from the Jacobian at the solution q;
- * returns how many parameters the data do not determine (-1: out of memory). */
+ * returns how many parameters the data do not determine (-1: out of memory); flat[j] marks
+ * those whose column is numerically zero (FLAT_FRACTION), not exactly zero or dependent. */
 static int fill_statistics(const struct fit_ctx* c, const double* q, const gsl_vector* f,
-                           gsl_matrix* cov, struct wetdem_fit_result* res)
+                           gsl_matrix* cov, struct wetdem_fit_result* res, bool* flat)
 {
     const struct wetdem_fit_problem* pb = c->pb;
     size_t np = pb->n_params;
@@ -421,9 +455,11 @@ static int fill_statistics(const struct fit_ctx* c, const double* q, const gsl_v
         undetermined[j] = column_is_zero(c->jac, j);
         use[j] = !undetermined[j];
     }
-    /* undetermined combinations, then bounds hit (closer than AT_BOUND_SD sd): each pass
-       removes parameters from the covariance, so at most 2 np passes */
-    for (size_t pass = 0; pass < 2 * np; pass++) {
+    /* undetermined combinations, then bounds hit (closer than AT_BOUND_SD sd), then columns
+       that are numerically zero (after the bounds: near a bound the column of the variable
+       vanishes with dp/dq): each pass removes parameters from the covariance, so at most
+       3 np passes */
+    for (size_t pass = 0; pass < 3 * np; pass++) {
         int dep = inverse_normal_matrix(c->jac, use, cov, undetermined);
         if (dep < 0)
             return -1;
@@ -441,6 +477,12 @@ static int fill_statistics(const struct fit_ctx* c, const double* q, const gsl_v
                 changed = true;
             }
         }
+        for (size_t j = 0; j < np && !changed; j++)
+            if (use[j] && flat_change(c, q, j) < FLAT_FRACTION * res->residual_std) {
+                flat[j] = undetermined[j] = true;
+                use[j] = false;
+                changed = true;
+            }
         if (!changed)
             break;
     }
@@ -540,11 +582,35 @@ static int report(struct fit_ctx* c, int st, gsl_matrix* cov, const struct wetde
     if (predicted)
         memcpy(predicted, c->pred, c->pb->n_data * sizeof *predicted);
     gsl_vector_view f = gsl_vector_view_array(c->r_plus, c->pb->n_data);
-    int n_und = fill_statistics(c, c->q_jac, &f.vector, cov, res);
+    bool flat[NP_MAX] = {false};
+    int n_und = fill_statistics(c, c->q_jac, &f.vector, cov, res, flat);
     if (n_und < 0)
         return wetdem_status_fail(msg, msg_size, WETDEM_ERR_NOMEM, "out of memory");
     char names[300];
     undetermined_names(c, res, names, sizeof names);
+    size_t jf = 0;
+    while (jf < np && !flat[jf])
+        jf++;
+    if (jf < np) { /* a flat start, or a fit that ran onto a plateau */
+        const struct param_map* m = &c->map[jf];
+        char step[80];
+        if (m->kind == WETDEM_FIT_LINEAR)
+            snprintf(step, sizeof step, "a change by %g", flat_step(m, c->q_jac[jf]));
+        else
+            snprintf(step, sizeof step, "a factor 10 in its distance to %s",
+                     m->kind == WETDEM_FIT_LOGISTIC ? "the nearer bound" : "its bound");
+        return wetdem_status_fail(
+            msg, msg_size, WETDEM_ERR_UNDETERMINED,
+            "the data do not determine %s: where the fit stopped, at %g (from the start %g), "
+            "the predictions hardly depend on it: %s would change the residuals by %.2g, under "
+            "%g of their scatter s = %.3g (its column of the Jacobian is numerically zero; "
+            "standard error inf)%s%s%s; start it elsewhere, nearer the value you expect, or "
+            "hold it fixed",
+            param_name(c->pb, jf), res->values[jf], c->pb->initial[jf], step,
+            flat_change(c, c->q_jac, jf), FLAT_FRACTION, res->residual_std,
+            n_und > 1 ? "; not determined: " : "", n_und > 1 ? names : "",
+            st == WETDEM_ERR_MAX_STEPS ? "; and no convergence in the iterations allowed" : "");
+    }
     if (n_und > 0)
         return wetdem_status_fail(
             msg, msg_size, WETDEM_ERR_UNDETERMINED,

@@ -15,6 +15,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <dirent.h>
 #include <sys/types.h>
 #include <sys/wait.h>
 
@@ -206,6 +207,48 @@ static inline int test_run_cli_into(const char* args, char* out, size_t n)
     snprintf(out, n, "%s", r.out);
     free(r.out);
     return r.code;
+}
+
+/* Shell commands put before the CLI (test_run_cli's env) to make writing a file fail midway:
+ * a file size limit of 1024 bytes (2 blocks of 512 for /bin/sh's ulimit; 2048 bytes with
+ * bash's 1024-byte blocks), whose signal SIGXFSZ is ignored so that the write fails with
+ * EFBIG instead of killing the program. Pipes (the output tests read) have no such limit. */
+#define TEST_FILE_SIZE_LIMIT "trap '' XFSZ; ulimit -f 2;"
+
+/* The names in directory dir, hidden ones included (not "." and ".."), each followed by a
+ * newline, sorted, in a heap buffer (the caller frees it); "" for an empty directory and NULL
+ * when dir cannot be opened (e.g. it does not exist). */
+static inline char* test_list_dir(const char* dir)
+{
+    struct dirent** names = NULL;
+    int n = scandir(dir, &names, NULL, alphasort);
+    if (n < 0)
+        return NULL;
+    size_t len = 1;
+    for (int k = 0; k < n; k++)
+        len += strlen(names[k]->d_name) + 1;
+    char* out = malloc(len);
+    assert_non_null(out);
+    out[0] = '\0';
+    for (int k = 0; k < n; k++) {
+        if (strcmp(names[k]->d_name, ".") && strcmp(names[k]->d_name, "..")) {
+            strcat(out, names[k]->d_name);
+            strcat(out, "\n");
+        }
+        free(names[k]);
+    }
+    free(names);
+    return out;
+}
+
+/* Asserts that directory dir holds exactly the names in `want` ("a\nb\n": sorted, each
+ * followed by a newline; "" for none): no half-written file, no temporary file left. */
+static inline void test_check_dir(const char* dir, const char* want)
+{
+    char* got = test_list_dir(dir);
+    if (!got || strcmp(got, want) != 0)
+        fail_msg("directory %s holds\n%s\nexpected\n%s", dir, got ? got : "(no directory)\n", want);
+    free(got);
 }
 
 #endif

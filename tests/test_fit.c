@@ -251,6 +251,62 @@ static void test_fit_rank_deficient_jacobian_gives_infinite_errors(void** state)
     CHECK_REL(r.values[0] * r.values[1], 6.03, 1e-2); /* the product is what the data fix */
 }
 
+/* y_i = 0.1 x_i + 1e-7 sin(1000 b x_i): the predictions do not depend on b beyond a jitter of
+ * 1e-7, as those of a simulation do not depend on a parameter whose effect is cut off, or does
+ * not reach them, beyond their integration noise (the Poisson ratio of the Punch striker moves
+ * e_n by 1e-8 to 1e-7, of either sign: the CLI test below). */
+static int jitter_only(const double* p, double* out, char* msg, size_t n, void* ctx)
+{
+    (void)msg, (void)n, (void)ctx;
+    for (size_t i = 0; i < 8; i++)
+        out[i] = 0.1 * (double)(i + 1) + 1e-7 * sin(1000 * p[0] * (double)(i + 1));
+    return WETDEM_OK;
+}
+
+/* A start where the predictions are flat in a parameter "converged" after a few small steps
+ * (on the small step, the difference quotients being noise) and was reported as a result,
+ * WETDEM_OK with b = 0.475 +- 251 in [0, 1]. Its column of the Jacobian is numerically zero:
+ * a factor 10 in the distance to a bound moves the residuals by 2.4e-5, under 0.1 of their
+ * scatter s = 0.011. That is WETDEM_ERR_UNDETERMINED, with the parameter, where it stopped,
+ * its start and what to do; the statistics of the last iterate stay (dof > 0, standard error
+ * inf). */
+static void test_fit_numerically_zero_column_is_undetermined(void** state)
+{
+    (void)state;
+    double obs[8];
+    const double init[1] = {0.5}, lower[1] = {0}, upper[1] = {1};
+    const char* names[1] = {"b"};
+    gsl_rng* rng = gsl_rng_alloc(gsl_rng_mt19937);
+    gsl_rng_set(rng, 11);
+    for (size_t i = 0; i < 8; i++)
+        obs[i] = 0.1 * (double)(i + 1) + gsl_ran_gaussian(rng, 0.01);
+    gsl_rng_free(rng);
+    struct wetdem_fit_problem pb = {.n_params = 1,
+                                    .names = names,
+                                    .initial = init,
+                                    .n_data = 8,
+                                    .observed = obs,
+                                    .model = jitter_only,
+                                    .lower = lower,
+                                    .upper = upper};
+    struct wetdem_fit_options o;
+    wetdem_fit_options_init(&o);
+    struct wetdem_fit_result r;
+    char msg[1024] = "";
+    int st = wetdem_fit_run(&pb, &o, &r, NULL, msg, sizeof msg);
+    if (st != WETDEM_ERR_UNDETERMINED)
+        fail_msg("status %s (b = %g +- %g): %s", wetdem_status_name(st), r.values[0],
+                 r.std_errors[0], msg);
+    CHECK_CONTAINS(msg, "the data do not determine b: where the fit stopped, at ");
+    CHECK_CONTAINS(msg, "(from the start 0.5), the predictions hardly depend on it: a factor 10 "
+                        "in its distance to the nearer bound would change the residuals by ");
+    CHECK_CONTAINS(msg, "its column of the Jacobian is numerically zero");
+    CHECK_CONTAINS(msg, "start it elsewhere, nearer the value you expect, or hold it fixed");
+    assert_true(r.undetermined[0] && isinf(r.std_errors[0]));
+    assert_int_equal(r.dof, 7);
+    assert_true(r.values[0] > 0 && r.values[0] < 1);
+}
+
 /* y_i = p x_i for p in [0, 1]: the model fails above 1, as a scenario rejects a restitution
  * above 1; it records the largest and smallest value it was asked for. */
 struct bounded {
@@ -591,6 +647,37 @@ static void test_fit_cli_reports_undetermined_keys(void** state)
     expect_cli(args, 1, "the verlet step moved the gap by");
 }
 
+/* A start where the predictions are flat in a key is not a fit: the Punch striker's Poisson
+ * ratio, from its preset's 0.35, moves e_n by 1e-8 to 1e-7 (the integration noise; the dry
+ * restitution fixes the rebound), so the fit "converged" after two steps at -0.12 +- 223,
+ * "hardly determined", with exit 0 and --out written. It is an error naming the key, where it
+ * stopped and its start, with what to do (exit 1, no --out); the table shows std_error inf. */
+static void test_fit_cli_flat_start_is_not_a_result(void** state)
+{
+    (void)state;
+    if (!getenv("WETDEM_CLI"))
+        skip();
+    char out_csv[96], args[1024];
+    snprintf(out_csv, sizeof out_csv, "/tmp/wetdem_fit_flat_%d.csv", (int)getpid());
+    snprintf(args, sizeof args,
+             "fit examples/fit/punch_db_c.ini --data examples/fit/punch_0deg.csv --fit "
+             "material.striker.poisson_ratio --out %s",
+             out_csv);
+    struct test_run r = test_run_cli("", args, true);
+    if (r.code != 1)
+        fail_msg("wetdem %s: exit %d, expected 1\n%s", args, r.code, r.out);
+    CHECK_CONTAINS(r.out, "fit: the data do not determine material.striker.poisson_ratio: where "
+                          "the fit stopped, at ");
+    CHECK_CONTAINS(r.out, "(from the start 0.35), the predictions hardly depend on it");
+    CHECK_CONTAINS(r.out, "its column of the Jacobian is numerically zero");
+    CHECK_CONTAINS(r.out, "fit: --init starts a key elsewhere; a key left out of --fit is held");
+    CHECK_CONTAINS(r.out, "material.striker.poisson_ratio,-,");
+    CHECK_CONTAINS(r.out, ",inf,0.35,logistic\n");
+    CHECK_CONTAINS(r.out, "(not a fit: a key is not determined)");
+    free(r.out);
+    assert_null(test_read_file(out_csv, NULL));
+}
+
 /* Parameter steps stay inside the key's range: from 1 MPa the unbounded log fit stepped P_gt
  * to 3.1e46 Pa and stopped with "an --init value outside the key's range" (exit 2), and a
  * dry restitution fitted from 0.9 to data simulated at 0.995 probed 1.0096. */
@@ -655,6 +742,86 @@ static void test_fit_cli_reports_units_on_example(void** state)
         fail_msg("P_gt %.4g +- %.3g Pa vs 11.6e6", value, se);
 }
 
+/* Lines in the file at path (-1 when it cannot be read); *whole: it ends with a newline. */
+static int count_lines(const char* path, bool* whole)
+{
+    size_t len;
+    char* text = test_read_file(path, &len);
+    if (!text)
+        return -1;
+    int n = 0;
+    for (size_t i = 0; i < len; i++)
+        n += text[i] == '\n';
+    *whole = len > 0 && text[len - 1] == '\n';
+    free(text);
+    return n;
+}
+
+/* --out and --curve are written whole or not at all: they were written under their final
+ * names, so a write that failed midway (here: a file size limit of 1 kB) left a cut-off file
+ * there, with exit 1 (the curve, 200 points of some 6 kB; the data-vs-fit table of 72 rows,
+ * some 3.5 kB). A fit that succeeds leaves both files whole and nothing else. */
+static void test_fit_cli_writes_files_whole_or_not_at_all(void** state)
+{
+    (void)state;
+    if (!getenv("WETDEM_CLI"))
+        skip();
+    char dir[96], args[1024], fit_csv[128], curve_csv[128];
+    snprintf(dir, sizeof dir, "/tmp/wetdem_fit_out_%d", (int)getpid());
+    snprintf(fit_csv, sizeof fit_csv, "%s/fit.csv", dir);
+    snprintf(curve_csv, sizeof curve_csv, "%s/curve.csv", dir);
+    const char* fit = "fit examples/fit/punch_db_c.ini --fit glass.p_gt --init 4e6";
+    snprintf(args, sizeof args,
+             "%s --data examples/fit/punch_0deg.csv --out %s --curve %s --curve-points 200", fit,
+             fit_csv, curve_csv);
+    struct test_run r = test_run_cli("", args, true);
+    if (r.code != 0)
+        fail_msg("wetdem %s: exit %d\n%s", args, r.code, r.out);
+    free(r.out);
+    test_check_dir(dir, "curve.csv\nfit.csv\n");
+    bool whole = false;
+    assert_int_equal(count_lines(fit_csv, &whole), 2 + 1 + 9); /* provenance, header, rows */
+    assert_true(whole);
+    assert_int_equal(count_lines(curve_csv, &whole), 2 + 1 + 200);
+    assert_true(whole);
+    remove(fit_csv);
+    remove(curve_csv);
+    /* the curve cannot be written: exit 1 and no curve file; the table (0.6 kB) is whole */
+    r = test_run_cli(TEST_FILE_SIZE_LIMIT, args, true);
+    if (r.code != 1)
+        fail_msg("wetdem %s: exit %d, expected 1\n%s", args, r.code, r.out);
+    char needle[300];
+    snprintf(needle, sizeof needle, "fit: cannot write %s: File too large", curve_csv);
+    test_check_dir(dir, "fit.csv\n");
+    CHECK_CONTAINS(r.out, needle);
+    free(r.out);
+    assert_int_equal(count_lines(fit_csv, &whole), 2 + 1 + 9);
+    assert_true(whole);
+    remove(fit_csv);
+    /* the table cannot be written: exit 1, neither file (the curve is not made then) */
+    static char data[8192];
+    int used = snprintf(data, sizeof data, "stokes_n,e_n\n");
+    char* example = test_read_file("examples/fit/punch_0deg.csv", NULL);
+    assert_non_null(example);
+    const char* rows = strstr(example, "1.6,");
+    assert_non_null(rows);
+    for (int k = 0; k < 8; k++) /* each measurement 8 times: 72 rows */
+        used += snprintf(data + used, sizeof data - (size_t)used, "%s", rows);
+    free(example);
+    char csv[96];
+    temp_csv(csv, "rows72", data);
+    snprintf(args, sizeof args, "%s --data %s --out %s --curve %s", fit, csv, fit_csv, curve_csv);
+    r = test_run_cli(TEST_FILE_SIZE_LIMIT, args, true);
+    if (r.code != 1)
+        fail_msg("wetdem %s: exit %d, expected 1\n%s", args, r.code, r.out);
+    snprintf(needle, sizeof needle, "fit: cannot write %s: File too large", fit_csv);
+    test_check_dir(dir, "");
+    CHECK_CONTAINS(r.out, needle);
+    free(r.out);
+    remove(csv);
+    rmdir(dir);
+}
+
 /* The curve file holds the fitted model at every distinct angle of the data, however many:
  * 70 angles (0, 0.5, ..., 34.5 deg), 2 curve points each, give 140 rows and 70 angles. */
 static void test_fit_cli_curve_covers_every_angle(void** state)
@@ -706,15 +873,18 @@ int main(void)
         cmocka_unit_test(test_fit_rejects_bad_problems),
         cmocka_unit_test(test_fit_zero_jacobian_column_is_an_error_not_an_abort),
         cmocka_unit_test(test_fit_rank_deficient_jacobian_gives_infinite_errors),
+        cmocka_unit_test(test_fit_numerically_zero_column_is_undetermined),
         cmocka_unit_test(test_fit_stays_inside_bounds_and_reports_a_bound),
         cmocka_unit_test(test_fit_recovers_glass_pressure_from_simulated_data),
         cmocka_unit_test(test_fit_cli_rejects_bad_input),
         cmocka_unit_test(test_fit_cli_data_file_checks),
         cmocka_unit_test(test_fit_cli_refuses_keys_it_cannot_vary),
         cmocka_unit_test(test_fit_cli_reports_undetermined_keys),
+        cmocka_unit_test(test_fit_cli_flat_start_is_not_a_result),
         cmocka_unit_test(test_fit_cli_keeps_keys_in_range),
         cmocka_unit_test(test_fit_cli_reports_units_on_example),
         cmocka_unit_test(test_fit_cli_curve_covers_every_angle),
+        cmocka_unit_test(test_fit_cli_writes_files_whole_or_not_at_all),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -9,7 +9,8 @@
  *   - --set overrides change the resolved set-up and are checked like file keys;
  *   - docs/scenarios.md contains the key tables `wetdem docs-scenarios` generates;
  *   - `run --out` writes trajectory, events and summary with unit headers, and nothing at all
- *     when the input is bad or the run fails;
+ *     when the input is bad or the run fails; nothing half-written and no temporary file when
+ *     a run fails or a file cannot be written (pairwise and soft engines);
  *   - output paths that cannot be what they name (run --out a file or empty; sweep, map and
  *     fit --out or --curve a directory, empty or under a file) exit 2 before anything runs;
  *   - `sweep` rows come in input order and are bit-identical with 1 and 2 threads, for the
@@ -470,6 +471,59 @@ static void test_scenario_run_writes_files_or_nothing(void** state)
     CHECK_CONTAINS(head, "time [s],event [word]");
 }
 
+/* No file half-written under its name, and no temporary file left, whatever stops a run: the
+ * pairwise engine streamed its trajectory to the final name (a failed run, or one whose
+ * trajectory could not be written, left it cut off there, with the events of the failed run);
+ * the soft engine left the temporary files of events and summary when the trajectory could not
+ * be kept. A run that succeeds leaves its files and nothing else. */
+static void test_scenario_run_leaves_no_partial_files(void** state)
+{
+    (void)state;
+    char out[400], args[900];
+    /* the pairwise engine runs out of its event budget: exit 1, nothing in the directory */
+    snprintf(out, sizeof out, "%s/pw_failed", tmpdir);
+    snprintf(args, sizeof args,
+             "run examples/scenarios/davis_three.ini --out '%s' --set pairwise.max_events=2", out);
+    struct test_run r = run_cli(args);
+    if (r.code != 1)
+        fail_msg("exit %d, expected 1\n%s", r.code, r.out);
+    CHECK_CONTAINS(r.out, "event budget max_events = 2 exhausted");
+    free(r.out);
+    test_check_dir(out, "");
+    /* its trajectory (some 470 kB) cannot be written past 1 kB: exit 1, nothing kept */
+    snprintf(out, sizeof out, "%s/pw_full", tmpdir);
+    snprintf(args, sizeof args, "run examples/scenarios/davis_three.ini --out '%s'", out);
+    r = test_run_cli(TEST_FILE_SIZE_LIMIT, args, true);
+    if (r.code != 1)
+        fail_msg("exit %d, expected 1\n%s", r.code, r.out);
+    char needle[600];
+    snprintf(needle, sizeof needle, "run: cannot write %s/trajectory.csv", out);
+    test_check_dir(out, "");
+    CHECK_CONTAINS(r.out, needle);
+    free(r.out);
+    /* the same run with room: its three files and nothing else */
+    r = run_cli(args);
+    if (r.code != 0)
+        fail_msg("exit %d\n%s", r.code, r.out);
+    free(r.out);
+    test_check_dir(out, "events.csv\nsummary.json\ntrajectory.csv\n");
+    /* the soft engine's trajectory (2.5 kB, buffered until it is closed) cannot be kept: exit
+       1, no trajectory and no temporary file (the events, 0.4 kB, are whole) */
+    snprintf(out, sizeof out, "%s/soft_full", tmpdir);
+    snprintf(args, sizeof args, "run examples/scenarios/dry_hertz.ini --out '%s'", out);
+    r = test_run_cli(TEST_FILE_SIZE_LIMIT, args, true);
+    if (r.code != 1)
+        fail_msg("exit %d, expected 1\n%s", r.code, r.out);
+    char* names = test_list_dir(out);
+    assert_non_null(names);
+    if (strstr(names, "tmp") || strstr(names, "trajectory"))
+        fail_msg("%s holds:\n%s", out, names);
+    free(names);
+    snprintf(needle, sizeof needle, "run: cannot write %s/trajectory.csv: File too large", out);
+    CHECK_CONTAINS(r.out, needle);
+    free(r.out);
+}
+
 /* Output paths that cannot be what they name are refused while the arguments are read, with
  * exit 2, before any collision is run: run --out that is a file, empty or under a file;
  * sweep, map and fit --out (and fit --curve) that is a directory, empty, or under a file. */
@@ -905,6 +959,7 @@ int main(void)
         cmocka_unit_test(test_scenario_unresolved_hmin_is_reported),
         cmocka_unit_test(test_scenario_docs_list_every_key),
         cmocka_unit_test(test_scenario_run_writes_files_or_nothing),
+        cmocka_unit_test(test_scenario_run_leaves_no_partial_files),
         cmocka_unit_test(test_scenario_bad_output_paths_exit_2),
         cmocka_unit_test(test_scenario_batch_keys_rows_and_outputs),
         cmocka_unit_test(test_scenario_interrupted_map_writes_what_ran),

@@ -16,6 +16,7 @@
  */
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <gsl/gsl_randist.h>
@@ -778,6 +779,49 @@ static void test_track_cli_exits_2_with_line_number(void** state)
     CHECK_CONTAINS(out, "fps = 0: must be a frame rate in (0, 1e9] [1/s]");
 }
 
+/* --frames is written whole or not at all: it was written under its final name, so a write
+ * that failed midway (a file size limit of 1 kB; the frames of the example track are some
+ * 30 kB) left a cut-off file there, with exit 1. A track that succeeds leaves the whole file
+ * and nothing else. */
+static void test_track_cli_writes_frames_whole_or_not_at_all(void** state)
+{
+    (void)state;
+    if (!getenv("WETDEM_CLI"))
+        skip();
+    char dir[96], frames[128], args[512];
+    snprintf(dir, sizeof dir, "/tmp/wetdem_track_out_%d", (int)getpid());
+    snprintf(frames, sizeof frames, "%s/frames.csv", dir);
+    assert_int_equal(mkdir(dir, 0700), 0);
+    snprintf(args, sizeof args,
+             "track examples/tracks/punch_45deg.csv --fps 5000 --pixel-size 175e-6 --frames %s",
+             frames);
+    struct test_run r = test_run_cli(TEST_FILE_SIZE_LIMIT, args, true);
+    if (r.code != 1)
+        fail_msg("wetdem %s: exit %d, expected 1\n%s", args, r.code, r.out);
+    char needle[300];
+    snprintf(needle, sizeof needle, "track: cannot write %s: File too large", frames);
+    test_check_dir(dir, "");
+    CHECK_CONTAINS(r.out, needle);
+    free(r.out);
+    r = test_run_cli("", args, true);
+    if (r.code != 0)
+        fail_msg("wetdem %s: exit %d\n%s", args, r.code, r.out);
+    free(r.out);
+    test_check_dir(dir, "frames.csv\n");
+    size_t len;
+    char* text = test_read_file(frames, &len);
+    assert_non_null(text);
+    size_t lines = 0;
+    for (size_t i = 0; i < len; i++)
+        lines += text[i] == '\n';
+    /* provenance, header, and a row per interval of each sphere: 120 frames each */
+    assert_int_equal(lines, 2 + 1 + 2 * 119);
+    assert_true(len > 0 && text[len - 1] == '\n');
+    free(text);
+    remove(frames);
+    rmdir(dir);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -790,6 +834,7 @@ int main(void)
         cmocka_unit_test(test_track_rejects_malformed_files),
         cmocka_unit_test(test_track_rejects_short_or_mismatched_tracks),
         cmocka_unit_test(test_track_cli_exits_2_with_line_number),
+        cmocka_unit_test(test_track_cli_writes_frames_whole_or_not_at_all),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
