@@ -179,6 +179,25 @@ static inline bool test_signal_pending(pid_t pid, int sig)
     return pending;
 }
 
+/* Whether process pid has a handler of signal sig installed (/proc/PID/status: SigCgt). A test
+ * that interrupts a command waits for it: a signal sent before the handler is in place (a slow
+ * start, as under the sanitizers) kills the process instead of testing the handler. */
+static inline bool test_signal_caught(pid_t pid, int sig)
+{
+    char path[64], line[256];
+    snprintf(path, sizeof path, "/proc/%d/status", (int)pid);
+    FILE* f = fopen(path, "r");
+    bool caught = false;
+    while (f && fgets(line, sizeof line, f)) {
+        unsigned long long mask;
+        if (sscanf(line, "SigCgt: %llx", &mask) == 1 && (mask >> (sig - 1)) & 1u)
+            caught = true;
+    }
+    if (f)
+        fclose(f);
+    return caught;
+}
+
 struct test_run {
     char* out;
     int code;

@@ -641,7 +641,9 @@ static void test_scenario_interrupted_map_writes_what_ran(void** state)
     (void)state;
     char cmd[1400];
     snprintf(cmd, sizeof cmd, "%s/int.csv", tmpdir);
-    /* 10^4 three-sphere collisions: ~10 s on two cores, interrupted after 0.5 s */
+    /* 10^4 three-sphere collisions: ~10 s on two cores, interrupted 0.5 s after the map has
+       put its handler in place (not 0.5 s after the start: a slow start, as under the
+       sanitizers, would let the signal kill it before the handler is there) */
     pid_t pid = fork();
     assert_true(pid >= 0);
     if (pid == 0) {
@@ -652,6 +654,9 @@ static void test_scenario_interrupted_map_writes_what_ran(void** state)
               "--values2", "0:80:100", "--out", cmd, (char*)NULL);
         _exit(127);
     }
+    struct timespec nap = {0, 1000000};
+    for (int k = 0; k < 60000 && !test_signal_caught(pid, SIGINT); k++) /* up to a minute */
+        nanosleep(&nap, NULL);
     usleep(500000);
     /* twice back to back, as GNU timeout does (the process, then its group), the second as
        soon as the first is delivered: one request (the second killed the map at once) */
