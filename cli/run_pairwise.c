@@ -15,6 +15,7 @@
  * override the [davis] run length. Spheres are numbered from 1 in every output (Davis's
  * numbering: sphere 1 is the striker); the library counts from 0.
  */
+#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -427,6 +428,7 @@ static void print_check(const struct cli_scenario* sc, const struct wetdem_pairw
 /* Observer writing one trajectory row per frame. */
 struct traj {
     FILE* f;
+    int err; /* errno of the first write that failed (EIO if none was set), 0 */
 };
 
 static int write_frame(const struct wetdem_pairwise_frame* fr, void* ctx)
@@ -443,7 +445,10 @@ static int write_frame(const struct wetdem_pairwise_frame* fr, void* ctx)
     fprintf(t->f, ",%.12g,%.12g,%.12g,%.12g,%.12g,%.12g,%.12g", e->kinetic, e->capillary,
             e->gravity, e->viscous_normal, e->viscous_tangential, e->contact, e->residual);
     fputc('\n', t->f);
-    return ferror(t->f) ? -1 : 0;
+    if (!ferror(t->f))
+        return 0;
+    t->err = errno ? errno : EIO;
+    return -1;
 }
 
 static void trajectory_header(FILE* f, size_t n)
@@ -505,19 +510,22 @@ static int run_with_files(const struct cli_scenario* sc, const struct cli_run_op
     }
     if (cli_out_open(&ft, "run", opt->out_dir, traj_name) != 0)
         return CLI_EXIT_RUNTIME;
-    struct traj t = {ft.f};
+    struct traj t = {ft.f, 0};
     if (ft.f) {
         cli_print_provenance(ft.f, opt->argc, opt->argv);
         trajectory_header(ft.f, cfg->n_spheres);
         wetdem_pairwise_set_observer(pw, dt, write_frame, &t);
     }
+    errno = 0;
     *status = wetdem_pairwise_run(pw, cfg, r);
     *ran = true;
     if (*status != WETDEM_OK) {
-        if (ft.f && ferror(ft.f)) /* (what stopped the observer) */
-            cli_error("run: cannot write %s: a write failed", ft.final);
         cli_out_close(&ft, "run", false);
-        return CLI_EXIT_OK; /* (the caller reports the status) */
+        if (!t.err)
+            return CLI_EXIT_OK; /* (the caller reports the status) */
+        /* the observer stopped the run: the write is what failed, not the simulation */
+        cli_error("run: cannot write %s: %s", ft.final, strerror(t.err));
+        return CLI_EXIT_RUNTIME;
     }
     if (cli_out_open(&fe, "run", opt->out_dir, out_name(sc, "events", "events.csv")) != 0 ||
         cli_out_open(&fs, "run", opt->out_dir, out_name(sc, "summary", "summary.json")) != 0) {
@@ -563,7 +571,9 @@ int cli_run_pairwise(const struct cli_scenario* sc, const struct cli_run_options
     if (opt->out_dir) {
         bool ran = false;
         rc = run_with_files(sc, opt, &cfg, pw, &r, &status, &ran);
-        if (!ran) { /* refused, or no directory: no result to report */
+        /* refused, no directory, or a failed run whose failure was reported (its trajectory
+           could not be written): no result to report */
+        if (!ran || (rc != CLI_EXIT_OK && status != WETDEM_OK)) {
             wetdem_pairwise_free(pw);
             return rc;
         }

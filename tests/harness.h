@@ -158,25 +158,34 @@ static inline char* test_read_file(const char* path, size_t* len)
 
 /* Output of one CLI run (heap buffer, the caller frees it) and its exit code (-1 if the
  * program did not exit normally). */
+/* Whether bit sig of any of the masks named in `fields` ("SigPnd:", ...) of /proc/PID/status
+ * is set. */
+static inline bool test_proc_signal_bit(pid_t pid, const char* const* fields, int sig)
+{
+    char path[64], line[256];
+    snprintf(path, sizeof path, "/proc/%d/status", (int)pid);
+    FILE* f = fopen(path, "r");
+    bool set = false;
+    while (f && fgets(line, sizeof line, f))
+        for (const char* const* field = fields; *field; field++) {
+            size_t len = strlen(*field);
+            unsigned long long mask;
+            if (strncmp(line, *field, len) == 0 && sscanf(line + len, " %llx", &mask) == 1 &&
+                (mask >> (sig - 1)) & 1u)
+                set = true;
+        }
+    if (f)
+        fclose(f);
+    return set;
+}
+
 /* Whether signal sig is pending for process pid, not yet delivered (/proc/PID/status: SigPnd
  * for the thread, ShdPnd for the process): a second signal sent while the first is pending
  * merges with it, so a test of two signals waits for the first to be delivered. */
 static inline bool test_signal_pending(pid_t pid, int sig)
 {
-    char path[64], line[256];
-    snprintf(path, sizeof path, "/proc/%d/status", (int)pid);
-    FILE* f = fopen(path, "r");
-    bool pending = false;
-    while (f && fgets(line, sizeof line, f)) {
-        unsigned long long mask;
-        if ((sscanf(line, "SigPnd: %llx", &mask) == 1 ||
-             sscanf(line, "ShdPnd: %llx", &mask) == 1) &&
-            (mask >> (sig - 1)) & 1u)
-            pending = true;
-    }
-    if (f)
-        fclose(f);
-    return pending;
+    static const char* const fields[] = {"SigPnd:", "ShdPnd:", NULL};
+    return test_proc_signal_bit(pid, fields, sig);
 }
 
 /* Whether process pid has a handler of signal sig installed (/proc/PID/status: SigCgt). A test
@@ -184,18 +193,8 @@ static inline bool test_signal_pending(pid_t pid, int sig)
  * start, as under the sanitizers) kills the process instead of testing the handler. */
 static inline bool test_signal_caught(pid_t pid, int sig)
 {
-    char path[64], line[256];
-    snprintf(path, sizeof path, "/proc/%d/status", (int)pid);
-    FILE* f = fopen(path, "r");
-    bool caught = false;
-    while (f && fgets(line, sizeof line, f)) {
-        unsigned long long mask;
-        if (sscanf(line, "SigCgt: %llx", &mask) == 1 && (mask >> (sig - 1)) & 1u)
-            caught = true;
-    }
-    if (f)
-        fclose(f);
-    return caught;
+    static const char* const fields[] = {"SigCgt:", NULL};
+    return test_proc_signal_bit(pid, fields, sig);
 }
 
 struct test_run {
@@ -268,6 +267,22 @@ static inline void test_check_dir(const char* dir, const char* want)
     if (!got || strcmp(got, want) != 0)
         fail_msg("directory %s holds\n%s\nexpected\n%s", dir, got ? got : "(no directory)\n", want);
     free(got);
+}
+
+/* Runs the CLI with ARGS under TEST_FILE_SIZE_LIMIT and asserts that it exits 1 with
+ * "<cmd>: cannot write <path>: File too large" and that directory dir then holds exactly
+ * `want` (test_check_dir): a write that fails midway leaves no cut-off or temporary file. */
+static inline void test_check_write_fails(const char* args, const char* cmd, const char* path,
+                                          const char* dir, const char* want)
+{
+    struct test_run r = test_run_cli(TEST_FILE_SIZE_LIMIT, args, true);
+    if (r.code != 1)
+        fail_msg("wetdem %s: exit %d, expected 1\n%s", args, r.code, r.out);
+    char needle[1100];
+    snprintf(needle, sizeof needle, "%s: cannot write %s: File too large", cmd, path);
+    test_check_dir(dir, want);
+    CHECK_CONTAINS(r.out, needle);
+    free(r.out);
 }
 
 #endif

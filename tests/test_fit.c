@@ -787,14 +787,7 @@ static void test_fit_cli_writes_files_whole_or_not_at_all(void** state)
     remove(fit_csv);
     remove(curve_csv);
     /* the curve cannot be written: exit 1 and no curve file; the table (0.6 kB) is whole */
-    r = test_run_cli(TEST_FILE_SIZE_LIMIT, args, true);
-    if (r.code != 1)
-        fail_msg("wetdem %s: exit %d, expected 1\n%s", args, r.code, r.out);
-    char needle[300];
-    snprintf(needle, sizeof needle, "fit: cannot write %s: File too large", curve_csv);
-    test_check_dir(dir, "fit.csv\n");
-    CHECK_CONTAINS(r.out, needle);
-    free(r.out);
+    test_check_write_fails(args, "fit", curve_csv, dir, "fit.csv\n");
     assert_int_equal(count_lines(fit_csv, &whole), 2 + 1 + 9);
     assert_true(whole);
     remove(fit_csv);
@@ -811,13 +804,7 @@ static void test_fit_cli_writes_files_whole_or_not_at_all(void** state)
     char csv[96];
     temp_csv(csv, "rows72", data);
     snprintf(args, sizeof args, "%s --data %s --out %s --curve %s", fit, csv, fit_csv, curve_csv);
-    r = test_run_cli(TEST_FILE_SIZE_LIMIT, args, true);
-    if (r.code != 1)
-        fail_msg("wetdem %s: exit %d, expected 1\n%s", args, r.code, r.out);
-    snprintf(needle, sizeof needle, "fit: cannot write %s: File too large", fit_csv);
-    test_check_dir(dir, "");
-    CHECK_CONTAINS(r.out, needle);
-    free(r.out);
+    test_check_write_fails(args, "fit", fit_csv, dir, "");
     remove(csv);
     rmdir(dir);
 }
