@@ -20,6 +20,7 @@
 #include "cli_util.h"
 #include "output_csv.h"
 #include "scenario.h"
+#include "signals.h"
 
 #define MAX_SETS 256
 
@@ -129,15 +130,24 @@ static int run_soft(const struct cli_scenario* sc, struct cli_setup* su, const s
         return CLI_EXIT_RUNTIME;
     struct cli_trajectory t = {
         .f = traj.f, .target_is_wall = su->spec.target_is_wall, .argc = argc, .argv = argv};
-    if (traj.f)
+    struct cli_saved_signals saved;
+    if (traj.f) {
         wetdem_sim_set_observer(su->sim, su->trajectory_interval, cli_trajectory_observe, &t);
+        cli_signals_install_run(traj.tmp, &saved);
+    }
     struct wetdem_collision_result res;
+    errno = 0;
     int st = wetdem_collision_run(su->sim, &su->spec, &res);
-    if (st < 0) {
-        cli_error("run %s: %s (%s)", sc->file, wetdem_sim_errmsg(su->sim), wetdem_status_name(st));
-        if (traj.f && ferror(traj.f)) /* (what stopped the observer) */
-            cli_error("run: cannot write %s: a write failed", traj.final);
+    int stopped = traj.f ? cli_signals_finish_run("run", &saved) : 0;
+    if (stopped || st < 0) {
         cli_out_close(&traj, "run", false);
+        if (stopped)
+            return stopped;
+        if (t.err) /* the observer stopped the run: the write failed, not the simulation */
+            cli_error("run: cannot write %s: %s", traj.final, strerror(t.err));
+        else
+            cli_error("run %s: %s (%s)", sc->file, wetdem_sim_errmsg(su->sim),
+                      wetdem_status_name(st));
         return CLI_EXIT_RUNTIME;
     }
     cli_setup_capture(su, &res);

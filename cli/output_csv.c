@@ -7,11 +7,13 @@
  * the models' forces depend on per-pair history (tangential spring, largest approach speed
  * for h_eps) that an observer cannot see, so a recomputed force would be wrong.
  */
+#include <errno.h>
 #include <math.h>
 #include <string.h>
 
 #include "cli_util.h"
 #include "output_csv.h"
+#include "signals.h"
 
 #define RAD2DEG (180.0 / 3.14159265358979323846)
 
@@ -371,5 +373,9 @@ int cli_trajectory_observe(const struct wetdem_sim* sim, void* ctx)
     double gap, v_n;
     pair_gap(sim, t, &gap, &v_n);
     fprintf(t->f, ",%.12g,%.12g\n", gap, v_n);
-    return ferror(t->f) ? 1 : 0;
+    if (ferror(t->f)) {
+        t->err = errno ? errno : EIO;
+        return 1;
+    }
+    return cli_stop_signal ? 1 : 0;
 }

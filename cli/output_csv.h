@@ -73,13 +73,15 @@ void cli_events_csv(FILE* f, const struct wetdem_sim* sim, int argc, char** argv
 /* Trajectory writer: pass as the observer context of wetdem_sim_set_observer(). */
 struct cli_trajectory {
     FILE* f;
+    int err; /* errno of the first write that failed (EIO if none was set), 0 */
     bool header_done;
     bool target_is_wall;
     int argc;
     char** argv;
 };
 /* Observer writing one row: time, position, velocity and spin of each particle, the gap and
- * the normal approach speed of the pair. Returns 0, or 1 if the file cannot be written. */
+ * the normal approach speed of the pair. Returns 0, or 1 to stop the run: the file cannot be
+ * written (t->err), or a signal asked the command to stop (cli_stop_signal). */
 int cli_trajectory_observe(const struct wetdem_sim* sim, void* ctx);
 
 /* A number as JSON (null for NaN or infinity). */

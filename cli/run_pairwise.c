@@ -24,6 +24,7 @@
 #include "cli_util.h"
 #include "output_csv.h"
 #include "scenario.h"
+#include "signals.h"
 
 #define NUM CLI_KEY_NUMBER
 #define COUNT CLI_KEY_COUNT
@@ -446,7 +447,7 @@ static int write_frame(const struct wetdem_pairwise_frame* fr, void* ctx)
             e->gravity, e->viscous_normal, e->viscous_tangential, e->contact, e->residual);
     fputc('\n', t->f);
     if (!ferror(t->f))
-        return 0;
+        return cli_stop_signal ? -1 : 0; /* (a signal asked the command to stop) */
     t->err = errno ? errno : EIO;
     return -1;
 }
@@ -511,14 +512,23 @@ static int run_with_files(const struct cli_scenario* sc, const struct cli_run_op
     if (cli_out_open(&ft, "run", opt->out_dir, traj_name) != 0)
         return CLI_EXIT_RUNTIME;
     struct traj t = {ft.f, 0};
+    struct cli_saved_signals saved;
     if (ft.f) {
         cli_print_provenance(ft.f, opt->argc, opt->argv);
         trajectory_header(ft.f, cfg->n_spheres);
         wetdem_pairwise_set_observer(pw, dt, write_frame, &t);
+        cli_signals_install_run(ft.tmp, &saved);
     }
     errno = 0;
     *status = wetdem_pairwise_run(pw, cfg, r);
     *ran = true;
+    int stopped = ft.f ? cli_signals_finish_run("run", &saved) : 0;
+    if (stopped) {
+        cli_out_close(&ft, "run", false);
+        if (*status == WETDEM_OK)
+            *status = WETDEM_ERR_CALLBACK; /* (the caller reports nothing more) */
+        return stopped;
+    }
     if (*status != WETDEM_OK) {
         cli_out_close(&ft, "run", false);
         if (!t.err)

@@ -90,3 +90,24 @@ void cli_signals_restore(const struct cli_saved_signals* saved)
     sigaction(SIGINT, &saved->sigint, NULL);
     sigaction(SIGTERM, &saved->sigterm, NULL);
 }
+
+void cli_signals_install_run(const char* tmp, struct cli_saved_signals* saved)
+{
+    cli_signals_install("\nwetdem: run: stopping; this run's files are not kept (a second "
+                        "signal 1 s or more after this one, or a third, stops at once)\n",
+                        "\nwetdem: run: stopped at once by a repeated signal\n", tmp, saved);
+}
+
+int cli_signals_finish_run(const char* what, const struct cli_saved_signals* saved)
+{
+    int sig = (int)cli_stop_signal;
+    if (!sig) {
+        cli_signals_restore(saved);
+        return 0;
+    }
+    fprintf(stderr,
+            "wetdem: %s: interrupted by signal %d: no file written (a run's files are kept "
+            "only whole)\n",
+            what, sig);
+    return 128 + sig;
+}

@@ -1,7 +1,8 @@
 /*
  * signals.h — SIGINT and SIGTERM for the long commands (`run` of many particles, `sweep`,
- * `map`): the first signal asks the command to stop cleanly (write its checkpoint, or the
- * table of the points that ran); a repeat within CLI_SIGNAL_GRACE_S of it is taken as the same
+ * `map`, and `run --out` of one collision while its trajectory is written): the first signal
+ * asks the command to stop cleanly (write its checkpoint, or the table of the points that ran;
+ * a single collision keeps no file, as its files are written whole or not at all); a repeat within CLI_SIGNAL_GRACE_S of it is taken as the same
  * request (GNU timeout signals the process, then its process group, which holds the process:
  * two signals milliseconds apart); a second signal after that, or a third, stops at once by
  * the signal's default action. A signal ignored when the handlers are installed (nohup, a
@@ -40,5 +41,15 @@ void cli_signals_install(const char* notice, const char* stop_note, const char* 
  * duplicate arriving once the command has finished would otherwise kill it, turning its exit
  * code into death by the signal. */
 void cli_signals_restore(const struct cli_saved_signals* saved);
+
+/* A single run whose file `tmp` (a trajectory under its temporary name) is open while it runs:
+ * the first SIGINT or SIGTERM asks the run to stop (its observer returns non-zero when
+ * cli_stop_signal is set), and a repeated one removes `tmp` before it stops at once. */
+void cli_signals_install_run(const char* tmp, struct cli_saved_signals* saved);
+
+/* After such a run: 0 when no signal came (the handlers put back), otherwise prints "wetdem:
+ * <what>: interrupted by signal N: ..." and returns the exit code 128 + N (the handlers kept,
+ * as cli_signals_restore says). The caller has removed the run's temporary files. */
+int cli_signals_finish_run(const char* what, const struct cli_saved_signals* saved);
 
 #endif

@@ -680,6 +680,51 @@ static void test_scenario_interrupted_map_writes_what_ran(void** state)
     free(table);
 }
 
+/* Runs `wetdem run FILE --set SET1 --set SET2 --set SET3 --out tmpdir/NAME` (a collision of
+ * about 5-10 s), sends SIGINT once its handler is in place and 0.3 s more have passed, and
+ * checks that it stops with exit 130 and leaves no file, not even a temporary one: a
+ * collision's files are written whole or not at all. */
+static void check_interrupted_run_keeps_nothing(const char* file, const char* const sets[3],
+                                                const char* name)
+{
+    char out[512];
+    snprintf(out, sizeof out, "%s/%s", tmpdir, name);
+    pid_t pid = fork();
+    assert_true(pid >= 0);
+    if (pid == 0) {
+        signal(SIGINT, SIG_DFL);
+        freopen("/dev/null", "w", stdout);
+        freopen("/dev/null", "w", stderr);
+        execl(test_cli_path(), test_cli_path(), "run", file, "--set", sets[0], "--set", sets[1],
+              "--set", sets[2], "--out", out, (char*)NULL);
+        _exit(127);
+    }
+    struct timespec nap = {0, 1000000};
+    for (int k = 0; k < 60000 && !test_signal_caught(pid, SIGINT); k++) /* up to a minute */
+        nanosleep(&nap, NULL);
+    usleep(300000);
+    kill(pid, SIGINT);
+    int status = 0;
+    waitpid(pid, &status, 0);
+    if (!WIFEXITED(status))
+        fail_msg("run %s died by signal %d instead of stopping", file, WTERMSIG(status));
+    assert_int_equal(WEXITSTATUS(status), 130);
+    test_check_dir(out, "");
+    rmdir(out);
+}
+
+/* SIGINT during `run --out` of one collision, soft (Verlet at a tiny step, ~10 s) and
+ * pairwise (t* = 2e5, ~5 s): exit 130, no file and no temporary file (they were left as
+ * hidden .NAME.tmpPID files, the process killed by the signal). */
+static void test_scenario_interrupted_run_keeps_nothing(void** state)
+{
+    (void)state;
+    const char* soft[3] = {"integrator.name=verlet", "verlet.dt=1e-8", "integrator.max_steps=1e12"};
+    check_interrupted_run_keeps_nothing("examples/scenarios/nijssen_head_on.ini", soft, "soft_int");
+    const char* pairwise[3] = {"davis.t_star_end=200000", "davis.capillary=1000", "davis.stokes=2"};
+    check_interrupted_run_keeps_nothing("examples/scenarios/davis_three.ini", pairwise, "pw_int");
+}
+
 /* Data lines (not starting with '#') of a sweep. */
 static char* data_lines(const char* text)
 {
@@ -964,6 +1009,7 @@ int main(void)
         cmocka_unit_test(test_scenario_bad_output_paths_exit_2),
         cmocka_unit_test(test_scenario_batch_keys_rows_and_outputs),
         cmocka_unit_test(test_scenario_interrupted_map_writes_what_ran),
+        cmocka_unit_test(test_scenario_interrupted_run_keeps_nothing),
         cmocka_unit_test(test_scenario_sweep_order_and_threads),
         cmocka_unit_test(test_scenario_sweep_point_equals_run),
         cmocka_unit_test(test_scenario_sweep_pairwise_threads_and_status),
