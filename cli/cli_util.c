@@ -178,7 +178,7 @@ static void parent_dir(const char* path, char* dir, size_t n)
     snprintf(dir, n, "%s", path);
     char* slash = strrchr(dir, '/');
     if (slash)
-        *slash = '\0';
+        slash[slash == dir] = '\0'; /* ("/x": "/") */
     else
         dir[0] = '\0';
 }
@@ -216,18 +216,54 @@ int cli_check_output_path(const char* what, const char* option, const char* path
     return CLI_EXIT_OK;
 }
 
+/* Where output to `path` goes: *direct when path exists and is not a regular file (a device
+ * such as /dev/stdout or /dev/null, a FIFO, a process substitution), which is written in place,
+ * never replaced; otherwise the regular file that path names, with a symbolic link followed to
+ * its target (so the link stays a link), written under a temporary name next to it and renamed
+ * over it when whole. */
+static void output_target(const char* path, char* final, size_t n, bool* direct)
+{
+    struct stat st;
+    *direct = false;
+    snprintf(final, n, "%s", path);
+    if (lstat(path, &st) != 0)
+        return; /* a new file */
+    if (S_ISLNK(st.st_mode)) {
+        char* target = realpath(path, NULL);
+        if (target && stat(target, &st) == 0 && S_ISREG(st.st_mode))
+            snprintf(final, n, "%s", target);
+        else
+            *direct = true; /* (a link to a device, or a dangling one: written through) */
+        free(target);
+        return;
+    }
+    *direct = !S_ISREG(st.st_mode);
+}
+
 int cli_check_writable(const char* what, const char* option, const char* path)
 {
     if (!path)
         return CLI_EXIT_OK;
-    char dir[1024], tmp[1100];
+    char dir[1400], tmp[2900];
     parent_dir(path, dir, sizeof dir);
     if (dir[0] && cli_make_dirs(dir) != 0) {
         cli_error("%s: %s %s: cannot create directory %s: %s", what, option, path, dir,
                   strerror(errno));
         return CLI_EXIT_USAGE;
     }
-    snprintf(tmp, sizeof tmp, "%s.tmp%ld", path, (long)getpid()); /* (the name written later) */
+    char final[1400];
+    bool direct;
+    output_target(path, final, sizeof final, &direct);
+    if (direct) { /* written in place (a device, a FIFO: not opened here, it could block) */
+        if (access(final, W_OK) == 0)
+            return CLI_EXIT_OK;
+        cli_error("%s: %s %s cannot be written: %s", what, option, path, strerror(errno));
+        return CLI_EXIT_USAGE;
+    }
+    parent_dir(final, dir, sizeof dir);
+    snprintf(tmp, sizeof tmp, "%s/%s.tmp%ld", dir[0] ? dir : ".",
+             strrchr(final, '/') ? strrchr(final, '/') + 1 : final,
+             (long)getpid()); /* (the name written later) */
     FILE* f = fopen(tmp, "w");
     if (!f) {
         cli_error("%s: %s %s cannot be written: %s", what, option, path, strerror(errno));
@@ -238,22 +274,38 @@ int cli_check_writable(const char* what, const char* option, const char* path)
     return CLI_EXIT_OK;
 }
 
-/* Closes f, written under the name tmp; with keep, renames it to path when every write
- * succeeded, otherwise (or without keep) removes it. 0, or -1 after printing "wetdem: <what>:
- * cannot write <path>: <why>" when keep was asked for but the file could not be kept. */
-static int finish_file(FILE* f, const char* tmp, const char* path, const char* what, bool keep)
+/* Opens the file that output to `path` writes: in place (o->direct) or under the temporary
+ * name of its target (o->tmp). 0, or -1 with errno set. */
+static int open_output(struct cli_out_file* o, const char* path, const char* tmp_format)
 {
-    bool bad = ferror(f) != 0; /* a write failed (its errno may be long gone) */
+    output_target(path, o->final, sizeof o->final, &o->direct);
+    if (o->direct) {
+        snprintf(o->tmp, sizeof o->tmp, "%s", o->final);
+        o->f = fopen(o->final, "w");
+    } else {
+        /* the temporary name: tmp_format applied to the target's directory and base name */
+        char dir[1400];
+        parent_dir(o->final, dir, sizeof dir);
+        const char* base = strrchr(o->final, '/');
+        base = base ? base + 1 : o->final;
+        snprintf(o->tmp, sizeof o->tmp, tmp_format, dir[0] ? dir : ".", base, (long)getpid());
+        o->f = fopen(o->tmp, "w");
+    }
+    return o->f ? 0 : -1;
+}
+
+/* Closes o's stream: 0 when every write reached the file, otherwise the errno of the failure
+ * (EIO when none is known; a failed write's errno may be long gone, flushing the rest fails
+ * again with the reason). */
+static int close_stream(struct cli_out_file* o)
+{
+    if (!o->f)
+        return 0;
+    bool bad = ferror(o->f) != 0;
     errno = 0;
-    int err = fclose(f) != 0 ? errno : 0; /* (flushing the rest: fails again, with the reason) */
-    if (keep && !bad && !err && rename(tmp, path) == 0)
-        return 0;
-    err = err ? err : errno;
-    remove(tmp);
-    if (!keep)
-        return 0;
-    cli_error("%s: cannot write %s: %s", what, path, err ? strerror(err) : "a write failed");
-    return -1;
+    int err = fclose(o->f) != 0 ? (errno ? errno : EIO) : 0;
+    o->f = NULL;
+    return err ? err : bad ? EIO : 0;
 }
 
 int cli_write_output(const char* path, const char* what, void (*write)(FILE* f, const void* ctx),
@@ -269,28 +321,27 @@ int cli_write_output(const char* path, const char* what, void (*write)(FILE* f, 
         cli_error("%s: cannot create directory %s for %s: %s", what, dir, path, strerror(errno));
         return CLI_EXIT_RUNTIME;
     }
-    char tmp[1100];
-    snprintf(tmp, sizeof tmp, "%s.tmp%ld", path, (long)getpid());
-    FILE* f = fopen(tmp, "w");
-    if (!f) {
-        cli_error("%s: cannot write %s: %s", what, tmp, strerror(errno));
+    struct cli_out_file o;
+    if (open_output(&o, path, "%s/%s.tmp%ld") != 0) {
+        cli_error("%s: cannot write %s: %s", what, path, strerror(errno));
         return CLI_EXIT_RUNTIME;
     }
-    write(f, ctx);
-    return finish_file(f, tmp, path, what, true) == 0 ? CLI_EXIT_OK : CLI_EXIT_RUNTIME;
+    write(o.f, ctx);
+    struct cli_out_file* files[1] = {&o};
+    return cli_out_close_all(files, 1, what, true) == 0 ? CLI_EXIT_OK : CLI_EXIT_RUNTIME;
 }
 
 int cli_out_open(struct cli_out_file* o, const char* what, const char* dir, const char* name)
 {
     o->f = NULL;
     o->final[0] = o->tmp[0] = '\0';
+    o->direct = false;
     if (!dir || !name[0])
         return 0;
-    snprintf(o->final, sizeof o->final, "%s/%s", dir, name);
-    snprintf(o->tmp, sizeof o->tmp, "%s/.%s.tmp%ld", dir, name, (long)getpid());
-    o->f = fopen(o->tmp, "w");
-    if (!o->f) {
-        cli_error("%s: cannot write %s: %s", what, o->tmp, strerror(errno));
+    char path[1400];
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    if (open_output(o, path, "%s/.%s.tmp%ld") != 0) {
+        cli_error("%s: cannot write %s: %s", what, path, strerror(errno));
         return -1;
     }
     return 0;
@@ -298,11 +349,39 @@ int cli_out_open(struct cli_out_file* o, const char* what, const char* dir, cons
 
 int cli_out_close(struct cli_out_file* o, const char* what, bool keep)
 {
-    if (!o->f)
+    struct cli_out_file* files[1] = {o};
+    return cli_out_close_all(files, 1, what, keep);
+}
+
+int cli_out_close_all(struct cli_out_file* const* files, size_t n, const char* what, bool keep)
+{
+    int failed = -1, err = 0; /* the first file that could not be written whole, and why */
+    for (size_t k = 0; k < n; k++) {
+        bool was_open = files[k]->f != NULL;
+        int e = close_stream(files[k]);
+        if (was_open && e && failed < 0) {
+            failed = (int)k;
+            err = e;
+        }
+    }
+    keep = keep && failed < 0;
+    for (size_t k = 0; k < n; k++) {
+        struct cli_out_file* o = files[k];
+        if (!o->tmp[0] || o->direct)
+            continue; /* (not wanted; or written in place, which cannot be taken back) */
+        if (keep && rename(o->tmp, o->final) != 0 && failed < 0) {
+            failed = (int)k;
+            err = errno;
+            keep = false; /* the rest are removed: the set is incomplete */
+        }
+        if (!keep)
+            remove(o->tmp);
+        o->tmp[0] = '\0';
+    }
+    if (failed < 0)
         return 0;
-    FILE* f = o->f;
-    o->f = NULL;
-    return finish_file(f, o->tmp, o->final, what, keep);
+    cli_error("%s: cannot write %s: %s", what, files[failed]->final, strerror(err));
+    return -1;
 }
 
 const char* cli_article(const char* word)

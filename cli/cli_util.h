@@ -98,17 +98,26 @@ int cli_write_output(const char* path, const char* what, void (*write)(FILE* f, 
  * leaves nothing half-written under the final name. */
 struct cli_out_file {
     char final[1400], tmp[1400];
-    FILE* f; /* NULL: not open (no directory, or the name is empty: the file is not wanted) */
+    FILE* f;     /* NULL: not open (no directory, or the name is empty: the file is not wanted) */
+    bool direct; /* the name is a device or FIFO (/dev/stdout, /dev/null): written in place */
 };
 
 /* Opens the temporary file of DIR/NAME (nothing when dir is NULL or name empty: o->f NULL).
- * 0, or -1 after printing "wetdem: <what>: cannot write <tmp>: <why>". */
+ * A symbolic link is followed (its target is replaced, the link kept); a name that is a device
+ * or FIFO is written in place. 0, or -1 after printing "wetdem: <what>: cannot write
+ * DIR/NAME: <why>". */
 int cli_out_open(struct cli_out_file* o, const char* what, const char* dir, const char* name);
 
 /* Closes o; with keep, renames it to its final name when everything was written, otherwise
  * (or without keep) removes the temporary file. 0, or -1 after printing "wetdem: <what>:
  * cannot write <final>: <why>" when keep was asked for but the file could not be kept. */
 int cli_out_close(struct cli_out_file* o, const char* what, bool keep);
+
+/* Closes the n files of one result as a set: with keep, and only when every one was written
+ * whole, renames them all to their final names; otherwise removes every temporary file, so a
+ * run never leaves some of its files beside older ones. Files not open are skipped. 0, or -1
+ * after printing "wetdem: <what>: cannot write <final>: <why>" for the first that failed. */
+int cli_out_close_all(struct cli_out_file* const* files, size_t n, const char* what, bool keep);
 
 /* Writes v to f with the fewest significant digits (15, 16 or 17) that read back as exactly
  * v, so CSV output is both exact and readable ("1e-05", not "1.0000000000000001e-05"). */

@@ -44,7 +44,9 @@ static void usage(FILE* f)
                "              (many-particle runs: VTK series, CSV, checkpoint, summary)\n"
                "  --json      print the summary as JSON\n"
                "  --check     check the scenario and print the resolved set-up; do not run\n"
-               "  --restart C resume a many-particle run from checkpoint C (same scenario)\n");
+               "  --restart C resume a many-particle run from checkpoint C (same scenario)\n"
+               "The files of one collision are kept as a set, whole, or not at all. Ctrl-C or\n"
+               "SIGTERM: exit 128 + N (a many-particle run writes its checkpoint first).\n");
 }
 
 static int parse_args(int argc, char** argv, struct run_args* a)
@@ -131,16 +133,17 @@ static int run_soft(const struct cli_scenario* sc, struct cli_setup* su, const s
     struct cli_trajectory t = {
         .f = traj.f, .target_is_wall = su->spec.target_is_wall, .argc = argc, .argv = argv};
     struct cli_saved_signals saved;
-    if (traj.f) {
+    bool guarded = traj.f != NULL; /* (a signal stops the run: cli_signals_install_run) */
+    if (guarded) {
         wetdem_sim_set_observer(su->sim, su->trajectory_interval, cli_trajectory_observe, &t);
         cli_signals_install_run(traj.tmp, &saved);
     }
     struct wetdem_collision_result res;
     errno = 0;
     int st = wetdem_collision_run(su->sim, &su->spec, &res);
-    int stopped = traj.f ? cli_signals_finish_run("run", &saved) : 0;
-    if (stopped || st < 0) {
+    if ((guarded && cli_stop_signal) || st < 0) {
         cli_out_close(&traj, "run", false);
+        int stopped = guarded ? cli_signals_finish_run("run", &saved) : 0;
         if (stopped)
             return stopped;
         if (t.err) /* the observer stopped the run: the write failed, not the simulation */
@@ -151,22 +154,26 @@ static int run_soft(const struct cli_scenario* sc, struct cli_setup* su, const s
         return CLI_EXIT_RUNTIME;
     }
     cli_setup_capture(su, &res);
+    struct cli_out_file* files[3] = {&traj, &events, &summary};
     if (cli_out_open(&events, "run", a->out_dir, su->events_file) != 0 ||
         cli_out_open(&summary, "run", a->out_dir, su->summary_file) != 0) {
-        cli_out_close(&traj, "run", false);
-        cli_out_close(&events, "run", false);
-        return CLI_EXIT_RUNTIME;
+        cli_out_close_all(files, 2, "run", false);
+        int stopped = guarded ? cli_signals_finish_run("run", &saved) : 0;
+        return stopped ? stopped : CLI_EXIT_RUNTIME;
     }
     if (events.f)
         cli_events_csv(events.f, su->sim, argc, argv);
     if (summary.f)
         cli_summary_json(summary.f, sc, su, &res);
-    /* every file closed, each kept whole or removed (none left under its temporary name) */
-    bool kept = cli_out_close(&traj, "run", true) == 0;
-    kept = cli_out_close(&events, "run", true) == 0 && kept;
-    kept = cli_out_close(&summary, "run", true) == 0 && kept;
-    if (!kept)
+    /* the three files as a set: all kept whole, or none (a signal until now keeps none) */
+    sigset_t mask;
+    cli_signals_block(&mask);
+    int stopped = guarded ? cli_signals_finish_run("run", &saved) : 0;
+    if (cli_out_close_all(files, 3, "run", !stopped) != 0)
         rc = CLI_EXIT_RUNTIME;
+    cli_signals_unblock(&mask);
+    if (stopped)
+        return stopped;
     if (a->json)
         cli_summary_json(stdout, sc, su, &res);
     else

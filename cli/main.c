@@ -60,7 +60,8 @@ static void print_help(FILE* f)
     for (size_t k = 0; k < sizeof commands / sizeof commands[0]; k++)
         if (commands[k].fn)
             fprintf(f, "  %s\n      %s\n", commands[k].usage, commands[k].summary);
-    fprintf(f, "\nexit codes: 0 ok, 1 runtime error, 2 usage or input error\n"
+    fprintf(f, "\nexit codes: 0 ok, 1 runtime error, 2 usage or input error, 128 + N stopped by\n"
+               "signal N (130: Ctrl-C) after writing what it could (run, sweep, map)\n"
                "docs: docs/index.md\n");
 }
 
@@ -86,7 +87,10 @@ static int cmd_docs_cli(int argc, char** argv)
            "command is in the [README](../README.md#the-command-line-tool); scenario files are "
            "described in [scenarios.md](scenarios.md). Exit codes: 0 ok, 1 runtime error, 2 "
            "usage or input error (a message names the option or key, the value and the valid "
-           "range, with a \"did you mean\" hint for misspelt names).\n\n"
+           "range, with a \"did you mean\" hint for misspelt names), 128 + N stopped by signal "
+           "N (130 for Ctrl-C: a many-particle run after writing its checkpoint, `sweep` and "
+           "`map` after writing the table of the points that ran, a single collision keeping "
+           "no file).\n\n"
            "## wetdem\n\n```text\n");
     print_help(stdout);
     printf("```\n");

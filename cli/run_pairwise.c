@@ -506,14 +506,15 @@ static int run_with_files(const struct cli_scenario* sc, const struct cli_run_op
     if (rc != CLI_EXIT_OK)
         return rc; /* before the directory is made */
     if (cli_make_dirs(opt->out_dir) != 0) {
-        cli_error("run: cannot create directory %s", opt->out_dir);
+        cli_error("run: cannot create directory %s: %s", opt->out_dir, strerror(errno));
         return CLI_EXIT_RUNTIME;
     }
     if (cli_out_open(&ft, "run", opt->out_dir, traj_name) != 0)
         return CLI_EXIT_RUNTIME;
     struct traj t = {ft.f, 0};
     struct cli_saved_signals saved;
-    if (ft.f) {
+    bool guarded = ft.f != NULL; /* (a signal stops the run: cli_signals_install_run) */
+    if (guarded) {
         cli_print_provenance(ft.f, opt->argc, opt->argv);
         trajectory_header(ft.f, cfg->n_spheres);
         wetdem_pairwise_set_observer(pw, dt, write_frame, &t);
@@ -522,26 +523,26 @@ static int run_with_files(const struct cli_scenario* sc, const struct cli_run_op
     errno = 0;
     *status = wetdem_pairwise_run(pw, cfg, r);
     *ran = true;
-    int stopped = ft.f ? cli_signals_finish_run("run", &saved) : 0;
-    if (stopped) {
+    if ((guarded && cli_stop_signal) || *status != WETDEM_OK) {
         cli_out_close(&ft, "run", false);
-        if (*status == WETDEM_OK)
-            *status = WETDEM_ERR_CALLBACK; /* (the caller reports nothing more) */
-        return stopped;
-    }
-    if (*status != WETDEM_OK) {
-        cli_out_close(&ft, "run", false);
+        int stopped = guarded ? cli_signals_finish_run("run", &saved) : 0;
+        if (stopped) {
+            if (*status == WETDEM_OK)
+                *status = WETDEM_ERR_CALLBACK; /* (the caller reports nothing more) */
+            return stopped;
+        }
         if (!t.err)
             return CLI_EXIT_OK; /* (the caller reports the status) */
         /* the observer stopped the run: the write is what failed, not the simulation */
         cli_error("run: cannot write %s: %s", ft.final, strerror(t.err));
         return CLI_EXIT_RUNTIME;
     }
+    struct cli_out_file* files[3] = {&ft, &fe, &fs};
     if (cli_out_open(&fe, "run", opt->out_dir, out_name(sc, "events", "events.csv")) != 0 ||
         cli_out_open(&fs, "run", opt->out_dir, out_name(sc, "summary", "summary.json")) != 0) {
-        cli_out_close(&ft, "run", false);
-        cli_out_close(&fe, "run", false);
-        return CLI_EXIT_RUNTIME;
+        cli_out_close_all(files, 2, "run", false);
+        int stopped = guarded ? cli_signals_finish_run("run", &saved) : 0;
+        return stopped ? stopped : CLI_EXIT_RUNTIME;
     }
     if (fe.f) {
         cli_print_provenance(fe.f, opt->argc, opt->argv);
@@ -549,11 +550,15 @@ static int run_with_files(const struct cli_scenario* sc, const struct cli_run_op
     }
     if (fs.f)
         summary_json(fs.f, r);
-    /* every file closed, each kept whole or removed (none left under its temporary name) */
-    bool kept = cli_out_close(&ft, "run", true) == 0;
-    kept = cli_out_close(&fe, "run", true) == 0 && kept;
-    kept = cli_out_close(&fs, "run", true) == 0 && kept;
-    return kept ? CLI_EXIT_OK : CLI_EXIT_RUNTIME;
+    /* the three files as a set: all kept whole, or none (a signal until now keeps none) */
+    sigset_t mask;
+    cli_signals_block(&mask);
+    int stopped = guarded ? cli_signals_finish_run("run", &saved) : 0;
+    rc = cli_out_close_all(files, 3, "run", !stopped) == 0 ? CLI_EXIT_OK : CLI_EXIT_RUNTIME;
+    cli_signals_unblock(&mask);
+    if (stopped && *status == WETDEM_OK)
+        *status = WETDEM_ERR_CALLBACK; /* (the caller reports nothing more) */
+    return stopped ? stopped : rc;
 }
 
 int cli_run_pairwise(const struct cli_scenario* sc, const struct cli_run_options* opt)

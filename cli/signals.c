@@ -111,3 +111,17 @@ int cli_signals_finish_run(const char* what, const struct cli_saved_signals* sav
             what, sig);
     return 128 + sig;
 }
+
+void cli_signals_block(sigset_t* old)
+{
+    sigset_t set;
+    sigemptyset(&set);
+    sigaddset(&set, SIGINT);
+    sigaddset(&set, SIGTERM);
+    sigprocmask(SIG_BLOCK, &set, old);
+}
+
+void cli_signals_unblock(const sigset_t* old)
+{
+    sigprocmask(SIG_SETMASK, old, NULL);
+}

@@ -49,7 +49,14 @@ void cli_signals_install_run(const char* tmp, struct cli_saved_signals* saved);
 
 /* After such a run: 0 when no signal came (the handlers put back), otherwise prints "wetdem:
  * <what>: interrupted by signal N: ..." and returns the exit code 128 + N (the handlers kept,
- * as cli_signals_restore says). The caller has removed the run's temporary files. */
+ * as cli_signals_restore says); the caller removes the run's temporary files. Called with the
+ * signals blocked (cli_signals_block) before the files are renamed, so that none comes between
+ * the test and the renames: one that comes then is delivered, under the handlers put back,
+ * once the files are whole. */
 int cli_signals_finish_run(const char* what, const struct cli_saved_signals* saved);
+
+/* Blocks SIGINT and SIGTERM (held pending), saving the mask in *old; unblocks them. */
+void cli_signals_block(sigset_t* old);
+void cli_signals_unblock(const sigset_t* old);
 
 #endif

@@ -815,6 +815,55 @@ static void test_track_cli_writes_frames_whole_or_not_at_all(void** state)
     rmdir(dir);
 }
 
+/* --frames naming a symbolic link writes the link's target and keeps the link; naming a
+ * device (here through a link to /dev/null) writes it in place: the temporary file renamed over
+ * the name replaced the link, and would have replaced a device node with a regular file. */
+static void test_track_cli_frames_through_links_and_devices(void** state)
+{
+    (void)state;
+    if (!getenv("WETDEM_CLI"))
+        skip();
+    char dir[96], target[128], link[128], null_link[128], args[512];
+    snprintf(dir, sizeof dir, "/tmp/wetdem_track_links_%d", (int)getpid());
+    snprintf(target, sizeof target, "%s/target.csv", dir);
+    snprintf(link, sizeof link, "%s/link.csv", dir);
+    snprintf(null_link, sizeof null_link, "%s/null.csv", dir);
+    assert_int_equal(mkdir(dir, 0700), 0);
+    FILE* f = fopen(target, "w");
+    assert_non_null(f);
+    fputs("old\n", f);
+    fclose(f);
+    assert_int_equal(symlink("target.csv", link), 0);
+    assert_int_equal(symlink("/dev/null", null_link), 0);
+    const char* track = "track examples/tracks/punch_45deg.csv --fps 5000 --pixel-size 175e-6";
+    snprintf(args, sizeof args, "%s --frames %s", track, link);
+    struct test_run r = test_run_cli("", args, true);
+    if (r.code != 0)
+        fail_msg("wetdem %s: exit %d\n%s", args, r.code, r.out);
+    free(r.out);
+    struct stat st;
+    assert_int_equal(lstat(link, &st), 0);
+    assert_true(S_ISLNK(st.st_mode));
+    char* text = test_read_file(target, NULL);
+    assert_non_null(text);
+    CHECK_CONTAINS(text, "sphere,frame,time_s,");
+    free(text);
+    snprintf(args, sizeof args, "%s --frames %s", track, null_link);
+    r = test_run_cli("", args, true);
+    if (r.code != 0)
+        fail_msg("wetdem %s: exit %d\n%s", args, r.code, r.out);
+    free(r.out);
+    assert_int_equal(lstat(null_link, &st), 0);
+    assert_true(S_ISLNK(st.st_mode));
+    assert_int_equal(stat("/dev/null", &st), 0);
+    assert_true(S_ISCHR(st.st_mode));
+    test_check_dir(dir, "link.csv\nnull.csv\ntarget.csv\n");
+    remove(link);
+    remove(null_link);
+    remove(target);
+    rmdir(dir);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -828,6 +877,7 @@ int main(void)
         cmocka_unit_test(test_track_rejects_short_or_mismatched_tracks),
         cmocka_unit_test(test_track_cli_exits_2_with_line_number),
         cmocka_unit_test(test_track_cli_writes_frames_whole_or_not_at_all),
+        cmocka_unit_test(test_track_cli_frames_through_links_and_devices),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
