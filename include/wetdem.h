@@ -1126,7 +1126,7 @@ struct wetdem_fit_result {
     double residual_std; /* s = sqrt(cost/dof), in units of the scale */
     size_t dof;          /* n_data - n_params; 0 when the fit stopped before a solution */
     size_t iterations;
-    size_t model_evals; /* calls of the model function */
+    size_t model_evals; /* calls of the model function (the flat-start probes included) */
     int converged_by;   /* 1 small step (xtol), 2 small gradient (gtol), 3 small cost change;
                            0 not converged */
     int transform[WETDEM_FIT_MAX_PARAMS];     /* enum wetdem_fit_transform of each parameter */
@@ -1136,13 +1136,17 @@ struct wetdem_fit_result {
                                              of its initial distance (the fit ran towards it);
                                              its standard error is then NAN and the others'
                                              are those with it held there; 0 inside */
-    bool undetermined[WETDEM_FIT_MAX_PARAMS]; /* the data do not determine it (its column of
-                                                 the Jacobian is zero, or numerically zero at
-                                                 the solution: a factor 10 in the distance to
-                                                 a bound, or a change of its own size for an
-                                                 unbounded one, would move the residuals by
-                                                 less than 0.1 of their scatter s; or a
-                                                 combination of columns is zero):
+    bool undetermined[WETDEM_FIT_MAX_PARAMS]; /* the data do not determine it: its column of
+                                                 the Jacobian is zero, or a combination of
+                                                 columns is; or a flat start (a bounded
+                                                 parameter that ended within a factor 10 of its
+                                                 start, where a factor 1000 either way in its
+                                                 distance to the bound, or in (p - lower)/
+                                                 (upper - p) with two bounds, moves the
+                                                 residuals by less than 0.1 of their scatter s,
+                                                 by its column and by two evaluations of the
+                                                 model; an unbounded parameter has no such
+                                                 scale: only its zero column counts):
                                                  WETDEM_ERR_UNDETERMINED */
 };
 
@@ -1155,13 +1159,14 @@ WETDEM_API void wetdem_fit_options_init(struct wetdem_fit_options* opt);
  * bound), WETDEM_ERR_CALLBACK or the model's status (the model failed), WETDEM_ERR_MAX_STEPS
  * (not converged; *result holds the last iterate), WETDEM_ERR_UNDETERMINED (the data do not
  * depend on a parameter, exactly or beyond their scatter where the fit stopped, e.g. at a start
- * where its effect is cut off, or do not determine some parameters separately: *result holds
- * the last iterate with those parameters' standard errors INFINITY), WETDEM_ERR_STEP (the solver
- * found no step that lowers the cost) or WETDEM_ERR_NOMEM; msg (may be NULL) receives a
- * message. GSL's error handler is switched off while the call runs and the caller's handler
- * restored before it returns, so a GSL error never aborts the program; GSL keeps that handler
- * in one process-wide variable, so do not change it, or rely on GSL's default handler, in
- * another thread while a fit runs. */
+ * where its effect is cut off (see undetermined above), or do not determine some parameters
+ * separately: *result holds the last iterate with those parameters' standard errors INFINITY),
+ * WETDEM_ERR_STEP (the solver found no step that lowers the cost) or WETDEM_ERR_NOMEM; msg (may
+ * be NULL) receives a message. A flat-start probe the model fails on is no failure of the fit
+ * (it only means the parameter is not flat). GSL's error handler is switched off while the
+ * call runs and the caller's handler restored before it returns, so a GSL error never aborts
+ * the program; GSL keeps that handler in one process-wide variable, so do not change it, or
+ * rely on GSL's default handler, in another thread while a fit runs. */
 WETDEM_API int wetdem_fit_run(const struct wetdem_fit_problem* problem,
                               const struct wetdem_fit_options* opt,
                               struct wetdem_fit_result* result, double* predicted, char* msg,

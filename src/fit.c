@@ -21,11 +21,13 @@
  * default h = 1e-2 keeps the difference quotient's noise (~1e-4/h) below 1 % while its
  * truncation error is O(h^2). A column of J that is exactly zero means the predictions do not
  * change with that parameter: the fit stops with WETDEM_ERR_UNDETERMINED (GSL's QR would
- * otherwise fail on a Jacobian of rank 0). A column that is numerically zero at the solution
- * (FLAT_FRACTION below: the predictions move with the parameter by less than their noise, as
- * at a start where its effect is cut off) is WETDEM_ERR_UNDETERMINED too: the solver stops
- * there at once, on a small step or gradient, and the parameter is where it started, not
- * fitted.
+ * otherwise fail on a Jacobian of rank 0). A flat start is WETDEM_ERR_UNDETERMINED too
+ * (FLAT_FRACTION below): where a bounded parameter's effect is cut off, its difference
+ * quotients are the predictions' noise and the solver stops at once, on a small step or
+ * gradient, at or near the start, not fitted. It is told by evaluating the model a factor 1000
+ * either way (in the distance to the bound, or in (p - a)/(b - p)), not by the size of the
+ * column, which near a bound is small for a well-determined parameter too; an unbounded
+ * parameter has no such scale, so only its exactly zero column is caught.
  *
  * Standard errors (Gauss-Newton linearisation at the solution): cov(q) = s^2 (J^T J)^-1 with
  * the residual variance s^2 = S/(n - p), i.e. the scatter of the data about the fit sets the
@@ -67,19 +69,28 @@
  * enormous; the predictions that far away are not those the step was computed from. */
 #define Q_STEP_MAX 2.302585092994046
 
-/* A column of the Jacobian is numerically zero at the solution (the data do not determine the
- * parameter there, though its column is not exactly zero) when moving the parameter by
- * FLAT_STEP in its variable would change the residuals by less than FLAT_FRACTION of their
- * scatter s: ||J_j|| FLAT_STEP < FLAT_FRACTION s. FLAT_STEP is ln 10 for a bounded or log
- * variable (a factor 10 in the distance to the bound, the longest step the solver takes) and
- * max(|p|, 1) for a linear one (a change of its own size, the unit of its difference step).
- * Equivalently its standard error with the others held fixed, s/||J_j||, exceeds 10 such
- * steps (ten decades of the distance to a bound): no estimate at all. A start where the
- * predictions are flat in a parameter (its effect cut off) "converges" at once on the small
- * gradient; the fit would otherwise report that start with a huge standard error as a
- * result. */
+/* A flat start: a bounded parameter whose predictions do not move with it where the fit
+ * stopped, though its column of the Jacobian is not exactly zero (the difference quotients are
+ * the model's noise, as at a start where its effect is cut off: the solver stops at once, on a
+ * small step or gradient, at or near the start). It is WETDEM_ERR_UNDETERMINED when
+ *  - it ended within Q_STEP_MAX (one step's reach, a factor 10) of its start in its variable:
+ *    a parameter that travelled further followed the data, and is judged by its statistics;
+ *  - the Jacobian says moving it by FLAT_PROBE in its variable changes the residuals by less
+ *    than FLAT_FRACTION of their scatter s, ||J_j|| FLAT_PROBE < FLAT_FRACTION s (a screen:
+ *    the probes below run only for such a column);
+ *  - and the model, evaluated with the parameter at q_j - FLAT_PROBE and q_j + FLAT_PROBE (the
+ *    others where they are), confirms it: each changes the residual vector by less than
+ *    FLAT_FRACTION s (2-norm). A probe the model fails on counts as a change.
+ * FLAT_PROBE = 3 ln 10 is a factor 1000 either way in the distance to a one-sided bound, and
+ * in the odds (p - a)/(b - p) of a two-sided range (from its middle: 0.1 % to 99.9 % of it).
+ * The probes, not the Jacobian, decide because near a bound the column of a log variable
+ * vanishes with dp/dq = p - a: a well-determined parameter 0.002 from a bound with standard
+ * error 0.05 has a column as small as a flat one, but a factor 1000 further from the bound
+ * moves the residuals by far more than s. An unbounded (linear) parameter is never judged so:
+ * no step is free of its units (a change of max(|p|, 1) misfires on data with a large scatter
+ * in small units), so only its exactly zero column is caught. */
 #define FLAT_FRACTION 0.1
-#define FLAT_STEP_LOG 2.302585092994046
+#define FLAT_PROBE (3 * 2.302585092994046)
 
 /* A bound is "hit" when the estimate is closer to it than this fraction of its standard
  * error (the data cannot tell it from the bound) and than AT_BOUND_TRAVEL of its initial
@@ -209,24 +220,32 @@ static int at_bound(const struct param_map* m, double p, double sd)
 
 /* ---- residuals and Jacobian --------------------------------------------------------------- */
 
-/* Scaled residuals r[0..n) at fitted variables q. */
-static int residuals_at(struct fit_ctx* c, const double* q, double* r)
+/* Scaled residuals r[0..n) at fitted variables q; a failure's message into msg. Counts the
+ * evaluation. */
+static int evaluate(struct fit_ctx* c, const double* q, double* r, char* msg, size_t n_msg)
 {
     const struct wetdem_fit_problem* pb = c->pb;
     double p[NP_MAX];
     for (size_t j = 0; j < pb->n_params; j++)
         p[j] = to_param(&c->map[j], q[j]);
     c->evals++;
-    char msg[sizeof c->msg] = "";
-    int st = pb->model(p, c->pred, msg, sizeof msg, pb->ctx);
+    int st = pb->model(p, c->pred, msg, n_msg, pb->ctx);
     for (size_t i = 0; st == WETDEM_OK && i < pb->n_data; i++) {
         double s = pb->scale ? pb->scale[i] : 1.0;
         r[i] = (c->pred[i] - pb->observed[i]) / s;
         if (!isfinite(r[i]))
-            st = wetdem_status_fail(msg, sizeof msg, WETDEM_ERR_NUMERIC,
+            st = wetdem_status_fail(msg, n_msg, WETDEM_ERR_NUMERIC,
                                     "the model gave a non-finite prediction %g for data point %zu",
                                     c->pred[i], i + 1);
     }
+    return st;
+}
+
+/* evaluate(), keeping the first failure (c->status, c->msg): the fit stops on it. */
+static int residuals_at(struct fit_ctx* c, const double* q, double* r)
+{
+    char msg[sizeof c->msg] = "";
+    int st = evaluate(c, q, r, msg, sizeof msg);
     if (st != WETDEM_OK && c->status == WETDEM_OK) {
         c->status = st;
         snprintf(c->msg, sizeof c->msg, "%s", msg);
@@ -420,26 +439,51 @@ static void fill_errors(const struct fit_ctx* c, const gsl_matrix* cov, const bo
     }
 }
 
-/* The change of variable of parameter j whose effect on the residuals tells whether its column
- * is numerically zero (FLAT_STEP_LOG, or max(|p|, 1) for a linear variable). */
-static double flat_step(const struct param_map* m, double q)
-{
-    return m->kind == WETDEM_FIT_LINEAR ? fmax(fabs(q), 1.0) : FLAT_STEP_LOG;
-}
+/* What the flat-start test (FLAT_FRACTION) found for one parameter. */
+struct flat_test {
+    int state;     /* 0 not looked at, 1 flat, -1 not flat */
+    double p[2];   /* the parameter at q_j - FLAT_PROBE and q_j + FLAT_PROBE */
+    double change; /* the larger change of the residuals (2-norm) there */
+};
 
-/* The change of the residuals (2-norm) that moving parameter j by flat_step would make, by the
- * Jacobian at q. */
-static double flat_change(const struct fit_ctx* c, const double* q, size_t j)
+/* Whether parameter j is flat where the fit stopped (q, residuals f, scatter s): see
+ * FLAT_FRACTION. Evaluates the model (at most twice) only for a column that passes the
+ * screens; a failed evaluation leaves no trace but its count. */
+static bool is_flat(struct fit_ctx* c, const double* q, const gsl_vector* f, double s, size_t j,
+                    struct flat_test* t)
 {
+    const struct param_map* m = &c->map[j];
+    size_t np = c->pb->n_params, n = c->pb->n_data;
     gsl_vector_const_view col = gsl_matrix_const_column(c->jac, j);
-    return gsl_blas_dnrm2(&col.vector) * flat_step(&c->map[j], q[j]);
+    if (m->kind == WETDEM_FIT_LINEAR || !(s > 0) ||
+        fabs(q[j] - to_variable(m, c->pb->initial[j])) >= Q_STEP_MAX ||
+        !(gsl_blas_dnrm2(&col.vector) * FLAT_PROBE < FLAT_FRACTION * s))
+        return false;
+    double qp[NP_MAX];
+    t->change = 0;
+    for (int side = 0; side < 2; side++) {
+        memcpy(qp, q, np * sizeof *qp);
+        qp[j] = q[j] + (side ? FLAT_PROBE : -FLAT_PROBE);
+        t->p[side] = to_param(m, qp[j]);
+        char msg[sizeof c->msg];
+        if (evaluate(c, qp, c->r_minus, msg, sizeof msg) != WETDEM_OK)
+            return false;
+        double sum = 0;
+        for (size_t i = 0; i < n; i++)
+            sum += pow(c->r_minus[i] - gsl_vector_get(f, i), 2);
+        t->change = fmax(t->change, sqrt(sum));
+        if (!(t->change < FLAT_FRACTION * s))
+            return false;
+    }
+    return true;
 }
 
 /* Values, standard errors, correlations and bound flags from the Jacobian at the solution q;
- * returns how many parameters the data do not determine (-1: out of memory); flat[j] marks
- * those whose column is numerically zero (FLAT_FRACTION), not exactly zero or dependent. */
-static int fill_statistics(const struct fit_ctx* c, const double* q, const gsl_vector* f,
-                           gsl_matrix* cov, struct wetdem_fit_result* res, bool* flat)
+ * returns how many parameters the data do not determine (-1: out of memory); flat[j].state is
+ * 1 for those whose column is numerically zero (FLAT_FRACTION), not exactly zero or
+ * dependent. */
+static int fill_statistics(struct fit_ctx* c, const double* q, const gsl_vector* f, gsl_matrix* cov,
+                           struct wetdem_fit_result* res, struct flat_test* flat)
 {
     const struct wetdem_fit_problem* pb = c->pb;
     size_t np = pb->n_params;
@@ -455,10 +499,10 @@ static int fill_statistics(const struct fit_ctx* c, const double* q, const gsl_v
         undetermined[j] = column_is_zero(c->jac, j);
         use[j] = !undetermined[j];
     }
-    /* undetermined combinations, then bounds hit (closer than AT_BOUND_SD sd), then columns
-       that are numerically zero (after the bounds: near a bound the column of the variable
-       vanishes with dp/dq): each pass removes parameters from the covariance, so at most
-       3 np passes */
+    /* undetermined combinations, then bounds hit (closer than AT_BOUND_SD sd), then flat
+       starts (after the bounds: a parameter at a bound is a result): each pass removes
+       parameters from the covariance, so at most 3 np passes; a parameter is probed for a
+       flat start at most once */
     for (size_t pass = 0; pass < 3 * np; pass++) {
         int dep = inverse_normal_matrix(c->jac, use, cov, undetermined);
         if (dep < 0)
@@ -477,12 +521,16 @@ static int fill_statistics(const struct fit_ctx* c, const double* q, const gsl_v
                 changed = true;
             }
         }
-        for (size_t j = 0; j < np && !changed; j++)
-            if (use[j] && flat_change(c, q, j) < FLAT_FRACTION * res->residual_std) {
-                flat[j] = undetermined[j] = true;
+        for (size_t j = 0; j < np && !changed; j++) {
+            if (!use[j] || flat[j].state != 0)
+                continue;
+            flat[j].state = is_flat(c, q, f, res->residual_std, j, &flat[j]) ? 1 : -1;
+            if (flat[j].state == 1) {
+                undetermined[j] = true;
                 use[j] = false;
                 changed = true;
             }
+        }
         if (!changed)
             break;
     }
@@ -582,33 +630,29 @@ static int report(struct fit_ctx* c, int st, gsl_matrix* cov, const struct wetde
     if (predicted)
         memcpy(predicted, c->pred, c->pb->n_data * sizeof *predicted);
     gsl_vector_view f = gsl_vector_view_array(c->r_plus, c->pb->n_data);
-    bool flat[NP_MAX] = {false};
+    struct flat_test flat[NP_MAX] = {{0}};
     int n_und = fill_statistics(c, c->q_jac, &f.vector, cov, res, flat);
     if (n_und < 0)
         return wetdem_status_fail(msg, msg_size, WETDEM_ERR_NOMEM, "out of memory");
     char names[300];
     undetermined_names(c, res, names, sizeof names);
     size_t jf = 0;
-    while (jf < np && !flat[jf])
+    while (jf < np && flat[jf].state != 1)
         jf++;
-    if (jf < np) { /* a flat start, or a fit that ran onto a plateau */
-        const struct param_map* m = &c->map[jf];
-        char step[80];
-        if (m->kind == WETDEM_FIT_LINEAR)
-            snprintf(step, sizeof step, "a change by %g", flat_step(m, c->q_jac[jf]));
-        else
-            snprintf(step, sizeof step, "a factor 10 in its distance to %s",
-                     m->kind == WETDEM_FIT_LOGISTIC ? "the nearer bound" : "its bound");
+    if (jf < np) { /* a flat start */
+        const struct flat_test* t = &flat[jf];
         return wetdem_status_fail(
             msg, msg_size, WETDEM_ERR_UNDETERMINED,
             "the data do not determine %s: where the fit stopped, at %g (from the start %g), "
-            "the predictions hardly depend on it: %s would change the residuals by %.2g, under "
-            "%g of their scatter s = %.3g (its column of the Jacobian is numerically zero; "
-            "standard error inf)%s%s%s; start it elsewhere, nearer the value you expect, or "
-            "hold it fixed",
-            param_name(c->pb, jf), res->values[jf], c->pb->initial[jf], step,
-            flat_change(c, c->q_jac, jf), FLAT_FRACTION, res->residual_std,
-            n_und > 1 ? "; not determined: " : "", n_und > 1 ? names : "",
+            "the predictions hardly depend on it: at %g and at %g (a factor 1000 either way in "
+            "%s) the residuals change by at most %.2g, under %g of their scatter s = %.3g (its "
+            "column of the Jacobian is numerically zero; standard error inf)%s%s%s; start it "
+            "elsewhere, nearer the value you expect, or hold it fixed",
+            param_name(c->pb, jf), res->values[jf], c->pb->initial[jf], t->p[0], t->p[1],
+            c->map[jf].kind == WETDEM_FIT_LOGISTIC ? "the ratio (p - lower)/(upper - p)"
+                                                   : "its distance to its bound",
+            t->change, FLAT_FRACTION, res->residual_std, n_und > 1 ? "; not determined: " : "",
+            n_und > 1 ? names : "",
             st == WETDEM_ERR_MAX_STEPS ? "; and no convergence in the iterations allowed" : "");
     }
     if (n_und > 0)

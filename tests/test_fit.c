@@ -254,10 +254,21 @@ static void test_fit_rank_deficient_jacobian_gives_infinite_errors(void** state)
 /* y_i = 0.1 x_i + 1e-7 sin(1000 b x_i): the predictions do not depend on b beyond a jitter of
  * 1e-7, as those of a simulation do not depend on a parameter whose effect is cut off, or does
  * not reach them, beyond their integration noise (the Poisson ratio of the Punch striker moves
- * e_n by 1e-8 to 1e-7, of either sign: the CLI test below). */
+ * e_n by 1e-8 to 1e-7, of either sign: the CLI test below). It counts its calls, and refuses b
+ * below refuse_below (as a scenario refuses a value). */
+struct jitter {
+    size_t calls;
+    double refuse_below;
+};
+
 static int jitter_only(const double* p, double* out, char* msg, size_t n, void* ctx)
 {
-    (void)msg, (void)n, (void)ctx;
+    struct jitter* jt = ctx;
+    jt->calls++;
+    if (p[0] < jt->refuse_below) {
+        snprintf(msg, n, "b = %g refused", p[0]);
+        return WETDEM_ERR_INVALID;
+    }
     for (size_t i = 0; i < 8; i++)
         out[i] = 0.1 * (double)(i + 1) + 1e-7 * sin(1000 * p[0] * (double)(i + 1));
     return WETDEM_OK;
@@ -265,11 +276,14 @@ static int jitter_only(const double* p, double* out, char* msg, size_t n, void* 
 
 /* A start where the predictions are flat in a parameter "converged" after a few small steps
  * (on the small step, the difference quotients being noise) and was reported as a result,
- * WETDEM_OK with b = 0.475 +- 251 in [0, 1]. Its column of the Jacobian is numerically zero:
- * a factor 10 in the distance to a bound moves the residuals by 2.4e-5, under 0.1 of their
- * scatter s = 0.011. That is WETDEM_ERR_UNDETERMINED, with the parameter, where it stopped,
- * its start and what to do; the statistics of the last iterate stay (dof > 0, standard error
- * inf). */
+ * WETDEM_OK with b = 0.475 +- 251 in [0, 1]. It stays near its start, its column of the
+ * Jacobian is numerically zero, and the model at 0.1 % and 99.9 % of the range (a factor 1000
+ * either way in (b - 0)/(1 - b)) confirms it: the residuals change by 3e-7, under 0.1 of their
+ * scatter s = 0.011. That is WETDEM_ERR_UNDETERMINED, with the parameter, where it stopped, its
+ * start, the probes and what to do; the statistics of the last iterate stay (dof > 0, standard
+ * error inf), and the two probes are counted in model_evals. A probe the model refuses counts
+ * as a change, not as the fit's failure: the fit is then judged by its statistics, as before
+ * the rule (WETDEM_OK, a huge standard error). */
 static void test_fit_numerically_zero_column_is_undetermined(void** state)
 {
     (void)state;
@@ -281,12 +295,14 @@ static void test_fit_numerically_zero_column_is_undetermined(void** state)
     for (size_t i = 0; i < 8; i++)
         obs[i] = 0.1 * (double)(i + 1) + gsl_ran_gaussian(rng, 0.01);
     gsl_rng_free(rng);
+    struct jitter jt = {0, -1};
     struct wetdem_fit_problem pb = {.n_params = 1,
                                     .names = names,
                                     .initial = init,
                                     .n_data = 8,
                                     .observed = obs,
                                     .model = jitter_only,
+                                    .ctx = &jt,
                                     .lower = lower,
                                     .upper = upper};
     struct wetdem_fit_options o;
@@ -298,13 +314,159 @@ static void test_fit_numerically_zero_column_is_undetermined(void** state)
         fail_msg("status %s (b = %g +- %g): %s", wetdem_status_name(st), r.values[0],
                  r.std_errors[0], msg);
     CHECK_CONTAINS(msg, "the data do not determine b: where the fit stopped, at ");
-    CHECK_CONTAINS(msg, "(from the start 0.5), the predictions hardly depend on it: a factor 10 "
-                        "in its distance to the nearer bound would change the residuals by ");
+    CHECK_CONTAINS(msg, "(from the start 0.5), the predictions hardly depend on it: at 0.000");
+    CHECK_CONTAINS(msg, "(a factor 1000 either way in the ratio (p - lower)/(upper - p)) the "
+                        "residuals change by at most ");
+    CHECK_CONTAINS(msg, "under 0.1 of their scatter s = 0.0106");
     CHECK_CONTAINS(msg, "its column of the Jacobian is numerically zero");
     CHECK_CONTAINS(msg, "start it elsewhere, nearer the value you expect, or hold it fixed");
     assert_true(r.undetermined[0] && isinf(r.std_errors[0]));
     assert_int_equal(r.dof, 7);
     assert_true(r.values[0] > 0 && r.values[0] < 1);
+    assert_int_equal(r.model_evals, jt.calls);
+    /* the probe towards 0 refused: no verdict of flatness, and no failure of the fit */
+    jt = (struct jitter){0, 0.01};
+    st = wetdem_fit_run(&pb, &o, &r, NULL, msg, sizeof msg);
+    if (st != WETDEM_OK)
+        fail_msg("status %s with a refused probe: %s", wetdem_status_name(st), msg);
+    assert_false(r.undetermined[0]);
+    assert_true(r.std_errors[0] > 1);
+    assert_int_equal(r.model_evals, jt.calls);
+}
+
+/* ---- what is not a flat start ----------------------------------------------------------- */
+
+#define N_LINE 10
+
+/* y_i = p x_i, x_i = 1..10 (ctx NULL); or, with ctx pointing at a unit u, the offset model
+ * y_i = x_i/u + p: predictions and offset in units u times smaller. */
+static int line_model(const double* p, double* out, char* msg, size_t n, void* ctx)
+{
+    (void)msg, (void)n;
+    for (size_t i = 0; i < N_LINE; i++) {
+        double x = (double)(i + 1);
+        out[i] = ctx ? x / *(const double*)ctx + p[0] : p[0] * x;
+    }
+    return WETDEM_OK;
+}
+
+/* Observations of line_model whose least-squares p (without bounds) is exactly `best`: Gaussian
+ * noise sigma, its part along the model's column (x_i, or 1 for the offset) taken out. */
+static void line_data(double best, double sigma, const double* unit, double* obs)
+{
+    gsl_rng* rng = gsl_rng_alloc(gsl_rng_mt19937);
+    gsl_rng_set(rng, 5);
+    double e[N_LINE], exx = 0, ex = 0;
+    for (size_t i = 0; i < N_LINE; i++) {
+        double x = unit ? 1.0 : (double)(i + 1);
+        e[i] = gsl_ran_gaussian(rng, sigma);
+        exx += x * x;
+        ex += x * e[i];
+    }
+    gsl_rng_free(rng);
+    for (size_t i = 0; i < N_LINE; i++) {
+        double x = (double)(i + 1), col = unit ? 1.0 : x;
+        obs[i] = (unit ? x / *unit + best : best * x) + e[i] - ex / exx * col;
+    }
+}
+
+/* Fits line_model to line_data(best, sigma) from init, bounded to [lower, upper] (NULL: none,
+ * with unit: a linear variable); fails unless the status is WETDEM_OK, the parameter is
+ * determined and at_bound is `side`. */
+static void expect_fit(const char* what, double best, double sigma, double init,
+                       const double* lower, const double* upper, const double* unit, int side,
+                       struct wetdem_fit_result* r)
+{
+    double obs[N_LINE];
+    line_data(best, sigma, unit, obs);
+    const double start[1] = {init};
+    const bool linear[1] = {false};
+    const char* names[1] = {"p"};
+    struct wetdem_fit_problem pb = {.n_params = 1,
+                                    .names = names,
+                                    .initial = start,
+                                    .n_data = N_LINE,
+                                    .observed = obs,
+                                    .model = line_model,
+                                    .ctx = (void*)unit,
+                                    .lower = lower,
+                                    .upper = upper,
+                                    .is_log = unit ? linear : NULL};
+    struct wetdem_fit_options o;
+    wetdem_fit_options_init(&o);
+    char msg[1024] = "";
+    int st = wetdem_fit_run(&pb, &o, r, NULL, msg, sizeof msg);
+    if (st != WETDEM_OK || r->undetermined[0] || r->at_bound[0] != side)
+        fail_msg("%s: status %s, p = %g +- %g, at_bound %d (expected %d): %s", what,
+                 wetdem_status_name(st), r->values[0], r->std_errors[0], r->at_bound[0], side, msg);
+}
+
+/* Near a bound the column of a log variable shrinks with the distance d to it (dp/dq = d), so
+ * a rule on the Jacobian alone (a factor 10 in d moving the residuals by less than 0.1 s)
+ * called a parameter undetermined when d < 0.04 of its standard error: y = p x with noise
+ * sd 1 (standard error 0.05) and best p = 0.002 gave WETDEM_ERR_UNDETERMINED from 1 and from
+ * 0.003, with p >= 0 and with p in [0, 1], and so did data that push p past 0 and leave it
+ * 4e-9 to 4e-8 from it. The model decides: a factor 1000 further from the bound moves the
+ * residuals by far more than s (best 2e-4 from 3e-4: the probes run and say so), and a fit
+ * that travelled more than a factor 10 is not looked at. Each gives what it gave before the
+ * rule: a result (WETDEM_OK), at the bound when it ran into it (AT_BOUND_TRAVEL). */
+static void test_fit_near_a_bound_is_not_a_flat_start(void** state)
+{
+    (void)state;
+    const double zero[1] = {0}, one[1] = {1};
+    struct wetdem_fit_result r;
+    /* best 0.002, 0.04 standard errors from the bound, from far and from near */
+    expect_fit("p >= 0, best 0.002 from 1", 0.002, 1, 1, zero, NULL, NULL, 0, &r);
+    CHECK_REL(r.values[0], 0.002, 1e-4);
+    CHECK_REL(r.std_errors[0], 0.0515, 0.01);
+    assert_int_equal(r.transform[0], WETDEM_FIT_LOG_LOWER);
+    expect_fit("p >= 0, best 0.002 from 0.003", 0.002, 1, 0.003, zero, NULL, NULL, 0, &r);
+    CHECK_REL(r.values[0], 0.002, 1e-4);
+    size_t evals_near = r.model_evals;
+    expect_fit("p in [0, 1], best 0.002 from 0.5", 0.002, 1, 0.5, zero, one, NULL, 0, &r);
+    CHECK_REL(r.values[0], 0.002, 1e-4);
+    assert_int_equal(r.transform[0], WETDEM_FIT_LOGISTIC);
+    expect_fit("p in [0, 1], best 0.002 from 0.003", 0.002, 1, 0.003, zero, one, NULL, 0, &r);
+    CHECK_REL(r.values[0], 0.002, 1e-4);
+    /* best 2e-4, 0.004 standard errors from the bound, from near: the Jacobian alone would
+       call it flat, the model at 0.2 does not */
+    expect_fit("p >= 0, best 2e-4 from 3e-4", 2e-4, 1, 3e-4, zero, NULL, NULL, 0, &r);
+    CHECK_REL(r.values[0], 2e-4, 0.01);
+    expect_fit("p in [0, 1], best 2e-4 from 3e-4", 2e-4, 1, 3e-4, zero, one, NULL, 0, &r);
+    CHECK_REL(r.values[0], 2e-4, 0.01);
+    /* best 0.998, near the upper bound */
+    expect_fit("p in [0, 1], best 0.998 from 0.5", 0.998, 1, 0.5, zero, one, NULL, 0, &r);
+    CHECK_REL(r.values[0], 0.998, 1e-6);
+    /* data that want p < 0: the fit runs to the bound; at it (six decades travelled) or, from
+       1e-3 and 0.003, 4e-9 and 4e-8 from it (1e-7 and 1e-6 standard errors), as before */
+    expect_fit("p >= 0, best -0.02 from 1e-3", -0.02, 1, 1e-3, zero, NULL, NULL, 0, &r);
+    assert_true(r.values[0] > 0 && r.values[0] < 1e-7);
+    expect_fit("p >= 0, best -0.02 from 1e-2", -0.02, 1, 1e-2, zero, NULL, NULL, -1, &r);
+    expect_fit("p >= 0, best -0.002 from 1", -0.002, 1, 1, zero, NULL, NULL, -1, &r);
+    expect_fit("p >= 0, best -0.002 from 0.003", -0.002, 1, 0.003, zero, NULL, NULL, 0, &r);
+    expect_fit("p in [0, 1], best -0.002 from 0.5", -0.002, 1, 0.5, zero, one, NULL, -1, &r);
+    expect_fit("p in [0, 1], best -0.02 from 1e-3", -0.02, 1, 1e-3, zero, one, NULL, 0, &r);
+    /* a column the Jacobian shows to matter is not probed: no evaluation beyond the fit's */
+    assert_true(evals_near < 20);
+}
+
+/* An unbounded parameter has no step free of its units: a rule "a change of max(|p|, 1) moves
+ * the residuals by less than 0.1 s" called an offset p = 1 undetermined in data with noise
+ * sd 103 (s = 98, standard error 31), and the same fit in units 100 times smaller (p = 0.01,
+ * noise sd 1.03) a result. Both are results, the same in either unit; only an exactly zero
+ * column of an unbounded parameter is caught. */
+static void test_fit_unbounded_parameter_is_not_judged_by_its_units(void** state)
+{
+    (void)state;
+    struct wetdem_fit_result r, r100;
+    const double unit1 = 1, unit100 = 100;
+    expect_fit("offset 1, scatter 103", 1, 103, 0.5, NULL, NULL, &unit1, 0, &r);
+    assert_int_equal(r.transform[0], WETDEM_FIT_LINEAR);
+    CHECK_REL(r.values[0], 1, 1e-6);
+    assert_true(r.std_errors[0] > 20 && r.std_errors[0] < 50);
+    expect_fit("offset 0.01, scatter 1.03", 0.01, 1.03, 0.005, NULL, NULL, &unit100, 0, &r100);
+    CHECK_REL(r100.values[0], 0.01, 1e-6);
+    CHECK_REL(r100.std_errors[0], r.std_errors[0] / 100, 1e-6);
 }
 
 /* y_i = p x_i for p in [0, 1]: the model fails above 1, as a scenario rejects a restitution
@@ -650,8 +812,10 @@ static void test_fit_cli_reports_undetermined_keys(void** state)
 /* A start where the predictions are flat in a key is not a fit: the Punch striker's Poisson
  * ratio, from its preset's 0.35, moves e_n by 1e-8 to 1e-7 (the integration noise; the dry
  * restitution fixes the rebound), so the fit "converged" after two steps at -0.12 +- 223,
- * "hardly determined", with exit 0 and --out written. It is an error naming the key, where it
- * stopped and its start, with what to do (exit 1, no --out); the table shows std_error inf. */
+ * "hardly determined", with exit 0 and --out written. The model at -0.998 and 0.499 (a factor
+ * 1000 either way) moves the residuals by 1.4e-6, under 0.1 of s = 0.018. It is an error
+ * naming the key, where it stopped, its start and those probes, with what to do (exit 1, no
+ * --out); the table shows std_error inf. */
 static void test_fit_cli_flat_start_is_not_a_result(void** state)
 {
     (void)state;
@@ -668,7 +832,9 @@ static void test_fit_cli_flat_start_is_not_a_result(void** state)
         fail_msg("wetdem %s: exit %d, expected 1\n%s", args, r.code, r.out);
     CHECK_CONTAINS(r.out, "fit: the data do not determine material.striker.poisson_ratio: where "
                           "the fit stopped, at ");
-    CHECK_CONTAINS(r.out, "(from the start 0.35), the predictions hardly depend on it");
+    CHECK_CONTAINS(r.out, "(from the start 0.35), the predictions hardly depend on it: at -0.99");
+    CHECK_CONTAINS(r.out, "(a factor 1000 either way in the ratio (p - lower)/(upper - p)) the "
+                          "residuals change by at most ");
     CHECK_CONTAINS(r.out, "its column of the Jacobian is numerically zero");
     CHECK_CONTAINS(r.out, "fit: --init starts a key elsewhere; a key left out of --fit is held");
     CHECK_CONTAINS(r.out, "material.striker.poisson_ratio,-,");
@@ -861,6 +1027,8 @@ int main(void)
         cmocka_unit_test(test_fit_zero_jacobian_column_is_an_error_not_an_abort),
         cmocka_unit_test(test_fit_rank_deficient_jacobian_gives_infinite_errors),
         cmocka_unit_test(test_fit_numerically_zero_column_is_undetermined),
+        cmocka_unit_test(test_fit_near_a_bound_is_not_a_flat_start),
+        cmocka_unit_test(test_fit_unbounded_parameter_is_not_judged_by_its_units),
         cmocka_unit_test(test_fit_stays_inside_bounds_and_reports_a_bound),
         cmocka_unit_test(test_fit_recovers_glass_pressure_from_simulated_data),
         cmocka_unit_test(test_fit_cli_rejects_bad_input),
