@@ -308,6 +308,35 @@ static int close_stream(struct cli_out_file* o)
     return err ? err : bad ? EIO : 0;
 }
 
+int cli_write_outputs(const struct cli_output* outs, size_t n, const char* what)
+{
+    struct cli_out_file files[CLI_MAX_OUTPUTS];
+    struct cli_out_file* set[CLI_MAX_OUTPUTS];
+    size_t open = 0;
+    int rc = CLI_EXIT_OK;
+    for (size_t k = 0; k < n && k < CLI_MAX_OUTPUTS && rc == CLI_EXIT_OK; k++) {
+        if (!outs[k].path)
+            continue;
+        char dir[1024];
+        parent_dir(outs[k].path, dir, sizeof dir);
+        if (dir[0] && cli_make_dirs(dir) != 0) {
+            cli_error("%s: cannot create directory %s for %s: %s", what, dir, outs[k].path,
+                      strerror(errno));
+            rc = CLI_EXIT_RUNTIME;
+        } else if (open_output(&files[open], outs[k].path, "%s/%s.tmp%ld") != 0) {
+            cli_error("%s: cannot write %s: %s", what, outs[k].path, strerror(errno));
+            rc = CLI_EXIT_RUNTIME;
+        } else {
+            outs[k].write(files[open].f, outs[k].ctx);
+            set[open] = &files[open];
+            open++;
+        }
+    }
+    if (cli_out_close_all(set, open, what, rc == CLI_EXIT_OK) != 0)
+        rc = CLI_EXIT_RUNTIME;
+    return rc;
+}
+
 int cli_write_output(const char* path, const char* what, void (*write)(FILE* f, const void* ctx),
                      const void* ctx)
 {
@@ -315,20 +344,8 @@ int cli_write_output(const char* path, const char* what, void (*write)(FILE* f, 
         write(stdout, ctx);
         return fflush(stdout) == 0 ? CLI_EXIT_OK : CLI_EXIT_RUNTIME;
     }
-    char dir[1024];
-    parent_dir(path, dir, sizeof dir);
-    if (dir[0] && cli_make_dirs(dir) != 0) {
-        cli_error("%s: cannot create directory %s for %s: %s", what, dir, path, strerror(errno));
-        return CLI_EXIT_RUNTIME;
-    }
-    struct cli_out_file o;
-    if (open_output(&o, path, "%s/%s.tmp%ld") != 0) {
-        cli_error("%s: cannot write %s: %s", what, path, strerror(errno));
-        return CLI_EXIT_RUNTIME;
-    }
-    write(o.f, ctx);
-    struct cli_out_file* files[1] = {&o};
-    return cli_out_close_all(files, 1, what, true) == 0 ? CLI_EXIT_OK : CLI_EXIT_RUNTIME;
+    const struct cli_output out = {path, write, ctx};
+    return cli_write_outputs(&out, 1, what);
 }
 
 int cli_out_open(struct cli_out_file* o, const char* what, const char* dir, const char* name)

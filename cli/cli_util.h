@@ -92,6 +92,19 @@ int cli_check_writable(const char* what, const char* option, const char* path);
 int cli_write_output(const char* path, const char* what, void (*write)(FILE* f, const void* ctx),
                      const void* ctx);
 
+/* One of the files of a result written as a set (cli_write_outputs); path NULL: not wanted. */
+struct cli_output {
+    const char* path;
+    void (*write)(FILE* f, const void* ctx);
+    const void* ctx;
+};
+#define CLI_MAX_OUTPUTS 4
+
+/* Writes the n (at most CLI_MAX_OUTPUTS) files of one result as a set, as cli_write_output
+ * writes one: all renamed to their names when every one is whole, none otherwise (an earlier
+ * file of that name stays as it was). Returns an exit code. */
+int cli_write_outputs(const struct cli_output* outs, size_t n, const char* what);
+
 /* A file written while a run goes on (a trajectory streamed row by row) or after it, in an
  * --out directory: under the temporary name DIR/.NAME.tmpPID, renamed to DIR/NAME by
  * cli_out_close only when the run and every write succeeded, so an interrupted or failed run

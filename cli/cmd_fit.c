@@ -928,18 +928,9 @@ static void curve_table(FILE* f, const void* ctx)
                 t->pred[t->n + k]);
 }
 
-/* Writes --out whole or not at all (cli_write_output). Returns an exit code. */
-static int write_fit_csv(const char* path, const struct fit_ctx* c, const double* pred, int argc,
-                         char** argv)
-{
-    struct table_ctx t = {.c = c, .pred = pred, .argc = argc, .argv = argv};
-    return cli_write_output(path, "fit", fit_table, &t);
-}
-
-/* The fitted model on `m` log-spaced Stokes numbers over the data range, per distinct angle,
- * written to path whole or not at all. Returns an exit code. */
-static int write_curve_csv(const char* path, const struct fit_ctx* c, const double* values, int m,
-                           int argc, char** argv)
+/* The fitted model on `m` log-spaced Stokes numbers over the data range, per distinct angle
+ * (--curve): t->pts and t->pred (freed by the caller) and t->n. Returns an exit code. */
+static int compute_curve(const struct fit_ctx* c, const double* values, int m, struct table_ctx* t)
 {
     double lo = INFINITY, hi = 0;
     double* angles = malloc((c->n_pts ? c->n_pts : 1) * sizeof *angles); /* every distinct one */
@@ -965,15 +956,31 @@ static int write_curve_csv(const char* path, const struct fit_ctx* c, const doub
     }
     if (st == WETDEM_OK)
         st = simulate(c, values, pts, n, e, e + n, msg, sizeof msg);
-    int rc = CLI_EXIT_RUNTIME;
-    if (st == WETDEM_OK) {
-        struct table_ctx t = {.c = c, .pts = pts, .pred = e, .n = n, .argc = argc, .argv = argv};
-        rc = cli_write_output(path, "fit", curve_table, &t);
-    } else
-        cli_error("fit: curve: %s", msg);
     free(angles);
-    free(pts);
-    free(e);
+    t->pts = pts;
+    t->pred = e;
+    t->n = n;
+    if (st == WETDEM_OK)
+        return CLI_EXIT_OK;
+    cli_error("fit: curve: %s", msg);
+    return CLI_EXIT_RUNTIME;
+}
+
+/* Writes --out and --curve as a set: both whole, or neither (the curve is computed first, so
+ * a curve that cannot be computed or written leaves no --out either). Returns an exit code. */
+static int write_outputs(const struct fit_args* a, const struct fit_ctx* c, const double* pred,
+                         const double* values, int argc, char** argv)
+{
+    struct table_ctx fit = {.c = c, .pred = pred, .argc = argc, .argv = argv};
+    struct table_ctx curve = {.c = c, .argc = argc, .argv = argv};
+    int rc = a->curve ? compute_curve(c, values, a->curve_points, &curve) : CLI_EXIT_OK;
+    if (rc == CLI_EXIT_OK) {
+        const struct cli_output outs[2] = {{a->out, fit_table, &fit},
+                                           {a->curve, curve_table, &curve}};
+        rc = cli_write_outputs(outs, 2, "fit");
+    }
+    free((void*)curve.pts);
+    free((void*)curve.pred);
     return rc;
 }
 
@@ -1027,10 +1034,7 @@ static int run_fit(const struct fit_args* a, struct fit_ctx* c, const double* in
     if (has_result)
         print_result(c, init, lower, upper, &r, st, pred, a->omega_scale, argc, argv);
     if (st == WETDEM_OK || st == WETDEM_ERR_MAX_STEPS) {
-        if (a->out)
-            rc = write_fit_csv(a->out, c, pred, argc, argv);
-        if (rc == CLI_EXIT_OK && a->curve)
-            rc = write_curve_csv(a->curve, c, r.values, a->curve_points, argc, argv);
+        rc = write_outputs(a, c, pred, r.values, argc, argv);
     }
     if (st != WETDEM_OK) {
         cli_error("fit: %s", msg);
