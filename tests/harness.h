@@ -141,6 +141,15 @@ static inline char* test_slurp(FILE* f, size_t* len)
     return buf;
 }
 
+/* Writes text to the file path (created or truncated). */
+static inline void test_write_file(const char* path, const char* text)
+{
+    FILE* f = fopen(path, "w");
+    assert_non_null(f);
+    fputs(text, f);
+    assert_int_equal(fclose(f), 0);
+}
+
 /* The whole file at path as test_slurp gives it, or NULL (and *len 0) when it cannot be
  * opened. */
 static inline char* test_read_file(const char* path, size_t* len)

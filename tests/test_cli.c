@@ -349,10 +349,8 @@ static const char* temp_scenario(const char* text)
     snprintf(path, sizeof path, "/tmp/wetdem_test_cli_XXXXXX");
     int fd = mkstemp(path);
     assert_true(fd >= 0);
-    FILE* f = fdopen(fd, "w");
-    assert_non_null(f);
-    fputs(text, f);
-    fclose(f);
+    close(fd);
+    test_write_file(path, text);
     return path;
 }
 

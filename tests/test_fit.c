@@ -627,10 +627,7 @@ static void test_fit_recovers_glass_pressure_from_simulated_data(void** state)
 static void temp_csv(char path[96], const char* tag, const char* text)
 {
     snprintf(path, 96, "/tmp/wetdem_fit_%s_%d.csv", tag, (int)getpid());
-    FILE* f = fopen(path, "w");
-    assert_non_null(f);
-    fputs(text, f);
-    fclose(f);
+    test_write_file(path, text);
 }
 
 /* `wetdem fit ARGS` must exit with `rc` and print `needle`. */

@@ -88,6 +88,15 @@ static struct wetdem_sim* wet_box(size_t n, bool wet)
     return sim;
 }
 
+/* wet_box(n, true) run to time t with its checkpoint written to path (the caller frees it). */
+static struct wetdem_sim* wet_box_checkpointed(size_t n, double t, const char* path)
+{
+    struct wetdem_sim* sim = wet_box(n, true);
+    CHECK_OK(wetdem_sim_integrate(sim, t));
+    CHECK_OK(wetdem_sim_write_checkpoint(sim, path));
+    return sim;
+}
+
 static void test_many_same_result_for_any_thread_count(void** state)
 {
     (void)state;
@@ -162,9 +171,7 @@ static void test_many_restart_is_bit_identical(void** state)
     close(mkstemp(path));
     struct wetdem_sim* whole = wet_box(150, true);
     CHECK_OK(wetdem_sim_integrate(whole, 1.2e-3));
-    struct wetdem_sim* first = wet_box(150, true);
-    CHECK_OK(wetdem_sim_integrate(first, 0.5e-3));
-    CHECK_OK(wetdem_sim_write_checkpoint(first, path));
+    struct wetdem_sim* first = wet_box_checkpointed(150, 0.5e-3, path);
     CHECK_OK(wetdem_sim_integrate(first, 1.2e-3)); /* continuing in memory is the same too */
     test_check_same_particles(whole, first);
     struct wetdem_sim* resumed = wet_box(150, true);
@@ -198,10 +205,7 @@ static void test_many_restart_refuses_impossible_states(void** state)
     char good[] = "/tmp/wetdem_test_many_good_XXXXXX", bad[] = "/tmp/wetdem_test_many_bad_XXXXXX";
     close(mkstemp(good));
     close(mkstemp(bad));
-    struct wetdem_sim* first = wet_box(60, true);
-    CHECK_OK(wetdem_sim_integrate(first, 0.2e-3));
-    CHECK_OK(wetdem_sim_write_checkpoint(first, good));
-    wetdem_sim_free(first);
+    wetdem_sim_free(wet_box_checkpointed(60, 0.2e-3, good));
     const char* want[] = {"particle 3: position, velocity and spin must be finite",
                           "particle 5: position, velocity and spin must be finite",
                           "particle 7: radius must be > 0 and finite, got -0.001 m",
@@ -288,10 +292,7 @@ static void test_many_restart_reads_checkpoints_with_contact_counts(void** state
     close(mkstemp(old));
     struct wetdem_sim* whole = wet_box(150, true);
     CHECK_OK(wetdem_sim_integrate(whole, 1.2e-3));
-    struct wetdem_sim* first = wet_box(150, true);
-    CHECK_OK(wetdem_sim_integrate(first, 0.5e-3));
-    CHECK_OK(wetdem_sim_write_checkpoint(first, good));
-    wetdem_sim_free(first);
+    wetdem_sim_free(wet_box_checkpointed(150, 0.5e-3, good));
     for (int extra = 0; extra < 2; extra++) { /* the counts; then one byte more */
         struct wetdem_checkpoint ck;
         char msg[256];
@@ -1321,9 +1322,7 @@ static void test_many_counts_survive_a_restart(void** state)
     (void)state;
     char path[] = "/tmp/wetdem_test_many_counts_XXXXXX";
     close(mkstemp(path));
-    struct wetdem_sim* sim = wet_box(150, true);
-    CHECK_OK(wetdem_sim_integrate(sim, 1e-3));
-    CHECK_OK(wetdem_sim_write_checkpoint(sim, path));
+    struct wetdem_sim* sim = wet_box_checkpointed(150, 1e-3, path);
     struct wetdem_sim* resumed = wet_box(150, true);
     CHECK_OK(wetdem_sim_read_checkpoint(resumed, path));
     struct wetdem_many_stats a, b;

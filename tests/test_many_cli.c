@@ -52,10 +52,7 @@ static const char* tpath(const char* name)
 
 static void write_text(const char* name, const char* text)
 {
-    FILE* f = fopen(tpath(name), "w");
-    assert_non_null(f);
-    fputs(text, f);
-    fclose(f);
+    test_write_file(tpath(name), text);
 }
 
 static bool exists(const char* name)

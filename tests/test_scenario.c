@@ -55,10 +55,7 @@ static const char* write_file(const char* name, const char* text)
     static int next = 0;
     char* path = paths[next++ % 4];
     snprintf(path, 512, "%s/%s", tmpdir, name);
-    FILE* f = fopen(path, "w");
-    assert_non_null(f);
-    fputs(text, f);
-    fclose(f);
+    test_write_file(path, text);
     return path;
 }
 

@@ -638,10 +638,7 @@ static const char* write_temp(const char* text)
 {
     static char path[64];
     snprintf(path, sizeof path, "/tmp/wetdem_track_%d.csv", (int)getpid());
-    FILE* f = fopen(path, "w");
-    assert_non_null(f);
-    fputs(text, f);
-    fclose(f);
+    test_write_file(path, text);
     return path;
 }
 
