@@ -119,7 +119,7 @@ static int build_pair_slots(struct wetdem_sim* sim, size_t k)
 {
     struct wetdem_engine* e = &sim->engine;
     struct wetdem_contact c;
-    double range, scratch[64];
+    double range, scratch[WETDEM_HISTORY_SCRATCH];
     pair_state(sim, k, &c, &range, scratch);
     if (c.gap < range) /* strictly inside: a run stopped exactly at separation stays done */
         e->pairs.items[k].has_interacted = true;
@@ -191,7 +191,7 @@ void wetdem_event_values(struct wetdem_sim* sim, double* g)
 {
     struct wetdem_engine* e = &sim->engine;
     struct wetdem_contact c;
-    double range = 0.0, scratch[64];
+    double range = 0.0, scratch[WETDEM_HISTORY_SCRATCH];
     size_t current = (size_t)-1;
     e->stats.root_evals++;
     for (size_t q = 0; q < e->n_slots; q++) {
@@ -295,7 +295,7 @@ double wetdem_event_smallest_branch_gap(const struct wetdem_sim* sim)
         if (!(h_k > 0.0 && h_k < h_min))
             continue;
         struct wetdem_contact c;
-        double range, scratch[64];
+        double range, scratch[WETDEM_HISTORY_SCRATCH];
         pair_state(sim, p, &c, &range, scratch);
         if (wetdem_sim_laws_jump_at(sim, &c, scratch, h_k))
             h_min = h_k;
@@ -320,7 +320,7 @@ static void note_branch_step(struct wetdem_sim* sim, size_t q)
     if (!(ratio > e->stats.hmin_step_ratio))
         return;
     struct wetdem_contact c;
-    double range, scratch[64];
+    double range, scratch[WETDEM_HISTORY_SCRATCH];
     pair_state(sim, p, &c, &range, scratch);
     if (wetdem_sim_laws_jump_at(sim, &c, scratch, h_k))
         e->stats.hmin_step_ratio = ratio;

@@ -22,8 +22,9 @@
  * With verlet.hmin_fraction > 0 the step is also held at or below hmin_fraction x h_min / v,
  * h_min the smallest gap inside their range at the start where the force laws jump (the
  * thin-film laws with below_hmin = c switch off there, docs/engines.md "Steps and h_min"; a
- * law continuous there, as nijssen's blend, sets no bound) and v that speed scale. Without pairs the run is one step (exact for free flight and constant force).
- * The last step is shortened to land on t_end.
+ * law continuous there, as nijssen's blend, sets no bound) and v that speed scale. Without
+ * pairs the run is one step (exact for free flight and constant force). The last step is
+ * shortened to land on t_end.
  *
  * Pair histories are committed at every step (c->dt = dt). Events: the event functions are
  * compared before and after every step and crossings are placed by linear interpolation of

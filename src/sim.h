@@ -14,6 +14,9 @@
 #define WETDEM_ERRMSG_SIZE 1024
 #define WETDEM_MAX_INTEGRATORS 4        /* registered integrators (integrator.c) */
 #define WETDEM_INTEGRATOR_PARAMS_MAX 16 /* doubles of one integrator's parameter block */
+/* Doubles of per-pair history a force evaluation can hold on the stack (scratch copies, fresh
+ * histories); a set-up with more is refused when a run starts (sim_integrate.c). */
+#define WETDEM_HISTORY_SCRATCH 64
 
 /* A model enabled on this simulation with its own parameter block. */
 struct wetdem_model_slot {

@@ -23,8 +23,6 @@
 #include "models.h"
 #include "vec3.h"
 
-#define HISTORY_SCRATCH 64 /* doubles of per-pair history a force evaluation can hold */
-
 void wetdem_sim_engine_init(struct wetdem_sim* sim)
 {
     struct wetdem_engine* e = &sim->engine;
@@ -179,7 +177,7 @@ static int eval_pair(struct wetdem_sim* sim, size_t k, double t, bool commit, bo
             wetdem_sim_history_beyond_range(sim, &c, wetdem_sim_record_range(sim, &c), history);
         return WETDEM_OK;
     }
-    double scratch[HISTORY_SCRATCH];
+    double scratch[WETDEM_HISTORY_SCRATCH];
     if (history)
         memcpy(scratch, history, sim->history_len * sizeof *scratch);
     c.dt = t - e->t_committed;
@@ -354,10 +352,10 @@ static int check_run(struct wetdem_sim* sim, double t_end)
         return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
                                "observer interval = %g s must be finite and >= 0",
                                e->observer_interval);
-    if (sim->history_len > HISTORY_SCRATCH)
+    if (sim->history_len > WETDEM_HISTORY_SCRATCH)
         return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
                                "the enabled models keep %zu doubles of pair history; at most %d",
-                               sim->history_len, HISTORY_SCRATCH);
+                               sim->history_len, WETDEM_HISTORY_SCRATCH);
     char why[128];
     for (size_t k = 0; k < sim->n_particles; k++)
         if (!wetdem_sim_particle_valid(&sim->particles[k], why, sizeof why))

@@ -627,7 +627,7 @@ static int restore_pairs(struct wetdem_sim* sim, const struct wetdem_checkpoint*
     for (size_t q = 0; q < np; q++)
         pairs[q] =
             (struct wetdem_celllist_pair){(uint32_t)ck->pairs[q].i, (uint32_t)ck->pairs[q].j};
-    double fresh[64];
+    double fresh[WETDEM_HISTORY_SCRATCH];
     if (len)
         wetdem_sim_history_init(sim, fresh);
     wetdem_celllist_remap_history(pairs, ck->history, np, m->cl.pairs, m->history, m->cl.n_pairs,

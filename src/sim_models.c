@@ -362,8 +362,9 @@ double wetdem_sim_contact_time(const struct wetdem_sim* sim, const struct wetdem
 double wetdem_sim_relaxation_time(const struct wetdem_sim* sim, struct wetdem_contact* c,
                                   const struct wetdem_model** which)
 {
-    double history[64] = {0}; /* a fresh pair's min-separation record (offset 0) */
-    c->h_min = sim->minsep.model->history_len <= 64
+    double history[WETDEM_HISTORY_SCRATCH] = {
+        0}; /* a fresh pair's min-separation record (offset 0) */
+    c->h_min = sim->minsep.model->history_len <= WETDEM_HISTORY_SCRATCH
                    ? sim->minsep.model->min_separation(sim->minsep.params, c, history)
                    : 0.0;
     double t = INFINITY;
@@ -428,7 +429,7 @@ bool wetdem_sim_contact_is_bridged(const struct wetdem_sim* sim, const struct we
 static double change_across(const struct wetdem_sim* sim, const struct wetdem_contact* c,
                             const double* history, double h, double eps)
 {
-    double f_n[2], f_t[2], scratch[64];
+    double f_n[2], f_t[2], scratch[WETDEM_HISTORY_SCRATCH];
     for (int side = 0; side < 2; side++) {
         struct wetdem_contact at = *c;
         struct wetdem_pair_force f;
@@ -447,7 +448,7 @@ static double change_across(const struct wetdem_sim* sim, const struct wetdem_co
 bool wetdem_sim_laws_jump_at(const struct wetdem_sim* sim, const struct wetdem_contact* c,
                              const double* history, double h)
 {
-    if (sim->history_len > 64)
+    if (sim->history_len > WETDEM_HISTORY_SCRATCH)
         return false;
     double wide = change_across(sim, c, history, h, 1e-6);
     return wide > 0.0 && change_across(sim, c, history, h, 1e-9) >= 0.5 * wide;
@@ -455,10 +456,11 @@ bool wetdem_sim_laws_jump_at(const struct wetdem_sim* sim, const struct wetdem_c
 
 double wetdem_sim_jump_gap(const struct wetdem_sim* sim, const struct wetdem_contact* c)
 {
-    if (sim->history_len > 64 || sim->minsep.model->history_len > 64)
+    if (sim->history_len > WETDEM_HISTORY_SCRATCH ||
+        sim->minsep.model->history_len > WETDEM_HISTORY_SCRATCH)
         return INFINITY;
     struct wetdem_contact p = *c;
-    double history[64] = {0}, gaps[WETDEM_MAX_THRESHOLDS], gap = INFINITY;
+    double history[WETDEM_HISTORY_SCRATCH] = {0}, gaps[WETDEM_MAX_THRESHOLDS], gap = INFINITY;
     p.h_min = sim->minsep.model->min_separation(sim->minsep.params, &p, history);
     double range = wetdem_sim_contact_range(sim, &p);
     for (size_t k = 0; k < sim->n_models; k++) {
@@ -506,7 +508,8 @@ static double tangential_after(const struct wetdem_sim* sim, struct wetdem_conta
 double wetdem_sim_tangential_time(const struct wetdem_sim* sim, const struct wetdem_contact* c,
                                   double t_contact)
 {
-    if (!(isfinite(t_contact) && t_contact > 0.0 && c->v_n > 0.0) || sim->history_len > 64)
+    if (!(isfinite(t_contact) && t_contact > 0.0 && c->v_n > 0.0) ||
+        sim->history_len > WETDEM_HISTORY_SCRATCH)
         return INFINITY;
     /* The largest overlap of the impact: Hertz's t_c = 2.94 delta_max / v (Johnson 1985
      * Eq. 11.25). A linear spring's is v t_c / pi, 7 % smaller, so there the stiffnesses are
@@ -544,9 +547,9 @@ double wetdem_sim_tangential_time(const struct wetdem_sim* sim, const struct wet
 int wetdem_sim_eval_contact(const struct wetdem_sim* sim, struct wetdem_contact* c, double* history,
                             struct wetdem_pair_force* out, struct wetdem_pair_force* per_model)
 {
-    double scratch[64];
+    double scratch[WETDEM_HISTORY_SCRATCH];
     if (!history) {
-        if (sim->history_len > 64)
+        if (sim->history_len > WETDEM_HISTORY_SCRATCH)
             return WETDEM_ERR_INVALID;
         wetdem_sim_history_init(sim, scratch);
         history = scratch;
