@@ -1010,11 +1010,11 @@ static inline __attribute__((always_inline)) void set_skip_time(const struct pas
     P->skip_until[q] = (float)(until - fabs(until) * 1.2e-7);
 }
 
-/* The squared reach of the cheap gap test of pair (i, j) with mixed properties x [m^2]. */
-static double reach2(const struct wetdem_celllist_item* xr, size_t i, size_t j,
-                     const struct wetdem_many_mix* x)
+/* The squared reach of the cheap gap test of pair (i, j) out to the gap `range` [m^2]: the
+ * interaction range of its mixed properties (x->range), or a min-separation record's. */
+static double reach2(const struct wetdem_celllist_item* xr, size_t i, size_t j, double range)
 {
-    double lim = xr[i].r + xr[j].r + x->range;
+    double lim = xr[i].r + xr[j].r + range;
     return lim * lim * (1 + PREFILTER_MARGIN);
 }
 
@@ -1034,8 +1034,7 @@ static void record_limits(const struct wetdem_sim* sim)
             &m->mix[(size_t)sim->particles[i].material * nm + (size_t)sim->particles[j].material];
         struct wetdem_contact c = {.r_eff = contact_reduced(xr[i].r, xr[j].r)};
         copy_mix(&c, x);
-        double lim = xr[i].r + xr[j].r + fmax(x->range, wetdem_sim_record_range(sim, &c));
-        m->pair_lim2[q] = lim * lim * (1 + PREFILTER_MARGIN);
+        m->pair_lim2[q] = reach2(xr, i, j, fmax(x->range, wetdem_sim_record_range(sim, &c)));
     }
 }
 
@@ -2148,7 +2147,7 @@ static int pair_constants(struct wetdem_sim* sim)
         size_t i = m->cl.pairs[q].i, j = m->cl.pairs[q].j;
         const struct wetdem_particle *a = &sim->particles[i], *b = &sim->particles[j];
         const struct wetdem_many_mix* x = &m->mix[(size_t)a->material * nm + (size_t)b->material];
-        m->pair_lim2[q] = reach2(m->xr, i, j, x);
+        m->pair_lim2[q] = reach2(m->xr, i, j, x->range);
         if (!lean)
             continue;
         double* c = m->pair_cache[q];
