@@ -910,6 +910,17 @@ static struct wetdem_sim* wall_impact(const char* force, const char* minsep, dou
     return sim;
 }
 
+/* The contact of wall_impact's sphere with its wall at x = 0 (normal +x), for the closed forms
+ * of its mixed properties. */
+static struct wetdem_contact wall_impact_contact(const struct wetdem_sim* sim)
+{
+    struct wetdem_contact c;
+    wetdem_contact_with_wall(&c, &sim->particles[0], &sim->materials[0],
+                             (struct wetdem_vec3){0, 0, 0}, (struct wetdem_vec3){1, 0, 0},
+                             &sim->materials[0], &sim->fluid);
+    return c;
+}
+
 /* The derived step bounds the travel per step against h_min (docs/many.md, Time step): `sb`
  * switches off below h_min (ehd: 0.37 R* (mu v/(E* R*))^(2/5), 70.7 nm at the speed scale
  * v = 0.1 m/s, twice the impact speed), and a step that crosses it at once mis-times that
@@ -933,10 +944,7 @@ static void test_many_step_resolves_hmin(void** state)
         CHECK_OK(wetdem_sim_integrate(sim, 0.02676));
         struct wetdem_many_stats st;
         CHECK_OK(wetdem_sim_many_stats(sim, &st));
-        struct wetdem_contact c;
-        wetdem_contact_with_wall(&c, &sim->particles[0], &sim->materials[0],
-                                 (struct wetdem_vec3){0, 0, 0}, (struct wetdem_vec3){1, 0, 0},
-                                 &sim->materials[0], &sim->fluid);
+        struct wetdem_contact c = wall_impact_contact(sim);
         double h_min = minsep_ehd_gap(0.01, 0.1, c.e_star, 6.35e-3);
         CHECK_REL(st.hmin_crossing_time, h_min / 0.1, 1e-12);
         CHECK_REL(st.dt, fraction * (h_min / 0.1), 1e-12);
@@ -966,10 +974,7 @@ static void test_many_step_resolves_the_tangential_spring(void** state)
     CHECK_OK(wetdem_sim_integrate(sim, 1e-5));
     struct wetdem_many_stats st;
     CHECK_OK(wetdem_sim_many_stats(sim, &st));
-    struct wetdem_contact c;
-    wetdem_contact_with_wall(&c, &sim->particles[0], &sim->materials[0],
-                             (struct wetdem_vec3){0, 0, 0}, (struct wetdem_vec3){1, 0, 0},
-                             &sim->materials[0], &sim->fluid);
+    struct wetdem_contact c = wall_impact_contact(sim);
     double t_c = wetdem_force_hertz_contact_time(c.e_star, c.r_eff, c.m_eff, 0.1);
     CHECK_REL(st.contact_time, t_c * sqrt(c.e_star / (14 * c.g_star)), 1e-7);
     CHECK_REL(st.dt, 0.02 * st.contact_time, 1e-12);
