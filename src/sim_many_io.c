@@ -114,15 +114,10 @@ int wetdem_sim_many_links(const struct wetdem_sim* sim, uint32_t* per_particle,
     return WETDEM_OK;
 }
 
-int wetdem_sim_many_stats(const struct wetdem_sim* sim, struct wetdem_many_stats* s)
+/* The fields of the statistics other than the links (counts, step, timers). */
+static void fill_run_stats(const struct wetdem_sim* sim, struct wetdem_many_stats* s)
 {
-    memset(s, 0, sizeof *s);
     const struct wetdem_many* m = sim->many;
-    if (!m || !m->started)
-        return WETDEM_ERR_INVALID;
-    int st = wetdem_sim_many_links(sim, NULL, s);
-    if (st != WETDEM_OK)
-        return st;
     s->candidate_pairs = m->cl.n_pairs;
     s->list_builds = m->cl.n_builds;
     s->dt = m->dt;
@@ -135,28 +130,56 @@ int wetdem_sim_many_stats(const struct wetdem_sim* sim, struct wetdem_many_stats
     s->seconds_lists = m->seconds_lists;
     s->seconds_output = m->seconds_output;
     s->threads = wetdem_many_parallel(m, sim->n_particles) ? omp_get_max_threads() : 1;
-    return WETDEM_OK;
+}
+
+int wetdem_sim_many_stats(const struct wetdem_sim* sim, struct wetdem_many_stats* s)
+{
+    memset(s, 0, sizeof *s);
+    const struct wetdem_many* m = sim->many;
+    if (!m || !m->started)
+        return WETDEM_ERR_INVALID;
+    int st = wetdem_sim_many_links(sim, NULL, s);
+    if (st == WETDEM_OK)
+        fill_run_stats(sim, s);
+    return st;
 }
 
 /* ---- VTK and CSV ---- */
 
-int wetdem_sim_write_vtk(struct wetdem_sim* sim, const char* path, bool binary)
+/* Each particle's contacts as the enabled models define them, and the run's links in *s
+ * (wetdem_sim_many_links); NULL, with the failure recorded, when out of memory. */
+static uint32_t* contact_counts(struct wetdem_sim* sim, struct wetdem_many_stats* s)
 {
-    /* each particle's contacts as the enabled models define them (wetdem_sim_many_links) */
-    uint32_t* contacts = NULL;
-    if (sim->many && sim->many->started) {
-        struct wetdem_many_stats s;
-        contacts = malloc((sim->n_particles ? sim->n_particles : 1) * sizeof *contacts);
-        if (!contacts || wetdem_sim_many_links(sim, contacts, &s) != WETDEM_OK) {
-            free(contacts);
-            return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory for the contact counts");
-        }
+    uint32_t* contacts = malloc((sim->n_particles ? sim->n_particles : 1) * sizeof *contacts);
+    if (!contacts || wetdem_sim_many_links(sim, contacts, s) != WETDEM_OK) {
+        free(contacts);
+        wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory for the contact counts");
+        return NULL;
     }
+    return contacts;
+}
+
+/* The frame at `path`, with the given contact counts (NULL: none, a run not started). */
+static int write_vtk_counts(struct wetdem_sim* sim, const char* path, bool binary,
+                            const uint32_t* contacts)
+{
     char msg[512];
     int st = wetdem_output_vtk_write(path, sim->particles, sim->n_particles, contacts,
                                      sim->engine.time, binary, msg, sizeof msg);
-    free(contacts);
     return st == WETDEM_OK ? st : wetdem_sim_fail(sim, st, "%s", msg);
+}
+
+int wetdem_sim_write_vtk(struct wetdem_sim* sim, const char* path, bool binary)
+{
+    uint32_t* contacts = NULL;
+    if (sim->many && sim->many->started) {
+        struct wetdem_many_stats s;
+        if (!(contacts = contact_counts(sim, &s)))
+            return WETDEM_ERR_NOMEM;
+    }
+    int st = write_vtk_counts(sim, path, binary, contacts);
+    free(contacts);
+    return st;
 }
 
 /* "<prefix><suffix>" into buf. */
@@ -201,12 +224,13 @@ static int add_series_entry(struct wetdem_sim* sim, const char* name, double tim
     return WETDEM_OK;
 }
 
-static int write_vtk_frame(struct wetdem_sim* sim)
+/* The next frame of the series, with each particle's contact count. */
+static int write_vtk_frame(struct wetdem_sim* sim, const uint32_t* contacts)
 {
     struct wetdem_many* m = sim->many;
     char path[4096], series[4096];
     wetdem_output_vtk_path(path, sizeof path, m->output_prefix, m->vtk_files);
-    int st = wetdem_sim_write_vtk(sim, path, m->set.vtk_binary);
+    int st = write_vtk_counts(sim, path, m->set.vtk_binary, contacts);
     if (st == WETDEM_OK)
         st = add_series_entry(sim, base_name(path), sim->engine.time);
     if (st != WETDEM_OK)
@@ -267,7 +291,9 @@ static void csv_header(const struct wetdem_sim* sim, FILE* f)
     fputc('\n', f);
 }
 
-static int write_csv_row(struct wetdem_sim* sim)
+/* The next row of the CSV; `links`, when not NULL, holds the run's links at this step (worked
+ * out for the VTK frame of the same step), else they are worked out here. */
+static int write_csv_row(struct wetdem_sim* sim, const struct wetdem_many_stats* links)
 {
     struct wetdem_many* m = sim->many;
     char path[4096];
@@ -279,7 +305,11 @@ static int write_csv_row(struct wetdem_sim* sim)
     if (m->csv_rows == 0 || (fseek(f, 0, SEEK_END) == 0 && ftell(f) == 0))
         csv_header(sim, f);
     struct wetdem_many_stats s;
-    st = wetdem_sim_many_stats(sim, &s);
+    if (links) {
+        s = *links;
+        fill_run_stats(sim, &s);
+    } else
+        st = wetdem_sim_many_stats(sim, &s);
     if (st != WETDEM_OK) {
         fclose(f);
         return wetdem_sim_fail(sim, st, "out of memory for the contact counts");
@@ -309,7 +339,7 @@ int wetdem_sim_many_write_csv_row(struct wetdem_sim* sim)
     if (!sim || !sim->many || !sim->many->started || !sim->many->output_prefix)
         return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
                                "many: a CSV row needs a started many-particle run with outputs");
-    return write_csv_row(sim);
+    return write_csv_row(sim, NULL);
 }
 
 /* Output k is due at multiples of `every` steps, once per step. */
@@ -326,10 +356,17 @@ int wetdem_sim_many_outputs(struct wetdem_sim* sim, bool final)
     struct wetdem_many* m = sim->many;
     int st = WETDEM_OK;
     (void) final;
-    if (m->output_prefix && due(m->step, m->set.vtk_every, &m->next_vtk_step))
-        st = write_vtk_frame(sim);
+    /* the links are worked out once for the frame and, when due at the same step, the row */
+    struct wetdem_many_stats links;
+    bool have_links = false;
+    if (m->output_prefix && due(m->step, m->set.vtk_every, &m->next_vtk_step)) {
+        uint32_t* contacts = contact_counts(sim, &links);
+        st = contacts ? write_vtk_frame(sim, contacts) : WETDEM_ERR_NOMEM;
+        have_links = contacts != NULL;
+        free(contacts);
+    }
     if (st == WETDEM_OK && m->output_prefix && due(m->step, m->set.csv_every, &m->next_csv_step))
-        st = write_csv_row(sim);
+        st = write_csv_row(sim, have_links ? &links : NULL);
     if (st == WETDEM_OK && m->checkpoint_path && m->step > 0 &&
         due(m->step, m->set.checkpoint_every, &m->next_checkpoint_step))
         st = wetdem_sim_write_checkpoint(sim, m->checkpoint_path);
