@@ -703,6 +703,14 @@ static int collision_summary(struct wetdem_track* t, const struct wetdem_track_o
 {
     size_t n_int = t->s[0].n - 1, h = (size_t)o->window / 2;
     size_t n_ref = o->window > TRACK_MIN_FIT ? (size_t)o->window : TRACK_MIN_FIT, si = 0;
+    /* the reference velocity is the mean of the first n_ref intervals, and a collision after
+       them is a change that lasts h + 1 more */
+    if (n_int < n_ref + h + 1)
+        return fail(t, WETDEM_ERR_INVALID,
+                    "sphere %d has %zu frames; finding a collision needs at least %zu (the first "
+                    "%zu frame intervals set the reference velocity and a change must last %zu "
+                    "more; window = %d)",
+                    t->s[0].id, t->s[0].n, n_ref + h + 2, n_ref, h + 1, o->window);
     int st = pick_striker(t, o, n_ref, &si);
     if (st != WETDEM_OK)
         return st;

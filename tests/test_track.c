@@ -733,6 +733,23 @@ static void test_track_rejects_short_or_mismatched_tracks(void** state)
     CHECK_STATUS(wetdem_track_analyse(t, &o, &s), WETDEM_ERR_INVALID);
     CHECK_CONTAINS(wetdem_track_errmsg(t), "no collision found");
     wetdem_track_free(t);
+    /* Two spheres with frames enough for the smoothing (7) but not for the reference velocity
+       (the mean of the first 7 intervals; a collision after them lasting 4 more): 7 to 11
+       frames are refused with the count needed (7 frames read past the 6 velocities, found by
+       make fuzz); 12 are enough to look for a collision. */
+    for (int n = 7; n <= 12; n++) {
+        t = wetdem_track_create();
+        for (int f = 0; f < n; f++) {
+            double moving[6] = {f, 0, 10 + f, 0, 5 + f, 8};
+            CHECK_OK(wetdem_track_add_frame(t, 1, f, moving));
+            double other[6] = {200, 0, 210, 0, 205, 8};
+            CHECK_OK(wetdem_track_add_frame(t, 2, f, other));
+        }
+        CHECK_STATUS(wetdem_track_analyse(t, &o, &s), WETDEM_ERR_INVALID);
+        CHECK_CONTAINS(wetdem_track_errmsg(t),
+                       n < 12 ? "finding a collision needs at least 12" : "no collision found");
+        wetdem_track_free(t);
+    }
 }
 
 static void test_track_cli_exits_2_with_line_number(void** state)
