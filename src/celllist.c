@@ -398,6 +398,8 @@ static int scan_cell(const struct wetdem_celllist* cl, const struct scan* sc, in
     for (int r = 1; r < m; r++)
         others += runs[r].hi - runs[r].lo;
     size_t used = b->used, need = used + na * (na - 1) / 2 + na * others;
+    if (need == used) /* one particle and no neighbours: no pair (b->pairs may be NULL) */
+        return WETDEM_OK;
     if (need > b->cap && reserve((void**)&b->pairs, &b->cap, need, sizeof *b->pairs))
         return WETDEM_ERR_NOMEM;
     bool image = cl->box.periodic[0] || cl->box.periodic[1] || cl->box.periodic[2];
