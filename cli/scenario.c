@@ -507,6 +507,18 @@ static void note_section(struct reader* r, const char* text)
     memcpy(name, p + 1, len);
     name[len] = '\0';
     trim(name);
+    /* inih drops what follows the ']' (a key written on the header's line would be lost) */
+    const char* rest = close + 1;
+    while (isspace((unsigned char)*rest))
+        rest++;
+    if (*rest) {
+        size_t n = strcspn(rest, "\r\n");
+        fprintf(stderr,
+                "%s:%d: text after the section header [%s]: '%.*s'; a header stands alone on its "
+                "line, its keys on the lines below\n",
+                r->sc->file, r->line, name, (int)(n < 60 ? n : 60), rest);
+        r->n_errors++;
+    }
     if (push_section(r->sc, name, r->line) != 0)
         r->out_of_memory = true;
 }

@@ -187,6 +187,9 @@ static void test_scenario_bad_files_exit_2_with_line(void** state)
     (void)state;
     static const struct bad_case cases[] = {
         {"malformed", "[collision]\nstokes = 5\nstriker delrin\n", ":3:", "malformed line"},
+        /* inih reads "[fluid] viscosity = 0.1" as the header alone: the key was lost */
+        {"header", "[collision]\nstokes = 5\n[fluid] viscosity = 0.1\n",
+         ":3:", "text after the section header [fluid]: 'viscosity = 0.1'"},
         {"section", "[collision]\nstokes = 5\n[fluids]\nviscosity = 1\n",
          ":3:", "did you mean [fluid]"},
         {"key", "[collision]\nstokse = 5\n", ":2:", "did you mean 'stokes'"},
