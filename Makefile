@@ -7,6 +7,8 @@
 #   make validate long validation sweeps and figures (docs/validation.md)
 #   make bench    benchmarks with ratios against baselines measured in the same run
 #   make figures  redraw the figures from the CSV in out/validate (no new simulations)
+#   make fuzz     fuzz scenario files, checkpoints and tracked dots (libFuzzer, clang, ASan + UBSan);
+#                 FUZZ_SECONDS per target, 120 by default
 
 CC      ?= gcc
 BUILD   ?= build
@@ -33,7 +35,7 @@ EX_SRC   = $(sort $(wildcard examples/*/main.c))
 EX_BIN   = $(patsubst examples/%/main.c,$(BUILD)/examples/%,$(EX_SRC))
 
 .PHONY: all deps test check san test-san demo validate bench figures docs clean format \
-        check-format check-prefix check-docs examples
+        check-format check-prefix check-docs examples fuzz fuzz-build
 
 all: deps $(BUILD)/libwetdem.a $(BUILD)/libwetdem.so $(BUILD)/wetdem
 
@@ -103,7 +105,7 @@ check-docs: all
 check-format:
 	@scripts/install-deps check
 	@clang-format --dry-run -Werror src/*.c src/*.h include/*.h cli/*.c cli/*.h tests/*.c \
-	  tests/*.h examples/*/main.c bench/*.c && echo "check-format: ok"
+	  tests/*.h tests/fuzz/*.c tests/fuzz/*.h examples/*/main.c bench/*.c && echo "check-format: ok"
 
 check: test test-san check-prefix check-docs check-format
 
@@ -127,9 +129,36 @@ bench: all
 	@scripts/install-deps bench
 	@scripts/bench $(BUILD)/wetdem
 
+# Fuzzing, in a build tree of its own: scenario files (every engine, as `run --check` reads
+# them), checkpoints and the dots CSV of `track`, as any bytes (tests/fuzz/, scripts/fuzz;
+# README, "make fuzz").
+FUZZ_SECONDS ?= 120
+FUZZ_SAN = -fsanitize=address,undefined,float-cast-overflow -fno-sanitize-recover=all \
+           -fno-omit-frame-pointer
+FUZZ_TARGETS = fuzz_scenario fuzz_checkpoint fuzz_track
+
+fuzz:
+	@scripts/install-deps fuzz
+	@$(MAKE) --no-print-directory fuzz-build BUILD=build-fuzz CC=clang OPT=-O1 \
+	  EXTRA_CFLAGS="$(FUZZ_SAN) -fsanitize=fuzzer-no-link"
+	@scripts/fuzz build-fuzz $(FUZZ_SECONDS) $(FUZZ_TARGETS)
+
+fuzz-build: $(patsubst %,$(BUILD)/fuzz/%,$(FUZZ_TARGETS))
+
+# The CLI's main() as wetdem_cli_main, for the scenario target.
+$(BUILD)/fuzz/cli_main.o: cli/main.c include/wetdem.h $(wildcard cli/*.h) $(BUILD)/version.stamp \
+                          $(BUILD)/flags.stamp
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS_ALL) -DWETDEM_GIT_HASH='"$(GIT_HASH)"' -Dmain=wetdem_cli_main -c $< -o $@
+
+$(BUILD)/fuzz/%: tests/fuzz/%.c $(wildcard tests/fuzz/*.h) $(filter-out $(BUILD)/cli/main.o,$(CLI_OBJ)) \
+                 $(BUILD)/fuzz/cli_main.o $(BUILD)/libwetdem.a
+	$(CC) $(CFLAGS_ALL) -fsanitize=fuzzer -o $@ $< $(filter-out $(BUILD)/cli/main.o,$(CLI_OBJ)) \
+	  $(BUILD)/fuzz/cli_main.o $(BUILD)/libwetdem.a $(LDLIBS) $(FUZZ_SAN)
+
 format:
 	clang-format -i src/*.c src/*.h include/*.h cli/*.c cli/*.h tests/*.c tests/*.h examples/*/main.c \
-	  bench/*.c
+	  bench/*.c tests/fuzz/*.c tests/fuzz/*.h
 
 clean:
-	rm -rf build build-san
+	rm -rf build build-san build-fuzz

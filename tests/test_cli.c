@@ -5,7 +5,8 @@
  * form of the reynolds model, F = 6 pi mu R*^2 v_n / h), bad input (exit 2, message), and
  * `--help`/`-h` of every subcommand listed by `wetdem --help` (usage on stdout, exit 0), and
  * the choice of models: a model of the wrong kind named with its kind, and [model.NAME]
- * sections of models that a --set of [models] left out.
+ * sections of models that a --set of [models] left out; the inputs `make fuzz` found
+ * (tests/fuzz/regressions/), each answered as any other file.
  *
  * The CLI path comes from the environment variable WETDEM_CLI (set by `make test`), falling
  * back to build/wetdem relative to the working directory (the repository root).
@@ -390,6 +391,37 @@ static void test_cli_unused_model_sections(void** state)
     remove(stray);
 }
 
+/* Inputs found by `make fuzz` (tests/fuzz/regressions/), each once a memory error, undefined
+ * behaviour or a silent loss: the answer now is that of any other file. Under `make test-san`
+ * AddressSanitizer checks the track's way; the cell list's zero offset of a NULL pointer only
+ * clang's UBSan reports (`make fuzz`: the file is in its corpus), GCC's does not look. */
+static void test_cli_fuzz_regressions(void** state)
+{
+    (void)state;
+    static const struct {
+        const char* args;
+        int code;
+        const char* needle;
+    } cases[] = {
+        /* 7 frames of two spheres: the striker's pick read past the 6 velocities */
+        {"track tests/fuzz/regressions/track_too_short.csv --fps 5000 --pixel-size 0.000175", 2,
+         "sphere 1 has 7 frames; finding a collision needs at least 12"},
+        /* two spheres 0.13 m apart: a cell of one sphere without neighbours offset a NULL list */
+        {"run tests/fuzz/regressions/cell_without_pairs.ini --check", 0,
+         "is valid (many-particle run)"},
+        /* "[particle.s4] coated": inih kept the header and dropped the rest without a word */
+        {"run tests/fuzz/regressions/header_with_text.ini --check", 2,
+         "header_with_text.ini:35: text after the section header [particle.s4]: 'coated'"},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        struct test_run r = run_cli(cases[k].args, true);
+        if (r.code != cases[k].code || !strstr(r.out, cases[k].needle))
+            fail_msg("wetdem %s: exit %d (want %d), output:\n%s", cases[k].args, r.code,
+                     cases[k].code, r.out);
+        free(r.out);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -405,6 +437,7 @@ int main(void)
         cmocka_unit_test(test_cli_model_of_the_wrong_kind),
         cmocka_unit_test(test_cli_unused_model_sections),
         cmocka_unit_test(test_cli_integrator_names_in_set),
+        cmocka_unit_test(test_cli_fuzz_regressions),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
