@@ -578,15 +578,23 @@ static char* read_line(char* str, int num, void* stream)
     return str;
 }
 
-static int on_pair(void* user, const char* section, const char* key, const char* value)
+static int on_pair(void* user, const char* section_as_read, const char* key, const char* value)
 {
     struct reader* r = user;
     char v[CLI_VALUE_MAX];
     copy_text(v, sizeof v, value);
     strip_hash_comment(v);
-    if (section[0] == '\0') {
-        fprintf(stderr, "%s:%d: key '%s' comes before any [section]\n", r->sc->file, r->line, key);
-        r->n_errors++;
+    /* "[ fluid ]" is [fluid], as the section marks have it (note_section); inih keeps the
+       spaces (its lines hold fewer than 256 characters) */
+    char section[256];
+    copy_text(section, sizeof section, section_as_read);
+    trim(section);
+    if (section[0] == '\0') { /* (a header "[ ]" is reported as an unknown section []) */
+        if (section_as_read[0] == '\0') {
+            fprintf(stderr, "%s:%d: key '%s' comes before any [section]\n", r->sc->file, r->line,
+                    key);
+            r->n_errors++;
+        }
         return 1;
     }
     if (strlen(section) >= CLI_NAME_MAX || strlen(key) >= CLI_NAME_MAX) {

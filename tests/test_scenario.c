@@ -190,6 +190,8 @@ static void test_scenario_bad_files_exit_2_with_line(void** state)
         /* inih reads "[fluid] viscosity = 0.1" as the header alone: the key was lost */
         {"header", "[collision]\nstokes = 5\n[fluid] viscosity = 0.1\n",
          ":3:", "text after the section header [fluid]: 'viscosity = 0.1'"},
+        /* a header of spaces names no section (its key was also said to come before any) */
+        {"empty header", "[ ]\nstokes = 5\n", ":1:", "unknown section []"},
         {"section", "[collision]\nstokes = 5\n[fluids]\nviscosity = 1\n",
          ":3:", "did you mean [fluid]"},
         {"key", "[collision]\nstokse = 5\n", ":2:", "did you mean 'stokes'"},
@@ -387,6 +389,15 @@ static void test_scenario_boms_crlf_and_long_comments(void** state)
     char args[700];
     snprintf(args, sizeof args, "run '%s' --check", write_file("windows.ini", text));
     struct test_run r = run_cli(args);
+    if (r.code != 0)
+        fail_msg("exit %d\n%s", r.code, r.out);
+    CHECK_CONTAINS(r.out, "stokes_n      7.5 -");
+    free(r.out);
+    /* spaces inside a header's brackets are not part of its name: "[ collision ]" is
+       [collision] (it was refused as a section that no engine reads) */
+    snprintf(args, sizeof args, "run '%s' --check",
+             write_file("spaced.ini", "[ collision ]\nstokes = 7.5\n[fluid ]\nviscosity = 0.01\n"));
+    r = run_cli(args);
     if (r.code != 0)
         fail_msg("exit %d\n%s", r.code, r.out);
     CHECK_CONTAINS(r.out, "stokes_n      7.5 -");
