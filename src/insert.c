@@ -457,10 +457,14 @@ int wetdem_insert_particles_among(const struct wetdem_insert_spec* spec,
                  ? place_lattice(spec, r_max, out, msg, msg_size)
                  : place_random(spec, rng, r_max, existing, n_existing, out, msg, msg_size);
     for (size_t i = 0; st == WETDEM_OK && i < spec->n; i++) {
+        /* one statement a draw: as arguments of one call their order was the compiler's (GCC
+           drew z first, clang x), and a seed gave other velocities with clang; z, y, x keeps
+           the spheres that earlier builds gave */
         double sd = spec->velocity_sigma;
-        out[i].vel = vec3(spec->velocity.x + gsl_ran_gaussian_ziggurat(rng, sd),
-                          spec->velocity.y + gsl_ran_gaussian_ziggurat(rng, sd),
-                          spec->velocity.z + gsl_ran_gaussian_ziggurat(rng, sd));
+        double dz = gsl_ran_gaussian_ziggurat(rng, sd);
+        double dy = gsl_ran_gaussian_ziggurat(rng, sd);
+        double dx = gsl_ran_gaussian_ziggurat(rng, sd);
+        out[i].vel = vec3(spec->velocity.x + dx, spec->velocity.y + dy, spec->velocity.z + dz);
     }
     gsl_rng_free(rng);
     return st;

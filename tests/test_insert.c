@@ -1,8 +1,11 @@
 /*
  * test_insert.c — initial configurations (src/insert.c): reproducibility from the seed, no
  * overlap (brute force, minimum image on periodic axes), spheres inside the region, lattice
- * capacity by hand arithmetic, radius and velocity statistics, clear errors.
+ * capacity by hand arithmetic, radius and velocity statistics, the order of the draws (so
+ * that a seed gives the same spheres whatever the compiler), clear errors.
  */
+#include <gsl/gsl_randist.h>
+#include <gsl/gsl_rng.h>
 #include <stdlib.h>
 
 #include "harness.h"
@@ -72,6 +75,34 @@ static void test_insert_same_seed_gives_identical_particles(void** state)
     s.seed = 43;
     CHECK_OK(wetdem_insert_particles(&s, c, NULL, 0));
     assert_memory_not_equal(a, c, sizeof a);
+}
+
+/* The draws of a lattice spec, redone here from the seed with GSL: the radii in sphere order,
+ * then each sphere's velocity, z, y and x. Bit for bit: as the arguments of one call, the
+ * three velocity draws came in the compiler's order, and a clang build gave other velocities
+ * than a GCC build for the same seed (x and z exchanged). */
+static void test_insert_draws_in_a_stated_order(void** state)
+{
+    (void)state;
+    struct wetdem_insert_spec s = base_spec(WETDEM_INSERT_LATTICE, 5);
+    s.velocity = (struct wetdem_vec3){0.5, -0.25, 1};
+    struct wetdem_particle p[5];
+    CHECK_OK(wetdem_insert_particles(&s, p, NULL, 0));
+    gsl_rng* rng = gsl_rng_alloc(gsl_rng_mt19937);
+    assert_non_null(rng);
+    gsl_rng_set(rng, s.seed);
+    for (size_t i = 0; i < s.n; i++)
+        CHECK_ABS(p[i].radius, s.radius_min + (s.radius_max - s.radius_min) * gsl_rng_uniform(rng),
+                  0);
+    for (size_t i = 0; i < s.n; i++) {
+        double dz = gsl_ran_gaussian_ziggurat(rng, s.velocity_sigma);
+        double dy = gsl_ran_gaussian_ziggurat(rng, s.velocity_sigma);
+        double dx = gsl_ran_gaussian_ziggurat(rng, s.velocity_sigma);
+        CHECK_ABS(p[i].vel.x, s.velocity.x + dx, 0);
+        CHECK_ABS(p[i].vel.y, s.velocity.y + dy, 0);
+        CHECK_ABS(p[i].vel.z, s.velocity.z + dz, 0);
+    }
+    gsl_rng_free(rng);
 }
 
 static void test_insert_random_has_no_overlap(void** state)
@@ -435,6 +466,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_insert_same_seed_gives_identical_particles),
+        cmocka_unit_test(test_insert_draws_in_a_stated_order),
         cmocka_unit_test(test_insert_random_has_no_overlap),
         cmocka_unit_test(test_insert_random_periodic_respects_images),
         cmocka_unit_test(test_insert_lattice_capacity_by_hand),
