@@ -1,8 +1,8 @@
 # wetdem — build, test, demo, validation, benchmarks.
 #   make          library (static + shared) and the wetdem CLI in build/
 #   make test     build and run every unit test (installs missing Debian packages first)
-#   make check    everything CI checks: tests under ASan+UBSan, symbol prefixes, docs freshness,
-#                 C layout (clang-format)
+#   make check    everything CI checks: tests under ASan+UBSan (built by GCC and by clang),
+#                 symbol prefixes, docs freshness, C layout (clang-format)
 #   make demo     the built-in default scenario
 #   make validate long validation sweeps and figures (docs/validation.md)
 #   make bench    benchmarks with ratios against baselines measured in the same run
@@ -34,7 +34,7 @@ TEST_BIN = $(patsubst tests/%.c,$(BUILD)/tests/%,$(TEST_SRC))
 EX_SRC   = $(sort $(wildcard examples/*/main.c))
 EX_BIN   = $(patsubst examples/%/main.c,$(BUILD)/examples/%,$(EX_SRC))
 
-.PHONY: all deps test check san test-san demo validate bench figures docs clean format \
+.PHONY: all deps test check san test-san test-san-clang demo validate bench figures docs clean format \
         check-format check-prefix check-docs examples fuzz fuzz-build
 
 all: deps $(BUILD)/libwetdem.a $(BUILD)/libwetdem.so $(BUILD)/wetdem
@@ -86,11 +86,20 @@ examples: $(EX_BIN)
 test: all $(TEST_BIN) $(EX_BIN)
 	@WETDEM_CLI=$(abspath $(BUILD)/wetdem) tests/run-tests $(TEST_BIN) $(EX_BIN) tests/test_install_deps.sh
 
-# Tests again under AddressSanitizer + UndefinedBehaviorSanitizer, in a separate build tree.
+# Tests again under AddressSanitizer + UndefinedBehaviorSanitizer, in a separate build tree,
+# built by GCC (test-san) and by clang (test-san-clang: its UBSan also reports pointer
+# arithmetic on NULL, which GCC's does not look for).
+SAN = -fsanitize=address,undefined,float-cast-overflow
 test-san:
 	$(MAKE) test BUILD=build-san OPT=-O1 \
-	  EXTRA_CFLAGS="-fsanitize=address,undefined,float-cast-overflow -fno-sanitize-recover=all -fno-omit-frame-pointer" \
-	  LDLIBS="$(LDLIBS) -fsanitize=address,undefined,float-cast-overflow"
+	  EXTRA_CFLAGS="$(SAN) -fno-sanitize-recover=all -fno-omit-frame-pointer" \
+	  LDLIBS="$(LDLIBS) $(SAN)"
+
+test-san-clang:
+	@scripts/install-deps fuzz
+	$(MAKE) test BUILD=build-san-clang CC=clang OPT=-O1 \
+	  EXTRA_CFLAGS="$(SAN) -fno-sanitize-recover=all -fno-omit-frame-pointer" \
+	  LDLIBS="$(LDLIBS) $(SAN)"
 
 check-prefix: all
 	@tools/check-prefix $(BUILD)
@@ -107,7 +116,7 @@ check-format:
 	@clang-format --dry-run -Werror src/*.c src/*.h include/*.h cli/*.c cli/*.h tests/*.c \
 	  tests/*.h tests/fuzz/*.c tests/fuzz/*.h examples/*/main.c bench/*.c && echo "check-format: ok"
 
-check: test test-san check-prefix check-docs check-format
+check: test test-san test-san-clang check-prefix check-docs check-format
 
 docs: all
 	$(BUILD)/wetdem docs-models > docs/models.md
@@ -133,8 +142,7 @@ bench: all
 # them), checkpoints and the dots CSV of `track`, as any bytes (tests/fuzz/, scripts/fuzz;
 # README, "make fuzz").
 FUZZ_SECONDS ?= 120
-FUZZ_SAN = -fsanitize=address,undefined,float-cast-overflow -fno-sanitize-recover=all \
-           -fno-omit-frame-pointer
+FUZZ_SAN = $(SAN) -fno-sanitize-recover=all -fno-omit-frame-pointer
 FUZZ_TARGETS = fuzz_scenario fuzz_checkpoint fuzz_track
 
 fuzz:
@@ -161,4 +169,4 @@ format:
 	  bench/*.c tests/fuzz/*.c tests/fuzz/*.h
 
 clean:
-	rm -rf build build-san build-fuzz
+	rm -rf build build-san build-san-clang build-fuzz
