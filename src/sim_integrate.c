@@ -28,7 +28,7 @@ void wetdem_sim_engine_init(struct wetdem_sim* sim)
     struct wetdem_engine* e = &sim->engine;
     memset(e, 0, sizeof *e);
     const struct wetdem_integrator* const* reg = wetdem_integrator_registry();
-    for (size_t k = 0; reg[k] && k < WETDEM_MAX_INTEGRATORS; k++)
+    for (size_t k = 0; k < WETDEM_MAX_INTEGRATORS && reg[k]; k++)
         wetdem_param_init_defaults(reg[k]->params, e->integrator_params[k]);
     e->integrator = 0;
     e->last_observed = NAN;
