@@ -7,8 +7,8 @@
 #   make validate long validation sweeps and figures (docs/validation.md)
 #   make bench    benchmarks with ratios against baselines measured in the same run
 #   make figures  redraw the figures from the CSV in out/validate (no new simulations)
-#   make fuzz     fuzz scenario files, checkpoints and tracked dots (libFuzzer, clang, ASan + UBSan);
-#                 FUZZ_SECONDS per target, 120 by default
+#   make fuzz     fuzz scenario files, checkpoints, tracked dots and fit data (libFuzzer, clang,
+#                 ASan and UBSan); FUZZ_SECONDS per target, 120 by default
 
 CC      ?= gcc
 BUILD   ?= build
@@ -34,8 +34,8 @@ TEST_BIN = $(patsubst tests/%.c,$(BUILD)/tests/%,$(TEST_SRC))
 EX_SRC   = $(sort $(wildcard examples/*/main.c))
 EX_BIN   = $(patsubst examples/%/main.c,$(BUILD)/examples/%,$(EX_SRC))
 
-.PHONY: all deps test check san test-san test-san-clang demo validate bench figures docs clean format \
-        check-format check-prefix check-docs examples fuzz fuzz-build
+.PHONY: all deps test check san test-san test-san-clang demo validate bench figures docs clean \
+        format check-format check-prefix check-docs examples fuzz fuzz-build
 
 all: deps $(BUILD)/libwetdem.a $(BUILD)/libwetdem.so $(BUILD)/wetdem
 
@@ -90,15 +90,13 @@ test: all $(TEST_BIN) $(EX_BIN)
 # built by GCC (test-san) and by clang (test-san-clang: its UBSan also reports pointer
 # arithmetic on NULL, which GCC's does not look for).
 SAN = -fsanitize=address,undefined,float-cast-overflow
+SAN_CFLAGS = $(SAN) -fno-sanitize-recover=all -fno-omit-frame-pointer
 test-san:
-	$(MAKE) test BUILD=build-san OPT=-O1 \
-	  EXTRA_CFLAGS="$(SAN) -fno-sanitize-recover=all -fno-omit-frame-pointer" \
-	  LDLIBS="$(LDLIBS) $(SAN)"
+	$(MAKE) test BUILD=build-san OPT=-O1 EXTRA_CFLAGS="$(SAN_CFLAGS)" LDLIBS="$(LDLIBS) $(SAN)"
 
 test-san-clang:
 	@scripts/install-deps fuzz
-	$(MAKE) test BUILD=build-san-clang CC=clang OPT=-O1 \
-	  EXTRA_CFLAGS="$(SAN) -fno-sanitize-recover=all -fno-omit-frame-pointer" \
+	$(MAKE) test BUILD=build-san-clang CC=clang OPT=-O1 EXTRA_CFLAGS="$(SAN_CFLAGS)" \
 	  LDLIBS="$(LDLIBS) $(SAN)"
 
 check-prefix: all
@@ -139,16 +137,15 @@ bench: all
 	@scripts/bench $(BUILD)/wetdem
 
 # Fuzzing, in a build tree of its own: scenario files (every engine, as `run --check` reads
-# them), checkpoints and the dots CSV of `track`, as any bytes (tests/fuzz/, scripts/fuzz;
-# README, "make fuzz").
+# them), checkpoints, the dots CSV of `track` and the data CSV of `fit`, as any bytes
+# (tests/fuzz/, scripts/fuzz; README, "make fuzz").
 FUZZ_SECONDS ?= 120
-FUZZ_SAN = $(SAN) -fno-sanitize-recover=all -fno-omit-frame-pointer
-FUZZ_TARGETS = fuzz_scenario fuzz_checkpoint fuzz_track
+FUZZ_TARGETS = fuzz_scenario fuzz_checkpoint fuzz_track fuzz_fit_data
 
 fuzz:
 	@scripts/install-deps fuzz
 	@$(MAKE) --no-print-directory fuzz-build BUILD=build-fuzz CC=clang OPT=-O1 \
-	  EXTRA_CFLAGS="$(FUZZ_SAN) -fsanitize=fuzzer-no-link"
+	  EXTRA_CFLAGS="$(SAN_CFLAGS) -fsanitize=fuzzer-no-link"
 	@scripts/fuzz build-fuzz $(FUZZ_SECONDS) $(FUZZ_TARGETS)
 
 fuzz-build: $(patsubst %,$(BUILD)/fuzz/%,$(FUZZ_TARGETS))
@@ -159,10 +156,12 @@ $(BUILD)/fuzz/cli_main.o: cli/main.c include/wetdem.h $(wildcard cli/*.h) $(BUIL
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS_ALL) -DWETDEM_GIT_HASH='"$(GIT_HASH)"' -Dmain=wetdem_cli_main -c $< -o $@
 
-$(BUILD)/fuzz/%: tests/fuzz/%.c $(wildcard tests/fuzz/*.h) $(filter-out $(BUILD)/cli/main.o,$(CLI_OBJ)) \
-                 $(BUILD)/fuzz/cli_main.o $(BUILD)/libwetdem.a
-	$(CC) $(CFLAGS_ALL) -fsanitize=fuzzer -o $@ $< $(filter-out $(BUILD)/cli/main.o,$(CLI_OBJ)) \
-	  $(BUILD)/fuzz/cli_main.o $(BUILD)/libwetdem.a $(LDLIBS) $(FUZZ_SAN)
+# The CLI's objects without its main(), and the library.
+FUZZ_LINK = $(filter-out $(BUILD)/cli/main.o,$(CLI_OBJ)) $(BUILD)/fuzz/cli_main.o \
+            $(BUILD)/libwetdem.a
+
+$(BUILD)/fuzz/%: tests/fuzz/%.c $(wildcard tests/fuzz/*.h) $(FUZZ_LINK)
+	$(CC) $(CFLAGS_ALL) -fsanitize=fuzzer -o $@ $< $(FUZZ_LINK) $(LDLIBS) $(SAN_CFLAGS)
 
 format:
 	clang-format -i src/*.c src/*.h include/*.h cli/*.c cli/*.h tests/*.c tests/*.h examples/*/main.c \

@@ -18,9 +18,9 @@
 int wetdem_cli_main(int argc, char** argv);
 
 /* Writes data to /tmp/wetdem_fuzz_PID.EXT, runs `wetdem` with args[] in which the word "FILE"
- * stands for that path (at most 15 words), removes the file, and aborts on a finding. */
-static inline void fuzz_cli_on_file(const uint8_t* data, size_t size, const char* ext,
-                                    const char* const* args)
+ * stands for that path (at most 15 words), removes the file and returns the exit code. */
+static inline int fuzz_cli_run_on_file(const uint8_t* data, size_t size, const char* ext,
+                                       const char* const* args)
 {
     char path[64];
     snprintf(path, sizeof path, "/tmp/wetdem_fuzz_%ld.%s", (long)getpid(), ext);
@@ -34,6 +34,14 @@ static inline void fuzz_cli_on_file(const uint8_t* data, size_t size, const char
     argv[argc] = NULL;
     int rc = wetdem_cli_main(argc, argv);
     remove(path);
+    return rc;
+}
+
+/* fuzz_cli_run_on_file, aborting (a finding) on an exit code other than 0 and 2. */
+static inline void fuzz_cli_on_file(const uint8_t* data, size_t size, const char* ext,
+                                    const char* const* args)
+{
+    int rc = fuzz_cli_run_on_file(data, size, ext, args);
     if (rc != 0 && rc != 2)
         abort();
 }
