@@ -357,7 +357,7 @@ int wetdem_sim_many_outputs(struct wetdem_sim* sim, bool final)
     int st = WETDEM_OK;
     (void) final;
     /* the links are worked out once for the frame and, when due at the same step, the row */
-    struct wetdem_many_stats links;
+    struct wetdem_many_stats links = {0}; /* zeroed, as wetdem_sim_many_stats starts */
     bool have_links = false;
     if (m->output_prefix && due(m->step, m->set.vtk_every, &m->next_vtk_step)) {
         uint32_t* contacts = contact_counts(sim, &links);
