@@ -7,8 +7,8 @@
 #   make validate long validation sweeps and figures (docs/validation.md)
 #   make bench    benchmarks with ratios against baselines measured in the same run
 #   make figures  redraw the figures from the CSV in out/validate (no new simulations)
-#   make fuzz     fuzz scenario files, checkpoints, tracked dots and fit data (libFuzzer, clang,
-#                 ASan and UBSan); FUZZ_SECONDS per target, 120 by default
+#   make fuzz     fuzz scenario files, checkpoints, tracked dots, fit data and command lines
+#                 (libFuzzer, clang, ASan and UBSan); FUZZ_SECONDS per target, 120 by default
 
 CC      ?= gcc
 BUILD   ?= build
@@ -140,7 +140,7 @@ bench: all
 # them), checkpoints, the dots CSV of `track` and the data CSV of `fit`, as any bytes
 # (tests/fuzz/, scripts/fuzz; README, "make fuzz").
 FUZZ_SECONDS ?= 120
-FUZZ_TARGETS = fuzz_scenario fuzz_checkpoint fuzz_track fuzz_fit_data
+FUZZ_TARGETS = fuzz_scenario fuzz_checkpoint fuzz_track fuzz_fit_data fuzz_args
 
 fuzz:
 	@scripts/install-deps fuzz
