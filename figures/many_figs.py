@@ -1,7 +1,7 @@
 """Figures and checks of the many-particle validation piece (scripts/validate.d/40-many.sh).
 
-Reads the --out directories of the three shipped scenarios (global.csv, summary.json and, for
-the cradle, the ASCII VTK frames) and writes docs/figures/many_cradle.png,
+Reads the --out directories of the three shipped scenarios (global.csv, summary.json and the
+VTK frames, ASCII or binary) and writes docs/figures/many_cradle.png,
 many_settling.png and many_agglomeration.png. Checks, each printed and failing the script:
   cradle        x momentum conserved (no walls, no gravity: only pair forces, equal and
                 opposite) to 1e-9 of the striker's; the last sphere leaves with more than
@@ -13,7 +13,9 @@ many_settling.png and many_agglomeration.png. Checks, each printed and failing t
   agglomeration the number of liquid bridges grows tenfold, the mean agglomerate size grows
                 tenfold, the agglomerate count first rises above its start (clusters form)
                 and then falls (they merge); closure < 2e-2 of the work (larger steps: 1/20
-                of the contact time).
+                of the contact time); the VTK frames' agglomerate labels agree with the
+                CSV rows of their steps (count and mean size), and their bridges and
+                contacts per sphere add up to twice the rows'.
 Usage: /usr/bin/python3 figures/many_figs.py --dir out/validate/many
 """
 import argparse
@@ -42,22 +44,54 @@ def read_global(path):
     return {n: rows[:, k] for k, n in enumerate(names)}
 
 
-def read_vtk_ascii(path):
-    """(time, positions n x 3, velocities n x 3) of an ASCII frame written by wetdem."""
-    with open(path) as f:
-        tok = f.read().split()
-    t = float(tok[tok.index("TIME") + 4])
-    k = tok.index("POINTS")
-    n = int(tok[k + 1])
-    pos = np.array(tok[k + 3:k + 3 + 3 * n], float).reshape(n, 3)
-    k = tok.index("velocity")
-    vel = np.array(tok[k + 4:k + 4 + 3 * n], float).reshape(n, 3)
-    return t, pos, vel
+def read_vtk(path):
+    """The arrays of a frame written by wetdem (legacy POLYDATA, ASCII or big-endian binary:
+    src/output_vtk.c) as {name: array}: TIME, POINTS (n x 3), VERTICES and every point array
+    (radius, velocity n x 3, spin, contacts, bridges, agglomerate, material, id)."""
+    data = open(path, "rb").read()
+    binary = data.split(b"\n", 3)[2].strip() == b"BINARY"
+    at, out = 0, {}
+
+    def line():
+        nonlocal at
+        end = data.index(b"\n", at)
+        words = data[at:end].decode().split()
+        at = end + 1
+        return words
+
+    def values(count, kind):  # count values of kind "double" or "int"
+        nonlocal at
+        if binary:
+            dtype = ">f8" if kind == "double" else ">i4"
+            a = np.frombuffer(data, dtype, count, at)
+            at += a.nbytes + 1  # the data, then its newline
+            return a
+        got = []
+        while len(got) < count:
+            got += line()
+        return np.array(got, float if kind == "double" else int)
+
+    for _ in range(4):  # version, title, format, dataset
+        line()
+    while at < len(data):
+        w = line()
+        if not w or w[0] in ("FIELD", "POINT_DATA"):
+            continue
+        if w[0] == "POINTS":
+            out["POINTS"] = values(3 * int(w[1]), w[2]).reshape(-1, 3)
+        elif w[0] == "VERTICES":
+            out["VERTICES"] = values(int(w[2]), "int")
+        else:  # a field array: name, components, tuples, type
+            a = values(int(w[1]) * int(w[2]), w[3])
+            out[w[0]] = a.reshape(-1, int(w[1])) if int(w[1]) > 1 else a
+    return out
 
 
 def frames(run_dir):
+    """(time, positions, velocities) of each frame of a run, in the order of its series."""
     series = json.load(open(os.path.join(run_dir, "particles.vtk.series")))
-    return [read_vtk_ascii(os.path.join(run_dir, e["name"])) for e in series["files"]]
+    fr = [read_vtk(os.path.join(run_dir, e["name"])) for e in series["files"]]
+    return [(f["TIME"][0], f["POINTS"], f["velocity"]) for f in fr]
 
 
 def cradle(run_dir):
@@ -124,8 +158,37 @@ def agglomeration(run_dir):
           f"agglomerates {n[0]:.0f} at the start, {n.max():.0f} at most, {n[-1]:.0f} at the end")
     check(abs(e["balance_error"]) < 2e-2 * abs(e["work_total"]),
           f"energy closure {abs(e['balance_error']) / abs(e['work_total']):.2e} of the work")
+    # each frame's agglomerate labels are those of the CSV row of its step: as many labels,
+    # 1..A, as agglomerates, each of >= 2 spheres, of the row's mean size (the CSV gives time
+    # and size to 9 and 6 significant digits, the frame its time exactly); its spheres' bridges
+    # and contacts add up to twice the row's (no walls: each link has two ends)
+    series = json.load(open(os.path.join(run_dir, "particles.vtk.series")))
+    matched = 0
+    for entry in series["files"]:
+        f = read_vtk(os.path.join(run_dir, entry["name"]))
+        row = np.flatnonzero(np.abs(g["time_s"] - f["TIME"][0]) <= 1e-8 * f["TIME"][0])
+        if len(row) == 0:
+            continue
+        matched += 1
+        labels = f["agglomerate"]
+        sizes = np.bincount(labels)[1:]
+        r = row[0]
+        a_count = g["agglomerates"][r]
+        if not (len(sizes) == a_count and (sizes >= 2).all() and
+                f["bridges"].sum() == 2 * g["bridges"][r] and
+                f["contacts"].sum() == 2 * g["contacts"][r] and
+                (a_count == 0 or
+                 abs(sizes.mean() - g["mean_agglomerate_size"][r]) <= 1e-5 * sizes.mean())):
+            break
+    else:
+        matched = -matched
+    check(matched < 0, f"the {abs(matched)} frames at CSV rows: their labels give the rows' "
+          "agglomerates and mean sizes, their bridges and contacts twice the rows'")
+    # a frame while the agglomerates merge (about 15 of them; at the end one spans the box)
+    snaps = [read_vtk(os.path.join(run_dir, e["name"])) for e in series["files"]]
+    snap = min(snaps, key=lambda f: abs(int(f["agglomerate"].max()) - 15))
     t = g["time_s"] * 1e3
-    fig, (a, b) = plt.subplots(1, 2, figsize=(9, 3.6))
+    fig, (a, b, s) = plt.subplots(1, 3, figsize=(13, 3.8))
     a.semilogy(t, g["kinetic_J"])
     a.set_xlabel("time [ms]")
     a.set_ylabel("kinetic energy [J]")
@@ -135,6 +198,22 @@ def agglomeration(run_dir):
     c = b.twinx()
     c.plot(t, size, color="C1", label="mean size")
     c.set_ylabel("mean agglomerate size [spheres]", color="C1")
+    # that frame seen along z, each agglomerate in a colour of its own (tab20 without its
+    # greys), single spheres white (ParaView: colour the Glyph by the point array "agglomerate")
+    pos, lab, rad = snap["POINTS"] * 1e3, snap["agglomerate"], snap["radius"] * 1e3
+    order = np.argsort(pos[:, 2])  # the nearer spheres drawn last
+    palette = np.array([plt.get_cmap("tab20")(i) for i in range(20) if i not in (14, 15)])
+    colours = palette[(lab[order] - 1) % len(palette)]
+    colours[lab[order] == 0] = (1.0, 1.0, 1.0, 1.0)
+    for k, c_k in zip(order, colours):
+        s.add_patch(plt.Circle(pos[k, :2], rad[k], facecolor=c_k, edgecolor="k", lw=0.3))
+    s.set_xlim(pos[:, 0].min() - 0.6, pos[:, 0].max() + 0.6)
+    s.set_ylim(pos[:, 1].min() - 0.6, pos[:, 1].max() + 0.6)
+    s.set_aspect("equal")
+    s.set_xlabel("x [mm]")
+    s.set_ylabel("y [mm]")
+    s.set_title(f"t = {snap['TIME'][0] * 1e3:.0f} ms: {lab.max()} agglomerates, "
+                f"{(lab == 0).sum()} single spheres (white)", fontsize=9)
     fig.suptitle("400 wet spheres in a periodic box")
     fig.tight_layout()
     fig.savefig(os.path.join(FIGURES, "many_agglomeration.png"), dpi=120)

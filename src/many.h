@@ -503,9 +503,16 @@ int wetdem_sim_many_outputs(struct wetdem_sim* sim, bool final);
  * Outputs): into s, the particle pairs and particle-wall pairs in contact (contacts), the
  * particle pairs bridged (bridges), and the clusters of >= 2 particles joined by bridges,
  * found by union-find over the bridged pairs (agglomerates, mean_agglomerate); the other
- * fields are left as they are. per_particle (optional, n_particles entries) receives each
- * particle's contacts with particles and walls. WETDEM_OK or WETDEM_ERR_NOMEM. */
-int wetdem_sim_many_links(const struct wetdem_sim* sim, uint32_t* per_particle,
+ * fields are left as they are. per (optional, as each of its arrays, of n_particles entries)
+ * receives each particle's contacts with particles and walls, its liquid bridges, and the
+ * label of its agglomerate: 1, 2, ... in the order of the agglomerates' lowest particle index,
+ * 0 for a particle in none. WETDEM_OK or WETDEM_ERR_NOMEM. */
+struct wetdem_many_per_particle {
+    uint32_t* contacts;
+    uint32_t* bridges;
+    uint32_t* agglomerate;
+};
+int wetdem_sim_many_links(const struct wetdem_sim* sim, const struct wetdem_many_per_particle* per,
                           struct wetdem_many_stats* s);
 
 #endif

@@ -7,8 +7,8 @@
  *   FIELD FieldData 1, TIME 1 1 double      simulated time [s] (ParaView shows it)
  *   POINTS n double                         centres [m]
  *   VERTICES n 2n                           one vertex cell per sphere ("1 i")
- *   POINT_DATA n, FIELD FieldData 6: radius [m], velocity [m/s], spin [rad/s], contacts,
- *                                    material, id
+ *   POINT_DATA n, FIELD FieldData 8: radius [m], velocity [m/s], spin [rad/s], contacts,
+ *                                    bridges, agglomerate, material, id
  * The point arrays form a FIELD rather than SCALARS/VECTORS attributes because VTK's legacy
  * reader loads only the first SCALARS and VECTORS unless told otherwise; field arrays are all
  * read.
@@ -90,22 +90,25 @@ static void write_vectors(FILE* f, const char* head, const struct wetdem_particl
         fputc('\n', f);
 }
 
-/* Integer point data: 0 contacts, 1 material, 2 id. */
+enum int_data { INT_COUNT, INT_MATERIAL, INT_ID };
+
+/* Integer point data: a count or label (`count`, NULL for zeros), material or id. */
 static void write_ints(FILE* f, const char* name, const struct wetdem_particle* p, size_t n,
-                       const uint32_t* contacts, int which, bool binary)
+                       const uint32_t* count, enum int_data which, bool binary)
 {
     fprintf(f, "%s 1 %zu int\n", name, n);
     for (size_t k = 0; k < n; k++) {
-        int32_t v = which == 0 ? (contacts ? (int32_t)contacts[k] : 0)
-                               : (which == 1 ? (int32_t)p[k].material : (int32_t)k);
+        int32_t v = which == INT_COUNT
+                        ? (count ? (int32_t)count[k] : 0)
+                        : (which == INT_MATERIAL ? (int32_t)p[k].material : (int32_t)k);
         put_int(f, v, binary);
     }
     if (binary)
         fputc('\n', f);
 }
 
-static void write_body(FILE* f, const struct wetdem_particle* p, size_t n, const uint32_t* contacts,
-                       double time, bool binary)
+static void write_body(FILE* f, const struct wetdem_particle* p, size_t n,
+                       const struct wetdem_output_vtk_links* links, double time, bool binary)
 {
     fprintf(f,
             "# vtk DataFile Version 3.0\nwetdem particles t = %.17g s\n%s\n"
@@ -125,16 +128,20 @@ static void write_body(FILE* f, const struct wetdem_particle* p, size_t n, const
     }
     if (binary)
         fputc('\n', f);
-    fprintf(f, "POINT_DATA %zu\nFIELD FieldData 6\nradius 1 %zu double\n", n, n);
+    fprintf(f, "POINT_DATA %zu\nFIELD FieldData 8\nradius 1 %zu double\n", n, n);
     for (size_t k = 0; k < n; k++)
         put_double(f, p[k].radius, binary);
     if (binary)
         fputc('\n', f);
     write_vectors(f, "velocity 3 %zu double\n", p, n, 1, binary);
     write_vectors(f, "spin 3 %zu double\n", p, n, 2, binary);
-    write_ints(f, "contacts", p, n, contacts, 0, binary);
-    write_ints(f, "material", p, n, contacts, 1, binary);
-    write_ints(f, "id", p, n, contacts, 2, binary);
+    const struct wetdem_output_vtk_links none = {0};
+    const struct wetdem_output_vtk_links* l = links ? links : &none;
+    write_ints(f, "contacts", p, n, l->contacts, INT_COUNT, binary);
+    write_ints(f, "bridges", p, n, l->bridges, INT_COUNT, binary);
+    write_ints(f, "agglomerate", p, n, l->agglomerate, INT_COUNT, binary);
+    write_ints(f, "material", p, n, NULL, INT_MATERIAL, binary);
+    write_ints(f, "id", p, n, NULL, INT_ID, binary);
 }
 
 /* Closes f (opened on tmp) and renames tmp to path; cleans up on failure. */
@@ -165,8 +172,8 @@ static FILE* open_tmp(const char* path, char* tmp, size_t tmp_size, char* msg, s
 }
 
 int wetdem_output_vtk_write(const char* path, const struct wetdem_particle* p, size_t n,
-                            const uint32_t* contacts, double time, bool binary, char* msg,
-                            size_t msg_size)
+                            const struct wetdem_output_vtk_links* links, double time, bool binary,
+                            char* msg, size_t msg_size)
 {
     if (n > INT32_MAX)
         return wetdem_status_fail(msg, msg_size, WETDEM_ERR_IO,
@@ -175,7 +182,7 @@ int wetdem_output_vtk_write(const char* path, const struct wetdem_particle* p, s
     FILE* f = open_tmp(path, tmp, sizeof tmp, msg, msg_size);
     if (!f)
         return WETDEM_ERR_IO;
-    write_body(f, p, n, contacts, time, binary);
+    write_body(f, p, n, links, time, binary);
     return finish_atomic(f, tmp, path, msg, msg_size);
 }
 

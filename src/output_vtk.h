@@ -10,15 +10,23 @@
 
 #include "wetdem.h"
 
+/* Each particle's links (arrays of n entries): contacts with particles and walls, liquid
+ * bridges, and the label of its agglomerate (0: none). */
+struct wetdem_output_vtk_links {
+    const uint32_t* contacts;
+    const uint32_t* bridges;
+    const uint32_t* agglomerate;
+};
+
 /* Writes n particles as a legacy VTK POLYDATA file (one vertex per sphere) with the point
- * data radius [m], velocity [m/s], spin [rad/s], contacts (count per particle; contacts may be
- * NULL for zeros), material and id, and the simulated time [s] as field data TIME. binary:
+ * data radius [m], velocity [m/s], spin [rad/s], contacts, bridges and agglomerate (links may
+ * be NULL for zeros), material and id, and the simulated time [s] as field data TIME. binary:
  * big-endian binary arrays as the legacy format requires, else ASCII with 17 significant
  * digits (exact round trip). The file is written to a temporary name and renamed, so a
  * reader never sees half a file. Returns WETDEM_OK or WETDEM_ERR_IO (message in msg). */
 int wetdem_output_vtk_write(const char* path, const struct wetdem_particle* p, size_t n,
-                            const uint32_t* contacts, double time, bool binary, char* msg,
-                            size_t msg_size);
+                            const struct wetdem_output_vtk_links* links, double time, bool binary,
+                            char* msg, size_t msg_size);
 
 /* Formats "<prefix>_<index, 6 digits>.vtk" into buf. Returns the length snprintf would write. */
 int wetdem_output_vtk_path(char* buf, size_t size, const char* prefix, uint64_t index);

@@ -58,22 +58,42 @@ static void unite(size_t* parent, size_t* size, size_t a, size_t b)
     size[a] += size[b];
 }
 
-int wetdem_sim_many_links(const struct wetdem_sim* sim, uint32_t* per_particle,
+/* Labels each particle's agglomerate (of >= 2 particles) 1, 2, ... in the order of the
+ * agglomerates' lowest particle index, 0 for a particle in none; label[] is scratch of n. */
+static void label_agglomerates(size_t* parent, const size_t* size, size_t n, size_t* label,
+                               uint32_t* agglomerate)
+{
+    uint32_t next = 0;
+    for (size_t k = 0; k < n; k++)
+        label[k] = 0;
+    for (size_t k = 0; k < n; k++) {
+        size_t r = find_root(parent, k);
+        if (size[r] >= 2 && label[r] == 0)
+            label[r] = ++next;
+        agglomerate[k] = (uint32_t)label[r];
+    }
+}
+
+int wetdem_sim_many_links(const struct wetdem_sim* sim, const struct wetdem_many_per_particle* per,
                           struct wetdem_many_stats* s)
 {
     const struct wetdem_many* m = sim->many;
     size_t n = sim->n_particles;
     s->contacts = s->bridges = s->agglomerates = 0;
     s->mean_agglomerate = 0;
-    size_t* parent = malloc((n ? n : 1) * 2 * sizeof *parent);
+    size_t* parent = malloc((n ? n : 1) * 3 * sizeof *parent);
     if (!parent)
         return WETDEM_ERR_NOMEM;
     size_t* size = parent + n;
+    uint32_t* contacts = per ? per->contacts : NULL;
+    uint32_t* bridges = per ? per->bridges : NULL;
     for (size_t k = 0; k < n; k++) {
         parent[k] = k;
         size[k] = 1;
-        if (per_particle)
-            per_particle[k] = 0;
+        if (contacts)
+            contacts[k] = 0;
+        if (bridges)
+            bridges[k] = 0;
     }
     /* every pair within a model's range is in the candidate list */
     for (size_t q = 0; q < m->cl.n_pairs; q++) {
@@ -83,13 +103,17 @@ int wetdem_sim_many_links(const struct wetdem_sim* sim, uint32_t* per_particle,
         const double* hist = wetdem_many_pair_history(sim, q);
         if (wetdem_sim_contact_is_in_contact(sim, &c, hist)) {
             s->contacts++;
-            if (per_particle) {
-                per_particle[i]++;
-                per_particle[j]++;
+            if (contacts) {
+                contacts[i]++;
+                contacts[j]++;
             }
         }
         if (wetdem_sim_contact_is_bridged(sim, &c, hist)) {
             s->bridges++;
+            if (bridges) {
+                bridges[i]++;
+                bridges[j]++;
+            }
             unite(parent, size, i, j);
         }
     }
@@ -99,8 +123,8 @@ int wetdem_sim_many_links(const struct wetdem_sim* sim, uint32_t* per_particle,
             wetdem_sim_many_contact(sim, i, w, true, &c);
             if (wetdem_sim_contact_is_in_contact(sim, &c, wetdem_many_wall_history(sim, i, w))) {
                 s->contacts++;
-                if (per_particle)
-                    per_particle[i]++;
+                if (contacts)
+                    contacts[i]++;
             }
         }
     size_t members = 0;
@@ -110,6 +134,8 @@ int wetdem_sim_many_links(const struct wetdem_sim* sim, uint32_t* per_particle,
             members += size[k];
         }
     s->mean_agglomerate = s->agglomerates ? (double)members / (double)s->agglomerates : 0.0;
+    if (per && per->agglomerate)
+        label_agglomerates(parent, size, n, parent + 2 * n, per->agglomerate);
     free(parent);
     return WETDEM_OK;
 }
@@ -146,39 +172,45 @@ int wetdem_sim_many_stats(const struct wetdem_sim* sim, struct wetdem_many_stats
 
 /* ---- VTK and CSV ---- */
 
-/* Each particle's contacts as the enabled models define them, and the run's links in *s
- * (wetdem_sim_many_links); NULL, with the failure recorded, when out of memory. */
-static uint32_t* contact_counts(struct wetdem_sim* sim, struct wetdem_many_stats* s)
+/* Each particle's contacts and liquid bridges as the enabled models define them and the label
+ * of its agglomerate, into *v, and the run's links into *s (wetdem_sim_many_links). Returns the
+ * block that holds v's arrays, for free(); NULL, with the failure recorded, when out of memory. */
+static uint32_t* per_particle_links(struct wetdem_sim* sim, struct wetdem_many_stats* s,
+                                    struct wetdem_output_vtk_links* v)
 {
-    uint32_t* contacts = malloc((sim->n_particles ? sim->n_particles : 1) * sizeof *contacts);
-    if (!contacts || wetdem_sim_many_links(sim, contacts, s) != WETDEM_OK) {
-        free(contacts);
+    size_t n = sim->n_particles ? sim->n_particles : 1;
+    uint32_t* block = malloc(3 * n * sizeof *block);
+    struct wetdem_many_per_particle per = {block, block + n, block + 2 * n};
+    if (!block || wetdem_sim_many_links(sim, &per, s) != WETDEM_OK) {
+        free(block);
         wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory for the contact counts");
         return NULL;
     }
-    return contacts;
+    *v = (struct wetdem_output_vtk_links){per.contacts, per.bridges, per.agglomerate};
+    return block;
 }
 
-/* The frame at `path`, with the given contact counts (NULL: none, a run not started). */
-static int write_vtk_counts(struct wetdem_sim* sim, const char* path, bool binary,
-                            const uint32_t* contacts)
+/* The frame at `path`, with the given links of each particle (NULL: none, a run not started). */
+static int write_vtk_links(struct wetdem_sim* sim, const char* path, bool binary,
+                           const struct wetdem_output_vtk_links* links)
 {
     char msg[512];
-    int st = wetdem_output_vtk_write(path, sim->particles, sim->n_particles, contacts,
+    int st = wetdem_output_vtk_write(path, sim->particles, sim->n_particles, links,
                                      sim->engine.time, binary, msg, sizeof msg);
     return st == WETDEM_OK ? st : wetdem_sim_fail(sim, st, "%s", msg);
 }
 
 int wetdem_sim_write_vtk(struct wetdem_sim* sim, const char* path, bool binary)
 {
-    uint32_t* contacts = NULL;
+    uint32_t* block = NULL;
+    struct wetdem_output_vtk_links links;
     if (sim->many && sim->many->started) {
         struct wetdem_many_stats s;
-        if (!(contacts = contact_counts(sim, &s)))
+        if (!(block = per_particle_links(sim, &s, &links)))
             return WETDEM_ERR_NOMEM;
     }
-    int st = write_vtk_counts(sim, path, binary, contacts);
-    free(contacts);
+    int st = write_vtk_links(sim, path, binary, block ? &links : NULL);
+    free(block);
     return st;
 }
 
@@ -224,13 +256,13 @@ static int add_series_entry(struct wetdem_sim* sim, const char* name, double tim
     return WETDEM_OK;
 }
 
-/* The next frame of the series, with each particle's contact count. */
-static int write_vtk_frame(struct wetdem_sim* sim, const uint32_t* contacts)
+/* The next frame of the series, with each particle's links. */
+static int write_vtk_frame(struct wetdem_sim* sim, const struct wetdem_output_vtk_links* links)
 {
     struct wetdem_many* m = sim->many;
     char path[4096], series[4096];
     wetdem_output_vtk_path(path, sizeof path, m->output_prefix, m->vtk_files);
-    int st = write_vtk_counts(sim, path, m->set.vtk_binary, contacts);
+    int st = write_vtk_links(sim, path, m->set.vtk_binary, links);
     if (st == WETDEM_OK)
         st = add_series_entry(sim, base_name(path), sim->engine.time);
     if (st != WETDEM_OK)
@@ -360,10 +392,11 @@ int wetdem_sim_many_outputs(struct wetdem_sim* sim, bool final)
     struct wetdem_many_stats links = {0}; /* zeroed, as wetdem_sim_many_stats starts */
     bool have_links = false;
     if (m->output_prefix && due(m->step, m->set.vtk_every, &m->next_vtk_step)) {
-        uint32_t* contacts = contact_counts(sim, &links);
-        st = contacts ? write_vtk_frame(sim, contacts) : WETDEM_ERR_NOMEM;
-        have_links = contacts != NULL;
-        free(contacts);
+        struct wetdem_output_vtk_links per;
+        uint32_t* block = per_particle_links(sim, &links, &per);
+        st = block ? write_vtk_frame(sim, &per) : WETDEM_ERR_NOMEM;
+        have_links = block != NULL;
+        free(block);
     }
     if (st == WETDEM_OK && m->output_prefix && due(m->step, m->set.csv_every, &m->next_csv_step))
         st = write_csv_row(sim, have_links ? &links : NULL);

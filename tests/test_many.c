@@ -1283,8 +1283,9 @@ static void test_many_hooke_budget_dissipates(void** state)
 /* Contacts where an enabled model exerts a solid-contact force (nijssen's at 0 < h < h_min
  * too), bridges where an enabled film model's bridge joins two spheres, and the agglomerates
  * of those bridges, for the hand-built configuration: totals (walls counted once) and each
- * sphere's contacts (what the VTK files give), for model sets with and without a contact and a
- * film model. */
+ * sphere's contacts, bridges and agglomerate label (what the VTK files give: the bridged
+ * chain 0-1-2 is agglomerate 1, the pair 3-4 agglomerate 2, numbered by their lowest sphere),
+ * for model sets with and without a contact and a film model. */
 static void test_many_contacts_and_bridges_follow_the_models(void** state)
 {
     (void)state;
@@ -1292,30 +1293,43 @@ static void test_many_contacts_and_bridges_follow_the_models(void** state)
         const char* models;
         size_t contacts, bridges, agglomerates;
         double mean;
-        uint32_t per[HB_N];
+        uint32_t per[HB_N], per_bridges[HB_N], label[HB_N];
     } cases[] = {
-        {"hertz mindlin sb capillary", 2, 3, 2, 2.5, {1, 1, 0, 0, 0, 1, 0, 0}},
-        {"hertz mindlin", 2, 0, 0, 0, {1, 1, 0, 0, 0, 1, 0, 0}}, /* dry: no bridge */
-        {"hooke", 2, 0, 0, 0, {1, 1, 0, 0, 0, 1, 0, 0}},
-        {"nijssen", 4, 0, 0, 0, {1, 2, 1, 0, 0, 1, 1, 0}}, /* contact below h_min, no bridge */
-        {"reynolds", 0, 0, 0, 0, {0}},                     /* no contact model */
-        {"sb capillary", 0, 3, 2, 2.5, {0}},
-        {"davis", 0, 3, 2, 2.5, {0}},
+        {"hertz mindlin sb capillary",
+         2,
+         3,
+         2,
+         2.5,
+         {1, 1, 0, 0, 0, 1, 0, 0},
+         {1, 2, 1, 1, 1, 0, 0, 0},
+         {1, 1, 1, 2, 2, 0, 0, 0}},
+        {"hertz mindlin", 2, 0, 0, 0, {1, 1, 0, 0, 0, 1, 0, 0}, {0}, {0}}, /* dry: no bridge */
+        {"hooke", 2, 0, 0, 0, {1, 1, 0, 0, 0, 1, 0, 0}, {0}, {0}},
+        {"nijssen", 4, 0, 0, 0, {1, 2, 1, 0, 0, 1, 1, 0}, {0}, {0}}, /* contact below h_min */
+        {"reynolds", 0, 0, 0, 0, {0}, {0}, {0}},                     /* no contact model */
+        {"sb capillary", 0, 3, 2, 2.5, {0}, {1, 2, 1, 1, 1, 0, 0, 0}, {1, 1, 1, 2, 2, 0, 0, 0}},
+        {"davis", 0, 3, 2, 2.5, {0}, {1, 2, 1, 1, 1, 0, 0, 0}, {1, 1, 1, 2, 2, 0, 0, 0}},
     };
     for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
         struct wetdem_sim* sim = hand_built(cases[k].models);
         struct wetdem_many_stats s;
         CHECK_OK(wetdem_sim_many_stats(sim, &s));
-        uint32_t per[HB_N];
+        uint32_t per[HB_N], bridges[HB_N], label[HB_N];
         struct wetdem_many_stats t;
-        CHECK_OK(wetdem_sim_many_links(sim, per, &t));
+        CHECK_OK(wetdem_sim_many_links(sim, &(struct wetdem_many_per_particle){per, bridges, label},
+                                       &t));
         if (s.contacts != cases[k].contacts || s.bridges != cases[k].bridges ||
             s.agglomerates != cases[k].agglomerates || s.mean_agglomerate != cases[k].mean ||
-            memcmp(per, cases[k].per, sizeof per) != 0)
+            memcmp(per, cases[k].per, sizeof per) != 0 ||
+            memcmp(bridges, cases[k].per_bridges, sizeof bridges) != 0 ||
+            memcmp(label, cases[k].label, sizeof label) != 0)
             fail_msg("models %s: contacts %zu, bridges %zu, agglomerates %zu (mean %g), per "
-                     "sphere %u %u %u %u %u %u %u %u",
+                     "sphere %u %u %u %u %u %u %u %u, bridges %u %u %u %u %u, labels %u %u %u "
+                     "%u %u",
                      cases[k].models, s.contacts, s.bridges, s.agglomerates, s.mean_agglomerate,
-                     per[0], per[1], per[2], per[3], per[4], per[5], per[6], per[7]);
+                     per[0], per[1], per[2], per[3], per[4], per[5], per[6], per[7], bridges[0],
+                     bridges[1], bridges[2], bridges[3], bridges[4], label[0], label[1], label[2],
+                     label[3], label[4]);
         wetdem_sim_free(sim);
     }
 }

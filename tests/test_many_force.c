@@ -591,7 +591,8 @@ static uint32_t* reported_links(const struct wetdem_sim* sim, struct wetdem_many
     uint32_t* per_particle = malloc((sim->n_particles ? sim->n_particles : 1) * sizeof(uint32_t));
     assert_non_null(per_particle);
     *s = (struct wetdem_many_stats){0};
-    CHECK_OK(wetdem_sim_many_links(sim, per_particle, s));
+    CHECK_OK(wetdem_sim_many_links(
+        sim, &(struct wetdem_many_per_particle){.contacts = per_particle}, s));
     return per_particle;
 }
 

@@ -13,7 +13,17 @@
 
 #define N 37
 
-static void make_particles(struct wetdem_particle* p, uint32_t* contacts)
+/* Each particle's links, as the arrays of struct wetdem_output_vtk_links. */
+struct links_data {
+    uint32_t contacts[N], bridges[N], agglomerate[N];
+};
+
+static struct wetdem_output_vtk_links links_of(const struct links_data* d)
+{
+    return (struct wetdem_output_vtk_links){d->contacts, d->bridges, d->agglomerate};
+}
+
+static void make_particles(struct wetdem_particle* p, struct links_data* links)
 {
     for (size_t k = 0; k < N; k++) {
         double t = (double)k;
@@ -22,7 +32,9 @@ static void make_particles(struct wetdem_particle* p, uint32_t* contacts)
                                         .omega = vec3(1e5 / (t + 3), 0, -0.1 * t),
                                         .radius = 1e-3 * (1 + t / 97),
                                         .material = (int)(k % 3)};
-        contacts[k] = (uint32_t)(k * 7 % 5);
+        links->contacts[k] = (uint32_t)(k * 7 % 5);
+        links->bridges[k] = (uint32_t)(k * 3 % 4);
+        links->agglomerate[k] = (uint32_t)(k / 5);
     }
 }
 
@@ -130,8 +142,8 @@ static void check_header(FILE* f, double time, bool binary)
     assert_true(get_double(f, binary) == time);
 }
 
-static void parse_back(const char* path, const struct wetdem_particle* p, const uint32_t* contacts,
-                       double time, bool binary)
+static void parse_back(const char* path, const struct wetdem_particle* p,
+                       const struct links_data* links, double time, bool binary)
 {
     FILE* f = fopen(path, "rb");
     assert_non_null(f);
@@ -159,7 +171,7 @@ static void parse_back(const char* path, const struct wetdem_particle* p, const 
     expect(f, count);
     expect(f, "FIELD");
     expect(f, "FieldData");
-    expect(f, "6");
+    expect(f, "8");
     expect(f, "radius");
     expect(f, "1");
     expect(f, count);
@@ -169,15 +181,19 @@ static void parse_back(const char* path, const struct wetdem_particle* p, const 
         assert_true(get_double(f, binary) == p[k].radius);
     check_vectors(f, "velocity", p, 1, binary);
     check_vectors(f, "spin", p, 2, binary);
-    int32_t want[3][N];
+    int32_t want[5][N];
     for (int32_t k = 0; k < N; k++) {
-        want[0][k] = (int32_t)contacts[k];
-        want[1][k] = p[k].material;
-        want[2][k] = k;
+        want[0][k] = (int32_t)links->contacts[k];
+        want[1][k] = (int32_t)links->bridges[k];
+        want[2][k] = (int32_t)links->agglomerate[k];
+        want[3][k] = p[k].material;
+        want[4][k] = k;
     }
     check_ints(f, "contacts", want[0], binary);
-    check_ints(f, "material", want[1], binary);
-    check_ints(f, "id", want[2], binary);
+    check_ints(f, "bridges", want[1], binary);
+    check_ints(f, "agglomerate", want[2], binary);
+    check_ints(f, "material", want[3], binary);
+    check_ints(f, "id", want[4], binary);
     char tail[8];
     assert_int_equal(fscanf(f, "%7s", tail), EOF); /* nothing else in the file */
     fclose(f);
@@ -187,7 +203,7 @@ static void parse_back(const char* path, const struct wetdem_particle* p, const 
  * not. The script prints the number of points, the sum of contacts, and radius/velocity of
  * point 5 with 17 digits, which must equal what was written. */
 static bool read_with_vtk(const char* path, const struct wetdem_particle* p,
-                          const uint32_t* contacts)
+                          const struct links_data* links)
 {
     if (system("/usr/bin/python3 -c 'import vtk' >/dev/null 2>&1") != 0)
         return false;
@@ -210,7 +226,7 @@ static bool read_with_vtk(const char* path, const struct wetdem_particle* p,
     assert_int_equal(got, 5);
     long want_sum = 0;
     for (size_t k = 0; k < N; k++)
-        want_sum += contacts[k];
+        want_sum += links->contacts[k];
     assert_int_equal(n_points, N);
     assert_int_equal(n_verts, N);
     assert_int_equal(sum, want_sum);
@@ -221,18 +237,23 @@ static bool read_with_vtk(const char* path, const struct wetdem_particle* p,
 static void round_trip(bool binary)
 {
     struct wetdem_particle p[N];
-    uint32_t contacts[N];
-    make_particles(p, contacts);
+    struct links_data links;
+    make_particles(p, &links);
+    struct wetdem_output_vtk_links arrays = links_of(&links);
     char path[] = "/tmp/wetdem_test_vtk_XXXXXX";
     int fd = mkstemp(path);
     assert_true(fd >= 0);
     close(fd);
     char msg[256] = "";
     double time = 0.123456789012345678;
-    CHECK_OK(wetdem_output_vtk_write(path, p, N, contacts, time, binary, msg, sizeof msg));
-    parse_back(path, p, contacts, time, binary);
-    if (!read_with_vtk(path, p, contacts))
+    CHECK_OK(wetdem_output_vtk_write(path, p, N, &arrays, time, binary, msg, sizeof msg));
+    parse_back(path, p, &links, time, binary);
+    if (!read_with_vtk(path, p, &links))
         print_message("python3 vtk not available: checked the format structurally only\n");
+    /* without links (a run not started) the counts and labels are zeros */
+    CHECK_OK(wetdem_output_vtk_write(path, p, N, NULL, time, binary, msg, sizeof msg));
+    static const struct links_data zeros;
+    parse_back(path, p, &zeros, time, binary);
     char tmp[64];
     snprintf(tmp, sizeof tmp, "%s.tmp", path);
     assert_int_equal(access(tmp, F_OK), -1); /* the temporary was renamed away */
@@ -255,8 +276,8 @@ static void test_output_vtk_bad_path_is_an_io_error(void** state)
 {
     (void)state;
     struct wetdem_particle p[N];
-    uint32_t contacts[N];
-    make_particles(p, contacts);
+    struct links_data links;
+    make_particles(p, &links);
     char msg[256] = "";
     CHECK_STATUS(
         wetdem_output_vtk_write("/nonexistent-dir/x.vtk", p, N, NULL, 0, false, msg, sizeof msg),
