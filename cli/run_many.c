@@ -55,22 +55,26 @@
 struct series {
     char dir[PATH_CHARS], prefix[CLI_VALUE_MAX];
     bool binary;
+    bool links;    /* each frame also as PREFIX_links_NNNNNN.vtk, indexed by PREFIX_links */
     double* times; /* time of frame k [s] */
     size_t n, cap;
     unsigned long long last_step; /* step of the latest frame (valid when n > 0) */
 };
 
-static void frame_name(const struct series* s, size_t k, char* buf, size_t n)
+#define LINKS "_links"
+
+/* The name of frame k: PREFIX_NNNNNN.vtk, or of its links, PREFIX_links_NNNNNN.vtk. */
+static void frame_name(const struct series* s, size_t k, bool links, char* buf, size_t n)
 {
-    snprintf(buf, n, "%s_%06zu.vtk", s->prefix, k);
+    snprintf(buf, n, "%s%s_%06zu.vtk", s->prefix, links ? LINKS : "", k);
 }
 
-/* Whether `name` is a frame of this series, as frame_name() writes it: PREFIX_, six or more
- * digits, .vtk. */
-static bool is_frame_name(const struct series* s, const char* name)
+/* Whether `name` is named as frame_name() names the frames (links: their links) of a series of
+ * prefix `prefix`: PREFIX_, six or more digits, .vtk. */
+static bool is_frame_name(const char* prefix, const char* name)
 {
-    size_t lp = strlen(s->prefix), n = strlen(name);
-    if (n < lp + 1 + 6 + 4 || strncmp(name, s->prefix, lp) != 0 || name[lp] != '_' ||
+    size_t lp = strlen(prefix), n = strlen(name);
+    if (n < lp + 1 + 6 + 4 || strncmp(name, prefix, lp) != 0 || name[lp] != '_' ||
         strcmp(name + n - 4, ".vtk") != 0)
         return false;
     for (size_t k = lp + 1; k < n - 4; k++)
@@ -79,19 +83,25 @@ static bool is_frame_name(const struct series* s, const char* name)
     return true;
 }
 
-/* A fresh run replaces the run in its directory: removes the frames an earlier run left there
- * (the files named as this series names its frames, and no other file), which the new index
- * would not list and a shorter run would not overwrite. 0, or -1 with errno set. */
+/* A fresh run replaces the run in its directory: removes the frames and links an earlier run
+ * left there (the files named as this series names its frames and their links, and no other
+ * file), which the new index would not list and a shorter run would not overwrite; and the
+ * links' index, which a run without links would leave behind. 0, or -1 with errno set. */
 static int series_clear(const struct series* s)
 {
     DIR* d = opendir(s->dir);
     if (!d)
         return -1;
+    char links_prefix[CLI_VALUE_MAX + 8], links_index[CLI_VALUE_MAX + 24];
+    snprintf(links_prefix, sizeof links_prefix, "%s" LINKS, s->prefix);
+    snprintf(links_index, sizeof links_index, "%s.vtk.series", links_prefix);
     int rc = 0;
     for (struct dirent* e = readdir(d); e && rc == 0; e = readdir(d)) {
         char path[PATH_CHARS + 300];
         snprintf(path, sizeof path, "%s/%s", s->dir, e->d_name);
-        if (is_frame_name(s, e->d_name) && unlink(path) != 0 && errno != ENOENT)
+        if ((is_frame_name(s->prefix, e->d_name) || is_frame_name(links_prefix, e->d_name) ||
+             strcmp(e->d_name, links_index) == 0) &&
+            unlink(path) != 0 && errno != ENOENT)
             rc = -1;
     }
     int err = errno;
@@ -100,11 +110,12 @@ static int series_clear(const struct series* s)
     return rc;
 }
 
-/* Writes the .vtk.series index (temporary file, then rename). 0 or -1. */
-static int series_write(const struct series* s)
+/* Writes the .vtk.series index of the frames (links: of their links; temporary file, then
+ * rename). 0 or -1. */
+static int series_write_one(const struct series* s, bool links)
 {
     char path[PATH_CHARS + CLI_VALUE_MAX + 40], tmp[sizeof path + 8];
-    snprintf(path, sizeof path, "%s/%s.vtk.series", s->dir, s->prefix);
+    snprintf(path, sizeof path, "%s/%s%s.vtk.series", s->dir, s->prefix, links ? LINKS : "");
     snprintf(tmp, sizeof tmp, "%s.tmp", path);
     FILE* f = fopen(tmp, "w");
     if (!f)
@@ -112,7 +123,7 @@ static int series_write(const struct series* s)
     fputs("{\n  \"file-series-version\" : \"1.0\",\n  \"files\" : [\n", f);
     for (size_t k = 0; k < s->n; k++) {
         char name[CLI_VALUE_MAX + 40];
-        frame_name(s, k, name, sizeof name);
+        frame_name(s, k, links, name, sizeof name);
         fprintf(f, "    { \"name\" : \"%s\", \"time\" : %.17g }%s\n", name, s->times[k],
                 k + 1 < s->n ? "," : "");
     }
@@ -123,6 +134,13 @@ static int series_write(const struct series* s)
         return 0;
     remove(tmp);
     return -1;
+}
+
+/* Writes the index of the frames and, with links, that of their links. 0 or -1. */
+static int series_write(const struct series* s)
+{
+    return series_write_one(s, false) == 0 && (!s->links || series_write_one(s, true) == 0) ? 0
+                                                                                            : -1;
 }
 
 /* Appends a frame time to the index. 0 or -1 (out of memory). */
@@ -144,11 +162,17 @@ static int push_time(struct series* s, double time)
 static int series_add(struct series* s, struct wetdem_sim* sim, unsigned long long step)
 {
     char path[PATH_CHARS + CLI_VALUE_MAX + 40], name[CLI_VALUE_MAX + 40];
-    frame_name(s, s->n, name, sizeof name);
+    frame_name(s, s->n, false, name, sizeof name);
     snprintf(path, sizeof path, "%s/%s", s->dir, name);
     int st = wetdem_sim_write_vtk(sim, path, s->binary);
     if (st != WETDEM_OK)
         return st;
+    if (s->links) {
+        frame_name(s, s->n, true, name, sizeof name);
+        snprintf(path, sizeof path, "%s/%s", s->dir, name);
+        if ((st = wetdem_sim_write_vtk_links(sim, path, s->binary)) != WETDEM_OK)
+            return st;
+    }
     if (push_time(s, wetdem_sim_time(sim)) != 0)
         return WETDEM_ERR_NOMEM;
     s->last_step = step;
@@ -181,7 +205,7 @@ static void series_resume(struct series* s, double t, unsigned long long step, d
         const char* q = p ? strstr(line, "\"time\" : ") : NULL;
         if (!q || sscanf(p + 10, "%290[^\"]", name) != 1 || sscanf(q + 9, "%lf", &time) != 1)
             continue;
-        frame_name(s, s->n, want, sizeof want);
+        frame_name(s, s->n, false, want, sizeof want);
         if (strcmp(name, want) != 0 || !(time <= t) || push_time(s, time) != 0)
             break;
     }
@@ -872,7 +896,7 @@ int cli_run_many(const struct cli_scenario* sc, const struct cli_run_options* op
     if (rc == CLI_EXIT_OK && opt->check) {
         print_check(sc, &su, &pl, opt->json);
     } else if (rc == CLI_EXIT_OK) {
-        struct series vtk = {.binary = su.vtk_binary};
+        struct series vtk = {.binary = su.vtk_binary, .links = su.vtk_links};
         bool has_vtk = opt->out_dir && su.vtk_prefix[0] && su.vtk_every;
         snprintf(vtk.dir, sizeof vtk.dir, "%s", opt->out_dir ? opt->out_dir : "");
         snprintf(vtk.prefix, sizeof vtk.prefix, "%s", su.vtk_prefix);

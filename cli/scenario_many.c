@@ -134,6 +134,10 @@ static const struct cli_key_desc dump_keys[] = {
           "files a run."),
     WORD("vtk_binary", CLI_VALUE_CHOICE, "yes", cli_yes_no,
          "yes: binary legacy VTK (exact, compact); no: ASCII with 17 digits."),
+    WORD("vtk_links", CLI_VALUE_CHOICE, "no", cli_yes_no,
+         "yes: with each frame, PREFIX_links_NNNNNN.vtk (index PREFIX_links.vtk.series): every "
+         "contact and liquid bridge as a line, with its gap and normal and tangential force "
+         "(force chains, bridge networks: docs/many.md)."),
     WORD("csv", CLI_VALUE_TEXT, "global.csv", NULL,
          "CSV of global quantities (energies, contacts, liquid bridges, agglomerates, work per "
          "model) in --out DIR, ending in .csv; none disables it."),
@@ -694,6 +698,7 @@ static int build_run(const struct cli_scenario* sc, struct cli_many_setup* su)
     su->checkpoint_every =
         (unsigned long long)cli_scenario_number(sc, "dump", "checkpoint_every", 0);
     su->vtk_binary = strcmp(cli_scenario_text(sc, "dump", "vtk_binary", "yes"), "yes") == 0;
+    su->vtk_links = strcmp(cli_scenario_text(sc, "dump", "vtk_links", "no"), "yes") == 0;
     int rc;
     if ((rc = dump_name(sc, "vtk", "particles", su->vtk_prefix)) != CLI_EXIT_OK ||
         (rc = dump_name(sc, "csv", "global.csv", su->csv_name)) != CLI_EXIT_OK ||

@@ -24,6 +24,7 @@ struct cli_many_setup {
     unsigned long long csv_every;        /* steps between CSV rows (0: none) */
     unsigned long long checkpoint_every; /* steps between checkpoints (0: stop and end only) */
     bool vtk_binary;
+    bool vtk_links;                      /* also PREFIX_links_NNNNNN.vtk with each frame */
     char vtk_prefix[CLI_VALUE_MAX];      /* "" = no VTK files */
     char csv_name[CLI_VALUE_MAX];        /* ends in ".csv"; "" = none */
     char checkpoint_name[CLI_VALUE_MAX]; /* "" = none */

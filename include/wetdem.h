@@ -691,6 +691,16 @@ WETDEM_API int wetdem_sim_many_write_csv_row(struct wetdem_sim* sim);
 /* Writes the particles as a legacy VTK file (radius, velocity, spin, contacts as in
  * wetdem_many_stats, material, id). */
 WETDEM_API int wetdem_sim_write_vtk(struct wetdem_sim* sim, const char* path, bool binary);
+
+/* Writes the links of a started many-particle run as a legacy VTK file of lines: each
+ * particle pair in contact or joined by a liquid bridge, and each particle-wall contact (as
+ * wetdem_many_stats counts them), from centre to centre (across periodic boundaries, to the
+ * nearest image) or from the centre to the wall, with the cell data i, j (-1 - w for wall w),
+ * contact, bridge, gap [m], force_normal [N] (> 0 repulsive), force_tangential [N] and force
+ * (the vector on i, on j its opposite) [N]: the
+ * force of the enabled models at this state, with the pairs' histories as the latest step
+ * left them (docs/many.md, Outputs). WETDEM_ERR_INVALID before a run, WETDEM_ERR_IO. */
+WETDEM_API int wetdem_sim_write_vtk_links(struct wetdem_sim* sim, const char* path, bool binary);
 /* Writes a checkpoint of a many-particle run (atomic: temporary file, then rename).
  * Returns WETDEM_OK, WETDEM_ERR_INVALID (not in many mode) or WETDEM_ERR_IO. */
 WETDEM_API int wetdem_sim_write_checkpoint(struct wetdem_sim* sim, const char* path);

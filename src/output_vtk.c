@@ -1,6 +1,7 @@
 /*
- * output_vtk.c — legacy VTK (version 3.0) POLYDATA files of the particles, ASCII or binary,
- * and ParaView ".vtk.series" time-series files. Prefix: wetdem_output_vtk.
+ * output_vtk.c — legacy VTK (version 3.0) POLYDATA files of the particles and of their links
+ * (contacts and liquid bridges as lines), ASCII or binary, and ParaView ".vtk.series"
+ * time-series files. Prefix: wetdem_output_vtk.
  *
  * Layout (VTK User's Guide, "VTK File Formats", legacy format):
  *   # vtk DataFile Version 3.0 / title / ASCII|BINARY / DATASET POLYDATA
@@ -9,6 +10,9 @@
  *   VERTICES n 2n                           one vertex cell per sphere ("1 i")
  *   POINT_DATA n, FIELD FieldData 8: radius [m], velocity [m/s], spin [rad/s], contacts,
  *                                    bridges, agglomerate, material, id
+ * Links: POINTS 2n (the ends of each line), LINES n 3n ("2 2k 2k+1"), CELL_DATA n with FIELD
+ * FieldData 8: i, j, contact, bridge (int), gap [m], force_normal [N], force_tangential [N],
+ * force (3 components, on i) [N].
  * The point arrays form a FIELD rather than SCALARS/VECTORS attributes because VTK's legacy
  * reader loads only the first SCALARS and VECTORS unless told otherwise; field arrays are all
  * read.
@@ -107,16 +111,22 @@ static void write_ints(FILE* f, const char* name, const struct wetdem_particle* 
         fputc('\n', f);
 }
 
-static void write_body(FILE* f, const struct wetdem_particle* p, size_t n,
-                       const struct wetdem_output_vtk_links* links, double time, bool binary)
+/* The title, format and TIME field data of a file. */
+static void write_head(FILE* f, const char* what, double time, bool binary)
 {
     fprintf(f,
-            "# vtk DataFile Version 3.0\nwetdem particles t = %.17g s\n%s\n"
+            "# vtk DataFile Version 3.0\nwetdem %s t = %.17g s\n%s\n"
             "DATASET POLYDATA\nFIELD FieldData 1\nTIME 1 1 double\n",
-            time, binary ? "BINARY" : "ASCII");
+            what, time, binary ? "BINARY" : "ASCII");
     put_double(f, time, binary);
     if (binary)
         fputc('\n', f);
+}
+
+static void write_body(FILE* f, const struct wetdem_particle* p, size_t n,
+                       const struct wetdem_output_vtk_links* links, double time, bool binary)
+{
+    write_head(f, "particles", time, binary);
     write_vectors(f, "POINTS %zu double\n", p, n, 0, binary);
     fprintf(f, "VERTICES %zu %zu\n", n, 2 * n);
     for (size_t k = 0; k < n; k++) {
@@ -142,6 +152,56 @@ static void write_body(FILE* f, const struct wetdem_particle* p, size_t n,
     write_ints(f, "agglomerate", p, n, l->agglomerate, INT_COUNT, binary);
     write_ints(f, "material", p, n, NULL, INT_MATERIAL, binary);
     write_ints(f, "id", p, n, NULL, INT_ID, binary);
+}
+
+/* A cell array of the links: member `which` of each, 0 i, 1 j, 2 contact, 3 bridge (int), 4
+ * gap, 5 force_normal, 6 force_tangential (double), 7 force (3 doubles). */
+static void write_link_array(FILE* f, const char* name, const struct wetdem_output_vtk_link* l,
+                             size_t n, int which, bool binary)
+{
+    fprintf(f, "%s %d %zu %s\n", name, which == 7 ? 3 : 1, n, which < 4 ? "int" : "double");
+    for (size_t k = 0; k < n; k++) {
+        switch (which) {
+        case 0: put_int(f, l[k].i, binary); break;
+        case 1: put_int(f, l[k].j, binary); break;
+        case 2: put_int(f, l[k].contact, binary); break;
+        case 3: put_int(f, l[k].bridge, binary); break;
+        case 4: put_double(f, l[k].gap, binary); break;
+        case 5: put_double(f, l[k].f_normal, binary); break;
+        case 6: put_double(f, l[k].f_tangential, binary); break;
+        default: put_vec(f, l[k].force, binary); break;
+        }
+    }
+    if (binary)
+        fputc('\n', f);
+}
+
+static void write_links_body(FILE* f, const struct wetdem_output_vtk_link* l, size_t n, double time,
+                             bool binary)
+{
+    write_head(f, "links", time, binary);
+    fprintf(f, "POINTS %zu double\n", 2 * n);
+    for (size_t k = 0; k < n; k++) {
+        put_vec(f, l[k].a, binary);
+        put_vec(f, l[k].b, binary);
+    }
+    if (binary)
+        fputc('\n', f);
+    fprintf(f, "LINES %zu %zu\n", n, 3 * n);
+    for (size_t k = 0; k < n; k++) {
+        int32_t cell[3] = {2, (int32_t)(2 * k), (int32_t)(2 * k + 1)};
+        if (binary)
+            put_be(f, cell, sizeof cell[0], 3);
+        else
+            fprintf(f, "2 %zu %zu\n", 2 * k, 2 * k + 1);
+    }
+    if (binary)
+        fputc('\n', f);
+    fprintf(f, "CELL_DATA %zu\nFIELD FieldData 8\n", n);
+    static const char* const names[] = {
+        "i", "j", "contact", "bridge", "gap", "force_normal", "force_tangential", "force"};
+    for (int w = 0; w < 8; w++)
+        write_link_array(f, names[w], l, n, w, binary);
 }
 
 /* Closes f (opened on tmp) and renames tmp to path; cleans up on failure. */
@@ -183,6 +243,20 @@ int wetdem_output_vtk_write(const char* path, const struct wetdem_particle* p, s
     if (!f)
         return WETDEM_ERR_IO;
     write_body(f, p, n, links, time, binary);
+    return finish_atomic(f, tmp, path, msg, msg_size);
+}
+
+int wetdem_output_vtk_links_write(const char* path, const struct wetdem_output_vtk_link* links,
+                                  size_t n, double time, bool binary, char* msg, size_t msg_size)
+{
+    if (n > INT32_MAX / 3)
+        return wetdem_status_fail(msg, msg_size, WETDEM_ERR_IO,
+                                  "too many links for a legacy VTK file: %zu", n);
+    char tmp[4096];
+    FILE* f = open_tmp(path, tmp, sizeof tmp, msg, msg_size);
+    if (!f)
+        return WETDEM_ERR_IO;
+    write_links_body(f, links, n, time, binary);
     return finish_atomic(f, tmp, path, msg, msg_size);
 }
 

@@ -28,6 +28,26 @@ int wetdem_output_vtk_write(const char* path, const struct wetdem_particle* p, s
                             const struct wetdem_output_vtk_links* links, double time, bool binary,
                             char* msg, size_t msg_size);
 
+/* A link between two spheres, or a sphere and a wall, for wetdem_output_vtk_links_write: the
+ * line from a to b (the centres, the second as seen from the first across periodic
+ * boundaries; or the centre and the foot of the perpendicular on the wall). */
+struct wetdem_output_vtk_link {
+    struct wetdem_vec3 a, b;
+    int32_t i, j;             /* particle indices; j = -1 - w for wall w */
+    bool contact, bridge;     /* a solid contact, a liquid bridge (as the models define them) */
+    double gap;               /* surface gap h [m], < 0: overlap */
+    double f_normal;          /* normal force on i [N], > 0 repulsive */
+    double f_tangential;      /* size of the tangential force [N] */
+    struct wetdem_vec3 force; /* the whole force on i [N] (on j: its opposite) */
+};
+
+/* Writes n links as a legacy VTK POLYDATA file of lines (two points a line) with the cell data
+ * i, j, contact, bridge (0 or 1), gap [m], force_normal [N], force_tangential [N] and force
+ * (3 components, on i) [N], and the time [s] as field data TIME; binary and atomic as wetdem_output_vtk_write. Returns WETDEM_OK
+ * or WETDEM_ERR_IO (message in msg). */
+int wetdem_output_vtk_links_write(const char* path, const struct wetdem_output_vtk_link* links,
+                                  size_t n, double time, bool binary, char* msg, size_t msg_size);
+
 /* Formats "<prefix>_<index, 6 digits>.vtk" into buf. Returns the length snprintf would write. */
 int wetdem_output_vtk_path(char* buf, size_t size, const char* prefix, uint64_t index);
 

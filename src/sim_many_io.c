@@ -214,6 +214,101 @@ int wetdem_sim_write_vtk(struct wetdem_sim* sim, const char* path, bool binary)
     return st;
 }
 
+/* ---- links: contacts and liquid bridges as lines ---- */
+
+/* Link of contact c (history `hist`, committed) into *l when it is a contact or a bridge;
+ * false if it is neither. The force is that of the enabled models at this state with the
+ * history as the latest step left it, not advanced (dt = 0, on a copy). */
+static bool link_of(const struct wetdem_sim* sim, struct wetdem_contact* c, const double* hist,
+                    struct wetdem_output_vtk_link* l, int* status)
+{
+    bool contact = wetdem_sim_contact_is_in_contact(sim, c, hist);
+    bool bridge = !c->is_wall && wetdem_sim_contact_is_bridged(sim, c, hist);
+    if (!contact && !bridge)
+        return false;
+    double scratch[WETDEM_HISTORY_SCRATCH];
+    if (sim->history_len)
+        memcpy(scratch, hist, sim->history_len * sizeof *scratch);
+    c->dt = 0.0;
+    struct wetdem_pair_force f;
+    int st = wetdem_sim_eval_contact(sim, c, sim->history_len ? scratch : NULL, &f, NULL);
+    if (st < 0 && *status == WETDEM_OK)
+        *status = st;
+    const struct wetdem_vec3 a = sim->particles[c->i].pos;
+    double reach = c->gap + c->radius_i + (c->is_wall ? 0.0 : c->radius_j); /* a to b */
+    *l = (struct wetdem_output_vtk_link){
+        .a = a,
+        .b = vec3_axpy(a, -reach, c->normal), /* the normal points from j to i */
+        .i = (int32_t)c->i,
+        .j = c->is_wall ? -1 - (int32_t)c->j : (int32_t)c->j,
+        .contact = contact,
+        .bridge = bridge,
+        .gap = c->gap,
+        .f_normal = st < 0 ? NAN : f.f_normal,
+        .f_tangential = st < 0 ? NAN : vec3_norm(f.f_tan),
+        .force = st < 0 ? vec3(NAN, NAN, NAN) : vec3_axpy(f.f_tan, f.f_normal, c->normal),
+    };
+    return true;
+}
+
+/* Appends link l to the growing array *links (count *n, capacity *cap). */
+static bool push_link(struct wetdem_output_vtk_link** links, size_t* n, size_t* cap,
+                      const struct wetdem_output_vtk_link* l)
+{
+    if (*n == *cap) {
+        size_t c = *cap ? 2 * *cap : 1024;
+        struct wetdem_output_vtk_link* grown = realloc(*links, c * sizeof *grown);
+        if (!grown)
+            return false;
+        *links = grown;
+        *cap = c;
+    }
+    (*links)[(*n)++] = *l;
+    return true;
+}
+
+int wetdem_sim_write_vtk_links(struct wetdem_sim* sim, const char* path, bool binary)
+{
+    const struct wetdem_many* m = sim->many;
+    if (!m || !m->started)
+        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
+                               "links: a VTK file of links needs a started many-particle run");
+    if (sim->history_len > WETDEM_HISTORY_SCRATCH)
+        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
+                               "links: the models keep %zu history values a pair, more than %d",
+                               sim->history_len, WETDEM_HISTORY_SCRATCH);
+    struct wetdem_output_vtk_link* links = NULL;
+    size_t n = 0, cap = 0;
+    bool ok = true;
+    int status = WETDEM_OK;
+    for (size_t q = 0; ok && q < m->cl.n_pairs; q++) { /* every pair within range is listed */
+        struct wetdem_contact c;
+        struct wetdem_output_vtk_link l;
+        wetdem_sim_many_contact(sim, m->cl.pairs[q].i, m->cl.pairs[q].j, false, &c);
+        if (link_of(sim, &c, wetdem_many_pair_history(sim, q), &l, &status))
+            ok = push_link(&links, &n, &cap, &l);
+    }
+    for (size_t i = 0; ok && i < sim->n_particles; i++)
+        for (size_t w = 0; ok && w < sim->n_walls; w++) {
+            struct wetdem_contact c;
+            struct wetdem_output_vtk_link l;
+            wetdem_sim_many_contact(sim, i, w, true, &c);
+            if (link_of(sim, &c, wetdem_many_wall_history(sim, i, w), &l, &status))
+                ok = push_link(&links, &n, &cap, &l);
+        }
+    int st = WETDEM_OK;
+    char msg[512];
+    if (!ok)
+        st = wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory for the links");
+    else if (status != WETDEM_OK)
+        st = wetdem_sim_fail(sim, status, "links: a model failed on a link's force");
+    else if ((st = wetdem_output_vtk_links_write(path, links, n, sim->engine.time, binary, msg,
+                                                 sizeof msg)) != WETDEM_OK)
+        st = wetdem_sim_fail(sim, st, "%s", msg);
+    free(links);
+    return st;
+}
+
 /* "<prefix><suffix>" into buf. */
 static int prefixed(struct wetdem_sim* sim, char* buf, size_t n, const char* suffix)
 {

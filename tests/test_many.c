@@ -1334,6 +1334,139 @@ static void test_many_contacts_and_bridges_follow_the_models(void** state)
     }
 }
 
+/* The values of cell or point array `name` of an ASCII VTK file's text (its header "name
+ * components tuples type", then the values), components x tuples of them into out[]; the
+ * number read. */
+static size_t vtk_array(const char* text, const char* name, double* out, size_t max)
+{
+    char head[64];
+    snprintf(head, sizeof head, "\n%s ", name);
+    const char* at = strstr(text, head);
+    assert_non_null(at);
+    int comps = 0, tuples = 0, used = 0;
+    assert_int_equal(sscanf(at, " %*s %d %d %*s%n", &comps, &tuples, &used), 2);
+    at += used;
+    size_t n = (size_t)comps * (size_t)tuples;
+    assert_true(n <= max);
+    for (size_t k = 0; k < n; k++) {
+        char* end;
+        out[k] = strtod(at, &end);
+        assert_true(end != at);
+        at = end;
+    }
+    return n;
+}
+
+/* The links file of the hand-built configuration, at rest (its velocities set to zero after
+ * its step, so that no viscous or damping force acts): one line for each pair in contact or
+ * bridged and each particle-wall contact (0-1 overlapping and bridged, 1-2 and 3-4 bridged
+ * apart, 5 on the floor), from centre to centre or to the floor, |b - a| = r_i + r_j + h; the
+ * normal forces those of wetdem_sim_pair_force and of the closed forms, Hertz (4/3) E*
+ * sqrt(R*) delta^(3/2) minus capillary suction 8 pi R* sigma, to 1e-12 (rounding of two
+ * evaluations of the same sums: the engine's mixed properties and the pair's); no tangential
+ * force at rest beyond the spring of one step from rest (< 1e-9 of the normal one). */
+static void test_many_links_are_the_contacts_and_bridges(void** state)
+{
+    (void)state;
+    struct wetdem_sim* sim = hand_built("hertz mindlin sb capillary");
+    size_t n;
+    struct wetdem_particle* p = wetdem_sim_particles(sim, &n);
+    for (size_t k = 0; k < n; k++)
+        p[k].vel = p[k].omega = vec3(0, 0, 0);
+    char path[] = "/tmp/wetdem_test_links_XXXXXX";
+    close(mkstemp(path));
+    CHECK_OK(wetdem_sim_write_vtk_links(sim, path, false));
+    char* text = test_read_file(path, NULL);
+    enum { L = 4 };
+    double i[8], j[8], contact[8], bridge[8], gap[8], fn[8], ft[8], force[24], pts[48];
+    assert_int_equal(vtk_array(text, "i", i, 8), L);
+    vtk_array(text, "j", j, 8);
+    vtk_array(text, "contact", contact, 8);
+    vtk_array(text, "bridge", bridge, 8);
+    vtk_array(text, "gap", gap, 8);
+    vtk_array(text, "force_normal", fn, 8);
+    vtk_array(text, "force_tangential", ft, 8);
+    assert_int_equal(vtk_array(text, "force", force, 24), 3 * L);
+    const char* points = strstr(text, "POINTS 8 double\n");
+    assert_non_null(points);
+    points += strlen("POINTS 8 double\n");
+    for (int k = 0; k < 3 * 2 * L; k++)
+        pts[k] = strtod(points, (char**)&points);
+    CHECK_CONTAINS(text, "LINES 4 12\n2 0 1\n2 2 3\n2 4 5\n2 6 7\n");
+    static const double want[L][4] = {{0, 1, 1, 1}, {1, 2, 0, 1}, {3, 4, 0, 1}, {5, -1, 1, 0}};
+    double sigma = 0.02;
+    for (int k = 0; k < L; k++) {
+        assert_true(i[k] == want[k][0] && j[k] == want[k][1] && contact[k] == want[k][2] &&
+                    bridge[k] == want[k][3]);
+        struct wetdem_contact c;
+        struct wetdem_pair_force f;
+        CHECK_OK(wetdem_sim_pair_force(sim, (size_t)i[k], (size_t)(long)j[k], &c, &f));
+        CHECK_REL(gap[k], c.gap, 1e-12);
+        CHECK_REL(fn[k], f.f_normal, 1e-12);
+        double k_hertz = 4.0 / 3.0 * c.e_star * sqrt(c.r_eff), delta = c.gap < 0 ? -c.gap : 0;
+        CHECK_REL(fn[k], k_hertz * pow(delta, 1.5) - 8 * M_PI * c.r_eff * sigma, 1e-12);
+        assert_true(ft[k] <= 1e-9 * fabs(fn[k]));
+        struct wetdem_vec3 a = vec3(pts[6 * k], pts[6 * k + 1], pts[6 * k + 2]);
+        struct wetdem_vec3 b = vec3(pts[6 * k + 3], pts[6 * k + 4], pts[6 * k + 5]);
+        struct wetdem_vec3 d = vec3_sub(a, b);
+        assert_true(vec3_norm(vec3_sub(a, p[(size_t)i[k]].pos)) == 0);
+        double r_j = j[k] >= 0 ? p[(size_t)j[k]].radius : 0;
+        CHECK_REL(vec3_norm(d), p[(size_t)i[k]].radius + r_j + c.gap, 1e-12);
+        /* the force on i: f_n along the normal from j to i, plus the tangential part */
+        struct wetdem_vec3 fv = vec3(force[3 * k], force[3 * k + 1], force[3 * k + 2]);
+        CHECK_ABS(vec3_norm(vec3_sub(fv, vec3_scale(c.normal, fn[k]))), 0, 1e-9 * fabs(fn[k]));
+    }
+    free(text);
+    remove(path);
+    wetdem_sim_free(sim);
+}
+
+/* Across a periodic boundary a link runs from i to the nearest image of j, 2R + h long, and
+ * not across the box; before a run there are no links to write. */
+static void test_many_links_cross_periodic_boundaries(void** state)
+{
+    (void)state;
+    struct wetdem_sim* sim = wetdem_sim_create();
+    struct wetdem_material m = {.density = 2500,
+                                .youngs_modulus = 1e7,
+                                .poisson_ratio = 0.3,
+                                .restitution = 0.5,
+                                .film = 10e-6};
+    assert_int_equal(wetdem_sim_add_material(sim, &m), 0);
+    CHECK_OK(wetdem_sim_set_fluid(
+        sim, &(struct wetdem_fluid){.viscosity = 0.01, .surface_tension = 0.02, .density = 1000}));
+    CHECK_OK(wetdem_sim_enable_model(sim, "capillary"));
+    double R = 0.5e-3, box = 4e-3, h = 5e-6;
+    CHECK_OK(wetdem_sim_add_particle(
+        sim, (struct wetdem_particle){.pos = {box - R - h / 2, 2e-3, 2e-3}, .radius = R}));
+    CHECK_OK(wetdem_sim_add_particle(
+        sim, (struct wetdem_particle){.pos = {R + h / 2, 2e-3, 2e-3}, .radius = R}));
+    struct wetdem_many_settings s = {
+        .periodic = {true, true, true}, .box_hi = {box, box, box}, .dt = 1e-9, .skin = 0.1e-3};
+    CHECK_OK(wetdem_sim_set_many(sim, &s));
+    char path[] = "/tmp/wetdem_test_links_XXXXXX";
+    close(mkstemp(path));
+    CHECK_STATUS(wetdem_sim_write_vtk_links(sim, path, false), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(wetdem_sim_errmsg(sim), "started many-particle run");
+    CHECK_OK(wetdem_sim_integrate(sim, 1e-9));
+    CHECK_OK(wetdem_sim_write_vtk_links(sim, path, false));
+    char* text = test_read_file(path, NULL);
+    CHECK_CONTAINS(text, "LINES 1 3\n");
+    const char* points = strstr(text, "POINTS 2 double\n") + strlen("POINTS 2 double\n");
+    double x[6];
+    for (int k = 0; k < 6; k++)
+        x[k] = strtod(points, (char**)&points);
+    double gap;
+    vtk_array(text, "gap", &gap, 1);
+    CHECK_REL(gap, h, 1e-9); /* (the spheres moved by < 1e-12 m in their one step) */
+    CHECK_REL(sqrt((x[3] - x[0]) * (x[3] - x[0]) + (x[4] - x[1]) * (x[4] - x[1]) +
+                   (x[5] - x[2]) * (x[5] - x[2])),
+              2 * R + gap, 1e-12);
+    free(text);
+    remove(path);
+    wetdem_sim_free(sim);
+}
+
 /* The counts come from the state and the histories, so a restored checkpoint reports those of
  * the run that wrote it before any step (the force pass's own marks are not in it). */
 static void test_many_counts_survive_a_restart(void** state)
@@ -1546,6 +1679,8 @@ int main(void)
         cmocka_unit_test(test_many_elastic_energy_is_the_contact_models),
         cmocka_unit_test(test_many_hooke_budget_dissipates),
         cmocka_unit_test(test_many_contacts_and_bridges_follow_the_models),
+        cmocka_unit_test(test_many_links_are_the_contacts_and_bridges),
+        cmocka_unit_test(test_many_links_cross_periodic_boundaries),
         cmocka_unit_test(test_many_counts_survive_a_restart),
         cmocka_unit_test(test_many_writes_vtk_and_csv),
         cmocka_unit_test(test_many_restart_continues_outputs),

@@ -13,7 +13,8 @@
  *     and prints the command that resumes it; resuming gives the uninterrupted run's files
  *     byte for byte; a third stops it at once, the earlier checkpoint intact;
  *   - the CSV ends with a row of the last step, in the library's format;
- *   - a fresh run into a used --out removes the earlier run's frames, and no other file;
+ *   - a fresh run into a used --out removes the earlier run's frames and links (vtk_links),
+ *     and no other file; a restart continues both, bit-identical to an uninterrupted run;
  *   - the summary prints a large mean agglomerate size as a whole number;
  *   - progress goes to stderr only when it is a terminal, with an estimate of the time left;
  *   - the example scenarios check, and the summary's energy budget adds up; a run whose budget
@@ -284,7 +285,8 @@ static unsigned long long csv_last_step(const char* name)
 /* The files of two --out directories are byte-identical, except the CSV column
  * candidate_pairs: the size of the neighbour list depends on when the list was last built,
  * and a restart builds it afresh (the forces do not depend on it: every pair within range is
- * in any valid list). The checkpoint holds such counters too and is not compared. */
+ * in any valid list). The checkpoint holds such counters too and is not compared. When a has
+ * links (vtk_links), so must b, the same. */
 static void check_same_outputs(const char* a, const char* b, size_t frames)
 {
     char names[64][64];
@@ -294,6 +296,13 @@ static void check_same_outputs(const char* a, const char* b, size_t frames)
     snprintf(names[n++], 64, "summary.json");
     for (size_t k = 0; k < frames && n < 64; k++)
         snprintf(names[n++], 64, "particles_%06zu.vtk", k);
+    char links_index[200];
+    snprintf(links_index, sizeof links_index, "%.100s/particles_links.vtk.series", a);
+    if (exists(links_index)) {
+        snprintf(names[n++], 64, "particles_links.vtk.series");
+        for (size_t k = 0; k < frames && n < 64; k++)
+            snprintf(names[n++], 64, "particles_links_%06zu.vtk", k);
+    }
     for (size_t k = 0; k < n; k++) {
         char pa[300], pb[300];
         snprintf(pa, sizeof pa, "%.100s/%.63s", a, names[k]);
@@ -583,19 +592,26 @@ static void test_many_cli_csv_ends_at_the_last_step(void** state)
 static void test_many_cli_fresh_run_replaces_earlier_frames(void** state)
 {
     (void)state;
-    scenario("frames.ini", "[dump]\nvtk_every = 100\ncsv_every = 20\n");
+    scenario("frames.ini", "[dump]\nvtk_every = 100\ncsv_every = 20\nvtk_links = yes\n");
     assert_int_equal(run_cli("run frames.ini --set run.steps=600 --out reuse"), 0);
+    for (int k = 0; k <= 6; k++) { /* each frame with its links */
+        char name[64];
+        snprintf(name, sizeof name, "reuse/particles_links_%06d.vtk", k);
+        if (!exists(name))
+            fail_msg("%s is missing", name);
+    }
     const char* keep[] = {"reuse/particles_notes.vtk", "reuse/other_000005.vtk",
                           "reuse/particles_000005.vtk.bak", "reuse/particles_00005.vtk"};
     for (size_t k = 0; k < 4; k++)
         write_text(keep[k], "not a frame of this run\n");
     assert_int_equal(run_cli("run frames.ini --set run.steps=200 --out reuse"), 0);
-    for (int k = 0; k <= 6; k++) {
-        char name[64];
-        snprintf(name, sizeof name, "reuse/particles_%06d.vtk", k);
-        if (exists(name) != (k <= 2))
-            fail_msg("%s %s", name, k <= 2 ? "is missing" : "of the earlier run is left");
-    }
+    for (int k = 0; k <= 6; k++)
+        for (int links = 0; links < 2; links++) {
+            char name[64];
+            snprintf(name, sizeof name, "reuse/particles%s_%06d.vtk", links ? "_links" : "", k);
+            if (exists(name) != (k <= 2))
+                fail_msg("%s %s", name, k <= 2 ? "is missing" : "of the earlier run is left");
+        }
     for (size_t k = 0; k < 4; k++)
         if (!exists(keep[k]))
             fail_msg("%s, not a frame, was removed", keep[k]);
@@ -604,6 +620,13 @@ static void test_many_cli_fresh_run_replaces_earlier_frames(void** state)
                      0);
     assert_int_equal(run_cli("run frames.ini --set run.steps=400 --out whole400"), 0);
     check_same_outputs("whole400", "reuse", 5);
+    /* a fresh run without links leaves none of the earlier run's, nor their index */
+    assert_int_equal(run_cli("run frames.ini --set run.steps=200 --set dump.vtk_links=no "
+                             "--out reuse"),
+                     0);
+    assert_false(exists("reuse/particles_links_000000.vtk"));
+    assert_false(exists("reuse/particles_links.vtk.series"));
+    assert_true(exists("reuse/particles_000002.vtk"));
 }
 
 /* The summary gives a large mean agglomerate size as a whole number: 1000 wet spheres on a

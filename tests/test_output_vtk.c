@@ -2,7 +2,8 @@
  * test_output_vtk.c — legacy VTK particle files (src/output_vtk.c): what is written is parsed
  * back here, keyword by keyword, and must equal the input bit for bit (ASCII with 17 digits
  * and big-endian binary are both exact); when the VTK Python module is installed the files
- * are also read with VTK's own legacy reader. Also: atomic write, series file, bad path.
+ * are also read with VTK's own legacy reader. Also: the links file (lines and cell data), atomic
+ * write, series file, bad path.
  */
 #include <stdlib.h>
 #include <unistd.h>
@@ -272,6 +273,90 @@ static void test_output_vtk_binary_round_trip(void** state)
     round_trip(true);
 }
 
+/* A links file: lines of two points each, and the cell arrays, read back bit for bit. */
+static void links_round_trip(bool binary)
+{
+    enum { NL = 5 };
+    struct wetdem_output_vtk_link l[NL];
+    for (int k = 0; k < NL; k++) {
+        double t = k + 1;
+        l[k] = (struct wetdem_output_vtk_link){.a = vec3(t / 3, -t, 1e-3 * t),
+                                               .b = vec3(t / 7, t * t, -1e-4 / t),
+                                               .i = k,
+                                               .j = k == 4 ? -1 : k + 1,
+                                               .contact = k % 2 == 0,
+                                               .bridge = k != 4,
+                                               .gap = -1e-6 / t,
+                                               .f_normal = sqrt(t) * 1e-3,
+                                               .f_tangential = 1e-5 / t,
+                                               .force = vec3(-t, 1 / t, sin(t))};
+    }
+    char path[] = "/tmp/wetdem_test_vtk_links_XXXXXX";
+    close(mkstemp(path));
+    char msg[256] = "";
+    double time = 1.0 / 3.0;
+    CHECK_OK(wetdem_output_vtk_links_write(path, l, NL, time, binary, msg, sizeof msg));
+    FILE* f = fopen(path, "rb");
+    assert_non_null(f);
+    check_header(f, time, binary);
+    expect(f, "POINTS");
+    expect(f, "10");
+    expect(f, "double");
+    begin_data(f, binary);
+    for (int k = 0; k < NL; k++)
+        for (int e = 0; e < 2; e++) {
+            struct wetdem_vec3 v = e ? l[k].b : l[k].a;
+            assert_true(get_double(f, binary) == v.x && get_double(f, binary) == v.y &&
+                        get_double(f, binary) == v.z);
+        }
+    expect(f, "LINES");
+    expect(f, "5");
+    expect(f, "15");
+    begin_data(f, binary);
+    for (int k = 0; k < NL; k++) {
+        assert_int_equal(get_int(f, binary), 2);
+        assert_int_equal(get_int(f, binary), 2 * k);
+        assert_int_equal(get_int(f, binary), 2 * k + 1);
+    }
+    expect(f, "CELL_DATA");
+    expect(f, "5");
+    expect(f, "FIELD");
+    expect(f, "FieldData");
+    expect(f, "8");
+    static const char* const names[] = {
+        "i", "j", "contact", "bridge", "gap", "force_normal", "force_tangential", "force"};
+    for (int w = 0; w < 8; w++) {
+        expect(f, names[w]);
+        expect(f, w == 7 ? "3" : "1");
+        expect(f, "5");
+        expect(f, w < 4 ? "int" : "double");
+        begin_data(f, binary);
+        for (int k = 0; k < NL; k++) {
+            const int32_t ints[4] = {l[k].i, l[k].j, l[k].contact, l[k].bridge};
+            const double dbl[3] = {l[k].gap, l[k].f_normal, l[k].f_tangential};
+            if (w < 4)
+                assert_int_equal(get_int(f, binary), ints[w]);
+            else if (w < 7)
+                assert_true(get_double(f, binary) == dbl[w - 4]);
+            else
+                assert_true(get_double(f, binary) == l[k].force.x &&
+                            get_double(f, binary) == l[k].force.y &&
+                            get_double(f, binary) == l[k].force.z);
+        }
+    }
+    char tail[8];
+    assert_int_equal(fscanf(f, "%7s", tail), EOF);
+    fclose(f);
+    remove(path);
+}
+
+static void test_output_vtk_links_round_trip(void** state)
+{
+    (void)state;
+    links_round_trip(false);
+    links_round_trip(true);
+}
+
 static void test_output_vtk_bad_path_is_an_io_error(void** state)
 {
     (void)state;
@@ -312,6 +397,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_output_vtk_ascii_round_trip),
         cmocka_unit_test(test_output_vtk_binary_round_trip),
+        cmocka_unit_test(test_output_vtk_links_round_trip),
         cmocka_unit_test(test_output_vtk_bad_path_is_an_io_error),
         cmocka_unit_test(test_output_vtk_series_and_names),
     };
