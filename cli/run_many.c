@@ -55,8 +55,9 @@
 struct series {
     char dir[PATH_CHARS], prefix[CLI_VALUE_MAX];
     bool binary;
-    bool links;    /* each frame also as PREFIX_links_NNNNNN.vtk, indexed by PREFIX_links */
-    double* times; /* time of frame k [s] */
+    bool links;        /* each frame also as PREFIX_links_NNNNNN.vtk, indexed by PREFIX_links */
+    size_t links_from; /* the first frame with links (after a restart of a run without) */
+    double* times;     /* time of frame k [s] */
     size_t n, cap;
     unsigned long long last_step; /* step of the latest frame (valid when n > 0) */
 };
@@ -121,7 +122,7 @@ static int series_write_one(const struct series* s, bool links)
     if (!f)
         return -1;
     fputs("{\n  \"file-series-version\" : \"1.0\",\n  \"files\" : [\n", f);
-    for (size_t k = 0; k < s->n; k++) {
+    for (size_t k = links ? s->links_from : 0; k < s->n; k++) {
         char name[CLI_VALUE_MAX + 40];
         frame_name(s, k, links, name, sizeof name);
         fprintf(f, "    { \"name\" : \"%s\", \"time\" : %.17g }%s\n", name, s->times[k],
@@ -213,6 +214,15 @@ static void series_resume(struct series* s, double t, unsigned long long step, d
         fclose(f);
     if (s->n && frame_step(s, s->n - 1, t, step, dt) == step && every && step % every != 0)
         s->n--;
+    /* the links index lists the frames from the first after which each has its links file:
+       a run written without links, resumed with them, has links from the restart on */
+    for (s->links_from = s->n; s->links && s->links_from > 0; s->links_from--) {
+        char name[CLI_VALUE_MAX + 40];
+        frame_name(s, s->links_from - 1, true, name, sizeof name);
+        snprintf(path, sizeof path, "%s/%s", s->dir, name);
+        if (access(path, F_OK) != 0)
+            break;
+    }
     s->last_step = s->n ? frame_step(s, s->n - 1, t, step, dt) : 0;
 }
 

@@ -627,6 +627,18 @@ static void test_many_cli_fresh_run_replaces_earlier_frames(void** state)
     assert_false(exists("reuse/particles_links_000000.vtk"));
     assert_false(exists("reuse/particles_links.vtk.series"));
     assert_true(exists("reuse/particles_000002.vtk"));
+    /* resumed with links, it has them from the restart on, and their index lists only those */
+    assert_int_equal(run_cli("run frames.ini --set run.steps=400 --out reuse --restart "
+                             "reuse/checkpoint.ckpt"),
+                     0);
+    char* index = test_read_file(tpath("reuse/particles_links.vtk.series"), NULL);
+    assert_non_null(index);
+    CHECK_CONTAINS(index, "\"particles_links_000003.vtk\"");
+    CHECK_CONTAINS(index, "\"particles_links_000004.vtk\"");
+    assert_null(strstr(index, "particles_links_000002.vtk"));
+    free(index);
+    assert_true(exists("reuse/particles_links_000004.vtk"));
+    assert_false(exists("reuse/particles_links_000002.vtk"));
 }
 
 /* The summary gives a large mean agglomerate size as a whole number: 1000 wet spheres on a
