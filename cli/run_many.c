@@ -598,12 +598,13 @@ static void print_check_json(const struct cli_scenario* sc, const struct cli_man
     cli_json_string(stdout, sc->file);
     printf(", \"engine\": \"many\", \"particles\": %zu, \"walls\": %zu, \"box_m\": "
            "[%.17g, %.17g, %.17g], \"periodic\": [%s, %s, %s], \"dt_s\": %.17g, "
-           "\"t_end_s\": %.17g, \"steps\": %llu, \"vtk_every\": %llu, \"csv_every\": %llu, "
-           "\"contacts\": %zu, \"bridges\": %zu, \"models\": [",
+           "\"t_end_s\": %.17g, \"steps\": %llu, \"vtk_every\": %llu, \"vtk_links\": %s, "
+           "\"csv_every\": %llu, \"contacts\": %zu, \"bridges\": %zu, \"models\": [",
            wetdem_sim_n_particles(su->sim), wetdem_sim_n_walls(su->sim), su->box[0], su->box[1],
            su->box[2], su->many.periodic[0] ? "true" : "false",
            su->many.periodic[1] ? "true" : "false", su->many.periodic[2] ? "true" : "false", pl->dt,
-           pl->t_end, pl->total, su->vtk_every, su->csv_every, s->contacts, s->bridges);
+           pl->t_end, pl->total, su->vtk_every, su->vtk_links ? "true" : "false", su->csv_every,
+           s->contacts, s->bridges);
     for (size_t k = 0; k < wetdem_sim_n_models(su->sim); k++) {
         printf("%s", k ? ", " : "");
         cli_json_string(stdout, wetdem_sim_model(su->sim, k)->name);
@@ -650,9 +651,10 @@ static void print_check(const struct cli_scenario* sc, const struct cli_many_set
                : pl->dt <= s.hmin_crossing_time ? "stays below it"
                                                 : "exceeds it");
     printf("  t_end         %.6g s\n  steps         %llu\n", pl->t_end, pl->total);
-    printf("  vtk_every     %llu\n  csv_every     %llu\n  contacts      %zu  (bridges %zu) at "
+    printf("  vtk_every     %llu%s\n  csv_every     %llu\n  contacts      %zu  (bridges %zu) at "
            "t = 0\n  models       ",
-           su->vtk_every, su->csv_every, s.contacts, s.bridges);
+           su->vtk_every, su->vtk_links ? "  (with links)" : "", su->csv_every, s.contacts,
+           s.bridges);
     for (size_t k = 0; k < wetdem_sim_n_models(su->sim); k++)
         printf(" %s", wetdem_sim_model(su->sim, k)->name);
     printf("\n");
