@@ -231,33 +231,48 @@ static FILE* open_tmp(const char* path, char* tmp, size_t tmp_size, char* msg, s
     return f;
 }
 
+/* What a VTK file holds: particles (p, links) or, is_links, links (l), n of them. */
+struct vtk_content {
+    bool is_links;
+    const struct wetdem_particle* p;
+    const struct wetdem_output_vtk_links* links;
+    const struct wetdem_output_vtk_link* l;
+    size_t n;
+    double time;
+    bool binary;
+};
+
+/* Writes the content to path, atomically. */
+static int write_vtk_file(const char* path, const struct vtk_content* c, char* msg, size_t n)
+{
+    if (c->n > (c->is_links ? INT32_MAX / 3 : INT32_MAX))
+        return wetdem_status_fail(msg, n, WETDEM_ERR_IO, "too many %s for a legacy VTK file: %zu",
+                                  c->is_links ? "links" : "particles", c->n);
+    char tmp[4096];
+    FILE* f = open_tmp(path, tmp, sizeof tmp, msg, n);
+    if (!f)
+        return WETDEM_ERR_IO;
+    if (c->is_links)
+        write_links_body(f, c->l, c->n, c->time, c->binary);
+    else
+        write_body(f, c->p, c->n, c->links, c->time, c->binary);
+    return finish_atomic(f, tmp, path, msg, n);
+}
+
 int wetdem_output_vtk_write(const char* path, const struct wetdem_particle* p, size_t n,
                             const struct wetdem_output_vtk_links* links, double time, bool binary,
                             char* msg, size_t msg_size)
 {
-    if (n > INT32_MAX)
-        return wetdem_status_fail(msg, msg_size, WETDEM_ERR_IO,
-                                  "too many particles for a legacy VTK file: %zu", n);
-    char tmp[4096];
-    FILE* f = open_tmp(path, tmp, sizeof tmp, msg, msg_size);
-    if (!f)
-        return WETDEM_ERR_IO;
-    write_body(f, p, n, links, time, binary);
-    return finish_atomic(f, tmp, path, msg, msg_size);
+    const struct vtk_content c = {.p = p, .links = links, .n = n, .time = time, .binary = binary};
+    return write_vtk_file(path, &c, msg, msg_size);
 }
 
 int wetdem_output_vtk_links_write(const char* path, const struct wetdem_output_vtk_link* links,
                                   size_t n, double time, bool binary, char* msg, size_t msg_size)
 {
-    if (n > INT32_MAX / 3)
-        return wetdem_status_fail(msg, msg_size, WETDEM_ERR_IO,
-                                  "too many links for a legacy VTK file: %zu", n);
-    char tmp[4096];
-    FILE* f = open_tmp(path, tmp, sizeof tmp, msg, msg_size);
-    if (!f)
-        return WETDEM_ERR_IO;
-    write_links_body(f, links, n, time, binary);
-    return finish_atomic(f, tmp, path, msg, msg_size);
+    const struct vtk_content c = {
+        .is_links = true, .l = links, .n = n, .time = time, .binary = binary};
+    return write_vtk_file(path, &c, msg, msg_size);
 }
 
 int wetdem_output_vtk_path(char* buf, size_t size, const char* prefix, uint64_t index)

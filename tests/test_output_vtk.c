@@ -355,6 +355,16 @@ static void test_output_vtk_links_round_trip(void** state)
     (void)state;
     links_round_trip(false);
     links_round_trip(true);
+    /* no links (a frame before any contact): a links file of none, not a particle file */
+    char path[] = "/tmp/wetdem_test_vtk_links_XXXXXX";
+    close(mkstemp(path));
+    char msg[256] = "";
+    CHECK_OK(wetdem_output_vtk_links_write(path, NULL, 0, 0.5, false, msg, sizeof msg));
+    char* text = test_read_file(path, NULL);
+    CHECK_CONTAINS(text, "wetdem links t = 0.5 s\n");
+    CHECK_CONTAINS(text, "POINTS 0 double\nLINES 0 0\nCELL_DATA 0\nFIELD FieldData 8\n");
+    free(text);
+    remove(path);
 }
 
 static void test_output_vtk_bad_path_is_an_io_error(void** state)
