@@ -8,6 +8,7 @@
  * (the row of cli_run_pairwise, whose status column is the engine's status). SIGINT or
  * SIGTERM stops starting points; the table of those that ran is still written.
  */
+#include <errno.h>
 #include <omp.h>
 #include <signal.h>
 #include <stdio.h>
@@ -144,7 +145,7 @@ static void run_all(const struct cli_scenario* base, struct cli_batch* b)
 {
     bool show = b->progress && isatty(STDERR_FILENO);
     double t0 = omp_get_wtime(), last = 0;
-    size_t done = 0, n = b->n_pts;
+    size_t done = 0, n = b->n_pts - b->n_kept; /* (progress of the points that run here) */
     char notice[200];
     snprintf(notice, sizeof notice,
              "\nwetdem: interrupted: finishing the collisions that run, then writing the table "
@@ -155,7 +156,9 @@ static void run_all(const struct cli_scenario* base, struct cli_batch* b)
                         "\nwetdem: stopped at once by a repeated signal, without the table\n", NULL,
                         &saved);
 #pragma omp parallel for schedule(dynamic, 1)
-    for (size_t k = 0; k < n; k++) {
+    for (size_t k = 0; k < b->n_pts; k++) {
+        if (b->pts[k].status == CLI_BATCH_KEPT || b->pts[k].status == CLI_BATCH_KEPT_FAILED)
+            continue;
         if (cli_stop_signal) {
             b->pts[k].status = CLI_BATCH_NOT_RUN;
             continue;
@@ -248,6 +251,129 @@ static int check_keys(const struct cli_batch* b)
     return CLI_EXIT_OK;
 }
 
+/* The unit of a scenario key for the header, "-" when it has none or is unknown. */
+static const char* key_unit(const char* key)
+{
+    char section[CLI_NAME_MAX], name[CLI_NAME_MAX], probe[CLI_VALUE_MAX];
+    snprintf(probe, sizeof probe, "%s=0", key);
+    const char* u = cli_override_split(probe, section, name, NULL) == 0
+                        ? cli_scenario_key_unit(section, name)
+                        : "";
+    return u[0] ? u : "-";
+}
+
+/* The table's column header, "KEY [unit],...,status [word],<engine columns>" (malloc'd;
+ * NULL when out of memory). */
+static char* table_header(const struct cli_batch* b)
+{
+    char* text = NULL;
+    size_t len = 0;
+    FILE* f = open_memstream(&text, &len);
+    if (!f)
+        return NULL;
+    for (int d = 0; d < b->n_keys; d++)
+        fprintf(f, "%s [%s],", b->key[d], key_unit(b->key[d]));
+    fprintf(f, "status [word],%s", b->header);
+    fclose(f);
+    return text;
+}
+
+/* The first fields of point p's row, its values "v1,[v2,]" as the table prints them. */
+static void row_values(const struct cli_batch* b, const struct cli_batch_point* p, char* buf,
+                       size_t n)
+{
+    size_t used = 0;
+    buf[0] = '\0';
+    for (int d = 0; d < b->n_keys && used < n; d++)
+        used += (size_t)snprintf(buf + used, n - used, "%.12g,", p->value[d]);
+}
+
+/* Whether a status word of a table is a failed run's: an error status or ENERGY_GREW. */
+static bool failed_word(const char* word, size_t len)
+{
+    return (len > 10 && strncmp(word, "WETDEM_ERR", 10) == 0) ||
+           (len == 11 && strncmp(word, "ENERGY_GREW", 11) == 0);
+}
+
+/* Row r (line `line` of the file) of the table of --resume, text without its newline: kept
+ * into point r unless NOT_RUN. An exit code, the message printed. */
+static int resume_row(struct cli_batch* b, size_t r, const char* text, size_t line)
+{
+    struct cli_batch_point* p = &b->pts[r];
+    char want[128];
+    row_values(b, p, want, sizeof want);
+    size_t lw = strlen(want);
+    if (strncmp(text, want, lw) != 0) {
+        char at[1024];
+        point_values(b, p, at, sizeof at);
+        cli_error("%s: --resume %s:%zu: the row '%.60s' is not of point %zu of this %s (%s): "
+                  "resume with the --values and --set of the run that wrote the table",
+                  b->cmd, b->resume, line, text, r + 1, b->cmd, at);
+        return CLI_EXIT_USAGE;
+    }
+    const char* status = text + lw;
+    size_t ls = strcspn(status, ",");
+    if (ls == 7 && strncmp(status, "NOT_RUN", 7) == 0)
+        return CLI_EXIT_OK;
+    if (!(p->row = strdup(status))) {
+        cli_error("%s: out of memory", b->cmd);
+        return CLI_EXIT_RUNTIME;
+    }
+    p->status = failed_word(status, ls) ? CLI_BATCH_KEPT_FAILED : CLI_BATCH_KEPT;
+    b->n_kept++;
+    return CLI_EXIT_OK;
+}
+
+/* Reads the table of b->resume, a table of this batch that an interruption left with rows
+ * NOT_RUN: its column header and the values of every row must be this batch's; the rows that
+ * ran are kept (verbatim: status word and fields), the others will run. '#' lines are passed
+ * over. An exit code, the message printed (with the file and line that differs). */
+static int read_resume(struct cli_batch* b)
+{
+    FILE* f = fopen(b->resume, "r");
+    if (!f) {
+        cli_error("%s: --resume %s: cannot read it: %s", b->cmd, b->resume, strerror(errno));
+        return CLI_EXIT_USAGE;
+    }
+    char* header = table_header(b);
+    char* text = NULL;
+    size_t cap = 0, line = 0, rows = 0;
+    int rc = header ? CLI_EXIT_OK : CLI_EXIT_RUNTIME;
+    bool seen_header = false;
+    for (ssize_t len; rc == CLI_EXIT_OK && (len = getline(&text, &cap, f)) >= 0;) {
+        line++;
+        while (len > 0 && (text[len - 1] == '\n' || text[len - 1] == '\r'))
+            text[--len] = '\0';
+        if (len == 0 || text[0] == '#')
+            continue;
+        if (!seen_header) {
+            seen_header = true;
+            if (strcmp(text, header) != 0) {
+                cli_error("%s: --resume %s:%zu: its columns are not those of this %s (another "
+                          "key, scenario or engine): '%.80s'",
+                          b->cmd, b->resume, line, b->cmd, text);
+                rc = CLI_EXIT_USAGE;
+            }
+        } else if (rows == b->n_pts) {
+            cli_error("%s: --resume %s:%zu: more rows than the %zu points of this %s", b->cmd,
+                      b->resume, line, b->n_pts, b->cmd);
+            rc = CLI_EXIT_USAGE;
+        } else {
+            rc = resume_row(b, rows++, text, line);
+        }
+    }
+    if (rc == CLI_EXIT_OK && rows != b->n_pts) {
+        cli_error("%s: --resume %s: %zu rows, where this %s has %zu points (a table cut short "
+                  "is not one an interruption writes)",
+                  b->cmd, b->resume, rows, b->cmd, b->n_pts);
+        rc = CLI_EXIT_USAGE;
+    }
+    free(text);
+    free(header);
+    fclose(f);
+    return rc;
+}
+
 int cli_batch_run(struct cli_batch* b)
 {
     b->engine = CLI_ENGINE_SOFT;
@@ -256,6 +382,7 @@ int cli_batch_run(struct cli_batch* b)
     b->n_pts = 1;
     b->wall = 0;
     b->interrupted = 0;
+    b->n_kept = 0;
     for (int d = 0; d < b->n_keys; d++)
         b->n_pts *= b->range[d].n;
     struct cli_scenario sc;
@@ -274,6 +401,8 @@ int cli_batch_run(struct cli_batch* b)
     double t0 = omp_get_wtime();
     if (rc == CLI_EXIT_OK)
         rc = build_all(&sc, b);
+    if (rc == CLI_EXIT_OK && b->resume)
+        rc = read_resume(b);
     if (rc == CLI_EXIT_OK) /* (after the input checks, which write nothing; before the runs) */
         rc = cli_check_writable(b->cmd, "--out", b->out);
     if (rc == CLI_EXIT_OK) {
@@ -282,17 +411,6 @@ int cli_batch_run(struct cli_batch* b)
     }
     cli_scenario_free(&sc);
     return rc;
-}
-
-/* The unit of a scenario key for the header, "-" when it has none or is unknown. */
-static const char* key_unit(const char* key)
-{
-    char section[CLI_NAME_MAX], name[CLI_NAME_MAX], probe[CLI_VALUE_MAX];
-    snprintf(probe, sizeof probe, "%s=0", key);
-    const char* u = cli_override_split(probe, section, name, NULL) == 0
-                        ? cli_scenario_key_unit(section, name)
-                        : "";
-    return u[0] ? u : "-";
 }
 
 /* The status word of a point: the engine's status, ENERGY_GREW for a run that succeeded with
@@ -330,20 +448,25 @@ size_t cli_batch_points_run(const struct cli_batch* b)
 void cli_batch_write_table(FILE* f, const struct cli_batch* b, int argc, char** argv)
 {
     cli_print_provenance(f, argc, argv);
-    for (int d = 0; d < b->n_keys; d++)
-        fprintf(f, "%s [%s],", b->key[d], key_unit(b->key[d]));
-    fprintf(f, "status [word],%s\n", b->header);
+    char* header = table_header(b);
+    fprintf(f, "%s\n", header ? header : "");
+    free(header);
     for (size_t k = 0; k < b->n_pts; k++) {
         const struct cli_batch_point* p = &b->pts[k];
-        for (int d = 0; d < b->n_keys; d++)
-            fprintf(f, "%.12g,", p->value[d]);
-        fprintf(f, "%s,", point_status(p));
+        char values[128];
+        row_values(b, p, values, sizeof values);
+        fputs(values, f);
+        if (p->status != CLI_BATCH_KEPT && p->status != CLI_BATCH_KEPT_FAILED)
+            fprintf(f, "%s,", point_status(p));
         if (p->status == CLI_BATCH_NOT_RUN)
             not_run_fields(f, b->header);
         else
             fputs(p->row ? p->row : "", f);
         fputc('\n', f);
     }
+    if (b->n_kept)
+        fprintf(f, "# resumed: %zu points kept from %s, %zu run now\n", b->n_kept, b->resume,
+                cli_batch_points_run(b) - b->n_kept);
     if (b->interrupted)
         fprintf(f, "# interrupted by signal %d: %zu of %zu points ran (status %s: not run)\n",
                 b->interrupted, cli_batch_points_run(b), b->n_pts, "NOT_RUN");
@@ -355,7 +478,7 @@ static void report_unresolved_hmin(const struct cli_batch* b)
     size_t n = 0, worst = 0;
     for (size_t k = 0; b->engine == CLI_ENGINE_SOFT && k < b->n_pts; k++) {
         char why[600];
-        if (b->pts[k].status < 0 || b->pts[k].status == CLI_BATCH_NOT_RUN ||
+        if (b->pts[k].status < 0 || b->pts[k].status >= CLI_BATCH_NOT_RUN ||
             !cli_hmin_unresolved(&b->pts[k].res, why, sizeof why))
             continue;
         if (n++ == 0 ||
@@ -380,13 +503,15 @@ int cli_batch_report_failures(const struct cli_batch* b, int rc)
                   "point, those left out with status NOT_RUN",
                   b->cmd, b->interrupted, cli_batch_points_run(b), b->n_pts);
     bool failed = false;
+    size_t kept_failed = 0;
     for (size_t k = 0; k < b->n_pts; k++) {
         const struct cli_batch_point* p = &b->pts[k];
         char where[1100];
         size_t used = (size_t)snprintf(where, sizeof where, "%s: ", b->cmd);
         point_values(b, p, where + used, sizeof where - used);
         char why[300];
-        if (p->status == CLI_BATCH_NOT_RUN)
+        kept_failed += p->status == CLI_BATCH_KEPT_FAILED;
+        if (p->status >= CLI_BATCH_NOT_RUN) /* (not run, or kept: its message is not kept) */
             continue;
         if (p->status >= 0) { /* (a pairwise point's result is zero: no energy ratio) */
             if (p->energy_grew && cli_energy_grew(p->res.energy_ratio, why, sizeof why)) {
@@ -396,6 +521,12 @@ int cli_batch_report_failures(const struct cli_batch* b, int rc)
             continue;
         }
         cli_error("%s: %s (%s)", where, p->errmsg, wetdem_status_name(p->status));
+        failed = true;
+    }
+    if (kept_failed) {
+        cli_error("%s: %zu of the points kept from %s had failed there (their status column); "
+                  "run them again without --resume for the messages",
+                  b->cmd, kept_failed, b->resume);
         failed = true;
     }
     /* a table not written first, then the interruption (as a program stopped by the signal,

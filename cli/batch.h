@@ -25,6 +25,9 @@
 
 /* Status of a point that an interruption (SIGINT, SIGTERM) left out: no engine status. */
 #define CLI_BATCH_NOT_RUN 1000
+/* Status of a point kept from the table of --resume, whose run there succeeded or failed. */
+#define CLI_BATCH_KEPT 1001
+#define CLI_BATCH_KEPT_FAILED 1002
 
 /* One point: its values, and after the run its status and CSV fields (its scenario and
  * set-up live only while it is checked and while it runs). */
@@ -34,7 +37,8 @@ struct cli_batch_point {
     int status;       /* the run's status (the pairwise engine's own), or CLI_BATCH_NOT_RUN */
     bool energy_grew; /* soft engine: it ran but ended with more energy (cli_energy_grew) */
     char errmsg[256]; /* the engine's message of a failed run */
-    char* row;        /* the engine's CSV fields, no newline (malloc'd) */
+    char* row;        /* the engine's CSV fields, no newline (malloc'd); of a point kept
+                         from --resume, its status word and fields as that table has them */
 };
 
 /* A batch: the caller fills the first block, cli_batch_run() the second. */
@@ -48,8 +52,10 @@ struct cli_batch {
     int n_keys; /* 1 or 2 */
     const char* key[CLI_BATCH_MAX_KEYS];
     struct cli_range range[CLI_BATCH_MAX_KEYS];
-    bool progress;   /* progress and time left on stderr when it is a terminal */
-    const char* out; /* the table's file (NULL: stdout): checked writable before the runs */
+    bool progress;      /* progress and time left on stderr when it is a terminal */
+    const char* out;    /* the table's file (NULL: stdout): checked writable before the runs */
+    const char* resume; /* a table this batch wrote, interrupted (NULL: none): its points that
+                           ran are kept, only those NOT_RUN run */
 
     enum cli_engine engine;
     char* header;                /* the engine's CSV column header, no newline (malloc'd) */
@@ -57,11 +63,14 @@ struct cli_batch {
     size_t n_pts;
     double wall;     /* build and run time [s] */
     int interrupted; /* the signal (SIGINT, SIGTERM) that stopped the batch early, or 0 */
+    size_t n_kept;   /* points kept from the table of --resume */
 };
 
 /* Checks the keys (two names of one key, or speed and stokes, are refused), loads the file
- * with the overrides, checks the engine, builds every point serially, checks that `out` can
- * be written, and runs the points in parallel. Returns an exit code: an input error of the
+ * with the overrides, checks the engine, builds every point serially, reads the table of
+ * `resume` (its columns and every row's values must be this batch's: exit 2 with the line
+ * that differs), checks that `out` can be written, and runs the points in parallel (those
+ * kept from `resume` not again). Returns an exit code: an input error of the
  * file or of any point, or an output that cannot be written, stops before anything runs
  * (message printed, exit 2); a failed run is not an error here, its status is in its point
  * (see cli_batch_report_failures). SIGINT or SIGTERM while the points run stops starting new
@@ -77,12 +86,13 @@ int cli_batch_run(struct cli_batch* b);
  * its trailer. */
 void cli_batch_write_table(FILE* f, const struct cli_batch* b, int argc, char** argv);
 
-/* How many points ran (all of them unless the batch was interrupted). */
+/* How many points ran, here or in the table of --resume (all unless interrupted). */
 size_t cli_batch_points_run(const struct cli_batch* b);
 
-/* Prints "CMD: KEY = value, ...: message (status)" for every failed run. Returns rc (the
- * table's write) when it is not CLI_EXIT_OK, else 128 + the signal when the batch was
- * interrupted, else CLI_EXIT_RUNTIME when any run failed, else CLI_EXIT_OK. */
+/* Prints "CMD: KEY = value, ...: message (status)" for every failed run (for those kept from
+ * --resume, how many failed there). Returns rc (the table's write) when it is not
+ * CLI_EXIT_OK, else 128 + the signal when the batch was interrupted, else CLI_EXIT_RUNTIME
+ * when any run failed, else CLI_EXIT_OK. */
 int cli_batch_report_failures(const struct cli_batch* b, int rc);
 
 /* Frees the points, the header and the scenario. */

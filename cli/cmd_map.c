@@ -29,6 +29,7 @@ struct map_args {
     const char* values[2];
     bool is_log[2];
     const char* out;
+    const char* resume;
     const char* sets[MAP_MAX_SETS];
     int n_sets;
 };
@@ -44,7 +45,8 @@ static void usage(FILE* f)
 {
     fprintf(f,
             "usage: wetdem map FILE --param KEY --values A:B:N --param2 KEY2 --values2 A:B:N\n"
-            "                  [--log] [--log2] [--out FILE.csv] [--set section.key=value ...]\n"
+            "                  [--log] [--log2] [--out FILE.csv] [--resume FILE.csv]\n"
+            "                  [--set section.key=value ...]\n"
             "A grid of independent collisions over two scenario keys (KEY slowest), in\n"
             "parallel (OMP_NUM_THREADS); rows in grid order, bit-identical for any thread count.\n"
             "  --param KEY      first key (scenario key or model parameter, e.g. davis.stokes)\n"
@@ -52,6 +54,8 @@ static void usage(FILE* f)
             "  --param2 KEY2    second key, varied fastest\n"
             "  --values2 A:B:N  its N values; --log2: geometric\n"
             "  --out FILE.csv   write the grid there (default: stdout)\n"
+            "  --resume T.csv   the grid of this map that Ctrl-C stopped: keep its rows that ran,\n"
+            "                   run those NOT_RUN (T may be the --out file)\n"
             "  --set K=V        override a scenario key or model parameter (repeatable)\n");
 }
 
@@ -71,6 +75,8 @@ static int parse_args(int argc, char** argv, struct map_args* a)
             a->values[1] = argv[++k];
         else if (strcmp(s, "--out") == 0 && next)
             a->out = argv[++k];
+        else if (strcmp(s, "--resume") == 0 && next)
+            a->resume = argv[++k];
         else if (strcmp(s, "--set") == 0 && next && a->n_sets < MAP_MAX_SETS)
             a->sets[a->n_sets++] = argv[++k];
         else if (strcmp(s, "--log") == 0)
@@ -80,9 +86,9 @@ static int parse_args(int argc, char** argv, struct map_args* a)
         else if (s[0] != '-' && !a->file)
             a->file = s;
         else {
-            static const char* const options[] = {"--param",   "--values", "--param2",
-                                                  "--values2", "--out",    "--set",
-                                                  "--log",     "--log2",   NULL};
+            static const char* const options[] = {"--param", "--values", "--param2", "--values2",
+                                                  "--out",   "--resume", "--set",    "--log",
+                                                  "--log2",  NULL};
             char hint[64];
             cli_error("map: unexpected argument '%s'%s", s,
                       cli_option_hint(s, options, hint, sizeof hint));
@@ -108,7 +114,7 @@ static void write_table(FILE* f, const void* ctx)
     const struct map_table* t = ctx;
     const struct cli_batch* b = t->batch;
     cli_batch_write_table(f, b, t->argc, t->argv);
-    size_t runs = cli_batch_points_run(b);
+    size_t runs = cli_batch_points_run(b) - b->n_kept; /* (run here, not kept) */
     fprintf(f, "# totals: runs=%zu wall_time_s=%.6f threads=%d collisions_per_s=%.3f\n", runs,
             b->wall, omp_get_max_threads(), b->wall > 0 ? (double)runs / b->wall : 0.0);
 }
@@ -129,7 +135,8 @@ int cmd_map(int argc, char** argv)
                           .n_keys = 2,
                           .key = {a.key[0], a.key[1]},
                           .progress = true,
-                          .out = a.out};
+                          .out = a.out,
+                          .resume = a.resume};
     for (int d = 0; d < 2 && rc == CLI_EXIT_OK; d++)
         rc = cli_parse_range(a.values[d], a.is_log[d], d ? "--values2" : "--values", &b.range[d]);
     if (rc != CLI_EXIT_OK)

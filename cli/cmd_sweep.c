@@ -34,6 +34,7 @@ struct sweep_args {
     const char* key;
     const char* values;
     const char* out;
+    const char* resume;
     bool is_log;
     const char* sets[MAX_SETS];
     int n_sets;
@@ -49,11 +50,13 @@ struct sweep_table {
 static void usage(FILE* f)
 {
     fprintf(f, "usage: wetdem sweep FILE --param KEY --values A:B:N [--log] [--out FILE.csv]\n"
-               "                    [--set section.key=value ...]\n"
+               "                    [--resume FILE.csv] [--set section.key=value ...]\n"
                "Independent collisions, one per value of KEY (any scenario key, e.g.\n"
                "collision.stokes, or a model parameter), in parallel (OMP_NUM_THREADS).\n"
                "  --values A:B:N  N values from A to B (both included); --log: geometric\n"
                "  --out FILE.csv  write the table there (default: stdout)\n"
+               "  --resume T.csv  the table of this sweep that Ctrl-C stopped: keep its rows that\n"
+               "                  ran, run those NOT_RUN (T may be the --out file)\n"
                "  --set K=V       override a scenario key or model parameter (repeatable)\n");
 }
 
@@ -69,6 +72,8 @@ static int parse_args(int argc, char** argv, struct sweep_args* a)
             a->values = argv[++k];
         else if (strcmp(s, "--out") == 0 && next)
             a->out = argv[++k];
+        else if (strcmp(s, "--resume") == 0 && next)
+            a->resume = argv[++k];
         else if (strcmp(s, "--set") == 0 && next && a->n_sets < MAX_SETS)
             a->sets[a->n_sets++] = argv[++k];
         else if (strcmp(s, "--log") == 0)
@@ -76,7 +81,7 @@ static int parse_args(int argc, char** argv, struct sweep_args* a)
         else if (s[0] != '-' && !a->file)
             a->file = s;
         else {
-            static const char* const options[] = {"--param", "--values", "--out",
+            static const char* const options[] = {"--param", "--values", "--out", "--resume",
                                                   "--set",   "--log",    NULL};
             char hint[64];
             cli_error("sweep: unexpected argument '%s'%s", s,
@@ -101,8 +106,8 @@ static void write_table(FILE* f, const void* ctx)
     const struct cli_batch* b = t->batch;
     cli_batch_write_table(f, b, t->argc, t->argv);
     if (b->engine == CLI_ENGINE_PAIRWISE) {
-        fprintf(f, "# totals: runs=%zu wall_time_s=%.6f threads=%d\n", cli_batch_points_run(b),
-                b->wall, omp_get_max_threads());
+        fprintf(f, "# totals: runs=%zu wall_time_s=%.6f threads=%d\n",
+                cli_batch_points_run(b) - b->n_kept, b->wall, omp_get_max_threads());
         return;
     }
     struct wetdem_stats tot = {0};
@@ -117,8 +122,8 @@ static void write_table(FILE* f, const void* ctx)
     fprintf(f,
             "# totals: runs=%zu steps=%llu force_evals=%llu pair_evals=%llu root_evals=%llu "
             "events=%llu wall_time_s=%.6f threads=%d\n",
-            cli_batch_points_run(b), tot.steps, tot.force_evals, tot.pair_evals, tot.root_evals,
-            tot.events, b->wall, omp_get_max_threads());
+            cli_batch_points_run(b) - b->n_kept, tot.steps, tot.force_evals, tot.pair_evals,
+            tot.root_evals, tot.events, b->wall, omp_get_max_threads());
 }
 
 int cmd_sweep(int argc, char** argv)
@@ -137,7 +142,8 @@ int cmd_sweep(int argc, char** argv)
                           .n_keys = 1,
                           .key = {a.key},
                           .progress = true,
-                          .out = a.out};
+                          .out = a.out,
+                          .resume = a.resume};
     if (rc == CLI_EXIT_OK)
         rc = cli_parse_range(a.values, a.is_log, "--values", &b.range[0]);
     if (rc != CLI_EXIT_OK)

@@ -89,8 +89,8 @@ static int cmd_docs_cli(int argc, char** argv)
            "usage or input error (a message names the option or key, the value and the valid "
            "range, with a \"did you mean\" hint for misspelt names), 128 + N stopped by signal "
            "N (130 for Ctrl-C: a many-particle run after writing its checkpoint, `sweep` and "
-           "`map` after writing the table of the points that ran, a single collision keeping "
-           "no file).\n\n"
+           "`map` after writing the table of the points that ran, which `--resume` completes, a "
+           "single collision keeping no file).\n\n"
            "## wetdem\n\n```text\n");
     print_help(stdout);
     printf("```\n");

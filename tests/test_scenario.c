@@ -702,6 +702,126 @@ static void test_scenario_interrupted_map_writes_what_ran(void** state)
     free(table);
 }
 
+/* The data rows of a table (no '#' line), as one string (malloc'd). */
+static char* data_rows(const char* table)
+{
+    char* rows = calloc(strlen(table) + 1, 1);
+    assert_non_null(rows);
+    for (const char* line = table; *line;) {
+        const char* end = strchr(line, '\n');
+        size_t len = end ? (size_t)(end - line) + 1 : strlen(line);
+        if (line[0] != '#')
+            strncat(rows, line, len);
+        line += len;
+    }
+    return rows;
+}
+
+/* The table of a map with the data rows in `gone` turned into what an interruption writes for
+ * them (values, NOT_RUN, none for the [word] columns and nan for the others), or with `failed`
+ * set, their status word into WETDEM_ERR_NUMERIC (a run that failed), into tmpdir/name. */
+static void cut_table(const char* table, const int* gone, int n_gone, bool failed, const char* name)
+{
+    size_t cap = 4 * strlen(table) + 1, row = 0;
+    char* out = calloc(cap, 1);
+    assert_non_null(out);
+    const char* header = NULL;
+    for (const char* line = table; *line;) {
+        const char* end = strchr(line, '\n');
+        size_t len = end ? (size_t)(end - line) + 1 : strlen(line);
+        bool hit = false;
+        if (line[0] != '#' && header) {
+            for (int g = 0; g < n_gone; g++)
+                hit = hit || gone[g] == (int)row;
+            row++;
+        } else if (line[0] != '#') {
+            header = line;
+        }
+        if (!hit) {
+            strncat(out, line, len);
+        } else { /* two values, then the status and the engine's columns */
+            const char* status = strchr(strchr(line, ',') + 1, ',') + 1;
+            strncat(out, line, (size_t)(status - line));
+            strcat(out, failed ? "WETDEM_ERR_NUMERIC" : "NOT_RUN");
+            if (failed) {
+                strncat(out, strchr(status, ','), len - (size_t)(strchr(status, ',') - line));
+            } else {
+                const char* col = strstr(header, "status [word],") + strlen("status [word],");
+                for (; col && *col != '\n'; col = strpbrk(col, ",\n"), col += col && *col == ',') {
+                    size_t lc = strcspn(col, ",\n");
+                    strcat(out,
+                           lc >= 6 && strncmp(col + lc - 6, "[word]", 6) == 0 ? ",none" : ",nan");
+                    if (col[lc] != ',')
+                        break;
+                }
+                strcat(out, "\n");
+            }
+        }
+        line += len;
+    }
+    write_file(name, out);
+    free(out);
+}
+
+/* A map resumed from its interrupted table (rows NOT_RUN) runs only those points, keeps the
+ * others verbatim, and its data rows are those of the uninterrupted map, bit for bit (the
+ * rows are the same runs: docs/cli.md); it may write over the table it resumes. A table of
+ * other values, columns or length is refused (exit 2, with its file and line), as is one that
+ * cannot be read; a kept row of a failed run makes the exit code 1, as it did there. */
+static void test_scenario_resumed_map_equals_the_whole(void** state)
+{
+    (void)state;
+    char args[1600];
+    const char* map = "map examples/scenarios/davis_three.ini --param davis.stokes --values "
+                      "0.5:30:3 --param2 davis.angle_deg --values2 0:80:4";
+    snprintf(args, sizeof args, "%s --out %s/whole.csv", map, tmpdir);
+    expect_run(args, 0, NULL);
+    char path[600];
+    snprintf(path, sizeof path, "%s/whole.csv", tmpdir);
+    char* whole = test_read_file(path, NULL);
+    assert_non_null(whole);
+    static const int gone[] = {1, 4, 5, 11};
+    cut_table(whole, gone, 4, false, "cut.csv");
+    snprintf(path, sizeof path, "%s/cut.csv", tmpdir);
+    char* cut = test_read_file(path, NULL);
+    CHECK_CONTAINS(cut, "\n0.5,26.6666666667,NOT_RUN,none,none,nan,");
+    free(cut);
+    snprintf(args, sizeof args, "%s --resume %s/cut.csv --out %s/cut.csv", map, tmpdir, tmpdir);
+    expect_run(args, 0, NULL);
+    char* resumed = test_read_file(path, NULL);
+    char *a = data_rows(whole), *b = data_rows(resumed);
+    assert_string_equal(a, b);
+    CHECK_CONTAINS(resumed, "# resumed: 8 points kept from ");
+    CHECK_CONTAINS(resumed, "# totals: runs=4 ");
+    free(a);
+    free(b);
+    free(resumed);
+    /* refused: other values (the first row that differs, with its line), other columns, a
+       table cut short, none */
+    snprintf(args, sizeof args,
+             "map examples/scenarios/davis_three.ini --param davis.stokes --values 0.5:30:4 "
+             "--param2 davis.angle_deg --values2 0:80:4 --resume %s/whole.csv",
+             tmpdir);
+    expect_run(args, 2, "whole.csv:8: the row '15.25,0,WETDEM_OK,");
+    expect_run(args, 2, "resume with the --values and --set of the run that wrote the table");
+    snprintf(args, sizeof args,
+             "sweep examples/scenarios/davis_three.ini --param davis.stokes --values 0.5:30:12 "
+             "--resume %s/whole.csv",
+             tmpdir);
+    expect_run(args, 2, "whole.csv:3: its columns are not those of this sweep");
+    snprintf(args, sizeof args, "%s --param davis.stokes --values 0.5:30:3 --resume %s",
+             "map examples/scenarios/davis_three.ini --param2 davis.angle_deg --values2 0:80:4",
+             write_file("short.csv", "davis.stokes [-],davis.angle_deg [deg],status [word]\n"));
+    expect_run(args, 2, "its columns are not those of this map");
+    snprintf(args, sizeof args, "%s --resume %s/none.csv", map, tmpdir);
+    expect_run(args, 2, "none.csv: cannot read it");
+    /* a kept row of a failed run */
+    cut_table(whole, gone, 1, true, "failed.csv");
+    snprintf(args, sizeof args, "%s --resume %s/failed.csv", map, tmpdir);
+    expect_run(args, 1, "1 of the points kept from ");
+    free(whole);
+}
+
 /* Runs `wetdem run FILE --set SET1 --set SET2 --set SET3 --out tmpdir/NAME` (a collision of
  * about 5-10 s), sends SIGINT once its handler is in place and 0.3 s more have passed, and
  * checks that it stops with exit 130 and leaves no file, not even a temporary one: a
@@ -1031,6 +1151,7 @@ int main(void)
         cmocka_unit_test(test_scenario_bad_output_paths_exit_2),
         cmocka_unit_test(test_scenario_batch_keys_rows_and_outputs),
         cmocka_unit_test(test_scenario_interrupted_map_writes_what_ran),
+        cmocka_unit_test(test_scenario_resumed_map_equals_the_whole),
         cmocka_unit_test(test_scenario_interrupted_run_keeps_nothing),
         cmocka_unit_test(test_scenario_sweep_order_and_threads),
         cmocka_unit_test(test_scenario_sweep_point_equals_run),
