@@ -124,7 +124,7 @@ static void write_head(FILE* f, const char* what, double time, bool binary)
 }
 
 static void write_body(FILE* f, const struct wetdem_particle* p, size_t n,
-                       const struct wetdem_output_vtk_links* links, double time, bool binary)
+                       const struct wetdem_output_vtk_counts* counts, double time, bool binary)
 {
     write_head(f, "particles", time, binary);
     write_vectors(f, "POINTS %zu double\n", p, n, 0, binary);
@@ -145,11 +145,11 @@ static void write_body(FILE* f, const struct wetdem_particle* p, size_t n,
         fputc('\n', f);
     write_vectors(f, "velocity 3 %zu double\n", p, n, 1, binary);
     write_vectors(f, "spin 3 %zu double\n", p, n, 2, binary);
-    const struct wetdem_output_vtk_links none = {0};
-    const struct wetdem_output_vtk_links* l = links ? links : &none;
-    write_ints(f, "contacts", p, n, l->contacts, INT_COUNT, binary);
-    write_ints(f, "bridges", p, n, l->bridges, INT_COUNT, binary);
-    write_ints(f, "agglomerate", p, n, l->agglomerate, INT_COUNT, binary);
+    const struct wetdem_output_vtk_counts none = {0};
+    const struct wetdem_output_vtk_counts* c = counts ? counts : &none;
+    write_ints(f, "contacts", p, n, c->contacts, INT_COUNT, binary);
+    write_ints(f, "bridges", p, n, c->bridges, INT_COUNT, binary);
+    write_ints(f, "agglomerate", p, n, c->agglomerate, INT_COUNT, binary);
     write_ints(f, "material", p, n, NULL, INT_MATERIAL, binary);
     write_ints(f, "id", p, n, NULL, INT_ID, binary);
 }
@@ -231,11 +231,11 @@ static FILE* open_tmp(const char* path, char* tmp, size_t tmp_size, char* msg, s
     return f;
 }
 
-/* What a VTK file holds: particles (p, links) or, is_links, links (l), n of them. */
+/* What a VTK file holds: particles (p, counts) or, is_links, links (l), n of them. */
 struct vtk_content {
     bool is_links;
     const struct wetdem_particle* p;
-    const struct wetdem_output_vtk_links* links;
+    const struct wetdem_output_vtk_counts* counts;
     const struct wetdem_output_vtk_link* l;
     size_t n;
     double time;
@@ -255,15 +255,15 @@ static int write_vtk_file(const char* path, const struct vtk_content* c, char* m
     if (c->is_links)
         write_links_body(f, c->l, c->n, c->time, c->binary);
     else
-        write_body(f, c->p, c->n, c->links, c->time, c->binary);
+        write_body(f, c->p, c->n, c->counts, c->time, c->binary);
     return finish_atomic(f, tmp, path, msg, n);
 }
 
 int wetdem_output_vtk_write(const char* path, const struct wetdem_particle* p, size_t n,
-                            const struct wetdem_output_vtk_links* links, double time, bool binary,
+                            const struct wetdem_output_vtk_counts* counts, double time, bool binary,
                             char* msg, size_t msg_size)
 {
-    const struct vtk_content c = {.p = p, .links = links, .n = n, .time = time, .binary = binary};
+    const struct vtk_content c = {.p = p, .counts = counts, .n = n, .time = time, .binary = binary};
     return write_vtk_file(path, &c, msg, msg_size);
 }
 

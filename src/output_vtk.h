@@ -10,22 +10,22 @@
 
 #include "wetdem.h"
 
-/* Each particle's links (arrays of n entries): contacts with particles and walls, liquid
+/* Each particle's counts (arrays of n entries): contacts with particles and walls, liquid
  * bridges, and the label of its agglomerate (0: none). */
-struct wetdem_output_vtk_links {
+struct wetdem_output_vtk_counts {
     const uint32_t* contacts;
     const uint32_t* bridges;
     const uint32_t* agglomerate;
 };
 
 /* Writes n particles as a legacy VTK POLYDATA file (one vertex per sphere) with the point
- * data radius [m], velocity [m/s], spin [rad/s], contacts, bridges and agglomerate (links may
+ * data radius [m], velocity [m/s], spin [rad/s], contacts, bridges and agglomerate (counts may
  * be NULL for zeros), material and id, and the simulated time [s] as field data TIME. binary:
  * big-endian binary arrays as the legacy format requires, else ASCII with 17 significant
  * digits (exact round trip). The file is written to a temporary name and renamed, so a
  * reader never sees half a file. Returns WETDEM_OK or WETDEM_ERR_IO (message in msg). */
 int wetdem_output_vtk_write(const char* path, const struct wetdem_particle* p, size_t n,
-                            const struct wetdem_output_vtk_links* links, double time, bool binary,
+                            const struct wetdem_output_vtk_counts* counts, double time, bool binary,
                             char* msg, size_t msg_size);
 
 /* A link between two spheres, or a sphere and a wall, for wetdem_output_vtk_links_write: the

@@ -175,8 +175,8 @@ int wetdem_sim_many_stats(const struct wetdem_sim* sim, struct wetdem_many_stats
 /* Each particle's contacts and liquid bridges as the enabled models define them and the label
  * of its agglomerate, into *v, and the run's links into *s (wetdem_sim_many_links). Returns the
  * block that holds v's arrays, for free(); NULL, with the failure recorded, when out of memory. */
-static uint32_t* per_particle_links(struct wetdem_sim* sim, struct wetdem_many_stats* s,
-                                    struct wetdem_output_vtk_links* v)
+static uint32_t* particle_counts(struct wetdem_sim* sim, struct wetdem_many_stats* s,
+                                 struct wetdem_output_vtk_counts* v)
 {
     size_t n = sim->n_particles ? sim->n_particles : 1;
     uint32_t* block = malloc(3 * n * sizeof *block);
@@ -186,16 +186,16 @@ static uint32_t* per_particle_links(struct wetdem_sim* sim, struct wetdem_many_s
         wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory for the contact counts");
         return NULL;
     }
-    *v = (struct wetdem_output_vtk_links){per.contacts, per.bridges, per.agglomerate};
+    *v = (struct wetdem_output_vtk_counts){per.contacts, per.bridges, per.agglomerate};
     return block;
 }
 
-/* The frame at `path`, with the given links of each particle (NULL: none, a run not started). */
-static int write_vtk_links(struct wetdem_sim* sim, const char* path, bool binary,
-                           const struct wetdem_output_vtk_links* links)
+/* The frame at `path`, with each particle's counts (NULL: none, a run not started). */
+static int write_particle_frame(struct wetdem_sim* sim, const char* path, bool binary,
+                                const struct wetdem_output_vtk_counts* counts)
 {
     char msg[512];
-    int st = wetdem_output_vtk_write(path, sim->particles, sim->n_particles, links,
+    int st = wetdem_output_vtk_write(path, sim->particles, sim->n_particles, counts,
                                      sim->engine.time, binary, msg, sizeof msg);
     return st == WETDEM_OK ? st : wetdem_sim_fail(sim, st, "%s", msg);
 }
@@ -203,13 +203,13 @@ static int write_vtk_links(struct wetdem_sim* sim, const char* path, bool binary
 int wetdem_sim_write_vtk(struct wetdem_sim* sim, const char* path, bool binary)
 {
     uint32_t* block = NULL;
-    struct wetdem_output_vtk_links links;
+    struct wetdem_output_vtk_counts counts;
     if (sim->many && sim->many->started) {
         struct wetdem_many_stats s;
-        if (!(block = per_particle_links(sim, &s, &links)))
+        if (!(block = particle_counts(sim, &s, &counts)))
             return WETDEM_ERR_NOMEM;
     }
-    int st = write_vtk_links(sim, path, binary, block ? &links : NULL);
+    int st = write_particle_frame(sim, path, binary, block ? &counts : NULL);
     free(block);
     return st;
 }
@@ -351,13 +351,13 @@ static int add_series_entry(struct wetdem_sim* sim, const char* name, double tim
     return WETDEM_OK;
 }
 
-/* The next frame of the series, with each particle's links. */
-static int write_vtk_frame(struct wetdem_sim* sim, const struct wetdem_output_vtk_links* links)
+/* The next frame of the series, with each particle's counts. */
+static int write_vtk_frame(struct wetdem_sim* sim, const struct wetdem_output_vtk_counts* counts)
 {
     struct wetdem_many* m = sim->many;
     char path[4096], series[4096];
     wetdem_output_vtk_path(path, sizeof path, m->output_prefix, m->vtk_files);
-    int st = write_vtk_links(sim, path, m->set.vtk_binary, links);
+    int st = write_particle_frame(sim, path, m->set.vtk_binary, counts);
     if (st == WETDEM_OK)
         st = add_series_entry(sim, base_name(path), sim->engine.time);
     if (st != WETDEM_OK)
@@ -487,8 +487,8 @@ int wetdem_sim_many_outputs(struct wetdem_sim* sim, bool final)
     struct wetdem_many_stats links = {0}; /* zeroed, as wetdem_sim_many_stats starts */
     bool have_links = false;
     if (m->output_prefix && due(m->step, m->set.vtk_every, &m->next_vtk_step)) {
-        struct wetdem_output_vtk_links per;
-        uint32_t* block = per_particle_links(sim, &links, &per);
+        struct wetdem_output_vtk_counts per;
+        uint32_t* block = particle_counts(sim, &links, &per);
         st = block ? write_vtk_frame(sim, &per) : WETDEM_ERR_NOMEM;
         have_links = block != NULL;
         free(block);

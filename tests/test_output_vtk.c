@@ -14,17 +14,17 @@
 
 #define N 37
 
-/* Each particle's links, as the arrays of struct wetdem_output_vtk_links. */
-struct links_data {
+/* Each particle's links, as the arrays of struct wetdem_output_vtk_counts. */
+struct counts_data {
     uint32_t contacts[N], bridges[N], agglomerate[N];
 };
 
-static struct wetdem_output_vtk_links links_of(const struct links_data* d)
+static struct wetdem_output_vtk_counts counts_of(const struct counts_data* d)
 {
-    return (struct wetdem_output_vtk_links){d->contacts, d->bridges, d->agglomerate};
+    return (struct wetdem_output_vtk_counts){d->contacts, d->bridges, d->agglomerate};
 }
 
-static void make_particles(struct wetdem_particle* p, struct links_data* links)
+static void make_particles(struct wetdem_particle* p, struct counts_data* links)
 {
     for (size_t k = 0; k < N; k++) {
         double t = (double)k;
@@ -144,7 +144,7 @@ static void check_header(FILE* f, double time, bool binary)
 }
 
 static void parse_back(const char* path, const struct wetdem_particle* p,
-                       const struct links_data* links, double time, bool binary)
+                       const struct counts_data* links, double time, bool binary)
 {
     FILE* f = fopen(path, "rb");
     assert_non_null(f);
@@ -204,7 +204,7 @@ static void parse_back(const char* path, const struct wetdem_particle* p,
  * not. The script prints the number of points, the sum of contacts, and radius/velocity of
  * point 5 with 17 digits, which must equal what was written. */
 static bool read_with_vtk(const char* path, const struct wetdem_particle* p,
-                          const struct links_data* links)
+                          const struct counts_data* links)
 {
     if (system("/usr/bin/python3 -c 'import vtk' >/dev/null 2>&1") != 0)
         return false;
@@ -238,9 +238,9 @@ static bool read_with_vtk(const char* path, const struct wetdem_particle* p,
 static void round_trip(bool binary)
 {
     struct wetdem_particle p[N];
-    struct links_data links;
+    struct counts_data links;
     make_particles(p, &links);
-    struct wetdem_output_vtk_links arrays = links_of(&links);
+    struct wetdem_output_vtk_counts arrays = counts_of(&links);
     char path[] = "/tmp/wetdem_test_vtk_XXXXXX";
     int fd = mkstemp(path);
     assert_true(fd >= 0);
@@ -253,7 +253,7 @@ static void round_trip(bool binary)
         print_message("python3 vtk not available: checked the format structurally only\n");
     /* without links (a run not started) the counts and labels are zeros */
     CHECK_OK(wetdem_output_vtk_write(path, p, N, NULL, time, binary, msg, sizeof msg));
-    static const struct links_data zeros;
+    static const struct counts_data zeros;
     parse_back(path, p, &zeros, time, binary);
     char tmp[64];
     snprintf(tmp, sizeof tmp, "%s.tmp", path);
@@ -371,7 +371,7 @@ static void test_output_vtk_bad_path_is_an_io_error(void** state)
 {
     (void)state;
     struct wetdem_particle p[N];
-    struct links_data links;
+    struct counts_data links;
     make_particles(p, &links);
     char msg[256] = "";
     CHECK_STATUS(
