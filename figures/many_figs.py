@@ -27,7 +27,10 @@ import os
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))),
+                                "tools"))
 from common import FIGURES, ROOT, np, plt  # noqa: E402
+from wetdem_vtk import read_vtk  # noqa: E402
 
 failures = []
 
@@ -45,51 +48,6 @@ def read_global(path):
     names = lines[0].split(",")
     rows = np.array([[float(x) for x in ln.split(",")] for ln in lines[1:]])
     return {n: rows[:, k] for k, n in enumerate(names)}
-
-
-def read_vtk(path):
-    """The arrays of a frame or links file written by wetdem (legacy POLYDATA, ASCII or
-    big-endian binary: src/output_vtk.c) as {name: array}: TIME, POINTS (n x 3), VERTICES or
-    LINES, and every point array (radius, velocity n x 3, spin, contacts, bridges,
-    agglomerate, material, id) or cell array (i, j, contact, bridge, gap, force_normal,
-    force_tangential, force n x 3)."""
-    data = open(path, "rb").read()
-    binary = data.split(b"\n", 3)[2].strip() == b"BINARY"
-    at, out = 0, {}
-
-    def line():
-        nonlocal at
-        end = data.index(b"\n", at)
-        words = data[at:end].decode().split()
-        at = end + 1
-        return words
-
-    def values(count, kind):  # count values of kind "double" or "int"
-        nonlocal at
-        if binary:
-            dtype = ">f8" if kind == "double" else ">i4"
-            a = np.frombuffer(data, dtype, count, at)
-            at += a.nbytes + 1  # the data, then its newline
-            return a
-        got = []
-        while len(got) < count:
-            got += line()
-        return np.array(got, float if kind == "double" else int)
-
-    for _ in range(4):  # version, title, format, dataset
-        line()
-    while at < len(data):
-        w = line()
-        if not w or w[0] in ("FIELD", "POINT_DATA", "CELL_DATA"):
-            continue
-        if w[0] == "POINTS":
-            out["POINTS"] = values(3 * int(w[1]), w[2]).reshape(-1, 3)
-        elif w[0] in ("VERTICES", "LINES"):
-            out[w[0]] = values(int(w[2]), "int")
-        else:  # a field array: name, components, tuples, type
-            a = values(int(w[1]) * int(w[2]), w[3])
-            out[w[0]] = a.reshape(-1, int(w[1])) if int(w[1]) > 1 else a
-    return out
 
 
 def frames(run_dir):
