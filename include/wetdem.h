@@ -599,6 +599,9 @@ struct wetdem_many_settings {
                                             <prefix>.csv; NULL: no files (copied) */
     unsigned long long vtk_every;        /* steps between VTK files; 0: none */
     bool vtk_binary;                     /* binary instead of ASCII VTK */
+    bool vtk_links;                      /* with each VTK file, <prefix>_links_NNNNNN.vtk
+                                            (wetdem_sim_write_vtk_links) and the index
+                                            <prefix>_links.vtk.series */
     unsigned long long csv_every;        /* steps between rows of global quantities; 0: none */
     const char* checkpoint_path;         /* NULL: no checkpoints (copied) */
     unsigned long long checkpoint_every; /* steps between checkpoints; 0: only when stopped */

@@ -405,6 +405,8 @@ struct wetdem_many {
     char** vtk_names; /* the .vtk.series entries: file names and times [s] */
     double* vtk_times;
     size_t n_series, vtk_names_cap;
+    size_t links_from; /* with vtk_links, the first entry with links (a run resumed with links
+                          after it was written without has them from the restart on) */
 };
 
 /* Whether loops over n particles of m run in parallel. */

@@ -13,6 +13,7 @@
  */
 #include <omp.h>
 #include <stdio.h>
+#include <unistd.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -24,6 +25,7 @@
 
 #define CSV_SUFFIX ".csv"
 #define SERIES_SUFFIX ".vtk.series"
+#define LINKS_SUFFIX "_links"
 /* Energy-budget accumulators of a checkpoint: k0, u0, el0, then per model the work on pairs
  * and on walls and the latest pass's part of each (many.h); checkpoints written before the
  * latest-pass terms were kept have only the first three groups. */
@@ -351,13 +353,54 @@ static int add_series_entry(struct wetdem_sim* sim, const char* name, double tim
     return WETDEM_OK;
 }
 
-/* The next frame of the series, with each particle's counts. */
+/* The name of the links of series entry `name` (X_NNNNNN.vtk: X_links_NNNNNN.vtk), malloc'd. */
+static char* links_name(const char* name)
+{
+    const char* digits = strrchr(name, '_');
+    size_t head = digits ? (size_t)(digits - name) : strlen(name);
+    char* s = malloc(strlen(name) + sizeof LINKS_SUFFIX);
+    if (s)
+        sprintf(s, "%.*s" LINKS_SUFFIX "%s", (int)head, name, name + head);
+    return s;
+}
+
+/* The index <prefix>_links.vtk.series: the links of the series entries from links_from on. */
+static int write_links_series(struct wetdem_sim* sim)
+{
+    struct wetdem_many* m = sim->many;
+    size_t n = m->n_series - m->links_from;
+    char** names = calloc(n ? n : 1, sizeof *names);
+    int st = names ? WETDEM_OK : WETDEM_ERR_NOMEM;
+    for (size_t k = 0; st == WETDEM_OK && k < n; k++)
+        if (!(names[k] = links_name(m->vtk_names[m->links_from + k])))
+            st = WETDEM_ERR_NOMEM;
+    if (st != WETDEM_OK)
+        st = wetdem_sim_fail(sim, st, "out of memory for the links' index");
+    char series[4096], msg[512];
+    if (st == WETDEM_OK)
+        st = prefixed(sim, series, sizeof series, LINKS_SUFFIX SERIES_SUFFIX);
+    if (st == WETDEM_OK && wetdem_output_vtk_series_write(series, (const char* const*)names,
+                                                          m->vtk_times + m->links_from, n, msg,
+                                                          sizeof msg) != WETDEM_OK)
+        st = wetdem_sim_fail(sim, WETDEM_ERR_IO, "%s", msg);
+    for (size_t k = 0; names && k < n; k++)
+        free(names[k]);
+    free(names);
+    return st;
+}
+
+/* The next frame of the series, with each particle's counts, and with vtk_links its links. */
 static int write_vtk_frame(struct wetdem_sim* sim, const struct wetdem_output_vtk_counts* counts)
 {
     struct wetdem_many* m = sim->many;
-    char path[4096], series[4096];
+    char path[4096], series[4096], links_prefix[4096], links[4200];
     wetdem_output_vtk_path(path, sizeof path, m->output_prefix, m->vtk_files);
     int st = write_particle_frame(sim, path, m->set.vtk_binary, counts);
+    if (st == WETDEM_OK && m->set.vtk_links &&
+        (st = prefixed(sim, links_prefix, sizeof links_prefix, LINKS_SUFFIX)) == WETDEM_OK) {
+        wetdem_output_vtk_path(links, sizeof links, links_prefix, m->vtk_files);
+        st = wetdem_sim_write_vtk_links(sim, links, m->set.vtk_binary);
+    }
     if (st == WETDEM_OK)
         st = add_series_entry(sim, base_name(path), sim->engine.time);
     if (st != WETDEM_OK)
@@ -369,7 +412,27 @@ static int write_vtk_frame(struct wetdem_sim* sim, const struct wetdem_output_vt
         wetdem_output_vtk_series_write(series, (const char* const*)m->vtk_names, m->vtk_times,
                                        m->n_series, msg, sizeof msg) != WETDEM_OK)
         st = wetdem_sim_fail(sim, WETDEM_ERR_IO, "%s", msg);
+    if (st == WETDEM_OK && m->set.vtk_links)
+        st = write_links_series(sim);
     return st;
+}
+
+/* With vtk_links after a restart: the first series entry from which on every entry has its
+ * links file (the directory of the series is that of the prefix). */
+static void find_links_from(struct wetdem_sim* sim)
+{
+    struct wetdem_many* m = sim->many;
+    const char* slash = strrchr(m->output_prefix, '/');
+    int dir = slash ? (int)(slash - m->output_prefix + 1) : 0;
+    for (m->links_from = m->n_series; m->links_from > 0; m->links_from--) {
+        char* name = links_name(m->vtk_names[m->links_from - 1]);
+        char path[4096];
+        snprintf(path, sizeof path, "%.*s%s", dir, m->output_prefix, name ? name : "");
+        bool there = name && access(path, F_OK) == 0;
+        free(name);
+        if (!there)
+            break;
+    }
 }
 
 /* After a restart: the frames 0 .. vtk_files-1 written before it go back into the series
@@ -402,6 +465,8 @@ static int reload_series(struct wetdem_sim* sim)
     }
     if (f)
         fclose(f);
+    if (m->set.vtk_links)
+        find_links_from(sim);
     return WETDEM_OK;
 }
 

@@ -1503,14 +1503,23 @@ static void test_many_writes_vtk_and_csv(void** state)
     s.vtk_every = 50;
     s.csv_every = 25;
     s.vtk_binary = true;
+    s.vtk_links = true;
     s.energy_budget = true;
     CHECK_OK(wetdem_sim_set_many(sim, &s));
     CHECK_OK(wetdem_sim_integrate(sim, 2e-4)); /* 100 steps: VTK at 0, 50, 100 */
-    for (int k = 0; k < 3; k++) {
-        snprintf(path, sizeof path, "%s/run_%06d.vtk", dir, k);
-        assert_int_equal(access(path, F_OK), 0);
-        remove(path);
+    for (int k = 0; k < 3; k++) {              /* each frame with its links */
+        for (int links = 0; links < 2; links++) {
+            snprintf(path, sizeof path, "%s/run%s_%06d.vtk", dir, links ? "_links" : "", k);
+            assert_int_equal(access(path, F_OK), 0);
+            remove(path);
+        }
     }
+    snprintf(path, sizeof path, "%s/run_links.vtk.series", dir);
+    char* index = test_read_file(path, NULL);
+    assert_non_null(index);
+    CHECK_CONTAINS(index, "{ \"name\" : \"run_links_000002.vtk\", \"time\" : ");
+    free(index);
+    remove(path);
     snprintf(path, sizeof path, "%s/run_000003.vtk", dir);
     assert_int_equal(access(path, F_OK), -1);
     snprintf(path, sizeof path, "%s/run.csv", dir);
@@ -1556,7 +1565,9 @@ static void test_many_writes_vtk_and_csv(void** state)
 }
 
 /* A resumed run continues the VTK numbering (no frame overwritten) and its series index lists
- * the frames of both pieces; a resumed run whose CSV is missing starts it with a header. */
+ * the frames of both pieces; a resumed run whose CSV is missing starts it with a header.
+ * Resumed with links (vtk_links) after a first piece without, it writes links from the
+ * restart on, and their index lists only those. */
 static void test_many_restart_continues_outputs(void** state)
 {
     (void)state;
@@ -1576,6 +1587,7 @@ static void test_many_restart_continues_outputs(void** state)
     snprintf(path, sizeof path, "%s/run.csv", dir);
     remove(path);
     struct wetdem_sim* resumed = wet_box(40, true);
+    s.vtk_links = true;
     CHECK_OK(wetdem_sim_set_many(resumed, &s));
     CHECK_OK(wetdem_sim_read_checkpoint(resumed, ck));
     CHECK_OK(wetdem_sim_integrate(resumed, 4e-4)); /* frames 3, 4 at steps 150, 200 */
@@ -1583,7 +1595,18 @@ static void test_many_restart_continues_outputs(void** state)
         snprintf(path, sizeof path, "%s/run_%06d.vtk", dir, k);
         assert_int_equal(access(path, F_OK), 0);
         remove(path);
+        snprintf(path, sizeof path, "%s/run_links_%06d.vtk", dir, k);
+        assert_int_equal(access(path, F_OK), k >= 3 ? 0 : -1);
+        remove(path);
     }
+    snprintf(path, sizeof path, "%s/run_links.vtk.series", dir);
+    char* index = test_read_file(path, NULL);
+    assert_non_null(index);
+    CHECK_CONTAINS(index, "[\n    { \"name\" : \"run_links_000003.vtk\", \"time\" : ");
+    CHECK_CONTAINS(index, "\"run_links_000004.vtk\"");
+    assert_null(strstr(index, "run_links_000002.vtk"));
+    free(index);
+    remove(path);
     snprintf(path, sizeof path, "%s/run.vtk.series", dir);
     FILE* f = fopen(path, "r");
     assert_non_null(f);
