@@ -54,15 +54,24 @@ static int build_point(const struct cli_scenario* base, const struct cli_batch* 
     return rc;
 }
 
-/* "KEY = VALUE[, KEY2 = VALUE2]" of point p into buf. */
-static void point_values(const struct cli_batch* b, const struct cli_batch_point* p, char* buf,
-                         size_t n)
+/* The values of point p into buf: for messages, "KEY = VALUE[, KEY2 = VALUE2]"; else as the
+ * first fields of its row, "VALUE,[VALUE2,]" (12 digits both). */
+static void format_values(const struct cli_batch* b, const struct cli_batch_point* p,
+                          bool for_message, char* buf, size_t n)
 {
     size_t used = 0;
     buf[0] = '\0';
     for (int d = 0; d < b->n_keys && used < n; d++)
-        used += (size_t)snprintf(buf + used, n - used, "%s%s = %.12g", d ? ", " : "", b->key[d],
-                                 p->value[d]);
+        used += (size_t)(for_message ? snprintf(buf + used, n - used, "%s%s = %.12g", d ? ", " : "",
+                                                b->key[d], p->value[d])
+                                     : snprintf(buf + used, n - used, "%.12g,", p->value[d]));
+}
+
+/* "KEY = VALUE[, KEY2 = VALUE2]" of point p into buf. */
+static void point_values(const struct cli_batch* b, const struct cli_batch_point* p, char* buf,
+                         size_t n)
+{
+    format_values(b, p, true, buf, n);
 }
 
 /* Checks every point by building it (serially: every input error is reported before anything
@@ -282,10 +291,7 @@ static char* table_header(const struct cli_batch* b)
 static void row_values(const struct cli_batch* b, const struct cli_batch_point* p, char* buf,
                        size_t n)
 {
-    size_t used = 0;
-    buf[0] = '\0';
-    for (int d = 0; d < b->n_keys && used < n; d++)
-        used += (size_t)snprintf(buf + used, n - used, "%.12g,", p->value[d]);
+    format_values(b, p, false, buf, n);
 }
 
 /* Whether a status word of a table is a failed run's: an error status or ENERGY_GREW. */
