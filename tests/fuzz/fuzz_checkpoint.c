@@ -2,15 +2,17 @@
  * fuzz_checkpoint.c — libFuzzer target: any bytes as a checkpoint of a small wet box (30
  * spheres, Hertz–Mindlin + Stokes–Reynolds thin film + capillary bridges, two walls, periodic
  * in x and y), restored with wetdem_sim_read_checkpoint into a fresh set-up of the same box;
- * a checkpoint the library accepts is then run on for 20 steps. Built and run by `make fuzz`.
+ * a checkpoint the library accepts is written as a VTK frame and a links file (the counts,
+ * agglomerate labels and link forces of the restored state and histories), then run on for
+ * 20 steps. Built and run by `make fuzz`.
  *
  * The seed is the box's own checkpoint after 50 steps, written by LLVMFuzzerInitialize into
  * the corpus directory (the first argument that is not an option). The input's last four bytes
  * are replaced by the CRC-32 of the others before it is read, so that mutations reach the
  * sections behind the checksum (a wrong checksum, the reader's first test, is covered by
  * tests/test_checkpoint.c). A finding is a crash, a
- * sanitizer report, a leak, a hang, a rejected checkpoint or a failed run on from an accepted
- * one without a message, or the seed itself rejected.
+ * sanitizer report, a leak, a hang, a rejected checkpoint, a failed frame or run on from an
+ * accepted one without a message, or the seed itself rejected.
  */
 #include <stdint.h>
 #include <stdio.h>
@@ -116,7 +118,15 @@ int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size)
     struct wetdem_sim* sim = small_wet_box();
     if (wetdem_sim_read_checkpoint(sim, path) == WETDEM_OK) {
         double t = wetdem_sim_time(sim);
-        /* an accepted state runs on, or the engine says why not */
+        /* an accepted state runs on, or the engine says why not; its frame and links (the
+           counts, labels and forces of the restored histories) are written, or why not said */
+        char vtk[64];
+        snprintf(vtk, sizeof vtk, "/tmp/wetdem_fuzz_ck_%ld.vtk", (long)getpid());
+        if ((wetdem_sim_write_vtk(sim, vtk, true) != WETDEM_OK ||
+             wetdem_sim_write_vtk_links(sim, vtk, false) != WETDEM_OK) &&
+            !wetdem_sim_errmsg(sim)[0])
+            abort();
+        remove(vtk);
         if (wetdem_sim_integrate(sim, t + 20 * STEP) != WETDEM_OK && !wetdem_sim_errmsg(sim)[0])
             abort();
     } else if (!wetdem_sim_errmsg(sim)[0])
