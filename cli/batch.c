@@ -330,6 +330,37 @@ static int resume_row(struct cli_batch* b, size_t r, const char* text, size_t li
     return CLI_EXIT_OK;
 }
 
+/* FNV-1a (64 bits) of n bytes, continuing from h. */
+static unsigned long long fnv1a(unsigned long long h, const void* data, size_t n)
+{
+    const unsigned char* p = data;
+    for (size_t k = 0; k < n; k++)
+        h = (h ^ p[k]) * 0x100000001b3ULL;
+    return h;
+}
+
+/* The hash of what the points' results depend on besides their values: the scenario file's
+ * bytes and the --set overrides, in order. 0 when the file cannot be read (then loading it
+ * failed first). */
+static unsigned long long scenario_hash(const struct cli_batch* b)
+{
+    FILE* f = fopen(b->file, "rb");
+    if (!f)
+        return 0;
+    unsigned long long h = 0xcbf29ce484222325ULL;
+    char buf[4096];
+    for (size_t n; (n = fread(buf, 1, sizeof buf, f)) > 0;)
+        h = fnv1a(h, buf, n);
+    fclose(f);
+    for (int k = 0; k < b->n_sets; k++) {
+        h = fnv1a(h, "\n--set ", 7);
+        h = fnv1a(h, b->sets[k], strlen(b->sets[k]));
+    }
+    return h;
+}
+
+#define HASH_LINE "# scenario hash: "
+
 /* Reads the table of b->resume, a table of this batch that an interruption left with rows
  * NOT_RUN: its column header and the values of every row must be this batch's; the rows that
  * ran are kept (verbatim: status word and fields), the others will run. '#' lines are passed
@@ -350,6 +381,15 @@ static int read_resume(struct cli_batch* b)
         line++;
         while (len > 0 && (text[len - 1] == '\n' || text[len - 1] == '\r'))
             text[--len] = '\0';
+        unsigned long long was;
+        if (strncmp(text, HASH_LINE, strlen(HASH_LINE)) == 0 &&
+            sscanf(text + strlen(HASH_LINE), "%llx", &was) == 1 && was != b->scenario_hash) {
+            cli_error("%s: --resume %s:%zu: the table was written from another version of %s or "
+                      "with other --set overrides (scenario hash %016llx, now %016llx): its rows "
+                      "would not be those of this %s",
+                      b->cmd, b->resume, line, b->file, was, b->scenario_hash, b->cmd);
+            rc = CLI_EXIT_USAGE;
+        }
         if (len == 0 || text[0] == '#')
             continue;
         if (!seen_header) {
@@ -396,6 +436,7 @@ int cli_batch_run(struct cli_batch* b)
     int rc = check_keys(b);
     if (rc == CLI_EXIT_OK)
         rc = cli_load_with_overrides(b->file, b->sets, b->n_sets, &sc);
+    b->scenario_hash = rc == CLI_EXIT_OK ? scenario_hash(b) : 0;
     if (rc == CLI_EXIT_OK)
         rc = check_engine(&sc, b);
     if (rc == CLI_EXIT_OK && !(b->pts = calloc(b->n_pts, sizeof *b->pts))) {
@@ -454,6 +495,8 @@ size_t cli_batch_points_run(const struct cli_batch* b)
 void cli_batch_write_table(FILE* f, const struct cli_batch* b, int argc, char** argv)
 {
     cli_print_provenance(f, argc, argv);
+    fprintf(f, HASH_LINE "%016llx (the scenario file's bytes and the --set overrides)\n",
+            b->scenario_hash);
     char* header = table_header(b);
     fprintf(f, "%s\n", header ? header : "");
     free(header);

@@ -64,6 +64,8 @@ struct cli_batch {
     double wall;     /* build and run time [s] */
     int interrupted; /* the signal (SIGINT, SIGTERM) that stopped the batch early, or 0 */
     size_t n_kept;   /* points kept from the table of --resume */
+    unsigned long long scenario_hash; /* of the file's bytes and the --set overrides (the table
+                                         records it, --resume compares it) */
 };
 
 /* Checks the keys (two names of one key, or speed and stokes, are refused), loads the file
@@ -81,7 +83,8 @@ struct cli_batch {
 int cli_batch_run(struct cli_batch* b);
 
 /* Writes the '#' provenance lines, the header "KEY [unit],...,status [word],<engine columns>"
- * and one row per point "value,...,status,<engine fields>" (status: the engine's status name,
+ * (after a '#' line with the scenario's hash) and one row per point
+ * "value,...,status,<engine fields>" (status: the engine's status name,
  * ENERGY_GREW, or NOT_RUN), and after an interruption a '#' line saying so; the caller adds
  * its trailer. */
 void cli_batch_write_table(FILE* f, const struct cli_batch* b, int argc, char** argv);

@@ -765,9 +765,10 @@ static void cut_table(const char* table, const int* gone, int n_gone, bool faile
 
 /* A map resumed from its interrupted table (rows NOT_RUN) runs only those points, keeps the
  * others verbatim, and its data rows are those of the uninterrupted map, bit for bit (the
- * rows are the same runs: docs/cli.md); it may write over the table it resumes. A table of
- * other values, columns or length is refused (exit 2, with its file and line), as is one that
- * cannot be read; a kept row of a failed run makes the exit code 1, as it did there. */
+ * rows are the same runs: docs/scenarios.md); it may write over the table it resumes. A table
+ * of other values, columns, length or scenario (its hash line) is refused (exit 2, with its
+ * file and line), as is one that cannot be read; a kept row of a failed run makes the exit
+ * code 1, as it did there. */
 static void test_scenario_resumed_map_equals_the_whole(void** state)
 {
     (void)state;
@@ -802,19 +803,23 @@ static void test_scenario_resumed_map_equals_the_whole(void** state)
              "map examples/scenarios/davis_three.ini --param davis.stokes --values 0.5:30:4 "
              "--param2 davis.angle_deg --values2 0:80:4 --resume %s/whole.csv",
              tmpdir);
-    expect_run(args, 2, "whole.csv:8: the row '15.25,0,WETDEM_OK,");
+    expect_run(args, 2, "whole.csv:9: the row '15.25,0,WETDEM_OK,");
     expect_run(args, 2, "resume with the --values and --set of the run that wrote the table");
     snprintf(args, sizeof args,
              "sweep examples/scenarios/davis_three.ini --param davis.stokes --values 0.5:30:12 "
              "--resume %s/whole.csv",
              tmpdir);
-    expect_run(args, 2, "whole.csv:3: its columns are not those of this sweep");
+    expect_run(args, 2, "whole.csv:4: its columns are not those of this sweep");
     snprintf(args, sizeof args, "%s --param davis.stokes --values 0.5:30:3 --resume %s",
              "map examples/scenarios/davis_three.ini --param2 davis.angle_deg --values2 0:80:4",
              write_file("short.csv", "davis.stokes [-],davis.angle_deg [deg],status [word]\n"));
     expect_run(args, 2, "its columns are not those of this map");
     snprintf(args, sizeof args, "%s --resume %s/none.csv", map, tmpdir);
     expect_run(args, 2, "none.csv: cannot read it");
+    /* the same columns and values from another scenario (here a friction set), whose rows
+       would differ: the table's scenario hash says so */
+    snprintf(args, sizeof args, "%s --set davis.friction=0.1 --resume %s/whole.csv", map, tmpdir);
+    expect_run(args, 2, "whole.csv:3: the table was written from another version of");
     /* a kept row of a failed run */
     cut_table(whole, gone, 1, true, "failed.csv");
     snprintf(args, sizeof args, "%s --resume %s/failed.csv", map, tmpdir);
