@@ -376,6 +376,8 @@ static int read_resume(struct cli_batch* b)
     char* text = NULL;
     size_t cap = 0, line = 0, rows = 0;
     int rc = header ? CLI_EXIT_OK : CLI_EXIT_RUNTIME;
+    if (!header)
+        cli_error("%s: out of memory", b->cmd);
     bool seen_header = false;
     for (ssize_t len; rc == CLI_EXIT_OK && (len = getline(&text, &cap, f)) >= 0;) {
         line++;
