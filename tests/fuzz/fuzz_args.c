@@ -15,7 +15,11 @@
  * so a many-particle scenario is set up and not run.
  *
  * A finding is a crash, a sanitizer report, a leak, a hang, or an exit code other than 0 and
- * 2 (fuzz_cli.h).
+ * 2 (fuzz_cli.h). Exit 1 is one too, though `sweep` and `map` give it for a point whose run
+ * failed: such a failure is either a limit the message names or a defect of the engine (this
+ * target found three spheres in a closed loop of contacts that could not settle their events,
+ * docs/validation_davis.md), so it is kept to be examined; words that lower a run's own limits
+ * (max_steps) are passed over, as their failures are the intended answer.
  */
 #include <stdint.h>
 #include <stdio.h>
@@ -50,7 +54,7 @@ static const char* const REFUSED_OPTIONS[] = {"--out",    "--restart", "--curve"
  * fuzz_scenario.c passes over such files). */
 static int word_refused(const char* w, double max_points)
 {
-    if (strchr(w, '/'))
+    if (strchr(w, '/') || strstr(w, "max_steps"))
         return 1;
     for (const char* const* o = REFUSED_OPTIONS; *o; o++)
         if (strncmp(w, *o, strlen(*o)) == 0)
