@@ -34,7 +34,7 @@ TEST_BIN = $(patsubst tests/%.c,$(BUILD)/tests/%,$(TEST_SRC))
 EX_SRC   = $(sort $(wildcard examples/*/main.c))
 EX_BIN   = $(patsubst examples/%/main.c,$(BUILD)/examples/%,$(EX_SRC))
 
-.PHONY: all deps test check san test-san test-san-clang demo validate bench figures docs clean \
+.PHONY: all deps test check san test-san test-san-clang demo validate paraview bench figures docs clean \
         format check-format check-prefix check-docs examples fuzz fuzz-build
 
 all: deps $(BUILD)/libwetdem.a $(BUILD)/libwetdem.so $(BUILD)/wetdem
@@ -125,12 +125,18 @@ demo: all
 	@scripts/demo $(BUILD)/wetdem
 
 validate: all
-	@scripts/install-deps figures
+	@scripts/install-deps validate
 	@scripts/validate $(BUILD)/wetdem
 
 figures:
 	@scripts/install-deps figures
 	@for f in figures/*.py; do $(PYTHON) $$f || exit 1; done
+
+# ParaView itself opens the many-particle output and renders a figure (installs ParaView,
+# about 440 MB, when missing; not part of validate for that reason).
+paraview: all
+	@scripts/install-deps paraview
+	@scripts/paraview $(BUILD)/wetdem
 
 bench: all
 	@scripts/install-deps bench

@@ -1,0 +1,35 @@
+#!/usr/bin/env bash
+# The many-particle VTK output read by VTK's own legacy reader (Debian python3-vtk9, the
+# reader ParaView uses for .vtk files) and checked by tools/check_vtk_with_vtk.py: the
+# .vtk.series indexes as ParaView reads them, frames and links files without a reader error,
+# the arrays of docs/many.md, lines as long as the gap they carry, the same numbers as
+# tools/wetdem_vtk.py, and a binary and an ASCII run of one scenario bit for bit the same.
+# Runs: 30 ms of the settling example (links; periodic in x and y, so links cross the box's
+# faces) in binary and in ASCII, and 20 ms of the agglomeration example (periodic in x, y and
+# z) with links; then the outputs of 40-many.sh when present.
+# Usage: scripts/validate.d/42-vtk.sh PATH_TO_WETDEM_CLI   (from the repository root)
+set -euo pipefail
+cli=${1:?usage: 42-vtk.sh PATH_TO_WETDEM_CLI}
+out=out/validate/vtk
+S=examples/scenarios
+export OMP_WAIT_POLICY=${OMP_WAIT_POLICY:-passive}
+rm -rf "$out"
+mkdir -p "$out"
+
+settle=(--set run.t_end=0.03 --set dump.vtk_every=500)
+echo "-- settling, 30 ms, binary frames and links"
+"$cli" run $S/many_settling.ini "${settle[@]}" --out "$out/settling_binary" > /dev/null
+echo "-- the same in ASCII"
+"$cli" run $S/many_settling.ini "${settle[@]}" --set dump.vtk_binary=no \
+    --out "$out/settling_ascii" > /dev/null
+echo "-- agglomeration, 20 ms, with links"
+"$cli" run $S/many_agglomeration.ini --set run.t_end=0.02 --set dump.vtk_every=1000 \
+    --set dump.vtk_links=yes \
+    --out "$out/agglomeration" > /dev/null
+
+runs=("$out/agglomeration")
+for d in out/validate/many/cradle out/validate/many/settling out/validate/many/agglomeration; do
+  [ -d "$d" ] && runs+=("$d")
+done
+/usr/bin/python3 tools/check_vtk_with_vtk.py --all-kinds "${runs[@]}" \
+    --same "$out/settling_binary" "$out/settling_ascii"
