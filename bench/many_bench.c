@@ -21,8 +21,18 @@
  * so wetdem dry, wetdem wet and both LIGGGHTS variants run the same configuration. Contact
  * histories are not carried over, in either code.
  *
+ * Cross-check with LIGGGHTS (scripts/validate.d/47-liggghts.sh): --frictionless leaves hertz
+ * alone (no mindlin) and --restitution E sets e (1: elastic, where the force depends on the
+ * positions only and both codes' velocity Verlet steps are the same map); --trace FILE writes
+ * the state every --trace-every K steps from the start, as LIGGGHTS' dump of
+ * bench/liggghts/frictionless.in does;
+ * --perturb moves every sphere by one unit in the last place of its x, the reference for how
+ * fast rounding differences grow in this system.
+ *
  * Usage: many_bench [--wet] [--film M] [--n N] [--settle S] [--steps S] [--dt DT] [--data FILE]
  *                   [--budget] [--state-in FILE] [--state-out FILE]
+ *                   [--frictionless] [--restitution E] [--trace FILE] [--trace-every K]
+ *                   [--perturb]
  * Prints one line: "wetdem <dry|wet> n=.. threads=.. steps=.. seconds=.. cpu_seconds=..
  * psteps_per_s=..
  * maxrss_kb=.. contacts=.. bridges=.. pairs=.. builds=.. kick_s=.. forces_s=.. lists_s=.. film=.."
@@ -30,6 +40,7 @@
  * list builds, wetdem_many_stats; film: the wet spheres' film thickness, 0 dry). Uses only the
  * public API.
  */
+#include <math.h>
 #include <omp.h>
 #include <sys/resource.h>
 #include <stdio.h>
@@ -151,12 +162,23 @@ static void read_data(const char* path, struct wetdem_sim* sim)
     }
 }
 
-static void setup(struct wetdem_sim* sim, bool wet, double film, size_t n, double hi[3])
+/* Appends the state at step `step` to the trace: "step id x y z vx vy vz" a sphere. */
+static void write_trace(FILE* f, struct wetdem_sim* sim, unsigned long step)
+{
+    size_t n;
+    const struct wetdem_particle* p = wetdem_sim_particles_const(sim, &n);
+    for (size_t k = 0; k < n; k++)
+        fprintf(f, "%lu %zu %.17g %.17g %.17g %.17g %.17g %.17g\n", step, k + 1, p[k].pos.x,
+                p[k].pos.y, p[k].pos.z, p[k].vel.x, p[k].vel.y, p[k].vel.z);
+}
+
+static void setup(struct wetdem_sim* sim, bool wet, bool frictionless, double restitution,
+                  double film, size_t n, double hi[3])
 {
     struct wetdem_material m = {.density = 2500,
                                 .youngs_modulus = 1e7,
                                 .poisson_ratio = 0.3,
-                                .restitution = 0.5,
+                                .restitution = restitution,
                                 .friction_dry = 0.5,
                                 .friction_lub = 0.5,
                                 .roughness = 0,
@@ -167,7 +189,8 @@ static void setup(struct wetdem_sim* sim, bool wet, double film, size_t n, doubl
     struct wetdem_fluid fl = {.viscosity = 0.01, .surface_tension = 0.02, .density = 1000};
     if ((st = wetdem_sim_set_fluid(sim, &fl)) != WETDEM_OK)
         die(sim, st, "fluid");
-    const char* models[] = {"hertz", "mindlin", wet ? "sb" : NULL, wet ? "capillary" : NULL};
+    const char* models[] = {"hertz", frictionless ? NULL : "mindlin", wet ? "sb" : NULL,
+                            wet ? "capillary" : NULL};
     for (int k = 0; k < 4 && models[k]; k++)
         if ((st = wetdem_sim_enable_model(sim, models[k])) != WETDEM_OK)
             die(sim, st, models[k]);
@@ -200,7 +223,10 @@ static void setup(struct wetdem_sim* sim, bool wet, double film, size_t n, doubl
 
 int main(int argc, char** argv)
 {
-    bool wet = false, budget = false;
+    bool wet = false, budget = false, frictionless = false, perturb = false;
+    double restitution = 0.5;
+    const char* trace = NULL;
+    unsigned long trace_every = 100;
     size_t n = 20000;
     unsigned long settle = 1000, steps = 2000;
     const char* data = NULL;
@@ -212,6 +238,18 @@ int main(int argc, char** argv)
             wet = true;
         else if (!strcmp(argv[k], "--budget"))
             budget = true;
+        else if (!strcmp(argv[k], "--frictionless"))
+            frictionless = true;
+        else if (!strcmp(argv[k], "--restitution") && k + 1 < argc &&
+                 (restitution = strtod(argv[++k], NULL)) > 0 && restitution <= 1)
+            continue;
+        else if (!strcmp(argv[k], "--perturb"))
+            perturb = true;
+        else if (!strcmp(argv[k], "--trace") && k + 1 < argc)
+            trace = argv[++k];
+        else if (!strcmp(argv[k], "--trace-every") && k + 1 < argc &&
+                 (trace_every = strtoul(argv[++k], NULL, 10)) > 0)
+            continue;
         else if (!strcmp(argv[k], "--n") && k + 1 < argc)
             n = strtoul(argv[++k], NULL, 10);
         else if (!strcmp(argv[k], "--settle") && k + 1 < argc)
@@ -232,7 +270,9 @@ int main(int argc, char** argv)
         else {
             fprintf(stderr, "usage: many_bench [--wet] [--film M (0 < M < 1e-3 m)] [--budget] "
                             "[--n N] [--settle S] [--steps S] [--dt DT] [--data FILE] "
-                            "[--state-in FILE] [--state-out FILE]\n");
+                            "[--state-in FILE] [--state-out FILE] [--frictionless] "
+                            "[--restitution E (0 < E <= 1)] [--trace FILE] [--trace-every K] "
+                            "[--perturb]\n");
             return 2;
         }
     }
@@ -242,15 +282,38 @@ int main(int argc, char** argv)
     }
     struct wetdem_sim* sim = wetdem_sim_create();
     double hi[3];
-    setup(sim, wet, film, n, hi);
+    setup(sim, wet, frictionless, restitution, film, n, hi);
     if (state_in)
         read_data(state_in, sim);
+    if (perturb) {
+        size_t np;
+        struct wetdem_particle* p = wetdem_sim_particles(sim, &np);
+        for (size_t k = 0; k < np; k++)
+            p[k].pos.x = nextafter(p[k].pos.x, INFINITY);
+    }
     if (data) {
         write_data(data, sim, hi);
         return 0;
     }
     struct wetdem_many_settings ms = {.dt = dt, .skin = 0.2e-3, .energy_budget = budget};
     int st = wetdem_sim_set_many(sim, &ms);
+    if (trace) { /* the traced run: steps 0, K, 2K, ... up to settle + steps, untimed */
+        FILE* f = fopen(trace, "w");
+        if (!f || st != WETDEM_OK) {
+            fprintf(stderr, "many_bench: cannot write %s\n", trace);
+            return 1;
+        }
+        for (unsigned long step = 0;; step += trace_every) {
+            if (step && (st = wetdem_sim_integrate(sim, (double)step * dt)) != WETDEM_OK)
+                die(sim, st, "traced run");
+            write_trace(f, sim, step);
+            if (step + trace_every > settle + steps)
+                break;
+        }
+        fclose(f);
+        wetdem_sim_free(sim);
+        return 0;
+    }
     if (st != WETDEM_OK || (st = wetdem_sim_integrate(sim, settle * dt)) != WETDEM_OK)
         die(sim, st, "settling run");
     struct wetdem_many_stats s0, s;
