@@ -25,8 +25,8 @@ import os
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from common import FIGURES, ROOT, np, plt  # noqa: E402
-from many_figs import check, failures  # noqa: E402  (the many pieces' checks)
+from common import ROOT, np, plt  # noqa: E402
+from many_figs import check, save_and_finish  # noqa: E402  (the many pieces' checks)
 
 DTS = ["1e-5", "5e-6", "2.5e-6", "1.25e-6"]
 DT_REFERENCE = 3.125e-7
@@ -131,14 +131,7 @@ def main():
     ax[1].legend(fontsize=8, loc="upper left")
     fig.suptitle("2000 spheres settling in a box, from one state: wetdem against LIGGGHTS 3.8",
                  fontsize=11)
-    fig.tight_layout()
-    os.makedirs(FIGURES, exist_ok=True)
-    path = os.path.join(FIGURES, "liggghts_crosscheck.png")
-    fig.savefig(path, dpi=120)
-    print(f"  wrote {os.path.relpath(path)}")
-    if failures:
-        print(f"{len(failures)} check(s) failed")
-        sys.exit(1)
+    save_and_finish(fig, "liggghts_crosscheck.png")
 
 
 if __name__ == "__main__":

@@ -41,6 +41,19 @@ def check(ok, text):
         failures.append(text)
 
 
+def save_and_finish(fig, name):
+    """Writes the figure to docs/figures/NAME (tight layout, 120 dpi), then exits 1 when a
+    check failed."""
+    fig.tight_layout()
+    os.makedirs(FIGURES, exist_ok=True)
+    path = os.path.join(FIGURES, name)
+    fig.savefig(path, dpi=120)
+    print(f"  wrote {os.path.relpath(path)}")
+    if failures:
+        print(f"{len(failures)} check(s) failed")
+        sys.exit(1)
+
+
 def read_global(path):
     """global.csv as {column: array}."""
     with open(path) as f:

@@ -20,8 +20,8 @@ import os
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from common import FIGURES, ROOT, np, plt  # noqa: E402
-from many_figs import check, failures, read_global  # noqa: E402  (the many pieces' checks)
+from common import ROOT, np, plt  # noqa: E402
+from many_figs import check, read_global, save_and_finish  # noqa: E402  (the many pieces' checks)
 
 
 def map_speed(lam, steps):
@@ -97,14 +97,7 @@ def main():
     ax[1].set_ylabel("energy-budget closure error")
     ax[1].legend(fontsize=8, loc="upper left")
     ax[1].set_title("Energy budget (trapezoid rule), second order")
-    fig.tight_layout()
-    os.makedirs(FIGURES, exist_ok=True)
-    path = os.path.join(FIGURES, "many_step_bound.png")
-    fig.savefig(path, dpi=120)
-    print(f"  wrote {os.path.relpath(path)}")
-    if failures:
-        print(f"{len(failures)} check(s) failed")
-        sys.exit(1)
+    save_and_finish(fig, "many_step_bound.png")
 
 
 if __name__ == "__main__":
