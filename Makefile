@@ -146,7 +146,7 @@ bench: all
 # them), checkpoints, the dots CSV of `track` and the data CSV of `fit`, as any bytes
 # (tests/fuzz/, scripts/fuzz; README, "make fuzz").
 FUZZ_SECONDS ?= 120
-FUZZ_TARGETS = fuzz_scenario fuzz_checkpoint fuzz_track fuzz_fit_data fuzz_args
+FUZZ_TARGETS = fuzz_scenario fuzz_checkpoint fuzz_track fuzz_fit_data fuzz_args fuzz_sphere_file
 
 fuzz:
 	@scripts/install-deps fuzz

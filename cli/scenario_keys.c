@@ -261,17 +261,35 @@ void cli_section_suggestion(const char* name, char* msg, size_t n)
                  hint ? "; did you mean [model." : "", hint ? hint : "", hint ? "]?" : "");
         return;
     }
-    const char* names[32];
-    size_t m = 0;
-    for (size_t k = 0; sections[k].name && m + 1 < 32; k++)
-        if (!strstr(sections[k].name, ".*"))
-            names[m++] = sections[k].name;
-    for (size_t k = 0; cli_pairwise_sections && cli_pairwise_sections[k].name && m + 1 < 32; k++)
-        names[m++] = cli_pairwise_sections[k].name;
-    for (size_t k = 0; cli_many_sections && cli_many_sections[k].name && m + 1 < 32; k++)
-        if (!strstr(cli_many_sections[k].name, ".*"))
-            names[m++] = cli_many_sections[k].name;
+    /* the fixed sections, and the families NAME.* (shown as [NAME.NAME]) */
+    const char* names[40];
+    char families[12][32];
+    size_t m = 0, nf = 0;
+    const struct cli_section_desc* tables[3] = {sections, cli_pairwise_sections, cli_many_sections};
+    for (int t = 0; t < 3; t++)
+        for (size_t k = 0; tables[t] && tables[t][k].name && m + 1 < 40; k++) {
+            const char* star = strstr(tables[t][k].name, ".*");
+            if (!star)
+                names[m++] = tables[t][k].name;
+            else if (nf < 12)
+                snprintf(families[nf++], sizeof families[0], "%.*s",
+                         (int)(star - tables[t][k].name), tables[t][k].name);
+        }
     names[m] = NULL;
+    const char* dot = strchr(name, '.');
+    if (dot) { /* a misspelt family: [reed.bed] -> [read.bed] */
+        char prefix[64];
+        snprintf(prefix, sizeof prefix, "%.*s", (int)(dot - name), name);
+        const char* fam[13];
+        for (size_t k = 0; k < nf; k++)
+            fam[k] = families[k];
+        fam[nf] = NULL;
+        const char* hint = wetdem_param_suggest(prefix, fam);
+        if (hint) {
+            snprintf(msg, n, " (did you mean [%s%s]?)", hint, dot);
+            return;
+        }
+    }
     const char* hint = wetdem_param_suggest(name, names);
     if (hint) {
         snprintf(msg, n, " (did you mean [%s]?)", hint);
@@ -280,8 +298,8 @@ void cli_section_suggestion(const char* name, char* msg, size_t n)
     size_t used = (size_t)snprintf(msg, n, "; valid sections:");
     for (size_t k = 0; names[k] && used < n; k++)
         used += (size_t)snprintf(msg + used, n - used, " [%s]", names[k]);
-    if (used < n)
-        snprintf(msg + used, n - used, " [material.NAME] [model.NAME]");
+    for (size_t k = 0; k < nf && used < n; k++)
+        used += (size_t)snprintf(msg + used, n - used, " [%s.NAME]", families[k]);
 }
 
 const char* cli_scenario_key_unit(const char* section, const char* key)

@@ -5,6 +5,11 @@
  * [model.NAME], [integrator] and [sim] sections. docs/many.md ("From the command line") and
  * the generated tables of docs/scenarios.md describe every key.
  *
+ * Spheres read from a file ([read.NAME]: a CSV or a frame of a wetdem run, sphere_file.c)
+ * are taken as they are: they may overlap each other and the walls, as a settled packing does
+ * (their contacts start without tangential history); only their centres must lie in the box,
+ * and they must not overlap the groups before them.
+ *
  * Geometry: the box is [0, size_x] x [0, size_y] x [0, size_z] [m]. A periodic axis wraps
  * (minimum image); on the other axes [walls] puts plane walls on the faces (by default on
  * every face of a non-periodic axis), with normals into the box. A wall on a periodic axis
@@ -18,6 +23,7 @@
  * Every check runs before anything is written; each failure names the file, the line and the
  * key (scenario.h error convention).
  */
+#include <ctype.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -26,6 +32,7 @@
 
 #include "cli_util.h"
 #include "scenario_many.h"
+#include "sphere_file.h"
 
 #define NUM CLI_KEY_NUMBER
 #define COUNT CLI_KEY_COUNT
@@ -104,6 +111,19 @@ static const struct cli_key_desc particle_keys[] = {
     {0},
 };
 
+static const struct cli_key_desc spheres_keys[] = {
+    WORD("file", CLI_VALUE_TEXT, "required", NULL,
+         "The spheres' file, relative to the scenario file's directory unless absolute: a frame "
+         "of a wetdem run (PREFIX_NNNNNN.vtk: centres, radius, velocity, spin; a run's "
+         "PREFIX.vtk.series stands for its last frame), or a CSV whose "
+         "header names the columns x, y, z, radius [m] and optionally vx, vy, vz [m/s], spin_x, "
+         "spin_y, spin_z [rad/s] (a name may carry its unit, 'x [m]'; '#' lines are skipped). "
+         "Values are checked as the keys of [particle.NAME]. The spheres may overlap each other "
+         "and the walls (a settled packing does); their centres must lie in the box."),
+    WORD("material", CLI_VALUE_NAME, "steel1", NULL, "Material of every sphere, as in [insert]."),
+    {0},
+};
+
 static const struct cli_key_desc run_keys[] = {
     NUM("t_end", "s", "give t_end or steps", 0, 1e6, true, false,
         "Simulated time of the run, at most 1e15 steps of dt."),
@@ -165,6 +185,11 @@ const struct cli_section_desc cli_many_sections[] = {
      "the spheres before it: put larger spheres first).",
      insert_keys},
     {"particle.*", "Many-particle run: one sphere NAME placed explicitly.", particle_keys},
+    {"read.*",
+     "Many-particle run: spheres read from a file, a frame of an earlier run or a CSV table (a "
+     "packing settled dry and then wetted, a state from another code); added in file order "
+     "with the other groups.",
+     spheres_keys},
     {"run", "Many-particle run: length, time step, neighbour-list skin, energy budget.", run_keys},
     {"dump", "Many-particle run: files written in `wetdem run --out DIR`.", dump_keys},
     {0},
@@ -550,6 +575,49 @@ static int build_particle(const struct cli_scenario* sc, struct cli_many_setup* 
     return CLI_EXIT_OK;
 }
 
+/* The [read.NAME] file: its value, relative to the scenario file's directory unless it is
+ * absolute, into path. */
+static void sphere_file_path(const struct cli_scenario* sc, const char* value, char* path, size_t n)
+{
+    const char* slash = strrchr(sc->file, '/');
+    if (value[0] == '/' || !slash)
+        snprintf(path, n, "%s", value);
+    else
+        snprintf(path, n, "%.*s/%s", (int)(slash - sc->file), sc->file, value);
+}
+
+static int build_sphere_file(const struct cli_scenario* sc, struct cli_many_setup* su,
+                             struct materials* mt, const char* section)
+{
+    const struct cli_entry* e = cli_scenario_find(sc, section, "file");
+    if (!e || !e->value[0]) {
+        cli_scenario_section_error(sc, section, "[%s] needs file (a CSV or a frame .vtk)", section);
+        return CLI_EXIT_USAGE;
+    }
+    int material;
+    int rc = material_index(sc, su->sim, mt, section,
+                            cli_scenario_text(sc, section, "material", "steel1"), &material);
+    if (rc != CLI_EXIT_OK)
+        return rc;
+    char path[2200], why[512];
+    sphere_file_path(sc, e->value, path, sizeof path);
+    struct wetdem_particle* p = NULL;
+    size_t n = 0;
+    if (cli_read_sphere_file(path, &p, &n, why, sizeof why) != 0) {
+        bool memory = strcmp(why, "out of memory") == 0;
+        /* "PATH:LINE: why" for a CSV (why starts with its line), "PATH: why" otherwise */
+        cli_scenario_error(sc, e, "%s:%s%s", path, isdigit((unsigned char)why[0]) ? "" : " ", why);
+        return memory ? CLI_EXIT_RUNTIME : CLI_EXIT_USAGE;
+    }
+    for (size_t k = 0; k < n && rc == CLI_EXIT_OK; k++) {
+        p[k].material = material;
+        if (wetdem_sim_add_particle(su->sim, p[k]) != WETDEM_OK)
+            rc = cli_scenario_lib_error(sc, e, section, su->sim);
+    }
+    free(p);
+    return rc;
+}
+
 /* Separation of a and b along axis k, minimum image on periodic axes [m]. */
 static double axis_delta(const struct cli_many_setup* su, int k, double a, double b)
 {
@@ -559,10 +627,12 @@ static double axis_delta(const struct cli_many_setup* su, int k, double a, doubl
     return d;
 }
 
-/* A group of spheres: its section and the index of its first sphere. */
+/* A group of spheres: its section, the index of its first sphere, and whether it was read from
+ * a file (then its spheres may overlap the walls). */
 struct group {
     const char* section;
     size_t from;
+    bool from_file;
 };
 
 /* Spheres [from, n) of the latest of groups[0 .. n_groups) against the spheres of the groups
@@ -573,13 +643,14 @@ static int check_group(const struct cli_scenario* sc, const struct cli_many_setu
 {
     const char* section = groups[n_groups - 1].section;
     size_t from = groups[n_groups - 1].from;
+    bool inside_walls = !groups[n_groups - 1].from_file; /* else the centre inside the box */
     size_t n;
     const struct wetdem_particle* p = wetdem_sim_particles_const(su->sim, &n);
     for (size_t i = from; i < n; i++) {
         double x[3] = {p[i].pos.x, p[i].pos.y, p[i].pos.z};
         for (int k = 0; k < 3; k++) {
-            double lo = (faces >> (2 * k)) & 1u ? p[i].radius : 0.0;
-            double hi = (faces >> (2 * k + 1)) & 1u ? p[i].radius : 0.0;
+            double lo = inside_walls && (faces >> (2 * k)) & 1u ? p[i].radius : 0.0;
+            double hi = inside_walls && (faces >> (2 * k + 1)) & 1u ? p[i].radius : 0.0;
             if (!(x[k] >= lo && x[k] <= su->box[k] - hi)) {
                 cli_scenario_section_error(sc, section,
                                            "sphere %zu of [%s] (centre %c = %g m, "
@@ -611,8 +682,8 @@ static int check_group(const struct cli_scenario* sc, const struct cli_many_setu
     return CLI_EXIT_OK;
 }
 
-/* Every [insert], [insert.NAME] and [particle.NAME] in file order. *first: material name of
- * the first group (default of [walls] material). */
+/* Every [insert], [insert.NAME], [particle.NAME] and [read.NAME] in file order. *first:
+ * material name of the first group (default of [walls] material). */
 static int build_spheres(const struct cli_scenario* sc, struct cli_many_setup* su,
                          struct materials* mt, unsigned faces, const char** first)
 {
@@ -626,10 +697,13 @@ static int build_spheres(const struct cli_scenario* sc, struct cli_many_setup* s
     for (size_t s = 0; s < sc->n_sections; s++) {
         const char* name = sc->sections[s].name;
         bool ins = strcmp(name, "insert") == 0 || strncmp(name, "insert.", 7) == 0;
-        if (!ins && strncmp(name, "particle.", 9) != 0)
+        bool file = strncmp(name, "read.", 5) == 0;
+        if (!ins && !file && strncmp(name, "particle.", 9) != 0)
             continue;
-        groups[n_groups++] = (struct group){name, wetdem_sim_n_particles(su->sim)};
-        int rc = ins ? build_insert(sc, su, mt, name) : build_particle(sc, su, mt, name);
+        groups[n_groups++] = (struct group){name, wetdem_sim_n_particles(su->sim), file};
+        int rc = ins    ? build_insert(sc, su, mt, name)
+                 : file ? build_sphere_file(sc, su, mt, name)
+                        : build_particle(sc, su, mt, name);
         if (rc == CLI_EXIT_OK)
             rc = check_group(sc, su, groups, n_groups, faces);
         if (rc != CLI_EXIT_OK) {
@@ -643,7 +717,7 @@ static int build_spheres(const struct cli_scenario* sc, struct cli_many_setup* s
     if (!*first) {
         cli_scenario_section_error(sc, "box",
                                    "no spheres: add an [insert] section (or "
-                                   "[insert.NAME], [particle.NAME])");
+                                   "[insert.NAME], [particle.NAME], [read.NAME])");
         return CLI_EXIT_USAGE;
     }
     return CLI_EXIT_OK;
@@ -733,8 +807,8 @@ int cli_many_build(const struct cli_scenario* sc, struct cli_many_setup* su)
         return CLI_EXIT_USAGE;
     }
     static const char* const reads[] = {
-        "engine",     "box",   "walls",  "insert",  "insert.*",   "particle.*", "run", "dump",
-        "material.*", "fluid", "models", "model.*", "integrator", "sim",        NULL};
+        "engine", "box",        "walls", "insert", "insert.*", "particle.*", "read.*", "run",
+        "dump",   "material.*", "fluid", "models", "model.*",  "integrator", "sim",    NULL};
     if (cli_scenario_check_read(sc, "a many-particle run", reads) != CLI_EXIT_OK)
         return CLI_EXIT_USAGE;
     su->sim = wetdem_sim_create();

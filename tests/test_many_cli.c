@@ -17,6 +17,8 @@
  *     and no other file; a restart continues both, bit-identical to an uninterrupted run;
  *   - the summary prints a large mean agglomerate size as a whole number;
  *   - progress goes to stderr only when it is a terminal, with an estimate of the time left;
+ *   - [read.NAME] starts a run from a frame of another (ASCII or binary) bit for bit, or from a
+ *     CSV at its values; bad files exit 2 with the scenario's line and the file's line;
  *   - the example scenarios check, and the summary's energy budget adds up; a run whose budget
  *     does not close (a step too long for the contacts) says so and exits 1, and a restart
  *     from an edited checkpoint whose budget does not close is refused with exit 2.
@@ -90,17 +92,20 @@ static char* expect_exit(const char* args, int code, const char* needle)
     return err;
 }
 
-/* A wet granular box: 150 spheres, periodic in x and y, floor and lid, gravity. */
-static const char* const base =
-    "[box]\nsize_x = 6e-3\nsize_y = 6e-3\nsize_z = 8e-3\nperiodic = x y\n"
-    "[material.wet]\ndensity = 2500\nyoungs_modulus = 1e7\npoisson_ratio = 0.3\n"
-    "restitution = 0.6\nfriction_dry = 0.4\nfriction_lub = 0.1\nfilm = 20e-6\n"
-    "[fluid]\nviscosity = 0.01\nsurface_tension = 0.02\n"
-    "[models]\nforce = hertz mindlin sb capillary\nmin_separation = fixed\n"
+/* A wet granular box, periodic in x and y, floor and lid, gravity (21 lines)... */
+#define WET_BOX                                                                                    \
+    "[box]\nsize_x = 6e-3\nsize_y = 6e-3\nsize_z = 8e-3\nperiodic = x y\n"                         \
+    "[material.wet]\ndensity = 2500\nyoungs_modulus = 1e7\npoisson_ratio = 0.3\n"                  \
+    "restitution = 0.6\nfriction_dry = 0.4\nfriction_lub = 0.1\nfilm = 20e-6\n"                    \
+    "[fluid]\nviscosity = 0.01\nsurface_tension = 0.02\n"                                          \
+    "[models]\nforce = hertz mindlin sb capillary\nmin_separation = fixed\n"                       \
     "[sim]\ngravity_z = -9.81\n"
-    "[insert]\ncount = 150\nradius_min = 0.4e-3\nradius_max = 0.5e-3\nmaterial = wet\n"
-    "velocity_sigma = 0.2\nseed = 7\n"
-    "[run]\ndt = 2e-6\n";
+
+/* ... with 150 spheres. */
+static const char* const base =
+    WET_BOX "[insert]\ncount = 150\nradius_min = 0.4e-3\nradius_max = 0.5e-3\nmaterial = wet\n"
+            "velocity_sigma = 0.2\nseed = 7\n"
+            "[run]\ndt = 2e-6\n";
 
 /* base + extra lines, into tmpdir/name. */
 static void scenario(const char* name, const char* extra)
@@ -729,6 +734,152 @@ static void test_many_cli_random_groups_share_the_box(void** state)
     expect_bad("groups_bad.ini", text, 13, "insert the groups of larger spheres first");
 }
 
+/* The text of file `name` in tmpdir from its line starting with "POINTS" on (a frame's
+ * spheres and their arrays, without the title and TIME that carry the time); NULL if none. */
+static char* frame_from_points(const char* name, size_t* len)
+{
+    size_t n = 0;
+    char* text = test_read_file(tpath(name), &n);
+    assert_non_null(text);
+    for (size_t k = 0; k + 7 < n; k++)
+        if ((k == 0 || text[k - 1] == '\n') && memcmp(text + k, "POINTS ", 7) == 0) {
+            *len = n - k;
+            memmove(text, text + k, n - k);
+            return text;
+        }
+    free(text);
+    return NULL;
+}
+
+/* [read.NAME]: spheres from a frame of an earlier run (ASCII and binary) start the run at that
+ * frame's state bit for bit; from a CSV at the parsed values; bad files exit 2 naming the
+ * scenario line, the file and its line or array, and write nothing. */
+static void test_many_cli_read_spheres_from_a_file(void** state)
+{
+    (void)state;
+    for (int binary = 0; binary < 2; binary++) {
+        char extra[200], text[2048];
+        snprintf(extra, sizeof extra, "steps = 40\n[dump]\nvtk_every = 40\nvtk_binary = %s\n",
+                 binary ? "yes" : "no");
+        scenario("src.ini", extra);
+        assert_int_equal(run_cli("run src.ini --out src"), 0);
+        /* the state at step 40, read into a run of its own: its frame 0 is that state, and its
+           counts of contacts, bridges and agglomerates are those of the frame read */
+        snprintf(text, sizeof text,
+                 WET_BOX "[read.bed]\nfile = src/particles_000001.vtk\nmaterial = wet\n"
+                         "[run]\ndt = 2e-6\nsteps = 1\n[dump]\nvtk_every = 1\nvtk_binary = %s\n",
+                 binary ? "yes" : "no");
+        write_text("dst.ini", text);
+        assert_int_equal(run_cli("run dst.ini --out dst"), 0);
+        size_t la = 0, lb = 0;
+        char* a = frame_from_points("src/particles_000001.vtk", &la);
+        char* b = frame_from_points("dst/particles_000000.vtk", &lb);
+        assert_non_null(a);
+        assert_non_null(b);
+        if (la != lb || memcmp(a, b, la) != 0)
+            fail_msg("%s frame read and written again differs from the frame read",
+                     binary ? "a binary" : "an ASCII");
+        free(a);
+        free(b);
+    }
+    /* a run's .vtk.series index stands for its last frame (step 40 of the binary run) */
+    write_text("series.ini", WET_BOX "[read.bed]\nfile = src/particles.vtk.series\nmaterial = wet\n"
+                                     "[run]\ndt = 2e-6\nsteps = 1\n[dump]\nvtk_every = 1\n");
+    assert_int_equal(run_cli("run series.ini --out series"), 0);
+    size_t la = 0, lb = 0;
+    char* a = frame_from_points("src/particles_000001.vtk", &la);
+    char* b = frame_from_points("series/particles_000000.vtk", &lb);
+    assert_true(a && b && la == lb && memcmp(a, b, la) == 0);
+    free(a);
+    free(b);
+    /* a CSV: the spheres at the values parsed (the ASCII frame's %.17g gives them back),
+       overlapping each other and the floor as a settled packing does; blank and '#' lines
+       skipped, units in the header */
+    static const char* const row[3][6] = {
+        {"1.0000000000000001e-3", "3e-3", "0.49999999999999994e-3", "5e-4", "0.1", "2"},
+        {"1.9e-3", "3e-3", "0.5e-3", "0.5e-3", "-0.10000000000000001", "0"},
+        {"4.2e-3", "3e-3", "3.3333333333333335e-3", "4e-4", "0", "-7.5"}};
+    char csv[1024] = "# three spheres\nx [m], y [m], z [m], radius [m], vx, spin_y\n";
+    for (int i = 0; i < 3; i++) {
+        size_t at = strlen(csv);
+        snprintf(csv + at, sizeof csv - at, "%s%s, %s, %s, %s, %s, %s\n", i == 2 ? "\n" : "",
+                 row[i][0], row[i][1], row[i][2], row[i][3], row[i][4], row[i][5]);
+    }
+    write_text("bed.csv", csv);
+    write_text("csv.ini", WET_BOX "[read.bed]\nfile = bed.csv\nmaterial = wet\n[run]\ndt = 2e-6\n"
+                                  "steps = 1\n[dump]\nvtk_every = 1\nvtk_binary = no\n");
+    assert_int_equal(run_cli("run csv.ini --out csv"), 0);
+    char* frame = test_read_file(tpath("csv/particles_000000.vtk"), NULL);
+    assert_non_null(frame);
+    for (int i = 0; i < 3; i++) {
+        double v[6];
+        for (int k = 0; k < 6; k++)
+            v[k] = strtod(row[i][k], NULL);
+        char want[3][200];
+        snprintf(want[0], sizeof want[0], "\n%.17g %.17g %.17g\n", v[0], v[1], v[2]);
+        snprintf(want[1], sizeof want[1], "\n%.17g\n", v[3]);
+        snprintf(want[2], sizeof want[2], "\n%.17g 0 0\n", v[4]);
+        for (int k = 0; k < 3; k++)
+            CHECK_CONTAINS(frame, want[k]);
+    }
+    CHECK_CONTAINS(frame, "spin 3 3 double\n0 2 0\n0 0 0\n0 -7.5 0\n");
+    free(frame);
+
+    /* bad files: the scenario's file line (22), the file's own line or array */
+    const char* head = WET_BOX "[read.bed]\nfile = ";
+    const char* tail = "\nmaterial = wet\n[run]\ndt = 2e-6\nsteps = 1\n";
+    struct {
+        const char *csv, *what;
+    } bad[] = {
+        {"x,y,z,radus\n1e-3,1e-3,1e-3,1e-4\n", "bad.csv:1: unknown column 'radus' (did you "
+                                               "mean 'radius'?)"},
+        {"x,y,z\n1e-3,1e-3,1e-3\n", "bad.csv:1: the header has no column 'radius'"},
+        {"# c\nx,y,z,radius\n1e-3,1e-3,1e-3,1e-4\n2e-3,1e-3,nan,1e-4\n",
+         "bad.csv:4: z = 'nan' is not a finite number"},
+        {"x,y,z,radius\n1e-3,1e-3,1e-3,-1e-4\n",
+         "bad.csv:2: radius = -0.0001 m is not in (0, 1] m"},
+        {"x,y,z,radius\n1e-3,1e-3,1e-3\n", "bad.csv:2: 3 fields, the header has 4 columns"},
+        {"x,y,z,radius\n", "bad.csv:1: no spheres after the header"},
+        {"x,y,z,radius\n1e-3,1e-3,9e-3,1e-4\n", "sphere 1 of [read.bed] (centre z = 0.009 m"},
+    };
+    for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {
+        write_text("bad.csv", bad[k].csv);
+        char text[2048];
+        snprintf(text, sizeof text, "%s%s%s", head, "bad.csv", tail);
+        /* the sphere outside the box is a fault of the group (its section line, 22) */
+        expect_bad("badread.ini", text, 22 + (k < 6), bad[k].what);
+    }
+    char text[2048];
+    snprintf(text, sizeof text, "%s%s%s", head, "missing.csv", tail);
+    expect_bad("missing.ini", text, 23, "missing.csv: cannot read it: No such file or directory");
+    /* a links file is not a frame; a binary frame cut short is refused, not read past its end */
+    scenario("links.ini", "steps = 4\n[dump]\nvtk_every = 4\nvtk_links = yes\n");
+    assert_int_equal(run_cli("run links.ini --out lk"), 0);
+    snprintf(text, sizeof text, "%s%s%s", head, "lk/particles_links_000001.vtk", tail);
+    expect_bad("links_read.ini", text, 23, "a links file (LINES), not a particle frame");
+    size_t n = 0;
+    char* whole = test_read_file(tpath("lk/particles_000001.vtk"), &n);
+    assert_non_null(whole);
+    FILE* f = fopen(tpath("cut.vtk"), "wb");
+    assert_non_null(f);
+    fwrite(whole, 1, n / 2, f);
+    fclose(f);
+    free(whole);
+    snprintf(text, sizeof text, "%s%s%s", head, "cut.vtk", tail);
+    expect_bad("cut_read.ini", text, 23, "the file ends within");
+    write_text("empty.vtk.series",
+               "{\n  \"file-series-version\" : \"1.0\",\n  \"files\" : [\n  ]\n}\n");
+    snprintf(text, sizeof text, "%s%s%s", head, "empty.vtk.series", tail);
+    expect_bad("series_read.ini", text, 23, "empty.vtk.series: the index lists no frame");
+    /* and none of them to overlap a group before it */
+    snprintf(text, sizeof text,
+             WET_BOX "[particle.a]\nradius = 1e-3\nx = 1e-3\ny = 3e-3\nz = 1e-3\n"
+                     "[read.bed]\nfile = bed.csv\n[run]\ndt = 2e-6\nsteps = 1\n");
+    expect_bad("overlap_read.ini", text, 27,
+               "sphere 1 of [read.bed] overlaps sphere 1 of "
+               "[particle.a]");
+}
+
 /* The shipped examples check; the summary's budget: input = kinetic + potential + elastic +
  * dissipated exactly as defined, and the closure error small against the energies. */
 static void test_many_cli_examples_and_budget(void** state)
@@ -892,6 +1043,7 @@ int main(void)
         cmocka_unit_test(test_many_cli_summary_mean_size_readable),
         cmocka_unit_test(test_many_cli_progress_only_on_a_terminal),
         cmocka_unit_test(test_many_cli_random_groups_share_the_box),
+        cmocka_unit_test(test_many_cli_read_spheres_from_a_file),
         cmocka_unit_test(test_many_cli_examples_and_budget),
         cmocka_unit_test(test_many_cli_warns_about_the_step),
     };

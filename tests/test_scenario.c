@@ -194,6 +194,13 @@ static void test_scenario_bad_files_exit_2_with_line(void** state)
         {"empty header", "[ ]\nstokes = 5\n", ":1:", "unknown section []"},
         {"section", "[collision]\nstokes = 5\n[fluids]\nviscosity = 1\n",
          ":3:", "did you mean [fluid]"},
+        /* a misspelt family of named sections: the name kept, the family suggested */
+        {"family", "[box]\nsize_x = 1e-2\n[reed.bed]\nfile = a.csv\n",
+         ":3:", "unknown section [reed.bed] (did you mean [read.bed]?)"},
+        /* nothing close: every section, the named families as [FAMILY.NAME] */
+        {"no section", "[zzz]\n", ":1:",
+         "[material.NAME] [model.NAME] [sphere.NAME] "
+         "[insert.NAME] [particle.NAME] [read.NAME]"},
         {"key", "[collision]\nstokse = 5\n", ":2:", "did you mean 'stokes'"},
         {"nan", "[collision]\n\nstokes = nan\n", ":3:", "not a finite number"},
         {"inf", "[collision]\nspeed = inf\n", ":2:", "not a finite number"},

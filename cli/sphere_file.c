@@ -1,0 +1,532 @@
+/*
+ * sphere_file.c — spheres read from a file ([read.NAME] of a many-particle scenario; see
+ * sphere_file.h): a CSV table with a header naming its columns, or a particle frame written by
+ * a wetdem run (src/output_vtk.c: legacy VTK POLYDATA, ASCII with 17 digits or big-endian
+ * binary, the spheres' centres as POINTS and radius, velocity and spin among the point field
+ * arrays), so that a run can start from the state where another one ended: a packing settled
+ * dry and then wetted, a state from another code, a measured packing. A run's .vtk.series index
+ * stands for the last frame it lists.
+ *
+ * Every value is checked as the scenario keys of [particle.NAME] are (finite, and within the
+ * same ranges), with the line of the CSV or the array of the frame in the message. The values
+ * of a frame are its bits (binary) or its 17 digits (ASCII), so a run started from a frame
+ * starts from the state that wrote it.
+ */
+#include "sphere_file.h"
+
+#include <ctype.h>
+#include <errno.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdbool.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cli_util.h"
+
+#define MAX_SPHERES 100000000 /* as [insert] count */
+
+/* The columns a CSV may have (the [particle.NAME] keys), with their ranges and units. */
+enum column { X, Y, Z, RADIUS, VX, VY, VZ, SPIN_X, SPIN_Y, SPIN_Z, N_COLUMNS };
+static const char* const column_names[] = {"x",  "y",      "z",      "radius", "vx", "vy",
+                                           "vz", "spin_x", "spin_y", "spin_z", NULL};
+static const struct {
+    double lo, hi;
+    bool lo_open;
+    const char* unit;
+} column_range[N_COLUMNS] = {
+    {-1e3, 1e3, false, "m"},     {-1e3, 1e3, false, "m"},     {-1e3, 1e3, false, "m"},
+    {0, 1, true, "m"},           {-1e3, 1e3, false, "m/s"},   {-1e3, 1e3, false, "m/s"},
+    {-1e3, 1e3, false, "m/s"},   {-1e6, 1e6, false, "rad/s"}, {-1e6, 1e6, false, "rad/s"},
+    {-1e6, 1e6, false, "rad/s"},
+};
+
+static int fail(char* err, size_t err_len, const char* fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+
+static int fail(char* err, size_t err_len, const char* fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(err, err_len, fmt, ap);
+    va_end(ap);
+    return -1;
+}
+
+/* Whether value v lies in column c's range; otherwise writes why into err. */
+static bool in_range(enum column c, double v, char* err, size_t err_len, const char* where)
+{
+    bool ok = column_range[c].lo_open ? v > column_range[c].lo : v >= column_range[c].lo;
+    if (ok && v <= column_range[c].hi)
+        return true;
+    fail(err, err_len, "%s%s = %g %s is not in %c%g, %g] %s", where, column_names[c], v,
+         column_range[c].unit, column_range[c].lo_open ? '(' : '[', column_range[c].lo,
+         column_range[c].hi, column_range[c].unit);
+    return false;
+}
+
+/* The sphere of values v (indexed by column; absent columns 0). */
+static struct wetdem_particle sphere_of(const double v[N_COLUMNS])
+{
+    return (struct wetdem_particle){.pos = {v[X], v[Y], v[Z]},
+                                    .vel = {v[VX], v[VY], v[VZ]},
+                                    .omega = {v[SPIN_X], v[SPIN_Y], v[SPIN_Z]},
+                                    .radius = v[RADIUS]};
+}
+
+/* Appends p to the growing array *a (count *n, capacity *cap). */
+static bool push(struct wetdem_particle** a, size_t* n, size_t* cap, struct wetdem_particle p)
+{
+    if (*n == *cap) {
+        size_t c = *cap ? 2 * *cap : 256;
+        struct wetdem_particle* grown = realloc(*a, c * sizeof *grown);
+        if (!grown)
+            return false;
+        *a = grown;
+        *cap = c;
+    }
+    (*a)[(*n)++] = p;
+    return true;
+}
+
+/* The whole file, NUL-terminated, malloc'd; *len its length. NULL with errno set. */
+static char* read_all(const char* path, size_t* len)
+{
+    FILE* f = fopen(path, "rb");
+    if (!f)
+        return NULL;
+    size_t cap = 1 << 16, n = 0;
+    char* buf = malloc(cap);
+    while (buf) {
+        n += fread(buf + n, 1, cap - n - 1, f);
+        if (ferror(f) || n < cap - 1)
+            break;
+        char* grown = realloc(buf, 2 * cap);
+        if (!grown) {
+            free(buf);
+            buf = NULL;
+            errno = ENOMEM;
+            break;
+        }
+        buf = grown;
+        cap *= 2;
+    }
+    bool bad = !buf || ferror(f);
+    fclose(f);
+    if (bad) {
+        free(buf);
+        if (!errno)
+            errno = EIO;
+        return NULL;
+    }
+    buf[n] = '\0';
+    *len = n;
+    return buf;
+}
+
+/* ---------------------------------------------------------------------------- CSV --- */
+
+/* Cuts s at the end of its line (\n, and a \r before it); returns the next line or NULL. */
+static char* cut_line(char* s)
+{
+    char* nl = strchr(s, '\n');
+    if (nl)
+        *nl = '\0';
+    size_t len = strlen(s);
+    if (len && s[len - 1] == '\r')
+        s[len - 1] = '\0';
+    return nl ? nl + 1 : NULL;
+}
+
+/* s without leading and trailing blanks (in place). */
+static char* trim(char* s)
+{
+    while (isspace((unsigned char)*s))
+        s++;
+    size_t len = strlen(s);
+    while (len && isspace((unsigned char)s[len - 1]))
+        s[--len] = '\0';
+    return s;
+}
+
+static bool is_blank_or_comment(const char* s)
+{
+    while (isspace((unsigned char)*s))
+        s++;
+    return *s == '\0' || *s == '#';
+}
+
+/* The header's columns into col[] (the column of each field, in order; *n_fields of them). */
+static int read_header(char* line, size_t line_no, int col[N_COLUMNS], size_t* n_fields, char* err,
+                       size_t err_len)
+{
+    bool seen[N_COLUMNS] = {false};
+    *n_fields = 0;
+    char* save = NULL;
+    for (char* f = strtok_r(line, ",", &save); f; f = strtok_r(NULL, ",", &save)) {
+        char* name = trim(f);
+        name[strcspn(name, " [")] = '\0'; /* "x [m]" -> "x" */
+        int c = 0;
+        while (column_names[c] && strcmp(column_names[c], name) != 0)
+            c++;
+        if (!column_names[c]) {
+            const char* hint = wetdem_param_suggest(name, column_names);
+            return fail(err, err_len,
+                        "%zu: unknown column '%s'%s%s%s (columns: x, y, z, radius; optional vx, "
+                        "vy, vz, spin_x, spin_y, spin_z)",
+                        line_no, name, hint ? " (did you mean '" : "", hint ? hint : "",
+                        hint ? "'?)" : "");
+        }
+        if (seen[c])
+            return fail(err, err_len, "%zu: column '%s' given twice", line_no, name);
+        if (*n_fields == N_COLUMNS)
+            return fail(err, err_len, "%zu: too many columns", line_no);
+        seen[c] = true;
+        col[(*n_fields)++] = c;
+    }
+    for (int c = X; c <= RADIUS; c++)
+        if (!seen[c])
+            return fail(err, err_len,
+                        "%zu: the header has no column '%s' (x, y, z and radius are "
+                        "required)",
+                        line_no, column_names[c]);
+    return 0;
+}
+
+static int read_csv(char* text, struct wetdem_particle** out, size_t* n, char* err, size_t err_len)
+{
+    int col[N_COLUMNS];
+    size_t n_fields = 0, cap = 0, line_no = 0;
+    bool have_header = false;
+    if (strncmp(text, "\xEF\xBB\xBF", 3) == 0) /* a byte-order mark */
+        text += 3;
+    for (char *line = text, *next; line; line = next) {
+        next = cut_line(line);
+        if (!next && !*line)
+            break; /* (the end of a file that ends with a newline) */
+        line_no++;
+        if (is_blank_or_comment(line))
+            continue;
+        if (!have_header) {
+            if (read_header(line, line_no, col, &n_fields, err, err_len) != 0)
+                return -1;
+            have_header = true;
+            continue;
+        }
+        double v[N_COLUMNS] = {0};
+        size_t k = 0;
+        char where[64];
+        snprintf(where, sizeof where, "%zu: ", line_no);
+        for (char *f = line, *end;; f = end + 1) {
+            end = strchr(f, ',');
+            if (end)
+                *end = '\0';
+            if (k == n_fields)
+                return fail(err, err_len, "%zu: more fields than the header's %zu columns", line_no,
+                            n_fields);
+            char* field = trim(f);
+            if (cli_number(field, &v[col[k]]) != 0)
+                return fail(err, err_len, "%zu: %s = '%s' is not a finite number", line_no,
+                            column_names[col[k]], field);
+            if (!in_range(col[k], v[col[k]], err, err_len, where))
+                return -1;
+            k++;
+            if (!end)
+                break;
+        }
+        if (k != n_fields)
+            return fail(err, err_len, "%zu: %zu fields, the header has %zu columns", line_no, k,
+                        n_fields);
+        if (*n == MAX_SPHERES)
+            return fail(err, err_len, "%zu: more than %d spheres", line_no, MAX_SPHERES);
+        if (!push(out, n, &cap, sphere_of(v)))
+            return fail(err, err_len, "out of memory");
+    }
+    if (!have_header)
+        return fail(err, err_len,
+                    "%zu: no header (a line naming the columns: x, y, z, radius, "
+                    "...)",
+                    line_no);
+    if (*n == 0)
+        return fail(err, err_len, "%zu: no spheres after the header", line_no);
+    return 0;
+}
+
+/* ---------------------------------------------------------------------------- VTK --- */
+
+struct vtk_cursor {
+    const char* data;
+    size_t len, at;
+    bool binary;
+};
+
+/* The next line's words into w (at most 8, of at most 63 bytes); their number, -1 at the end. */
+static int vtk_line(struct vtk_cursor* c, char w[8][64])
+{
+    if (c->at >= c->len)
+        return -1;
+    const char* s = c->data + c->at;
+    const char* nl = memchr(s, '\n', c->len - c->at);
+    size_t len = nl ? (size_t)(nl - s) : c->len - c->at;
+    c->at += len + (nl != NULL);
+    int n = 0;
+    for (size_t k = 0; k < len && n < 8;) {
+        while (k < len && isspace((unsigned char)s[k]))
+            k++;
+        size_t b = k;
+        while (k < len && !isspace((unsigned char)s[k]))
+            k++;
+        if (k > b) {
+            size_t m = k - b < 63 ? k - b : 63;
+            memcpy(w[n], s + b, m);
+            w[n++][m] = '\0';
+        }
+    }
+    return n;
+}
+
+/* Whether count values of `size` bytes (binary) or of at least two characters (ASCII, a digit
+ * and a separator) can follow: checked before an array is allocated for them. */
+static bool vtk_fits(const struct vtk_cursor* c, size_t count, size_t size)
+{
+    return count <= (c->len - c->at) / (c->binary ? size : 2) + (c->binary ? 0 : 1);
+}
+
+/* count values of `type` (double, float or int) into out (NULL: skipped). */
+static int vtk_values(struct vtk_cursor* c, size_t count, const char* type, double* out,
+                      const char* what, char* err, size_t err_len)
+{
+    size_t size = strcmp(type, "double") == 0 ? 8 : 4;
+    bool is_int = strcmp(type, "int") == 0;
+    if (!is_int && size == 4 && strcmp(type, "float") != 0)
+        return fail(err, err_len, "%s: values of type '%s' (wetdem writes double and int)", what,
+                    type);
+    if (c->binary) {
+        if (count > (c->len - c->at) / size)
+            return fail(err, err_len, "%s: the file ends within its %zu values", what, count);
+        const unsigned char* p = (const unsigned char*)c->data + c->at;
+        for (size_t k = 0; out && k < count; k++, p += size) {
+            uint64_t u = 0;
+            for (size_t b = 0; b < size; b++)
+                u = u << 8 | p[b];
+            if (size == 8) {
+                memcpy(&out[k], &u, 8);
+            } else if (is_int) {
+                out[k] = (double)(int32_t)(uint32_t)u;
+            } else {
+                uint32_t u32 = (uint32_t)u;
+                float f;
+                memcpy(&f, &u32, 4);
+                out[k] = f;
+            }
+        }
+        c->at += count * size;
+        if (c->at < c->len && c->data[c->at] == '\n')
+            c->at++;
+        return 0;
+    }
+    for (size_t k = 0; k < count; k++) {
+        while (c->at < c->len && isspace((unsigned char)c->data[c->at]))
+            c->at++;
+        size_t b = c->at;
+        while (c->at < c->len && !isspace((unsigned char)c->data[c->at]))
+            c->at++;
+        char word[64];
+        size_t m = c->at - b;
+        if (m == 0)
+            return fail(err, err_len, "%s: the file ends within its %zu values", what, count);
+        if (m > 63)
+            return fail(err, err_len, "%s: value %zu is not a number", what, k + 1);
+        memcpy(word, c->data + b, m);
+        word[m] = '\0';
+        double v;
+        if (cli_number(word, &v) != 0)
+            return fail(err, err_len, "%s: value %zu, '%s', is not a finite number", what, k + 1,
+                        word);
+        if (out)
+            out[k] = v;
+    }
+    if (c->at < c->len && c->data[c->at] == '\n')
+        c->at++;
+    return 0;
+}
+
+/* A count from a header word: a whole number up to MAX_SPHERES x 3, or -1. */
+static long long vtk_count(const char* w)
+{
+    char* end;
+    errno = 0;
+    long long v = strtoll(w, &end, 10);
+    return errno || *end || v < 0 || v > 3LL * MAX_SPHERES ? -1 : v;
+}
+
+static int read_vtk(const char* data, size_t len, struct wetdem_particle** out, size_t* n,
+                    char* err, size_t err_len)
+{
+    struct vtk_cursor c = {.data = data, .len = len};
+    char w[8][64];
+    int nw = vtk_line(&c, w);
+    if (nw < 2 || strcmp(w[0], "#") != 0 || strcmp(w[1], "vtk") != 0)
+        return fail(err, err_len, "not a legacy VTK file (no '# vtk DataFile' first line)");
+    vtk_line(&c, w); /* the title */
+    nw = vtk_line(&c, w);
+    if (nw != 1 || (strcmp(w[0], "ASCII") != 0 && strcmp(w[0], "BINARY") != 0))
+        return fail(err, err_len, "line 3 is not ASCII or BINARY");
+    c.binary = strcmp(w[0], "BINARY") == 0;
+    nw = vtk_line(&c, w);
+    if (nw != 2 || strcmp(w[0], "DATASET") != 0 || strcmp(w[1], "POLYDATA") != 0)
+        return fail(err, err_len, "not a wetdem frame: line 4 is not DATASET POLYDATA");
+    double *pos = NULL, *arrays[3] = {NULL, NULL, NULL}; /* radius, velocity, spin */
+    static const char* const wanted[] = {"radius", "velocity", "spin"};
+    static const int comps[] = {1, 3, 3};
+    long long n_points = -1;
+    int rc = 0;
+    while (rc == 0 && (nw = vtk_line(&c, w)) >= 0) {
+        if (nw == 0)
+            continue;
+        if (strcmp(w[0], "POINTS") == 0 && nw == 3 && n_points < 0 &&
+            (n_points = vtk_count(w[1])) >= 0) {
+            if (n_points > MAX_SPHERES)
+                rc = fail(err, err_len, "POINTS %lld: more than %d spheres", n_points, MAX_SPHERES);
+            else if (!vtk_fits(&c, (size_t)(3 * n_points), 8))
+                rc = fail(err, err_len, "POINTS: the file ends within its %lld values",
+                          3 * n_points);
+            else if (!(pos = malloc((size_t)(3 * n_points + 1) * sizeof *pos)))
+                rc = fail(err, err_len, "out of memory");
+            else
+                rc = vtk_values(&c, (size_t)(3 * n_points), w[2], pos, "POINTS", err, err_len);
+        } else if (strcmp(w[0], "VERTICES") == 0 && nw == 3 && vtk_count(w[2]) >= 0) {
+            rc = vtk_values(&c, (size_t)vtk_count(w[2]), "int", NULL, "VERTICES", err, err_len);
+        } else if (strcmp(w[0], "LINES") == 0) {
+            rc = fail(err, err_len,
+                      "a links file (LINES), not a particle frame: give the frame "
+                      "PREFIX_NNNNNN.vtk beside it");
+        } else if (strcmp(w[0], "POINT_DATA") == 0 && nw == 2) {
+            if (vtk_count(w[1]) != n_points)
+                rc = fail(err, err_len, "POINT_DATA %s for %lld points", w[1], n_points);
+        } else if (strcmp(w[0], "FIELD") == 0 && nw == 3 && vtk_count(w[2]) >= 0) {
+            long long k_arrays = vtk_count(w[2]);
+            for (long long k = 0; rc == 0 && k < k_arrays; k++) {
+                nw = vtk_line(&c, w);
+                long long nc = nw == 4 ? vtk_count(w[1]) : -1, nt = nw == 4 ? vtk_count(w[2]) : -1;
+                if (nc <= 0 || nt < 0 || nc > 9) {
+                    rc = fail(err, err_len, "FIELD array %lld: not 'NAME COMPONENTS TUPLES TYPE'",
+                              k + 1);
+                    break;
+                }
+                int a = 0;
+                while (a < 3 && strcmp(w[0], wanted[a]) != 0)
+                    a++;
+                double* dest = NULL;
+                if (a < 3 && !arrays[a]) {
+                    if (nc != comps[a] || nt != n_points) {
+                        rc = fail(err, err_len, "array %s: %lld x %lld values, expected %d x %lld",
+                                  wanted[a], nt, nc, comps[a], n_points);
+                        break;
+                    }
+                    if (!vtk_fits(&c, (size_t)(nc * nt), 8)) {
+                        rc = fail(err, err_len, "array %s: the file ends within its values",
+                                  wanted[a]);
+                        break;
+                    }
+                    dest = arrays[a] = malloc((size_t)(nc * nt + 1) * sizeof *dest);
+                    if (!dest) {
+                        rc = fail(err, err_len, "out of memory");
+                        break;
+                    }
+                }
+                char what[80];
+                snprintf(what, sizeof what, "array %s", w[0]);
+                rc = vtk_values(&c, (size_t)(nc * nt), w[3], dest, what, err, err_len);
+            }
+        } else {
+            rc = fail(err, err_len, "not a wetdem frame: unexpected '%s'", w[0]);
+        }
+    }
+    if (rc == 0 && n_points <= 0)
+        rc = fail(err, err_len, "no POINTS (or none)");
+    if (rc == 0 && !arrays[0])
+        rc = fail(err, err_len, "no point array 'radius' (a frame of a wetdem run has one)");
+    size_t cap = 0;
+    for (long long i = 0; rc == 0 && i < n_points; i++) {
+        double v[N_COLUMNS] = {0};
+        for (int k = 0; k < 3; k++) {
+            v[X + k] = pos[3 * i + k];
+            v[VX + k] = arrays[1] ? arrays[1][3 * i + k] : 0;
+            v[SPIN_X + k] = arrays[2] ? arrays[2][3 * i + k] : 0;
+        }
+        v[RADIUS] = arrays[0][i];
+        char where[64];
+        snprintf(where, sizeof where, "sphere %lld: ", i + 1);
+        for (int k = 0; rc == 0 && k < N_COLUMNS; k++)
+            if (!isfinite(v[k]))
+                rc = fail(err, err_len, "%s%s is not a finite number", where, column_names[k]);
+            else if (!in_range(k, v[k], err, err_len, where))
+                rc = -1;
+        if (rc == 0 && !push(out, n, &cap, sphere_of(v)))
+            rc = fail(err, err_len, "out of memory");
+    }
+    free(pos);
+    for (int a = 0; a < 3; a++)
+        free(arrays[a]);
+    return rc;
+}
+
+/* The path of the last frame a .vtk.series index lists (ParaView's JSON, as
+ * src/output_vtk.c writes it: {"name" : "X", "time" : T} entries), beside the index. */
+static int last_frame(const char* index, const char* text, char* path, size_t n, char* err,
+                      size_t err_len)
+{
+    const char *entry = NULL, *at = text;
+    while ((at = strstr(at, "\"name\"")) != NULL)
+        entry = at++;
+    const char* open = entry ? strchr(entry + 6, '"') : NULL;
+    const char* close = open ? strchr(open + 1, '"') : NULL;
+    if (!close || close == open + 1)
+        return fail(err, err_len, "the index lists no frame (a .vtk.series of a wetdem run)");
+    const char* slash = strrchr(index, '/');
+    int dir = slash ? (int)(slash - index + 1) : 0;
+    if ((size_t)snprintf(path, n, "%.*s%.*s", dir, index, (int)(close - open - 1), open + 1) >= n)
+        return fail(err, err_len, "the path of its last frame is too long");
+    size_t len = strlen(path);
+    if (len < 5 || strcmp(path + len - 4, ".vtk") != 0)
+        return fail(err, err_len, "its last frame, %s, is not a .vtk file", path + dir);
+    return 0;
+}
+
+int cli_read_sphere_file(const char* path, struct wetdem_particle** out, size_t* n, char* err,
+                         size_t err_len)
+{
+    *out = NULL;
+    *n = 0;
+    size_t len = 0;
+    errno = 0;
+    char* text = read_all(path, &len);
+    if (!text)
+        return fail(err, err_len, "cannot read it: %s", strerror(errno));
+    size_t plen = strlen(path);
+    if (plen > 11 && strcmp(path + plen - 11, ".vtk.series") == 0) {
+        char frame[4200];
+        int rc = last_frame(path, text, frame, sizeof frame, err, err_len);
+        free(text);
+        if (rc != 0)
+            return rc;
+        char why[400];
+        if (cli_read_sphere_file(frame, out, n, why, sizeof why) == 0)
+            return 0;
+        return fail(err, err_len, "its last frame %s: %s", frame, why);
+    }
+    int rc = plen > 4 && strcmp(path + plen - 4, ".vtk") == 0
+                 ? read_vtk(text, len, out, n, err, err_len)
+                 : (memchr(text, '\0', len) ? fail(err, err_len, "a CSV with a NUL byte")
+                                            : read_csv(text, out, n, err, err_len));
+    free(text);
+    if (rc != 0) {
+        free(*out);
+        *out = NULL;
+        *n = 0;
+    }
+    return rc;
+}

@@ -1,0 +1,23 @@
+/*
+ * sphere_file.h — spheres read from a file for a many-particle scenario ([read.NAME]): a CSV
+ * table or a particle frame that a wetdem run wrote (PREFIX_NNNNNN.vtk, ASCII or binary).
+ */
+#ifndef WETDEM_CLI_SPHERE_FILE_H
+#define WETDEM_CLI_SPHERE_FILE_H
+
+#include <stddef.h>
+
+#include "wetdem.h"
+
+/* Reads the spheres of `path` into a malloc'd array *out of *n (caller frees): a file whose
+ * name ends in .vtk as a wetdem frame (POINTS, the point arrays radius and, when present,
+ * velocity and spin), any other as CSV ('#' lines and blank lines skipped; a header naming
+ * the columns, x, y, z and radius required, vx, vy, vz, spin_x, spin_y, spin_z optional, a
+ * name may carry its unit as "x [m]"; one row a sphere). Every value must be a finite number
+ * within the range of the [particle.NAME] key of that name. Material, film and mass are left
+ * at zero for the caller. Returns 0, or -1 with a one-line reason in err ("LINE: ..." for a
+ * CSV, naming the array for a frame; "out of memory" when that was the reason). */
+int cli_read_sphere_file(const char* path, struct wetdem_particle** out, size_t* n, char* err,
+                         size_t err_len);
+
+#endif
