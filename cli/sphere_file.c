@@ -23,6 +23,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "cli_util.h"
 
@@ -97,6 +98,12 @@ static char* read_all(const char* path, size_t* len)
     FILE* f = fopen(path, "rb");
     if (!f)
         return NULL;
+    struct stat st;
+    if (fstat(fileno(f), &st) != 0 || !S_ISREG(st.st_mode)) { /* not /dev/zero, a FIFO, ... */
+        fclose(f);
+        errno = S_ISDIR(st.st_mode) ? EISDIR : EINVAL;
+        return NULL;
+    }
     size_t cap = 1 << 16, n = 0;
     char* buf = malloc(cap);
     while (buf) {
@@ -505,7 +512,8 @@ int cli_read_sphere_file(const char* path, struct wetdem_particle** out, size_t*
     errno = 0;
     char* text = read_all(path, &len);
     if (!text)
-        return fail(err, err_len, "cannot read it: %s", strerror(errno));
+        return fail(err, err_len, "cannot read it: %s",
+                    errno == EINVAL ? "not a regular file" : strerror(errno));
     size_t plen = strlen(path);
     if (plen > 11 && strcmp(path + plen - 11, ".vtk.series") == 0) {
         char frame[4200];

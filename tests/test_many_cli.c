@@ -852,6 +852,8 @@ static void test_many_cli_read_spheres_from_a_file(void** state)
     char text[2048];
     snprintf(text, sizeof text, "%s%s%s", head, "missing.csv", tail);
     expect_bad("missing.ini", text, 23, "missing.csv: cannot read it: No such file or directory");
+    snprintf(text, sizeof text, "%s%s%s", head, "/dev/zero", tail); /* not read for ever */
+    expect_bad("device.ini", text, 23, "/dev/zero: cannot read it: not a regular file");
     /* a links file is not a frame; a binary frame cut short is refused, not read past its end */
     scenario("links.ini", "steps = 4\n[dump]\nvtk_every = 4\nvtk_links = yes\n");
     assert_int_equal(run_cli("run links.ini --out lk"), 0);
