@@ -143,7 +143,8 @@ bench: all
 	@scripts/bench $(BUILD)/wetdem
 
 # Fuzzing, in a build tree of its own: scenario files (every engine, as `run --check` reads
-# them), checkpoints, the dots CSV of `track` and the data CSV of `fit`, as any bytes
+# them), checkpoints, the dots CSV of `track`, the data CSV of `fit` and the spheres files of
+# [read.NAME], as any bytes
 # (tests/fuzz/, scripts/fuzz; README, "make fuzz").
 FUZZ_SECONDS ?= 120
 FUZZ_TARGETS = fuzz_scenario fuzz_checkpoint fuzz_track fuzz_fit_data fuzz_args fuzz_sphere_file
