@@ -111,7 +111,7 @@ static const struct cli_key_desc particle_keys[] = {
     {0},
 };
 
-static const struct cli_key_desc spheres_keys[] = {
+static const struct cli_key_desc read_keys[] = {
     WORD("file", CLI_VALUE_TEXT, "required", NULL,
          "The spheres' file, relative to the scenario file's directory unless absolute: a frame "
          "of a wetdem run (PREFIX_NNNNNN.vtk: centres, radius, velocity, spin; a run's "
@@ -189,7 +189,7 @@ const struct cli_section_desc cli_many_sections[] = {
      "Many-particle run: spheres read from a file, a frame of an earlier run or a CSV table (a "
      "packing settled dry and then wetted, a state from another code); added in file order "
      "with the other groups.",
-     spheres_keys},
+     read_keys},
     {"run", "Many-particle run: length, time step, neighbour-list skin, energy budget.", run_keys},
     {"dump", "Many-particle run: files written in `wetdem run --out DIR`.", dump_keys},
     {0},
