@@ -156,8 +156,9 @@ static const struct cli_key_desc dump_keys[] = {
          "yes: binary legacy VTK (exact, compact); no: ASCII with 17 digits."),
     WORD("vtk_links", CLI_VALUE_CHOICE, "no", cli_yes_no,
          "yes: with each frame, PREFIX_links_NNNNNN.vtk (index PREFIX_links.vtk.series): every "
-         "contact and liquid bridge as a line, with its gap and normal and tangential force "
-         "(force chains, bridge networks: docs/many.md)."),
+         "contact and liquid bridge, and every pair apart that lubrication acts on, as a line, "
+         "with its gap and normal and tangential force (force chains, bridge networks: "
+         "docs/many.md)."),
     WORD("csv", CLI_VALUE_TEXT, "global.csv", NULL,
          "CSV of global quantities (energies, contacts, liquid bridges, agglomerates, work per "
          "model) in --out DIR, ending in .csv; none disables it."),

@@ -697,7 +697,10 @@ WETDEM_API int wetdem_sim_write_vtk(struct wetdem_sim* sim, const char* path, bo
 
 /* Writes the links of a started many-particle run as a legacy VTK file of lines: each
  * particle pair in contact or joined by a liquid bridge, and each particle-wall contact (as
- * wetdem_many_stats counts them), from centre to centre (across periodic boundaries, to the
+ * wetdem_many_stats counts them), each liquid bridge to a wall (bridge 1; the counts leave
+ * them out), and each other particle or particle-wall pair on which a
+ * model exerts a force (lubrication between surfaces apart: nijssen, reynolds; contact and
+ * bridge 0), from centre to centre (across periodic boundaries, to the
  * nearest image) or from the centre to the wall, with the cell data i, j (-1 - w for wall w),
  * contact, bridge, gap [m], force_normal [N] (> 0 repulsive), force_tangential [N] and force
  * (the vector on i, on j its opposite) [N]: the

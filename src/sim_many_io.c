@@ -216,18 +216,17 @@ int wetdem_sim_write_vtk(struct wetdem_sim* sim, const char* path, bool binary)
     return st;
 }
 
-/* ---- links: contacts and liquid bridges as lines ---- */
+/* ---- links: contacts, liquid bridges and pairs apart that a model acts on, as lines ---- */
 
-/* Link of contact c (history `hist`, committed) into *l when it is a contact or a bridge;
- * false if it is neither. The force is that of the enabled models at this state with the
- * history as the latest step left it, not advanced (dt = 0, on a copy). */
+/* Link of contact c (history `hist`, committed) into *l when it is a contact or a bridge, or
+ * a model exerts a force on it (lubrication between spheres apart: nijssen, reynolds); false
+ * otherwise. The force is that of the enabled models at this state with the history as the
+ * latest step left it, not advanced (dt = 0, on a copy). */
 static bool link_of(const struct wetdem_sim* sim, struct wetdem_contact* c, const double* hist,
                     struct wetdem_output_vtk_link* l, int* status)
 {
     bool contact = wetdem_sim_contact_is_in_contact(sim, c, hist);
-    bool bridge = !c->is_wall && wetdem_sim_contact_is_bridged(sim, c, hist);
-    if (!contact && !bridge)
-        return false;
+    bool bridge = wetdem_sim_contact_is_bridged(sim, c, hist); /* (to a wall too, here) */
     double scratch[WETDEM_HISTORY_SCRATCH];
     if (sim->history_len)
         memcpy(scratch, hist, sim->history_len * sizeof *scratch);
@@ -236,6 +235,8 @@ static bool link_of(const struct wetdem_sim* sim, struct wetdem_contact* c, cons
     int st = wetdem_sim_eval_contact(sim, c, sim->history_len ? scratch : NULL, &f, NULL);
     if (st < 0 && *status == WETDEM_OK)
         *status = st;
+    if (!contact && !bridge && (st < 0 || (f.f_normal == 0 && vec3_norm(f.f_tan) == 0)))
+        return false;
     const struct wetdem_vec3 a = sim->particles[c->i].pos;
     double reach = c->gap + c->radius_i + (c->is_wall ? 0.0 : c->radius_j); /* a to b */
     *l = (struct wetdem_output_vtk_link){

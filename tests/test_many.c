@@ -1359,8 +1359,9 @@ static size_t vtk_array(const char* text, const char* name, double* out, size_t 
 
 /* The links file of the hand-built configuration, at rest (its velocities set to zero after
  * its step, so that no viscous or damping force acts): one line for each pair in contact or
- * bridged and each particle-wall contact (0-1 overlapping and bridged, 1-2 and 3-4 bridged
- * apart, 5 on the floor), from centre to centre or to the floor, |b - a| = r_i + r_j + h; the
+ * bridged, particles or with a wall (0-1 overlapping and bridged, 1-2 and 3-4 bridged apart,
+ * 5 on the floor in its film, 6 bridged to the floor 0.5 um above it), from centre to centre
+ * or to the floor, |b - a| = r_i + r_j + h; the
  * normal forces those of wetdem_sim_pair_force and of the closed forms, Hertz (4/3) E*
  * sqrt(R*) delta^(3/2) minus capillary suction 8 pi R* sigma, to 1e-12 (rounding of two
  * evaluations of the same sums: the engine's mixed properties and the pair's); no tangential
@@ -1377,7 +1378,7 @@ static void test_many_links_are_the_contacts_and_bridges(void** state)
     close(mkstemp(path));
     CHECK_OK(wetdem_sim_write_vtk_links(sim, path, false));
     char* text = test_read_file(path, NULL);
-    enum { L = 4 };
+    enum { L = 5 };
     double i[8], j[8], contact[8], bridge[8], gap[8], fn[8], ft[8], force[24], pts[48];
     assert_int_equal(vtk_array(text, "i", i, 8), L);
     vtk_array(text, "j", j, 8);
@@ -1387,13 +1388,14 @@ static void test_many_links_are_the_contacts_and_bridges(void** state)
     vtk_array(text, "force_normal", fn, 8);
     vtk_array(text, "force_tangential", ft, 8);
     assert_int_equal(vtk_array(text, "force", force, 24), 3 * L);
-    const char* points = strstr(text, "POINTS 8 double\n");
+    const char* points = strstr(text, "POINTS 10 double\n");
     assert_non_null(points);
-    points += strlen("POINTS 8 double\n");
+    points += strlen("POINTS 10 double\n");
     for (int k = 0; k < 3 * 2 * L; k++)
         pts[k] = strtod(points, (char**)&points);
-    CHECK_CONTAINS(text, "LINES 4 12\n2 0 1\n2 2 3\n2 4 5\n2 6 7\n");
-    static const double want[L][4] = {{0, 1, 1, 1}, {1, 2, 0, 1}, {3, 4, 0, 1}, {5, -1, 1, 0}};
+    CHECK_CONTAINS(text, "LINES 5 15\n2 0 1\n2 2 3\n2 4 5\n2 6 7\n2 8 9\n");
+    static const double want[L][4] = {
+        {0, 1, 1, 1}, {1, 2, 0, 1}, {3, 4, 0, 1}, {5, -1, 1, 1}, {6, -1, 0, 1}};
     double sigma = 0.02;
     for (int k = 0; k < L; k++) {
         assert_true(i[k] == want[k][0] && j[k] == want[k][1] && contact[k] == want[k][2] &&
@@ -1419,6 +1421,68 @@ static void test_many_links_are_the_contacts_and_bridges(void** state)
     free(text);
     remove(path);
     wetdem_sim_free(sim);
+}
+
+/* Lubrication between surfaces apart is a link too (contact and bridge 0), with its closed
+ * form: spheres 0 and 1 (R = 1 mm, gap 50 um < the cut-off R* = 0.5 mm) approaching at
+ * 0.02 m/s feel reynolds' 6 pi mu R*^2 v_n / h, evaluated at the frame's state (gap, normal and
+ * relative velocity of the positions and velocities after the step) to 1e-11 (h = |d| - 2R
+ * keeps about 1e-14 of its digits, the rest is the order of the same products); spheres 2
+ * and 3, 30 um apart and moving together, feel nothing and have no line, nor has any pair of
+ * a model set that exerts no force beyond contact and the films. */
+static void test_many_links_include_lubrication_apart(void** state)
+{
+    (void)state;
+    for (int wet = 0; wet < 2; wet++) {
+        struct wetdem_sim* sim = wetdem_sim_create();
+        struct wetdem_material m = {
+            .density = 2500, .youngs_modulus = 1e7, .poisson_ratio = 0.3, .restitution = 0.5};
+        assert_int_equal(wetdem_sim_add_material(sim, &m), 0);
+        double mu = 0.01, R = 1e-3, h = 50e-6, v = 0.01;
+        CHECK_OK(wetdem_sim_set_fluid(
+            sim,
+            &(struct wetdem_fluid){.viscosity = mu, .surface_tension = 0.02, .density = 1000}));
+        CHECK_OK(wetdem_sim_enable_model(sim, wet ? "reynolds" : "hertz"));
+        const struct wetdem_particle p[4] = {
+            {.pos = {3e-3, 3e-3, 5e-3}, .vel = {v, 0, 0}, .radius = R},
+            {.pos = {5e-3 + h, 3e-3, 5e-3}, .vel = {-v, 0, 0}, .radius = R},
+            {.pos = {3e-3, 7e-3, 5e-3}, .vel = {v, 0, 0}, .radius = R},
+            {.pos = {5e-3 + 30e-6, 7e-3, 5e-3}, .vel = {v, 0, 0}, .radius = R}};
+        for (int k = 0; k < 4; k++)
+            CHECK_OK(wetdem_sim_add_particle(sim, p[k]));
+        struct wetdem_many_settings s = {
+            .box_lo = {0, 0, 0}, .box_hi = {10e-3, 10e-3, 10e-3}, .dt = 1e-9, .skin = 0.1e-3};
+        CHECK_OK(wetdem_sim_set_many(sim, &s));
+        CHECK_OK(wetdem_sim_integrate(sim, 1e-9));
+        char path[] = "/tmp/wetdem_test_links_XXXXXX";
+        close(mkstemp(path));
+        CHECK_OK(wetdem_sim_write_vtk_links(sim, path, false));
+        char* text = test_read_file(path, NULL);
+        if (!wet) {
+            CHECK_CONTAINS(text, "LINES 0 0\n");
+        } else {
+            CHECK_CONTAINS(text, "LINES 1 3\n");
+            double i, j, contact, bridge, gap, fn;
+            vtk_array(text, "i", &i, 1);
+            vtk_array(text, "j", &j, 1);
+            vtk_array(text, "contact", &contact, 1);
+            vtk_array(text, "bridge", &bridge, 1);
+            vtk_array(text, "gap", &gap, 1);
+            vtk_array(text, "force_normal", &fn, 1);
+            assert_true(i + j == 1 && contact == 0 && bridge == 0);
+            const struct wetdem_particle* q = wetdem_sim_particles_const(sim, NULL);
+            struct wetdem_vec3 d = vec3_sub(q[(size_t)i].pos, q[(size_t)j].pos);
+            struct wetdem_vec3 n = vec3_scale(d, 1 / vec3_norm(d));
+            double v_n = -vec3_dot(vec3_sub(q[(size_t)i].vel, q[(size_t)j].vel), n);
+            double r_eff = R / 2, h_now = vec3_norm(d) - 2 * R;
+            CHECK_REL(gap, h_now, 1e-11);
+            CHECK_REL(fn, 6 * M_PI * mu * r_eff * r_eff * v_n / h_now, 1e-11);
+            assert_true(fn > 0 && fabs(v_n - 2 * v) < 1e-6 * v); /* approaching: repulsive */
+        }
+        free(text);
+        remove(path);
+        wetdem_sim_free(sim);
+    }
 }
 
 /* Across a periodic boundary a link runs from i to the nearest image of j, 2R + h long, and
@@ -1704,6 +1768,7 @@ int main(void)
         cmocka_unit_test(test_many_contacts_and_bridges_follow_the_models),
         cmocka_unit_test(test_many_links_are_the_contacts_and_bridges),
         cmocka_unit_test(test_many_links_cross_periodic_boundaries),
+        cmocka_unit_test(test_many_links_include_lubrication_apart),
         cmocka_unit_test(test_many_counts_survive_a_restart),
         cmocka_unit_test(test_many_writes_vtk_and_csv),
         cmocka_unit_test(test_many_restart_continues_outputs),
