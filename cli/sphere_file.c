@@ -251,6 +251,8 @@ static int read_csv(char* text, struct wetdem_particle** out, size_t* n, char* e
         if (!push(out, n, &cap, sphere_of(v)))
             return fail(err, err_len, "out of memory");
     }
+    if (line_no == 0)
+        return fail(err, err_len, "the file is empty (a CSV needs a header and a row a sphere)");
     if (!have_header)
         return fail(err, err_len,
                     "%zu: no header (a line naming the columns: x, y, z, radius, "

@@ -840,14 +840,16 @@ static void test_many_cli_read_spheres_from_a_file(void** state)
          "bad.csv:2: radius = -0.0001 m is not in (0, 1] m"},
         {"x,y,z,radius\n1e-3,1e-3,1e-3\n", "bad.csv:2: 3 fields, the header has 4 columns"},
         {"x,y,z,radius\n", "bad.csv:1: no spheres after the header"},
+        {"", "bad.csv: the file is empty"},
         {"x,y,z,radius\n1e-3,1e-3,9e-3,1e-4\n", "sphere 1 of [read.bed] (centre z = 0.009 m"},
     };
     for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {
         write_text("bad.csv", bad[k].csv);
         char text[2048];
         snprintf(text, sizeof text, "%s%s%s", head, "bad.csv", tail);
-        /* the sphere outside the box is a fault of the group (its section line, 22) */
-        expect_bad("badread.ini", text, 22 + (k < 6), bad[k].what);
+        /* the sphere outside the box (the last case) is a fault of the group: its section's
+           line, 22 */
+        expect_bad("badread.ini", text, 22 + (k + 1 < sizeof bad / sizeof bad[0]), bad[k].what);
     }
     char text[2048];
     snprintf(text, sizeof text, "%s%s%s", head, "missing.csv", tail);
