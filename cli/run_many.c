@@ -62,12 +62,10 @@ struct series {
     unsigned long long last_step; /* step of the latest frame (valid when n > 0) */
 };
 
-#define LINKS "_links"
-
 /* The name of frame k: PREFIX_NNNNNN.vtk, or of its links, PREFIX_links_NNNNNN.vtk. */
 static void frame_name(const struct series* s, size_t k, bool links, char* buf, size_t n)
 {
-    snprintf(buf, n, "%s%s_%06zu.vtk", s->prefix, links ? LINKS : "", k);
+    snprintf(buf, n, "%s%s_%06zu.vtk", s->prefix, links ? WETDEM_LINKS_SUFFIX : "", k);
 }
 
 /* Whether `name` is named as frame_name() names the frames (links: their links) of a series of
@@ -94,7 +92,7 @@ static int series_clear(const struct series* s)
     if (!d)
         return -1;
     char links_prefix[CLI_VALUE_MAX + 8], links_index[CLI_VALUE_MAX + 24];
-    snprintf(links_prefix, sizeof links_prefix, "%s" LINKS, s->prefix);
+    snprintf(links_prefix, sizeof links_prefix, "%s" WETDEM_LINKS_SUFFIX, s->prefix);
     snprintf(links_index, sizeof links_index, "%s.vtk.series", links_prefix);
     int rc = 0;
     for (struct dirent* e = readdir(d); e && rc == 0; e = readdir(d)) {
@@ -116,7 +114,8 @@ static int series_clear(const struct series* s)
 static int series_write_one(const struct series* s, bool links)
 {
     char path[PATH_CHARS + CLI_VALUE_MAX + 40], tmp[sizeof path + 8];
-    snprintf(path, sizeof path, "%s/%s%s.vtk.series", s->dir, s->prefix, links ? LINKS : "");
+    snprintf(path, sizeof path, "%s/%s%s.vtk.series", s->dir, s->prefix,
+             links ? WETDEM_LINKS_SUFFIX : "");
     snprintf(tmp, sizeof tmp, "%s.tmp", path);
     FILE* f = fopen(tmp, "w");
     if (!f)

@@ -601,7 +601,8 @@ struct wetdem_many_settings {
     bool vtk_binary;                     /* binary instead of ASCII VTK */
     bool vtk_links;                      /* with each VTK file, <prefix>_links_NNNNNN.vtk
                                             (wetdem_sim_write_vtk_links) and the index
-                                            <prefix>_links.vtk.series */
+                                            <prefix>_links.vtk.series
+                                            (WETDEM_LINKS_SUFFIX) */
     unsigned long long csv_every;        /* steps between rows of global quantities; 0: none */
     const char* checkpoint_path;         /* NULL: no checkpoints (copied) */
     unsigned long long checkpoint_every; /* steps between checkpoints; 0: only when stopped */
@@ -615,6 +616,9 @@ struct wetdem_many_settings {
 /* Most steps one wetdem_sim_integrate() call of a many-particle run takes: a longer call is
  * refused (a 2-core machine does some 1e7 particle-steps a second). */
 #define WETDEM_MANY_MAX_STEPS 1e15
+/* What links files add to the name of their frames and index: <prefix>_links_NNNNNN.vtk beside
+ * <prefix>_NNNNNN.vtk, <prefix>_links.vtk.series (the library's frames and the CLI's alike). */
+#define WETDEM_LINKS_SUFFIX "_links"
 
 /* Switches sim to the many-particle mode: wetdem_sim_integrate() then runs velocity Verlet
  * over cell lists (no event location), with walls, gravity, periodic axes, OpenMP, outputs and

@@ -25,7 +25,6 @@
 
 #define CSV_SUFFIX ".csv"
 #define SERIES_SUFFIX ".vtk.series"
-#define LINKS_SUFFIX "_links"
 /* Energy-budget accumulators of a checkpoint: k0, u0, el0, then per model the work on pairs
  * and on walls and the latest pass's part of each (many.h); checkpoints written before the
  * latest-pass terms were kept have only the first three groups. */
@@ -359,9 +358,9 @@ static char* links_name(const char* name)
 {
     const char* digits = strrchr(name, '_');
     size_t head = digits ? (size_t)(digits - name) : strlen(name);
-    char* s = malloc(strlen(name) + sizeof LINKS_SUFFIX);
+    char* s = malloc(strlen(name) + sizeof WETDEM_LINKS_SUFFIX);
     if (s)
-        sprintf(s, "%.*s" LINKS_SUFFIX "%s", (int)head, name, name + head);
+        sprintf(s, "%.*s" WETDEM_LINKS_SUFFIX "%s", (int)head, name, name + head);
     return s;
 }
 
@@ -379,7 +378,7 @@ static int write_links_series(struct wetdem_sim* sim)
         st = wetdem_sim_fail(sim, st, "out of memory for the links' index");
     char series[4096], msg[512];
     if (st == WETDEM_OK)
-        st = prefixed(sim, series, sizeof series, LINKS_SUFFIX SERIES_SUFFIX);
+        st = prefixed(sim, series, sizeof series, WETDEM_LINKS_SUFFIX SERIES_SUFFIX);
     if (st == WETDEM_OK && wetdem_output_vtk_series_write(series, (const char* const*)names,
                                                           m->vtk_times + m->links_from, n, msg,
                                                           sizeof msg) != WETDEM_OK)
@@ -398,7 +397,7 @@ static int write_vtk_frame(struct wetdem_sim* sim, const struct wetdem_output_vt
     wetdem_output_vtk_path(path, sizeof path, m->output_prefix, m->vtk_files);
     int st = write_particle_frame(sim, path, m->set.vtk_binary, counts);
     if (st == WETDEM_OK && m->set.vtk_links &&
-        (st = prefixed(sim, links_prefix, sizeof links_prefix, LINKS_SUFFIX)) == WETDEM_OK) {
+        (st = prefixed(sim, links_prefix, sizeof links_prefix, WETDEM_LINKS_SUFFIX)) == WETDEM_OK) {
         wetdem_output_vtk_path(links, sizeof links, links_prefix, m->vtk_files);
         st = wetdem_sim_write_vtk_links(sim, links, m->set.vtk_binary);
     }
