@@ -421,6 +421,73 @@ bool cli_wants_help(int argc, char** argv)
     return false;
 }
 
+int cli_csv_split(char* line, char** f, int max, bool is_header)
+{
+    int n = 0;
+    for (char* p = line; p && n < max; n++) {
+        char* comma = strchr(p, ',');
+        if (comma)
+            *comma = '\0';
+        while (*p == ' ' || *p == '\t')
+            p++;
+        char* end = p + strcspn(p, is_header ? "[\r\n" : "\r\n");
+        while (end > p && (end[-1] == ' ' || end[-1] == '\t'))
+            end--;
+        *end = '\0';
+        f[n] = p;
+        p = comma ? comma + 1 : NULL;
+    }
+    return n;
+}
+
+int cli_csv_columns(char** f, int n, const char* const* names, int* col, int* bad, char* err,
+                    size_t err_len)
+{
+    int n_names = 0;
+    while (names[n_names])
+        col[n_names++] = -1;
+    for (int k = 0; k < n; k++) {
+        int c = 0;
+        while (c < n_names && strcmp(f[k], names[c]) != 0)
+            c++;
+        *bad = k;
+        if (c < n_names && col[c] >= 0) {
+            snprintf(err, err_len, "column %s appears twice (columns %d and %d)", f[k], col[c] + 1,
+                     k + 1);
+            return CLI_CSV_TWICE;
+        }
+        if (c < n_names) {
+            col[c] = k;
+            continue;
+        }
+        const char* hint = f[k][0] ? wetdem_param_suggest(f[k], names) : NULL;
+        for (int m = 0; !hint && f[k][0] && m < n_names; m++) /* the unit left out: angle */
+            if (strncmp(names[m], f[k], strlen(f[k])) == 0)
+                hint = names[m];
+        snprintf(err, err_len, "unknown column '%s'%s%s%s", f[k], hint ? " (did you mean '" : "",
+                 hint ? hint : "", hint ? "'?)" : "");
+        return CLI_CSV_UNKNOWN;
+    }
+    return 0;
+}
+
+bool cli_series_entry(const char* line, char* name, size_t n, double* time)
+{
+    const char* p = strstr(line, "\"name\" : \"");
+    const char* q = p ? strstr(line, "\"time\" : ") : NULL;
+    if (!q)
+        return false;
+    p += strlen("\"name\" : \"");
+    size_t len = strcspn(p, "\"");
+    char* end;
+    *time = strtod(q + strlen("\"time\" : "), &end);
+    if (len == 0 || len >= n || p[len] != '"' || end == q + strlen("\"time\" : "))
+        return false;
+    memcpy(name, p, len);
+    name[len] = '\0';
+    return true;
+}
+
 const char* cli_option_hint(const char* arg, const char* const* options, char* buf, size_t n)
 {
     const char* hint = arg[0] == '-' ? wetdem_param_suggest(arg, options) : NULL;

@@ -64,6 +64,23 @@ bool cli_wants_help(int argc, char** argv);
  * "" when arg does not start with '-' or nothing is close. Returns buf, for "%s". */
 const char* cli_option_hint(const char* arg, const char* const* options, char* buf, size_t n);
 
+/* Splits a CSV line in place at commas into at most max fields f[], blanks trimmed, and a
+ * trailing " [unit]" too when is_header ("x [m]" is x). Returns the number of fields. */
+int cli_csv_split(char* line, char** f, int max, bool is_header);
+
+/* Maps the header fields f[0 .. n) to the columns `names` (NULL-terminated): col[c] is the
+ * field of column c, or -1. Each known column at most once, no other. Returns 0, or with *bad
+ * the offending field and why in err: CLI_CSV_UNKNOWN, "unknown column 'X'" with a "did you
+ * mean" hint (also for a name whose unit was left out: angle for angle_deg), or CLI_CSV_TWICE,
+ * "column X appears twice (columns I and J)". The caller adds the file and line. */
+enum { CLI_CSV_UNKNOWN = -1, CLI_CSV_TWICE = -2 };
+int cli_csv_columns(char** f, int n, const char* const* names, int* col, int* bad, char* err,
+                    size_t err_len);
+
+/* Whether `line` is an entry of a .vtk.series index as wetdem writes them,
+ * { "name" : "NAME", "time" : T }: then its name (if shorter than n) and time. */
+bool cli_series_entry(const char* line, char* name, size_t n, double* time);
+
 /* Writes the '#' provenance lines that start every CSV the CLI prints:
  *     # wetdem <version> (git <hash>)
  *     # command: wetdem <argv[0]> <argv[1]> ...

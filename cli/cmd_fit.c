@@ -165,62 +165,24 @@ static int parse_args(int argc, char** argv, struct fit_args* a)
 
 /* ---- data file ---------------------------------------------------------------------------- */
 
-/* Splits a CSV line in place at commas; trims blanks and a trailing " [unit]" when is_header.
- * Returns the number of fields (at most max). */
-static int split_csv(char* line, char** f, int max, bool is_header)
-{
-    int n = 0;
-    for (char* p = line; p && n < max; n++) {
-        char* comma = strchr(p, ',');
-        if (comma)
-            *comma = '\0';
-        while (*p == ' ' || *p == '\t')
-            p++;
-        char* end = p + strcspn(p, is_header ? "[\r\n" : "\r\n");
-        while (end > p && (end[-1] == ' ' || end[-1] == '\t'))
-            end--;
-        *end = '\0';
-        f[n] = p;
-        p = comma ? comma + 1 : NULL;
-    }
-    return n;
-}
-
 enum { COL_STOKES, COL_EN, COL_ANGLE, COL_OMEGA, N_COLS };
-static const char* const col_names[N_COLS] = {"stokes_n", "e_n", "angle_deg", "omega_rad_s"};
+static const char* const col_names[N_COLS + 1] = {"stokes_n", "e_n", "angle_deg", "omega_rad_s",
+                                                  NULL};
 
 /* Maps the header's fields to the columns: each known column at most once, no other (a column
  * the fit would not read, e.g. per-point uncertainties, is refused rather than ignored). */
 static int read_header(const char* path, long line, char** f, int n, int col[N_COLS])
 {
-    for (int c = 0; c < N_COLS; c++)
-        col[c] = -1;
-    for (int k = 0; k < n; k++) {
-        int c = 0;
-        while (c < N_COLS && strcmp(f[k], col_names[c]) != 0)
-            c++;
-        if (c < N_COLS && col[c] >= 0) {
-            cli_error("%s:%ld: column %s appears twice (columns %d and %d)", path, line, f[k],
-                      col[c] + 1, k + 1);
-            return CLI_EXIT_USAGE;
-        }
-        if (c < N_COLS) {
-            col[c] = k;
-            continue;
-        }
-        const char* names[N_COLS + 1];
-        memcpy(names, col_names, sizeof col_names);
-        names[N_COLS] = NULL;
-        const char* hint = f[k][0] ? wetdem_param_suggest(f[k], names) : NULL;
-        for (int m = 0; !hint && f[k][0] && m < N_COLS;
-             m++) /* "angle", "omega": the unit left out */
-            if (strncmp(col_names[m], f[k], strlen(f[k])) == 0)
-                hint = col_names[m];
-        cli_error("%s:%ld: column %d: unknown column '%s'%s%s%s; the columns are stokes_n and e_n "
-                  "(required), angle_deg and omega_rad_s (per-point uncertainties are not read: "
-                  "the scatter of the data about the fit sets the standard errors)",
-                  path, line, k + 1, f[k], hint ? " (did you mean '" : "", hint ? hint : "",
-                  hint ? "'?)" : "");
+    char why[300];
+    int bad = 0, rc = cli_csv_columns(f, n, col_names, col, &bad, why, sizeof why);
+    if (rc != 0) {
+        if (rc == CLI_CSV_TWICE)
+            cli_error("%s:%ld: %s", path, line, why);
+        else
+            cli_error("%s:%ld: column %d: %s; the columns are stokes_n and e_n (required), "
+                      "angle_deg and omega_rad_s (per-point uncertainties are not read: the "
+                      "scatter of the data about the fit sets the standard errors)",
+                      path, line, bad + 1, why);
         return CLI_EXIT_USAGE;
     }
     if (col[COL_STOKES] < 0 || col[COL_EN] < 0) {
@@ -308,7 +270,7 @@ static int read_data(const char* path, struct point** out, size_t* n_out)
         s += strspn(s, " \t");
         if (*s == '#' || *s == '\n' || *s == '\r' || *s == '\0')
             continue;
-        int nf = split_csv(s, f, 64, !have_header);
+        int nf = cli_csv_split(s, f, 64, !have_header);
         if (!have_header) {
             rc = read_header(path, line, f, nf, col);
             have_header = true;

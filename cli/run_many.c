@@ -201,9 +201,7 @@ static void series_resume(struct series* s, double t, unsigned long long step, d
     while (f && fgets(line, sizeof line, f)) {
         char name[CLI_VALUE_MAX + 40], want[CLI_VALUE_MAX + 40];
         double time;
-        const char* p = strstr(line, "\"name\" : \"");
-        const char* q = p ? strstr(line, "\"time\" : ") : NULL;
-        if (!q || sscanf(p + 10, "%290[^\"]", name) != 1 || sscanf(q + 9, "%lf", &time) != 1)
+        if (!cli_series_entry(line, name, sizeof name, &time))
             continue;
         frame_name(s, s->n, false, want, sizeof want);
         if (strcmp(name, want) != 0 || !(time <= t) || push_time(s, time) != 0)

@@ -604,11 +604,10 @@ static int build_sphere_file(const struct cli_scenario* sc, struct cli_many_setu
     sphere_file_path(sc, e->value, path, sizeof path);
     struct wetdem_particle* p = NULL;
     size_t n = 0;
-    if (cli_read_sphere_file(path, &p, &n, why, sizeof why) != 0) {
-        bool memory = strcmp(why, "out of memory") == 0;
+    if ((rc = cli_read_sphere_file(path, &p, &n, why, sizeof why)) != CLI_EXIT_OK) {
         /* "PATH:LINE: why" for a CSV (why starts with its line), "PATH: why" otherwise */
         cli_scenario_error(sc, e, "%s:%s%s", path, isdigit((unsigned char)why[0]) ? "" : " ", why);
-        return memory ? CLI_EXIT_RUNTIME : CLI_EXIT_USAGE;
+        return rc;
     }
     for (size_t k = 0; k < n && rc == CLI_EXIT_OK; k++) {
         p[k].material = material;

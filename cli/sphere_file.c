@@ -28,6 +28,7 @@
 #include "cli_util.h"
 
 #define MAX_SPHERES 100000000 /* as [insert] count */
+#define MAX_FIELDS 64         /* fields of a CSV line read (more: a count error) */
 
 /* The columns a CSV may have (the [particle.NAME] keys), with their ranges and units. */
 enum column { X, Y, Z, RADIUS, VX, VY, VZ, SPIN_X, SPIN_Y, SPIN_Z, N_COLUMNS };
@@ -47,13 +48,20 @@ static const struct {
 static int fail(char* err, size_t err_len, const char* fmt, ...)
     __attribute__((format(printf, 3, 4)));
 
+/* Writes why into err; returns CLI_EXIT_USAGE (bad input). */
 static int fail(char* err, size_t err_len, const char* fmt, ...)
 {
     va_list ap;
     va_start(ap, fmt);
     vsnprintf(err, err_len, fmt, ap);
     va_end(ap);
-    return -1;
+    return CLI_EXIT_USAGE;
+}
+
+static int no_memory(char* err, size_t err_len)
+{
+    snprintf(err, err_len, "out of memory");
+    return CLI_EXIT_RUNTIME;
 }
 
 /* Whether value v lies in column c's range; otherwise writes why into err. */
@@ -147,17 +155,6 @@ static char* cut_line(char* s)
     return nl ? nl + 1 : NULL;
 }
 
-/* s without leading and trailing blanks (in place). */
-static char* trim(char* s)
-{
-    while (isspace((unsigned char)*s))
-        s++;
-    size_t len = strlen(s);
-    while (len && isspace((unsigned char)s[len - 1]))
-        s[--len] = '\0';
-    return s;
-}
-
 static bool is_blank_or_comment(const char* s)
 {
     while (isspace((unsigned char)*s))
@@ -165,47 +162,33 @@ static bool is_blank_or_comment(const char* s)
     return *s == '\0' || *s == '#';
 }
 
-/* The header's columns into col[] (the column of each field, in order; *n_fields of them). */
-static int read_header(char* line, size_t line_no, int col[N_COLUMNS], size_t* n_fields, char* err,
+/* The header's fields (*n_fields of them) mapped to the columns: col[c] is the field of column
+ * c, or -1. */
+static int read_header(char* line, size_t line_no, int col[N_COLUMNS], int* n_fields, char* err,
                        size_t err_len)
 {
-    bool seen[N_COLUMNS] = {false};
-    *n_fields = 0;
-    char* save = NULL;
-    for (char* f = strtok_r(line, ",", &save); f; f = strtok_r(NULL, ",", &save)) {
-        char* name = trim(f);
-        name[strcspn(name, " [")] = '\0'; /* "x [m]" -> "x" */
-        int c = 0;
-        while (column_names[c] && strcmp(column_names[c], name) != 0)
-            c++;
-        if (!column_names[c]) {
-            const char* hint = wetdem_param_suggest(name, column_names);
-            return fail(err, err_len,
-                        "%zu: unknown column '%s'%s%s%s (columns: x, y, z, radius; optional vx, "
-                        "vy, vz, spin_x, spin_y, spin_z)",
-                        line_no, name, hint ? " (did you mean '" : "", hint ? hint : "",
-                        hint ? "'?)" : "");
-        }
-        if (seen[c])
-            return fail(err, err_len, "%zu: column '%s' given twice", line_no, name);
-        if (*n_fields == N_COLUMNS)
-            return fail(err, err_len, "%zu: too many columns", line_no);
-        seen[c] = true;
-        col[(*n_fields)++] = c;
-    }
+    char* f[MAX_FIELDS];
+    *n_fields = cli_csv_split(line, f, MAX_FIELDS, true);
+    char why[300];
+    int bad;
+    if (cli_csv_columns(f, *n_fields, column_names, col, &bad, why, sizeof why) != 0)
+        return fail(err, err_len,
+                    "%zu: %s (columns: x, y, z, radius; optional vx, vy, vz, spin_x, spin_y, "
+                    "spin_z)",
+                    line_no, why);
     for (int c = X; c <= RADIUS; c++)
-        if (!seen[c])
+        if (col[c] < 0)
             return fail(err, err_len,
                         "%zu: the header has no column '%s' (x, y, z and radius are "
                         "required)",
                         line_no, column_names[c]);
-    return 0;
+    return CLI_EXIT_OK;
 }
 
 static int read_csv(char* text, struct wetdem_particle** out, size_t* n, char* err, size_t err_len)
 {
-    int col[N_COLUMNS];
-    size_t n_fields = 0, cap = 0, line_no = 0;
+    int col[N_COLUMNS + 1], n_fields = 0;
+    size_t cap = 0, line_no = 0;
     bool have_header = false;
     if (strncmp(text, "\xEF\xBB\xBF", 3) == 0) /* a byte-order mark */
         text += 3;
@@ -217,39 +200,33 @@ static int read_csv(char* text, struct wetdem_particle** out, size_t* n, char* e
         if (is_blank_or_comment(line))
             continue;
         if (!have_header) {
-            if (read_header(line, line_no, col, &n_fields, err, err_len) != 0)
-                return -1;
+            int rc = read_header(line, line_no, col, &n_fields, err, err_len);
+            if (rc != CLI_EXIT_OK)
+                return rc;
             have_header = true;
             continue;
         }
+        char* f[MAX_FIELDS];
+        int nf = cli_csv_split(line, f, MAX_FIELDS, false);
+        if (nf != n_fields)
+            return fail(err, err_len, "%zu: %d fields, the header has %d columns", line_no, nf,
+                        n_fields);
         double v[N_COLUMNS] = {0};
-        size_t k = 0;
         char where[64];
         snprintf(where, sizeof where, "%zu: ", line_no);
-        for (char *f = line, *end;; f = end + 1) {
-            end = strchr(f, ',');
-            if (end)
-                *end = '\0';
-            if (k == n_fields)
-                return fail(err, err_len, "%zu: more fields than the header's %zu columns", line_no,
-                            n_fields);
-            char* field = trim(f);
-            if (cli_number(field, &v[col[k]]) != 0)
+        for (int c = 0; c < N_COLUMNS; c++) {
+            if (col[c] < 0)
+                continue;
+            if (cli_number(f[col[c]], &v[c]) != 0)
                 return fail(err, err_len, "%zu: %s = '%s' is not a finite number", line_no,
-                            column_names[col[k]], field);
-            if (!in_range(col[k], v[col[k]], err, err_len, where))
-                return -1;
-            k++;
-            if (!end)
-                break;
+                            column_names[c], f[col[c]]);
+            if (!in_range(c, v[c], err, err_len, where))
+                return CLI_EXIT_USAGE;
         }
-        if (k != n_fields)
-            return fail(err, err_len, "%zu: %zu fields, the header has %zu columns", line_no, k,
-                        n_fields);
         if (*n == MAX_SPHERES)
             return fail(err, err_len, "%zu: more than %d spheres", line_no, MAX_SPHERES);
         if (!push(out, n, &cap, sphere_of(v)))
-            return fail(err, err_len, "out of memory");
+            return no_memory(err, err_len);
     }
     if (line_no == 0)
         return fail(err, err_len, "the file is empty (a CSV needs a header and a row a sphere)");
@@ -403,7 +380,7 @@ static int read_vtk(const char* data, size_t len, struct wetdem_particle** out, 
                 rc = fail(err, err_len, "POINTS: the file ends within its %lld values",
                           3 * n_points);
             else if (!(pos = malloc((size_t)(3 * n_points + 1) * sizeof *pos)))
-                rc = fail(err, err_len, "out of memory");
+                rc = no_memory(err, err_len);
             else
                 rc = vtk_values(&c, (size_t)(3 * n_points), w[2], pos, "POINTS", err, err_len);
         } else if (strcmp(w[0], "VERTICES") == 0 && nw == 3 && vtk_count(w[2]) >= 0) {
@@ -442,7 +419,7 @@ static int read_vtk(const char* data, size_t len, struct wetdem_particle** out, 
                     }
                     dest = arrays[a] = malloc((size_t)(nc * nt + 1) * sizeof *dest);
                     if (!dest) {
-                        rc = fail(err, err_len, "out of memory");
+                        rc = no_memory(err, err_len);
                         break;
                     }
                 }
@@ -473,9 +450,9 @@ static int read_vtk(const char* data, size_t len, struct wetdem_particle** out, 
             if (!isfinite(v[k]))
                 rc = fail(err, err_len, "%s%s is not a finite number", where, column_names[k]);
             else if (!in_range(k, v[k], err, err_len, where))
-                rc = -1;
+                rc = CLI_EXIT_USAGE;
         if (rc == 0 && !push(out, n, &cap, sphere_of(v)))
-            rc = fail(err, err_len, "out of memory");
+            rc = no_memory(err, err_len);
     }
     free(pos);
     for (int a = 0; a < 3; a++)
@@ -483,26 +460,28 @@ static int read_vtk(const char* data, size_t len, struct wetdem_particle** out, 
     return rc;
 }
 
-/* The path of the last frame a .vtk.series index lists (ParaView's JSON, as
- * src/output_vtk.c writes it: {"name" : "X", "time" : T} entries), beside the index. */
-static int last_frame(const char* index, const char* text, char* path, size_t n, char* err,
+/* The path of the last frame a .vtk.series index lists (the text of the index, cut into lines
+ * here), beside the index. */
+static int last_frame(const char* index, char* text, char* path, size_t n, char* err,
                       size_t err_len)
 {
-    const char *entry = NULL, *at = text;
-    while ((at = strstr(at, "\"name\"")) != NULL)
-        entry = at++;
-    const char* open = entry ? strchr(entry + 6, '"') : NULL;
-    const char* close = open ? strchr(open + 1, '"') : NULL;
-    if (!close || close == open + 1)
+    char name[1024] = "", entry[sizeof name];
+    double time;
+    for (char *line = text, *next; line; line = next) {
+        next = cut_line(line);
+        if (cli_series_entry(line, entry, sizeof entry, &time))
+            memcpy(name, entry, sizeof name);
+    }
+    if (!name[0])
         return fail(err, err_len, "the index lists no frame (a .vtk.series of a wetdem run)");
     const char* slash = strrchr(index, '/');
     int dir = slash ? (int)(slash - index + 1) : 0;
-    if ((size_t)snprintf(path, n, "%.*s%.*s", dir, index, (int)(close - open - 1), open + 1) >= n)
+    if ((size_t)snprintf(path, n, "%.*s%s", dir, index, name) >= n)
         return fail(err, err_len, "the path of its last frame is too long");
     size_t len = strlen(path);
     if (len < 5 || strcmp(path + len - 4, ".vtk") != 0)
-        return fail(err, err_len, "its last frame, %s, is not a .vtk file", path + dir);
-    return 0;
+        return fail(err, err_len, "its last frame, %s, is not a .vtk file", name);
+    return CLI_EXIT_OK;
 }
 
 int cli_read_sphere_file(const char* path, struct wetdem_particle** out, size_t* n, char* err,
@@ -513,6 +492,8 @@ int cli_read_sphere_file(const char* path, struct wetdem_particle** out, size_t*
     size_t len = 0;
     errno = 0;
     char* text = read_all(path, &len);
+    if (!text && errno == ENOMEM)
+        return no_memory(err, err_len);
     if (!text)
         return fail(err, err_len, "cannot read it: %s",
                     errno == EINVAL ? "not a regular file" : strerror(errno));
@@ -521,12 +502,10 @@ int cli_read_sphere_file(const char* path, struct wetdem_particle** out, size_t*
         char frame[4200];
         int rc = last_frame(path, text, frame, sizeof frame, err, err_len);
         free(text);
-        if (rc != 0)
-            return rc;
         char why[400];
-        if (cli_read_sphere_file(frame, out, n, why, sizeof why) == 0)
-            return 0;
-        return fail(err, err_len, "its last frame %s: %s", frame, why);
+        if (rc == CLI_EXIT_OK && (rc = cli_read_sphere_file(frame, out, n, why, sizeof why)) != 0)
+            snprintf(err, err_len, "its last frame %s: %s", frame, why);
+        return rc;
     }
     int rc = plen > 4 && strcmp(path + plen - 4, ".vtk") == 0
                  ? read_vtk(text, len, out, n, err, err_len)
