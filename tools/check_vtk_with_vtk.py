@@ -29,7 +29,7 @@ import sys
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from wetdem_vtk import read_series, read_vtk  # noqa: E402
+from wetdem_vtk import LINK_ARRAYS, POINT_ARRAYS, read_series, read_vtk  # noqa: E402
 
 try:
     from vtkmodules.util.numpy_support import vtk_to_numpy
@@ -39,11 +39,6 @@ except ImportError:
     print("check_vtk_with_vtk: needs VTK's Python module (Debian package python3-vtk9)",
           file=sys.stderr)
     sys.exit(2)
-
-POINT_ARRAYS = {"radius": 1, "velocity": 3, "spin": 3, "contacts": 1, "bridges": 1,
-                "agglomerate": 1, "material": 1, "id": 1}
-LINK_ARRAYS = {"i": 1, "j": 1, "contact": 1, "bridge": 1, "gap": 1, "force_normal": 1,
-               "force_tangential": 1, "force": 3}
 
 failures = []
 link_kinds = {"pair": 0, "periodic": 0, "wall": 0}  # links checked, by kind

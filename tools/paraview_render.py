@@ -19,24 +19,22 @@ it gives POLYDATA with the arrays of docs/many.md (point arrays for frames, cell
 links), one vertex a particle and two points a link.
 """
 import argparse
-import json
 import os
 import sys
 
 from paraview.simple import (AssignViewToLayout, Clip, ColorBy, CreateLayout, CreateView,
-                             ExtractSurface,
-                             GetColorTransferFunction, GetScalarBar, Glyph, OpenDataFile, Render,
-                             SaveScreenshot, Show, Tube, UpdatePipeline, servermanager)
+                             ExtractSurface, GetColorTransferFunction, GetScalarBar, Glyph,
+                             OpenDataFile, Render, SaveScreenshot, Show, Tube, UpdatePipeline,
+                             servermanager)
 
-POINT_ARRAYS = ["radius", "velocity", "spin", "contacts", "bridges", "agglomerate", "material",
-                "id"]
-LINK_ARRAYS = ["i", "j", "contact", "bridge", "gap", "force_normal", "force_tangential", "force"]
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from wetdem_vtk import LINK_ARRAYS, POINT_ARRAYS, read_series  # noqa: E402
 
 
 def check(index):
     """Opens the index in ParaView; returns (source, its times, its failures)."""
     failures = []
-    listed = [e["time"] for e in json.load(open(index))["files"]]
+    listed = [t for t, _ in read_series(index)]
     src = OpenDataFile(index)
     times = list(src.TimestepValues) if len(listed) > 1 else listed
     if times != listed:
@@ -48,7 +46,7 @@ def check(index):
         d = servermanager.Fetch(src)
         data = d.GetCellData() if links else d.GetPointData()
         names = [data.GetArrayName(k) for k in range(data.GetNumberOfArrays())]
-        want = LINK_ARRAYS if links else POINT_ARRAYS
+        want = list(LINK_ARRAYS if links else POINT_ARRAYS)
         if d.GetClassName() != "vtkPolyData" or names != want:
             failures.append(f"{index} at t = {t}: {d.GetClassName()} with {names}, expected "
                             f"vtkPolyData with {want}")

@@ -17,6 +17,14 @@ import sys
 import numpy as np
 
 
+# The arrays of a frame (point data) and of a links file (cell data), in the order
+# src/output_vtk.c writes them, with their numbers of components.
+POINT_ARRAYS = {"radius": 1, "velocity": 3, "spin": 3, "contacts": 1, "bridges": 1,
+                "agglomerate": 1, "material": 1, "id": 1}
+LINK_ARRAYS = {"i": 1, "j": 1, "contact": 1, "bridge": 1, "gap": 1, "force_normal": 1,
+               "force_tangential": 1, "force": 3}
+
+
 def read_vtk(path):
     """The arrays of a frame or links file written by wetdem (legacy POLYDATA, ASCII or
     big-endian binary: src/output_vtk.c) as {name: array}: TIME, POINTS (n x 3), VERTICES or
