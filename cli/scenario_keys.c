@@ -263,6 +263,7 @@ void cli_section_suggestion(const char* name, char* msg, size_t n)
     }
     /* the fixed sections, and the families NAME.* (shown as [NAME.NAME]) */
     const char* names[40];
+    const char* fam[13]; /* -> families[], NULL-terminated */
     char families[12][32];
     size_t m = 0, nf = 0;
     const struct cli_section_desc* tables[3] = {sections, cli_pairwise_sections, cli_many_sections};
@@ -271,19 +272,19 @@ void cli_section_suggestion(const char* name, char* msg, size_t n)
             const char* star = strstr(tables[t][k].name, ".*");
             if (!star)
                 names[m++] = tables[t][k].name;
-            else if (nf < 12)
-                snprintf(families[nf++], sizeof families[0], "%.*s",
-                         (int)(star - tables[t][k].name), tables[t][k].name);
+            else if (nf < 12) {
+                snprintf(families[nf], sizeof families[0], "%.*s", (int)(star - tables[t][k].name),
+                         tables[t][k].name);
+                fam[nf] = families[nf];
+                nf++;
+            }
         }
     names[m] = NULL;
+    fam[nf] = NULL;
     const char* dot = strchr(name, '.');
     if (dot) { /* a misspelt family: [reed.bed] -> [read.bed] */
         char prefix[64];
         snprintf(prefix, sizeof prefix, "%.*s", (int)(dot - name), name);
-        const char* fam[13];
-        for (size_t k = 0; k < nf; k++)
-            fam[k] = families[k];
-        fam[nf] = NULL;
         const char* hint = wetdem_param_suggest(prefix, fam);
         if (hint) {
             snprintf(msg, n, " (did you mean [%s%s]?)", hint, dot);
