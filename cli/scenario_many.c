@@ -107,7 +107,9 @@ static const struct cli_key_desc particle_keys[] = {
     NUM("spin_y", "rad/s", "0", -1e6, 1e6, false, false, "Spin, y."),
     NUM("spin_z", "rad/s", "0", -1e6, 1e6, false, false, "Spin, z."),
     WORD("material", CLI_VALUE_NAME, "steel1", NULL, "Material, as in [insert]."),
-    WORD("fixed", CLI_VALUE_CHOICE, "no", cli_yes_no, "yes: held in place (infinite mass)."),
+    WORD("fixed", CLI_VALUE_CHOICE, "no", cli_yes_no,
+         "yes: held in place (infinite mass), at rest: vx ... spin_z must then be 0. Fixed "
+         "spheres meet neither each other nor the walls."),
     {0},
 };
 
@@ -121,6 +123,10 @@ static const struct cli_key_desc read_keys[] = {
          "Values are checked as the keys of [particle.NAME]. The spheres may overlap each other "
          "and the walls (a settled packing does); their centres must lie in the box."),
     WORD("material", CLI_VALUE_NAME, "steel1", NULL, "Material of every sphere, as in [insert]."),
+    WORD("fixed", CLI_VALUE_CHOICE, "no", cli_yes_no,
+         "yes: every sphere of the file held in place (infinite mass), e.g. a rough base of "
+         "glued spheres; the file's velocities and spins are then not used (a fixed sphere is "
+         "at rest)."),
     {0},
 };
 
@@ -609,8 +615,12 @@ static int build_sphere_file(const struct cli_scenario* sc, struct cli_many_setu
         cli_scenario_error(sc, e, "%s:%s%s", path, isdigit((unsigned char)why[0]) ? "" : " ", why);
         return rc;
     }
+    bool fixed = strcmp(cli_scenario_text(sc, section, "fixed", "no"), "yes") == 0;
     for (size_t k = 0; k < n && rc == CLI_EXIT_OK; k++) {
         p[k].material = material;
+        if (fixed)
+            p[k] = (struct wetdem_particle){
+                .pos = p[k].pos, .radius = p[k].radius, .material = material, .is_fixed = true};
         if (wetdem_sim_add_particle(su->sim, p[k]) != WETDEM_OK)
             rc = cli_scenario_lib_error(sc, e, section, su->sim);
     }

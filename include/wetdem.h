@@ -53,7 +53,8 @@ struct wetdem_particle {
     double radius;            /* [m], > 0 */
     double mass;              /* [kg], > 0; 0 means "from the material density" when added */
     int material;             /* index into the simulation's material table */
-    bool is_fixed;            /* held in place (infinite mass), e.g. a target on a support */
+    bool is_fixed;            /* held in place (infinite mass), e.g. a target on a support;
+                               * its velocity and spin must then be zero */
 };
 
 /* Solid and film properties of one material. All per particle; pairs mix them

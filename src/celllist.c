@@ -13,8 +13,9 @@
  *     of particles: (x+1, y, z), (x-1..x+1, y+1, z) and (x-1..x+1, y-1..y+1, z+1). On a
  *     periodic axis with n >= 3 cells the offsets wrap and still name distinct cells; with
  *     n <= 2 they would coincide, so there the distinct neighbours B of A are enumerated and
- *     only those with index B > A are searched. A pair (a, b) with h_ab < reach + skin is
- *     stored as (min, max) in a per-thread buffer; threads take contiguous blocks of cells
+ *     only those with index B > A are searched. A pair (a, b) with h_ab < reach + skin, not
+ *     both fixed, is stored as (min, max) in a per-thread buffer; threads take contiguous
+ *     blocks of cells
  *     with about n / threads particles each;
  *  3. counting-sorts the buffers by i into the list (first_pair holds the offsets) and sorts
  *     each segment by j (insertion sort: segments are short). The result does not depend on
@@ -88,6 +89,7 @@ void wetdem_celllist_clear(struct wetdem_celllist* cl)
     free(cl->cell_items);
     free(cl->cell_of);
     free(cl->sorted);
+    free(cl->fixed_sorted);
     free(cl->pairs);
     free(cl->first_pair);
     free(cl->pos_at_build);
@@ -184,6 +186,7 @@ static int bin_particles(struct wetdem_celllist* cl, const struct wetdem_particl
         reserve((void**)&cl->cell_items, &cl->items_cap, n, sizeof(uint32_t)) ||
         reserve((void**)&cl->cell_of, &cl->cell_of_cap, n, sizeof(uint32_t)) ||
         reserve((void**)&cl->sorted, &cl->sorted_cap, n, sizeof *cl->sorted) ||
+        (cl->any_fixed && reserve((void**)&cl->fixed_sorted, &cl->fixed_cap, n, 1)) ||
         reserve((void**)&cl->counts, &cl->counts_cap, (size_t)nt * n_cells, sizeof(size_t)))
         return WETDEM_ERR_NOMEM;
 #pragma omp parallel num_threads(nt)
@@ -216,6 +219,8 @@ static int bin_particles(struct wetdem_celllist* cl, const struct wetdem_particl
             cl->cell_items[s] = (uint32_t)i;
             cl->sorted[s] =
                 (struct wetdem_celllist_item){p[i].pos.x, p[i].pos.y, p[i].pos.z, p[i].radius};
+            if (cl->any_fixed)
+                cl->fixed_sorted[s] = p[i].is_fixed;
         }
     }
     return WETDEM_OK;
@@ -318,7 +323,8 @@ struct scan {
     const struct wetdem_celllist_item* x; /* cell-ordered positions and radii */
     const uint32_t* id;                   /* cell-ordered particle indices */
     const struct wetdem_celllist_box* box;
-    double extra;     /* reach + skin [m] */
+    const unsigned char* fixed; /* cell-ordered is_fixed, NULL when no particle is fixed */
+    double extra;               /* reach + skin [m] */
     ptrdiff_t off[5]; /* first cell of the 5 forward rows of an interior cell, from the cell */
 };
 
@@ -336,6 +342,7 @@ static inline __attribute__((always_inline)) size_t scan_runs(const struct scan*
                                                               bool periodic)
 {
     const struct wetdem_celllist_item a = sc->x[s];
+    bool a_fixed = sc->fixed && sc->fixed[s]; /* then its fixed partners are left out */
     size_t count = 0;
     for (int r = 0; r < m; r++)
         for (size_t t = runs[r].lo; t < runs[r].hi; t++) {
@@ -344,7 +351,7 @@ static inline __attribute__((always_inline)) size_t scan_runs(const struct scan*
                 periodic ? celllist_delta(sc->box, vec3(a.x, a.y, a.z), vec3(b->x, b->y, b->z))
                          : vec3(a.x - b->x, a.y - b->y, a.z - b->z);
             double lim = a.r + b->r + sc->extra;
-            if (vec3_dot(d, d) < lim * lim)
+            if (vec3_dot(d, d) < lim * lim && !(a_fixed && sc->fixed[t]))
                 out[count++] = ordered(sc->id[s], sc->id[t]);
         }
     return count;
@@ -455,7 +462,7 @@ static int scan_block(struct wetdem_celllist* cl, const struct scan* sc, size_t 
 
 /* Checks the particles; r_max [m] is the largest radius, [lo, hi] the bounding box [m]. */
 static int check_input(const struct wetdem_particle* p, size_t n, double* r_max, double lo[3],
-                       double hi[3], char* msg, size_t msg_size)
+                       double hi[3], bool* any_fixed, char* msg, size_t msg_size)
 {
     if (n >= UINT32_MAX) {
         set_msg(msg, msg_size, "too many particles for the neighbour list: %zu (limit %u)", n,
@@ -466,12 +473,14 @@ static int check_input(const struct wetdem_particle* p, size_t n, double* r_max,
        particle is the lowest index of one */
     double r = 0, l[3] = {INFINITY, INFINITY, INFINITY}, h[3] = {-INFINITY, -INFINITY, -INFINITY};
     size_t bad = SIZE_MAX;
+    int fixed = 0;
 #pragma omp parallel for schedule(static) reduction(max                                            \
-                                                    : r, h[:3])                                    \
+                                                    : r, h[:3], fixed)                             \
     reduction(min                                                                                  \
               : l[:3], bad) if (n >= PARALLEL_MIN)
     for (size_t i = 0; i < n; i++) {
         double x[3] = {p[i].pos.x, p[i].pos.y, p[i].pos.z};
+        fixed = p[i].is_fixed ? 1 : fixed;
         if (!vec3_is_finite(p[i].pos) || !(p[i].radius > 0 && isfinite(p[i].radius))) {
             bad = i < bad ? i : bad;
             continue;
@@ -488,6 +497,7 @@ static int check_input(const struct wetdem_particle* p, size_t n, double* r_max,
         return WETDEM_ERR_INVALID;
     }
     *r_max = r;
+    *any_fixed = fixed != 0;
     memcpy(lo, l, sizeof l);
     memcpy(hi, h, sizeof h);
     return WETDEM_OK;
@@ -617,6 +627,7 @@ static int fill_pairs(struct wetdem_celllist* cl, size_t n)
     struct scan sc = {cl->sorted,
                       cl->cell_items,
                       &cl->box,
+                      cl->any_fixed ? cl->fixed_sorted : NULL,
                       cl->reach + cl->skin,
                       {1, nx - 1, nxy - nx - 1, nxy - 1, nxy + nx - 1}};
 #pragma omp parallel num_threads(max_threads)
@@ -642,7 +653,7 @@ int wetdem_celllist_build(struct wetdem_celllist* cl, const struct wetdem_partic
                           char* msg, size_t msg_size)
 {
     double r_max, lo[3], hi[3];
-    int st = check_input(p, n, &r_max, lo, hi, msg, msg_size);
+    int st = check_input(p, n, &r_max, lo, hi, &cl->any_fixed, msg, msg_size);
     if (st != WETDEM_OK)
         return st;
     st = setup_grid(cl, lo, hi, n, 2 * r_max + cl->reach + cl->skin, msg, msg_size);

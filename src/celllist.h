@@ -12,7 +12,9 @@
  * is the Verlet margin. Between builds no particle may move more than skin/2 (rebuild
  * criterion, wetdem_celllist_needs_rebuild), so a gap can shrink by at most skin and every pair
  * with h_ij < reach at any time is in the list (Verlet 1967; the guarantee that LAMMPS PR #4685
- * restored for beyond-contact granular pairs).
+ * restored for beyond-contact granular pairs). A pair of two fixed particles (is_fixed) is not
+ * listed: neither moves, and infinite masses have no pair force (the two-body engine's pair
+ * set, pairs.c, leaves them out alike).
  *
  * Cells are cubes-or-boxes of edge >= 2 R_max + reach + skin, so every candidate of a particle
  * lies in its own cell or one of the 26 neighbouring cells; each pair of neighbouring cells is
@@ -61,7 +63,9 @@ struct wetdem_celllist {
     uint32_t* cell_items;                /* particle indices grouped by cell */
     uint32_t* cell_of;                   /* cell of each particle */
     struct wetdem_celllist_item* sorted; /* positions and radii aligned with cell_items */
-    size_t cells_cap, items_cap, cell_of_cap, sorted_cap;
+    unsigned char* fixed_sorted;         /* is_fixed aligned with cell_items, when any_fixed */
+    bool any_fixed;                      /* a particle of the build is fixed */
+    size_t cells_cap, items_cap, cell_of_cap, sorted_cap, fixed_cap;
     /* pair list, sorted by (i, j) */
     struct wetdem_celllist_pair* pairs;
     size_t n_pairs, pairs_cap;

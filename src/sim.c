@@ -136,6 +136,14 @@ bool wetdem_sim_particle_valid(const struct wetdem_particle* p, char* why, size_
         snprintf(why, n, "radius must be > 0 and finite, got %g m", p->radius);
     else if (!(isfinite(p->mass) && p->mass > 0))
         snprintf(why, n, "mass must be > 0 and finite, got %g kg", p->mass);
+    else if (p->is_fixed && !(p->vel.x == 0 && p->vel.y == 0 && p->vel.z == 0 && p->omega.x == 0 &&
+                              p->omega.y == 0 && p->omega.z == 0))
+        /* the engines neither move it nor count its energy: a velocity would enter the pair
+         * forces as the surface speed of a sphere that stands still */
+        snprintf(why, n,
+                 "a fixed particle is held in place: its velocity and spin must be 0, got v = "
+                 "(%g, %g, %g) m/s, omega = (%g, %g, %g) rad/s",
+                 p->vel.x, p->vel.y, p->vel.z, p->omega.x, p->omega.y, p->omega.z);
     else
         return true;
     return false;
@@ -157,7 +165,7 @@ int wetdem_sim_add_particle(struct wetdem_sim* sim, struct wetdem_particle p)
                                    "%g kg/m^3, R = %g m) is not a positive finite number",
                                    k, p.mass, density, p.radius);
     }
-    char why[128];
+    char why[256];
     if (!wetdem_sim_particle_valid(&p, why, sizeof why))
         return wetdem_sim_fail(sim, WETDEM_ERR_INVALID, "particle %zu: %s", k, why);
     if (grow((void**)&sim->particles, &sim->particles_cap, k + 1, sizeof p) != WETDEM_OK)

@@ -509,8 +509,9 @@ static void swap_pair_arrays(struct wetdem_many* m)
     m->flags_cap = cap;
 }
 
-/* Walls within wall_reach + skin of each particle at this build (Verlet criterion as for pairs);
- * the histories of the other particle-wall pairs are reset. */
+/* Walls within wall_reach + skin of each particle at this build (Verlet criterion as for pairs),
+ * none for a fixed particle (it never meets a wall: pairs.c alike); the histories of the other
+ * particle-wall pairs are reset. */
 static int update_wall_masks(struct wetdem_sim* sim)
 {
     struct wetdem_many* m = sim->many;
@@ -521,11 +522,12 @@ static int update_wall_masks(struct wetdem_sim* sim)
 #pragma omp parallel for schedule(static) if (wetdem_many_parallel(m, n))
     for (size_t i = 0; i < n; i++) {
         uint64_t mask = 0;
+        bool fixed = sim->particles[i].is_fixed;
         for (size_t w = 0; w < nw && w < 64; w++) {
             const struct wetdem_wall* wall = &sim->walls[w];
             double gap = vec3_dot(vec3_sub(sim->particles[i].pos, wall->point), wall->normal) -
                          sim->particles[i].radius;
-            if (gap < lim)
+            if (gap < lim && !fixed)
                 mask |= (uint64_t)1 << w;
             else if (len && m->wall_dirty[i] >> w & 1) {
                 wetdem_sim_history_init(sim, m->wall_history + (i * nw + w) * len);
@@ -539,7 +541,7 @@ static int update_wall_masks(struct wetdem_sim* sim)
     m->n_wall_list = 0;
     size_t n_entries = 0;
     for (size_t i = 0; i < n; i++) {
-        if (m->wall_mask[i] || nw > 64)
+        if (m->wall_mask[i] || (nw > 64 && !sim->particles[i].is_fixed))
             m->wall_list[m->n_wall_list++] = (uint32_t)i;
         n_entries += (size_t)__builtin_popcountll(m->wall_mask[i]);
     }
@@ -1080,7 +1082,7 @@ void wetdem_sim_many_energies(const struct wetdem_sim* sim, double* kinetic, dou
         el += wetdem_sim_contact_elastic_energy(sim, &c, wetdem_many_pair_history(sim, q));
     }
     for (size_t i = 0; m && i < sim->n_particles; i++)
-        for (size_t w = 0; w < sim->n_walls; w++) {
+        for (size_t w = 0; w < sim->n_walls && !sim->particles[i].is_fixed; w++) {
             struct wetdem_contact c;
             wetdem_sim_many_contact(sim, i, w, true, &c);
             el += wetdem_sim_contact_elastic_energy(sim, &c, wetdem_many_wall_history(sim, i, w));

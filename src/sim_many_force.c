@@ -1683,7 +1683,7 @@ static void start_sums_of_block(const struct pass* P, size_t b, struct failure* 
                 start_sum(sim, m->wall_list[s], true, fail);
     } else
         for (size_t k = begin; k < end; k++)
-            start_sum(sim, k, wall_mask[k] || every_wall, fail);
+            start_sum(sim, k, wall_mask[k] || (every_wall && !m->fixed[k]), fail);
     const size_t* first_in = m->cross_first + m->n_blocks + 1;
     for (size_t s = first_in[b]; s < first_in[b + 1]; s++) {
         size_t e = m->cross_in[s], q = m->cross_q[e], k = P->pairs[q].j;

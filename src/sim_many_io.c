@@ -119,7 +119,7 @@ int wetdem_sim_many_links(const struct wetdem_sim* sim, const struct wetdem_many
         }
     }
     for (size_t i = 0; i < n; i++)
-        for (size_t w = 0; w < sim->n_walls; w++) {
+        for (size_t w = 0; w < sim->n_walls && !sim->particles[i].is_fixed; w++) {
             struct wetdem_contact c;
             wetdem_sim_many_contact(sim, i, w, true, &c);
             if (wetdem_sim_contact_is_in_contact(sim, &c, wetdem_many_wall_history(sim, i, w))) {
@@ -291,7 +291,7 @@ int wetdem_sim_write_vtk_links(struct wetdem_sim* sim, const char* path, bool bi
             ok = push_link(&links, &n, &cap, &l);
     }
     for (size_t i = 0; ok && i < sim->n_particles; i++)
-        for (size_t w = 0; ok && w < sim->n_walls; w++) {
+        for (size_t w = 0; ok && w < sim->n_walls && !sim->particles[i].is_fixed; w++) {
             struct wetdem_contact c;
             struct wetdem_output_vtk_link l;
             wetdem_sim_many_contact(sim, i, w, true, &c);
@@ -781,7 +781,7 @@ static int check_restorable(struct wetdem_sim* sim, const struct wetdem_checkpoi
             return wetdem_sim_fail(sim, WETDEM_ERR_PARSE,
                                    "checkpoint '%s': particle %zu has material %d", path, k,
                                    p->material);
-        char why[128]; /* what wetdem_sim_add_particle accepts */
+        char why[256]; /* what wetdem_sim_add_particle accepts */
         if (!wetdem_sim_particle_valid(p, why, sizeof why))
             return wetdem_sim_fail(sim, WETDEM_ERR_PARSE, "checkpoint '%s': particle %zu: %s", path,
                                    k, why);

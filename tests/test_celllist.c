@@ -37,14 +37,16 @@ static bool within(const struct wetdem_celllist_box* box, const struct wetdem_pa
     return vec3_dot(d, d) < lim * lim;
 }
 
-/* Every brute-force pair with gap < reach + skin is listed, in (i, j) order, and nothing else. */
+/* Every brute-force pair with gap < reach + skin, not both fixed, is listed, in (i, j) order,
+ * and nothing else. */
 static void check_against_brute_force(const struct wetdem_celllist* cl,
                                       const struct wetdem_particle* p, size_t n)
 {
     size_t k = 0;
     for (size_t i = 0; i < n; i++)
         for (size_t j = i + 1; j < n; j++) {
-            if (!within(&cl->box, p, i, j, cl->reach + cl->skin))
+            if (!within(&cl->box, p, i, j, cl->reach + cl->skin) ||
+                (p[i].is_fixed && p[j].is_fixed))
                 continue;
             if (k >= cl->n_pairs || cl->pairs[k].i != i || cl->pairs[k].j != j)
                 fail_msg("pair (%zu, %zu) missing or out of order at list position %zu", i, j, k);
@@ -94,6 +96,26 @@ static void test_celllist_matches_brute_force_open_box(void** state)
 {
     (void)state;
     run_case((bool[3]){false, false, false}, 30e-3, 600, 1);
+}
+
+/* A third of the spheres fixed (a rough base and obstacles): no pair of two of them is
+ * listed, on 1 and 2 threads (the parallel build from 512 spheres), and every pair with a
+ * free sphere still is. */
+static void test_celllist_leaves_out_pairs_of_fixed_spheres(void** state)
+{
+    (void)state;
+    struct wetdem_particle* p = random_spheres(600, 30e-3, 0.5e-3, 1.5e-3, 4);
+    struct wetdem_celllist_box box = {{0, 0, 0}, {30e-3, 30e-3, 30e-3}, {true, false, true}};
+    size_t all = build_and_check(&box, p, 600, 0.4e-3, 1, 0), fixed_pairs = 0;
+    for (size_t i = 0; i < 600; i += 3)
+        p[i].is_fixed = true;
+    for (size_t i = 0; i < 600; i += 3)
+        for (size_t j = i + 3; j < 600; j += 3)
+            fixed_pairs += within(&box, p, i, j, 0.4e-3 + 0.2e-3);
+    assert_true(fixed_pairs > 10); /* the case is exercised */
+    for (int threads = 1; threads <= 2; threads++)
+        assert_int_equal(build_and_check(&box, p, 600, 0.4e-3, threads, 0), all - fixed_pairs);
+    free(p);
 }
 
 static void test_celllist_matches_brute_force_periodic(void** state)
@@ -363,6 +385,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_celllist_matches_brute_force_open_box),
         cmocka_unit_test(test_celllist_matches_brute_force_periodic),
+        cmocka_unit_test(test_celllist_leaves_out_pairs_of_fixed_spheres),
         cmocka_unit_test(test_celllist_small_periodic_boxes_have_no_duplicates),
         cmocka_unit_test(test_celllist_single_periodic_cell),
         cmocka_unit_test(test_celllist_periodic_axes_of_few_cells),

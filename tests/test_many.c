@@ -879,6 +879,63 @@ static void test_many_step_comes_from_the_pairs_that_occur(void** state)
     }
 }
 
+/* A fixed bed of two spheres that overlap each other by 0.1 mm and the floor by 1 um (as a
+ * settled bed read from a file does), wet, and a free sphere dropped onto one of them: fixed
+ * spheres meet neither each other nor a wall (infinite masses would give the contact damping
+ * no finite value), so the run goes on, the bed stays where it was bit for bit, the only
+ * contact is the free sphere's, and it lands on the bed. With 69 more walls far away (the
+ * path for more than 64 walls, which scans every wall of every particle) the free sphere
+ * moves bit for bit the same: those walls are beyond reach. */
+static void test_many_fixed_spheres_meet_neither_each_other_nor_walls(void** state)
+{
+    (void)state;
+    double z_end[2];
+    for (int many_walls = 0; many_walls < 2; many_walls++) {
+        struct wetdem_sim* sim = wetdem_sim_create();
+        struct wetdem_material m;
+        CHECK_OK(wetdem_material_preset("glass", &m));
+        m.film = 20e-6;
+        assert_int_equal(wetdem_sim_add_material(sim, &m), 0);
+        CHECK_OK(wetdem_sim_set_fluid(
+            sim, &(struct wetdem_fluid){.viscosity = 0.01, .surface_tension = 0.02}));
+        const char* models[] = {"hertz", "mindlin", "sb", "capillary", "fixed"};
+        for (int k = 0; k < 5; k++)
+            CHECK_OK(wetdem_sim_enable_model(sim, models[k]));
+        CHECK_OK(wetdem_sim_set_param(sim, "fixed.h_min", 1e-6));
+        CHECK_OK(wetdem_sim_set_param(sim, "sim.gravity_z", -9.81));
+        const struct wetdem_particle bed[2] = {
+            {.pos = {0, 0, 0.499e-3}, .radius = 0.5e-3, .is_fixed = true},
+            {.pos = {0.9e-3, 0, 0.499e-3}, .radius = 0.5e-3, .is_fixed = true}};
+        CHECK_OK(wetdem_sim_add_particle(sim, bed[0]));
+        CHECK_OK(wetdem_sim_add_particle(sim, bed[1]));
+        CHECK_OK(wetdem_sim_add_particle(
+            sim, (struct wetdem_particle){.pos = {0, 0, 1.8e-3}, .radius = 0.5e-3}));
+        for (int w = 0; many_walls && w < 69; w++) /* 1 m below and further */
+            CHECK_OK(wetdem_sim_add_wall(sim, vec3(0, 0, -1.0 - 1e-3 * w), vec3(0, 0, 1), 0));
+        /* the floor last: with 70 walls it is beyond the 64 of the walls' bit masks */
+        CHECK_OK(wetdem_sim_add_wall(sim, vec3(0, 0, 0), vec3(0, 0, 1), 0));
+        assert_int_equal(wetdem_sim_n_walls(sim), many_walls ? 70 : 1);
+        CHECK_OK(wetdem_sim_set_many(sim, &(struct wetdem_many_settings){.skin = 5e-5}));
+        CHECK_OK(wetdem_sim_integrate(sim, 20e-3));
+        const struct wetdem_particle* p = wetdem_sim_particles_const(sim, NULL);
+        for (int k = 0; k < 2; k++)
+            assert_memory_equal(&p[k].pos, &bed[k].pos, sizeof bed[k].pos);
+        /* free fall from 0.3 mm above contact takes 7.8 ms: by 20 ms the free sphere has
+           entered bed[0]'s film (the films' sum is 40 um) and is held in it by the viscous
+           force, gap between 0 and 40 um; the one liquid bridge is theirs, and there is no
+           contact: neither the bed's own overlap nor its cut into the floor counts */
+        struct wetdem_many_stats st;
+        CHECK_OK(wetdem_sim_many_stats(sim, &st));
+        assert_int_equal(st.contacts, 0);
+        assert_int_equal(st.bridges, 1);
+        double gap = p[2].pos.z - bed[0].pos.z - 2 * 0.5e-3;
+        assert_true(gap > 0 && gap < 40e-6);
+        z_end[many_walls] = p[2].pos.z;
+        wetdem_sim_free(sim);
+    }
+    assert_memory_equal(&z_end[0], &z_end[1], sizeof z_end[0]);
+}
+
 /* A glass sphere of R = 6.35 mm (50 um films, roughness 1 um) in a 0.01 Pa s liquid strikes
  * the wall x = 0 at 0.05 m/s, 30 deg from its normal, from a gap of 0.1 mm (the set-up of
  * examples/scenarios/wall_collision.ini with these materials): the force models `force`
@@ -1756,6 +1813,7 @@ int main(void)
         cmocka_unit_test(test_many_step_stays_below_the_viscous_relaxation_time),
         cmocka_unit_test(test_many_step_follows_the_contact_model),
         cmocka_unit_test(test_many_step_comes_from_the_pairs_that_occur),
+        cmocka_unit_test(test_many_fixed_spheres_meet_neither_each_other_nor_walls),
         cmocka_unit_test(test_many_step_resolves_hmin),
         cmocka_unit_test(test_many_step_resolves_the_tangential_spring),
         cmocka_unit_test(test_many_divergence_stops_the_run),

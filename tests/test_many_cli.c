@@ -824,6 +824,39 @@ static void test_many_cli_read_spheres_from_a_file(void** state)
     }
     CHECK_CONTAINS(frame, "spin 3 3 double\n0 2 0\n0 0 0\n0 -7.5 0\n");
     free(frame);
+    /* the same spheres as a fixed base: at rest whatever the file's velocities and spins, and
+       where the file put them after 200 steps, while a free sphere falls */
+    write_text("fixed.ini", WET_BOX "[read.bed]\nfile = bed.csv\nmaterial = wet\nfixed = yes\n"
+                                    "[particle.drop]\nradius = 4e-4\nx = 3e-3\ny = 3e-3\nz = "
+                                    "2.5e-3\nmaterial = wet\n[run]\ndt = 2e-6\nsteps = 200\n"
+                                    "[dump]\nvtk_every = 200\nvtk_binary = no\n");
+    assert_int_equal(run_cli("run fixed.ini --out fixed"), 0);
+    for (int f = 0; f < 2; f++) {
+        frame = test_read_file(
+            tpath(f ? "fixed/particles_000001.vtk" : "fixed/particles_000000.vtk"), NULL);
+        assert_non_null(frame);
+        char want[600] = "POINTS 4 double\n";
+        for (int i = 0; i < 3; i++) {
+            size_t at = strlen(want);
+            snprintf(want + at, sizeof want - at, "%.17g %.17g %.17g\n", strtod(row[i][0], NULL),
+                     strtod(row[i][1], NULL), strtod(row[i][2], NULL));
+        }
+        CHECK_CONTAINS(frame, want);
+        CHECK_CONTAINS(frame, "velocity 3 4 double\n0 0 0\n0 0 0\n0 0 0\n");
+        CHECK_CONTAINS(frame, "spin 3 4 double\n0 0 0\n0 0 0\n0 0 0\n");
+        /* fixed spheres meet neither each other (the first two overlap by 0.1 mm) nor a wall
+           (the first cuts the floor by 1e-19 m): no contact, and no infinite-mass force */
+        CHECK_CONTAINS(frame, "contacts 1 4 int\n0\n0\n0\n0\n");
+        if (f) { /* the free sphere has fallen by g t^2 / 2 (0.78 um: velocity Verlet is exact
+                    under a constant force but for rounding, a few ulp of z over 200 steps) */
+            const char* line = strstr(frame, want) + strlen(want);
+            double x, y, z, t = 200 * 2e-6;
+            assert_int_equal(sscanf(line, "%lf %lf %lf", &x, &y, &z), 3);
+            CHECK_ABS(z, 2.5e-3 - 0.5 * 9.81 * t * t, 1e-17);
+            CHECK_REL(x, 3e-3, 0);
+        }
+        free(frame);
+    }
 
     /* bad files: the scenario's file line (22), the file's own line or array */
     const char* head = WET_BOX "[read.bed]\nfile = ";

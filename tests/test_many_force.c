@@ -813,7 +813,12 @@ static void test_many_drift_in_the_force_pass_changes_no_result(void** state)
             for (int k = 0; k < 2; k++) {
                 sims[k] = fixture ? wet_pile(all, 4, false, 0, false, WETDEM_MANY_BULK_BEST)
                                   : wet_gas(false, false);
-                wetdem_sim_particles(sims[k], NULL)[3].is_fixed = true;
+                struct wetdem_particle* p3 = &wetdem_sim_particles(sims[k], NULL)[3];
+                *p3 = (struct wetdem_particle){.pos = p3->pos,
+                                               .radius = p3->radius,
+                                               .mass = p3->mass,
+                                               .material = p3->material,
+                                               .is_fixed = true}; /* at rest */
                 sims[k]->many->no_drift_in_pass = k == 1;
             }
             for (int call = 1; call <= 4; call++) {

@@ -63,9 +63,23 @@ static void test_params_particle_rejects_bad_radius(void** state)
     p.mass = -1.0;
     CHECK_STATUS(wetdem_sim_add_particle(sim, p), WETDEM_ERR_INVALID);
     CHECK_CONTAINS(wetdem_sim_errmsg(sim), "mass");
+    /* a fixed sphere stands still: a velocity or a spin would act in its pair forces only */
+    p = sphere(1e-3);
+    p.is_fixed = true;
+    p.vel.z = -0.5;
+    CHECK_STATUS(wetdem_sim_add_particle(sim, p), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(wetdem_sim_errmsg(sim), "fixed particle is held in place: its velocity and "
+                                           "spin must be 0, got v = (0, 0, -0.5) m/s");
+    p.vel.z = 0;
+    p.omega.y = 1e-300;
+    CHECK_STATUS(wetdem_sim_add_particle(sim, p), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(wetdem_sim_errmsg(sim), "omega = (0, 1e-300, 0) rad/s");
     assert_int_equal(wetdem_sim_n_particles(sim), 0); /* nothing half-added */
     CHECK_OK(wetdem_sim_add_particle(sim, sphere(1e-3)));
     assert_int_equal(wetdem_sim_n_particles(sim), 1);
+    p.omega.y = 0; /* at rest it is taken */
+    CHECK_OK(wetdem_sim_add_particle(sim, p));
+    assert_int_equal(wetdem_sim_n_particles(sim), 2);
     wetdem_sim_free(sim);
 }
 
