@@ -113,20 +113,24 @@ static const struct cli_key_desc particle_keys[] = {
     {0},
 };
 
+static const char* const read_fixed_choices[] = {"file", "yes", "no", NULL};
+
 static const struct cli_key_desc read_keys[] = {
     WORD("file", CLI_VALUE_TEXT, "required", NULL,
          "The spheres' file, relative to the scenario file's directory unless absolute: a frame "
-         "of a wetdem run (PREFIX_NNNNNN.vtk: centres, radius, velocity, spin; a run's "
+         "of a wetdem run (PREFIX_NNNNNN.vtk: centres, radius, velocity, spin, fixed; a run's "
          "PREFIX.vtk.series stands for its last frame), or a CSV whose "
          "header names the columns x, y, z, radius [m] and optionally vx, vy, vz [m/s], spin_x, "
-         "spin_y, spin_z [rad/s] (a name may carry its unit, 'x [m]'; '#' lines are skipped). "
+         "spin_y, spin_z [rad/s], fixed (0 or 1) (a name may carry its unit, 'x [m]'; '#' lines "
+         "are skipped). "
          "Values are checked as the keys of [particle.NAME]. The spheres may overlap each other "
          "and the walls (a settled packing does); their centres must lie in the box."),
     WORD("material", CLI_VALUE_NAME, "steel1", NULL, "Material of every sphere, as in [insert]."),
-    WORD("fixed", CLI_VALUE_CHOICE, "no", cli_yes_no,
-         "yes: every sphere of the file held in place (infinite mass), e.g. a rough base of "
-         "glued spheres; the file's velocities and spins are then not used (a fixed sphere is "
-         "at rest)."),
+    WORD("fixed", CLI_VALUE_CHOICE, "file", read_fixed_choices,
+         "Which spheres are held in place (infinite mass, at rest): file, those the file marks "
+         "(a frame's fixed array, a CSV's fixed column of 0 and 1; none if it has neither); "
+         "yes, every sphere (a rough base of glued spheres, a settled bed as an obstacle: the "
+         "file's velocities and spins are then not used); no, none."),
     {0},
 };
 
@@ -615,12 +619,14 @@ static int build_sphere_file(const struct cli_scenario* sc, struct cli_many_setu
         cli_scenario_error(sc, e, "%s:%s%s", path, isdigit((unsigned char)why[0]) ? "" : " ", why);
         return rc;
     }
-    bool fixed = strcmp(cli_scenario_text(sc, section, "fixed", "no"), "yes") == 0;
+    const char* fixed = cli_scenario_text(sc, section, "fixed", "file");
     for (size_t k = 0; k < n && rc == CLI_EXIT_OK; k++) {
         p[k].material = material;
-        if (fixed)
+        if (strcmp(fixed, "yes") == 0) /* at rest */
             p[k] = (struct wetdem_particle){
                 .pos = p[k].pos, .radius = p[k].radius, .material = material, .is_fixed = true};
+        else if (strcmp(fixed, "no") == 0)
+            p[k].is_fixed = false;
         if (wetdem_sim_add_particle(su->sim, p[k]) != WETDEM_OK)
             rc = cli_scenario_lib_error(sc, e, section, su->sim);
     }

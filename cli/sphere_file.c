@@ -2,13 +2,14 @@
  * sphere_file.c — spheres read from a file ([read.NAME] of a many-particle scenario; see
  * sphere_file.h): a CSV table with a header naming its columns, or a particle frame written by
  * a wetdem run (src/output_vtk.c: legacy VTK POLYDATA, ASCII with 17 digits or big-endian
- * binary, the spheres' centres as POINTS and radius, velocity and spin among the point field
- * arrays), so that a run can start from the state where another one ended: a packing settled
+ * binary, the spheres' centres as POINTS and radius, velocity, spin and fixed among the point
+ * field arrays), so that a run can start from the state where another one ended: a packing settled
  * dry and then wetted, a state from another code, a measured packing. A run's .vtk.series index
  * stands for the last frame it lists.
  *
  * Every value is checked as the scenario keys of [particle.NAME] are (finite, and within the
- * same ranges), with the line of the CSV or the array of the frame in the message. The values
+ * same ranges; fixed 0 or 1, and a fixed sphere at rest), with the line of the CSV or the
+ * sphere of the frame in the message. The values
  * of a frame are its bits (binary) or its 17 digits (ASCII), so a run started from a frame
  * starts from the state that wrote it.
  */
@@ -31,9 +32,9 @@
 #define MAX_FIELDS 64         /* fields of a CSV line read (more: a count error) */
 
 /* The columns a CSV may have (the [particle.NAME] keys), with their ranges and units. */
-enum column { X, Y, Z, RADIUS, VX, VY, VZ, SPIN_X, SPIN_Y, SPIN_Z, N_COLUMNS };
-static const char* const column_names[] = {"x",  "y",      "z",      "radius", "vx", "vy",
-                                           "vz", "spin_x", "spin_y", "spin_z", NULL};
+enum column { X, Y, Z, RADIUS, VX, VY, VZ, SPIN_X, SPIN_Y, SPIN_Z, FIXED, N_COLUMNS };
+static const char* const column_names[] = {"x",  "y",      "z",      "radius", "vx",    "vy",
+                                           "vz", "spin_x", "spin_y", "spin_z", "fixed", NULL};
 static const struct {
     double lo, hi;
     bool lo_open;
@@ -42,7 +43,7 @@ static const struct {
     {-1e3, 1e3, false, "m"},     {-1e3, 1e3, false, "m"},     {-1e3, 1e3, false, "m"},
     {0, 1, true, "m"},           {-1e3, 1e3, false, "m/s"},   {-1e3, 1e3, false, "m/s"},
     {-1e3, 1e3, false, "m/s"},   {-1e6, 1e6, false, "rad/s"}, {-1e6, 1e6, false, "rad/s"},
-    {-1e6, 1e6, false, "rad/s"},
+    {-1e6, 1e6, false, "rad/s"}, {0, 1, false, "-"},
 };
 
 static int fail(char* err, size_t err_len, const char* fmt, ...)
@@ -64,25 +65,40 @@ static int no_memory(char* err, size_t err_len)
     return CLI_EXIT_RUNTIME;
 }
 
-/* Whether value v lies in column c's range; otherwise writes why into err. */
+/* Whether value v lies in column c's range (fixed: 0 or 1); otherwise writes why into err. */
 static bool in_range(enum column c, double v, char* err, size_t err_len, const char* where)
 {
     bool ok = column_range[c].lo_open ? v > column_range[c].lo : v >= column_range[c].lo;
-    if (ok && v <= column_range[c].hi)
+    if (ok && v <= column_range[c].hi && (c != FIXED || v == 0 || v == 1))
         return true;
+    if (c == FIXED) {
+        fail(err, err_len, "%sfixed = %g is not 0 (free) or 1 (held in place)", where, v);
+        return false;
+    }
     fail(err, err_len, "%s%s = %g %s is not in %c%g, %g] %s", where, column_names[c], v,
          column_range[c].unit, column_range[c].lo_open ? '(' : '[', column_range[c].lo,
          column_range[c].hi, column_range[c].unit);
     return false;
 }
 
-/* The sphere of values v (indexed by column; absent columns 0). */
-static struct wetdem_particle sphere_of(const double v[N_COLUMNS])
+/* The sphere of values v (indexed by column; absent columns 0), checked: a fixed one must be
+ * at rest (else why, after `where`, into err and false). */
+static bool sphere_of(const double v[N_COLUMNS], struct wetdem_particle* p, char* err,
+                      size_t err_len, const char* where)
 {
-    return (struct wetdem_particle){.pos = {v[X], v[Y], v[Z]},
-                                    .vel = {v[VX], v[VY], v[VZ]},
-                                    .omega = {v[SPIN_X], v[SPIN_Y], v[SPIN_Z]},
-                                    .radius = v[RADIUS]};
+    *p = (struct wetdem_particle){.pos = {v[X], v[Y], v[Z]},
+                                  .vel = {v[VX], v[VY], v[VZ]},
+                                  .omega = {v[SPIN_X], v[SPIN_Y], v[SPIN_Z]},
+                                  .radius = v[RADIUS],
+                                  .is_fixed = v[FIXED] == 1};
+    for (int c = VX; p->is_fixed && c <= SPIN_Z; c++)
+        if (v[c] != 0) {
+            fail(err, err_len,
+                 "%sa fixed sphere (fixed = 1) is held in place, at rest: %s = %g must be 0", where,
+                 column_names[c], v[c]);
+            return false;
+        }
+    return true;
 }
 
 /* Appends p to the growing array *a (count *n, capacity *cap). */
@@ -174,7 +190,7 @@ static int read_header(char* line, size_t line_no, int col[N_COLUMNS], int* n_fi
     if (cli_csv_columns(f, *n_fields, column_names, col, &bad, why, sizeof why) != 0)
         return fail(err, err_len,
                     "%zu: %s (columns: x, y, z, radius; optional vx, vy, vz, spin_x, spin_y, "
-                    "spin_z)",
+                    "spin_z, fixed)",
                     line_no, why);
     for (int c = X; c <= RADIUS; c++)
         if (col[c] < 0)
@@ -225,7 +241,10 @@ static int read_csv(char* text, struct wetdem_particle** out, size_t* n, char* e
         }
         if (*n == MAX_SPHERES)
             return fail(err, err_len, "%zu: more than %d spheres", line_no, MAX_SPHERES);
-        if (!push(out, n, &cap, sphere_of(v)))
+        struct wetdem_particle p;
+        if (!sphere_of(v, &p, err, err_len, where))
+            return CLI_EXIT_USAGE;
+        if (!push(out, n, &cap, p))
             return no_memory(err, err_len);
     }
     if (line_no == 0)
@@ -364,9 +383,9 @@ static int read_vtk(const char* data, size_t len, struct wetdem_particle** out, 
     nw = vtk_line(&c, w);
     if (nw != 2 || strcmp(w[0], "DATASET") != 0 || strcmp(w[1], "POLYDATA") != 0)
         return fail(err, err_len, "not a wetdem frame: line 4 is not DATASET POLYDATA");
-    double *pos = NULL, *arrays[3] = {NULL, NULL, NULL}; /* radius, velocity, spin */
-    static const char* const wanted[] = {"radius", "velocity", "spin"};
-    static const int comps[] = {1, 3, 3};
+    double *pos = NULL, *arrays[4] = {NULL, NULL, NULL, NULL}; /* as wanted[] */
+    static const char* const wanted[] = {"radius", "velocity", "spin", "fixed"};
+    static const int comps[] = {1, 3, 3, 1};
     long long n_points = -1;
     int rc = 0;
     while (rc == 0 && (nw = vtk_line(&c, w)) >= 0) {
@@ -403,16 +422,16 @@ static int read_vtk(const char* data, size_t len, struct wetdem_particle** out, 
                     break;
                 }
                 int a = 0;
-                while (a < 3 && strcmp(w[0], wanted[a]) != 0)
+                while (a < 4 && strcmp(w[0], wanted[a]) != 0)
                     a++;
                 double* dest = NULL;
-                if (a < 3 && !arrays[a]) {
+                if (a < 4 && !arrays[a]) {
                     if (nc != comps[a] || nt != n_points) {
                         rc = fail(err, err_len, "array %s: %lld x %lld values, expected %d x %lld",
                                   wanted[a], nt, nc, comps[a], n_points);
                         break;
                     }
-                    if (!vtk_fits(&c, (size_t)(nc * nt), 8)) {
+                    if (!vtk_fits(&c, (size_t)(nc * nt), strcmp(w[3], "double") == 0 ? 8 : 4)) {
                         rc = fail(err, err_len, "array %s: the file ends within its values",
                                   wanted[a]);
                         break;
@@ -444,6 +463,7 @@ static int read_vtk(const char* data, size_t len, struct wetdem_particle** out, 
             v[SPIN_X + k] = arrays[2] ? arrays[2][3 * i + k] : 0;
         }
         v[RADIUS] = arrays[0][i];
+        v[FIXED] = arrays[3] ? arrays[3][i] : 0;
         char where[64];
         snprintf(where, sizeof where, "sphere %lld: ", i + 1);
         for (int k = 0; rc == 0 && k < N_COLUMNS; k++)
@@ -451,11 +471,14 @@ static int read_vtk(const char* data, size_t len, struct wetdem_particle** out, 
                 rc = fail(err, err_len, "%s%s is not a finite number", where, column_names[k]);
             else if (!in_range(k, v[k], err, err_len, where))
                 rc = CLI_EXIT_USAGE;
-        if (rc == 0 && !push(out, n, &cap, sphere_of(v)))
+        struct wetdem_particle p;
+        if (rc == 0 && !sphere_of(v, &p, err, err_len, where))
+            rc = CLI_EXIT_USAGE;
+        if (rc == 0 && !push(out, n, &cap, p))
             rc = no_memory(err, err_len);
     }
     free(pos);
-    for (int a = 0; a < 3; a++)
+    for (int a = 0; a < 4; a++)
         free(arrays[a]);
     return rc;
 }

@@ -8,8 +8,9 @@
  *   FIELD FieldData 1, TIME 1 1 double      simulated time [s] (ParaView shows it)
  *   POINTS n double                         centres [m]
  *   VERTICES n 2n                           one vertex cell per sphere ("1 i")
- *   POINT_DATA n, FIELD FieldData 8: radius [m], velocity [m/s], spin [rad/s], contacts,
- *                                    bridges, agglomerate, material, id
+ *   POINT_DATA n, FIELD FieldData 9: radius [m], velocity [m/s], spin [rad/s], contacts,
+ *                                    bridges, agglomerate, material, id, fixed (1: held in
+ *                                    place)
  * Links: POINTS 2n (the ends of each line), LINES n 3n ("2 2k 2k+1"), CELL_DATA n with FIELD
  * FieldData 8: i, j, contact, bridge (int), gap [m], force_normal [N], force_tangential [N],
  * force (3 components, on i) [N].
@@ -94,17 +95,18 @@ static void write_vectors(FILE* f, const char* head, const struct wetdem_particl
         fputc('\n', f);
 }
 
-enum int_data { INT_COUNT, INT_MATERIAL, INT_ID };
+enum int_data { INT_COUNT, INT_MATERIAL, INT_ID, INT_FIXED };
 
-/* Integer point data: a count or label (`count`, NULL for zeros), material or id. */
+/* Integer point data: a count or label (`count`, NULL for zeros), material, id or fixed. */
 static void write_ints(FILE* f, const char* name, const struct wetdem_particle* p, size_t n,
                        const uint32_t* count, enum int_data which, bool binary)
 {
     fprintf(f, "%s 1 %zu int\n", name, n);
     for (size_t k = 0; k < n; k++) {
-        int32_t v = which == INT_COUNT
-                        ? (count ? (int32_t)count[k] : 0)
-                        : (which == INT_MATERIAL ? (int32_t)p[k].material : (int32_t)k);
+        int32_t v = which == INT_COUNT      ? (count ? (int32_t)count[k] : 0)
+                    : which == INT_MATERIAL ? (int32_t)p[k].material
+                    : which == INT_FIXED    ? (int32_t)p[k].is_fixed
+                                            : (int32_t)k;
         put_int(f, v, binary);
     }
     if (binary)
@@ -138,7 +140,7 @@ static void write_body(FILE* f, const struct wetdem_particle* p, size_t n,
     }
     if (binary)
         fputc('\n', f);
-    fprintf(f, "POINT_DATA %zu\nFIELD FieldData 8\nradius 1 %zu double\n", n, n);
+    fprintf(f, "POINT_DATA %zu\nFIELD FieldData 9\nradius 1 %zu double\n", n, n);
     for (size_t k = 0; k < n; k++)
         put_double(f, p[k].radius, binary);
     if (binary)
@@ -152,6 +154,7 @@ static void write_body(FILE* f, const struct wetdem_particle* p, size_t n,
     write_ints(f, "agglomerate", p, n, c->agglomerate, INT_COUNT, binary);
     write_ints(f, "material", p, n, NULL, INT_MATERIAL, binary);
     write_ints(f, "id", p, n, NULL, INT_ID, binary);
+    write_ints(f, "fixed", p, n, NULL, INT_FIXED, binary);
 }
 
 /* A cell array of the links: member `which` of each, 0 i, 1 j, 2 contact, 3 bridge (int), 4

@@ -20,7 +20,8 @@ struct wetdem_output_vtk_counts {
 
 /* Writes n particles as a legacy VTK POLYDATA file (one vertex per sphere) with the point
  * data radius [m], velocity [m/s], spin [rad/s], contacts, bridges and agglomerate (counts may
- * be NULL for zeros), material and id, and the simulated time [s] as field data TIME. binary:
+ * be NULL for zeros), material, id and fixed (1 for a sphere held in place), and the
+ * simulated time [s] as field data TIME. binary:
  * big-endian binary arrays as the legacy format requires, else ASCII with 17 significant
  * digits (exact round trip). The file is written to a temporary name and renamed, so a
  * reader never sees half a file. Returns WETDEM_OK or WETDEM_ERR_IO (message in msg). */

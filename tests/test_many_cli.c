@@ -855,8 +855,42 @@ static void test_many_cli_read_spheres_from_a_file(void** state)
             CHECK_ABS(z, 2.5e-3 - 0.5 * 9.81 * t * t, 1e-17);
             CHECK_REL(x, 3e-3, 0);
         }
+        CHECK_CONTAINS(frame, "fixed 1 4 int\n1\n1\n1\n0\n");
         free(frame);
     }
+    /* that frame read back as it is (fixed = file, the default) starts a run at its state bit
+       for bit, the base still fixed; with fixed = no every sphere is free */
+    const char* again = WET_BOX "[read.all]\nfile = fixed/particles_000001.vtk\nmaterial = wet\n"
+                                "%s[run]\ndt = 2e-6\nsteps = 1\n[dump]\nvtk_every = 1\n"
+                                "vtk_binary = no\n";
+    char ini[2048];
+    snprintf(ini, sizeof ini, again, "");
+    write_text("again.ini", ini);
+    assert_int_equal(run_cli("run again.ini --out again"), 0);
+    a = frame_from_points("fixed/particles_000001.vtk", &la);
+    b = frame_from_points("again/particles_000000.vtk", &lb);
+    assert_true(a && b && la == lb && memcmp(a, b, la) == 0);
+    free(a);
+    free(b);
+    snprintf(ini, sizeof ini, again, "fixed = no\n");
+    write_text("again.ini", ini);
+    assert_int_equal(run_cli("run again.ini --out free"), 0);
+    frame = test_read_file(tpath("free/particles_000000.vtk"), NULL);
+    assert_non_null(frame);
+    CHECK_CONTAINS(frame, "fixed 1 4 int\n0\n0\n0\n0\n");
+    free(frame);
+    /* a CSV's fixed column */
+    write_text("fixed.csv", "x,y,z,radius,vx,fixed\n1e-3,3e-3,1e-3,4e-4,0,1\n"
+                            "3e-3,3e-3,3e-3,4e-4,0.1,0\n");
+    write_text("fixed_csv.ini", WET_BOX "[read.bed]\nfile = fixed.csv\nmaterial = wet\n[run]\n"
+                                        "dt = 2e-6\nsteps = 1\n[dump]\nvtk_every = 1\n"
+                                        "vtk_binary = no\n");
+    assert_int_equal(run_cli("run fixed_csv.ini --out fixed_csv"), 0);
+    frame = test_read_file(tpath("fixed_csv/particles_000000.vtk"), NULL);
+    assert_non_null(frame);
+    CHECK_CONTAINS(frame, "fixed 1 2 int\n1\n0\n");
+    CHECK_CONTAINS(frame, "velocity 3 2 double\n0 0 0\n0.10000000000000001 0 0\n");
+    free(frame);
 
     /* bad files: the scenario's file line (22), the file's own line or array */
     const char* head = WET_BOX "[read.bed]\nfile = ";
@@ -872,6 +906,10 @@ static void test_many_cli_read_spheres_from_a_file(void** state)
         {"x,y,z,radius\n1e-3,1e-3,1e-3,-1e-4\n",
          "bad.csv:2: radius = -0.0001 m is not in (0, 1] m"},
         {"x,y,z,radius\n1e-3,1e-3,1e-3\n", "bad.csv:2: 3 fields, the header has 4 columns"},
+        {"x,y,z,radius,fixed\n1e-3,1e-3,1e-3,1e-4,0.5\n",
+         "bad.csv:2: fixed = 0.5 is not 0 (free) or 1 (held in place)"},
+        {"x,y,z,radius,fixed,spin_z\n1e-3,1e-3,1e-3,1e-4,1,-3\n",
+         "bad.csv:2: a fixed sphere (fixed = 1) is held in place, at rest: spin_z = -3 must be 0"},
         {"x,y,z,radius\n", "bad.csv:1: no spheres after the header"},
         {"", "bad.csv: the file is empty"},
         {"x,y,z,radius\n1e-3,1e-3,9e-3,1e-4\n", "sphere 1 of [read.bed] (centre z = 0.009 m"},

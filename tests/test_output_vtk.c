@@ -33,6 +33,11 @@ static void make_particles(struct wetdem_particle* p, struct counts_data* links)
                                         .omega = vec3(1e5 / (t + 3), 0, -0.1 * t),
                                         .radius = 1e-3 * (1 + t / 97),
                                         .material = (int)(k % 3)};
+        if (k % 4 == 1) /* a fixed sphere, at rest */
+            p[k] = (struct wetdem_particle){.pos = p[k].pos,
+                                            .radius = p[k].radius,
+                                            .material = p[k].material,
+                                            .is_fixed = true};
         links->contacts[k] = (uint32_t)(k * 7 % 5);
         links->bridges[k] = (uint32_t)(k * 3 % 4);
         links->agglomerate[k] = (uint32_t)(k / 5);
@@ -172,7 +177,7 @@ static void parse_back(const char* path, const struct wetdem_particle* p,
     expect(f, count);
     expect(f, "FIELD");
     expect(f, "FieldData");
-    expect(f, "8");
+    expect(f, "9");
     expect(f, "radius");
     expect(f, "1");
     expect(f, count);
@@ -182,19 +187,21 @@ static void parse_back(const char* path, const struct wetdem_particle* p,
         assert_true(get_double(f, binary) == p[k].radius);
     check_vectors(f, "velocity", p, 1, binary);
     check_vectors(f, "spin", p, 2, binary);
-    int32_t want[5][N];
+    int32_t want[6][N];
     for (int32_t k = 0; k < N; k++) {
         want[0][k] = (int32_t)links->contacts[k];
         want[1][k] = (int32_t)links->bridges[k];
         want[2][k] = (int32_t)links->agglomerate[k];
         want[3][k] = p[k].material;
         want[4][k] = k;
+        want[5][k] = p[k].is_fixed;
     }
     check_ints(f, "contacts", want[0], binary);
     check_ints(f, "bridges", want[1], binary);
     check_ints(f, "agglomerate", want[2], binary);
     check_ints(f, "material", want[3], binary);
     check_ints(f, "id", want[4], binary);
+    check_ints(f, "fixed", want[5], binary);
     char tail[8];
     assert_int_equal(fscanf(f, "%7s", tail), EOF); /* nothing else in the file */
     fclose(f);

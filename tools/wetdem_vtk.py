@@ -20,7 +20,7 @@ import numpy as np
 # The arrays of a frame (point data) and of a links file (cell data), in the order
 # src/output_vtk.c writes them, with their numbers of components.
 POINT_ARRAYS = {"radius": 1, "velocity": 3, "spin": 3, "contacts": 1, "bridges": 1,
-                "agglomerate": 1, "material": 1, "id": 1}
+                "agglomerate": 1, "material": 1, "id": 1, "fixed": 1}
 LINK_ARRAYS = {"i": 1, "j": 1, "contact": 1, "bridge": 1, "gap": 1, "force_normal": 1,
                "force_tangential": 1, "force": 3}
 
@@ -29,7 +29,7 @@ def read_vtk(path):
     """The arrays of a frame or links file written by wetdem (legacy POLYDATA, ASCII or
     big-endian binary: src/output_vtk.c) as {name: array}: TIME, POINTS (n x 3), VERTICES or
     LINES, and every point array (radius, velocity n x 3, spin, contacts, bridges,
-    agglomerate, material, id) or cell array (i, j, contact, bridge, gap, force_normal,
+    agglomerate, material, id, fixed) or cell array (i, j, contact, bridge, gap, force_normal,
     force_tangential, force n x 3)."""
     data = open(path, "rb").read()
     binary = data.split(b"\n", 3)[2].strip() == b"BINARY"
