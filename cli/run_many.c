@@ -409,11 +409,24 @@ static void warn_step(const struct cli_scenario* sc, const struct cli_many_setup
                   sc->file, s->dt, s->dt / s->hmin_crossing_time, s->hmin_crossing_time);
 }
 
+/* How many of the run's spheres are fixed (held in place). */
+static size_t n_fixed(const struct cli_many_setup* su)
+{
+    size_t n, count = 0;
+    const struct wetdem_particle* p = wetdem_sim_particles_const(su->sim, &n);
+    for (size_t k = 0; k < n; k++)
+        count += p[k].is_fixed;
+    return count;
+}
+
 static void summary_text(FILE* f, const struct cli_many_setup* su, const struct outcome* o)
 {
     const struct wetdem_many_stats* s = &o->stats;
-    fprintf(f, "particles          %zu  (walls %zu)\n", wetdem_sim_n_particles(su->sim),
-            wetdem_sim_n_walls(su->sim));
+    size_t fixed = n_fixed(su);
+    fprintf(f, "particles          %zu  (", wetdem_sim_n_particles(su->sim));
+    if (fixed)
+        fprintf(f, "%zu fixed, ", fixed);
+    fprintf(f, "walls %zu)\n", wetdem_sim_n_walls(su->sim));
     fprintf(f, "time               %.6g s  (step %llu, dt = %.4g s, %.3g s wall, %d thread%s)\n",
             wetdem_sim_time(su->sim), s->step, s->dt, o->wall, s->threads,
             s->threads == 1 ? "" : "s");
@@ -480,8 +493,10 @@ static void summary_json(FILE* f, const struct cli_scenario* sc, const struct cl
     fprintf(f, "{\"engine\": \"many\", \"version\": \"%s\", \"git\": \"%s\", \"scenario\": ",
             WETDEM_VERSION, WETDEM_GIT_HASH);
     cli_json_string(f, sc->file);
-    fprintf(f, ", \"interrupted\": %s, \"particles\": %zu, \"walls\": %zu, \"step\": %llu, ",
-            o->interrupted ? "true" : "false", wetdem_sim_n_particles(su->sim),
+    fprintf(f,
+            ", \"interrupted\": %s, \"particles\": %zu, \"fixed\": %zu, \"walls\": %zu, "
+            "\"step\": %llu, ",
+            o->interrupted ? "true" : "false", wetdem_sim_n_particles(su->sim), n_fixed(su),
             wetdem_sim_n_walls(su->sim), s->step);
     json_num(f, "time_s", wetdem_sim_time(su->sim), true);
     json_num(f, "dt_s", s->dt, true);
@@ -593,12 +608,13 @@ static void print_check_json(const struct cli_scenario* sc, const struct cli_man
 {
     printf("{\"scenario\": ");
     cli_json_string(stdout, sc->file);
-    printf(", \"engine\": \"many\", \"particles\": %zu, \"walls\": %zu, \"box_m\": "
+    printf(", \"engine\": \"many\", \"particles\": %zu, \"fixed\": %zu, \"walls\": %zu, "
+           "\"box_m\": "
            "[%.17g, %.17g, %.17g], \"periodic\": [%s, %s, %s], \"dt_s\": %.17g, "
            "\"t_end_s\": %.17g, \"steps\": %llu, \"vtk_every\": %llu, \"vtk_links\": %s, "
            "\"csv_every\": %llu, \"contacts\": %zu, \"bridges\": %zu, \"models\": [",
-           wetdem_sim_n_particles(su->sim), wetdem_sim_n_walls(su->sim), su->box[0], su->box[1],
-           su->box[2], su->many.periodic[0] ? "true" : "false",
+           wetdem_sim_n_particles(su->sim), n_fixed(su), wetdem_sim_n_walls(su->sim), su->box[0],
+           su->box[1], su->box[2], su->many.periodic[0] ? "true" : "false",
            su->many.periodic[1] ? "true" : "false", su->many.periodic[2] ? "true" : "false", pl->dt,
            pl->t_end, pl->total, su->vtk_every, su->vtk_links ? "true" : "false", su->csv_every,
            s->contacts, s->bridges);
@@ -626,10 +642,13 @@ static void print_check(const struct cli_scenario* sc, const struct cli_many_set
         return;
     }
     printf("scenario %s is valid (many-particle run)\n", sc->file);
-    printf("  particles     %zu\n  walls         %zu\n  box           %g x %g x %g m, periodic "
-           "%s%s%s%s\n",
-           wetdem_sim_n_particles(su->sim), wetdem_sim_n_walls(su->sim), su->box[0], su->box[1],
-           su->box[2], su->many.periodic[0] ? "x" : "", su->many.periodic[1] ? "y" : "",
+    size_t fixed = n_fixed(su);
+    printf("  particles     %zu", wetdem_sim_n_particles(su->sim));
+    if (fixed)
+        printf("  (%zu fixed)", fixed);
+    printf("\n  walls         %zu\n  box           %g x %g x %g m, periodic %s%s%s%s\n",
+           wetdem_sim_n_walls(su->sim), su->box[0], su->box[1], su->box[2],
+           su->many.periodic[0] ? "x" : "", su->many.periodic[1] ? "y" : "",
            su->many.periodic[2] ? "z" : "",
            su->many.periodic[0] || su->many.periodic[1] || su->many.periodic[2] ? "" : "none");
     printf("  dt            %.6g s\n", pl->dt);

@@ -831,6 +831,16 @@ static void test_many_cli_read_spheres_from_a_file(void** state)
                                     "2.5e-3\nmaterial = wet\n[run]\ndt = 2e-6\nsteps = 200\n"
                                     "[dump]\nvtk_every = 200\nvtk_binary = no\n");
     assert_int_equal(run_cli("run fixed.ini --out fixed"), 0);
+    char* said = test_read_file(tpath("out.txt"), NULL);
+    CHECK_CONTAINS(said, "particles          4  (3 fixed, walls 2)");
+    free(said);
+    said = test_read_file(tpath("fixed/summary.json"), NULL);
+    CHECK_CONTAINS(said, "\"particles\": 4, \"fixed\": 3, \"walls\": 2,");
+    free(said);
+    assert_int_equal(run_cli("run fixed.ini --check"), 0);
+    said = test_read_file(tpath("out.txt"), NULL);
+    CHECK_CONTAINS(said, "  particles     4  (3 fixed)\n");
+    free(said);
     for (int f = 0; f < 2; f++) {
         frame = test_read_file(
             tpath(f ? "fixed/particles_000001.vtk" : "fixed/particles_000000.vtk"), NULL);
