@@ -92,6 +92,20 @@ static char* expect_exit(const char* args, int code, const char* needle)
     return err;
 }
 
+/* Runs args, expects exit 0 and `needle` in the file `name` of tmpdir (out.txt: stdout). */
+static void expect_output(const char* args, const char* name, const char* needle)
+{
+    int got = run_cli(args);
+    if (got != 0) {
+        char* err = stderr_text();
+        fail_msg("%s: exit %d, expected 0\n%s", args, got, err);
+    }
+    char* text = test_read_file(tpath(name), NULL);
+    assert_non_null(text);
+    CHECK_CONTAINS(text, needle);
+    free(text);
+}
+
 /* A wet granular box, periodic in x and y, floor and lid, gravity (21 lines)... */
 #define WET_BOX                                                                                    \
     "[box]\nsize_x = 6e-3\nsize_y = 6e-3\nsize_z = 8e-3\nperiodic = x y\n"                         \
@@ -658,10 +672,7 @@ static void test_many_cli_summary_mean_size_readable(void** state)
                "surface_tension = 0.02\n[models]\nforce = hertz sb capillary\n[insert]\n"
                "layout = lattice\ncount = 1000\nradius = 0.45e-3\ngap = 10e-6\nmaterial = wet\n"
                "[run]\nsteps = 1\n");
-    assert_int_equal(run_cli("run agglomerate.ini"), 0);
-    char* out = test_read_file(tpath("out.txt"), NULL);
-    CHECK_CONTAINS(out, "agglomerates       1  (mean size 1000)\n");
-    free(out);
+    expect_output("run agglomerate.ini", "out.txt", "agglomerates       1  (mean size 1000)\n");
 }
 
 /* Progress: nothing on stderr when it is a file; on a terminal, the spheres placed by the
@@ -721,10 +732,7 @@ static void test_many_cli_random_groups_share_the_box(void** state)
              "[insert.small]\ncount = 400\nradius = 0.3e-3\nseed = 2\n",
              box);
     write_text("groups.ini", text);
-    assert_int_equal(run_cli("run groups.ini --check"), 0);
-    char* out = test_read_file(tpath("out.txt"), NULL);
-    CHECK_CONTAINS(out, "particles     408");
-    free(out);
+    expect_output("run groups.ini --check", "out.txt", "particles     408");
     /* 1500 of 0.3 mm first (0.17): a big sphere's centre needs none of theirs within 1.8 mm,
      * where 1500 x 4/3 pi (1.8 mm)^3 / (10 mm)^3 = 37 are expected (a chance of e^-37) */
     snprintf(text, sizeof text,
@@ -830,17 +838,12 @@ static void test_many_cli_read_spheres_from_a_file(void** state)
                                     "[particle.drop]\nradius = 4e-4\nx = 3e-3\ny = 3e-3\nz = "
                                     "2.5e-3\nmaterial = wet\n[run]\ndt = 2e-6\nsteps = 200\n"
                                     "[dump]\nvtk_every = 200\nvtk_binary = no\n");
-    assert_int_equal(run_cli("run fixed.ini --out fixed"), 0);
-    char* said = test_read_file(tpath("out.txt"), NULL);
-    CHECK_CONTAINS(said, "particles          4  (3 fixed, walls 2)");
-    free(said);
-    said = test_read_file(tpath("fixed/summary.json"), NULL);
+    expect_output("run fixed.ini --out fixed", "out.txt",
+                  "particles          4  (3 fixed, walls 2)");
+    char* said = test_read_file(tpath("fixed/summary.json"), NULL);
     CHECK_CONTAINS(said, "\"particles\": 4, \"fixed\": 3, \"walls\": 2,");
     free(said);
-    assert_int_equal(run_cli("run fixed.ini --check"), 0);
-    said = test_read_file(tpath("out.txt"), NULL);
-    CHECK_CONTAINS(said, "  particles     4  (3 fixed)\n");
-    free(said);
+    expect_output("run fixed.ini --check", "out.txt", "  particles     4  (3 fixed)\n");
     for (int f = 0; f < 2; f++) {
         frame = test_read_file(
             tpath(f ? "fixed/particles_000001.vtk" : "fixed/particles_000000.vtk"), NULL);
