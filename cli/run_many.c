@@ -622,6 +622,11 @@ static void print_check_json(const struct cli_scenario* sc, const struct cli_man
         printf("%s", k ? ", " : "");
         cli_json_string(stdout, wetdem_sim_model(su->sim, k)->name);
     }
+    printf("], \"materials\": [");
+    for (int k = 0; k < wetdem_sim_n_materials(su->sim); k++) {
+        printf("%s", k ? ", " : "");
+        cli_json_string(stdout, su->material_names[k]);
+    }
     printf("], ");
     const char* key[3] = {"relaxation_time_s", "contact_time_s", "hmin_crossing_time_s"};
     double value[3] = {s->relaxation_time, s->contact_time, s->hmin_crossing_time};
@@ -673,6 +678,10 @@ static void print_check(const struct cli_scenario* sc, const struct cli_many_set
            s.bridges);
     for (size_t k = 0; k < wetdem_sim_n_models(su->sim); k++)
         printf(" %s", wetdem_sim_model(su->sim, k)->name);
+    printf("\n  materials    "); /* (their indices: frames' material array, [read.NAME]) */
+    for (int k = 0; k < wetdem_sim_n_materials(su->sim); k++)
+        printf(" %d %s%s", k, su->material_names[k],
+               k + 1 < wetdem_sim_n_materials(su->sim) ? "," : "");
     printf("\n");
 }
 

@@ -24,6 +24,7 @@
  * key (scenario.h error convention).
  */
 #include <ctype.h>
+#include <limits.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -37,7 +38,7 @@
 #define NUM CLI_KEY_NUMBER
 #define COUNT CLI_KEY_COUNT
 #define WORD CLI_KEY_WORD
-#define MAX_MATERIALS 32
+#define MAX_MATERIALS CLI_MANY_MAX_MATERIALS
 
 static const char* const layouts[] = {"lattice", "random", NULL};
 static const char* const face_names[] = {"x_min", "x_max", "y_min", "y_max",
@@ -126,6 +127,10 @@ static const struct cli_key_desc read_keys[] = {
          "Values are checked as the keys of [particle.NAME]. The spheres may overlap each other "
          "and the walls (a settled packing does); their centres must lie in the box."),
     WORD("material", CLI_VALUE_NAME, "steel1", NULL, "Material of every sphere, as in [insert]."),
+    WORD("materials", CLI_VALUE_TEXT, "none (material)", NULL,
+         "Instead of material: the materials of the file's material indices 0, 1, ..., e.g. "
+         "'glass steel1' (a CSV's material column; a frame's material array, the index of each "
+         "sphere's material in the run that wrote it, as `wetdem run --check` lists them)."),
     WORD("fixed", CLI_VALUE_CHOICE, "file", read_fixed_choices,
          "Which spheres are held in place (infinite mass, at rest): file, those the file marks "
          "(a frame's fixed array, a CSV's fixed column of 0 and 1; none if it has neither); "
@@ -281,22 +286,22 @@ static int build_settings(const struct cli_scenario* sc, struct wetdem_sim* sim)
 /* ------------------------------------------------------------------------- materials --- */
 
 struct materials {
-    const char* names[MAX_MATERIALS];
+    char names[MAX_MATERIALS][CLI_NAME_MAX];
     int index[MAX_MATERIALS];
     size_t n;
 };
 
 /* Index of material `name` in sim, added on first use ([material.NAME] first, then a preset).
  * `use` is the entry naming it (NULL: the default, reported at `section`). */
-static int material_index(const struct cli_scenario* sc, struct wetdem_sim* sim,
-                          struct materials* mt, const char* section, const char* name, int* index)
+static int material_index_at(const struct cli_scenario* sc, struct wetdem_sim* sim,
+                             struct materials* mt, const char* section, const struct cli_entry* use,
+                             const char* name, int* index)
 {
     for (size_t k = 0; k < mt->n; k++)
         if (strcmp(mt->names[k], name) == 0) {
             *index = mt->index[k];
             return CLI_EXIT_OK;
         }
-    const struct cli_entry* use = cli_scenario_find(sc, section, "material");
     char msec[CLI_NAME_MAX];
     snprintf(msec, sizeof msec, "material.%s", name);
     struct wetdem_material m;
@@ -323,9 +328,17 @@ static int material_index(const struct cli_scenario* sc, struct wetdem_sim* sim,
     *index = wetdem_sim_add_material(sim, &m);
     if (*index < 0)
         return cli_scenario_lib_error(sc, use, section, sim);
-    mt->names[mt->n] = name;
+    snprintf(mt->names[mt->n], sizeof mt->names[0], "%s", name);
     mt->index[mt->n++] = *index;
     return CLI_EXIT_OK;
+}
+
+/* material_index_at for the `material` key of `section`. */
+static int material_index(const struct cli_scenario* sc, struct wetdem_sim* sim,
+                          struct materials* mt, const char* section, const char* name, int* index)
+{
+    return material_index_at(sc, sim, mt, section, cli_scenario_find(sc, section, "material"), name,
+                             index);
 }
 
 /* ------------------------------------------------------------------------------- box --- */
@@ -597,6 +610,83 @@ static void sphere_file_path(const struct cli_scenario* sc, const char* value, c
         snprintf(path, n, "%.*s/%s", (int)(slash - sc->file), sc->file, value);
 }
 
+/* The [read.NAME] materials list (materials = A B ...: the materials of the file's indices 0, 1,
+ * ...) resolved into index[0 .. *n), sim's materials. */
+static int read_materials(const struct cli_scenario* sc, struct cli_many_setup* su,
+                          struct materials* mt, const char* section, const struct cli_entry* list,
+                          int* index, size_t* n)
+{
+    char buf[CLI_VALUE_MAX], *save = NULL;
+    snprintf(buf, sizeof buf, "%s", list->value);
+    *n = 0;
+    for (char* tok = strtok_r(buf, " ,\t", &save); tok; tok = strtok_r(NULL, " ,\t", &save)) {
+        if (*n == MAX_MATERIALS) {
+            cli_scenario_error(sc, list, "more than %d materials", MAX_MATERIALS);
+            return CLI_EXIT_USAGE;
+        }
+        int rc = material_index_at(sc, su->sim, mt, section, list, tok, &index[(*n)++]);
+        if (rc != CLI_EXIT_OK)
+            return rc;
+    }
+    if (*n == 0) {
+        cli_scenario_error(sc, list,
+                           "materials names none: give the materials of the file's "
+                           "indices 0, 1, ... (e.g. 'glass steel1')");
+        return CLI_EXIT_USAGE;
+    }
+    return CLI_EXIT_OK;
+}
+
+/* Each sphere's material: with `materials`, the one its index in the file (p[k].material, -1
+ * when the file has none) names; without, `material` for all, with a warning when the file's
+ * spheres have several indices (their materials are then not kept apart). */
+static int assign_materials(const struct cli_scenario* sc, struct cli_many_setup* su,
+                            struct materials* mt, const char* section, const char* path,
+                            struct wetdem_particle* p, size_t n)
+{
+    const struct cli_entry* list = cli_scenario_find(sc, section, "materials");
+    const struct cli_entry* one = cli_scenario_find(sc, section, "material");
+    if (list && one) {
+        cli_scenario_error(sc, list,
+                           "give material (every sphere) or materials (by the file's "
+                           "material column), not both");
+        return CLI_EXIT_USAGE;
+    }
+    int index[MAX_MATERIALS], material;
+    size_t n_list = 0;
+    int rc = list ? read_materials(sc, su, mt, section, list, index, &n_list)
+                  : material_index(sc, su->sim, mt, section,
+                                   cli_scenario_text(sc, section, "material", "steel1"), &material);
+    if (rc != CLI_EXIT_OK)
+        return rc;
+    int lo = INT_MAX, hi = -1;
+    for (size_t k = 0; k < n; k++) {
+        int m = p[k].material;
+        if (list && (m < 0 || (size_t)m >= n_list)) {
+            if (m < 0)
+                cli_scenario_error(sc, list,
+                                   "%s has no material column (a CSV) or array (a frame) for "
+                                   "materials to map",
+                                   path);
+            else
+                cli_scenario_error(sc, list,
+                                   "sphere %zu of %s has material %d; materials names %zu "
+                                   "(indices 0 to %zu)",
+                                   k + 1, path, m, n_list, n_list - 1);
+            return CLI_EXIT_USAGE;
+        }
+        lo = m < lo ? m : lo;
+        hi = m > hi ? m : hi;
+        p[k].material = list ? index[m] : material;
+    }
+    if (!list && lo >= 0 && hi > lo)
+        cli_error("warning: %s: [%s]: the spheres of %s have material indices %d to %d; every one "
+                  "takes material = %s (materials = ... keeps them apart)",
+                  sc->file, section, path, lo, hi,
+                  cli_scenario_text(sc, section, "material", "steel1"));
+    return CLI_EXIT_OK;
+}
+
 static int build_sphere_file(const struct cli_scenario* sc, struct cli_many_setup* su,
                              struct materials* mt, const char* section)
 {
@@ -605,26 +695,24 @@ static int build_sphere_file(const struct cli_scenario* sc, struct cli_many_setu
         cli_scenario_section_error(sc, section, "[%s] needs file (a CSV or a frame .vtk)", section);
         return CLI_EXIT_USAGE;
     }
-    int material;
-    int rc = material_index(sc, su->sim, mt, section,
-                            cli_scenario_text(sc, section, "material", "steel1"), &material);
-    if (rc != CLI_EXIT_OK)
-        return rc;
     char path[2200], why[512];
     sphere_file_path(sc, e->value, path, sizeof path);
     struct wetdem_particle* p = NULL;
     size_t n = 0;
-    if ((rc = cli_read_sphere_file(path, &p, &n, why, sizeof why)) != CLI_EXIT_OK) {
+    int rc = cli_read_sphere_file(path, &p, &n, why, sizeof why);
+    if (rc != CLI_EXIT_OK) {
         /* "PATH:LINE: why" for a CSV (why starts with its line), "PATH: why" otherwise */
         cli_scenario_error(sc, e, "%s:%s%s", path, isdigit((unsigned char)why[0]) ? "" : " ", why);
         return rc;
     }
+    rc = assign_materials(sc, su, mt, section, path, p, n);
     const char* fixed = cli_scenario_text(sc, section, "fixed", "file");
     for (size_t k = 0; k < n && rc == CLI_EXIT_OK; k++) {
-        p[k].material = material;
         if (strcmp(fixed, "yes") == 0) /* at rest */
-            p[k] = (struct wetdem_particle){
-                .pos = p[k].pos, .radius = p[k].radius, .material = material, .is_fixed = true};
+            p[k] = (struct wetdem_particle){.pos = p[k].pos,
+                                            .radius = p[k].radius,
+                                            .material = p[k].material,
+                                            .is_fixed = true};
         else if (strcmp(fixed, "no") == 0)
             p[k].is_fixed = false;
         if (wetdem_sim_add_particle(su->sim, p[k]) != WETDEM_OK)
@@ -726,8 +814,12 @@ static int build_spheres(const struct cli_scenario* sc, struct cli_many_setup* s
             free(groups);
             return rc;
         }
-        if (!*first)
-            *first = cli_scenario_text(sc, name, "material", "steel1");
+        if (!*first) { /* the material of the group's first sphere */
+            int m = wetdem_sim_particles_const(su->sim, NULL)[groups[n_groups - 1].from].material;
+            for (size_t k = 0; k < mt->n && !*first; k++)
+                if (mt->index[k] == m)
+                    *first = mt->names[k];
+        }
     }
     free(groups);
     if (!*first) {
@@ -848,6 +940,10 @@ int cli_many_build(const struct cli_scenario* sc, struct cli_many_setup* su)
         cli_many_setup_free(su);
         return rc;
     }
+    for (size_t k = 0; k < mt.n; k++) /* (every material of sim came through mt) */
+        if (mt.index[k] >= 0 && mt.index[k] < MAX_MATERIALS)
+            snprintf(su->material_names[mt.index[k]], sizeof su->material_names[0], "%s",
+                     mt.names[k]);
     if (wetdem_sim_set_many(su->sim, &su->many) != WETDEM_OK) {
         rc = cli_many_report_start(sc, wetdem_sim_errmsg(su->sim));
         cli_many_setup_free(su);

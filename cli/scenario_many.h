@@ -12,9 +12,13 @@
 
 #include "scenario.h"
 
+/* Most materials a many-particle scenario may name. */
+#define CLI_MANY_MAX_MATERIALS 32
+
 /* Everything a many-particle run needs, resolved from a scenario. */
 struct cli_many_setup {
-    struct wetdem_sim* sim;           /* owned: materials, fluid, models, walls, particles */
+    struct wetdem_sim* sim; /* owned: materials, fluid, models, walls, particles */
+    char material_names[CLI_MANY_MAX_MATERIALS][CLI_NAME_MAX]; /* of sim's materials 0, 1, ... */
     struct wetdem_many_settings many; /* periodic box, dt, skin, energy budget; no outputs */
     double box[3];                    /* box edges [m]: the box is [0, box[k]] */
     unsigned long long steps;         /* from [run] steps, or 0 when t_end is given */

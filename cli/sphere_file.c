@@ -32,9 +32,10 @@
 #define MAX_FIELDS 64         /* fields of a CSV line read (more: a count error) */
 
 /* The columns a CSV may have (the [particle.NAME] keys), with their ranges and units. */
-enum column { X, Y, Z, RADIUS, VX, VY, VZ, SPIN_X, SPIN_Y, SPIN_Z, FIXED, N_COLUMNS };
-static const char* const column_names[] = {"x",  "y",      "z",      "radius", "vx",    "vy",
-                                           "vz", "spin_x", "spin_y", "spin_z", "fixed", NULL};
+enum column { X, Y, Z, RADIUS, VX, VY, VZ, SPIN_X, SPIN_Y, SPIN_Z, FIXED, MATERIAL, N_COLUMNS };
+static const char* const column_names[] = {"x",     "y",        "z",      "radius", "vx",
+                                           "vy",    "vz",       "spin_x", "spin_y", "spin_z",
+                                           "fixed", "material", NULL};
 static const struct {
     double lo, hi;
     bool lo_open;
@@ -43,7 +44,7 @@ static const struct {
     {-1e3, 1e3, false, "m"},     {-1e3, 1e3, false, "m"},     {-1e3, 1e3, false, "m"},
     {0, 1, true, "m"},           {-1e3, 1e3, false, "m/s"},   {-1e3, 1e3, false, "m/s"},
     {-1e3, 1e3, false, "m/s"},   {-1e6, 1e6, false, "rad/s"}, {-1e6, 1e6, false, "rad/s"},
-    {-1e6, 1e6, false, "rad/s"}, {0, 1, false, "-"},
+    {-1e6, 1e6, false, "rad/s"}, {0, 1, false, "-"},          {0, 1000, false, "-"},
 };
 
 static int fail(char* err, size_t err_len, const char* fmt, ...)
@@ -65,14 +66,23 @@ static int no_memory(char* err, size_t err_len)
     return CLI_EXIT_RUNTIME;
 }
 
-/* Whether value v lies in column c's range (fixed: 0 or 1); otherwise writes why into err. */
+/* Whether value v lies in column c's range (fixed: 0 or 1; material: a whole number);
+ * otherwise writes why into err. */
 static bool in_range(enum column c, double v, char* err, size_t err_len, const char* where)
 {
     bool ok = column_range[c].lo_open ? v > column_range[c].lo : v >= column_range[c].lo;
-    if (ok && v <= column_range[c].hi && (c != FIXED || v == 0 || v == 1))
+    if (ok && v <= column_range[c].hi && (c != FIXED || v == 0 || v == 1) &&
+        (c != MATERIAL || v == floor(v)))
         return true;
     if (c == FIXED) {
         fail(err, err_len, "%sfixed = %g is not 0 (free) or 1 (held in place)", where, v);
+        return false;
+    }
+    if (c == MATERIAL) {
+        fail(err, err_len,
+             "%smaterial = %g is not a whole number in [0, 1000] (the index of the sphere's "
+             "material in [read.NAME] materials)",
+             where, v);
         return false;
     }
     fail(err, err_len, "%s%s = %g %s is not in %c%g, %g] %s", where, column_names[c], v,
@@ -81,8 +91,8 @@ static bool in_range(enum column c, double v, char* err, size_t err_len, const c
     return false;
 }
 
-/* The sphere of values v (indexed by column; absent columns 0), checked: a fixed one must be
- * at rest (else why, after `where`, into err and false). */
+/* The sphere of values v (indexed by column; absent columns 0, material -1), checked: a fixed
+ * one must be at rest (else why, after `where`, into err and false). */
 static bool sphere_of(const double v[N_COLUMNS], struct wetdem_particle* p, char* err,
                       size_t err_len, const char* where)
 {
@@ -90,6 +100,7 @@ static bool sphere_of(const double v[N_COLUMNS], struct wetdem_particle* p, char
                                   .vel = {v[VX], v[VY], v[VZ]},
                                   .omega = {v[SPIN_X], v[SPIN_Y], v[SPIN_Z]},
                                   .radius = v[RADIUS],
+                                  .material = (int)v[MATERIAL],
                                   .is_fixed = v[FIXED] == 1};
     for (int c = VX; p->is_fixed && c <= SPIN_Z; c++)
         if (v[c] != 0) {
@@ -190,7 +201,7 @@ static int read_header(char* line, size_t line_no, int col[N_COLUMNS], int* n_fi
     if (cli_csv_columns(f, *n_fields, column_names, col, &bad, why, sizeof why) != 0)
         return fail(err, err_len,
                     "%zu: %s (columns: x, y, z, radius; optional vx, vy, vz, spin_x, spin_y, "
-                    "spin_z, fixed)",
+                    "spin_z, fixed, material)",
                     line_no, why);
     for (int c = X; c <= RADIUS; c++)
         if (col[c] < 0)
@@ -228,6 +239,7 @@ static int read_csv(char* text, struct wetdem_particle** out, size_t* n, char* e
             return fail(err, err_len, "%zu: %d fields, the header has %d columns", line_no, nf,
                         n_fields);
         double v[N_COLUMNS] = {0};
+        v[MATERIAL] = -1; /* none given */
         char where[64];
         snprintf(where, sizeof where, "%zu: ", line_no);
         for (int c = 0; c < N_COLUMNS; c++) {
@@ -383,9 +395,9 @@ static int read_vtk(const char* data, size_t len, struct wetdem_particle** out, 
     nw = vtk_line(&c, w);
     if (nw != 2 || strcmp(w[0], "DATASET") != 0 || strcmp(w[1], "POLYDATA") != 0)
         return fail(err, err_len, "not a wetdem frame: line 4 is not DATASET POLYDATA");
-    double *pos = NULL, *arrays[4] = {NULL, NULL, NULL, NULL}; /* as wanted[] */
-    static const char* const wanted[] = {"radius", "velocity", "spin", "fixed"};
-    static const int comps[] = {1, 3, 3, 1};
+    double *pos = NULL, *arrays[5] = {NULL, NULL, NULL, NULL, NULL}; /* as wanted[] */
+    static const char* const wanted[] = {"radius", "velocity", "spin", "fixed", "material"};
+    static const int comps[] = {1, 3, 3, 1, 1};
     long long n_points = -1;
     int rc = 0;
     while (rc == 0 && (nw = vtk_line(&c, w)) >= 0) {
@@ -422,10 +434,10 @@ static int read_vtk(const char* data, size_t len, struct wetdem_particle** out, 
                     break;
                 }
                 int a = 0;
-                while (a < 4 && strcmp(w[0], wanted[a]) != 0)
+                while (a < 5 && strcmp(w[0], wanted[a]) != 0)
                     a++;
                 double* dest = NULL;
-                if (a < 4 && !arrays[a]) {
+                if (a < 5 && !arrays[a]) {
                     if (nc != comps[a] || nt != n_points) {
                         rc = fail(err, err_len, "array %s: %lld x %lld values, expected %d x %lld",
                                   wanted[a], nt, nc, comps[a], n_points);
@@ -464,10 +476,13 @@ static int read_vtk(const char* data, size_t len, struct wetdem_particle** out, 
         }
         v[RADIUS] = arrays[0][i];
         v[FIXED] = arrays[3] ? arrays[3][i] : 0;
+        v[MATERIAL] = arrays[4] ? arrays[4][i] : -1;
         char where[64];
         snprintf(where, sizeof where, "sphere %lld: ", i + 1);
         for (int k = 0; rc == 0 && k < N_COLUMNS; k++)
-            if (!isfinite(v[k]))
+            if (k == MATERIAL && !arrays[4])
+                continue; /* (none given: -1) */
+            else if (!isfinite(v[k]))
                 rc = fail(err, err_len, "%s%s is not a finite number", where, column_names[k]);
             else if (!in_range(k, v[k], err, err_len, where))
                 rc = CLI_EXIT_USAGE;
@@ -478,7 +493,7 @@ static int read_vtk(const char* data, size_t len, struct wetdem_particle** out, 
             rc = no_memory(err, err_len);
     }
     free(pos);
-    for (int a = 0; a < 4; a++)
+    for (int a = 0; a < 5; a++)
         free(arrays[a]);
     return rc;
 }

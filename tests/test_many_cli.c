@@ -904,6 +904,57 @@ static void test_many_cli_read_spheres_from_a_file(void** state)
     CHECK_CONTAINS(frame, "fixed 1 2 int\n1\n0\n");
     CHECK_CONTAINS(frame, "velocity 3 2 double\n0 0 0\n0.10000000000000001 0 0\n");
     free(frame);
+    /* two materials by a CSV's material column; the frame of that run (material array 0 1 1
+       as the scenario's materials list them) read back with the same list starts at its state
+       bit for bit; without the list every sphere takes `material`, with a warning */
+    write_text("two.csv", "x,y,z,radius,material\n1e-3,3e-3,1e-3,4e-4,0\n3e-3,3e-3,3e-3,4e-4,1\n"
+                          "5e-3,3e-3,3e-3,4e-4,1\n");
+    const char* two = WET_BOX "[read.bed]\nfile = %s\n%s\n[run]\ndt = 2e-6\nsteps = 1\n"
+                              "[dump]\nvtk_every = 1\nvtk_binary = no\n";
+    snprintf(ini, sizeof ini, two, "two.csv", "materials = wet glass");
+    write_text("two.ini", ini);
+    expect_output("run two.ini --check", "out.txt", "  materials     0 wet, 1 glass\n");
+    assert_int_equal(run_cli("run two.ini --out two"), 0);
+    frame = test_read_file(tpath("two/particles_000000.vtk"), NULL);
+    assert_non_null(frame);
+    CHECK_CONTAINS(frame, "material 1 3 int\n0\n1\n1\n");
+    free(frame);
+    snprintf(ini, sizeof ini, two, "two/particles_000000.vtk", "materials = wet, glass");
+    write_text("two_again.ini", ini);
+    assert_int_equal(run_cli("run two_again.ini --out two_again"), 0);
+    a = frame_from_points("two/particles_000000.vtk", &la);
+    b = frame_from_points("two_again/particles_000000.vtk", &lb);
+    assert_true(a && b && la == lb && memcmp(a, b, la) == 0);
+    free(a);
+    free(b);
+    snprintf(ini, sizeof ini, two, "two/particles_000000.vtk", "material = wet");
+    write_text("two_one.ini", ini);
+    assert_int_equal(run_cli("run two_one.ini --out two_one"), 0);
+    char* warned = stderr_text();
+    CHECK_CONTAINS(warned, "two_one.ini: [read.bed]: the spheres of two/particles_000000.vtk have "
+                           "material indices 0 to 1; every one takes material = wet (materials = "
+                           "... keeps them apart)");
+    free(warned);
+    frame = test_read_file(tpath("two_one/particles_000000.vtk"), NULL);
+    CHECK_CONTAINS(frame, "material 1 3 int\n0\n0\n0\n");
+    free(frame);
+    /* and what materials refuses: the scenario's line of the key (24) */
+    const struct {
+        const char *file, *keys, *what;
+    } refused[] = {
+        {"two.csv", "materials = wet",
+         "sphere 2 of two.csv has material 1; materials names 1 "
+         "(indices 0 to 0)"},
+        {"bed.csv", "materials = wet glass", "bed.csv has no material column (a CSV) or array"},
+        {"two.csv", "materials = wet glas", "unknown material 'glas' (did you mean 'glass'?)"},
+        {"two.csv", "materials = wet glass\nmaterial = wet",
+         "give material (every sphere) or materials (by the file's material column), not both"},
+        {"two.csv", "materials = ,", "materials names none"},
+    };
+    for (size_t k = 0; k < sizeof refused / sizeof refused[0]; k++) {
+        snprintf(ini, sizeof ini, two, refused[k].file, refused[k].keys);
+        expect_bad("refused.ini", ini, 24, refused[k].what);
+    }
 
     /* bad files: the scenario's file line (22), the file's own line or array */
     const char* head = WET_BOX "[read.bed]\nfile = ";
@@ -923,6 +974,8 @@ static void test_many_cli_read_spheres_from_a_file(void** state)
          "bad.csv:2: fixed = 0.5 is not 0 (free) or 1 (held in place)"},
         {"x,y,z,radius,fixed,spin_z\n1e-3,1e-3,1e-3,1e-4,1,-3\n",
          "bad.csv:2: a fixed sphere (fixed = 1) is held in place, at rest: spin_z = -3 must be 0"},
+        {"x,y,z,radius,material\n1e-3,1e-3,1e-3,1e-4,1.5\n",
+         "bad.csv:2: material = 1.5 is not a whole number in [0, 1000]"},
         {"x,y,z,radius\n", "bad.csv:1: no spheres after the header"},
         {"", "bad.csv: the file is empty"},
         {"x,y,z,radius\n1e-3,1e-3,9e-3,1e-4\n", "sphere 1 of [read.bed] (centre z = 0.009 m"},

@@ -4,7 +4,7 @@
  * byte is odd, else as a CSV. A finding is a crash, a sanitizer report, a leak, a hang, or
  * spheres accepted with a value outside the ranges the reader promises (finite everywhere, a
  * radius in (0, 1] m, centres and speeds within 1000, spins within 1e6, a fixed sphere at
- * rest), or an error without a message.
+ * rest, a material index in [0, 1000] or -1 for none), or an error without a message.
  */
 #include <math.h>
 #include <stdint.h>
@@ -41,7 +41,8 @@ int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size)
         if (!(p[k].radius > 0 && p[k].radius <= 1) || !within(p[k].pos.x, 1e3) ||
             !within(p[k].pos.y, 1e3) || !within(p[k].pos.z, 1e3) || !within(p[k].vel.x, 1e3) ||
             !within(p[k].vel.y, 1e3) || !within(p[k].vel.z, 1e3) || !within(p[k].omega.x, 1e6) ||
-            !within(p[k].omega.y, 1e6) || !within(p[k].omega.z, 1e6) ||
+            !within(p[k].omega.y, 1e6) || !within(p[k].omega.z, 1e6) || p[k].material < -1 ||
+            p[k].material > 1000 ||
             (p[k].is_fixed && (p[k].vel.x != 0 || p[k].vel.y != 0 || p[k].vel.z != 0 ||
                                p[k].omega.x != 0 || p[k].omega.y != 0 || p[k].omega.z != 0)))
             abort();
