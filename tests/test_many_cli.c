@@ -759,6 +759,22 @@ static char* frame_from_points(const char* name, size_t* len)
     return NULL;
 }
 
+/* Runs `args` (exit 0) and requires frame `dst` of tmpdir to hold the spheres and arrays of
+ * frame `src` bit for bit (frame_from_points: the time may differ). */
+static void run_gives_frame(const char* args, const char* dst, const char* src)
+{
+    assert_int_equal(run_cli(args), 0);
+    size_t la = 0, lb = 0;
+    char* a = frame_from_points(src, &la);
+    char* b = frame_from_points(dst, &lb);
+    assert_non_null(a);
+    assert_non_null(b);
+    if (la != lb || memcmp(a, b, la) != 0)
+        fail_msg("%s: %s, the frame written, differs from %s, the frame read", args, dst, src);
+    free(a);
+    free(b);
+}
+
 /* [read.NAME]: spheres from a frame of an earlier run (ASCII and binary) start the run at that
  * frame's state bit for bit; from a CSV at the parsed values; bad files exit 2 naming the
  * scenario line, the file and its line or array, and write nothing. */
@@ -778,28 +794,14 @@ static void test_many_cli_read_spheres_from_a_file(void** state)
                          "[run]\ndt = 2e-6\nsteps = 1\n[dump]\nvtk_every = 1\nvtk_binary = %s\n",
                  binary ? "yes" : "no");
         write_text("dst.ini", text);
-        assert_int_equal(run_cli("run dst.ini --out dst"), 0);
-        size_t la = 0, lb = 0;
-        char* a = frame_from_points("src/particles_000001.vtk", &la);
-        char* b = frame_from_points("dst/particles_000000.vtk", &lb);
-        assert_non_null(a);
-        assert_non_null(b);
-        if (la != lb || memcmp(a, b, la) != 0)
-            fail_msg("%s frame read and written again differs from the frame read",
-                     binary ? "a binary" : "an ASCII");
-        free(a);
-        free(b);
+        run_gives_frame("run dst.ini --out dst", "dst/particles_000000.vtk",
+                        "src/particles_000001.vtk");
     }
     /* a run's .vtk.series index stands for its last frame (step 40 of the binary run) */
     write_text("series.ini", WET_BOX "[read.bed]\nfile = src/particles.vtk.series\nmaterial = wet\n"
                                      "[run]\ndt = 2e-6\nsteps = 1\n[dump]\nvtk_every = 1\n");
-    assert_int_equal(run_cli("run series.ini --out series"), 0);
-    size_t la = 0, lb = 0;
-    char* a = frame_from_points("src/particles_000001.vtk", &la);
-    char* b = frame_from_points("series/particles_000000.vtk", &lb);
-    assert_true(a && b && la == lb && memcmp(a, b, la) == 0);
-    free(a);
-    free(b);
+    run_gives_frame("run series.ini --out series", "series/particles_000000.vtk",
+                    "src/particles_000001.vtk");
     /* a CSV: the spheres at the values parsed (the ASCII frame's %.17g gives them back),
        overlapping each other and the floor as a settled packing does; blank and '#' lines
        skipped, units in the header */
@@ -879,12 +881,8 @@ static void test_many_cli_read_spheres_from_a_file(void** state)
     char ini[2048];
     snprintf(ini, sizeof ini, again, "");
     write_text("again.ini", ini);
-    assert_int_equal(run_cli("run again.ini --out again"), 0);
-    a = frame_from_points("fixed/particles_000001.vtk", &la);
-    b = frame_from_points("again/particles_000000.vtk", &lb);
-    assert_true(a && b && la == lb && memcmp(a, b, la) == 0);
-    free(a);
-    free(b);
+    run_gives_frame("run again.ini --out again", "again/particles_000000.vtk",
+                    "fixed/particles_000001.vtk");
     snprintf(ini, sizeof ini, again, "fixed = no\n");
     write_text("again.ini", ini);
     assert_int_equal(run_cli("run again.ini --out free"), 0);
@@ -921,12 +919,8 @@ static void test_many_cli_read_spheres_from_a_file(void** state)
     free(frame);
     snprintf(ini, sizeof ini, two, "two/particles_000000.vtk", "materials = wet, glass");
     write_text("two_again.ini", ini);
-    assert_int_equal(run_cli("run two_again.ini --out two_again"), 0);
-    a = frame_from_points("two/particles_000000.vtk", &la);
-    b = frame_from_points("two_again/particles_000000.vtk", &lb);
-    assert_true(a && b && la == lb && memcmp(a, b, la) == 0);
-    free(a);
-    free(b);
+    run_gives_frame("run two_again.ini --out two_again", "two_again/particles_000000.vtk",
+                    "two/particles_000000.vtk");
     snprintf(ini, sizeof ini, two, "two/particles_000000.vtk", "material = wet");
     write_text("two_one.ini", ini);
     assert_int_equal(run_cli("run two_one.ini --out two_one"), 0);
