@@ -119,11 +119,12 @@ static const char* const read_fixed_choices[] = {"file", "yes", "no", NULL};
 static const struct cli_key_desc read_keys[] = {
     WORD("file", CLI_VALUE_TEXT, "required", NULL,
          "The spheres' file, relative to the scenario file's directory unless absolute: a frame "
-         "of a wetdem run (PREFIX_NNNNNN.vtk: centres, radius, velocity, spin, fixed; a run's "
+         "of a wetdem run (PREFIX_NNNNNN.vtk: centres, radius, velocity, spin, fixed, material; "
+         "a run's "
          "PREFIX.vtk.series stands for its last frame), or a CSV whose "
          "header names the columns x, y, z, radius [m] and optionally vx, vy, vz [m/s], spin_x, "
-         "spin_y, spin_z [rad/s], fixed (0 or 1) (a name may carry its unit, 'x [m]'; '#' lines "
-         "are skipped). "
+         "spin_y, spin_z [rad/s], fixed (0 or 1), material (an index: see materials) (a name "
+         "may carry its unit, 'x [m]'; '#' lines are skipped). "
          "Values are checked as the keys of [particle.NAME]. The spheres may overlap each other "
          "and the walls (a settled packing does); their centres must lie in the box."),
     WORD("material", CLI_VALUE_NAME, "steel1", NULL, "Material of every sphere, as in [insert]."),
