@@ -1,8 +1,8 @@
 """Figures and checks of the many-particle validation piece (scripts/validate.d/40-many.sh).
 
-Reads the --out directories of the three shipped scenarios (global.csv, summary.json and the
-VTK frames, ASCII or binary) and writes docs/figures/many_cradle.png,
-many_settling.png and many_agglomeration.png. Checks, each printed and failing the script:
+Reads the --out directories of the four shipped scenarios (global.csv, summary.json and the
+VTK frames, ASCII or binary) and writes docs/figures/many_cradle.png, many_settling.png,
+many_agglomeration.png and many_rough_base.png. Checks, each printed and failing the script:
   cradle        x momentum conserved (no walls, no gravity: only pair forces, equal and
                 opposite) to 1e-9 of the striker's; the last sphere leaves with more than
                 half the striker's speed and faster than every other sphere;
@@ -18,6 +18,11 @@ many_settling.png and many_agglomeration.png. Checks, each printed and failing t
                 of the contact time); the VTK frames' agglomerate labels agree with the
                 CSV rows of their steps (count and mean size), and their bridges and
                 contacts per sphere add up to twice the rows'.
+  rough base    the 64 fixed spheres read from examples/scenarios/rough_base.csv stay where
+                the file put them, bit for bit, and at rest in every frame (marked fixed);
+                no free sphere reaches the floor (the floor does no work: the base holds the
+                grains); closure < 2e-3 of the work; at rest at the end (kinetic < 1e-4 of
+                the potential energy released).
 Usage: /usr/bin/python3 figures/many_figs.py --dir out/validate/many
 """
 import argparse
@@ -230,6 +235,70 @@ def agglomeration(run_dir):
     fig.savefig(os.path.join(FIGURES, "many_agglomeration.png"), dpi=120)
 
 
+def rough_base(run_dir):
+    print("wet spheres settling onto a rough base of fixed spheres")
+    with open(os.path.join(ROOT, "examples", "scenarios", "rough_base.csv")) as f:
+        rows = [ln for ln in f if not ln.startswith("#") and ln.strip()][1:]
+    base = np.array([[float(x) for x in ln.split(",")] for ln in rows])
+    nb = len(base)
+    series = json.load(open(os.path.join(run_dir, "particles.vtk.series")))
+    fr = [read_vtk(os.path.join(run_dir, e["name"])) for e in series["files"]]
+    moved = max(np.abs(f["POINTS"][:nb] - base[:, :3]).max() for f in fr)
+    still = max(np.abs(f["velocity"][:nb]).max() + np.abs(f["spin"][:nb]).max() for f in fr)
+    marked = all((f["fixed"][:nb] == 1).all() and (f["fixed"][nb:] == 0).all() for f in fr)
+    check(moved == 0 and still == 0 and marked,
+          f"the {nb} base spheres stay where the file put them in all {len(fr)} frames "
+          f"(largest move {moved:g} m, speed {still:g}), marked fixed")
+    last = fr[-1]
+    bottom = (last["POINTS"][nb:, 2] - last["radius"][nb:]).min()
+    s = json.load(open(os.path.join(run_dir, "summary.json")))
+    e = s["energy_J"]
+    floor = sum(abs(m["walls"]) for m in e["work_by_model"])
+    check(bottom > 0 and floor == 0,
+          f"no free sphere reaches the floor (lowest bottom {bottom * 1e3:.3f} mm; floor's work "
+          f"{floor:g} J)")
+    g = read_global(os.path.join(run_dir, "global.csv"))
+    released = g["potential_J"][0] - e["potential"]
+    check(abs(e["balance_error"]) < 2e-3 * abs(e["work_total"]),
+          f"energy closure {abs(e['balance_error']) / abs(e['work_total']):.2e} of the work")
+    check(e["kinetic"] < 1e-4 * released,
+          f"at rest: kinetic {e['kinetic']:.2e} J against {released:.2e} J released")
+    from matplotlib.collections import PatchCollection
+    from matplotlib.patches import Circle
+    fig, (a, b) = plt.subplots(1, 2, figsize=(11, 4.2), gridspec_kw={"width_ratios": [1, 1.3]})
+    t = g["time_s"] * 1e3
+    a.semilogy(t, np.maximum(g["kinetic_J"], 1e-14), label="kinetic")
+    a.semilogy(t, g["dissipated_J"].clip(1e-14), label="dissipated")
+    a.semilogy(t, (g["potential_J"][0] - g["potential_J"]).clip(1e-14), label="potential released")
+    a.set_xlabel("time [ms]")
+    a.set_ylabel("energy [J]")
+    a.legend(fontsize=8)
+    # the last frame seen along y, a slab 1.5 mm thick through the middle: base grey, grains
+    # shaded by their height
+    y, mid = last["POINTS"][:, 1], 3e-3
+    sel = np.abs(y - mid) < 0.75e-3
+    x, z, r = last["POINTS"][sel, 0] * 1e3, last["POINTS"][sel, 2] * 1e3, last["radius"][sel] * 1e3
+    fixed = last["fixed"][sel] == 1
+    grains = PatchCollection([Circle((x[k], z[k]), r[k]) for k in np.flatnonzero(~fixed)],
+                             cmap="viridis", edgecolor="k", linewidth=0.3)
+    grains.set_array(z[~fixed])
+    b.add_collection(grains)
+    b.add_collection(PatchCollection([Circle((x[k], z[k]), r[k]) for k in np.flatnonzero(fixed)],
+                                     facecolor="0.6", edgecolor="k", linewidth=0.3))
+    b.axhline(0, color="k", linewidth=1)
+    b.set_xlim(0, 6)
+    b.set_ylim(-0.2, z.max() + 0.6)
+    b.set_aspect("equal")
+    b.set_xlabel("x [mm]")
+    b.set_ylabel("z [mm]")
+    b.set_title(f"t = {last['TIME'][0] * 1e3:.0f} ms, |y - 3 mm| < 0.75 mm: the fixed base (grey) "
+                "and the grains on it", fontsize=9)
+    fig.suptitle(f"{len(last['radius']) - nb} wet spheres settling onto a rough base of {nb} "
+                 "glued spheres")
+    fig.tight_layout()
+    fig.savefig(os.path.join(FIGURES, "many_rough_base.png"), dpi=120)
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--dir", default=os.path.join(ROOT, "out", "validate", "many"))
@@ -238,6 +307,7 @@ def main():
     cradle(os.path.join(d, "cradle"))
     settling(os.path.join(d, "settling"))
     agglomeration(os.path.join(d, "agglomeration"))
+    rough_base(os.path.join(d, "rough_base"))
     if failures:
         print(f"{len(failures)} check(s) failed")
         sys.exit(1)

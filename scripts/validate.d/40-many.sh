@@ -1,10 +1,12 @@
 #!/usr/bin/env bash
-# Many-particle runs from the command line with the three shipped scenarios: the Stokes
-# cradle (momentum handed along a chain of wet spheres), wet granular settling in a box, and
-# agglomeration in a periodic box. Run directories in out/validate/many/, figures in
+# Many-particle runs from the command line with the four shipped scenarios: the Stokes
+# cradle (momentum handed along a chain of wet spheres), wet granular settling in a box,
+# agglomeration in a periodic box, and settling onto a rough base of fixed spheres read from
+# a file. Run directories in out/validate/many/, figures in
 # docs/figures/many_*.png (figures/many_figs.py, which checks on the outputs that the cradle
 # conserves momentum and hands it to the last sphere, that the energy budget closes, that the
-# bed comes to rest and that the agglomerates grow) and what they show in docs/many.md.
+# bed comes to rest, that the agglomerates grow and that the base stays put) and what they
+# show in docs/many.md.
 # OMP_WAIT_POLICY=passive: on a shared machine, spinning OpenMP threads slow the run several
 # fold (docs/many.md); the cradle (5 spheres) runs on one thread.
 # Usage: scripts/validate.d/40-many.sh PATH_TO_WETDEM_CLI   (from the repository root)
@@ -22,4 +24,6 @@ echo "-- wet granular settling: 2000 spheres in a box periodic in x and y"
 "$cli" run $S/many_settling.ini --out "$out/settling"
 echo "-- agglomeration: 400 wet spheres in a periodic box"
 "$cli" run $S/many_agglomeration.ini --out "$out/agglomeration"
+echo "-- rough base: 400 wet spheres settle onto 64 glued spheres read from a file"
+"$cli" run $S/many_rough_base.ini --out "$out/rough_base"
 /usr/bin/python3 figures/many_figs.py --dir "$out"
