@@ -748,18 +748,27 @@ int wetdem_sim_many_prepare(struct wetdem_sim* sim)
             return st;
         m->kernel_ready = true;
     }
+    size_t known = m->started ? m->cl.n_at_build : 0; /* particles the engine has forces of */
     if (size_particle_arrays(sim) != WETDEM_OK)
         return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory for %zu particles",
                                sim->n_particles);
+    /* particles added since: no pair force yet (their first half kick is gravity's alone; the
+       first force pass of the call gives them theirs) */
+    for (size_t k = known; k < sim->n_particles; k++)
+        m->force[k] = m->torque[k] = vec3(0, 0, 0);
     if (refresh) {
         sync_records(sim);     /* (never stale here: a call ends with them written) */
         m->skip_ready = false; /* the positions are loaded anew: no skips at the next pass */
     }
+    /* a particle fixed or freed since the lists were built for these particles (which leave
+       out pairs of two fixed ones and a fixed one's walls): they are rebuilt */
+    bool built = m->cl.n_builds > 0 && m->cl.n_at_build == sim->n_particles, refixed = false;
     for (size_t k = 0; refresh && k < sim->n_particles; k++) { /* the user may move particles */
         const struct wetdem_particle* p = &sim->particles[k];
         m->xr[k] = (struct wetdem_celllist_item){p->pos.x, p->pos.y, p->pos.z, p->radius};
         m->vw[k][0] = p->vel;
         m->vw[k][1] = p->omega;
+        refixed = refixed || (built && m->fixed[k] != p->is_fixed);
         m->fixed[k] = p->is_fixed;
         m->inv[k][0] = 1.0 / p->mass;
         m->inv[k][1] = 1.0 / (0.4 * p->mass * p->radius * p->radius);
@@ -772,7 +781,7 @@ int wetdem_sim_many_prepare(struct wetdem_sim* sim)
     bool moved = track ? m->max_disp2 > 0.25 * m->cl.skin * m->cl.skin
                        : wetdem_celllist_needs_rebuild(&m->cl, sim->particles, sim->n_particles);
     m->max_disp_valid = false;
-    if (moved)
+    if (moved || refixed)
         return rebuild(sim);
     return WETDEM_OK;
 }
