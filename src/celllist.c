@@ -335,14 +335,14 @@ static struct wetdem_celllist_pair ordered(uint32_t a, uint32_t b)
 
 /* Tests particle s against the runs; appends the listed pairs as (min, max) to out and
  * returns their number. `periodic`: the minimum-image displacement of celllist_delta, else
- * the plain difference (a constant at each call, so each variant compiles to its own loop). */
-static inline __attribute__((always_inline)) size_t scan_runs(const struct scan* sc, size_t s,
+ * the plain difference; `s_fixed`: s is fixed, and its fixed partners are left out (constants
+ * at each call, so each variant compiles to its own loop). */
+static inline __attribute__((always_inline)) size_t scan_loop(const struct scan* sc, size_t s,
                                                               const struct run* runs, int m,
                                                               struct wetdem_celllist_pair* out,
-                                                              bool periodic)
+                                                              bool periodic, bool s_fixed)
 {
     const struct wetdem_celllist_item a = sc->x[s];
-    bool a_fixed = sc->fixed && sc->fixed[s]; /* then its fixed partners are left out */
     size_t count = 0;
     for (int r = 0; r < m; r++)
         for (size_t t = runs[r].lo; t < runs[r].hi; t++) {
@@ -351,10 +351,20 @@ static inline __attribute__((always_inline)) size_t scan_runs(const struct scan*
                 periodic ? celllist_delta(sc->box, vec3(a.x, a.y, a.z), vec3(b->x, b->y, b->z))
                          : vec3(a.x - b->x, a.y - b->y, a.z - b->z);
             double lim = a.r + b->r + sc->extra;
-            if (vec3_dot(d, d) < lim * lim && !(a_fixed && sc->fixed[t]))
+            if (vec3_dot(d, d) < lim * lim && !(s_fixed && sc->fixed[t]))
                 out[count++] = ordered(sc->id[s], sc->id[t]);
         }
     return count;
+}
+
+/* scan_loop of particle s, with its fixed partners left out when s is fixed. */
+static inline __attribute__((always_inline)) size_t scan_runs(const struct scan* sc, size_t s,
+                                                              const struct run* runs, int m,
+                                                              struct wetdem_celllist_pair* out,
+                                                              bool periodic)
+{
+    return sc->fixed && sc->fixed[s] ? scan_loop(sc, s, runs, m, out, periodic, true)
+                                     : scan_loop(sc, s, runs, m, out, periodic, false);
 }
 
 static size_t scan_plain(const struct scan* sc, size_t s, const struct run* runs, int m,
