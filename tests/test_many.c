@@ -962,7 +962,7 @@ static void test_many_freeing_a_fixed_sphere_between_calls(void** state)
     const double R = 0.5e-3, h = 10e-6, dt = 1e-7;
     CHECK_OK(wetdem_sim_add_particle(sim, (struct wetdem_particle){.radius = R, .is_fixed = true}));
     CHECK_OK(wetdem_sim_add_particle(
-        sim, (struct wetdem_particle){.pos = {2 * R + h}, .radius = R, .is_fixed = true}));
+        sim, (struct wetdem_particle){.pos = {2 * R + h, 0, 0}, .radius = R, .is_fixed = true}));
     CHECK_OK(wetdem_sim_set_many(sim, &(struct wetdem_many_settings){.skin = 5e-5, .dt = dt}));
     CHECK_OK(wetdem_sim_integrate(sim, 10 * dt));
     struct wetdem_particle* p = wetdem_sim_particles(sim, NULL);
