@@ -68,6 +68,18 @@ def read_global(path):
     return {n: rows[:, k] for k, n in enumerate(names)}
 
 
+def energy_panel(ax, g):
+    """Kinetic, dissipated and released potential energy against time (global.csv columns),
+    on a log scale (values below 1e-14 J drawn at it)."""
+    t = g["time_s"] * 1e3
+    ax.semilogy(t, np.maximum(g["kinetic_J"], 1e-14), label="kinetic")
+    ax.semilogy(t, g["dissipated_J"].clip(1e-14), label="dissipated")
+    ax.semilogy(t, (g["potential_J"][0] - g["potential_J"]).clip(1e-14), label="potential released")
+    ax.set_xlabel("time [ms]")
+    ax.set_ylabel("energy [J]")
+    ax.legend(fontsize=8)
+
+
 def frames(run_dir):
     """(time, positions, velocities) of each frame of a run, in the order of its series."""
     series = json.load(open(os.path.join(run_dir, "particles.vtk.series")))
@@ -129,12 +141,7 @@ def settling(run_dir):
           f"{min(ratios):.3f} to {max(ratios):.3f})")
     t = g["time_s"] * 1e3
     fig, (a, b, c) = plt.subplots(1, 3, figsize=(13, 3.8))
-    a.semilogy(t, np.maximum(g["kinetic_J"], 1e-14), label="kinetic")
-    a.semilogy(t, g["dissipated_J"].clip(1e-14), label="dissipated")
-    a.semilogy(t, (g["potential_J"][0] - g["potential_J"]).clip(1e-14), label="potential released")
-    a.set_xlabel("time [ms]")
-    a.set_ylabel("energy [J]")
-    a.legend(fontsize=8)
+    energy_panel(a, g)
     for name in [c for c in g if c.startswith("work_")]:
         b.plot(t, -g[name] * 1e6, label=name[5:-2])
     b.set_xlabel("time [ms]")
@@ -266,13 +273,7 @@ def rough_base(run_dir):
     from matplotlib.collections import PatchCollection
     from matplotlib.patches import Circle
     fig, (a, b) = plt.subplots(1, 2, figsize=(11, 4.2), gridspec_kw={"width_ratios": [1, 1.3]})
-    t = g["time_s"] * 1e3
-    a.semilogy(t, np.maximum(g["kinetic_J"], 1e-14), label="kinetic")
-    a.semilogy(t, g["dissipated_J"].clip(1e-14), label="dissipated")
-    a.semilogy(t, (g["potential_J"][0] - g["potential_J"]).clip(1e-14), label="potential released")
-    a.set_xlabel("time [ms]")
-    a.set_ylabel("energy [J]")
-    a.legend(fontsize=8)
+    energy_panel(a, g)
     # the last frame seen along y, a slab 1.5 mm thick through the middle: base grey, grains
     # shaded by their height
     y, mid = last["POINTS"][:, 1], 3e-3

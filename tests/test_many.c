@@ -879,6 +879,20 @@ static void test_many_step_comes_from_the_pairs_that_occur(void** state)
     }
 }
 
+/* A simulation of material 0, the glass preset with 20 um films, in a liquid of 0.01 Pa s and
+ * 0.02 N/m; no model enabled yet. */
+static struct wetdem_sim* wet_glass(void)
+{
+    struct wetdem_sim* sim = wetdem_sim_create();
+    struct wetdem_material m;
+    CHECK_OK(wetdem_material_preset("glass", &m));
+    m.film = 20e-6;
+    assert_int_equal(wetdem_sim_add_material(sim, &m), 0);
+    CHECK_OK(wetdem_sim_set_fluid(
+        sim, &(struct wetdem_fluid){.viscosity = 0.01, .surface_tension = 0.02}));
+    return sim;
+}
+
 /* A fixed bed of two spheres that overlap each other by 0.1 mm and the floor by 1 um (as a
  * settled bed read from a file does), wet, and a free sphere dropped onto one of them: fixed
  * spheres meet neither each other nor a wall (infinite masses would give the contact damping
@@ -891,13 +905,7 @@ static void test_many_fixed_spheres_meet_neither_each_other_nor_walls(void** sta
     (void)state;
     double z_end[2];
     for (int many_walls = 0; many_walls < 2; many_walls++) {
-        struct wetdem_sim* sim = wetdem_sim_create();
-        struct wetdem_material m;
-        CHECK_OK(wetdem_material_preset("glass", &m));
-        m.film = 20e-6;
-        assert_int_equal(wetdem_sim_add_material(sim, &m), 0);
-        CHECK_OK(wetdem_sim_set_fluid(
-            sim, &(struct wetdem_fluid){.viscosity = 0.01, .surface_tension = 0.02}));
+        struct wetdem_sim* sim = wet_glass();
         const char* models[] = {"hertz", "mindlin", "sb", "capillary", "fixed"};
         for (int k = 0; k < 5; k++)
             CHECK_OK(wetdem_sim_enable_model(sim, models[k]));
@@ -949,13 +957,7 @@ static void test_many_fixed_spheres_meet_neither_each_other_nor_walls(void** sta
 static void test_many_freeing_a_fixed_sphere_between_calls(void** state)
 {
     (void)state;
-    struct wetdem_sim* sim = wetdem_sim_create();
-    struct wetdem_material m;
-    CHECK_OK(wetdem_material_preset("glass", &m));
-    m.film = 20e-6;
-    assert_int_equal(wetdem_sim_add_material(sim, &m), 0);
-    CHECK_OK(wetdem_sim_set_fluid(
-        sim, &(struct wetdem_fluid){.viscosity = 0.01, .surface_tension = 0.02}));
+    struct wetdem_sim* sim = wet_glass();
     CHECK_OK(wetdem_sim_enable_model(sim, "hertz"));
     CHECK_OK(wetdem_sim_enable_model(sim, "sb"));
     CHECK_OK(wetdem_sim_enable_model(sim, "capillary"));
