@@ -11,12 +11,8 @@
 # fold (docs/many.md); the cradle (5 spheres) runs on one thread.
 # Usage: scripts/validate.d/40-many.sh PATH_TO_WETDEM_CLI   (from the repository root)
 set -euo pipefail
-cli=${1:?usage: 40-many.sh PATH_TO_WETDEM_CLI}
-out=out/validate/many
-S=examples/scenarios
-export OMP_WAIT_POLICY=${OMP_WAIT_POLICY:-passive}
-rm -rf "$out"
-mkdir -p "$out"
+. scripts/piece-start.sh
+piece_start 40-many.sh out/validate/many "$@"
 
 echo "-- Stokes cradle: five coated steel spheres, the first strikes at 0.4 m/s"
 OMP_NUM_THREADS=1 "$cli" run $S/many_stokes_cradle.ini --out "$out/cradle"

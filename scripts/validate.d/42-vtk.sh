@@ -9,12 +9,8 @@
 # z) with links; then the outputs of 40-many.sh when present.
 # Usage: scripts/validate.d/42-vtk.sh PATH_TO_WETDEM_CLI   (from the repository root)
 set -euo pipefail
-cli=${1:?usage: 42-vtk.sh PATH_TO_WETDEM_CLI}
-out=out/validate/vtk
-S=examples/scenarios
-export OMP_WAIT_POLICY=${OMP_WAIT_POLICY:-passive}
-rm -rf "$out"
-mkdir -p "$out"
+. scripts/piece-start.sh
+piece_start 42-vtk.sh out/validate/vtk "$@"
 
 settle=(--set run.t_end=0.03 --set dump.vtk_every=500)
 echo "-- settling, 30 ms, binary frames and links"

@@ -8,10 +8,8 @@
 # the budget's second order, and draws docs/figures/many_step_bound.png.
 # Usage: scripts/validate.d/45-many-step.sh PATH_TO_WETDEM_CLI   (from the repository root)
 set -euo pipefail
-cli=${1:?usage: 45-many-step.sh PATH_TO_WETDEM_CLI}
-out=out/validate/many_step
-rm -rf "$out"
-mkdir -p "$out"
+. scripts/piece-start.sh
+piece_start 45-many-step.sh out/validate/many_step "$@"
 export OMP_NUM_THREADS=1
 
 cat >"$out/pair.ini" <<'EOF'

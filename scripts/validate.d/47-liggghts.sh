@@ -13,12 +13,10 @@
 # Checks and figure: figures/liggghts_crosscheck.py -> docs/figures/liggghts_crosscheck.png.
 # Usage: scripts/validate.d/47-liggghts.sh PATH_TO_WETDEM_CLI   (from the repository root)
 set -euo pipefail
-cli=${1:?usage: 47-liggghts.sh PATH_TO_WETDEM_CLI}
-out=out/validate/liggghts
+. scripts/piece-start.sh
+piece_start 47-liggghts.sh out/validate/liggghts "$@"
 deck=$(pwd)/bench/liggghts
 lib=$(dirname "$cli")/libwetdem.a
-rm -rf "$out"
-mkdir -p "$out"
 cc -std=c11 -D_DEFAULT_SOURCE -O2 -fopenmp -Iinclude bench/many_bench.c "$lib" \
    -lsundials_cvode -lsundials_nvecserial -lgsl -lgslcblas -linih -lm -o "$out/many_bench"
 N=2000
