@@ -286,21 +286,18 @@ static int build_settings(const struct cli_scenario* sc, struct wetdem_sim* sim)
 
 /* ------------------------------------------------------------------------- materials --- */
 
-struct materials {
-    char names[MAX_MATERIALS][CLI_NAME_MAX];
-    int index[MAX_MATERIALS];
-    size_t n;
-};
-
-/* Index of material `name` in sim, added on first use ([material.NAME] first, then a preset).
- * `use` is the entry naming it (NULL: the default, reported at `section`). */
-static int material_index_at(const struct cli_scenario* sc, struct wetdem_sim* sim,
-                             struct materials* mt, const char* section, const struct cli_entry* use,
-                             const char* name, int* index)
+/* Index of material `name` in su->sim, added on first use ([material.NAME] first, then a
+ * preset) with its name in su->material_names (every material of the run comes through here,
+ * so the table's k-th name is material k). `use` is the entry naming it (NULL: the default,
+ * reported at `section`). */
+static int material_index_at(const struct cli_scenario* sc, struct cli_many_setup* su,
+                             const char* section, const struct cli_entry* use, const char* name,
+                             int* index)
 {
-    for (size_t k = 0; k < mt->n; k++)
-        if (strcmp(mt->names[k], name) == 0) {
-            *index = mt->index[k];
+    int n = wetdem_sim_n_materials(su->sim);
+    for (int k = 0; k < n; k++)
+        if (strcmp(su->material_names[k], name) == 0) {
+            *index = k;
             return CLI_EXIT_OK;
         }
     char msec[CLI_NAME_MAX];
@@ -322,23 +319,22 @@ static int material_index_at(const struct cli_scenario* sc, struct wetdem_sim* s
                                        hint ? hint : "", hint ? "'?)" : "", name);
         return CLI_EXIT_USAGE;
     }
-    if (mt->n == MAX_MATERIALS) {
+    if (n == MAX_MATERIALS) {
         cli_scenario_section_error(sc, section, "more than %d materials", MAX_MATERIALS);
         return CLI_EXIT_USAGE;
     }
-    *index = wetdem_sim_add_material(sim, &m);
+    *index = wetdem_sim_add_material(su->sim, &m);
     if (*index < 0)
-        return cli_scenario_lib_error(sc, use, section, sim);
-    snprintf(mt->names[mt->n], sizeof mt->names[0], "%s", name);
-    mt->index[mt->n++] = *index;
+        return cli_scenario_lib_error(sc, use, section, su->sim);
+    snprintf(su->material_names[*index], sizeof su->material_names[0], "%s", name);
     return CLI_EXIT_OK;
 }
 
 /* material_index_at for the `material` key of `section`. */
-static int material_index(const struct cli_scenario* sc, struct wetdem_sim* sim,
-                          struct materials* mt, const char* section, const char* name, int* index)
+static int material_index(const struct cli_scenario* sc, struct cli_many_setup* su,
+                          const char* section, const char* name, int* index)
 {
-    return material_index_at(sc, sim, mt, section, cli_scenario_find(sc, section, "material"), name,
+    return material_index_at(sc, su, section, cli_scenario_find(sc, section, "material"), name,
                              index);
 }
 
@@ -416,7 +412,7 @@ static int wall_faces(const struct cli_scenario* sc, const struct cli_many_setup
 }
 
 static int build_walls(const struct cli_scenario* sc, struct cli_many_setup* su,
-                       struct materials* mt, const char* first_material)
+                       const char* first_material)
 {
     unsigned faces;
     int rc = wall_faces(sc, su, &faces);
@@ -424,7 +420,7 @@ static int build_walls(const struct cli_scenario* sc, struct cli_many_setup* su,
         return rc;
     int mat;
     const char* name = cli_scenario_text(sc, "walls", "material", first_material);
-    if ((rc = material_index(sc, su->sim, mt, "walls", name, &mat)) != CLI_EXIT_OK)
+    if ((rc = material_index(sc, su, "walls", name, &mat)) != CLI_EXIT_OK)
         return rc;
     for (int f = 0; f < 6; f++) {
         if (!(faces & (1u << f)))
@@ -526,7 +522,7 @@ static int on_insert_progress(unsigned long long done, unsigned long long total,
 }
 
 static int build_insert(const struct cli_scenario* sc, struct cli_many_setup* su,
-                        struct materials* mt, const char* section)
+                        const char* section)
 {
     if (!cli_scenario_find(sc, section, "count")) {
         cli_scenario_section_error(sc, section, "[%s] needs count", section);
@@ -556,8 +552,8 @@ static int build_insert(const struct cli_scenario* sc, struct cli_many_setup* su
     }
     s.lo = (struct wetdem_vec3){lo[0], lo[1], lo[2]};
     s.hi = (struct wetdem_vec3){hi[0], hi[1], hi[2]};
-    rc = material_index(sc, su->sim, mt, section,
-                        cli_scenario_text(sc, section, "material", "steel1"), &s.material);
+    rc = material_index(sc, su, section, cli_scenario_text(sc, section, "material", "steel1"),
+                        &s.material);
     if (rc != CLI_EXIT_OK)
         return rc;
     struct insert_progress prog = {.section = section};
@@ -575,7 +571,7 @@ static int build_insert(const struct cli_scenario* sc, struct cli_many_setup* su
 }
 
 static int build_particle(const struct cli_scenario* sc, struct cli_many_setup* su,
-                          struct materials* mt, const char* section)
+                          const char* section)
 {
     static const char* const req[] = {"radius", "x", "y", "z"};
     for (int k = 0; k < 4; k++)
@@ -591,8 +587,8 @@ static int build_particle(const struct cli_scenario* sc, struct cli_many_setup* 
         .radius = N("radius"),
         .is_fixed = strcmp(cli_scenario_text(sc, section, "fixed", "no"), "yes") == 0};
 #undef N
-    int rc = material_index(sc, su->sim, mt, section,
-                            cli_scenario_text(sc, section, "material", "steel1"), &p.material);
+    int rc = material_index(sc, su, section, cli_scenario_text(sc, section, "material", "steel1"),
+                            &p.material);
     if (rc != CLI_EXIT_OK)
         return rc;
     if (wetdem_sim_add_particle(su->sim, p) != WETDEM_OK)
@@ -614,8 +610,7 @@ static void sphere_file_path(const struct cli_scenario* sc, const char* value, c
 /* The [read.NAME] materials list (materials = A B ...: the materials of the file's indices 0, 1,
  * ...) resolved into index[0 .. *n), sim's materials. */
 static int read_materials(const struct cli_scenario* sc, struct cli_many_setup* su,
-                          struct materials* mt, const char* section, const struct cli_entry* list,
-                          int* index, size_t* n)
+                          const char* section, const struct cli_entry* list, int* index, size_t* n)
 {
     char buf[CLI_VALUE_MAX], *save = NULL;
     snprintf(buf, sizeof buf, "%s", list->value);
@@ -625,7 +620,7 @@ static int read_materials(const struct cli_scenario* sc, struct cli_many_setup* 
             cli_scenario_error(sc, list, "more than %d materials", MAX_MATERIALS);
             return CLI_EXIT_USAGE;
         }
-        int rc = material_index_at(sc, su->sim, mt, section, list, tok, &index[(*n)++]);
+        int rc = material_index_at(sc, su, section, list, tok, &index[(*n)++]);
         if (rc != CLI_EXIT_OK)
             return rc;
     }
@@ -642,8 +637,8 @@ static int read_materials(const struct cli_scenario* sc, struct cli_many_setup* 
  * when the file has none) names; without, `material` for all, with a warning when the file's
  * spheres have several indices (their materials are then not kept apart). */
 static int assign_materials(const struct cli_scenario* sc, struct cli_many_setup* su,
-                            struct materials* mt, const char* section, const char* path,
-                            struct wetdem_particle* p, size_t n)
+                            const char* section, const char* path, struct wetdem_particle* p,
+                            size_t n)
 {
     const struct cli_entry* list = cli_scenario_find(sc, section, "materials");
     const struct cli_entry* one = cli_scenario_find(sc, section, "material");
@@ -655,8 +650,8 @@ static int assign_materials(const struct cli_scenario* sc, struct cli_many_setup
     }
     int index[MAX_MATERIALS], material;
     size_t n_list = 0;
-    int rc = list ? read_materials(sc, su, mt, section, list, index, &n_list)
-                  : material_index(sc, su->sim, mt, section,
+    int rc = list ? read_materials(sc, su, section, list, index, &n_list)
+                  : material_index(sc, su, section,
                                    cli_scenario_text(sc, section, "material", "steel1"), &material);
     if (rc != CLI_EXIT_OK)
         return rc;
@@ -689,7 +684,7 @@ static int assign_materials(const struct cli_scenario* sc, struct cli_many_setup
 }
 
 static int build_sphere_file(const struct cli_scenario* sc, struct cli_many_setup* su,
-                             struct materials* mt, const char* section)
+                             const char* section)
 {
     const struct cli_entry* e = cli_scenario_find(sc, section, "file");
     if (!e || !e->value[0]) {
@@ -706,7 +701,7 @@ static int build_sphere_file(const struct cli_scenario* sc, struct cli_many_setu
         cli_scenario_error(sc, e, "%s:%s%s", path, isdigit((unsigned char)why[0]) ? "" : " ", why);
         return rc;
     }
-    rc = assign_materials(sc, su, mt, section, path, p, n);
+    rc = assign_materials(sc, su, section, path, p, n);
     const char* fixed = cli_scenario_text(sc, section, "fixed", "file");
     for (size_t k = 0; k < n && rc == CLI_EXIT_OK; k++) {
         if (strcmp(fixed, "yes") == 0) /* at rest */
@@ -789,8 +784,8 @@ static int check_group(const struct cli_scenario* sc, const struct cli_many_setu
 
 /* Every [insert], [insert.NAME], [particle.NAME] and [read.NAME] in file order. *first:
  * material name of the first group (default of [walls] material). */
-static int build_spheres(const struct cli_scenario* sc, struct cli_many_setup* su,
-                         struct materials* mt, unsigned faces, const char** first)
+static int build_spheres(const struct cli_scenario* sc, struct cli_many_setup* su, unsigned faces,
+                         const char** first)
 {
     *first = NULL;
     struct group* groups = malloc((sc->n_sections ? sc->n_sections : 1) * sizeof *groups);
@@ -806,9 +801,9 @@ static int build_spheres(const struct cli_scenario* sc, struct cli_many_setup* s
         if (!ins && !file && strncmp(name, "particle.", 9) != 0)
             continue;
         groups[n_groups++] = (struct group){name, wetdem_sim_n_particles(su->sim), file};
-        int rc = ins    ? build_insert(sc, su, mt, name)
-                 : file ? build_sphere_file(sc, su, mt, name)
-                        : build_particle(sc, su, mt, name);
+        int rc = ins    ? build_insert(sc, su, name)
+                 : file ? build_sphere_file(sc, su, name)
+                        : build_particle(sc, su, name);
         if (rc == CLI_EXIT_OK)
             rc = check_group(sc, su, groups, n_groups, faces);
         if (rc != CLI_EXIT_OK) {
@@ -817,9 +812,7 @@ static int build_spheres(const struct cli_scenario* sc, struct cli_many_setup* s
         }
         if (!*first) { /* the material of the group's first sphere */
             int m = wetdem_sim_particles_const(su->sim, NULL)[groups[n_groups - 1].from].material;
-            for (size_t k = 0; k < mt->n && !*first; k++)
-                if (mt->index[k] == m)
-                    *first = mt->names[k];
+            *first = su->material_names[m];
         }
     }
     free(groups);
@@ -925,7 +918,6 @@ int cli_many_build(const struct cli_scenario* sc, struct cli_many_setup* su)
         cli_error("out of memory creating a simulation");
         return CLI_EXIT_RUNTIME;
     }
-    struct materials mt = {.n = 0};
     const char* first = NULL;
     unsigned faces = 0;
     int rc;
@@ -935,16 +927,12 @@ int cli_many_build(const struct cli_scenario* sc, struct cli_many_setup* su)
         (rc = build_settings(sc, su->sim)) != CLI_EXIT_OK ||
         (rc = build_box(sc, su)) != CLI_EXIT_OK ||
         (rc = wall_faces(sc, su, &faces)) != CLI_EXIT_OK ||
-        (rc = build_spheres(sc, su, &mt, faces, &first)) != CLI_EXIT_OK ||
-        (rc = build_walls(sc, su, &mt, first)) != CLI_EXIT_OK ||
+        (rc = build_spheres(sc, su, faces, &first)) != CLI_EXIT_OK ||
+        (rc = build_walls(sc, su, first)) != CLI_EXIT_OK ||
         (rc = build_run(sc, su)) != CLI_EXIT_OK) {
         cli_many_setup_free(su);
         return rc;
     }
-    for (size_t k = 0; k < mt.n; k++) /* (every material of sim came through mt) */
-        if (mt.index[k] >= 0 && mt.index[k] < MAX_MATERIALS)
-            snprintf(su->material_names[mt.index[k]], sizeof su->material_names[0], "%s",
-                     mt.names[k]);
     if (wetdem_sim_set_many(su->sim, &su->many) != WETDEM_OK) {
         rc = cli_many_report_start(sc, wetdem_sim_errmsg(su->sim));
         cli_many_setup_free(su);

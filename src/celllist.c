@@ -15,8 +15,7 @@
  *     n <= 2 they would coincide, so there the distinct neighbours B of A are enumerated and
  *     only those with index B > A are searched. A pair (a, b) with h_ab < reach + skin, not
  *     both fixed, is stored as (min, max) in a per-thread buffer; threads take contiguous
- *     blocks of cells
- *     with about n / threads particles each;
+ *     blocks of cells with about n / threads particles each;
  *  3. counting-sorts the buffers by i into the list (first_pair holds the offsets) and sorts
  *     each segment by j (insertion sort: segments are short). The result does not depend on
  *     the order in which pairs were found, so it is the same for any thread count.

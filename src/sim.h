@@ -106,8 +106,9 @@ int wetdem_sim_fail(struct wetdem_sim* sim, int status, const char* fmt, ...)
     __attribute__((format(printf, 3, 4)));
 
 /* Whether particle p is one a simulation can hold: finite position, velocity and spin, radius
- * and mass finite and > 0, a fixed one at rest. If not, why[0 .. n) receives what is wrong, with the value (for
- * wetdem_sim_add_particle, the start of a run and a checkpoint being restored alike). */
+ * and mass finite and > 0, a fixed one at rest. If not, why[0 .. n) receives what is wrong,
+ * with the value (for wetdem_sim_add_particle, the start of a run and a checkpoint being
+ * restored alike). */
 bool wetdem_sim_particle_valid(const struct wetdem_particle* p, char* why, size_t n);
 
 /* Fills c->h_min from the min-separation model, then sums every enabled force model into
