@@ -426,6 +426,15 @@ static inline struct wetdem_particle wetdem_many_particle(const struct wetdem_si
     return p;
 }
 
+/* How many walls particle i can meet: none when it is fixed (a fixed sphere and a wall never
+ * interact, as in pairs.c), else all. The loops over a particle's walls that read the state
+ * (counts, links, elastic energy) stop there; the force pass's wall lists are built to it
+ * (update_wall_masks). */
+static inline size_t wetdem_many_walls_of(const struct wetdem_sim* sim, size_t i)
+{
+    return sim->particles[i].is_fixed ? 0 : sim->n_walls;
+}
+
 /* The committed history of candidate pair q, and of particle i with wall w (NULL without
  * history). */
 static inline const double* wetdem_many_pair_history(const struct wetdem_sim* sim, size_t q)

@@ -1091,7 +1091,7 @@ void wetdem_sim_many_energies(const struct wetdem_sim* sim, double* kinetic, dou
         el += wetdem_sim_contact_elastic_energy(sim, &c, wetdem_many_pair_history(sim, q));
     }
     for (size_t i = 0; m && i < sim->n_particles; i++)
-        for (size_t w = 0; w < sim->n_walls && !sim->particles[i].is_fixed; w++) {
+        for (size_t w = 0; w < wetdem_many_walls_of(sim, i); w++) {
             struct wetdem_contact c;
             wetdem_sim_many_contact(sim, i, w, true, &c);
             el += wetdem_sim_contact_elastic_energy(sim, &c, wetdem_many_wall_history(sim, i, w));

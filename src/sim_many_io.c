@@ -119,7 +119,7 @@ int wetdem_sim_many_links(const struct wetdem_sim* sim, const struct wetdem_many
         }
     }
     for (size_t i = 0; i < n; i++)
-        for (size_t w = 0; w < sim->n_walls && !sim->particles[i].is_fixed; w++) {
+        for (size_t w = 0; w < wetdem_many_walls_of(sim, i); w++) {
             struct wetdem_contact c;
             wetdem_sim_many_contact(sim, i, w, true, &c);
             if (wetdem_sim_contact_is_in_contact(sim, &c, wetdem_many_wall_history(sim, i, w))) {
@@ -291,7 +291,7 @@ int wetdem_sim_write_vtk_links(struct wetdem_sim* sim, const char* path, bool bi
             ok = push_link(&links, &n, &cap, &l);
     }
     for (size_t i = 0; ok && i < sim->n_particles; i++)
-        for (size_t w = 0; ok && w < sim->n_walls && !sim->particles[i].is_fixed; w++) {
+        for (size_t w = 0; ok && w < wetdem_many_walls_of(sim, i); w++) {
             struct wetdem_contact c;
             struct wetdem_output_vtk_link l;
             wetdem_sim_many_contact(sim, i, w, true, &c);
