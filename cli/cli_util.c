@@ -421,7 +421,7 @@ bool cli_wants_help(int argc, char** argv)
     return false;
 }
 
-int cli_csv_split(char* line, char** f, int max, bool is_header)
+int cli_csv_split(char* line, char** f, int max)
 {
     int n = 0;
     for (char* p = line; p && n < max; n++) {
@@ -430,7 +430,7 @@ int cli_csv_split(char* line, char** f, int max, bool is_header)
             *comma = '\0';
         while (*p == ' ' || *p == '\t')
             p++;
-        char* end = p + strcspn(p, is_header ? "[\r\n" : "\r\n");
+        char* end = p + strcspn(p, "\r\n");
         while (end > p && (end[-1] == ' ' || end[-1] == '\t'))
             end--;
         *end = '\0';
@@ -440,21 +440,69 @@ int cli_csv_split(char* line, char** f, int max, bool is_header)
     return n;
 }
 
-int cli_csv_columns(char** f, int n, const char* const* names, int* col, int* bad, char* err,
-                    size_t err_len)
+/* Cuts a header field "name [unit]" in place into its name (blanks trimmed) and *unit (the
+ * text between the brackets, blanks trimmed; NULL without brackets). Returns false when the
+ * brackets are not one pair ending the field. */
+static bool split_unit(char* field, const char** unit)
+{
+    *unit = NULL;
+    char* open = strchr(field, '[');
+    if (!open)
+        return !strchr(field, ']');
+    char* close = strchr(open, ']');
+    if (!close || close[1] != '\0' || strchr(open + 1, '[') || strchr(close + 1, ']'))
+        return false;
+    *close = '\0';
+    char* u = open + 1;
+    while (*u == ' ' || *u == '\t')
+        u++;
+    for (char* e = close; e > u && (e[-1] == ' ' || e[-1] == '\t');)
+        *--e = '\0';
+    *unit = u;
+    for (char* e = open; e > field && (e[-1] == ' ' || e[-1] == '\t');)
+        *--e = '\0';
+    *open = '\0';
+    return true;
+}
+
+/* Whether a header's unit label is the column's SI unit (a dimensionless one, "-", also "1"
+ * or nothing). */
+static bool unit_matches(const char* given, const char* unit)
+{
+    if (strcmp(unit, "-") == 0)
+        return !given[0] || strcmp(given, "-") == 0 || strcmp(given, "1") == 0;
+    return strcmp(given, unit) == 0;
+}
+
+int cli_csv_columns(char** f, int n, const char* const* names, const char* const* units, int* col,
+                    int* bad, char* err, size_t err_len)
 {
     int n_names = 0;
     while (names[n_names])
         col[n_names++] = -1;
     for (int k = 0; k < n; k++) {
+        *bad = k;
+        char given[256];
+        snprintf(given, sizeof given, "%s", f[k]);
+        const char* unit;
+        if (!split_unit(f[k], &unit)) {
+            snprintf(err, err_len, "column '%s': a unit is written as 'name [unit]'", given);
+            return CLI_CSV_UNKNOWN;
+        }
         int c = 0;
         while (c < n_names && strcmp(f[k], names[c]) != 0)
             c++;
-        *bad = k;
         if (c < n_names && col[c] >= 0) {
             snprintf(err, err_len, "column %s appears twice (columns %d and %d)", f[k], col[c] + 1,
                      k + 1);
             return CLI_CSV_TWICE;
+        }
+        if (c < n_names && unit && !unit_matches(unit, units[c])) {
+            snprintf(err, err_len,
+                     "column '%s': %s is read in %s, not %s (values are read as they stand, "
+                     "in SI units: convert them, or label the column [%s])",
+                     given, names[c], units[c], unit[0] ? unit : "[]", units[c]);
+            return CLI_CSV_UNKNOWN;
         }
         if (c < n_names) {
             col[c] = k;
@@ -469,6 +517,18 @@ int cli_csv_columns(char** f, int n, const char* const* names, int* col, int* ba
         return CLI_CSV_UNKNOWN;
     }
     return 0;
+}
+
+bool cli_is_frame_name(const char* prefix, const char* name)
+{
+    size_t lp = strlen(prefix), n = strlen(name);
+    if (n < lp + 1 + 6 + 4 || strncmp(name, prefix, lp) != 0 || name[lp] != '_' ||
+        strcmp(name + n - 4, ".vtk") != 0)
+        return false;
+    for (size_t k = lp + 1; k < n - 4; k++)
+        if (!isdigit((unsigned char)name[k]))
+            return false;
+    return true;
 }
 
 bool cli_series_entry(const char* line, char* name, size_t n, double* time)

@@ -64,18 +64,26 @@ bool cli_wants_help(int argc, char** argv);
  * "" when arg does not start with '-' or nothing is close. Returns buf, for "%s". */
 const char* cli_option_hint(const char* arg, const char* const* options, char* buf, size_t n);
 
-/* Splits a CSV line in place at commas into at most max fields f[], blanks trimmed, and a
- * trailing " [unit]" too when is_header ("x [m]" is x). Returns the number of fields. */
-int cli_csv_split(char* line, char** f, int max, bool is_header);
+/* Splits a CSV line in place at commas into at most max fields f[], blanks trimmed. Returns
+ * the number of fields. */
+int cli_csv_split(char* line, char** f, int max);
 
-/* Maps the header fields f[0 .. n) to the columns `names` (NULL-terminated): col[c] is the
- * field of column c, or -1. Each known column at most once, no other. Returns 0, or with *bad
- * the offending field and why in err: CLI_CSV_UNKNOWN, "unknown column 'X'" with a "did you
- * mean" hint (also for a name whose unit was left out: angle for angle_deg), or CLI_CSV_TWICE,
- * "column X appears twice (columns I and J)". The caller adds the file and line. */
+/* Maps the header fields f[0 .. n) to the columns `names` (NULL-terminated; their SI units in
+ * `units`, "-" for none): col[c] is the field of column c, or -1. A field may carry its unit,
+ * "x [m]", which must be the column's ("-", "1" or "[]" for a dimensionless one): values are
+ * read as they stand. Each known column at most once, no other. The fields are cut to their
+ * names in place. Returns 0, or with *bad the offending field and why in err:
+ * CLI_CSV_UNKNOWN, "unknown column 'X'" with a "did you mean" hint (also for a name whose
+ * unit was left out: angle for angle_deg), or a unit other than the column's; or
+ * CLI_CSV_TWICE, "column X appears twice (columns I and J)". The caller adds the file and
+ * line. */
 enum { CLI_CSV_UNKNOWN = -1, CLI_CSV_TWICE = -2 };
-int cli_csv_columns(char** f, int n, const char* const* names, int* col, int* bad, char* err,
-                    size_t err_len);
+int cli_csv_columns(char** f, int n, const char* const* names, const char* const* units, int* col,
+                    int* bad, char* err, size_t err_len);
+
+/* Whether `name` is named as a many-particle run names the frames of a series of prefix
+ * `prefix`: PREFIX_, six or more digits, .vtk. */
+bool cli_is_frame_name(const char* prefix, const char* name);
 
 /* Whether `line` is an entry of a .vtk.series index as wetdem writes them,
  * { "name" : "NAME", "time" : T }: then its name (if shorter than n) and time. */

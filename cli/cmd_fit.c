@@ -168,13 +168,14 @@ static int parse_args(int argc, char** argv, struct fit_args* a)
 enum { COL_STOKES, COL_EN, COL_ANGLE, COL_OMEGA, N_COLS };
 static const char* const col_names[N_COLS + 1] = {"stokes_n", "e_n", "angle_deg", "omega_rad_s",
                                                   NULL};
+static const char* const col_units[N_COLS] = {"-", "-", "deg", "rad/s"};
 
 /* Maps the header's fields to the columns: each known column at most once, no other (a column
  * the fit would not read, e.g. per-point uncertainties, is refused rather than ignored). */
 static int read_header(const char* path, long line, char** f, int n, int col[N_COLS])
 {
     char why[300];
-    int bad = 0, rc = cli_csv_columns(f, n, col_names, col, &bad, why, sizeof why);
+    int bad = 0, rc = cli_csv_columns(f, n, col_names, col_units, col, &bad, why, sizeof why);
     if (rc != 0) {
         if (rc == CLI_CSV_TWICE)
             cli_error("%s:%ld: %s", path, line, why);
@@ -270,7 +271,7 @@ static int read_data(const char* path, struct point** out, size_t* n_out)
         s += strspn(s, " \t");
         if (*s == '#' || *s == '\n' || *s == '\r' || *s == '\0')
             continue;
-        int nf = cli_csv_split(s, f, 64, !have_header);
+        int nf = cli_csv_split(s, f, 64);
         if (!have_header) {
             rc = read_header(path, line, f, nf, col);
             have_header = true;

@@ -31,7 +31,6 @@
  * Progress with an estimate of the time left goes to stderr, only when stderr is a terminal,
  * at most twice a second.
  */
-#include <ctype.h>
 #include <dirent.h>
 #include <errno.h>
 #include <math.h>
@@ -60,26 +59,15 @@ struct series {
     double* times;     /* time of frame k [s] */
     size_t n, cap;
     unsigned long long last_step; /* step of the latest frame (valid when n > 0) */
+    /* why series_add failed (the checkpoint written on the stop that follows may replace the
+       library's message) */
+    char error[PATH_CHARS + CLI_VALUE_MAX + 200];
 };
 
 /* The name of frame k: PREFIX_NNNNNN.vtk, or of its links, PREFIX_links_NNNNNN.vtk. */
 static void frame_name(const struct series* s, size_t k, bool links, char* buf, size_t n)
 {
     snprintf(buf, n, "%s%s_%06zu.vtk", s->prefix, links ? WETDEM_LINKS_SUFFIX : "", k);
-}
-
-/* Whether `name` is named as frame_name() names the frames (links: their links) of a series of
- * prefix `prefix`: PREFIX_, six or more digits, .vtk. */
-static bool is_frame_name(const char* prefix, const char* name)
-{
-    size_t lp = strlen(prefix), n = strlen(name);
-    if (n < lp + 1 + 6 + 4 || strncmp(name, prefix, lp) != 0 || name[lp] != '_' ||
-        strcmp(name + n - 4, ".vtk") != 0)
-        return false;
-    for (size_t k = lp + 1; k < n - 4; k++)
-        if (!isdigit((unsigned char)name[k]))
-            return false;
-    return true;
 }
 
 /* A fresh run replaces the run in its directory: removes the frames and links an earlier run
@@ -98,8 +86,8 @@ static int series_clear(const struct series* s)
     for (struct dirent* e = readdir(d); e && rc == 0; e = readdir(d)) {
         char path[PATH_CHARS + 300];
         snprintf(path, sizeof path, "%s/%s", s->dir, e->d_name);
-        if ((is_frame_name(s->prefix, e->d_name) || is_frame_name(links_prefix, e->d_name) ||
-             strcmp(e->d_name, links_index) == 0) &&
+        if ((cli_is_frame_name(s->prefix, e->d_name) ||
+             cli_is_frame_name(links_prefix, e->d_name) || strcmp(e->d_name, links_index) == 0) &&
             unlink(path) != 0 && errno != ENOENT)
             rc = -1;
     }
@@ -110,7 +98,7 @@ static int series_clear(const struct series* s)
 }
 
 /* Writes the .vtk.series index of the frames (links: of their links; temporary file, then
- * rename). 0 or -1. */
+ * rename). 0, or -1 with errno set. */
 static int series_write_one(const struct series* s, bool links)
 {
     char path[PATH_CHARS + CLI_VALUE_MAX + 40], tmp[sizeof path + 8];
@@ -132,7 +120,9 @@ static int series_write_one(const struct series* s, bool links)
     ok = fclose(f) == 0 && ok;
     if (ok && rename(tmp, path) == 0)
         return 0;
+    int err = errno ? errno : EIO;
     remove(tmp);
+    errno = err;
     return -1;
 }
 
@@ -158,25 +148,33 @@ static int push_time(struct series* s, double time)
     return 0;
 }
 
-/* Writes frame n at the current state and appends it to the index. WETDEM status. */
+/* Writes frame n at the current state and appends it to the index. WETDEM status; on failure
+ * s->error says why. */
 static int series_add(struct series* s, struct wetdem_sim* sim, unsigned long long step)
 {
     char path[PATH_CHARS + CLI_VALUE_MAX + 40], name[CLI_VALUE_MAX + 40];
     frame_name(s, s->n, false, name, sizeof name);
     snprintf(path, sizeof path, "%s/%s", s->dir, name);
     int st = wetdem_sim_write_vtk(sim, path, s->binary);
-    if (st != WETDEM_OK)
-        return st;
-    if (s->links) {
+    if (st == WETDEM_OK && s->links) {
         frame_name(s, s->n, true, name, sizeof name);
         snprintf(path, sizeof path, "%s/%s", s->dir, name);
-        if ((st = wetdem_sim_write_vtk_links(sim, path, s->binary)) != WETDEM_OK)
-            return st;
+        st = wetdem_sim_write_vtk_links(sim, path, s->binary);
     }
-    if (push_time(s, wetdem_sim_time(sim)) != 0)
+    if (st != WETDEM_OK) {
+        snprintf(s->error, sizeof s->error, "%s", wetdem_sim_errmsg(sim));
+        return st;
+    }
+    if (push_time(s, wetdem_sim_time(sim)) != 0) {
+        snprintf(s->error, sizeof s->error, "out of memory for the frames' index");
         return WETDEM_ERR_NOMEM;
+    }
     s->last_step = step;
-    return series_write(s) == 0 ? WETDEM_OK : WETDEM_ERR_IO;
+    if (series_write(s) == 0)
+        return WETDEM_OK;
+    snprintf(s->error, sizeof s->error, "cannot write %s/%s.vtk.series: %s", s->dir, s->prefix,
+             strerror(errno));
+    return WETDEM_ERR_IO;
 }
 
 /* The step of frame k, from its time on the grid t = k dt, given the time t at step `step`. */
@@ -190,37 +188,59 @@ static unsigned long long frame_step(const struct series* s, size_t k, double t,
  * order, named as this run names them); the rest are dropped and will be written again. A
  * frame at t itself is kept only on the grid of `every`: off it, it is the last frame that
  * the run which wrote the checkpoint added at its end, which the uninterrupted run does not
- * have. */
-static void series_resume(struct series* s, double t, unsigned long long step, double dt,
-                          unsigned long long every)
+ * have. A frame on disk beyond those the index lists means the index is missing or cut short:
+ * numbering from its end would overwrite frames the resumed run does not write again, so the
+ * restart is refused (CLI exit code; nothing is touched). */
+static int series_resume(struct series* s, double t, unsigned long long step, double dt,
+                         unsigned long long every)
 {
     char path[PATH_CHARS + CLI_VALUE_MAX + 40];
     snprintf(path, sizeof path, "%s/%s.vtk.series", s->dir, s->prefix);
     FILE* f = fopen(path, "r");
     char line[1024];
+    size_t listed = 0; /* entries in order, named as this run names them */
+    bool later = false;
     while (f && fgets(line, sizeof line, f)) {
         char name[CLI_VALUE_MAX + 40], want[CLI_VALUE_MAX + 40];
         double time;
         if (!cli_series_entry(line, name, sizeof name, &time))
             continue;
-        frame_name(s, s->n, false, want, sizeof want);
-        if (strcmp(name, want) != 0 || !(time <= t) || push_time(s, time) != 0)
+        frame_name(s, listed, false, want, sizeof want);
+        if (strcmp(name, want) != 0)
             break;
+        listed++;
+        later = later || !(time <= t);
+        if (!later && push_time(s, time) != 0) {
+            fclose(f);
+            cli_error("--restart: out of memory reading %s", path);
+            return CLI_EXIT_RUNTIME;
+        }
     }
     if (f)
         fclose(f);
+    char name[CLI_VALUE_MAX + 40], frame[sizeof path];
+    frame_name(s, listed, false, name, sizeof name);
+    snprintf(frame, sizeof frame, "%s/%s", s->dir, name);
+    if (access(frame, F_OK) == 0) {
+        cli_error("--restart: %s %s, but %s exists: the resumed run would number its frames "
+                  "from %zu and overwrite frames it does not write again; restore the index, "
+                  "or move the frames from %s on elsewhere",
+                  path, f ? "lists fewer frames than the directory holds" : "is missing", frame,
+                  listed, name);
+        return CLI_EXIT_USAGE;
+    }
     if (s->n && frame_step(s, s->n - 1, t, step, dt) == step && every && step % every != 0)
         s->n--;
     /* the links index lists the frames from the first after which each has its links file:
        a run written without links, resumed with them, has links from the restart on */
     for (s->links_from = s->n; s->links && s->links_from > 0; s->links_from--) {
-        char name[CLI_VALUE_MAX + 40];
         frame_name(s, s->links_from - 1, true, name, sizeof name);
         snprintf(path, sizeof path, "%s/%s", s->dir, name);
         if (access(path, F_OK) != 0)
             break;
     }
     s->last_step = s->n ? frame_step(s, s->n - 1, t, step, dt) : 0;
+    return CLI_EXIT_OK;
 }
 
 /* ----------------------------------------------------------- CSV: last row, restart --- */
@@ -241,8 +261,10 @@ static int csv_final_row(const char* csv_prefix, unsigned long long csv_every,
 /* Keeps the comment and header lines of the CSV and the rows up to `step` (second column),
  * rewriting the file atomically when rows are dropped. A row at `step` itself is kept only on
  * the grid of `every`: off it, it is the last row that the run which wrote the checkpoint
- * added at its end (csv_final_row), which the uninterrupted run does not have. CLI exit
- * code; a missing file is an input error (the rows before the checkpoint would be lost). */
+ * added at its end (csv_final_row), which the uninterrupted run does not have. A last line
+ * without its newline, a row cut short by a crash or a full disk, is dropped too (the resumed
+ * run would append to it). CLI exit code; a missing file is an input error (the rows before
+ * the checkpoint would be lost). */
 static int csv_resume(const char* path, unsigned long long step, unsigned long long every,
                       const char* out_dir)
 {
@@ -262,7 +284,8 @@ static int csv_resume(const char* path, unsigned long long step, unsigned long l
         const char* comma = strchr(line, ',');
         bool data = line[0] >= '0' && line[0] <= '9' && comma;
         unsigned long long row = data ? strtoull(comma + 1, NULL, 10) : 0;
-        if (data && (row > step || (row == step && every && step % every != 0))) {
+        bool whole = strchr(line, '\n') != NULL; /* (a row cut by a crash ends without) */
+        if (!whole || (data && (row > step || (row == step && every && step % every != 0)))) {
             dropped = true;
             continue;
         }
@@ -290,7 +313,7 @@ struct progress {
     unsigned long long run_total; /* steps of the whole run */
     bool tty;
     double last_print; /* [s] of wall time */
-    int status;        /* first failure writing a frame */
+    int status;        /* first failure writing a frame (its message: vtk->error) */
 };
 
 static void print_progress(struct progress* p, unsigned long long done, unsigned long long total,
@@ -547,8 +570,25 @@ static int write_summary(const char* dir, const struct cli_scenario* sc,
     return CLI_EXIT_RUNTIME;
 }
 
+/* Prints " word" as a POSIX shell reads it back: in single quotes when it holds a character
+ * the shell treats specially (or is empty), a quote inside as '\''. */
+static void print_shell_word(FILE* f, const char* word)
+{
+    if (word[0] && !strpbrk(word, " \t\n'\"\\$`;&|<>()*?[]{}~#!")) {
+        fprintf(f, " %s", word);
+        return;
+    }
+    fputs(" '", f);
+    for (const char* c = word; *c; c++)
+        if (*c == '\'')
+            fputs("'\\''", f);
+        else
+            fputc(*c, f);
+    fputc('\'', f);
+}
+
 /* Prints the command that resumes an interrupted run: the original arguments with
- * --restart CHECKPOINT (replacing an earlier --restart). */
+ * --restart CHECKPOINT (replacing an earlier --restart), each quoted for the shell. */
 static void print_resume(const struct cli_run_options* opt, const char* ckpt)
 {
     fprintf(stderr, "wetdem: resume with: wetdem");
@@ -557,10 +597,11 @@ static void print_resume(const struct cli_run_options* opt, const char* ckpt)
             k++;
             continue;
         }
-        bool quote = strpbrk(opt->argv[k], " \t'\"$;&|<>()*?") != NULL;
-        fprintf(stderr, quote ? " '%s'" : " %s", opt->argv[k]);
+        print_shell_word(stderr, opt->argv[k]);
     }
-    fprintf(stderr, " --restart %s\n", ckpt);
+    fputs(" --restart", stderr);
+    print_shell_word(stderr, ckpt);
+    fputc('\n', stderr);
 }
 
 /* ------------------------------------------------------------------------ the run --- */
@@ -611,13 +652,14 @@ static void print_check_json(const struct cli_scenario* sc, const struct cli_man
     printf(", \"engine\": \"many\", \"particles\": %zu, \"fixed\": %zu, \"walls\": %zu, "
            "\"box_m\": "
            "[%.17g, %.17g, %.17g], \"periodic\": [%s, %s, %s], \"dt_s\": %.17g, "
-           "\"t_end_s\": %.17g, \"steps\": %llu, \"vtk_every\": %llu, \"vtk_links\": %s, "
+           "\"time_s\": %.17g, \"t_end_s\": %.17g, \"steps\": %llu, \"vtk_every\": %llu, "
+           "\"vtk_links\": %s, "
            "\"csv_every\": %llu, \"contacts\": %zu, \"bridges\": %zu, \"models\": [",
            wetdem_sim_n_particles(su->sim), n_fixed(su), wetdem_sim_n_walls(su->sim), su->box[0],
            su->box[1], su->box[2], su->many.periodic[0] ? "true" : "false",
            su->many.periodic[1] ? "true" : "false", su->many.periodic[2] ? "true" : "false", pl->dt,
-           pl->t_end, pl->total, su->vtk_every, su->vtk_links ? "true" : "false", su->csv_every,
-           s->contacts, s->bridges);
+           wetdem_sim_time(su->sim), pl->t_end, pl->total, su->vtk_every,
+           su->vtk_links ? "true" : "false", su->csv_every, s->contacts, s->bridges);
     for (size_t k = 0; k < wetdem_sim_n_models(su->sim); k++) {
         printf("%s", k ? ", " : "");
         cli_json_string(stdout, wetdem_sim_model(su->sim, k)->name);
@@ -638,11 +680,12 @@ static void print_check_json(const struct cli_scenario* sc, const struct cli_man
 }
 
 static void print_check(const struct cli_scenario* sc, const struct cli_many_setup* su,
-                        const struct plan* pl, bool json)
+                        const struct plan* pl, const struct cli_run_options* opt)
 {
     struct wetdem_many_stats s;
     wetdem_sim_many_stats(su->sim, &s);
-    if (json) {
+    bool opt_restart = opt->restart != NULL;
+    if (opt->json) {
         print_check_json(sc, su, pl, &s);
         return;
     }
@@ -673,9 +716,9 @@ static void print_check(const struct cli_scenario* sc, const struct cli_many_set
                                                 : "exceeds it");
     printf("  t_end         %.6g s\n  steps         %llu\n", pl->t_end, pl->total);
     printf("  vtk_every     %llu%s\n  csv_every     %llu\n  contacts      %zu  (bridges %zu) at "
-           "t = 0\n  models       ",
+           "t = %.6g s%s\n  models       ",
            su->vtk_every, su->vtk_links ? "  (with links)" : "", su->csv_every, s.contacts,
-           s.bridges);
+           s.bridges, wetdem_sim_time(su->sim), opt_restart ? " (the checkpoint's)" : "");
     for (size_t k = 0; k < wetdem_sim_n_models(su->sim); k++)
         printf(" %s", wetdem_sim_model(su->sim, k)->name);
     printf("\n  materials    "); /* (their indices: frames' material array, [read.NAME]) */
@@ -708,9 +751,9 @@ static int set_outputs(struct cli_many_setup* su, const struct cli_run_options* 
     return wetdem_sim_set_many(su->sim, &m) == WETDEM_OK ? CLI_EXIT_OK : CLI_EXIT_RUNTIME;
 }
 
-/* Restores the checkpoint and trims the outputs after it. */
-static int resume(const struct cli_many_setup* su, const struct cli_run_options* opt,
-                  const struct plan* pl, struct series* vtk)
+/* Restores the checkpoint and checks that this run can continue it; touches no file. */
+static int restore(const struct cli_many_setup* su, const struct cli_run_options* opt,
+                   const struct plan* pl)
 {
     size_t n_scenario = wetdem_sim_n_particles(su->sim);
     if (wetdem_sim_read_checkpoint(su->sim, opt->restart) != WETDEM_OK) {
@@ -749,16 +792,27 @@ static int resume(const struct cli_many_setup* su, const struct cli_run_options*
                   pl->t_end);
         return CLI_EXIT_USAGE;
     }
-    if (pl->csv_prefix[0]) {
+    return CLI_EXIT_OK;
+}
+
+/* Restores the checkpoint and trims the outputs after it. */
+static int resume(const struct cli_many_setup* su, const struct cli_run_options* opt,
+                  const struct plan* pl, struct series* vtk)
+{
+    int rc = restore(su, opt, pl);
+    if (rc != CLI_EXIT_OK)
+        return rc;
+    struct wetdem_many_stats s;
+    wetdem_sim_many_stats(su->sim, &s);
+    /* the index first: it refuses without touching a file, the CSV's trim rewrites one */
+    rc = vtk ? series_resume(vtk, wetdem_sim_time(su->sim), s.step, pl->dt, su->vtk_every)
+             : CLI_EXIT_OK;
+    if (rc == CLI_EXIT_OK && pl->csv_prefix[0]) {
         char path[PATH_CHARS + 8];
         snprintf(path, sizeof path, "%s.csv", pl->csv_prefix);
-        int rc = csv_resume(path, s.step, su->csv_every, opt->out_dir);
-        if (rc != CLI_EXIT_OK)
-            return rc;
+        rc = csv_resume(path, s.step, su->csv_every, opt->out_dir);
     }
-    if (vtk)
-        series_resume(vtk, wetdem_sim_time(su->sim), s.step, pl->dt, su->vtk_every);
-    return CLI_EXIT_OK;
+    return rc;
 }
 
 /* After the stepping: interrupted, failed or done (last frame, final checkpoint, summary). */
@@ -770,7 +824,7 @@ static int finish(const struct cli_scenario* sc, struct cli_many_setup* su,
     wetdem_sim_many_stats(su->sim, &o.stats);
     o.has_budget = wetdem_sim_energy_budget(su->sim, &o.budget) == WETDEM_OK;
     if (prog->status != WETDEM_OK) {
-        cli_error("run %s: writing a VTK frame: %s", sc->file, wetdem_sim_errmsg(su->sim));
+        cli_error("run %s: writing a VTK frame: %s", sc->file, prog->vtk->error);
         return CLI_EXIT_RUNTIME;
     }
     if (st < 0) {
@@ -786,18 +840,22 @@ static int finish(const struct cli_scenario* sc, struct cli_many_setup* su,
         fprintf(stderr, "%swetdem: interrupted by %s at t = %.9g s (step %llu of %llu)",
                 prog->tty ? "\n" : "", sig == SIGTERM ? "SIGTERM" : "SIGINT",
                 wetdem_sim_time(su->sim), o.stats.step, pl->total);
-        if (!pl->checkpoint[0]) {
-            fprintf(stderr, "; no checkpoint (run with --out DIR to keep one)\n");
-            return 128 + sig;
-        }
-        fprintf(stderr, "; checkpoint %s written\n", pl->checkpoint);
-        write_summary(opt->out_dir, sc, su, &o);
-        print_resume(opt, pl->checkpoint);
+        if (!pl->checkpoint[0])
+            fprintf(stderr, "; no checkpoint (%s)\n",
+                    opt->out_dir ? "[dump] checkpoint = none: the run cannot be resumed"
+                                 : "run with --out DIR to keep one");
+        else
+            fprintf(stderr, "; checkpoint %s written\n", pl->checkpoint);
+        write_summary(opt->out_dir, sc, su, &o); /* ("interrupted": true) */
+        if (opt->json)
+            summary_json(stdout, sc, su, &o);
+        if (pl->checkpoint[0])
+            print_resume(opt, pl->checkpoint);
         return 128 + sig;
     }
     if (prog->vtk && (prog->vtk->n == 0 || prog->vtk->last_step != o.stats.step) &&
         series_add(prog->vtk, su->sim, o.stats.step) != WETDEM_OK) {
-        cli_error("run %s: writing the last VTK frame: %s", sc->file, wetdem_sim_errmsg(su->sim));
+        cli_error("run %s: writing the last VTK frame: %s", sc->file, prog->vtk->error);
         return CLI_EXIT_RUNTIME;
     }
     if (pl->checkpoint[0] && wetdem_sim_write_checkpoint(su->sim, pl->checkpoint) != WETDEM_OK) {
@@ -847,7 +905,7 @@ static int check_output_volume(const struct cli_scenario* sc, const struct cli_m
             continue;
         char text[300];
         snprintf(text, sizeof text,
-                 "writes %.3g %s over the run's %llu steps, more than %g: raise %s, or set %s",
+                 "writes %.0f %s over the run's %llu steps, more than %.0f: raise %s, or set %s",
                  count, out[k].what, pl->total, out[k].most, out[k].key, out[k].off);
         const struct cli_entry* e = cli_scenario_find(sc, "dump", out[k].key);
         if (e)
@@ -928,10 +986,13 @@ int cli_run_many(const struct cli_scenario* sc, const struct cli_run_options* op
         return rc;
     struct plan pl = {0};
     rc = dry_start(sc, &su, &pl);
-    if (rc == CLI_EXIT_OK && opt->out_dir && !opt->check)
+    if (rc == CLI_EXIT_OK && opt->out_dir)
         rc = check_output_volume(sc, &su, &pl);
-    if (rc == CLI_EXIT_OK && opt->check) {
-        print_check(sc, &su, &pl, opt->json);
+    if (rc == CLI_EXIT_OK && opt->check) { /* (with --restart: whether it can be continued) */
+        if (opt->restart)
+            rc = restore(&su, opt, &pl);
+        if (rc == CLI_EXIT_OK)
+            print_check(sc, &su, &pl, opt);
     } else if (rc == CLI_EXIT_OK) {
         struct series vtk = {.binary = su.vtk_binary, .links = su.vtk_links};
         bool has_vtk = opt->out_dir && su.vtk_prefix[0] && su.vtk_every;

@@ -689,31 +689,49 @@ int cli_override_split(const char* text, char* section, char* key, char* value)
     return 0;
 }
 
-/* A --set of a [material.NAME] the file does not define would add a material no sphere uses
- * (a misspelt name, or a preset's name, whose section would start from the field defaults,
- * not from the preset): refused with the file's materials as a hint. Returns an exit code. */
-static int new_material(const struct cli_scenario* sc, const char* key_value, const char* section)
+/* The families of named sections that are things of the scenario, each with its noun. */
+static const struct {
+    const char* prefix;
+    const char* noun;
+} named_families[] = {{"material.", "a material"},
+                      {"particle.", "a sphere"},
+                      {"sphere.", "a sphere"},
+                      {"insert.", "an insertion"},
+                      {"read.", "a read of a file"}};
+
+/* A --set of a named section the file does not define ([material.NAME], [particle.NAME],
+ * [sphere.NAME], [insert.NAME], [read.NAME]) would add an entry that no section reads (a
+ * misspelt name; for a material, a preset's name, whose section would start from the field
+ * defaults, not from the preset): refused with the file's sections of that family as a hint.
+ * Returns an exit code. */
+static int new_named_section(const struct cli_scenario* sc, const char* key_value,
+                             const char* section)
 {
-    if (strncmp(section, "material.", 9) != 0 || cli_scenario_has_section(sc, section))
+    size_t f = 0, n_families = sizeof named_families / sizeof named_families[0];
+    while (f < n_families &&
+           strncmp(section, named_families[f].prefix, strlen(named_families[f].prefix)) != 0)
+        f++;
+    if (f == n_families || cli_scenario_has_section(sc, section))
         return CLI_EXIT_OK;
+    const char* prefix = named_families[f].prefix;
     const char* names[64];
     size_t n = 0;
     for (size_t k = 0; k < sc->n_sections && n + 1 < 64; k++)
-        if (strncmp(sc->sections[k].name, "material.", 9) == 0)
+        if (strncmp(sc->sections[k].name, prefix, strlen(prefix)) == 0)
             names[n++] = sc->sections[k].name;
     names[n] = NULL;
     const char* hint = wetdem_param_suggest(section, names);
     char also[256] = "";
     struct wetdem_material m;
-    if (!hint && wetdem_material_preset(section + 9, &m) == WETDEM_OK)
+    if (!hint && f == 0 && wetdem_material_preset(section + 9, &m) == WETDEM_OK)
         snprintf(also, sizeof also,
                  "; to change preset %s, give the file a [material.NAME] section with preset = %s "
                  "and use NAME",
                  section + 9, section + 9);
-    cli_error("%s: --set %s: the file has no section [%s]%s%s%s%s; --set changes a material the "
-              "file defines, it does not add one",
+    cli_error("%s: --set %s: the file has no section [%s]%s%s%s%s; --set changes %s the file "
+              "defines, it does not add one",
               sc->file, key_value, section, hint ? " (did you mean [" : "", hint ? hint : "",
-              hint ? "]?)" : "", also);
+              hint ? "]?)" : "", also, named_families[f].noun);
     return CLI_EXIT_USAGE;
 }
 
@@ -729,7 +747,7 @@ int cli_scenario_override(struct cli_scenario* sc, const char* key_value)
         cli_error("--set %s: unknown section [%s]%s", key_value, section, msg);
         return CLI_EXIT_USAGE;
     }
-    if (new_material(sc, key_value, section) != CLI_EXIT_OK)
+    if (new_named_section(sc, key_value, section) != CLI_EXIT_OK)
         return CLI_EXIT_USAGE;
     struct cli_entry probe = {.line = 0};
     copy_text(probe.section, sizeof probe.section, section);

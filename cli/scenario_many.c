@@ -136,7 +136,8 @@ static const struct cli_key_desc read_keys[] = {
          "Which spheres are held in place (infinite mass, at rest): file, those the file marks "
          "(a frame's fixed array, a CSV's fixed column of 0 and 1; none if it has neither); "
          "yes, every sphere (a rough base of glued spheres, a settled bed as an obstacle: the "
-         "file's velocities and spins are then not used); no, none."),
+         "file's velocities and spins are then not used); no, none (the file's fixed column or "
+         "array is then not read)."),
     {0},
 };
 
@@ -695,22 +696,20 @@ static int build_sphere_file(const struct cli_scenario* sc, struct cli_many_setu
     sphere_file_path(sc, e->value, path, sizeof path);
     struct wetdem_particle* p = NULL;
     size_t n = 0;
-    int rc = cli_read_sphere_file(path, &p, &n, why, sizeof why);
+    const char* fixed = cli_scenario_text(sc, section, "fixed", "file");
+    int rc = cli_read_sphere_file(path, strcmp(fixed, "file") == 0, &p, &n, why, sizeof why);
     if (rc != CLI_EXIT_OK) {
         /* "PATH:LINE: why" for a CSV (why starts with its line), "PATH: why" otherwise */
         cli_scenario_error(sc, e, "%s:%s%s", path, isdigit((unsigned char)why[0]) ? "" : " ", why);
         return rc;
     }
     rc = assign_materials(sc, su, section, path, p, n);
-    const char* fixed = cli_scenario_text(sc, section, "fixed", "file");
     for (size_t k = 0; k < n && rc == CLI_EXIT_OK; k++) {
         if (strcmp(fixed, "yes") == 0) /* at rest */
             p[k] = (struct wetdem_particle){.pos = p[k].pos,
                                             .radius = p[k].radius,
                                             .material = p[k].material,
                                             .is_fixed = true};
-        else if (strcmp(fixed, "no") == 0)
-            p[k].is_fixed = false;
         if (wetdem_sim_add_particle(su->sim, p[k]) != WETDEM_OK)
             rc = cli_scenario_lib_error(sc, e, section, su->sim);
     }
@@ -843,6 +842,61 @@ static int dump_name(const struct cli_scenario* sc, const char* key, const char*
     return CLI_EXIT_OK;
 }
 
+/* The files of --out DIR must not share a name (the one written last would replace the
+ * other, and a fresh run removes whatever is named as its frames): the CSV, the checkpoint,
+ * the summary, the frames' index and their links' index (each also as its temporary
+ * NAME.tmp), none named as a frame or a links frame. The message stands at the key of the
+ * first of the two in that order that the scenario gives. */
+static int dump_names_distinct(const struct cli_scenario* sc, const struct cli_many_setup* su)
+{
+    char index[CLI_VALUE_MAX + 16] = "", links_index[CLI_VALUE_MAX + 24] = "",
+                               links_prefix[CLI_VALUE_MAX + 8] = "";
+    if (su->vtk_prefix[0]) {
+        snprintf(index, sizeof index, "%s.vtk.series", su->vtk_prefix);
+        snprintf(links_prefix, sizeof links_prefix, "%s" WETDEM_LINKS_SUFFIX, su->vtk_prefix);
+        snprintf(links_index, sizeof links_index, "%s.vtk.series", links_prefix);
+    }
+    const struct {
+        const char *key, *name, *what;
+    } file[5] = {{"vtk", index, "the frames' index"},
+                 {"vtk", links_index, "the links' index"},
+                 {"csv", su->csv_name, "the CSV"},
+                 {"checkpoint", su->checkpoint_name, "the checkpoint"},
+                 {"summary", su->summary_name, "the summary"}};
+    for (int a = 0; a < 5; a++) {
+        char clash[80] = "";
+        const char* clash_key = "vtk";
+        if (a >= 2 && file[a].name[0] && su->vtk_prefix[0] &&
+            (cli_is_frame_name(su->vtk_prefix, file[a].name) ||
+             cli_is_frame_name(links_prefix, file[a].name)))
+            snprintf(clash, sizeof clash, "a VTK frame");
+        for (int b = 0; file[a].name[0] && !clash[0] && b < 5; b++) {
+            size_t lb = strlen(file[b].name);
+            bool same = strcmp(file[a].name, file[b].name) == 0,
+                 tmp = strncmp(file[a].name, file[b].name, lb) == 0 &&
+                       strcmp(file[a].name + lb, ".tmp") == 0;
+            if (b != a && lb && (same || tmp)) {
+                snprintf(clash, sizeof clash, "%s%s", same ? "" : "the temporary file of ",
+                         file[b].what);
+                clash_key = file[b].key;
+            }
+        }
+        if (!clash[0])
+            continue;
+        const struct cli_entry* e = cli_scenario_find(sc, "dump", file[a].key);
+        if (!e)
+            e = cli_scenario_find(sc, "dump", clash_key);
+        const char* text = "%s would name both %s and %s: give the outputs of --out distinct "
+                           "names";
+        if (e)
+            cli_scenario_error(sc, e, text, file[a].name, file[a].what, clash);
+        else
+            cli_scenario_section_error(sc, "dump", text, file[a].name, file[a].what, clash);
+        return CLI_EXIT_USAGE;
+    }
+    return CLI_EXIT_OK;
+}
+
 static int build_run(const struct cli_scenario* sc, struct cli_many_setup* su)
 {
     const struct cli_entry* te = cli_scenario_find(sc, "run", "t_end");
@@ -888,7 +942,7 @@ static int build_run(const struct cli_scenario* sc, struct cli_many_setup* su)
                            ".csv");
         return CLI_EXIT_USAGE;
     }
-    return CLI_EXIT_OK;
+    return dump_names_distinct(sc, su);
 }
 
 int cli_many_report_start(const struct cli_scenario* sc, const char* msg)

@@ -36,15 +36,15 @@ enum column { X, Y, Z, RADIUS, VX, VY, VZ, SPIN_X, SPIN_Y, SPIN_Z, FIXED, MATERI
 static const char* const column_names[] = {"x",     "y",        "z",      "radius", "vx",
                                            "vy",    "vz",       "spin_x", "spin_y", "spin_z",
                                            "fixed", "material", NULL};
+static const char* const column_units[N_COLUMNS] = {"m",   "m",     "m",     "m",     "m/s", "m/s",
+                                                    "m/s", "rad/s", "rad/s", "rad/s", "-",   "-"};
 static const struct {
     double lo, hi;
     bool lo_open;
-    const char* unit;
 } column_range[N_COLUMNS] = {
-    {-1e3, 1e3, false, "m"},     {-1e3, 1e3, false, "m"},     {-1e3, 1e3, false, "m"},
-    {0, 1, true, "m"},           {-1e3, 1e3, false, "m/s"},   {-1e3, 1e3, false, "m/s"},
-    {-1e3, 1e3, false, "m/s"},   {-1e6, 1e6, false, "rad/s"}, {-1e6, 1e6, false, "rad/s"},
-    {-1e6, 1e6, false, "rad/s"}, {0, 1, false, "-"},          {0, 1000, false, "-"},
+    {-1e3, 1e3, false}, {-1e3, 1e3, false}, {-1e3, 1e3, false}, {0, 1, true},
+    {-1e3, 1e3, false}, {-1e3, 1e3, false}, {-1e3, 1e3, false}, {-1e6, 1e6, false},
+    {-1e6, 1e6, false}, {-1e6, 1e6, false}, {0, 1, false},      {0, 1000, false},
 };
 
 static int fail(char* err, size_t err_len, const char* fmt, ...)
@@ -86,22 +86,23 @@ static bool in_range(enum column c, double v, char* err, size_t err_len, const c
         return false;
     }
     fail(err, err_len, "%s%s = %g %s is not in %c%g, %g] %s", where, column_names[c], v,
-         column_range[c].unit, column_range[c].lo_open ? '(' : '[', column_range[c].lo,
-         column_range[c].hi, column_range[c].unit);
+         column_units[c], column_range[c].lo_open ? '(' : '[', column_range[c].lo,
+         column_range[c].hi, column_units[c]);
     return false;
 }
 
 /* The sphere of values v (indexed by column; absent columns 0, material -1), checked: a fixed
- * one must be at rest (else why, after `where`, into err and false). */
-static bool sphere_of(const double v[N_COLUMNS], struct wetdem_particle* p, char* err,
-                      size_t err_len, const char* where)
+ * one must be at rest (else why, after `where`, into err and false). Without marks_fixed the
+ * fixed column is not used: the sphere is free. */
+static bool sphere_of(const double v[N_COLUMNS], bool marks_fixed, struct wetdem_particle* p,
+                      char* err, size_t err_len, const char* where)
 {
     *p = (struct wetdem_particle){.pos = {v[X], v[Y], v[Z]},
                                   .vel = {v[VX], v[VY], v[VZ]},
                                   .omega = {v[SPIN_X], v[SPIN_Y], v[SPIN_Z]},
                                   .radius = v[RADIUS],
                                   .material = (int)v[MATERIAL],
-                                  .is_fixed = v[FIXED] == 1};
+                                  .is_fixed = marks_fixed && v[FIXED] == 1};
     for (int c = VX; p->is_fixed && c <= SPIN_Z; c++)
         if (v[c] != 0) {
             fail(err, err_len,
@@ -195,10 +196,10 @@ static int read_header(char* line, size_t line_no, int col[N_COLUMNS], int* n_fi
                        size_t err_len)
 {
     char* f[MAX_FIELDS];
-    *n_fields = cli_csv_split(line, f, MAX_FIELDS, true);
+    *n_fields = cli_csv_split(line, f, MAX_FIELDS);
     char why[300];
     int bad;
-    if (cli_csv_columns(f, *n_fields, column_names, col, &bad, why, sizeof why) != 0)
+    if (cli_csv_columns(f, *n_fields, column_names, column_units, col, &bad, why, sizeof why) != 0)
         return fail(err, err_len,
                     "%zu: %s (columns: x, y, z, radius; optional vx, vy, vz, spin_x, spin_y, "
                     "spin_z, fixed, material)",
@@ -212,7 +213,8 @@ static int read_header(char* line, size_t line_no, int col[N_COLUMNS], int* n_fi
     return CLI_EXIT_OK;
 }
 
-static int read_csv(char* text, struct wetdem_particle** out, size_t* n, char* err, size_t err_len)
+static int read_csv(char* text, bool marks_fixed, struct wetdem_particle** out, size_t* n,
+                    char* err, size_t err_len)
 {
     int col[N_COLUMNS + 1], n_fields = 0;
     size_t cap = 0, line_no = 0;
@@ -234,7 +236,7 @@ static int read_csv(char* text, struct wetdem_particle** out, size_t* n, char* e
             continue;
         }
         char* f[MAX_FIELDS];
-        int nf = cli_csv_split(line, f, MAX_FIELDS, false);
+        int nf = cli_csv_split(line, f, MAX_FIELDS);
         if (nf != n_fields)
             return fail(err, err_len, "%zu: %d fields, the header has %d columns", line_no, nf,
                         n_fields);
@@ -254,7 +256,7 @@ static int read_csv(char* text, struct wetdem_particle** out, size_t* n, char* e
         if (*n == MAX_SPHERES)
             return fail(err, err_len, "%zu: more than %d spheres", line_no, MAX_SPHERES);
         struct wetdem_particle p;
-        if (!sphere_of(v, &p, err, err_len, where))
+        if (!sphere_of(v, marks_fixed, &p, err, err_len, where))
             return CLI_EXIT_USAGE;
         if (!push(out, n, &cap, p))
             return no_memory(err, err_len);
@@ -379,8 +381,8 @@ static long long vtk_count(const char* w)
     return errno || *end || v < 0 || v > 3LL * MAX_SPHERES ? -1 : v;
 }
 
-static int read_vtk(const char* data, size_t len, struct wetdem_particle** out, size_t* n,
-                    char* err, size_t err_len)
+static int read_vtk(const char* data, size_t len, bool marks_fixed, struct wetdem_particle** out,
+                    size_t* n, char* err, size_t err_len)
 {
     struct vtk_cursor c = {.data = data, .len = len};
     char w[8][64];
@@ -487,7 +489,7 @@ static int read_vtk(const char* data, size_t len, struct wetdem_particle** out, 
             else if (!in_range(k, v[k], err, err_len, where))
                 rc = CLI_EXIT_USAGE;
         struct wetdem_particle p;
-        if (rc == 0 && !sphere_of(v, &p, err, err_len, where))
+        if (rc == 0 && !sphere_of(v, marks_fixed, &p, err, err_len, where))
             rc = CLI_EXIT_USAGE;
         if (rc == 0 && !push(out, n, &cap, p))
             rc = no_memory(err, err_len);
@@ -522,8 +524,8 @@ static int last_frame(const char* index, char* text, char* path, size_t n, char*
     return CLI_EXIT_OK;
 }
 
-int cli_read_sphere_file(const char* path, struct wetdem_particle** out, size_t* n, char* err,
-                         size_t err_len)
+int cli_read_sphere_file(const char* path, bool marks_fixed, struct wetdem_particle** out,
+                         size_t* n, char* err, size_t err_len)
 {
     *out = NULL;
     *n = 0;
@@ -541,14 +543,15 @@ int cli_read_sphere_file(const char* path, struct wetdem_particle** out, size_t*
         int rc = last_frame(path, text, frame, sizeof frame, err, err_len);
         free(text);
         char why[400];
-        if (rc == CLI_EXIT_OK && (rc = cli_read_sphere_file(frame, out, n, why, sizeof why)) != 0)
+        if (rc == CLI_EXIT_OK &&
+            (rc = cli_read_sphere_file(frame, marks_fixed, out, n, why, sizeof why)) != 0)
             snprintf(err, err_len, "its last frame %s: %s", frame, why);
         return rc;
     }
     int rc = plen > 4 && strcmp(path + plen - 4, ".vtk") == 0
-                 ? read_vtk(text, len, out, n, err, err_len)
+                 ? read_vtk(text, len, marks_fixed, out, n, err, err_len)
                  : (memchr(text, '\0', len) ? fail(err, err_len, "a CSV with a NUL byte")
-                                            : read_csv(text, out, n, err, err_len));
+                                            : read_csv(text, marks_fixed, out, n, err, err_len));
     free(text);
     if (rc != 0) {
         free(*out);

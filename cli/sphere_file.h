@@ -5,6 +5,7 @@
 #ifndef WETDEM_CLI_SPHERE_FILE_H
 #define WETDEM_CLI_SPHERE_FILE_H
 
+#include <stdbool.h>
 #include <stddef.h>
 
 #include "cli.h"
@@ -17,12 +18,14 @@
  * header naming the columns, x, y, z and radius required, vx, vy, vz, spin_x, spin_y, spin_z,
  * fixed and material optional, a name may carry its unit as "x [m]"; one row a sphere). Every
  * value must be a finite number within the range of the [particle.NAME] key of that name,
- * fixed 0 or 1 (is_fixed), a fixed sphere at rest, material a whole number in [0, 1000] (the
+ * fixed 0 or 1 (is_fixed, and a fixed sphere at rest, when marks_fixed: the file says which
+ * spheres are fixed; otherwise every sphere is read as free), material a whole number in
+ * [0, 1000] (the
  * file's index, left in .material for the caller to map; -1 when the file has none). Film
  * and mass are left at zero for the caller. Returns CLI_EXIT_OK, or CLI_EXIT_USAGE (bad input) or
  * CLI_EXIT_RUNTIME (out of memory) with a one-line reason in err ("LINE: ..." for a CSV,
  * naming the array for a frame). */
-int cli_read_sphere_file(const char* path, struct wetdem_particle** out, size_t* n, char* err,
-                         size_t err_len);
+int cli_read_sphere_file(const char* path, bool marks_fixed, struct wetdem_particle** out,
+                         size_t* n, char* err, size_t err_len);
 
 #endif

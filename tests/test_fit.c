@@ -725,6 +725,8 @@ static void test_fit_cli_data_file_checks(void** state)
     expect_cli(args, 2, ":1: column stokes_n appears twice (columns 1 and 3)");
     temp_csv(csv, "data", "stokes_n [-],e_n [-],sigma\n2,0.5,0.01\n3,0.6,0.01\n");
     expect_cli(args, 2, ":1: column 3: unknown column 'sigma'; the columns are stokes_n and e_n");
+    temp_csv(csv, "data", "stokes_n,e_n [1],angle_deg [rad]\n2,0.5,0\n3,0.6,0\n");
+    expect_cli(args, 2, "column 'angle_deg [rad]': angle_deg is read in deg, not rad");
     temp_csv(csv, "data", "stokes_n,e_n,angle\n2,0.5,0\n3,0.6,0\n");
     expect_cli(args, 2, "unknown column 'angle' (did you mean 'angle_deg'?)");
     temp_csv(csv, "data", "\xEF\xBB\xBFstokes_n,e_n\n2,0.5\n3,abc\n"); /* read past the header */

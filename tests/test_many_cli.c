@@ -219,11 +219,22 @@ static void test_many_cli_bad_inputs_exit_2_with_file_and_line(void** state)
     expect_bad("vtk_flood.ini",
                "[box]\nsize_x = 1e-2\nsize_y = 1e-2\nsize_z = 1e-2\n[insert]\ncount = 5\n"
                "radius = 1e-3\n[run]\nsteps = 200000\n[dump]\nvtk_every = 1\n",
-               11, "writes 2e+05 VTK files over the run's 200000 steps, more than 100000");
+               11, "writes 200001 VTK files over the run's 200000 steps, more than 100000");
     expect_bad("csv_flood.ini",
                "[box]\nsize_x = 1e-2\nsize_y = 1e-2\nsize_z = 1e-2\n[insert]\ncount = 5\n"
                "radius = 1e-3\n[run]\nsteps = 20000000\n[dump]\ncsv_every = 1\n",
-               11, "writes 2e+07 CSV rows over the run's 20000000 steps, more than 1e+07");
+               11, "writes 20000001 CSV rows over the run's 20000000 steps, more than 10000000");
+    /* --check says so too (it said "valid") */
+    free(expect_exit("run vtk_flood.ini --check --out flood", 2, "writes 200001 VTK files"));
+    /* two outputs of one name: the one written last replaced the other */
+    expect_bad("clash.ini",
+               "[box]\nsize_x = 1e-2\nsize_y = 1e-2\nsize_z = 1e-2\n[insert]\ncount = 5\n"
+               "radius = 1e-3\n[run]\nsteps = 10\n[dump]\ncheckpoint = global.csv\n",
+               11, "global.csv would name both the CSV and the checkpoint");
+    expect_bad("clash_frame.ini",
+               "[box]\nsize_x = 1e-2\nsize_y = 1e-2\nsize_z = 1e-2\n[insert]\ncount = 5\n"
+               "radius = 1e-3\n[run]\nsteps = 10\n[dump]\nsummary = particles_000003.vtk\n",
+               11, "particles_000003.vtk would name both the summary and a VTK frame");
     /* a density of 1e-300 kg/m^3 makes m/c_d underflow to 0 though h_min > 0: the message
      * names the mass, not a missing h_min; 1e300 makes the Hertz contact time infinite, and
      * a step of a quarter of the relaxation time (2e291 s) would send the spheres to inf: the
@@ -247,6 +258,13 @@ static void test_many_cli_bad_inputs_exit_2_with_file_and_line(void** state)
     scenario("sweep.ini", "");
     free(expect_exit("sweep sweep.ini --param run.dt --values 1e-6:2e-6:2", 2,
                      "runs with 'wetdem run'"));
+    /* a --set of a sphere, an insertion or a file read the file does not define was an entry
+       no section read: the run went on without it */
+    free(expect_exit("run overlap3.ini --check --set particle.aa.x=1e-3", 2,
+                     "--set particle.aa.x=1e-3: the file has no section [particle.aa] (did you "
+                     "mean [particle.a]?); --set changes a sphere the file defines"));
+    free(expect_exit("run sweep.ini --check --set insert.big.count=3", 2,
+                     "the file has no section [insert.big]; --set changes an insertion"));
 }
 
 /* Removes field `col` (0-based) from every comma-separated line of text, in place. */
@@ -379,6 +397,44 @@ static void test_many_cli_restart_is_bit_identical(void** state)
     assert_int_equal(run_cli("run box.ini --set run.steps=600 --out crash"), 0);
     assert_int_equal(run_cli("run box.ini --set run.steps=600 --out crash --restart old.ckpt"), 0);
     check_same_outputs("whole", "crash", 7);
+    /* a crash in the middle of a CSV row: the cut row (no newline) is dropped, not joined to
+       the first row the resumed run appends */
+    assert_int_equal(run_cli("run box.ini --set run.steps=300 --out cut"), 0);
+    FILE* f = fopen(tpath("cut/global.csv"), "a");
+    assert_non_null(f);
+    fputs("0.00061570,30", f);
+    fclose(f);
+    assert_int_equal(run_cli("run box.ini --set run.steps=600 --out cut --restart "
+                             "cut/checkpoint.ckpt"),
+                     0);
+    check_same_outputs("whole", "cut", 7);
+    /* a missing index (or one cut short) beside the frames: numbering from its end overwrote
+       them; refused, exit 2, nothing touched */
+    assert_int_equal(run_cli("run box.ini --set run.steps=300 --out noindex"), 0);
+    assert_int_equal(rename(tpath("noindex/particles.vtk.series"), tpath("index.keep")), 0);
+    char* before = test_read_file(tpath("noindex/global.csv"), NULL);
+    free(expect_exit("run box.ini --set run.steps=600 --out noindex --restart "
+                     "noindex/checkpoint.ckpt",
+                     2,
+                     "noindex/particles.vtk.series is missing, but "
+                     "noindex/particles_000000.vtk exists"));
+    char* after = test_read_file(tpath("noindex/global.csv"), NULL);
+    assert_string_equal(before, after);
+    free(before);
+    free(after);
+    write_text("noindex/particles.vtk.series",
+               "{\n  \"file-series-version\" : \"1.0\",\n  \"files\" : [\n    { \"name\" : "
+               "\"particles_000000.vtk\", \"time\" : 0 }\n  ]\n}\n");
+    free(expect_exit("run box.ini --set run.steps=600 --out noindex --restart "
+                     "noindex/checkpoint.ckpt",
+                     2,
+                     "lists fewer frames than the directory holds, but "
+                     "noindex/particles_000001.vtk exists"));
+    assert_int_equal(rename(tpath("index.keep"), tpath("noindex/particles.vtk.series")), 0);
+    assert_int_equal(run_cli("run box.ini --set run.steps=600 --out noindex --restart "
+                             "noindex/checkpoint.ckpt"),
+                     0);
+    check_same_outputs("whole", "noindex", 7);
     /* a checkpoint of another set-up is refused: exit 2, and the outputs stay as they were */
     code = run_cli("run box.ini --set run.steps=600 --set material.wet.film=30e-6 --out split "
                    "--restart split/checkpoint.ckpt");
@@ -407,6 +463,14 @@ static void test_many_cli_restart_is_bit_identical(void** state)
     assert_int_equal(code, 2);
     CHECK_CONTAINS(err, "the checkpoint holds 150 spheres but the scenario places 151");
     free(err);
+    /* --check --restart makes the same checks, and says "valid" only when the run would go */
+    free(expect_exit("run box.ini --check --set run.steps=900 --set insert.count=151 --restart "
+                     "split/checkpoint.ckpt",
+                     2, "the checkpoint holds 150 spheres but the scenario places 151"));
+    expect_output("run box.ini --check --set run.steps=900 --restart split/checkpoint.ckpt",
+                  "out.txt", "contacts      ");
+    expect_output("run box.ini --check --set run.steps=900 --restart split/checkpoint.ckpt",
+                  "out.txt", "at t = 0.0012 s (the checkpoint's)");
     code = run_cli("run box.ini --set run.steps=600 --out split --restart split/checkpoint.ckpt");
     err = stderr_text();
     assert_int_equal(code, 2);
@@ -503,10 +567,13 @@ static void test_many_cli_sigint_writes_a_checkpoint_and_resumes(void** state)
     (void)state;
     scenario("long.ini", "[dump]\nvtk_every = 2000\ncsv_every = 10\n");
     assert_int_equal(run_cli("run long.ini --set run.steps=12000 --out ref"), 0);
-    const char* dirs[2] = {"sig", "sig2"};
+    /* the second directory's name needs quoting: the printed command must run as printed */
+    const char* dirs[2] = {"sig", "it's 2"};
+    const char* quoted[2] = {"sig", "'it'\\''s 2'"};
+    const char* quoted_ckpt[2] = {"sig/checkpoint.ckpt", "'it'\\''s 2/checkpoint.ckpt'"};
     for (int k = 0; k < 2; k++) {
         char args[200], csv[64], resume[300];
-        snprintf(args, sizeof args, "run long.ini --set run.steps=12000 --out %s", dirs[k]);
+        snprintf(args, sizeof args, "run long.ini --set run.steps=12000 --out %s", quoted[k]);
         snprintf(csv, sizeof csv, "%s/global.csv", dirs[k]);
         int status = interrupt_cli(args, csv, k + 1);
         char* err = stderr_text();
@@ -517,20 +584,35 @@ static void test_many_cli_sigint_writes_a_checkpoint_and_resumes(void** state)
         CHECK_CONTAINS(err, "stopping after this step to write the checkpoint");
         CHECK_CONTAINS(err, "interrupted by SIGINT");
         snprintf(resume, sizeof resume,
-                 "resume with: wetdem run long.ini --set run.steps=12000 --out %s --restart "
-                 "%s/checkpoint.ckpt",
-                 dirs[k], dirs[k]);
+                 "resume with: wetdem run long.ini --set run.steps=12000 --out %s --restart %s",
+                 quoted[k], quoted_ckpt[k]);
         CHECK_CONTAINS(err, resume);
         assert_int_equal(csv_last_step(csv), interrupted_step(err));
-        free(err);
         snprintf(args, sizeof args, "%s/checkpoint.ckpt", dirs[k]);
         assert_true(exists(args));
-        snprintf(args, sizeof args,
-                 "run long.ini --set run.steps=12000 --out %s --restart %s/checkpoint.ckpt",
-                 dirs[k], dirs[k]);
+        /* the command as printed, after "resume with: wetdem " */
+        const char* printed = strstr(err, "resume with: wetdem ") + strlen("resume with: wetdem ");
+        snprintf(args, sizeof args, "%.*s", (int)strcspn(printed, "\n"), printed);
+        free(err);
         assert_int_equal(run_cli(args), 0);
         check_same_outputs("ref", dirs[k], 7); /* frames at 0, 2000, ..., 12000 */
     }
+    /* without a checkpoint there is nothing to resume from: said so (it said "run with --out"
+       though --out was given), and the summary is written all the same */
+    int status = interrupt_cli("run long.ini --set run.steps=12000 --set dump.checkpoint=none "
+                               "--out nock",
+                               "nock/global.csv", 1);
+    char* err = stderr_text();
+    if (!WIFEXITED(status) || WEXITSTATUS(status) != 130)
+        fail_msg("SIGINT without a checkpoint: status %d, expected exit 130\n%s", status, err);
+    CHECK_CONTAINS(err, "no checkpoint ([dump] checkpoint = none: the run cannot be resumed)");
+    if (strstr(err, "resume with"))
+        fail_msg("a resume command without a checkpoint:\n%s", err);
+    free(err);
+    char* summary = test_read_file(tpath("nock/summary.json"), NULL);
+    assert_non_null(summary);
+    CHECK_CONTAINS(summary, "\"interrupted\": true");
+    free(summary);
 }
 
 /* A third SIGINT, sent while the run is still stopping after the first (20000 spheres: a step
@@ -902,6 +984,27 @@ static void test_many_cli_read_spheres_from_a_file(void** state)
     CHECK_CONTAINS(frame, "fixed 1 2 int\n1\n0\n");
     CHECK_CONTAINS(frame, "velocity 3 2 double\n0 0 0\n0.10000000000000001 0 0\n");
     free(frame);
+    /* with fixed = no the column is not read, so a sphere it marks fixed may move (it was
+       refused as "a fixed sphere ... at rest"); with fixed = yes the velocities are not used */
+    write_text("moving.csv", "x,y,z,radius,vx,fixed\n1e-3,3e-3,1e-3,4e-4,0.1,1\n");
+    write_text("moving.ini", WET_BOX "[read.bed]\nfile = moving.csv\nmaterial = wet\n[run]\n"
+                                     "dt = 2e-6\nsteps = 1\n[dump]\nvtk_every = 1\n"
+                                     "vtk_binary = no\n");
+    free(expect_exit("run moving.ini --check", 2, "must be 0"));
+    const char* fixed_as[2] = {"no", "yes"};
+    const char* want[2] = {"fixed 1 1 int\n0\n", "fixed 1 1 int\n1\n"};
+    for (int k = 0; k < 2; k++) {
+        char args[200];
+        snprintf(args, sizeof args, "run moving.ini --out moving --set read.bed.fixed=%s",
+                 fixed_as[k]);
+        assert_int_equal(run_cli(args), 0);
+        frame = test_read_file(tpath("moving/particles_000000.vtk"), NULL);
+        assert_non_null(frame);
+        CHECK_CONTAINS(frame, want[k]);
+        CHECK_CONTAINS(frame, k ? "velocity 3 1 double\n0 0 0\n"
+                                : "velocity 3 1 double\n0.10000000000000001 0 0\n");
+        free(frame);
+    }
     /* two materials by a CSV's material column; the frame of that run (material array 0 1 1
        as the scenario's materials list them) read back with the same list starts at its state
        bit for bit; without the list every sphere takes `material`, with a warning */
@@ -959,6 +1062,11 @@ static void test_many_cli_read_spheres_from_a_file(void** state)
         {"x,y,z,radus\n1e-3,1e-3,1e-3,1e-4\n", "bad.csv:1: unknown column 'radus' (did you "
                                                "mean 'radius'?)"},
         {"x,y,z\n1e-3,1e-3,1e-3\n", "bad.csv:1: the header has no column 'radius'"},
+        /* a unit label is checked, not dropped: vx [mm/s] read as m/s was 1000 x too fast */
+        {"x,y,z,radius,vx [mm/s]\n1e-3,1e-3,1e-3,1e-4,5\n",
+         "bad.csv:1: column 'vx [mm/s]': vx is read in m/s, not mm/s"},
+        {"x [m] extra,y,z,radius\n1e-3,1e-3,1e-3,1e-4\n",
+         "bad.csv:1: column 'x [m] extra': a unit is written as 'name [unit]'"},
         {"# c\nx,y,z,radius\n1e-3,1e-3,1e-3,1e-4\n2e-3,1e-3,nan,1e-4\n",
          "bad.csv:4: z = 'nan' is not a finite number"},
         {"x,y,z,radius\n1e-3,1e-3,1e-3,-1e-4\n",

@@ -33,7 +33,7 @@ int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size)
     struct wetdem_particle* p = NULL;
     size_t n = 0;
     char err[512] = "";
-    int rc = cli_read_sphere_file(path, &p, &n, err, sizeof err);
+    int rc = cli_read_sphere_file(path, true, &p, &n, err, sizeof err);
     remove(path);
     if (rc != 0 && (!err[0] || p || n))
         abort();
