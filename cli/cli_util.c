@@ -216,6 +216,27 @@ int cli_check_output_path(const char* what, const char* option, const char* path
     return CLI_EXIT_OK;
 }
 
+int cli_check_not_input(const char* what, const char* option, const char* out,
+                        const char* const* in, const char* const* in_names, int n)
+{
+    struct stat so, si;
+    bool out_exists = out && stat(out, &so) == 0;
+    for (int k = 0; out && k < n; k++) {
+        if (!in[k])
+            continue;
+        bool same = out_exists && stat(in[k], &si) == 0
+                        ? so.st_dev == si.st_dev && so.st_ino == si.st_ino && S_ISREG(so.st_mode)
+                        : strcmp(out, in[k]) == 0;
+        if (same) {
+            cli_error("%s: %s %s is also %s: the command would write over it; give another "
+                      "name",
+                      what, option, out, in_names[k]);
+            return CLI_EXIT_USAGE;
+        }
+    }
+    return CLI_EXIT_OK;
+}
+
 /* Where output to `path` goes: *direct when path exists and is not a regular file (a device
  * such as /dev/stdout or /dev/null, a FIFO, a process substitution), which is written in place,
  * never replaced; otherwise the regular file that path names, with a symbolic link followed to

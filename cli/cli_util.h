@@ -103,6 +103,13 @@ int cli_make_dirs(const char* dir);
  * (stdout, no output) passes. Returns CLI_EXIT_OK or CLI_EXIT_USAGE after printing why. */
 int cli_check_output_path(const char* what, const char* option, const char* path, bool is_dir);
 
+/* Checks that output `out` of `option` (NULL passes) names none of the files in[0 .. n), each
+ * named in_names[k] in the message ("FILE", "--data"): the same file (device and inode) when
+ * both exist, the same path otherwise. Writing over an input would destroy it. Returns
+ * CLI_EXIT_OK or CLI_EXIT_USAGE after printing why. */
+int cli_check_not_input(const char* what, const char* option, const char* out,
+                        const char* const* in, const char* const* in_names, int n);
+
 /* Checks that a file can be written at path (NULL passes) before the work that produces it
  * runs: makes its directory when missing and creates, then removes, the temporary file
  * cli_write_output would write. Returns CLI_EXIT_OK, or prints "wetdem: <what>: <option>

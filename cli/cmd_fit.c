@@ -160,7 +160,16 @@ static int parse_args(int argc, char** argv, struct fit_args* a)
         return CLI_EXIT_USAGE;
     }
     int rc = cli_check_output_path("fit", "--out", a->out, false);
-    return rc == CLI_EXIT_OK ? cli_check_output_path("fit", "--curve", a->curve, false) : rc;
+    if (rc == CLI_EXIT_OK)
+        rc = cli_check_output_path("fit", "--curve", a->curve, false);
+    /* neither output may be an input, nor the other output (one would replace the other) */
+    const char* in[3] = {a->file, a->data, a->out};
+    const char* names[3] = {"FILE", "--data", "--out"};
+    if (rc == CLI_EXIT_OK)
+        rc = cli_check_not_input("fit", "--out", a->out, in, names, 2);
+    if (rc == CLI_EXIT_OK)
+        rc = cli_check_not_input("fit", "--curve", a->curve, in, names, 3);
+    return rc;
 }
 
 /* ---- data file ---------------------------------------------------------------------------- */

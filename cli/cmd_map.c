@@ -105,7 +105,10 @@ static int parse_args(int argc, char** argv, struct map_args* a)
         cli_error("map: --param and --param2 are both '%s'", a->key[0]);
         return CLI_EXIT_USAGE;
     }
-    return cli_check_output_path("map", "--out", a->out, false);
+    const char* in[1] = {a->file};
+    const char* names[1] = {"FILE"};
+    int rc = cli_check_output_path("map", "--out", a->out, false);
+    return rc == CLI_EXIT_OK ? cli_check_not_input("map", "--out", a->out, in, names, 1) : rc;
 }
 
 /* The table with the map's trailer. */

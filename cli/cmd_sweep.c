@@ -95,7 +95,10 @@ static int parse_args(int argc, char** argv, struct sweep_args* a)
         usage(stderr);
         return CLI_EXIT_USAGE;
     }
-    return cli_check_output_path("sweep", "--out", a->out, false);
+    const char* in[1] = {a->file};
+    const char* names[1] = {"FILE"};
+    int rc = cli_check_output_path("sweep", "--out", a->out, false);
+    return rc == CLI_EXIT_OK ? cli_check_not_input("sweep", "--out", a->out, in, names, 1) : rc;
 }
 
 /* The table with the sweep's trailer: for the soft engine, the integrator counts summed over

@@ -119,7 +119,9 @@ static int parse_args(int argc, char** argv, struct track_cli* c)
                   missing, usage);
         return CLI_EXIT_USAGE;
     }
-    return CLI_EXIT_OK;
+    const char* in[1] = {c->input};
+    const char* names[1] = {"DOTS.csv"};
+    return cli_check_not_input("track", "--frames", c->frames_path, in, names, 1);
 }
 
 /* What frames_table prints. */

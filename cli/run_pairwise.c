@@ -223,6 +223,8 @@ static int build_config(const struct cli_scenario* sc, struct wetdem_pairwise_co
 {
     static const char* const reads[] = {"engine", "davis", "pairwise", "sphere.*", "output", NULL};
     int rc = cli_scenario_check_read(sc, "the pairwise engine", reads);
+    if (rc == CLI_EXIT_OK)
+        rc = cli_scenario_check_outputs(sc);
     if (rc != CLI_EXIT_OK)
         return rc;
     bool davis = cli_scenario_has_section(sc, "davis");

@@ -196,6 +196,11 @@ int cli_scenario_integrator_name_typo(const struct cli_scenario* sc, const struc
 /* A trajectory of t_end / interval rows [s / s]: CLI_EXIT_OK if at most
  * CLI_MAX_TRAJECTORY_ROWS, else the message at [output] trajectory_interval (or at [output],
  * else at [run_section], when the interval is automatic) and CLI_EXIT_USAGE. */
+/* Checks the [output] names of a collision run: each a plain file name in the --out
+ * directory (no '/', not starting with '.') or none, and no two the same (the one written
+ * last would replace the other). Returns an exit code (message printed). */
+int cli_scenario_check_outputs(const struct cli_scenario* sc);
+
 int cli_scenario_check_trajectory(const struct cli_scenario* sc, const char* run_section,
                                   double t_end, double interval);
 

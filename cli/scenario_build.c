@@ -413,6 +413,34 @@ static void output_name(const struct cli_scenario* sc, const char* key, const ch
     snprintf(out, CLI_VALUE_MAX, "%s", strcmp(v, "none") == 0 ? "" : v);
 }
 
+int cli_scenario_check_outputs(const struct cli_scenario* sc)
+{
+    static const char* const key[3] = {"trajectory", "events", "summary"};
+    static const char* const def[3] = {"trajectory.csv", "events.csv", "summary.json"};
+    const struct cli_entry* e[3];
+    const char* name[3];
+    for (int k = 0; k < 3; k++) {
+        e[k] = cli_scenario_find(sc, "output", key[k]);
+        name[k] = e[k] ? e[k]->value : def[k];
+        if (e[k] && (strchr(name[k], '/') || !name[k][0] || name[k][0] == '.')) {
+            cli_scenario_error(sc, e[k],
+                               "a file name in the --out directory (no '/', not starting with "
+                               "'.'), or none");
+            return CLI_EXIT_USAGE;
+        }
+    }
+    for (int k = 1; k < 3; k++)
+        for (int j = 0; j < k; j++)
+            if (strcmp(name[k], "none") != 0 && strcmp(name[k], name[j]) == 0) {
+                cli_scenario_error(sc, e[k] ? e[k] : e[j],
+                                   "%s would name both the %s and the %s: give the outputs of "
+                                   "--out distinct names",
+                                   name[k], key[j], key[k]);
+                return CLI_EXIT_USAGE;
+            }
+    return CLI_EXIT_OK;
+}
+
 int cli_scenario_check_trajectory(const struct cli_scenario* sc, const char* run_section,
                                   double t_end, double interval)
 {
@@ -458,7 +486,8 @@ int cli_scenario_build(const struct cli_scenario* sc, struct cli_setup* su)
         (rc = build_materials(sc, su, &mi, &mj)) != CLI_EXIT_OK ||
         (rc = build_models(sc, su->sim)) != CLI_EXIT_OK ||
         (rc = build_integrator(sc, su->sim)) != CLI_EXIT_OK ||
-        (rc = build_kinematics(sc, su, &mi, &mj)) != CLI_EXIT_OK) {
+        (rc = build_kinematics(sc, su, &mi, &mj)) != CLI_EXIT_OK ||
+        (rc = cli_scenario_check_outputs(sc)) != CLI_EXIT_OK) {
         cli_setup_free(su);
         return rc;
     }

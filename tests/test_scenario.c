@@ -579,6 +579,33 @@ static void test_scenario_bad_output_paths_exit_2(void** state)
              "fit examples/scenarios/dry_hertz.ini --data '%s' --fit hertz.damping --curve '%s'",
              file, tmpdir);
     expect_run(args, 2, "fit: --curve");
+    /* an output over an input destroyed it (the measured data, the scenario) with exit 0 */
+    const char* data = write_file("meas.csv", "stokes_n,e_n\n2,0.5\n3,0.6\n");
+    snprintf(args, sizeof args,
+             "fit examples/fit/punch_db_c.ini --data '%s' --fit glass.p_gt --out '%s'", data, data);
+    expect_run(args, 2, "is also --data: the command would write over it");
+    snprintf(args, sizeof args,
+             "fit examples/fit/punch_db_c.ini --data '%s' --fit glass.p_gt --out '%s/a.csv' "
+             "--curve '%s/a.csv'",
+             data, tmpdir, tmpdir);
+    expect_run(args, 2, "a.csv is also --out");
+    expect_run("sweep examples/scenarios/dry_hertz.ini --param collision.speed --values 0.5:1:2 "
+               "--out ./examples/scenarios/dry_hertz.ini",
+               2, "sweep: --out ./examples/scenarios/dry_hertz.ini is also FILE");
+    expect_run("track examples/tracks/punch_45deg.csv --fps 5000 --pixel-size 1e-4 --frames "
+               "examples/tracks/punch_45deg.csv",
+               2, "track: --frames examples/tracks/punch_45deg.csv is also DOTS.csv");
+    /* [output] names: a plain name in --out, no two the same (the summary replaced the events
+     * after the run, which then failed with exit 1 and left a mixed set) */
+    snprintf(args, sizeof args,
+             "run examples/scenarios/dry_hertz.ini --set output.summary=events.csv --out '%s/o'",
+             tmpdir);
+    expect_run(args, 2, "events.csv would name both the events and the summary");
+    snprintf(args, sizeof args,
+             "run examples/scenarios/davis_three.ini --set output.trajectory=../up.csv --out "
+             "'%s/o'",
+             tmpdir);
+    expect_run(args, 2, "a file name in the --out directory (no '/', not starting with '.')");
     /* a directory that cannot be made: the pairwise engine reported a result it never
      * computed (a crash) */
     expect_run("run examples/scenarios/davis_three.ini --out /proc/wetdem_no/out", 1,
