@@ -56,8 +56,9 @@ size_t cli_result_fields(const struct cli_setup* su, const struct wetdem_collisi
     out[n++] = num("e_n_observed", "-", "e_n at observe_time after the first interaction",
                    r->e_n_observed);
     out[n++] = num("energy_ratio", "-",
-                   "kinetic energy of the relative motion and spins at the end over that at "
-                   "t = 0 (at most 1; nan with gravity)",
+                   "energy of the relative motion and spins plus that the conservative forces "
+                   "store at the gap (elastic overlap, capillary well), at the end over that at "
+                   "t = 0 (at most 1, < 0 bound in a capillary well; nan with gravity)",
                    r->energy_ratio);
     out[n++] = num("angle_in", "deg",
                    "impact angle to the line of centres at contact of the straight-line approach",
@@ -114,7 +115,7 @@ bool cli_energy_grew(double energy_ratio, char* msg, size_t n)
     if (!(isfinite(energy_ratio) && energy_ratio > 1.01))
         return false;
     snprintf(msg, n,
-             "ends with %.4g times the kinetic energy it began with, which the models cannot "
+             "ends with %.4g times the energy it began with, which the models cannot "
              "give: the integration is too coarse for the contact; with [integrator] name = "
              "verlet halve dt_fraction (or dt), or use name = cvode; with cvode lower rtol and "
              "atol",

@@ -545,9 +545,12 @@ struct wetdem_collision_result {
     bool solid_contact;                  /* gap reached 0 */
     bool hmin_reached;                   /* gap reached h_min */
     bool separated;                      /* left the interaction range by t_end */
-    double energy_ratio;        /* kinetic energy of the relative motion and spins at the end
-                                   over that at the start [-]: at most 1 in the passive models
-                                   (up to the integration error); NAN with gravity */
+    double energy_ratio;        /* energy of the relative motion and spins, plus that stored
+                                   by the conservative forces at the gap (elastic overlap,
+                                   capillary well: docs/engines.md), at the end over that at
+                                   the start [-]: at most 1 in the passive models (up to the
+                                   integration error), < 0 when bound in a capillary well;
+                                   NAN with gravity */
     double rotation_angle;      /* angle the line of centres turned during interaction [rad] */
     double rotation_close;      /* the part of rotation_angle turned after the approach was
                                    first arrested (first minimum of the gap) while the gap was

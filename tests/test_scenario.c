@@ -322,7 +322,7 @@ static void test_scenario_energy_gain_is_an_error(void** state)
     (void)state;
     expect_run("run examples/scenarios/dry_hertz.ini", 0, NULL);
     expect_run("run examples/scenarios/dry_hertz.ini --set integrator.dt_fraction=0.5", 1,
-               "times the kinetic energy it began with, which the models cannot give: the "
+               "times the energy it began with, which the models cannot give: the "
                "integration is too coarse for the contact; with [integrator] name = verlet "
                "halve dt_fraction");
     /* CVODE's tolerances end where such gains end (1e-3 gave 4.2 times on a Nijssen map) */
