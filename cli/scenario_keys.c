@@ -84,7 +84,9 @@ static const struct cli_key_desc fluid_keys[] = {
 static const struct cli_key_desc models_keys[] = {
     WORD("force", CLI_VALUE_NAME_LIST, "hertz", NULL,
          "Force models summed for every pair, separated by spaces or commas, e.g. "
-         "'hertz mindlin nijssen' or 'hertz mindlin db davis capillary' (wetdem models)."),
+         "'nijssen' (its own Hertz-Mindlin contact) or 'hertz mindlin db davis capillary' "
+         "(wetdem models); two laws of one contact force (hertz and hooke, nijssen and "
+         "hertz or mindlin) are refused."),
     WORD("min_separation", CLI_VALUE_NAME, "fixed", NULL,
          "Minimum-separation model giving h_min: fixed, roughness, ehd, max or glass."),
     {0},

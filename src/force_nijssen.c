@@ -198,7 +198,7 @@ const struct wetdem_model wetdem_force_nijssen = {
     .kind = WETDEM_MODEL_FLUID,
     .summary = "immersed lubrication with minimum approach, lever blend into Hertz-Mindlin",
     .doc = "Lubrication model of Nijssen et al. for immersed spheres in unresolved DEM, with "
-           "its own Hertz-Mindlin contact (do not also enable hertz or mindlin). Minimum "
+           "its own Hertz-Mindlin contact (hertz, hooke or mindlin beside it are refused). Minimum "
            "approach h_min = max(h_sigma, h_eps): mean roughness (sigma_i + sigma_j)/2 or the "
            "elastohydrodynamic gap 0.37 R* (mu v0/(E* R*))^(2/5), v0 being the largest "
            "approach speed of this pair since it came within the cut-off (per-pair history, "

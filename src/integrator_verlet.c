@@ -95,8 +95,19 @@ static int choose_step(struct wetdem_sim* sim, const struct verlet_params* p, do
         held = hold < *dt;
         *dt = held ? hold : *dt;
     }
-    if (!(*dt > 0) || !isfinite(*dt))
-        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID, "verlet: step %g s is not usable", *dt);
+    if (!(*dt > 0) || !isfinite(*dt)) {
+        if (p->dt > 0 || !(t_contact > 0) || !isfinite(t_contact))
+            return wetdem_sim_fail(sim, WETDEM_ERR_INVALID, "verlet: step %g s is not usable%s",
+                                   *dt,
+                                   p->dt > 0 ? ""
+                                             : ": the contact time it derives from is not a "
+                                               "positive finite number (check the materials' "
+                                               "youngs_modulus and density, and the radii)");
+        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
+                               "verlet: step %g s is not usable: %g x the contact time %g s "
+                               "(check the materials' youngs_modulus and density, and the radii)",
+                               *dt, p->dt_fraction, t_contact);
+    }
     if (span / *dt > p->max_steps)
         return wetdem_sim_fail(sim, WETDEM_ERR_MAX_STEPS,
                                "verlet: %.3g steps of %.3g s to reach t = %.9g s exceed "

@@ -72,6 +72,35 @@ static int make_slot(struct wetdem_sim* sim, struct wetdem_model_slot* slot,
     return WETDEM_OK;
 }
 
+/* Whether a force model carries a normal solid-contact law: it stores elastic energy (hertz,
+ * hooke, and nijssen's own Hertz contact). */
+static bool has_normal_contact(const struct wetdem_model* m)
+{
+    return m->elastic_energy != NULL;
+}
+
+/* Whether a force model carries a tangential contact law: a contact model without a normal
+ * one (mindlin's spring), or a fluid model with its own contact (nijssen's Hertz-Mindlin). */
+static bool has_tangential_contact(const struct wetdem_model* m)
+{
+    return m->kind == WETDEM_MODEL_CONTACT ? !has_normal_contact(m)
+                                           : m->kind == WETDEM_MODEL_FLUID && has_normal_contact(m);
+}
+
+/* The enabled model that would count one of the contact forces twice beside `model`: a second
+ * normal contact law, or a second tangential one; NULL when none. */
+static const struct wetdem_model* contact_twice(const struct wetdem_sim* sim,
+                                                const struct wetdem_model* model)
+{
+    for (size_t k = 0; k < sim->n_models; k++) {
+        const struct wetdem_model* m = sim->models[k].model;
+        if ((has_normal_contact(m) && has_normal_contact(model)) ||
+            (has_tangential_contact(m) && has_tangential_contact(model)))
+            return m;
+    }
+    return NULL;
+}
+
 int wetdem_sim_add_model(struct wetdem_sim* sim, const struct wetdem_model* model,
                          const void* params)
 {
@@ -94,6 +123,17 @@ int wetdem_sim_add_model(struct wetdem_sim* sim, const struct wetdem_model* mode
         if (strcmp(sim->models[k].model->name, model->name) == 0)
             return wetdem_sim_fail(sim, WETDEM_ERR_INVALID, "model '%s' is already enabled",
                                    model->name);
+    const struct wetdem_model* twice = contact_twice(sim, model);
+    if (twice)
+        return wetdem_sim_fail(
+            sim, WETDEM_ERR_INVALID,
+            "model '%s' and model '%s' both give the %s contact force, which would be counted "
+            "twice; enable one of them%s",
+            model->name, twice->name,
+            has_normal_contact(model) && has_normal_contact(twice) ? "normal" : "tangential",
+            model->kind == WETDEM_MODEL_FLUID || twice->kind == WETDEM_MODEL_FLUID
+                ? " (a fluid model with its own contact replaces hertz and mindlin)"
+                : "");
     if (sim->n_models >= WETDEM_MAX_MODELS)
         return wetdem_sim_fail(sim, WETDEM_ERR_INVALID, "at most %d force models",
                                WETDEM_MAX_MODELS);
