@@ -820,9 +820,6 @@ static int finish(const struct cli_scenario* sc, struct cli_many_setup* su,
                   const struct cli_run_options* opt, const struct plan* pl, struct progress* prog,
                   int st, double wall)
 {
-    struct outcome o = {.wall = wall, .interrupted = st == WETDEM_EVENT};
-    wetdem_sim_many_stats(su->sim, &o.stats);
-    o.has_budget = wetdem_sim_energy_budget(su->sim, &o.budget) == WETDEM_OK;
     if (prog->status != WETDEM_OK) {
         cli_error("run %s: writing a VTK frame: %s", sc->file, prog->vtk->error);
         return CLI_EXIT_RUNTIME;
@@ -831,6 +828,11 @@ static int finish(const struct cli_scenario* sc, struct cli_many_setup* su,
         cli_error("run %s: %s (%s)", sc->file, wetdem_sim_errmsg(su->sim), wetdem_status_name(st));
         return CLI_EXIT_RUNTIME;
     }
+    /* (after the failures: a query refused, as the budget of a run without one, leaves its
+       message in place of theirs) */
+    struct outcome o = {.wall = wall, .interrupted = st == WETDEM_EVENT};
+    wetdem_sim_many_stats(su->sim, &o.stats);
+    o.has_budget = wetdem_sim_energy_budget(su->sim, &o.budget) == WETDEM_OK;
     if (csv_final_row(pl->csv_prefix, su->csv_every, su->sim) != WETDEM_OK) {
         cli_error("run %s: cannot append the last row to %s.csv", sc->file, pl->csv_prefix);
         return CLI_EXIT_RUNTIME;
@@ -957,8 +959,9 @@ static int run(const struct cli_scenario* sc, struct cli_many_setup* su,
                         tmp, &saved);
     double t0 = omp_get_wtime();
     int st = opt->restart ? WETDEM_OK : wetdem_sim_integrate(su->sim, wetdem_sim_time(su->sim));
-    struct wetdem_many_stats s;
-    wetdem_sim_many_stats(su->sim, &s);
+    struct wetdem_many_stats s = {0};
+    if (st == WETDEM_OK) /* (a failed start keeps its message for finish) */
+        wetdem_sim_many_stats(su->sim, &s);
     prog.base_step = s.step;
     bool frame_due = vtk && su->vtk_every && s.step % su->vtk_every == 0 &&
                      !(vtk->n > 0 && vtk->last_step == s.step);

@@ -367,8 +367,11 @@ WETDEM_API size_t wetdem_sim_n_walls(const struct wetdem_sim* sim);
  * model; one impulse model). Enabling a min-separation model replaces the previous one.
  * Returns WETDEM_OK, WETDEM_ERR_NOT_FOUND (message with a suggestion) or WETDEM_ERR_INVALID. */
 WETDEM_API int wetdem_sim_enable_model(struct wetdem_sim* sim, const char* name);
-/* Attaches a custom force model to this simulation only; params (model->params_size bytes)
- * are copied. */
+/* Attaches a custom force model to this simulation only; params (model->params_size bytes;
+ * NULL: the descriptors' defaults) are copied. Checked first: a name, a kind, the hooks the
+ * kind needs (pair for force models, min_separation), a descriptor table (an empty {0} one
+ * without parameters) and every value of params within its descriptor's range. Returns
+ * WETDEM_OK, WETDEM_ERR_INVALID (with a message) or WETDEM_ERR_NOMEM. */
 WETDEM_API int wetdem_sim_add_model(struct wetdem_sim* sim, const struct wetdem_model* model,
                                     const void* params);
 /* Disables every force model and resets the min-separation model to "fixed". */
@@ -564,13 +567,15 @@ struct wetdem_collision_result {
 };
 
 /* Sets up and runs one binary collision on `sim` (its particles are replaced; its materials,
- * fluid, models, integrator and parameters are used). Returns WETDEM_OK or a negative status.
+ * fluid, models, integrator and parameters are used) with the two-body engine: refused
+ * (WETDEM_ERR_INVALID) in the many-particle mode. Returns WETDEM_OK or a negative status.
  * The event log of the run stays available through wetdem_sim_events(). */
 WETDEM_API int wetdem_collision_run(struct wetdem_sim* sim,
                                     const struct wetdem_collision_spec* spec,
                                     struct wetdem_collision_result* result);
 /* Removes all particles and walls, the event log, pair histories and statistics, and sets
- * the time to 0; materials, fluid, models and parameters are kept. */
+ * the time to 0; materials, fluid, models and parameters are kept. In the many-particle mode
+ * the mode and its settings stay, and its state starts afresh (step 0, a new energy budget). */
 WETDEM_API void wetdem_sim_reset(struct wetdem_sim* sim);
 /* Deep copy (materials, fluid, models, parameters, integrator, particles; not the observer).
  * NULL if out of memory. For running independent collisions in parallel. */
@@ -949,7 +954,8 @@ WETDEM_API void wetdem_pairwise_config_init(struct wetdem_pairwise_config* cfg);
  * "spheres 1 and 2 (spheres[0], spheres[1])"). Returns WETDEM_OK or WETDEM_ERR_INVALID. */
 WETDEM_API int wetdem_pairwise_config_validate(const struct wetdem_pairwise_config* cfg, char* msg,
                                                size_t msg_size);
-/* Sets the observer called every `interval` seconds [s] (> 0) of a run; fn NULL removes it. */
+/* Sets the observer called every `interval` seconds [s] of a run; fn NULL removes it. A run
+ * with an observer and an interval that is not finite and > 0 is refused (WETDEM_ERR_INVALID). */
 WETDEM_API void wetdem_pairwise_set_observer(struct wetdem_pairwise* pw, double interval,
                                              wetdem_pairwise_observer_fn fn, void* ctx);
 /* Runs one collision from cfg (copied) and fills *res. Returns WETDEM_OK, or a negative
@@ -1061,8 +1067,9 @@ WETDEM_API void wetdem_track_free(struct wetdem_track* track);
 /* Last detailed error message of this track ("" if none). */
 WETDEM_API const char* wetdem_track_errmsg(const struct wetdem_track* track);
 /* Appends one frame of sphere `sphere_id` (>= 0; at most two spheres): xy = x1,y1,x2,y2,x3,y3
- * [pixel]. Frames of a sphere must follow one another without gaps. Returns WETDEM_OK,
- * WETDEM_ERR_INVALID (NaN, gap, non-increasing frame, third sphere) or WETDEM_ERR_NOMEM. */
+ * [pixel]. Frames of a sphere must follow one another without gaps; |frame| <= 1e12. Returns
+ * WETDEM_OK, WETDEM_ERR_INVALID (NaN, gap, non-increasing or out-of-range frame, third sphere)
+ * or WETDEM_ERR_NOMEM. */
 WETDEM_API int wetdem_track_add_frame(struct wetdem_track* track, int sphere_id, long frame,
                                       const double xy[6]);
 /* Reads a CSV of rows frame,sphere,x1,y1,x2,y2,x3,y3 (optional header, '#' comments) and

@@ -608,6 +608,11 @@ int wetdem_collision_run(struct wetdem_sim* sim, const struct wetdem_collision_s
     if (!sim || !spec || !result)
         return wetdem_sim_fail(sim, WETDEM_ERR_INVALID, "collision: NULL argument");
     memset(result, 0, sizeof *result);
+    if (sim->many) /* (its steps feed no tracker: the result would be that of no collision) */
+        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
+                               "collision: the simulation is in the many-particle mode; a "
+                               "collision is run and analysed by the two-body engine: call "
+                               "wetdem_sim_set_many(sim, NULL) first");
     int st = check_spec(sim, spec);
     struct setup su;
     if (st == WETDEM_OK)

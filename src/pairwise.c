@@ -131,7 +131,7 @@ const char* wetdem_pairwise_errmsg(const struct wetdem_pairwise* pw)
 void wetdem_pairwise_set_observer(struct wetdem_pairwise* pw, double interval,
                                   wetdem_pairwise_observer_fn fn, void* ctx)
 {
-    pw->obs = (interval > 0.0 && isfinite(interval)) ? fn : NULL;
+    pw->obs = fn; /* (an interval it cannot use is refused by the next run) */
     pw->obs_ctx = ctx;
     pw->obs_interval = interval;
 }
@@ -1149,6 +1149,13 @@ int wetdem_pairwise_run(struct wetdem_pairwise* pw, const struct wetdem_pairwise
     int st = wetdem_pairwise_config_validate(cfg, pw->errmsg, sizeof pw->errmsg);
     if (st != WETDEM_OK)
         return st;
+    if (pw->obs && !(pw->obs_interval > 0.0 && isfinite(pw->obs_interval))) {
+        snprintf(pw->errmsg, sizeof pw->errmsg,
+                 "observer interval = %g s must be finite and > 0 (set_observer with fn NULL "
+                 "removes the observer)",
+                 pw->obs_interval);
+        return WETDEM_ERR_INVALID;
+    }
     pw->cfg = *cfg;
     pw->res = res;
     pw->t = 0.0;

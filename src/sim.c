@@ -128,9 +128,13 @@ struct wetdem_fluid wetdem_sim_fluid(const struct wetdem_sim* sim)
     return sim->fluid;
 }
 
-bool wetdem_sim_particle_valid(const struct wetdem_particle* p, char* why, size_t n)
+bool wetdem_sim_particle_valid(const struct wetdem_sim* sim, const struct wetdem_particle* p,
+                               char* why, size_t n)
 {
-    if (!vec3_is_finite(p->pos) || !vec3_is_finite(p->vel) || !vec3_is_finite(p->omega))
+    if (p->material < 0 || p->material >= sim->n_materials)
+        snprintf(why, n, "material %d does not exist (valid 0..%d)", p->material,
+                 sim->n_materials - 1);
+    else if (!vec3_is_finite(p->pos) || !vec3_is_finite(p->vel) || !vec3_is_finite(p->omega))
         snprintf(why, n, "position, velocity and spin must be finite");
     else if (!(isfinite(p->radius) && p->radius > 0))
         snprintf(why, n, "radius must be > 0 and finite, got %g m", p->radius);
@@ -166,7 +170,7 @@ int wetdem_sim_add_particle(struct wetdem_sim* sim, struct wetdem_particle p)
                                    k, p.mass, density, p.radius);
     }
     char why[256];
-    if (!wetdem_sim_particle_valid(&p, why, sizeof why))
+    if (!wetdem_sim_particle_valid(sim, &p, why, sizeof why))
         return wetdem_sim_fail(sim, WETDEM_ERR_INVALID, "particle %zu: %s", k, why);
     if (grow((void**)&sim->particles, &sim->particles_cap, k + 1, sizeof p) != WETDEM_OK)
         return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory adding particle %zu", k);
@@ -234,6 +238,7 @@ void wetdem_sim_reset(struct wetdem_sim* sim)
     sim->n_walls = 0;
     sim->errmsg[0] = '\0';
     wetdem_sim_engine_clear(sim);
+    wetdem_sim_many_reset(sim);
 }
 
 /* Copies n elements of size `size` into a fresh allocation (*dst); NULL source gives NULL. */

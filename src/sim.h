@@ -105,11 +105,13 @@ struct wetdem_sim {
 int wetdem_sim_fail(struct wetdem_sim* sim, int status, const char* fmt, ...)
     __attribute__((format(printf, 3, 4)));
 
-/* Whether particle p is one a simulation can hold: finite position, velocity and spin, radius
- * and mass finite and > 0, a fixed one at rest. If not, why[0 .. n) receives what is wrong,
- * with the value (for wetdem_sim_add_particle, the start of a run and a checkpoint being
- * restored alike). */
-bool wetdem_sim_particle_valid(const struct wetdem_particle* p, char* why, size_t n);
+/* Whether particle p is one simulation sim can hold: a material sim has, finite position,
+ * velocity and spin, radius and mass finite and > 0, a fixed one at rest. If not, why[0 .. n)
+ * receives what is wrong, with the value (for wetdem_sim_add_particle, the start of a run,
+ * wetdem_sim_pair_force and a checkpoint being restored alike: the first two read particles a
+ * caller may have edited through wetdem_sim_particles()). */
+bool wetdem_sim_particle_valid(const struct wetdem_sim* sim, const struct wetdem_particle* p,
+                               char* why, size_t n);
 
 /* Fills c->h_min from the min-separation model, then sums every enabled force model into
  * *out (zeroed first). history: sim->history_len doubles (committed state in, advanced state
@@ -190,6 +192,9 @@ void wetdem_sim_build_contact(const struct wetdem_sim* sim, size_t i, size_t j, 
 
 /* sim_many.c: frees the many-particle state (wetdem_sim_free calls it). */
 void wetdem_sim_many_free(struct wetdem_sim* sim);
+/* sim_many.c: starts the many-particle state afresh with its settings (wetdem_sim_reset calls
+ * it): step 0, no lists, a new energy budget; nothing without the mode. */
+void wetdem_sim_many_reset(struct wetdem_sim* sim);
 /* sim_many.c: runs the many-particle engine to t_end (wetdem_sim_integrate dispatches). */
 int wetdem_sim_many_integrate(struct wetdem_sim* sim, double t_end);
 

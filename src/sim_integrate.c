@@ -358,7 +358,7 @@ static int check_run(struct wetdem_sim* sim, double t_end)
                                sim->history_len, WETDEM_HISTORY_SCRATCH);
     char why[256];
     for (size_t k = 0; k < sim->n_particles; k++)
-        if (!wetdem_sim_particle_valid(&sim->particles[k], why, sizeof why))
+        if (!wetdem_sim_particle_valid(sim, &sim->particles[k], why, sizeof why))
             return wetdem_sim_fail(sim, WETDEM_ERR_INVALID, "particle %zu: %s", k, why);
     return WETDEM_OK;
 }

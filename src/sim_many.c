@@ -156,6 +156,23 @@ int wetdem_sim_set_many(struct wetdem_sim* sim, const struct wetdem_many_setting
     return WETDEM_OK;
 }
 
+void wetdem_sim_many_reset(struct wetdem_sim* sim)
+{
+    if (!sim->many)
+        return;
+    /* set_many frees the state it replaces, the settings' strings with it: copies first */
+    struct wetdem_many_settings s = sim->many->set;
+    char* prefix = dup_string(s.output_prefix);
+    char* checkpoint = dup_string(s.checkpoint_path);
+    s.output_prefix = prefix;
+    s.checkpoint_path = checkpoint;
+    if ((s.output_prefix && !prefix) || (s.checkpoint_path && !checkpoint) ||
+        wetdem_sim_set_many(sim, &s) != WETDEM_OK)
+        wetdem_sim_many_free(sim); /* (out of memory: back to the two-body mode) */
+    free(prefix);
+    free(checkpoint);
+}
+
 /* ---- start-up bounds ---- */
 
 /* Contact of two copies of particle p (materials a, b) at gap `gap`, or of p with a wall. */
@@ -1312,7 +1329,11 @@ int wetdem_sim_energy_budget(const struct wetdem_sim* sim, struct wetdem_energy_
     memset(b, 0, sizeof *b);
     const struct wetdem_many* m = sim->many;
     if (!m || !m->started || !m->set.energy_budget) /* (without it, no work was summed) */
-        return WETDEM_ERR_INVALID;
+        /* the message buffer is the sim's one mutable part for a reader (a heap object) */
+        return wetdem_sim_fail((struct wetdem_sim*)sim, WETDEM_ERR_INVALID, "energy_budget: %s",
+                               !m            ? "the simulation is not in the many-particle mode"
+                               : !m->started ? "the many-particle run has not started"
+                                             : "the run's energy_budget setting is off");
     wetdem_sim_many_energies(sim, &b->kinetic, &b->potential, &b->elastic);
     b->input = m->energy.k0 + m->energy.u0 + m->energy.el0;
     double work = 0;

@@ -163,8 +163,10 @@ int wetdem_sim_many_stats(const struct wetdem_sim* sim, struct wetdem_many_stats
 {
     memset(s, 0, sizeof *s);
     const struct wetdem_many* m = sim->many;
-    if (!m || !m->started)
-        return WETDEM_ERR_INVALID;
+    if (!m || !m->started) /* (the message buffer: as wetdem_sim_energy_budget) */
+        return wetdem_sim_fail((struct wetdem_sim*)sim, WETDEM_ERR_INVALID, "many_stats: %s",
+                               !m ? "the simulation is not in the many-particle mode"
+                                  : "the many-particle run has not started");
     int st = wetdem_sim_many_links(sim, NULL, s);
     if (st == WETDEM_OK)
         fill_run_stats(sim, s);
@@ -782,7 +784,7 @@ static int check_restorable(struct wetdem_sim* sim, const struct wetdem_checkpoi
                                    "checkpoint '%s': particle %zu has material %d", path, k,
                                    p->material);
         char why[256]; /* what wetdem_sim_add_particle accepts */
-        if (!wetdem_sim_particle_valid(p, why, sizeof why))
+        if (!wetdem_sim_particle_valid(sim, p, why, sizeof why))
             return wetdem_sim_fail(sim, WETDEM_ERR_PARSE, "checkpoint '%s': particle %zu: %s", path,
                                    k, why);
     }

@@ -101,9 +101,49 @@ static const struct wetdem_model* contact_twice(const struct wetdem_sim* sim,
     return NULL;
 }
 
+/* Whether `model` is one the engines can call, and params (NULL: the defaults) within its
+ * descriptors' ranges; the message goes to sim. */
+static int check_model(struct wetdem_sim* sim, const struct wetdem_model* model, const void* params)
+{
+    if (!model || !model->name || !model->name[0])
+        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID, "add_model: a model needs a name");
+    if (model->kind < WETDEM_MODEL_CONTACT || model->kind > WETDEM_MODEL_IMPULSE)
+        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
+                               "model '%s': kind %d is none of contact, fluid, min-separation "
+                               "and impulse",
+                               model->name, (int)model->kind);
+    if (model->kind == WETDEM_MODEL_MIN_SEPARATION && !model->min_separation)
+        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
+                               "model '%s': a min-separation model needs its min_separation hook",
+                               model->name);
+    if (!model->params)
+        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
+                               "model '%s': params must be a {0}-terminated descriptor table (an "
+                               "empty one for a model without parameters)",
+                               model->name);
+    for (const struct wetdem_param_desc* d = model->params; d->name; d++) {
+        if (d->offset + sizeof(double) > model->params_size)
+            return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
+                                   "model '%s': parameter %s at offset %zu lies beyond params_size "
+                                   "%zu",
+                                   model->name, d->name, d->offset, model->params_size);
+        if (!params)
+            continue;
+        double value;
+        memcpy(&value, (const char*)params + d->offset, sizeof value);
+        char msg[256];
+        if (wetdem_param_validate(d, value, msg, sizeof msg) != WETDEM_OK)
+            return wetdem_sim_fail(sim, WETDEM_ERR_INVALID, "model '%s': %s", model->name, msg);
+    }
+    return WETDEM_OK;
+}
+
 int wetdem_sim_add_model(struct wetdem_sim* sim, const struct wetdem_model* model,
                          const void* params)
 {
+    int checked = check_model(sim, model, params);
+    if (checked != WETDEM_OK)
+        return checked;
     if (model->kind == WETDEM_MODEL_MIN_SEPARATION) {
         struct wetdem_model_slot slot;
         int st = make_slot(sim, &slot, model, params);
@@ -621,6 +661,13 @@ int wetdem_sim_pair_force(struct wetdem_sim* sim, size_t i, size_t j, struct wet
                                "pair (%zu, %zu): indices must address two different particles "
                                "(0..%zu) or a wall",
                                i, j, sim->n_particles);
+    /* the particles may have been edited through wetdem_sim_particles() since they were added */
+    char why[256];
+    for (int side = 0; side < 2 - is_wall; side++)
+        if (!wetdem_sim_particle_valid(sim, &sim->particles[side ? j : i], why, sizeof why))
+            return wetdem_sim_fail(sim, WETDEM_ERR_INVALID, "particle %zu: %s", side ? j : i, why);
+    if (!out)
+        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID, "pair_force: out is NULL");
     struct wetdem_contact local;
     struct wetdem_contact* cc = c ? c : &local;
     wetdem_sim_build_contact(sim, i, is_wall ? (size_t)-1 - j : j, is_wall, cc);

@@ -46,6 +46,7 @@
 
 #include "track.h"
 
+#define TRACK_MAX_FRAME 1000000000000L /* |frame number| at most [-] */
 #define TRACK_MAX_SPHERES 2
 #define TRACK_ERRMSG_SIZE 512
 #define TRACK_LINE_MAX 4096
@@ -153,6 +154,10 @@ int wetdem_track_add_frame(struct wetdem_track* track, int sphere_id, long frame
 {
     if (sphere_id < 0)
         return fail(track, WETDEM_ERR_INVALID, "sphere id %d must be >= 0", sphere_id);
+    /* (a bound far beyond any video keeps first_frame + n, below, from overflowing) */
+    if (frame < -TRACK_MAX_FRAME || frame > TRACK_MAX_FRAME)
+        return fail(track, WETDEM_ERR_INVALID, "sphere %d: frame %ld is out of range [%ld, %ld]",
+                    sphere_id, frame, -TRACK_MAX_FRAME, TRACK_MAX_FRAME);
     for (int c = 0; c < 6; c++)
         if (!isfinite(xy[c]))
             return fail(track, WETDEM_ERR_INVALID, "sphere %d frame %ld: %s is not finite (%g)",

@@ -879,6 +879,41 @@ static void test_contact_laws_are_not_counted_twice(void** state)
     }
 }
 
+/* wetdem_sim_add_model checks what it is given, as wetdem_sim_set_param checks a value: a
+ * parameter out of its range or NaN, a model without a kind, a min-separation model without
+ * its hook (the next force evaluation called NULL), a model without a descriptor table (a
+ * later misspelt parameter name read it) were all accepted. */
+static void test_add_model_checks_the_model_and_its_params(void** state)
+{
+    (void)state;
+    const struct wetdem_model* hertz = wetdem_model_find("hertz");
+    double params[16];
+    assert_true(hertz->params_size <= sizeof params);
+    wetdem_param_init_defaults(hertz->params, params);
+    struct wetdem_sim* sim = wetdem_sim_create();
+    const struct wetdem_param_desc* d = &hertz->params[0];
+    double good = params[d->offset / sizeof(double)];
+    params[d->offset / sizeof(double)] = NAN;
+    assert_int_equal(wetdem_sim_add_model(sim, hertz, params), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(wetdem_sim_errmsg(sim), d->name);
+    params[d->offset / sizeof(double)] = good;
+    struct wetdem_model copy = *hertz;
+    copy.name = "my_hertz";
+    copy.kind = 0;
+    assert_int_equal(wetdem_sim_add_model(sim, &copy, params), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(wetdem_sim_errmsg(sim), "kind 0");
+    copy.kind = WETDEM_MODEL_MIN_SEPARATION;
+    assert_int_equal(wetdem_sim_add_model(sim, &copy, NULL), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(wetdem_sim_errmsg(sim), "needs its min_separation hook");
+    copy.kind = WETDEM_MODEL_CONTACT;
+    copy.params = NULL;
+    assert_int_equal(wetdem_sim_add_model(sim, &copy, NULL), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(wetdem_sim_errmsg(sim), "descriptor table");
+    assert_int_equal(wetdem_sim_n_models(sim), 0);
+    CHECK_OK(wetdem_sim_add_model(sim, hertz, params));
+    wetdem_sim_free(sim);
+}
+
 int main(int argc, char** argv)
 {
     if (argc > 1 && strcmp(argv[1], "--regen-hertz-table") == 0) {
@@ -910,6 +945,7 @@ int main(int argc, char** argv)
         cmocka_unit_test(test_hooke_collision_recovers_e_and_contact_time),
         cmocka_unit_test(test_contact_model_objects_are_documented),
         cmocka_unit_test(test_contact_laws_are_not_counted_twice),
+        cmocka_unit_test(test_add_model_checks_the_model_and_its_params),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -122,6 +122,18 @@ static int failing_model(const double* p, double* out, char* msg, size_t n, void
     return WETDEM_ERR_INVALID;
 }
 
+/* A model returning a status of the success class (> 0): the fit returned it as its own,
+ * with an empty result and no message. */
+static int positive_model(const double* p, double* out, char* msg, size_t n, void* ctx)
+{
+    (void)p;
+    (void)out;
+    (void)msg;
+    (void)n;
+    (void)ctx;
+    return 5;
+}
+
 static void test_fit_rejects_bad_problems(void** state)
 {
     (void)state;
@@ -137,6 +149,10 @@ static void test_fit_rejects_bad_problems(void** state)
     pb.n_data = 2;
     CHECK_STATUS(wetdem_fit_run(&pb, &o, &r, NULL, msg, sizeof msg), WETDEM_ERR_INVALID);
     CHECK_CONTAINS(msg, "model broke at 1");
+    pb.model = positive_model;
+    CHECK_STATUS(wetdem_fit_run(&pb, &o, &r, NULL, msg, sizeof msg), WETDEM_ERR_CALLBACK);
+    CHECK_CONTAINS(msg, "the model returned 5");
+    pb.model = failing_model;
     const double neg[1] = {-1.0};
     const bool log_flag[1] = {true};
     pb.initial = neg;

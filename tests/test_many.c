@@ -1847,6 +1847,53 @@ static void test_many_rejects_bad_settings(void** state)
     wetdem_sim_free(sim);
 }
 
+/* Misuse of the API that read memory out of bounds or gave wrong results with WETDEM_OK:
+ * a material index edited through the writable particle view (the start of a call and
+ * wetdem_sim_pair_force checked position, speed and radius, not the material: a heap read
+ * past the materials), a collision run in the many-particle mode (no tracker: "stick" with
+ * e = 0), and a reset in that mode (it kept the step count: the next call's clock ran on from
+ * the old run's, 1.5e-3 s after a run to 5e-4 s). */
+static void test_many_api_misuse_is_refused(void** state)
+{
+    (void)state;
+    struct wetdem_sim* sim = wet_box(20, true);
+    CHECK_OK(wetdem_sim_integrate(sim, 1e-4));
+    struct wetdem_particle* p = wetdem_sim_particles(sim, NULL);
+    p[3].material = 9;
+    assert_int_equal(wetdem_sim_integrate(sim, 2e-4), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(wetdem_sim_errmsg(sim), "particle 3: material 9 does not exist (valid 0..0)");
+    struct wetdem_pair_force f;
+    assert_int_equal(wetdem_sim_pair_force(sim, 3, 4, NULL, &f), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(wetdem_sim_errmsg(sim), "material 9 does not exist");
+    p[3].material = 0;
+    p[4].pos.x = NAN;
+    assert_int_equal(wetdem_sim_pair_force(sim, 3, 4, NULL, &f), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(wetdem_sim_errmsg(sim),
+                   "particle 4: position, velocity and spin must be finite");
+    p[4].pos.x = 1e-3;
+    /* the queries say why they refuse */
+    struct wetdem_sim* two = wetdem_sim_create();
+    struct wetdem_many_stats st;
+    assert_int_equal(wetdem_sim_many_stats(two, &st), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(wetdem_sim_errmsg(two), "not in the many-particle mode");
+    wetdem_sim_free(two);
+    /* a collision is the two-body engine's */
+    struct wetdem_collision_spec spec = {
+        .radius_i = 1e-3, .radius_j = 1e-3, .speed = 0.1, .t_end = 1e-3};
+    struct wetdem_collision_result r;
+    assert_int_equal(wetdem_collision_run(sim, &spec, &r), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(wetdem_sim_errmsg(sim), "many-particle mode");
+    /* a reset starts the mode's state afresh: time and step from 0 */
+    wetdem_sim_reset(sim);
+    CHECK_OK(wetdem_sim_add_particle(
+        sim, (struct wetdem_particle){.pos = {4e-3, 4e-3, 6e-3}, .radius = 0.4e-3}));
+    CHECK_OK(wetdem_sim_integrate(sim, 5e-4));
+    CHECK_OK(wetdem_sim_many_stats(sim, &st));
+    assert_true(fabs(wetdem_sim_time(sim) - 5e-4) <= st.dt);
+    assert_int_equal(st.step, (unsigned long long)llround(wetdem_sim_time(sim) / st.dt));
+    wetdem_sim_free(sim);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -1868,6 +1915,7 @@ int main(void)
         cmocka_unit_test(test_many_fixed_spheres_meet_neither_each_other_nor_walls),
         cmocka_unit_test(test_many_freeing_a_fixed_sphere_between_calls),
         cmocka_unit_test(test_many_step_resolves_hmin),
+        cmocka_unit_test(test_many_api_misuse_is_refused),
         cmocka_unit_test(test_many_step_resolves_the_tangential_spring),
         cmocka_unit_test(test_many_divergence_stops_the_run),
         cmocka_unit_test(test_many_nan_velocity_stops_the_run),

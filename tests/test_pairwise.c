@@ -1265,6 +1265,15 @@ static void test_pairwise_observer_frames(void** state)
     assert_true(acc[1] == 0.0);
     CHECK_REL(acc[2], c.t_end, 1e-15);
     CHECK_REL(acc[3], r.v_10 / (4.0 * r.a_ref), 1e-14);
+    /* an interval it cannot use dropped the observer and ran without it */
+    const double bad[3] = {0.0, -1.0, NAN};
+    for (int k = 0; k < 3; k++) {
+        wetdem_pairwise_set_observer(pw, bad[k], count_frames, acc);
+        assert_int_equal(wetdem_pairwise_run(pw, &c, &r), WETDEM_ERR_INVALID);
+        CHECK_CONTAINS(wetdem_pairwise_errmsg(pw), "observer interval");
+    }
+    wetdem_pairwise_set_observer(pw, 0.0, NULL, NULL);
+    CHECK_OK(wetdem_pairwise_run(pw, &c, &r));
     wetdem_pairwise_free(pw);
 }
 

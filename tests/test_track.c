@@ -14,6 +14,7 @@
  * (Punch set-up, soft engine, contact-bounce at 30 and 45 deg) and compares the tracked
  * values with the simulation's, within the propagated noise plus the method's biases.
  */
+#include <limits.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
@@ -703,6 +704,9 @@ static void test_track_rejects_short_or_mismatched_tracks(void** state)
     o.window = 4;
     CHECK_STATUS(wetdem_track_analyse(t, &o, &s), WETDEM_ERR_INVALID);
     CHECK_CONTAINS(wetdem_track_errmsg(t), "window = 4");
+    /* a frame number near LONG_MAX overflowed first_frame + n (undefined behaviour) */
+    CHECK_STATUS(wetdem_track_add_frame(t, 1, LONG_MAX, xy), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(wetdem_track_errmsg(t), "is out of range [-1000000000000, 1000000000000]");
     o.window = 7;
     o.pixel_size = 1e300; /* (it made the first frames' speeds look like the collision) */
     CHECK_STATUS(wetdem_track_analyse(t, &o, &s), WETDEM_ERR_INVALID);

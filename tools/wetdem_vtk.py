@@ -48,7 +48,9 @@ def read_vtk(path):
             dtype = ">f8" if kind == "double" else ">i4"
             a = np.frombuffer(data, dtype, count, at)
             at += a.nbytes + 1  # the data, then its newline
-            return a
+            # native float64 / int64, writable, as the ASCII branch gives (frombuffer's view is
+            # big-endian and read-only: an in-place edit raised "output array is read-only")
+            return a.astype(float if kind == "double" else int)
         got = []
         while len(got) < count:
             got += line()
