@@ -234,9 +234,8 @@ static int check_keys(const struct cli_batch* b)
     static const char* const options[CLI_BATCH_MAX_KEYS] = {"--param", "--param2"};
     char full[CLI_BATCH_MAX_KEYS][2 * CLI_NAME_MAX + 2];
     for (int d = 0; d < b->n_keys; d++) {
-        char probe[CLI_VALUE_MAX], section[CLI_NAME_MAX], key[CLI_NAME_MAX];
-        snprintf(probe, sizeof probe, "%s=0", b->key[d]);
-        if (cli_override_split(probe, section, key, NULL) != 0)
+        char section[CLI_NAME_MAX], key[CLI_NAME_MAX];
+        if (cli_key_split(options[d], b->key[d], section, key) != 0)
             return CLI_EXIT_USAGE;
         snprintf(full[d], sizeof full[d], "%s.%s", section, key);
     }

@@ -108,7 +108,8 @@ int cli_parse_range(const char* text, bool is_log, const char* what, struct cli_
         return CLI_EXIT_USAGE;
     }
     if (is_log && !(r->first > 0 && r->last > 0)) {
-        cli_error("%s: '%s' with --log needs A > 0 and B > 0", what, text);
+        cli_error("%s: '%s' with %s needs A > 0 and B > 0", what, text,
+                  strcmp(what, "--values2") == 0 ? "--log2" : "--log");
         return CLI_EXIT_USAGE;
     }
     return CLI_EXIT_OK;

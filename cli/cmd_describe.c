@@ -6,6 +6,7 @@
  * simulation settings) or "presets" (the material presets and their values). An unknown NAME gets a "did you mean" hint and exit code 2.
  * Everything printed comes from the library's descriptor tables.
  */
+#include <ctype.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -111,7 +112,12 @@ static int unknown_name(const char* name)
     for (size_t k = 0; special_names[k]; k++)
         names[n++] = special_names[k];
     names[n] = NULL;
-    const char* hint = wetdem_param_suggest(name, names);
+    char lower[64]; /* the names are lower case: NIJSSEN is nijssen */
+    size_t len = 0;
+    for (; name[len] && len + 1 < sizeof lower; len++)
+        lower[len] = (char)tolower((unsigned char)name[len]);
+    lower[len] = '\0';
+    const char* hint = wetdem_param_suggest(lower, names);
     cli_error("describe: unknown name '%s'%s%s%s; valid: a model name (see 'wetdem models'), "
               "an integrator (verlet, cvode), material, fluid, sim or presets",
               name, hint ? " (did you mean '" : "", hint ? hint : "", hint ? "'?)" : "");

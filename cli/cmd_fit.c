@@ -131,9 +131,13 @@ static int parse_args(int argc, char** argv, struct fit_args* a)
                 cli_error("fit: --omega-scale %s: must be > 0 [rad/s]", v);
                 rc = CLI_EXIT_USAGE;
             }
-        } else if (strcmp(s, "--fd-step") == 0)
+        } else if (strcmp(s, "--fd-step") == 0) {
             rc = cli_parse_double(v, s, &a->fd_step);
-        else if (strcmp(s, "--max-iter") == 0 || strcmp(s, "--curve-points") == 0) {
+            if (rc == CLI_EXIT_OK && !(a->fd_step > 0 && a->fd_step < 1)) {
+                cli_error("fit: --fd-step %s: must be in (0, 1) (a relative step)", v);
+                rc = CLI_EXIT_USAGE;
+            }
+        } else if (strcmp(s, "--max-iter") == 0 || strcmp(s, "--curve-points") == 0) {
             if ((rc = cli_parse_double(v, s, &x)) == CLI_EXIT_OK &&
                 (x != floor(x) || x < 1 || x > 100000)) {
                 cli_error("fit: %s %s: must be an integer in [1, 100000]", s, v);
@@ -545,6 +549,11 @@ static int parse_keys(const char* list, struct fit_ctx* c)
 {
     char buf[1024];
     snprintf(buf, sizeof buf, "%s", list);
+    size_t len = strlen(buf);
+    if (!len || buf[0] == ',' || buf[len - 1] == ',' || strstr(buf, ",,")) {
+        cli_error("fit: --fit '%s': an empty key (the keys are separated by single commas)", list);
+        return CLI_EXIT_USAGE;
+    }
     const char* given[WETDEM_FIT_MAX_PARAMS];
     c->n_keys = 0;
     for (char* tok = strtok(buf, ","); tok; tok = strtok(NULL, ",")) {
@@ -552,9 +561,8 @@ static int parse_keys(const char* list, struct fit_ctx* c)
             cli_error("fit: --fit: at most %d parameters", WETDEM_FIT_MAX_PARAMS);
             return CLI_EXIT_USAGE;
         }
-        char probe[CLI_NAME_MAX * 2 + 4], section[CLI_NAME_MAX], key[CLI_NAME_MAX];
-        snprintf(probe, sizeof probe, "%s=0", tok);
-        if (cli_override_split(probe, section, key, NULL) != 0 ||
+        char section[CLI_NAME_MAX], key[CLI_NAME_MAX];
+        if (cli_key_split("--fit", tok, section, key) != 0 ||
             check_key(tok, section, key) != CLI_EXIT_OK)
             return CLI_EXIT_USAGE;
         char* full = c->keys[c->n_keys];
@@ -1039,6 +1047,12 @@ int cmd_fit(int argc, char** argv)
     if (rc == CLI_EXIT_OK && (rc = cli_scenario_engine(&sc, &engine)) == CLI_EXIT_OK &&
         engine != CLI_ENGINE_SOFT) {
         cli_error("fit: %s: only the soft engine can be fitted ([engine] type = soft)", a.file);
+        rc = CLI_EXIT_USAGE;
+    }
+    if (rc == CLI_EXIT_OK && cli_scenario_is_many && cli_scenario_is_many(&sc)) {
+        cli_error("fit: %s is a many-particle scenario; fit calibrates binary collisions "
+                  "([collision]: docs/calibration.md)",
+                  a.file);
         rc = CLI_EXIT_USAGE;
     }
     if (rc == CLI_EXIT_OK)

@@ -652,22 +652,26 @@ int cli_scenario_load(const char* path, struct cli_scenario* sc)
 
 /* ---- overrides ---- */
 
-/* Splits "a.b.c=value" into section "a.b", key "c" and value; a leading model name
- * "nijssen.x" becomes section "model.nijssen". Returns 0 or -1 (message printed). */
-int cli_override_split(const char* text, char* section, char* key, char* value)
+/* cli_override_split, with the messages naming `option`: "--set" for "a.b.c=value", or the
+ * option that gave a key alone ("--param": text is "a.b.c=0", shown without its "=0"). */
+static int split_key_value(const char* option, const char* text, char* section, char* key,
+                           char* value)
 {
+    bool set = strcmp(option, "--set") == 0;
     const char* eq = strchr(text, '=');
     const char* dot = NULL;
     for (const char* p = text; eq && p < eq; p++)
         if (*p == '.')
             dot = p;
+    int shown = set || !eq ? (int)strlen(text) : (int)(eq - text);
     if (!eq || !dot || dot == text || dot + 1 == eq) {
-        cli_error("--set '%s': expected section.key=value, e.g. --set collision.stokes=50", text);
+        cli_error("%s '%.*s': expected section.key%s, e.g. %s collision.stokes%s", option, shown,
+                  text, set ? "=value" : "", option, set ? "=50" : "");
         return -1;
     }
     size_t slen = (size_t)(dot - text), klen = (size_t)(eq - dot - 1);
     if (slen >= CLI_NAME_MAX - 6 || klen >= CLI_NAME_MAX || strlen(eq + 1) >= CLI_VALUE_MAX - 1) {
-        cli_error("--set '%.60s...': section, key or value too long", text);
+        cli_error("%s '%.60s...': section, key or value too long", option, text);
         return -1;
     }
     memcpy(section, text, slen);
@@ -698,6 +702,18 @@ static const struct {
                       {"sphere.", "a sphere"},
                       {"insert.", "an insertion"},
                       {"read.", "a read of a file"}};
+
+int cli_override_split(const char* text, char* section, char* key, char* value)
+{
+    return split_key_value("--set", text, section, key, value);
+}
+
+int cli_key_split(const char* option, const char* name, char* section, char* key)
+{
+    char probe[CLI_VALUE_MAX];
+    snprintf(probe, sizeof probe, "%s=0", name);
+    return split_key_value(option, probe, section, key, NULL);
+}
 
 /* A --set of a named section the file does not define ([material.NAME], [particle.NAME],
  * [sphere.NAME], [insert.NAME], [read.NAME]) would add an entry that no section reads (a
@@ -778,6 +794,25 @@ int cli_scenario_override(struct cli_scenario* sc, const char* key_value)
 
 /* ---- shared by run, sweep and fit ---- */
 
+/* Warns (once a command) about a [material.NAME] named after a preset without preset = NAME:
+ * a striker = NAME then takes the section, whose fields start from the field defaults, not
+ * from the preset's (delrin's section with only a roughness ran at steel's density). */
+static void warn_shadowed_presets(const struct cli_scenario* sc)
+{
+    for (size_t k = 0; k < sc->n_sections; k++) {
+        const char* name = sc->sections[k].name;
+        struct wetdem_material m;
+        if (strncmp(name, "material.", 9) != 0 ||
+            wetdem_material_preset(name + 9, &m) != WETDEM_OK ||
+            cli_scenario_find(sc, name, "preset"))
+            continue;
+        cli_error("warning: %s:%d: [%s] has the name of a preset but no 'preset = %s': its "
+                  "fields not given start from the field defaults (docs/scenarios.md), not from "
+                  "the preset's; add the line to start from it",
+                  sc->file, sc->sections[k].line, name, name + 9);
+    }
+}
+
 /* Loads the file and applies the overrides. */
 int cli_load_with_overrides(const char* file, const char* const* sets, int n_sets,
                             struct cli_scenario* sc)
@@ -791,5 +826,7 @@ int cli_load_with_overrides(const char* file, const char* const* sets, int n_set
                   file);
         rc = CLI_EXIT_USAGE;
     }
+    if (rc == CLI_EXIT_OK)
+        warn_shadowed_presets(sc);
     return rc;
 }

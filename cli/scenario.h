@@ -256,6 +256,9 @@ const char* cli_scenario_key_unit(const char* section, const char* key);
 /* Splits an override "a.b.key=value" into section and key (a model name "nijssen" becomes
  * "model.nijssen"). 0, or -1 with a message printed. value may be NULL. */
 int cli_override_split(const char* text, char* section, char* key, char* value);
+/* The same for a key given alone by `option` ("--param", "--fit"): "a.b.c" into section and
+ * key; the message names the option. Returns 0 or -1 (message printed). */
+int cli_key_split(const char* option, const char* name, char* section, char* key);
 
 /* ---- shared by run, sweep and fit ---- */
 

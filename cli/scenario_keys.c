@@ -288,6 +288,10 @@ void cli_section_suggestion(const char* name, char* msg, size_t n)
         char prefix[64];
         snprintf(prefix, sizeof prefix, "%.*s", (int)(dot - name), name);
         const char* hint = wetdem_param_suggest(prefix, fam);
+        if (hint && strcmp(hint, prefix) == 0) { /* the family is right: its NAME is not */
+            snprintf(msg, n, ": '%s' is not a NAME (letters, digits, '_' and '-')", dot + 1);
+            return;
+        }
         if (hint) {
             snprintf(msg, n, " (did you mean [%s%s]?)", hint, dot);
             return;

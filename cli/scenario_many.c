@@ -945,8 +945,32 @@ static int build_run(const struct cli_scenario* sc, struct cli_many_setup* su)
     return dump_names_distinct(sc, su);
 }
 
+/* The entry of a key the library's start-up message names (reset_ratio or h_min of a
+ * [model.NAME], [run] skin), when the scenario gives it; NULL otherwise. */
+static const struct cli_entry* named_entry(const struct cli_scenario* sc, const char* msg)
+{
+    static const char* const keys[] = {"reset_ratio", "h_min", "skin"};
+    for (int k = 0; k < 3; k++) {
+        if (!strstr(msg, keys[k]))
+            continue;
+        for (size_t q = 0; q < sc->n_entries; q++) {
+            const struct cli_entry* e = &sc->entries[q];
+            bool section =
+                k == 2 ? strcmp(e->section, "run") == 0 : strncmp(e->section, "model.", 6) == 0;
+            if (section && strcmp(e->key, keys[k]) == 0)
+                return e;
+        }
+    }
+    return NULL;
+}
+
 int cli_many_report_start(const struct cli_scenario* sc, const char* msg)
 {
+    const struct cli_entry* e = named_entry(sc, msg);
+    if (e) {
+        cli_scenario_error(sc, e, "%s", msg);
+        return CLI_EXIT_USAGE;
+    }
     bool box = strstr(msg, "periodic") || strstr(msg, "box") || strstr(msg, "cell");
     cli_scenario_section_error(sc, box ? "box" : "run", "%s", msg);
     return CLI_EXIT_USAGE;

@@ -364,8 +364,11 @@ static int run_loop(struct wetdem_sim* sim, struct run* r, struct solver* s,
         if (steps > p->max_steps)
             return wetdem_sim_fail(sim, WETDEM_ERR_MAX_STEPS,
                                    "cvode: cvode.max_steps = %.3g steps taken before t = %.9g s "
-                                   "(now at %.9g s)",
-                                   p->max_steps, t_end, sim->engine.time);
+                                   "(now at %.9g s); raise it, or for pairs slower than "
+                                   "sim.speed_floor = %g m/s, whose time and length scales bound "
+                                   "the steps, lower that",
+                                   p->max_steps, t_end, sim->engine.time,
+                                   sim->settings.speed_floor);
         if (!bdf && p->method == METHOD_AUTO && quiet > p->stiff_steps) {
             int st = switch_to_bdf(sim, r, s, p, t_end);
             if (st != WETDEM_OK)

@@ -310,6 +310,63 @@ static void test_cli_bad_options_get_hints(void** state)
     check_cli_cases(cases, sizeof cases / sizeof cases[0]);
 }
 
+/* Messages that named the wrong thing: a --param without its section called "--set 'stokes=0'"
+ * (an option the user never typed, a value from nowhere), --log2 called --log, a NAME with a
+ * dot was suggested as itself, an upper-case model got no hint, --fd-step 0 came back as the
+ * library's list of five options, an empty --fit key was skipped, a many-particle scenario
+ * fitted blamed a data point, a contact counted twice ran, a preset's name on a section
+ * without its preset ran at the field defaults unsaid. */
+static void test_cli_messages_name_what_is_wrong(void** state)
+{
+    (void)state;
+    const char* head = "examples/scenarios/nijssen_head_on.ini";
+    char args[10][400];
+    snprintf(args[0], 400, "sweep %s --param stokes --values 10:20:2", head);
+    snprintf(args[1], 400,
+             "map %s --param collision.stokes --values 10:20:2 --param2 collision.angle_deg "
+             "--values2 0:80:2 --log2",
+             head);
+    snprintf(args[2], 400, "fit %s --data examples/fit/punch_0deg.csv --fit glass.p_gt --fd-step 0",
+             "examples/fit/punch_db_c.ini");
+    snprintf(args[3], 400, "fit %s --data examples/fit/punch_0deg.csv --fit glass.p_gt,",
+             "examples/fit/punch_db_c.ini");
+    snprintf(args[4], 400,
+             "fit examples/scenarios/many_settling.ini --data examples/fit/punch_0deg.csv --fit "
+             "glass.p_gt");
+    snprintf(args[5], 400, "run %s --check --set 'models.force=nijssen hertz'", head);
+    const struct cli_case cases[] = {
+        {args[0], "--param 'stokes': expected section.key, e.g. --param collision.stokes", 2},
+        {args[1], "'0:80:2' with --log2 needs A > 0", 2},
+        {args[2], "fit: --fd-step 0: must be in (0, 1)", 2},
+        {args[3], "--fit 'glass.p_gt,': an empty key", 2},
+        {args[4], "is a many-particle scenario; fit calibrates binary collisions", 2},
+        {args[5], "model 'hertz' and model 'nijssen' both give the normal contact force", 2},
+        {"describe NIJSSEN", "(did you mean 'nijssen'?)", 2},
+    };
+    check_cli_cases(cases, sizeof cases / sizeof cases[0]);
+    const char* dir = getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp";
+    char path[300], cmd[400];
+    snprintf(path, sizeof path, "%s/wetdem_cli_names_%d.ini", dir, (int)getpid());
+    const char* text[2] = {"[collision]\nstriker = delrin\nspeed = 0.5\n[material.delrin]\n"
+                           "roughness = 1e-7\n[models]\nforce = hertz\n",
+                           "[collision]\nstriker = a\nspeed = 0.5\n[material.a.b]\n"
+                           "preset = glass\n[models]\nforce = hertz\n"};
+    const char* want[2] = {"[material.delrin] has the name of a preset but no 'preset = delrin'",
+                           "unknown section [material.a.b]: 'a.b' is not a NAME"};
+    for (int k = 0; k < 2; k++) {
+        FILE* f = fopen(path, "w");
+        assert_non_null(f);
+        fputs(text[k], f);
+        fclose(f);
+        snprintf(cmd, sizeof cmd, "run %s --check", path);
+        struct test_run r = run_cli(cmd, true);
+        assert_int_equal(r.code, k ? 2 : 0); /* (the first a warning) */
+        CHECK_CONTAINS(r.out, want[k]);
+        free(r.out);
+    }
+    remove(path);
+}
+
 /* Models chosen where they do not belong are named with their kind ("an impulse model"); a
  * minimum-separation slot holding a force model is refused in both engines (the many-particle
  * one summed it as a force). */
@@ -435,6 +492,7 @@ int main(void)
         cmocka_unit_test(test_cli_forces_bad_input),
         cmocka_unit_test(test_cli_bad_options_get_hints),
         cmocka_unit_test(test_cli_model_of_the_wrong_kind),
+        cmocka_unit_test(test_cli_messages_name_what_is_wrong),
         cmocka_unit_test(test_cli_unused_model_sections),
         cmocka_unit_test(test_cli_integrator_names_in_set),
         cmocka_unit_test(test_cli_fuzz_regressions),
