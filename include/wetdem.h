@@ -12,7 +12,9 @@
  *
  * Status codes: 0 success, > 0 success with information, < 0 error (enum wetdem_status). The
  * library never exits or aborts; a failing call on a simulation stores a message that
- * wetdem_sim_errmsg() returns.
+ * wetdem_sim_errmsg() returns. Pointer arguments are not NULL unless an entry says what NULL
+ * means; the functions that take a name, a material, a fluid, a model or a path also refuse a
+ * NULL one (WETDEM_ERR_INVALID; wetdem_model_find: NULL).
  *
  * Sections, in the order a user needs them: value types; status; parameters; materials;
  * models; simulation; pair forces; hard-sphere impulses; soft engine; analysis;

@@ -232,8 +232,7 @@ static int evaluate(struct fit_ctx* c, const double* q, double* r, char* msg, si
     int st = pb->model(p, c->pred, msg, n_msg, pb->ctx);
     if (st > 0) /* (a status of the success class would end the fit as if it had converged) */
         st = wetdem_status_fail(msg, n_msg, WETDEM_ERR_CALLBACK,
-                                "the model returned %d, neither WETDEM_OK nor an error status",
-                                st);
+                                "the model returned %d, neither WETDEM_OK nor an error status", st);
     for (size_t i = 0; st == WETDEM_OK && i < pb->n_data; i++) {
         double s = pb->scale ? pb->scale[i] : 1.0;
         r[i] = (c->pred[i] - pb->observed[i]) / s;

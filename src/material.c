@@ -96,6 +96,8 @@ static const struct named_fluid fluid_presets[] = {
 
 int wetdem_material_preset(const char* name, struct wetdem_material* m)
 {
+    if (!name || !m)
+        return WETDEM_ERR_INVALID;
     for (size_t k = 0; k < sizeof material_presets / sizeof material_presets[0]; k++)
         if (strcmp(material_presets[k].name, name) == 0) {
             *m = material_presets[k].m;

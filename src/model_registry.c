@@ -36,6 +36,8 @@ const struct wetdem_model* const* wetdem_model_registry(void)
 
 const struct wetdem_model* wetdem_model_find(const char* name)
 {
+    if (!name)
+        return NULL;
     for (size_t k = 0; registry[k]; k++)
         if (strcmp(registry[k]->name, name) == 0)
             return registry[k];

@@ -81,6 +81,8 @@ static int grow(void** array, size_t* cap, size_t need, size_t size)
 
 int wetdem_sim_add_material(struct wetdem_sim* sim, const struct wetdem_material* m)
 {
+    if (!m)
+        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID, "add_material: NULL material");
     char msg[512];
     if (wetdem_material_validate(m, msg, sizeof msg) != WETDEM_OK)
         return wetdem_sim_fail(sim, WETDEM_ERR_INVALID, "%s", msg);
@@ -94,6 +96,8 @@ int wetdem_sim_add_material(struct wetdem_sim* sim, const struct wetdem_material
 
 int wetdem_sim_add_material_preset(struct wetdem_sim* sim, const char* name)
 {
+    if (!name)
+        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID, "add_material_preset: NULL name");
     struct wetdem_material m;
     if (wetdem_material_preset(name, &m) != WETDEM_OK) {
         const char* hint = wetdem_param_suggest(name, wetdem_material_preset_names());
@@ -116,6 +120,8 @@ int wetdem_sim_n_materials(const struct wetdem_sim* sim)
 
 int wetdem_sim_set_fluid(struct wetdem_sim* sim, const struct wetdem_fluid* f)
 {
+    if (!f)
+        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID, "set_fluid: NULL fluid");
     char msg[512];
     if (wetdem_fluid_validate(f, msg, sizeof msg) != WETDEM_OK)
         return wetdem_sim_fail(sim, WETDEM_ERR_INVALID, "%s", msg);

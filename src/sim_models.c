@@ -197,6 +197,8 @@ static void model_names(const char** names, size_t cap)
 
 int wetdem_sim_enable_model(struct wetdem_sim* sim, const char* name)
 {
+    if (!name)
+        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID, "enable_model: NULL name");
     const struct wetdem_model* m = wetdem_model_find(name);
     if (!m) {
         const char* names[64];
@@ -338,6 +340,8 @@ static int find_target(const struct wetdem_sim* sim, const char* name, struct pa
 
 int wetdem_sim_set_param(struct wetdem_sim* sim, const char* name, double value)
 {
+    if (!name)
+        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID, "set_param: NULL name");
     struct param_target t;
     int st = find_target(sim, name, &t);
     if (st != WETDEM_OK)
@@ -352,6 +356,9 @@ int wetdem_sim_set_param(struct wetdem_sim* sim, const char* name, double value)
 
 int wetdem_sim_set_param_str(struct wetdem_sim* sim, const char* name, const char* value)
 {
+    if (!name || !value)
+        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID, "set_param_str: NULL %s",
+                               name ? "value" : "name");
     struct param_target t;
     int st = find_target(sim, name, &t);
     if (st != WETDEM_OK)

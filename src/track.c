@@ -308,6 +308,8 @@ static int read_line(struct wetdem_track* t, char* text, bool* seen_data)
 
 int wetdem_track_read_csv(struct wetdem_track* track, const char* path)
 {
+    if (!path)
+        return fail(track, WETDEM_ERR_INVALID, "read_csv: NULL path");
     FILE* fp = fopen(path, "r");
     if (!fp)
         return fail(track, WETDEM_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
@@ -752,6 +754,8 @@ static int collision_summary(struct wetdem_track* t, const struct wetdem_track_o
 int wetdem_track_analyse(struct wetdem_track* track, const struct wetdem_track_options* opt,
                          struct wetdem_track_summary* summary)
 {
+    if (!opt || !summary)
+        return fail(track, WETDEM_ERR_INVALID, "analyse: NULL %s", opt ? "summary" : "options");
     memset(summary, 0, sizeof *summary);
     summary->e_n = summary->stokes_n = NAN;
     int st = check_options(track, opt);

@@ -406,6 +406,27 @@ static void test_params_public_settings_and_integrator_tables(void** state)
     wetdem_sim_free(sim);
 }
 
+/* A NULL name, material, fluid or model is refused with a message (each crashed). */
+static void test_params_null_arguments_are_refused(void** state)
+{
+    (void)state;
+    struct wetdem_sim* s = wetdem_sim_create();
+    struct wetdem_material m;
+    assert_int_equal(wetdem_sim_enable_model(s, NULL), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(wetdem_sim_errmsg(s), "NULL name");
+    assert_int_equal(wetdem_sim_set_param(s, NULL, 1), WETDEM_ERR_INVALID);
+    assert_int_equal(wetdem_sim_set_param_str(s, "sim.speed_floor", NULL), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(wetdem_sim_errmsg(s), "NULL value");
+    assert_null(wetdem_model_find(NULL));
+    assert_int_equal(wetdem_material_preset(NULL, &m), WETDEM_ERR_INVALID);
+    assert_int_equal(wetdem_sim_add_material_preset(s, NULL), WETDEM_ERR_INVALID);
+    assert_int_equal(wetdem_sim_add_material(s, NULL), WETDEM_ERR_INVALID);
+    assert_int_equal(wetdem_sim_set_fluid(s, NULL), WETDEM_ERR_INVALID);
+    assert_int_equal(wetdem_sim_add_model(s, NULL, NULL), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(wetdem_sim_errmsg(s), "a model needs a name");
+    wetdem_sim_free(s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -422,6 +443,7 @@ int main(void)
         cmocka_unit_test(test_params_presets_match_seed_tables),
         cmocka_unit_test(test_params_mass_from_density),
         cmocka_unit_test(test_params_public_settings_and_integrator_tables),
+        cmocka_unit_test(test_params_null_arguments_are_refused),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
