@@ -808,7 +808,7 @@ struct wetdem_pairwise_config {
     double restitution;          /* e_dry (0, 1] */
     double friction;             /* mu_f of the contact impulse [-] >= 0 */
     double gravity_x, gravity_y; /* [m/s^2] */
-    double t_end;                /* longest simulated time [s] > 0 */
+    double t_end;                /* longest simulated time [s], in [WETDEM_MIN_SPAN, 1e9] */
     double rtol;                 /* relative tolerance of the integrator, [1e-14, 1e-5]; 1e-9 */
     double rest_speed_ratio;     /* contacts slower than this x v_n0 (without v_n0 > 0: x the
                                     largest initial sphere speed) become resting [-]; 1e-3 */

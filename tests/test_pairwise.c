@@ -1228,7 +1228,10 @@ static void test_pairwise_config_rejected(void** state)
     b = c;
     b.t_end = 1e-300; /* CVODE failed with "tstop is behind t" below about 1e-160 s */
     CHECK_STATUS(wetdem_pairwise_config_validate(&b, msg, sizeof msg), WETDEM_ERR_INVALID);
-    CHECK_CONTAINS(msg, "t_end = 1e-300 s: must be in [1e-150, inf)");
+    CHECK_CONTAINS(msg, "t_end = 1e-300 s: must be in [1e-150, 1e9]");
+    b.t_end = 1e100; /* CVODE failed at t = 0 with repeated right-hand-side errors */
+    CHECK_STATUS(wetdem_pairwise_config_validate(&b, msg, sizeof msg), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(msg, "t_end = 1e+100 s: must be in [1e-150, 1e9]");
     b = c;
     b.spheres[0].vx = NAN;
     struct wetdem_pairwise* pw = wetdem_pairwise_create();
