@@ -744,10 +744,12 @@ static int new_named_section(const struct cli_scenario* sc, const char* key_valu
                  "; to change preset %s, give the file a [material.NAME] section with preset = %s "
                  "and use NAME",
                  section + 9, section + 9);
-    cli_error("%s: --set %s: the file has no section [%s]%s%s%s%s; --set changes %s the file "
-              "defines, it does not add one",
-              sc->file, key_value, section, hint ? " (did you mean [" : "", hint ? hint : "",
-              hint ? "]?)" : "", also, named_families[f].noun);
+    /* (the form of every other error of a --set: "FILE: --set KEY=VALUE: why") */
+    fprintf(stderr,
+            "%s: --set %s: the file has no section [%s]%s%s%s%s; --set changes %s the file "
+            "defines, it does not add one\n",
+            sc->file, key_value, section, hint ? " (did you mean [" : "", hint ? hint : "",
+            hint ? "]?)" : "", also, named_families[f].noun);
     return CLI_EXIT_USAGE;
 }
 
