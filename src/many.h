@@ -387,10 +387,14 @@ struct wetdem_many {
     struct wetdem_celllist_item* xr;
     struct wetdem_vec3 (*vw)[2];
     unsigned char* fixed; /* per particle: is_fixed of the record */
-    bool records_stale;   /* the records' positions, velocities and spins are behind */
-    double (*inv)[2];     /* per particle: 1/m [1/kg] and 1/I = 1/(0.4 m R^2) [1/(kg m^2)], computed
+    /* per particle: the box lengths its wraps on the periodic axes have taken off its position
+       since the run started (x unwrapped = x + image L), so that gravity along a periodic axis
+       keeps a continuous potential -m g . x unwrapped; restored from checkpoints */
+    int32_t (*image)[3];
+    bool records_stale; /* the records' positions, velocities and spins are behind */
+    double (*inv)[2];   /* per particle: 1/m [1/kg] and 1/I = 1/(0.4 m R^2) [1/(kg m^2)], computed
                          with the integrator's own expressions when a run (re)starts */
-    double* m_eff;        /* per particle: contact_effective_mass (the mass, infinite if fixed) */
+    double* m_eff;      /* per particle: contact_effective_mass (the mass, infinite if fixed) */
     size_t particle_cap;
     struct wetdem_many_energy energy;
     /* with an energy budget, the work of a force pass, model by model (n_models doubles per

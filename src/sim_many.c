@@ -109,6 +109,7 @@ void wetdem_sim_many_free(struct wetdem_sim* sim)
     free(m->m_eff);
     free(m->vw);
     free(m->fixed);
+    free(m->image);
     free(m->pair_work);
     free(m->wall_work);
     free(m->cross_work);
@@ -492,7 +493,8 @@ static int size_particle_arrays(struct wetdem_sim* sim)
         {(void**)&m->vh, sizeof *m->vh},       {(void**)&m->wh, sizeof *m->wh},
         {(void**)&m->xr, sizeof *m->xr},       {(void**)&m->inv, sizeof *m->inv},
         {(void**)&m->m_eff, sizeof *m->m_eff}, {(void**)&m->vw, sizeof *m->vw},
-        {(void**)&m->fixed, sizeof *m->fixed}, {(void**)&m->wall_dirty, sizeof *m->wall_dirty}};
+        {(void**)&m->fixed, sizeof *m->fixed}, {(void**)&m->wall_dirty, sizeof *m->wall_dirty},
+        {(void**)&m->image, sizeof *m->image}};
     size_t c = cap;
     for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++) {
         c = cap;
@@ -771,8 +773,10 @@ int wetdem_sim_many_prepare(struct wetdem_sim* sim)
                                sim->n_particles);
     /* particles added since: no pair force yet (their first half kick is gravity's alone; the
        first force pass of the call gives them theirs) */
-    for (size_t k = known; k < sim->n_particles; k++)
+    for (size_t k = known; k < sim->n_particles; k++) {
         m->force[k] = m->torque[k] = vec3(0, 0, 0);
+        m->image[k][0] = m->image[k][1] = m->image[k][2] = 0;
+    }
     if (refresh) {
         sync_records(sim);     /* (never stale here: a call ends with them written) */
         m->skip_ready = false; /* the positions are loaded anew: no skips at the next pass */
@@ -812,14 +816,18 @@ static struct wetdem_vec3 gravity(const struct wetdem_sim* sim)
     return vec3(sim->settings.gravity_x, sim->settings.gravity_y, sim->settings.gravity_z);
 }
 
-/* Wraps x into [lo, hi) on the periodic axes. */
-static struct wetdem_vec3 wrap(const struct wetdem_celllist_box* b, struct wetdem_vec3 x)
+/* Wraps x into [lo, hi) on the periodic axes, counting the box lengths taken off in image
+ * (a store only when a wrap happens). */
+static struct wetdem_vec3 wrap(const struct wetdem_celllist_box* b, struct wetdem_vec3 x,
+                               int32_t image[3])
 {
     double c[3] = {x.x, x.y, x.z};
     for (int k = 0; k < 3; k++)
         if (b->periodic[k]) {
-            double len = b->hi[k] - b->lo[k];
-            c[k] -= len * floor((c[k] - b->lo[k]) / len);
+            double len = b->hi[k] - b->lo[k], n = floor((c[k] - b->lo[k]) / len);
+            c[k] -= len * n;
+            if (n != 0)
+                image[k] += (int32_t)n;
         }
     return vec3(c[0], c[1], c[2]);
 }
@@ -835,6 +843,7 @@ struct kick_arrays {
     const double (*restrict inv)[2];
     struct wetdem_celllist_item* restrict xr;
     struct wetdem_vec3 (*restrict vw)[2];
+    int32_t (*restrict image)[3];
 };
 
 /* Half kick and drift of particle k; its velocities become the predicted ones v' + a dt/2,
@@ -858,7 +867,7 @@ kick_drift_one(const struct kick_arrays* A, const struct wetdem_celllist_box* bo
     double v2 = vec3_dot(vh, vh);
     v2 = v2 == v2 ? v2 : INFINITY; /* a NaN wins no max: count it as infinite */
     *v2_max = v2 > *v2_max ? v2 : *v2_max;
-    x = periodic ? wrap(box, x) : x;
+    x = periodic ? wrap(box, x, A->image[k]) : x;
     A->vh[k] = vh;
     A->wh[k] = wh;
     A->xr[k].x = x.x;
@@ -882,7 +891,8 @@ static inline __attribute__((always_inline)) void kick_drift_range(struct wetdem
                                        .wh = m->wh,
                                        .inv = (const double(*)[2])m->inv,
                                        .xr = m->xr,
-                                       .vw = m->vw};
+                                       .vw = m->vw,
+                                       .image = m->image};
     const unsigned char* fixed = m->fixed;
     const struct wetdem_celllist_box* box = &m->cl.box;
     bool periodic = box->periodic[0] || box->periodic[1] || box->periodic[2];
@@ -1097,6 +1107,17 @@ void wetdem_sim_many_energies(const struct wetdem_sim* sim, double* kinetic, dou
         k += 0.5 * p->mass * vec3_dot(p->vel, p->vel) +
              0.2 * p->mass * p->radius * p->radius * vec3_dot(p->omega, p->omega);
         u -= p->mass * vec3_dot(g, p->pos);
+        /* the box lengths its periodic wraps took off: the potential of the unwrapped
+           position, continuous across a wrap (without it, gravity along a periodic axis put
+           m g L into the closure error at every crossing) */
+        const int32_t* im = m && m->image && i < m->cl.n_at_build ? m->image[i] : NULL;
+        if (im && (im[0] || im[1] || im[2])) {
+            const struct wetdem_celllist_box* b = &m->cl.box;
+            struct wetdem_vec3 shift =
+                vec3(im[0] * (b->hi[0] - b->lo[0]), im[1] * (b->hi[1] - b->lo[1]),
+                     im[2] * (b->hi[2] - b->lo[2]));
+            u -= p->mass * vec3_dot(g, shift);
+        }
     }
     /* the energy stored in the solid contacts, as the enabled models define it (their
      * elastic_energy hooks: the Hertz (8/15) E* sqrt(R*) delta^(5/2), hooke's k delta^2 / 2,

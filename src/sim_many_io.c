@@ -614,15 +614,24 @@ static size_t blob_size(size_t n)
     return 2 * sizeof(double) + n * 6 * sizeof(double);
 }
 
-/* Whether a USER blob of `size` bytes fits n particles: blob_size(n), or that and a uint32 per
+/* The blob as written now: blob_size(n), then each particle's periodic images (3 int32). */
+static size_t blob_size_images(size_t n)
+{
+    return blob_size(n) + n * 3 * sizeof(int32_t);
+}
+
+/* Whether a USER blob of `size` bytes fits n particles: blob_size_images(n); blob_size(n),
+ * written before the images were kept (read as no wraps: such a run's budget had the jumps
+ * of its wraps, if gravity acted along a periodic axis); or blob_size(n) and a uint32 per
  * particle, each one's count of solid overlaps at the latest pass, which checkpoints held while
  * the force pass counted them. Nothing reads those counts (the reported ones are worked out
  * from the state: wetdem_sim_many_links), so such a checkpoint resumes the same run and its
- * counts are skipped; the sizes differ for every n > 0, so neither layout is taken for the
- * other. */
+ * counts are skipped; the three sizes differ for every n > 0, so no layout is taken for
+ * another. */
 static bool blob_size_fits(size_t size, size_t n)
 {
-    return size == blob_size(n) || size == blob_size(n) + n * sizeof(uint32_t);
+    return size == blob_size_images(n) || size == blob_size(n) ||
+           size == blob_size(n) + n * sizeof(uint32_t);
 }
 
 static int fill_checkpoint(struct wetdem_sim* sim, struct wetdem_checkpoint* ck)
@@ -633,7 +642,7 @@ static int fill_checkpoint(struct wetdem_sim* sim, struct wetdem_checkpoint* ck)
     ck->pairs = malloc((total ? total : 1) * sizeof *ck->pairs);
     ck->history = malloc((total * len > 0 ? total * len : 1) * sizeof(double));
     ck->walls = malloc((nw ? nw : 1) * sizeof *ck->walls);
-    ck->extra = malloc(blob_size(n));
+    ck->extra = malloc(blob_size_images(n));
     ck->energy = malloc(N_ENERGY * sizeof(double));
     if (!ck->pairs || !ck->history || !ck->walls || !ck->extra || !ck->energy)
         return WETDEM_ERR_NOMEM;
@@ -656,6 +665,8 @@ static int fill_checkpoint(struct wetdem_sim* sim, struct wetdem_checkpoint* ck)
                         m->torque[k].x, m->torque[k].y, m->torque[k].z};
         memcpy(b + 16 + k * 48, ft, 48);
     }
+    if (n)
+        memcpy(b + blob_size(n), m->image, n * sizeof *m->image);
     double* e = ck->energy;
     e[0] = m->energy.k0;
     e[1] = m->energy.u0;
@@ -680,7 +691,7 @@ static int fill_checkpoint(struct wetdem_sim* sim, struct wetdem_checkpoint* ck)
         .energy = ck->energy,
         .n_energy = N_ENERGY,
         .extra = ck->extra,
-        .extra_size = blob_size(n),
+        .extra_size = blob_size_images(n),
         .output = {m->vtk_files, m->csv_rows, m->next_vtk_step, m->next_csv_step}};
     return WETDEM_OK;
 }
@@ -873,6 +884,8 @@ static int restore_pairs(struct wetdem_sim* sim, const struct wetdem_checkpoint*
         m->force[k] = vec3(ft[0], ft[1], ft[2]);
         m->torque[k] = vec3(ft[3], ft[4], ft[5]);
     }
+    if (n && ck->extra_size == blob_size_images(n)) /* (prepare zeroed them: older layouts) */
+        memcpy(m->image, ck->extra + blob_size(n), n * sizeof *m->image);
     for (size_t q = 0; q < m->cl.n_pairs; q++) /* histories may be stale: check on next use */
         m->flags[q] = WETDEM_MANY_DIRTY | WETDEM_MANY_SPRING;
     m->started = true;
