@@ -473,7 +473,8 @@ static double stored_energy(const struct wetdem_sim* sim)
         wetdem_sim_history_init(sim, scratch);
     struct wetdem_contact at = c;
     at.v_n = 0.0;
-    cuts[n++] = sim->minsep.model->min_separation(sim->minsep.params, &at, scratch);
+    at.h_min = sim->minsep.model->min_separation(sim->minsep.params, &at, scratch);
+    cuts[n++] = at.h_min; /* (the thresholds below read it) */
     for (size_t m = 0; m < sim->n_models; m++) {
         const struct wetdem_model_slot* sl = &sim->models[m];
         size_t count =
