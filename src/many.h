@@ -389,8 +389,10 @@ struct wetdem_many {
     unsigned char* fixed; /* per particle: is_fixed of the record */
     /* per particle: the box lengths its wraps on the periodic axes have taken off its position
        since the run started (x unwrapped = x + image L), so that gravity along a periodic axis
-       keeps a continuous potential -m g . x unwrapped; restored from checkpoints */
-    int32_t (*image)[3];
+       keeps a continuous potential -m g . x unwrapped; restored from checkpoints. Whole
+       numbers held as doubles (exact to 2^53; a diverging run's wrap counts, beyond any
+       integer type, stay defined until the run stops on its non-finite state) */
+    double (*image)[3];
     bool records_stale; /* the records' positions, velocities and spins are behind */
     double (*inv)[2];   /* per particle: 1/m [1/kg] and 1/I = 1/(0.4 m R^2) [1/(kg m^2)], computed
                          with the integrator's own expressions when a run (re)starts */

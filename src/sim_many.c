@@ -819,7 +819,7 @@ static struct wetdem_vec3 gravity(const struct wetdem_sim* sim)
 /* Wraps x into [lo, hi) on the periodic axes, counting the box lengths taken off in image
  * (a store only when a wrap happens). */
 static struct wetdem_vec3 wrap(const struct wetdem_celllist_box* b, struct wetdem_vec3 x,
-                               int32_t image[3])
+                               double image[3])
 {
     double c[3] = {x.x, x.y, x.z};
     for (int k = 0; k < 3; k++)
@@ -827,7 +827,7 @@ static struct wetdem_vec3 wrap(const struct wetdem_celllist_box* b, struct wetde
             double len = b->hi[k] - b->lo[k], n = floor((c[k] - b->lo[k]) / len);
             c[k] -= len * n;
             if (n != 0)
-                image[k] += (int32_t)n;
+                image[k] += n;
         }
     return vec3(c[0], c[1], c[2]);
 }
@@ -843,7 +843,7 @@ struct kick_arrays {
     const double (*restrict inv)[2];
     struct wetdem_celllist_item* restrict xr;
     struct wetdem_vec3 (*restrict vw)[2];
-    int32_t (*restrict image)[3];
+    double (*restrict image)[3];
 };
 
 /* Half kick and drift of particle k; its velocities become the predicted ones v' + a dt/2,
@@ -1110,7 +1110,7 @@ void wetdem_sim_many_energies(const struct wetdem_sim* sim, double* kinetic, dou
         /* the box lengths its periodic wraps took off: the potential of the unwrapped
            position, continuous across a wrap (without it, gravity along a periodic axis put
            m g L into the closure error at every crossing) */
-        const int32_t* im = m && m->image && i < m->cl.n_at_build ? m->image[i] : NULL;
+        const double* im = m && m->image && i < m->cl.n_at_build ? m->image[i] : NULL;
         if (im && (im[0] || im[1] || im[2])) {
             const struct wetdem_celllist_box* b = &m->cl.box;
             struct wetdem_vec3 shift =

@@ -614,10 +614,10 @@ static size_t blob_size(size_t n)
     return 2 * sizeof(double) + n * 6 * sizeof(double);
 }
 
-/* The blob as written now: blob_size(n), then each particle's periodic images (3 int32). */
+/* The blob as written now: blob_size(n), then each particle's periodic images (3 doubles). */
 static size_t blob_size_images(size_t n)
 {
-    return blob_size(n) + n * 3 * sizeof(int32_t);
+    return blob_size(n) + n * 3 * sizeof(double);
 }
 
 /* Whether a USER blob of `size` bytes fits n particles: blob_size_images(n); blob_size(n),
@@ -744,6 +744,13 @@ static int check_restorable_values(struct wetdem_sim* sim, const struct wetdem_c
         memcpy(ft, ck->extra + 16 + k * 48, sizeof ft);
         if (!all_finite(ft, 6))
             bad = "a non-finite force or torque";
+    }
+    for (size_t k = 0; !bad && ck->extra_size == blob_size_images(n) && k < n; k++) {
+        double im[3];
+        memcpy(im, ck->extra + blob_size(n) + k * sizeof im, sizeof im);
+        for (int a = 0; a < 3; a++)
+            if (!(isfinite(im[a]) && im[a] == floor(im[a])))
+                bad = "a periodic image count that is not a whole number";
     }
     if (!bad && !all_finite(ck->energy, ck->n_energy))
         bad = "a non-finite energy-budget term";

@@ -283,7 +283,7 @@ static void test_many_restart_refuses_impossible_states(void** state)
 /* Checkpoints of the earlier layouts are read and resume the run bit for bit: one whose USER
  * section held each particle's count of solid overlaps after the forces and torques (4 bytes
  * a particle; the counts skipped, the reported ones are worked out from the state), and one
- * without the periodic images that follow them now (12 bytes a particle; read as no wraps,
+ * without the periodic images that follow them now (24 bytes a particle; read as no wraps,
  * which this box's gravity, across its periodic axes, does not feel); a USER section of any
  * other size is still refused. */
 static void test_many_restart_reads_checkpoints_with_contact_counts(void** state)
@@ -301,9 +301,9 @@ static void test_many_restart_reads_checkpoints_with_contact_counts(void** state
         char msg[256];
         CHECK_OK(wetdem_checkpoint_read(good, &ck, msg, sizeof msg));
         size_t n = ck.n_particles, base = 16 + 48 * n;  /* dt, t0, force and torque */
-        assert_int_equal(ck.extra_size, base + 12 * n); /* and the images */
+        assert_int_equal(ck.extra_size, base + 24 * n); /* and the images */
         size_t size = base + (variant ? n * sizeof(uint32_t) + (size_t)extra : 0);
-        unsigned char* blob = realloc(ck.extra, size > base + 12 * n ? size : base + 12 * n);
+        unsigned char* blob = realloc(ck.extra, size > base + 24 * n ? size : base + 24 * n);
         assert_non_null(blob);
         memset(blob + base, 0x5a, size - base); /* counts no run has */
         ck.extra = blob;
