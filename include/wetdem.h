@@ -1164,9 +1164,9 @@ struct wetdem_fit_result {
                            0 not converged */
     int transform[WETDEM_FIT_MAX_PARAMS];     /* enum wetdem_fit_transform of each parameter */
     int at_bound[WETDEM_FIT_MAX_PARAMS];      /* -1 at its lower bound, +1 at its upper bound:
-                                             closer to it than 1e-3 of its standard error (the
-                                             data do not tell it from the bound) and than 1e-6
-                                             of its initial distance (the fit ran towards it);
+                                             closer to it than its standard error (the data do
+                                             not tell it from the bound) and than 1e-3 of its
+                                             initial distance (the fit ran towards it);
                                              its standard error is then NAN and the others'
                                              are those with it held there; 0 inside */
     bool undetermined[WETDEM_FIT_MAX_PARAMS]; /* the data do not determine it: its column of

@@ -425,7 +425,7 @@ static void expect_fit(const char* what, double best, double sigma, double init,
  * 4e-9 to 4e-8 from it. The model decides: a factor 1000 further from the bound moves the
  * residuals by far more than s (best 2e-4 from 3e-4: the probes run and say so), and a fit
  * that travelled more than a factor 10 is not looked at. Each gives what it gave before the
- * rule: a result (WETDEM_OK), at the bound when it ran into it (AT_BOUND_TRAVEL). */
+ * rule: a result (WETDEM_OK), at the bound when it ran into it (AT_BOUND_SD, AT_BOUND_TRAVEL). */
 static void test_fit_near_a_bound_is_not_a_flat_start(void** state)
 {
     (void)state;
@@ -453,15 +453,20 @@ static void test_fit_near_a_bound_is_not_a_flat_start(void** state)
     /* best 0.998, near the upper bound */
     expect_fit("p in [0, 1], best 0.998 from 0.5", 0.998, 1, 0.5, zero, one, NULL, 0, &r);
     CHECK_REL(r.values[0], 0.998, 1e-6);
-    /* data that want p < 0: the fit runs to the bound; at it (six decades travelled) or, from
-       1e-3 and 0.003, 4e-9 and 4e-8 from it (1e-7 and 1e-6 standard errors), as before */
-    expect_fit("p >= 0, best -0.02 from 1e-3", -0.02, 1, 1e-3, zero, NULL, NULL, 0, &r);
+    /* data that want p < 0: the fit runs to the bound and is reported at it, from near starts
+       too (from 1e-3 and 0.003 it stops 4e-9 and 4e-8 from it, 1e-7 and 1e-6 standard errors,
+       three decades and more closer than it started: these were reported as ordinary values
+       when the rule asked for six decades, and so was a restitution whose data want e > 1,
+       stopped by the solver 1e-6 from 1 with a meaningless standard error) */
+    expect_fit("p >= 0, best -0.02 from 1e-3", -0.02, 1, 1e-3, zero, NULL, NULL, -1, &r);
     assert_true(r.values[0] > 0 && r.values[0] < 1e-7);
     expect_fit("p >= 0, best -0.02 from 1e-2", -0.02, 1, 1e-2, zero, NULL, NULL, -1, &r);
     expect_fit("p >= 0, best -0.002 from 1", -0.002, 1, 1, zero, NULL, NULL, -1, &r);
-    expect_fit("p >= 0, best -0.002 from 0.003", -0.002, 1, 0.003, zero, NULL, NULL, 0, &r);
+    expect_fit("p >= 0, best -0.002 from 0.003", -0.002, 1, 0.003, zero, NULL, NULL, -1, &r);
     expect_fit("p in [0, 1], best -0.002 from 0.5", -0.002, 1, 0.5, zero, one, NULL, -1, &r);
-    expect_fit("p in [0, 1], best -0.02 from 1e-3", -0.02, 1, 1e-3, zero, one, NULL, 0, &r);
+    expect_fit("p in [0, 1], best -0.02 from 1e-3", -0.02, 1, 1e-3, zero, one, NULL, -1, &r);
+    expect_fit("p in [0, 1], best 1.02 from 0.9", 1.02, 0.01, 0.9, zero, one, NULL, 1, &r);
+    expect_fit("p in [0, 1], best 1.002 from 0.999", 1.002, 0.01, 0.999, zero, one, NULL, 1, &r);
     /* a column the Jacobian shows to matter is not probed: no evaluation beyond the fit's */
     assert_true(evals_near < 20);
 }
