@@ -19,7 +19,9 @@
  * dimensionless cvode.atol serves all: positions atol L, velocities atol V, spins atol V/L,
  * with L the smallest free radius [m] and V the speed scale of wetdem_sim_speed_scale() [m/s]
  * at the start of the run. Largest step: cvode.max_step, or 0.1 L/V when 0, so that no step
- * can carry a pair through its interaction range unseen.
+ * can carry a pair through its interaction range unseen, and for a pair closing in the larger
+ * of half the time to close its gap and 0.1 of its contact time (contact_step_bound), so that
+ * no step carries it through a whole solid contact.
  *
  * Run loop: CVode(CV_ONE_STEP) up to the stop time t_end. After every accepted step (or
  * located root) the pair histories are committed at the returned time (RHS evaluations are
@@ -203,7 +205,42 @@ struct solver {
     SUNNonlinearSolver nls;
     int* rootsfound;
     double h_max; /* largest step [s] */
+    double h_cur; /* the largest step in effect: h_max, or less by contact_step_bound */
 };
+
+/* A bound on the next step [s] that keeps a solid contact from being stepped over: the root
+ * finder sees a sign change of the gap between the ends of a step only, so a grazing pair
+ * whose contact is shorter than a step passed through it unseen (e = 1, no contact force, at
+ * 89 degrees). For each pair closing in (v_n > 0, gap > 0): the larger of half the time to
+ * close its gap at v_n and 0.1 of its contact time at v_n (wetdem_sim_contact_time; a step
+ * that long may cross gap 0, where the root is found, but cannot also leave the contact,
+ * which lasts ten of them). INFINITY without such a pair or a contact model. */
+static double contact_step_bound(const struct wetdem_sim* sim)
+{
+    double bound = INFINITY;
+    const struct wetdem_pairs* pl = &sim->engine.pairs;
+    for (size_t k = 0; k < pl->n; k++) {
+        const struct wetdem_pair* q = &pl->items[k];
+        struct wetdem_contact c;
+        wetdem_sim_build_contact(sim, q->i, q->j, q->is_wall, &c);
+        if (!(c.v_n > 0 && c.gap > 0))
+            continue;
+        double t_c = wetdem_sim_contact_time(sim, &c);
+        if (isfinite(t_c) && t_c > 0)
+            bound = fmin(bound, fmax(0.5 * c.gap / c.v_n, 0.1 * t_c));
+    }
+    return bound;
+}
+
+/* Sets CVODE's largest step to h_max or the tighter contact_step_bound. 0 or -1. */
+static int limit_step(const struct wetdem_sim* sim, struct solver* s)
+{
+    double h = fmin(s->h_max, contact_step_bound(sim));
+    if (h == s->h_cur)
+        return 0;
+    s->h_cur = h;
+    return CVodeSetMaxStep(s->mem, h) == CV_SUCCESS ? 0 : -1;
+}
 
 static void solver_free(struct solver* s)
 {
@@ -256,6 +293,7 @@ static int solver_create(struct wetdem_sim* sim, struct run* r, const struct cvo
     double len = wetdem_sim_length_scale(sim), speed = wetdem_sim_speed_scale(sim, NULL);
     double h_max = p->max_step > 0 ? p->max_step : 0.1 * len / speed;
     s->h_max = h_max;
+    s->h_cur = fmin(h_max, contact_step_bound(sim));
     int ok = SUNContext_Create(NULL, &s->ctx) == 0;
     ok = ok && (s->y = N_VNew_Serial(n, s->ctx)) && (s->abstol = N_VNew_Serial(n, s->ctx)) &&
          (s->ytmp = N_VNew_Serial(n, s->ctx));
@@ -274,7 +312,7 @@ static int solver_create(struct wetdem_sim* sim, struct run* r, const struct cvo
          CVodeSVtolerances(s->mem, p->rtol, s->abstol) == CV_SUCCESS &&
          CVodeSetUserData(s->mem, r) == CV_SUCCESS &&
          CVodeSetStopTime(s->mem, t_end) == CV_SUCCESS &&
-         CVodeSetMaxStep(s->mem, h_max) == CV_SUCCESS &&
+         CVodeSetMaxStep(s->mem, s->h_cur) == CV_SUCCESS &&
          CVodeRootInit(s->mem, (int)sim->engine.n_slots, roots) == CV_SUCCESS &&
          CVodeSetMaxOrd(s->mem, (int)fmin(p->max_order, bdf ? 5 : 12)) == CV_SUCCESS &&
          attach_solvers(s, bdf, n) == 0;
@@ -386,10 +424,12 @@ static int run_loop(struct wetdem_sim* sim, struct run* r, struct solver* s,
             return WETDEM_EVENT;
         double h_last = 0;
         CVodeGetLastStep(s->mem, &h_last);
-        if (flag == CV_ROOT_RETURN || h_last > 0.5 * s->h_max)
+        if (flag == CV_ROOT_RETURN || h_last > 0.5 * s->h_cur)
             quiet = 0; /* an event, or a step limited by max_step rather than stability */
         if (flag == CV_TSTOP_RETURN)
             sim->engine.time = t_end;
+        if (limit_step(sim, s) != 0)
+            return wetdem_sim_fail(sim, WETDEM_ERR_STEP, "cvode: cannot set the largest step");
     }
     return WETDEM_OK;
 }
