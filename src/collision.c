@@ -404,29 +404,6 @@ static double collision_energy(const struct wetdem_sim* sim)
     return e;
 }
 
-/* The enabled models' normal force on the pair at gap h with the surfaces at rest [N], from a
- * copy of the pair's history (NULL: a fresh pair); every damping and viscous term is
- * proportional to a speed, so what is left is the conservative part: the elastic contact, the
- * capillary bridge. *ok is cleared when a model fails. */
-static double force_at_rest(const struct wetdem_sim* sim, struct wetdem_contact c,
-                            const double* history, double h, bool* ok)
-{
-    double scratch[WETDEM_HISTORY_SCRATCH];
-    if (history)
-        memcpy(scratch, history, sim->history_len * sizeof *scratch);
-    c.gap = h;
-    c.v_n = 0.0;
-    c.v_t = vec3(0, 0, 0);
-    c.dt = 0.0;
-    struct wetdem_pair_force f;
-    if (wetdem_sim_eval_contact(sim, &c, history ? scratch : NULL, &f, NULL) != WETDEM_OK ||
-        !isfinite(f.f_normal)) {
-        *ok = false;
-        return 0.0;
-    }
-    return f.f_normal;
-}
-
 static int compare_doubles(const void* a, const void* b)
 {
     double x = *(const double*)a, y = *(const double*)b;
@@ -439,7 +416,7 @@ static int compare_doubles(const void* a, const void* b)
 #define STORED_ENERGY_POINTS 64
 
 /* The energy the pair's forces store at its present gap [J]: the work their conservative part
- * (force_at_rest) does as the pair separates at rest from the gap to the end of its
+ * (wetdem_sim_force_at_rest) does as the pair separates at rest from the gap to the end of its
  * interaction range, with its history (h_min records, tangential springs) held as it is now.
  * A Hertz overlap's (8/15) E* sqrt(R*) delta^(5/2) > 0; a capillary bridge's -F (delta - h)
  * < 0 (a well). 0 beyond the range; NAN if a model fails or the history is too long. The
@@ -448,41 +425,41 @@ static int compare_doubles(const void* a, const void* b)
  * which needs no error handler and so is safe in parallel collisions. */
 static double stored_energy(const struct wetdem_sim* sim)
 {
-    struct wetdem_contact c;
-    pair_contact(sim, &c);
-    double range = wetdem_sim_contact_range(sim, &c);
-    if (!(c.gap < range))
-        return 0.0;
     if (sim->history_len > WETDEM_HISTORY_SCRATCH)
         return NAN;
-    const double* history = NULL;
+    /* the pair of particle 0 and its partner in the engine's list, which holds every pair
+       once a run has begun; before, the pair is fresh */
     const struct wetdem_pairs* pl = &sim->engine.pairs;
-    for (size_t k = 0; k < pl->n; k++)
-        if (pl->items[k].i == 0 && pl->items[k].j == (sim->n_walls ? 0u : 1u))
-            history = wetdem_pairs_history(pl, k);
-    double cuts[2 * WETDEM_MAX_THRESHOLDS + 5], gaps[WETDEM_MAX_THRESHOLDS];
+    size_t k = 0;
+    while (k < pl->n && !(pl->items[k].i == 0 && pl->items[k].j == (sim->n_walls ? 0u : 1u)))
+        k++;
+    const double* history = k < pl->n ? wetdem_pairs_history(pl, k) : NULL;
+    struct wetdem_contact c;
+    double range, scratch[WETDEM_HISTORY_SCRATCH];
+    if (k < pl->n) {
+        wetdem_event_pair_state(sim, k, &c, &range, scratch); /* (c.h_min: thresholds read it) */
+    } else {
+        pair_contact(sim, &c);
+        range = wetdem_sim_contact_range(sim, &c);
+        wetdem_sim_history_init(sim, scratch);
+        c.h_min = sim->minsep.model->min_separation(sim->minsep.params, &c, scratch);
+    }
+    if (!(c.gap < range))
+        return 0.0;
+    double cuts[WETDEM_MAX_MODELS * WETDEM_MAX_THRESHOLDS + 5], gaps[WETDEM_MAX_THRESHOLDS];
     size_t n = 0;
     cuts[n++] = c.gap;
     cuts[n++] = range;
     cuts[n++] = 0.0;
     cuts[n++] = c.film; /* (where a capillary bridge ends) */
-    double scratch[WETDEM_HISTORY_SCRATCH];
-    if (history)
-        memcpy(scratch, history, sim->history_len * sizeof *scratch);
-    else
-        wetdem_sim_history_init(sim, scratch);
-    struct wetdem_contact at = c;
-    at.v_n = 0.0;
-    at.h_min = sim->minsep.model->min_separation(sim->minsep.params, &at, scratch);
-    cuts[n++] = at.h_min; /* (the thresholds below read it) */
+    cuts[n++] = c.h_min;
     for (size_t m = 0; m < sim->n_models; m++) {
         const struct wetdem_model_slot* sl = &sim->models[m];
         size_t count =
             sl->model->thresholds
-                ? sl->model->thresholds(sl->params, &at, scratch + sl->history_offset, gaps)
+                ? sl->model->thresholds(sl->params, &c, scratch + sl->history_offset, gaps)
                 : 0;
-        for (size_t q = 0; q < count && q < WETDEM_MAX_THRESHOLDS && n < sizeof cuts / sizeof *cuts;
-             q++)
+        for (size_t q = 0; q < count && q < WETDEM_MAX_THRESHOLDS; q++)
             cuts[n++] = gaps[q];
     }
     qsort(cuts, n, sizeof *cuts, compare_doubles);
@@ -491,19 +468,18 @@ static double stored_energy(const struct wetdem_sim* sim)
     if (!table)
         return NAN;
     double energy = 0.0;
-    bool ok = true;
-    for (size_t k = 0; k + 1 < n; k++) {
-        double a = cuts[k], b = cuts[k + 1];
+    for (size_t q = 0; q + 1 < n; q++) {
+        double a = cuts[q], b = cuts[q + 1];
         if (!(a >= c.gap && b <= range && b > a))
             continue;
-        for (size_t q = 0; q < STORED_ENERGY_POINTS; q++) {
+        for (size_t p = 0; p < STORED_ENERGY_POINTS; p++) {
             double x, w;
-            gsl_integration_glfixed_point(a, b, q, &x, &w, table);
-            energy += w * force_at_rest(sim, c, history, x, &ok);
+            gsl_integration_glfixed_point(a, b, p, &x, &w, table);
+            energy += w * wetdem_sim_force_at_rest(sim, c, history, x); /* (NAN on failure) */
         }
     }
     gsl_integration_glfixed_table_free(table);
-    return ok ? energy : NAN;
+    return energy;
 }
 
 /* Contact time, contact/h_min flags and the last interaction end, from the event log. */

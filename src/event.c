@@ -36,8 +36,8 @@ const char* wetdem_event_kind_name(enum wetdem_event_kind kind)
 
 /* Geometry of pair k at the current state: contact (with h_min from the min-separation model
  * evaluated on a scratch copy of the committed history) and range [m]. */
-static void pair_state(const struct wetdem_sim* sim, size_t k, struct wetdem_contact* c,
-                       double* range, double* scratch)
+void wetdem_event_pair_state(const struct wetdem_sim* sim, size_t k, struct wetdem_contact* c,
+                             double* range, double* scratch)
 {
     const struct wetdem_pair* p = &sim->engine.pairs.items[k];
     const double* history = wetdem_pairs_history(&sim->engine.pairs, k);
@@ -120,7 +120,7 @@ static int build_pair_slots(struct wetdem_sim* sim, size_t k)
     struct wetdem_engine* e = &sim->engine;
     struct wetdem_contact c;
     double range, scratch[WETDEM_HISTORY_SCRATCH];
-    pair_state(sim, k, &c, &range, scratch);
+    wetdem_event_pair_state(sim, k, &c, &range, scratch);
     if (c.gap < range) /* strictly inside: a run stopped exactly at separation stays done */
         e->pairs.items[k].has_interacted = true;
     struct wetdem_event_slot inner[WETDEM_MAX_MODELS * WETDEM_MAX_THRESHOLDS];
@@ -198,7 +198,7 @@ void wetdem_event_values(struct wetdem_sim* sim, double* g)
         const struct wetdem_event_slot* s = &e->slots[q];
         if (s->pair != current) {
             current = s->pair;
-            pair_state(sim, current, &c, &range, scratch);
+            wetdem_event_pair_state(sim, current, &c, &range, scratch);
             e->pair_gap[current] = c.gap;
             e->pair_vn[current] = c.v_n;
             e->pair_range[current] = range;
@@ -296,7 +296,7 @@ double wetdem_event_smallest_branch_gap(const struct wetdem_sim* sim)
             continue;
         struct wetdem_contact c;
         double range, scratch[WETDEM_HISTORY_SCRATCH];
-        pair_state(sim, p, &c, &range, scratch);
+        wetdem_event_pair_state(sim, p, &c, &range, scratch);
         if (wetdem_sim_laws_jump_at(sim, &c, scratch, h_k))
             h_min = h_k;
     }
@@ -321,7 +321,7 @@ static void note_branch_step(struct wetdem_sim* sim, size_t q)
         return;
     struct wetdem_contact c;
     double range, scratch[WETDEM_HISTORY_SCRATCH];
-    pair_state(sim, p, &c, &range, scratch);
+    wetdem_event_pair_state(sim, p, &c, &range, scratch);
     if (wetdem_sim_laws_jump_at(sim, &c, scratch, h_k))
         e->stats.hmin_step_ratio = ratio;
 }

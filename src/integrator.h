@@ -59,6 +59,11 @@ struct wetdem_event_slot {
 /* Builds the event functions of every pair of engine.pairs at the current state. Returns
  * WETDEM_OK or WETDEM_ERR_NOMEM. */
 int wetdem_event_slots_build(struct wetdem_sim* sim);
+/* Geometry of pair k at the current state: its contact c (h_min from the min-separation
+ * model on a scratch copy of the committed history, left in scratch: sim->history_len
+ * doubles) and its interaction range *range [m]. */
+void wetdem_event_pair_state(const struct wetdem_sim* sim, size_t k, struct wetdem_contact* c,
+                             double* range, double* scratch);
 /* Evaluates every event function at the current particle state with the committed pair
  * histories (not modified) into g[n_slots]; writes engine.pair_gap and engine.pair_vn.
  * Counts one root evaluation. */

@@ -566,16 +566,23 @@ double wetdem_sim_jump_gap(const struct wetdem_sim* sim, const struct wetdem_con
     return gap;
 }
 
-/* The normal force of the enabled models at overlap `overlap` with the surfaces at rest [N]
- * (elastic parts only: every damping and viscous term is proportional to a speed), or NAN. */
-static double force_at_rest(const struct wetdem_sim* sim, struct wetdem_contact c, double overlap)
+double wetdem_sim_force_at_rest(const struct wetdem_sim* sim, struct wetdem_contact c,
+                                const double* history, double gap)
 {
+    double scratch[WETDEM_HISTORY_SCRATCH];
+    if (history && sim->history_len > WETDEM_HISTORY_SCRATCH)
+        return NAN;
+    if (history)
+        memcpy(scratch, history, sim->history_len * sizeof *scratch);
     struct wetdem_pair_force f;
-    c.gap = -overlap;
+    c.gap = gap;
     c.v_n = 0.0;
     c.v_t = vec3(0, 0, 0);
     c.dt = 0.0;
-    return wetdem_sim_eval_contact(sim, &c, NULL, &f, NULL) == WETDEM_OK ? f.f_normal : NAN;
+    return wetdem_sim_eval_contact(sim, &c, history ? scratch : NULL, &f, NULL) == WETDEM_OK &&
+                   isfinite(f.f_normal)
+               ? f.f_normal
+               : NAN;
 }
 
 /* The tangential force along t of the enabled models at overlap `overlap` when a fresh
@@ -605,8 +612,8 @@ double wetdem_sim_tangential_time(const struct wetdem_sim* sim, const struct wet
     /* k_n = dF_n/d(delta) by a central difference: F_n ~ delta^(3/2) (hertz) or ~ delta
      * (hooke), so the truncation error is ~eps^2 and the rounding ~1e-16/eps, both far below
      * the accuracy a time scale needs */
-    double k_n = (force_at_rest(sim, *c, overlap * (1 + eps)) -
-                  force_at_rest(sim, *c, overlap * (1 - eps))) /
+    double k_n = (wetdem_sim_force_at_rest(sim, *c, NULL, -overlap * (1 + eps)) -
+                  wetdem_sim_force_at_rest(sim, *c, NULL, -overlap * (1 - eps))) /
                  (2 * eps * overlap);
     /* k_t from a spring stretched by u dt and by 2 u dt at the same sliding speed u: the
      * difference removes the dashpots (mindlin's, and any viscous tangential law), which
