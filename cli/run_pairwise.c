@@ -482,13 +482,6 @@ static void events_csv(FILE* f, const struct wetdem_pairwise* pw)
                 ev[e].k + 1, ev[e].l + 1, ev[e].gap, ev[e].v_n);
 }
 
-/* The [output] name of a file in --out DIR ("" for "none": not written). */
-static const char* out_name(const struct cli_scenario* sc, const char* key, const char* def)
-{
-    const char* name = cli_scenario_text(sc, "output", key, def);
-    return strcmp(name, "none") == 0 ? "" : name;
-}
-
 /* The run with files in opt->out_dir: the trajectory written during the run, events and
  * summary after it, each under a temporary name renamed only when the run succeeded and the
  * file was written whole (a failed or interrupted run leaves nothing under the final names).
@@ -500,7 +493,11 @@ static int run_with_files(const struct cli_scenario* sc, const struct cli_run_op
     struct cli_out_file ft, fe, fs;
     double dt = cli_scenario_number(sc, "output", "trajectory_interval", 0.0);
     dt = dt > 0.0 ? dt : cfg->t_end / 2000.0;
-    const char* traj_name = out_name(sc, "trajectory", "trajectory.csv");
+    char traj_name[CLI_VALUE_MAX], events_name[CLI_VALUE_MAX], summary_name[CLI_VALUE_MAX];
+    /* (checked by build_config: cli_scenario_check_outputs) */
+    cli_scenario_out_name(sc, "output", "trajectory", "trajectory.csv", traj_name);
+    cli_scenario_out_name(sc, "output", "events", "events.csv", events_name);
+    cli_scenario_out_name(sc, "output", "summary", "summary.json", summary_name);
     int rc = traj_name[0] ? cli_scenario_check_trajectory(
                                 sc, cli_scenario_has_section(sc, "davis") ? "davis" : "pairwise",
                                 cfg->t_end, dt)
@@ -540,8 +537,8 @@ static int run_with_files(const struct cli_scenario* sc, const struct cli_run_op
         return CLI_EXIT_RUNTIME;
     }
     struct cli_out_file* files[3] = {&ft, &fe, &fs};
-    if (cli_out_open(&fe, "run", opt->out_dir, out_name(sc, "events", "events.csv")) != 0 ||
-        cli_out_open(&fs, "run", opt->out_dir, out_name(sc, "summary", "summary.json")) != 0) {
+    if (cli_out_open(&fe, "run", opt->out_dir, events_name) != 0 ||
+        cli_out_open(&fs, "run", opt->out_dir, summary_name) != 0) {
         cli_out_close_all(files, 2, "run", false);
         int stopped = guarded ? cli_signals_finish_run("run", &saved) : 0;
         return stopped ? stopped : CLI_EXIT_RUNTIME;

@@ -196,6 +196,12 @@ int cli_scenario_integrator_name_typo(const struct cli_scenario* sc, const struc
 /* A trajectory of t_end / interval rows [s / s]: CLI_EXIT_OK if at most
  * CLI_MAX_TRAJECTORY_ROWS, else the message at [output] trajectory_interval (or at [output],
  * else at [run_section], when the interval is automatic) and CLI_EXIT_USAGE. */
+/* The file name that `key` of [section] gives in the --out directory (def when not given), ""
+ * for "none", into out (CLI_VALUE_MAX chars). A given name must be a plain file name: not
+ * empty, no '/', not starting with '.'. Returns an exit code (the message at the key). */
+int cli_scenario_out_name(const struct cli_scenario* sc, const char* section, const char* key,
+                          const char* def, char* out);
+
 /* Checks the [output] names of a collision run: each a plain file name in the --out
  * directory (no '/', not starting with '.') or none, and no two the same (the one written
  * last would replace the other). Returns an exit code (message printed). */

@@ -407,32 +407,34 @@ static int build_kinematics(const struct cli_scenario* sc, struct cli_setup* su,
     return CLI_EXIT_OK;
 }
 
-static void output_name(const struct cli_scenario* sc, const char* key, const char* def, char* out)
+int cli_scenario_out_name(const struct cli_scenario* sc, const char* section, const char* key,
+                          const char* def, char* out)
 {
-    const char* v = cli_scenario_text(sc, "output", key, def);
+    const struct cli_entry* e = cli_scenario_find(sc, section, key);
+    const char* v = e ? e->value : def;
     snprintf(out, CLI_VALUE_MAX, "%s", strcmp(v, "none") == 0 ? "" : v);
+    if (e && (strchr(v, '/') || !v[0] || v[0] == '.')) {
+        cli_scenario_error(sc, e,
+                           "a file name in the --out directory (no '/', not starting with '.'), "
+                           "or none");
+        return CLI_EXIT_USAGE;
+    }
+    return CLI_EXIT_OK;
 }
 
 int cli_scenario_check_outputs(const struct cli_scenario* sc)
 {
     static const char* const key[3] = {"trajectory", "events", "summary"};
     static const char* const def[3] = {"trajectory.csv", "events.csv", "summary.json"};
-    const struct cli_entry* e[3];
-    const char* name[3];
-    for (int k = 0; k < 3; k++) {
-        e[k] = cli_scenario_find(sc, "output", key[k]);
-        name[k] = e[k] ? e[k]->value : def[k];
-        if (e[k] && (strchr(name[k], '/') || !name[k][0] || name[k][0] == '.')) {
-            cli_scenario_error(sc, e[k],
-                               "a file name in the --out directory (no '/', not starting with "
-                               "'.'), or none");
+    char name[3][CLI_VALUE_MAX];
+    for (int k = 0; k < 3; k++)
+        if (cli_scenario_out_name(sc, "output", key[k], def[k], name[k]) != CLI_EXIT_OK)
             return CLI_EXIT_USAGE;
-        }
-    }
     for (int k = 1; k < 3; k++)
         for (int j = 0; j < k; j++)
-            if (strcmp(name[k], "none") != 0 && strcmp(name[k], name[j]) == 0) {
-                cli_scenario_error(sc, e[k] ? e[k] : e[j],
+            if (name[k][0] && strcmp(name[k], name[j]) == 0) {
+                const struct cli_entry* e = cli_scenario_find(sc, "output", key[k]);
+                cli_scenario_error(sc, e ? e : cli_scenario_find(sc, "output", key[j]),
                                    "%s would name both the %s and the %s: give the outputs of "
                                    "--out distinct names",
                                    name[k], key[j], key[k]);
@@ -491,9 +493,10 @@ int cli_scenario_build(const struct cli_scenario* sc, struct cli_setup* su)
         cli_setup_free(su);
         return rc;
     }
-    output_name(sc, "trajectory", "trajectory.csv", su->trajectory_file);
-    output_name(sc, "events", "events.csv", su->events_file);
-    output_name(sc, "summary", "summary.json", su->summary_file);
+    /* (checked by cli_scenario_check_outputs above) */
+    cli_scenario_out_name(sc, "output", "trajectory", "trajectory.csv", su->trajectory_file);
+    cli_scenario_out_name(sc, "output", "events", "events.csv", su->events_file);
+    cli_scenario_out_name(sc, "output", "summary", "summary.json", su->summary_file);
     return CLI_EXIT_OK;
 }
 

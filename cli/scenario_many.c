@@ -826,22 +826,6 @@ static int build_spheres(const struct cli_scenario* sc, struct cli_many_setup* s
 
 /* --------------------------------------------------------------------- run and dump --- */
 
-/* A [dump] file name: "" for none; must be a plain name (no '/') so that everything stays in
- * the --out directory. */
-static int dump_name(const struct cli_scenario* sc, const char* key, const char* def, char* out)
-{
-    const struct cli_entry* e = cli_scenario_find(sc, "dump", key);
-    const char* v = e ? e->value : def;
-    snprintf(out, CLI_VALUE_MAX, "%s", strcmp(v, "none") == 0 ? "" : v);
-    if (e && (strchr(v, '/') || !v[0] || v[0] == '.')) {
-        cli_scenario_error(sc, e,
-                           "a file name in the --out directory (no '/', not starting "
-                           "with '.'), or none");
-        return CLI_EXIT_USAGE;
-    }
-    return CLI_EXIT_OK;
-}
-
 /* The files of --out DIR must not share a name (the one written last would replace the
  * other, and a fresh run removes whatever is named as its frames): the CSV, the checkpoint,
  * the summary, the frames' index and their links' index (each also as its temporary
@@ -930,10 +914,14 @@ static int build_run(const struct cli_scenario* sc, struct cli_many_setup* su)
     su->vtk_binary = strcmp(cli_scenario_text(sc, "dump", "vtk_binary", "yes"), "yes") == 0;
     su->vtk_links = strcmp(cli_scenario_text(sc, "dump", "vtk_links", "no"), "yes") == 0;
     int rc;
-    if ((rc = dump_name(sc, "vtk", "particles", su->vtk_prefix)) != CLI_EXIT_OK ||
-        (rc = dump_name(sc, "csv", "global.csv", su->csv_name)) != CLI_EXIT_OK ||
-        (rc = dump_name(sc, "checkpoint", "checkpoint.ckpt", su->checkpoint_name)) != CLI_EXIT_OK ||
-        (rc = dump_name(sc, "summary", "summary.json", su->summary_name)) != CLI_EXIT_OK)
+    if ((rc = cli_scenario_out_name(sc, "dump", "vtk", "particles", su->vtk_prefix)) !=
+            CLI_EXIT_OK ||
+        (rc = cli_scenario_out_name(sc, "dump", "csv", "global.csv", su->csv_name)) !=
+            CLI_EXIT_OK ||
+        (rc = cli_scenario_out_name(sc, "dump", "checkpoint", "checkpoint.ckpt",
+                                    su->checkpoint_name)) != CLI_EXIT_OK ||
+        (rc = cli_scenario_out_name(sc, "dump", "summary", "summary.json", su->summary_name)) !=
+            CLI_EXIT_OK)
         return rc;
     size_t len = strlen(su->csv_name);
     if (len && (len < 5 || strcmp(su->csv_name + len - 4, ".csv") != 0)) {

@@ -797,10 +797,6 @@ static int check_restorable(struct wetdem_sim* sim, const struct wetdem_checkpoi
                                path);
     for (size_t k = 0; k < n; k++) {
         const struct wetdem_particle* p = &ck->particles[k];
-        if (p->material < 0 || p->material >= sim->n_materials)
-            return wetdem_sim_fail(sim, WETDEM_ERR_PARSE,
-                                   "checkpoint '%s': particle %zu has material %d", path, k,
-                                   p->material);
         char why[256]; /* what wetdem_sim_add_particle accepts */
         if (!wetdem_sim_particle_valid(sim, p, why, sizeof why))
             return wetdem_sim_fail(sim, WETDEM_ERR_PARSE, "checkpoint '%s': particle %zu: %s", path,
