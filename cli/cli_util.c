@@ -52,16 +52,33 @@ int cli_number(const char* text, double* out)
     char* end = NULL;
     errno = 0;
     double v = strtod(text, &end);
-    if (end != p || errno == ERANGE || !isfinite(v))
+    if (end != p)
+        return -1;
+    if (errno == ERANGE) /* (strtod's ERANGE: overflow to inf, or an underflow below DBL_MIN) */
+        return fabs(v) >= 1 ? -2 : -3;
+    if (!isfinite(v))
         return -1;
     *out = v;
     return 0;
 }
 
+const char* cli_number_problem(const char* text)
+{
+    double v;
+    switch (cli_number(text, &v)) {
+    case 0: return NULL;
+    case -2: return "beyond the range of a double (magnitude up to 1.8e308)";
+    case -3:
+        return "below the smallest normal double (magnitude 2.2e-308): write 0 or a larger "
+               "value";
+    default: return "not a finite number";
+    }
+}
+
 int cli_parse_double(const char* text, const char* what, double* out)
 {
     if (cli_number(text, out) != 0) {
-        cli_error("%s: '%s' is not a finite number", what, text);
+        cli_error("%s: '%s' is %s", what, text, cli_number_problem(text));
         return CLI_EXIT_USAGE;
     }
     return CLI_EXIT_OK;
@@ -363,8 +380,8 @@ int cli_write_output(const char* path, const char* what, void (*write)(FILE* f, 
                      const void* ctx)
 {
     if (!path) {
-        write(stdout, ctx);
-        return fflush(stdout) == 0 ? CLI_EXIT_OK : CLI_EXIT_RUNTIME;
+        write(stdout, ctx); /* a failed write is reported at the exit (main's finish_stdout) */
+        return CLI_EXIT_OK;
     }
     const struct cli_output out = {path, write, ctx};
     return cli_write_outputs(&out, 1, what);
@@ -392,6 +409,71 @@ int cli_out_close(struct cli_out_file* o, const char* what, bool keep)
     return cli_out_close_all(files, 1, what, keep);
 }
 
+/* The name an existing target is kept under while its set is replaced: its temporary name
+ * with ".old" appended. */
+static void backup_name(const struct cli_out_file* o, char* buf, size_t size)
+{
+    snprintf(buf, size, "%s.old", o->tmp);
+}
+
+/* Puts the set's targets back as they were before the first k renames of replace_set: the
+ * new files removed, the old ones (had[j]) renamed back. */
+static void restore_set(struct cli_out_file* const* files, size_t k, const bool* had,
+                        const bool* placed)
+{
+    char old[1500];
+    for (size_t j = 0; j < k; j++) {
+        if (placed[j])
+            remove(files[j]->final);
+        backup_name(files[j], old, sizeof old);
+        if (had[j])
+            rename(old, files[j]->final);
+    }
+}
+
+/* Replaces the targets of the n written files as one set: every existing target is first
+ * moved aside (to its backup name), then every temporary file renamed into place, then the
+ * backups removed. When any rename fails, the renames already made are undone, so the set is
+ * replaced whole or not at all (a renaming the directory refuses, e.g. a sticky directory's
+ * file of another user, fails in the first pass). 0, or the index of the file that failed
+ * + 1 with *err its errno. */
+static size_t replace_set(struct cli_out_file* const* files, size_t n, int* err)
+{
+    bool had[CLI_MAX_OUTPUTS] = {false}, placed[CLI_MAX_OUTPUTS] = {false};
+    char old[1500];
+    n = n < CLI_MAX_OUTPUTS ? n : CLI_MAX_OUTPUTS;
+    for (size_t k = 0; k < n; k++) {
+        const struct cli_out_file* o = files[k];
+        struct stat st;
+        if (!o->tmp[0] || o->direct || lstat(o->final, &st) != 0)
+            continue;
+        backup_name(o, old, sizeof old);
+        if (S_ISDIR(st.st_mode) || rename(o->final, old) != 0) {
+            *err = S_ISDIR(st.st_mode) ? EISDIR : errno;
+            restore_set(files, k, had, placed);
+            return k + 1;
+        }
+        had[k] = true;
+    }
+    for (size_t k = 0; k < n; k++) {
+        const struct cli_out_file* o = files[k];
+        if (!o->tmp[0] || o->direct)
+            continue;
+        if (rename(o->tmp, o->final) != 0) {
+            *err = errno;
+            restore_set(files, n, had, placed);
+            return k + 1;
+        }
+        placed[k] = true;
+    }
+    for (size_t k = 0; k < n; k++)
+        if (had[k]) {
+            backup_name(files[k], old, sizeof old);
+            remove(old);
+        }
+    return 0;
+}
+
 int cli_out_close_all(struct cli_out_file* const* files, size_t n, const char* what, bool keep)
 {
     int failed = -1, err = 0; /* the first file that could not be written whole, and why */
@@ -403,17 +485,14 @@ int cli_out_close_all(struct cli_out_file* const* files, size_t n, const char* w
             err = e;
         }
     }
-    keep = keep && failed < 0;
+    if (keep && failed < 0) {
+        size_t bad = replace_set(files, n, &err);
+        failed = bad ? (int)bad - 1 : -1;
+    }
     for (size_t k = 0; k < n; k++) {
         struct cli_out_file* o = files[k];
-        if (!o->tmp[0] || o->direct)
-            continue; /* (not wanted; or written in place, which cannot be taken back) */
-        if (keep && rename(o->tmp, o->final) != 0 && failed < 0) {
-            failed = (int)k;
-            err = errno;
-            keep = false; /* the rest are removed: the set is incomplete */
-        }
-        if (!keep)
+        /* (not wanted, or written in place, which cannot be taken back; kept ones are gone) */
+        if (o->tmp[0] && !o->direct)
             remove(o->tmp);
         o->tmp[0] = '\0';
     }

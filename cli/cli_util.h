@@ -32,9 +32,13 @@ void cli_error(const char* fmt, ...) __attribute__((format(printf, 1, 2)));
 
 /* Parses the whole of `text` as one finite number in plain decimal or exponent notation
  * ("6.35e-3", "-2", "+.5E4": the syntax docs/scenarios.md gives; not hexadecimal, "inf" or
- * "nan", which strtod would also take, nor a value beyond the range of a double). 0 and *out
- * set, or -1. */
+ * "nan", which strtod would also take, nor a value beyond the range of a double or below
+ * its smallest normal value). 0 and *out set; or -1 (syntax), -2 (overflow), -3 (underflow). */
 int cli_number(const char* text, double* out);
+
+/* What is wrong with `text` as a number ("not a finite number", "beyond the range of a double
+ * ...", "below the smallest normal double ..."); NULL when cli_number takes it. */
+const char* cli_number_problem(const char* text);
 
 /* Parses `text` as one finite number (cli_number). `what`
  * names the option in the error message, e.g. "--speed". Returns CLI_EXIT_OK and sets *out,
@@ -159,7 +163,8 @@ int cli_out_open(struct cli_out_file* o, const char* what, const char* dir, cons
 int cli_out_close(struct cli_out_file* o, const char* what, bool keep);
 
 /* Closes the n files of one result as a set: with keep, and only when every one was written
- * whole, renames them all to their final names; otherwise removes every temporary file, so a
+ * whole, renames them all to their final names (n <= CLI_MAX_OUTPUTS; a rename that fails
+ * undoes the others, the older files put back); otherwise removes every temporary file, so a
  * run never leaves some of its files beside older ones. Files not open are skipped. 0, or -1
  * after printing "wetdem: <what>: cannot write <final>: <why>" for the first that failed. */
 int cli_out_close_all(struct cli_out_file* const* files, size_t n, const char* what, bool keep);

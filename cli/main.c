@@ -3,8 +3,12 @@
  * `wetdem docs-cli`, the command-line reference (docs/cli.md) made of every command's --help.
  * Subcommands that a build does not contain are reported as such (weak symbols).
  */
+#include <errno.h>
+#include <fcntl.h>
+#include <stdbool.h>
 #include <stdio.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "cli.h"
 #include "cli_util.h"
@@ -113,7 +117,40 @@ static int cmd_docs_cli(int argc, char** argv)
     return fflush(stdout) == 0 ? CLI_EXIT_OK : CLI_EXIT_RUNTIME;
 }
 
-int main(int argc, char** argv)
+/* The exit code of a command whose results went to standard output: rc, unless writing them
+ * failed (a full disk, a closed descriptor), which a redirected table would otherwise hide
+ * behind exit 0. A broken pipe ends the process by SIGPIPE before this. */
+static int finish_stdout(int rc)
+{
+    errno = 0;
+    bool bad = fflush(stdout) != 0 || ferror(stdout);
+    int err = errno;
+    if (fclose(stdout) != 0 && !bad) {
+        bad = true;
+        err = errno;
+    }
+    if (!bad)
+        return rc;
+    /* EBADF: stdout was closed before the start; nothing was written there */
+    fprintf(stderr, "wetdem: cannot write standard output: %s\n", strerror(err ? err : EIO));
+    return rc == CLI_EXIT_OK ? CLI_EXIT_RUNTIME : rc;
+}
+
+/* Opens /dev/null on each of the standard descriptors that is closed, the wrong way round
+ * (read-only for output, write-only for input): no file the run opens can take a standard
+ * descriptor's number and receive the table meant for stdout, and a write to a closed stdout
+ * still fails (EBADF), as finish_stdout reports. */
+static void guard_std_descriptors(void)
+{
+    for (int fd = 0; fd <= 2; fd++)
+        if (fcntl(fd, F_GETFD) == -1 && errno == EBADF) {
+            int got = open("/dev/null", fd == 0 ? O_WRONLY : O_RDONLY);
+            if (got >= 0 && got != fd) /* a lower one was closed too and took it: next round */
+                close(got);
+        }
+}
+
+static int dispatch(int argc, char** argv)
 {
     if (argc < 2) {
         print_help(stderr);
@@ -145,4 +182,10 @@ int main(int argc, char** argv)
     fprintf(stderr, "wetdem: unknown command '%s'%s%s%s; see 'wetdem --help'\n", argv[1],
             hint ? " (did you mean '" : "", hint ? hint : "", hint ? "'?)" : "");
     return CLI_EXIT_USAGE;
+}
+
+int main(int argc, char** argv)
+{
+    guard_std_descriptors();
+    return finish_stdout(dispatch(argc, argv));
 }

@@ -97,6 +97,25 @@ static int series_clear(const struct series* s)
     return rc;
 }
 
+/* A fresh run replaces the run in its directory (as series_clear its frames): removes the
+ * summary, global CSV and checkpoint an earlier run left there under this run's names, or,
+ * for an output this run does not write, under the default names; the summary first, so a
+ * run that fails or is killed before its end leaves no summary beside its files that
+ * describes the earlier run. 0, or -1 with errno set. */
+static int outputs_clear(const char* dir, const struct cli_many_setup* su)
+{
+    const char* names[][2] = {{su->summary_name, "summary.json"},
+                              {su->csv_name, "global.csv"},
+                              {su->checkpoint_name, "checkpoint.ckpt"}};
+    for (size_t k = 0; k < sizeof names / sizeof names[0]; k++) {
+        char path[PATH_CHARS + CLI_VALUE_MAX];
+        snprintf(path, sizeof path, "%s/%s", dir, names[k][0][0] ? names[k][0] : names[k][1]);
+        if (unlink(path) != 0 && errno != ENOENT)
+            return -1;
+    }
+    return 0;
+}
+
 /* Writes the .vtk.series index of the frames (links: of their links; temporary file, then
  * rename). 0, or -1 with errno set. */
 static int series_write_one(const struct series* s, bool links)
@@ -565,8 +584,9 @@ static int write_summary(const char* dir, const struct cli_scenario* sc,
     ok = f && fclose(f) == 0 && ok;
     if (ok && rename(tmp, path) == 0)
         return CLI_EXIT_OK;
+    int err = errno ? errno : EIO;
     remove(tmp);
-    cli_error("run: cannot write %s", path);
+    cli_error("run: cannot write %s: %s", path, strerror(err));
     return CLI_EXIT_RUNTIME;
 }
 
@@ -784,6 +804,16 @@ static int restore(const struct cli_many_setup* su, const struct cli_run_options
     }
     struct wetdem_many_stats s;
     wetdem_sim_many_stats(su->sim, &s);
+    /* the step is the checkpoint's; one the scenario now derives otherwise ([integrator]
+       dt_fraction, a material's stiffness: not in the checkpoint's fingerprint, which holds
+       the settings' dt) would misplace the run's end, its frames and its CSV rows */
+    if (s.dt != pl->dt) {
+        cli_error("--restart %s: the checkpoint's step is dt = %.9g s, this scenario's %.9g s "
+                  "(run.dt, integrator.dt or dt_fraction, the materials): resume with the "
+                  "scenario of the run that wrote it",
+                  opt->restart, s.dt, pl->dt);
+        return CLI_EXIT_USAGE;
+    }
     if (s.step >= pl->total) {
         cli_error("--restart %s: the checkpoint is at step %llu (t = %.9g s), and this run ends "
                   "at step %llu ([run] t_end = %.9g s): the run that wrote it had reached its "
@@ -940,6 +970,11 @@ static int run(const struct cli_scenario* sc, struct cli_many_setup* su,
     if (vtk && !opt->restart && series_clear(vtk) != 0) {
         cli_error("run: cannot remove the frames %s_NNNNNN.vtk of an earlier run in %s: %s",
                   vtk->prefix, vtk->dir, strerror(errno));
+        return CLI_EXIT_RUNTIME;
+    }
+    if (opt->out_dir && !opt->restart && outputs_clear(opt->out_dir, su) != 0) {
+        cli_error("run: cannot remove the summary, CSV or checkpoint of an earlier run in %s: %s",
+                  opt->out_dir, strerror(errno));
         return CLI_EXIT_RUNTIME;
     }
     /* from the first output on, until every file is written: a signal asks for a stop */

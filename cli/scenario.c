@@ -269,9 +269,8 @@ static int check_number(const struct cli_scenario* sc, const struct cli_entry* e
 {
     double v;
     if (cli_number(e->value, &v) != 0) {
-        cli_scenario_error(sc, e,
-                           "not a finite number%s%s%s (decimal or exponent notation, "
-                           "e.g. 6.35e-3)",
+        const char* why = cli_number_problem(e->value);
+        cli_scenario_error(sc, e, "%s%s%s%s (decimal or exponent notation, e.g. 6.35e-3)", why,
                            d->unit[0] ? " [" : "", d->unit, d->unit[0] ? "]" : "");
         return CLI_EXIT_USAGE;
     }
@@ -561,6 +560,17 @@ static char* read_line(char* str, int num, void* stream)
     if (memchr(text, '\0', (size_t)got)) { /* a binary file: one message, not one a line */
         fprintf(stderr, "%s:%d: a NUL byte: not a text (INI) scenario file\n", r->sc->file,
                 r->line);
+        r->n_errors++;
+        return NULL;
+    }
+    const char* cr = memchr(text, '\r', (size_t)got);
+    size_t at = cr ? (size_t)(cr - text) : 0, n_got = (size_t)got;
+    /* (CRLF, or a CR last in the file, ends a line; a CR inside one ends lines too) */
+    if (cr && !(at + 1 == n_got || (at + 2 == n_got && text[at + 1] == '\n'))) {
+        fprintf(stderr,
+                "%s:%d: a carriage return inside the line: line endings of classic Mac OS (CR "
+                "only)? convert them: tr '\\r' '\\n' < FILE > NEW\n",
+                r->sc->file, r->line);
         r->n_errors++;
         return NULL;
     }

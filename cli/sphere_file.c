@@ -248,8 +248,8 @@ static int read_csv(char* text, bool marks_fixed, struct wetdem_particle** out, 
             if (col[c] < 0)
                 continue;
             if (cli_number(f[col[c]], &v[c]) != 0)
-                return fail(err, err_len, "%zu: %s = '%s' is not a finite number", line_no,
-                            column_names[c], f[col[c]]);
+                return fail(err, err_len, "%zu: %s = '%s' is %s", line_no, column_names[c],
+                            f[col[c]], cli_number_problem(f[col[c]]));
             if (!in_range(c, v[c], err, err_len, where))
                 return CLI_EXIT_USAGE;
         }
@@ -362,8 +362,8 @@ static int vtk_values(struct vtk_cursor* c, size_t count, const char* type, doub
         word[m] = '\0';
         double v;
         if (cli_number(word, &v) != 0)
-            return fail(err, err_len, "%s: value %zu, '%s', is not a finite number", what, k + 1,
-                        word);
+            return fail(err, err_len, "%s: value %zu, '%s', is %s", what, k + 1, word,
+                        cli_number_problem(word));
         if (out)
             out[k] = v;
     }

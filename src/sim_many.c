@@ -1160,6 +1160,8 @@ static int start(struct wetdem_sim* sim)
         return st;
     m->t0 = sim->engine.time;
     m->step = 0;
+    /* the first periodic checkpoint at step checkpoint_every (a restored run sets its own) */
+    m->next_checkpoint_step = m->set.checkpoint_every;
     st = forces_and_work(sim, WETDEM_MANY_END_NONE);
     if (st != WETDEM_OK)
         return st;

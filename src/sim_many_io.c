@@ -15,6 +15,7 @@
 #include <stdio.h>
 #include <unistd.h>
 #include <stdlib.h>
+#include <errno.h>
 #include <string.h>
 
 #include "checkpoint.h"
@@ -494,7 +495,9 @@ static int write_csv_row(struct wetdem_sim* sim, const struct wetdem_many_stats*
     int st = prefixed(sim, path, sizeof path, CSV_SUFFIX);
     FILE* f = st == WETDEM_OK ? fopen(path, m->csv_rows ? "a" : "w") : NULL;
     if (!f)
-        return st != WETDEM_OK ? st : wetdem_sim_fail(sim, WETDEM_ERR_IO, "cannot open '%s'", path);
+        return st != WETDEM_OK ? st
+                               : wetdem_sim_fail(sim, WETDEM_ERR_IO, "cannot open '%s': %s", path,
+                                                 strerror(errno));
     /* a header for a new file, also when a resumed run's CSV is missing or empty */
     if (m->csv_rows == 0 || (fseek(f, 0, SEEK_END) == 0 && ftell(f) == 0))
         csv_header(sim, f);
@@ -522,10 +525,14 @@ static int write_csv_row(struct wetdem_sim* sim, const struct wetdem_many_stats*
         fprintf(f, ",%.9g,%.3g", b.dissipated, b.balance_error);
     }
     fputc('\n', f);
+    errno = 0;
     bool ok = !ferror(f);
     ok = fclose(f) == 0 && ok;
+    int err = errno ? errno : EIO; /* (a write's own errno may be gone; fclose's flush fails
+                                      again with the reason) */
     m->csv_rows++;
-    return ok ? WETDEM_OK : wetdem_sim_fail(sim, WETDEM_ERR_IO, "cannot write '%s'", path);
+    return ok ? WETDEM_OK
+              : wetdem_sim_fail(sim, WETDEM_ERR_IO, "cannot write '%s': %s", path, strerror(err));
 }
 
 int wetdem_sim_many_write_csv_row(struct wetdem_sim* sim)

@@ -11,6 +11,7 @@
  * The CLI path comes from the environment variable WETDEM_CLI (set by `make test`), falling
  * back to build/wetdem relative to the working directory (the repository root).
  */
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "harness.h"
@@ -412,6 +413,114 @@ static const char* temp_scenario(const char* text)
     return path;
 }
 
+/* Runs "'<CLI>' args" with stderr to the pipe read and stdout where args send it; the exit
+ * code, stderr in *err (caller frees). */
+static int run_cli_stderr(const char* args, char** err)
+{
+    char cmd[1024];
+    snprintf(cmd, sizeof cmd, "'%s' %s", test_cli_path(), args);
+    FILE* p = popen(cmd, "r");
+    assert_non_null(p);
+    *err = test_slurp(p, NULL);
+    int status = pclose(p);
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+/* A table that cannot be written to standard output (a full disk, a closed descriptor) is an
+ * error with the reason, exit 1: it was exit 0 with a truncated table, and a redirected
+ * `wetdem docs-models > docs/models.md` on a full disk left half a file. A command that
+ * writes nothing there is not affected by a closed stdout. */
+static void test_cli_stdout_write_failures(void** state)
+{
+    (void)state;
+    static const struct {
+        const char* args;
+        int code;
+        const char* message;
+    } cases[] = {
+        {"forces hertz 2>&1 >/dev/full", 1, "cannot write standard output: No space left"},
+        {"models 2>&1 >/dev/full", 1, "cannot write standard output: No space left"},
+        {"describe hertz 2>&1 >&-", 1, "cannot write standard output: Bad file descriptor"},
+        {"--version 2>&1 >/dev/full", 1, "cannot write standard output"},
+        {"sweep examples/scenarios/dry_hertz.ini --param collision.speed --values 0.1:0.5:3 "
+         "2>&1 >/dev/full",
+         1, "cannot write standard output: No space left"},
+        {"describe hertz 2>&1 >/dev/null", 0, ""},
+        {"run examples/scenarios/dry_hertz.ini --check --json 2>&1 >/dev/null", 0, ""},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        char* err;
+        int code = run_cli_stderr(cases[k].args, &err);
+        if (code != cases[k].code)
+            fail_msg("'%s' exited %d, expected %d:\n%s", cases[k].args, code, cases[k].code, err);
+        CHECK_CONTAINS(err, cases[k].message);
+        free(err);
+    }
+}
+
+/* Numbers a double cannot hold are named as such (they were "not a finite number"), and a
+ * file with classic Mac OS line endings (CR only), which inih read as one line, is named as
+ * that (it was "no [section] in the file"). */
+static void test_cli_numbers_out_of_range_and_cr_lines(void** state)
+{
+    (void)state;
+    static const struct cli_case cases[] = {
+        {"run examples/scenarios/dry_hertz.ini --check --set collision.speed=4.9e-324",
+         "collision.speed=4.9e-324: below the smallest normal double", 2},
+        {"run examples/scenarios/dry_hertz.ini --check --set collision.speed=-1e999",
+         "collision.speed=-1e999: beyond the range of a double", 2},
+        {"forces --model reynolds --radius 1e-400", "'1e-400' is below the smallest normal double",
+         2},
+    };
+    check_cli_cases(cases, sizeof cases / sizeof cases[0]);
+    const char* path = temp_scenario("[collision]\rspeed = 0.1\r[models]\rforce = hertz\r");
+    char args[128];
+    snprintf(args, sizeof args, "run %s --check", path);
+    struct test_run r = run_cli(args, true);
+    assert_int_equal(r.code, 2);
+    CHECK_CONTAINS(r.out, ":1: a carriage return inside the line");
+    free(r.out);
+    remove(path);
+}
+
+/* The files of one run are replaced as a set, whole or not at all: when one target cannot be
+ * replaced (here events.csv is a directory) the others keep the earlier run's contents, and
+ * no temporary or backup file is left. Before, the files renamed ahead of it were the new
+ * run's and the rest the old run's. */
+static void test_cli_run_outputs_replaced_whole_or_not_at_all(void** state)
+{
+    (void)state;
+    char dir[] = "/tmp/wetdem_test_cli_set_XXXXXX";
+    assert_non_null(mkdtemp(dir));
+    char args[256], path[300];
+    snprintf(args, sizeof args, "run examples/scenarios/dry_hertz.ini --out %s", dir);
+    struct test_run r = run_cli(args, true);
+    assert_int_equal(r.code, 0);
+    free(r.out);
+    snprintf(path, sizeof path, "%s/trajectory.csv", dir);
+    test_write_file(path, "OLD\n");
+    snprintf(path, sizeof path, "%s/events.csv", dir);
+    assert_int_equal(remove(path), 0);
+    assert_int_equal(mkdir(path, 0755), 0);
+    r = run_cli(args, true);
+    assert_int_equal(r.code, 1);
+    CHECK_CONTAINS(r.out, "events.csv: Is a directory");
+    free(r.out);
+    snprintf(path, sizeof path, "%s/trajectory.csv", dir);
+    char* text = test_read_file(path, NULL);
+    assert_non_null(text);
+    assert_string_equal(text, "OLD\n");
+    free(text);
+    snprintf(args, sizeof args, "ls -A %s", dir);
+    FILE* p = popen(args, "r");
+    char* names = test_slurp(p, NULL);
+    pclose(p);
+    assert_string_equal(names, "events.csv\nsummary.json\ntrajectory.csv\n");
+    free(names);
+    snprintf(args, sizeof args, "rm -rf '%s'", dir);
+    assert_int_equal(system(args), 0);
+}
+
 /* A [model.NAME] section of the file for a model that a --set of [models] switched away from
  * is ignored, so one file serves both choices (the files below hold [model.fixed] and
  * [model.glass], for the models they choose); a --set of such a parameter, a section the
@@ -496,6 +605,9 @@ int main(void)
         cmocka_unit_test(test_cli_unused_model_sections),
         cmocka_unit_test(test_cli_integrator_names_in_set),
         cmocka_unit_test(test_cli_fuzz_regressions),
+        cmocka_unit_test(test_cli_stdout_write_failures),
+        cmocka_unit_test(test_cli_run_outputs_replaced_whole_or_not_at_all),
+        cmocka_unit_test(test_cli_numbers_out_of_range_and_cr_lines),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -486,6 +486,23 @@ static void test_many_stop_flag_writes_a_checkpoint(void** state)
     wetdem_sim_free(sim);
 }
 
+/* The periodic checkpoint of a fresh run is first written at step checkpoint_every, not at
+ * step 1 (a full write and sync no one asked for, and a checkpoint a killed run would have
+ * resumed from the start with). */
+static void test_many_first_checkpoint_at_its_interval(void** state)
+{
+    (void)state;
+    char path[] = "/tmp/wetdem_test_many_first_ckpt_XXXXXX";
+    struct wetdem_sim* sim = stoppable_box(path, NULL);
+    sim->many->set.checkpoint_every = 50;
+    CHECK_OK(wetdem_sim_integrate(sim, 49 * 2e-6));
+    assert_int_equal(access(path, F_OK), -1);
+    CHECK_OK(wetdem_sim_integrate(sim, 50 * 2e-6));
+    assert_int_equal(access(path, F_OK), 0);
+    remove(path);
+    wetdem_sim_free(sim);
+}
+
 /* A stop raised while a force pass also began the next step (many.h WETDEM_MANY_END_STEP:
  * the step's state is read by nothing) ends the run after that next step, with a checkpoint
  * from which the run goes on bit for bit as if never stopped. */
@@ -1963,6 +1980,7 @@ int main(void)
         cmocka_unit_test(test_many_restart_refuses_impossible_states),
         cmocka_unit_test(test_many_restart_reads_checkpoints_with_contact_counts),
         cmocka_unit_test(test_many_stop_flag_writes_a_checkpoint),
+        cmocka_unit_test(test_many_first_checkpoint_at_its_interval),
         cmocka_unit_test(test_many_stop_during_a_drifting_step_loses_nothing),
         cmocka_unit_test(test_many_deferred_kick_is_bit_identical),
         cmocka_unit_test(test_many_displacement_bound_rebuilds_at_the_same_steps),

@@ -740,6 +740,52 @@ static void test_many_cli_fresh_run_replaces_earlier_frames(void** state)
     free(index);
     assert_true(exists("reuse/particles_links_000004.vtk"));
     assert_false(exists("reuse/particles_links_000002.vtk"));
+    /* a fresh run that fails leaves no summary of the earlier run beside its own files (the
+       final checkpoint cannot be written: its temporary name is a directory) */
+    assert_true(exists("reuse/summary.json"));
+    assert_int_equal(mkdir(tpath("reuse/checkpoint.ckpt.tmp"), 0755), 0);
+    free(expect_exit("run frames.ini --set run.steps=200 --out reuse", 1, "checkpoint"));
+    assert_false(exists("reuse/summary.json"));
+    assert_int_equal(rmdir(tpath("reuse/checkpoint.ckpt.tmp")), 0);
+    /* nor, when it writes neither, the earlier run's CSV and checkpoint */
+    assert_int_equal(run_cli("run frames.ini --set run.steps=200 --out reuse"), 0);
+    assert_int_equal(run_cli("run frames.ini --set run.steps=200 --set dump.csv=none "
+                             "--set dump.checkpoint=none --out reuse"),
+                     0);
+    assert_true(exists("reuse/summary.json"));
+    assert_false(exists("reuse/global.csv"));
+    assert_false(exists("reuse/checkpoint.ckpt"));
+}
+
+/* A restart whose scenario derives another step (here [integrator] dt_fraction, which the
+ * checkpoint's fingerprint does not hold: it holds the settings' dt, 0 = derived) is refused
+ * before any file is touched: it ran on with the checkpoint's step, its end and its outputs
+ * placed by the other, and a restart it then found past its end had cut the CSV's last row. */
+static void test_many_cli_restart_refuses_another_step(void** state)
+{
+    (void)state;
+    write_text("derived.ini",
+               WET_BOX "[insert]\ncount = 60\nradius_min = 0.4e-3\nradius_max = 0.5e-3\n"
+                       "material = wet\nseed = 7\n[dump]\ncsv_every = 10\n");
+    assert_int_equal(run_cli("run derived.ini --set run.steps=40 --out der"), 0);
+    char* before = test_read_file(tpath("der/global.csv"), NULL);
+    assert_non_null(before);
+    const char* other = "--set integrator.dt_fraction=0.01 --restart der/checkpoint.ckpt";
+    char args[512];
+    snprintf(args, sizeof args, "run derived.ini --set run.steps=80 %s --out der", other);
+    free(expect_exit(args, 2, "the checkpoint's step is dt = "));
+    snprintf(args, sizeof args, "run derived.ini --set run.steps=20 %s --out der", other);
+    free(expect_exit(args, 2, "the checkpoint's step is dt = "));
+    snprintf(args, sizeof args, "run derived.ini --check --set run.steps=80 %s", other);
+    free(expect_exit(args, 2, "the checkpoint's step is dt = "));
+    char* after = test_read_file(tpath("der/global.csv"), NULL);
+    assert_non_null(after);
+    assert_string_equal(before, after);
+    free(before);
+    free(after);
+    assert_int_equal(run_cli("run derived.ini --set run.steps=80 --out der --restart "
+                             "der/checkpoint.ckpt"),
+                     0);
 }
 
 /* The summary gives a large mean agglomerate size as a whole number: 1000 wet spheres on a
@@ -1284,6 +1330,7 @@ int main(void)
         cmocka_unit_test(test_many_cli_third_signal_stops_at_once),
         cmocka_unit_test(test_many_cli_csv_ends_at_the_last_step),
         cmocka_unit_test(test_many_cli_fresh_run_replaces_earlier_frames),
+        cmocka_unit_test(test_many_cli_restart_refuses_another_step),
         cmocka_unit_test(test_many_cli_summary_mean_size_readable),
         cmocka_unit_test(test_many_cli_progress_only_on_a_terminal),
         cmocka_unit_test(test_many_cli_random_groups_share_the_box),

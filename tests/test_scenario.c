@@ -208,7 +208,7 @@ static void test_scenario_bad_files_exit_2_with_line(void** state)
            here, and 1e-400 would underflow to 0 */
         {"hex", "[collision]\nspeed = 0x10\n", ":2:", "decimal or exponent notation"},
         {"comma", "[collision]\nspeed = 0,5\n", ":2:", "not a finite number"},
-        {"underflow", "[collision]\nspeed = 1e-400\n", ":2:", "not a finite number"},
+        {"underflow", "[collision]\nspeed = 1e-400\n", ":2:", "below the smallest normal double"},
         {"exponent", "[collision]\nspeed = 5e\n", ":2:", "not a finite number"},
         {"preset", "[collision]\nstokes = 5\nstriker = m\n[material.m]\npreset = zzz\n",
          ":5:", "the presets are steel1, steel2"},
