@@ -55,6 +55,10 @@ size_t cli_result_fields(const struct cli_setup* su, const struct wetdem_collisi
                    r->e_t);
     out[n++] = num("e_n_observed", "-", "e_n at observe_time after the first interaction",
                    r->e_n_observed);
+    out[n++] = num("e_n_contact", "-",
+                   "e_n referred to the line of centres at the closest approach (the middle of "
+                   "the last contact; nan without one)",
+                   r->e_n_contact);
     out[n++] = num("energy_ratio", "-",
                    "energy of the relative motion and spins plus that the conservative forces "
                    "store at the gap (elastic overlap, capillary well), at the end over that at "

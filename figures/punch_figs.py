@@ -75,16 +75,27 @@ def fig8_9(d):
     angle_panel(ax, data["fig8d"], "e_n_observed", "Fig. 9: DB, C, e_n at t = 0.07 s", "e_n [-]")
     save(fig, "punch_fig9.png")
     # e_n independent of the angle in contact-bounce (St_n >= 2.5), every model (Punch Sec.
-    # 4.2). The impact angle and v_n0 = U cos(angle) refer to contact of the straight-line
-    # approach (Punch Eq. 16), the rebound to the line of centres at the closest approach:
-    # spread 0.003. Referred to the line where the films part (it turns by ~1 deg from
-    # contact to gap delta_ij at 60 deg) the spread was 0.047.
+    # 4.2, the experiments). The impact angle and v_n0 = U cos(angle) refer to contact of the
+    # straight-line approach (Punch Eq. 16); the contact's own restitution, e_n_contact,
+    # referred to the line of centres at the closest approach, is the same at every angle
+    # (spread 0.003). e_n (Punch Eq. 3, the line where the films part, turned by 1.5-2 deg
+    # from contact at 60 deg) is about 0.04 higher at 60 deg (docs/engines.md).
     for f in FIG8:
         st = data[f][0]["stokes_n"]
-        en = np.array([data[f][a]["e_n"] for a in ANGLES])
+        en = np.array([data[f][a]["e_n_contact"] for a in ANGLES])
         hi = st >= 2.5
         spread = (en.max(axis=0) - en.min(axis=0))[hi].max()
-        check(spread < 0.01, f"{f}: e_n spread over 0-60 deg at St_n >= 2.5 is {spread:.3f} < 0.01")
+        check(spread < 0.01,
+              f"{f}: e_n_contact spread over 0-60 deg at St_n >= 2.5 is {spread:.3f} < 0.01")
+    # e_n rises with St_n past the critical St_n, at every angle, with no step where the
+    # outcome turns from stick-rotate-separate to bounce (one rebound normal for both)
+    for f in FIG8:
+        for a in ANGLES:
+            c = data[f][a]
+            m = c["stokes_n"] >= 1.5
+            drop = -np.diff(c["e_n"][m]).min()
+            check(drop < 0.01, f"{f}, {a} deg: largest fall of e_n between neighbouring St_n >= 1.5 "
+                  f"is {max(drop, 0.0):.4f} < 0.01")
     # SB vs DB with the c treatment: negligible difference (Punch Sec. 4.2.1)
     for a in ANGLES:
         b, dd = data["fig8b"][a], data["fig8d"][a]

@@ -536,13 +536,19 @@ struct wetdem_collision_result {
     double e_t;                    /* tangential restitution of the contact-point velocity [-]
                                    (-1 smooth, +1 reversed; NAN without initial slip) */
     double e_n_observed;           /* e_n evaluated at observe_time (NAN if not requested) */
+    double e_n_contact;            /* e_n referred to the line of centres at the last local
+                                      minimum of the gap (the middle of the last contact) [-]:
+                                      the contact's own restitution, free of the turn of the
+                                      line while films part; NAN if the gap had no minimum, 0
+                                      when not separated */
     double angle_in, angle_out;    /* impact angle of the straight-line approach (= spec angle)
                                    and rebound angle of the relative velocity, to the normal
                                    [rad] */
     struct wetdem_vec3 normal_out; /* n_f: the unit line of centres (from j to i) that the
-                                      rebound is referred to, at the last local minimum of the
-                                      gap (the start of the final separation); at the end if
-                                      the gap had none */
+                                      rebound is referred to: where the films last parted
+                                      (film-coated pairs); without films, at the last local
+                                      minimum of the gap, or where a stick-rotate-separate
+                                      doublet left close_gap; at the end if none of these */
     struct wetdem_vec3 omega_i, omega_j; /* final spins [rad/s] */
     double contact_duration;             /* total time with gap < 0 [s] */
     double interaction_duration;         /* time from first interaction to separation [s] */

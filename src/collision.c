@@ -16,14 +16,18 @@
  * Runs to separation (gap >= rebound_gap_factor x range, receding) or t_end.
  * With the relative velocity of centres dv = v_i - v_j, n0 = +x (the contact normal of the
  * straight-line approach, which defines theta and v_n0) and n_f the rebound normal, the line of
- * centres where the final separation starts: for a bounce at the last local minimum of the gap
- * (the middle of the contact), for stick-rotate-separate where the doublet leaves near contact
- * (the gap rises through h_close, below), for a pair that has not separated at the end.
- * Punch Eq. 3 takes n_f "at the time of final relative velocity", for its thin films within a
- * degree of this; but the line of centres keeps turning after the spheres part (by tens of
- * degrees over nijssen's cut-off R*), and a normal taken at the end of the run made the results
- * depend on where the run stops (rebound_gap_factor) and gave e_n > 1 for an elastic
- * frictionless impact. Velocities are taken at the end (separation or t_end):
+ * centres at the time of the final relative velocity (Punch Eq. 3): for a film-coated pair
+ * where the films last part (the gap rises through delta_ij), whatever the outcome; for a pair
+ * without films, whose lubrication reaches out to nijssen's cut-off R*, for a bounce at the
+ * last local minimum of the gap (the middle of the contact) and for stick-rotate-separate where
+ * the doublet leaves near contact (the gap rises through h_close, below); for a pair that has
+ * not separated, the line at the end. The line of centres keeps turning after the spheres part
+ * (by tens of degrees over the cut-off), and a normal taken at the end of the run made the
+ * results depend on where the run stops (rebound_gap_factor) and gave e_n > 1 for an elastic
+ * frictionless impact. One normal for every outcome of a film-coated pair keeps e_n continuous
+ * where the outcome changes (a normal at the closest approach for a bounce dropped e_n by 0.1
+ * where a thin-film collision turned from stick-rotate-separate to bounce). Velocities are
+ * taken at the end (separation or t_end):
  *   e   = |dv_f| / |dv_0|                                   (Nijssen; Yang & Hunt)
  *   e_n = -(dv_f . n_f) / (dv_0 . n0)                        (Punch Eq. 3)
  *   (e and e_n are 0 when the pair has not separated by t_end: no rebound)
@@ -75,6 +79,7 @@ const char* wetdem_outcome_name(enum wetdem_outcome outcome)
 /* Per-step record of the pair (0, 1) or (0, wall 0), kept by the monitor. */
 struct tracker {
     double h_close; /* gap below which the pair counts as a doublet [m] */
+    double film;    /* the pair's film thickness delta_ij [m], 0 without films */
     double t_prev, gap_prev, vn_prev;
     struct wetdem_vec3 n_prev, dv_prev;
     double min_gap;
@@ -92,14 +97,19 @@ struct tracker {
     struct wetdem_vec3 n_turn;  /* the line of centres at the last one */
     bool left_close;            /* the gap has risen through h_close */
     struct wetdem_vec3 n_leave; /* the line of centres the last time it did */
+    bool left_film;             /* the gap has risen through the film thickness */
+    struct wetdem_vec3 n_film;  /* the line of centres the last time it did */
 };
 
 /* The rebound normal n_f, given the line of centres `now` (docs/engines.md, "Collision
- * analysis"): where the pair last turned as a doublet in near contact (stick-rotate-separate),
- * the line where it left near contact; else the line at the last local minimum of the gap;
- * `now` when there was neither. */
+ * analysis"): for a film-coated pair the line where the films last parted; without films,
+ * where the pair last turned as a doublet in near contact (stick-rotate-separate), the line
+ * where it left near contact, else the line at the last local minimum of the gap; `now` when
+ * there was none of these. */
 static struct wetdem_vec3 rebound_normal(const struct tracker* tr, struct wetdem_vec3 now)
 {
+    if (tr->film > 0)
+        return tr->left_film ? tr->n_film : now;
     if (tr->rotation_close > SRS_ANGLE)
         return tr->left_close ? tr->n_leave : now;
     return tr->turned ? tr->n_turn : now;
@@ -201,6 +211,11 @@ static int monitor(struct wetdem_sim* sim, void* ctx)
         tr->n_leave = unit_between(tr->n_prev, c.normal,
                                    (tr->h_close - tr->gap_prev) / (c.gap - tr->gap_prev));
         tr->left_close = true;
+    }
+    if (tr->gap_prev < tr->film && c.gap >= tr->film) {
+        tr->n_film =
+            unit_between(tr->n_prev, c.normal, (tr->film - tr->gap_prev) / (c.gap - tr->gap_prev));
+        tr->left_film = true;
     }
     tr->min_gap = fmin(tr->min_gap, low);
     if (tr->interacting) {
@@ -351,6 +366,7 @@ static void start_tracker(const struct wetdem_sim* sim, const struct setup* su,
     struct wetdem_contact c;
     pair_contact(sim, &c);
     *tr = (struct tracker){.h_close = su->h_close,
+                           .film = c.film,
                            .t_prev = 0,
                            .gap_prev = c.gap,
                            .vn_prev = c.v_n,
@@ -523,6 +539,8 @@ static void restitution(const struct wetdem_sim* sim, const struct initial* in,
      * way (e = 1 and e_n = -1 for a striker still on its way in) */
     r->e = separated ? vec3_norm(dvf) / vec3_norm(in->dv) : 0.0;
     r->e_n = dn0 < 0 ? (separated ? -dnf / dn0 : 0.0) : NAN;
+    r->e_n_contact =
+        dn0 < 0 && tr->turned ? (separated ? -vec3_dot(dvf, tr->n_turn) / dn0 : 0.0) : NAN;
     r->angle_in = atan2(vec3_norm(vec3_reject(in->dv, in->n)), -dn0);
     r->angle_out = atan2(vec3_norm(vec3_reject(dvf, nf)), dnf);
     r->normal_out = nf;

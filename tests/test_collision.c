@@ -694,6 +694,34 @@ static void test_collision_outcome_with_films(void** state)
     s.close_gap = -1;
     CHECK_STATUS(wetdem_collision_run(sim, &s, &r), WETDEM_ERR_INVALID);
     CHECK_CONTAINS(wetdem_sim_errmsg(sim), "close_gap");
+    /* one rebound normal, where the films part, for both outcomes: across the Stokes number
+       where the outcome turns from stick-rotate-separate (St_n 1.55) to bounce (1.6) e_n rises
+       smoothly (0.159, 0.191, 0.228 at 1.55, 1.595, 1.64); with the closest approach for the
+       bounce it dropped to 0.060 there. The steps between neighbours are 0.03-0.04: a fall
+       of any size fails. */
+    s.close_gap = 0;
+    s.t_end = 0.2;
+    const double st[] = {1.55, 1.595, 1.64};
+    double e_n[3];
+    enum wetdem_outcome outcome[3];
+    for (int k = 0; k < 3; k++) {
+        s.stokes = st[k];
+        CHECK_OK(wetdem_collision_run(sim, &s, &r));
+        assert_true(r.separated);
+        e_n[k] = r.e_n;
+        outcome[k] = r.outcome;
+        /* e_n_contact: the contact's own restitution, referred to the closest approach (the
+           line of centres turns by 1.5-4.5 degrees until the films part: lower here) */
+        assert_true(r.e_n_contact < r.e_n);
+    }
+    assert_int_equal(outcome[0], WETDEM_OUTCOME_STICK_ROTATE_SEPARATE);
+    assert_int_equal(outcome[2], WETDEM_OUTCOME_BOUNCE);
+    assert_true(e_n[1] > e_n[0] && e_n[2] > e_n[1]);
+    /* head-on the line of centres does not turn: both normals are +x */
+    s.angle = 0;
+    s.stokes = 3;
+    CHECK_OK(wetdem_collision_run(sim, &s, &r));
+    CHECK_REL(r.e_n_contact, r.e_n, 1e-12);
     wetdem_sim_free(sim);
 }
 

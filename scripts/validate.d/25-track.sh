@@ -18,8 +18,8 @@ mkdir -p "$out"
 
 "$cli" run examples/tracks/punch_45deg.ini --out "$out/run" > "$out/run.txt"
 $py tools/track_render.py "$out/run/trajectory.csv" --out "$dots"
-# m = 7960 kg/m^3 x 4/3 pi (12.7 mm)^3 = 0.06824 kg (Punch Table 1), mu = 10 Pa s
-"$cli" track "$dots" --fps 5000 --pixel-size 175e-6 --radius 12.7e-3 --mass 0.06824 \
+# m = 7960 kg/m^3 x 4/3 pi (12.7 mm)^3 = 0.06830 kg (Punch Table 1), mu = 10 Pa s
+"$cli" track "$dots" --fps 5000 --pixel-size 175e-6 --radius 12.7e-3 --mass 0.06830 \
   --viscosity 10 --frames "$out/frames.csv" --json > "$out/track.json"
 cat "$out/track.json"
 $py figures/punch_track.py --dots "$dots" --frames "$out/frames.csv" \
