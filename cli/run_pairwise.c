@@ -73,7 +73,10 @@ static const struct cli_key_desc pairwise_keys[] = {
         "Relative tolerance of CVODE (above 1e-5 its speeds are too coarse for the rest speed)."),
     NUM("rest_speed_ratio", "-", "1e-3", 0, 1, false, true,
         "Contacts slower than this times v_n0 are held at h_min (resting contact); without "
-        "v_n0 > 0, times the largest initial sphere speed."),
+        "v_n0 > 0, times the largest initial sphere speed. When > 0, so is at least every "
+        "contact whose kinetic energy is within 1e4 x the energy the reset of its gap to "
+        "h_min adds against the suction (docs/derivations/pairwise.md); 0: no contact is "
+        "held."),
     COUNT("stop_when_separated", "1", 0, 1,
           "1: stop once every pair is apart and receding; 0: run to t_end."),
     COUNT("ref_i", "1", 1, 8, "Reference pair (v_n0, delta_12, t-hat, t*): first."),

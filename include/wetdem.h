@@ -817,7 +817,10 @@ struct wetdem_pairwise_config {
     double t_end;                /* longest simulated time [s], in [WETDEM_MIN_SPAN, 1e9] */
     double rtol;                 /* relative tolerance of the integrator, [1e-14, 1e-5]; 1e-9 */
     double rest_speed_ratio;     /* contacts slower than this x v_n0 (without v_n0 > 0: x the
-                                    largest initial sphere speed) become resting [-]; 1e-3 */
+                                    largest initial sphere speed), and when > 0 at least those
+                                    whose kinetic energy is within 1e4 x the energy the reset
+                                    of the gap to h_min adds (docs/derivations/pairwise.md),
+                                    become resting [-]; 1e-3 */
     bool stop_when_separated;    /* stop once every pair is apart and receding (default true) */
     size_t ref_i, ref_j;         /* reference pair for v_n0, delta_12, t-hat, t* (default 0, 1) */
     size_t max_events;           /* event budget (default 100000) */

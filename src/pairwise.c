@@ -608,6 +608,26 @@ static int emit_until(struct wetdem_pairwise* pw, double t_hi)
  * 1e-3. The slack is 4e-19 m at h_min = 4e-7 m, far below any of the model's lengths. */
 #define CONTACT_SLACK 1e-12
 
+/* The slowest contact that is not resting because of CONTACT_SLACK [m/s]: setting the gap
+ * to h_min at a contact lifts a film-coated pair by CONTACT_SLACK h_min against its
+ * capillary suction 8 pi a sigma, an energy dU it did not have; a contact whose kinetic
+ * energy (1/2) m* v^2 is within REST_LIFT_ENERGY dU of that is resting. Without this floor
+ * two wet spheres released at rest (the rest speed then 1e-3 of the 1 um/s fallback scale)
+ * bounced with e_dry = 1 at ~1e-7 m/s, where the lift, 2.5e-22 J a bounce, gave back what
+ * the viscous force took, until the event budget ran out. In Davis's set-ups (Ca >= 0.01) it
+ * lies far below the rest speed (~4e-5 v_n0 against 1e-3). 0 without capillarity. */
+#define REST_LIFT_ENERGY 1e4
+static double lift_rest_speed(const struct wetdem_pairwise_system* sys)
+{
+    double v = 0.0;
+    for (size_t p = 0; p < sys->n_pairs && sys->sigma > 0.0; p++)
+        if (sys->delta[p] > sys->h_min) {
+            double lift = 8.0 * M_PI * sys->a_eff[p] * sys->sigma * CONTACT_SLACK * sys->h_min;
+            v = fmax(v, sqrt(2.0 * REST_LIFT_ENERGY * lift / sys->m_eff[p]));
+        }
+    return v;
+}
+
 /* Guard values of every pair at state y: g[G_KINDS * p + kind], >= 0 while the mode holds. */
 static bool guards(struct wetdem_pairwise* pw, const double* y, double* g)
 {
@@ -1022,6 +1042,8 @@ static void initial_state(struct wetdem_pairwise* pw)
     pw->v_scale = v > 0.0 ? v : 1e-6;
     /* (without an approach of the reference pair, the largest initial speed: Sec. 7) */
     pw->rest_speed = cfg->rest_speed_ratio * (res->v_n0 > 0.0 ? res->v_n0 : pw->v_scale);
+    if (cfg->rest_speed_ratio > 0.0) /* (0: no resting contact at all) */
+        pw->rest_speed = fmax(pw->rest_speed, lift_rest_speed(sys));
     memset(&pw->md, 0, sizeof pw->md);
     for (size_t p = 0; p < sys->n_pairs; p++) {
         struct wetdem_pairwise_pair_result* r = &res->pairs[p];
