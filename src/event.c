@@ -297,7 +297,7 @@ double wetdem_event_smallest_branch_gap(const struct wetdem_sim* sim)
         struct wetdem_contact c;
         double range, scratch[WETDEM_HISTORY_SCRATCH];
         wetdem_event_pair_state(sim, p, &c, &range, scratch);
-        if (wetdem_sim_laws_jump_at(sim, &c, scratch, h_k))
+        if (wetdem_sim_laws_resolve_at(sim, &c, scratch, h_k))
             h_min = h_k;
     }
     return h_min;
@@ -305,10 +305,12 @@ double wetdem_event_smallest_branch_gap(const struct wetdem_sim* sim)
 
 /* Keeps in stats.hmin_step_ratio the gap change of the step just taken, as a multiple of
  * the branch gap h_k of model slot q that it crossed (h_k = gap - g at the step's end), where
- * the force laws jump at h_k (wetdem_sim_laws_jump_at). A fixed step samples the force law
- * only at its ends: with a change of the order of h_k it puts the switch (c: to zero) at a
- * step end, not where the gap crosses h_k. Where the laws are continuous at h_k (nijssen's
- * lever blend into contact, nc) the step's error there is of second order and is not counted. */
+ * the force laws jump at h_k, or peak there and fall steeply below it
+ * (wetdem_sim_laws_resolve_at). A fixed step samples the force law only at its ends: with a
+ * change of the order of h_k it puts the switch (c: to zero) at a step end, not where the gap
+ * crosses h_k, or steps over the peak. Where the laws are continuous and flat at h_k (nc;
+ * nijssen's lever blend in water, where the contact force takes over) the step's error there
+ * is of second order and is not counted. */
 static void note_branch_step(struct wetdem_sim* sim, size_t q)
 {
     struct wetdem_engine* e = &sim->engine;
@@ -322,7 +324,7 @@ static void note_branch_step(struct wetdem_sim* sim, size_t q)
     struct wetdem_contact c;
     double range, scratch[WETDEM_HISTORY_SCRATCH];
     wetdem_event_pair_state(sim, p, &c, &range, scratch);
-    if (wetdem_sim_laws_jump_at(sim, &c, scratch, h_k))
+    if (wetdem_sim_laws_resolve_at(sim, &c, scratch, h_k))
         e->stats.hmin_step_ratio = ratio;
 }
 

@@ -159,6 +159,14 @@ bool wetdem_sim_contact_is_bridged(const struct wetdem_sim* sim, const struct we
  * nijssen's overlap shifted to h_min, ~(h_min - h)^1/4). */
 bool wetdem_sim_laws_jump_at(const struct wetdem_sim* sim, const struct wetdem_contact* c,
                              const double* history, double h);
+/* True when a fixed step must resolve the gap h of contact c: the laws jump there
+ * (wetdem_sim_laws_jump_at), or their normal force peaks there and falls steeply below it,
+ * by more than a quarter within h/2 (nijssen's lever blend in a viscous liquid: the
+ * lubrication force at h_min far above the contact's at an overlap of h_min, so the blend
+ * falls from the peak nearly to zero over h_min; in water the contact force takes over and
+ * it falls by ~10 %). */
+bool wetdem_sim_laws_resolve_at(const struct wetdem_sim* sim, const struct wetdem_contact* c,
+                                const double* history, double h);
 /* Smallest gap 0 < h < range [m] at which the enabled force laws of contact c (a fresh pair
  * at approach speed c->v_n) jump: a branch gap from the models' thresholds() where the summed
  * forces change as much across 1e-9 of it as across 1e-6 (h_min where the thin-film laws

@@ -541,6 +541,36 @@ bool wetdem_sim_laws_jump_at(const struct wetdem_sim* sim, const struct wetdem_c
     return wide > 0.0 && change_across(sim, c, history, h, 1e-9) >= 0.5 * wide;
 }
 
+/* The summed normal force of the enabled models on contact c at gap h [N]; NAN if a model
+ * fails. */
+static double normal_force_at(const struct wetdem_sim* sim, const struct wetdem_contact* c,
+                              const double* history, double h)
+{
+    double scratch[WETDEM_HISTORY_SCRATCH];
+    struct wetdem_contact at = *c;
+    struct wetdem_pair_force f;
+    at.gap = h;
+    at.dt = 0.0;
+    if (history)
+        memcpy(scratch, history, sim->history_len * sizeof *scratch);
+    if (wetdem_sim_eval_contact(sim, &at, history ? scratch : NULL, &f, NULL) != WETDEM_OK)
+        return NAN;
+    return f.f_normal;
+}
+
+#define PEAK_FALL 0.75 /* force at h/2 over that at h below which h is a peak to resolve */
+
+bool wetdem_sim_laws_resolve_at(const struct wetdem_sim* sim, const struct wetdem_contact* c,
+                                const double* history, double h)
+{
+    if (wetdem_sim_laws_jump_at(sim, c, history, h))
+        return true;
+    if (sim->history_len > WETDEM_HISTORY_SCRATCH)
+        return false;
+    double at = normal_force_at(sim, c, history, h);
+    return at > 0.0 && normal_force_at(sim, c, history, 0.5 * h) < PEAK_FALL * at;
+}
+
 double wetdem_sim_jump_gap(const struct wetdem_sim* sim, const struct wetdem_contact* c)
 {
     if (sim->history_len > WETDEM_HISTORY_SCRATCH ||

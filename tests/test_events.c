@@ -449,6 +449,54 @@ static void test_events_verlet_resolves_hmin(void** state)
     assert_true(coarse[0] == coarse[1]); /* the default step does not see h_min move */
 }
 
+/* nijssen in a viscous liquid: Steel I head-on in 80 w% glycerol at St = 49 (the nijssen
+ * model with ehd h_min; Nijssen Table 1 and the glycerol80 preset). Its lever blend peaks at
+ * h_min and falls nearly to zero below it (the lubrication force there, ~7 N, far above the
+ * contact's at an overlap of h_min), and the default Verlet step (2 % of the Hertz time)
+ * moves the gap by ~1.9 h_min: the run reports it (hmin_step_ratio > 0.1; it was 0, and e
+ * was off by 0.008 here, up to 0.019 over St = 22-200), and hmin_fraction = 0.1 brings e to
+ * CVODE's converged value (measured 1e-5; 1e-3 asserted, a tenth of the coarse error). In
+ * water (Delrin, St = 50) the contact force takes over below h_min: not counted. */
+static double nijssen_e(const char* preset, const char* fluid, double stokes,
+                        const char* integrator, double hmin_fraction, double* ratio)
+{
+    struct wetdem_sim* sim = wetdem_sim_create();
+    struct wetdem_fluid f;
+    CHECK_OK(wetdem_fluid_preset(fluid, &f));
+    CHECK_OK(wetdem_sim_set_fluid(sim, &f));
+    int mat = wetdem_sim_add_material_preset(sim, preset);
+    CHECK_OK(wetdem_sim_enable_model(sim, "nijssen"));
+    CHECK_OK(wetdem_sim_enable_model(sim, "ehd"));
+    CHECK_OK(wetdem_sim_set_integrator(sim, integrator));
+    CHECK_OK(wetdem_sim_set_param(sim, "verlet.hmin_fraction", hmin_fraction));
+    struct wetdem_collision_spec spec = {.material_i = mat,
+                                         .material_j = mat,
+                                         .radius_i = 6.35e-3,
+                                         .radius_j = 6.35e-3,
+                                         .stokes = stokes,
+                                         .t_end = 1.0};
+    struct wetdem_collision_result r;
+    CHECK_OK(wetdem_collision_run(sim, &spec, &r));
+    *ratio = r.stats.hmin_step_ratio;
+    wetdem_sim_free(sim);
+    return r.e;
+}
+
+static void test_events_verlet_resolves_the_nijssen_peak(void** state)
+{
+    (void)state;
+    double ratio;
+    double want = nijssen_e("steel1", "glycerol80", 49.09, "cvode", 0, &ratio);
+    double coarse = nijssen_e("steel1", "glycerol80", 49.09, "verlet", 0, &ratio);
+    assert_true(ratio > WETDEM_HMIN_STEP_RATIO_MAX);
+    assert_true(fabs(coarse - want) > 0.005); /* (measured 0.0085) */
+    double fine = nijssen_e("steel1", "glycerol80", 49.09, "verlet", 0.1, &ratio);
+    assert_true(ratio <= 0.1);
+    CHECK_ABS(fine, want, 1e-3);
+    nijssen_e("delrin", "water", 50, "verlet", 0, &ratio);
+    assert_true(ratio == 0.0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -462,6 +510,7 @@ int main(void)
         cmocka_unit_test(test_events_hmin_step_ratio),
         cmocka_unit_test(test_events_hmin_fraction_holds_the_step),
         cmocka_unit_test(test_events_verlet_resolves_hmin),
+        cmocka_unit_test(test_events_verlet_resolves_the_nijssen_peak),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
