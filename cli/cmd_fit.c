@@ -693,7 +693,13 @@ static int initial_values(const struct fit_args* a, const struct fit_ctx* c, dou
     }
     char buf[1024];
     snprintf(buf, sizeof buf, "%s", a->init);
-    size_t n = 0;
+    size_t len = strlen(buf), n = 0;
+    if (!len || buf[0] == ',' || buf[len - 1] == ',' || strstr(buf, ",,")) {
+        cli_error("fit: --init '%s': an empty value (the values are separated by single commas, "
+                  "one for each --fit key)",
+                  a->init);
+        return CLI_EXIT_USAGE;
+    }
     char* save = NULL;
     for (char* tok = strtok_r(buf, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
         if (n == c->n_keys) {
@@ -847,8 +853,11 @@ static void print_result(const struct fit_ctx* c, const double* init, const doub
         size_t at;
         residual_stats(res, c->n_pts, &rms, &max, &at);
         const char* unit = part ? "rad/s" : "-";
-        printf("# residuals %s (fit - data): rms %.3g [%s], largest %.3g [%s] at St_n = %g\n",
-               part ? "omega" : "e_n", rms, unit, res[at], unit, c->pts[at].stokes);
+        char angle[64] = ""; /* (rows of several angles may share a Stokes number) */
+        if (c->pts[at].has_angle)
+            snprintf(angle, sizeof angle, ", angle_deg = %g", c->pts[at].angle_deg);
+        printf("# residuals %s (fit - data): rms %.3g [%s], largest %.3g [%s] at St_n = %g%s\n",
+               part ? "omega" : "e_n", rms, unit, res[at], unit, c->pts[at].stokes, angle);
     }
     if (c->use_omega)
         printf("# spin residuals weighed as e_n residuals times %g rad/s (--omega-scale)\n",

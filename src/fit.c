@@ -163,12 +163,12 @@ static double to_variable(const struct param_map* m, double p)
     }
 }
 
-/* dp/dq at p. */
+/* dp/dq at p (negative for an upper bound alone: p = hi - e^q). */
 static double slope(const struct param_map* m, double p)
 {
     switch (m->kind) {
     case WETDEM_FIT_LOG_LOWER: return p - m->lo;
-    case WETDEM_FIT_LOG_UPPER: return m->hi - p;
+    case WETDEM_FIT_LOG_UPPER: return -(m->hi - p);
     case WETDEM_FIT_LOGISTIC: return (p - m->lo) / (m->hi - m->lo) * (m->hi - p);
     default: return 1.0;
     }
@@ -427,8 +427,10 @@ done:
     return found;
 }
 
-/* Standard errors and correlations of the parameters with use[j] from cov; the others get
- * `other` (INFINITY for undetermined, NAN at a bound) and NAN correlations. */
+/* Standard errors and correlations of the parameters with use[j] from cov, the covariance of
+ * the fit variables q (delta method: dp = slope dq, so the correlation of p_j and p_k is that
+ * of q_j and q_k times the signs of both slopes); the others get INFINITY (undetermined) or
+ * NAN (at a bound) and NAN correlations. */
 static void fill_errors(const struct fit_ctx* c, const gsl_matrix* cov, const bool* use,
                         const bool* undetermined, struct wetdem_fit_result* res)
 {
@@ -438,11 +440,16 @@ static void fill_errors(const struct fit_ctx* c, const gsl_matrix* cov, const bo
         res->std_errors[j] = use[j]            ? fabs(slope(&c->map[j], res->values[j])) * sq
                              : undetermined[j] ? INFINITY
                                                : NAN;
-        for (size_t k = 0; k < np; k++)
+        for (size_t k = 0; k < np; k++) {
+            double sign =
+                (slope(&c->map[j], res->values[j]) < 0) != (slope(&c->map[k], res->values[k]) < 0)
+                    ? -1.0
+                    : 1.0;
             res->correlation[j][k] =
-                use[j] && use[k] ? gsl_matrix_get(cov, j, k) /
+                use[j] && use[k] ? sign * gsl_matrix_get(cov, j, k) /
                                        sqrt(gsl_matrix_get(cov, j, j) * gsl_matrix_get(cov, k, k))
                                  : NAN;
+        }
     }
 }
 

@@ -89,6 +89,57 @@ static void test_fit_recovers_closed_form_parameters(void** state)
     gsl_rng_free(rng);
 }
 
+/* y = a + b x, a linear model whose least-squares solution, errors and correlation have a
+ * closed form: the correlation of a and b is -sum(x) / sqrt(n sum(x^2)) (here x = 0..11:
+ * -0.8417), whatever the bounds. With b bounded above only (b = hi - e^q, dp/dq < 0) it came
+ * out with the opposite sign: the delta method's sign of the slope was dropped. */
+static int straight_model(const double* p, double* out, char* msg, size_t n_msg, void* ctx)
+{
+    (void)msg;
+    (void)n_msg;
+    (void)ctx;
+    for (int i = 0; i < 12; i++)
+        out[i] = p[0] + p[1] * i;
+    return WETDEM_OK;
+}
+
+static void test_fit_correlation_sign_with_any_bounds(void** state)
+{
+    (void)state;
+    double obs[12], sx = 0, sxx = 0;
+    for (int i = 0; i < 12; i++) {
+        obs[i] = 2 + 0.5 * i + 0.1 * sin(3.0 * i); /* (a fixed, deterministic scatter) */
+        sx += i;
+        sxx += (double)i * i;
+    }
+    double want = -sx / sqrt(12 * sxx);
+    const char* names[2] = {"a", "b"};
+    const double init[2] = {1, 1}, none[2] = {-INFINITY, -INFINITY};
+    const double up_b[2] = {INFINITY, 10}, up_a[2] = {10, INFINITY}, lo_b[2] = {-INFINITY, 0};
+    const double* lowers[] = {none, none, none, lo_b};
+    const double* uppers[] = {NULL, up_b, up_a, NULL};
+    for (int k = 0; k < 4; k++) {
+        struct wetdem_fit_problem pb = {.n_params = 2,
+                                        .names = names,
+                                        .initial = init,
+                                        .lower = lowers[k],
+                                        .upper = uppers[k],
+                                        .n_data = 12,
+                                        .observed = obs,
+                                        .model = straight_model};
+        struct wetdem_fit_options o;
+        wetdem_fit_options_init(&o);
+        o.fd_step = 1e-6;
+        struct wetdem_fit_result r;
+        char msg[256];
+        if (wetdem_fit_run(&pb, &o, &r, NULL, msg, sizeof msg) != WETDEM_OK)
+            fail_msg("case %d: %s", k, msg);
+        /* (the linear model's Jacobian is exact up to the finite difference, 1e-6) */
+        CHECK_ABS(r.correlation[0][1], want, 1e-4);
+        CHECK_ABS(r.correlation[1][0], want, 1e-4);
+    }
+}
+
 static void test_fit_standard_errors_are_calibrated(void** state)
 {
     (void)state;
@@ -686,6 +737,14 @@ static void test_fit_cli_rejects_bad_input(void** state)
                ":2: column e_n: '99999999999' is not a restitution coefficient in [0, 1.5)");
     temp_csv(bad, "bad", "e_n,angle_deg\n0.5,0\n");
     expect_cli(args, 2, ":1: the header must name columns stokes_n and e_n");
+    /* an empty --init value was dropped (strtok), and the rest shifted to the other keys */
+    char init_args[512];
+    snprintf(
+        init_args, sizeof init_args,
+        "fit %s --data examples/fit/punch_0deg.csv --fit glass.p_gt,material.striker.restitution"
+        " --init ',4e6,,0.9,'",
+        ini);
+    expect_cli(init_args, 2, "--init ',4e6,,0.9,': an empty value");
     /* a line longer than the reader's buffer is an error, not read as two lines */
     static char long_line[6000];
     int used = snprintf(long_line, sizeof long_line, "# ");
@@ -1044,6 +1103,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_fit_recovers_closed_form_parameters),
         cmocka_unit_test(test_fit_standard_errors_are_calibrated),
+        cmocka_unit_test(test_fit_correlation_sign_with_any_bounds),
         cmocka_unit_test(test_fit_rejects_bad_problems),
         cmocka_unit_test(test_fit_zero_jacobian_column_is_an_error_not_an_abort),
         cmocka_unit_test(test_fit_rank_deficient_jacobian_gives_infinite_errors),
