@@ -142,7 +142,7 @@ static void frames_table(FILE* f, const void* ctx)
         size_t n;
         const struct wetdem_track_sample* q = wetdem_track_samples(c->t, k, &n);
         for (size_t i = 0; i < n; i++)
-            fprintf(f, "%d,%ld,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.6g\n",
+            fprintf(f, "%d,%ld,%.15g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.6g\n",
                     wetdem_track_sphere_id(c->t, k), q[i].frame, q[i].time, q[i].vx_raw,
                     q[i].vy_raw, q[i].omega_raw, q[i].vx, q[i].vy, q[i].omega, q[i].residual);
     }
@@ -157,7 +157,6 @@ static void print_summary(const struct wetdem_track_summary* s, bool json)
 {
     const double deg = 180.0 / M_PI;
     const struct kv rows[] = {
-        {"collision_frame", (double)s->collision_frame},
         {"collision_time_s", s->collision_time},
         {"striker", s->striker_id},
         {"target", s->target_id},
@@ -187,14 +186,17 @@ static void print_summary(const struct wetdem_track_summary* s, bool json)
     else
         printf("spheres = %zu\nhas_collision = %s\n", s->n_spheres,
                s->has_collision ? "true" : "false");
+    if (n) /* (a whole number, not rounded to 9 digits as a double: frames run to 1e12) */
+        printf(json ? "  \"collision_frame\": %ld,\n" : "collision_frame = %ld\n",
+               s->collision_frame);
     for (size_t k = 0; k < n; k++) {
         const char* sep = k + 1 < n ? "," : "";
         if (json && !isfinite(rows[k].value))
             printf("  \"%s\": null%s\n", rows[k].key, sep);
         else if (json)
-            printf("  \"%s\": %.9g%s\n", rows[k].key, rows[k].value, sep);
+            printf("  \"%s\": %.*g%s\n", rows[k].key, k == 0 ? 15 : 9, rows[k].value, sep);
         else
-            printf("%s = %.9g\n", rows[k].key, rows[k].value);
+            printf("%s = %.*g\n", rows[k].key, k == 0 ? 15 : 9, rows[k].value);
     }
     if (json)
         printf("}\n");

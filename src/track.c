@@ -173,9 +173,15 @@ int wetdem_track_add_frame(struct wetdem_track* track, int sphere_id, long frame
             return fail(track, WETDEM_ERR_INVALID,
                         "sphere %d: frame %ld follows frame %ld; frames must increase", sphere_id,
                         frame, last);
+        if (frame == last + 2)
+            return fail(track, WETDEM_ERR_INVALID,
+                        "sphere %d: frame %ld follows frame %ld; frame %ld is missing (or comes "
+                        "later: the rows of a sphere must be in frame order)",
+                        sphere_id, frame, last, last + 1);
         if (frame > last + 1)
             return fail(track, WETDEM_ERR_INVALID,
-                        "sphere %d: frame %ld follows frame %ld; frames %ld to %ld are missing",
+                        "sphere %d: frame %ld follows frame %ld; frames %ld to %ld are missing "
+                        "(or come later: the rows of a sphere must be in frame order)",
                         sphere_id, frame, last, last + 1, frame - 1);
     } else {
         s->first_frame = frame;
@@ -326,7 +332,10 @@ int wetdem_track_read_csv(struct wetdem_track* track, const char* path)
                 path, line);
             break;
         }
-        char* text = trim(buf);
+        char* text = buf;
+        if (line == 1 && strncmp(text, "\xef\xbb\xbf", 3) == 0)
+            text += 3; /* a UTF-8 byte order mark (spreadsheets' "CSV UTF-8") */
+        text = trim(text);
         if (*text == '\0' || *text == '#')
             continue;
         st = read_line(track, text, &seen_data);
@@ -680,6 +689,15 @@ static int restitution(struct wetdem_track* t, const struct wetdem_track_options
                     "the spheres are not approaching before the collision at frame %ld "
                     "(normal relative speed %g m/s)",
                     sum->collision_frame, -sum->speed_n0);
+    /* a velocity change that is no collision (a tracker glitch, noise, a slow drift read as
+       a change) leaves the spheres approaching "after" it: e_n < 0 is no restitution */
+    if (!(sum->speed_nf > 0))
+        return fail(t, WETDEM_ERR_INVALID,
+                    "the spheres are still approaching after the velocity change found at frame "
+                    "%ld (normal relative speed %g m/s after, %g before): it is not a collision "
+                    "(a tracker glitch or noise?); raise --threshold, or cut the recording to "
+                    "the collision",
+                    sum->collision_frame, -sum->speed_nf, sum->speed_n0);
     sum->e_n = sum->speed_nf / sum->speed_n0;
     double cosine = sum->speed_n0 / hypot(v0x, v0y);
     sum->impact_angle = acos(cosine > 1 ? 1 : cosine);
