@@ -31,12 +31,25 @@ E_DRY = 0.97  # Nijssen Table 1, every material
 
 
 def read_csv(path):
-    """Columns of a wetdem CSV as {name: array}; units in read_csv.units[name]."""
+    """Columns of a wetdem CSV as {name: array}; the units of the last file read in
+    read_csv.units[name] (the header's [unit], "" without one). A table of an interrupted
+    sweep or map (rows with status NOT_RUN) raises ValueError naming the file: those rows
+    hold nan, which a figure would draw as results ("no rebound")."""
     with open(path) as f:
-        lines = [ln.rstrip("\n") for ln in f if not ln.startswith("#") and ln.strip()]
+        lines = [ln.rstrip("\r\n") for ln in f if not ln.startswith("#") and ln.strip()]
+    if not lines:
+        raise ValueError(f"{path}: no header and no rows")
     header = lines[0].split(",")
     names = [h.split(" [")[0].strip() for h in header]
+    read_csv.units = {n: (h.split(" [", 1)[1].rstrip("]") if " [" in h else "")
+                      for n, h in zip(names, header)}
     rows = [ln.split(",") for ln in lines[1:]]
+    if "status" in names:
+        k = names.index("status")
+        left = sum(1 for r in rows if len(r) > k and r[k] == "NOT_RUN")
+        if left:
+            raise ValueError(f"{path}: {left} of {len(rows)} points NOT_RUN (an interrupted "
+                             f"batch): finish it with the same command and --resume {path}")
     data = {}
     for k, name in enumerate(names):
         col = [r[k] for r in rows]

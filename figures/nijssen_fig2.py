@@ -8,6 +8,7 @@ import argparse
 import glob
 import os
 import re
+import sys
 
 import common
 from common import plt
@@ -19,7 +20,12 @@ def load(directory):
         st = float(re.search(r"fig2_st([0-9.e+-]+)$", d).group(1))
         runs.append((st, common.read_csv(os.path.join(d, "trajectory.csv")),
                      common.read_json(os.path.join(d, "summary.json"))))
-    return sorted(runs, key=lambda r: r[0])
+    runs.sort(key=lambda r: r[0])
+    # (without this, a missing or mistyped --dir drew empty axes over the committed figure)
+    if not runs or runs[0][0] > 1 or runs[-1][0] < 100:
+        sys.exit(f"nijssen_fig2: no fig2_st* runs from St = 1 to St >= 100 in {directory} "
+                 "(run scripts/validate.d/10-nijssen.sh)")
+    return runs
 
 
 def main():

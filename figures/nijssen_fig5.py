@@ -14,6 +14,7 @@ import argparse
 import glob
 import os
 import re
+import sys
 
 import numpy as np
 
@@ -34,6 +35,9 @@ def main():
     mean_out = {}
     for ax, (key, title) in zip(axes, RANGES):
         files = glob.glob(os.path.join(a.dir, f"fig5_{key}_st*.csv"))
+        if not files:  # (it drew empty axes over the committed figure, then failed a check)
+            sys.exit(f"nijssen_fig5: no fig5_{key}_st*.csv in {a.dir} "
+                     "(run scripts/validate.d/10-nijssen.sh)")
         runs = sorted((float(re.search(r"_st([0-9.e+-]+)\.csv$", f).group(1)),
                        common.read_csv(f)) for f in files)
         outs = []

@@ -30,14 +30,30 @@ def read_vtk(path):
     big-endian binary: src/output_vtk.c) as {name: array}: TIME, POINTS (n x 3), VERTICES or
     LINES, and every point array (radius, velocity n x 3, spin, contacts, bridges,
     agglomerate, material, id, fixed) or cell array (i, j, contact, bridge, gap, force_normal,
-    force_tangential, force n x 3)."""
+    force_tangential, force n x 3). A file that is cut short or does not hold what its
+    headers announce (FIELD counts, POINT_DATA / CELL_DATA tuples, the binary blocks'
+    newlines) raises ValueError naming the file: a frame cut by a crash is not returned with
+    arrays missing."""
     data = open(path, "rb").read()
-    binary = data.split(b"\n", 3)[2].strip() == b"BINARY"
+    try:
+        return _parse_vtk(data)
+    except (ValueError, IndexError, UnicodeDecodeError) as e:
+        raise ValueError(f"{path}: not a whole wetdem VTK file (truncated or corrupt?): {e}") \
+            from None
+
+
+def _parse_vtk(data):
+    head = data.split(b"\n", 4)
+    if len(head) < 5 or not head[0].startswith(b"# vtk DataFile"):
+        raise ValueError("no '# vtk DataFile' header of 4 lines")
+    binary = head[2].strip() == b"BINARY"
     at, out = 0, {}
 
     def line():
         nonlocal at
-        end = data.index(b"\n", at)
+        end = data.find(b"\n", at)
+        if end < 0:
+            raise ValueError(f"the file ends inside a line at byte {at}")
         words = data[at:end].decode().split()
         at = end + 1
         return words
@@ -47,6 +63,8 @@ def read_vtk(path):
         if binary:
             dtype = ">f8" if kind == "double" else ">i4"
             a = np.frombuffer(data, dtype, count, at)
+            if data[at + a.nbytes:at + a.nbytes + 1] != b"\n":
+                raise ValueError(f"no newline after a binary block at byte {at + a.nbytes}")
             at += a.nbytes + 1  # the data, then its newline
             # native float64 / int64, writable, as the ASCII branch gives (frombuffer's view is
             # big-endian and read-only: an in-place edit raised "output array is read-only")
@@ -54,21 +72,39 @@ def read_vtk(path):
         got = []
         while len(got) < count:
             got += line()
+        if len(got) != count:
+            raise ValueError(f"{len(got)} values where {count} were announced")
         return np.array(got, float if kind == "double" else int)
 
     for _ in range(4):  # version, title, format, dataset
         line()
+    field_left, tuples = 0, None  # arrays still due in the FIELD block; tuples of the data
     while at < len(data):
         w = line()
-        if not w or w[0] in ("FIELD", "POINT_DATA", "CELL_DATA"):
+        if not w:
             continue
-        if w[0] == "POINTS":
+        if w[0] == "FIELD":
+            if field_left:
+                raise ValueError(f"a FIELD block with {field_left} arrays missing")
+            field_left = int(w[2])
+        elif w[0] in ("POINT_DATA", "CELL_DATA"):
+            tuples = int(w[1])
+        elif w[0] == "POINTS":
             out["POINTS"] = values(3 * int(w[1]), w[2]).reshape(-1, 3)
         elif w[0] in ("VERTICES", "LINES"):
             out[w[0]] = values(int(w[2]), "int")
         else:  # a field array: name, components, tuples, type
+            if not field_left:
+                raise ValueError(f"array {w[0]} outside a FIELD block or beyond its count")
+            if tuples is not None and int(w[2]) != tuples:
+                raise ValueError(f"array {w[0]} has {w[2]} tuples, the data {tuples}")
             a = values(int(w[1]) * int(w[2]), w[3])
             out[w[0]] = a.reshape(-1, int(w[1])) if int(w[1]) > 1 else a
+            field_left -= 1
+    if field_left:
+        raise ValueError(f"the file ends with {field_left} arrays of its FIELD block missing")
+    if "POINTS" not in out or "TIME" not in out:
+        raise ValueError("no POINTS or no TIME")
     return out
 
 

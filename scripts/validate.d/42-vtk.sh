@@ -29,3 +29,31 @@ for d in out/validate/many/cradle out/validate/many/settling out/validate/many/a
 done
 /usr/bin/python3 tools/check_vtk_with_vtk.py --all-kinds "${runs[@]}" \
     --same "$out/settling_binary" "$out/settling_ascii"
+
+echo "-- tools/wetdem_vtk.py refuses a frame cut short (a crash mid-write), naming the file"
+/usr/bin/python3 - "$out" <<'PY'
+import os, random, sys
+sys.path.insert(0, "tools")
+from wetdem_vtk import read_vtk
+out = sys.argv[1]
+files = [f"{out}/settling_binary/particles_000001.vtk", f"{out}/settling_ascii/particles_000001.vtk",
+         f"{out}/agglomeration/particles_links_000001.vtk"]
+cut, rng, bad = f"{out}/cut.vtk", random.Random(7), []
+for f in files:
+    data, whole = open(f, "rb").read(), None
+    whole = read_vtk(f)
+    for n in sorted({0, 10, len(data) - 2} | {rng.randrange(len(data)) for _ in range(100)}):
+        open(cut, "wb").write(data[:n])
+        try:
+            got = read_vtk(cut)
+            if set(got) != set(whole) or any(got[k].shape != whole[k].shape for k in got):
+                bad.append(f"{f} cut at {n}: read with arrays missing or short")
+        except ValueError as e:
+            if cut not in str(e):
+                bad.append(f"{f} cut at {n}: the message does not name the file: {e}")
+os.remove(cut)
+for b in bad:
+    print("  [FAIL]", b)
+print(f"  [{'FAIL' if bad else 'ok'}] {3 * 100} cuts of 3 files: every one refused, naming the file")
+sys.exit(1 if bad else 0)
+PY
