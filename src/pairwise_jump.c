@@ -26,6 +26,10 @@
  * normal impulses from one small linear system), with no tangential impulse (its size
  * mu_f I_n vanishes with the contact speed); which pairs then stay held is decided at the
  * force level (wetdem_pairwise_rhs_hold_set).
+ * Simultaneous contacts without friction: the pairs met at one instant get their normal
+ * impulses together, sum_q coupling(p, q) J_q = -(1 + e_dry) v_n,p, so that every v_n of the
+ * set is reversed to -e_dry v_n at once (Newton's rule for each contact of a multiple
+ * collision); applied only when every J_q > 0 (else the engine resolves them one by one).
  */
 #include <math.h>
 
@@ -141,6 +145,38 @@ static bool plastic_solve(const struct wetdem_pairwise_system* sys,
             A[a][c] = wetdem_pairwise_rhs_coupling(sys, k, list[a], list[c]);
     }
     return wetdem_pairwise_rhs_solve(n, A, J);
+}
+
+bool wetdem_pairwise_jump_simultaneous(const struct wetdem_pairwise_system* sys,
+                                       const struct wetdem_pairwise_mode* md,
+                                       const struct wetdem_pairwise_kin* k, const bool* set,
+                                       double* y)
+{
+    size_t list[PW_PMAX], n = 0;
+    double J[PW_PMAX], A[PW_PMAX][PW_PMAX];
+    for (size_t p = 0; p < sys->n_pairs; p++)
+        if (set[p])
+            list[n++] = p;
+    for (size_t a = 0; a < n; a++) {
+        J[a] = -(1.0 + sys->e_dry) * k->v_n[list[a]];
+        for (size_t c = 0; c < n; c++)
+            A[a][c] = wetdem_pairwise_rhs_coupling(sys, k, list[a], list[c]);
+    }
+    if (!wetdem_pairwise_rhs_solve(n, A, J))
+        return false;
+    for (size_t a = 0; a < n; a++)
+        if (!(J[a] > 0.0)) /* (coupling(p, p) = -1/m*: J > 0 pushes the pair apart) */
+            return false;
+    double gvx[PW_NMAX] = {0}, gvy[PW_NMAX] = {0}, gw[PW_NMAX] = {0};
+    for (size_t a = 0; a < n; a++) { /* impulse on i: -J e_ij, on j: +J e_ij */
+        size_t q = list[a], i = sys->pi[q], j = sys->pj[q];
+        gvx[i] -= J[a] * k->c[q] / sys->m[i];
+        gvy[i] -= J[a] * k->s[q] / sys->m[i];
+        gvx[j] += J[a] * k->c[q] / sys->m[j];
+        gvy[j] += J[a] * k->s[q] / sys->m[j];
+    }
+    add_jumps(sys, md, k, gvx, gvy, gw, y);
+    return true;
 }
 
 bool wetdem_pairwise_jump_plastic(const struct wetdem_pairwise_system* sys,

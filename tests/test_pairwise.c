@@ -718,6 +718,50 @@ static void test_pairwise_relabelling_symmetry(void** state)
     check_relabel(3.0, 1000.0, 3.0, false); /* films stay overlapping: compare at t_end */
 }
 
+/* A sphere meeting two touching spheres at the same instant (dry, e_dry = 1, no friction;
+ * sphere 1 at 1 m/s along +x, spheres 2 and 3 at +-30 degrees from its path, 2R + h_min apart):
+ * the simultaneous impulses, J/m = 2 cos 30 / (1 + 2 cos^2 30) each, leave sphere 1 at
+ * (-0.2, 0) and spheres 2 and 3 at (0.6, +-0.3464) m/s. One impulse after the other, in pair
+ * order, left sphere 1 at (-0.125, -0.2165), and at (-0.125, +0.2165) with 2 and 3
+ * renumbered. The same with films and viscosity (whose contacts the integration meets 4e-13 s
+ * apart): sphere 1 stays on the line (it left at vy = +-0.163, by the numbering). */
+static void test_pairwise_simultaneous_contacts_are_symmetric(void** state)
+{
+    (void)state;
+    const double a = 1e-3, m = 1e-5, h_min = 1e-6, d = 2 * a + h_min;
+    for (int wet = 0; wet < 2; wet++)
+        for (int swap = 0; swap < 2; swap++) {
+            struct wetdem_pairwise_config c;
+            wetdem_pairwise_config_init(&c);
+            c.n_spheres = 3;
+            c.h_min = h_min;
+            c.restitution = 1.0;
+            c.t_end = 0.01;
+            double film = wet ? 50e-6 : 0.0, y = swap ? -d / 2 : d / 2;
+            c.viscosity = wet ? 0.05 : 0.0;
+            c.spheres[0] = (struct wetdem_pairwise_sphere){.radius = a,
+                                                           .mass = m,
+                                                           .film = film,
+                                                           .x = -sqrt(d * d - d * d / 4) - 2 * film,
+                                                           .vx = 1.0};
+            c.spheres[1] =
+                (struct wetdem_pairwise_sphere){.radius = a, .mass = m, .film = film, .y = y};
+            c.spheres[2] =
+                (struct wetdem_pairwise_sphere){.radius = a, .mass = m, .film = film, .y = -y};
+            struct wetdem_pairwise_result r;
+            CHECK_OK(run(&c, &r, NULL));
+            /* wet: the films' forces before and after, integrated at rtol 1e-9: 1e-6 m/s */
+            CHECK_ABS(r.final[0].vy, 0.0, wet ? 1e-6 : 1e-12);
+            CHECK_ABS(r.final[1].vx, r.final[2].vx, wet ? 1e-6 : 1e-12);
+            CHECK_ABS(r.final[1].vy, -r.final[2].vy, wet ? 1e-6 : 1e-12);
+            if (!wet) {
+                CHECK_ABS(r.final[0].vx, -0.2, 1e-12);
+                CHECK_ABS(r.final[1].vx, 0.6, 1e-12);
+                CHECK_ABS(fabs(r.final[1].vy), 0.6 / sqrt(3.0), 1e-12);
+            }
+        }
+}
+
 /* Determinism: the same input gives bit-identical results. */
 static void test_pairwise_deterministic(void** state)
 {
@@ -1336,6 +1380,7 @@ int main(void)
         cmocka_unit_test(test_pairwise_energy_budget_at_every_frame),
         cmocka_unit_test(test_pairwise_energy_with_gravity),
         cmocka_unit_test(test_pairwise_relabelling_symmetry),
+        cmocka_unit_test(test_pairwise_simultaneous_contacts_are_symmetric),
         cmocka_unit_test(test_pairwise_deterministic),
         cmocka_unit_test(test_pairwise_positions_match_cartesian),
         cmocka_unit_test(test_pairwise_unequal_triangle_matches_cartesian),
