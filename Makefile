@@ -10,7 +10,10 @@
 #   make fuzz     fuzz scenario files, checkpoints, tracked dots, fit data and command lines
 #                 (libFuzzer, clang, ASan and UBSan); FUZZ_SECONDS per target, 120 by default
 
-CC      ?= gcc
+# (make's own default is cc; a CC from the command line or the environment is kept)
+ifeq ($(origin CC),default)
+CC       = gcc
+endif
 BUILD   ?= build
 PYTHON  ?= /usr/bin/python3
 CSTD     = -std=c11 -D_DEFAULT_SOURCE
@@ -20,7 +23,7 @@ OPT     ?= -O2
 # -fno-math-errno: sqrt compiles to the instruction alone (it is correctly rounded either way;
 # nothing here reads errno after a math function)
 CFLAGS_ALL = $(CSTD) $(WARN) $(OPT) -g -fPIC -fvisibility=hidden -ffp-contract=off \
-             -fno-math-errno -fopenmp -Iinclude -Isrc $(EXTRA_CFLAGS)
+             -fno-math-errno -fopenmp -Iinclude -Isrc $(EXTRA_CFLAGS) $(CPPFLAGS) $(CFLAGS)
 LDLIBS   = -lsundials_cvode -lsundials_nvecserial -lgsl -lgslcblas -linih -lm -fopenmp
 VERSION := $(shell sed -n 's/^\#define WETDEM_VERSION "\(.*\)"/\1/p' include/wetdem.h)
 GIT_HASH := $(shell git rev-parse --short HEAD 2>/dev/null || echo unknown)
@@ -46,8 +49,9 @@ $(BUILD)/obj/%.o: src/%.c include/wetdem.h $(wildcard src/*.h) $(BUILD)/flags.st
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS_ALL) -c $< -o $@
 
-# Rebuild everything when the compiler flags change.
-$(BUILD)/flags.stamp: FORCE
+# Rebuild everything when the compiler flags change. (After the dependencies are in place:
+# every compile waits for it, also under make -j.)
+$(BUILD)/flags.stamp: FORCE | deps
 	@mkdir -p $(dir $@)
 	@echo '$(CC) $(CFLAGS_ALL)' | cmp -s - $@ || echo '$(CC) $(CFLAGS_ALL)' > $@
 
@@ -68,23 +72,23 @@ $(BUILD)/libwetdem.a: $(LIB_OBJ)
 	ar rcs $@ $^
 
 $(BUILD)/libwetdem.so: $(LIB_OBJ)
-	$(CC) -shared -o $@ $^ $(LDLIBS)
+	$(CC) -shared $(LDFLAGS) -o $@ $^ $(LDLIBS)
 
 $(BUILD)/wetdem: $(CLI_OBJ) $(BUILD)/libwetdem.a
-	$(CC) -o $@ $(CLI_OBJ) $(BUILD)/libwetdem.a $(LDLIBS)
+	$(CC) $(LDFLAGS) -o $@ $(CLI_OBJ) $(BUILD)/libwetdem.a $(LDLIBS)
 
 $(BUILD)/tests/%: tests/%.c $(wildcard tests/*.h) $(BUILD)/libwetdem.a $(BUILD)/flags.stamp
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS_ALL) -Itests -o $@ $< $(BUILD)/libwetdem.a $(LDLIBS) -lcmocka
+	$(CC) $(CFLAGS_ALL) $(LDFLAGS) -Itests -o $@ $< $(BUILD)/libwetdem.a $(LDLIBS) -lcmocka
 
 $(BUILD)/examples/%: examples/%/main.c $(BUILD)/libwetdem.a $(BUILD)/flags.stamp
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS_ALL) -o $@ $< $(BUILD)/libwetdem.a $(LDLIBS)
+	$(CC) $(CFLAGS_ALL) $(LDFLAGS) -o $@ $< $(BUILD)/libwetdem.a $(LDLIBS)
 
 examples: $(EX_BIN)
 
 test: all $(TEST_BIN) $(EX_BIN)
-	@WETDEM_CLI=$(abspath $(BUILD)/wetdem) tests/run-tests $(TEST_BIN) $(EX_BIN) tests/test_install_deps.sh
+	@WETDEM_CLI='$(abspath $(BUILD)/wetdem)' tests/run-tests $(TEST_BIN) $(EX_BIN) tests/test_install_deps.sh
 
 # Tests again under AddressSanitizer + UndefinedBehaviorSanitizer, in a separate build tree,
 # built by GCC (test-san) and by clang (test-san-clang: its UBSan also reports pointer

@@ -435,7 +435,9 @@ static void restore_set(struct cli_out_file* const* files, size_t k, const bool*
  * moved aside (to its backup name), then every temporary file renamed into place, then the
  * backups removed. When any rename fails, the renames already made are undone, so the set is
  * replaced whole or not at all (a renaming the directory refuses, e.g. a sticky directory's
- * file of another user, fails in the first pass). 0, or the index of the file that failed
+ * file of another user, fails in the first pass). A process killed between the two passes
+ * (SIGKILL: the signals a run handles are held while its files are renamed) leaves the
+ * targets under their backup names, .NAME.tmpPID.old. 0, or the index of the file that failed
  * + 1 with *err its errno. */
 static size_t replace_set(struct cli_out_file* const* files, size_t n, int* err)
 {

@@ -865,21 +865,22 @@ static int simultaneous_contacts(struct wetdem_pairwise* pw, const bool* set)
 }
 
 /* The set of pairs whose contact guard is negative in g, or whose gap lies within the
- * integration's resolution of h_min (SIMULTANEOUS_RTOL x rtol x the sum of the radii, the
- * error of a centre distance), and that approach at the rest speed or faster, when there are
- * two or more of them and no friction; false otherwise. Contacts closer in time than the
+ * integration's resolution of h_min, and that approach at the rest speed or faster, when there
+ * are two or more of them and no friction; false otherwise. Contacts closer in time than the
  * integration can tell apart are one multiple collision: in a symmetric wet set-up the second
- * pair's gap was 2.9e-13 m above h_min (3e-7 of it) when the first was met. A pair the tree
- * does not track (its gap from the tracked ones, Davis Appendix B) joins too: the impulses
- * act on the spheres. */
-#define SIMULTANEOUS_RTOL 10.0
+ * pair's gap was 2.9e-13 m above h_min (3e-7 of it) when the first was met. The resolution is
+ * rtol (a_i + a_j), the error of a centre distance: a pair the tree does not track has its gap
+ * from the tracked pairs' centre distances (Davis Appendix B), and two gaps that should be
+ * equal differ by that much when one is tracked and the other not (a tracked gap alone is
+ * integrated to atol = rtol h_min). Such a pair joins the set too: the impulses act on the
+ * spheres. At rtol 1e-5 (the largest allowed) and 1 mm spheres the window is 2e-8 m; gaps
+ * 5e-8 m apart are two collisions. */
 static bool simultaneous_set(const struct wetdem_pairwise* pw, const double* g,
                              const struct wetdem_pairwise_kin* k, bool* set)
 {
     size_t n = 0;
     for (size_t q = 0; q < pw->sys.n_pairs; q++) {
-        double within = SIMULTANEOUS_RTOL * pw->cfg.rtol *
-                        (pw->sys.a[pw->sys.pi[q]] + pw->sys.a[pw->sys.pj[q]]);
+        double within = pw->cfg.rtol * (pw->sys.a[pw->sys.pi[q]] + pw->sys.a[pw->sys.pj[q]]);
         bool met = g[G_KINDS * q + G_CONTACT] < 0.0 || k->h[q] <= pw->sys.h_min + within;
         set[q] = met && !pw->md.resting[q] && k->v_n[q] >= pw->rest_speed && k->v_n[q] > 0.0;
         n += set[q];

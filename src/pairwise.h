@@ -156,11 +156,6 @@ int wetdem_pairwise_jump_apply(const struct wetdem_pairwise_system* sys,
                                const struct wetdem_pairwise_mode* md, size_t p,
                                struct wetdem_pairwise_kin* k, double* y);
 
-/* Plastic impulses of the pairs in `set` (a contact slower than the rest speed and the pairs
- * touching at h_min that move slower than it): normal impulses J_q that bring every v_n of the
- * set to zero at once, sum_q coupling(p, q) J_q = -v_n,p. A J_q < 0 (a pull of at most
- * m* x rest speed) is the regularisation that lets the force-level contact problem decide
- * which pairs stay held. Updates y; false if the system is singular. */
 /* Frictionless impulses of the pairs in `set`, met at one instant while approaching: normal
  * impulses J_q that reverse every v_n of the set to -e_dry v_n at once, sum_q coupling(p, q)
  * J_q = -(1 + e_dry) v_n,p. Updates y and returns true only when every J_q pushes the pair
@@ -170,6 +165,11 @@ bool wetdem_pairwise_jump_simultaneous(const struct wetdem_pairwise_system* sys,
                                        const struct wetdem_pairwise_kin* k, const bool* set,
                                        double* y);
 
+/* Plastic impulses of the pairs in `set` (a contact slower than the rest speed and the pairs
+ * touching at h_min that move slower than it): normal impulses J_q that bring every v_n of the
+ * set to zero at once, sum_q coupling(p, q) J_q = -v_n,p. A J_q < 0 (a pull of at most
+ * m* x rest speed) is the regularisation that lets the force-level contact problem decide
+ * which pairs stay held. Updates y; false if the system is singular. */
 bool wetdem_pairwise_jump_plastic(const struct wetdem_pairwise_system* sys,
                                   const struct wetdem_pairwise_mode* md,
                                   const struct wetdem_pairwise_kin* k, const bool* set, double* y);

@@ -690,14 +690,16 @@ static int restitution(struct wetdem_track* t, const struct wetdem_track_options
                     "(normal relative speed %g m/s)",
                     sum->collision_frame, -sum->speed_n0);
     /* a velocity change that is no collision (a tracker glitch, noise, a slow drift read as
-       a change) leaves the spheres approaching "after" it: e_n < 0 is no restitution */
-    if (!(sum->speed_nf > 0))
+       a change) leaves the spheres approaching "after" it, faster than the threshold that
+       marks a change; a pair that sticks (e_n = 0) leaves at about 0, noise either way, and
+       is reported as measured */
+    if (-sum->speed_nf > o->threshold)
         return fail(t, WETDEM_ERR_INVALID,
                     "the spheres are still approaching after the velocity change found at frame "
-                    "%ld (normal relative speed %g m/s after, %g before): it is not a collision "
-                    "(a tracker glitch or noise?); raise --threshold, or cut the recording to "
-                    "the collision",
-                    sum->collision_frame, -sum->speed_nf, sum->speed_n0);
+                    "%ld (normal relative speed %g m/s after, %g before; more than the threshold "
+                    "%g m/s): it is not a collision (a tracker glitch or noise?); raise "
+                    "--threshold, or cut the recording to the collision",
+                    sum->collision_frame, -sum->speed_nf, sum->speed_n0, o->threshold);
     sum->e_n = sum->speed_nf / sum->speed_n0;
     double cosine = sum->speed_n0 / hypot(v0x, v0y);
     sum->impact_angle = acos(cosine > 1 ? 1 : cosine);
