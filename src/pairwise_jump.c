@@ -133,18 +133,48 @@ int wetdem_pairwise_jump_apply(const struct wetdem_pairwise_system* sys,
     return WETDEM_OK;
 }
 
-/* Impulses J of the pairs in list[0..n) that zero their normal velocities; false if singular. */
-static bool plastic_solve(const struct wetdem_pairwise_system* sys,
-                          const struct wetdem_pairwise_kin* k, const size_t* list, size_t n,
-                          double* J)
+/* The pairs of `set` into list; their number. */
+static size_t set_list(const struct wetdem_pairwise_system* sys, const bool* set, size_t* list)
+{
+    size_t n = 0;
+    for (size_t p = 0; p < sys->n_pairs; p++)
+        if (set[p])
+            list[n++] = p;
+    return n;
+}
+
+/* Normal impulses J of the pairs in list[0..n) that change each v_n by -factor v_n (factor 1:
+ * to zero, plastic; 1 + e_dry: reversed to -e_dry v_n); false if singular. J > 0 pushes the
+ * pair apart (coupling(p, p) = -1/m*). */
+static bool normal_solve(const struct wetdem_pairwise_system* sys,
+                         const struct wetdem_pairwise_kin* k, const size_t* list, size_t n,
+                         double factor, double* J)
 {
     double A[PW_PMAX][PW_PMAX];
     for (size_t a = 0; a < n; a++) {
-        J[a] = -k->v_n[list[a]];
+        J[a] = -factor * k->v_n[list[a]];
         for (size_t c = 0; c < n; c++)
             A[a][c] = wetdem_pairwise_rhs_coupling(sys, k, list[a], list[c]);
     }
     return wetdem_pairwise_rhs_solve(n, A, J);
+}
+
+/* Adds to y the velocity jumps of the normal impulses J of the pairs in list[0..n): on i
+ * -J e_ij / m_i, on j +J e_ij / m_j. */
+static void apply_normal_impulses(const struct wetdem_pairwise_system* sys,
+                                  const struct wetdem_pairwise_mode* md,
+                                  const struct wetdem_pairwise_kin* k, const size_t* list, size_t n,
+                                  const double* J, double* y)
+{
+    double gvx[PW_NMAX] = {0}, gvy[PW_NMAX] = {0}, gw[PW_NMAX] = {0};
+    for (size_t a = 0; a < n; a++) {
+        size_t q = list[a], i = sys->pi[q], j = sys->pj[q];
+        gvx[i] -= J[a] * k->c[q] / sys->m[i];
+        gvy[i] -= J[a] * k->s[q] / sys->m[i];
+        gvx[j] += J[a] * k->c[q] / sys->m[j];
+        gvy[j] += J[a] * k->s[q] / sys->m[j];
+    }
+    add_jumps(sys, md, k, gvx, gvy, gw, y);
 }
 
 bool wetdem_pairwise_jump_simultaneous(const struct wetdem_pairwise_system* sys,
@@ -152,30 +182,15 @@ bool wetdem_pairwise_jump_simultaneous(const struct wetdem_pairwise_system* sys,
                                        const struct wetdem_pairwise_kin* k, const bool* set,
                                        double* y)
 {
-    size_t list[PW_PMAX], n = 0;
-    double J[PW_PMAX], A[PW_PMAX][PW_PMAX];
-    for (size_t p = 0; p < sys->n_pairs; p++)
-        if (set[p])
-            list[n++] = p;
-    for (size_t a = 0; a < n; a++) {
-        J[a] = -(1.0 + sys->e_dry) * k->v_n[list[a]];
-        for (size_t c = 0; c < n; c++)
-            A[a][c] = wetdem_pairwise_rhs_coupling(sys, k, list[a], list[c]);
-    }
-    if (!wetdem_pairwise_rhs_solve(n, A, J))
+    size_t list[PW_PMAX] = {0}; /* (filled by set_list; zeroed for the compiler's flow analysis) */
+    size_t n = set_list(sys, set, list);
+    double J[PW_PMAX];
+    if (!normal_solve(sys, k, list, n, 1.0 + sys->e_dry, J))
         return false;
     for (size_t a = 0; a < n; a++)
-        if (!(J[a] > 0.0)) /* (coupling(p, p) = -1/m*: J > 0 pushes the pair apart) */
+        if (!(J[a] > 0.0))
             return false;
-    double gvx[PW_NMAX] = {0}, gvy[PW_NMAX] = {0}, gw[PW_NMAX] = {0};
-    for (size_t a = 0; a < n; a++) { /* impulse on i: -J e_ij, on j: +J e_ij */
-        size_t q = list[a], i = sys->pi[q], j = sys->pj[q];
-        gvx[i] -= J[a] * k->c[q] / sys->m[i];
-        gvy[i] -= J[a] * k->s[q] / sys->m[i];
-        gvx[j] += J[a] * k->c[q] / sys->m[j];
-        gvy[j] += J[a] * k->s[q] / sys->m[j];
-    }
-    add_jumps(sys, md, k, gvx, gvy, gw, y);
+    apply_normal_impulses(sys, md, k, list, n, J, y);
     return true;
 }
 
@@ -183,22 +198,12 @@ bool wetdem_pairwise_jump_plastic(const struct wetdem_pairwise_system* sys,
                                   const struct wetdem_pairwise_mode* md,
                                   const struct wetdem_pairwise_kin* k, const bool* set, double* y)
 {
-    size_t list[PW_PMAX], n = 0;
+    size_t list[PW_PMAX] = {0}; /* (filled by set_list; zeroed for the compiler's flow analysis) */
+    size_t n = set_list(sys, set, list);
     double J[PW_PMAX];
-    for (size_t p = 0; p < sys->n_pairs; p++)
-        if (set[p])
-            list[n++] = p;
-    if (!plastic_solve(sys, k, list, n, J))
+    if (!normal_solve(sys, k, list, n, 1.0, J))
         return false;
-    double gvx[PW_NMAX] = {0}, gvy[PW_NMAX] = {0}, gw[PW_NMAX] = {0};
-    for (size_t a = 0; a < n; a++) { /* impulse on i: -J e_ij, on j: +J e_ij */
-        size_t q = list[a], i = sys->pi[q], j = sys->pj[q];
-        gvx[i] -= J[a] * k->c[q] / sys->m[i];
-        gvy[i] -= J[a] * k->s[q] / sys->m[i];
-        gvx[j] += J[a] * k->c[q] / sys->m[j];
-        gvy[j] += J[a] * k->s[q] / sys->m[j];
-    }
-    add_jumps(sys, md, k, gvx, gvy, gw, y);
+    apply_normal_impulses(sys, md, k, list, n, J, y);
     for (size_t a = 0; a < n; a++) {
         int e = md->edge_of_pair[list[a]];
         if (e >= 0)
