@@ -141,7 +141,8 @@ bool cli_hmin_unresolved(const struct wetdem_collision_result* r, char* msg, siz
     if (used > 0 && (size_t)used < n && isfinite(bound))
         used += snprintf(msg + used, n - (size_t)used,
                          "; where a law switches there (below_hmin = c) e_n can be off by up "
-                         "to about %.2g (hmin_step_ratio / St_n)",
+                         "to about %.2g (hmin_step_ratio / St_n), where it peaks there (nijssen "
+                         "in a viscous liquid) by more",
                          bound);
     if (used > 0 && (size_t)used < n)
         snprintf(msg + used, n - (size_t)used,

@@ -360,7 +360,8 @@ static void test_scenario_unresolved_hmin_is_reported(void** state)
                ": the verlet step moved the gap by 0.917 h_min in a step that crossed h_min (it "
                "is resolved at 0.1 or less), so the result changes in jumps, not smoothly, with "
                "h_min; where a law switches there (below_hmin = c) e_n can be off by up to about "
-               "0.059 (hmin_step_ratio / St_n); set [integrator] hmin_fraction = 0.1");
+               "0.059 (hmin_step_ratio / St_n), where it peaks there (nijssen in a viscous "
+               "liquid) by more; set [integrator] hmin_fraction = 0.1");
     expect_run(args, 0, "hmin_step_ratio        0.91655144");
     const char* quiet[] = {"--set integrator.hmin_fraction=0.1", "--set integrator.name=cvode"};
     for (int k = 0; k < 2; k++) {
