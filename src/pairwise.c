@@ -801,8 +801,42 @@ static int rest_contact(struct wetdem_pairwise* pw, size_t p, const struct wetde
     return set_held(pw, hold, p, &k2, v_n);
 }
 
-/* Contact at the rest speed or faster: the hard-sphere impulse of Appendix A. Held pairs whose
- * normal velocity it changes are let go (an approaching one is a contact of its own next). */
+/* Sets the gap of tracked pair p to h_min: a contact is located within ~1e-13 of it
+ * (CONTACT_SLACK). */
+static void gap_to_hmin(struct wetdem_pairwise* pw, size_t p)
+{
+    pw->y[PW_ANCHOR_LEN + PW_EDGE_LEN * (size_t)pw->md.edge_of_pair[p] + PW_H] = pw->sys.h_min;
+}
+
+/* Bookkeeping of an impulse on pair p, met at approach speed v_n: counted and logged. */
+static int note_impulse(struct wetdem_pairwise* pw, size_t p, double v_n)
+{
+    pw->approaching[p] = false;
+    pw->reversal[p] = REV_IMPULSE;
+    pw->res->pairs[p].n_contacts++;
+    return log_event(pw, WETDEM_PAIRWISE_CONTACT, p, p, pw->sys.h_min, v_n);
+}
+
+/* After impulses (the kinematics before them in *before): the held pairs whose normal velocity
+ * they changed are let go (an approaching one is a contact of its own next). */
+static int release_moved(struct wetdem_pairwise* pw, const struct wetdem_pairwise_kin* before)
+{
+    struct wetdem_pairwise_kin after;
+    if (!current_kin(pw, &after))
+        return WETDEM_ERR_NUMERIC;
+    for (size_t q = 0; q < pw->sys.n_pairs; q++) {
+        if (!pw->md.resting[q] || after.v_n[q] == before->v_n[q])
+            continue;
+        pw->md.resting[q] = false;
+        int st = log_event(pw, WETDEM_PAIRWISE_REST_END, q, q, after.h[q], after.v_n[q]);
+        if (st != WETDEM_OK)
+            return st;
+    }
+    return WETDEM_OK;
+}
+
+/* Contact at the rest speed or faster: the hard-sphere impulse of Appendix A, and the held
+ * pairs it moves let go. */
 static int hard_contact(struct wetdem_pairwise* pw, size_t p, struct wetdem_pairwise_kin* k,
                         double v_n)
 {
@@ -812,20 +846,8 @@ static int hard_contact(struct wetdem_pairwise* pw, size_t p, struct wetdem_pair
                     "hard-sphere impulse of spheres %zu and %zu (spheres[%zu], spheres[%zu]) "
                     "failed at t = %g s",
                     pw->sys.pi[p] + 1, pw->sys.pj[p] + 1, pw->sys.pi[p], pw->sys.pj[p], pw->t);
-    pw->res->pairs[p].n_contacts++;
-    if ((st = log_event(pw, WETDEM_PAIRWISE_CONTACT, p, p, pw->sys.h_min, v_n)) != WETDEM_OK)
-        return st;
-    struct wetdem_pairwise_kin k2;
-    if (!current_kin(pw, &k2))
-        return WETDEM_ERR_NUMERIC;
-    for (size_t q = 0; q < pw->sys.n_pairs; q++) {
-        if (!pw->md.resting[q] || k2.v_n[q] == k->v_n[q])
-            continue;
-        pw->md.resting[q] = false;
-        if ((st = log_event(pw, WETDEM_PAIRWISE_REST_END, q, q, k2.h[q], k2.v_n[q])) != WETDEM_OK)
-            return st;
-    }
-    return WETDEM_OK;
+    st = note_impulse(pw, p, v_n);
+    return st == WETDEM_OK ? release_moved(pw, k) : st;
 }
 
 /* Contacts met at one instant, frictionless, at the rest speed or faster
@@ -837,31 +859,19 @@ static int hard_contact(struct wetdem_pairwise* pw, size_t p, struct wetdem_pair
 static int simultaneous_contacts(struct wetdem_pairwise* pw, const bool* set)
 {
     for (size_t q = 0; q < pw->sys.n_pairs; q++)
-        if (set[q] && pw->md.edge_of_pair[q] >= 0) /* (within ~1e-13 of h_min: on_contact) */
-            pw->y[PW_ANCHOR_LEN + PW_EDGE_LEN * (size_t)pw->md.edge_of_pair[q] + PW_H] =
-                pw->sys.h_min;
-    struct wetdem_pairwise_kin k, k2;
+        if (set[q] && pw->md.edge_of_pair[q] >= 0)
+            gap_to_hmin(pw, q);
+    struct wetdem_pairwise_kin k;
     if (!current_kin(pw, &k))
         return WETDEM_ERR_NUMERIC;
     if (!wetdem_pairwise_jump_simultaneous(&pw->sys, &pw->md, &k, set, pw->y))
         return WETDEM_EVENT;
-    if (!current_kin(pw, &k2))
-        return WETDEM_ERR_NUMERIC;
     for (size_t q = 0; q < pw->sys.n_pairs; q++) {
-        int st = WETDEM_OK;
-        if (set[q]) {
-            pw->approaching[q] = false;
-            pw->reversal[q] = REV_IMPULSE;
-            pw->res->pairs[q].n_contacts++;
-            st = log_event(pw, WETDEM_PAIRWISE_CONTACT, q, q, pw->sys.h_min, k.v_n[q]);
-        } else if (pw->md.resting[q] && k2.v_n[q] != k.v_n[q]) { /* as in hard_contact */
-            pw->md.resting[q] = false;
-            st = log_event(pw, WETDEM_PAIRWISE_REST_END, q, q, k2.h[q], k2.v_n[q]);
-        }
+        int st = set[q] ? note_impulse(pw, q, k.v_n[q]) : WETDEM_OK;
         if (st != WETDEM_OK)
             return st;
     }
-    return WETDEM_OK;
+    return release_moved(pw, &k); /* (the set's own pairs are not held) */
 }
 
 /* The set of pairs whose contact guard is negative in g, or whose gap lies within the
@@ -893,8 +903,7 @@ static int on_contact(struct wetdem_pairwise* pw, size_t p)
     int st = pw->md.edge_of_pair[p] < 0 ? retree(pw, p) : WETDEM_OK;
     if (st != WETDEM_OK)
         return st;
-    double* v = pw->y + PW_ANCHOR_LEN + PW_EDGE_LEN * (size_t)pw->md.edge_of_pair[p];
-    v[PW_H] = pw->sys.h_min; /* the located crossing is within ~1e-13 of it */
+    gap_to_hmin(pw, p);
     struct wetdem_pairwise_kin k;
     if (!current_kin(pw, &k))
         return WETDEM_ERR_NUMERIC;
@@ -966,7 +975,8 @@ static int process_events(struct wetdem_pairwise* pw)
         switch (idx % G_KINDS) {
         case G_FILM: st = on_film(pw, p, &k); break;
         case G_CONTACT:
-            /* (the pair tracked first, as on_contact does, so that the set can hold it) */
+            /* (the pair tracked first, as on_contact does, so that its gap can be set to h_min
+               with the others of the set) */
             st = pw->md.edge_of_pair[p] < 0 ? retree(pw, p) : WETDEM_OK;
             if (st == WETDEM_OK && (!guards(pw, pw->y, g) || !current_kin(pw, &k)))
                 st = WETDEM_ERR_NUMERIC;

@@ -510,26 +510,32 @@ bool wetdem_sim_contact_is_bridged(const struct wetdem_sim* sim, const struct we
     return false;
 }
 
+/* The enabled models' forces on contact c moved to gap `gap`, with a scratch copy of the
+ * committed history `history` (NULL: a fresh pair; at most WETDEM_HISTORY_SCRATCH doubles)
+ * and no time elapsed, into *f. WETDEM status. */
+static int force_at_gap(const struct wetdem_sim* sim, struct wetdem_contact c,
+                        const double* history, double gap, struct wetdem_pair_force* f)
+{
+    double scratch[WETDEM_HISTORY_SCRATCH];
+    if (history)
+        memcpy(scratch, history, sim->history_len * sizeof *scratch);
+    c.gap = gap;
+    c.dt = 0.0;
+    return wetdem_sim_eval_contact(sim, &c, history ? scratch : NULL, f, NULL);
+}
+
 /* Change of the enabled models' forces on contact c (committed history `history`, NULL: a
  * fresh pair) across the gap h, between h (1 + eps) and h (1 - eps): of the summed normal
  * force plus that of the size of the summed tangential force [N]; NAN if a model fails. */
 static double change_across(const struct wetdem_sim* sim, const struct wetdem_contact* c,
                             const double* history, double h, double eps)
 {
-    double f_n[2], f_t[2], scratch[WETDEM_HISTORY_SCRATCH];
-    for (int side = 0; side < 2; side++) {
-        struct wetdem_contact at = *c;
-        struct wetdem_pair_force f;
-        at.gap = h * (side ? 1 - eps : 1 + eps);
-        at.dt = 0.0;
-        if (history)
-            memcpy(scratch, history, sim->history_len * sizeof *scratch);
-        if (wetdem_sim_eval_contact(sim, &at, history ? scratch : NULL, &f, NULL) != WETDEM_OK)
+    struct wetdem_pair_force f[2];
+    for (int side = 0; side < 2; side++)
+        if (force_at_gap(sim, *c, history, h * (side ? 1 - eps : 1 + eps), &f[side]) != WETDEM_OK)
             return NAN;
-        f_n[side] = f.f_normal;
-        f_t[side] = vec3_norm(f.f_tan);
-    }
-    return fabs(f_n[0] - f_n[1]) + fabs(f_t[0] - f_t[1]);
+    return fabs(f[0].f_normal - f[1].f_normal) +
+           fabs(vec3_norm(f[0].f_tan) - vec3_norm(f[1].f_tan));
 }
 
 bool wetdem_sim_laws_jump_at(const struct wetdem_sim* sim, const struct wetdem_contact* c,
@@ -546,16 +552,8 @@ bool wetdem_sim_laws_jump_at(const struct wetdem_sim* sim, const struct wetdem_c
 static double normal_force_at(const struct wetdem_sim* sim, const struct wetdem_contact* c,
                               const double* history, double h)
 {
-    double scratch[WETDEM_HISTORY_SCRATCH];
-    struct wetdem_contact at = *c;
     struct wetdem_pair_force f;
-    at.gap = h;
-    at.dt = 0.0;
-    if (history)
-        memcpy(scratch, history, sim->history_len * sizeof *scratch);
-    if (wetdem_sim_eval_contact(sim, &at, history ? scratch : NULL, &f, NULL) != WETDEM_OK)
-        return NAN;
-    return f.f_normal;
+    return force_at_gap(sim, *c, history, h, &f) == WETDEM_OK ? f.f_normal : NAN;
 }
 
 #define PEAK_FALL 0.75 /* force at h/2 over that at h below which h is a peak to resolve */
@@ -599,20 +597,13 @@ double wetdem_sim_jump_gap(const struct wetdem_sim* sim, const struct wetdem_con
 double wetdem_sim_force_at_rest(const struct wetdem_sim* sim, struct wetdem_contact c,
                                 const double* history, double gap)
 {
-    double scratch[WETDEM_HISTORY_SCRATCH];
     if (history && sim->history_len > WETDEM_HISTORY_SCRATCH)
         return NAN;
-    if (history)
-        memcpy(scratch, history, sim->history_len * sizeof *scratch);
     struct wetdem_pair_force f;
-    c.gap = gap;
     c.v_n = 0.0;
     c.v_t = vec3(0, 0, 0);
-    c.dt = 0.0;
-    return wetdem_sim_eval_contact(sim, &c, history ? scratch : NULL, &f, NULL) == WETDEM_OK &&
-                   isfinite(f.f_normal)
-               ? f.f_normal
-               : NAN;
+    return force_at_gap(sim, c, history, gap, &f) == WETDEM_OK && isfinite(f.f_normal) ? f.f_normal
+                                                                                       : NAN;
 }
 
 /* The tangential force along t of the enabled models at overlap `overlap` when a fresh
