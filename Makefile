@@ -9,6 +9,8 @@
 #   make figures  redraw the figures from the CSV in out/validate (no new simulations)
 #   make fuzz     fuzz scenario files, checkpoints, tracked dots, fit data and command lines
 #                 (libFuzzer, clang, ASan and UBSan); FUZZ_SECONDS per target, 120 by default
+#   make install  the header, both libraries, wetdem.pc, the CLI, examples and docs under
+#                 PREFIX (/usr/local), staged under DESTDIR if set; make uninstall removes them
 
 # (make's own default is cc; a CC from the command line or the environment is kept)
 ifeq ($(origin CC),default)
@@ -28,6 +30,11 @@ LDLIBS   = -lsundials_cvode -lsundials_nvecserial -lgsl -lgslcblas -linih -lm -f
 VERSION := $(shell sed -n 's/^\#define WETDEM_VERSION "\(.*\)"/\1/p' include/wetdem.h)
 GIT_HASH := $(shell git rev-parse --short HEAD 2>/dev/null || echo unknown)
 
+# The shared library's name carries MAJOR.MINOR while the major version is 0 (a 0.x minor
+# release may change the ABI; from 1.0 the major alone).
+SOVERSION := $(if $(filter 0.%,$(VERSION)),$(basename $(VERSION)),$(firstword $(subst ., ,$(VERSION))))
+SONAME   = libwetdem.so.$(SOVERSION)
+
 LIB_SRC  = $(sort $(wildcard src/*.c))
 LIB_OBJ  = $(patsubst src/%.c,$(BUILD)/obj/%.o,$(LIB_SRC))
 CLI_SRC  = $(sort $(wildcard cli/*.c))
@@ -37,7 +44,7 @@ TEST_BIN = $(patsubst tests/%.c,$(BUILD)/tests/%,$(TEST_SRC))
 EX_SRC   = $(sort $(wildcard examples/*/main.c))
 EX_BIN   = $(patsubst examples/%/main.c,$(BUILD)/examples/%,$(EX_SRC))
 
-.PHONY: all deps test check san test-san test-san-clang demo validate paraview bench figures docs clean \
+.PHONY: install uninstall all deps test check san test-san test-san-clang demo validate paraview bench figures docs clean \
         format check-format check-prefix check-docs examples fuzz fuzz-build
 
 all: deps $(BUILD)/libwetdem.a $(BUILD)/libwetdem.so $(BUILD)/wetdem
@@ -72,7 +79,8 @@ $(BUILD)/libwetdem.a: $(LIB_OBJ)
 	ar rcs $@ $^
 
 $(BUILD)/libwetdem.so: $(LIB_OBJ)
-	$(CC) -shared $(LDFLAGS) -o $@ $^ $(LDLIBS)
+	$(CC) -shared -Wl,-soname,$(SONAME) $(LDFLAGS) -o $@ $^ $(LDLIBS)
+	@ln -sf libwetdem.so $(BUILD)/$(SONAME)
 
 $(BUILD)/wetdem: $(CLI_OBJ) $(BUILD)/libwetdem.a
 	$(CC) $(LDFLAGS) -o $@ $(CLI_OBJ) $(BUILD)/libwetdem.a $(LDLIBS)
@@ -88,7 +96,9 @@ $(BUILD)/examples/%: examples/%/main.c $(BUILD)/libwetdem.a $(BUILD)/flags.stamp
 examples: $(EX_BIN)
 
 test: all $(TEST_BIN) $(EX_BIN)
-	@WETDEM_CLI='$(abspath $(BUILD)/wetdem)' tests/run-tests $(TEST_BIN) $(EX_BIN) tests/test_install_deps.sh
+	@WETDEM_CLI='$(abspath $(BUILD)/wetdem)' CC='$(CC)' WETDEM_BUILD='$(BUILD)' \
+	  WETDEM_EXTRA_CFLAGS='$(EXTRA_CFLAGS)' tests/run-tests $(TEST_BIN) $(EX_BIN) \
+	  tests/test_install_deps.sh tests/test_install.sh
 
 # Tests again under AddressSanitizer + UndefinedBehaviorSanitizer, in a separate build tree,
 # built by GCC (test-san) and by clang (test-san-clang: its UBSan also reports pointer
@@ -177,6 +187,43 @@ $(BUILD)/fuzz/%: tests/fuzz/%.c $(wildcard tests/fuzz/*.h) $(FUZZ_LINK)
 format:
 	clang-format -i src/*.c src/*.h include/*.h cli/*.c cli/*.h tests/*.c tests/*.h examples/*/main.c \
 	  bench/*.c tests/fuzz/*.c tests/fuzz/*.h
+
+# Installation. PREFIX is written into wetdem.pc; DESTDIR only stages the files (packaging).
+# The CLI links the static library, so it needs no library path at run time.
+PREFIX     ?= /usr/local
+BINDIR     ?= $(PREFIX)/bin
+LIBDIR     ?= $(PREFIX)/lib
+INCLUDEDIR ?= $(PREFIX)/include
+DATADIR    ?= $(PREFIX)/share/wetdem
+DOCDIR     ?= $(PREFIX)/share/doc/wetdem
+INSTALL    ?= install
+INSTALLED_FILES = $(BINDIR)/wetdem $(INCLUDEDIR)/wetdem.h $(LIBDIR)/libwetdem.a \
+  $(LIBDIR)/libwetdem.so.$(VERSION) $(LIBDIR)/$(SONAME) $(LIBDIR)/libwetdem.so \
+  $(LIBDIR)/pkgconfig/wetdem.pc
+INSTALLED_DIRS = $(DATADIR) $(DOCDIR)
+
+$(BUILD)/wetdem.pc: wetdem.pc.in include/wetdem.h FORCE
+	@sed -e 's|@PREFIX@|$(PREFIX)|' -e 's|@LIBDIR@|$(patsubst $(PREFIX)/%,$${prefix}/%,$(LIBDIR))|' \
+	  -e 's|@INCLUDEDIR@|$(patsubst $(PREFIX)/%,$${prefix}/%,$(INCLUDEDIR))|' \
+	  -e 's|@VERSION@|$(VERSION)|' $< > $@.tmp && mv $@.tmp $@
+
+install: all $(BUILD)/wetdem.pc
+	$(INSTALL) -d '$(DESTDIR)$(BINDIR)' '$(DESTDIR)$(INCLUDEDIR)' '$(DESTDIR)$(LIBDIR)/pkgconfig' \
+	  '$(DESTDIR)$(DATADIR)' '$(DESTDIR)$(DOCDIR)'
+	$(INSTALL) -m 755 $(BUILD)/wetdem '$(DESTDIR)$(BINDIR)/wetdem'
+	$(INSTALL) -m 644 include/wetdem.h '$(DESTDIR)$(INCLUDEDIR)/wetdem.h'
+	$(INSTALL) -m 644 $(BUILD)/libwetdem.a '$(DESTDIR)$(LIBDIR)/libwetdem.a'
+	$(INSTALL) -m 755 $(BUILD)/libwetdem.so '$(DESTDIR)$(LIBDIR)/libwetdem.so.$(VERSION)'
+	ln -sf libwetdem.so.$(VERSION) '$(DESTDIR)$(LIBDIR)/$(SONAME)'
+	ln -sf $(SONAME) '$(DESTDIR)$(LIBDIR)/libwetdem.so'
+	$(INSTALL) -m 644 $(BUILD)/wetdem.pc '$(DESTDIR)$(LIBDIR)/pkgconfig/wetdem.pc'
+	cp -R examples '$(DESTDIR)$(DATADIR)/'
+	$(INSTALL) -m 644 tools/wetdem_vtk.py '$(DESTDIR)$(DATADIR)/wetdem_vtk.py'
+	cp -R README.md CHANGELOG.md docs '$(DESTDIR)$(DOCDIR)/'
+
+uninstall:
+	rm -f $(foreach f,$(INSTALLED_FILES),'$(DESTDIR)$(f)')
+	rm -rf $(foreach d,$(INSTALLED_DIRS),'$(DESTDIR)$(d)')
 
 clean:
 	rm -rf build build-san build-san-clang build-fuzz
