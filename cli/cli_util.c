@@ -255,11 +255,30 @@ int cli_check_not_input(const char* what, const char* option, const char* out,
     return CLI_EXIT_OK;
 }
 
-/* Where output to `path` goes: *direct when path exists and is not a regular file (a device
- * such as /dev/stdout or /dev/null, a FIFO, a process substitution), which is written in place,
- * never replaced; otherwise the regular file that path names, with a symbolic link followed to
- * its target (so the link stays a link), written under a temporary name next to it and renamed
- * over it when whole. */
+/* The standard stream (stdout or stderr) whose open file `path` names, or NULL: /dev/stdout,
+ * /dev/fd/1 or any other name of that file. Such output goes through the stream itself, after
+ * what the command printed there and before what it prints next: when standard output is a
+ * regular file (`> FILE`), /dev/stdout names that file, and writing it under a temporary name
+ * renamed over it would unlink the file the stream still writes to, losing the rest of the
+ * output (the summary that fit and track print after their files). */
+static FILE* output_std_stream(const char* path)
+{
+    struct stat sp, sf;
+    if (stat(path, &sp) != 0)
+        return NULL;
+    const int fds[2] = {STDOUT_FILENO, STDERR_FILENO};
+    FILE* const streams[2] = {stdout, stderr};
+    for (int k = 0; k < 2; k++)
+        if (fstat(fds[k], &sf) == 0 && sf.st_dev == sp.st_dev && sf.st_ino == sp.st_ino)
+            return streams[k];
+    return NULL;
+}
+
+/* Where output to `path` goes: *direct when path names a standard stream's file (above) or
+ * exists and is not a regular file (a device such as /dev/null, a FIFO, a process
+ * substitution), which is written in place, never replaced; otherwise the regular file that
+ * path names, with a symbolic link followed to its target (so the link stays a link), written
+ * under a temporary name next to it and renamed over it when whole. */
 static void output_target(const char* path, char* final, size_t n, bool* direct)
 {
     struct stat st;
@@ -267,6 +286,10 @@ static void output_target(const char* path, char* final, size_t n, bool* direct)
     snprintf(final, n, "%s", path);
     if (lstat(path, &st) != 0)
         return; /* a new file */
+    if (output_std_stream(path)) {
+        *direct = true;
+        return;
+    }
     if (S_ISLNK(st.st_mode)) {
         char* target = realpath(path, NULL);
         if (target && stat(target, &st) == 0 && S_ISREG(st.st_mode))
@@ -318,9 +341,10 @@ int cli_check_writable(const char* what, const char* option, const char* path)
 static int open_output(struct cli_out_file* o, const char* path, const char* tmp_format)
 {
     output_target(path, o->final, sizeof o->final, &o->direct);
+    o->std = o->direct ? output_std_stream(o->final) : NULL;
     if (o->direct) {
         snprintf(o->tmp, sizeof o->tmp, "%s", o->final);
-        o->f = fopen(o->final, "w");
+        o->f = o->std ? o->std : fopen(o->final, "w");
     } else {
         /* the temporary name: tmp_format applied to the target's directory and base name */
         char dir[1400];
@@ -342,7 +366,7 @@ static int close_stream(struct cli_out_file* o)
         return 0;
     bool bad = ferror(o->f) != 0;
     errno = 0;
-    int err = fclose(o->f) != 0 ? (errno ? errno : EIO) : 0;
+    int err = (o->std ? fflush(o->f) : fclose(o->f)) != 0 ? (errno ? errno : EIO) : 0;
     o->f = NULL;
     return err ? err : bad ? EIO : 0;
 }
@@ -390,6 +414,7 @@ int cli_write_output(const char* path, const char* what, void (*write)(FILE* f, 
 int cli_out_open(struct cli_out_file* o, const char* what, const char* dir, const char* name)
 {
     o->f = NULL;
+    o->std = NULL;
     o->final[0] = o->tmp[0] = '\0';
     o->direct = false;
     if (!dir || !name[0])

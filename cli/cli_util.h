@@ -149,6 +149,8 @@ struct cli_out_file {
     char final[1400], tmp[1400];
     FILE* f;     /* NULL: not open (no directory, or the name is empty: the file is not wanted) */
     bool direct; /* the name is a device or FIFO (/dev/stdout, /dev/null): written in place */
+    FILE* std;   /* stdout or stderr when the name is that stream's file (/dev/stdout, also
+                    when it is a regular file): written through the stream, flushed, not closed */
 };
 
 /* Opens the temporary file of DIR/NAME (nothing when dir is NULL or name empty: o->f NULL).

@@ -458,6 +458,47 @@ static void test_cli_stdout_write_failures(void** state)
     }
 }
 
+/* Output named /dev/stdout goes through standard output in place, also when that is a
+ * regular file (`> FILE`): the CSV of fit --out and track --frames and the summary printed
+ * beside it all reach the file. Before, /dev/stdout led to that file, which was replaced by a
+ * temporary one renamed over it, and the summary went to the unlinked file and was lost. */
+static void test_cli_dev_stdout_output_to_a_redirected_file(void** state)
+{
+    (void)state;
+    char dir[] = "/tmp/wetdem_test_cli_stdout_XXXXXX";
+    assert_non_null(mkdtemp(dir));
+    static const struct {
+        const char* args;
+        const char* summary;
+        const char* table;
+    } cases[] = {
+        {"fit examples/fit/punch_db_c.ini --data examples/fit/punch_0deg.csv --fit glass.p_gt "
+         "--init 4e6 --out /dev/stdout",
+         "parameter,unit,value,std_error,initial,fitted_as\nmodel.glass.p_gt,Pa,",
+         "\nstokes_n [-],angle_deg [deg],e_n_data [-],e_n_fit [-],e_n_residual [-]\n1.6,0,"},
+        {"track examples/tracks/punch_45deg.csv --fps 5000 --pixel-size 175e-6 --frames "
+         "/dev/stdout",
+         "\ne_n = 0.70", "\nsphere,frame,time_s,vx_raw_m_s,"},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        char args[600], path[300];
+        snprintf(path, sizeof path, "%s/out.txt", dir);
+        snprintf(args, sizeof args, "%s > %s", cases[k].args, path);
+        struct test_run r = run_cli(args, false);
+        if (r.code != 0)
+            fail_msg("'%s' exited %d", args, r.code);
+        free(r.out);
+        char* text = test_read_file(path, NULL);
+        assert_non_null(text);
+        CHECK_CONTAINS(text, cases[k].summary);
+        CHECK_CONTAINS(text, cases[k].table);
+        free(text);
+        test_check_dir(dir, "out.txt\n");
+        assert_int_equal(remove(path), 0);
+    }
+    assert_int_equal(rmdir(dir), 0);
+}
+
 /* Numbers a double cannot hold are named as such (they were "not a finite number"), and a
  * file with classic Mac OS line endings (CR only), which inih read as one line, is named as
  * that (it was "no [section] in the file"). */
@@ -607,6 +648,7 @@ int main(void)
         cmocka_unit_test(test_cli_fuzz_regressions),
         cmocka_unit_test(test_cli_stdout_write_failures),
         cmocka_unit_test(test_cli_run_outputs_replaced_whole_or_not_at_all),
+        cmocka_unit_test(test_cli_dev_stdout_output_to_a_redirected_file),
         cmocka_unit_test(test_cli_numbers_out_of_range_and_cr_lines),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
