@@ -872,8 +872,9 @@ struct wetdem_pairwise_pair_result {
     double t_end;        /* last film separation [s] (NAN if none) */
     double min_gap;      /* smallest gap seen at step ends and events [m] */
     int mechanism;       /* enum wetdem_outcome: stick, stick-rotate-separate (reversed by the
-                           film and centrifugal forces) or bounce (reversed by an impulse);
-                           -1 if the films never met */
+                           film and centrifugal forces) or bounce (reversed by an impulse, its
+                           own or a neighbour's that knocked it apart); -1 if the films never
+                           met */
 };
 
 /* Energy budget of a pairwise run [J]. The mechanical energy is the kinetic energy

@@ -817,14 +817,23 @@ static int note_impulse(struct wetdem_pairwise* pw, size_t p, double v_n)
     return log_event(pw, WETDEM_PAIRWISE_CONTACT, p, p, pw->sys.h_min, v_n);
 }
 
-/* After impulses (the kinematics before them in *before): the held pairs whose normal velocity
- * they changed are let go (an approaching one is a contact of its own next). */
+/* After impulses (the kinematics before them in *before): a film pair they set receding, from
+ * approaching, at rest, or receding without any reversal before (pushed through a neighbour's
+ * film), was reversed by an impulse, its own or a neighbour's: a sphere knocked out of another's
+ * films is a bounce, not stick-rotate-separate; and the held pairs whose normal velocity they
+ * changed are let go (an approaching one is a contact of its own next). */
 static int release_moved(struct wetdem_pairwise* pw, const struct wetdem_pairwise_kin* before)
 {
     struct wetdem_pairwise_kin after;
     if (!current_kin(pw, &after))
         return WETDEM_ERR_NUMERIC;
     for (size_t q = 0; q < pw->sys.n_pairs; q++) {
+        bool knocked = after.v_n[q] < 0.0 && after.v_n[q] < before->v_n[q] &&
+                       (before->v_n[q] >= 0.0 || pw->reversal[q] == REV_NONE);
+        if (pw->md.film[q] && knocked) {
+            pw->approaching[q] = false;
+            pw->reversal[q] = REV_IMPULSE;
+        }
         if (!pw->md.resting[q] || after.v_n[q] == before->v_n[q])
             continue;
         pw->md.resting[q] = false;

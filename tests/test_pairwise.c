@@ -1169,6 +1169,42 @@ static void test_pairwise_released_pair_is_not_a_bounce(void** state)
     wetdem_pairwise_free(pw);
 }
 
+/* A film pair knocked apart by its neighbour's impulse is a bounce. Sphere 1 drifts at 1 cm/s
+ * into the films of sphere 2; sphere 3 strikes sphere 2 at 1 m/s from below, at 80 degrees to
+ * the 1-2 line, and knocks it out of sphere 1's films. Pair 1-2 has no impulse of its own:
+ * its reversal is the 2-3 impulse, and it was labelled stick-rotate-separate (after a stick
+ * it never had) until this version. */
+static void test_pairwise_knocked_apart_is_a_bounce(void** state)
+{
+    (void)state;
+    const double a = 1e-3, m = 3e-5, film = 25e-6, d12 = 2 * a + 20e-6, d23 = 2 * a + 60e-6;
+    const double phi = 80.0 * M_PI / 180.0;
+    struct wetdem_pairwise_config c;
+    wetdem_pairwise_config_init(&c);
+    c.n_spheres = 3;
+    c.viscosity = 0.01;
+    c.h_min = 1e-6;
+    c.t_end = 0.01;
+    c.spheres[0] =
+        (struct wetdem_pairwise_sphere){.radius = a, .mass = m, .film = film, .vx = 0.01};
+    c.spheres[1] = (struct wetdem_pairwise_sphere){.radius = a, .mass = m, .film = film, .x = d12};
+    c.spheres[2] = (struct wetdem_pairwise_sphere){.radius = a,
+                                                   .mass = m,
+                                                   .film = film,
+                                                   .x = d12 - d23 * cos(phi),
+                                                   .y = -d23 * sin(phi),
+                                                   .vx = cos(phi),
+                                                   .vy = sin(phi)};
+    struct wetdem_pairwise_result r;
+    CHECK_OK(run(&c, &r, NULL));
+    const struct wetdem_pairwise_pair_result *p12 = &r.pairs[0], *p23 = &r.pairs[2];
+    assert_true(p12->films_met && !p12->bound && p12->n_contacts == 0);
+    assert_true(p12->v_n_out > 0.1); /* knocked out at 0.23 m/s, not drawn apart slowly */
+    assert_int_equal(p12->mechanism, WETDEM_OUTCOME_BOUNCE);
+    assert_true(p23->n_contacts == 1);
+    assert_int_equal(p23->mechanism, WETDEM_OUTCOME_BOUNCE);
+}
+
 /* ------------------------------------------------------------- tree and partner change */
 
 /* Converting the state to another tracked tree keeps every sphere: 1e-15 relative to the
@@ -1393,6 +1429,7 @@ int main(void)
         cmocka_unit_test(test_pairwise_scales_of_the_reference_pair),
         cmocka_unit_test(test_pairwise_two_sphere_mechanisms),
         cmocka_unit_test(test_pairwise_released_pair_is_not_a_bounce),
+        cmocka_unit_test(test_pairwise_knocked_apart_is_a_bounce),
         cmocka_unit_test(test_pairwise_tree_change_keeps_spheres),
         cmocka_unit_test(test_pairwise_partner_change_logged),
         cmocka_unit_test(test_pairwise_davis_builder),
