@@ -859,22 +859,49 @@ static int hard_contact(struct wetdem_pairwise* pw, size_t p, struct wetdem_pair
     return st == WETDEM_OK ? release_moved(pw, k) : st;
 }
 
-/* Contacts met at one instant, frictionless, at the rest speed or faster
- * (`set`, two or more): their impulses together (wetdem_pairwise_jump_simultaneous), so that
- * the result does not depend on the pairs' numbering, as one impulse after the other did (a
- * sphere meeting two touching ones symmetrically left off the symmetry line). Returns
- * WETDEM_EVENT when the joint solution would pull a pair (the caller then resolves them one
- * by one). */
+/* Whether no pair of `set` slips at state k: |v_s| = |-r Omega + v_omega| within CVODE's
+ * absolute tolerance on the speeds (rtol x the initial speed scale), below which the
+ * integration does not resolve a slip. */
+static bool set_does_not_slip(const struct wetdem_pairwise* pw, const bool* set,
+                              const struct wetdem_pairwise_kin* k)
+{
+    double tol = pw->cfg.rtol * pw->v_scale;
+    for (size_t q = 0; q < pw->sys.n_pairs; q++)
+        if (set[q] && !(fabs(-k->r[q] * k->omega_lc[q] + k->v_w[q]) <= tol))
+            return false;
+    return true;
+}
+
+/* Contacts met at one instant at the rest speed or faster (`set`, two or more): their normal
+ * impulses together (wetdem_pairwise_jump_simultaneous), so that the result does not depend
+ * on the pairs' numbering, as one impulse after the other did (a sphere meeting two touching
+ * ones symmetrically left off the symmetry line). With friction this holds when no pair of
+ * the set slips before or after the normal impulses (spheres in a line): no friction impulse
+ * is then called for, and the frictionless result is the frictional one (one after the other,
+ * a sphere squeezed between two at 1 m/s, e_dry = 0.8, mu_f = 0.3, left at 0.009 m/s instead
+ * of at rest). Returns WETDEM_EVENT, the velocities untouched, when the joint solution would
+ * pull a pair or friction would act (the caller then resolves them one by one). */
 static int simultaneous_contacts(struct wetdem_pairwise* pw, const bool* set)
 {
+    struct wetdem_pairwise_kin k, after;
+    bool friction = pw->sys.mu_f > 0.0;
+    if (!current_kin(pw, &k))
+        return WETDEM_ERR_NUMERIC;
+    if (friction && !set_does_not_slip(pw, set, &k))
+        return WETDEM_EVENT;
     for (size_t q = 0; q < pw->sys.n_pairs; q++)
         if (set[q] && pw->md.edge_of_pair[q] >= 0)
             gap_to_hmin(pw, q);
-    struct wetdem_pairwise_kin k;
     if (!current_kin(pw, &k))
         return WETDEM_ERR_NUMERIC;
+    double y_before[PW_YMAX];
+    memcpy(y_before, pw->y, sizeof y_before);
     if (!wetdem_pairwise_jump_simultaneous(&pw->sys, &pw->md, &k, set, pw->y))
         return WETDEM_EVENT;
+    if (friction && (!current_kin(pw, &after) || !set_does_not_slip(pw, set, &after))) {
+        memcpy(pw->y, y_before, sizeof y_before);
+        return WETDEM_EVENT;
+    }
     for (size_t q = 0; q < pw->sys.n_pairs; q++) {
         int st = set[q] ? note_impulse(pw, q, k.v_n[q]) : WETDEM_OK;
         if (st != WETDEM_OK)
@@ -885,7 +912,7 @@ static int simultaneous_contacts(struct wetdem_pairwise* pw, const bool* set)
 
 /* The set of pairs whose contact guard is negative in g, or whose gap lies within the
  * integration's resolution of h_min, and that approach at the rest speed or faster, when there
- * are two or more of them and no friction; false otherwise. Contacts closer in time than the
+ * are two or more of them; false otherwise. Contacts closer in time than the
  * integration can tell apart are one multiple collision: in a symmetric wet set-up the second
  * pair's gap was 2.9e-13 m above h_min (3e-7 of it) when the first was met. The resolution is
  * rtol (a_i + a_j), the error of a centre distance: a pair the tree does not track has its gap
@@ -904,7 +931,7 @@ static bool simultaneous_set(const struct wetdem_pairwise* pw, const double* g,
         set[q] = met && !pw->md.resting[q] && k->v_n[q] >= pw->rest_speed && k->v_n[q] > 0.0;
         n += set[q];
     }
-    return n >= 2 && pw->sys.mu_f == 0.0;
+    return n >= 2;
 }
 
 static int on_contact(struct wetdem_pairwise* pw, size_t p)

@@ -26,10 +26,11 @@
  * normal impulses from one small linear system), with no tangential impulse (its size
  * mu_f I_n vanishes with the contact speed); which pairs then stay held is decided at the
  * force level (wetdem_pairwise_rhs_hold_set).
- * Simultaneous contacts without friction: the pairs met at one instant get their normal
- * impulses together, sum_q coupling(p, q) J_q = -(1 + e_dry) v_n,p, so that every v_n of the
- * set is reversed to -e_dry v_n at once (Newton's rule for each contact of a multiple
- * collision); applied only when every J_q > 0 (else the engine resolves them one by one).
+ * Simultaneous contacts without friction, or with friction when none of them slips: the pairs
+ * met at one instant get their normal impulses together, sum_q coupling(p, q) J_q =
+ * -(1 + e_dry) v_n,p, so that every v_n of the set is reversed to -e_dry v_n at once (Newton's
+ * rule for each contact of a multiple collision); applied only when every J_q > 0 (else the
+ * engine resolves them one by one).
  */
 #include <math.h>
 

@@ -762,6 +762,42 @@ static void test_pairwise_simultaneous_contacts_are_symmetric(void** state)
         }
 }
 
+/* A sphere squeezed between two in a line (dry, equal spheres at 1 m/s from both sides,
+ * e_dry = 0.8) with friction mu_f = 0.3: nothing slips, so no friction impulse acts and the
+ * joint impulses of the frictionless rule give (-0.8, 0, 0.8) m/s whatever the numbering. One
+ * impulse after the other, the rule for every frictional set until this version, left the
+ * middle sphere at 0.009 m/s (or -0.009, numbered the other way). Impulses and free flight
+ * along a line are exact but for rounding: 1e-12 m/s. */
+static void test_pairwise_simultaneous_line_with_friction(void** state)
+{
+    (void)state;
+    const double a = 1e-3, m = 3e-5, h_min = 1e-6, d = 2 * a + 10e-6;
+    const double x[3] = {-d, 0.0, d}, v[3] = {1.0, 0.0, -1.0};
+    const size_t order[2][3] = {{0, 1, 2}, {1, 2, 0}}; /* input slot of each sphere */
+    for (int o = 0; o < 2; o++) {
+        struct wetdem_pairwise_config c;
+        wetdem_pairwise_config_init(&c);
+        c.n_spheres = 3;
+        c.h_min = h_min;
+        c.restitution = 0.8;
+        c.friction = 0.3;
+        c.t_end = 1e-3;
+        for (size_t i = 0; i < 3; i++)
+            c.spheres[order[o][i]] =
+                (struct wetdem_pairwise_sphere){.radius = a, .mass = m, .x = x[i], .vx = v[i]};
+        c.ref_i = order[o][0];
+        c.ref_j = order[o][1];
+        struct wetdem_pairwise_result r;
+        CHECK_OK(run(&c, &r, NULL));
+        for (size_t i = 0; i < 3; i++) {
+            const struct wetdem_pairwise_sphere* s = &r.final[order[o][i]];
+            CHECK_ABS(s->vx, -0.8 * v[i], 1e-12);
+            CHECK_ABS(s->vy, 0.0, 1e-12);
+            CHECK_ABS(s->omega, 0.0, 1e-9);
+        }
+    }
+}
+
 /* Determinism: the same input gives bit-identical results. */
 static void test_pairwise_deterministic(void** state)
 {
@@ -1417,6 +1453,7 @@ int main(void)
         cmocka_unit_test(test_pairwise_energy_with_gravity),
         cmocka_unit_test(test_pairwise_relabelling_symmetry),
         cmocka_unit_test(test_pairwise_simultaneous_contacts_are_symmetric),
+        cmocka_unit_test(test_pairwise_simultaneous_line_with_friction),
         cmocka_unit_test(test_pairwise_deterministic),
         cmocka_unit_test(test_pairwise_positions_match_cartesian),
         cmocka_unit_test(test_pairwise_unequal_triangle_matches_cartesian),
