@@ -294,11 +294,16 @@ int wetdem_pairwise_config_validate(const struct wetdem_pairwise_config* c, char
         for (size_t j = i + 1; j < c->n_spheres; j++) {
             const struct wetdem_pairwise_sphere *a = &c->spheres[i], *b = &c->spheres[j];
             double h = hypot(b->x - a->x, b->y - a->y) - a->radius - b->radius;
-            if (!(h >= c->h_min))
+            /* The gap is a difference of lengths of the centres' size: spheres placed at
+             * exactly h_min (a cradle's chain) come out a few ulps of those lengths short. */
+            double rounding =
+                8.0 * DBL_EPSILON *
+                (fabs(a->x) + fabs(a->y) + fabs(b->x) + fabs(b->y) + a->radius + b->radius);
+            if (!(h >= c->h_min - rounding))
                 return wetdem_status_fail(
                     msg, n, WETDEM_ERR_INVALID,
-                    "initial gap of spheres %zu and %zu (spheres[%zu], spheres[%zu]) = %g m: "
-                    "must be >= h_min = %g m",
+                    "initial gap of spheres %zu and %zu (spheres[%zu], spheres[%zu]) = %.9g m: "
+                    "must be >= h_min = %.9g m",
                     i + 1, j + 1, i, j, h, c->h_min);
         }
     return WETDEM_OK;

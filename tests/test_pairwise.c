@@ -798,6 +798,33 @@ static void test_pairwise_simultaneous_line_with_friction(void** state)
     }
 }
 
+/* A Newton's cradle of four equal dry elastic spheres touching at h_min, placed as a user
+ * writes it (centres at k (2a + h_min) in decimal): the computed gaps come out a few ulps of
+ * the centres' size short of h_min, which must not be refused; the striker's velocity passes
+ * down the chain to the last sphere and the others stop (equal masses, e_dry = 1: exact up to
+ * rounding of the three impulses, 1e-12 of the 1 m/s). */
+static void test_pairwise_cradle_placed_at_h_min(void** state)
+{
+    (void)state;
+    const double x[4] = {0.0, 0.010001, 0.020002, 0.030003}; /* a = 5 mm, h_min = 1 um */
+    struct wetdem_pairwise_config c;
+    wetdem_pairwise_config_init(&c);
+    c.n_spheres = 4;
+    c.h_min = 1e-6;
+    c.t_end = 1e-3;
+    for (size_t i = 0; i < 4; i++)
+        c.spheres[i] = (struct wetdem_pairwise_sphere){
+            .radius = 0.005, .mass = 4e-3, .x = x[i], .vx = i == 0 ? 1.0 : 0.0};
+    double h12 = x[1] - x[0] - 0.01;
+    assert_true(h12 < c.h_min); /* the case: rounding puts the gap below h_min */
+    struct wetdem_pairwise_result r;
+    CHECK_OK(run(&c, &r, NULL));
+    for (size_t i = 0; i < 4; i++) {
+        CHECK_ABS(r.final[i].vx, i == 3 ? 1.0 : 0.0, 1e-12);
+        CHECK_ABS(r.final[i].vy, 0.0, 1e-12);
+    }
+}
+
 /* Determinism: the same input gives bit-identical results. */
 static void test_pairwise_deterministic(void** state)
 {
@@ -1454,6 +1481,7 @@ int main(void)
         cmocka_unit_test(test_pairwise_relabelling_symmetry),
         cmocka_unit_test(test_pairwise_simultaneous_contacts_are_symmetric),
         cmocka_unit_test(test_pairwise_simultaneous_line_with_friction),
+        cmocka_unit_test(test_pairwise_cradle_placed_at_h_min),
         cmocka_unit_test(test_pairwise_deterministic),
         cmocka_unit_test(test_pairwise_positions_match_cartesian),
         cmocka_unit_test(test_pairwise_unequal_triangle_matches_cartesian),
