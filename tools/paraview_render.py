@@ -2,8 +2,8 @@
 opens the run's .vtk.series indexes in ParaView, checks what ParaView reads, and renders a
 frame: the spheres (Glyph, scale array radius, factor 2) coloured by a point array, and, when
 the run wrote links, beside them the force network (each contact and bridge as a tube
-coloured by its normal force). The recipe of docs/many.md ("Outputs", "In ParaView"), as a
-script to adapt.
+coloured by its normal force). The recipe of docs/many.md (section "Outputs (`--out DIR`)",
+its "ParaView" paragraph), as a script to adapt.
 
     xvfb-run -a pvbatch tools/paraview_render.py RUN_DIR --png OUT.png
         [--color ARRAY] [--time T] [--check-only]
