@@ -6,9 +6,12 @@
  * Engines: soft (a CSV row of every field of struct wetdem_collision_result, cli/output_csv.c;
  * nan and none for a failed run, status ENERGY_GREW for a run whose energy grew) and pairwise
  * (the row of cli_run_pairwise, whose status column is the engine's status). SIGINT or
- * SIGTERM stops starting points; the table of those that ran is still written.
+ * SIGTERM stops starting points; the table of those that ran is still written. While the
+ * points run, the table of those done is saved to the output file every save_every seconds
+ * (the others NOT_RUN), so that a process killed outright can be resumed from it.
  */
 #include <errno.h>
+#include <math.h>
 #include <omp.h>
 #include <signal.h>
 #include <stdio.h>
@@ -137,6 +140,30 @@ static void run_point(const struct cli_scenario* base, const struct cli_batch* b
     cli_setup_free(&su); /* the row holds all that is reported */
 }
 
+/* Saves the table of the points done so far (called under the batch's lock, which every
+ * point takes when it finishes, so those marked done are complete): written as the final
+ * table is, whole or not at all, with the others NOT_RUN. The next save is save_every
+ * seconds later, or 50 x this write's time if longer. A failed write is reported once and
+ * the batch goes on without saving. */
+static void save_partial(struct cli_batch* b, double* next_save)
+{
+    double w0 = omp_get_wtime();
+    b->wall = w0 - b->t_start;
+    b->saving = true;
+    int rc = cli_write_output(b->out, b->cmd, b->write_table, b->table_ctx);
+    b->saving = false;
+    double now = omp_get_wtime();
+    if (rc != CLI_EXIT_OK) {
+        cli_error("warning: %s: the table of the points done so far could not be saved (above); "
+                  "the points go on running, and no more saves are tried",
+                  b->cmd);
+        *next_save = INFINITY;
+        return;
+    }
+    b->n_saves++;
+    *next_save = now + fmax(b->save_every, 50.0 * (now - w0));
+}
+
 static void show_progress(const char* cmd, size_t done, size_t n, double t0)
 {
     double elapsed = omp_get_wtime() - t0;
@@ -154,6 +181,8 @@ static void run_all(const struct cli_scenario* base, struct cli_batch* b)
 {
     bool show = b->progress && isatty(STDERR_FILENO);
     double t0 = omp_get_wtime(), last = 0;
+    double next_save =
+        b->save_every > 0 && b->out && b->write_table ? t0 + b->save_every : INFINITY;
     size_t done = 0, n = b->n_pts - b->n_kept; /* (progress of the points that run here) */
     char notice[200];
     snprintf(notice, sizeof notice,
@@ -175,8 +204,11 @@ static void run_all(const struct cli_scenario* base, struct cli_batch* b)
         run_point(base, b, &b->pts[k]);
 #pragma omp critical(batch_progress)
         {
+            b->pts[k].done = true;
             done++;
             double now = omp_get_wtime();
+            if (now >= next_save && done < n && !cli_stop_signal)
+                save_partial(b, &next_save);
             if (show && !cli_stop_signal && (now - last > 0.2 || done == n)) {
                 show_progress(b->cmd, done, n, t0);
                 last = now;
@@ -325,7 +357,22 @@ static int resume_row(struct cli_batch* b, size_t r, const char* text, size_t li
         return CLI_EXIT_RUNTIME;
     }
     p->status = failed_word(status, ls) ? CLI_BATCH_KEPT_FAILED : CLI_BATCH_KEPT;
+    p->done = true;
     b->n_kept++;
+    return CLI_EXIT_OK;
+}
+
+int cli_batch_parse_save_every(const char* cmd, const char* text, double* out)
+{
+    double v;
+    const char* problem = cli_number(text, &v) == 0 ? NULL : cli_number_problem(text);
+    if (problem || !(v >= 0.0 && v <= 1e9)) {
+        cli_error("%s: --save-every '%s': %s; it is the time between saves of the table while "
+                  "the points run, seconds in [0, 1e9] (0: never)",
+                  cmd, text, problem ? problem : "out of range");
+        return CLI_EXIT_USAGE;
+    }
+    *out = v;
     return CLI_EXIT_OK;
 }
 
@@ -430,6 +477,9 @@ int cli_batch_run(struct cli_batch* b)
     b->wall = 0;
     b->interrupted = 0;
     b->n_kept = 0;
+    b->saving = false;
+    b->n_saves = 0;
+    b->t_start = omp_get_wtime();
     for (int d = 0; d < b->n_keys; d++)
         b->n_pts *= b->range[d].n;
     struct cli_scenario sc;
@@ -446,7 +496,6 @@ int cli_batch_run(struct cli_batch* b)
     }
     if (rc == CLI_EXIT_OK)
         rc = engine_header(&sc, b);
-    double t0 = omp_get_wtime();
     if (rc == CLI_EXIT_OK)
         rc = build_all(&sc, b);
     if (rc == CLI_EXIT_OK && b->resume)
@@ -455,7 +504,7 @@ int cli_batch_run(struct cli_batch* b)
         rc = cli_check_writable(b->cmd, "--out", b->out);
     if (rc == CLI_EXIT_OK) {
         run_all(&sc, b);
-        b->wall = omp_get_wtime() - t0;
+        b->wall = omp_get_wtime() - b->t_start;
     }
     cli_scenario_free(&sc);
     return rc;
@@ -489,7 +538,7 @@ size_t cli_batch_points_run(const struct cli_batch* b)
 {
     size_t n = 0;
     for (size_t k = 0; k < b->n_pts; k++)
-        n += b->pts[k].status != CLI_BATCH_NOT_RUN;
+        n += b->pts[k].done;
     return n;
 }
 
@@ -506,12 +555,14 @@ void cli_batch_write_table(FILE* f, const struct cli_batch* b, int argc, char** 
         char values[128];
         row_values(b, p, values, sizeof values);
         fputs(values, f);
-        if (p->status != CLI_BATCH_KEPT && p->status != CLI_BATCH_KEPT_FAILED)
-            fprintf(f, "%s,", point_status(p));
-        if (p->status == CLI_BATCH_NOT_RUN)
+        if (!p->done) { /* (left out by an interruption, or still to run) */
+            fputs("NOT_RUN,", f);
             not_run_fields(f, b->header);
-        else
+        } else {
+            if (p->status != CLI_BATCH_KEPT && p->status != CLI_BATCH_KEPT_FAILED)
+                fprintf(f, "%s,", point_status(p));
             fputs(p->row ? p->row : "", f);
+        }
         fputc('\n', f);
     }
     if (b->n_kept)
@@ -520,6 +571,12 @@ void cli_batch_write_table(FILE* f, const struct cli_batch* b, int argc, char** 
     if (b->interrupted)
         fprintf(f, "# interrupted by signal %d: %zu of %zu points ran (status %s: not run)\n",
                 b->interrupted, cli_batch_points_run(b), b->n_pts, "NOT_RUN");
+    if (b->saving)
+        fprintf(f,
+                "# saved while running: %zu of %zu points done after %.1f s (status NOT_RUN: "
+                "not run yet; if the run is lost, the same command with --resume and this "
+                "table runs the rest)\n",
+                cli_batch_points_run(b), b->n_pts, b->wall);
 }
 
 /* One line for the points whose fixed step did not resolve h_min (information). */

@@ -39,7 +39,17 @@ struct cli_batch_point {
     char errmsg[256]; /* the engine's message of a failed run */
     char* row;        /* the engine's CSV fields, no newline (malloc'd); of a point kept
                          from --resume, its status word and fields as that table has them */
+    bool done;        /* it ran here (set under the batch's lock when it finished) or was
+                         kept from --resume: only then are its status and row read while
+                         the batch runs (the table saved meanwhile) */
 };
+
+/* The default of --save-every [s]: a batch of a minute or less is never saved midway. */
+#define CLI_BATCH_SAVE_EVERY_S 60.0
+
+/* Parses the value of `cmd`'s --save-every, seconds in [0, 1e9] (0: never). Returns
+ * CLI_EXIT_OK and sets *out, or prints why and returns CLI_EXIT_USAGE. */
+int cli_batch_parse_save_every(const char* cmd, const char* text, double* out);
 
 /* A batch: the caller fills the first block, cli_batch_run() the second. */
 struct cli_batch {
@@ -56,6 +66,14 @@ struct cli_batch {
     const char* out;    /* the table's file (NULL: stdout): checked writable before the runs */
     const char* resume; /* a table this batch wrote, interrupted (NULL: none): its points that
                            ran are kept, only those NOT_RUN run */
+    double save_every;  /* while the points run, the table of those done so far is written to
+                           `out` every save_every seconds or more (never more than 2 % of the
+                           time: at least 50 x the last write), the others NOT_RUN, so that a
+                           run killed outright (SIGKILL, power) can be completed by --resume;
+                           0, or out NULL (stdout): never */
+    void (*write_table)(FILE* f, const void* ctx); /* the caller's writer of the table (with
+                                                      its trailer), for those saves */
+    const void* table_ctx;
 
     enum cli_engine engine;
     char* header;                /* the engine's CSV column header, no newline (malloc'd) */
@@ -66,6 +84,9 @@ struct cli_batch {
     size_t n_kept;   /* points kept from the table of --resume */
     unsigned long long scenario_hash; /* of the file's bytes and the --set overrides (the table
                                          records it, --resume compares it) */
+    bool saving;    /* the table is being saved while the batch runs (a '#' line says so) */
+    size_t n_saves; /* saves so far */
+    double t_start; /* omp_get_wtime() when the batch started building [s] */
 };
 
 /* Checks the keys (two names of one key, or speed and stokes, are refused), loads the file
@@ -85,11 +106,12 @@ int cli_batch_run(struct cli_batch* b);
 /* Writes the '#' provenance lines, the header "KEY [unit],...,status [word],<engine columns>"
  * (after a '#' line with the scenario's hash) and one row per point
  * "value,...,status,<engine fields>" (status: the engine's status name,
- * ENERGY_GREW, or NOT_RUN), and after an interruption a '#' line saying so; the caller adds
- * its trailer. */
+ * ENERGY_GREW, or NOT_RUN), and after an interruption, or when saved while the batch runs, a
+ * '#' line saying so; the caller adds its trailer (reading only the points marked done). */
 void cli_batch_write_table(FILE* f, const struct cli_batch* b, int argc, char** argv);
 
-/* How many points ran, here or in the table of --resume (all unless interrupted). */
+/* How many points ran, here or in the table of --resume (all unless interrupted; while the
+ * table is saved, those done so far). */
 size_t cli_batch_points_run(const struct cli_batch* b);
 
 /* Prints "CMD: KEY = value, ...: message (status)" for every failed run (for those kept from

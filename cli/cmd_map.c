@@ -30,6 +30,7 @@ struct map_args {
     bool is_log[2];
     const char* out;
     const char* resume;
+    const char* save_every;
     const char* sets[MAP_MAX_SETS];
     int n_sets;
 };
@@ -46,7 +47,7 @@ static void usage(FILE* f)
     fprintf(f,
             "usage: wetdem map FILE --param KEY --values A:B:N --param2 KEY2 --values2 A:B:N\n"
             "                  [--log] [--log2] [--out FILE.csv] [--resume FILE.csv]\n"
-            "                  [--set section.key=value ...]\n"
+            "                  [--save-every S] [--set section.key=value ...]\n"
             "A grid of independent collisions over two scenario keys (KEY slowest), in\n"
             "parallel (OMP_NUM_THREADS); rows in grid order, bit-identical for any thread count.\n"
             "  --param KEY      first key (scenario key or model parameter, e.g. davis.stokes)\n"
@@ -56,6 +57,8 @@ static void usage(FILE* f)
             "  --out FILE.csv   write the grid there (default: stdout)\n"
             "  --resume T.csv   the grid of this map that Ctrl-C stopped: keep its rows that ran,\n"
             "                   run those NOT_RUN (T may be the --out file)\n"
+            "  --save-every S   while it runs, save the grid of the points done to --out every\n"
+            "                   S seconds (default 60; 0: never), for --resume after a crash\n"
             "  --set K=V        override a scenario key or model parameter (repeatable)\n");
 }
 
@@ -77,6 +80,8 @@ static int parse_args(int argc, char** argv, struct map_args* a)
             a->out = argv[++k];
         else if (strcmp(s, "--resume") == 0 && next)
             a->resume = argv[++k];
+        else if (strcmp(s, "--save-every") == 0 && next)
+            a->save_every = argv[++k];
         else if (strcmp(s, "--set") == 0 && next && a->n_sets < MAP_MAX_SETS)
             a->sets[a->n_sets++] = argv[++k];
         else if (strcmp(s, "--log") == 0)
@@ -86,9 +91,9 @@ static int parse_args(int argc, char** argv, struct map_args* a)
         else if (s[0] != '-' && !a->file)
             a->file = s;
         else {
-            static const char* const options[] = {"--param", "--values", "--param2", "--values2",
-                                                  "--out",   "--resume", "--set",    "--log",
-                                                  "--log2",  NULL};
+            static const char* const options[] = {
+                "--param",      "--values", "--param2", "--values2", "--out", "--resume",
+                "--save-every", "--set",    "--log",    "--log2",    NULL};
             char hint[64];
             cli_error("map: unexpected argument '%s'%s", s,
                       cli_option_hint(s, options, hint, sizeof hint));
@@ -139,9 +144,15 @@ int cmd_map(int argc, char** argv)
                           .key = {a.key[0], a.key[1]},
                           .progress = true,
                           .out = a.out,
-                          .resume = a.resume};
+                          .resume = a.resume,
+                          .save_every = CLI_BATCH_SAVE_EVERY_S,
+                          .write_table = write_table};
+    struct map_table t = {&b, argc, argv};
+    b.table_ctx = &t;
     for (int d = 0; d < 2 && rc == CLI_EXIT_OK; d++)
         rc = cli_parse_range(a.values[d], a.is_log[d], d ? "--values2" : "--values", &b.range[d]);
+    if (rc == CLI_EXIT_OK && a.save_every)
+        rc = cli_batch_parse_save_every("map", a.save_every, &b.save_every);
     if (rc != CLI_EXIT_OK)
         return rc;
     double points = (double)b.range[0].n * (double)b.range[1].n;
@@ -152,7 +163,6 @@ int cmd_map(int argc, char** argv)
     }
     rc = cli_batch_run(&b);
     if (rc == CLI_EXIT_OK) { /* (also after an interruption: the points that ran) */
-        struct map_table t = {&b, argc, argv};
         rc = cli_write_output(a.out, "map", write_table, &t);
         rc = cli_batch_report_failures(&b, rc);
     }

@@ -35,6 +35,7 @@ struct sweep_args {
     const char* values;
     const char* out;
     const char* resume;
+    const char* save_every;
     bool is_log;
     const char* sets[MAX_SETS];
     int n_sets;
@@ -49,15 +50,19 @@ struct sweep_table {
 
 static void usage(FILE* f)
 {
-    fprintf(f, "usage: wetdem sweep FILE --param KEY --values A:B:N [--log] [--out FILE.csv]\n"
-               "                    [--resume FILE.csv] [--set section.key=value ...]\n"
-               "Independent collisions, one per value of KEY (any scenario key, e.g.\n"
-               "collision.stokes, or a model parameter), in parallel (OMP_NUM_THREADS).\n"
-               "  --values A:B:N  N values from A to B (both included); --log: geometric\n"
-               "  --out FILE.csv  write the table there (default: stdout)\n"
-               "  --resume T.csv  the table of this sweep that Ctrl-C stopped: keep its rows that\n"
-               "                  ran, run those NOT_RUN (T may be the --out file)\n"
-               "  --set K=V       override a scenario key or model parameter (repeatable)\n");
+    fprintf(
+        f,
+        "usage: wetdem sweep FILE --param KEY --values A:B:N [--log] [--out FILE.csv]\n"
+        "                    [--resume FILE.csv] [--save-every S] [--set section.key=value ...]\n"
+        "Independent collisions, one per value of KEY (any scenario key, e.g.\n"
+        "collision.stokes, or a model parameter), in parallel (OMP_NUM_THREADS).\n"
+        "  --values A:B:N  N values from A to B (both included); --log: geometric\n"
+        "  --out FILE.csv  write the table there (default: stdout)\n"
+        "  --resume T.csv  the table of this sweep that Ctrl-C stopped: keep its rows that\n"
+        "                  ran, run those NOT_RUN (T may be the --out file)\n"
+        "  --save-every S  while it runs, save the table of the points done to --out every\n"
+        "                  S seconds (default 60; 0: never), for --resume after a crash\n"
+        "  --set K=V       override a scenario key or model parameter (repeatable)\n");
 }
 
 static int parse_args(int argc, char** argv, struct sweep_args* a)
@@ -74,6 +79,8 @@ static int parse_args(int argc, char** argv, struct sweep_args* a)
             a->out = argv[++k];
         else if (strcmp(s, "--resume") == 0 && next)
             a->resume = argv[++k];
+        else if (strcmp(s, "--save-every") == 0 && next)
+            a->save_every = argv[++k];
         else if (strcmp(s, "--set") == 0 && next && a->n_sets < MAX_SETS)
             a->sets[a->n_sets++] = argv[++k];
         else if (strcmp(s, "--log") == 0)
@@ -81,8 +88,8 @@ static int parse_args(int argc, char** argv, struct sweep_args* a)
         else if (s[0] != '-' && !a->file)
             a->file = s;
         else {
-            static const char* const options[] = {"--param", "--values", "--out", "--resume",
-                                                  "--set",   "--log",    NULL};
+            static const char* const options[] = {"--param",      "--values", "--out", "--resume",
+                                                  "--save-every", "--set",    "--log", NULL};
             char hint[64];
             cli_error("sweep: unexpected argument '%s'%s", s,
                       cli_option_hint(s, options, hint, sizeof hint));
@@ -115,6 +122,8 @@ static void write_table(FILE* f, const void* ctx)
     }
     struct wetdem_stats tot = {0};
     for (size_t k = 0; k < b->n_pts; k++) {
+        if (!b->pts[k].done) /* (still running when the table is saved midway) */
+            continue;
         const struct wetdem_stats* s = &b->pts[k].res.stats;
         tot.steps += s->steps;
         tot.force_evals += s->force_evals;
@@ -146,14 +155,19 @@ int cmd_sweep(int argc, char** argv)
                           .key = {a.key},
                           .progress = true,
                           .out = a.out,
-                          .resume = a.resume};
+                          .resume = a.resume,
+                          .save_every = CLI_BATCH_SAVE_EVERY_S,
+                          .write_table = write_table};
+    struct sweep_table t = {&b, argc, argv};
+    b.table_ctx = &t;
     if (rc == CLI_EXIT_OK)
         rc = cli_parse_range(a.values, a.is_log, "--values", &b.range[0]);
+    if (rc == CLI_EXIT_OK && a.save_every)
+        rc = cli_batch_parse_save_every("sweep", a.save_every, &b.save_every);
     if (rc != CLI_EXIT_OK)
         return rc;
     rc = cli_batch_run(&b);
     if (rc == CLI_EXIT_OK) { /* (also after an interruption: the points that ran) */
-        struct sweep_table t = {&b, argc, argv};
         rc = cli_write_output(a.out, "sweep", write_table, &t);
         rc = cli_batch_report_failures(&b, rc);
     }

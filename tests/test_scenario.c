@@ -905,6 +905,80 @@ static void test_scenario_resumed_map_equals_the_whole(void** state)
     free(whole);
 }
 
+/* A map killed outright (SIGKILL: no handler, no table at the end) leaves the table it saved
+ * while running (--save-every): whole, under its name, every point there, those done with
+ * their rows and the others NOT_RUN, and a line saying so; --resume with it runs the rest,
+ * and the data rows are those of the uninterrupted map, bit for bit. --save-every outside
+ * [0, 1e9] seconds is refused (exit 2). */
+static void test_scenario_killed_map_resumes_from_its_saved_table(void** state)
+{
+    (void)state;
+    const char* map = "map examples/scenarios/davis_three.ini --param davis.stokes --values "
+                      "0.5:30:20 --param2 davis.angle_deg --values2 0:80:20";
+    char saved[600], args[1600];
+    snprintf(saved, sizeof saved, "%s/saved.csv", tmpdir);
+    /* 400 three-sphere collisions on one thread (about 1.5 s, longer under the sanitizers),
+       saved every 50 ms, killed as soon as a save is there */
+    pid_t pid = fork();
+    assert_true(pid >= 0);
+    if (pid == 0) {
+        freopen("/dev/null", "w", stderr);
+        setenv("OMP_NUM_THREADS", "1", 1);
+        execl(test_cli_path(), test_cli_path(), "map", "examples/scenarios/davis_three.ini",
+              "--param", "davis.stokes", "--values", "0.5:30:20", "--param2", "davis.angle_deg",
+              "--values2", "0:80:20", "--save-every", "0.05", "--out", saved, (char*)NULL);
+        _exit(127);
+    }
+    struct timespec nap = {0, 1000000};
+    char* table = NULL;
+    for (int k = 0; k < 60000 && !table; k++) { /* up to a minute */
+        nanosleep(&nap, NULL);
+        table = test_read_file(saved, NULL);
+        if (table && !strstr(table, "# saved while running: ")) {
+            free(table);
+            table = NULL;
+            fail_msg("the map finished before a save could be seen"); /* (not a saved table) */
+        }
+    }
+    kill(pid, SIGKILL);
+    int status = 0;
+    waitpid(pid, &status, 0);
+    assert_non_null(table);
+    CHECK_CONTAINS(table, ",NOT_RUN,none,none,nan,");
+    CHECK_CONTAINS(table, ",WETDEM_OK,");
+    size_t rows = 0;
+    for (const char* line = table; line && *line;
+         line = strchr(line, '\n'), line = line ? line + 1 : NULL)
+        rows += line[0] != '#' && line[0] != '\n';
+    assert_int_equal(rows, 1 + 20 * 20); /* the header and every point */
+    free(table);
+
+    snprintf(args, sizeof args, "%s --resume %s --out %s/resumed.csv", map, saved, tmpdir);
+    expect_run(args, 0, NULL);
+    snprintf(args, sizeof args, "%s --out %s/whole.csv --save-every 0", map, tmpdir);
+    expect_run(args, 0, NULL);
+    char path[600];
+    snprintf(path, sizeof path, "%s/resumed.csv", tmpdir);
+    char* resumed = test_read_file(path, NULL);
+    snprintf(path, sizeof path, "%s/whole.csv", tmpdir);
+    char* whole = test_read_file(path, NULL);
+    assert_non_null(resumed);
+    assert_non_null(whole);
+    CHECK_CONTAINS(resumed, "# resumed: ");
+    char *a = data_rows(whole), *b = data_rows(resumed);
+    assert_string_equal(a, b);
+    free(a);
+    free(b);
+    free(resumed);
+    free(whole);
+
+    static const char* const bad[] = {"-1", "nan", "2e9", "soon"};
+    for (int k = 0; k < 4; k++) {
+        snprintf(args, sizeof args, "%s --save-every %s", map, bad[k]);
+        expect_run(args, 2, "--save-every");
+    }
+}
+
 /* Runs `wetdem run FILE --set SET1 --set SET2 --set SET3 --out tmpdir/NAME` (a collision of
  * about 5-10 s), sends SIGINT once its handler is in place and 0.3 s more have passed, and
  * checks that it stops with exit 130 and leaves no file, not even a temporary one: a
@@ -1235,6 +1309,7 @@ int main(void)
         cmocka_unit_test(test_scenario_batch_keys_rows_and_outputs),
         cmocka_unit_test(test_scenario_interrupted_map_writes_what_ran),
         cmocka_unit_test(test_scenario_resumed_map_equals_the_whole),
+        cmocka_unit_test(test_scenario_killed_map_resumes_from_its_saved_table),
         cmocka_unit_test(test_scenario_closed_loop_of_contacts_settles),
         cmocka_unit_test(test_scenario_interrupted_run_keeps_nothing),
         cmocka_unit_test(test_scenario_sweep_order_and_threads),
