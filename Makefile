@@ -200,7 +200,9 @@ INSTALL    ?= install
 INSTALLED_FILES = $(BINDIR)/wetdem $(INCLUDEDIR)/wetdem.h $(LIBDIR)/libwetdem.a \
   $(LIBDIR)/libwetdem.so.$(VERSION) $(LIBDIR)/$(SONAME) $(LIBDIR)/libwetdem.so \
   $(LIBDIR)/pkgconfig/wetdem.pc
-INSTALLED_DIRS = $(DATADIR) $(DOCDIR)
+# (only what install put there, so that a DATADIR or DOCDIR shared with others is left)
+INSTALLED_TREES = $(DATADIR)/examples $(DATADIR)/wetdem_vtk.py $(DOCDIR)/README.md \
+  $(DOCDIR)/CHANGELOG.md $(DOCDIR)/docs
 
 $(BUILD)/wetdem.pc: wetdem.pc.in include/wetdem.h FORCE
 	@sed -e 's|@PREFIX@|$(PREFIX)|' -e 's|@LIBDIR@|$(patsubst $(PREFIX)/%,$${prefix}/%,$(LIBDIR))|' \
@@ -223,7 +225,8 @@ install: all $(BUILD)/wetdem.pc
 
 uninstall:
 	rm -f $(foreach f,$(INSTALLED_FILES),'$(DESTDIR)$(f)')
-	rm -rf $(foreach d,$(INSTALLED_DIRS),'$(DESTDIR)$(d)')
+	rm -rf $(foreach d,$(INSTALLED_TREES),'$(DESTDIR)$(d)')
+	-rmdir '$(DESTDIR)$(DATADIR)' '$(DESTDIR)$(DOCDIR)' 2>/dev/null || true
 
 clean:
 	rm -rf build build-san build-san-clang build-fuzz

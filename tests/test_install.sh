@@ -3,7 +3,8 @@
 # the stage with PREFIX written into wetdem.pc; the shared library's SONAME is the name of the
 # installed link to it; a program built against an install through pkg-config, linked to the
 # shared and to the static library, prints the same as the example built in the tree; the
-# installed CLI reports the version pkg-config does; `make uninstall` leaves no file behind.
+# installed CLI reports the version pkg-config does; `make uninstall` leaves no file of its
+# own behind, and removes none it did not install.
 # Run by `make test`: the nested make inherits the outer one's variables (BUILD, CC,
 # EXTRA_CFLAGS), so a sanitizer build installs its own objects; WETDEM_EXTRA_CFLAGS carries the
 # sanitizer flags to the compiles here.
@@ -58,9 +59,10 @@ ex="$here/${WETDEM_BUILD:-build}/examples/01_pair_force"
 [ -x "$ex" ] && { "$ex" | cmp -s - "$work/out_shared" || fail "output differs from $ex"; }
 "$work/p/bin/wetdem" --version | grep -q "$version" || fail "installed wetdem --version"
 
-# 3. Uninstall leaves nothing.
+# 3. Uninstall leaves nothing of its own, and what others put beside it.
+echo mine >"$work/p/share/wetdem/mine.txt"
 make -s -C "$here" uninstall PREFIX="$work/p" >"$work/log" 2>&1 || { cat "$work/log"; fail "make uninstall"; }
 left=$(find "$work/p" \( -type f -o -type l \) | head -5)
-[ -z "$left" ] || fail "make uninstall left: $left"
+[ "$left" = "$work/p/share/wetdem/mine.txt" ] || fail "make uninstall left or removed: '$left'"
 
 [ $fails -eq 0 ] && echo "test_install: ok" || { echo "test_install: $fails failure(s)"; exit 1; }
