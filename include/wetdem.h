@@ -14,7 +14,8 @@
  * library never exits or aborts; a failing call on a simulation stores a message that
  * wetdem_sim_errmsg() returns. Pointer arguments are not NULL unless an entry says what NULL
  * means; the functions that take a name, a material, a fluid, a model or a path also refuse a
- * NULL one (WETDEM_ERR_INVALID; wetdem_model_find: NULL).
+ * NULL one (WETDEM_ERR_INVALID; a lookup that returns a pointer, an index or a size gives NULL,
+ * -1 or 0, as for a name it does not know).
  *
  * Sections, in the order a user needs them: value types; status; parameters; materials;
  * models; simulation; pair forces; hard-sphere impulses; soft engine; analysis;
@@ -154,7 +155,8 @@ WETDEM_API const char* wetdem_param_suggest(const char* word, const char* const*
  * Returns WETDEM_OK or WETDEM_ERR_NOT_FOUND. */
 WETDEM_API int wetdem_material_preset(const char* name, struct wetdem_material* m);
 /* Fills *f with the fluid that goes with a preset: "water" (1e-3 Pa s), "glycerol80"
- * (Yang & Hunt 80 w% glycerol, 0.057 Pa s), "silicone10" (Punch: 10 Pa s, 0.0205 N/m). */
+ * (Yang & Hunt 80 w% glycerol, 0.057 Pa s), "silicone10" (Punch: 10 Pa s, 0.0205 N/m).
+ * Returns WETDEM_OK or WETDEM_ERR_NOT_FOUND. */
 WETDEM_API int wetdem_fluid_preset(const char* name, struct wetdem_fluid* f);
 /* NULL-terminated list of material preset names. */
 WETDEM_API const char* const* wetdem_material_preset_names(void);
@@ -392,7 +394,8 @@ WETDEM_API int wetdem_sim_set_param(struct wetdem_sim* sim, const char* name, do
  * as text too. */
 WETDEM_API int wetdem_sim_set_param_str(struct wetdem_sim* sim, const char* name,
                                         const char* value);
-/* Reads a parameter by dotted name into *value. */
+/* Reads a parameter by dotted name into *value. Returns WETDEM_OK, WETDEM_ERR_NOT_FOUND ("did
+ * you mean ...") or WETDEM_ERR_INVALID (NULL name or value). */
 WETDEM_API int wetdem_sim_param(const struct wetdem_sim* sim, const char* name, double* value);
 /* Descriptor table ({0}-terminated, static) of the simulation settings, set as "sim.<name>"
  * (gravity, stop on separation, speed floor); the defaults are those of a new simulation. */

@@ -19,7 +19,7 @@ size_t wetdem_abi_sizeof(const char* type_name)
         {"contact", sizeof(struct wetdem_contact)},
         {"pair_force", sizeof(struct wetdem_pair_force)},
     };
-    for (size_t k = 0; k < sizeof sizes / sizeof sizes[0]; k++)
+    for (size_t k = 0; type_name && k < sizeof sizes / sizeof sizes[0]; k++)
         if (strcmp(sizes[k].name, type_name) == 0)
             return sizes[k].size;
     return 0;

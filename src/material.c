@@ -16,6 +16,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "status.h"
 #include "wetdem.h"
 
 struct named_material {
@@ -113,6 +114,8 @@ const char* const* wetdem_material_preset_names(void)
 
 int wetdem_fluid_preset(const char* name, struct wetdem_fluid* f)
 {
+    if (!name || !f)
+        return WETDEM_ERR_INVALID;
     for (size_t k = 0; k < sizeof fluid_presets / sizeof fluid_presets[0]; k++)
         if (strcmp(fluid_presets[k].name, name) == 0) {
             *f = fluid_presets[k].f;
@@ -182,10 +185,14 @@ static int validate_struct(const struct wetdem_param_desc* table, const void* ob
 
 int wetdem_material_validate(const struct wetdem_material* m, char* msg, size_t n)
 {
+    if (!m)
+        return wetdem_status_fail(msg, n, WETDEM_ERR_INVALID, "material: NULL");
     return validate_struct(material_params, m, "material", msg, n);
 }
 
 int wetdem_fluid_validate(const struct wetdem_fluid* f, char* msg, size_t n)
 {
+    if (!f)
+        return wetdem_status_fail(msg, n, WETDEM_ERR_INVALID, "fluid: NULL");
     return validate_struct(fluid_params, f, "fluid", msg, n);
 }

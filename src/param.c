@@ -22,7 +22,7 @@ size_t wetdem_param_count(const struct wetdem_param_desc* table)
 const struct wetdem_param_desc* wetdem_param_find(const struct wetdem_param_desc* table,
                                                   const char* name)
 {
-    for (size_t k = 0; table && table[k].name; k++)
+    for (size_t k = 0; table && name && table[k].name; k++)
         if (strcmp(table[k].name, name) == 0)
             return &table[k];
     return NULL;
@@ -92,7 +92,7 @@ int wetdem_param_validate(const struct wetdem_param_desc* d, double value, char*
 
 int wetdem_param_choice_index(const struct wetdem_param_desc* d, const char* word)
 {
-    for (int k = 0; d->choices && d->choices[k]; k++)
+    for (int k = 0; word && d->choices && d->choices[k]; k++)
         if (strcmp(d->choices[k], word) == 0)
             return k;
     return -1;
@@ -135,6 +135,8 @@ const char* wetdem_param_suggest(const char* word, const char* const* candidates
 {
     const char* best = NULL;
     size_t best_d = (size_t)-1;
+    if (!word)
+        return NULL;
     for (size_t k = 0; candidates && candidates[k]; k++) {
         size_t d = edit_distance(word, candidates[k]);
         if (d < best_d) {

@@ -91,13 +91,14 @@ int wetdem_sim_engine_copy(struct wetdem_sim* dst, const struct wetdem_sim* src)
 
 int wetdem_sim_set_integrator(struct wetdem_sim* sim, const char* name)
 {
-    int k = name ? wetdem_integrator_index(name, strlen(name)) : -1;
+    if (!name)
+        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID, "set_integrator: NULL name");
+    int k = wetdem_integrator_index(name, strlen(name));
     if (k < 0) {
-        const char* hint = name ? wetdem_param_suggest(name, wetdem_integrator_names()) : NULL;
+        const char* hint = wetdem_param_suggest(name, wetdem_integrator_names());
         return wetdem_sim_fail(sim, WETDEM_ERR_NOT_FOUND,
-                               "unknown integrator '%s'%s%s%s (valid: verlet, cvode)",
-                               name ? name : "(null)", hint ? " (did you mean '" : "",
-                               hint ? hint : "", hint ? "'?)" : "");
+                               "unknown integrator '%s'%s%s%s (valid: verlet, cvode)", name,
+                               hint ? " (did you mean '" : "", hint ? hint : "", hint ? "'?)" : "");
     }
     sim->engine.integrator = (size_t)k;
     return WETDEM_OK;

@@ -206,6 +206,8 @@ static int write_particle_frame(struct wetdem_sim* sim, const char* path, bool b
 
 int wetdem_sim_write_vtk(struct wetdem_sim* sim, const char* path, bool binary)
 {
+    if (!path)
+        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID, "write_vtk: NULL path");
     uint32_t* block = NULL;
     struct wetdem_output_vtk_counts counts;
     if (sim->many && sim->many->started) {
@@ -274,6 +276,8 @@ static bool push_link(struct wetdem_output_vtk_link** links, size_t* n, size_t* 
 
 int wetdem_sim_write_vtk_links(struct wetdem_sim* sim, const char* path, bool binary)
 {
+    if (!path)
+        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID, "links: NULL path");
     const struct wetdem_many* m = sim->many;
     if (!m || !m->started)
         return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
@@ -705,6 +709,8 @@ static int fill_checkpoint(struct wetdem_sim* sim, struct wetdem_checkpoint* ck)
 
 int wetdem_sim_write_checkpoint(struct wetdem_sim* sim, const char* path)
 {
+    if (!path)
+        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID, "write_checkpoint: NULL path");
     if (!sim->many || !sim->many->started)
         return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
                                "checkpoints need a started many-particle run (wetdem_sim_set_many "
@@ -904,6 +910,8 @@ static int restore_pairs(struct wetdem_sim* sim, const struct wetdem_checkpoint*
 
 int wetdem_sim_read_checkpoint(struct wetdem_sim* sim, const char* path)
 {
+    if (!path)
+        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID, "read_checkpoint: NULL path");
     if (!sim->many)
         return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
                                "reading a checkpoint needs the many-particle mode "

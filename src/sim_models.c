@@ -386,6 +386,9 @@ int wetdem_sim_set_param_str(struct wetdem_sim* sim, const char* name, const cha
 
 int wetdem_sim_param(const struct wetdem_sim* sim, const char* name, double* value)
 {
+    if (!name || !value) /* (the message buffer: as wetdem_sim_energy_budget) */
+        return wetdem_sim_fail((struct wetdem_sim*)sim, WETDEM_ERR_INVALID, "param: NULL %s",
+                               name ? "value" : "name");
     struct param_target t;
     int st = find_target(sim, name, &t);
     if (st == WETDEM_OK)

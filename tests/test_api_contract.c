@@ -1,0 +1,68 @@
+/*
+ * test_api_contract.c — the public API under misuse, against the contract of wetdem.h: a NULL
+ * name, material, fluid or path is refused (WETDEM_ERR_INVALID with a message, or the "not
+ * found" answer of a lookup), never dereferenced.
+ */
+#include <stdlib.h>
+
+#include "harness.h"
+
+/* A started many-particle run of one glass sphere (the state the file writers need). */
+static struct wetdem_sim* started_many_run(void)
+{
+    struct wetdem_sim* sim = wetdem_sim_create();
+    assert_non_null(sim);
+    assert_int_equal(wetdem_sim_add_material_preset(sim, "glass"), 0);
+    CHECK_OK(wetdem_sim_add_particle(
+        sim, (struct wetdem_particle){.radius = 1e-3, .vel = {0.1, 0, 0}, .material = 0}));
+    CHECK_OK(wetdem_sim_enable_model(sim, "hertz"));
+    struct wetdem_many_settings ms = {.dt = 1e-6};
+    CHECK_OK(wetdem_sim_set_many(sim, &ms));
+    CHECK_OK(wetdem_sim_integrate(sim, 1e-5));
+    return sim;
+}
+
+static void test_api_null_names_materials_fluids_and_paths_are_refused(void** state)
+{
+    (void)state;
+    struct wetdem_fluid f;
+    char msg[128] = "";
+    assert_int_equal(wetdem_fluid_preset(NULL, &f), WETDEM_ERR_INVALID);
+    assert_int_equal(wetdem_fluid_preset("water", NULL), WETDEM_ERR_INVALID);
+    assert_int_equal(wetdem_material_validate(NULL, msg, sizeof msg), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(msg, "NULL");
+    assert_int_equal(wetdem_fluid_validate(NULL, msg, sizeof msg), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(msg, "NULL");
+    /* lookups answer as for a name they do not know */
+    const struct wetdem_param_desc* settings = wetdem_sim_settings_params();
+    assert_null(wetdem_param_find(settings, NULL));
+    assert_int_equal(
+        wetdem_param_choice_index(wetdem_param_find(settings, "stop_on_separation"), NULL), -1);
+    assert_null(wetdem_param_suggest(NULL, wetdem_integrator_names()));
+    assert_int_equal(wetdem_abi_sizeof(NULL), 0);
+
+    struct wetdem_sim* sim = started_many_run();
+    double v = 0;
+    assert_int_equal(wetdem_sim_param(sim, NULL, &v), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(wetdem_sim_errmsg(sim), "NULL name");
+    assert_int_equal(wetdem_sim_param(sim, "sim.gravity_x", NULL), WETDEM_ERR_INVALID);
+    assert_int_equal(wetdem_sim_set_integrator(sim, NULL), WETDEM_ERR_INVALID);
+    assert_int_equal(wetdem_sim_write_vtk(sim, NULL, false), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(wetdem_sim_errmsg(sim), "NULL path");
+    assert_int_equal(wetdem_sim_write_vtk_links(sim, NULL, false), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(wetdem_sim_errmsg(sim), "NULL path");
+    assert_int_equal(wetdem_sim_write_checkpoint(sim, NULL), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(wetdem_sim_errmsg(sim), "NULL path");
+    assert_int_equal(wetdem_sim_read_checkpoint(sim, NULL), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(wetdem_sim_errmsg(sim), "NULL path");
+    CHECK_OK(wetdem_sim_param(sim, "sim.gravity_x", &v)); /* the sim is untouched */
+    wetdem_sim_free(sim);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_api_null_names_materials_fluids_and_paths_are_refused),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
