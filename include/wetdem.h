@@ -749,7 +749,8 @@ enum wetdem_insert_layout {
 /* What to insert and where. Seeded: the same spec gives bit-identical particles. */
 struct wetdem_insert_spec {
     enum wetdem_insert_layout layout;
-    size_t n;                    /* number of spheres, >= 1 */
+    size_t n;                    /* number of spheres, >= 1 (at most SIZE_MAX / (2 x
+                                    sizeof(struct wetdem_particle))) */
     struct wetdem_vec3 lo, hi;   /* region [m]; spheres lie inside it on non-periodic axes */
     bool periodic[3];            /* axes on which the region wraps (overlaps through images) */
     double radius_min;           /* radii uniform in [radius_min, radius_max] [m], > 0 */

@@ -31,6 +31,7 @@
 
 #define DEFAULT_ATTEMPTS 10000
 #define RSA_JAMMING 0.38 /* random sequential addition limit of equal spheres [-] */
+#define INSERT_MAX_COUNT (SIZE_MAX / (2 * sizeof(struct wetdem_particle)))
 
 static double axis(struct wetdem_vec3 v, int k)
 {
@@ -52,6 +53,13 @@ int wetdem_insert_check(const struct wetdem_insert_spec* s, char* msg, size_t n)
                                   "insert.layout must be lattice or random");
     if (s->n == 0)
         return wetdem_status_fail(msg, n, WETDEM_ERR_INVALID, "insert.count must be >= 1, got 0");
+    /* the spheres' arrays (particles, and the random layout's two doubles a sphere) must have a
+       size that size_t holds: a larger count wrapped it to a small block */
+    if (s->n > INSERT_MAX_COUNT)
+        return wetdem_status_fail(msg, n, WETDEM_ERR_INVALID,
+                                  "insert.count = %zu is more than the %zu spheres an array can "
+                                  "address",
+                                  s->n, (size_t)INSERT_MAX_COUNT);
     for (int k = 0; k < 3; k++) {
         double lo = axis(s->lo, k), hi = axis(s->hi, k);
         if (!(isfinite(lo) && isfinite(hi) && hi > lo))

@@ -946,12 +946,15 @@ int wetdem_sim_insert(struct wetdem_sim* sim, const struct wetdem_insert_spec* s
     struct wetdem_particle* p = malloc((spec->n ? spec->n : 1) * sizeof *p);
     if (!p)
         return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory for %zu particles", spec->n);
+    size_t n_before = sim->n_particles;
     int st =
         wetdem_insert_particles_among(spec, sim->particles, sim->n_particles, p, msg, sizeof msg);
     if (st != WETDEM_OK)
         st = wetdem_sim_fail(sim, st, "%s", msg);
     for (size_t k = 0; st == WETDEM_OK && k < spec->n; k++)
         st = wetdem_sim_add_particle(sim, p[k]);
+    if (st != WETDEM_OK) /* (a sphere refused: e.g. a velocity drawn beyond the doubles) */
+        sim->n_particles = n_before;
     free(p);
     return st;
 }

@@ -1,7 +1,8 @@
 /*
  * test_api_contract.c — the public API under misuse, against the contract of wetdem.h: a NULL
  * name, material, fluid or path is refused (WETDEM_ERR_INVALID with a message, or the "not
- * found" answer of a lookup), never dereferenced.
+ * found" answer of a lookup), never dereferenced; an insertion is whole or nothing, also for
+ * counts whose arrays no size_t can measure.
  */
 #include <stdlib.h>
 
@@ -59,10 +60,45 @@ static void test_api_null_names_materials_fluids_and_paths_are_refused(void** st
     wetdem_sim_free(sim);
 }
 
+static void test_api_insert_is_whole_or_nothing(void** state)
+{
+    (void)state;
+    struct wetdem_sim* sim = wetdem_sim_create();
+    assert_int_equal(wetdem_sim_add_material_preset(sim, "glass"), 0);
+    CHECK_OK(wetdem_sim_add_particle(sim, (struct wetdem_particle){.radius = 1e-3, .material = 0}));
+    /* a count whose particle array wrapped size_t: refused, not written past a small block */
+    struct wetdem_insert_spec sp = {
+        .layout = WETDEM_INSERT_RANDOM,
+        .n = (size_t)1 << 59,
+        .lo = {1, 1, 1},
+        .hi = {1e100, 1e100, 1e100},
+        .radius_min = 1e-3,
+        .radius_max = 1e-3,
+    };
+    assert_int_equal(wetdem_sim_insert(sim, &sp), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(wetdem_sim_errmsg(sim), "insert.count");
+    sp.layout = WETDEM_INSERT_LATTICE;
+    assert_int_equal(wetdem_sim_insert(sim, &sp), WETDEM_ERR_INVALID);
+    assert_int_equal(wetdem_sim_n_particles(sim), 1);
+    /* velocities drawn beyond the doubles: the sphere that has one is refused, and none of
+     * the spheres before it stays */
+    sp.n = 1000;
+    sp.hi = (struct wetdem_vec3){2, 2, 2};
+    sp.velocity_sigma = 1e308;
+    assert_int_equal(wetdem_sim_insert(sim, &sp), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(wetdem_sim_errmsg(sim), "must be finite");
+    assert_int_equal(wetdem_sim_n_particles(sim), 1);
+    sp.velocity_sigma = 1;
+    CHECK_OK(wetdem_sim_insert(sim, &sp));
+    assert_int_equal(wetdem_sim_n_particles(sim), 1001);
+    wetdem_sim_free(sim);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_api_null_names_materials_fluids_and_paths_are_refused),
+        cmocka_unit_test(test_api_insert_is_whole_or_nothing),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
