@@ -321,9 +321,12 @@ struct wetdem_impulse_result {
 /* Applies a hard-sphere collision to bodies i and j in place. normal: unit, from j to i.
  * The normal relative velocity is reversed with e_dry (A1-A3); friction gives a tangential
  * impulse mu_f J_n opposing slip (sliding, A8-A11) unless that exceeds what arrests the slip
- * (A36), in which case slip stops (A33). Returns WETDEM_OK, or WETDEM_ERR_INVALID for
- * non-positive masses/radii, e_dry outside (0, 1] or mu_f < 0. Separating pairs
- * (v_n <= 0) are left unchanged and WETDEM_OK is returned. */
+ * (A36), in which case slip stops (A33). Returns WETDEM_OK; WETDEM_ERR_INVALID for
+ * non-finite velocities, non-positive masses/radii/inertias, a movable body whose 1/m or
+ * R^2/I overflows, a normal that is not unit, e_dry outside (0, 1] or mu_f not in [0, inf);
+ * or WETDEM_ERR_NUMERIC when the impulse or the velocities after it overflow. The bodies are
+ * unchanged on an error. Separating pairs (v_n <= 0) are left unchanged and WETDEM_OK is
+ * returned. */
 WETDEM_API int wetdem_hard_impulse(struct wetdem_impulse_body* bi, struct wetdem_impulse_body* bj,
                                    struct wetdem_vec3 normal, double restitution, double friction,
                                    struct wetdem_impulse_result* result);

@@ -49,7 +49,8 @@ static bool is_immovable(const struct wetdem_impulse_body* b)
 }
 
 /* Finite velocities, m > 0, R > 0 and I > 0; an immovable body's inertia is not used, and
- * only an immovable body may be a plane (R = INFINITY). */
+ * only an immovable body may be a plane (R = INFINITY). A movable body's 1/m and R^2/I must be
+ * finite: a mass or inertia near the least double made them infinite and the velocities NaN. */
 static bool body_is_valid(const struct wetdem_impulse_body* b)
 {
     if (!vec3_is_finite(b->vel) || !vec3_is_finite(b->omega))
@@ -58,7 +59,8 @@ static bool body_is_valid(const struct wetdem_impulse_body* b)
         return false;
     if (is_immovable(b))
         return true;
-    return b->inertia > 0.0 && !isinf(b->radius);
+    return b->inertia > 0.0 && !isinf(b->radius) && isfinite(1.0 / b->mass) &&
+           isfinite(b->radius * b->radius / b->inertia);
 }
 
 /* Velocity of body b's surface at the contact point, which lies at R n_out from its centre. */
@@ -135,8 +137,15 @@ int wetdem_hard_impulse(struct wetdem_impulse_body* bi, struct wetdem_impulse_bo
     struct wetdem_vec3 j_t =
         tangential_impulse(vec3_reject(u, n), 1.0 / inv_mt, j_n, friction, &is_sticking);
     struct wetdem_vec3 impulse = vec3_axpy(j_t, j_n, n);
-    apply_impulse(bi, n_i, impulse);
-    apply_impulse(bj, n, vec3_neg(impulse));
+    struct wetdem_impulse_body after_i = *bi, after_j = *bj;
+    apply_impulse(&after_i, n_i, impulse);
+    apply_impulse(&after_j, n, vec3_neg(impulse));
+    if (!vec3_is_finite(impulse) || !vec3_is_finite(after_i.vel) ||
+        !vec3_is_finite(after_i.omega) || !vec3_is_finite(after_j.vel) ||
+        !vec3_is_finite(after_j.omega)) /* speeds near the largest double: left as they were */
+        return WETDEM_ERR_NUMERIC;
+    *bi = after_i;
+    *bj = after_j;
     if (result)
         *result = (struct wetdem_impulse_result){j_n, j_t, is_sticking};
     return WETDEM_OK;

@@ -2,7 +2,8 @@
  * test_api_contract.c — the public API under misuse, against the contract of wetdem.h: a NULL
  * name, material, fluid or path is refused (WETDEM_ERR_INVALID with a message, or the "not
  * found" answer of a lookup), never dereferenced; an insertion is whole or nothing, also for
- * counts whose arrays no size_t can measure.
+ * counts whose arrays no size_t can measure; a hard-sphere impulse that would give NaN or
+ * infinite velocities is an error that leaves the bodies as they were.
  */
 #include <stdlib.h>
 
@@ -94,11 +95,43 @@ static void test_api_insert_is_whole_or_nothing(void** state)
     wetdem_sim_free(sim);
 }
 
+static void test_api_hard_impulse_never_returns_nan_velocities(void** state)
+{
+    (void)state;
+    const struct wetdem_impulse_body wall = {{0, 0, 0}, {0, 0, 0}, INFINITY, INFINITY, INFINITY};
+    const struct wetdem_vec3 n = {-1, 0, 0}; /* from the wall (j) to the sphere (i) */
+    struct {
+        struct wetdem_impulse_body sphere;
+        int status;
+    } cases[] = {
+        /* 1/m overflows: v += (1/m) J was inf x 0 = NaN */
+        {{{1, 0, 0}, {0, 0, 0}, 1e-320, 1, 0.4}, WETDEM_ERR_INVALID},
+        /* R^2/I overflows: the spin became NaN */
+        {{{1, 0, 1}, {0, 0, 0}, 1, 1, 1e-320}, WETDEM_ERR_INVALID},
+        /* (1 + e) v_n overflows: J_n and the velocities were infinite */
+        {{{1e308, 0, 0}, {0, 0, 0}, 1, 1, 0.4}, WETDEM_ERR_NUMERIC},
+        {{{1e308, 0, 1e308}, {0, 0, 0}, 1, 1, 0.4}, WETDEM_ERR_NUMERIC},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        struct wetdem_impulse_body bi = cases[k].sphere, bj = wall;
+        struct wetdem_impulse_result r;
+        CHECK_STATUS(wetdem_hard_impulse(&bi, &bj, n, 1.0, 0.5, &r), cases[k].status);
+        assert_memory_equal(&bi, &cases[k].sphere, sizeof bi);
+        assert_memory_equal(&bj, &wall, sizeof bj);
+        CHECK_ABS(r.impulse_normal, 0.0, 0.0);
+    }
+    /* large but representable: applied as before */
+    struct wetdem_impulse_body bi = {{1e300, 0, 0}, {0, 0, 0}, 1, 1, 0.4}, bj = wall;
+    CHECK_OK(wetdem_hard_impulse(&bi, &bj, n, 0.5, 0.0, NULL));
+    CHECK_REL(bi.vel.x, -0.5e300, 1e-15);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_api_null_names_materials_fluids_and_paths_are_refused),
         cmocka_unit_test(test_api_insert_is_whole_or_nothing),
+        cmocka_unit_test(test_api_hard_impulse_never_returns_nan_velocities),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
