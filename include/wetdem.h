@@ -1137,13 +1137,14 @@ struct wetdem_fit_problem {
                                  upper are both NULL */
     size_t n_data;            /* > n_params (the residual variance needs a degree of freedom) */
     const double* observed;   /* [n_data] */
-    const double* scale;      /* [n_data] divisor of each residual (> 0), NULL: all 1 */
+    const double* scale;      /* [n_data] divisor of each residual (finite, > 0), NULL: all 1 */
     wetdem_fit_model_fn model;
     void* ctx;
     const double* lower; /* [n_params] lower bounds (-INFINITY: none); NULL: none */
     const double* upper; /* [n_params] upper bounds (INFINITY: none); NULL: none */
 };
 
+/* Options of wetdem_fit_run(): max_iter >= 1, tolerances finite and > 0, fd_step in (0, 1). */
 struct wetdem_fit_options {
     int max_iter;   /* trust-region iterations (50) */
     double xtol;    /* step tolerance, relative in the fitted variables (1e-6) */

@@ -352,18 +352,22 @@ static int check_problem(const struct wetdem_fit_problem* pb, const struct wetde
     if (!pb->model || !pb->initial || !pb->observed)
         return wetdem_status_fail(msg, n, WETDEM_ERR_INVALID,
                                   "model, initial values and observations needed");
+    /* (an infinite scale silenced its point; an infinite tolerance stopped the solver at its
+       first iterate, reported as converged) */
     for (size_t i = 0; i < pb->n_data; i++)
-        if (!isfinite(pb->observed[i]) || (pb->scale && !(pb->scale[i] > 0)))
+        if (!isfinite(pb->observed[i]) ||
+            (pb->scale && !(isfinite(pb->scale[i]) && pb->scale[i] > 0)))
             return wetdem_status_fail(
                 msg, n, WETDEM_ERR_INVALID,
-                "data point %zu: observation %g must be finite and its scale > 0", i + 1,
-                pb->observed[i]);
-    if (o->max_iter < 1 || !(o->fd_step > 0 && o->fd_step < 1) || !(o->xtol > 0) ||
-        !(o->gtol > 0) || !(o->ftol > 0))
+                "data point %zu: observation %g must be finite and its scale %g finite and > 0",
+                i + 1, pb->observed[i], pb->scale ? pb->scale[i] : 1.0);
+    if (o->max_iter < 1 || !(o->fd_step > 0 && o->fd_step < 1) ||
+        !(isfinite(o->xtol) && o->xtol > 0) || !(isfinite(o->gtol) && o->gtol > 0) ||
+        !(isfinite(o->ftol) && o->ftol > 0))
         return wetdem_status_fail(
             msg, n, WETDEM_ERR_INVALID,
-            "fit options: max_iter >= 1, tolerances > 0 and fd_step in (0, 1) needed "
-            "(got %d, %g, %g, %g, %g)",
+            "fit options: max_iter >= 1, tolerances finite and > 0 and fd_step in (0, 1) needed "
+            "(got max_iter %d, xtol %g, gtol %g, ftol %g, fd_step %g)",
             o->max_iter, o->xtol, o->gtol, o->ftol, o->fd_step);
     return WETDEM_OK;
 }

@@ -3,7 +3,8 @@
  * name, material, fluid or path is refused (WETDEM_ERR_INVALID with a message, or the "not
  * found" answer of a lookup), never dereferenced; an insertion is whole or nothing, also for
  * counts whose arrays no size_t can measure; a hard-sphere impulse that would give NaN or
- * infinite velocities is an error that leaves the bodies as they were.
+ * infinite velocities is an error that leaves the bodies as they were; a fit refuses an
+ * infinite scale or tolerance.
  */
 #include <stdlib.h>
 
@@ -126,12 +127,53 @@ static void test_api_hard_impulse_never_returns_nan_velocities(void** state)
     CHECK_REL(bi.vel.x, -0.5e300, 1e-15);
 }
 
+/* predicted_i = p0 i + p1 for i = 0..4 */
+static int straight_line(const double* p, double* predicted, char* msg, size_t msg_size, void* ctx)
+{
+    (void)msg, (void)msg_size, (void)ctx;
+    for (int i = 0; i < 5; i++)
+        predicted[i] = p[0] * i + p[1];
+    return WETDEM_OK;
+}
+
+static void test_api_fit_refuses_infinite_scale_and_tolerances(void** state)
+{
+    (void)state;
+    const double observed[5] = {1, 2, 3, 4, 5}, initial[2] = {1, 0.5};
+    const double scale[5] = {1, 1, INFINITY, 1, 1};
+    struct wetdem_fit_problem pb = {.n_params = 2,
+                                    .initial = initial,
+                                    .n_data = 5,
+                                    .observed = observed,
+                                    .model = straight_line};
+    struct wetdem_fit_options opt;
+    struct wetdem_fit_result res;
+    char msg[256] = "";
+    wetdem_fit_options_init(&opt);
+    CHECK_OK(wetdem_fit_run(&pb, &opt, &res, NULL, msg, sizeof msg));
+    CHECK_REL(res.values[0], 1.0, 1e-6);
+    pb.scale = scale; /* would drop data point 3 from the fit */
+    assert_int_equal(wetdem_fit_run(&pb, &opt, &res, NULL, msg, sizeof msg), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(msg, "data point 3");
+    CHECK_CONTAINS(msg, "scale inf");
+    pb.scale = NULL;
+    double* tolerances[3] = {&opt.xtol, &opt.gtol, &opt.ftol};
+    for (int k = 0; k < 3; k++) { /* xtol inf stopped at the first iterate, "converged" */
+        wetdem_fit_options_init(&opt);
+        *tolerances[k] = INFINITY;
+        assert_int_equal(wetdem_fit_run(&pb, &opt, &res, NULL, msg, sizeof msg),
+                         WETDEM_ERR_INVALID);
+        CHECK_CONTAINS(msg, "tol inf");
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_api_null_names_materials_fluids_and_paths_are_refused),
         cmocka_unit_test(test_api_insert_is_whole_or_nothing),
         cmocka_unit_test(test_api_hard_impulse_never_returns_nan_velocities),
+        cmocka_unit_test(test_api_fit_refuses_infinite_scale_and_tolerances),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
