@@ -155,7 +155,7 @@ WETDEM_API const char* wetdem_param_suggest(const char* word, const char* const*
  * Returns WETDEM_OK or WETDEM_ERR_NOT_FOUND. */
 WETDEM_API int wetdem_material_preset(const char* name, struct wetdem_material* m);
 /* Fills *f with the fluid that goes with a preset: "water" (1e-3 Pa s), "glycerol80"
- * (Yang & Hunt 80 w% glycerol, 0.057 Pa s), "silicone10" (Punch: 10 Pa s, 0.0205 N/m).
+ * (Yang & Hunt 80 w% glycerol, 0.060 Pa s), "silicone10" (Punch: 10 Pa s, 0.0205 N/m).
  * Returns WETDEM_OK or WETDEM_ERR_NOT_FOUND. */
 WETDEM_API int wetdem_fluid_preset(const char* name, struct wetdem_fluid* f);
 /* NULL-terminated list of material preset names. */
@@ -277,8 +277,9 @@ WETDEM_API const struct wetdem_model* wetdem_model_find(const char* name);
 /* "contact", "fluid", "min-separation", "impulse". */
 WETDEM_API const char* wetdem_model_kind_name(enum wetdem_model_kind kind);
 
-/* Builds the contact of particles a (as i) and b (as j) with their materials and the fluid.
- * h_min and dt are left 0 for the caller to fill. */
+/* Builds the contact of particles a (as i) and b (as j) with their materials and the fluid
+ * (NULL: none, viscosity and surface tension 0). h_min and dt are left 0 for the caller to
+ * fill. */
 WETDEM_API void
 wetdem_contact_from_particles(struct wetdem_contact* c, const struct wetdem_particle* a,
                               const struct wetdem_material* ma, const struct wetdem_particle* b,
@@ -393,8 +394,8 @@ WETDEM_API const struct wetdem_model* wetdem_sim_min_separation_model(const stru
  * min-separation model, "fluid.<field>", "sim.<setting>". Checks range and finiteness.
  * Returns WETDEM_OK, WETDEM_ERR_NOT_FOUND ("did you mean ...") or WETDEM_ERR_INVALID. */
 WETDEM_API int wetdem_sim_set_param(struct wetdem_sim* sim, const char* name, double value);
-/* Sets an enumerated parameter by word, e.g. ("db.below_hmin", "nc"); numbers are accepted
- * as text too. */
+/* Sets a parameter from text: an enumerated one by word, e.g. ("db.below_hmin", "nc"), any
+ * other by a number as text ("1e-3"); checked as wetdem_sim_set_param does. */
 WETDEM_API int wetdem_sim_set_param_str(struct wetdem_sim* sim, const char* name,
                                         const char* value);
 /* Reads a parameter by dotted name into *value. Returns WETDEM_OK, WETDEM_ERR_NOT_FOUND ("did
@@ -405,8 +406,10 @@ WETDEM_API int wetdem_sim_param(const struct wetdem_sim* sim, const char* name, 
 WETDEM_API const struct wetdem_param_desc* wetdem_sim_settings_params(void);
 
 /* Evaluates the sum of the enabled force models for particles i and j (j may equal
- * (size_t)-1 - w to address wall w) with the given per-pair history (may be NULL: fresh
- * history), at the current state. Writes the contact used into *c if non-NULL. */
+ * (size_t)-1 - w to address wall w) with a fresh per-pair history (no tangential spring, no
+ * min-separation record), at the current state. Writes the contact used into *c if non-NULL.
+ * Returns WETDEM_OK, WETDEM_ERR_INVALID (indices, an invalid particle, out NULL) or a model's
+ * negative status. */
 WETDEM_API int wetdem_sim_pair_force(struct wetdem_sim* sim, size_t i, size_t j,
                                      struct wetdem_contact* c, struct wetdem_pair_force* out);
 
@@ -591,8 +594,9 @@ WETDEM_API int wetdem_collision_run(struct wetdem_sim* sim,
  * the time to 0; materials, fluid, models and parameters are kept. In the many-particle mode
  * the mode and its settings stay, and its state starts afresh (step 0, a new energy budget). */
 WETDEM_API void wetdem_sim_reset(struct wetdem_sim* sim);
-/* Deep copy (materials, fluid, models, parameters, integrator, particles; not the observer).
- * NULL if out of memory. For running independent collisions in parallel. */
+/* Deep copy (materials, fluid, models, parameters, integrator, particles, walls, time, pair
+ * histories, event log; not the observer, and not the many-particle mode: the copy is in the
+ * two-body mode). NULL if out of memory. For running independent collisions in parallel. */
 WETDEM_API struct wetdem_sim* wetdem_sim_clone(const struct wetdem_sim* sim);
 
 /* ======================================================================================== */
