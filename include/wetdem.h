@@ -135,8 +135,9 @@ WETDEM_API int wetdem_param_validate(const struct wetdem_param_desc* d, double v
                                      size_t msg_size);
 /* Writes the valid range of d as text, e.g. "(0, 1]" or "one of: c, nc". */
 WETDEM_API void wetdem_param_range_text(const struct wetdem_param_desc* d, char* buf, size_t n);
-/* value with the fewest significant digits, at least min_digits (1..17), that read back as
- * value (17 if none do, as for NaN); e.g. 1.000000000001 at 6, not 1. */
+/* value with the fewest significant digits, at least min_digits (1..17; others are taken as
+ * the nearer end), that read back as value (17 if none do, as for NaN); e.g. 1.000000000001
+ * at 6, not 1. */
 WETDEM_API void wetdem_param_format_value(double value, int min_digits, char* buf, size_t n);
 /* Index of `word` among d->choices, or -1. */
 WETDEM_API int wetdem_param_choice_index(const struct wetdem_param_desc* d, const char* word);

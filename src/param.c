@@ -57,7 +57,9 @@ void wetdem_param_range_text(const struct wetdem_param_desc* d, char* buf, size_
 
 void wetdem_param_format_value(double value, int min_digits, char* buf, size_t n)
 {
-    for (int digits = min_digits < 1 ? 1 : min_digits; digits <= 17; digits++) {
+    /* (clamped to 1..17: above 17 the loop ran never and left buf as it was) */
+    int first = min_digits < 1 ? 1 : (min_digits > 17 ? 17 : min_digits);
+    for (int digits = first; digits <= 17; digits++) {
         snprintf(buf, n, "%.*g", digits, value);
         if (strtod(buf, NULL) == value)
             return;

@@ -4,7 +4,7 @@
  * found" answer of a lookup), never dereferenced; an insertion is whole or nothing, also for
  * counts whose arrays no size_t can measure; a hard-sphere impulse that would give NaN or
  * infinite velocities is an error that leaves the bodies as they were; a fit refuses an
- * infinite scale or tolerance.
+ * infinite scale or tolerance; a value is formatted whatever the digits asked for.
  */
 #include <stdlib.h>
 
@@ -96,6 +96,20 @@ static void test_api_insert_is_whole_or_nothing(void** state)
     wetdem_sim_free(sim);
 }
 
+static void test_api_format_value_always_writes(void** state)
+{
+    (void)state;
+    char buf[64];
+    int digits[] = {-5, 0, 1, 17, 18, 100};
+    for (size_t k = 0; k < sizeof digits / sizeof digits[0]; k++) {
+        strcpy(buf, "stale");
+        wetdem_param_format_value(1.5, digits[k], buf, sizeof buf);
+        CHECK_ABS(strtod(buf, NULL), 1.5, 0.0);
+    }
+    wetdem_param_format_value(0.1, 100, buf, sizeof buf);
+    assert_string_equal(buf, "0.10000000000000001");
+}
+
 static void test_api_hard_impulse_never_returns_nan_velocities(void** state)
 {
     (void)state;
@@ -174,6 +188,7 @@ int main(void)
         cmocka_unit_test(test_api_insert_is_whole_or_nothing),
         cmocka_unit_test(test_api_hard_impulse_never_returns_nan_velocities),
         cmocka_unit_test(test_api_fit_refuses_infinite_scale_and_tolerances),
+        cmocka_unit_test(test_api_format_value_always_writes),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
