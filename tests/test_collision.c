@@ -78,8 +78,10 @@ static void test_collision_hertz_undamped(void** state)
     }
 }
 
-/* Damped Hertz with the "exact" coefficient rebounds with e_dry = 0.9 (head-on, so e = e_n);
- * 0.5 % for both integrators at their defaults (measured: 1e-4 Verlet, 2e-7 CVODE). */
+/* Damped Hertz with the "exact" coefficient rebounds with e_dry = 0.9 (head-on, so e = e_n):
+ * a closed form, so only the integration error remains: measured 9.7e-5 for Verlet at its
+ * default step (2 % of the contact time) and 1.9e-8 for CVODE at rtol 1e-8; 5e-4 and 1e-6
+ * asserted (a damping coefficient off by 1 % moves ln e, -0.105, by 1 %: e by 1e-3). */
 static void test_collision_hertz_damped(void** state)
 {
     (void)state;
@@ -89,8 +91,8 @@ static void test_collision_hertz_damped(void** state)
         struct wetdem_collision_spec s = head_on(mat, 0.5, 1e-3);
         struct wetdem_collision_result r;
         CHECK_OK(wetdem_collision_run(sim, &s, &r));
-        CHECK_REL(r.e, 0.9, 5e-3);
-        CHECK_REL(r.e_n, 0.9, 5e-3);
+        CHECK_REL(r.e, 0.9, q ? 1e-6 : 5e-4);
+        CHECK_REL(r.e_n, 0.9, q ? 1e-6 : 5e-4);
         CHECK_REL(r.energy_ratio, r.e * r.e, 1e-12);
         wetdem_sim_free(sim);
     }
@@ -299,7 +301,8 @@ static void test_collision_cvode_sees_a_grazing_pass(void** state)
 }
 
 /* e falls monotonically as the viscosity of the Reynolds lubrication rises (fixed impact
- * speed 0.5 m/s, Hertz e_dry 0.97); at mu = 0 it is e_dry (0.5 %). */
+ * speed 0.5 m/s, Hertz e_dry 0.97); at mu = 0 it is e_dry (CVODE at rtol 1e-8: measured
+ * 6.5e-8 off, 1e-6 asserted). */
 static void test_collision_e_falls_with_viscosity(void** state)
 {
     (void)state;
@@ -313,7 +316,7 @@ static void test_collision_e_falls_with_viscosity(void** state)
         struct wetdem_collision_result r;
         CHECK_OK(wetdem_collision_run(sim, &s, &r));
         if (k == 0)
-            CHECK_REL(r.e, 0.97, 5e-3);
+            CHECK_REL(r.e, 0.97, 1e-6);
         if (!(r.e < e_prev))
             fail_msg("mu = %g: e = %g is not below %g", mus[k], r.e, e_prev);
         e_prev = r.e;
@@ -324,8 +327,12 @@ static void test_collision_e_falls_with_viscosity(void** state)
 /* Particle-wall lubrication acts: a Delrin sphere hits a Delrin wall in water at St = 50
  * (nijssen). Legendre et al. (2006) give e/e_dry = exp(-35/St) = 0.50 there; the model gives
  * ~0.62 e_dry. Asserted: a clear rebound (e > 0.2) well below e_dry (e < 0.8 e_dry), h_min
- * reached; the same impact with 1e-6 of the viscosity (St = 5e7) rebounds with e_dry
- * (0.5 %), so the loss is lubrication. Both integrators. */
+ * reached; the same impact with 1e-6 of the viscosity (St = 5e7) and smooth surfaces rebounds
+ * with e_dry, so the loss is lubrication: the exact Hertz damping gives e_dry to the
+ * integration error (measured 1e-6 CVODE, 1.9e-4 Verlet at 2 % of the contact time; 1e-5 and
+ * 1e-3 asserted). (With Delrin's roughness, h_min = 0.8 um, the lever blend of Nijssen Eq. 9
+ * between 0 and h_min softens the contact and e comes out 0.4 % above e_dry.) Both
+ * integrators. */
 static void test_collision_wall_lubrication(void** state)
 {
     (void)state;
@@ -341,7 +348,7 @@ static void test_collision_wall_lubrication(void** state)
         struct wetdem_collision_result r;
         CHECK_OK(wetdem_collision_run(sim, &s, &r));
         double e_dry = wetdem_sim_material(sim, mat)->restitution;
-        CHECK_REL(r.stokes_n, 50, 1e-12);
+        CHECK_REL(r.stokes_n, 50, 1e-12); /* St from the speed and back: a few roundings */
         assert_true(r.separated && r.hmin_reached);
         if (!(r.e > 0.2 && r.e < 0.8 * e_dry))
             fail_msg("%s: wall rebound e = %g, expected in (0.2, %g)", integrators[q], r.e,
@@ -349,16 +356,21 @@ static void test_collision_wall_lubrication(void** state)
         double speed = r.speed_n0;
         struct wetdem_fluid f = {.viscosity = 1e-9, .surface_tension = 0, .density = 1000};
         CHECK_OK(wetdem_sim_set_fluid(sim, &f));
+        struct wetdem_material smooth = *wetdem_sim_material(sim, mat);
+        smooth.roughness = 0;
+        s.material_i = s.material_j = wetdem_sim_add_material(sim, &smooth);
         s.stokes = 0;
         s.speed = speed;
         CHECK_OK(wetdem_collision_run(sim, &s, &r));
-        CHECK_REL(r.e, e_dry, 5e-3);
+        assert_true(r.separated);
+        CHECK_REL(r.e, e_dry, q ? 1e-5 : 1e-3);
         wetdem_sim_free(sim);
     }
 }
 
 /* Verlet at a small step (0.5 % of the Hertz time) and CVODE (rtol 1e-10) agree on e of a
- * Nijssen collision (Delrin, St = 200) within 0.5 %; measured ~1e-4. */
+ * Nijssen collision (Delrin, St = 200): the difference is Verlet's error, measured 2.0e-5;
+ * 2e-4 asserted. */
 static void test_collision_integrators_agree(void** state)
 {
     (void)state;
@@ -377,7 +389,7 @@ static void test_collision_integrators_agree(void** state)
         e[q] = r.e;
         wetdem_sim_free(sim);
     }
-    CHECK_REL(e[0], e[1], 5e-3);
+    CHECK_REL(e[0], e[1], 2e-4);
 }
 
 /* Swapping the roles of two unlike spheres (glass 4 mm striking steel 6.35 mm, and the
