@@ -181,7 +181,9 @@ static void test_minsep_swap_invariant(void** state)
         double params[4], ha[3] = {0.2, 0, 0}, hb[3] = {0.2, 0, 0};
         wetdem_param_init_defaults(models[k]->params, params);
         CHECK_REL(minsep(models[k], params, &s, hb), minsep(models[k], params, &c, ha), 0);
-        CHECK_REL(hb[0], ha[0], 0);
+        assert_true(models[k]->history_len <= 3);
+        for (size_t q = 0; q < models[k]->history_len; q++)
+            CHECK_REL(hb[q], ha[q], 0);
     }
 }
 

@@ -1220,6 +1220,16 @@ static void test_pairwise_two_sphere_mechanisms(void** state)
     CHECK_OK(run(&c, &r, NULL));
     assert_int_equal(r.pairs[0].mechanism, WETDEM_OUTCOME_BOUNCE);
     assert_int_equal(r.pairs[0].n_contacts, 1);
+    /* head-on at St_n = 1, below I(h_min/delta) = I(0.005) = 4.22 (the critical Stokes number
+       of the closed form at the top of this file): stopped in the films before h_min */
+    d.stokes = 1.0;
+    d.angle_deg = 0.0;
+    CHECK_OK(wetdem_pairwise_davis_config(&d, &c, msg, sizeof msg));
+    CHECK_OK(run(&c, &r, NULL));
+    assert_int_equal(r.pairs[0].mechanism, WETDEM_OUTCOME_STICK);
+    assert_int_equal(r.pairs[0].n_contacts, 0);
+    assert_true(r.pairs[0].bound && r.pairs[0].min_gap > c.h_min);
+    assert_int_equal(r.outcome, WETDEM_PAIRWISE_FA);
 }
 
 /* A pair held at h_min (resting contact, v_n = 0) and then let go separates through the film
