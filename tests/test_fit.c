@@ -960,7 +960,9 @@ static void test_fit_cli_keeps_keys_in_range(void** state)
     row = strstr(out, "material.striker.restitution,-,");
     assert_non_null(row);
     assert_int_equal(sscanf(row, "material.striker.restitution,-,%lf", &value), 1);
-    CHECK_ABS(value, 0.995, 1e-3);
+    /* the data are e_n to 6 decimals: their rounding (<= 5e-7) leaves a standard error of
+       1.7e-6 on e_dry; measured 1.5e-6 off; 1e-5 asserted (1e-3 let a fit stopped early pass) */
+    CHECK_ABS(value, 0.995, 1e-5);
     CHECK_CONTAINS(out, ",0.9,logistic\n");
     remove(csv);
 }
