@@ -617,7 +617,10 @@ static void test_many_cli_sigint_writes_a_checkpoint_and_resumes(void** state)
 
 /* A third SIGINT, sent while the run is still stopping after the first (20000 spheres: a step
  * and a checkpoint take milliseconds, the signals microseconds), stops it at once by the
- * signal: no new checkpoint, the periodic one before intact, no temporary file left. */
+ * signal: no new checkpoint, the periodic one before intact, no temporary file left. On a
+ * loaded machine this process may be descheduled for longer than the run takes to stop; the
+ * run then ends as after one request (exit 130, "interrupted by SIGINT"), which is tried
+ * again, up to three times in all: any other end fails at once. */
 static void test_many_cli_third_signal_stops_at_once(void** state)
 {
     (void)state;
@@ -628,17 +631,31 @@ static void test_many_cli_third_signal_stops_at_once(void** state)
                "layout = lattice\ncount = 20000\nradius = 0.45e-3\ngap = 10e-6\nmaterial = wet\n"
                "velocity_sigma = 0.01\n[run]\nsteps = 100000\n[dump]\nvtk_every = 100000\n"
                "csv_every = 1\ncheckpoint_every = 2\n");
-    int status = interrupt_cli("run slow.ini --out slow", "slow/global.csv", 3);
-    char* err = stderr_text();
+    char dir[32], args[64], csv[64], path[64];
+    int status = 0;
+    char* err = NULL;
+    for (int attempt = 0; attempt < 3; attempt++) {
+        snprintf(dir, sizeof dir, "slow%d", attempt);
+        snprintf(args, sizeof args, "run slow.ini --out %s", dir);
+        snprintf(csv, sizeof csv, "%s/global.csv", dir);
+        free(err);
+        status = interrupt_cli(args, csv, 3);
+        err = stderr_text();
+        if (!(WIFEXITED(status) && WEXITSTATUS(status) == 130 &&
+              strstr(err, "interrupted by SIGINT")))
+            break; /* not a run that stopped before the signals came */
+    }
     if (!WIFSIGNALED(status) || WTERMSIG(status) != SIGINT)
         fail_msg("3 SIGINT: status %d, expected death by SIGINT\n%s", status, err);
     CHECK_CONTAINS(err, "stopped at once by a repeated signal, without a new checkpoint");
     assert_null(strstr(err, "interrupted by SIGINT"));
     free(err);
-    assert_false(exists("slow/checkpoint.ckpt.tmp"));
+    snprintf(path, sizeof path, "%s/checkpoint.ckpt.tmp", dir);
+    assert_false(exists(path));
     struct wetdem_checkpoint ck;
     char msg[256];
-    CHECK_OK(wetdem_checkpoint_read(tpath("slow/checkpoint.ckpt"), &ck, msg, sizeof msg));
+    snprintf(path, sizeof path, "%s/checkpoint.ckpt", dir);
+    CHECK_OK(wetdem_checkpoint_read(tpath(path), &ck, msg, sizeof msg));
     assert_int_equal(ck.n_particles, 20000);
     assert_int_equal(ck.step % 2, 0); /* a periodic one */
     wetdem_checkpoint_clear(&ck);
