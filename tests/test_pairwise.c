@@ -733,6 +733,21 @@ static void test_pairwise_relabelling_symmetry(void** state)
     check_relabel(3.0, 1000.0, 3.0, false); /* films stay overlapping: compare at t_end */
 }
 
+/* Three spheres (set by the caller) with hard contact at h_min, e_dry, mu_f, run to t_end,
+ * no fluid. */
+static struct wetdem_pairwise_config three_dry(double h_min, double e_dry, double mu_f,
+                                               double t_end)
+{
+    struct wetdem_pairwise_config c;
+    wetdem_pairwise_config_init(&c);
+    c.n_spheres = 3;
+    c.h_min = h_min;
+    c.restitution = e_dry;
+    c.friction = mu_f;
+    c.t_end = t_end;
+    return c;
+}
+
 /* A sphere meeting two touching spheres at the same instant (dry, e_dry = 1, no friction;
  * sphere 1 at 1 m/s along +x, spheres 2 and 3 at +-30 degrees from its path, 2R + h_min apart):
  * the simultaneous impulses, J/m = 2 cos 30 / (1 + 2 cos^2 30) each, leave sphere 1 at
@@ -746,12 +761,7 @@ static void test_pairwise_simultaneous_contacts_are_symmetric(void** state)
     const double a = 1e-3, m = 1e-5, h_min = 1e-6, d = 2 * a + h_min;
     for (int wet = 0; wet < 2; wet++)
         for (int swap = 0; swap < 2; swap++) {
-            struct wetdem_pairwise_config c;
-            wetdem_pairwise_config_init(&c);
-            c.n_spheres = 3;
-            c.h_min = h_min;
-            c.restitution = 1.0;
-            c.t_end = 0.01;
+            struct wetdem_pairwise_config c = three_dry(h_min, 1.0, 0.0, 0.01);
             double film = wet ? 50e-6 : 0.0, y = swap ? -d / 2 : d / 2;
             c.viscosity = wet ? 0.05 : 0.0;
             c.spheres[0] = (struct wetdem_pairwise_sphere){.radius = a,
@@ -790,13 +800,7 @@ static void test_pairwise_simultaneous_line_with_friction(void** state)
     const double x[3] = {-d, 0.0, d}, v[3] = {1.0, 0.0, -1.0};
     const size_t order[2][3] = {{0, 1, 2}, {1, 2, 0}}; /* input slot of each sphere */
     for (int o = 0; o < 2; o++) {
-        struct wetdem_pairwise_config c;
-        wetdem_pairwise_config_init(&c);
-        c.n_spheres = 3;
-        c.h_min = h_min;
-        c.restitution = 0.8;
-        c.friction = 0.3;
-        c.t_end = 1e-3;
+        struct wetdem_pairwise_config c = three_dry(h_min, 0.8, 0.3, 1e-3);
         for (size_t i = 0; i < 3; i++)
             c.spheres[order[o][i]] =
                 (struct wetdem_pairwise_sphere){.radius = a, .mass = m, .x = x[i], .vx = v[i]};
