@@ -438,7 +438,9 @@ WETDEM_API const char* wetdem_integrator_summary(const char* name);
 #define WETDEM_MIN_SPAN 1e-150
 
 /* Advances the simulation to time t_end [s]. Returns WETDEM_OK at t_end, WETDEM_EVENT when a
- * stop condition fired (sim.stop_on_separation), or a negative status (message in errmsg). */
+ * stop condition fired (sim.stop_on_separation), or a negative status (message in errmsg).
+ * In the many-particle mode steps are whole and time stays on the grid t0 + k dt: the run
+ * ends at its first point at or after t_end - 1e-9 dt (wetdem_sim_time() tells which). */
 WETDEM_API int wetdem_sim_integrate(struct wetdem_sim* sim, double t_end);
 /* Current simulated time [s]. */
 WETDEM_API double wetdem_sim_time(const struct wetdem_sim* sim);
