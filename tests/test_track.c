@@ -132,7 +132,7 @@ static void test_track_savgol_matches_closed_form(void** state)
     double hat[49];
     CHECK_OK(wetdem_track_savgol_hat(5, 2, hat));
     for (int m = 0; m < 5; m++)
-        CHECK_ABS(hat[2 * 5 + m], w5[m] / 35, 1e-14); /* QR round-off, entries O(1) */
+        CHECK_ABS(hat[2 * 5 + m], w5[m] / 35, 1e-14); /* QR round-off, entries O(1): 1.4e-16 */
     CHECK_OK(wetdem_track_savgol_hat(7, 2, hat));
     for (int m = 0; m < 7; m++)
         CHECK_ABS(hat[3 * 7 + m], w7[m] / 21, 1e-14);
@@ -144,14 +144,15 @@ static void test_track_savgol_keeps_quadratics_up_to_the_ends(void** state)
 {
     (void)state;
     /* A least-squares polynomial of order 2 reproduces any quadratic exactly, including the
-     * shifted (end) windows; round-off on values O(100) is ~1e-12. */
+     * shifted (end) windows. Round-off: 7 terms of values up to 60 (ulp 7e-15) times
+     * weights carrying 1e-16 of QR round-off, ~1e-13; 1e-12 (measured 1.4e-14). */
     double hat[49], x[20], out[20];
     CHECK_OK(wetdem_track_savgol_hat(7, 2, hat));
     for (int i = 0; i < 20; i++)
         x[i] = 1 + 2.5 * i - 0.3 * i * i;
     wetdem_track_savgol_apply(hat, 7, x, 20, out);
     for (int i = 0; i < 20; i++)
-        CHECK_ABS(out[i], x[i], 1e-11);
+        CHECK_ABS(out[i], x[i], 1e-12);
 }
 
 /* ---- Eq. 23 and its small-angle bias ------------------------------------------------------- */
@@ -175,9 +176,13 @@ static void test_track_interval_small_angle_bias_is_exact(void** state)
     p1[1] = p0[1] + v[1] * dt;
     double rms;
     CHECK_OK(wetdem_track_solve_interval(p0, p1, dt, out, &rms));
-    CHECK_REL(out[2], sin(a) / dt, 1e-12); /* round-off of a 6x3 QR on O(1e-3) data */
+    /* round-off of a 6x3 QR on positions ~0.02 m whose differences (~3e-3 m) carry the
+       rotation: ~10 ulp, 1e-13 (measured 3.4e-15) */
+    CHECK_REL(out[2], sin(a) / dt, 1e-13);
+    /* the translation v dt = 8e-5 m is a difference of positions ~0.01 m, which keeps only
+       ~125 ulp of its digits (3e-14): 1e-12 (measured 1.6e-14) */
     for (int c = 0; c < 2; c++)
-        CHECK_REL(out[c], v[c] + (cos(a) - 1) * (d2[c] + d3[c]) / (3 * dt), 1e-10);
+        CHECK_REL(out[c], v[c] + (cos(a) - 1) * (d2[c] + d3[c]) / (3 * dt), 1e-12);
     /* Degenerate dots: all three in one place. */
     double z[6] = {1, 1, 1, 1, 1, 1};
     CHECK_STATUS(wetdem_track_solve_interval(z, z, dt, out, NULL), WETDEM_ERR_NUMERIC);
@@ -392,12 +397,14 @@ static void test_track_noise_free_recovery_is_tight(void** state)
             fail_msg("output %d: got %.9g, true %.9g, bias bound %.3g", q, got[q], want[q],
                      method_bias[q]);
     CHECK_ABS(s.angle_centres, 30 * M_PI / 180, 0.01); /* striker 0.2 mm short of contact */
-    /* y_down negates y: the spin changes sign, the speeds do not. */
+    /* y_down negates y: the spin changes sign, the speeds do not. Negation is exact and
+       commutes with rounding, so only libm's odd functions could differ, by an ulp or so:
+       1e-14 (measured 0). */
     o.y_down = true;
     double flipped[N_OUT];
     CHECK_OK(analyse_dots(dots, &o, flipped, &s));
-    CHECK_REL(flipped[4], -got[4], 1e-9);
-    CHECK_REL(flipped[8], got[8], 1e-9);
+    CHECK_REL(flipped[4], -got[4], 1e-14);
+    CHECK_REL(flipped[8], got[8], 1e-14);
     free(dots);
 }
 
@@ -495,7 +502,9 @@ static void sim_pose(const struct sim_record* r, double fps, int k, double t, do
         size_t i = (size_t)lround(t * SIM_SUB * fps);
         assert_true(i < r->n);
         q = r->q + SIM_COLS * i;
-        assert_true(fabs(q[0] - t) < 1e-12); /* on the observer's grid */
+        /* on the observer's grid (spacing 25 us): the sample times carry round-off of ~1e-19 s
+           (measured 1.1e-19), 1e-16 s is ~60 ulp of 10 ms */
+        assert_true(fabs(q[0] - t) < 1e-16);
     }
     const double* s = q + 1 + 6 * k;
     double tau = t - q[0];
@@ -596,12 +605,12 @@ static void check_noise_free(const struct synth* y, const struct wetdem_track_op
     CHECK_OK(analyse_dots(dots, o, got, &s));
     simulated_truth(rec, y, o, res, s.collision_frame, want, bias);
     /* The values taken from the record are the ones wetdem_collision_run reports (same
-     * definitions; round-off of the recorded states only). */
-    CHECK_REL(want[8], res->e_n, 1e-9);
-    CHECK_REL(want[9], res->angle_in, 1e-9);
-    CHECK_REL(want[10], res->stokes_n, 1e-9);
-    CHECK_REL(want[4], res->omega_i.z, 1e-12);
-    CHECK_REL(want[7], res->omega_j.z, 1e-12);
+     * definitions of the same states: a few roundings in another order, 1e-14; measured 0). */
+    CHECK_REL(want[8], res->e_n, 1e-14);
+    CHECK_REL(want[9], res->angle_in, 1e-14);
+    CHECK_REL(want[10], res->stokes_n, 1e-14);
+    CHECK_REL(want[4], res->omega_i.z, 1e-14);
+    CHECK_REL(want[7], res->omega_j.z, 1e-14);
     /* Floors: the film force sets in gradually at h = delta, so the velocity has begun to
      * change (below the threshold) by the collision frame and the smoothing window of the
      * last interval of the before-fit reaches it (2e-6 m/s here); round-off in the end
