@@ -701,9 +701,11 @@ static void test_scenario_interrupted_map_writes_what_ran(void** state)
     (void)state;
     char cmd[1400];
     snprintf(cmd, sizeof cmd, "%s/int.csv", tmpdir);
-    /* 10^4 three-sphere collisions: ~10 s on two cores, interrupted 0.5 s after the map has
-       put its handler in place (not 0.5 s after the start: a slow start, as under the
-       sanitizers, would let the signal kill it before the handler is there) */
+    /* 10^4 three-sphere collisions: ~10 s on two cores, interrupted once the map has put
+       its handler in place (not at a time after the start: a slow start, as under the
+       sanitizers, would let the signal kill it before the handler is there) and has finished
+       a collision, which its first save (--save-every 0.05) shows: it saves only when a
+       point finishes (not after a fixed time, at which on a loaded machine none may have) */
     pid_t pid = fork();
     assert_true(pid >= 0);
     if (pid == 0) {
@@ -711,13 +713,21 @@ static void test_scenario_interrupted_map_writes_what_ran(void** state)
         freopen("/dev/null", "w", stderr);
         execl(test_cli_path(), test_cli_path(), "map", "examples/scenarios/davis_three.ini",
               "--param", "davis.stokes", "--values", "0.5:30:100", "--param2", "davis.angle_deg",
-              "--values2", "0:80:100", "--out", cmd, (char*)NULL);
+              "--values2", "0:80:100", "--save-every", "0.05", "--out", cmd, (char*)NULL);
         _exit(127);
     }
     struct timespec nap = {0, 1000000};
     for (int k = 0; k < 60000 && !test_signal_caught(pid, SIGINT); k++) /* up to a minute */
         nanosleep(&nap, NULL);
-    usleep(500000);
+    for (int k = 0; k < 60000 && access(cmd, F_OK) != 0; k++) /* up to a minute */
+        nanosleep(&nap, NULL);
+    char* saved = test_read_file(cmd, NULL);
+    if (!saved || !strstr(saved, "# saved while running: ")) {
+        kill(pid, SIGKILL);
+        waitpid(pid, NULL, 0);
+        fail_msg("no table saved while the map ran:\n%.300s", saved ? saved : "(none)");
+    }
+    free(saved);
     /* twice back to back, as GNU timeout does (the process, then its group), the second as
        soon as the first is delivered: one request (the second killed the map at once) */
     kill(pid, SIGINT);
