@@ -693,6 +693,19 @@ static void test_scenario_batch_keys_rows_and_outputs(void** state)
     free(out);
 }
 
+/* A map's table of which some points ran and some did not: a row for every one of the
+ * n_points and the header, at least one NOT_RUN (nan and none fields) and one that ran. */
+static void check_part_ran(const char* table, size_t n_points)
+{
+    CHECK_CONTAINS(table, ",NOT_RUN,none,none,nan,");
+    CHECK_CONTAINS(table, ",WETDEM_OK,");
+    size_t rows = 0;
+    for (const char* line = table; line && *line;
+         line = strchr(line, '\n'), line = line ? line + 1 : NULL)
+        rows += line[0] != '#' && line[0] != '\n';
+    assert_int_equal(rows, 1 + n_points);
+}
+
 /* SIGINT during a map (it lost every collision that had run): the collisions running finish,
  * the others are left out, and the table is still written, whole and under its name, with
  * every point (NOT_RUN for those left out) and a line saying so; exit 128 + 2. */
@@ -743,14 +756,8 @@ static void test_scenario_interrupted_map_writes_what_ran(void** state)
     snprintf(cmd, sizeof cmd, "%s/int.csv", tmpdir);
     char* table = test_read_file(cmd, NULL);
     assert_non_null(table);
-    CHECK_CONTAINS(table, ",NOT_RUN,none,none,nan,");
-    CHECK_CONTAINS(table, ",WETDEM_OK,");
+    check_part_ran(table, 100 * 100);
     CHECK_CONTAINS(table, "# interrupted by signal 2: ");
-    size_t rows = 0;
-    for (const char* line = table; line && *line;
-         line = strchr(line, '\n'), line = line ? line + 1 : NULL)
-        rows += line[0] != '#' && line[0] != '\n';
-    assert_int_equal(rows, 1 + 100 * 100); /* the header and every point */
     free(table);
 }
 
@@ -961,13 +968,7 @@ static void test_scenario_killed_map_resumes_from_its_saved_table(void** state)
     int status = 0;
     waitpid(pid, &status, 0);
     assert_non_null(table);
-    CHECK_CONTAINS(table, ",NOT_RUN,none,none,nan,");
-    CHECK_CONTAINS(table, ",WETDEM_OK,");
-    size_t rows = 0;
-    for (const char* line = table; line && *line;
-         line = strchr(line, '\n'), line = line ? line + 1 : NULL)
-        rows += line[0] != '#' && line[0] != '\n';
-    assert_int_equal(rows, 1 + 20 * 20); /* the header and every point */
+    check_part_ran(table, 20 * 20);
     free(table);
 
     snprintf(args, sizeof args, "%s --resume %s --out %s/resumed.csv", map, saved, tmpdir);
