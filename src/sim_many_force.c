@@ -1000,14 +1000,20 @@ static inline __attribute__((always_inline)) void pair_delta(const struct pass* 
 
 /* Candidate q's skip time from its squared distance r2 [m^2] (within_reach). A candidate
  * that passes gets a time before the clock (beyond < 0): it is tested again. */
-static inline __attribute__((always_inline)) void set_skip_time(const struct pass* P, size_t q,
-                                                                double r2)
+static inline __attribute__((always_inline)) float skip_time(const struct pass* P, size_t q,
+                                                             double r2)
 {
     const struct skip_bound* B = &P->bound;
     double beyond = (r2 - (P->lim2[q] * B->rel + B->abs)) * B->inv_2dmax; /* <= |d| - far */
     double until = P->clock + 0.5 * (beyond < B->cap ? beyond : B->cap);
     /* kept as a float rounded down (one float ulp off, then to nearest): never later */
-    P->skip_until[q] = (float)(until - fabs(until) * 1.2e-7);
+    return (float)(until - fabs(until) * 1.2e-7);
+}
+
+static inline __attribute__((always_inline)) void set_skip_time(const struct pass* P, size_t q,
+                                                                double r2)
+{
+    P->skip_until[q] = skip_time(P, q, r2);
 }
 
 /* The squared reach of the cheap gap test of pair (i, j) out to the gap `range` [m^2]: the
@@ -1710,12 +1716,18 @@ test_candidates(const struct pass* P, bool listed, size_t q_begin, size_t n, siz
     size_t n_hits = 0;
     for (size_t k = 0; k < n; k++) {
         size_t q = listed ? hits[k] : q_begin + k, i = pairs[q].i, j = pairs[q].j;
+        /* a pair crossing into a later block was tested, and given its skip time, before the
+           barrier (cross_pairs_share), and that block's thread may be drifting j now: its test
+           here reads i twice instead, is not used, and leaves the time as it is */
+        bool own = j < end_block;
         struct wetdem_vec3 d;
         const struct wetdem_many_mix* x;
-        bool near = within_reach(P, q, i, j, periodic, single, maintain, &d, &x);
+        bool near = within_reach(P, q, i, own ? j : i, periodic, single, false, &d, &x);
+        if (maintain) /* (within_reach's) */
+            P->skip_until[q] = own ? skip_time(P, q, vec3_dot(d, d)) : P->skip_until[q];
         hits[n_hits] = (uint32_t)q;
         hit_near[n_hits] = near;
-        n_hits += ((size_t)near | (size_t)(flags[q] != 0)) & (size_t)(j < end_block);
+        n_hits += ((size_t)near | (size_t)(flags[q] != 0)) & (size_t)own;
     }
     return n_hits;
 }
