@@ -1222,9 +1222,10 @@ WETDEM_API void wetdem_fit_options_init(struct wetdem_fit_options* opt);
  * WETDEM_ERR_STEP (the solver found no step that lowers the cost) or WETDEM_ERR_NOMEM; msg (may
  * be NULL) receives a message. A flat-start probe the model fails on is no failure of the fit
  * (it only means the parameter is not flat). GSL's error handler is switched off while the
- * call runs and the caller's handler restored before it returns, so a GSL error never aborts
- * the program; GSL keeps that handler in one process-wide variable, so do not change it, or
- * rely on GSL's default handler, in another thread while a fit runs. */
+ * call runs, so a GSL error never aborts the program, and the caller's handler is restored when
+ * the call returns, or with fits running at once in several threads, when the last of them
+ * returns; GSL keeps that handler in one process-wide variable, so do not change it, or rely on
+ * GSL's default handler, in another thread while a fit runs. */
 WETDEM_API int wetdem_fit_run(const struct wetdem_fit_problem* problem,
                               const struct wetdem_fit_options* opt,
                               struct wetdem_fit_result* result, double* predicted, char* msg,
