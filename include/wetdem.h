@@ -17,6 +17,18 @@
  * NULL one (WETDEM_ERR_INVALID; a lookup that returns a pointer, an index or a size gives NULL,
  * -1 or 0, as for a name it does not know).
  *
+ * Threads (docs/concepts.md): every object (struct wetdem_sim, wetdem_pairwise, wetdem_track)
+ * holds all of its state, and the library's tables are read-only, so distinct objects may be
+ * used at the same time from different threads (pthreads, OpenMP), with results bit-identical
+ * to using them one after the other. One object is used by one thread at a time (no locks:
+ * calls on it must not overlap, reading ones included, as a failing query stores its message
+ * in the object), except that several threads may wetdem_sim_clone() one simulation that none
+ * changes meanwhile; callbacks run in the calling thread. The one process-wide
+ * setting the library changes is GSL's error handler, switched off from the start of the first
+ * running fit to the end of the last (wetdem_fit_run). A many-particle run's OpenMP loops use
+ * the calling thread's omp_get_max_threads(): when several threads run at once, lower it in
+ * each (omp_set_num_threads; the results do not depend on it) so as not to oversubscribe cores.
+ *
  * Sections, in the order a user needs them: value types; status; parameters; materials;
  * models; simulation; pair forces; hard-sphere impulses; soft engine; analysis;
  * pairwise engine; tracking and fitting.
