@@ -36,8 +36,7 @@ struct wetdem_sim* wetdem_sim_create(void)
         return NULL;
     wetdem_fluid_preset("water", &sim->fluid);
     sim->minsep.model = &wetdem_minsep_fixed;
-    sim->minsep.params =
-        calloc(1, wetdem_minsep_fixed.params_size ? wetdem_minsep_fixed.params_size : 1);
+    sim->minsep.params = calloc(1, wetdem_sim_slot_size(&wetdem_minsep_fixed));
     if (!sim->minsep.params) {
         free(sim);
         return NULL;
@@ -53,7 +52,8 @@ void wetdem_sim_free(struct wetdem_sim* sim)
 {
     if (!sim)
         return;
-    wetdem_sim_clear_models(sim);
+    for (size_t k = 0; k < sim->n_models; k++)
+        free(sim->models[k].params);
     wetdem_sim_engine_free(sim);
     wetdem_sim_many_free(sim);
     free(sim->minsep.params);
@@ -264,7 +264,7 @@ static int copy_array(void** dst, const void* src, size_t n, size_t size)
 static int copy_slot(struct wetdem_model_slot* dst, const struct wetdem_model_slot* src)
 {
     *dst = *src;
-    size_t size = src->model->params_size ? src->model->params_size : 1;
+    size_t size = wetdem_sim_slot_size(src->model);
     dst->params = malloc(size);
     if (!dst->params)
         return WETDEM_ERR_NOMEM;

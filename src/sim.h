@@ -21,7 +21,7 @@
 /* A model enabled on this simulation with its own parameter block. */
 struct wetdem_model_slot {
     const struct wetdem_model* model;
-    void* params;          /* model->params_size bytes, owned */
+    void* params;          /* wetdem_sim_slot_size(model) bytes, owned */
     size_t history_offset; /* first double of this model's slice in a pair's history */
 };
 
@@ -100,6 +100,11 @@ struct wetdem_sim {
     struct wetdem_engine engine; /* soft engine: time, pairs, events, integrator */
     struct wetdem_many* many;    /* many-particle mode (many.h, sim_many.c), NULL if off */
 };
+
+/* Bytes of the parameter block of a slot of `model`: its params_size (at least 1); a
+ * min-separation model's block also holds the fixed model's parameters, so that
+ * wetdem_sim_clear_models() goes back to it in place, with no allocation that could fail. */
+size_t wetdem_sim_slot_size(const struct wetdem_model* model);
 
 /* Formats a message into sim->errmsg and returns status (printf-style). */
 int wetdem_sim_fail(struct wetdem_sim* sim, int status, const char* fmt, ...)

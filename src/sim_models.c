@@ -56,10 +56,18 @@ static void recompute_history_layout(struct wetdem_sim* sim)
     sim->history_len = off;
 }
 
+size_t wetdem_sim_slot_size(const struct wetdem_model* model)
+{
+    size_t size = model->params_size ? model->params_size : 1;
+    if (model->kind == WETDEM_MODEL_MIN_SEPARATION && size < wetdem_minsep_fixed.params_size)
+        size = wetdem_minsep_fixed.params_size;
+    return size;
+}
+
 static int make_slot(struct wetdem_sim* sim, struct wetdem_model_slot* slot,
                      const struct wetdem_model* model, const void* params)
 {
-    void* p = calloc(1, model->params_size ? model->params_size : 1);
+    void* p = calloc(1, wetdem_sim_slot_size(model));
     if (!p)
         return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory enabling %s", model->name);
     if (params)
@@ -216,12 +224,11 @@ void wetdem_sim_clear_models(struct wetdem_sim* sim)
     for (size_t k = 0; k < sim->n_models; k++)
         free(sim->models[k].params);
     sim->n_models = 0;
-    if (sim->minsep.model != &wetdem_minsep_fixed) {
-        struct wetdem_model_slot slot;
-        if (make_slot(sim, &slot, &wetdem_minsep_fixed, NULL) == WETDEM_OK) {
-            free(sim->minsep.params);
-            sim->minsep = slot;
-        }
+    if (sim->minsep.model != &wetdem_minsep_fixed) { /* in place (wetdem_sim_slot_size) */
+        memset(sim->minsep.params, 0, wetdem_sim_slot_size(&wetdem_minsep_fixed));
+        wetdem_param_init_defaults(wetdem_minsep_fixed.params, sim->minsep.params);
+        sim->minsep.model = &wetdem_minsep_fixed;
+        sim->minsep.history_offset = 0;
     }
     recompute_history_layout(sim);
 }
