@@ -482,8 +482,9 @@ void wetdem_sim_many_energies(const struct wetdem_sim* sim, double* kinetic, dou
 int wetdem_sim_many_prepare(struct wetdem_sim* sim);
 /* The time scales of the step for the current particles, as at the start of a run: sets
  * m->relaxation_time (what the step is held below; INFINITY when nothing damps),
- * m->contact_time and m->crossing_time (wetdem_many_stats). */
-void wetdem_sim_many_time_scales(struct wetdem_sim* sim);
+ * m->contact_time and m->crossing_time (wetdem_many_stats). Returns WETDEM_OK or
+ * WETDEM_ERR_NOMEM (message in sim). */
+int wetdem_sim_many_time_scales(struct wetdem_sim* sim);
 
 /* sim_many_force.c */
 /* Builds the material-pair table and chooses the kernel (fused or generic); needs m->reach

@@ -297,16 +297,19 @@ struct step_scales {
     double gap; /* smallest gap where the force laws jump (h_min), same pairs and materials [m] */
 };
 
-/* The time scales of the pairs of sp at its speed scale (struct step_scales). */
-static void step_scales(const struct wetdem_sim* sim, const struct step_spheres* sp,
-                        struct step_scales* s)
+/* The time scales of the pairs of sp at its speed scale (struct step_scales). Returns
+ * WETDEM_OK or WETDEM_ERR_NOMEM (message in sim). */
+static int step_scales(struct wetdem_sim* sim, const struct step_spheres* sp, struct step_scales* s)
 {
     *s = (struct step_scales){.t_contact = INFINITY, .tau = INFINITY, .gap = INFINITY};
-    /* bit 1: a particle's material, bit 2: a wall's (all of them if there is no memory) */
+    /* bit 1: a particle's material, bit 2: a wall's */
     unsigned char* used = calloc((size_t)sim->n_materials + 1, 1);
-    for (size_t k = 0; used && k < sim->n_particles; k++)
+    if (!used)
+        return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "many: out of memory for %d materials",
+                               sim->n_materials);
+    for (size_t k = 0; k < sim->n_particles; k++)
         used[sim->particles[k].material] |= 1;
-    for (size_t w = 0; used && w < sim->n_walls; w++)
+    for (size_t w = 0; w < sim->n_walls; w++)
         used[sim->walls[w].material] |= 2;
     bool first = true; /* (the first pair names the contact time even where it is not finite) */
     for (int a = 0; a < sim->n_materials; a++)
@@ -324,7 +327,7 @@ static void step_scales(const struct wetdem_sim* sim, const struct step_spheres*
                     s->contact_probe = probe;
                     first = false;
                 }
-                if (used && !((used[a] & 1) && (used[b] & (probe == PROBE_WALL ? 2 : 1))))
+                if (!((used[a] & 1) && (used[b] & (probe == PROBE_WALL ? 2 : 1))))
                     continue;
                 const struct wetdem_model* which;
                 double tau = wetdem_sim_relaxation_time(sim, &c, &which);
@@ -336,6 +339,7 @@ static void step_scales(const struct wetdem_sim* sim, const struct step_spheres*
                 s->gap = fmin(s->gap, wetdem_sim_jump_gap(sim, &c));
             }
     free(used);
+    return WETDEM_OK;
 }
 
 /* The spheres of struct step_spheres and the speed scale of the step [m/s]: twice the largest
@@ -376,25 +380,28 @@ static void start_speed(const struct wetdem_sim* sim, struct step_spheres* sp)
 }
 
 /* The spheres and time scales of the step for the current particles, into the engine's
- * relaxation_time, contact_time and crossing_time too. Needs at least one particle. */
-static void time_scales(struct wetdem_sim* sim, struct step_spheres* sp, struct step_scales* s)
+ * relaxation_time, contact_time and crossing_time too. Needs at least one particle. Returns
+ * WETDEM_OK or WETDEM_ERR_NOMEM. */
+static int time_scales(struct wetdem_sim* sim, struct step_spheres* sp, struct step_scales* s)
 {
     struct wetdem_many* m = sim->many;
     start_speed(sim, sp);
-    step_scales(sim, sp, s);
+    int st = step_scales(sim, sp, s);
+    if (st != WETDEM_OK)
+        return st;
     m->relaxation_time = s->tau;
     m->contact_time = s->t_contact;
     m->crossing_time = s->gap / sp->speed;
+    return WETDEM_OK;
 }
 
-void wetdem_sim_many_time_scales(struct wetdem_sim* sim)
+int wetdem_sim_many_time_scales(struct wetdem_sim* sim)
 {
     struct wetdem_many* m = sim->many;
     m->relaxation_time = m->contact_time = m->crossing_time = INFINITY;
     struct step_spheres sp;
     struct step_scales s;
-    if (sim->n_particles > 0)
-        time_scales(sim, &sp, &s);
+    return sim->n_particles > 0 ? time_scales(sim, &sp, &s) : WETDEM_OK;
 }
 
 /* Step [s]: many.dt, else verlet.dt, else the shortest of verlet.dt_fraction x the shortest
@@ -422,7 +429,9 @@ static int choose_dt(struct wetdem_sim* sim, double* dt)
     }
     struct step_spheres sp;
     struct step_scales s;
-    time_scales(sim, &sp, &s);
+    int st = time_scales(sim, &sp, &s);
+    if (st != WETDEM_OK)
+        return st;
     double tau = s.tau;
     if (tau == 0 && s.h_at > 0) /* m/c_d underflowed to 0: a mass near the least double */
         return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,

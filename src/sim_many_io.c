@@ -169,9 +169,12 @@ int wetdem_sim_many_stats(const struct wetdem_sim* sim, struct wetdem_many_stats
                                !m ? "the simulation is not in the many-particle mode"
                                   : "the many-particle run has not started");
     int st = wetdem_sim_many_links(sim, NULL, s);
-    if (st == WETDEM_OK)
-        fill_run_stats(sim, s);
-    return st;
+    if (st != WETDEM_OK)
+        return wetdem_sim_fail((struct wetdem_sim*)sim, st,
+                               "many_stats: out of memory for the agglomerates of %zu particles",
+                               sim->n_particles);
+    fill_run_stats(sim, s);
+    return WETDEM_OK;
 }
 
 /* ---- VTK and CSV ---- */
@@ -425,21 +428,25 @@ static int write_vtk_frame(struct wetdem_sim* sim, const struct wetdem_output_vt
 }
 
 /* With vtk_links after a restart: the first series entry from which on every entry has its
- * links file (the directory of the series is that of the prefix). */
-static void find_links_from(struct wetdem_sim* sim)
+ * links file (the directory of the series is that of the prefix). Returns WETDEM_OK or
+ * WETDEM_ERR_NOMEM. */
+static int find_links_from(struct wetdem_sim* sim)
 {
     struct wetdem_many* m = sim->many;
     const char* slash = strrchr(m->output_prefix, '/');
     int dir = slash ? (int)(slash - m->output_prefix + 1) : 0;
     for (m->links_from = m->n_series; m->links_from > 0; m->links_from--) {
         char* name = links_name(m->vtk_names[m->links_from - 1]);
+        if (!name)
+            return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory for the links' index");
         char path[4096];
-        snprintf(path, sizeof path, "%.*s%s", dir, m->output_prefix, name ? name : "");
-        bool there = name && access(path, F_OK) == 0;
+        snprintf(path, sizeof path, "%.*s%s", dir, m->output_prefix, name);
+        bool there = access(path, F_OK) == 0;
         free(name);
         if (!there)
             break;
     }
+    return WETDEM_OK;
 }
 
 /* After a restart: the frames 0 .. vtk_files-1 written before it go back into the series
@@ -472,9 +479,7 @@ static int reload_series(struct wetdem_sim* sim)
     }
     if (f)
         fclose(f);
-    if (m->set.vtk_links)
-        find_links_from(sim);
-    return WETDEM_OK;
+    return m->set.vtk_links ? find_links_from(sim) : WETDEM_OK;
 }
 
 static void csv_header(const struct wetdem_sim* sim, FILE* f)
@@ -838,7 +843,9 @@ static int restore_state(struct wetdem_sim* sim, const struct wetdem_checkpoint*
     m->step = ck->step;
     memcpy(&m->dt, ck->extra, 8);
     memcpy(&m->t0, ck->extra + 8, 8);
-    wetdem_sim_many_time_scales(sim); /* not in the checkpoint */
+    int st = wetdem_sim_many_time_scales(sim); /* not in the checkpoint */
+    if (st != WETDEM_OK)
+        return st;
     m->energy.k0 = ck->energy[0];
     m->energy.u0 = ck->energy[1];
     m->energy.el0 = ck->energy[2];
