@@ -456,8 +456,10 @@ int wetdem_insert_particles_among(const struct wetdem_insert_spec* spec,
                                   const struct wetdem_particle* existing, size_t n_existing,
                                   struct wetdem_particle* out, char* msg, size_t msg_size)
 {
-    gsl_rng* rng = gsl_rng_alloc(gsl_rng_mt19937);
-    if (!rng)
+    /* the generator in memory of our own: gsl_rng_alloc calls GSL's error handler, whose
+       default aborts, when out of memory */
+    gsl_rng gen = {gsl_rng_mt19937, calloc(1, gsl_rng_mt19937->size)}, *rng = &gen;
+    if (!gen.state)
         return wetdem_status_fail(msg, msg_size, WETDEM_ERR_NOMEM, "insert: out of memory");
     gsl_rng_set(rng, spec->seed);
     double r_max = draw_radii(spec, rng, out);
@@ -474,6 +476,6 @@ int wetdem_insert_particles_among(const struct wetdem_insert_spec* spec,
         double dx = gsl_ran_gaussian_ziggurat(rng, sd);
         out[i].vel = vec3(spec->velocity.x + dx, spec->velocity.y + dy, spec->velocity.z + dz);
     }
-    gsl_rng_free(rng);
+    free(gen.state);
     return st;
 }

@@ -357,32 +357,33 @@ int wetdem_track_savgol_hat(int window, int order, double* hat)
     if (window < 1 || window % 2 == 0 || order < 0 || order >= window)
         return WETDEM_ERR_INVALID;
     size_t w = (size_t)window, p = (size_t)order + 1;
-    gsl_matrix* v = gsl_matrix_alloc(w, p);
-    gsl_vector* tau = gsl_vector_alloc(p);
-    gsl_matrix* q = gsl_matrix_alloc(w, w);
-    gsl_matrix* r = gsl_matrix_alloc(w, p);
-    int st = (v && tau && q && r) ? WETDEM_OK : WETDEM_ERR_NOMEM;
-    if (st == WETDEM_OK) {
-        /* Vandermonde matrix on the centred abscissa u = k - window/2 (better conditioned). */
-        for (size_t k = 0; k < w; k++)
+    /* views of one block of our own: GSL's allocators call its error handler, whose default
+       aborts, when out of memory */
+    double* block = malloc((2 * w * p + p + w * w) * sizeof *block);
+    if (!block)
+        return WETDEM_ERR_NOMEM;
+    gsl_matrix_view vv = gsl_matrix_view_array(block, w, p);
+    gsl_matrix_view rv = gsl_matrix_view_array(block + w * p, w, p);
+    gsl_vector_view tv = gsl_vector_view_array(block + 2 * w * p, p);
+    gsl_matrix_view qv = gsl_matrix_view_array(block + 2 * w * p + p, w, w);
+    gsl_matrix *v = &vv.matrix, *r = &rv.matrix, *q = &qv.matrix;
+    gsl_vector* tau = &tv.vector;
+    /* Vandermonde matrix on the centred abscissa u = k - window/2 (better conditioned). */
+    for (size_t k = 0; k < w; k++)
+        for (size_t j = 0; j < p; j++)
+            gsl_matrix_set(v, k, j, pow((double)k - (double)(w / 2), (double)j));
+    gsl_linalg_QR_decomp(v, tau);
+    gsl_linalg_QR_unpack(v, tau, q, r);
+    /* V has full column rank, so H = Q1 Q1^T with Q1 the first p columns of Q. */
+    for (size_t a = 0; a < w; a++)
+        for (size_t b = 0; b < w; b++) {
+            double sum = 0;
             for (size_t j = 0; j < p; j++)
-                gsl_matrix_set(v, k, j, pow((double)k - (double)(w / 2), (double)j));
-        gsl_linalg_QR_decomp(v, tau);
-        gsl_linalg_QR_unpack(v, tau, q, r);
-        /* V has full column rank, so H = Q1 Q1^T with Q1 the first p columns of Q. */
-        for (size_t a = 0; a < w; a++)
-            for (size_t b = 0; b < w; b++) {
-                double sum = 0;
-                for (size_t j = 0; j < p; j++)
-                    sum += gsl_matrix_get(q, a, j) * gsl_matrix_get(q, b, j);
-                hat[a * w + b] = sum;
-            }
-    }
-    gsl_matrix_free(v);
-    gsl_vector_free(tau);
-    gsl_matrix_free(q);
-    gsl_matrix_free(r);
-    return st;
+                sum += gsl_matrix_get(q, a, j) * gsl_matrix_get(q, b, j);
+            hat[a * w + b] = sum;
+        }
+    free(block);
+    return WETDEM_OK;
 }
 
 void wetdem_track_savgol_apply(const double* hat, int window, const double* x, size_t n,
@@ -800,6 +801,8 @@ int wetdem_track_analyse(struct wetdem_track* track, const struct wetdem_track_o
     if (!hat)
         return fail(track, WETDEM_ERR_NOMEM, "out of memory");
     st = wetdem_track_savgol_hat(opt->window, opt->order, hat);
+    if (st != WETDEM_OK) /* (the window and order were checked) */
+        st = fail(track, st, "out of memory for the Savitzky-Golay weights");
     for (size_t k = 0; st == WETDEM_OK && k < track->n_spheres; k++)
         st = sphere_velocities(track, &track->s[k], opt, hat);
     free(hat);
