@@ -315,16 +315,20 @@ static void fill_abstol(const struct run* r, double atol, double len, double spe
         }
 }
 
-/* The method's iteration: Adams with fixed-point iteration or BDF with dense Newton. */
+/* The method's iteration: Adams with fixed-point iteration or BDF with dense Newton. Returns
+ * CV_SUCCESS, CV_MEM_FAIL (out of memory) or another CVODE flag. */
 static int attach_solvers(struct solver* s, bool bdf, sunindextype n)
 {
     if (!bdf) {
         s->nls = SUNNonlinSol_FixedPoint(s->y, 0, s->ctx);
-        return s->nls && CVodeSetNonlinearSolver(s->mem, s->nls) == CV_SUCCESS ? 0 : -1;
+        return s->nls ? CVodeSetNonlinearSolver(s->mem, s->nls) : CV_MEM_FAIL;
     }
     s->jac = SUNDenseMatrix(n, n, s->ctx);
     s->ls = s->jac ? SUNLinSol_Dense(s->y, s->jac, s->ctx) : NULL;
-    return s->ls && CVodeSetLinearSolver(s->mem, s->ls, s->jac) == CV_SUCCESS ? 0 : -1;
+    if (!s->ls)
+        return CV_MEM_FAIL;
+    int flag = CVodeSetLinearSolver(s->mem, s->ls, s->jac);
+    return flag == CVLS_MEM_FAIL ? CV_MEM_FAIL : flag;
 }
 
 static int solver_create(struct wetdem_sim* sim, struct run* r, const struct cvode_params* p,
@@ -350,16 +354,26 @@ static int solver_create(struct wetdem_sim* sim, struct run* r, const struct cvo
     pack(r, N_VGetArrayPointer(s->y));
     fill_abstol(r, p->atol, len, speed, N_VGetArrayPointer(s->abstol));
     CVodeSetErrHandlerFn(s->mem, error_handler, sim);
-    ok = CVodeInit(s->mem, rhs, sim->engine.time, s->y) == CV_SUCCESS &&
-         CVodeSVtolerances(s->mem, p->rtol, s->abstol) == CV_SUCCESS &&
-         CVodeSetUserData(s->mem, r) == CV_SUCCESS &&
-         CVodeSetStopTime(s->mem, t_end) == CV_SUCCESS &&
-         CVodeSetMaxStep(s->mem, s->h_cur) == CV_SUCCESS &&
-         CVodeRootInit(s->mem, (int)sim->engine.n_slots, roots) == CV_SUCCESS &&
-         CVodeSetMaxOrd(s->mem, (int)fmin(p->max_order, bdf ? 5 : 12)) == CV_SUCCESS &&
-         attach_solvers(s, bdf, n) == 0;
-    return ok ? WETDEM_OK
-              : wetdem_sim_fail(sim, WETDEM_ERR_INVALID, "cvode: set-up failed: %s", sim->errmsg);
+    int flag = CVodeInit(s->mem, rhs, sim->engine.time, s->y);
+    if (flag == CV_SUCCESS)
+        flag = CVodeSVtolerances(s->mem, p->rtol, s->abstol);
+    if (flag == CV_SUCCESS)
+        flag = CVodeSetUserData(s->mem, r);
+    if (flag == CV_SUCCESS)
+        flag = CVodeSetStopTime(s->mem, t_end);
+    if (flag == CV_SUCCESS)
+        flag = CVodeSetMaxStep(s->mem, s->h_cur);
+    if (flag == CV_SUCCESS)
+        flag = CVodeRootInit(s->mem, (int)sim->engine.n_slots, roots);
+    if (flag == CV_SUCCESS)
+        flag = CVodeSetMaxOrd(s->mem, (int)fmin(p->max_order, bdf ? 5 : 12));
+    if (flag == CV_SUCCESS)
+        flag = attach_solvers(s, bdf, n);
+    if (flag == CV_MEM_FAIL)
+        return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "cvode: out of memory setting up");
+    return flag == CV_SUCCESS
+               ? WETDEM_OK
+               : wetdem_sim_fail(sim, WETDEM_ERR_INVALID, "cvode: set-up failed: %s", sim->errmsg);
 }
 
 /* Observer calls at the observer times in (previous time, t_new], on the interpolant. */

@@ -50,7 +50,7 @@ struct wetdem_pairwise {
     /* CVODE */
     SUNContext sunctx;
     void* cvode;
-    N_Vector nv, atol;
+    N_Vector nv, atol, dky; /* dky: dense output (interpolate), made with the others */
     SUNMatrix mat;
     SUNLinearSolver ls;
     size_t cv_dim;
@@ -104,12 +104,14 @@ static void free_cvode(struct wetdem_pairwise* pw)
         N_VDestroy(pw->nv);
     if (pw->atol)
         N_VDestroy(pw->atol);
+    if (pw->dky)
+        N_VDestroy(pw->dky);
     if (pw->sunctx)
         SUNContext_Free(&pw->sunctx);
     pw->cvode = NULL;
     pw->ls = NULL;
     pw->mat = NULL;
-    pw->nv = pw->atol = NULL;
+    pw->nv = pw->atol = pw->dky = NULL;
     pw->sunctx = NULL;
     pw->cv_dim = 0;
 }
@@ -360,17 +362,18 @@ static int setup_cvode(struct wetdem_pairwise* pw)
             return fail(pw, WETDEM_ERR_NOMEM, "cannot create the SUNDIALS context");
         pw->nv = N_VNew_Serial((sunindextype)dim, pw->sunctx);
         pw->atol = N_VNew_Serial((sunindextype)dim, pw->sunctx);
+        pw->dky = N_VNew_Serial((sunindextype)dim, pw->sunctx);
         pw->cvode = CVodeCreate(CV_BDF, pw->sunctx);
-        if (!pw->nv || !pw->atol || !pw->cvode)
+        if (!pw->nv || !pw->atol || !pw->dky || !pw->cvode)
             return fail(pw, WETDEM_ERR_NOMEM, "out of memory creating the integrator");
+        CVodeSetErrHandlerFn(pw->cvode, cv_err, pw);
         memcpy(N_VGetArrayPointer(pw->nv), pw->y, dim * sizeof(double));
         if (CVodeInit(pw->cvode, cv_rhs, 0.0, pw->nv) != CV_SUCCESS)
             return fail(pw, WETDEM_ERR_NOMEM, "CVodeInit failed");
         pw->mat = SUNDenseMatrix((sunindextype)dim, (sunindextype)dim, pw->sunctx);
-        pw->ls = SUNLinSol_Dense(pw->nv, pw->mat, pw->sunctx);
-        if (!pw->mat || !pw->ls || CVodeSetLinearSolver(pw->cvode, pw->ls, pw->mat) != 0)
+        pw->ls = pw->mat ? SUNLinSol_Dense(pw->nv, pw->mat, pw->sunctx) : NULL;
+        if (!pw->ls || CVodeSetLinearSolver(pw->cvode, pw->ls, pw->mat) != 0)
             return fail(pw, WETDEM_ERR_NOMEM, "cannot attach the dense linear solver");
-        CVodeSetErrHandlerFn(pw->cvode, cv_err, pw);
         CVodeSetMaxErrTestFails(pw->cvode, 20);
         CVodeSetMaxConvFails(pw->cvode, 50);
         pw->cv_dim = dim;
@@ -394,11 +397,10 @@ static int restart(struct wetdem_pairwise* pw)
 /* y at time t inside the last step (dense output). */
 static bool interpolate(struct wetdem_pairwise* pw, double t, double* y)
 {
-    N_Vector tmp = N_VMake_Serial((sunindextype)pw->cv_dim, y, pw->sunctx);
-    int st = tmp ? CVodeGetDky(pw->cvode, t, 0, tmp) : -1;
-    if (tmp)
-        N_VDestroy(tmp);
-    return st == CV_SUCCESS;
+    if (CVodeGetDky(pw->cvode, t, 0, pw->dky) != CV_SUCCESS)
+        return false;
+    memcpy(y, N_VGetArrayPointer(pw->dky), pw->cv_dim * sizeof *y);
+    return true;
 }
 
 /* ---------------------------------------------------------------------- event log ---- */
