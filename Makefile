@@ -89,6 +89,20 @@ $(BUILD)/tests/%: tests/%.c $(wildcard tests/*.h) $(BUILD)/libwetdem.a $(BUILD)/
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS_ALL) $(LDFLAGS) -Itests -o $@ $< $(BUILD)/libwetdem.a $(LDLIBS) -lcmocka
 
+# The allocation-failure test fails the library's allocations through wrappers of its own:
+# of the C allocator, and of the SUNDIALS and GSL constructors the library calls.
+ALLOC_WRAP = -Wl,--wrap=malloc,--wrap=calloc,--wrap=realloc,--wrap=strdup,--wrap=free \
+  -Wl,--wrap=SUNContext_Create,--wrap=N_VNew_Serial,--wrap=CVodeCreate,--wrap=CVodeInit \
+  -Wl,--wrap=CVodeRootInit,--wrap=SUNDenseMatrix,--wrap=SUNLinSol_Dense \
+  -Wl,--wrap=CVodeSetLinearSolver,--wrap=SUNNonlinSol_FixedPoint,--wrap=gsl_rng_alloc \
+  -Wl,--wrap=gsl_matrix_alloc,--wrap=gsl_matrix_calloc,--wrap=gsl_vector_alloc \
+  -Wl,--wrap=gsl_multifit_nlinear_alloc,--wrap=gsl_integration_glfixed_table_alloc
+$(BUILD)/tests/test_alloc_failure: tests/test_alloc_failure.c $(wildcard tests/*.h) \
+                                   $(BUILD)/libwetdem.a $(BUILD)/flags.stamp
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS_ALL) $(LDFLAGS) $(ALLOC_WRAP) -Itests -o $@ $< $(BUILD)/libwetdem.a \
+	  $(LDLIBS) -lcmocka
+
 $(BUILD)/examples/%: examples/%/main.c $(BUILD)/libwetdem.a $(BUILD)/flags.stamp
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS_ALL) $(LDFLAGS) -o $@ $< $(BUILD)/libwetdem.a $(LDLIBS)
