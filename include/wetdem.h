@@ -25,7 +25,8 @@
  * in the object), except that several threads may wetdem_sim_clone() one simulation that none
  * changes meanwhile; callbacks run in the calling thread. The one process-wide
  * setting the library changes is GSL's error handler, switched off from the start of the first
- * running fit to the end of the last (wetdem_fit_run). A many-particle run's OpenMP loops use
+ * running fit to the end of the last (wetdem_fit_run), and for the moment a collision analysis
+ * allocates its quadrature table. A many-particle run's OpenMP loops use
  * the calling thread's omp_get_max_threads(): when several threads run at once, lower it in
  * each (omp_set_num_threads; the results do not depend on it) so as not to oversubscribe cores.
  *

@@ -59,6 +59,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "gsl_guard.h"
 #include "integrator.h"
 #include "vec3.h"
 
@@ -479,8 +480,10 @@ static double stored_energy(const struct wetdem_sim* sim)
             cuts[n++] = gaps[q];
     }
     qsort(cuts, n, sizeof *cuts, compare_doubles);
+    wetdem_gsl_guard_enter(); /* (out of memory, the allocation calls GSL's error handler) */
     gsl_integration_glfixed_table* table =
         gsl_integration_glfixed_table_alloc(STORED_ENERGY_POINTS);
+    wetdem_gsl_guard_leave();
     if (!table)
         return NAN;
     double energy = 0.0;

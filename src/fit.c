@@ -40,12 +40,11 @@
  *
  * GSL reports errors through one process-wide handler whose default aborts; the library must
  * never abort its host, so the handler is switched off while any fit runs and the caller's is
- * restored when the last one ends (fits may run at once in several threads: see wetdem.h), and
- * every GSL status is checked here.
+ * restored when the last one ends (gsl_guard.c: fits may run at once in several threads, see
+ * wetdem.h), and every GSL status is checked here.
  */
 #include <float.h>
 #include <math.h>
-#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -57,6 +56,7 @@
 #include <gsl/gsl_multifit_nlinear.h>
 #include <gsl/gsl_vector.h>
 
+#include "gsl_guard.h"
 #include "status.h"
 #include "wetdem.h"
 
@@ -689,31 +689,6 @@ static int report(struct fit_ctx* c, int st, gsl_matrix* cov, const struct wetde
     return WETDEM_OK;
 }
 
-/* GSL's error handler is one process-wide variable. Each fit saving it, switching it off and
- * putting the saved one back would race with fits in other threads, and the wrong order of
- * ends would leave it on while a fit still runs or off for good; so the fits count themselves
- * in under a lock: the first switches it off, the last restores the caller's. (The library's
- * only mutable state outside the objects.) */
-static pthread_mutex_t gsl_handler_lock = PTHREAD_MUTEX_INITIALIZER;
-static size_t gsl_handler_fits;              /* fits running */
-static gsl_error_handler_t* gsl_handler_own; /* the caller's, while the count is not 0 */
-
-static void gsl_handler_enter(void)
-{
-    pthread_mutex_lock(&gsl_handler_lock);
-    if (gsl_handler_fits++ == 0)
-        gsl_handler_own = gsl_set_error_handler_off();
-    pthread_mutex_unlock(&gsl_handler_lock);
-}
-
-static void gsl_handler_leave(void)
-{
-    pthread_mutex_lock(&gsl_handler_lock);
-    if (--gsl_handler_fits == 0)
-        gsl_set_error_handler(gsl_handler_own);
-    pthread_mutex_unlock(&gsl_handler_lock);
-}
-
 int wetdem_fit_run(const struct wetdem_fit_problem* problem, const struct wetdem_fit_options* opt,
                    struct wetdem_fit_result* result, double* predicted, char* msg, size_t msg_size)
 {
@@ -727,7 +702,7 @@ int wetdem_fit_run(const struct wetdem_fit_problem* problem, const struct wetdem
         st = setup_map(problem, j, &c.map[j], msg, msg_size);
     if (st != WETDEM_OK)
         return st;
-    gsl_handler_enter();
+    wetdem_gsl_guard_enter();
     c.pred = malloc(n * sizeof *c.pred);
     c.r_plus = malloc(n * sizeof *c.r_plus);
     c.r_minus = malloc(n * sizeof *c.r_minus);
@@ -756,6 +731,6 @@ done:
     free(c.pred);
     free(c.r_plus);
     free(c.r_minus);
-    gsl_handler_leave();
+    wetdem_gsl_guard_leave();
     return st;
 }
