@@ -79,6 +79,8 @@ check "gives up at the deadline (1 call)" [ "$(grep -c '^apt-get update' "$work/
 check "names the held lock" grep -q "Could not get lock" <<<"$err"
 
 installs() { grep '^apt-get install' "$work/log" | grep -qw -- "$1"; }
+run "the locale sources missing" FAKE_MISSING=locales
+check "the build set installs locales (test_locale's localedef)" installs locales
 SET=validate run "VTK's Python module, neither package there" FAKE_MISSING="python3-vtk9 python3-paraview"
 check "installs python3-vtk9" installs python3-vtk9
 check "not python3-paraview" bash -c "! grep '^apt-get install' '$work/log' | grep -qw python3-paraview"
