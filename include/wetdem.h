@@ -30,6 +30,10 @@
  * the calling thread's omp_get_max_threads(): when several threads run at once, lower it in
  * each (omp_set_num_threads; the results do not depend on it) so as not to oversubscribe cores.
  *
+ * Locale (docs/concepts.md): numbers in the library's files and in the text it reads have a
+ * decimal point whatever LC_NUMERIC the host set; a call that reads or writes them switches
+ * its own thread to the C locale (uselocale) until it returns, and not the process's.
+ *
  * Sections, in the order a user needs them: value types; status; parameters; materials;
  * models; simulation; pair forces; hard-sphere impulses; soft engine; analysis;
  * pairwise engine; tracking and fitting.
@@ -150,7 +154,7 @@ WETDEM_API int wetdem_param_validate(const struct wetdem_param_desc* d, double v
 WETDEM_API void wetdem_param_range_text(const struct wetdem_param_desc* d, char* buf, size_t n);
 /* value with the fewest significant digits, at least min_digits (1..17; others are taken as
  * the nearer end), that read back as value (17 if none do, as for NaN); e.g. 1.000000000001
- * at 6, not 1. */
+ * at 6, not 1; with a decimal point in any locale. */
 WETDEM_API void wetdem_param_format_value(double value, int min_digits, char* buf, size_t n);
 /* Index of `word` among d->choices, or -1. */
 WETDEM_API int wetdem_param_choice_index(const struct wetdem_param_desc* d, const char* word);
@@ -409,7 +413,8 @@ WETDEM_API const struct wetdem_model* wetdem_sim_min_separation_model(const stru
  * Returns WETDEM_OK, WETDEM_ERR_NOT_FOUND ("did you mean ...") or WETDEM_ERR_INVALID. */
 WETDEM_API int wetdem_sim_set_param(struct wetdem_sim* sim, const char* name, double value);
 /* Sets a parameter from text: an enumerated one by word, e.g. ("db.below_hmin", "nc"), any
- * other by a number as text ("1e-3"); checked as wetdem_sim_set_param does. */
+ * other by a number as text ("1e-3", "0.5": a decimal point in any locale); checked as
+ * wetdem_sim_set_param does. */
 WETDEM_API int wetdem_sim_set_param_str(struct wetdem_sim* sim, const char* name,
                                         const char* value);
 /* Reads a parameter by dotted name into *value. Returns WETDEM_OK, WETDEM_ERR_NOT_FOUND ("did

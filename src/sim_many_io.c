@@ -20,6 +20,7 @@
 
 #include "checkpoint.h"
 #include "insert.h"
+#include "locale_guard.h"
 #include "many.h"
 #include "output_vtk.h"
 #include "vec3.h"
@@ -31,6 +32,13 @@
  * latest-pass terms were kept have only the first three groups. */
 #define N_ENERGY (3 + 4 * WETDEM_MAX_MODELS)
 #define N_ENERGY_RIGHT_SUM (3 + 2 * WETDEM_MAX_MODELS)
+
+/* The status of a writer or reader that could not switch to the C locale. */
+static int no_c_locale(struct wetdem_sim* sim)
+{
+    return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM,
+                           "out of memory for the C locale of the numbers in files");
+}
 
 /* ---- contacts, liquid bridges, agglomerates ---- */
 
@@ -207,7 +215,7 @@ static int write_particle_frame(struct wetdem_sim* sim, const char* path, bool b
     return st == WETDEM_OK ? st : wetdem_sim_fail(sim, st, "%s", msg);
 }
 
-int wetdem_sim_write_vtk(struct wetdem_sim* sim, const char* path, bool binary)
+static int write_vtk(struct wetdem_sim* sim, const char* path, bool binary)
 {
     if (!path)
         return wetdem_sim_fail(sim, WETDEM_ERR_INVALID, "write_vtk: NULL path");
@@ -277,7 +285,7 @@ static bool push_link(struct wetdem_output_vtk_link** links, size_t* n, size_t* 
     return true;
 }
 
-int wetdem_sim_write_vtk_links(struct wetdem_sim* sim, const char* path, bool binary)
+static int write_vtk_links(struct wetdem_sim* sim, const char* path, bool binary)
 {
     if (!path)
         return wetdem_sim_fail(sim, WETDEM_ERR_INVALID, "links: NULL path");
@@ -409,7 +417,7 @@ static int write_vtk_frame(struct wetdem_sim* sim, const struct wetdem_output_vt
     if (st == WETDEM_OK && m->set.vtk_links &&
         (st = prefixed(sim, links_prefix, sizeof links_prefix, WETDEM_LINKS_SUFFIX)) == WETDEM_OK) {
         wetdem_output_vtk_path(links, sizeof links, links_prefix, m->vtk_files);
-        st = wetdem_sim_write_vtk_links(sim, links, m->set.vtk_binary);
+        st = write_vtk_links(sim, links, m->set.vtk_binary);
     }
     if (st == WETDEM_OK)
         st = add_series_entry(sim, base_name(path), sim->engine.time);
@@ -549,7 +557,18 @@ int wetdem_sim_many_write_csv_row(struct wetdem_sim* sim)
     if (!sim || !sim->many || !sim->many->started || !sim->many->output_prefix)
         return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
                                "many: a CSV row needs a started many-particle run with outputs");
-    return write_csv_row(sim, NULL);
+    struct wetdem_locale_guard g;
+    if (wetdem_locale_guard_enter(&g) != WETDEM_OK)
+        return no_c_locale(sim);
+    int st = write_csv_row(sim, NULL);
+    wetdem_locale_guard_leave(&g);
+    return st;
+}
+
+/* Whether due() would be true now (without moving `next`). */
+static bool is_due(uint64_t step, unsigned long long every, uint64_t next)
+{
+    return every && step >= next;
 }
 
 /* Output k is due at multiples of `every` steps, once per step. */
@@ -561,11 +580,24 @@ static bool due(uint64_t step, unsigned long long every, uint64_t* next)
     return true;
 }
 
+static int write_checkpoint(struct wetdem_sim* sim, const char* path);
+
 int wetdem_sim_many_outputs(struct wetdem_sim* sim, bool final)
 {
     struct wetdem_many* m = sim->many;
     int st = WETDEM_OK;
     (void) final;
+    /* the C locale for the files' numbers only at the steps that write any (the observer and
+     * the progress callback, between them, run in the host's locale) */
+    bool any = (m->output_prefix && (is_due(m->step, m->set.vtk_every, m->next_vtk_step) ||
+                                     is_due(m->step, m->set.csv_every, m->next_csv_step))) ||
+               (m->checkpoint_path && m->step > 0 &&
+                is_due(m->step, m->set.checkpoint_every, m->next_checkpoint_step));
+    if (!any)
+        return WETDEM_OK;
+    struct wetdem_locale_guard g;
+    if (wetdem_locale_guard_enter(&g) != WETDEM_OK)
+        return no_c_locale(sim);
     /* the links are worked out once for the frame and, when due at the same step, the row */
     struct wetdem_many_stats links = {0}; /* zeroed, as wetdem_sim_many_stats starts */
     bool have_links = false;
@@ -580,7 +612,8 @@ int wetdem_sim_many_outputs(struct wetdem_sim* sim, bool final)
         st = write_csv_row(sim, have_links ? &links : NULL);
     if (st == WETDEM_OK && m->checkpoint_path && m->step > 0 &&
         due(m->step, m->set.checkpoint_every, &m->next_checkpoint_step))
-        st = wetdem_sim_write_checkpoint(sim, m->checkpoint_path);
+        st = write_checkpoint(sim, m->checkpoint_path);
+    wetdem_locale_guard_leave(&g);
     return st;
 }
 
@@ -712,7 +745,7 @@ static int fill_checkpoint(struct wetdem_sim* sim, struct wetdem_checkpoint* ck)
     return WETDEM_OK;
 }
 
-int wetdem_sim_write_checkpoint(struct wetdem_sim* sim, const char* path)
+static int write_checkpoint(struct wetdem_sim* sim, const char* path)
 {
     if (!path)
         return wetdem_sim_fail(sim, WETDEM_ERR_INVALID, "write_checkpoint: NULL path");
@@ -915,7 +948,7 @@ static int restore_pairs(struct wetdem_sim* sim, const struct wetdem_checkpoint*
     return WETDEM_OK;
 }
 
-int wetdem_sim_read_checkpoint(struct wetdem_sim* sim, const char* path)
+static int read_checkpoint(struct wetdem_sim* sim, const char* path)
 {
     if (!path)
         return wetdem_sim_fail(sim, WETDEM_ERR_INVALID, "read_checkpoint: NULL path");
@@ -936,6 +969,48 @@ int wetdem_sim_read_checkpoint(struct wetdem_sim* sim, const char* path)
     if (st == WETDEM_OK)
         st = reload_series(sim);
     wetdem_checkpoint_clear(&ck);
+    return st;
+}
+
+/* ---- the public writers and readers, in the C locale (locale_guard.h) ---- */
+
+int wetdem_sim_write_vtk(struct wetdem_sim* sim, const char* path, bool binary)
+{
+    struct wetdem_locale_guard g;
+    if (wetdem_locale_guard_enter(&g) != WETDEM_OK)
+        return no_c_locale(sim);
+    int st = write_vtk(sim, path, binary);
+    wetdem_locale_guard_leave(&g);
+    return st;
+}
+
+int wetdem_sim_write_vtk_links(struct wetdem_sim* sim, const char* path, bool binary)
+{
+    struct wetdem_locale_guard g;
+    if (wetdem_locale_guard_enter(&g) != WETDEM_OK)
+        return no_c_locale(sim);
+    int st = write_vtk_links(sim, path, binary);
+    wetdem_locale_guard_leave(&g);
+    return st;
+}
+
+int wetdem_sim_write_checkpoint(struct wetdem_sim* sim, const char* path)
+{
+    struct wetdem_locale_guard g;
+    if (wetdem_locale_guard_enter(&g) != WETDEM_OK)
+        return no_c_locale(sim);
+    int st = write_checkpoint(sim, path);
+    wetdem_locale_guard_leave(&g);
+    return st;
+}
+
+int wetdem_sim_read_checkpoint(struct wetdem_sim* sim, const char* path)
+{
+    struct wetdem_locale_guard g;
+    if (wetdem_locale_guard_enter(&g) != WETDEM_OK)
+        return no_c_locale(sim);
+    int st = read_checkpoint(sim, path); /* (the times of the .vtk.series file) */
+    wetdem_locale_guard_leave(&g);
     return st;
 }
 

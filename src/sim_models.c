@@ -13,6 +13,7 @@
 #include <string.h>
 
 #include "integrator.h"
+#include "locale_guard.h"
 #include "models.h"
 #include "sim.h"
 #include "vec3.h"
@@ -361,7 +362,7 @@ int wetdem_sim_set_param(struct wetdem_sim* sim, const char* name, double value)
     return WETDEM_OK;
 }
 
-int wetdem_sim_set_param_str(struct wetdem_sim* sim, const char* name, const char* value)
+static int set_param_str(struct wetdem_sim* sim, const char* name, const char* value)
 {
     if (!name || !value)
         return wetdem_sim_fail(sim, WETDEM_ERR_INVALID, "set_param_str: NULL %s",
@@ -389,6 +390,19 @@ int wetdem_sim_set_param_str(struct wetdem_sim* sim, const char* name, const cha
         return wetdem_sim_fail(sim, WETDEM_ERR_INVALID, "%s = '%s' is not a number [%s]", name,
                                value, t.desc->unit);
     return wetdem_sim_set_param(sim, name, v);
+}
+
+/* The number in the C locale: "0.5", whatever LC_NUMERIC the host set (locale_guard.h). */
+int wetdem_sim_set_param_str(struct wetdem_sim* sim, const char* name, const char* value)
+{
+    struct wetdem_locale_guard g;
+    if (wetdem_locale_guard_enter(&g) != WETDEM_OK)
+        return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM,
+                               "set_param_str: out of memory for the C "
+                               "locale of the numbers");
+    int st = set_param_str(sim, name, value);
+    wetdem_locale_guard_leave(&g);
+    return st;
 }
 
 int wetdem_sim_param(const struct wetdem_sim* sim, const char* name, double* value)

@@ -44,6 +44,7 @@
 #include <gsl/gsl_matrix.h>
 #include <gsl/gsl_vector.h>
 
+#include "locale_guard.h"
 #include "track.h"
 
 #define TRACK_MAX_FRAME 1000000000000L /* |frame number| at most [-] */
@@ -312,7 +313,7 @@ static int read_line(struct wetdem_track* t, char* text, bool* seen_data)
     return parse_row(t, f);
 }
 
-int wetdem_track_read_csv(struct wetdem_track* track, const char* path)
+static int read_csv(struct wetdem_track* track, const char* path)
 {
     if (!path)
         return fail(track, WETDEM_ERR_INVALID, "read_csv: NULL path");
@@ -347,6 +348,17 @@ int wetdem_track_read_csv(struct wetdem_track* track, const char* path)
     fclose(fp);
     if (st == WETDEM_OK && track->n_spheres == 0)
         st = fail(track, WETDEM_ERR_PARSE, "%s: no data rows", path);
+    return st;
+}
+
+/* The numbers of the file in the C locale: "0.5", whatever LC_NUMERIC the host set. */
+int wetdem_track_read_csv(struct wetdem_track* track, const char* path)
+{
+    struct wetdem_locale_guard g;
+    if (wetdem_locale_guard_enter(&g) != WETDEM_OK)
+        return fail(track, WETDEM_ERR_NOMEM, "read_csv: out of memory for the C locale");
+    int st = read_csv(track, path);
+    wetdem_locale_guard_leave(&g);
     return st;
 }
 
