@@ -112,6 +112,46 @@ static inline void test_check_same_particles(const struct wetdem_sim* a, const s
 
 /* ---- the command-line tool ---- */
 
+/* The small wet granular gas of several tests, set up in sim (the many-particle mode is the
+ * caller's): n spheres of radius 0.4-0.5 mm at random (seed) in [0, side]^2 x [0, height], at
+ * 0.2 m/s spread, periodic in x and y, a floor at z = 0, gravity; one material (2500 kg/m^3,
+ * E = 10 MPa, nu = 0.3, e = 0.6, friction 0.4 dry and 0.1 lubricated) with films of `film`
+ * [m], a fluid of 0.01 Pa s and 0.02 N/m, models hertz, mindlin, sb, capillary and `extra`
+ * when not NULL. Returns the first status that is an error (the message in sim), or
+ * WETDEM_OK. */
+static inline int test_wet_gas(struct wetdem_sim* sim, size_t n, double side, double height,
+                               double film, unsigned long seed, const char* extra)
+{
+    struct wetdem_material m = {.density = 2500,
+                                .youngs_modulus = 1e7,
+                                .poisson_ratio = 0.3,
+                                .restitution = 0.6,
+                                .friction_dry = 0.4,
+                                .friction_lub = 0.1,
+                                .film = film};
+    int st = wetdem_sim_add_material(sim, &m);
+    struct wetdem_fluid f = {.viscosity = 0.01, .surface_tension = 0.02, .density = 1000};
+    st = st < 0 ? st : wetdem_sim_set_fluid(sim, &f);
+    const char* models[] = {"hertz", "mindlin", "sb", "capillary", extra};
+    for (int k = 0; k < 5 && st >= 0 && models[k]; k++)
+        st = wetdem_sim_enable_model(sim, models[k]);
+    struct wetdem_insert_spec spec = {.layout = WETDEM_INSERT_RANDOM,
+                                      .n = n,
+                                      .lo = {0, 0, 0},
+                                      .hi = {side, side, height},
+                                      .periodic = {true, true, false},
+                                      .radius_min = 0.4e-3,
+                                      .radius_max = 0.5e-3,
+                                      .velocity_sigma = 0.2,
+                                      .seed = seed};
+    st = st < 0 ? st : wetdem_sim_insert(sim, &spec);
+    st = st < 0 ? st
+                : wetdem_sim_add_wall(sim, (struct wetdem_vec3){0, 0, 0},
+                                      (struct wetdem_vec3){0, 0, 1}, 0);
+    st = st < 0 ? st : wetdem_sim_set_param(sim, "sim.gravity_z", -9.81);
+    return st < 0 ? st : WETDEM_OK;
+}
+
 /* Path of the CLI: $WETDEM_CLI (set by `make test`), else build/wetdem relative to the
  * working directory (the repository root). */
 static inline const char* test_cli_path(void)

@@ -465,33 +465,7 @@ static int many_box(struct wetdem_sim** out_sim, struct outcome* out)
     snprintf(ck, sizeof ck, "%s/run.ck", out_dir);
     struct wetdem_sim* sim = *out_sim = wetdem_sim_create();
     CREATED(out, sim);
-    struct wetdem_material m = {.density = 2500,
-                                .youngs_modulus = 1e7,
-                                .poisson_ratio = 0.3,
-                                .restitution = 0.6,
-                                .friction_dry = 0.4,
-                                .friction_lub = 0.1,
-                                .film = 40e-6};
-    STEP(out, wetdem_sim_add_material(sim, &m), wetdem_sim_errmsg(sim));
-    struct wetdem_fluid f = {.viscosity = 0.01, .surface_tension = 0.02, .density = 1000};
-    STEP(out, wetdem_sim_set_fluid(sim, &f), wetdem_sim_errmsg(sim));
-    const char* models[] = {"hertz", "mindlin", "sb", "capillary", "ehd"};
-    for (size_t k = 0; k < sizeof models / sizeof models[0]; k++)
-        STEP(out, wetdem_sim_enable_model(sim, models[k]), wetdem_sim_errmsg(sim));
-    struct wetdem_insert_spec spec = {.layout = WETDEM_INSERT_RANDOM,
-                                      .n = 12,
-                                      .lo = {0, 0, 0},
-                                      .hi = {3e-3, 3e-3, 3e-3},
-                                      .periodic = {true, true, false},
-                                      .radius_min = 0.4e-3,
-                                      .radius_max = 0.5e-3,
-                                      .velocity_sigma = 0.2,
-                                      .seed = 7};
-    STEP(out, wetdem_sim_insert(sim, &spec), wetdem_sim_errmsg(sim));
-    STEP(out,
-         wetdem_sim_add_wall(sim, (struct wetdem_vec3){0, 0, 0}, (struct wetdem_vec3){0, 0, 1}, 0),
-         wetdem_sim_errmsg(sim));
-    STEP(out, wetdem_sim_set_param(sim, "sim.gravity_z", -9.81), wetdem_sim_errmsg(sim));
+    STEP(out, test_wet_gas(sim, 12, 3e-3, 3e-3, 40e-6, 7, "ehd"), wetdem_sim_errmsg(sim));
     struct wetdem_many_settings s = {.periodic = {true, true, false},
                                      .box_lo = {0, 0, 0},
                                      .box_hi = {3e-3, 3e-3, 3e-3},

@@ -278,38 +278,8 @@ static void run_track(struct job* j)
 static void run_many(struct job* j)
 {
     struct wetdem_sim* sim = wetdem_sim_create();
-    struct wetdem_material m = {.density = 2500,
-                                .youngs_modulus = 1e7,
-                                .poisson_ratio = 0.3,
-                                .restitution = 0.6,
-                                .friction_dry = 0.4,
-                                .friction_lub = 0.1,
-                                .film = 20e-6};
-    int st = sim ? WETDEM_OK : WETDEM_ERR_NOMEM;
-    if (st == WETDEM_OK && wetdem_sim_add_material(sim, &m) != 0)
-        st = WETDEM_ERR_INVALID;
-    struct wetdem_fluid fl = {.viscosity = 0.01, .surface_tension = 0.02, .density = 1000};
-    if (st == WETDEM_OK)
-        st = wetdem_sim_set_fluid(sim, &fl);
-    const char* models[] = {"hertz", "mindlin", "sb", "capillary"};
-    for (int k = 0; k < 4 && st == WETDEM_OK; k++)
-        st = wetdem_sim_enable_model(sim, models[k]);
-    struct wetdem_insert_spec spec = {.layout = WETDEM_INSERT_RANDOM,
-                                      .n = 64,
-                                      .lo = {0, 0, 0},
-                                      .hi = {4e-3, 4e-3, 6e-3},
-                                      .periodic = {true, true, false},
-                                      .radius_min = 0.4e-3,
-                                      .radius_max = 0.5e-3,
-                                      .velocity_sigma = 0.2,
-                                      .seed = 7 + (unsigned long)j->variant};
-    if (st == WETDEM_OK)
-        st = wetdem_sim_insert(sim, &spec);
-    if (st == WETDEM_OK)
-        st = wetdem_sim_add_wall(sim, (struct wetdem_vec3){0, 0, 0}, (struct wetdem_vec3){0, 0, 1},
-                                 0);
-    if (st == WETDEM_OK)
-        st = wetdem_sim_set_param(sim, "sim.gravity_z", -9.81);
+    int st = sim ? test_wet_gas(sim, 64, 4e-3, 6e-3, 20e-6, 7 + (unsigned long)j->variant, NULL)
+                 : WETDEM_ERR_NOMEM;
     struct wetdem_many_settings s = {.periodic = {true, true, false},
                                      .box_lo = {0, 0, 0},
                                      .box_hi = {4e-3, 4e-3, 6e-3},

@@ -67,32 +67,7 @@ static struct wetdem_sim* wet_box(const char* dir, char* prefix, char* ck, size_
     snprintf(ck, n, "%s/run.ck", dir);
     struct wetdem_sim* sim = wetdem_sim_create();
     assert_non_null(sim);
-    struct wetdem_material m = {.density = 2500,
-                                .youngs_modulus = 1e7,
-                                .poisson_ratio = 0.3,
-                                .restitution = 0.6,
-                                .friction_dry = 0.4,
-                                .friction_lub = 0.1,
-                                .film = 20e-6};
-    CHECK_OK(wetdem_sim_add_material(sim, &m));
-    struct wetdem_fluid f = {.viscosity = 0.01, .surface_tension = 0.02, .density = 1000};
-    CHECK_OK(wetdem_sim_set_fluid(sim, &f));
-    const char* models[] = {"hertz", "mindlin", "sb", "capillary"};
-    for (int k = 0; k < 4; k++)
-        CHECK_OK(wetdem_sim_enable_model(sim, models[k]));
-    struct wetdem_insert_spec spec = {.layout = WETDEM_INSERT_RANDOM,
-                                      .n = 20,
-                                      .lo = {0, 0, 0},
-                                      .hi = {4e-3, 4e-3, 4e-3},
-                                      .periodic = {true, true, false},
-                                      .radius_min = 0.4e-3,
-                                      .radius_max = 0.5e-3,
-                                      .velocity_sigma = 0.2,
-                                      .seed = 7};
-    CHECK_OK(wetdem_sim_insert(sim, &spec));
-    CHECK_OK(
-        wetdem_sim_add_wall(sim, (struct wetdem_vec3){0, 0, 0}, (struct wetdem_vec3){0, 0, 1}, 0));
-    CHECK_OK(wetdem_sim_set_param(sim, "sim.gravity_z", -9.81));
+    CHECK_OK(test_wet_gas(sim, 20, 4e-3, 4e-3, 20e-6, 7, NULL));
     struct wetdem_many_settings s = {.periodic = {true, true, false},
                                      .box_hi = {4e-3, 4e-3, 4e-3},
                                      .dt = 2e-6,
