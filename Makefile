@@ -117,14 +117,21 @@ test: all $(TEST_BIN) $(EX_BIN)
 # Tests again under AddressSanitizer + UndefinedBehaviorSanitizer, in a separate build tree,
 # built by GCC (test-san) and by clang (test-san-clang: its UBSan also reports pointer
 # arithmetic on NULL, which GCC's does not look for).
+# ASAN_OPTIONS intercept_tls_get_addr=0: the sanitizers' runtime of GCC 12 and clang 14 takes a
+# block of dynamic TLS whose address falls on one offset in its page for glibc 2.19's layout and
+# reads a bogus range from it, so that LeakSanitizer's scan at exit crashed ("Tracer caught
+# signal 11") in about one run of test_many_force in five (google/sanitizers issue 1322). The
+# library keeps no allocation reachable only from dynamic TLS, so nothing is lost to the scan.
+SAN_ENV = ASAN_OPTIONS="$${ASAN_OPTIONS:+$$ASAN_OPTIONS:}intercept_tls_get_addr=0"
 SAN = -fsanitize=address,undefined,float-cast-overflow
 SAN_CFLAGS = $(SAN) -fno-sanitize-recover=all -fno-omit-frame-pointer
 test-san:
-	$(MAKE) test BUILD=build-san OPT=-O1 EXTRA_CFLAGS="$(SAN_CFLAGS)" LDLIBS="$(LDLIBS) $(SAN)"
+	$(SAN_ENV) $(MAKE) test BUILD=build-san OPT=-O1 EXTRA_CFLAGS="$(SAN_CFLAGS)" \
+	  LDLIBS="$(LDLIBS) $(SAN)"
 
 test-san-clang:
 	@scripts/install-deps fuzz
-	$(MAKE) test BUILD=build-san-clang CC=clang OPT=-O1 EXTRA_CFLAGS="$(SAN_CFLAGS)" \
+	$(SAN_ENV) $(MAKE) test BUILD=build-san-clang CC=clang OPT=-O1 EXTRA_CFLAGS="$(SAN_CFLAGS)" \
 	  LDLIBS="$(LDLIBS) $(SAN)"
 
 check-prefix: all

@@ -195,7 +195,9 @@ static uint32_t* particle_counts(struct wetdem_sim* sim, struct wetdem_many_stat
 {
     size_t n = sim->n_particles ? sim->n_particles : 1;
     uint32_t* block = malloc(3 * n * sizeof *block);
-    struct wetdem_many_per_particle per = {block, block + n, block + 2 * n};
+    struct wetdem_many_per_particle per = {0};
+    if (block) /* (no offset from NULL when out of memory) */
+        per = (struct wetdem_many_per_particle){block, block + n, block + 2 * n};
     if (!block || wetdem_sim_many_links(sim, &per, s) != WETDEM_OK) {
         free(block);
         wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory for the contact counts");
