@@ -567,12 +567,6 @@ int wetdem_sim_many_write_csv_row(struct wetdem_sim* sim)
     return st;
 }
 
-/* Whether due() would be true now (without moving `next`). */
-static bool is_due(uint64_t step, unsigned long long every, uint64_t next)
-{
-    return every && step >= next;
-}
-
 /* Output k is due at multiples of `every` steps, once per step. */
 static bool due(uint64_t step, unsigned long long every, uint64_t* next)
 {
@@ -589,13 +583,13 @@ int wetdem_sim_many_outputs(struct wetdem_sim* sim, bool final)
     struct wetdem_many* m = sim->many;
     int st = WETDEM_OK;
     (void) final;
+    bool vtk = m->output_prefix && due(m->step, m->set.vtk_every, &m->next_vtk_step);
+    bool csv = m->output_prefix && due(m->step, m->set.csv_every, &m->next_csv_step);
+    bool ck = m->checkpoint_path && m->step > 0 &&
+              due(m->step, m->set.checkpoint_every, &m->next_checkpoint_step);
     /* the C locale for the files' numbers only at the steps that write any (the observer and
      * the progress callback, between them, run in the host's locale) */
-    bool any = (m->output_prefix && (is_due(m->step, m->set.vtk_every, m->next_vtk_step) ||
-                                     is_due(m->step, m->set.csv_every, m->next_csv_step))) ||
-               (m->checkpoint_path && m->step > 0 &&
-                is_due(m->step, m->set.checkpoint_every, m->next_checkpoint_step));
-    if (!any)
+    if (!(vtk || csv || ck))
         return WETDEM_OK;
     struct wetdem_locale_guard g;
     if (wetdem_locale_guard_enter(&g) != WETDEM_OK)
@@ -603,17 +597,16 @@ int wetdem_sim_many_outputs(struct wetdem_sim* sim, bool final)
     /* the links are worked out once for the frame and, when due at the same step, the row */
     struct wetdem_many_stats links = {0}; /* zeroed, as wetdem_sim_many_stats starts */
     bool have_links = false;
-    if (m->output_prefix && due(m->step, m->set.vtk_every, &m->next_vtk_step)) {
+    if (vtk) {
         struct wetdem_output_vtk_counts per;
         uint32_t* block = particle_counts(sim, &links, &per);
         st = block ? write_vtk_frame(sim, &per) : WETDEM_ERR_NOMEM;
         have_links = block != NULL;
         free(block);
     }
-    if (st == WETDEM_OK && m->output_prefix && due(m->step, m->set.csv_every, &m->next_csv_step))
+    if (st == WETDEM_OK && csv)
         st = write_csv_row(sim, have_links ? &links : NULL);
-    if (st == WETDEM_OK && m->checkpoint_path && m->step > 0 &&
-        due(m->step, m->set.checkpoint_every, &m->next_checkpoint_step))
+    if (st == WETDEM_OK && ck)
         st = write_checkpoint(sim, m->checkpoint_path);
     wetdem_locale_guard_leave(&g);
     return st;
