@@ -118,16 +118,18 @@ int wetdem_sim_fail(struct wetdem_sim* sim, int status, const char* fmt, ...)
 bool wetdem_sim_particle_valid(const struct wetdem_sim* sim, const struct wetdem_particle* p,
                                char* why, size_t n);
 
-/* Fills c->h_min from the min-separation model, then sums every enabled force model into
- * *out (zeroed first). history: sim->history_len doubles (committed state in, advanced state
- * out), or NULL for a fresh pair with nothing kept. per_model (optional, n_models entries)
- * receives each model's own contribution. */
 /* The normal force of the enabled models on contact c at gap `gap` with the surfaces at rest
  * [N]: the conservative part (elastic contact, capillary bridge), every damping and viscous
  * term being proportional to a speed; from a copy of `history` (NULL: a fresh pair). NAN if a
  * model fails or the force is not finite. */
 double wetdem_sim_force_at_rest(const struct wetdem_sim* sim, struct wetdem_contact c,
                                 const double* history, double gap);
+/* Whether every component of a pair force is finite. */
+bool wetdem_pair_force_is_finite(const struct wetdem_pair_force* f);
+/* Fills c->h_min from the min-separation model, then sums every enabled force model into
+ * *out (zeroed first). history: sim->history_len doubles (committed state in, advanced state
+ * out), or NULL for a fresh pair with nothing kept. per_model (optional, n_models entries)
+ * receives each model's own contribution. */
 int wetdem_sim_eval_contact(const struct wetdem_sim* sim, struct wetdem_contact* c, double* history,
                             struct wetdem_pair_force* out, struct wetdem_pair_force* per_model);
 

@@ -158,12 +158,6 @@ static void apply_pair(struct wetdem_engine* e, const struct wetdem_contact* c,
     }
 }
 
-static bool pair_force_is_finite(const struct wetdem_pair_force* f)
-{
-    return isfinite(f->f_normal) && vec3_is_finite(f->f_tan) && vec3_is_finite(f->torque_i) &&
-           vec3_is_finite(f->torque_j);
-}
-
 /* Evaluates pair k at time t; applies the force when accumulate; keeps the history when
  * commit. */
 static int eval_pair(struct wetdem_sim* sim, size_t k, double t, bool commit, bool accumulate)
@@ -190,7 +184,7 @@ static int eval_pair(struct wetdem_sim* sim, size_t k, double t, bool commit, bo
                                "pair (%zu, %s%zu) at t = %.9g s: a force model failed "
                                "(%s)",
                                p->i, p->is_wall ? "wall " : "", p->j, t, wetdem_status_name(st));
-    if (!pair_force_is_finite(&f))
+    if (!wetdem_pair_force_is_finite(&f))
         return wetdem_sim_fail(sim, WETDEM_ERR_NUMERIC,
                                "pair (%zu, %s%zu) at t = %.9g s, gap %.6g m: non-finite force",
                                p->i, p->is_wall ? "wall " : "", p->j, t, c.gap);

@@ -181,6 +181,25 @@ static void test_api_fit_refuses_infinite_scale_and_tolerances(void** state)
     }
 }
 
+/* A force that overflows (a sphere 1e308 m behind a wall: Hertz's k delta^1.5) is reported as
+ * a numerical failure, as the integrators report it, not returned as a result. */
+static void test_api_pair_force_refuses_non_finite_force(void** state)
+{
+    (void)state;
+    struct wetdem_sim* sim = wetdem_sim_create();
+    assert_non_null(sim);
+    assert_int_equal(wetdem_sim_add_material_preset(sim, "glass"), 0);
+    CHECK_OK(wetdem_sim_add_particle(sim, (struct wetdem_particle){.radius = 1e-3, .material = 0}));
+    CHECK_OK(wetdem_sim_add_wall(sim, (struct wetdem_vec3){0, 0, 1e308},
+                                 (struct wetdem_vec3){0, 0, 1}, 0));
+    CHECK_OK(wetdem_sim_enable_model(sim, "hertz"));
+    struct wetdem_pair_force f;
+    struct wetdem_contact c;
+    assert_int_equal(wetdem_sim_pair_force(sim, 0, (size_t)-1, &c, &f), WETDEM_ERR_NUMERIC);
+    CHECK_CONTAINS(wetdem_sim_errmsg(sim), "non-finite force");
+    wetdem_sim_free(sim);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -189,6 +208,7 @@ int main(void)
         cmocka_unit_test(test_api_hard_impulse_never_returns_nan_velocities),
         cmocka_unit_test(test_api_fit_refuses_infinite_scale_and_tolerances),
         cmocka_unit_test(test_api_format_value_always_writes),
+        cmocka_unit_test(test_api_pair_force_refuses_non_finite_force),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
