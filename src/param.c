@@ -54,11 +54,10 @@ void wetdem_param_range_text(const struct wetdem_param_desc* d, char* buf, size_
     int digits = d->integer ? 10 : 6; /* counts in full: [0, 4294967295], not 4.29497e+09 */
     /* (in the C locale: "[0.5, 1]", not "[0,5, 1]"; without one, in the thread's) */
     struct wetdem_locale_guard g;
-    int c = wetdem_locale_guard_enter(&g);
+    (void)wetdem_locale_guard_enter(&g); /* (leave undoes only an enter that succeeded) */
     snprintf(buf, n, "%s%c%.*g, %.*g%c", d->integer ? "integer in " : "", d->min_open ? '(' : '[',
              digits, d->min, digits, d->max, d->max_open ? ')' : ']');
-    if (c == WETDEM_OK)
-        wetdem_locale_guard_leave(&g);
+    wetdem_locale_guard_leave(&g);
 }
 
 void wetdem_param_format_value(double value, int min_digits, char* buf, size_t n)
@@ -68,14 +67,13 @@ void wetdem_param_format_value(double value, int min_digits, char* buf, size_t n
     /* the text of a number for files and command lines: in the C locale (without one, which
      * does not happen with glibc or musl, in the thread's; it still reads back there) */
     struct wetdem_locale_guard g;
-    int c = wetdem_locale_guard_enter(&g);
+    (void)wetdem_locale_guard_enter(&g); /* (leave undoes only an enter that succeeded) */
     for (int digits = first; digits <= 17; digits++) {
         snprintf(buf, n, "%.*g", digits, value);
         if (strtod(buf, NULL) == value)
             break;
     }
-    if (c == WETDEM_OK)
-        wetdem_locale_guard_leave(&g);
+    wetdem_locale_guard_leave(&g);
 }
 
 int wetdem_param_validate(const struct wetdem_param_desc* d, double value, char* msg,
