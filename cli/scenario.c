@@ -388,6 +388,16 @@ static size_t section_key_names(const struct cli_section_info* info, const char*
     return n;
 }
 
+/* Whether the section accepts key: one of its table or of its library table, or any key of a
+ * section whose keys the library checks ([integrator], [sim]). */
+static bool section_has_key(const struct cli_section_info* info, const char* key)
+{
+    for (size_t k = 0; info->desc && info->desc->keys && info->desc->keys[k].key; k++)
+        if (strcmp(info->desc->keys[k].key, key) == 0)
+            return true;
+    return info->open_keys || wetdem_param_find(info->lib_keys, key) != NULL;
+}
+
 static void unknown_key(const struct cli_scenario* sc, const struct cli_entry* e,
                         const struct cli_section_info* info)
 {
@@ -693,7 +703,13 @@ static int split_key_value(const char* option, const char* text, char* section, 
         trim(value);
     }
     struct cli_section_info info;
-    if (cli_section_lookup(section, &info) != 0 && wetdem_model_find(section)) {
+    const struct wetdem_model* model = wetdem_model_find(section);
+    bool is_section = cli_section_lookup(section, &info) == 0;
+    /* a model's library name, nijssen.cutoff_ratio: [model.nijssen] cutoff_ratio; also where
+     * the model shares its name with a section that lacks the key (davis.below_hmin is the
+     * davis model's, [davis] the pairwise engine's) */
+    if (model &&
+        (!is_section || (!section_has_key(&info, key) && wetdem_param_find(model->params, key)))) {
         memmove(section + 6, section, slen + 1); /* slen < CLI_NAME_MAX - 6 checked above */
         memcpy(section, "model.", 6);
     } else if (wetdem_integrator_params(section)) {

@@ -155,6 +155,21 @@ static void test_scenario_set_overrides(void** state)
     assert_int_equal(r.code, 0);
     CHECK_REL(check_value(r.out, "impact_speed"), 2 * 0.0253093363, 1e-8);
     free(r.out);
+    /* davis is a model and also the pairwise engine's section [davis]: the model's parameter
+       by its library name is the model's (docs/models.md names it davis.below_hmin), and the
+       section's keys stay the section's */
+    r = run_cli("run examples/scenarios/punch_oblique.ini --json --set davis.below_hmin=nc");
+    struct test_run by_section =
+        run_cli("run examples/scenarios/punch_oblique.ini --json --set model.davis.below_hmin=nc");
+    assert_int_equal(r.code, 0);
+    assert_int_equal(by_section.code, 0);
+    assert_string_equal(r.out, by_section.out);
+    free(r.out);
+    free(by_section.out);
+    expect_run("run examples/scenarios/davis_three.ini --check --set davis.stokes=3", 0,
+               "0.000113097"); /* St_n 3 instead of the file's 2: masses m = St_n 6 pi mu a^2/v */
+    expect_run("run examples/scenarios/punch_oblique.ini --check --set davis.below_hmn=nc", 2,
+               "unknown key 'below_hmn' in [davis]");
     r = run_cli("run examples/scenarios/nijssen_head_on.ini --check --set collision.stoke=5");
     assert_int_equal(r.code, 2);
     CHECK_CONTAINS(r.out, "did you mean 'stokes'");
