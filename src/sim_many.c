@@ -1322,9 +1322,40 @@ static int one_step(struct wetdem_sim* sim, bool defer)
     return timed_outputs(sim, false, true);
 }
 
+/* Largest component of a wall's unit normal along a periodic axis: a wall there is not the
+ * same at the periodic images, so a sphere that crosses the periodic face jumps by the box
+ * length times that component relative to the wall (into it, or off it). 1e-12 admits normals
+ * whose zero components carry the round-off of a rotation (cos(pi/2) = 6e-17); the jump is
+ * then below 1e-12 of the box length, under the margins of the gap tests. */
+#define WALL_PERIODIC_NORMAL_MAX 1e-12
+
+/* Refuses a wall that is not parallel to every periodic axis (walls may be added between
+ * calls, so every call checks). */
+static int check_walls(struct wetdem_sim* sim)
+{
+    const struct wetdem_many_settings* s = &sim->many->set;
+    for (size_t w = 0; w < sim->n_walls; w++) {
+        struct wetdem_vec3 n = sim->walls[w].normal;
+        double c[3] = {n.x, n.y, n.z};
+        for (int k = 0; k < 3; k++)
+            if (s->periodic[k] && !(fabs(c[k]) <= WALL_PERIODIC_NORMAL_MAX))
+                return wetdem_sim_fail(
+                    sim, WETDEM_ERR_INVALID,
+                    "wall %zu: its unit normal (%g, %g, %g) has the component %g along the "
+                    "periodic axis %c, where |normal.%c| <= %g is needed: a wall must be parallel "
+                    "to every periodic axis, or a sphere crossing the periodic face jumps into "
+                    "the wall or off it",
+                    w, n.x, n.y, n.z, c[k], "xyz"[k], "xyz"[k], WALL_PERIODIC_NORMAL_MAX);
+    }
+    return WETDEM_OK;
+}
+
 int wetdem_sim_many_integrate(struct wetdem_sim* sim, double t_end)
 {
     struct wetdem_many* m = sim->many;
+    int wall_st = check_walls(sim);
+    if (wall_st != WETDEM_OK)
+        return wall_st;
     m->kernel_ready = false;  /* materials, models or parameters may have changed */
     m->disp_bound = INFINITY; /* particles may have been moved: measure at the first step */
     m->skip_ready = false;    /* and test every candidate at the first force pass */
