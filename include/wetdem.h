@@ -428,7 +428,9 @@ WETDEM_API const struct wetdem_param_desc* wetdem_sim_settings_params(void);
 
 /* Evaluates the sum of the enabled force models for particles i and j (j may equal
  * (size_t)-1 - w to address wall w) with a fresh per-pair history (no tangential spring, no
- * min-separation record), at the current state. Writes the contact used into *c if non-NULL.
+ * min-separation record), at the current state; in the many-particle mode with j at its
+ * periodic image nearest to i, as that engine pairs them. Writes the contact used into *c if
+ * non-NULL.
  * Returns WETDEM_OK, WETDEM_ERR_INVALID (indices, an invalid particle, out NULL),
  * WETDEM_ERR_NUMERIC (a force that is not finite) or a model's negative status. */
 WETDEM_API int wetdem_sim_pair_force(struct wetdem_sim* sim, size_t i, size_t j,

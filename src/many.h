@@ -493,7 +493,8 @@ int wetdem_sim_many_setup_kernel(struct wetdem_sim* sim);
 /* Mixed properties of materials a and b (setup_kernel must have run). */
 const struct wetdem_many_mix* wetdem_sim_many_mix(const struct wetdem_sim* sim, int a, int b);
 /* Contact of particle i with particle j (minimum image) or with wall j, properties from the
- * table: the same values as wetdem_sim_build_contact for a non-periodic pair. */
+ * table: the same values as wetdem_sim_build_contact (up to the rounding of the image's
+ * position across a periodic face). */
 void wetdem_sim_many_contact(const struct wetdem_sim* sim, size_t i, size_t j, bool is_wall,
                              struct wetdem_contact* c);
 /* The fused kernel: the same contract and results as wetdem_sim_eval_contact, for model sets

@@ -231,6 +231,12 @@ void wetdem_sim_build_contact(const struct wetdem_sim* sim, size_t i, size_t j, 
                                  &sim->materials[w->material], &sim->fluid);
     } else {
         const struct wetdem_particle* b = &sim->particles[j];
+        struct wetdem_particle image;
+        if (sim->many) { /* across a periodic face: the image of j that the engine pairs */
+            image = *b;
+            image.pos = wetdem_sim_many_nearest_image(sim, a->pos, b->pos);
+            b = &image;
+        }
         wetdem_contact_from_particles(c, a, &sim->materials[a->material], b,
                                       &sim->materials[b->material], &sim->fluid);
     }

@@ -207,7 +207,8 @@ bool wetdem_sim_history_beyond_range(const struct wetdem_sim* sim, struct wetdem
 /* Initial value of a pair's history: zeros except NAN-free defaults; writes history_len. */
 void wetdem_sim_history_init(const struct wetdem_sim* sim, double* history);
 
-/* Builds the contact of particle i with particle j, or with wall w when is_wall. */
+/* Builds the contact of particle i with particle j, or with wall w when is_wall. In the
+ * many-particle mode j is taken at its periodic image nearest to i, as that engine pairs them. */
 void wetdem_sim_build_contact(const struct wetdem_sim* sim, size_t i, size_t j, bool is_wall,
                               struct wetdem_contact* c);
 
@@ -216,6 +217,10 @@ void wetdem_sim_many_free(struct wetdem_sim* sim);
 /* sim_many.c: starts the many-particle state afresh with its settings (wetdem_sim_reset calls
  * it): step 0, no lists, a new energy budget; nothing without the mode. */
 void wetdem_sim_many_reset(struct wetdem_sim* sim);
+/* sim_many.c: the periodic image of position b nearest to position a in the box of the
+ * many-particle mode (b itself on its open axes) [m]. */
+struct wetdem_vec3 wetdem_sim_many_nearest_image(const struct wetdem_sim* sim, struct wetdem_vec3 a,
+                                                 struct wetdem_vec3 b);
 /* sim_many.c: runs the many-particle engine to t_end (wetdem_sim_integrate dispatches). */
 int wetdem_sim_many_integrate(struct wetdem_sim* sim, double t_end);
 

@@ -174,6 +174,17 @@ void wetdem_sim_many_reset(struct wetdem_sim* sim)
     free(checkpoint);
 }
 
+struct wetdem_vec3 wetdem_sim_many_nearest_image(const struct wetdem_sim* sim, struct wetdem_vec3 a,
+                                                 struct wetdem_vec3 b)
+{
+    const struct wetdem_many_settings* s = &sim->many->set; /* (the cell list's box is set from
+                                                               them when a run starts) */
+    const struct wetdem_celllist_box box = {{s->box_lo.x, s->box_lo.y, s->box_lo.z},
+                                            {s->box_hi.x, s->box_hi.y, s->box_hi.z},
+                                            {s->periodic[0], s->periodic[1], s->periodic[2]}};
+    return vec3_sub(a, celllist_delta(&box, a, b));
+}
+
 /* ---- start-up bounds ---- */
 
 /* Contact of two copies of particle p (materials a, b) at gap `gap`, or of p with a wall. */
