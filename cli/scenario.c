@@ -719,15 +719,15 @@ static int split_key_value(const char* option, const char* text, char* section, 
     return 0;
 }
 
-/* The families of named sections that are things of the scenario, each with its noun. */
+/* The families of named sections that are things of the scenario, each with its noun, and
+ * [insert] (an insertion too: its keys are read only where the file has the section). The
+ * first whose prefix a section starts with is its family. */
 static const struct {
     const char* prefix;
     const char* noun;
-} named_families[] = {{"material.", "a material"},
-                      {"particle.", "a sphere"},
-                      {"sphere.", "a sphere"},
-                      {"insert.", "an insertion"},
-                      {"read.", "a read of a file"}};
+} named_families[] = {{"material.", "a material"}, {"particle.", "a sphere"},
+                      {"sphere.", "a sphere"},     {"insert.", "an insertion"},
+                      {"insert", "an insertion"},  {"read.", "a read of a file"}};
 
 int cli_override_split(const char* text, char* section, char* key, char* value)
 {
@@ -742,10 +742,11 @@ int cli_key_split(const char* option, const char* name, char* section, char* key
 }
 
 /* A --set of a named section the file does not define ([material.NAME], [particle.NAME],
- * [sphere.NAME], [insert.NAME], [read.NAME]) would add an entry that no section reads (a
- * misspelt name; for a material, a preset's name, whose section would start from the field
- * defaults, not from the preset): refused with the file's sections of that family as a hint.
- * Returns an exit code. */
+ * [sphere.NAME], [insert.NAME], [read.NAME]) or of an [insert] it does not have would add an
+ * entry that no section reads (a misspelt name; for a material, a preset's name, whose section
+ * would start from the field defaults, not from the preset; an [insert] is built only where
+ * the file has one): refused with the file's sections of that family as a hint. Returns an
+ * exit code. */
 static int new_named_section(const struct cli_scenario* sc, const char* key_value,
                              const char* section)
 {

@@ -265,6 +265,11 @@ static void test_many_cli_bad_inputs_exit_2_with_file_and_line(void** state)
                      "mean [particle.a]?); --set changes a sphere the file defines"));
     free(expect_exit("run sweep.ini --check --set insert.big.count=3", 2,
                      "the file has no section [insert.big]; --set changes an insertion"));
+    /* nor did a --set of [insert] in a file without one: its spheres were never inserted,
+       and the run went on with the file's [particle.NAME] spheres alone */
+    free(expect_exit("run overlap3.ini --check --set insert.count=3", 2,
+                     "--set insert.count=3: the file has no section [insert]; --set changes an "
+                     "insertion the file defines"));
 }
 
 /* Removes field `col` (0-based) from every comma-separated line of text, in place. */
