@@ -129,9 +129,12 @@ static int setup_grid(struct wetdem_celllist* cl, const double bb_lo[3], const d
         if (cl->box.periodic[k]) {
             if (hi - lo < 2 * d_cut) {
                 set_msg(msg, msg_size,
-                        "periodic box length %g m is below twice the interaction distance "
-                        "2 R_max + reach + skin = %g m: a pair would interact through two images",
-                        hi - lo, d_cut);
+                        "periodic box length along %c, %g m, is below twice the interaction "
+                        "distance 2 R_max + reach + skin = %g m (R_max %g m, reach %g m, skin "
+                        "%g m): it must be at least %g m, or a pair would interact through two "
+                        "images",
+                        "xyz"[k], hi - lo, d_cut, 0.5 * (d_cut - cl->reach - cl->skin), cl->reach,
+                        cl->skin, 2 * d_cut);
                 return WETDEM_ERR_INVALID;
             }
         } else {
