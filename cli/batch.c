@@ -332,6 +332,63 @@ static bool failed_word(const char* word, size_t len)
            (len == 11 && strncmp(word, "ENERGY_GREW", 11) == 0);
 }
 
+/* Whether a status word is one a table of a batch writes: a status name or ENERGY_GREW. */
+static bool known_status(const char* word, size_t len)
+{
+    if (len == 11 && strncmp(word, "ENERGY_GREW", 11) == 0)
+        return true;
+    for (int s = -64; s <= 64; s++) {
+        const char* name = wetdem_status_name(s);
+        if (strcmp(name, "WETDEM_UNKNOWN") != 0 && strlen(name) == len &&
+            strncmp(word, name, len) == 0)
+            return true;
+    }
+    return false;
+}
+
+/* Why `kept`, the status word and fields of a row that ran, is not a row this batch writes
+ * (into why, returned), or NULL: a known status word, then one field per column of the
+ * engine's header, a word in each [word] column and a number (nan and inf as the table
+ * writes them) in the others. A kept row is copied as it stands, so an edited or damaged one
+ * would pass into the completed table unnoticed. */
+static const char* kept_row_problem(const struct cli_batch* b, const char* kept, char* why,
+                                    size_t n)
+{
+    size_t len = strcspn(kept, ",");
+    if (!known_status(kept, len)) {
+        snprintf(why, n,
+                 "status '%.*s' is none a run gives (WETDEM_OK, WETDEM_ERR_..., "
+                 "ENERGY_GREW, NOT_RUN)",
+                 (int)(len > 40 ? 40 : len), kept);
+        return why;
+    }
+    const char* field = kept[len] == ',' ? kept + len + 1 : NULL;
+    for (const char* col = b->header; col;) {
+        size_t lc = strcspn(col, ",");
+        if (!field) {
+            snprintf(why, n, "it ends before column '%.*s'", (int)lc, col);
+            return why;
+        }
+        size_t lf = strcspn(field, ",");
+        bool word = lc >= 6 && strncmp(col + lc - 6, "[word]", 6) == 0;
+        char text[64];
+        snprintf(text, sizeof text, "%.*s", (int)(lf < sizeof text ? lf : sizeof text - 1), field);
+        char* end = NULL;
+        if (lf == 0 || lf >= sizeof text || (!word && (strtod(text, &end), *end != '\0'))) {
+            snprintf(why, n, "column '%.*s': '%.*s' is not %s", (int)lc, col,
+                     (int)(lf > 40 ? 40 : lf), field, word ? "a word" : "a number");
+            return why;
+        }
+        col = col[lc] == ',' ? col + lc + 1 : NULL;
+        field = field[lf] == ',' ? field + lf + 1 : NULL;
+    }
+    if (field) {
+        snprintf(why, n, "it has more fields than the %s has columns", b->cmd);
+        return why;
+    }
+    return NULL;
+}
+
 /* Row r (line `line` of the file) of the table of --resume, text without its newline: kept
  * into point r unless NOT_RUN. An exit code, the message printed. */
 static int resume_row(struct cli_batch* b, size_t r, const char* text, size_t line)
@@ -352,6 +409,13 @@ static int resume_row(struct cli_batch* b, size_t r, const char* text, size_t li
     size_t ls = strcspn(status, ",");
     if (ls == 7 && strncmp(status, "NOT_RUN", 7) == 0)
         return CLI_EXIT_OK;
+    char why[256];
+    if (kept_row_problem(b, status, why, sizeof why)) {
+        cli_error("%s: --resume %s:%zu: the row of point %zu is not one this %s writes: %s "
+                  "(run the point again: write NOT_RUN in its status column)",
+                  b->cmd, b->resume, line, r + 1, b->cmd, why);
+        return CLI_EXIT_USAGE;
+    }
     if (!(p->row = strdup(status))) {
         cli_error("%s: out of memory", b->cmd);
         return CLI_EXIT_RUNTIME;

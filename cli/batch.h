@@ -91,8 +91,8 @@ struct cli_batch {
 
 /* Checks the keys (two names of one key, or speed and stokes, are refused), loads the file
  * with the overrides, checks the engine, builds every point serially, reads the table of
- * `resume` (its columns and every row's values must be this batch's: exit 2 with the line
- * that differs), checks that `out` can be written, and runs the points in parallel (those
+ * `resume` (its columns and every row's values must be this batch's, and each row kept one
+ * the batch writes: exit 2 with the line that differs), checks that `out` can be written, and runs the points in parallel (those
  * kept from `resume` not again). Returns an exit code: an input error of the
  * file or of any point, or an output that cannot be written, stops before anything runs
  * (message printed, exit 2); a failed run is not an error here, its status is in its point

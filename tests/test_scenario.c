@@ -944,6 +944,59 @@ static void test_scenario_resumed_map_equals_the_whole(void** state)
     free(whole);
 }
 
+/* A table given to --resume whose kept row (a point that ran) is not one the batch writes
+ * (a status word no run gives, a field that is no number, a row cut short or one field too
+ * many) is refused with its file and line, exit 2 and no output: its rows are copied into the
+ * completed table as they stand, so a damaged one passed there with exit 0. */
+static void test_scenario_resume_refuses_a_damaged_kept_row(void** state)
+{
+    (void)state;
+    char args[1400];
+    const char* sweep = "sweep examples/scenarios/dry_hertz.ini --param collision.speed "
+                        "--values 0.2:0.3:2";
+    snprintf(args, sizeof args, "%s --out %s/intact.csv", sweep, tmpdir);
+    expect_run(args, 0, NULL);
+    char path[600];
+    snprintf(path, sizeof path, "%s/intact.csv", tmpdir);
+    char* intact = test_read_file(path, NULL);
+    assert_non_null(intact);
+    char* row = strstr(intact, "\n0.2,WETDEM_OK,0.2,");
+    assert_non_null(row);
+    row += strlen("\n0.2,");
+    size_t head = (size_t)(row - intact), rest = strcspn(row, "\n");
+    static const struct {
+        const char *from, *to, *why;
+    } damage[] = {
+        {"WETDEM_OK,0.2,", "WETDEM_OKK,0.2,", "status 'WETDEM_OKK' is none a run gives"},
+        {"WETDEM_OK,0.2,", "WETDEM_OK,0.2x,", "column 'impact_speed [m/s]': '0.2x' is not a"},
+        {"WETDEM_OK,0.2,", "WETDEM_OK\n#", "it ends before column 'impact_speed [m/s]'"},
+        {NULL, ",1", "it has more fields than the sweep has columns"},
+    };
+    for (size_t k = 0; k < sizeof damage / sizeof damage[0]; k++) {
+        char* table = malloc(strlen(intact) + 64);
+        assert_non_null(table);
+        if (damage[k].from) {
+            snprintf(table, strlen(intact) + 64, "%.*s%s%s", (int)head, intact, damage[k].to,
+                     row + strlen(damage[k].from));
+        } else { /* one field more at the end of the row */
+            snprintf(table, strlen(intact) + 64, "%.*s%s%s", (int)(head + rest), intact,
+                     damage[k].to, row + rest);
+        }
+        const char* bad = write_file("damaged.csv", table);
+        free(table);
+        snprintf(args, sizeof args, "%s --resume %s --out %s/completed.csv", sweep, bad, tmpdir);
+        struct test_run r = run_cli(args);
+        if (r.code != 2)
+            fail_msg("%s: exit %d, expected 2\n%s", damage[k].why, r.code, r.out);
+        CHECK_CONTAINS(r.out, "damaged.csv:5: the row of point 1 is not one this sweep writes: ");
+        CHECK_CONTAINS(r.out, damage[k].why);
+        free(r.out);
+        snprintf(path, sizeof path, "%s/completed.csv", tmpdir);
+        assert_int_equal(access(path, F_OK), -1);
+    }
+    free(intact);
+}
+
 /* A map killed outright (SIGKILL: no handler, no table at the end) leaves the table it saved
  * while running (--save-every): whole, under its name, every point there, those done with
  * their rows and the others NOT_RUN, and a line saying so; --resume with it runs the rest,
@@ -1346,6 +1399,7 @@ int main(void)
         cmocka_unit_test(test_scenario_batch_keys_rows_and_outputs),
         cmocka_unit_test(test_scenario_interrupted_map_writes_what_ran),
         cmocka_unit_test(test_scenario_resumed_map_equals_the_whole),
+        cmocka_unit_test(test_scenario_resume_refuses_a_damaged_kept_row),
         cmocka_unit_test(test_scenario_killed_map_resumes_from_its_saved_table),
         cmocka_unit_test(test_scenario_closed_loop_of_contacts_settles),
         cmocka_unit_test(test_scenario_interrupted_run_keeps_nothing),
