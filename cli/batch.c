@@ -493,6 +493,8 @@ static int read_resume(struct cli_batch* b)
         line++;
         while (len > 0 && (text[len - 1] == '\n' || text[len - 1] == '\r'))
             text[--len] = '\0';
+        if (line == 1 && strncmp(text, "\xEF\xBB\xBF", 3) == 0) /* a UTF-8 byte-order mark */
+            memmove(text, text + 3, (size_t)(len -= 3) + 1);
         unsigned long long was;
         if (strncmp(text, HASH_LINE, strlen(HASH_LINE)) == 0 &&
             sscanf(text + strlen(HASH_LINE), "%llx", &was) == 1 && was != b->scenario_hash) {
@@ -519,6 +521,10 @@ static int read_resume(struct cli_batch* b)
         } else {
             rc = resume_row(b, rows++, text, line);
         }
+    }
+    if (rc == CLI_EXIT_OK && ferror(f)) { /* (a directory: EISDIR) */
+        cli_error("%s: --resume %s: cannot read it: %s", b->cmd, b->resume, strerror(errno));
+        rc = CLI_EXIT_USAGE;
     }
     if (rc == CLI_EXIT_OK && rows != b->n_pts) {
         cli_error("%s: --resume %s: %zu rows, where this %s has %zu points (a table cut short "

@@ -947,7 +947,8 @@ static void test_scenario_resumed_map_equals_the_whole(void** state)
 /* A table given to --resume whose kept row (a point that ran) is not one the batch writes
  * (a status word no run gives, a field that is no number, a row cut short or one field too
  * many) is refused with its file and line, exit 2 and no output: its rows are copied into the
- * completed table as they stand, so a damaged one passed there with exit 0. */
+ * completed table as they stand, so a damaged one passed there with exit 0. A byte-order mark
+ * is passed over, and a directory is named as one. */
 static void test_scenario_resume_refuses_a_damaged_kept_row(void** state)
 {
     (void)state;
@@ -994,6 +995,16 @@ static void test_scenario_resume_refuses_a_damaged_kept_row(void** state)
         snprintf(path, sizeof path, "%s/completed.csv", tmpdir);
         assert_int_equal(access(path, F_OK), -1);
     }
+    /* a table saved by an editor with a UTF-8 byte-order mark is this batch's all the same;
+       a directory cannot be read (it was "0 rows, where this sweep has 2 points") */
+    char* bom = malloc(strlen(intact) + 4);
+    assert_non_null(bom);
+    snprintf(bom, strlen(intact) + 4, "\xEF\xBB\xBF%s", intact);
+    snprintf(args, sizeof args, "%s --resume %s", sweep, write_file("bom.csv", bom));
+    free(bom);
+    expect_run(args, 0, "# resumed: 2 points kept from ");
+    snprintf(args, sizeof args, "%s --resume %s", sweep, tmpdir);
+    expect_run(args, 2, ": cannot read it: Is a directory");
     free(intact);
 }
 
