@@ -687,6 +687,22 @@ const char* cli_option_hint(const char* arg, const char* const* options, char* b
     return buf;
 }
 
+int cli_option_once(const char* cmd, const char* arg, const char* const* once, unsigned* seen)
+{
+    for (unsigned k = 0; once[k] && k < 32; k++) {
+        if (strcmp(arg, once[k]) != 0)
+            continue;
+        if (*seen & (1u << k)) {
+            cli_error("%s: %s is given twice: give it once (the second value would replace the "
+                      "first)",
+                      cmd, arg);
+            return CLI_EXIT_USAGE;
+        }
+        *seen |= 1u << k;
+    }
+    return CLI_EXIT_OK;
+}
+
 void cli_param_default_text(const struct wetdem_param_desc* d, char* buf, size_t n)
 {
     if (d->choices) {

@@ -68,6 +68,14 @@ bool cli_wants_help(int argc, char** argv);
  * "" when arg does not start with '-' or nothing is close. Returns buf, for "%s". */
 const char* cli_option_hint(const char* arg, const char* const* options, char* buf, size_t n);
 
+/* Refuses an option given a second time that takes one value: `once` lists such options of
+ * the command (NULL-terminated, at most 32), *seen has a bit for each given so far (0 at
+ * first). Call it with every argument at an option's place (not with the options' values);
+ * others pass. Returns CLI_EXIT_OK, or prints "wetdem: <cmd>: <arg> is given twice: give it
+ * once ..." and returns CLI_EXIT_USAGE: the later value would replace the earlier unseen
+ * (`sweep --param A --param B` swept B). */
+int cli_option_once(const char* cmd, const char* arg, const char* const* once, unsigned* seen);
+
 /* Splits a CSV line in place at commas into at most max fields f[], blanks trimmed. Returns
  * the number of fields. */
 int cli_csv_split(char* line, char** f, int max);

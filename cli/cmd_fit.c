@@ -94,11 +94,17 @@ static int parse_args(int argc, char** argv, struct fit_args* a)
     a->curve_points = 40;
     a->max_iter = 50;
     a->fd_step = 1e-2;
+    static const char* const once[] = {
+        "--data",        "--fit",     "--init",     "--out",          "--curve",
+        "--omega-scale", "--fd-step", "--max-iter", "--curve-points", NULL};
+    unsigned seen = 0;
     for (int k = 1; k < argc; k++) {
         const char* s = argv[k];
         const char* v = k + 1 < argc ? argv[k + 1] : NULL;
         int rc = CLI_EXIT_OK;
         double x;
+        if (v && cli_option_once("fit", s, once, &seen) != CLI_EXIT_OK)
+            return CLI_EXIT_USAGE;
         if (s[0] != '-') {
             if (a->file) {
                 cli_error("fit: more than one scenario file ('%s' and '%s')", a->file, s);

@@ -104,9 +104,14 @@ static bool takes_value(const char* opt)
 static int parse_args(int argc, char** argv, struct forces_opts* o)
 {
     bool log_flag = false;
+    static const char* const once[] = {"--preset", "--fluid", "--radius", "--speed",
+                                       "--slip",   "--gaps",  NULL};
+    unsigned seen = 0;
     for (int k = 1; k < argc; k++) {
         const char* a = argv[k];
         int rc = CLI_EXIT_OK;
+        if (k + 1 < argc && cli_option_once("forces", a, once, &seen) != CLI_EXIT_OK)
+            return CLI_EXIT_USAGE;
         if (strcmp(a, "--log") == 0) {
             log_flag = true;
         } else if (takes_value(a)) {

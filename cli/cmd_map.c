@@ -65,9 +65,14 @@ static void usage(FILE* f)
 static int parse_args(int argc, char** argv, struct map_args* a)
 {
     memset(a, 0, sizeof *a);
+    static const char* const once[] = {"--param", "--values", "--param2",     "--values2",
+                                       "--out",   "--resume", "--save-every", NULL};
+    unsigned seen = 0;
     for (int k = 1; k < argc; k++) {
         const char* s = argv[k];
         bool next = k + 1 < argc;
+        if (next && cli_option_once("map", s, once, &seen) != CLI_EXIT_OK)
+            return CLI_EXIT_USAGE;
         if (strcmp(s, "--param") == 0 && next)
             a->key[0] = argv[++k];
         else if (strcmp(s, "--values") == 0 && next)

@@ -52,9 +52,13 @@ static void usage(FILE* f)
 static int parse_args(int argc, char** argv, struct run_args* a)
 {
     memset(a, 0, sizeof *a);
+    static const char* const once[] = {"--out", "--restart", NULL};
+    unsigned seen = 0;
     for (int k = 1; k < argc; k++) {
         const char* s = argv[k];
         bool has_next = k + 1 < argc;
+        if (has_next && cli_option_once("run", s, once, &seen) != CLI_EXIT_OK)
+            return CLI_EXIT_USAGE;
         if (strcmp(s, "--set") == 0 && has_next && a->n_sets < MAX_SETS)
             a->sets[a->n_sets++] = argv[++k];
         else if (strcmp(s, "--out") == 0 && has_next)

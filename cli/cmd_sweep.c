@@ -68,9 +68,14 @@ static void usage(FILE* f)
 static int parse_args(int argc, char** argv, struct sweep_args* a)
 {
     memset(a, 0, sizeof *a);
+    static const char* const once[] = {"--param",  "--values",     "--out",
+                                       "--resume", "--save-every", NULL};
+    unsigned seen = 0;
     for (int k = 1; k < argc; k++) {
         const char* s = argv[k];
         bool next = k + 1 < argc;
+        if (next && cli_option_once("sweep", s, once, &seen) != CLI_EXIT_OK)
+            return CLI_EXIT_USAGE;
         if (strcmp(s, "--param") == 0 && next)
             a->key = argv[++k];
         else if (strcmp(s, "--values") == 0 && next)

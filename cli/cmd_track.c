@@ -89,8 +89,15 @@ static int parse_args(int argc, char** argv, struct track_cli* c)
     memset(c, 0, sizeof *c);
     wetdem_track_options_init(&c->opt);
     c->opt.fps = c->opt.pixel_size = NAN; /* not given (0 given is the library's to refuse) */
+    static const char* const once[] = {"--fps",    "--pixel-size", "--threshold", "--radius",
+                                       "--mass",   "--viscosity",  "--window",    "--order",
+                                       "--offset", "--fit-frames", "--striker",   "--frames",
+                                       NULL};
+    unsigned seen = 0;
     for (int k = 1; k < argc; k++) {
         const char* a = argv[k];
+        if (k + 1 < argc && cli_option_once("track", a, once, &seen) != CLI_EXIT_OK)
+            return CLI_EXIT_USAGE;
         if (strcmp(a, "--json") == 0) {
             c->json = true;
         } else if (strcmp(a, "--y-down") == 0) {

@@ -311,6 +311,37 @@ static void test_cli_bad_options_get_hints(void** state)
     check_cli_cases(cases, sizeof cases / sizeof cases[0]);
 }
 
+/* An option that takes one value, given twice, is refused by every command: the later value
+ * replaced the earlier unseen (`fit --fit A --fit B` fitted B alone, `sweep --param A --param
+ * B` swept B, `track --fps 5000 --fps 4000` ran at 4000). Repeatable options (--set, --model)
+ * and flags without a value stay as they were. */
+static void test_cli_single_options_given_twice(void** state)
+{
+    (void)state;
+    static const struct cli_case cases[] = {
+        {"run none.ini --out a --out b", "run: --out is given twice: give it once", 2},
+        {"run none.ini --restart a --restart b", "run: --restart is given twice", 2},
+        {"sweep none.ini --param collision.stokes --param collision.angle_deg --values 1:2:2",
+         "sweep: --param is given twice: give it once", 2},
+        {"sweep none.ini --param a.b --values 1:2:2 --values 1:3:2", "--values is given twice", 2},
+        {"map none.ini --values2 1:2:2 --values2 1:3:2", "map: --values2 is given twice", 2},
+        {"map none.ini --out a.csv --out b.csv", "map: --out is given twice", 2},
+        {"fit none.ini --data d.csv --fit glass.p_gt --fit fluid.viscosity",
+         "fit: --fit is given twice: give it once", 2},
+        {"fit none.ini --max-iter 5 --max-iter 6", "fit: --max-iter is given twice", 2},
+        {"forces --model reynolds --radius 1e-3 --radius 2e-3", "forces: --radius is given twice",
+         2},
+        {"track dots.csv --fps 5000 --fps 4000 --pixel-size 1e-4",
+         "track: --fps is given twice: give it once", 2},
+        {"track dots.csv --fps 5000 --pixel-size 1e-4 --frames a.csv --frames b.csv",
+         "track: --frames is given twice", 2},
+        {"forces --model reynolds --model hertz --set fluid.viscosity=0.1 --set sim.gravity_z=0 "
+         "--log --log",
+         "gap_m,f_normal_N", 0},
+    };
+    check_cli_cases(cases, sizeof cases / sizeof cases[0]);
+}
+
 /* Messages that named the wrong thing: a --param without its section called "--set 'stokes=0'"
  * (an option the user never typed, a value from nowhere), --log2 called --log, a NAME with a
  * dot was suggested as itself, an upper-case model got no hint, --fd-step 0 came back as the
@@ -641,6 +672,7 @@ int main(void)
         cmocka_unit_test(test_cli_forces_log_gaps_are_decades),
         cmocka_unit_test(test_cli_forces_bad_input),
         cmocka_unit_test(test_cli_bad_options_get_hints),
+        cmocka_unit_test(test_cli_single_options_given_twice),
         cmocka_unit_test(test_cli_model_of_the_wrong_kind),
         cmocka_unit_test(test_cli_messages_name_what_is_wrong),
         cmocka_unit_test(test_cli_unused_model_sections),
