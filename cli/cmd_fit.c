@@ -529,13 +529,17 @@ static int probe_override(const struct fit_ctx* c, const char* key, const char* 
     return rc;
 }
 
-/* Whether the key (full name) is one the fit sets per data point, which a fit of it would
- * override: a message and CLI_EXIT_USAGE, else CLI_EXIT_OK. */
-static int check_not_per_point(const char* tok, const char* full, const struct fit_ctx* c)
+/* Whether the key (full name) is one the fit sets per data point, which a fit of it (option
+ * "--fit") or a --set of it (option "--set", tok the whole override) would override: a
+ * message and CLI_EXIT_USAGE, else CLI_EXIT_OK. */
+static int check_not_per_point(const char* option, const char* tok, const char* full,
+                               const struct fit_ctx* c)
 {
     const char* why = NULL;
     if (strcmp(full, "collision.stokes") == 0)
-        why = "every data row sets it (its stokes_n), so every point would predict the same";
+        why = option[2] == 'f' ? "every data row sets it (its stokes_n), so every point would "
+                                 "predict the same"
+                               : "every data row sets it (its stokes_n)";
     else if (strcmp(full, "collision.speed") == 0)
         why = "every data row sets the Stokes number (stokes_n), from which the speed follows "
               "(speed and stokes exclude each other)";
@@ -543,8 +547,23 @@ static int check_not_per_point(const char* tok, const char* full, const struct f
         why = "every data row sets it (the angle_deg column)";
     if (!why)
         return CLI_EXIT_OK;
-    cli_error("fit: --fit %s: %s cannot be fitted: %s", tok, full, why);
+    cli_error("fit: %s %s: %s %s: %s", option, tok, full,
+              option[2] == 'f' ? "cannot be fitted" : "would never be used", why);
     return CLI_EXIT_USAGE;
+}
+
+/* Each --set of a key the data set per point is refused (check_not_per_point). */
+static int check_sets(const struct fit_args* a, const struct fit_ctx* c)
+{
+    for (int k = 0; k < a->n_sets; k++) {
+        char section[CLI_NAME_MAX], key[CLI_NAME_MAX], full[2 * CLI_NAME_MAX + 2];
+        if (cli_override_split(a->sets[k], section, key, NULL) != 0)
+            return CLI_EXIT_USAGE;
+        snprintf(full, sizeof full, "%s.%s", section, key);
+        if (check_not_per_point("--set", a->sets[k], full, c) != CLI_EXIT_OK)
+            return CLI_EXIT_USAGE;
+    }
+    return CLI_EXIT_OK;
 }
 
 /* Splits --fit into full "section.key" names and checks each: a known numeric key, not one
@@ -579,7 +598,7 @@ static int parse_keys(const char* list, struct fit_ctx* c)
                           given[j], tok);
                 return CLI_EXIT_USAGE;
             }
-        if (check_not_per_point(tok, full, c) != CLI_EXIT_OK)
+        if (check_not_per_point("--fit", tok, full, c) != CLI_EXIT_OK)
             return CLI_EXIT_USAGE;
         if (strncmp(section, "material.", 9) == 0 &&
             !cli_scenario_has_section(c->base, section)) { /* (the override says why) */
@@ -1079,6 +1098,8 @@ int cmd_fit(int argc, char** argv)
             cli_error("fit: --omega-scale needs an omega_rad_s column in %s", a.data);
             rc = CLI_EXIT_USAGE;
         }
+    if (rc == CLI_EXIT_OK)
+        rc = check_sets(&a, &c);
     if (rc == CLI_EXIT_OK)
         rc = parse_keys(a.fit, &c);
     if (rc == CLI_EXIT_OK)

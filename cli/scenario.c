@@ -842,13 +842,38 @@ static void warn_shadowed_presets(const struct cli_scenario* sc)
     }
 }
 
-/* Loads the file and applies the overrides. */
+/* Whether two --set overrides, already applied (so they split), set one key: 1 the same key,
+ * 2 collision speed and stokes (setting one replaces the other), else 0. */
+static int same_override_key(const char* a, const char* b)
+{
+    char sa[CLI_NAME_MAX], ka[CLI_NAME_MAX], sb[CLI_NAME_MAX], kb[CLI_NAME_MAX];
+    if (cli_override_split(a, sa, ka, NULL) != 0 || cli_override_split(b, sb, kb, NULL) != 0 ||
+        strcmp(sa, sb) != 0)
+        return 0;
+    bool impact_a = strcmp(sa, "collision") == 0 && (!strcmp(ka, "speed") || !strcmp(ka, "stokes"));
+    bool impact_b = strcmp(sb, "collision") == 0 && (!strcmp(kb, "speed") || !strcmp(kb, "stokes"));
+    return strcmp(ka, kb) == 0 ? 1 : impact_a && impact_b ? 2 : 0;
+}
+
+/* Loads the file and applies the overrides; two of one key are refused, as a key given twice
+ * in the file is: the later replaced the earlier unseen. */
 int cli_load_with_overrides(const char* file, const char* const* sets, int n_sets,
                             struct cli_scenario* sc)
 {
     int rc = cli_scenario_load(file, sc);
-    for (int k = 0; rc == CLI_EXIT_OK && k < n_sets; k++)
+    for (int k = 0; rc == CLI_EXIT_OK && k < n_sets; k++) {
         rc = cli_scenario_override(sc, sets[k]);
+        for (int j = 0; rc == CLI_EXIT_OK && j < k; j++) {
+            if (!same_override_key(sets[j], sets[k]))
+                continue;
+            cli_error("%s: --set %s and --set %s set one key%s: give it once", file, sets[j],
+                      sets[k],
+                      same_override_key(sets[j], sets[k]) == 2
+                          ? " (the impact, by speed or by stokes: setting one replaces the other)"
+                          : "");
+            rc = CLI_EXIT_USAGE;
+        }
+    }
     if (rc == CLI_EXIT_OK && sc->n_sections == 0 && sc->n_entries == 0) { /* (no --set) */
         cli_error("%s: no [section] in the file: a scenario has [section] headers and "
                   "'key = value' lines (docs/scenarios.md)",

@@ -342,6 +342,46 @@ static void test_cli_single_options_given_twice(void** state)
     check_cli_cases(cases, sizeof cases / sizeof cases[0]);
 }
 
+/* A --set that would never be used is refused with exit 2: a second --set of one key (also
+ * under its other name, or speed after stokes) replaced the first unseen, a --set of the key
+ * a sweep or map varies was replaced by every point's value, and one of the Stokes number or
+ * an angle given per data row of a fit by every row. */
+static void test_cli_set_overrides_never_used(void** state)
+{
+    (void)state;
+    static const struct cli_case cases[] = {
+        {"run examples/scenarios/dry_hertz.ini --check --set collision.speed=0.3 "
+         "--set collision.speed=0.4",
+         "--set collision.speed=0.3 and --set collision.speed=0.4 set one key: give it once", 2},
+        {"run examples/scenarios/nijssen_head_on.ini --check --set nijssen.cutoff_ratio=2 "
+         "--set model.nijssen.cutoff_ratio=3",
+         "set one key: give it once", 2},
+        {"run examples/scenarios/nijssen_head_on.ini --check --set collision.stokes=4 "
+         "--set collision.speed=0.3",
+         "set one key (the impact, by speed or by stokes", 2},
+        {"run examples/scenarios/nijssen_head_on.ini --check --set collision.stokes=4 "
+         "--set collision.angle_deg=30",
+         "is valid", 0},
+        {"sweep examples/scenarios/dry_hertz.ini --param collision.speed --values 0.1:0.2:2 "
+         "--set collision.speed=0.5",
+         "sweep: --set collision.speed=0.5 sets collision.speed, which --param collision.speed "
+         "varies: each point's value would replace it",
+         2},
+        {"sweep examples/scenarios/nijssen_head_on.ini --param collision.stokes --values 1:2:2 "
+         "--set collision.speed=0.5",
+         "which --param collision.stokes varies (the impact", 2},
+        {"map examples/scenarios/dry_hertz.ini --param collision.speed --values 0.1:0.2:2 "
+         "--param2 collision.angle_deg --values2 0:10:2 --set collision.angle_deg=5",
+         "map: --set collision.angle_deg=5 sets collision.angle_deg, which --param2", 2},
+        {"fit examples/fit/punch_db_c.ini --data examples/fit/punch_0deg.csv --fit glass.p_gt "
+         "--set collision.stokes=2",
+         "fit: --set collision.stokes=2: collision.stokes would never be used: every data row "
+         "sets it",
+         2},
+    };
+    check_cli_cases(cases, sizeof cases / sizeof cases[0]);
+}
+
 /* Messages that named the wrong thing: a --param without its section called "--set 'stokes=0'"
  * (an option the user never typed, a value from nowhere), --log2 called --log, a NAME with a
  * dot was suggested as itself, an upper-case model got no hint, --fd-step 0 came back as the
@@ -673,6 +713,7 @@ int main(void)
         cmocka_unit_test(test_cli_forces_bad_input),
         cmocka_unit_test(test_cli_bad_options_get_hints),
         cmocka_unit_test(test_cli_single_options_given_twice),
+        cmocka_unit_test(test_cli_set_overrides_never_used),
         cmocka_unit_test(test_cli_model_of_the_wrong_kind),
         cmocka_unit_test(test_cli_messages_name_what_is_wrong),
         cmocka_unit_test(test_cli_unused_model_sections),
