@@ -126,7 +126,8 @@ static const struct cli_key_desc read_keys[] = {
          "spin_y, spin_z [rad/s], fixed (0 or 1), material (an index: see materials) (a name "
          "may carry its unit, 'x [m]'; '#' lines are skipped). "
          "Values are checked as the keys of [particle.NAME]. The spheres may overlap each other "
-         "and the walls (a settled packing does); their centres must lie in the box."),
+         "and the walls (a settled packing does), but no two share a centre; their centres must "
+         "lie in the box."),
     WORD("material", CLI_VALUE_NAME, "steel1", NULL, "Material of every sphere, as in [insert]."),
     WORD("materials", CLI_VALUE_TEXT, "none (material)", NULL,
          "Instead of material: the materials of the file's material indices 0, 1, ..., e.g. "

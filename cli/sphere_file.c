@@ -128,6 +128,53 @@ static bool push(struct wetdem_particle** a, size_t* n, size_t* cap, struct wetd
     return true;
 }
 
+/* A sphere's centre and its place in the file, for finding two at one centre. */
+struct centre {
+    double x, y, z;
+    size_t index;
+};
+
+static int by_centre(const void* a, const void* b)
+{
+    const struct centre *p = a, *q = b;
+    int c = (p->x > q->x) - (p->x < q->x);
+    c = c ? c : (p->y > q->y) - (p->y < q->y);
+    c = c ? c : (p->z > q->z) - (p->z < q->z);
+    return c ? c : (p->index > q->index) - (p->index < q->index);
+}
+
+/* Two of the n spheres at one centre (a row given twice) cannot be a packing: every pair
+ * force acts along the line of centres, which they do not have, so the pair was pushed apart
+ * along an arbitrary axis from an overlap of a whole diameter. The first such pair, by its CSV
+ * lines (lines[i] of sphere i) or, without lines, by its place in the frame, into err:
+ * CLI_EXIT_USAGE; CLI_EXIT_OK when every centre is distinct. Sorting: O(n log n). */
+static int check_distinct_centres(const struct wetdem_particle* p, size_t n, const size_t* lines,
+                                  char* err, size_t err_len)
+{
+    struct centre* c = malloc((n ? n : 1) * sizeof *c);
+    if (!c)
+        return no_memory(err, err_len);
+    for (size_t i = 0; i < n; i++)
+        c[i] = (struct centre){p[i].pos.x, p[i].pos.y, p[i].pos.z, i};
+    qsort(c, n, sizeof *c, by_centre);
+    int rc = CLI_EXIT_OK;
+    for (size_t k = 1; k < n && rc == CLI_EXIT_OK; k++) {
+        if (c[k].x != c[k - 1].x || c[k].y != c[k - 1].y || c[k].z != c[k - 1].z)
+            continue;
+        size_t i = c[k - 1].index, j = c[k].index; /* i < j: the earlier in the file first */
+        const char* why = "two spheres at one centre have no line of centres for their "
+                          "contact; give each sphere once";
+        if (lines)
+            rc = fail(err, err_len, "%zu: centre (%g, %g, %g) m, that of line %zu: %s", lines[j],
+                      c[k].x, c[k].y, c[k].z, lines[i], why);
+        else
+            rc = fail(err, err_len, "sphere %zu: centre (%g, %g, %g) m, that of sphere %zu: %s",
+                      j + 1, c[k].x, c[k].y, c[k].z, i + 1, why);
+    }
+    free(c);
+    return rc;
+}
+
 /* The whole file, NUL-terminated, malloc'd; *len its length. NULL with errno set. */
 static char* read_all(const char* path, size_t* len)
 {
@@ -214,10 +261,10 @@ static int read_header(char* line, size_t line_no, int col[N_COLUMNS], int* n_fi
 }
 
 static int read_csv(char* text, bool marks_fixed, struct wetdem_particle** out, size_t* n,
-                    char* err, size_t err_len)
+                    size_t** lines, char* err, size_t err_len)
 {
     int col[N_COLUMNS + 1], n_fields = 0;
-    size_t cap = 0, line_no = 0;
+    size_t cap = 0, line_no = 0, lines_cap = 0;
     bool have_header = false;
     if (strncmp(text, "\xEF\xBB\xBF", 3) == 0) /* a byte-order mark */
         text += 3;
@@ -258,6 +305,14 @@ static int read_csv(char* text, bool marks_fixed, struct wetdem_particle** out, 
         struct wetdem_particle p;
         if (!sphere_of(v, marks_fixed, &p, err, err_len, where))
             return CLI_EXIT_USAGE;
+        if (*n == lines_cap) { /* (the line of each sphere, for messages) */
+            size_t* grown =
+                realloc(*lines, (lines_cap = lines_cap ? 2 * lines_cap : 256) * sizeof *grown);
+            if (!grown)
+                return no_memory(err, err_len);
+            *lines = grown;
+        }
+        (*lines)[*n] = line_no;
         if (!push(out, n, &cap, p))
             return no_memory(err, err_len);
     }
@@ -548,11 +603,16 @@ int cli_read_sphere_file(const char* path, bool marks_fixed, struct wetdem_parti
             snprintf(err, err_len, "its last frame %s: %s", frame, why);
         return rc;
     }
-    int rc = plen > 4 && strcmp(path + plen - 4, ".vtk") == 0
-                 ? read_vtk(text, len, marks_fixed, out, n, err, err_len)
-                 : (memchr(text, '\0', len) ? fail(err, err_len, "a CSV with a NUL byte")
-                                            : read_csv(text, marks_fixed, out, n, err, err_len));
+    size_t* lines = NULL; /* (a CSV's) */
+    int rc =
+        plen > 4 && strcmp(path + plen - 4, ".vtk") == 0
+            ? read_vtk(text, len, marks_fixed, out, n, err, err_len)
+            : (memchr(text, '\0', len) ? fail(err, err_len, "a CSV with a NUL byte")
+                                       : read_csv(text, marks_fixed, out, n, &lines, err, err_len));
     free(text);
+    if (rc == 0)
+        rc = check_distinct_centres(*out, *n, lines, err, err_len);
+    free(lines);
     if (rc != 0) {
         free(*out);
         *out = NULL;

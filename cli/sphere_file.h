@@ -21,7 +21,8 @@
  * fixed 0 or 1 (is_fixed, and a fixed sphere at rest, when marks_fixed: the file says which
  * spheres are fixed; otherwise every sphere is read as free), material a whole number in
  * [0, 1000] (the
- * file's index, left in .material for the caller to map; -1 when the file has none). Film
+ * file's index, left in .material for the caller to map; -1 when the file has none); no two
+ * spheres at one centre (a row given twice). Film
  * and mass are left at zero for the caller. Returns CLI_EXIT_OK, or CLI_EXIT_USAGE (bad input) or
  * CLI_EXIT_RUNTIME (out of memory) with a one-line reason in err ("LINE: ..." for a CSV,
  * naming the array for a frame). */

@@ -1148,6 +1148,9 @@ static void test_many_cli_read_spheres_from_a_file(void** state)
          "bad.csv:2: material = 1.5 is not a whole number in [0, 1000]"},
         {"x,y,z,radius\n", "bad.csv:1: no spheres after the header"},
         {"", "bad.csv: the file is empty"},
+        /* a row given twice: two spheres at one centre, pushed apart along an arbitrary axis */
+        {"x,y,z,radius\n1e-3,1e-3,1e-3,1e-4\n2e-3,1e-3,1e-3,1e-4\n1e-3,1e-3,1e-3,1e-4\n",
+         "bad.csv:4: centre (0.001, 0.001, 0.001) m, that of line 2: two spheres at one centre"},
         {"x,y,z,radius\n1e-3,1e-3,9e-3,1e-4\n", "sphere 1 of [read.bed] (centre z = 0.009 m"},
     };
     for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {
