@@ -491,6 +491,11 @@ static int check_options(struct wetdem_track* t, const struct wetdem_track_optio
     if (o->fit_frames != 0 && (o->fit_frames < TRACK_MIN_FIT || o->fit_frames > 1000000))
         return fail(t, WETDEM_ERR_INVALID, "fit_frames = %d: must be 0 (all) or in [%d, 1000000]",
                     o->fit_frames, TRACK_MIN_FIT);
+    if (o->striker < -1 || o->striker > 1000000) /* (another negative id was taken as -1) */
+        return fail(t, WETDEM_ERR_INVALID,
+                    "striker = %d: must be a sphere id in [0, 1000000], or -1 (the faster sphere "
+                    "at the start)",
+                    o->striker);
     /* St_n's inputs, within the ranges of the scenario keys of a sphere (docs/scenarios.md) */
     const double phys[3] = {o->radius, o->mass, o->viscosity}, top[3] = {1, 1e6, 1e9};
     const char *names[3] = {"radius", "mass", "viscosity"}, *units[3] = {"m", "kg", "Pa s"};

@@ -771,6 +771,11 @@ static void test_track_rejects_short_or_mismatched_tracks(void** state)
     o.viscosity = 0;
     CHECK_STATUS(wetdem_track_analyse(t, &o, &s), WETDEM_ERR_INVALID);
     CHECK_CONTAINS(wetdem_track_errmsg(t), "the Stokes number needs all three (or none)");
+    o.viscosity = 10;
+    /* a striker id below -1 (automatic) was taken as automatic */
+    o.striker = -5;
+    CHECK_STATUS(wetdem_track_analyse(t, &o, &s), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(wetdem_track_errmsg(t), "striker = -5: must be a sphere id in [0, 1000000]");
     wetdem_track_free(t);
     /* Two resting spheres: no collision, and the message says why. */
     t = wetdem_track_create();
