@@ -202,6 +202,10 @@ static void print_summary(const struct wetdem_track_summary* s, bool json)
             printf("  \"%s\": null%s\n", rows[k].key, sep);
         else if (json)
             printf("  \"%s\": %.*g%s\n", rows[k].key, k == 0 ? 15 : 9, rows[k].value, sep);
+        else if (!isfinite(rows[k].value)) /* (a comment, not "nan", for key = value readers) */
+            printf("# %s not computed: %s\n", rows[k].key,
+                   !strcmp(rows[k].key, "stokes_n") ? "give --radius, --mass and --viscosity"
+                                                    : "not defined for this track");
         else
             printf("%s = %.*g\n", rows[k].key, k == 0 ? 15 : 9, rows[k].value);
     }

@@ -896,6 +896,38 @@ static void test_track_cli_refuses_a_change_that_is_no_collision(void** state)
     CHECK_CONTAINS(out, "e_n = 0.704");
 }
 
+/* The summary never prints "nan": without --radius, --mass and --viscosity the Stokes number
+ * is a comment saying what it needs in the key = value text and null in JSON; with them it is
+ * St_n = m* v_n0 / (6 pi mu R*^2) of two equal spheres (Eq. 2), here from its own speed_n0. */
+static void test_track_cli_summary_has_no_nan(void** state)
+{
+    (void)state;
+    if (!getenv("WETDEM_CLI"))
+        skip();
+    const char* track = "track examples/tracks/punch_45deg.csv --fps 5000 --pixel-size 175e-6";
+    char args[512], out[8192];
+    assert_int_equal(test_run_cli_into(track, out, sizeof out), 0);
+    assert_null(strstr(out, "nan"));
+    CHECK_CONTAINS(out, "# stokes_n not computed: give --radius, --mass and --viscosity\n");
+    snprintf(args, sizeof args, "%s --json", track);
+    assert_int_equal(test_run_cli_into(args, out, sizeof out), 0);
+    assert_null(strstr(out, "nan"));
+    CHECK_CONTAINS(out, "\"stokes_n\": null\n");
+    const double radius = 6.35e-3, mass = 8.4e-3, viscosity = 0.02;
+    snprintf(args, sizeof args, "%s --radius %g --mass %g --viscosity %g", track, radius, mass,
+             viscosity);
+    assert_int_equal(test_run_cli_into(args, out, sizeof out), 0);
+    const char* v = strstr(out, "speed_n0_m_s = ");
+    const char* st = strstr(out, "stokes_n = ");
+    assert_non_null(v);
+    assert_non_null(st);
+    double speed = strtod(v + strlen("speed_n0_m_s = "), NULL);
+    double stokes = strtod(st + strlen("stokes_n = "), NULL);
+    /* (both printed to 9 digits: 1e-8 covers their rounding) */
+    CHECK_REL(stokes, (mass / 2) * speed / (6 * M_PI * viscosity * (radius / 2) * (radius / 2)),
+              1e-8);
+}
+
 /* --frames is written whole or not at all: it was written under its final name, so a write
  * that failed midway (a file size limit of 1 kB; the frames of the example track are some
  * 30 kB) left a cut-off file there, with exit 1. A track that succeeds leaves the whole file
@@ -995,6 +1027,7 @@ int main(void)
         cmocka_unit_test(test_track_rejects_short_or_mismatched_tracks),
         cmocka_unit_test(test_track_cli_exits_2_with_line_number),
         cmocka_unit_test(test_track_cli_refuses_a_change_that_is_no_collision),
+        cmocka_unit_test(test_track_cli_summary_has_no_nan),
         cmocka_unit_test(test_track_cli_writes_frames_whole_or_not_at_all),
         cmocka_unit_test(test_track_cli_frames_through_links_and_devices),
     };
