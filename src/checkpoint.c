@@ -29,6 +29,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "checkpoint.h"
@@ -492,16 +493,31 @@ static int slurp(const char* path, unsigned char** data, size_t* len, char* msg,
     if (!f)
         return wetdem_status_fail(msg, n, WETDEM_ERR_IO, "cannot open checkpoint '%s': %s", path,
                                   strerror(errno));
+    /* (a directory opens for reading; its size is no file's, which read as out of memory) */
+    struct stat st;
+    int err = fstat(fileno(f), &st) != 0 ? errno : (S_ISDIR(st.st_mode) ? EISDIR : 0);
+    if (err) {
+        fclose(f);
+        return wetdem_status_fail(msg, n, WETDEM_ERR_IO, "cannot read checkpoint '%s': %s", path,
+                                  strerror(err));
+    }
     long size = (fseek(f, 0, SEEK_END) == 0) ? ftell(f) : -1;
+    err = size < 0 ? errno : 0;
     *data = size >= 0 ? malloc(size ? (size_t)size : 1) : NULL;
-    bool ok =
-        *data && fseek(f, 0, SEEK_SET) == 0 && fread(*data, 1, (size_t)size, f) == (size_t)size;
+    bool ok = *data && fseek(f, 0, SEEK_SET) == 0 &&
+              (fread(*data, 1, (size_t)size, f) == (size_t)size || ((err = errno), false));
     fclose(f);
     if (!ok) {
+        bool no_memory = size >= 0 && !*data;
         free(*data);
         *data = NULL;
-        return wetdem_status_fail(msg, n, size < 0 ? WETDEM_ERR_IO : WETDEM_ERR_NOMEM,
-                                  "cannot read checkpoint '%s'", path);
+        if (no_memory)
+            return wetdem_status_fail(msg, n, WETDEM_ERR_NOMEM,
+                                      "cannot read checkpoint '%s': out of memory for its %ld "
+                                      "bytes",
+                                      path, size);
+        return wetdem_status_fail(msg, n, WETDEM_ERR_IO, "cannot read checkpoint '%s': %s", path,
+                                  err ? strerror(err) : "read failed");
     }
     *len = (size_t)size;
     return WETDEM_OK;

@@ -252,6 +252,21 @@ static void test_checkpoint_detects_damage(void** state)
     free(d);
 }
 
+/* A path that cannot be read is an I/O error that says why: a directory (it opens for reading
+ * on Linux, and its size read as an allocation of unknown size, WETDEM_ERR_NOMEM, without a
+ * reason) and a missing file. */
+static void test_checkpoint_unreadable_path_says_why(void** state)
+{
+    (void)state;
+    struct wetdem_checkpoint ck;
+    char msg[256] = "";
+    assert_int_equal(wetdem_checkpoint_read("/tmp", &ck, msg, sizeof msg), WETDEM_ERR_IO);
+    CHECK_CONTAINS(msg, "cannot read checkpoint '/tmp': Is a directory");
+    assert_int_equal(wetdem_checkpoint_read("/nonexistent/ck.bin", &ck, msg, sizeof msg),
+                     WETDEM_ERR_IO);
+    CHECK_CONTAINS(msg, "No such file or directory");
+}
+
 static void test_checkpoint_failed_write_keeps_the_old_file(void** state)
 {
     struct fixture* f = *state;
@@ -301,6 +316,7 @@ static void test_checkpoint_checksums_match_reference_values(void** state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_checkpoint_unreadable_path_says_why),
         cmocka_unit_test_setup_teardown(test_checkpoint_round_trip_is_exact, setup, teardown),
         cmocka_unit_test_setup_teardown(test_checkpoint_restored_rng_continues_the_sequence, setup,
                                         teardown),
