@@ -439,11 +439,14 @@ static int compare_doubles(const void* a, const void* b)
  * < 0 (a well). 0 beyond the range; NAN if a model fails or the history is too long. The
  * integral is taken piecewise between the branch gaps of the force laws (their thresholds,
  * h_min and contact at 0), where a force may jump, by fixed Gauss-Legendre quadrature (GSL),
- * which needs no error handler and so is safe in parallel collisions. */
-static double stored_energy(const struct wetdem_sim* sim)
+ * which needs no error handler and so is safe in parallel collisions. Into *energy (NAN when
+ * the pair's history does not fit the scratch space); WETDEM_OK, or WETDEM_ERR_NOMEM with the
+ * message set when the quadrature table cannot be allocated. */
+static int stored_energy(struct wetdem_sim* sim, double* energy)
 {
+    *energy = NAN;
     if (sim->history_len > WETDEM_HISTORY_SCRATCH)
-        return NAN;
+        return WETDEM_OK;
     /* the pair of particle 0 and its partner in the engine's list, which holds every pair
        once a run has begun; before, the pair is fresh */
     const struct wetdem_pairs* pl = &sim->engine.pairs;
@@ -461,8 +464,9 @@ static double stored_energy(const struct wetdem_sim* sim)
         wetdem_sim_history_init(sim, scratch);
         c.h_min = sim->minsep.model->min_separation(sim->minsep.params, &c, scratch);
     }
+    *energy = 0.0;
     if (!(c.gap < range))
-        return 0.0;
+        return WETDEM_OK;
     double cuts[WETDEM_MAX_MODELS * WETDEM_MAX_THRESHOLDS + 5], gaps[WETDEM_MAX_THRESHOLDS];
     size_t n = 0;
     cuts[n++] = c.gap;
@@ -485,8 +489,8 @@ static double stored_energy(const struct wetdem_sim* sim)
         gsl_integration_glfixed_table_alloc(STORED_ENERGY_POINTS);
     wetdem_gsl_guard_leave();
     if (!table)
-        return NAN;
-    double energy = 0.0;
+        return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM,
+                               "collision: out of memory for the quadrature of the stored energy");
     for (size_t q = 0; q + 1 < n; q++) {
         double a = cuts[q], b = cuts[q + 1];
         if (!(a >= c.gap && b <= range && b > a))
@@ -494,11 +498,11 @@ static double stored_energy(const struct wetdem_sim* sim)
         for (size_t p = 0; p < STORED_ENERGY_POINTS; p++) {
             double x, w;
             gsl_integration_glfixed_point(a, b, p, &x, &w, table);
-            energy += w * wetdem_sim_force_at_rest(sim, c, history, x); /* (NAN on failure) */
+            *energy += w * wetdem_sim_force_at_rest(sim, c, history, x); /* (NAN on failure) */
         }
     }
     gsl_integration_glfixed_table_free(table);
-    return energy;
+    return WETDEM_OK;
 }
 
 /* Contact time, contact/h_min flags and the last interaction end, from the event log. */
@@ -563,9 +567,11 @@ static void restitution(const struct wetdem_sim* sim, const struct initial* in,
     }
 }
 
-static void analyse(const struct wetdem_sim* sim, const struct setup* su, const struct initial* in,
-                    const struct tracker* tr, bool separated, bool start_in_contact,
-                    struct wetdem_collision_result* r)
+/* The result of a run that ended (separated or at t_end). WETDEM_OK, or WETDEM_ERR_NOMEM
+ * (stored_energy). */
+static int analyse(struct wetdem_sim* sim, const struct setup* su, const struct initial* in,
+                   const struct tracker* tr, bool separated, bool start_in_contact,
+                   struct wetdem_collision_result* r)
 {
     double mu = sim->fluid.viscosity;
     r->speed_n0 = su->speed_n0;
@@ -586,8 +592,13 @@ static void analyse(const struct wetdem_sim* sim, const struct setup* su, const 
         tr->interacting ? (separated ? t_last_end : sim->engine.time) - tr->t_first : 0.0;
     double g = fabs(sim->settings.gravity_x) + fabs(sim->settings.gravity_y) +
                fabs(sim->settings.gravity_z);
-    double e0 = in->energy + in->stored;
-    r->energy_ratio = e0 > 0 && g == 0 ? (collision_energy(sim) + stored_energy(sim)) / e0 : NAN;
+    double e0 = in->energy + in->stored, stored = NAN;
+    if (e0 > 0 && g == 0) {
+        int st = stored_energy(sim, &stored);
+        if (st != WETDEM_OK)
+            return st;
+    }
+    r->energy_ratio = e0 > 0 && g == 0 ? (collision_energy(sim) + stored) / e0 : NAN;
     r->rotation_angle = tr->rotation;
     r->rotation_close = tr->rotation_close;
     r->close_gap = su->h_close;
@@ -598,6 +609,7 @@ static void analyse(const struct wetdem_sim* sim, const struct setup* su, const 
     else
         r->outcome = WETDEM_OUTCOME_BOUNCE;
     r->stats = wetdem_sim_stats(sim);
+    return WETDEM_OK;
 }
 
 int wetdem_collision_run(struct wetdem_sim* sim, const struct wetdem_collision_spec* spec,
@@ -628,11 +640,11 @@ int wetdem_collision_run(struct wetdem_sim* sim, const struct wetdem_collision_s
                                "kinetic energy %g J underflows, so e and energy_ratio would be "
                                "0/0; give a larger speed",
                                spec->speed, in.energy);
-    in.stored = stored_energy(sim);
+    if ((st = stored_energy(sim, &in.stored)) != WETDEM_OK)
+        return st;
     bool in_contact = tr.gap_prev < 0;
     st = run(sim, spec, &tr);
     if (st < 0)
         return st;
-    analyse(sim, &su, &in, &tr, st == WETDEM_EVENT, in_contact, result);
-    return WETDEM_OK;
+    return analyse(sim, &su, &in, &tr, st == WETDEM_EVENT, in_contact, result);
 }
