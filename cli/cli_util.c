@@ -144,6 +144,11 @@ double cli_range_value(const struct cli_range* r, size_t k)
     return r->first + (r->last - r->first) * s;
 }
 
+int cli_setup_exit(int status)
+{
+    return status == WETDEM_ERR_NOMEM ? CLI_EXIT_RUNTIME : CLI_EXIT_USAGE;
+}
+
 int cli_apply_set(struct wetdem_sim* sim, const char* key_value)
 {
     const char* eq = strchr(key_value, '=');

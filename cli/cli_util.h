@@ -53,6 +53,11 @@ int cli_parse_range(const char* text, bool is_log, const char* what, struct cli_
 /* The k-th value (0 <= k < r->n) of a parsed range; the end points are returned exactly. */
 double cli_range_value(const struct cli_range* r, size_t k);
 
+/* The exit code of a library call that set up a run from the user's input and failed with
+ * `status`: CLI_EXIT_RUNTIME when it ran out of memory (WETDEM_ERR_NOMEM), which is no fault
+ * of the input, CLI_EXIT_USAGE for every other failure. */
+int cli_setup_exit(int status);
+
 /* Applies "KEY=VALUE" to sim through wetdem_sim_set_param_str (so enumerated parameters may
  * be given by word). Returns CLI_EXIT_OK, or prints "wetdem: --set KEY=VALUE: <library
  * message>" and returns CLI_EXIT_USAGE. */

@@ -171,7 +171,7 @@ static int build_sim(struct wetdem_sim* sim, const struct forces_opts* o)
     int mat = wetdem_sim_add_material_preset(sim, o->preset);
     if (mat < 0) {
         cli_error("forces: --preset: %s", wetdem_sim_errmsg(sim));
-        return CLI_EXIT_USAGE;
+        return cli_setup_exit(mat);
     }
     if (o->fluid) {
         struct wetdem_fluid fl;
@@ -188,15 +188,17 @@ static int build_sim(struct wetdem_sim* sim, const struct forces_opts* o)
                                  .radius = o->radius,
                                  .material = mat};
     struct wetdem_particle pj = {.radius = o->radius, .material = mat};
-    if (wetdem_sim_add_particle(sim, pi) != WETDEM_OK ||
-        wetdem_sim_add_particle(sim, pj) != WETDEM_OK) {
+    int st = wetdem_sim_add_particle(sim, pi);
+    if (st == WETDEM_OK)
+        st = wetdem_sim_add_particle(sim, pj);
+    if (st != WETDEM_OK) {
         cli_error("forces: %s", wetdem_sim_errmsg(sim));
-        return CLI_EXIT_USAGE;
+        return cli_setup_exit(st);
     }
     for (size_t k = 0; k < o->n_models; k++)
-        if (wetdem_sim_enable_model(sim, o->models[k]) != WETDEM_OK) {
+        if ((st = wetdem_sim_enable_model(sim, o->models[k])) != WETDEM_OK) {
             cli_error("forces: --model %s: %s", o->models[k], wetdem_sim_errmsg(sim));
-            return CLI_EXIT_USAGE;
+            return cli_setup_exit(st);
         }
     for (size_t k = 0; k < o->n_sets; k++) {
         int rc = cli_apply_set(sim, o->sets[k]);

@@ -639,8 +639,9 @@ struct plan {
  * lists, periodic box, reach). Fills the run length and the default output intervals. */
 static int dry_start(const struct cli_scenario* sc, struct cli_many_setup* su, struct plan* pl)
 {
-    if (wetdem_sim_integrate(su->sim, wetdem_sim_time(su->sim)) != WETDEM_OK)
-        return cli_many_report_start(sc, wetdem_sim_errmsg(su->sim));
+    int st = wetdem_sim_integrate(su->sim, wetdem_sim_time(su->sim));
+    if (st != WETDEM_OK)
+        return cli_many_report_start(sc, st, wetdem_sim_errmsg(su->sim));
     struct wetdem_many_stats s;
     wetdem_sim_many_stats(su->sim, &s);
     warn_step(sc, su, &s);

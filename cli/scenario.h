@@ -211,9 +211,10 @@ int cli_scenario_check_trajectory(const struct cli_scenario* sc, const char* run
                                   double t_end, double interval);
 
 /* Prints the library's message of sim against entry e (or against [section] when e is NULL)
- * and returns CLI_EXIT_USAGE. */
+ * and returns the exit code of the library's status: CLI_EXIT_RUNTIME for WETDEM_ERR_NOMEM
+ * (running out of memory is no fault of the input), CLI_EXIT_USAGE otherwise. */
 int cli_scenario_lib_error(const struct cli_scenario* sc, const struct cli_entry* e,
-                           const char* section, const struct wetdem_sim* sim);
+                           const char* section, const struct wetdem_sim* sim, int status);
 /* [fluid]: the preset, then every field given, set on sim. Returns an exit code. */
 int cli_scenario_build_fluid(const struct cli_scenario* sc, struct wetdem_sim* sim);
 /* A [material.NAME] section into *m: the library defaults, then its preset, then every field

@@ -30,13 +30,13 @@ double cli_stokes_speed(double stokes_n, double viscosity, double m_eff, double 
 }
 
 int cli_scenario_lib_error(const struct cli_scenario* sc, const struct cli_entry* e,
-                           const char* section, const struct wetdem_sim* sim)
+                           const char* section, const struct wetdem_sim* sim, int status)
 {
     if (e)
         cli_scenario_error(sc, e, "%s", wetdem_sim_errmsg(sim));
     else
         cli_scenario_section_error(sc, section, "%s", wetdem_sim_errmsg(sim));
-    return CLI_EXIT_USAGE;
+    return cli_setup_exit(status);
 }
 
 int cli_scenario_build_fluid(const struct cli_scenario* sc, struct wetdem_sim* sim)
@@ -53,8 +53,9 @@ int cli_scenario_build_fluid(const struct cli_scenario* sc, struct wetdem_sim* s
         if (e)
             *(double*)((char*)&f + d[k].offset) = strtod(e->value, NULL);
     }
-    if (wetdem_sim_set_fluid(sim, &f) != WETDEM_OK)
-        return cli_scenario_lib_error(sc, NULL, "fluid", sim);
+    int st = wetdem_sim_set_fluid(sim, &f);
+    if (st != WETDEM_OK)
+        return cli_scenario_lib_error(sc, NULL, "fluid", sim, st);
     return CLI_EXIT_OK;
 }
 
@@ -131,8 +132,9 @@ int cli_scenario_set_model_params(const struct cli_scenario* sc, struct wetdem_s
                                p->section + 6);
             return CLI_EXIT_USAGE;
         }
-        if (wetdem_sim_set_param_str(sim, name, p->value) != WETDEM_OK)
-            return cli_scenario_lib_error(sc, p, p->section, sim);
+        int st = wetdem_sim_set_param_str(sim, name, p->value);
+        if (st != WETDEM_OK)
+            return cli_scenario_lib_error(sc, p, p->section, sim, st);
     }
     return CLI_EXIT_OK;
 }
@@ -188,10 +190,10 @@ static int build_materials(const struct cli_scenario* sc, struct cli_setup* su,
         return rc;
     int ki = wetdem_sim_add_material(su->sim, mi);
     if (ki < 0)
-        return cli_scenario_lib_error(sc, ei, "collision", su->sim);
+        return cli_scenario_lib_error(sc, ei, "collision", su->sim, ki);
     int kj = ki;
     if (strcmp(si, sj) != 0 && (kj = wetdem_sim_add_material(su->sim, mj)) < 0)
-        return cli_scenario_lib_error(sc, ej, "collision", su->sim);
+        return cli_scenario_lib_error(sc, ej, "collision", su->sim, kj);
     su->spec.material_i = ki;
     su->spec.material_j = kj;
     return CLI_EXIT_OK;
@@ -212,8 +214,9 @@ static int enable_forces(const struct cli_scenario* sc, struct wetdem_sim* sim)
                                tok, tok);
             return CLI_EXIT_USAGE;
         }
-        if (wetdem_sim_enable_model(sim, tok) != WETDEM_OK)
-            return cli_scenario_lib_error(sc, e, "models", sim);
+        int st = wetdem_sim_enable_model(sim, tok);
+        if (st != WETDEM_OK)
+            return cli_scenario_lib_error(sc, e, "models", sim, st);
     }
     return CLI_EXIT_OK;
 }
@@ -230,8 +233,9 @@ int cli_scenario_enable_min_separation(const struct cli_scenario* sc, struct wet
                            cli_article(kind), kind);
         return CLI_EXIT_USAGE;
     }
-    if (wetdem_sim_enable_model(sim, e->value) != WETDEM_OK)
-        return cli_scenario_lib_error(sc, e, "models", sim);
+    int st = wetdem_sim_enable_model(sim, e->value);
+    if (st != WETDEM_OK)
+        return cli_scenario_lib_error(sc, e, "models", sim, st);
     return CLI_EXIT_OK;
 }
 
@@ -295,10 +299,11 @@ static int build_integrator(const struct cli_scenario* sc, struct wetdem_sim* si
         if (is_integrator && wetdem_sim_param(sim, full, &current) == WETDEM_ERR_NOT_FOUND &&
             other_integrator_has(name, p->key))
             continue; /* a parameter of the integrator not chosen (e.g. --set name=verlet) */
-        if (wetdem_sim_set_param_str(sim, full, p->value) != WETDEM_OK)
+        int st = wetdem_sim_set_param_str(sim, full, p->value);
+        if (st != WETDEM_OK)
             return cli_scenario_integrator_name_typo(sc, p) != CLI_EXIT_OK
                        ? CLI_EXIT_USAGE
-                       : cli_scenario_lib_error(sc, p, p->section, sim);
+                       : cli_scenario_lib_error(sc, p, p->section, sim, st);
     }
     return CLI_EXIT_OK;
 }

@@ -253,8 +253,9 @@ static int build_models(const struct cli_scenario* sc, struct wetdem_sim* sim)
                                tok, cli_article(kind), kind);
             return CLI_EXIT_USAGE;
         }
-        if (wetdem_sim_enable_model(sim, tok) != WETDEM_OK)
-            return cli_scenario_lib_error(sc, e, "models", sim);
+        int st = wetdem_sim_enable_model(sim, tok);
+        if (st != WETDEM_OK)
+            return cli_scenario_lib_error(sc, e, "models", sim, st);
     }
     int rc = cli_scenario_enable_min_separation(sc, sim);
     return rc == CLI_EXIT_OK ? cli_scenario_set_model_params(sc, sim) : rc;
@@ -278,10 +279,11 @@ static int build_settings(const struct cli_scenario* sc, struct wetdem_sim* sim)
             continue;
         char full[2 * CLI_NAME_MAX];
         snprintf(full, sizeof full, "%s.%s", integ ? "verlet" : "sim", p->key);
-        if (wetdem_sim_set_param_str(sim, full, p->value) != WETDEM_OK)
+        int st = wetdem_sim_set_param_str(sim, full, p->value);
+        if (st != WETDEM_OK)
             return cli_scenario_integrator_name_typo(sc, p) != CLI_EXIT_OK
                        ? CLI_EXIT_USAGE
-                       : cli_scenario_lib_error(sc, p, p->section, sim);
+                       : cli_scenario_lib_error(sc, p, p->section, sim, st);
     }
     return CLI_EXIT_OK;
 }
@@ -327,7 +329,7 @@ static int material_index_at(const struct cli_scenario* sc, struct cli_many_setu
     }
     *index = wetdem_sim_add_material(su->sim, &m);
     if (*index < 0)
-        return cli_scenario_lib_error(sc, use, section, su->sim);
+        return cli_scenario_lib_error(sc, use, section, su->sim, *index);
     snprintf(su->material_names[*index], sizeof su->material_names[0], "%s", name);
     return CLI_EXIT_OK;
 }
@@ -430,11 +432,11 @@ static int build_walls(const struct cli_scenario* sc, struct cli_many_setup* su,
         double point[3] = {0, 0, 0}, normal[3] = {0, 0, 0};
         point[f / 2] = (f % 2) ? su->box[f / 2] : 0.0;
         normal[f / 2] = (f % 2) ? -1.0 : 1.0;
-        if (wetdem_sim_add_wall(su->sim, (struct wetdem_vec3){point[0], point[1], point[2]},
-                                (struct wetdem_vec3){normal[0], normal[1], normal[2]},
-                                mat) != WETDEM_OK)
+        int st = wetdem_sim_add_wall(su->sim, (struct wetdem_vec3){point[0], point[1], point[2]},
+                                     (struct wetdem_vec3){normal[0], normal[1], normal[2]}, mat);
+        if (st != WETDEM_OK)
             return cli_scenario_lib_error(sc, cli_scenario_find(sc, "walls", "faces"), "walls",
-                                          su->sim);
+                                          su->sim, st);
     }
     return CLI_EXIT_OK;
 }
@@ -593,8 +595,9 @@ static int build_particle(const struct cli_scenario* sc, struct cli_many_setup* 
                             &p.material);
     if (rc != CLI_EXIT_OK)
         return rc;
-    if (wetdem_sim_add_particle(su->sim, p) != WETDEM_OK)
-        return cli_scenario_lib_error(sc, NULL, section, su->sim);
+    int st = wetdem_sim_add_particle(su->sim, p);
+    if (st != WETDEM_OK)
+        return cli_scenario_lib_error(sc, NULL, section, su->sim, st);
     return CLI_EXIT_OK;
 }
 
@@ -711,8 +714,9 @@ static int build_sphere_file(const struct cli_scenario* sc, struct cli_many_setu
                                             .radius = p[k].radius,
                                             .material = p[k].material,
                                             .is_fixed = true};
-        if (wetdem_sim_add_particle(su->sim, p[k]) != WETDEM_OK)
-            rc = cli_scenario_lib_error(sc, e, section, su->sim);
+        int st = wetdem_sim_add_particle(su->sim, p[k]);
+        if (st != WETDEM_OK)
+            rc = cli_scenario_lib_error(sc, e, section, su->sim, st);
     }
     free(p);
     return rc;
@@ -953,8 +957,12 @@ static const struct cli_entry* named_entry(const struct cli_scenario* sc, const 
     return NULL;
 }
 
-int cli_many_report_start(const struct cli_scenario* sc, const char* msg)
+int cli_many_report_start(const struct cli_scenario* sc, int status, const char* msg)
 {
+    if (status == WETDEM_ERR_NOMEM) { /* (no fault of the set-up: no key to point at) */
+        cli_error("%s: %s", sc->file, msg);
+        return CLI_EXIT_RUNTIME;
+    }
     const struct cli_entry* e = named_entry(sc, msg);
     if (e) {
         cli_scenario_error(sc, e, "%s", msg);
@@ -1000,8 +1008,9 @@ int cli_many_build(const struct cli_scenario* sc, struct cli_many_setup* su)
         cli_many_setup_free(su);
         return rc;
     }
-    if (wetdem_sim_set_many(su->sim, &su->many) != WETDEM_OK) {
-        rc = cli_many_report_start(sc, wetdem_sim_errmsg(su->sim));
+    int st = wetdem_sim_set_many(su->sim, &su->many);
+    if (st != WETDEM_OK) {
+        rc = cli_many_report_start(sc, st, wetdem_sim_errmsg(su->sim));
         cli_many_setup_free(su);
     }
     return rc;

@@ -42,7 +42,8 @@ int cli_many_build(const struct cli_scenario* sc, struct cli_many_setup* su);
 /* Frees the simulation of a setup. */
 void cli_many_setup_free(struct cli_many_setup* su);
 /* Reports a library message about the run set-up at [box] (periodic box, cell list) or
- * [run] (time step, reach) with the scenario's file and line. Returns CLI_EXIT_USAGE. */
-int cli_many_report_start(const struct cli_scenario* sc, const char* msg);
+ * [run] (time step, reach) with the scenario's file and line, and returns CLI_EXIT_USAGE;
+ * when the library's status is WETDEM_ERR_NOMEM, with the file only, CLI_EXIT_RUNTIME. */
+int cli_many_report_start(const struct cli_scenario* sc, int status, const char* msg);
 
 #endif
