@@ -275,6 +275,8 @@ static int read_data(const char* path, struct point** out, size_t* n_out)
     struct point* pts = calloc(MAX_POINTS, sizeof *pts);
     char buf[4096], *f[64];
     int col[N_COLS], rc = pts ? CLI_EXIT_OK : CLI_EXIT_RUNTIME;
+    if (!pts)
+        cli_error("fit: out of memory for the data of %s", path);
     bool have_header = false;
     int n_header = 0;
     size_t n = 0;
@@ -323,7 +325,8 @@ static int read_data(const char* path, struct point** out, size_t* n_out)
 /* ---- simulation of the measurements ------------------------------------------------------- */
 
 /* Builds the set-up of one point: the base scenario with the point's Stokes number and angle
- * and the parameter values. Returns an exit code (the builder prints its errors). */
+ * and the parameter values. Returns an exit code (the builder prints its errors):
+ * CLI_EXIT_USAGE when the scenario rejects the point, CLI_EXIT_RUNTIME when out of memory. */
 static int build_point(const struct fit_ctx* c, const double* params, const struct point* p,
                        struct cli_setup* su)
 {
@@ -404,7 +407,8 @@ static int first_failure(const struct fit_ctx* c, const struct point* pts, size_
 }
 
 /* Simulates n points with the given parameters into e_n[] and omega[] (|omega_i|). A point
- * the scenario rejects (the builder printed why) gives WETDEM_ERR_INVALID. */
+ * the scenario rejects (the builder printed why) gives WETDEM_ERR_INVALID; running out of
+ * memory WETDEM_ERR_NOMEM, with the message in msg as for every failure. */
 static int simulate(const struct fit_ctx* c, const double* params, const struct point* pts,
                     size_t n, double* e_n, double* omega, char* msg, size_t msg_size)
 {
@@ -412,16 +416,23 @@ static int simulate(const struct fit_ctx* c, const double* params, const struct 
     int* status = calloc(n, sizeof *status);
     struct wetdem_collision_result* res = calloc(n, sizeof *res);
     int st = (su && status && res) ? WETDEM_OK : WETDEM_ERR_NOMEM;
+    if (st != WETDEM_OK)
+        snprintf(msg, msg_size, "out of memory for %zu collisions", n);
     size_t built = 0;
-    for (; st == WETDEM_OK && built < n; built++)
-        if (build_point(c, params, &pts[built], &su[built]) != CLI_EXIT_OK) {
-            char where[1200], values[600];
-            point_where(c, &pts[built], where, sizeof where);
-            param_values(c, params, values, sizeof values);
-            st = WETDEM_ERR_INVALID;
+    for (; st == WETDEM_OK && built < n; built++) {
+        int rc = build_point(c, params, &pts[built], &su[built]);
+        if (rc == CLI_EXIT_OK)
+            continue;
+        char where[1200], values[600];
+        point_where(c, &pts[built], where, sizeof where);
+        param_values(c, params, values, sizeof values);
+        st = rc == CLI_EXIT_RUNTIME ? WETDEM_ERR_NOMEM : WETDEM_ERR_INVALID;
+        if (st == WETDEM_ERR_NOMEM)
+            snprintf(msg, msg_size, "out of memory setting up %s (the message above)", where);
+        else
             snprintf(msg, msg_size, "the scenario rejects %s with %s (the message above)", where,
                      values);
-        }
+    }
     if (st == WETDEM_OK) {
 #pragma omp parallel for schedule(dynamic, 1)
         for (size_t k = 0; k < n; k++) {
@@ -449,8 +460,10 @@ static int fit_model(const double* params, double* predicted, char* msg, size_t 
 {
     const struct fit_ctx* c = ctx;
     double* omega = malloc(c->n_pts * sizeof *omega);
-    if (!omega)
+    if (!omega) {
+        snprintf(msg, msg_size, "out of memory for %zu spins", c->n_pts);
         return WETDEM_ERR_NOMEM;
+    }
     int st = simulate(c, params, c->pts, c->n_pts, predicted, omega, msg, msg_size);
     if (st == WETDEM_OK && c->use_omega)
         memcpy(predicted + c->n_pts, omega, c->n_pts * sizeof *omega);
@@ -799,6 +812,8 @@ static int check_points(const struct fit_ctx* c, const double* init)
             cli_setup_free(&su);
             continue;
         }
+        if (rc == CLI_EXIT_RUNTIME) /* (out of memory: the builder said so) */
+            return rc;
         char where[1200], values[600];
         point_where(c, &c->pts[k], where, sizeof where);
         param_values(c, init, values, sizeof values);
@@ -814,17 +829,26 @@ static int check_points(const struct fit_ctx* c, const double* init)
 static const char* const converged_words[] = {"no", "small step", "small gradient",
                                               "small cost change"};
 
-/* Root mean square and largest magnitude of residuals r[0..n), and the index of the latter. */
-static void residual_stats(const double* r, size_t n, double* rms, double* max, size_t* at)
+/* The residual (fit - data) of point i: of e_n (part 0) or of the spin (part 1). */
+static double residual(const struct fit_ctx* c, const double* pred, size_t part, size_t i)
+{
+    return part ? pred[c->n_pts + i] - c->pts[i].omega : pred[i] - c->pts[i].e_n;
+}
+
+/* Root mean square and largest magnitude of the residuals of a part, and the index of the
+ * latter. */
+static void residual_stats(const struct fit_ctx* c, const double* pred, size_t part, double* rms,
+                           double* max, size_t* at)
 {
     double s = 0;
     *max = 0, *at = 0;
-    for (size_t i = 0; i < n; i++) {
-        s += r[i] * r[i];
-        if (fabs(r[i]) > *max)
-            *max = fabs(r[i]), *at = i;
+    for (size_t i = 0; i < c->n_pts; i++) {
+        double r = residual(c, pred, part, i);
+        s += r * r;
+        if (fabs(r) > *max)
+            *max = fabs(r), *at = i;
     }
-    *rms = n ? sqrt(s / (double)n) : 0;
+    *rms = c->n_pts ? sqrt(s / (double)c->n_pts) : 0;
 }
 
 static const char* const transform_words[] = {"linear", "log", "log-upper", "logistic"};
@@ -870,24 +894,21 @@ static void print_result(const struct fit_ctx* c, const double* init, const doub
            c->use_omega ? " (spin residuals in units of --omega-scale)" : " (e_n)", r->dof,
            r->iterations, r->model_evals, c->n_pts, converged_words[by],
            status == WETDEM_ERR_UNDETERMINED ? " (not a fit: a key is not determined)" : "");
-    double* res = malloc(c->n_pts * sizeof *res);
-    for (size_t part = 0; res && part < (c->use_omega ? 2u : 1u); part++) {
-        for (size_t i = 0; i < c->n_pts; i++)
-            res[i] = part ? pred[c->n_pts + i] - c->pts[i].omega : pred[i] - c->pts[i].e_n;
+    for (size_t part = 0; part < (c->use_omega ? 2u : 1u); part++) {
         double rms, max;
         size_t at;
-        residual_stats(res, c->n_pts, &rms, &max, &at);
+        residual_stats(c, pred, part, &rms, &max, &at);
         const char* unit = part ? "rad/s" : "-";
         char angle[64] = ""; /* (rows of several angles may share a Stokes number) */
         if (c->pts[at].has_angle)
             snprintf(angle, sizeof angle, ", angle_deg = %g", c->pts[at].angle_deg);
         printf("# residuals %s (fit - data): rms %.3g [%s], largest %.3g [%s] at St_n = %g%s\n",
-               part ? "omega" : "e_n", rms, unit, res[at], unit, c->pts[at].stokes, angle);
+               part ? "omega" : "e_n", rms, unit, residual(c, pred, part, at), unit,
+               c->pts[at].stokes, angle);
     }
     if (c->use_omega)
         printf("# spin residuals weighed as e_n residuals times %g rad/s (--omega-scale)\n",
                omega_scale);
-    free(res);
     for (size_t j = 0; j < c->n_keys && c->n_keys > 1; j++) {
         printf("# correlation %s:", c->keys[j]);
         for (size_t k = 0; k < c->n_keys; k++)
