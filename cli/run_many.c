@@ -264,17 +264,26 @@ static int series_resume(struct series* s, double t, unsigned long long step, do
 
 /* ----------------------------------------------------------- CSV: last row, restart --- */
 
-/* Appends the state at the end of the run (finished or interrupted) to the CSV as its last
- * row (wetdem_sim_many_write_csv_row), unless the library's rows, every csv_every steps, ended
- * there, so the CSV ends at the state summary.json reports. WETDEM status. */
+/* Appends the state at the end of the run (finished or interrupted), at `step`, to the CSV
+ * as its last row (wetdem_sim_many_write_csv_row), unless the library's rows, every csv_every
+ * steps, ended there, so the CSV ends at the state summary.json reports. WETDEM status. */
 static int csv_final_row(const char* csv_prefix, unsigned long long csv_every,
-                         struct wetdem_sim* sim)
+                         struct wetdem_sim* sim, unsigned long long step)
 {
-    struct wetdem_many_stats s;
-    if (!csv_prefix[0] || !csv_every || wetdem_sim_many_stats(sim, &s) != WETDEM_OK ||
-        s.step % csv_every == 0)
+    if (!csv_prefix[0] || !csv_every || step % csv_every == 0)
         return WETDEM_OK;
     return wetdem_sim_many_write_csv_row(sim);
+}
+
+/* wetdem_sim_many_stats, which allocates (for the agglomerates): CLI_EXIT_OK, or
+ * CLI_EXIT_RUNTIME after printing the library's message. */
+static int many_stats(const struct cli_scenario* sc, struct wetdem_sim* sim,
+                      struct wetdem_many_stats* s)
+{
+    if (wetdem_sim_many_stats(sim, s) == WETDEM_OK)
+        return CLI_EXIT_OK;
+    cli_error("run %s: %s", sc->file, wetdem_sim_errmsg(sim));
+    return CLI_EXIT_RUNTIME;
 }
 
 /* Keeps the comment and header lines of the CSV and the rows up to `step` (second column),
@@ -643,7 +652,9 @@ static int dry_start(const struct cli_scenario* sc, struct cli_many_setup* su, s
     if (st != WETDEM_OK)
         return cli_many_report_start(sc, st, wetdem_sim_errmsg(su->sim));
     struct wetdem_many_stats s;
-    wetdem_sim_many_stats(su->sim, &s);
+    int rc = many_stats(sc, su->sim, &s);
+    if (rc != CLI_EXIT_OK)
+        return rc;
     warn_step(sc, su, &s);
     pl->dt = s.dt;
     /* the library takes ceil((t_end - t)/dt) steps on the grid t = k dt */
@@ -700,15 +711,17 @@ static void print_check_json(const struct cli_scenario* sc, const struct cli_man
             printf("\"%s\": null%s", key[k], k < 2 ? ", " : "}\n");
 }
 
-static void print_check(const struct cli_scenario* sc, const struct cli_many_setup* su,
-                        const struct plan* pl, const struct cli_run_options* opt)
+/* The resolved set-up of `run --check`. CLI exit code. */
+static int print_check(const struct cli_scenario* sc, const struct cli_many_setup* su,
+                       const struct plan* pl, const struct cli_run_options* opt)
 {
     struct wetdem_many_stats s;
-    wetdem_sim_many_stats(su->sim, &s);
+    if (many_stats(sc, su->sim, &s) != CLI_EXIT_OK)
+        return CLI_EXIT_RUNTIME;
     bool opt_restart = opt->restart != NULL;
     if (opt->json) {
         print_check_json(sc, su, pl, &s);
-        return;
+        return CLI_EXIT_OK;
     }
     printf("scenario %s is valid (many-particle run)\n", sc->file);
     size_t fixed = n_fixed(su);
@@ -747,6 +760,7 @@ static void print_check(const struct cli_scenario* sc, const struct cli_many_set
         printf(" %d %s%s", k, su->material_names[k],
                k + 1 < wetdem_sim_n_materials(su->sim) ? "," : "");
     printf("\n");
+    return CLI_EXIT_OK;
 }
 
 /* Sets the mode again with the outputs of --out DIR and the stop flag. */
@@ -769,12 +783,15 @@ static int set_outputs(struct cli_many_setup* su, const struct cli_run_options* 
     m.progress = on_progress;
     m.progress_ctx = prog;
     m.progress_every = 1;
-    return wetdem_sim_set_many(su->sim, &m) == WETDEM_OK ? CLI_EXIT_OK : CLI_EXIT_RUNTIME;
+    if (wetdem_sim_set_many(su->sim, &m) == WETDEM_OK)
+        return CLI_EXIT_OK;
+    cli_error("run: %s", wetdem_sim_errmsg(su->sim));
+    return CLI_EXIT_RUNTIME;
 }
 
 /* Restores the checkpoint and checks that this run can continue it; touches no file. */
-static int restore(const struct cli_many_setup* su, const struct cli_run_options* opt,
-                   const struct plan* pl)
+static int restore(const struct cli_scenario* sc, const struct cli_many_setup* su,
+                   const struct cli_run_options* opt, const struct plan* pl)
 {
     size_t n_scenario = wetdem_sim_n_particles(su->sim);
     if (wetdem_sim_read_checkpoint(su->sim, opt->restart) != WETDEM_OK) {
@@ -804,7 +821,8 @@ static int restore(const struct cli_many_setup* su, const struct cli_run_options
         return CLI_EXIT_USAGE;
     }
     struct wetdem_many_stats s;
-    wetdem_sim_many_stats(su->sim, &s);
+    if (many_stats(sc, su->sim, &s) != CLI_EXIT_OK)
+        return CLI_EXIT_RUNTIME;
     /* the step is the checkpoint's; one the scenario now derives otherwise ([integrator]
        dt_fraction, a material's stiffness: not in the checkpoint's fingerprint, which holds
        the settings' dt) would misplace the run's end, its frames and its CSV rows */
@@ -827,14 +845,15 @@ static int restore(const struct cli_many_setup* su, const struct cli_run_options
 }
 
 /* Restores the checkpoint and trims the outputs after it. */
-static int resume(const struct cli_many_setup* su, const struct cli_run_options* opt,
-                  const struct plan* pl, struct series* vtk)
+static int resume(const struct cli_scenario* sc, const struct cli_many_setup* su,
+                  const struct cli_run_options* opt, const struct plan* pl, struct series* vtk)
 {
-    int rc = restore(su, opt, pl);
+    int rc = restore(sc, su, opt, pl);
     if (rc != CLI_EXIT_OK)
         return rc;
     struct wetdem_many_stats s;
-    wetdem_sim_many_stats(su->sim, &s);
+    if (many_stats(sc, su->sim, &s) != CLI_EXIT_OK)
+        return CLI_EXIT_RUNTIME;
     /* the index first: it refuses without touching a file, the CSV's trim rewrites one */
     rc = vtk ? series_resume(vtk, wetdem_sim_time(su->sim), s.step, pl->dt, su->vtk_every)
              : CLI_EXIT_OK;
@@ -862,10 +881,12 @@ static int finish(const struct cli_scenario* sc, struct cli_many_setup* su,
     /* (after the failures: a query refused, as the budget of a run without one, leaves its
        message in place of theirs) */
     struct outcome o = {.wall = wall, .interrupted = st == WETDEM_EVENT};
-    wetdem_sim_many_stats(su->sim, &o.stats);
+    if (many_stats(sc, su->sim, &o.stats) != CLI_EXIT_OK)
+        return CLI_EXIT_RUNTIME;
     o.has_budget = wetdem_sim_energy_budget(su->sim, &o.budget) == WETDEM_OK;
-    if (csv_final_row(pl->csv_prefix, su->csv_every, su->sim) != WETDEM_OK) {
-        cli_error("run %s: cannot append the last row to %s.csv", sc->file, pl->csv_prefix);
+    if (csv_final_row(pl->csv_prefix, su->csv_every, su->sim, o.stats.step) != WETDEM_OK) {
+        cli_error("run %s: cannot append the last row to %s.csv: %s", sc->file, pl->csv_prefix,
+                  wetdem_sim_errmsg(su->sim));
         return CLI_EXIT_RUNTIME;
     }
     if (st == WETDEM_EVENT) {
@@ -961,7 +982,7 @@ static int run(const struct cli_scenario* sc, struct cli_many_setup* su,
                             .tty = isatty(STDERR_FILENO) == 1};
     int rc = set_outputs(su, opt, pl, &prog);
     if (rc == CLI_EXIT_OK && opt->restart)
-        rc = resume(su, opt, pl, vtk);
+        rc = resume(sc, su, opt, pl, vtk);
     if (rc != CLI_EXIT_OK)
         return rc;
     if (opt->out_dir && cli_make_dirs(opt->out_dir) != 0) {
@@ -997,7 +1018,7 @@ static int run(const struct cli_scenario* sc, struct cli_many_setup* su,
     int st = opt->restart ? WETDEM_OK : wetdem_sim_integrate(su->sim, wetdem_sim_time(su->sim));
     struct wetdem_many_stats s = {0};
     if (st == WETDEM_OK) /* (a failed start keeps its message for finish) */
-        wetdem_sim_many_stats(su->sim, &s);
+        st = wetdem_sim_many_stats(su->sim, &s);
     prog.base_step = s.step;
     bool frame_due = vtk && su->vtk_every && s.step % su->vtk_every == 0 &&
                      !(vtk->n > 0 && vtk->last_step == s.step);
@@ -1029,9 +1050,9 @@ int cli_run_many(const struct cli_scenario* sc, const struct cli_run_options* op
         rc = check_output_volume(sc, &su, &pl);
     if (rc == CLI_EXIT_OK && opt->check) { /* (with --restart: whether it can be continued) */
         if (opt->restart)
-            rc = restore(&su, opt, &pl);
+            rc = restore(sc, &su, opt, &pl);
         if (rc == CLI_EXIT_OK)
-            print_check(sc, &su, &pl, opt);
+            rc = print_check(sc, &su, &pl, opt);
     } else if (rc == CLI_EXIT_OK) {
         struct series vtk = {.binary = su.vtk_binary, .links = su.vtk_links};
         bool has_vtk = opt->out_dir && su.vtk_prefix[0] && su.vtk_every;
