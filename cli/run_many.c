@@ -167,8 +167,20 @@ static int push_time(struct series* s, double time)
     return 0;
 }
 
+/* Removes frame k and its links after series_add failed to add it to the index: a frame on
+ * disk that the index does not list makes a restart refuse the directory (series_resume). */
+static void series_drop(const struct series* s, size_t k)
+{
+    char path[PATH_CHARS + CLI_VALUE_MAX + 40], name[CLI_VALUE_MAX + 40];
+    for (int links = 0; links < 2; links++) {
+        frame_name(s, k, links, name, sizeof name);
+        snprintf(path, sizeof path, "%s/%s", s->dir, name);
+        remove(path);
+    }
+}
+
 /* Writes frame n at the current state and appends it to the index. WETDEM status; on failure
- * s->error says why. */
+ * s->error says why, and a frame that could not be indexed is not left on disk. */
 static int series_add(struct series* s, struct wetdem_sim* sim, unsigned long long step)
 {
     char path[PATH_CHARS + CLI_VALUE_MAX + 40], name[CLI_VALUE_MAX + 40];
@@ -182,10 +194,12 @@ static int series_add(struct series* s, struct wetdem_sim* sim, unsigned long lo
     }
     if (st != WETDEM_OK) {
         snprintf(s->error, sizeof s->error, "%s", wetdem_sim_errmsg(sim));
+        series_drop(s, s->n);
         return st;
     }
     if (push_time(s, wetdem_sim_time(sim)) != 0) {
         snprintf(s->error, sizeof s->error, "out of memory for the frames' index");
+        series_drop(s, s->n);
         return WETDEM_ERR_NOMEM;
     }
     s->last_step = step;
