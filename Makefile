@@ -103,16 +103,27 @@ $(BUILD)/tests/test_alloc_failure: tests/test_alloc_failure.c $(wildcard tests/*
 	$(CC) $(CFLAGS_ALL) $(LDFLAGS) $(ALLOC_WRAP) -Itests -o $@ $< $(BUILD)/libwetdem.a \
 	  $(LDLIBS) -lcmocka
 
+# The CLI linked with the same wrappers, the allocation to fail named by an environment variable
+# (tests/cli_alloc_wrap.c), for tests/test_cli_alloc_failure.sh. It runs in the sanitizer
+# builds too: --wrap redirects only the calls these objects make, and __real_malloc is the
+# sanitizer's malloc (LeakSanitizer then also checks the blocks libc allocated for them).
+$(BUILD)/tests/wetdem_alloc_fail: tests/cli_alloc_wrap.c $(CLI_OBJ) $(BUILD)/libwetdem.a \
+                                  $(BUILD)/flags.stamp
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS_ALL) $(LDFLAGS) $(ALLOC_WRAP) -o $@ tests/cli_alloc_wrap.c $(CLI_OBJ) \
+	  $(BUILD)/libwetdem.a $(LDLIBS)
+
 $(BUILD)/examples/%: examples/%/main.c $(BUILD)/libwetdem.a $(BUILD)/flags.stamp
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS_ALL) $(LDFLAGS) -o $@ $< $(BUILD)/libwetdem.a $(LDLIBS)
 
 examples: $(EX_BIN)
 
-test: all $(TEST_BIN) $(EX_BIN)
+test: all $(TEST_BIN) $(EX_BIN) $(BUILD)/tests/wetdem_alloc_fail
 	@WETDEM_CLI='$(abspath $(BUILD)/wetdem)' CC='$(CC)' WETDEM_BUILD='$(BUILD)' \
+	  WETDEM_CLI_ALLOC_FAIL='$(abspath $(BUILD)/tests/wetdem_alloc_fail)' \
 	  WETDEM_EXTRA_CFLAGS='$(EXTRA_CFLAGS)' tests/run-tests $(TEST_BIN) $(EX_BIN) \
-	  tests/test_install_deps.sh tests/test_install.sh
+	  tests/test_install_deps.sh tests/test_install.sh tests/test_cli_alloc_failure.sh
 
 # Tests again under AddressSanitizer + UndefinedBehaviorSanitizer, in a separate build tree,
 # built by GCC (test-san) and by clang (test-san-clang: its UBSan also reports pointer

@@ -1,0 +1,192 @@
+/*
+ * cli_alloc_wrap.c — the failing allocator of build/tests/wetdem_alloc_fail, the command-line
+ * tool linked with the wrappers of the allocation-failure test (Makefile, ALLOC_WRAP): every
+ * malloc, calloc, realloc and strdup of the CLI and of the library, and every constructor of a
+ * SUNDIALS or GSL object the library calls, counts as one allocation, and the one numbered
+ * WETDEM_TEST_FAIL_ALLOC (1-based; unset or 0: none) fails as in tests/test_alloc_failure.c (an
+ * allocator returns NULL, a SUNDIALS constructor NULL or its memory-failure flag, a GSL one
+ * NULL after calling GSL's error handler, whose default aborts). At exit the program writes
+ * "allocations A failed F live L" to the file WETDEM_TEST_ALLOC_REPORT (when set): A
+ * allocations counted, F 1 when the one to fail was reached, L blocks allocated through the
+ * wrappers and not freed (-1: too many to keep track of).
+ * tests/test_cli_alloc_failure.sh drives it. Allocations inside the shared libraries (libc's
+ * stdio buffers, SUNDIALS, GSL, inih, OpenMP) do not pass through the wrappers.
+ */
+#include <stdatomic.h>
+#include <stdbool.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cvode/cvode.h>
+#include <cvode/cvode_ls.h>
+#include <gsl/gsl_errno.h>
+#include <gsl/gsl_integration.h>
+#include <gsl/gsl_matrix.h>
+#include <gsl/gsl_multifit_nlinear.h>
+#include <gsl/gsl_rng.h>
+#include <nvector/nvector_serial.h>
+#include <sunlinsol/sunlinsol_dense.h>
+#include <sunmatrix/sunmatrix_dense.h>
+#include <sunnonlinsol/sunnonlinsol_fixedpoint.h>
+
+void* __real_malloc(size_t size);
+void* __real_calloc(size_t n, size_t size);
+void* __real_realloc(void* p, size_t size);
+char* __real_strdup(const char* s);
+void __real_free(void* p);
+
+void* __wrap_malloc(size_t size);
+void* __wrap_calloc(size_t n, size_t size);
+void* __wrap_realloc(void* p, size_t size);
+char* __wrap_strdup(const char* s);
+void __wrap_free(void* p);
+
+static atomic_long alloc_count; /* allocations so far */
+static long alloc_fail_at;      /* the allocation to fail (1-based); 0: none */
+static atomic_bool alloc_failed;
+
+static bool inject(void)
+{
+    long k = atomic_fetch_add(&alloc_count, 1) + 1;
+    if (alloc_fail_at > 0 && k == alloc_fail_at) {
+        atomic_store(&alloc_failed, true);
+        return true;
+    }
+    return false;
+}
+
+/* The blocks allocated through the wrappers and not freed: an open-addressing set of pointers
+ * under a spin lock (a sweep may run in several threads). Blocks libc allocates itself
+ * (getline's, scandir's) are not in it, and freeing them changes nothing. */
+#define LIVE_CAP (1u << 18)
+static void* live[LIVE_CAP];
+static size_t live_n;
+static bool live_overflow; /* more blocks than the set takes: the count is not known */
+static void* const live_tomb = &live_n;
+static atomic_flag live_lock = ATOMIC_FLAG_INIT;
+
+static size_t live_hash(const void* p)
+{
+    return (size_t)(((uintptr_t)p >> 4) * 0x9E3779B97F4A7C15ull) & (LIVE_CAP - 1);
+}
+
+static void live_update(void* removed, void* added)
+{
+    while (atomic_flag_test_and_set_explicit(&live_lock, memory_order_acquire))
+        ;
+    if (removed)
+        for (size_t k = live_hash(removed); live[k]; k = (k + 1) & (LIVE_CAP - 1))
+            if (live[k] == removed) {
+                live[k] = live_tomb;
+                live_n--;
+                break;
+            }
+    if (added && live_n < LIVE_CAP / 2) {
+        size_t k = live_hash(added);
+        while (live[k] && live[k] != live_tomb)
+            k = (k + 1) & (LIVE_CAP - 1);
+        live[k] = added;
+        live_n++;
+    } else if (added)
+        live_overflow = true;
+    atomic_flag_clear_explicit(&live_lock, memory_order_release);
+}
+
+static void* counted(void* p)
+{
+    if (p)
+        live_update(NULL, p);
+    return p;
+}
+
+void* __wrap_malloc(size_t size)
+{
+    return inject() ? NULL : counted(__real_malloc(size));
+}
+
+void* __wrap_calloc(size_t n, size_t size)
+{
+    return inject() ? NULL : counted(__real_calloc(n, size));
+}
+
+void* __wrap_realloc(void* p, size_t size)
+{
+    if (inject())
+        return NULL;
+    void* q = __real_realloc(p, size);
+    if (q)
+        live_update(p, q);
+    return q;
+}
+
+char* __wrap_strdup(const char* s)
+{
+    return inject() ? NULL : counted(__real_strdup(s));
+}
+
+void __wrap_free(void* p)
+{
+    if (p)
+        live_update(p, NULL);
+    __real_free(p);
+}
+
+/* Constructors of SUNDIALS and GSL objects, as in tests/test_alloc_failure.c. */
+#define FALLIBLE(type, name, params, args, failed)                                                 \
+    type __real_##name params;                                                                     \
+    type __wrap_##name params;                                                                     \
+    type __wrap_##name params                                                                      \
+    {                                                                                              \
+        if (inject())                                                                              \
+            return failed;                                                                         \
+        return __real_##name args;                                                                 \
+    }
+#define GSL_FAILED(type) (gsl_error("out of memory", __FILE__, __LINE__, GSL_ENOMEM), (type)NULL)
+
+FALLIBLE(int, SUNContext_Create, (void* comm, SUNContext* ctx), (comm, ctx), -1)
+FALLIBLE(N_Vector, N_VNew_Serial, (sunindextype n, SUNContext ctx), (n, ctx), NULL)
+FALLIBLE(void*, CVodeCreate, (int lmm, SUNContext ctx), (lmm, ctx), NULL)
+FALLIBLE(int, CVodeInit, (void* mem, CVRhsFn f, sunrealtype t0, N_Vector y0), (mem, f, t0, y0),
+         CV_MEM_FAIL)
+FALLIBLE(int, CVodeRootInit, (void* mem, int n, CVRootFn g), (mem, n, g), CV_MEM_FAIL)
+FALLIBLE(SUNMatrix, SUNDenseMatrix, (sunindextype m, sunindextype n, SUNContext ctx), (m, n, ctx),
+         NULL)
+FALLIBLE(SUNLinearSolver, SUNLinSol_Dense, (N_Vector y, SUNMatrix a, SUNContext ctx), (y, a, ctx),
+         NULL)
+FALLIBLE(int, CVodeSetLinearSolver, (void* mem, SUNLinearSolver ls, SUNMatrix a), (mem, ls, a),
+         CVLS_MEM_FAIL)
+FALLIBLE(SUNNonlinearSolver, SUNNonlinSol_FixedPoint, (N_Vector y, int m, SUNContext ctx),
+         (y, m, ctx), NULL)
+FALLIBLE(gsl_rng*, gsl_rng_alloc, (const gsl_rng_type* t), (t), GSL_FAILED(gsl_rng*))
+FALLIBLE(gsl_matrix*, gsl_matrix_alloc, (size_t n1, size_t n2), (n1, n2), GSL_FAILED(gsl_matrix*))
+FALLIBLE(gsl_matrix*, gsl_matrix_calloc, (size_t n1, size_t n2), (n1, n2), GSL_FAILED(gsl_matrix*))
+FALLIBLE(gsl_vector*, gsl_vector_alloc, (size_t n), (n), GSL_FAILED(gsl_vector*))
+FALLIBLE(gsl_multifit_nlinear_workspace*, gsl_multifit_nlinear_alloc,
+         (const gsl_multifit_nlinear_type* t, const gsl_multifit_nlinear_parameters* p, size_t n,
+          size_t np),
+         (t, p, n, np), GSL_FAILED(gsl_multifit_nlinear_workspace*))
+FALLIBLE(gsl_integration_glfixed_table*, gsl_integration_glfixed_table_alloc, (size_t n), (n),
+         GSL_FAILED(gsl_integration_glfixed_table*))
+
+static void report(void)
+{
+    const char* path = getenv("WETDEM_TEST_ALLOC_REPORT");
+    if (!path || !*path)
+        return;
+    FILE* f = fopen(path, "w");
+    if (!f)
+        return;
+    fprintf(f, "allocations %ld failed %d live %ld\n", atomic_load(&alloc_count),
+            atomic_load(&alloc_failed) ? 1 : 0, live_overflow ? -1L : (long)live_n);
+    fclose(f);
+}
+
+/* Before main: reads the allocation to fail and registers the report. */
+__attribute__((constructor)) static void arm_from_environment(void)
+{
+    const char* n = getenv("WETDEM_TEST_FAIL_ALLOC");
+    alloc_fail_at = n ? strtol(n, NULL, 10) : 0;
+    atexit(report);
+}
