@@ -207,6 +207,13 @@ void wetdem_event_values(struct wetdem_sim* sim, double* g)
     }
 }
 
+void wetdem_event_keep_pair_state(struct wetdem_sim* sim)
+{
+    struct wetdem_engine* e = &sim->engine;
+    memcpy(e->pair_gap_prev, e->pair_gap, e->pairs.n * sizeof *e->pair_gap);
+    memcpy(e->pair_vn_prev, e->pair_vn, e->pairs.n * sizeof *e->pair_vn);
+}
+
 /* Kind logged when slot s is crossed in direction dir; 0 for none. */
 static int kind_of(const struct wetdem_event_slot* s, int dir)
 {
@@ -328,12 +335,22 @@ static void note_branch_step(struct wetdem_sim* sim, size_t q)
         e->stats.hmin_step_ratio = ratio;
 }
 
-int wetdem_event_detect(struct wetdem_sim* sim, double t0, double h)
+/* Whether a value g = h - h_k of an event function puts its pair inside the threshold h_k.
+ * Exactly at it counts as outside: the interaction and the contact begin only below their
+ * thresholds (the laws vanish at the edge of their range and at gap 0), as has_interacted and
+ * the stop on separation count them, so a pair placed exactly touching, or exactly at the edge
+ * of its range, crosses when it moves inward. */
+static bool is_inside(double g)
+{
+    return g < 0;
+}
+
+int wetdem_event_detect(struct wetdem_sim* sim, double t0, double t1, const int* roots)
 {
     struct wetdem_engine* e = &sim->engine;
     size_t n = 0;
     for (size_t q = 0; q < e->n_slots; q++)
-        n += (e->g_prev[q] > 0) != (e->g_new[q] > 0);
+        n += is_inside(e->g_prev[q]) != is_inside(e->g_new[q]);
     if (n == 0)
         return WETDEM_OK;
     struct crossing* x = malloc(n * sizeof *x);
@@ -342,11 +359,12 @@ int wetdem_event_detect(struct wetdem_sim* sim, double t0, double h)
     n = 0;
     for (size_t q = 0; q < e->n_slots; q++) {
         double a = e->g_prev[q], b = e->g_new[q];
-        if ((a > 0) == (b > 0))
+        if (is_inside(a) == is_inside(b))
             continue;
-        double theta = a / (a - b);
-        x[n++] = (struct crossing){t0 + theta * h, theta, q, b > 0 ? 1 : -1};
-        if (e->slots[q].source == WETDEM_EVENT_SOURCE_MODEL)
+        double theta = roots && roots[q] ? 1.0 : a / (a - b);
+        x[n++] = (struct crossing){theta < 1.0 ? t0 + theta * (t1 - t0) : t1, theta, q,
+                                   is_inside(b) ? -1 : 1};
+        if (!roots && e->slots[q].source == WETDEM_EVENT_SOURCE_MODEL)
             note_branch_step(sim, q);
     }
     sort_crossings(x, n);

@@ -25,15 +25,19 @@
  *
  * Run loop: CVode(CV_ONE_STEP) up to the stop time t_end. After every accepted step (or
  * located root) the pair histories are committed at the returned time (RHS evaluations are
- * trials on scratch copies); on a root the events are logged (CVodeGetRootInfo: g rising =
- * the gap rose through the threshold, an "end" event) and the integrator is restarted with
- * CVodeReInit at the root, at order 1, so that it never steps across the discontinuity.
+ * trials on scratch copies) and the events of every event function that changed side are
+ * logged (wetdem_event_detect): at the root CVODE located (CVodeGetRootInfo), or, for a
+ * function exactly zero where CVODE started or restarted, which it does not report (a pair
+ * placed exactly touching), interpolated between the step ends. On a root the integrator is
+ * restarted with CVodeReInit there, at order 1, so that it never steps across the
+ * discontinuity.
  * History-carrying models (tangential spring, largest approach speed) are therefore coupled to
  * first order in the step: their state advances once per accepted step with the end-of-step
  * kinematics and is not part of CVODE's error control (docs/engines.md).
  */
 #include <math.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include <cvode/cvode.h>
 #include <nvector/nvector_serial.h>
@@ -397,22 +401,6 @@ static int observe_between(struct wetdem_sim* sim, struct run* r, struct solver*
     return WETDEM_OK;
 }
 
-/* Logs the roots found at t: starts in slot order, then ends in reverse slot order. */
-static int log_roots(struct wetdem_sim* sim, const int* found, double t)
-{
-    struct wetdem_engine* e = &sim->engine;
-    int st = WETDEM_OK;
-    for (size_t q = 0; q < e->n_slots && st == WETDEM_OK; q++)
-        if (found[q] < 0)
-            st = wetdem_event_record(sim, q, -1, t, e->pair_gap[e->slots[q].pair],
-                                     e->pair_vn[e->slots[q].pair]);
-    for (size_t q = e->n_slots; q-- > 0 && st == WETDEM_OK;)
-        if (found[q] > 0)
-            st = wetdem_event_record(sim, q, 1, t, e->pair_gap[e->slots[q].pair],
-                                     e->pair_vn[e->slots[q].pair]);
-    return st;
-}
-
 /* Bookkeeping after CVode returned flag >= 0 at t: observer, commit, events, restart at a
  * root, stop check, monitor. *stop is set when the separation condition holds. */
 static int after_return(struct wetdem_sim* sim, struct run* r, struct solver* s, int flag, double t,
@@ -421,15 +409,23 @@ static int after_return(struct wetdem_sim* sim, struct run* r, struct solver* s,
     struct wetdem_engine* e = &sim->engine;
     int st = observe_between(sim, r, s, t);
     unpack(r, N_VGetArrayPointer(s->y));
+    double t_prev = e->time;
     e->time = t;
     if (st == WETDEM_OK)
         st = wetdem_sim_commit_histories(sim, t);
     if (st != WETDEM_OK)
         return st;
     wetdem_event_values(sim, e->g_new);
-    if (flag == CV_ROOT_RETURN) {
+    if (flag == CV_ROOT_RETURN)
         CVodeGetRootInfo(s->mem, s->rootsfound);
-        st = log_roots(sim, s->rootsfound, t);
+    else
+        memset(s->rootsfound, 0, e->n_slots * sizeof *s->rootsfound);
+    st = wetdem_event_detect(sim, t_prev, t, s->rootsfound);
+    double* g = e->g_prev; /* g_new becomes the previous state of the next return */
+    e->g_prev = e->g_new;
+    e->g_new = g;
+    wetdem_event_keep_pair_state(sim);
+    if (flag == CV_ROOT_RETURN) {
         add_counters(sim, s->mem);
         if (st == WETDEM_OK && CVodeReInit(s->mem, t, s->y) != CV_SUCCESS)
             st = WETDEM_ERR_STEP;

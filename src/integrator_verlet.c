@@ -175,7 +175,7 @@ static int step(struct wetdem_sim* sim, double t0, double h, struct wetdem_vec3*
     e->stats.steps++;
     shift_pair_state(e);
     wetdem_event_values(sim, e->g_new);
-    st = wetdem_event_detect(sim, t0, h);
+    st = wetdem_event_detect(sim, t0, t1, NULL);
     double* t = e->g_prev; /* g_new becomes the previous state of the next step */
     e->g_prev = e->g_new;
     e->g_new = t;

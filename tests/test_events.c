@@ -497,6 +497,75 @@ static void test_events_verlet_resolves_the_nijssen_peak(void** state)
     assert_true(ratio == 0.0);
 }
 
+/* A pair placed exactly at a threshold (g = 0 to the bit) has not yet crossed it: the
+ * interaction and the contact begin only below (the laws are zero at the edge of their range
+ * and at gap 0). Both integrators log the crossing when the pair moves inward, at the time it
+ * leaves the threshold. Before, a start exactly at a threshold counted as inside for the
+ * events but as outside for the stop on separation (CVODE, moreover, does not report a root
+ * function that is exactly zero where it starts): the entry was never logged and the pair
+ * never counted as interacting.
+ * (1) The null model's sphere starts at gap = RANGE exactly, moving in at 0.1 m/s:
+ *     interaction start at 0, h_min at (1 - 0.2)/0.1 = 8 ms, contact at 10 ms (exact to
+ *     round-off, as in test_events_free_flight_times).
+ * (2) A Newton's cradle of three steel spheres (R = 1 mm, hertz, e_dry = 0.97 of steel1):
+ *     the striker hits at 0.5 m/s the middle one, which touches the third exactly (x = 0 and
+ *     2 mm). With the stop on separation the run must go on until the middle and the third
+ *     sphere have parted too, and end as with a gap of 1e-12 m between them. Before, the
+ *     contact of the touching pair was never logged, the run stopped when the striker had
+ *     left, with the middle sphere at 0.15 m/s still pushing the third (0.045 m/s when the
+ *     contact is followed). The two starts differ by the 1e-12 m gap, which moves the
+ *     velocities by ~1e-9 of 0.5 m/s: 1e-6 m/s asserted. */
+static void test_events_start_exactly_at_a_threshold(void** state)
+{
+    (void)state;
+    enum wetdem_event_kind kinds[] = {WETDEM_EVENT_INTERACTION_START, WETDEM_EVENT_HMIN_REACHED,
+                                      WETDEM_EVENT_CONTACT_START};
+    double times[] = {0.0, 0.008, 0.010};
+    for (int q = 0; q < 2; q++) {
+        struct wetdem_sim* sim = wall_sim(integrators[q], RANGE, -0.1, &null_model);
+        CHECK_OK(wetdem_sim_set_param(sim, "verlet.dt", 1.5e-3));
+        CHECK_OK(wetdem_sim_integrate(sim, 0.0105));
+        check_log(sim, kinds, times, 3, 1e-12);
+        wetdem_sim_free(sim);
+    }
+    for (int q = 0; q < 2; q++) {
+        double v_end[2][3];
+        for (int touching = 0; touching < 2; touching++) {
+            struct wetdem_sim* sim = wetdem_sim_create();
+            int mat = wetdem_sim_add_material_preset(sim, "steel1");
+            CHECK_OK(wetdem_sim_enable_model(sim, "hertz"));
+            CHECK_OK(wetdem_sim_set_integrator(sim, integrators[q]));
+            CHECK_OK(wetdem_sim_set_param_str(sim, "sim.stop_on_separation", "yes"));
+            double x[3] = {-2.01e-3, 0.0, touching ? 2e-3 : 2e-3 + 1e-12};
+            for (int k = 0; k < 3; k++) {
+                struct wetdem_particle p = {.pos = {x[k], 0, 0},
+                                            .vel = {k ? 0 : 0.5, 0, 0},
+                                            .radius = 1e-3,
+                                            .material = mat};
+                CHECK_OK(wetdem_sim_add_particle(sim, p));
+            }
+            CHECK_STATUS(wetdem_sim_integrate(sim, 1e-3), WETDEM_EVENT);
+            size_t n, started = 0, ended = 0;
+            const struct wetdem_event_record* ev = wetdem_sim_events(sim, &n);
+            for (size_t k = 0; k < n; k++) {
+                if (ev[k].i == 1 && ev[k].j == 2) {
+                    started += ev[k].kind == WETDEM_EVENT_CONTACT_START;
+                    ended += ev[k].kind == WETDEM_EVENT_CONTACT_END;
+                }
+            }
+            assert_int_equal(started, 1);
+            assert_int_equal(ended, 1);
+            const struct wetdem_particle* ps = wetdem_sim_particles_const(sim, &n);
+            for (int k = 0; k < 3; k++)
+                v_end[touching][k] = ps[k].vel.x;
+            wetdem_sim_free(sim);
+        }
+        for (int k = 0; k < 3; k++)
+            CHECK_ABS(v_end[1][k], v_end[0][k], 1e-6);
+        assert_true(v_end[1][1] < 0.1);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -511,6 +580,7 @@ int main(void)
         cmocka_unit_test(test_events_hmin_fraction_holds_the_step),
         cmocka_unit_test(test_events_verlet_resolves_hmin),
         cmocka_unit_test(test_events_verlet_resolves_the_nijssen_peak),
+        cmocka_unit_test(test_events_start_exactly_at_a_threshold),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
