@@ -90,7 +90,8 @@ $(BUILD)/tests/%: tests/%.c $(wildcard tests/*.h) $(BUILD)/libwetdem.a $(BUILD)/
 	$(CC) $(CFLAGS_ALL) $(LDFLAGS) -Itests -o $@ $< $(BUILD)/libwetdem.a $(LDLIBS) -lcmocka
 
 # The allocation-failure test fails the library's allocations through wrappers of its own:
-# of the C allocator, and of the SUNDIALS and GSL constructors the library calls.
+# of the C allocator, and of the SUNDIALS and GSL constructors the library calls (the same
+# functions as tests/alloc_fallible.h wraps).
 ALLOC_WRAP = -Wl,--wrap=malloc,--wrap=calloc,--wrap=realloc,--wrap=strdup,--wrap=free \
   -Wl,--wrap=SUNContext_Create,--wrap=N_VNew_Serial,--wrap=CVodeCreate,--wrap=CVodeInit \
   -Wl,--wrap=CVodeRootInit,--wrap=SUNDenseMatrix,--wrap=SUNLinSol_Dense \
@@ -107,7 +108,8 @@ $(BUILD)/tests/test_alloc_failure: tests/test_alloc_failure.c $(wildcard tests/*
 # (tests/cli_alloc_wrap.c), for tests/test_cli_alloc_failure.sh. It runs in the sanitizer
 # builds too: --wrap redirects only the calls these objects make, and __real_malloc is the
 # sanitizer's malloc (LeakSanitizer then also checks the blocks libc allocated for them).
-$(BUILD)/tests/wetdem_alloc_fail: tests/cli_alloc_wrap.c $(CLI_OBJ) $(BUILD)/libwetdem.a \
+$(BUILD)/tests/wetdem_alloc_fail: tests/cli_alloc_wrap.c tests/alloc_fallible.h $(CLI_OBJ) \
+                                  $(BUILD)/libwetdem.a \
                                   $(BUILD)/flags.stamp
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS_ALL) $(LDFLAGS) $(ALLOC_WRAP) -o $@ tests/cli_alloc_wrap.c $(CLI_OBJ) \
