@@ -130,6 +130,7 @@ static void run_point(const struct cli_scenario* base, const struct cli_batch* b
         } else {
             char why[300];
             p->energy_grew = cli_energy_grew(p->res.energy_ratio, why, sizeof why);
+            p->r_eff = su.r_eff;
             cli_setup_capture(&su, &p->res);
             cli_csv_result_row(f, &su, &p->res);
         }
@@ -670,6 +671,29 @@ void cli_batch_write_table(FILE* f, const struct cli_batch* b, int argc, char** 
                 cli_batch_points_run(b), b->n_pts, b->wall);
 }
 
+/* One line for the points whose spheres overlapped beyond the contact laws (information). */
+static void report_large_overlap(const struct cli_batch* b)
+{
+    size_t n = 0, worst = 0;
+    char why[600];
+    for (size_t k = 0; b->engine == CLI_ENGINE_SOFT && k < b->n_pts; k++) {
+        const struct cli_batch_point* p = &b->pts[k];
+        if (p->status < 0 || p->status >= CLI_BATCH_NOT_RUN ||
+            !cli_overlap_large(&p->res, p->r_eff, why, sizeof why))
+            continue;
+        if (n++ == 0 ||
+            -p->res.min_gap / p->r_eff > -b->pts[worst].res.min_gap / b->pts[worst].r_eff)
+            worst = k;
+    }
+    if (n == 0)
+        return;
+    char where[1100];
+    point_values(b, &b->pts[worst], where, sizeof where);
+    cli_overlap_large(&b->pts[worst].res, b->pts[worst].r_eff, why, sizeof why);
+    cli_error("warning: %s: in %zu of %zu collisions (column min_gap) %s; the worst, at %s", b->cmd,
+              n, b->n_pts, why, where);
+}
+
 /* One line for the points whose fixed step did not resolve h_min (information). */
 static void report_unresolved_hmin(const struct cli_batch* b)
 {
@@ -696,6 +720,7 @@ static void report_unresolved_hmin(const struct cli_batch* b)
 int cli_batch_report_failures(const struct cli_batch* b, int rc)
 {
     report_unresolved_hmin(b);
+    report_large_overlap(b);
     if (b->interrupted)
         cli_error("%s: interrupted by signal %d: %zu of %zu points ran; the table has every "
                   "point, those left out with status NOT_RUN",

@@ -36,6 +36,7 @@ struct cli_batch_point {
     struct wetdem_collision_result res; /* soft engine: the run's result (zero for pairwise) */
     int status;       /* the run's status (the pairwise engine's own), or CLI_BATCH_NOT_RUN */
     bool energy_grew; /* soft engine: it ran but ended with more energy (cli_energy_grew) */
+    double r_eff;     /* soft engine: R* of its set-up [m] (cli_overlap_large) */
     char errmsg[256]; /* the engine's message of a failed run */
     char* row;        /* the engine's CSV fields, no newline (malloc'd); of a point kept
                          from --resume, its status word and fields as that table has them */

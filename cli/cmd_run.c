@@ -191,6 +191,8 @@ static int run_soft(const struct cli_scenario* sc, struct cli_setup* su, const s
     }
     if (rc == CLI_EXIT_OK && cli_hmin_unresolved(&res, why, sizeof why))
         cli_error("warning: run %s: %s", sc->file, why);
+    if (rc == CLI_EXIT_OK && cli_overlap_large(&res, su->r_eff, why, sizeof why))
+        cli_error("warning: run %s: %s", sc->file, why);
     return rc;
 }
 

@@ -127,6 +127,19 @@ bool cli_energy_grew(double energy_ratio, char* msg, size_t n)
     return true;
 }
 
+bool cli_overlap_large(const struct wetdem_collision_result* r, double r_eff, char* msg, size_t n)
+{
+    double ratio = -r->min_gap / r_eff;
+    if (!(ratio > CLI_OVERLAP_RATIO_MAX))
+        return false;
+    snprintf(msg, n,
+             "the spheres overlapped by %.3g m, %.3g R*: the contact laws hold for overlaps "
+             "small against R* (Hertz's below about %g R*), so this result extrapolates them; "
+             "the impact is too fast or the solid too soft for them",
+             -r->min_gap, ratio, CLI_OVERLAP_RATIO_MAX);
+    return true;
+}
+
 bool cli_hmin_unresolved(const struct wetdem_collision_result* r, char* msg, size_t n)
 {
     double ratio = r->stats.hmin_step_ratio;

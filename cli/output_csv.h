@@ -46,6 +46,14 @@ bool cli_energy_grew(double energy_ratio, char* msg, size_t n);
  * step moved the gap, the e_n error it can cause and what to change ("the verlet step ..."). */
 bool cli_hmin_unresolved(const struct wetdem_collision_result* r, char* msg, size_t n);
 
+/* Overlap over R* above which the contact laws are extrapolated: Hertz's law holds while the
+ * contact radius sqrt(delta R*) is small against R* (at 0.1 R* it is already 0.3 R*). */
+#define CLI_OVERLAP_RATIO_MAX 0.1
+/* Whether a collision's spheres overlapped by more than CLI_OVERLAP_RATIO_MAX R* (r_eff [m]):
+ * information, not an error. Then writes into msg[n] the overlap and what it means ("the
+ * spheres overlapped by ..."). */
+bool cli_overlap_large(const struct wetdem_collision_result* r, double r_eff, char* msg, size_t n);
+
 /* Records what the result struct lacks from the final state of su->sim: the striker's own
  * speed and the angle of its velocity to the line of centres, theta_i,1 of Nijssen Fig. 1c,
  * atan2(|v_t|, |v . n|) in [0, pi/2] (n: the rebound normal r->normal_out, the line of

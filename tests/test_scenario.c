@@ -403,6 +403,58 @@ static void test_scenario_unresolved_hmin_is_reported(void** state)
                "moved the gap by 0.935 h_min");
 }
 
+/* An overlap beyond what the contact laws hold for (above 0.1 R*) is reported, not an error:
+ * two soft undamped spheres (R = 1 mm, rho = 1000 kg/m^3, E = 1 MPa, nu = 0, e_dry = 1) at
+ * 1 m/s overlap by Hertz's delta_max = (15 m* v^2 / (16 E* sqrt(R*)))^(2/5) = 0.25 R*. run
+ * warns with that ratio and exits 0, a sweep warns once for its points (0.55 m/s: 0.155 R*);
+ * at 0.1 m/s (0.04 R*)
+ * nothing is said. */
+static void test_scenario_large_overlap_is_reported(void** state)
+{
+    (void)state;
+    const char* file = write_file("soft.ini", "[collision]\nstriker = soft\ntarget = sphere\n"
+                                              "speed = 1\ninitial_gap = 1e-5\nt_end = 0.1\n"
+                                              "striker_radius = 1e-3\n[material.soft]\n"
+                                              "density = 1000\nyoungs_modulus = 1e6\n"
+                                              "poisson_ratio = 0\nrestitution = 1\n[fluid]\n"
+                                              "viscosity = 0\n[models]\nforce = hertz\n"
+                                              "[integrator]\nname = cvode\n");
+    const double r_eff = 0.5e-3, m_eff = 0.5 * 1000 * 4.0 / 3.0 * M_PI * 1e-9, e_eff = 0.5e6;
+    const double delta = pow(15 * m_eff * 1.0 / (16 * e_eff * sqrt(r_eff)), 0.4);
+    char args[800];
+    snprintf(args, sizeof args, "run '%s'", file);
+    struct test_run r = run_cli(args);
+    assert_int_equal(r.code, 0);
+    const char* w = strstr(r.out, "wetdem: warning: run ");
+    assert_non_null(w);
+    const char* by = strstr(w, ": the spheres overlapped by ");
+    assert_non_null(by);
+    char* end;
+    double overlap = strtod(by + strlen(": the spheres overlapped by "), &end);
+    assert_true(strncmp(end, " m, ", 4) == 0);
+    double ratio = strtod(end + 4, &end);
+    /* (printed to 3 digits, 5e-3 of the value; the smallest gap is CVODE's at its steps,
+       2e-8 of the closed form) */
+    CHECK_REL(overlap, delta, 6e-3);
+    CHECK_REL(ratio, delta / r_eff, 6e-3);
+    CHECK_CONTAINS(end, " R*: the contact laws hold for overlaps small against R* (Hertz's "
+                        "below about 0.1 R*)");
+    free(r.out);
+    snprintf(args, sizeof args, "run '%s' --set collision.speed=0.1", file);
+    r = run_cli(args);
+    assert_int_equal(r.code, 0);
+    if (strstr(r.out, "warning"))
+        fail_msg("%s warns:\n%s", args, r.out);
+    free(r.out);
+    snprintf(args, sizeof args,
+             "sweep '%s' --param collision.speed --values 0.1:1:3 --out '%s/soft.csv'", file,
+             tmpdir);
+    expect_run(args, 0,
+               "wetdem: warning: sweep: in 2 of 3 collisions (column min_gap) the spheres "
+               "overlapped by ");
+    expect_run(args, 0, "; the worst, at collision.speed = 1\n");
+}
+
 /* What a file written elsewhere brings, accepted: a UTF-8 byte-order mark, CR LF line ends and
  * comments longer than a line may be (whole-line and inline, ';' and '#'); the values are
  * those without them. */
@@ -1401,6 +1453,7 @@ int main(void)
         cmocka_unit_test(test_scenario_set_overrides),
         cmocka_unit_test(test_scenario_bad_files_exit_2_with_line),
         cmocka_unit_test(test_scenario_boms_crlf_and_long_comments),
+        cmocka_unit_test(test_scenario_large_overlap_is_reported),
         cmocka_unit_test(test_scenario_energy_gain_is_an_error),
         cmocka_unit_test(test_scenario_unresolved_hmin_is_reported),
         cmocka_unit_test(test_scenario_docs_list_every_key),
