@@ -9,6 +9,7 @@
 #define WETDEM_CONTACT_H
 
 #include <math.h>
+#include <stdbool.h>
 
 #include "vec3.h"
 #include "wetdem.h"
@@ -21,6 +22,13 @@ static inline double contact_reduced(double a, double b)
     if (isinf(b))
         return a;
     return a * b / (a + b);
+}
+
+/* Whether every component of a pair force is finite. */
+static inline bool contact_force_is_finite(const struct wetdem_pair_force* f)
+{
+    return isfinite(f->f_normal) && vec3_is_finite(f->f_tan) && vec3_is_finite(f->torque_i) &&
+           vec3_is_finite(f->torque_j);
 }
 
 /* Mass of p as a pair sees it [kg]: infinite when the particle is held fixed. */

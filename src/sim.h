@@ -124,8 +124,6 @@ bool wetdem_sim_particle_valid(const struct wetdem_sim* sim, const struct wetdem
  * model fails or the force is not finite. */
 double wetdem_sim_force_at_rest(const struct wetdem_sim* sim, struct wetdem_contact c,
                                 const double* history, double gap);
-/* Whether every component of a pair force is finite. */
-bool wetdem_pair_force_is_finite(const struct wetdem_pair_force* f);
 /* Fills c->h_min from the min-separation model, then sums every enabled force model into
  * *out (zeroed first). history: sim->history_len doubles (committed state in, advanced state
  * out), or NULL for a fresh pair with nothing kept. per_model (optional, n_models entries)

@@ -19,6 +19,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "contact.h"
 #include "integrator.h"
 #include "models.h"
 #include "vec3.h"
@@ -184,7 +185,7 @@ static int eval_pair(struct wetdem_sim* sim, size_t k, double t, bool commit, bo
                                "pair (%zu, %s%zu) at t = %.9g s: a force model failed "
                                "(%s)",
                                p->i, p->is_wall ? "wall " : "", p->j, t, wetdem_status_name(st));
-    if (!wetdem_pair_force_is_finite(&f))
+    if (!contact_force_is_finite(&f))
         return wetdem_sim_fail(sim, WETDEM_ERR_NUMERIC,
                                "pair (%zu, %s%zu) at t = %.9g s, gap %.6g m: non-finite force",
                                p->i, p->is_wall ? "wall " : "", p->j, t, c.gap);

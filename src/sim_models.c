@@ -12,6 +12,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "contact.h"
 #include "integrator.h"
 #include "locale_guard.h"
 #include "models.h"
@@ -711,12 +712,6 @@ int wetdem_sim_eval_contact(const struct wetdem_sim* sim, struct wetdem_contact*
     return WETDEM_OK;
 }
 
-bool wetdem_pair_force_is_finite(const struct wetdem_pair_force* f)
-{
-    return isfinite(f->f_normal) && vec3_is_finite(f->f_tan) && vec3_is_finite(f->torque_i) &&
-           vec3_is_finite(f->torque_j);
-}
-
 int wetdem_sim_pair_force(struct wetdem_sim* sim, size_t i, size_t j, struct wetdem_contact* c,
                           struct wetdem_pair_force* out)
 {
@@ -737,7 +732,7 @@ int wetdem_sim_pair_force(struct wetdem_sim* sim, size_t i, size_t j, struct wet
     struct wetdem_contact* cc = c ? c : &local;
     wetdem_sim_build_contact(sim, i, is_wall ? (size_t)-1 - j : j, is_wall, cc);
     int st = wetdem_sim_eval_contact(sim, cc, NULL, out, NULL);
-    if (st == WETDEM_OK && !wetdem_pair_force_is_finite(out))
+    if (st == WETDEM_OK && !contact_force_is_finite(out))
         return wetdem_sim_fail(sim, WETDEM_ERR_NUMERIC,
                                "pair (%zu, %s%zu), gap %.6g m: non-finite force", i,
                                is_wall ? "wall " : "", is_wall ? (size_t)-1 - j : j, cc->gap);
