@@ -385,7 +385,9 @@ WETDEM_API struct wetdem_particle* wetdem_sim_particles(struct wetdem_sim* sim, 
 WETDEM_API size_t wetdem_sim_n_particles(const struct wetdem_sim* sim);
 /* Adds a plane wall through `point` with unit `normal` into the domain, of material k. In the
  * many-particle mode a wall must be parallel to every periodic axis (|normal| component along
- * it <= 1e-12): wetdem_sim_integrate refuses the run otherwise (WETDEM_ERR_INVALID). */
+ * it <= 1e-12): wetdem_sim_integrate refuses the run otherwise (WETDEM_ERR_INVALID). A wall
+ * added between calls of a many-particle run acts from the next call on, with fresh histories
+ * (docs/many.md, Limits). */
 WETDEM_API int wetdem_sim_add_wall(struct wetdem_sim* sim, struct wetdem_vec3 point,
                                    struct wetdem_vec3 normal, int material);
 /* Number of walls. */

@@ -224,6 +224,9 @@ struct wetdem_many {
     size_t history_cap;
     double* wall_history; /* n_particles x n_walls x history_len */
     size_t wall_history_cap;
+    /* the particles and walls wall_history is laid out for (sim_many.c layout_wall_history):
+       walls may be added between calls, which widens every particle's row */
+    size_t wall_history_n, wall_history_walls;
     struct wetdem_celllist_pair* old_pairs; /* previous list, for history remapping */
     double* old_history;
     size_t old_cap, old_history_cap;
@@ -301,6 +304,7 @@ struct wetdem_many {
     uint64_t* wall_mask; /* per particle: bit w set if wall w is within wall_reach + skin
                                     at the last build (walls >= 64 are always evaluated) */
     size_t wall_mask_cap;
+    size_t walls_masked;  /* walls when the masks were made: one added since needs a build */
     uint64_t* wall_dirty; /* per particle: bit w set if the history of wall w may differ
                                     from a fresh one (walls >= 64: always treated as set); all
                                     set when a run (re)starts (sim_many.c prepare) */

@@ -213,6 +213,10 @@ int wetdem_sim_add_wall(struct wetdem_sim* sim, struct wetdem_vec3 point, struct
         return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory adding a wall");
     sim->walls[sim->n_walls++] = (struct wetdem_wall){
         .point = point, .normal = vec3_scale(normal, 1.0 / len), .material = material};
+    if (wetdem_sim_many_walls_added(sim) != WETDEM_OK) { /* (a many-particle run under way) */
+        sim->n_walls--;
+        return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory adding a wall");
+    }
     return WETDEM_OK;
 }
 

@@ -212,6 +212,10 @@ void wetdem_sim_build_contact(const struct wetdem_sim* sim, size_t i, size_t j, 
 
 /* sim_many.c: frees the many-particle state (wetdem_sim_free calls it). */
 void wetdem_sim_many_free(struct wetdem_sim* sim);
+/* sim_many.c: after wetdem_sim_add_wall, lays the many-particle state's particle-wall
+ * histories out for the walls (the new wall's fresh), so that every reader of them and the
+ * next call see the wall. WETDEM_OK (also without the mode) or WETDEM_ERR_NOMEM. */
+int wetdem_sim_many_walls_added(struct wetdem_sim* sim);
 /* sim_many.c: starts the many-particle state afresh with its settings (wetdem_sim_reset calls
  * it): step 0, no lists, a new energy budget; nothing without the mode. */
 void wetdem_sim_many_reset(struct wetdem_sim* sim);

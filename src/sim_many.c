@@ -522,13 +522,39 @@ static int size_particle_arrays(struct wetdem_sim* sim)
             return WETDEM_ERR_NOMEM;
     }
     m->particle_cap = c;
-    size_t len = sim->history_len, nw = sim->n_walls * n * len;
-    size_t old = m->wall_history_cap;
-    if (grow((void**)&m->wall_history, &m->wall_history_cap, nw ? nw : 1, sizeof(double)))
-        return WETDEM_ERR_NOMEM;
-    for (size_t k = old / (len ? len : 1); len && k < nw / len; k++)
-        wetdem_sim_history_init(sim, m->wall_history + k * len);
     return WETDEM_OK;
+}
+
+/* Lays the particle-wall histories out for the current particles and walls: grown, each
+ * particle's row widened where walls were added since (its histories kept, the new walls'
+ * fresh), and every history of a particle added since fresh. Walls are only ever added to a
+ * many-mode state (a reset starts a new one). Returns WETDEM_OK or WETDEM_ERR_NOMEM. */
+static int layout_wall_history(struct wetdem_sim* sim)
+{
+    struct wetdem_many* m = sim->many;
+    size_t len = sim->history_len, n = sim->n_particles, nw = sim->n_walls;
+    size_t nw_old = m->wall_history_walls, kept = m->wall_history_n < n ? m->wall_history_n : n;
+    size_t need = n * nw * len;
+    if (m->wall_history && n == m->wall_history_n && nw == nw_old)
+        return WETDEM_OK;
+    if (grow((void**)&m->wall_history, &m->wall_history_cap, need > 0 ? need : 1, sizeof(double)))
+        return WETDEM_ERR_NOMEM;
+    double* h = m->wall_history;
+    for (size_t i = kept; len && i-- > 0;) { /* from the last row: each moves up, if at all */
+        memmove(h + i * nw * len, h + i * nw_old * len, nw_old * len * sizeof *h);
+        for (size_t w = nw_old; w < nw; w++)
+            wetdem_sim_history_init(sim, h + (i * nw + w) * len);
+    }
+    for (size_t k = kept * nw; len && k < n * nw; k++)
+        wetdem_sim_history_init(sim, h + k * len);
+    m->wall_history_n = n;
+    m->wall_history_walls = nw;
+    return WETDEM_OK;
+}
+
+int wetdem_sim_many_walls_added(struct wetdem_sim* sim)
+{
+    return sim->many && sim->many->wall_history ? layout_wall_history(sim) : WETDEM_OK;
 }
 
 /* Exchanges the pair histories and flags with the old-list buffers. */
@@ -575,6 +601,7 @@ static int update_wall_masks(struct wetdem_sim* sim)
         }
         m->wall_mask[i] = mask;
     }
+    m->walls_masked = nw;
     if (grow((void**)&m->wall_list, &m->wall_list_cap, n ? n : 1, sizeof *m->wall_list))
         return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory for %zu particles", n);
     m->n_wall_list = 0;
@@ -788,7 +815,7 @@ int wetdem_sim_many_prepare(struct wetdem_sim* sim)
         m->kernel_ready = true;
     }
     size_t known = m->started ? m->cl.n_at_build : 0; /* particles the engine has forces of */
-    if (size_particle_arrays(sim) != WETDEM_OK)
+    if (size_particle_arrays(sim) != WETDEM_OK || layout_wall_history(sim) != WETDEM_OK)
         return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory for %zu particles",
                                sim->n_particles);
     /* particles added since: no pair force yet (their first half kick is gravity's alone; the
@@ -822,7 +849,10 @@ int wetdem_sim_many_prepare(struct wetdem_sim* sim)
     bool moved = track ? m->max_disp2 > 0.25 * m->cl.skin * m->cl.skin
                        : wetdem_celllist_needs_rebuild(&m->cl, sim->particles, sim->n_particles);
     m->max_disp_valid = false;
-    if (moved || refixed)
+    /* a wall added since the lists were built: the masks of the walls to evaluate are made
+       anew, or the particles would not meet it until a move rebuilt them */
+    bool rewalled = m->cl.n_builds > 0 && m->walls_masked != sim->n_walls;
+    if (moved || refixed || rewalled)
         return rebuild(sim);
     return WETDEM_OK;
 }
