@@ -676,7 +676,13 @@ struct wetdem_many_settings {
 
 /* Switches sim to the many-particle mode: wetdem_sim_integrate() then runs velocity Verlet
  * over cell lists (no event location), with walls, gravity, periodic axes, OpenMP, outputs and
- * checkpoints as set. NULL switches back. Returns WETDEM_OK or WETDEM_ERR_INVALID. */
+ * checkpoints as set. NULL switches back. Returns WETDEM_OK or WETDEM_ERR_INVALID. On a started
+ * run it starts the mode afresh from the current particles and time: step 0, a new step, fresh
+ * pair histories and energy budget, outputs numbered from 0. The models of a started run stay
+ * those it started with: after models are enabled or cleared, wetdem_sim_integrate and the
+ * reports of the run refuse (WETDEM_ERR_INVALID) until they are enabled again as they were or
+ * the mode is started afresh; parameters, fluid and gravity may change between calls
+ * (docs/many.md, Limits). */
 WETDEM_API int wetdem_sim_set_many(struct wetdem_sim* sim, const struct wetdem_many_settings* s);
 
 #define WETDEM_ENERGY_MAX_MODELS 16

@@ -217,6 +217,11 @@ struct wetdem_many {
     double t0;              /* time of step 0 [s] */
     uint64_t step;          /* steps since t0 */
     bool started;
+    /* the force models of the run and its min-separation model, in order, as it started (or
+       was restored): its pair histories are laid out and its work summed by them, so a call
+       or a report after they changed is refused (sim_many.c wetdem_sim_many_check_models) */
+    const struct wetdem_model* run_models[WETDEM_MAX_MODELS + 1];
+    size_t run_n_models;
     /* wall time by phase in this process [s] (wetdem_many_stats): kicks and drifts, force
        passes (less their list builds), neighbour-list builds, outputs and observers */
     double seconds_kick, seconds_forces, seconds_lists, seconds_output;
@@ -489,6 +494,13 @@ int wetdem_sim_many_prepare(struct wetdem_sim* sim);
  * m->contact_time and m->crossing_time (wetdem_many_stats). Returns WETDEM_OK or
  * WETDEM_ERR_NOMEM (message in sim). */
 int wetdem_sim_many_time_scales(struct wetdem_sim* sim);
+
+/* Records the enabled models as those of the run (run_models), when it starts or is restored. */
+void wetdem_sim_many_keep_models(struct wetdem_sim* sim);
+/* WETDEM_OK when the enabled force models and the min-separation model are those the started
+ * run recorded (their parameters may change), else WETDEM_ERR_INVALID with a message naming
+ * both sets, beginning with `what` (the call refused). */
+int wetdem_sim_many_check_models(const struct wetdem_sim* sim, const char* what);
 
 /* sim_many_force.c */
 /* Builds the material-pair table and chooses the kernel (fused or generic); needs m->reach

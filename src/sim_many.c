@@ -1201,6 +1201,48 @@ static int timed_outputs(struct wetdem_sim* sim, bool final, bool observe)
     return st;
 }
 
+void wetdem_sim_many_keep_models(struct wetdem_sim* sim)
+{
+    struct wetdem_many* m = sim->many;
+    for (size_t k = 0; k < sim->n_models; k++)
+        m->run_models[k] = sim->models[k].model;
+    m->run_models[sim->n_models] = sim->minsep.model;
+    m->run_n_models = sim->n_models + 1;
+}
+
+/* The names of models[0 .. n - 1] (the last the min-separation model) into buf. */
+static void model_list(const struct wetdem_model* const* models, size_t n, char* buf, size_t size)
+{
+    size_t used = 0;
+    buf[0] = '\0';
+    for (size_t k = 0; k < n && used < size; k++)
+        used += (size_t)snprintf(buf + used, size - used, "%s%s%s", k ? " " : "",
+                                 k + 1 == n ? "min-separation " : "", models[k]->name);
+}
+
+int wetdem_sim_many_check_models(const struct wetdem_sim* sim, const char* what)
+{
+    const struct wetdem_many* m = sim->many;
+    const struct wetdem_model* now[WETDEM_MAX_MODELS + 1];
+    for (size_t k = 0; k < sim->n_models; k++)
+        now[k] = sim->models[k].model;
+    now[sim->n_models] = sim->minsep.model;
+    size_t n = sim->n_models + 1;
+    if (!m || !m->started ||
+        (n == m->run_n_models && memcmp(now, m->run_models, n * sizeof *now) == 0))
+        return WETDEM_OK;
+    char was[512], is[512];
+    model_list(m->run_models, m->run_n_models, was, sizeof was);
+    model_list(now, n, is, sizeof is);
+    /* the message buffer is the sim's one mutable part for a reader (a heap object) */
+    return wetdem_sim_fail((struct wetdem_sim*)sim, WETDEM_ERR_INVALID,
+                           "%s: the models of the many-particle run changed since it started "
+                           "(%s; now %s): its pair histories and energy budget are kept per "
+                           "model, so enable those again, or call wetdem_sim_set_many() to "
+                           "start the mode afresh from the current state",
+                           what, was, is);
+}
+
 /* First call of a many run: step size, pair list, forces and the energy at t0. */
 static int start(struct wetdem_sim* sim)
 {
@@ -1216,6 +1258,7 @@ static int start(struct wetdem_sim* sim)
     if (st != WETDEM_OK)
         return st;
     m->started = true;
+    wetdem_sim_many_keep_models(sim);
     /* the forces at t0 give the first half kick only: half their dt P (trapezoid rule) */
     struct wetdem_many_energy first = m->energy;
     memset(&m->energy, 0, sizeof m->energy);
@@ -1395,6 +1438,8 @@ int wetdem_sim_many_integrate(struct wetdem_sim* sim, double t_end)
 {
     struct wetdem_many* m = sim->many;
     int wall_st = check_walls(sim);
+    if (wall_st == WETDEM_OK)
+        wall_st = wetdem_sim_many_check_models(sim, "integrate");
     if (wall_st != WETDEM_OK)
         return wall_st;
     m->kernel_ready = false;  /* materials, models or parameters may have changed */
@@ -1438,6 +1483,9 @@ int wetdem_sim_energy_budget(const struct wetdem_sim* sim, struct wetdem_energy_
                                !m            ? "the simulation is not in the many-particle mode"
                                : !m->started ? "the many-particle run has not started"
                                              : "the run's energy_budget setting is off");
+    int st = wetdem_sim_many_check_models(sim, "energy_budget");
+    if (st != WETDEM_OK)
+        return st;
     wetdem_sim_many_energies(sim, &b->kinetic, &b->potential, &b->elastic);
     b->input = m->energy.k0 + m->energy.u0 + m->energy.el0;
     double work = 0;

@@ -176,7 +176,10 @@ int wetdem_sim_many_stats(const struct wetdem_sim* sim, struct wetdem_many_stats
         return wetdem_sim_fail((struct wetdem_sim*)sim, WETDEM_ERR_INVALID, "many_stats: %s",
                                !m ? "the simulation is not in the many-particle mode"
                                   : "the many-particle run has not started");
-    int st = wetdem_sim_many_links(sim, NULL, s);
+    int st = wetdem_sim_many_check_models(sim, "many_stats");
+    if (st != WETDEM_OK)
+        return st;
+    st = wetdem_sim_many_links(sim, NULL, s);
     if (st != WETDEM_OK)
         return wetdem_sim_fail((struct wetdem_sim*)sim, st,
                                "many_stats: out of memory for the agglomerates of %zu particles",
@@ -224,6 +227,9 @@ static int write_vtk(struct wetdem_sim* sim, const char* path, bool binary)
     uint32_t* block = NULL;
     struct wetdem_output_vtk_counts counts;
     if (sim->many && sim->many->started) {
+        int st = wetdem_sim_many_check_models(sim, "write_vtk");
+        if (st != WETDEM_OK)
+            return st;
         struct wetdem_many_stats s;
         if (!(block = particle_counts(sim, &s, &counts)))
             return WETDEM_ERR_NOMEM;
@@ -295,6 +301,9 @@ static int write_vtk_links(struct wetdem_sim* sim, const char* path, bool binary
     if (!m || !m->started)
         return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
                                "links: a VTK file of links needs a started many-particle run");
+    int checked = wetdem_sim_many_check_models(sim, "links");
+    if (checked != WETDEM_OK)
+        return checked;
     if (sim->history_len > WETDEM_HISTORY_SCRATCH)
         return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
                                "links: the models keep %zu history values a pair, more than %d",
@@ -559,6 +568,9 @@ int wetdem_sim_many_write_csv_row(struct wetdem_sim* sim)
     if (!sim || !sim->many || !sim->many->started || !sim->many->output_prefix)
         return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
                                "many: a CSV row needs a started many-particle run with outputs");
+    int checked = wetdem_sim_many_check_models(sim, "many: a CSV row");
+    if (checked != WETDEM_OK)
+        return checked;
     struct wetdem_locale_guard g;
     if (wetdem_locale_guard_enter(&g) != WETDEM_OK)
         return no_c_locale(sim);
@@ -748,8 +760,11 @@ static int write_checkpoint(struct wetdem_sim* sim, const char* path)
         return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
                                "checkpoints need a started many-particle run (wetdem_sim_set_many "
                                "and wetdem_sim_integrate)");
+    int st = wetdem_sim_many_check_models(sim, "write_checkpoint");
+    if (st != WETDEM_OK)
+        return st;
     struct wetdem_checkpoint ck = {0};
-    int st = fill_checkpoint(sim, &ck);
+    st = fill_checkpoint(sim, &ck);
     char msg[512] = "out of memory writing a checkpoint";
     if (st == WETDEM_OK)
         st = wetdem_checkpoint_write(path, &ck, msg, sizeof msg);
@@ -940,6 +955,7 @@ static int restore_pairs(struct wetdem_sim* sim, const struct wetdem_checkpoint*
     for (size_t q = 0; q < m->cl.n_pairs; q++) /* histories may be stale: check on next use */
         m->flags[q] = WETDEM_MANY_DIRTY | WETDEM_MANY_SPRING;
     m->started = true;
+    wetdem_sim_many_keep_models(sim);
     return WETDEM_OK;
 }
 

@@ -1,9 +1,11 @@
 /*
  * test_many_lifecycle.c — the many-particle mode driven through the C API as an embedding
  * program drives it (a CFD coupling that integrates in short pieces and edits the state in
- * between; docs/many.md, "Limits of this version"): walls added between calls.
+ * between; docs/many.md, "Limits of this version"): walls added between calls, the models
+ * changed between calls.
  */
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "harness.h"
@@ -77,10 +79,85 @@ static void test_many_wall_added_between_calls(void** state)
         wetdem_sim_free(sims[k]);
 }
 
+/* 60 wet spheres (hertz mindlin sb capillary) in a box periodic in x and y with a floor,
+ * under gravity, dt 2 us: the wet granular gas of tests/harness.h in the
+ * many-particle mode. */
+static struct wetdem_sim* wet_gas(void)
+{
+    struct wetdem_sim* sim = wetdem_sim_create();
+    CHECK_OK(test_wet_gas(sim, 60, 4e-3, 6e-3, 20e-6, 7, NULL));
+    CHECK_OK(
+        wetdem_sim_set_many(sim, &(struct wetdem_many_settings){.periodic = {true, true, false},
+                                                                .box_hi = {4e-3, 4e-3, 6e-3},
+                                                                .dt = 2e-6,
+                                                                .energy_budget = true}));
+    return sim;
+}
+
+/* The models of a started run changed between calls: its pair histories are laid out by the
+ * models it started with and its work summed per model. Enabling mindlin after a run of
+ * hertz sb capillary made the histories of every pair one double longer than their storage:
+ * the next call wrote past the pair histories (AddressSanitizer: heap buffer overflow) and
+ * stopped on a corrupted particle ("non-finite position or a bad radius 0 m"), and the energy
+ * budget summed the work of the models by their new places. A call and the reports that read
+ * the histories refuse such a change, name both sets and leave the run as it was: with the
+ * models enabled again as they were, it goes on bit for bit as if nothing had happened, and
+ * wetdem_sim_set_many() starts the mode afresh with the new ones. */
+static void test_many_models_changed_between_calls(void** state)
+{
+    (void)state;
+    struct wetdem_sim* whole = wet_gas();
+    CHECK_OK(wetdem_sim_integrate(whole, 4e-4));
+    struct wetdem_sim* sim = wet_gas();
+    CHECK_OK(wetdem_sim_integrate(sim, 2e-4));
+    double t = wetdem_sim_time(sim);
+    wetdem_sim_clear_models(sim);
+    CHECK_OK(wetdem_sim_enable_model(sim, "hertz"));
+    CHECK_OK(wetdem_sim_enable_model(sim, "sb"));
+    CHECK_STATUS(wetdem_sim_integrate(sim, 4e-4), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(wetdem_sim_errmsg(sim),
+                   "integrate: the models of the many-particle run changed since it started "
+                   "(hertz mindlin sb capillary min-separation fixed; now hertz sb "
+                   "min-separation fixed)");
+    CHECK_ABS(wetdem_sim_time(sim), t, 0);
+    struct wetdem_many_stats st;
+    struct wetdem_energy_budget b;
+    CHECK_STATUS(wetdem_sim_many_stats(sim, &st), WETDEM_ERR_INVALID);
+    CHECK_STATUS(wetdem_sim_energy_budget(sim, &b), WETDEM_ERR_INVALID);
+    CHECK_STATUS(wetdem_sim_write_checkpoint(sim, "/nonexistent/x.ckpt"), WETDEM_ERR_INVALID);
+    CHECK_STATUS(wetdem_sim_write_vtk_links(sim, "/nonexistent/x.vtk", false), WETDEM_ERR_INVALID);
+    CHECK_STATUS(wetdem_sim_write_vtk(sim, "/nonexistent/x.vtk", false), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(wetdem_sim_errmsg(sim), "write_vtk: the models of the many-particle run");
+    /* one more model (a longer history) too */
+    CHECK_OK(wetdem_sim_enable_model(sim, "mindlin"));
+    CHECK_OK(wetdem_sim_enable_model(sim, "capillary"));
+    CHECK_STATUS(wetdem_sim_integrate(sim, 4e-4), WETDEM_ERR_INVALID);
+    wetdem_sim_clear_models(sim);
+    const char* models[] = {"hertz", "mindlin", "sb", "capillary"};
+    for (int k = 0; k < 4; k++)
+        CHECK_OK(wetdem_sim_enable_model(sim, models[k]));
+    CHECK_OK(wetdem_sim_integrate(sim, 4e-4));
+    test_check_same_particles(whole, sim);
+    /* a new start of the mode takes other models */
+    wetdem_sim_clear_models(sim);
+    CHECK_OK(wetdem_sim_enable_model(sim, "hertz"));
+    CHECK_OK(
+        wetdem_sim_set_many(sim, &(struct wetdem_many_settings){.periodic = {true, true, false},
+                                                                .box_hi = {4e-3, 4e-3, 6e-3},
+                                                                .dt = 2e-6,
+                                                                .energy_budget = true}));
+    CHECK_OK(wetdem_sim_integrate(sim, 6e-4));
+    CHECK_OK(wetdem_sim_energy_budget(sim, &b));
+    assert_int_equal(b.n_models, 1);
+    wetdem_sim_free(whole);
+    wetdem_sim_free(sim);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_many_wall_added_between_calls),
+        cmocka_unit_test(test_many_models_changed_between_calls),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
