@@ -775,7 +775,12 @@ int wetdem_sim_many_prepare(struct wetdem_sim* sim)
         return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
                                "the enabled models keep %zu doubles of pair history; at most %d",
                                sim->history_len, HISTORY_MAX);
-    bool fresh_set = !m->started || sim->n_particles != m->cl.n_at_build;
+    /* a radius edited between calls changes gaps without a move, and the bounds of the reach
+       and the cells: the lists are bounded and built anew, as for a new particle */
+    bool resized = false;
+    for (size_t k = 0; m->started && k < sim->n_particles && k < m->cl.n_at_build; k++)
+        resized = resized || sim->particles[k].radius != m->xr[k].r;
+    bool fresh_set = !m->started || sim->n_particles != m->cl.n_at_build || resized;
     double r_min = INFINITY, skin = m->cl.skin;
     double reach = m->reach, list_reach = m->cl.reach, wall_reach = m->wall_reach;
     for (size_t k = 0; fresh_set && k < sim->n_particles; k++)
@@ -852,7 +857,7 @@ int wetdem_sim_many_prepare(struct wetdem_sim* sim)
     /* a wall added since the lists were built: the masks of the walls to evaluate are made
        anew, or the particles would not meet it until a move rebuilt them */
     bool rewalled = m->cl.n_builds > 0 && m->walls_masked != sim->n_walls;
-    if (moved || refixed || rewalled)
+    if (moved || refixed || rewalled || resized)
         return rebuild(sim);
     return WETDEM_OK;
 }

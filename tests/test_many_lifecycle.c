@@ -2,7 +2,7 @@
  * test_many_lifecycle.c — the many-particle mode driven through the C API as an embedding
  * program drives it (a CFD coupling that integrates in short pieces and edits the state in
  * between; docs/many.md, "Limits of this version"): walls added between calls, the models
- * changed between calls.
+ * changed between calls, radii grown into contact between calls.
  */
 #include <math.h>
 #include <stdlib.h>
@@ -153,11 +153,53 @@ static void test_many_models_changed_between_calls(void** state)
     wetdem_sim_free(sim);
 }
 
+/* Radii edited between calls change the gaps without a move. Two spheres 20 um apart and one
+ * 20 um above the floor, at rest, without gravity (hertz alone, skin 5 um: no candidate
+ * pairs), are grown by 30 um each between two calls, into 40 um of overlap with each other
+ * and 10 um with the floor. The lists were rebuilt only on a move of half the skin, which
+ * never came: no force acted, while wetdem_sim_pair_force gave 0.030 N and 0.0053 N, and the
+ * spheres stayed overlapped for good. The next call's first force pass sees the overlaps: the
+ * step's first half kick has the forces of the previous call (none), the drift moves nothing,
+ * and the closing half kick gives v = F dt / (2 m) with F the force at the grown radii
+ * (1e-12: the same formulas, a rounding or two apart). */
+static void test_many_radius_grown_between_calls(void** state)
+{
+    (void)state;
+    const double R = 0.5e-3, dt = 1e-7, grow = 30e-6;
+    struct wetdem_sim* sim = dry_sim("hertz");
+    CHECK_OK(wetdem_sim_add_wall(sim, vec3(0, 0, 0), vec3(0, 0, 1), 0));
+    CHECK_OK(
+        wetdem_sim_add_particle(sim, (struct wetdem_particle){.pos = {0, 0, 2e-3}, .radius = R}));
+    CHECK_OK(wetdem_sim_add_particle(
+        sim, (struct wetdem_particle){.pos = {2 * R + 20e-6, 0, 2e-3}, .radius = R}));
+    CHECK_OK(wetdem_sim_add_particle(
+        sim, (struct wetdem_particle){.pos = {5e-3, 0, R + 20e-6}, .radius = R}));
+    CHECK_OK(wetdem_sim_set_many(sim, &(struct wetdem_many_settings){.dt = dt, .skin = 5e-6}));
+    CHECK_OK(wetdem_sim_integrate(sim, 10 * dt));
+    struct wetdem_particle* p = wetdem_sim_particles(sim, NULL);
+    for (int k = 0; k < 3; k++) {
+        p[k].radius += grow;
+        p[k].mass = 2500 * 4.0 / 3.0 * M_PI * pow(p[k].radius, 3);
+    }
+    struct wetdem_pair_force pair, wall;
+    CHECK_OK(wetdem_sim_pair_force(sim, 1, 0, NULL, &pair)); /* normal from 0 to 1: +x */
+    CHECK_OK(wetdem_sim_pair_force(sim, 2, (size_t)-1 - 0, NULL, &wall)); /* +z */
+    assert_true(pair.f_normal > 0.02 && wall.f_normal > 0.004);           /* 0.030 N, 0.0053 N */
+    double m = p[0].mass;
+    CHECK_OK(wetdem_sim_integrate(sim, 11 * dt));
+    p = wetdem_sim_particles(sim, NULL);
+    CHECK_REL(p[1].vel.x, pair.f_normal * dt / (2 * m), 1e-12);
+    CHECK_REL(p[0].vel.x, -pair.f_normal * dt / (2 * m), 1e-12);
+    CHECK_REL(p[2].vel.z, wall.f_normal * dt / (2 * m), 1e-12);
+    wetdem_sim_free(sim);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_many_wall_added_between_calls),
         cmocka_unit_test(test_many_models_changed_between_calls),
+        cmocka_unit_test(test_many_radius_grown_between_calls),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
