@@ -216,6 +216,10 @@ void wetdem_sim_many_free(struct wetdem_sim* sim);
  * histories out for the walls (the new wall's fresh), so that every reader of them and the
  * next call see the wall. WETDEM_OK (also without the mode) or WETDEM_ERR_NOMEM. */
 int wetdem_sim_many_walls_added(struct wetdem_sim* sim);
+/* sim_many.c: the step of a started many-particle run [s], 0 otherwise. Its time stays on
+ * the grid t0 + k dt, so a call may end up to a step past its t_end: a later call to a t_end
+ * within that step takes no step (wetdem_sim_integrate). */
+double wetdem_sim_many_step(const struct wetdem_sim* sim);
 /* sim_many.c: starts the many-particle state afresh with its settings (wetdem_sim_reset calls
  * it): step 0, no lists, a new energy budget; nothing without the mode. */
 void wetdem_sim_many_reset(struct wetdem_sim* sim);

@@ -339,11 +339,15 @@ int wetdem_sim_observe_due(struct wetdem_sim* sim)
 static int check_run(struct wetdem_sim* sim, double t_end)
 {
     const struct wetdem_engine* e = &sim->engine;
-    if (!isfinite(t_end) || t_end < e->time)
+    double step = wetdem_sim_many_step(sim); /* 0 before a many-particle run */
+    if (!isfinite(t_end) || (t_end < e->time && !((e->time - t_end) / step < 1 - 1e-9)))
         return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
                                "integrate: t_end = %g s must be finite and >= the current time "
-                               "%.9g s",
-                               t_end, e->time);
+                               "%.9g s%s",
+                               t_end, e->time,
+                               step > 0 ? " less the step it passed (the many-particle mode "
+                                          "takes whole steps)"
+                                        : "");
     if (!(isfinite(e->observer_interval) && e->observer_interval >= 0))
         return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
                                "observer interval = %g s must be finite and >= 0",

@@ -552,6 +552,11 @@ static int layout_wall_history(struct wetdem_sim* sim)
     return WETDEM_OK;
 }
 
+double wetdem_sim_many_step(const struct wetdem_sim* sim)
+{
+    return sim->many && sim->many->started ? sim->many->dt : 0.0;
+}
+
 int wetdem_sim_many_walls_added(struct wetdem_sim* sim)
 {
     return sim->many && sim->many->wall_history ? layout_wall_history(sim) : WETDEM_OK;

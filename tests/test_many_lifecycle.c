@@ -2,7 +2,7 @@
  * test_many_lifecycle.c — the many-particle mode driven through the C API as an embedding
  * program drives it (a CFD coupling that integrates in short pieces and edits the state in
  * between; docs/many.md, "Limits of this version"): walls added between calls, the models
- * changed between calls, radii grown into contact between calls.
+ * changed between calls, radii grown into contact between calls, pieces shorter than a step.
  */
 #include <math.h>
 #include <stdlib.h>
@@ -194,12 +194,48 @@ static void test_many_radius_grown_between_calls(void** state)
     wetdem_sim_free(sim);
 }
 
+/* A driver whose own step is shorter than the engine's (a CFD solver at 0.3 dt) calls
+ * integrate at every one of its steps. The engine takes whole steps: the call to 0.3 dt ends
+ * at dt, and the header says a run ends at its first point of the grid at or after
+ * t_end - 1e-9 dt, which for the next call, to 0.6 dt, is dt itself: no step. That call was
+ * refused as a t_end in the past, and so was every other one of the driver's. Now the calls
+ * within a step the run has passed take no step, the pieces give the run of one call bit for
+ * bit, and a t_end a whole step back is still refused. */
+static void test_many_pieces_shorter_than_a_step(void** state)
+{
+    (void)state;
+    const double dt = 2e-6;
+    struct wetdem_sim* whole = wet_gas();
+    CHECK_OK(wetdem_sim_integrate(whole, 60 * dt));
+    struct wetdem_sim* sim = wet_gas();
+    for (int k = 1; k <= 200; k++) {
+        CHECK_OK(wetdem_sim_integrate(sim, k * 0.3 * dt));
+        assert_true(wetdem_sim_time(sim) >= k * 0.3 * dt - 1e-9 * dt);
+        assert_true(wetdem_sim_time(sim) < k * 0.3 * dt + dt);
+    }
+    test_check_same_particles(whole, sim);
+    struct wetdem_energy_budget a, b;
+    CHECK_OK(wetdem_sim_energy_budget(whole, &a));
+    CHECK_OK(wetdem_sim_energy_budget(sim, &b));
+    CHECK_ABS(b.work_total, a.work_total, 0);
+    double t = wetdem_sim_time(sim);
+    CHECK_OK(wetdem_sim_integrate(sim, t - 0.999 * dt)); /* within the step passed */
+    CHECK_ABS(wetdem_sim_time(sim), t, 0);
+    CHECK_STATUS(wetdem_sim_integrate(sim, t - dt), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(wetdem_sim_errmsg(sim), "less the step it passed");
+    CHECK_STATUS(wetdem_sim_integrate(sim, NAN), WETDEM_ERR_INVALID);
+    CHECK_ABS(wetdem_sim_time(sim), t, 0);
+    wetdem_sim_free(whole);
+    wetdem_sim_free(sim);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_many_wall_added_between_calls),
         cmocka_unit_test(test_many_models_changed_between_calls),
         cmocka_unit_test(test_many_radius_grown_between_calls),
+        cmocka_unit_test(test_many_pieces_shorter_than_a_step),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
