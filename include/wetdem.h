@@ -404,7 +404,10 @@ WETDEM_API int wetdem_sim_enable_model(struct wetdem_sim* sim, const char* name)
  * WETDEM_OK, WETDEM_ERR_INVALID (with a message) or WETDEM_ERR_NOMEM. */
 WETDEM_API int wetdem_sim_add_model(struct wetdem_sim* sim, const struct wetdem_model* model,
                                     const void* params);
-/* Disables every force model and resets the min-separation model to "fixed". */
+/* Disables every force model and resets the min-separation model to "fixed". In the two-body
+ * engine, after models are enabled or cleared between calls, the pair histories (tangential
+ * springs, min-separation records) are kept only if the models that keep history are the same
+ * ones in the same order, and otherwise start fresh (docs/engines.md, Pair list). */
 WETDEM_API void wetdem_sim_clear_models(struct wetdem_sim* sim);
 /* Number of enabled force models, and the k-th. */
 WETDEM_API size_t wetdem_sim_n_models(const struct wetdem_sim* sim);

@@ -65,9 +65,29 @@ static void list_pairs(const struct wetdem_sim* sim, struct wetdem_pair* items)
     }
 }
 
+_Static_assert(WETDEM_PAIRS_LAYOUT_MAX == WETDEM_MAX_MODELS + 1,
+               "a pair's history holds the slices of the min-separation and the force models");
+
+/* The models whose slices make up a pair's history (sim_models.c), in their order; returns
+ * their number. */
+static size_t history_layout(const struct wetdem_sim* sim, const struct wetdem_model** layout)
+{
+    size_t n = 0;
+    if (sim->minsep.model->history_len)
+        layout[n++] = sim->minsep.model;
+    for (size_t k = 0; k < sim->n_models; k++)
+        if (sim->models[k].model->history_len)
+            layout[n++] = sim->models[k].model;
+    return n;
+}
+
 int wetdem_pairs_update(struct wetdem_pairs* pl, struct wetdem_sim* sim)
 {
     size_t n = count_pairs(sim), len = sim->history_len;
+    const struct wetdem_model* layout[WETDEM_PAIRS_LAYOUT_MAX];
+    size_t n_layout = history_layout(sim, layout);
+    bool same_layout = len == pl->history_len && n_layout == pl->n_layout &&
+                       memcmp(layout, pl->layout, n_layout * sizeof *layout) == 0;
     struct wetdem_pair* items = malloc((n ? n : 1) * sizeof *items);
     double* history = malloc((n * len > 0 ? n * len : 1) * sizeof *history);
     if (!items || !history) {
@@ -77,7 +97,7 @@ int wetdem_pairs_update(struct wetdem_pairs* pl, struct wetdem_sim* sim)
     }
     list_pairs(sim, items);
     for (size_t k = 0; k < n; k++) {
-        long old = len == pl->history_len ? find_pair(pl, &items[k]) : -1;
+        long old = same_layout ? find_pair(pl, &items[k]) : -1;
         if (old >= 0) {
             items[k].has_interacted = pl->items[old].has_interacted;
             memcpy(history + k * len, pl->history + (size_t)old * len, len * sizeof *history);
@@ -92,6 +112,8 @@ int wetdem_pairs_update(struct wetdem_pairs* pl, struct wetdem_sim* sim)
     pl->n = pl->cap = n;
     pl->history_cap = n * len;
     pl->history_len = len;
+    memcpy(pl->layout, layout, n_layout * sizeof *layout);
+    pl->n_layout = n_layout;
     return WETDEM_OK;
 }
 
@@ -129,5 +151,7 @@ int wetdem_pairs_copy(struct wetdem_pairs* dst, const struct wetdem_pairs* src)
     dst->n = dst->cap = src->n;
     dst->history_cap = nh;
     dst->history_len = src->history_len;
+    memcpy(dst->layout, src->layout, sizeof dst->layout);
+    dst->n_layout = src->n_layout;
     return WETDEM_OK;
 }

@@ -16,6 +16,11 @@
 #include <stddef.h>
 
 struct wetdem_sim;
+struct wetdem_model;
+
+/* Most models a pair's history is laid out for: the min-separation model and WETDEM_MAX_MODELS
+ * force models (sim.h). */
+#define WETDEM_PAIRS_LAYOUT_MAX 17
 
 /* One candidate pair. The key (i, is_wall, j) orders the list. */
 struct wetdem_pair {
@@ -31,10 +36,17 @@ struct wetdem_pairs {
     double* history;    /* n * history_len doubles: committed per-pair state */
     size_t history_cap; /* doubles allocated */
     size_t history_len; /* doubles per pair when the list was built */
+    /* the models whose slices make up the history when the list was built, in their order:
+     * the min-separation model, then the force models, each if it keeps any history */
+    const struct wetdem_model* layout[WETDEM_PAIRS_LAYOUT_MAX];
+    size_t n_layout;
 };
 
 /* Rebuilds the list for the particles and walls of sim; keeps the history and flags of pairs
- * that stay in the list (same key, same history_len), initialises new ones. Returns WETDEM_OK
+ * that stay in the list (same key) while the models laying out the history are the same, in
+ * the same order; initialises new ones, and every history when those models changed (one
+ * model's record is no state of another: glass's approach speeds would become mindlin's
+ * spring). Returns WETDEM_OK
  * or WETDEM_ERR_NOMEM (message stored in sim). */
 int wetdem_pairs_update(struct wetdem_pairs* pl, struct wetdem_sim* sim);
 /* Committed history of pair k (history_len doubles; NULL when history_len is 0). */
