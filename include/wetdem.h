@@ -461,7 +461,9 @@ WETDEM_API const struct wetdem_param_desc* wetdem_integrator_params(const char* 
 WETDEM_API const char* wetdem_integrator_summary(const char* name);
 
 /* Shortest span t_end - t [s] that CVODE integrates (the cvode integrator and the pairwise
- * engine): below about 1e-160 s its step selection fails, so a shorter span is refused. */
+ * engine): below about 1e-160 s its step selection fails, so a shorter span is refused. The
+ * cvode integrator also refuses (WETDEM_ERR_INVALID, state unchanged) a span below
+ * 2 DBL_EPSILON |t_end|, which CVODE cannot tell from t (e.g. the next double after t). */
 #define WETDEM_MIN_SPAN 1e-150
 
 /* Advances the simulation to time t_end [s]. Returns WETDEM_OK at t_end, WETDEM_EVENT when a

@@ -35,6 +35,7 @@
  * first order in the step: their state advances once per accepted step with the end-of-step
  * kinematics and is not part of CVODE's error control (docs/engines.md).
  */
+#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -491,11 +492,20 @@ static int cvode_integrate(struct wetdem_sim* sim, const void* params, double t_
     const struct cvode_params* p = params;
     if (!(t_end > sim->engine.time))
         return WETDEM_OK;
-    if (t_end - sim->engine.time < WETDEM_MIN_SPAN)
+    double t = sim->engine.time, span = t_end - t;
+    /* CVODE starts no step to a t_end within two roundings of t ("tout too close to t0") */
+    double rounding = 2 * DBL_EPSILON * fmax(fabs(t), fabs(t_end));
+    if (span < WETDEM_MIN_SPAN)
         return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
                                "cvode: t_end - t = %g s is shorter than the %g s that CVODE "
                                "integrates; give a longer t_end",
-                               t_end - sim->engine.time, WETDEM_MIN_SPAN);
+                               span, WETDEM_MIN_SPAN);
+    if (span < rounding)
+        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
+                               "cvode: t_end - t = %g s is shorter than the %g s that CVODE "
+                               "integrates from t = %.17g s (2 x DBL_EPSILON x t_end); give a "
+                               "longer t_end",
+                               span, rounding, t);
     struct run r = {.sim = sim};
     r.free_index = malloc((sim->n_particles ? sim->n_particles : 1) * sizeof *r.free_index);
     if (!r.free_index)

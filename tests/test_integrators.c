@@ -129,6 +129,28 @@ static void test_integrators_shortest_span(void** state)
     wetdem_sim_free(sim);
 }
 
+/* CVODE cannot tell t_end from t when they are within 2 DBL_EPSILON of each other (its "tout
+ * too close to t0"): a call from t = 0.25 s to the next double, 5.6e-17 s on, far above
+ * WETDEM_MIN_SPAN, failed as WETDEM_ERR_STEP with CVODE's message. It is refused as a span
+ * too short, with the state untouched, and a span of 1e-15 s (9 of those roundings) is
+ * integrated. */
+static void test_integrators_shortest_span_after_t(void** state)
+{
+    (void)state;
+    struct wetdem_sim* sim = make_sim("cvode", 0.5, 0.3, false, NULL);
+    CHECK_OK(wetdem_sim_integrate(sim, 0.25));
+    struct wetdem_particle p = particle0(sim);
+    CHECK_STATUS(wetdem_sim_integrate(sim, nextafter(0.25, 1)), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(wetdem_sim_errmsg(sim), "t_end - t = 5.55112e-17 s is shorter than the "
+                                           "1.11022e-16 s that CVODE integrates from t");
+    assert_true(wetdem_sim_time(sim) == 0.25);
+    struct wetdem_particle q = particle0(sim);
+    assert_memory_equal(&p, &q, sizeof p);
+    CHECK_OK(wetdem_sim_integrate(sim, 0.25 + 1e-15));
+    assert_true(wetdem_sim_time(sim) == 0.25 + 1e-15);
+    wetdem_sim_free(sim);
+}
+
 /* A failure message may quote the one before it (wetdem_sim_fail formats into its own
  * buffer first: formatting into the message it reads garbled both) */
 static void test_integrators_message_quotes_the_last(void** state)
@@ -507,6 +529,7 @@ int main(void)
         cmocka_unit_test(test_integrators_free_flight),
         cmocka_unit_test(test_integrators_constant_force),
         cmocka_unit_test(test_integrators_shortest_span),
+        cmocka_unit_test(test_integrators_shortest_span_after_t),
         cmocka_unit_test(test_integrators_message_quotes_the_last),
         cmocka_unit_test(test_integrators_oscillators),
         cmocka_unit_test(test_integrators_verlet_order_two),
