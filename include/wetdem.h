@@ -521,7 +521,10 @@ struct wetdem_event_record {
 };
 /* Name of an event kind, e.g. "contact_start". */
 WETDEM_API const char* wetdem_event_kind_name(enum wetdem_event_kind kind);
-/* Borrowed view of the event log, valid until the next integrate/reset. */
+/* Borrowed view of the event log, valid until the next integrate/reset. The log holds every
+ * event since the simulation was created or reset (wetdem_collision_run starts it afresh):
+ * each call of wetdem_sim_integrate appends its own, so a run in pieces logs each crossing
+ * once, as one call does. */
 WETDEM_API const struct wetdem_event_record* wetdem_sim_events(const struct wetdem_sim* sim,
                                                                size_t* n);
 
@@ -1023,8 +1026,11 @@ WETDEM_API int wetdem_pairwise_config_validate(const struct wetdem_pairwise_conf
 WETDEM_API void wetdem_pairwise_set_observer(struct wetdem_pairwise* pw, double interval,
                                              wetdem_pairwise_observer_fn fn, void* ctx);
 /* Runs one collision from cfg (copied) and fills *res. Returns WETDEM_OK, or a negative
- * status with the message in wetdem_pairwise_errmsg(). The event log stays readable until
- * the next run. */
+ * status with the message in wetdem_pairwise_errmsg(); *res then holds no result (zeroed, with
+ * some fields filled up to the failure: time, final and n_events stay 0), and the event log
+ * the events up to it. The event log stays readable until the next run. One run object may
+ * run any number of configurations one after the other: each run is bit-identical to the
+ * same run on a new object. */
 WETDEM_API int wetdem_pairwise_run(struct wetdem_pairwise* pw,
                                    const struct wetdem_pairwise_config* cfg,
                                    struct wetdem_pairwise_result* res);

@@ -1489,10 +1489,58 @@ static void test_pairwise_observer_frames(void** state)
     wetdem_pairwise_free(pw);
 }
 
+/* One run object reused (its CVODE memory kept while the state has the same size) for
+ * runs of two and three spheres, after a failed run (an event budget of 2) and after a
+ * refused configuration: each run, its result and its event log, is bit-identical to the
+ * same run on a new object. */
+static void test_pairwise_run_object_reused(void** state)
+{
+    (void)state;
+    struct wetdem_pairwise_config two = davis(10, 1000, 60, 20), three = davis(5, 1000, 30, 20);
+    three.n_spheres = 3;
+    const struct wetdem_pairwise_config* cfgs[2] = {&two, &three};
+    struct wetdem_pairwise_result want[2], r;
+    struct wetdem_pairwise* fresh[2];
+    for (int k = 0; k < 2; k++)
+        run(cfgs[k], &want[k], &fresh[k]);
+    struct wetdem_pairwise_config few = three, bad = two;
+    few.max_events = 2;
+    bad.n_spheres = 1;
+    struct wetdem_pairwise* pw = wetdem_pairwise_create();
+    const int order[] = {1, 0, 1, -1, 0, 1, -2, 1, 0};
+    for (size_t q = 0; q < sizeof order / sizeof *order; q++) {
+        if (order[q] < 0) {
+            CHECK_STATUS(wetdem_pairwise_run(pw, order[q] == -1 ? &few : &bad, &r),
+                         order[q] == -1 ? WETDEM_ERR_MAX_STEPS : WETDEM_ERR_INVALID);
+            continue;
+        }
+        int k = order[q];
+        CHECK_OK(wetdem_pairwise_run(pw, cfgs[k], &r));
+        assert_memory_equal(&r, &want[k], sizeof r);
+        size_t n, m;
+        const struct wetdem_pairwise_event* ev = wetdem_pairwise_events(pw, &n);
+        const struct wetdem_pairwise_event* ew = wetdem_pairwise_events(fresh[k], &m);
+        assert_int_equal(n, m);
+        assert_true(n > 0);
+        for (size_t e = 0; e < n; e++) { /* (field by field: the records have padding) */
+            assert_int_equal(ev[e].kind, ew[e].kind);
+            assert_memory_equal(&ev[e].time, &ew[e].time, 3 * sizeof ev[e].time);
+            assert_true(ev[e].i == ew[e].i && ev[e].j == ew[e].j && ev[e].k == ew[e].k &&
+                        ev[e].l == ew[e].l);
+            assert_memory_equal(&ev[e].gap, &ew[e].gap, sizeof ev[e].gap);
+            assert_memory_equal(&ev[e].v_n, &ew[e].v_n, sizeof ev[e].v_n);
+        }
+    }
+    wetdem_pairwise_free(pw);
+    for (int k = 0; k < 2; k++)
+        wetdem_pairwise_free(fresh[k]);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_pairwise_headon_matches_closed_form),
+        cmocka_unit_test(test_pairwise_run_object_reused),
         cmocka_unit_test(test_pairwise_headon_sticks_below_critical_stokes),
         cmocka_unit_test(test_pairwise_dry_restitution_and_friction),
         cmocka_unit_test(test_pairwise_jump_formulas_match_vector_impulse),
