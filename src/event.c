@@ -210,6 +210,8 @@ void wetdem_event_values(struct wetdem_sim* sim, double* g)
 void wetdem_event_keep_pair_state(struct wetdem_sim* sim)
 {
     struct wetdem_engine* e = &sim->engine;
+    if (e->pairs.n == 0) /* (a lone particle: the arrays were never allocated, memcpy of NULL) */
+        return;
     memcpy(e->pair_gap_prev, e->pair_gap, e->pairs.n * sizeof *e->pair_gap);
     memcpy(e->pair_vn_prev, e->pair_vn, e->pairs.n * sizeof *e->pair_vn);
 }
