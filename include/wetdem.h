@@ -468,11 +468,12 @@ WETDEM_API const char* wetdem_integrator_summary(const char* name);
 
 /* Advances the simulation to time t_end [s]. Returns WETDEM_OK at t_end, WETDEM_EVENT when a
  * stop condition fired (sim.stop_on_separation), or a negative status (message in errmsg).
- * In the many-particle mode steps are whole and time stays on the grid t0 + k dt: the run
- * ends at its first point at or after t_end - 1e-9 dt (wetdem_sim_time() tells which), so a
- * t_end the run has already passed within its latest step (t_end > t - dt (1 - 1e-9)) takes
- * no step and returns WETDEM_OK; an earlier one, or one that is not finite, is refused with
- * WETDEM_ERR_INVALID and changes nothing. */
+ * A t_end equal to the current time does nothing; one before it, or one that is not finite,
+ * is refused with WETDEM_ERR_INVALID and changes nothing. In the many-particle mode steps are
+ * whole and time stays on the grid t0 + k dt: the run ends at its first point at or after
+ * t_end - 1e-9 dt (wetdem_sim_time() tells which), so a t_end the run has already passed
+ * within its latest step (t_end > t - dt (1 - 1e-9)) takes no step and returns WETDEM_OK; an
+ * earlier one is refused. */
 WETDEM_API int wetdem_sim_integrate(struct wetdem_sim* sim, double t_end);
 /* Current simulated time [s]. */
 WETDEM_API double wetdem_sim_time(const struct wetdem_sim* sim);
