@@ -1,5 +1,6 @@
 /*
- * alloc_fallible.h — the SUNDIALS and GSL constructors the library calls, wrapped to fail when
+ * alloc_fallible.h — the declarations of the C allocator's wrappers (each including file
+ * defines them), and the SUNDIALS and GSL constructors the library calls, wrapped to fail when
  * the including file's inject() says so (tests/test_alloc_failure.c, tests/cli_alloc_wrap.c;
  * the link flags are the Makefile's ALLOC_WRAP, which must name the same functions). A failed
  * SUNDIALS constructor returns NULL or its memory-failure flag; a failed GSL one calls GSL's
@@ -12,6 +13,7 @@
 #define WETDEM_TEST_ALLOC_FALLIBLE_H
 
 #include <stdbool.h>
+#include <stddef.h>
 
 #include <cvode/cvode.h>
 #include <cvode/cvode_ls.h>
@@ -24,6 +26,18 @@
 #include <sunlinsol/sunlinsol_dense.h>
 #include <sunmatrix/sunmatrix_dense.h>
 #include <sunnonlinsol/sunnonlinsol_fixedpoint.h>
+
+/* the C allocator, as linked with --wrap (the including file defines the __wrap_ ones) */
+void* __real_malloc(size_t size);
+void* __real_calloc(size_t n, size_t size);
+void* __real_realloc(void* p, size_t size);
+char* __real_strdup(const char* s);
+void __real_free(void* p);
+void* __wrap_malloc(size_t size);
+void* __wrap_calloc(size_t n, size_t size);
+void* __wrap_realloc(void* p, size_t size);
+char* __wrap_strdup(const char* s);
+void __wrap_free(void* p);
 
 static bool inject(void);
 

@@ -21,22 +21,10 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "alloc_fallible.h" /* the wrapped SUNDIALS and GSL constructors */
+#include "alloc_fallible.h" /* the wrappers' declarations, the SUNDIALS and GSL ones */
 #include "harness.h"
 
 /* ---- the failing allocator ---------------------------------------------------------------- */
-
-void* __real_malloc(size_t size);
-void* __real_calloc(size_t n, size_t size);
-void* __real_realloc(void* p, size_t size);
-char* __real_strdup(const char* s);
-void __real_free(void* p);
-
-void* __wrap_malloc(size_t size);
-void* __wrap_calloc(size_t n, size_t size);
-void* __wrap_realloc(void* p, size_t size);
-char* __wrap_strdup(const char* s);
-void __wrap_free(void* p);
 
 static atomic_long alloc_count;    /* allocations since arm() */
 static long alloc_fail_at;         /* the allocation to fail (1-based); 0: none */
