@@ -1,17 +1,17 @@
 /*
  * alloc_fallible.h — the declarations of the C allocator's wrappers (each including file
  * defines them), and the SUNDIALS and GSL constructors the library calls, wrapped to fail when
- * the including file's inject() says so (tests/test_alloc_failure.c, tests/cli_alloc_wrap.c;
+ * inject() below says so (tests/test_alloc_failure.c, tests/cli_alloc_wrap.c;
  * the link flags are the Makefile's ALLOC_WRAP, which must name the same functions). A failed
  * SUNDIALS constructor returns NULL or its memory-failure flag; a failed GSL one calls GSL's
  * error handler first (whose default aborts), then returns NULL, as GSL does.
  *
- * Include once, in a file that defines `static bool inject(void)`: whether this allocation
- * fails.
+ * Include once; the including file sets alloc_fail_at and reads alloc_count and alloc_failed.
  */
 #ifndef WETDEM_TEST_ALLOC_FALLIBLE_H
 #define WETDEM_TEST_ALLOC_FALLIBLE_H
 
+#include <stdatomic.h>
 #include <stdbool.h>
 #include <stddef.h>
 
@@ -39,7 +39,20 @@ void* __wrap_realloc(void* p, size_t size);
 char* __wrap_strdup(const char* s);
 void __wrap_free(void* p);
 
-static bool inject(void);
+static atomic_long alloc_count;  /* allocations counted (in the library's test: since arm()) */
+static long alloc_fail_at;       /* the allocation to fail (1-based); 0: none */
+static atomic_bool alloc_failed; /* the allocation alloc_fail_at was failed */
+
+/* Counts an allocation; whether it is the one to fail. */
+static bool inject(void)
+{
+    long k = atomic_fetch_add(&alloc_count, 1) + 1;
+    if (alloc_fail_at > 0 && k == alloc_fail_at) {
+        atomic_store(&alloc_failed, true);
+        return true;
+    }
+    return false;
+}
 
 #define FALLIBLE(type, name, params, args, failed)                                                 \
     type __real_##name params;                                                                     \

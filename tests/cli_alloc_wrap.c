@@ -21,20 +21,6 @@
 
 #include "alloc_fallible.h" /* the wrappers' declarations, the SUNDIALS and GSL ones */
 
-static atomic_long alloc_count; /* allocations so far */
-static long alloc_fail_at;      /* the allocation to fail (1-based); 0: none */
-static atomic_bool alloc_failed;
-
-static bool inject(void)
-{
-    long k = atomic_fetch_add(&alloc_count, 1) + 1;
-    if (alloc_fail_at > 0 && k == alloc_fail_at) {
-        atomic_store(&alloc_failed, true);
-        return true;
-    }
-    return false;
-}
-
 /* The blocks allocated through the wrappers and not freed: an open-addressing set of pointers
  * under a spin lock (a sweep may run in several threads). Blocks libc allocates itself
  * (getline's, scandir's) are not in it, and freeing them changes nothing. */

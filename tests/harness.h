@@ -112,23 +112,29 @@ static inline void test_check_same_particles(const struct wetdem_sim* a, const s
 
 /* ---- the command-line tool ---- */
 
+/* The soft glass-like material of the many-particle tests: 2500 kg/m^3, E = 10 MPa (a step of
+ * microseconds), nu = 0.3, e_dry = 0.6, friction 0.4 dry and 0.1 lubricated, films `film` [m]. */
+static inline struct wetdem_material test_soft_glass(double film)
+{
+    return (struct wetdem_material){.density = 2500,
+                                    .youngs_modulus = 1e7,
+                                    .poisson_ratio = 0.3,
+                                    .restitution = 0.6,
+                                    .friction_dry = 0.4,
+                                    .friction_lub = 0.1,
+                                    .film = film};
+}
+
 /* The small wet granular gas of several tests, set up in sim (the many-particle mode is the
  * caller's): n spheres of radius 0.4-0.5 mm at random (seed) in [0, side]^2 x [0, height], at
- * 0.2 m/s spread, periodic in x and y, a floor at z = 0, gravity; one material (2500 kg/m^3,
- * E = 10 MPa, nu = 0.3, e = 0.6, friction 0.4 dry and 0.1 lubricated) with films of `film`
- * [m], a fluid of 0.01 Pa s and 0.02 N/m, models hertz, mindlin, sb, capillary and `extra`
+ * 0.2 m/s spread, periodic in x and y, a floor at z = 0, gravity; one material,
+ * test_soft_glass(film), a fluid of 0.01 Pa s and 0.02 N/m, models hertz, mindlin, sb, capillary and `extra`
  * when not NULL. Returns the first status that is an error (the message in sim), or
  * WETDEM_OK. */
 static inline int test_wet_gas(struct wetdem_sim* sim, size_t n, double side, double height,
                                double film, unsigned long seed, const char* extra)
 {
-    struct wetdem_material m = {.density = 2500,
-                                .youngs_modulus = 1e7,
-                                .poisson_ratio = 0.3,
-                                .restitution = 0.6,
-                                .friction_dry = 0.4,
-                                .friction_lub = 0.1,
-                                .film = film};
+    struct wetdem_material m = test_soft_glass(film);
     int st = wetdem_sim_add_material(sim, &m);
     struct wetdem_fluid f = {.viscosity = 0.01, .surface_tension = 0.02, .density = 1000};
     st = st < 0 ? st : wetdem_sim_set_fluid(sim, &f);

@@ -26,9 +26,6 @@
 
 /* ---- the failing allocator ---------------------------------------------------------------- */
 
-static atomic_long alloc_count;    /* allocations since arm() */
-static long alloc_fail_at;         /* the allocation to fail (1-based); 0: none */
-static atomic_bool alloc_failed;   /* the allocation alloc_fail_at was failed */
 static atomic_bool alloc_tracking; /* record live blocks (between arm() and disarm()) */
 
 /* Live blocks allocated while tracking: an open-addressing set of pointers (the runs here hold
@@ -65,16 +62,6 @@ static void live_remove(void* p)
             live_n--;
             return;
         }
-}
-
-static bool inject(void)
-{
-    long k = atomic_fetch_add(&alloc_count, 1) + 1;
-    if (alloc_fail_at > 0 && k == alloc_fail_at) {
-        atomic_store(&alloc_failed, true);
-        return true;
-    }
-    return false;
 }
 
 void* __wrap_malloc(size_t size)

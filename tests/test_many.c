@@ -55,13 +55,7 @@ static void set_box_many(struct wetdem_sim* sim, wetdem_progress_fn fn, void* ct
 static struct wetdem_sim* wet_box(size_t n, bool wet)
 {
     struct wetdem_sim* sim = wetdem_sim_create();
-    struct wetdem_material m = {.density = 2500,
-                                .youngs_modulus = 1e7,
-                                .poisson_ratio = 0.3,
-                                .restitution = 0.6,
-                                .friction_dry = 0.4,
-                                .friction_lub = 0.1,
-                                .film = wet ? 20e-6 : 0};
+    struct wetdem_material m = test_soft_glass(wet ? 20e-6 : 0);
     assert_int_equal(wetdem_sim_add_material(sim, &m), 0);
     struct wetdem_fluid f = {.viscosity = 0.01, .surface_tension = 0.02, .density = 1000};
     CHECK_OK(wetdem_sim_set_fluid(sim, &f));

@@ -17,12 +17,7 @@
 static struct wetdem_sim* dry_sim(const char* models)
 {
     struct wetdem_sim* sim = wetdem_sim_create();
-    struct wetdem_material m = {.density = 2500,
-                                .youngs_modulus = 1e7,
-                                .poisson_ratio = 0.3,
-                                .restitution = 0.6,
-                                .friction_dry = 0.4,
-                                .friction_lub = 0.1};
+    struct wetdem_material m = test_soft_glass(0);
     assert_int_equal(wetdem_sim_add_material(sim, &m), 0);
     char names[64];
     snprintf(names, sizeof names, "%s", models);
