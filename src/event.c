@@ -9,7 +9,7 @@
  *   - separation_factor x range when the stop on separation needs it (not logged).
  * g falling through 0 starts a phase (interaction, h_min, contact), rising ends it.
  * The adaptive integrator hands these functions to its root finder; fixed-step integrators
- * compare them between steps and interpolate the crossing linearly (wetdem_event_detect).
+ * compare them between steps and interpolate the crossing linearly (wetdem_event_advance).
  * Prefix: wetdem_event_.
  */
 #include <math.h>
@@ -207,15 +207,6 @@ void wetdem_event_values(struct wetdem_sim* sim, double* g)
     }
 }
 
-void wetdem_event_keep_pair_state(struct wetdem_sim* sim)
-{
-    struct wetdem_engine* e = &sim->engine;
-    if (e->pairs.n == 0) /* (a lone particle: the arrays were never allocated, memcpy of NULL) */
-        return;
-    memcpy(e->pair_gap_prev, e->pair_gap, e->pairs.n * sizeof *e->pair_gap);
-    memcpy(e->pair_vn_prev, e->pair_vn, e->pairs.n * sizeof *e->pair_vn);
-}
-
 /* Kind logged when slot s is crossed in direction dir; 0 for none. */
 static int kind_of(const struct wetdem_event_slot* s, int dir)
 {
@@ -347,7 +338,19 @@ static bool is_inside(double g)
     return g < 0;
 }
 
-int wetdem_event_detect(struct wetdem_sim* sim, double t0, double t1, const int* roots)
+/* Copies engine.pair_gap and pair_vn (the latest wetdem_event_values) to pair_gap_prev and
+ * pair_vn_prev, the state detect() interpolates from. */
+static void keep_pair_state(struct wetdem_sim* sim)
+{
+    struct wetdem_engine* e = &sim->engine;
+    if (e->pairs.n == 0) /* (a lone particle: the arrays were never allocated, memcpy of NULL) */
+        return;
+    memcpy(e->pair_gap_prev, e->pair_gap, e->pairs.n * sizeof *e->pair_gap);
+    memcpy(e->pair_vn_prev, e->pair_vn, e->pairs.n * sizeof *e->pair_vn);
+}
+
+/* Detection between two evaluated states, g_prev at t0 and g_new at t1 (wetdem_event_advance). */
+static int detect(struct wetdem_sim* sim, double t0, double t1, const int* roots)
 {
     struct wetdem_engine* e = &sim->engine;
     size_t n = 0;
@@ -379,5 +382,23 @@ int wetdem_event_detect(struct wetdem_sim* sim, double t0, double t1, const int*
         st = wetdem_event_record(sim, x[k].slot, x[k].dir, x[k].t, gap, v_n);
     }
     free(x);
+    return st;
+}
+
+void wetdem_event_start(struct wetdem_sim* sim)
+{
+    wetdem_event_values(sim, sim->engine.g_prev);
+    keep_pair_state(sim);
+}
+
+int wetdem_event_advance(struct wetdem_sim* sim, double t0, double t1, const int* roots)
+{
+    struct wetdem_engine* e = &sim->engine;
+    wetdem_event_values(sim, e->g_new);
+    int st = detect(sim, t0, t1, roots);
+    double* g = e->g_prev; /* g_new becomes the previous state of the next step */
+    e->g_prev = e->g_new;
+    e->g_new = g;
+    keep_pair_state(sim);
     return st;
 }

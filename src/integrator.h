@@ -68,9 +68,6 @@ void wetdem_event_pair_state(const struct wetdem_sim* sim, size_t k, struct wetd
  * histories (not modified) into g[n_slots]; writes engine.pair_gap and engine.pair_vn.
  * Counts one root evaluation. */
 void wetdem_event_values(struct wetdem_sim* sim, double* g);
-/* Copies engine.pair_gap and pair_vn (the latest wetdem_event_values) to pair_gap_prev and
- * pair_vn_prev, the state wetdem_event_detect interpolates from. */
-void wetdem_event_keep_pair_state(struct wetdem_sim* sim);
 /* Records the events of slot k crossing in direction dir (-1: gap fell below the threshold,
  * +1: rose above it) at time t [s] with gap [m] and approach speed v_n [m/s]; marks the pair
  * as having interacted when its range is entered. Returns WETDEM_OK or WETDEM_ERR_NOMEM. */
@@ -81,16 +78,21 @@ int wetdem_event_record(struct wetdem_sim* sim, size_t k, int dir, double t, dou
  * over every pair at the latest evaluation of the event functions (engine.g_prev after
  * wetdem_event_values at the start of a run) [m]; INFINITY when there is none. */
 double wetdem_event_smallest_branch_gap(const struct wetdem_sim* sim);
-/* Detection between two evaluated states, g_prev at t0 and g_new at t1 [s]: for every slot
- * whose side of its threshold changed (inside: g < 0; exactly at the threshold is outside),
- * records the events in time order, with the crossing time and the pair's gap and v_n
- * interpolated linearly (engine.pair_gap_prev to engine.pair_gap), or at t1 for a slot that
- * roots[] marks as a root located there (CVODE; it reports no root for a function that is
- * exactly zero where it starts or restarts, which a pair placed at a threshold is, so its
- * crossing is found here). roots == NULL (Verlet): also raises stats.hmin_step_ratio to the
- * gap change of a step that crossed a branch gap h_k of the force laws (0 < h_k < range) over
- * h_k. */
-int wetdem_event_detect(struct wetdem_sim* sim, double t0, double t1, const int* roots);
+/* The state a run starts from: the event functions into engine.g_prev and the pairs' gaps and
+ * speeds as the previous state of the first step. */
+void wetdem_event_start(struct wetdem_sim* sim);
+/* After a step from t0 to t1 [s] (or a return of CVODE): evaluates the event functions at the
+ * current state into engine.g_new and, for every slot whose side of its threshold changed
+ * since g_prev (inside: g < 0; exactly at the threshold is outside), records the events in
+ * time order, with the crossing time and the pair's gap and v_n interpolated linearly
+ * (engine.pair_gap_prev to engine.pair_gap), or at t1 for a slot that roots[] marks as a root
+ * located there (CVODE; it reports no root for a function that is exactly zero where it
+ * starts or restarts, which a pair placed at a threshold is, so its crossing is found here).
+ * roots == NULL (Verlet): also raises stats.hmin_step_ratio to the gap change of a step that
+ * crossed a branch gap h_k of the force laws (0 < h_k < range) over h_k. Then the current
+ * state becomes the previous one (g_prev, pair_*_prev). Returns WETDEM_OK or
+ * WETDEM_ERR_NOMEM. */
+int wetdem_event_advance(struct wetdem_sim* sim, double t0, double t1, const int* roots);
 
 /* ---- sim_integrate.c: engine services ---- */
 

@@ -26,7 +26,7 @@
  * Run loop: CVode(CV_ONE_STEP) up to the stop time t_end. After every accepted step (or
  * located root) the pair histories are committed at the returned time (RHS evaluations are
  * trials on scratch copies) and the events of every event function that changed side are
- * logged (wetdem_event_detect): at the root CVODE located (CVodeGetRootInfo), or, for a
+ * logged (wetdem_event_advance): at the root CVODE located (CVodeGetRootInfo), or, for a
  * function exactly zero where CVODE started or restarted, which it does not report (a pair
  * placed exactly touching), interpolated between the step ends. On a root the integrator is
  * restarted with CVodeReInit there, at order 1, so that it never steps across the
@@ -416,16 +416,11 @@ static int after_return(struct wetdem_sim* sim, struct run* r, struct solver* s,
         st = wetdem_sim_commit_histories(sim, t);
     if (st != WETDEM_OK)
         return st;
-    wetdem_event_values(sim, e->g_new);
     if (flag == CV_ROOT_RETURN)
         CVodeGetRootInfo(s->mem, s->rootsfound);
     else
         memset(s->rootsfound, 0, e->n_slots * sizeof *s->rootsfound);
-    st = wetdem_event_detect(sim, t_prev, t, s->rootsfound);
-    double* g = e->g_prev; /* g_new becomes the previous state of the next return */
-    e->g_prev = e->g_new;
-    e->g_new = g;
-    wetdem_event_keep_pair_state(sim);
+    st = wetdem_event_advance(sim, t_prev, t, s->rootsfound);
     if (flag == CV_ROOT_RETURN) {
         add_counters(sim, s->mem);
         if (st == WETDEM_OK && CVodeReInit(s->mem, t, s->y) != CV_SUCCESS)
@@ -493,19 +488,15 @@ static int cvode_integrate(struct wetdem_sim* sim, const void* params, double t_
     if (!(t_end > sim->engine.time))
         return WETDEM_OK;
     double t = sim->engine.time, span = t_end - t;
-    /* CVODE starts no step to a t_end within two roundings of t ("tout too close to t0") */
-    double rounding = 2 * DBL_EPSILON * fmax(fabs(t), fabs(t_end));
-    if (span < WETDEM_MIN_SPAN)
+    /* CVODE's step selection fails below WETDEM_MIN_SPAN, and it starts no step to a t_end
+       within two roundings of t ("tout too close to t0") */
+    double shortest = fmax(WETDEM_MIN_SPAN, 2 * DBL_EPSILON * fmax(fabs(t), fabs(t_end)));
+    if (span < shortest)
         return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
                                "cvode: t_end - t = %g s is shorter than the %g s that CVODE "
-                               "integrates; give a longer t_end",
-                               span, WETDEM_MIN_SPAN);
-    if (span < rounding)
-        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
-                               "cvode: t_end - t = %g s is shorter than the %g s that CVODE "
-                               "integrates from t = %.17g s (2 x DBL_EPSILON x t_end); give a "
-                               "longer t_end",
-                               span, rounding, t);
+                               "integrates from t = %.17g s (1e-150 s, or 2 DBL_EPSILON t_end "
+                               "if more); give a longer t_end",
+                               span, shortest, t);
     struct run r = {.sim = sim};
     r.free_index = malloc((sim->n_particles ? sim->n_particles : 1) * sizeof *r.free_index);
     if (!r.free_index)

@@ -149,17 +149,6 @@ static void kick(struct wetdem_sim* sim, double h, const struct wetdem_vec3* vh,
     }
 }
 
-/* Moves the pair gaps and speeds of the state before the step into pair_*_prev. */
-static void shift_pair_state(struct wetdem_engine* e)
-{
-    double* t = e->pair_gap_prev;
-    e->pair_gap_prev = e->pair_gap;
-    e->pair_gap = t;
-    t = e->pair_vn_prev;
-    e->pair_vn_prev = e->pair_vn;
-    e->pair_vn = t;
-}
-
 /* One step of size h from t0; then events, stop check, monitor, observer. */
 static int step(struct wetdem_sim* sim, double t0, double h, struct wetdem_vec3* vh,
                 struct wetdem_vec3* wh, bool* stop)
@@ -173,12 +162,7 @@ static int step(struct wetdem_sim* sim, double t0, double h, struct wetdem_vec3*
     kick(sim, h, vh, wh);
     e->time = t1;
     e->stats.steps++;
-    shift_pair_state(e);
-    wetdem_event_values(sim, e->g_new);
-    st = wetdem_event_detect(sim, t0, t1, NULL);
-    double* t = e->g_prev; /* g_new becomes the previous state of the next step */
-    e->g_prev = e->g_new;
-    e->g_new = t;
+    st = wetdem_event_advance(sim, t0, t1, NULL);
     if (st == WETDEM_OK)
         *stop = wetdem_sim_separation_reached(sim);
     if (st == WETDEM_OK)

@@ -384,10 +384,8 @@ static int begin_run(struct wetdem_sim* sim)
     }
     if (st == WETDEM_OK)
         st = wetdem_sim_compute_forces(sim, e->time, false);
-    if (st == WETDEM_OK) {
-        wetdem_event_values(sim, e->g_prev);
-        wetdem_event_keep_pair_state(sim);
-    }
+    if (st == WETDEM_OK)
+        wetdem_event_start(sim);
     return st;
 }
 
