@@ -227,9 +227,6 @@ static int write_vtk(struct wetdem_sim* sim, const char* path, bool binary)
     uint32_t* block = NULL;
     struct wetdem_output_vtk_counts counts;
     if (sim->many && sim->many->started) {
-        int st = wetdem_sim_many_check_models(sim, "write_vtk");
-        if (st != WETDEM_OK)
-            return st;
         struct wetdem_many_stats s;
         if (!(block = particle_counts(sim, &s, &counts)))
             return WETDEM_ERR_NOMEM;
@@ -301,9 +298,6 @@ static int write_vtk_links(struct wetdem_sim* sim, const char* path, bool binary
     if (!m || !m->started)
         return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
                                "links: a VTK file of links needs a started many-particle run");
-    int checked = wetdem_sim_many_check_models(sim, "links");
-    if (checked != WETDEM_OK)
-        return checked;
     if (sim->history_len > WETDEM_HISTORY_SCRATCH)
         return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
                                "links: the models keep %zu history values a pair, more than %d",
@@ -760,11 +754,8 @@ static int write_checkpoint(struct wetdem_sim* sim, const char* path)
         return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
                                "checkpoints need a started many-particle run (wetdem_sim_set_many "
                                "and wetdem_sim_integrate)");
-    int st = wetdem_sim_many_check_models(sim, "write_checkpoint");
-    if (st != WETDEM_OK)
-        return st;
     struct wetdem_checkpoint ck = {0};
-    st = fill_checkpoint(sim, &ck);
+    int st = fill_checkpoint(sim, &ck);
     char msg[512] = "out of memory writing a checkpoint";
     if (st == WETDEM_OK)
         st = wetdem_checkpoint_write(path, &ck, msg, sizeof msg);
@@ -985,44 +976,50 @@ static int read_checkpoint(struct wetdem_sim* sim, const char* path)
 
 /* ---- the public writers and readers, in the C locale (locale_guard.h) ---- */
 
-int wetdem_sim_write_vtk(struct wetdem_sim* sim, const char* path, bool binary)
+enum file_call { WRITE_VTK, WRITE_VTK_LINKS, WRITE_CHECKPOINT, READ_CHECKPOINT };
+
+/* Runs a public file call: a writer refuses a run whose models changed since it started (its
+ * pair histories are laid out by them; the run's own outputs are written by calls that
+ * checked), then the call runs in the C locale. */
+static int file_call(struct wetdem_sim* sim, enum file_call call, const char* path, bool binary)
 {
+    static const char* const what[] = {"write_vtk", "links", "write_checkpoint", NULL};
+    int st = what[call] ? wetdem_sim_many_check_models(sim, what[call]) : WETDEM_OK;
+    if (st != WETDEM_OK)
+        return st;
     struct wetdem_locale_guard g;
     if (wetdem_locale_guard_enter(&g) != WETDEM_OK)
         return no_c_locale(sim);
-    int st = write_vtk(sim, path, binary);
+    switch (call) {
+    case WRITE_VTK: st = write_vtk(sim, path, binary); break;
+    case WRITE_VTK_LINKS: st = write_vtk_links(sim, path, binary); break;
+    case WRITE_CHECKPOINT: st = write_checkpoint(sim, path); break;
+    case READ_CHECKPOINT:
+        st = read_checkpoint(sim, path); /* (the times of the .vtk.series file) */
+        break;
+    }
     wetdem_locale_guard_leave(&g);
     return st;
+}
+
+int wetdem_sim_write_vtk(struct wetdem_sim* sim, const char* path, bool binary)
+{
+    return file_call(sim, WRITE_VTK, path, binary);
 }
 
 int wetdem_sim_write_vtk_links(struct wetdem_sim* sim, const char* path, bool binary)
 {
-    struct wetdem_locale_guard g;
-    if (wetdem_locale_guard_enter(&g) != WETDEM_OK)
-        return no_c_locale(sim);
-    int st = write_vtk_links(sim, path, binary);
-    wetdem_locale_guard_leave(&g);
-    return st;
+    return file_call(sim, WRITE_VTK_LINKS, path, binary);
 }
 
 int wetdem_sim_write_checkpoint(struct wetdem_sim* sim, const char* path)
 {
-    struct wetdem_locale_guard g;
-    if (wetdem_locale_guard_enter(&g) != WETDEM_OK)
-        return no_c_locale(sim);
-    int st = write_checkpoint(sim, path);
-    wetdem_locale_guard_leave(&g);
-    return st;
+    return file_call(sim, WRITE_CHECKPOINT, path, false);
 }
 
 int wetdem_sim_read_checkpoint(struct wetdem_sim* sim, const char* path)
 {
-    struct wetdem_locale_guard g;
-    if (wetdem_locale_guard_enter(&g) != WETDEM_OK)
-        return no_c_locale(sim);
-    int st = read_checkpoint(sim, path); /* (the times of the .vtk.series file) */
-    wetdem_locale_guard_leave(&g);
-    return st;
+    return file_call(sim, READ_CHECKPOINT, path, false);
 }
 
 /* ---- insertion ---- */
