@@ -671,56 +671,65 @@ void cli_batch_write_table(FILE* f, const struct cli_batch* b, int argc, char** 
                 cli_batch_points_run(b), b->n_pts, b->wall);
 }
 
-/* One line for the points whose spheres overlapped beyond the contact laws (information). */
-static void report_large_overlap(const struct cli_batch* b)
+/* What the points of a soft-engine batch are told about in one line (information): the
+ * result column that shows it, what it is, whether a point has it (then why, into msg) and
+ * how much (the worst point is named). */
+struct point_notice {
+    const char *column, *what;
+    bool (*has)(const struct cli_batch_point* p, char* msg, size_t n);
+    double (*size)(const struct cli_batch_point* p);
+};
+
+static bool hmin_unresolved(const struct cli_batch_point* p, char* msg, size_t n)
+{
+    return cli_hmin_unresolved(&p->res, msg, n);
+}
+
+static double hmin_ratio(const struct cli_batch_point* p)
+{
+    return p->res.stats.hmin_step_ratio;
+}
+
+static bool overlap_large(const struct cli_batch_point* p, char* msg, size_t n)
+{
+    return cli_overlap_large(&p->res, p->r_eff, msg, n);
+}
+
+static double overlap_ratio(const struct cli_batch_point* p)
+{
+    return -p->res.min_gap / p->r_eff;
+}
+
+/* One line for the points that ran and have notice c, with the worst and why. */
+static void report_notice(const struct cli_batch* b, const struct point_notice* c)
 {
     size_t n = 0, worst = 0;
     char why[600];
     for (size_t k = 0; b->engine == CLI_ENGINE_SOFT && k < b->n_pts; k++) {
         const struct cli_batch_point* p = &b->pts[k];
-        if (p->status < 0 || p->status >= CLI_BATCH_NOT_RUN ||
-            !cli_overlap_large(&p->res, p->r_eff, why, sizeof why))
+        if (p->status < 0 || p->status >= CLI_BATCH_NOT_RUN || !c->has(p, why, sizeof why))
             continue;
-        if (n++ == 0 ||
-            -p->res.min_gap / p->r_eff > -b->pts[worst].res.min_gap / b->pts[worst].r_eff)
+        if (n++ == 0 || c->size(p) > c->size(&b->pts[worst]))
             worst = k;
     }
     if (n == 0)
         return;
     char where[1100];
     point_values(b, &b->pts[worst], where, sizeof where);
-    cli_overlap_large(&b->pts[worst].res, b->pts[worst].r_eff, why, sizeof why);
-    cli_error("warning: %s: in %zu of %zu collisions (column min_gap) %s; the worst, at %s", b->cmd,
-              n, b->n_pts, why, where);
-}
-
-/* One line for the points whose fixed step did not resolve h_min (information). */
-static void report_unresolved_hmin(const struct cli_batch* b)
-{
-    size_t n = 0, worst = 0;
-    for (size_t k = 0; b->engine == CLI_ENGINE_SOFT && k < b->n_pts; k++) {
-        char why[600];
-        if (b->pts[k].status < 0 || b->pts[k].status >= CLI_BATCH_NOT_RUN ||
-            !cli_hmin_unresolved(&b->pts[k].res, why, sizeof why))
-            continue;
-        if (n++ == 0 ||
-            b->pts[k].res.stats.hmin_step_ratio > b->pts[worst].res.stats.hmin_step_ratio)
-            worst = k;
-    }
-    if (n == 0)
-        return;
-    char where[1100], why[600];
-    point_values(b, &b->pts[worst], where, sizeof where);
-    cli_hmin_unresolved(&b->pts[worst].res, why, sizeof why);
-    cli_error("warning: %s: in %zu of %zu collisions (column hmin_step_ratio) the step does not "
-              "resolve h_min; the worst, at %s: %s",
-              b->cmd, n, b->n_pts, where, why);
+    c->has(&b->pts[worst], why, sizeof why);
+    cli_error("warning: %s: in %zu of %zu collisions (column %s) %s; the worst, at %s: %s", b->cmd,
+              n, b->n_pts, c->column, c->what, where, why);
 }
 
 int cli_batch_report_failures(const struct cli_batch* b, int rc)
 {
-    report_unresolved_hmin(b);
-    report_large_overlap(b);
+    static const struct point_notice notices[] = {
+        {"hmin_step_ratio", "the step does not resolve h_min", hmin_unresolved, hmin_ratio},
+        {"min_gap", "the spheres overlap beyond what the contact laws hold for", overlap_large,
+         overlap_ratio},
+    };
+    for (size_t k = 0; k < sizeof notices / sizeof notices[0]; k++)
+        report_notice(b, &notices[k]);
     if (b->interrupted)
         cli_error("%s: interrupted by signal %d: %zu of %zu points ran; the table has every "
                   "point, those left out with status NOT_RUN",
