@@ -542,17 +542,17 @@ static int probe_override(const struct fit_ctx* c, const char* key, const char* 
     return rc;
 }
 
-/* Whether the key (full name) is one the fit sets per data point, which a fit of it (option
- * "--fit") or a --set of it (option "--set", tok the whole override) would override: a
- * message and CLI_EXIT_USAGE, else CLI_EXIT_OK. */
-static int check_not_per_point(const char* option, const char* tok, const char* full,
+/* Whether the key (full name) is one the fit sets per data point, which a fit of it
+ * (fitting: from --fit) or a --set of it (tok the whole override) would override: a message
+ * and CLI_EXIT_USAGE, else CLI_EXIT_OK. */
+static int check_not_per_point(bool fitting, const char* tok, const char* full,
                                const struct fit_ctx* c)
 {
     const char* why = NULL;
     if (strcmp(full, "collision.stokes") == 0)
-        why = option[2] == 'f' ? "every data row sets it (its stokes_n), so every point would "
-                                 "predict the same"
-                               : "every data row sets it (its stokes_n)";
+        why = fitting ? "every data row sets it (its stokes_n), so every point would "
+                        "predict the same"
+                      : "every data row sets it (its stokes_n)";
     else if (strcmp(full, "collision.speed") == 0)
         why = "every data row sets the Stokes number (stokes_n), from which the speed follows "
               "(speed and stokes exclude each other)";
@@ -560,8 +560,8 @@ static int check_not_per_point(const char* option, const char* tok, const char* 
         why = "every data row sets it (the angle_deg column)";
     if (!why)
         return CLI_EXIT_OK;
-    cli_error("fit: %s %s: %s %s: %s", option, tok, full,
-              option[2] == 'f' ? "cannot be fitted" : "would never be used", why);
+    cli_error("fit: %s %s: %s %s: %s", fitting ? "--fit" : "--set", tok, full,
+              fitting ? "cannot be fitted" : "would never be used", why);
     return CLI_EXIT_USAGE;
 }
 
@@ -573,7 +573,7 @@ static int check_sets(const struct fit_args* a, const struct fit_ctx* c)
         if (cli_override_split(a->sets[k], section, key, NULL) != 0)
             return CLI_EXIT_USAGE;
         snprintf(full, sizeof full, "%s.%s", section, key);
-        if (check_not_per_point("--set", a->sets[k], full, c) != CLI_EXIT_OK)
+        if (check_not_per_point(false, a->sets[k], full, c) != CLI_EXIT_OK)
             return CLI_EXIT_USAGE;
     }
     return CLI_EXIT_OK;
@@ -611,7 +611,7 @@ static int parse_keys(const char* list, struct fit_ctx* c)
                           given[j], tok);
                 return CLI_EXIT_USAGE;
             }
-        if (check_not_per_point("--fit", tok, full, c) != CLI_EXIT_OK)
+        if (check_not_per_point(true, tok, full, c) != CLI_EXIT_OK)
             return CLI_EXIT_USAGE;
         if (strncmp(section, "material.", 9) == 0 &&
             !cli_scenario_has_section(c->base, section)) { /* (the override says why) */
