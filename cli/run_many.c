@@ -803,9 +803,11 @@ static int set_outputs(struct cli_many_setup* su, const struct cli_run_options* 
     return CLI_EXIT_RUNTIME;
 }
 
-/* Restores the checkpoint and checks that this run can continue it; touches no file. */
+/* Restores the checkpoint and checks that this run can continue it, with the restored
+ * state's statistics into *s; touches no file. */
 static int restore(const struct cli_scenario* sc, const struct cli_many_setup* su,
-                   const struct cli_run_options* opt, const struct plan* pl)
+                   const struct cli_run_options* opt, const struct plan* pl,
+                   struct wetdem_many_stats* s)
 {
     size_t n_scenario = wetdem_sim_n_particles(su->sim);
     if (wetdem_sim_read_checkpoint(su->sim, opt->restart) != WETDEM_OK) {
@@ -834,24 +836,23 @@ static int restore(const struct cli_scenario* sc, const struct cli_many_setup* s
                   opt->restart, ratio, CLOSURE_LIMIT);
         return CLI_EXIT_USAGE;
     }
-    struct wetdem_many_stats s;
-    if (many_stats(sc, su->sim, &s) != CLI_EXIT_OK)
+    if (many_stats(sc, su->sim, s) != CLI_EXIT_OK)
         return CLI_EXIT_RUNTIME;
     /* the step is the checkpoint's; one the scenario now derives otherwise ([integrator]
        dt_fraction, a material's stiffness: not in the checkpoint's fingerprint, which holds
        the settings' dt) would misplace the run's end, its frames and its CSV rows */
-    if (s.dt != pl->dt) {
+    if (s->dt != pl->dt) {
         cli_error("--restart %s: the checkpoint's step is dt = %.9g s, this scenario's %.9g s "
                   "(run.dt, integrator.dt or dt_fraction, the materials): resume with the "
                   "scenario of the run that wrote it",
-                  opt->restart, s.dt, pl->dt);
+                  opt->restart, s->dt, pl->dt);
         return CLI_EXIT_USAGE;
     }
-    if (s.step >= pl->total) {
+    if (s->step >= pl->total) {
         cli_error("--restart %s: the checkpoint is at step %llu (t = %.9g s), and this run ends "
                   "at step %llu ([run] t_end = %.9g s): the run that wrote it had reached its "
                   "end; raise t_end (--set run.t_end=...) or steps to continue it",
-                  opt->restart, (unsigned long long)s.step, wetdem_sim_time(su->sim), pl->total,
+                  opt->restart, (unsigned long long)s->step, wetdem_sim_time(su->sim), pl->total,
                   pl->t_end);
         return CLI_EXIT_USAGE;
     }
@@ -862,12 +863,10 @@ static int restore(const struct cli_scenario* sc, const struct cli_many_setup* s
 static int resume(const struct cli_scenario* sc, const struct cli_many_setup* su,
                   const struct cli_run_options* opt, const struct plan* pl, struct series* vtk)
 {
-    int rc = restore(sc, su, opt, pl);
+    struct wetdem_many_stats s;
+    int rc = restore(sc, su, opt, pl, &s);
     if (rc != CLI_EXIT_OK)
         return rc;
-    struct wetdem_many_stats s;
-    if (many_stats(sc, su->sim, &s) != CLI_EXIT_OK)
-        return CLI_EXIT_RUNTIME;
     /* the index first: it refuses without touching a file, the CSV's trim rewrites one */
     rc = vtk ? series_resume(vtk, wetdem_sim_time(su->sim), s.step, pl->dt, su->vtk_every)
              : CLI_EXIT_OK;
@@ -1063,8 +1062,9 @@ int cli_run_many(const struct cli_scenario* sc, const struct cli_run_options* op
     if (rc == CLI_EXIT_OK && opt->out_dir)
         rc = check_output_volume(sc, &su, &pl);
     if (rc == CLI_EXIT_OK && opt->check) { /* (with --restart: whether it can be continued) */
+        struct wetdem_many_stats s;
         if (opt->restart)
-            rc = restore(sc, &su, opt, &pl);
+            rc = restore(sc, &su, opt, &pl, &s);
         if (rc == CLI_EXIT_OK)
             rc = print_check(sc, &su, &pl, opt);
     } else if (rc == CLI_EXIT_OK) {
