@@ -259,13 +259,6 @@ static int check_engine(const struct cli_scenario* sc, struct cli_batch* b)
     return rc;
 }
 
-/* Whether a key "section.key" gives the impact: collision.speed or collision.stokes, of
- * which setting one replaces the other. */
-static bool is_impact_key(const char* full)
-{
-    return strcmp(full, "collision.speed") == 0 || strcmp(full, "collision.stokes") == 0;
-}
-
 /* The keys as the scenario names them ("glass.p_gt" is [model.glass] p_gt): two names of one
  * key, or collision.speed and collision.stokes (a --set of one replaces the other), would give
  * rows labelled with values never used; a --set of a key varied would never be used. An exit
@@ -286,25 +279,25 @@ static int check_keys(const struct cli_batch* b)
             return CLI_EXIT_USAGE;
         snprintf(set, sizeof set, "%s.%s", section, key);
         for (int d = 0; d < b->n_keys; d++) {
-            if (strcmp(set, full[d]) != 0 && !(is_impact_key(set) && is_impact_key(full[d])))
+            int clash = cli_keys_clash(set, full[d]);
+            if (!clash)
                 continue;
             cli_error("%s: --set %s sets %s, which %s %s varies%s: each point's value would "
                       "replace it; leave it out",
                       b->cmd, b->sets[k], set, options[d], b->key[d],
-                      strcmp(set, full[d]) == 0
-                          ? ""
-                          : " (the impact, by speed or by stokes: setting one replaces the other)");
+                      clash == 2 ? CLI_IMPACT_CLASH : "");
             return CLI_EXIT_USAGE;
         }
     }
     if (b->n_keys < 2)
         return CLI_EXIT_OK;
-    if (strcmp(full[0], full[1]) == 0) {
+    int clash = cli_keys_clash(full[0], full[1]);
+    if (clash == 1) {
         cli_error("%s: %s %s and %s %s name the same key, %s", b->cmd, options[0], b->key[0],
                   options[1], b->key[1], full[0]);
         return CLI_EXIT_USAGE;
     }
-    if (is_impact_key(full[0]) && is_impact_key(full[1])) {
+    if (clash == 2) {
         cli_error("%s: %s %s and %s %s: the impact is given by speed or by stokes, and setting "
                   "one replaces the other, so the first would never be used",
                   b->cmd, options[0], b->key[0], options[1], b->key[1]);

@@ -842,17 +842,26 @@ static void warn_shadowed_presets(const struct cli_scenario* sc)
     }
 }
 
-/* Whether two --set overrides, already applied (so they split), set one key: 1 the same key,
- * 2 collision speed and stokes (setting one replaces the other), else 0. */
+static bool is_impact_key(const char* full)
+{
+    return strcmp(full, "collision.speed") == 0 || strcmp(full, "collision.stokes") == 0;
+}
+
+int cli_keys_clash(const char* a, const char* b)
+{
+    return strcmp(a, b) == 0 ? 1 : is_impact_key(a) && is_impact_key(b) ? 2 : 0;
+}
+
+/* cli_keys_clash of two --set overrides, already applied (so they split). */
 static int same_override_key(const char* a, const char* b)
 {
     char sa[CLI_NAME_MAX], ka[CLI_NAME_MAX], sb[CLI_NAME_MAX], kb[CLI_NAME_MAX];
-    if (cli_override_split(a, sa, ka, NULL) != 0 || cli_override_split(b, sb, kb, NULL) != 0 ||
-        strcmp(sa, sb) != 0)
+    if (cli_override_split(a, sa, ka, NULL) != 0 || cli_override_split(b, sb, kb, NULL) != 0)
         return 0;
-    bool impact_a = strcmp(sa, "collision") == 0 && (!strcmp(ka, "speed") || !strcmp(ka, "stokes"));
-    bool impact_b = strcmp(sb, "collision") == 0 && (!strcmp(kb, "speed") || !strcmp(kb, "stokes"));
-    return strcmp(ka, kb) == 0 ? 1 : impact_a && impact_b ? 2 : 0;
+    char full_a[2 * CLI_NAME_MAX + 2], full_b[2 * CLI_NAME_MAX + 2];
+    snprintf(full_a, sizeof full_a, "%s.%s", sa, ka);
+    snprintf(full_b, sizeof full_b, "%s.%s", sb, kb);
+    return cli_keys_clash(full_a, full_b);
 }
 
 /* Loads the file and applies the overrides; two of one key are refused, as a key given twice
@@ -864,13 +873,11 @@ int cli_load_with_overrides(const char* file, const char* const* sets, int n_set
     for (int k = 0; rc == CLI_EXIT_OK && k < n_sets; k++) {
         rc = cli_scenario_override(sc, sets[k]);
         for (int j = 0; rc == CLI_EXIT_OK && j < k; j++) {
-            if (!same_override_key(sets[j], sets[k]))
+            int clash = same_override_key(sets[j], sets[k]);
+            if (!clash)
                 continue;
             cli_error("%s: --set %s and --set %s set one key%s: give it once", file, sets[j],
-                      sets[k],
-                      same_override_key(sets[j], sets[k]) == 2
-                          ? " (the impact, by speed or by stokes: setting one replaces the other)"
-                          : "");
+                      sets[k], clash == 2 ? CLI_IMPACT_CLASH : "");
             rc = CLI_EXIT_USAGE;
         }
     }

@@ -266,6 +266,12 @@ int cli_override_split(const char* text, char* section, char* key, char* value);
 /* The same for a key given alone by `option` ("--param", "--fit"): "a.b.c" into section and
  * key; the message names the option. Returns 0 or -1 (message printed). */
 int cli_key_split(const char* option, const char* name, char* section, char* key);
+/* Whether two keys "section.key" (as those splits resolve them) set one thing: 1 the same
+ * key, 2 collision.speed and collision.stokes (the impact: setting one replaces the other),
+ * else 0. */
+int cli_keys_clash(const char* a, const char* b);
+/* What a clash 2 of cli_keys_clash means, for messages. */
+#define CLI_IMPACT_CLASH " (the impact, by speed or by stokes: setting one replaces the other)"
 
 /* ---- shared by run, sweep and fit ---- */
 
