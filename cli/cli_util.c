@@ -124,6 +124,11 @@ int cli_parse_range(const char* text, bool is_log, const char* what, struct cli_
         cli_error("%s: '%s' has N = 1 but A != B; use A:A:1 for a single value", what, text);
         return CLI_EXIT_USAGE;
     }
+    if (r->n > 1 && r->first == r->last) {
+        cli_error("%s: '%s' gives %zu identical values (A = B); use A:A:1 for a single value", what,
+                  text, r->n);
+        return CLI_EXIT_USAGE;
+    }
     if (is_log && !(r->first > 0 && r->last > 0)) {
         cli_error("%s: '%s' with %s needs A > 0 and B > 0", what, text,
                   strcmp(what, "--values2") == 0 ? "--log2" : "--log");
