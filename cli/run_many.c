@@ -219,9 +219,10 @@ static unsigned long long frame_step(const struct series* s, size_t k, double t,
 
 /* On restart: the frames of the existing index up to time t, the checkpoint's (entries in
  * order, named as this run names them); the rest are dropped and will be written again. A
- * frame at t itself is kept only on the grid of `every`: off it, it is the last frame that
- * the run which wrote the checkpoint added at its end, which the uninterrupted run does not
- * have. A frame on disk beyond those the index lists means the index is missing or cut short:
+ * frame at t itself is kept only on the grid of `every`, the vtk_every of the run that wrote
+ * the checkpoint (struct writer): off it, it is the last frame that run added at its end,
+ * which the uninterrupted run does not have (the resumed run writes a frame there when t is
+ * on its own grid). A frame on disk beyond those the index lists means the index is missing or cut short:
  * numbering from its end would overwrite frames the resumed run does not write again, so the
  * restart is refused (CLI exit code; nothing is touched). */
 static int series_resume(struct series* s, double t, unsigned long long step, double dt,
@@ -262,7 +263,7 @@ static int series_resume(struct series* s, double t, unsigned long long step, do
                   listed, name);
         return CLI_EXIT_USAGE;
     }
-    if (s->n && frame_step(s, s->n - 1, t, step, dt) == step && every && step % every != 0)
+    if (s->n && frame_step(s, s->n - 1, t, step, dt) == step && !(every && step % every == 0))
         s->n--;
     /* the links index lists the frames from the first after which each has its links file:
        a run written without links, resumed with them, has links from the restart on */
@@ -274,6 +275,59 @@ static int series_resume(struct series* s, double t, unsigned long long step, do
     }
     s->last_step = s->n ? frame_step(s, s->n - 1, t, step, dt) : 0;
     return CLI_EXIT_OK;
+}
+
+/* ------------------------------------------------- the run that wrote the checkpoint --- */
+
+/* The output intervals of the run that wrote the checkpoint: its frames and rows up to the
+ * checkpoint's step lie on their grid, except the frame and the row that run added at the
+ * step it ended at. */
+struct writer {
+    unsigned long long vtk_every, csv_every;
+    bool ended_here; /* that run ended (finished or was interrupted) at the checkpoint's step */
+};
+
+/* The value of "key": N in a JSON text, or false. */
+static bool json_count(const char* text, const char* key, unsigned long long* value)
+{
+    char pattern[64];
+    snprintf(pattern, sizeof pattern, "\"%s\": ", key);
+    const char* p = strstr(text, pattern);
+    if (!p || !(p[strlen(pattern)] >= '0' && p[strlen(pattern)] <= '9'))
+        return false;
+    *value = strtoull(p + strlen(pattern), NULL, 10);
+    return true;
+}
+
+/* The first `size` - 1 bytes of a file as a string (into buf), or false. */
+static bool read_head(const char* path, char* buf, size_t size)
+{
+    FILE* f = fopen(path, "r");
+    if (!f)
+        return false;
+    size_t n = fread(buf, 1, size - 1, f);
+    buf[n] = '\0';
+    fclose(f);
+    return true;
+}
+
+/* Finds the run that wrote the checkpoint at `step` from DIR/summary.json, which every run
+ * writes where it ends, with its step and output intervals: when the summary's step is the
+ * checkpoint's, its intervals; otherwise (no summary, or one of another step: a run that went
+ * on from the checkpoint and crashed) this run's, as though unchanged. */
+static struct writer find_writer(const char* dir, const struct cli_many_setup* su,
+                                 unsigned long long step)
+{
+    struct writer w = {su->vtk_every, su->csv_every, false};
+    char path[PATH_CHARS + CLI_VALUE_MAX];
+    snprintf(path, sizeof path, "%s/%s", dir, su->summary_name);
+    char text[8192]; /* (the step and the intervals come first) */
+    unsigned long long at, vtk, csv;
+    if (su->summary_name[0] && read_head(path, text, sizeof text) &&
+        json_count(text, "step", &at) && at == step && json_count(text, "vtk_every", &vtk) &&
+        json_count(text, "csv_every", &csv))
+        w = (struct writer){vtk, csv, true};
+    return w;
 }
 
 /* ----------------------------------------------------------- CSV: last row, restart --- */
@@ -302,14 +356,17 @@ static int many_stats(const struct cli_scenario* sc, struct wetdem_sim* sim,
 
 /* Keeps the comment and header lines of the CSV and the rows up to `step` (second column),
  * rewriting the file atomically when rows are dropped. A row at `step` itself is kept only on
- * the grid of `every`: off it, it is the last row that the run which wrote the checkpoint
- * added at its end (csv_final_row), which the uninterrupted run does not have. A last line
- * without its newline, a row cut short by a crash or a full disk, is dropped too (the resumed
- * run would append to it). CLI exit code; a missing file is an input error (the rows before
- * the checkpoint would be lost). */
-static int csv_resume(const char* path, unsigned long long step, unsigned long long every,
-                      const char* out_dir)
+ * the grid of w->csv_every, that of the run which wrote the checkpoint: off it, it is the last
+ * row that run added at its end (csv_final_row), which the uninterrupted run does not have. A
+ * last line without its newline, a row cut short by a crash or a full disk, is dropped too
+ * (the resumed run would append to it). *at_step says whether a row at `step` is kept. CLI
+ * exit code; a missing file, one without its header line, and one whose rows end before those
+ * the run that wrote the checkpoint had written (a file cut short or replaced) are input
+ * errors, and leave the file as it was (the resumed run would append its rows after a gap). */
+static int csv_resume(const char* path, unsigned long long step, const struct writer* w,
+                      const char* out_dir, bool* at_step)
 {
+    *at_step = false;
     FILE* f = fopen(path, "r");
     if (!f) {
         cli_error("--restart: %s is missing: give --out the directory of the interrupted run, "
@@ -321,21 +378,46 @@ static int csv_resume(const char* path, unsigned long long step, unsigned long l
     snprintf(tmp, sizeof tmp, "%s.tmp", path);
     FILE* g = fopen(tmp, "w");
     char line[4096];
-    bool dropped = false;
+    bool dropped = false, header = false, rows = false;
+    unsigned long long every = w->csv_every, last = 0; /* the last whole row's step */
     while (g && fgets(line, sizeof line, f)) {
         const char* comma = strchr(line, ',');
         bool data = line[0] >= '0' && line[0] <= '9' && comma;
         unsigned long long row = data ? strtoull(comma + 1, NULL, 10) : 0;
         bool whole = strchr(line, '\n') != NULL; /* (a row cut by a crash ends without) */
-        if (!whole || (data && (row > step || (row == step && every && step % every != 0)))) {
+        header = header || strncmp(line, "time_s,step,", 12) == 0;
+        if (data && whole) {
+            last = rows && last > row ? last : row;
+            rows = true;
+        }
+        if (!whole || (data && (row > step || (row == step && !(every && step % every == 0))))) {
             dropped = true;
             continue;
         }
+        *at_step = *at_step || (data && row == step);
         fputs(line, g);
     }
     fclose(f);
     bool ok = g && !ferror(g);
     ok = g && fclose(g) == 0 && ok;
+    /* the rows the run that wrote the checkpoint had written by then: one at the step it
+       ended at, else those of its grid (this run's, as far as is known) */
+    unsigned long long due = w->ended_here ? step : every ? step / every * every : 0;
+    if (ok && (!header || !rows || last < due)) {
+        remove(tmp);
+        if (!header)
+            cli_error("--restart: %s has no header line (time_s,step,...): it was emptied or "
+                      "cut at its start, and the rows up to the checkpoint are lost; restore "
+                      "it, or start the run afresh without --restart",
+                      path);
+        else
+            cli_error("--restart: %s %s%llu, before the checkpoint's step %llu: it was cut short "
+                      "or replaced, and the resumed run would leave a gap; restore it, or start "
+                      "the run afresh without --restart",
+                      path, rows ? "ends at step " : "has no rows, expected up to step ",
+                      rows ? last : due, step);
+        return CLI_EXIT_USAGE;
+    }
     if (ok && (!dropped || rename(tmp, path) == 0)) {
         remove(tmp);
         return CLI_EXIT_OK;
@@ -560,9 +642,10 @@ static void summary_json(FILE* f, const struct cli_scenario* sc, const struct cl
     cli_json_string(f, sc->file);
     fprintf(f,
             ", \"interrupted\": %s, \"particles\": %zu, \"fixed\": %zu, \"walls\": %zu, "
-            "\"step\": %llu, ",
+            "\"step\": %llu, \"vtk_every\": %llu, \"csv_every\": %llu, ",
             o->interrupted ? "true" : "false", wetdem_sim_n_particles(su->sim), n_fixed(su),
-            wetdem_sim_n_walls(su->sim), s->step);
+            wetdem_sim_n_walls(su->sim), s->step, su->vtk_prefix[0] ? su->vtk_every : 0,
+            su->csv_name[0] ? su->csv_every : 0);
     json_num(f, "time_s", wetdem_sim_time(su->sim), true);
     json_num(f, "dt_s", s->dt, true);
     fprintf(f, "\"contacts\": %zu, \"bridges\": %zu, \"agglomerates\": %zu, ", s->contacts,
@@ -848,7 +931,16 @@ static int restore(const struct cli_scenario* sc, const struct cli_many_setup* s
                   opt->restart, s->dt, pl->dt);
         return CLI_EXIT_USAGE;
     }
-    if (s->step >= pl->total) {
+    if (s->step > pl->total) {
+        cli_error("--restart %s: the checkpoint is at step %llu (t = %.9g s), after this run's "
+                  "end at step %llu ([run] t_end = %.9g s, or steps): a run cannot go back in "
+                  "time; give a t_end (--set run.t_end=...) or steps beyond the checkpoint's to "
+                  "continue it, or start afresh without --restart",
+                  opt->restart, (unsigned long long)s->step, wetdem_sim_time(su->sim), pl->total,
+                  pl->t_end);
+        return CLI_EXIT_USAGE;
+    }
+    if (s->step == pl->total) {
         cli_error("--restart %s: the checkpoint is at step %llu (t = %.9g s), and this run ends "
                   "at step %llu ([run] t_end = %.9g s): the run that wrote it had reached its "
                   "end; raise t_end (--set run.t_end=...) or steps to continue it",
@@ -867,13 +959,22 @@ static int resume(const struct cli_scenario* sc, const struct cli_many_setup* su
     int rc = restore(sc, su, opt, pl, &s);
     if (rc != CLI_EXIT_OK)
         return rc;
+    struct writer w = find_writer(opt->out_dir, su, s.step);
     /* the index first: it refuses without touching a file, the CSV's trim rewrites one */
-    rc = vtk ? series_resume(vtk, wetdem_sim_time(su->sim), s.step, pl->dt, su->vtk_every)
+    rc = vtk ? series_resume(vtk, wetdem_sim_time(su->sim), s.step, pl->dt, w.vtk_every)
              : CLI_EXIT_OK;
-    if (rc == CLI_EXIT_OK && pl->csv_prefix[0]) {
-        char path[PATH_CHARS + 8];
-        snprintf(path, sizeof path, "%s.csv", pl->csv_prefix);
-        rc = csv_resume(path, s.step, su->csv_every, opt->out_dir);
+    bool at_step = false;
+    char path[PATH_CHARS + 8];
+    snprintf(path, sizeof path, "%s.csv", pl->csv_prefix);
+    if (rc == CLI_EXIT_OK && pl->csv_prefix[0])
+        rc = csv_resume(path, s.step, &w, opt->out_dir, &at_step);
+    /* a row at the checkpoint's step on this run's grid that the CSV lacks (that run's grid
+       was another): the uninterrupted run with this run's settings has it */
+    if (rc == CLI_EXIT_OK && pl->csv_prefix[0] && !at_step && s.step % su->csv_every == 0 &&
+        wetdem_sim_many_write_csv_row(su->sim) != WETDEM_OK) {
+        cli_error("--restart: cannot append the row of step %llu to %s: %s", s.step, path,
+                  wetdem_sim_errmsg(su->sim));
+        rc = CLI_EXIT_RUNTIME;
     }
     return rc;
 }

@@ -789,7 +789,9 @@ WETDEM_API int wetdem_sim_write_checkpoint(struct wetdem_sim* sim, const char* p
 /* Restores a checkpoint into a sim set up exactly as the one that wrote it (materials, fluid,
  * models, parameters, walls, many settings): particles, time, step, pair histories, energy
  * budget and output counters are replaced; continuing gives bit-identical results to the
- * uninterrupted run. WETDEM_ERR_INVALID if the set-up differs, WETDEM_ERR_PARSE/IO if the
+ * uninterrupted run. The outputs go on at the multiples of the vtk_every, csv_every and
+ * checkpoint_every of the settings set now, which may differ from those of the run that
+ * wrote the checkpoint. WETDEM_ERR_INVALID if the set-up differs, WETDEM_ERR_PARSE/IO if the
  * file is bad. */
 WETDEM_API int wetdem_sim_read_checkpoint(struct wetdem_sim* sim, const char* path);
 

@@ -857,6 +857,12 @@ static int check_restorable(struct wetdem_sim* sim, const struct wetdem_checkpoi
     return check_restorable_values(sim, ck, path);
 }
 
+/* The first step after `step` on the grid of `every` (0: no such output). */
+static uint64_t next_on_grid(uint64_t step, unsigned long long every)
+{
+    return every ? (step / every + 1) * every : 0;
+}
+
 /* Particles, engine time and counters from ck. */
 static int restore_state(struct wetdem_sim* sim, const struct wetdem_checkpoint* ck)
 {
@@ -900,10 +906,12 @@ static int restore_state(struct wetdem_sim* sim, const struct wetdem_checkpoint*
     m->n_series = 0;
     m->vtk_files = ck->output.vtk_files; /* numbering continues: no frame is overwritten */
     m->csv_rows = ck->output.csv_rows;
-    m->next_vtk_step = ck->output.next_vtk_step;
-    m->next_csv_step = ck->output.next_csv_step;
-    unsigned long long every = m->set.checkpoint_every;
-    m->next_checkpoint_step = every ? (m->step / every + 1) * every : 0;
+    /* the outputs after the checkpoint follow the grid of this run's intervals, which may
+       differ from those of the run that wrote it (the checkpoint's next steps are that run's;
+       with the same intervals the two agree) */
+    m->next_vtk_step = next_on_grid(m->step, m->set.vtk_every);
+    m->next_csv_step = next_on_grid(m->step, m->set.csv_every);
+    m->next_checkpoint_step = next_on_grid(m->step, m->set.checkpoint_every);
     return WETDEM_OK;
 }
 

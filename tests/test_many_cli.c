@@ -508,6 +508,168 @@ static void test_many_cli_restart_is_bit_identical(void** state)
     check_same_outputs("split", "edited", 7);
 }
 
+/* The frames of a series index in order: their times into t[] (at most max); the count. Fails
+ * when a name is not the next number or a time does not increase. */
+static size_t series_times(const char* dir, double* t, size_t max)
+{
+    char path[300];
+    snprintf(path, sizeof path, "%s/particles.vtk.series", dir);
+    char* text = test_read_file(tpath(path), NULL);
+    if (!text)
+        fail_msg("%s is missing", path);
+    size_t n = 0;
+    for (const char* p = strstr(text, "\"name\" : \""); p && n < max;
+         p = strstr(p + 1, "\"name\" : \"")) {
+        size_t k;
+        double time;
+        if (sscanf(p, "\"name\" : \"particles_%zu.vtk\", \"time\" : %lf", &k, &time) != 2 || k != n)
+            fail_msg("%s: entry %zu is not particles_%06zu.vtk", path, n, n);
+        if (n > 0 && !(time > t[n - 1]))
+            fail_msg("%s: the time of entry %zu, %.17g, does not increase", path, n, time);
+        t[n++] = time;
+    }
+    free(text);
+    return n;
+}
+
+/* Whether frame `k` of dir a and frame `l` of dir b are byte-identical. */
+static bool same_frame(const char* a, size_t k, const char* b, size_t l)
+{
+    char pa[300], pb[300];
+    snprintf(pa, sizeof pa, "%s/particles_%06zu.vtk", a, k);
+    snprintf(pb, sizeof pb, "%s/particles_%06zu.vtk", b, l);
+    size_t la, lb;
+    char* ta = test_read_file(tpath(pa), &la);
+    char* tb = test_read_file(tpath(pb), &lb);
+    bool same = ta && tb && la == lb && memcmp(ta, tb, la) == 0;
+    free(ta);
+    free(tb);
+    return same;
+}
+
+/* The row of `step` in a CSV without its column candidate_pairs (caller frees), or NULL. */
+static char* csv_row(const char* name, unsigned long long step)
+{
+    char* text = test_read_file(tpath(name), NULL);
+    if (!text)
+        fail_msg("%s is missing", name);
+    char* found = NULL;
+    for (char* line = strtok(text, "\n"); line && !found; line = strtok(NULL, "\n")) {
+        const char* comma = strchr(line, ',');
+        if (line[0] >= '0' && line[0] <= '9' && comma && strtoull(comma + 1, NULL, 10) == step) {
+            size_t n = strlen(line);
+            found = malloc(n + 2);
+            snprintf(found, n + 2, "%s\n", line);
+            drop_column(found, 9);
+        }
+    }
+    free(text);
+    return found;
+}
+
+/* The steps of the data rows of a CSV, in order, into steps[] (at most max); the count. */
+static size_t csv_steps(const char* name, unsigned long long* steps, size_t max)
+{
+    char* text = test_read_file(tpath(name), NULL);
+    if (!text)
+        fail_msg("%s is missing", name);
+    size_t n = 0;
+    for (char* line = strtok(text, "\n"); line && n < max; line = strtok(NULL, "\n")) {
+        const char* comma = strchr(line, ',');
+        if (line[0] >= '0' && line[0] <= '9' && comma)
+            steps[n++] = strtoull(comma + 1, NULL, 10);
+    }
+    free(text);
+    return n;
+}
+
+/* A restart with other output intervals (vtk_every, csv_every; the defaults derive them from
+ * the run's length, so a longer t_end changes them too): the frames and rows up to the
+ * checkpoint's step are those of the run that wrote it, on its grid, those after it on the
+ * resumed run's grid; the frame and the row of the checkpoint's step are kept when they lie on
+ * the first grid (they were dropped when off the second), and written when on the second. No
+ * frame is lost or doubled, the index's times increase, and each frame and row is the
+ * uninterrupted run's of its step, byte for byte. */
+static void test_many_cli_restart_with_other_intervals(void** state)
+{
+    (void)state;
+    scenario("grid.ini", "");
+    const char* old_grid = "--set dump.vtk_every=100 --set dump.csv_every=20";
+    const char* new_grid = "--set dump.vtk_every=70 --set dump.csv_every=35";
+    char args[600];
+    snprintf(args, sizeof args, "run grid.ini --set run.steps=600 %s --out ref_old", old_grid);
+    assert_int_equal(run_cli(args), 0);
+    snprintf(args, sizeof args, "run grid.ini --set run.steps=600 %s --out ref_new", new_grid);
+    assert_int_equal(run_cli(args), 0);
+    /* split at 300 (on the first grids, off the second), at 305 (off both: its last frame and
+       row are dropped) and at 350 (off the first, on the second: written again) */
+    const unsigned long long split[3] = {300, 305, 350};
+    for (int c = 0; c < 3; c++) {
+        char dir[32], csv[64];
+        snprintf(dir, sizeof dir, "grid%llu", split[c]);
+        snprintf(csv, sizeof csv, "%s/global.csv", dir);
+        snprintf(args, sizeof args, "run grid.ini --set run.steps=%llu %s --out %s", split[c],
+                 old_grid, dir);
+        assert_int_equal(run_cli(args), 0);
+        snprintf(args, sizeof args,
+                 "run grid.ini --set run.steps=600 %s --out %s --restart %s/checkpoint.ckpt",
+                 new_grid, dir, dir);
+        int code = run_cli(args);
+        if (code != 0)
+            fail_msg("%s: exit %d\n%s", args, code, stderr_text());
+        /* the frames: 0, 100, 200, 300 of the first grid up to the split, then 350, 420,
+           490, 560 and the last, 600 */
+        unsigned long long want[16];
+        size_t n_want = 0;
+        for (unsigned long long k = 0; k <= split[c]; k += 100)
+            want[n_want++] = k;
+        for (unsigned long long k = 70; k < 600; k += 70)
+            if (k >= split[c] && !(k == split[c] && split[c] % 100 == 0))
+                want[n_want++] = k;
+        want[n_want++] = 600;
+        double t[32];
+        size_t n = series_times(dir, t, 32);
+        if (n != n_want)
+            fail_msg("split at %llu: %zu frames, expected %zu", split[c], n, n_want);
+        for (size_t k = 0; k < n; k++) {
+            /* the uninterrupted run's frame of that step */
+            bool first = want[k] % 100 == 0 && want[k] <= split[c];
+            size_t ref_k = first ? want[k] / 100 : want[k] == 600 ? 9 : want[k] / 70;
+            CHECK_ABS(t[k], 2e-6 * (double)want[k], 1e-15);
+            if (!same_frame(first ? "ref_old" : "ref_new", ref_k, dir, k))
+                fail_msg("split at %llu: frame %zu (step %llu) differs from the uninterrupted "
+                         "run's",
+                         split[c], k, want[k]);
+        }
+        /* the rows: every 20 up to the split, then every 35 after it, and the last */
+        unsigned long long rows[64], want_rows[64];
+        size_t n_rows = csv_steps(csv, rows, 64), n_want_rows = 0;
+        for (unsigned long long k = 0; k <= split[c]; k += 20)
+            want_rows[n_want_rows++] = k;
+        for (unsigned long long k = 35; k < 600; k += 35)
+            if (k > split[c] || (k == split[c] && split[c] % 20 != 0))
+                want_rows[n_want_rows++] = k;
+        want_rows[n_want_rows++] = 600;
+        if (n_rows != n_want_rows)
+            fail_msg("split at %llu: %zu CSV rows, expected %zu", split[c], n_rows, n_want_rows);
+        for (size_t k = 0; k < n_rows; k++) {
+            if (rows[k] != want_rows[k])
+                fail_msg("split at %llu: CSV row %zu is of step %llu, expected %llu", split[c], k,
+                         rows[k], want_rows[k]);
+            char* a = csv_row(csv, rows[k]);
+            char* b = csv_row(rows[k] % 20 == 0 && rows[k] <= split[c] ? "ref_old/global.csv"
+                                                                       : "ref_new/global.csv",
+                              rows[k]);
+            if (!a || !b || strcmp(a, b) != 0)
+                fail_msg("split at %llu: the CSV row of step %llu differs from the "
+                         "uninterrupted run's",
+                         split[c], rows[k]);
+            free(a);
+            free(b);
+        }
+    }
+}
+
 /* Number of data rows in a CSV (lines starting with a digit). */
 static size_t csv_rows(const char* path)
 {
@@ -560,6 +722,131 @@ static unsigned long long interrupted_step(const char* err)
     if (!p)
         fail_msg("no step in the interruption message:\n%s", err);
     return strtoull(p + 6, NULL, 10);
+}
+
+/* Copies tmpdir/a to tmpdir/b (a directory). */
+static void copy_dir(const char* a, const char* b)
+{
+    char cmd[1400];
+    snprintf(cmd, sizeof cmd, "rm -rf '%s/%s' && cp -r '%s/%s' '%s/%s'", tmpdir, b, tmpdir, a,
+             tmpdir, b);
+    assert_int_equal(system(cmd), 0);
+}
+
+/* Restarts as a demanding user tries them: a t_end before the checkpoint's time (exit 2, said
+ * so, nothing touched); a CSV deleted, emptied or cut short at a row's end (exit 2, the file
+ * as it was: the resumed run appended its rows after a gap); two restarts in a row, and one
+ * with another number of threads (bit-identical frames, index and summary), and one from a
+ * checkpoint written at a signal in the first step. */
+static void test_many_cli_restart_probes(void** state)
+{
+    (void)state;
+    scenario("probe.ini", "[dump]\nvtk_every = 100\ncsv_every = 20\n");
+    assert_int_equal(run_cli("run probe.ini --set run.steps=600 --out pwhole"), 0);
+    assert_int_equal(run_cli("run probe.ini --set run.steps=300 --out p300"), 0);
+    /* t_end before the checkpoint: refused, and not as "had reached its end" */
+    copy_dir("p300", "pshort");
+    char* err = expect_exit("run probe.ini --set run.t_end=4e-4 --out pshort --restart "
+                            "pshort/checkpoint.ckpt",
+                            2, "after this run's end at step 200");
+    CHECK_CONTAINS(err, "a run cannot go back in time");
+    assert_null(strstr(err, "had reached its end"));
+    free(err);
+    check_same_outputs("p300", "pshort", 4);
+    /* the CSV deleted, emptied, or cut short at the end of a row (rows 0..240 of 300) */
+    copy_dir("p300", "pcsv");
+    assert_int_equal(rename(tpath("pcsv/global.csv"), tpath("global.keep")), 0);
+    free(expect_exit("run probe.ini --set run.steps=600 --out pcsv --restart pcsv/checkpoint.ckpt",
+                     2, "pcsv/global.csv is missing"));
+    write_text("pcsv/global.csv", "");
+    free(expect_exit("run probe.ini --set run.steps=600 --out pcsv --restart pcsv/checkpoint.ckpt",
+                     2, "pcsv/global.csv has no header line"));
+    char* whole = test_read_file(tpath("global.keep"), NULL);
+    assert_non_null(whole);
+    char* cut = strstr(whole, "\n0.00052,260,"); /* the row of step 260 */
+    assert_non_null(cut);
+    cut[1] = '\0';
+    write_text("pcsv/global.csv", whole);
+    free(whole);
+    err = expect_exit("run probe.ini --set run.steps=600 --out pcsv --restart pcsv/checkpoint.ckpt",
+                      2, "pcsv/global.csv ends at step 240, before the checkpoint's step 300");
+    free(err);
+    char* kept = test_read_file(tpath("pcsv/global.csv"), NULL);
+    assert_non_null(strstr(kept, ",240,"));
+    assert_null(strstr(kept, ",260,"));
+    free(kept);
+    /* two restarts in a row */
+    copy_dir("p300", "ptwice");
+    assert_int_equal(run_cli("run probe.ini --set run.steps=450 --out ptwice --restart "
+                             "ptwice/checkpoint.ckpt"),
+                     0);
+    assert_int_equal(run_cli("run probe.ini --set run.steps=600 --out ptwice --restart "
+                             "ptwice/checkpoint.ckpt"),
+                     0);
+    check_same_outputs("pwhole", "ptwice", 7);
+    /* another thread count: 600 spheres, so that the run's loops use the threads (from 512) */
+    write_text("many.ini", WET_BOX "[insert]\ncount = 600\nradius_min = 0.2e-3\nradius_max = "
+                                   "0.25e-3\nmaterial = wet\nvelocity_sigma = 0.2\nseed = 7\n"
+                                   "[run]\ndt = 1e-6\n[dump]\nvtk_every = 50\ncsv_every = 10\n");
+    char cmd[1400];
+    snprintf(cmd, sizeof cmd,
+             "cd '%s' && OMP_NUM_THREADS=2 OMP_WAIT_POLICY=passive '%s' run many.ini --set "
+             "run.steps=200 --out %s > /dev/null 2> err.txt",
+             tmpdir, test_cli_path(), "pthr2");
+    assert_int_equal(system(cmd), 0);
+    snprintf(cmd, sizeof cmd,
+             "cd '%s' && OMP_NUM_THREADS=2 OMP_WAIT_POLICY=passive '%s' run many.ini --set "
+             "run.steps=100 --out %s > /dev/null 2> err.txt",
+             tmpdir, test_cli_path(), "pthr");
+    assert_int_equal(system(cmd), 0);
+    char* js = test_read_file(tpath("pthr/summary.json"), NULL);
+    assert_non_null(js);
+    free(js);
+    assert_int_equal(run_cli("run many.ini --set run.steps=200 --out pthr --restart "
+                             "pthr/checkpoint.ckpt"),
+                     0); /* (one thread) */
+    const char* same[3] = {"particles.vtk.series", "summary.json", "particles_000004.vtk"};
+    for (int k = 0; k < 3; k++) {
+        char pa[64], pb[64];
+        snprintf(pa, sizeof pa, "pthr2/%s", same[k]);
+        snprintf(pb, sizeof pb, "pthr/%s", same[k]);
+        size_t la, lb;
+        char* ta = test_read_file(tpath(pa), &la);
+        char* tb = test_read_file(tpath(pb), &lb);
+        if (!ta || !tb || la != lb || memcmp(ta, tb, la) != 0)
+            fail_msg("%s differs after a restart on one thread of a run on two", same[k]);
+        free(ta);
+        free(tb);
+    }
+    for (size_t k = 0; k <= 4; k++)
+        if (!same_frame("pthr2", k, "pthr", k))
+            fail_msg("frame %zu differs after a restart on one thread of a run on two", k);
+    /* a signal during the first step: 20000 spheres, a step takes milliseconds; the signal
+       goes as soon as the first frame is indexed */
+    write_text("first.ini",
+               "[box]\nsize_x = 28e-3\nsize_y = 28e-3\nsize_z = 28e-3\n[material.wet]\n"
+               "density = 2500\nyoungs_modulus = 1e7\nfilm = 20e-6\n[fluid]\nviscosity = 0.01\n"
+               "surface_tension = 0.02\n[models]\nforce = hertz sb capillary\n[insert]\n"
+               "layout = lattice\ncount = 20000\nradius = 0.45e-3\ngap = 10e-6\nmaterial = wet\n"
+               "velocity_sigma = 0.01\n[run]\nsteps = 40\n[dump]\nvtk_every = 10\n"
+               "csv_every = 5\n");
+    assert_int_equal(run_cli("run first.ini --out fwhole"), 0);
+    pid_t pid = spawn_cli("run first.ini --out first");
+    struct timespec nap = {0, 200000};
+    for (int k = 0; k < 100000 && !exists("first/particles.vtk.series"); k++)
+        nanosleep(&nap, NULL);
+    kill(pid, SIGINT);
+    int status;
+    assert_int_equal(waitpid(pid, &status, 0), pid);
+    err = stderr_text();
+    if (!WIFEXITED(status) || WEXITSTATUS(status) != 130)
+        fail_msg("SIGINT in the first step: status %d, expected exit 130\n%s", status, err);
+    assert_true(interrupted_step(err) < 40);
+    free(err);
+    int code = run_cli("run first.ini --out first --restart first/checkpoint.ckpt");
+    if (code != 0)
+        fail_msg("resume after a SIGINT in the first step: exit %d\n%s", code, stderr_text());
+    check_same_outputs("fwhole", "first", 5);
 }
 
 /* SIGINT: the checkpoint, exit 130, the command that resumes, and the CSV ending at the step
@@ -1352,6 +1639,8 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_many_cli_bad_inputs_exit_2_with_file_and_line),
         cmocka_unit_test(test_many_cli_restart_is_bit_identical),
+        cmocka_unit_test(test_many_cli_restart_with_other_intervals),
+        cmocka_unit_test(test_many_cli_restart_probes),
         cmocka_unit_test(test_many_cli_sigint_writes_a_checkpoint_and_resumes),
         cmocka_unit_test(test_many_cli_third_signal_stops_at_once),
         cmocka_unit_test(test_many_cli_csv_ends_at_the_last_step),
