@@ -8,8 +8,11 @@
  * round numbers they are; k = 0..N-1, with x_0 = A and x_{N-1} = B returned exactly.
  */
 #include <ctype.h>
+#include <dirent.h>
 #include <errno.h>
+#include <limits.h>
 #include <math.h>
+#include <signal.h>
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
@@ -346,14 +349,276 @@ int cli_check_writable(const char* what, const char* option, const char* path)
     return CLI_EXIT_OK;
 }
 
+/* ---- sets of files: the journal, and what a killed process left behind ----
+ *
+ * A set of files is replaced in three passes (replace_set): the targets moved aside to their
+ * backup names (TMP.old), the temporary files renamed to the targets, the backups removed.
+ * Before the first pass, a journal DIR/.wetdem-set.PID is written in every directory of the
+ * set (temporary name, then rename: each appears whole or not at all), listing the set's
+ * directories and each file's temporary and final name; the set counts as committed once
+ * every one of its journals exists, and they are removed when the passes are done. A process
+ * killed at any point (SIGKILL, a power cut) leaves files whose names hold its PID; the next
+ * process that writes one of the targets (open_output) finds them when that PID is no longer
+ * alive and puts them in order, saying so on stderr: a committed set is completed (every
+ * temporary file still there renamed to its target, the backups removed), one not committed
+ * is taken back (its temporary files removed, any target moved aside put back), and a
+ * temporary or backup file of the target outside any journal (a process killed while writing,
+ * or a version without journals) is removed, a backup put back first when its target is
+ * missing. So the directory holds either the earlier set or the new one, whole. */
+
+#define JOURNAL_PREFIX ".wetdem-set."
+#define SET_PATH 1500                /* a directory or file of a set, absolute */
+#define JOURNAL_PATH (SET_PATH + 40) /* a journal's path */
+
+/* snprintf into buf of what fits: false when it was cut (the name is then not used). */
+static bool format_path(char* buf, size_t size, const char* fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    int n = vsnprintf(buf, size, fmt, ap);
+    va_end(ap);
+    return n >= 0 && (size_t)n < size;
+}
+
+/* Whether process pid is alive (or its liveness cannot be known: then it is left alone). */
+static bool pid_alive(long pid)
+{
+    if (pid <= 0 || pid > INT_MAX || pid == (long)getpid())
+        return true;
+    return kill((pid_t)pid, 0) == 0 || errno != ESRCH;
+}
+
+static bool path_exists(const char* path)
+{
+    struct stat st;
+    return lstat(path, &st) == 0;
+}
+
+/* The PID in `name` after `prefix` when the rest is digits and then `suffix` exactly, or -1. */
+static long name_pid(const char* name, const char* prefix, const char* suffix)
+{
+    size_t n = strlen(prefix);
+    if (strncmp(name, prefix, n) != 0 || !isdigit((unsigned char)name[n]))
+        return -1;
+    char* end;
+    long pid = strtol(name + n, &end, 10);
+    return strcmp(end, suffix) == 0 ? pid : -1;
+}
+
+/* Completes (committed) or takes back the set of a dead process from its journal at `path`. */
+static void recover_journal(const char* path, long pid)
+{
+    FILE* f = fopen(path, "r");
+    if (!f)
+        return;
+    char line[2 * SET_PATH + 16], dirs[CLI_MAX_OUTPUTS][SET_PATH], tmp[CLI_MAX_OUTPUTS][SET_PATH],
+        final[CLI_MAX_OUTPUTS][SET_PATH];
+    size_t n_dirs = 0, n = 0;
+    bool whole = false;
+    while (fgets(line, sizeof line, f)) {
+        line[strcspn(line, "\n")] = '\0';
+        char* tab = strchr(line, '\t');
+        if (strncmp(line, "dir\t", 4) == 0 && n_dirs < CLI_MAX_OUTPUTS)
+            format_path(dirs[n_dirs++], sizeof dirs[0], "%s", line + 4);
+        else if (strncmp(line, "file\t", 5) == 0 && n < CLI_MAX_OUTPUTS &&
+                 (tab = strchr(line + 5, '\t')) != NULL) {
+            *tab = '\0';
+            format_path(tmp[n], sizeof tmp[0], "%s", line + 5);
+            format_path(final[n++], sizeof final[0], "%s", tab + 1);
+        } else if (strcmp(line, "end") == 0)
+            whole = true;
+    }
+    fclose(f);
+    char journal[JOURNAL_PATH];
+    bool committed = whole;
+    for (size_t d = 0; d < n_dirs && committed; d++) {
+        format_path(journal, sizeof journal, "%s/" JOURNAL_PREFIX "%ld", dirs[d], pid);
+        committed = path_exists(journal);
+    }
+    for (size_t k = 0; k < n; k++) {
+        char old[SET_PATH + 8];
+        format_path(old, sizeof old, "%s.old", tmp[k]);
+        bool has_tmp = path_exists(tmp[k]), has_old = path_exists(old);
+        if (committed && has_tmp && rename(tmp[k], final[k]) == 0)
+            cli_error("%s: completed from a set of files that process %ld, now gone, was "
+                      "replacing",
+                      final[k], pid);
+        else if (!committed && has_tmp)
+            remove(tmp[k]);
+        if (has_old && !committed && !path_exists(final[k]) && rename(old, final[k]) == 0)
+            cli_error("%s: put back: process %ld, now gone, had moved it aside to replace it",
+                      final[k], pid);
+        else if (has_old)
+            remove(old);
+    }
+    if (!committed && n > 0)
+        cli_error("%s: the files that process %ld, now gone, was writing there were not all "
+                  "written; the earlier ones stay",
+                  final[0], pid);
+    for (size_t d = 0; d < n_dirs; d++) {
+        format_path(journal, sizeof journal, "%s/" JOURNAL_PREFIX "%ld", dirs[d], pid);
+        remove(journal);
+    }
+    remove(path);
+}
+
+/* Puts in order what dead processes left in the directory of `final` (see above): their
+ * journals there, then the temporary and backup files of `final` (named as open_output and
+ * cli_out_open name them: BASE.tmpPID, .BASE.tmpPID, and those with .old). */
+static void recover_stale(const char* final)
+{
+    char dir[1400];
+    parent_dir(final, dir, sizeof dir);
+    const char* base = strrchr(final, '/');
+    base = base ? base + 1 : final;
+    DIR* d = opendir(dir[0] ? dir : ".");
+    if (!d)
+        return;
+    char names[2][CLI_MAX_OUTPUTS * 4][300];
+    size_t n_names[2] = {0, 0};
+    char visible[300], hidden[300];
+    format_path(visible, sizeof visible, "%s.tmp", base);
+    format_path(hidden, sizeof hidden, ".%s.tmp", base);
+    for (struct dirent* e = readdir(d); e; e = readdir(d)) {
+        bool journal = name_pid(e->d_name, JOURNAL_PREFIX, "") > 0 ||
+                       name_pid(e->d_name, JOURNAL_PREFIX, ".part") > 0;
+        bool mine = name_pid(e->d_name, visible, "") > 0 || name_pid(e->d_name, hidden, "") > 0 ||
+                    name_pid(e->d_name, visible, ".old") > 0 ||
+                    name_pid(e->d_name, hidden, ".old") > 0;
+        int kind = journal ? 0 : 1;
+        if ((journal || mine) && n_names[kind] < CLI_MAX_OUTPUTS * 4 && strlen(e->d_name) < 300)
+            format_path(names[kind][n_names[kind]++], 300, "%s", e->d_name);
+    }
+    closedir(d);
+    char path[1800];
+    for (size_t k = 0; k < n_names[0]; k++) {
+        long pid = name_pid(names[0][k], JOURNAL_PREFIX, "");
+        bool part = pid < 0;
+        if (part)
+            pid = name_pid(names[0][k], JOURNAL_PREFIX, ".part");
+        if (pid_alive(pid))
+            continue;
+        format_path(path, sizeof path, "%s/%s", dir[0] ? dir : ".", names[0][k]);
+        if (part)
+            remove(path);
+        else
+            recover_journal(path, pid);
+    }
+    for (size_t k = 0; k < n_names[1]; k++) {
+        const char* name = names[1][k];
+        bool old = name_pid(name, visible, ".old") > 0 || name_pid(name, hidden, ".old") > 0;
+        long pid = old ? (name_pid(name, visible, ".old") > 0 ? name_pid(name, visible, ".old")
+                                                              : name_pid(name, hidden, ".old"))
+                       : (name_pid(name, visible, "") > 0 ? name_pid(name, visible, "")
+                                                          : name_pid(name, hidden, ""));
+        format_path(path, sizeof path, "%s/%s", dir[0] ? dir : ".", name);
+        if (pid_alive(pid) || !path_exists(path)) /* (a journal may have dealt with it) */
+            continue;
+        if (old && !path_exists(final) && rename(path, final) == 0) {
+            cli_error("%s: put back from %s, where process %ld, now gone, had moved it aside "
+                      "to replace it",
+                      final, path, pid);
+            continue;
+        }
+        remove(path);
+        cli_error("%s: removed %s, left by process %ld, now gone, %s", final, path, pid,
+                  old ? "beside the file it had replaced" : "which had not finished writing it");
+    }
+}
+
+/* The absolute form of path (its directory resolved), into buf. 0 or -1. */
+static int absolute_path(const char* path, char* buf, size_t size)
+{
+    char dir[1400], real[PATH_MAX];
+    parent_dir(path, dir, sizeof dir);
+    const char* base = strrchr(path, '/');
+    base = base ? base + 1 : path;
+    if (!realpath(dir[0] ? dir : ".", real))
+        return -1;
+    int n = format_path(buf, size, "%s/%s", strcmp(real, "/") == 0 ? "" : real, base);
+    return n > 0 && (size_t)n < size ? 0 : -1;
+}
+
+/* Writes the journal of the set (files to be renamed: rename[k]) into each of its
+ * directories; 0, or -1 with those written removed. */
+static int write_journals(struct cli_out_file* const* files, size_t n, const bool* renamed,
+                          char dirs[][SET_PATH], size_t* n_dirs)
+{
+    char text[CLI_MAX_OUTPUTS * 3000 + 200];
+    size_t len = strlen(strcpy(text, "wetdem output set\n"));
+    *n_dirs = 0;
+    for (size_t k = 0; k < n; k++) {
+        char tmp[SET_PATH], final[SET_PATH], dir[SET_PATH];
+        if (!renamed[k])
+            continue;
+        if (absolute_path(files[k]->tmp, tmp, sizeof tmp) != 0 ||
+            absolute_path(files[k]->final, final, sizeof final) != 0)
+            return -1;
+        parent_dir(tmp, dir, sizeof dir);
+        bool seen = false;
+        for (size_t d = 0; d < *n_dirs; d++)
+            seen = seen || strcmp(dirs[d], dir) == 0;
+        if (!seen) {
+            format_path(dirs[(*n_dirs)++], SET_PATH, "%s", dir);
+            if (!format_path(text + len, sizeof text - len, "dir\t%s\n", dir))
+                return -1;
+            len += strlen(text + len);
+        }
+        if (!format_path(text + len, sizeof text - len, "file\t%s\t%s\n", tmp, final))
+            return -1;
+        len += strlen(text + len);
+    }
+    if (!format_path(text + len, sizeof text - len, "end\n"))
+        return -1;
+    len += strlen(text + len);
+    for (size_t d = 0; d < *n_dirs; d++) {
+        char path[JOURNAL_PATH], part[JOURNAL_PATH + 8];
+        format_path(path, sizeof path, "%s/" JOURNAL_PREFIX "%ld", dirs[d], (long)getpid());
+        format_path(part, sizeof part, "%s.part", path);
+        FILE* f = fopen(part, "w");
+        bool ok = f && fwrite(text, 1, len, f) == len;
+        ok = f && fclose(f) == 0 && ok;
+        if (!ok || rename(part, path) != 0) {
+            remove(part);
+            for (size_t e = 0; e < d; e++) {
+                format_path(path, sizeof path, "%s/" JOURNAL_PREFIX "%ld", dirs[e], (long)getpid());
+                remove(path);
+            }
+            return -1;
+        }
+    }
+    return 0;
+}
+
+/* Removes the set's journals (the last first: the set stops counting as committed at once). */
+static void remove_journals(char dirs[][SET_PATH], size_t n_dirs)
+{
+    for (size_t d = n_dirs; d-- > 0;) {
+        char path[JOURNAL_PATH];
+        format_path(path, sizeof path, "%s/" JOURNAL_PREFIX "%ld", dirs[d], (long)getpid());
+        remove(path);
+    }
+}
+
+/* Test hook: WETDEM_TEST_KILL_AT_RENAME=k kills the process with SIGKILL once k temporary
+ * files of a set of two or more have been renamed to their targets (0: right after the
+ * targets were moved aside), as a kill -9 or a power cut might. */
+static void maybe_killed(size_t renamed)
+{
+    const char* at = getenv("WETDEM_TEST_KILL_AT_RENAME");
+    if (at && at[0] && strtoul(at, NULL, 10) == renamed)
+        raise(SIGKILL);
+}
+
 /* Opens the file that output to `path` writes: in place (o->direct) or under the temporary
- * name of its target (o->tmp). 0, or -1 with errno set. */
+ * name of its target (o->tmp), after putting in order what killed processes left there
+ * (recover_stale). 0, or -1 with errno set. */
 static int open_output(struct cli_out_file* o, const char* path, const char* tmp_format)
 {
     output_target(path, o->final, sizeof o->final, &o->direct);
     o->std = o->direct ? output_std_stream(o->final) : NULL;
     if (o->direct) {
-        snprintf(o->tmp, sizeof o->tmp, "%s", o->final);
+        format_path(o->tmp, sizeof o->tmp, "%s", o->final);
         o->f = o->std ? o->std : fopen(o->final, "w");
     } else {
         /* the temporary name: tmp_format applied to the target's directory and base name */
@@ -361,7 +626,8 @@ static int open_output(struct cli_out_file* o, const char* path, const char* tmp
         parent_dir(o->final, dir, sizeof dir);
         const char* base = strrchr(o->final, '/');
         base = base ? base + 1 : o->final;
-        snprintf(o->tmp, sizeof o->tmp, tmp_format, dir[0] ? dir : ".", base, (long)getpid());
+        format_path(o->tmp, sizeof o->tmp, tmp_format, dir[0] ? dir : ".", base, (long)getpid());
+        recover_stale(o->final);
         o->f = fopen(o->tmp, "w");
     }
     return o->f ? 0 : -1;
@@ -430,7 +696,7 @@ int cli_out_open(struct cli_out_file* o, const char* what, const char* dir, cons
     if (!dir || !name[0])
         return 0;
     char path[1400];
-    snprintf(path, sizeof path, "%s/%s", dir, name);
+    format_path(path, sizeof path, "%s/%s", dir, name);
     if (open_output(o, path, "%s/.%s.tmp%ld") != 0) {
         cli_error("%s: cannot write %s: %s", what, path, strerror(errno));
         return -1;
@@ -448,7 +714,7 @@ int cli_out_close(struct cli_out_file* o, const char* what, bool keep)
  * with ".old" appended. */
 static void backup_name(const struct cli_out_file* o, char* buf, size_t size)
 {
-    snprintf(buf, size, "%s.old", o->tmp);
+    format_path(buf, size, "%s.old", o->tmp);
 }
 
 /* Puts the set's targets back as they were before the first k renames of replace_set: the
@@ -470,44 +736,62 @@ static void restore_set(struct cli_out_file* const* files, size_t k, const bool*
  * moved aside (to its backup name), then every temporary file renamed into place, then the
  * backups removed. When any rename fails, the renames already made are undone, so the set is
  * replaced whole or not at all (a renaming the directory refuses, e.g. a sticky directory's
- * file of another user, fails in the first pass). A process killed between the two passes
- * (SIGKILL: the signals a run handles are held while its files are renamed) leaves the
- * targets under their backup names, .NAME.tmpPID.old. 0, or the index of the file that failed
- * + 1 with *err its errno. */
+ * file of another user, fails in the first pass). A set of two or more files is recorded in
+ * journals first, so that what a process killed between the passes leaves (the targets under
+ * their backup names, .NAME.tmpPID.old) is completed by the next process that writes one of
+ * them (recover_stale). 0, or the index of the file that failed + 1 with *err its errno. */
 static size_t replace_set(struct cli_out_file* const* files, size_t n, int* err)
 {
     bool had[CLI_MAX_OUTPUTS] = {false}, placed[CLI_MAX_OUTPUTS] = {false};
-    char old[1500];
+    bool renamed[CLI_MAX_OUTPUTS] = {false};
+    char old[1500], dirs[CLI_MAX_OUTPUTS][SET_PATH];
+    size_t n_renamed = 0, n_dirs = 0;
     n = n < CLI_MAX_OUTPUTS ? n : CLI_MAX_OUTPUTS;
+    for (size_t k = 0; k < n; k++) {
+        renamed[k] = files[k]->tmp[0] && !files[k]->direct;
+        n_renamed += renamed[k];
+    }
+    if (n_renamed > 1 && write_journals(files, n, renamed, dirs, &n_dirs) != 0) {
+        *err = errno ? errno : EIO;
+        return 1;
+    }
     for (size_t k = 0; k < n; k++) {
         const struct cli_out_file* o = files[k];
         struct stat st;
-        if (!o->tmp[0] || o->direct || lstat(o->final, &st) != 0)
+        if (!renamed[k] || lstat(o->final, &st) != 0)
             continue;
         backup_name(o, old, sizeof old);
         if (S_ISDIR(st.st_mode) || rename(o->final, old) != 0) {
             *err = S_ISDIR(st.st_mode) ? EISDIR : errno;
             restore_set(files, k, had, placed);
+            remove_journals(dirs, n_dirs);
             return k + 1;
         }
         had[k] = true;
     }
+    size_t done = 0;
+    if (n_dirs)
+        maybe_killed(done);
     for (size_t k = 0; k < n; k++) {
         const struct cli_out_file* o = files[k];
-        if (!o->tmp[0] || o->direct)
+        if (!renamed[k])
             continue;
         if (rename(o->tmp, o->final) != 0) {
             *err = errno;
             restore_set(files, n, had, placed);
+            remove_journals(dirs, n_dirs);
             return k + 1;
         }
         placed[k] = true;
+        if (n_dirs)
+            maybe_killed(++done);
     }
     for (size_t k = 0; k < n; k++)
         if (had[k]) {
             backup_name(files[k], old, sizeof old);
             remove(old);
         }
+    remove_journals(dirs, n_dirs);
     return 0;
 }
 

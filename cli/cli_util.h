@@ -180,7 +180,9 @@ int cli_out_close(struct cli_out_file* o, const char* what, bool keep);
 /* Closes the n files of one result as a set: with keep, and only when every one was written
  * whole, renames them all to their final names (n <= CLI_MAX_OUTPUTS; a rename that fails
  * undoes the others, the older files put back); otherwise removes every temporary file, so a
- * run never leaves some of its files beside older ones. Files not open are skipped. 0, or -1
+ * run never leaves some of its files beside older ones. A set is recorded in a journal
+ * (DIR/.wetdem-set.PID) while it is renamed, so that what a killed process leaves is completed
+ * or taken back by the next that writes one of its files (docs/scenarios.md, Output). Files not open are skipped. 0, or -1
  * after printing "wetdem: <what>: cannot write <final>: <why>" for the first that failed. */
 int cli_out_close_all(struct cli_out_file* const* files, size_t n, const char* what, bool keep);
 

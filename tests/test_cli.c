@@ -12,6 +12,7 @@
  * back to build/wetdem relative to the working directory (the repository root).
  */
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include "harness.h"
@@ -636,6 +637,103 @@ static void test_cli_run_outputs_replaced_whole_or_not_at_all(void** state)
     assert_int_equal(system(args), 0);
 }
 
+/* A process killed (SIGKILL) while it replaces the files of a run leaves them in order for the
+ * next: killed after one of three files was renamed, or after every target was moved aside
+ * (to .NAME.tmpPID.old, the target then missing), its set is completed by the next run that
+ * writes there, which says so; a backup of a dead process whose target is missing is put back
+ * (even when that run then fails), its cut temporary files are removed, and the files of a
+ * live process are left alone. WETDEM_TEST_KILL_AT_RENAME=k kills a run after k renames. */
+static void test_cli_run_outputs_recovered_after_a_kill(void** state)
+{
+    (void)state;
+    char dir[] = "/tmp/wetdem_test_cli_kill_XXXXXX";
+    assert_non_null(mkdtemp(dir));
+    char args[400], b_args[400], path[400], path2[400];
+    const char* names[3] = {"trajectory.csv", "events.csv", "summary.json"};
+    snprintf(args, sizeof args, "run examples/scenarios/dry_hertz.ini --out %s/d", dir);
+    snprintf(b_args, sizeof b_args,
+             "run examples/scenarios/dry_hertz.ini --set collision.speed=0.2 --out %s/d", dir);
+    struct test_run r = run_cli(args, true);
+    assert_int_equal(r.code, 0);
+    free(r.out);
+    char* first[3]; /* the files of the first run */
+    for (int k = 0; k < 3; k++) {
+        snprintf(path, sizeof path, "%s/d/%s", dir, names[k]);
+        first[k] = test_read_file(path, NULL);
+        assert_non_null(first[k]);
+    }
+    /* killed after its first rename: trajectory.csv is new, the others aside or not placed */
+    r = test_run_cli("WETDEM_TEST_KILL_AT_RENAME=1", b_args, true);
+    if (r.code != 137 && r.code != -1)
+        fail_msg("a run with WETDEM_TEST_KILL_AT_RENAME=1: exit %d, expected a kill\n%s", r.code,
+                 r.out);
+    free(r.out);
+    snprintf(path, sizeof path, "%s/d", dir);
+    char* listing = test_list_dir(path);
+    CHECK_CONTAINS(listing, ".wetdem-set.");
+    CHECK_CONTAINS(listing, ".events.csv.tmp");
+    free(listing);
+    /* the next, killed in turn after moving every target aside: it completed the first set */
+    r = test_run_cli("WETDEM_TEST_KILL_AT_RENAME=0", args, true);
+    if (r.code != 137 && r.code != -1)
+        fail_msg("a run with WETDEM_TEST_KILL_AT_RENAME=0: exit %d, expected a kill\n%s", r.code,
+                 r.out);
+    CHECK_CONTAINS(r.out, "events.csv: completed from a set of files that process");
+    CHECK_CONTAINS(r.out, "summary.json: completed from a set of files that process");
+    free(r.out);
+    /* and the next, not killed, completes that one (no target was left under the backup
+       name) and writes its own: the first run's files, nothing else */
+    r = run_cli(args, true);
+    assert_int_equal(r.code, 0);
+    CHECK_CONTAINS(r.out, "trajectory.csv: completed from a set of files that process");
+    free(r.out);
+    snprintf(path, sizeof path, "%s/d", dir);
+    listing = test_list_dir(path);
+    assert_string_equal(listing, "events.csv\nsummary.json\ntrajectory.csv\n");
+    free(listing);
+    for (int k = 0; k < 3; k++) {
+        snprintf(path, sizeof path, "%s/d/%s", dir, names[k]);
+        char* text = test_read_file(path, NULL);
+        assert_string_equal(text, first[k]);
+        free(text);
+    }
+    /* by hand, as an earlier version left them: summary.json under the backup name of a dead
+       process, a cut temporary file of events.csv; and a temporary file of a live process
+       (this one). The run fails (a full disk), but the backup is put back. */
+    pid_t child = fork();
+    assert_true(child >= 0);
+    if (child == 0)
+        _exit(0);
+    assert_int_equal(waitpid(child, NULL, 0), child);
+    snprintf(path, sizeof path, "%s/d/summary.json", dir);
+    snprintf(path2, sizeof path2, "%s/d/.summary.json.tmp%ld.old", dir, (long)child);
+    assert_int_equal(rename(path, path2), 0);
+    snprintf(path, sizeof path, "%s/d/events.csv.tmp%ld", dir, (long)child);
+    test_write_file(path, "time_s,");
+    snprintf(path, sizeof path, "%s/d/.trajectory.csv.tmp%ld", dir, (long)getpid());
+    test_write_file(path, "a live process's\n");
+    r = test_run_cli(TEST_FILE_SIZE_LIMIT, args, true); /* (trajectory.csv: too large) */
+    assert_int_equal(r.code, 1);
+    CHECK_CONTAINS(r.out, "summary.json: put back from");
+    CHECK_CONTAINS(r.out, "which had not finished writing it");
+    free(r.out);
+    snprintf(path, sizeof path, "%s/d/summary.json", dir);
+    char* text = test_read_file(path, NULL);
+    assert_non_null(text);
+    assert_string_equal(text, first[2]);
+    free(text);
+    snprintf(path, sizeof path, "%s/d", dir);
+    listing = test_list_dir(path);
+    snprintf(path2, sizeof path2,
+             ".trajectory.csv.tmp%ld\nevents.csv\nsummary.json\ntrajectory.csv\n", (long)getpid());
+    assert_string_equal(listing, path2);
+    free(listing);
+    for (int k = 0; k < 3; k++)
+        free(first[k]);
+    snprintf(args, sizeof args, "rm -rf '%s'", dir);
+    assert_int_equal(system(args), 0);
+}
+
 /* A [model.NAME] section of the file for a model that a --set of [models] switched away from
  * is ignored, so one file serves both choices (the files below hold [model.fixed] and
  * [model.glass], for the models they choose); a --set of such a parameter, a section the
@@ -724,6 +822,7 @@ int main(void)
         cmocka_unit_test(test_cli_fuzz_regressions),
         cmocka_unit_test(test_cli_stdout_write_failures),
         cmocka_unit_test(test_cli_run_outputs_replaced_whole_or_not_at_all),
+        cmocka_unit_test(test_cli_run_outputs_recovered_after_a_kill),
         cmocka_unit_test(test_cli_dev_stdout_output_to_a_redirected_file),
         cmocka_unit_test(test_cli_numbers_out_of_range_and_cr_lines),
     };
