@@ -246,14 +246,10 @@ static int build_config(const struct cli_scenario* sc, struct wetdem_pairwise_co
 
 /* ----------------------------------------------------------------------- reporting ---- */
 
+/* The pair's label: "none" (WETDEM_OUTCOME_NONE) for a pair that never interacted. */
 static const char* mechanism_name(int m)
 {
-    switch (m) {
-    case WETDEM_OUTCOME_STICK: return "stick";
-    case WETDEM_OUTCOME_STICK_ROTATE_SEPARATE: return "stick-rotate-separate";
-    case WETDEM_OUTCOME_BOUNCE: return "bounce";
-    default: return "none";
-    }
+    return wetdem_outcome_name((enum wetdem_outcome)m);
 }
 
 static void sweep_header(FILE* f, const struct wetdem_pairwise_config* cfg)

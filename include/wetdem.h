@@ -541,11 +541,16 @@ WETDEM_API const struct wetdem_particle* wetdem_sim_particles_const(const struct
 /* ---- two-body collision analysis (SPEC §4) ---- */
 
 enum wetdem_outcome {
+    WETDEM_OUTCOME_NONE = -1,                 /* pairwise pair that never interacted: its films
+                                                 never met and it never touched */
     WETDEM_OUTCOME_STICK = 0,                 /* no separation by t_end */
     WETDEM_OUTCOME_STICK_ROTATE_SEPARATE = 1, /* separated after rotating as a doublet */
     WETDEM_OUTCOME_BOUNCE = 2,                /* separated promptly (contact-bounce) */
+    WETDEM_OUTCOME_RECEDE = 3,                /* pairwise pair that separated without having
+                                                 approached: it started inside (or at the edge
+                                                 of) its films and only receded, untouched */
 };
-/* "stick", "stick-rotate-separate", "bounce". */
+/* "none", "stick", "stick-rotate-separate", "bounce", "recede". */
 WETDEM_API const char* wetdem_outcome_name(enum wetdem_outcome outcome);
 
 /* A binary collision: sphere i (the striker) moves towards a target j at rest (a sphere, or a
@@ -929,10 +934,12 @@ struct wetdem_pairwise_pair_result {
     double t_start;      /* first film overlap [s] (NAN if none) */
     double t_end;        /* last film separation [s] (NAN if none) */
     double min_gap;      /* smallest gap seen at step ends and events [m] */
-    int mechanism;       /* enum wetdem_outcome: stick, stick-rotate-separate (reversed by the
-                           film and centrifugal forces) or bounce (reversed by an impulse, its
-                           own or a neighbour's that knocked it apart); -1 if the films never
-                           met */
+    int mechanism;       /* enum wetdem_outcome: stick (bound at the end),
+                           stick-rotate-separate (its approach reversed by the film and
+                           centrifugal forces), bounce (reversed by an impulse, its own or a neighbour's that
+                           knocked it apart; a pair without films: touched), recede (films
+                           overlapping from the start, never approached, never touched) or
+                           none (WETDEM_OUTCOME_NONE = -1: films never met, never touched) */
 };
 
 /* Energy budget of a pairwise run [J]. The mechanical energy is the kinetic energy

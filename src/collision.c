@@ -73,6 +73,8 @@ const char* wetdem_outcome_name(enum wetdem_outcome outcome)
     case WETDEM_OUTCOME_STICK: return "stick";
     case WETDEM_OUTCOME_STICK_ROTATE_SEPARATE: return "stick-rotate-separate";
     case WETDEM_OUTCOME_BOUNCE: return "bounce";
+    case WETDEM_OUTCOME_RECEDE: return "recede";
+    case WETDEM_OUTCOME_NONE: return "none";
     }
     return "unknown";
 }

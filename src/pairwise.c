@@ -1088,6 +1088,28 @@ static size_t uf_root(size_t* parent, size_t i)
     return i;
 }
 
+/* The label of pair p at the end (docs/derivations/pairwise.md Sec. 9), from what turned its
+ * approach round. Bound: stick. A pair without films (delta_ij <= h_min) has nothing to hold
+ * a doublet: bounce once a contact turned it (an impulse, or a slow contact held and let go,
+ * so that the label does not depend on the rest speed), none if it never touched. A film pair:
+ * none if the films never met; bounce or stick-rotate-separate by its last reversal; recede
+ * when there was none: its films overlapped from the start and it never approached. */
+static int pair_mechanism(const struct wetdem_pairwise* pw, size_t p)
+{
+    const struct wetdem_pairwise_pair_result* r = &pw->res->pairs[p];
+    if (r->bound)
+        return WETDEM_OUTCOME_STICK;
+    if (!(pw->sys.delta[p] > pw->sys.h_min))
+        return pw->reversal[p] == REV_NONE ? WETDEM_OUTCOME_NONE : WETDEM_OUTCOME_BOUNCE;
+    if (!r->films_met)
+        return WETDEM_OUTCOME_NONE;
+    switch (pw->reversal[p]) {
+    case REV_IMPULSE: return WETDEM_OUTCOME_BOUNCE;
+    case REV_FILM: return WETDEM_OUTCOME_STICK_ROTATE_SEPARATE;
+    default: return WETDEM_OUTCOME_RECEDE;
+    }
+}
+
 /* Clusters of bound pairs at the end: FA, PA (which sphere left) or FS. */
 static void classify(struct wetdem_pairwise* pw)
 {
@@ -1098,15 +1120,13 @@ static void classify(struct wetdem_pairwise* pw)
     for (size_t p = 0; p < pw->sys.n_pairs; p++) {
         struct wetdem_pairwise_pair_result* r = &res->pairs[p];
         r->bound = pw->md.film[p] || pw->md.resting[p];
+        r->mechanism = pair_mechanism(pw, p);
         if (!r->films_met) {
-            r->mechanism = -1;
             r->e_wet = r->e_wet_own = NAN;
+            if (r->bound) /* (a pair without films held at h_min) */
+                parent[uf_root(parent, pw->sys.pi[p])] = uf_root(parent, pw->sys.pj[p]);
             continue;
         }
-        r->mechanism =
-            r->bound ? WETDEM_OUTCOME_STICK
-                     : (pw->reversal[p] == REV_IMPULSE ? WETDEM_OUTCOME_BOUNCE
-                                                       : WETDEM_OUTCOME_STICK_ROTATE_SEPARATE);
         /* (without an approach of the reference pair at t = 0, e_ij,w has no scale) */
         r->e_wet = r->bound ? 0.0 : res->v_n0 > 0.0 ? r->v_n_out / res->v_n0 : NAN;
         r->e_wet_own = (r->bound ? 0.0 : r->v_n_out) / r->v_n_in;
@@ -1175,7 +1195,7 @@ static void initial_state(struct wetdem_pairwise* pw)
         r->j = sys->pj[p];
         r->t_start = r->t_end = NAN;
         r->min_gap = k.h[p];
-        r->mechanism = -1;
+        r->mechanism = WETDEM_OUTCOME_NONE;
         bool has_film = sys->delta[p] > sys->h_min;
         /* films "just touching" (to rounding of the input positions) count as touching */
         if (has_film && fabs(k.h[p] - sys->delta[p]) <= 1e-12 * sys->delta[p] && k.v_n[p] >= 0.0)

@@ -1297,6 +1297,123 @@ static void test_pairwise_knocked_apart_is_a_bounce(void** state)
     assert_int_equal(p23->mechanism, WETDEM_OUTCOME_BOUNCE);
 }
 
+/* Largest normal approach speed over the observer's frames. */
+static int max_approach(const struct wetdem_pairwise_frame* f, void* ctx)
+{
+    double* v = ctx;
+    *v = fmax(*v, f->v_n[0]);
+    return 0;
+}
+
+/* Runs c with frames every `interval` s; *v_max receives the largest approach speed of pair
+ * (0, 1) over them. */
+static void run_watching(const struct wetdem_pairwise_config* c, double interval,
+                         struct wetdem_pairwise_result* r, struct wetdem_pairwise** pw,
+                         double* v_max)
+{
+    *v_max = -INFINITY;
+    *pw = wetdem_pairwise_create();
+    wetdem_pairwise_set_observer(*pw, interval, max_approach, v_max);
+    CHECK_OK(wetdem_pairwise_run(*pw, c, r));
+}
+
+/* A pair that starts inside its films and only recedes never approached, never stuck and never
+ * touched: it is "recede", not stick-rotate-separate (which it was labelled until this
+ * version). Head-on, no capillarity, gap 0.3 delta, receding at v0: the films' suction slows it
+ * to v0 (1 - I(0.3)/St_n) where they part (the closed form at the top of this file, read from
+ * u = 0.3 outwards), and v_n stays < 0 throughout. Likewise a pair at rest at the edge of its
+ * films that slides along it (v_n = 0, tangential speed v0): it recedes at once. */
+static void test_pairwise_receding_in_films_is_recede(void** state)
+{
+    (void)state;
+    const double st = 10.0, film = 100e-6, v0 = 0.5, u0 = 0.3;
+    struct wetdem_pairwise_config c = head_on(st, film, v0);
+    c.spheres[0].vx = -v0;
+    c.spheres[1].x = c.spheres[0].radius + c.spheres[1].radius + u0 * film;
+    c.rtol = 1e-11;
+    struct wetdem_pairwise_result r;
+    struct wetdem_pairwise* pw;
+    double v_max;
+    run_watching(&c, 1e-6, &r, &pw, &v_max);
+    const struct wetdem_pairwise_pair_result* q = &r.pairs[0];
+    assert_true(v_max < 0.0); /* receding at every frame */
+    assert_true(q->films_met && !q->bound && q->n_contacts == 0);
+    assert_null(find_event(pw, WETDEM_PAIRWISE_CONTACT, 0));
+    assert_non_null(find_event(pw, WETDEM_PAIRWISE_FILM_END, 0));
+    CHECK_REL(q->min_gap, u0 * film, 1e-12); /* never closer than at the start */
+    CHECK_REL(q->v_n_out, v0 * (1.0 - closed_form_integral(u0) / st), 1e-6);
+    assert_true(isnan(q->e_wet_own)); /* no approach to divide by */
+    assert_int_equal(q->mechanism, WETDEM_OUTCOME_RECEDE);
+    assert_string_equal(wetdem_outcome_name(WETDEM_OUTCOME_RECEDE), "recede");
+    assert_int_equal(r.outcome, WETDEM_PAIRWISE_FS);
+    wetdem_pairwise_free(pw);
+
+    c.spheres[0].vx = 0.0; /* at the film edge, sliding along it */
+    c.spheres[0].vy = v0;
+    c.spheres[1].x = c.spheres[0].radius + c.spheres[1].radius + film;
+    run_watching(&c, 1e-6, &r, &pw, &v_max);
+    assert_true(v_max <= 0.0);
+    assert_true(q->films_met && !q->bound && q->n_contacts == 0);
+    assert_int_equal(q->mechanism, WETDEM_OUTCOME_RECEDE);
+    wetdem_pairwise_free(pw);
+}
+
+/* Two dry spheres (no films, delta = 0), 20 um apart, at v0 along x displaced by b. */
+static struct wetdem_pairwise_config dry_pair(double v0, double b)
+{
+    struct wetdem_pairwise_config c;
+    wetdem_pairwise_config_init(&c);
+    c.n_spheres = 2;
+    c.h_min = 1e-6;
+    c.restitution = 0.8;
+    c.t_end = 0.01;
+    c.spheres[0] = (struct wetdem_pairwise_sphere){.radius = 1e-3, .mass = 3e-5, .vx = v0, .y = b};
+    c.spheres[1] = (struct wetdem_pairwise_sphere){.radius = 1e-3, .mass = 3e-5, .x = 2.02e-3};
+    return c;
+}
+
+/* A pair without films has a label too: bounce when an impulse turned it, whatever the impact
+ * angle (there are no films to hold a doublet, so never stick-rotate-separate), "none" when it
+ * never touched. Until this version every dry pair was "none", a hard-sphere bounce included.
+ * Head-on at 0.5 m/s the relative velocity leaves at -e_dry v0; at 60 deg the normal part is
+ * reversed and scaled by e_dry, the tangential part kept (no friction); a miss by 10 um keeps
+ * its velocity. */
+static void test_pairwise_pair_without_films_labels(void** state)
+{
+    (void)state;
+    const double v0 = 0.5, s = 2e-3 + 1e-6; /* s = a_i + a_j + h_min: contact distance */
+    struct wetdem_pairwise_config c = dry_pair(v0, 0.0);
+    struct wetdem_pairwise_result r;
+    CHECK_OK(run(&c, &r, NULL));
+    const struct wetdem_pairwise_pair_result* q = &r.pairs[0];
+    assert_true(!q->films_met && !q->bound && q->n_contacts == 1);
+    CHECK_REL(r.final[0].vx - r.final[1].vx, -c.restitution * v0, 1e-12);
+    assert_int_equal(q->mechanism, WETDEM_OUTCOME_BOUNCE);
+    assert_int_equal(r.outcome, WETDEM_PAIRWISE_FS);
+
+    const double beta = 60.0 * M_PI / 180.0; /* impact angle at contact */
+    c = dry_pair(v0, -s * sin(beta));
+    c.rtol = 1e-11;
+    CHECK_OK(run(&c, &r, NULL));
+    assert_true(q->n_contacts == 1);
+    double nx = cos(beta), ny = sin(beta); /* unit normal from 0 to 1 at contact */
+    double dvx = r.final[0].vx - r.final[1].vx, dvy = r.final[0].vy - r.final[1].vy;
+    /* (the contact normal is integrated in the pair's polar coordinates: ~rtol x 100) */
+    CHECK_REL(dvx * nx + dvy * ny, -c.restitution * v0 * cos(beta), 1e-7);
+    CHECK_REL(-dvx * ny + dvy * nx, -v0 * sin(beta), 1e-7);
+    assert_int_equal(q->mechanism, WETDEM_OUTCOME_BOUNCE);
+
+    c = dry_pair(v0, -(s + 10e-6)); /* a miss */
+    CHECK_OK(run(&c, &r, NULL));
+    assert_true(q->n_contacts == 0 && q->min_gap > c.h_min);
+    /* (free flight, to the integration error of the pair's polar coordinates at rtol 1e-9) */
+    CHECK_ABS(r.final[0].vx, v0, 1e-6 * v0);
+    CHECK_ABS(r.final[0].vy, 0.0, 1e-6 * v0);
+    CHECK_ABS(r.final[1].vx, 0.0, 1e-6 * v0);
+    assert_int_equal(q->mechanism, WETDEM_OUTCOME_NONE);
+    assert_int_equal(r.outcome, WETDEM_PAIRWISE_FS);
+}
+
 /* ------------------------------------------------------------- tree and partner change */
 
 /* Converting the state to another tracked tree keeps every sphere: 1e-15 relative to the
@@ -1572,6 +1689,8 @@ int main(void)
         cmocka_unit_test(test_pairwise_two_sphere_mechanisms),
         cmocka_unit_test(test_pairwise_released_pair_is_not_a_bounce),
         cmocka_unit_test(test_pairwise_knocked_apart_is_a_bounce),
+        cmocka_unit_test(test_pairwise_receding_in_films_is_recede),
+        cmocka_unit_test(test_pairwise_pair_without_films_labels),
         cmocka_unit_test(test_pairwise_tree_change_keeps_spheres),
         cmocka_unit_test(test_pairwise_partner_change_logged),
         cmocka_unit_test(test_pairwise_davis_builder),
