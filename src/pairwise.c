@@ -708,6 +708,46 @@ static double locate(struct wetdem_pairwise* pw, size_t idx, double lo, double h
     return hi;
 }
 
+/* Normal approach speed of pair p at time t of the last step (NAN if the output fails). */
+static double v_n_at(struct wetdem_pairwise* pw, size_t p, double t)
+{
+    double y[PW_YMAX];
+    struct wetdem_pairwise_kin k;
+    if (!interpolate(pw, t, y) || !wetdem_pairwise_state_kin(&pw->sys, &pw->md, y, &k))
+        return NAN;
+    return k.v_n[p];
+}
+
+/* Earliest crossing of a guard of pair p hidden inside the step [lo, hi]: the pair turned from
+ * approach (v_lo > 0) to recession (v_hi <= 0), and its gap may have dipped below h_min or
+ * delta_ij and be back above at both ends, a grazing contact or film overlap shorter than the
+ * step (a sphere 1 um wide of h_min, 1 nm inside it, passed in 4 us between steps of 20 us
+ * untouched). The smallest gap is where v_n = 0, found by bisection on the dense output; a
+ * guard negative there is located between lo and that time. INFINITY if none. */
+static double hidden_crossing(struct wetdem_pairwise* pw, size_t p, double lo, double hi)
+{
+    double a = lo, b = hi;
+    for (int it = 0; it < 100 && a < b; it++) {
+        double m = 0.5 * (a + b);
+        if (m <= a || m >= b)
+            break;
+        double v = v_n_at(pw, p, m);
+        if (!isfinite(v))
+            return INFINITY;
+        if (v > 0.0)
+            a = m;
+        else
+            b = m;
+    }
+    double t_ev = INFINITY;
+    for (size_t kind = G_FILM; kind <= G_CONTACT; kind++) {
+        double g = guard_at(pw, G_KINDS * p + kind, b);
+        if (g < 0.0)
+            t_ev = fmin(t_ev, locate(pw, G_KINDS * p + kind, lo, b, g));
+    }
+    return t_ev;
+}
+
 /* ------------------------------------------------------------------ mode changes ---- */
 
 /* Current kinematics from pw->y. */
@@ -1241,6 +1281,9 @@ static bool wrap_angles(struct wetdem_pairwise* pw)
 static int advance(struct wetdem_pairwise* pw)
 {
     double t_lo = pw->t, t;
+    struct wetdem_pairwise_kin k_lo, k_hi;
+    if (!current_kin(pw, &k_lo))
+        return WETDEM_ERR_NUMERIC;
     int flag = CVode(pw->cvode, pw->cfg.t_end, pw->nv, &t, CV_ONE_STEP);
     if (flag < 0)
         return fail(pw, WETDEM_ERR_STEP, "integrator failed at t = %g s (%s)", t_lo, pw->errmsg);
@@ -1254,6 +1297,12 @@ static int advance(struct wetdem_pairwise* pw)
     for (size_t idx = 0; idx < G_KINDS * pw->sys.n_pairs; idx++)
         if (g[idx] < 0.0)
             t_ev = fmin(t_ev, locate(pw, idx, t_lo, t, g[idx]));
+    if (!wetdem_pairwise_state_kin(&pw->sys, &pw->md, y, &k_hi))
+        return fail(pw, WETDEM_ERR_NUMERIC, "state not finite at t = %g s", t);
+    for (size_t p = 0; p < pw->sys.n_pairs; p++)
+        if (!pw->md.resting[p] && k_lo.v_n[p] > 0.0 && !(k_hi.v_n[p] > 0.0) &&
+            g[G_KINDS * p + G_FILM] >= 0.0 && g[G_KINDS * p + G_CONTACT] >= 0.0)
+            t_ev = fmin(t_ev, hidden_crossing(pw, p, t_lo, t));
     if (isfinite(t_ev)) {
         int st = emit_until(pw, t_ev);
         if (st != WETDEM_OK || (st = dissipate(pw, t_lo, t_ev)) != WETDEM_OK)

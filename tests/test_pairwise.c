@@ -1414,6 +1414,44 @@ static void test_pairwise_pair_without_films_labels(void** state)
     assert_int_equal(r.outcome, WETDEM_PAIRWISE_FS);
 }
 
+/* A grazing contact shorter than a step is met: the gap of a pair that turns from approach to
+ * recession within a step is looked at where it is smallest. Dry spheres (h_min = 1 um) passing
+ * 1 nm inside h_min at 0.5 m/s stay below it for ~3 us, between step ends ~20 us apart: the
+ * contact was stepped over, the pair labelled none and left untouched. Now the impulse reverses
+ * the normal velocity at contact, v0 cos(beta) with sin(beta) = b / s, to -e_dry times it.
+ * Likewise a pass 1 nm into the films (a thin liquid, mu = 1e-6 Pa s) is a film overlap. */
+static void test_pairwise_grazing_contact_inside_a_step(void** state)
+{
+    (void)state;
+    const double v0 = 0.5, s = 2e-3 + 1e-6, b = s - 1e-9;
+    struct wetdem_pairwise_config c = dry_pair(v0, -b);
+    c.rtol = 1e-11;
+    struct wetdem_pairwise_result r;
+    struct wetdem_pairwise* pw;
+    CHECK_OK(run(&c, &r, &pw));
+    const struct wetdem_pairwise_pair_result* q = &r.pairs[0];
+    assert_non_null(find_event(pw, WETDEM_PAIRWISE_CONTACT, 0));
+    wetdem_pairwise_free(pw);
+    assert_true(q->n_contacts == 1 && q->min_gap <= c.h_min);
+    double sb = b / s, cb = sqrt(1.0 - sb * sb); /* the normal from 0 to 1 at contact */
+    double dvx = r.final[0].vx - r.final[1].vx, dvy = r.final[0].vy - r.final[1].vy;
+    CHECK_REL(dvx * cb + dvy * sb, -c.restitution * v0 * cb, 1e-3);
+    assert_int_equal(q->mechanism, WETDEM_OUTCOME_BOUNCE);
+
+    const double film = 25e-6; /* films of 25 um on each: reach a_i + a_j + 50 um */
+    c = dry_pair(v0, -(2e-3 + 2 * film - 1e-9));
+    c.spheres[0].film = c.spheres[1].film = film;
+    c.spheres[1].x = 2.1e-3;
+    c.viscosity = 1e-6;
+    CHECK_OK(run(&c, &r, &pw));
+    assert_non_null(find_event(pw, WETDEM_PAIRWISE_FILM_START, 0));
+    assert_non_null(find_event(pw, WETDEM_PAIRWISE_FILM_END, 0));
+    wetdem_pairwise_free(pw);
+    assert_true(q->films_met && !q->bound && q->n_contacts == 0);
+    assert_true(q->e_wet_own > 0.999); /* a pass: the thin liquid barely slows it */
+    assert_int_equal(q->mechanism, WETDEM_OUTCOME_STICK_ROTATE_SEPARATE);
+}
+
 /* ------------------------------------------------------------- tree and partner change */
 
 /* Converting the state to another tracked tree keeps every sphere: 1e-15 relative to the
@@ -1691,6 +1729,7 @@ int main(void)
         cmocka_unit_test(test_pairwise_knocked_apart_is_a_bounce),
         cmocka_unit_test(test_pairwise_receding_in_films_is_recede),
         cmocka_unit_test(test_pairwise_pair_without_films_labels),
+        cmocka_unit_test(test_pairwise_grazing_contact_inside_a_step),
         cmocka_unit_test(test_pairwise_tree_change_keeps_spheres),
         cmocka_unit_test(test_pairwise_partner_change_logged),
         cmocka_unit_test(test_pairwise_davis_builder),
