@@ -631,6 +631,11 @@ int wetdem_collision_run(struct wetdem_sim* sim, const struct wetdem_collision_s
         st = place_bodies(sim, spec, &su);
     if (st != WETDEM_OK)
         return st;
+    struct wetdem_contact c0;
+    pair_contact(sim, &c0);
+    c0.v_n = su.speed_n0;
+    if ((st = wetdem_sim_check_range_edge(sim, &c0)) != WETDEM_OK)
+        return st;
     struct tracker tr;
     start_tracker(sim, &su, spec, &tr);
     struct initial in = {

@@ -382,6 +382,24 @@ static int hertz_pair(const void* params, const struct wetdem_contact* c, double
     return WETDEM_OK;
 }
 
+/* Relaxation time m* / c_d [s] of the damping at the largest overlap of an undamped collision
+ * at c->v_n, delta_max = (5 m* v_n^2 / (4 k))^(2/5) (energy (1/2) m* v^2 = (2/5) k delta^(5/2)),
+ * where c_d = c(e) sqrt(m* k) delta^(1/4) is largest (the damped overlap is smaller):
+ * tau = sqrt(m* / k) / (c(e) delta_max^(1/4)). The exact coefficient grows as sqrt(5/(4 e))
+ * for small e_dry (header comment), so tau falls below the contact time as e_dry -> 0 and
+ * bounds the explicit many-particle step there (docs/many.md, Time step); INFINITY without
+ * damping (e_dry = 1) or approach speed. */
+static double hertz_relaxation_time(const void* params, const struct wetdem_contact* c)
+{
+    const struct hertz_params* p = params;
+    double coef = wetdem_force_hertz_damping_coefficient(c->restitution, (int)p->damping);
+    double k = hertz_stiffness(c->e_star, c->r_eff), v = c->v_n;
+    if (!(coef > 0.0 && v > 0.0 && k > 0.0 && c->m_eff > 0.0))
+        return INFINITY;
+    double delta_max = pow(1.25 * c->m_eff * v * v / k, 0.4);
+    return sqrt(c->m_eff / k) / (coef * sqrt(sqrt(delta_max)));
+}
+
 /* Energy stored in the elastic part of the law, (8/15) E* sqrt(R*) delta^(5/2) [J]: the
  * damping part is dissipative, whichever the form. */
 static double hertz_elastic_energy(const void* params, const struct wetdem_contact* c,
@@ -422,6 +440,7 @@ const struct wetdem_model wetdem_force_hertz = {
     .pair = hertz_pair,
     .thresholds = contact_only_thresholds,
     .contact_time = hertz_contact_time_hook,
+    .relaxation_time = hertz_relaxation_time,
     .elastic_energy = hertz_elastic_energy,
     .is_in_contact = contact_only_is_in_contact,
 };

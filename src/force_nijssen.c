@@ -210,7 +210,10 @@ const struct wetdem_model wetdem_force_nijssen = {
            "h_min and at 0; the force jumps only at h_co. Tangential: Mindlin spring on the "
            "shifted overlap with friction mu_dry when h_sigma >= h_eps (asperity contact), "
            "else mu_lub (a film remains), limited by mu times the elastic load of the contact "
-           "part. The simulation's min-separation model is not used by this model. Validated "
+           "part. The simulation's min-separation model is not used by this model. A pair "
+           "whose h_min at its approach speed reaches h_co would meet the solid force at the "
+           "cut-off; it is refused when the run starts (lower the roughness, raise E or "
+           "cutoff_ratio). Validated "
            "by Nijssen against Yang & Hunt for St ~ 1 to 10^4.",
     .equations = "Nijssen 2023 Eqs. 1, 3-10 (Eq. 5 fifth root; Eq. 9 lever weights)",
     .params = nijssen_params_desc,

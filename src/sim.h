@@ -179,6 +179,13 @@ bool wetdem_sim_laws_resolve_at(const struct wetdem_sim* sim, const struct wetde
  * INFINITY if there is none. Sets h_min from the min-separation model itself. */
 double wetdem_sim_jump_gap(const struct wetdem_sim* sim, const struct wetdem_contact* c);
 
+/* Checks that no enabled model of contact c (a fresh pair approaching at c->v_n) is already in
+ * solid contact at the edge of its range: there its solid force would switch on with a jump
+ * (nijssen when its minimum approach max(h_sigma, h_eps) reaches the cut-off h_co), which
+ * either stalls the integration or adds energy. Returns WETDEM_OK, or WETDEM_ERR_INVALID with
+ * a message naming the model, the gaps and the parameters that set them. */
+int wetdem_sim_check_range_edge(struct wetdem_sim* sim, const struct wetdem_contact* c);
+
 /* The time scale of the tangential oscillation of contact c [s], comparable with its normal
  * contact time t_contact at approach speed c->v_n (c at first touch): t_contact x
  * omega_n/omega_t, with omega^2 = k/m the enabled models' normal and tangential stiffnesses

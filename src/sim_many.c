@@ -309,7 +309,8 @@ struct step_scales {
 };
 
 /* The time scales of the pairs of sp at its speed scale (struct step_scales). Returns
- * WETDEM_OK or WETDEM_ERR_NOMEM (message in sim). */
+ * WETDEM_OK, WETDEM_ERR_NOMEM, or WETDEM_ERR_INVALID when a model is in contact at
+ * the edge of its range (wetdem_sim_check_range_edge; message in sim). */
 static int step_scales(struct wetdem_sim* sim, const struct step_spheres* sp, struct step_scales* s)
 {
     *s = (struct step_scales){.t_contact = INFINITY, .tau = INFINITY, .gap = INFINITY};
@@ -340,6 +341,11 @@ static int step_scales(struct wetdem_sim* sim, const struct step_spheres* sp, st
                 }
                 if (!((used[a] & 1) && (used[b] & (probe == PROBE_WALL ? 2 : 1))))
                     continue;
+                int edge = wetdem_sim_check_range_edge(sim, &c);
+                if (edge != WETDEM_OK) {
+                    free(used);
+                    return edge;
+                }
                 const struct wetdem_model* which;
                 double tau = wetdem_sim_relaxation_time(sim, &c, &which);
                 if (tau < s->tau) {
@@ -392,7 +398,7 @@ static void start_speed(const struct wetdem_sim* sim, struct step_spheres* sp)
 
 /* The spheres and time scales of the step for the current particles, into the engine's
  * relaxation_time, contact_time and crossing_time too. Needs at least one particle. Returns
- * WETDEM_OK or WETDEM_ERR_NOMEM. */
+ * WETDEM_OK or the error of step_scales. */
 static int time_scales(struct wetdem_sim* sim, struct step_spheres* sp, struct step_scales* s)
 {
     struct wetdem_many* m = sim->many;
@@ -457,14 +463,19 @@ static int choose_dt(struct wetdem_sim* sim, double* dt)
                                "minimum separation h_min > 0",
                                s.damper->name, s.h_at);
     if (given > 0) {
-        if (given >= tau)
+        if (given >= tau) {
+            /* a fluid law damps most at h_min; the contact damping (hertz) at the overlap */
+            char where[64] = "in contact";
+            if (s.damper->kind != WETDEM_MODEL_CONTACT)
+                snprintf(where, sizeof where, "at h_min = %g m", s.h_at);
             return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
                                    "many: the step dt = %g s is not below the viscous "
-                                   "relaxation time %g s that '%s' sets at h_min = %g m "
+                                   "relaxation time %g s that '%s' sets %s "
                                    "(m/c_d, shortest over the pairs that can occur): "
                                    "velocity Verlet is unstable there; use dt <= %g s (a "
                                    "quarter, dissipation within 3 %%), or 0 to derive it",
-                                   given, tau, s.damper->name, s.h_at, 0.25 * tau);
+                                   given, tau, s.damper->name, where, 0.25 * tau);
+        }
         *dt = given;
         return WETDEM_OK;
     }

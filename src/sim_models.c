@@ -712,6 +712,40 @@ int wetdem_sim_eval_contact(const struct wetdem_sim* sim, struct wetdem_contact*
     return WETDEM_OK;
 }
 
+int wetdem_sim_check_range_edge(struct wetdem_sim* sim, const struct wetdem_contact* c)
+{
+    if (sim->history_len > WETDEM_HISTORY_SCRATCH)
+        return WETDEM_OK;
+    for (size_t k = 0; k < sim->n_models; k++) {
+        const struct wetdem_model_slot* s = &sim->models[k];
+        if (!s->model->range || !s->model->is_in_contact)
+            continue;
+        struct wetdem_contact p = *c;
+        p.gap = s->model->range(s->params, &p);
+        if (!(p.gap > 0.0 && isfinite(p.gap)))
+            continue;
+        /* one evaluation there records what the pair's history keeps (nijssen: v0) */
+        double history[WETDEM_HISTORY_SCRATCH];
+        struct wetdem_pair_force f;
+        wetdem_sim_history_init(sim, history);
+        if (wetdem_sim_eval_contact(sim, &p, history, &f, NULL) != WETDEM_OK)
+            continue; /* (the run reports what the models refuse) */
+        if (!s->model->is_in_contact(s->params, &p, history + s->history_offset))
+            continue;
+        return wetdem_sim_fail(
+            sim, WETDEM_ERR_INVALID,
+            "model '%s' is in solid contact already at the edge of its range, gap %g m "
+            "(R* = %g m, approach speed %g m/s): its minimum approach (nijssen: h_min = "
+            "max(h_sigma, h_eps), the mean roughness (sigma_i + sigma_j)/2 = %g m or the "
+            "elastohydrodynamic gap 0.37 R* (mu v/(E* R*))^(2/5)) is not below its cut-off "
+            "(nijssen: h_co = cutoff_ratio R*), so the solid force would switch on with a jump "
+            "there; lower the materials' roughness, raise their youngs_modulus or the "
+            "model's cutoff_ratio",
+            s->model->name, p.gap, p.r_eff, p.v_n, p.roughness);
+    }
+    return WETDEM_OK;
+}
+
 int wetdem_sim_pair_force(struct wetdem_sim* sim, size_t i, size_t j, struct wetdem_contact* c,
                           struct wetdem_pair_force* out)
 {

@@ -368,6 +368,38 @@ static void test_collision_wall_lubrication(void** state)
     }
 }
 
+/* Nijssen's model with a minimum approach that reaches its cut-off: Delrin spheres
+ * (R* = 3.175 mm, h_co = R*) with a roughness of 1 cm, inside its valid range [0, 0.01] m
+ * but above h_co. The contact part of the lever blend then acts at an overlap shifted by
+ * h_min - h_co = 6.8 mm the moment the pair enters the range: the force jumps from zero to
+ * a Hertz force at 2 R* of overlap. CVODE ground on for 1e7 steps (minutes) before failing
+ * with max_steps; oblique, the pair rebounded with e_n = 1.06. The collision is now refused
+ * up front, naming the model, both gaps and the parameters that set them; a roughness below
+ * h_co still runs. */
+static void test_collision_nijssen_refuses_hmin_beyond_cutoff(void** state)
+{
+    (void)state;
+    int mat;
+    struct wetdem_sim* sim = make_sim("delrin", 0, "nijssen", NULL, "cvode", &mat);
+    struct wetdem_material m = *wetdem_sim_material(sim, mat);
+    m.roughness = 0.01;
+    int rough = wetdem_sim_add_material(sim, &m);
+    CHECK_OK(wetdem_sim_set_param(sim, "cvode.max_steps", 20000)); /* (fast either way) */
+    struct wetdem_collision_spec s = head_on(rough, 0.025, 2.5);
+    struct wetdem_collision_result r;
+    CHECK_STATUS(wetdem_collision_run(sim, &s, &r), WETDEM_ERR_INVALID);
+    const char* msg = wetdem_sim_errmsg(sim);
+    CHECK_CONTAINS(msg, "model 'nijssen' is in solid contact already at the edge of its range, "
+                        "gap 0.003175 m (R* = 0.003175 m");
+    CHECK_CONTAINS(msg, "(sigma_i + sigma_j)/2 = 0.01 m");
+    CHECK_CONTAINS(msg, "lower the materials' roughness");
+    m.roughness = 1e-3; /* below h_co: runs, and rebounds dissipatively */
+    s.material_i = s.material_j = wetdem_sim_add_material(sim, &m);
+    CHECK_OK(wetdem_collision_run(sim, &s, &r));
+    assert_true(r.e > 0 && r.e < 1);
+    wetdem_sim_free(sim);
+}
+
 /* Verlet at a small step (0.5 % of the Hertz time) and CVODE (rtol 1e-10) agree on e of a
  * Nijssen collision (Delrin, St = 200): the difference is Verlet's error, measured 2.0e-5;
  * 2e-4 asserted. */
@@ -898,6 +930,7 @@ int main(void)
         cmocka_unit_test(test_collision_cvode_sees_a_grazing_pass),
         cmocka_unit_test(test_collision_e_falls_with_viscosity),
         cmocka_unit_test(test_collision_wall_lubrication),
+        cmocka_unit_test(test_collision_nijssen_refuses_hmin_beyond_cutoff),
         cmocka_unit_test(test_collision_integrators_agree),
         cmocka_unit_test(test_collision_swap_roles),
         cmocka_unit_test(test_collision_deterministic_and_clone),

@@ -252,6 +252,39 @@ static struct wetdem_contact steel_pair(double gap, double v_n)
 /* hertz                                                                                     */
 /* ======================================================================================== */
 
+/* The dashpot's relaxation time m* / c_d (the many-particle step bound): c_d = dF_d/dv_n at
+ * the largest overlap of an undamped impact at v_n, delta_max = (5 m* v^2 / (4 k))^(2/5),
+ * taken here from the damping force itself (linear in v_n: F_d(v = 1 m/s)); it falls as
+ * 1/c(e) ~ sqrt(e) for small e_dry (c ~ sqrt(5/(4 e))), and without damping (e = 1) or
+ * approach it is infinite. 1e-12: the same products in another order. */
+static void test_hertz_relaxation_time_is_the_dashpot_at_the_largest_overlap(void** state)
+{
+    (void)state;
+    double p[1];
+    wetdem_param_init_defaults(wetdem_force_hertz.params, p);
+    struct wetdem_contact c = steel_pair(0, 0.5);
+    double k = (4.0 / 3.0) * c.e_star * sqrt(c.r_eff);
+    double delta = pow(1.25 * c.m_eff * 0.25 / k, 0.4);
+    double prev = INFINITY;
+    for (double e = 0.9; e > 1e-9; e /= 100) {
+        c.restitution = e;
+        double c_d =
+            wetdem_force_hertz_damping(c.e_star, c.r_eff, c.m_eff, delta, 1.0, e, /*exact*/ 0);
+        double tau = wetdem_force_hertz.relaxation_time(p, &c);
+        CHECK_REL(tau, c.m_eff / c_d, 1e-12);
+        assert_true(tau < prev);
+        prev = tau;
+    }
+    c.restitution = 1e-6; /* c ~ sqrt(5/(4 e)) = 1118: tau ~ a thousandth of the contact time */
+    assert_true(wetdem_force_hertz.relaxation_time(p, &c) <
+                1e-2 * wetdem_force_hertz.contact_time(p, &c));
+    c.restitution = 1.0;
+    assert_true(isinf(wetdem_force_hertz.relaxation_time(p, &c)));
+    c.restitution = 0.5;
+    c.v_n = 0;
+    assert_true(isinf(wetdem_force_hertz.relaxation_time(p, &c)));
+}
+
 static void test_hertz_elastic_force_at_hand_point(void** state)
 {
     (void)state;
@@ -941,6 +974,7 @@ int main(int argc, char** argv)
         cmocka_unit_test(test_mindlin_spring_rotates_into_tangent_plane),
         cmocka_unit_test(test_mindlin_swap_symmetry_and_torques),
         cmocka_unit_test(test_mindlin_resets_when_separated),
+        cmocka_unit_test(test_hertz_relaxation_time_is_the_dashpot_at_the_largest_overlap),
         cmocka_unit_test(test_hooke_force_closed_form),
         cmocka_unit_test(test_hooke_collision_recovers_e_and_contact_time),
         cmocka_unit_test(test_contact_model_objects_are_documented),

@@ -863,6 +863,47 @@ static void test_many_step_follows_the_contact_model(void** state)
     wetdem_sim_free(sim);
 }
 
+/* A nearly plastic dry contact: two glass spheres (R = 1 mm) head-on at 0.1 m/s, hertz alone,
+ * e_dry = 1e-6. The exact damping coefficient grows as sqrt(5/(4 e)) (~1100 here), so the
+ * dashpot relaxes the contact in m* / c_d, about a thousandth of the contact time; the derived
+ * step (0.02 x the contact time before) was 20 x that, and velocity Verlet diverged (the
+ * many_agglomeration example stopped with velocities of 1e154 m/s at e_dry = 1e-12, and its
+ * energy budget missed by 10 % at 1e-3). The hertz model's relaxation time now holds the step
+ * at a quarter of it: the run ends with the spheres stuck (relative speed below 1e-3 of the
+ * impact's: e_dry = 1e-6, the rest the discretisation) and the budget closed to 1e-3 of the
+ * input (measured 3.7e-4; the engine's own check allows 5e-2). */
+static void test_many_step_resolves_strong_contact_damping(void** state)
+{
+    (void)state;
+    struct wetdem_sim* sim = wetdem_sim_create();
+    struct wetdem_material m = pair_material(0);
+    m.restitution = 1e-6;
+    assert_int_equal(wetdem_sim_add_material(sim, &m), 0);
+    CHECK_OK(wetdem_sim_enable_model(sim, "hertz"));
+    double x = 1e-3 + 2.5e-6, u = 0.05;
+    CHECK_OK(wetdem_sim_add_particle(
+        sim, (struct wetdem_particle){.pos = {-x, 0, 0}, .vel = {u, 0, 0}, .radius = 1e-3}));
+    CHECK_OK(wetdem_sim_add_particle(
+        sim, (struct wetdem_particle){.pos = {x, 0, 0}, .vel = {-u, 0, 0}, .radius = 1e-3}));
+    CHECK_OK(wetdem_sim_set_many(
+        sim, &(struct wetdem_many_settings){.skin = 1e-4, .energy_budget = true}));
+    CHECK_OK(wetdem_sim_integrate(sim, 100e-6));
+    size_t n;
+    const struct wetdem_particle* p = wetdem_sim_particles(sim, &n);
+    double dv = p[0].vel.x - p[1].vel.x;
+    if (!(fabs(dv) < 1e-3 * 2 * u))
+        fail_msg("relative speed %g m/s after the contact, impact %g m/s", dv, 2 * u);
+    struct wetdem_energy_budget b;
+    CHECK_OK(wetdem_sim_energy_budget(sim, &b));
+    CHECK_ABS(b.balance_error, 0, 1e-3 * b.input);
+    struct wetdem_many_stats st;
+    CHECK_OK(wetdem_sim_many_stats(sim, &st));
+    assert_true(isfinite(st.relaxation_time));
+    assert_true(st.dt <= 0.25 * st.relaxation_time * (1 + 1e-12));
+    assert_true(st.relaxation_time < 1e-2 * st.contact_time);
+    wetdem_sim_free(sim);
+}
+
 /* The derived step comes from the pairs that can occur (docs/many.md, Time step): a free
  * sphere with another free one, with a fixed one, with a wall. A fixed sphere has infinite
  * mass, so two copies of it (what "the two smallest spheres" were when a fixed sphere was the
@@ -1152,11 +1193,13 @@ static int expect_finite_state(unsigned long long done, unsigned long long total
  * WETDEM_MANY_CONTACT_FRACTION_MAX); the motion then diverges, and the run stops at the first
  * step whose velocities are not finite, with WETDEM_ERR_NUMERIC naming that step, its time and
  * the particle, before any callback or output sees the state. Before, it ran to its end with
- * an infinite kinetic energy. */
+ * an infinite kinetic energy. The contacts are undamped (e_dry = 1): a step that long is at
+ * or above the relaxation time of a damped Hertz contact, and is refused up front. */
 static void test_many_divergence_stops_the_run(void** state)
 {
     (void)state;
     struct wetdem_sim* sim = wet_box(150, false);
+    sim->materials[0].restitution = 1.0;
     struct wetdem_many_settings s = box_settings();
     s.dt = 3e-4;
     s.progress = expect_finite_state;
@@ -2106,6 +2149,7 @@ int main(void)
         cmocka_unit_test(test_many_matches_few_body_engine),
         cmocka_unit_test(test_many_step_stays_below_the_viscous_relaxation_time),
         cmocka_unit_test(test_many_step_follows_the_contact_model),
+        cmocka_unit_test(test_many_step_resolves_strong_contact_damping),
         cmocka_unit_test(test_many_step_comes_from_the_pairs_that_occur),
         cmocka_unit_test(test_many_fixed_spheres_meet_neither_each_other_nor_walls),
         cmocka_unit_test(test_many_freeing_a_fixed_sphere_between_calls),

@@ -1572,7 +1572,9 @@ static size_t count_rows_finite(const char* name, bool* finite)
  * gives the time scales in wetdem_many_stats): the base scenario's given 2 us lets a pair at
  * its speed scale (2 m/s) travel several times h_min = 1 um in a step; many_hmin_fraction = 0 turns
  * that bound and its warning off, and the derived step keeps to the bound. A step of 0.3 ms,
- * some 8 x the contact time of the dry spheres, is warned about and diverges: the run stops
+ * some 8 x the contact time of the dry spheres, is refused up front (exit 2) where it is not
+ * below the relaxation time of the damped hertz contact, with the step to use; with undamped
+ * contacts (e_dry = 1) it is warned about and diverges: the run stops
  * at the first step whose motion is not finite with exit 1, naming the step, the time and
  * the particle, and every CSV row and VTK frame written before is of a finite state (one of
  * each for the start and every step done; no summary). Before, it ran to its end with an
@@ -1595,7 +1597,12 @@ static void test_many_cli_warns_about_the_step(void** state)
         free(err);
     }
 
+    err = expect_exit("run warn.ini --set 'models.force=hertz mindlin' --set run.dt=3e-4", 2,
+                      "many: the step dt = 0.0003 s is not below the viscous relaxation time ");
+    CHECK_CONTAINS(err, "that 'hertz' sets in contact");
+    free(err);
     err = expect_exit("run warn.ini --set 'models.force=hertz mindlin' --set run.dt=3e-4 "
+                      "--set material.wet.restitution=1 "
                       "--set dump.vtk_every=1 --set dump.csv_every=1 "
                       "--out div",
                       1, "wetdem: warning: warn.ini: the step dt = 0.0003 s is ");
