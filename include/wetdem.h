@@ -856,6 +856,11 @@ WETDEM_API int wetdem_sim_insert(struct wetdem_sim* sim, const struct wetdem_ins
 
 #define WETDEM_PAIRWISE_MAX_SPHERES 8
 #define WETDEM_PAIRWISE_MAX_PAIRS 28 /* MAX_SPHERES (MAX_SPHERES - 1) / 2 */
+/* Smallest h_min / (a_i + a_j) of a pairwise run: the gap of a pair outside the tracked tree
+ * (three spheres touching in a loop) is a difference of lengths of the spheres' size and is
+ * resolved to about this (docs/derivations/pairwise.md Sec. 8). For Davis's groups:
+ * film_ratio x hmin_ratio >= this. */
+#define WETDEM_PAIRWISE_MIN_HMIN_RATIO 5e-11
 
 /* One sphere of a pairwise run, in the x-y plane. */
 struct wetdem_pairwise_sphere {

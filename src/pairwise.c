@@ -295,6 +295,15 @@ int wetdem_pairwise_config_validate(const struct wetdem_pairwise_config* c, char
     for (size_t i = 0; i < c->n_spheres; i++)
         for (size_t j = i + 1; j < c->n_spheres; j++) {
             const struct wetdem_pairwise_sphere *a = &c->spheres[i], *b = &c->spheres[j];
+            double sum = a->radius + b->radius;
+            if (!(c->h_min >= WETDEM_PAIRWISE_MIN_HMIN_RATIO * sum))
+                return wetdem_status_fail(
+                    msg, n, WETDEM_ERR_INVALID,
+                    "h_min = %g m: must be >= %g (a_i + a_j) = %g m for spheres %zu and %zu "
+                    "(spheres[%zu], spheres[%zu]): a smaller gap is not resolved beside "
+                    "centre distances of %g m",
+                    c->h_min, WETDEM_PAIRWISE_MIN_HMIN_RATIO, WETDEM_PAIRWISE_MIN_HMIN_RATIO * sum,
+                    i + 1, j + 1, i, j, sum);
             double h = hypot(b->x - a->x, b->y - a->y) - a->radius - b->radius;
             /* The gap is a difference of lengths of the centres' size: spheres placed at
              * exactly h_min (a cradle's chain) come out a few ulps of those lengths short. */
@@ -322,6 +331,60 @@ static int cv_rhs(sunrealtype t, N_Vector y, N_Vector ydot, void* ud)
                                     N_VGetArrayPointer(ydot))
                ? 0
                : 1; /* recoverable: CVODE retries with a smaller step */
+}
+
+/* Largest change of any gap, as a fraction of h_min, that the difference quotients of the
+ * Jacobian may make by perturbing a tracked angle (cv_jac). */
+#define JAC_GAP_FRACTION 0.02
+
+/* Dense difference-quotient Jacobian: CVODE's own (cvLsDenseDQJac: increment
+ * max(sqrt(eps) |y_j|, 1000 |h| eps N ||f||_wrms / ewt_j)), except that the increment of a
+ * tracked angle theta_e is at most JAC_GAP_FRACTION h_min / r_e. Turning edge e by d theta
+ * shifts every sphere beyond it by r_e d theta, and with it the gaps of the pairs that are not
+ * tracked (a closed loop, Davis Appendix B), which are differences of lengths of the spheres'
+ * size. CVODE's increment, 1.5e-8 |theta|, shifted them by ~6e-11 m |theta| for 2 mm spheres:
+ * 1e-4 of h_min in Davis's Fig. 3 (h_a = h_m = 0.01), but the whole of it at h_a = 3e-6, where
+ * a perturbed state had a gap <= 0, the right-hand side failed for every step size and CVODE
+ * stopped with "the corrector convergence test failed repeatedly or with |h| = hmin". The
+ * force laws change over a gap's own size (~1/h, ln h), so a quotient must move it by a small
+ * part of h_min; rounding of a gap, ~1e-16 (a_i + a_j), stays below 1e-4 of that step while
+ * h_min > 1e-10 (a_i + a_j). With |theta| < ANGLE_WRAP the cap does not bind in Davis's
+ * Table-I range (h_a h_m >= 2e-6 at h_a = 0.002). */
+static int cv_jac(sunrealtype t, N_Vector y, N_Vector fy, SUNMatrix jac, void* ud, N_Vector tmp1,
+                  N_Vector tmp2, N_Vector tmp3)
+{
+    (void)tmp3;
+    struct wetdem_pairwise* pw = ud;
+    const struct wetdem_pairwise_system* sys = &pw->sys;
+    size_t n = pw->cv_dim;
+    sunrealtype h_step = 0.0;
+    if (CVodeGetErrWeights(pw->cvode, tmp2) != CV_SUCCESS ||
+        CVodeGetCurrentStep(pw->cvode, &h_step) != CV_SUCCESS)
+        return -1;
+    const double* ewt = N_VGetArrayPointer(tmp2);
+    double* yd = N_VGetArrayPointer(y);
+    const double* f0 = N_VGetArrayPointer(fy);
+    const double* f1 = N_VGetArrayPointer(tmp1);
+    double srur = sqrt(DBL_EPSILON), fnorm = N_VWrmsNorm(fy, tmp2);
+    double min_inc = fnorm != 0.0 ? 1000.0 * fabs(h_step) * DBL_EPSILON * (double)n * fnorm : 1.0;
+    for (size_t j = 0; j < n; j++) {
+        double saved = yd[j], inc = fmax(srur * fabs(saved), min_inc / ewt[j]);
+        if (j >= PW_ANCHOR_LEN && (j - PW_ANCHOR_LEN) % PW_EDGE_LEN == PW_THETA) {
+            size_t e = (j - PW_ANCHOR_LEN) / PW_EDGE_LEN, p = pw->md.edge[e];
+            double r = sys->a[sys->pi[p]] + sys->a[sys->pj[p]] + yd[j - PW_THETA + PW_H];
+            inc = fmin(inc, JAC_GAP_FRACTION * sys->h_min / r);
+        }
+        yd[j] += inc;
+        int st = cv_rhs(t, y, tmp1, ud);
+        yd[j] = saved;
+        if (st != 0)
+            return st;
+        double* col = SUNDenseMatrix_Column(jac, (sunindextype)j);
+        double inv = 1.0 / inc;
+        for (size_t i = 0; i < n; i++)
+            col[i] = inv * (f1[i] - f0[i]);
+    }
+    return 0;
 }
 
 static void cv_err(int code, const char* module, const char* function, char* msg, void* ud)
@@ -376,6 +439,7 @@ static int setup_cvode(struct wetdem_pairwise* pw)
             return fail(pw, WETDEM_ERR_NOMEM, "cannot attach the dense linear solver");
         CVodeSetMaxErrTestFails(pw->cvode, 20);
         CVodeSetMaxConvFails(pw->cvode, 50);
+        CVodeSetJacFn(pw->cvode, cv_jac);
         pw->cv_dim = dim;
     }
     CVodeSetUserData(pw->cvode, pw);
@@ -1196,6 +1260,9 @@ static void classify(struct wetdem_pairwise* pw)
 
 /* ------------------------------------------------------------------------------ run ---- */
 
+#ifndef HOLD_RATE_FACTOR
+#define HOLD_RATE_FACTOR 100.0
+#endif
 /* Reference quantities, initial modes, tree and state from the configuration. */
 static void initial_state(struct wetdem_pairwise* pw)
 {
@@ -1224,6 +1291,7 @@ static void initial_state(struct wetdem_pairwise* pw)
     for (size_t i = 0; i < sys->n; i++)
         v = fmax(v, fmax(hypot(k.ux[i], k.uy[i]), hypot(k.vx[i], k.vy[i])));
     pw->v_scale = v > 0.0 ? v : 1e-6;
+    sys->hold_rate = HOLD_RATE_FACTOR * cfg->rtol * pw->v_scale / sys->h_min;
     /* (without an approach of the reference pair, the largest initial speed: Sec. 7) */
     pw->rest_speed = cfg->rest_speed_ratio * (res->v_n0 > 0.0 ? res->v_n0 : pw->v_scale);
     if (cfg->rest_speed_ratio > 0.0) /* (0: no resting contact at all) */

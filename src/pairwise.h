@@ -37,6 +37,8 @@ struct wetdem_pairwise_system {
     double delta[PW_PMAX];                           /* delta_ij [m] */
     double mu, sigma, h_min, e_dry, mu_f;            /* [Pa s], [N/m], [m], [-], [-] */
     double gx, gy;                                   /* [m/s^2] */
+    double hold_rate; /* alpha [1/s]: a held pair that is not tracked is kept at h_min by
+                         dv_n/dt = alpha^2 (h - h_min) - 2 alpha v_n (pairwise_rhs.c) */
 };
 
 /* Discrete mode of a run: tracked tree and the per-pair switches. */

@@ -90,6 +90,15 @@ static int davis_validate(const struct wetdem_pairwise_davis* d, char* msg, size
         if (wetdem_param_validate(p, v, msg, n) != WETDEM_OK)
             return WETDEM_ERR_INVALID;
     }
+    /* h_min / (a_i + a_j) = h_m delta_12 / 4a = h_m h_a for the equal spheres */
+    if (!(d->film_ratio * d->hmin_ratio >= WETDEM_PAIRWISE_MIN_HMIN_RATIO))
+        return wetdem_status_fail(msg, n, WETDEM_ERR_INVALID,
+                                  "film_ratio = %g with hmin_ratio = %g: h_min is %g of the "
+                                  "spheres' diameter sum; need film_ratio x hmin_ratio >= %g "
+                                  "(film_ratio >= %g at this hmin_ratio)",
+                                  d->film_ratio, d->hmin_ratio, d->film_ratio * d->hmin_ratio,
+                                  WETDEM_PAIRWISE_MIN_HMIN_RATIO,
+                                  WETDEM_PAIRWISE_MIN_HMIN_RATIO / d->hmin_ratio);
     if (d->n_spheres == 3) {
         if (d->d23 + d->d13 < 1.0 || d->d13 - d->d23 < -1.0 || d->d23 - d->d13 < -1.0)
             return wetdem_status_fail(

@@ -198,6 +198,10 @@ static bool constraint_forces(const struct wetdem_pairwise_system* sys,
         double dvn, rdom;
         pair_accel(sys, k, f, rest[a], &dvn, &rdom);
         b[a] = -dvn;
+        if (md->edge_of_pair[rest[a]] < 0) { /* closed loop: gap from geometry, see above */
+            double al = sys->hold_rate;
+            b[a] += al * al * (k->h[rest[a]] - sys->h_min) - 2.0 * al * k->v_n[rest[a]];
+        }
         for (size_t c = 0; c < n; c++)
             A[a][c] = wetdem_pairwise_rhs_coupling(sys, k, rest[a], rest[c]);
     }

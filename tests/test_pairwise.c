@@ -1236,6 +1236,92 @@ static void test_pairwise_two_sphere_mechanisms(void** state)
     assert_int_equal(r.outcome, WETDEM_PAIRWISE_FA);
 }
 
+/* Davis's Table-I run at film ratio h_a = delta_12 / 4a and t* = 20. */
+static int run_film(double h_a, double st, double angle_deg, struct wetdem_pairwise_result* r)
+{
+    struct wetdem_pairwise_davis d;
+    wetdem_pairwise_davis_init(&d);
+    d.film_ratio = h_a;
+    d.stokes = st;
+    d.angle_deg = angle_deg;
+    struct wetdem_pairwise_config c;
+    char msg[256];
+    CHECK_OK(wetdem_pairwise_davis_config(&d, &c, msg, sizeof msg));
+    return run(&c, r, NULL);
+}
+
+/* Energy budget terms over the initial energy, and the residual over the budget's scale. */
+static void energy_fractions(const struct wetdem_pairwise_result* r, double* out)
+{
+    const struct wetdem_pairwise_energy* e = &r->energy;
+    out[0] = e->kinetic / e->initial;
+    out[1] = e->capillary / e->initial;
+    out[2] = e->viscous_normal / e->initial;
+    out[3] = e->viscous_tangential / e->initial;
+    out[4] = e->residual / wetdem_pairwise_energy_scale(e);
+}
+
+/* Thin films (h_a = 1e-6 and 1e-8, with h_min = 0.01 delta_12 down to 4e-13 m for 2 mm
+ * spheres). Davis's dimensionless problem (Eqs. 20-33) has h_a only in terms that carry
+ * tan(beta): the centrifugal and Coriolis terms St tan^2(beta) h_a r Omega^2 and
+ * 2 St h_a v Omega, the turning rate d theta/dt-hat = h_a tan(beta) Omega and the factor
+ * (4/3) h_a tan(beta) of the tangential force. So (1) head-on (beta = 0, spheres in a line) the
+ * problem does not depend on h_a at all: h_a = 1e-2 and 1e-8 agree to the integration error
+ * (measured 5e-8); (2) obliquely, in t* = v_10 t / 4a, the film phase is a boundary layer of
+ * relative length O(h_a) and the results tend to a limit as h_a -> 0 with O(h_a) corrections
+ * (Fig. 3's energy fractions move by 1.0e-5 from h_a = 1e-5 to 1e-6 and by 1.2e-6 from 1e-6
+ * to 1e-8); 5 h_a of the thicker film bounds them. Fig. 3's run ends with the three spheres
+ * held at h_min in a closed loop, whose third gap is computed from the other two pairs'
+ * angles (Appendix B): at h_a <= 3e-6 the Jacobian's difference quotients in those angles
+ * gave that gap a value <= 0 and CVODE stopped ("corrector convergence test failed
+ * repeatedly"); at 1e-8 the gap then drifted from h_min through the films (FA with pair 1-2
+ * "separated", budget residual 1.5e-3). The hold keeps it within 1 % of h_min. */
+static void test_pairwise_thin_films(void** state)
+{
+    (void)state;
+    struct wetdem_pairwise_result thick, thin;
+    double a[5], b[5];
+    /* (1) head-on, St_n = 27: sphere 1 stays on 2 (bounce into capture), 3 leaves */
+    CHECK_OK(run_film(1e-2, 27.0, 0.0, &thick));
+    CHECK_OK(run_film(1e-8, 27.0, 0.0, &thin));
+    assert_int_equal(thin.outcome, WETDEM_PAIRWISE_PA);
+    assert_int_equal(thin.outcome, thick.outcome);
+    assert_int_equal(thin.separated_sphere, thick.separated_sphere);
+    CHECK_ABS(thin.pairs[2].e_wet, thick.pairs[2].e_wet, 1e-6);
+    energy_fractions(&thick, a);
+    energy_fractions(&thin, b);
+    for (int k = 0; k < 4; k++)
+        CHECK_ABS(b[k], a[k], 1e-6);
+    assert_true(fabs(b[4]) < 1e-5);
+    /* (2) Fig. 3 (St_n = 2, beta = 30 deg, Ca = 1000): full agglomeration in a closed loop */
+    CHECK_OK(run_film(1e-6, 2.0, 30.0, &thick));
+    CHECK_OK(run_film(1e-8, 2.0, 30.0, &thin));
+    energy_fractions(&thick, a);
+    energy_fractions(&thin, b);
+    for (int k = 0; k < 4; k++)
+        CHECK_ABS(b[k], a[k], 5e-6);
+    const struct wetdem_pairwise_result* both[2] = {&thick, &thin};
+    for (int m = 0; m < 2; m++) {
+        const struct wetdem_pairwise_result* r = both[m];
+        assert_int_equal(r->outcome, WETDEM_PAIRWISE_FA);
+        double h_min = 0.01 * r->delta_ref;
+        for (size_t p = 0; p < 3; p++) {
+            assert_true(r->pairs[p].bound);
+            assert_true(r->pairs[p].min_gap > 0.99 * h_min);
+        }
+        energy_fractions(r, a);
+        assert_true(fabs(a[4]) < 1e-6);
+    }
+    /* (3) below h_min = 5e-11 (a_i + a_j) the run is refused up front, naming the groups */
+    struct wetdem_pairwise_davis d;
+    wetdem_pairwise_davis_init(&d);
+    d.film_ratio = 1e-9;
+    struct wetdem_pairwise_config c;
+    char msg[256];
+    CHECK_STATUS(wetdem_pairwise_davis_config(&d, &c, msg, sizeof msg), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(msg, "film_ratio x hmin_ratio >= 5e-11");
+}
+
 /* A pair held at h_min (resting contact, v_n = 0) and then let go separates through the film
  * and centrifugal forces with no impulse after the release: stick-rotate-separate, not bounce.
  * Three spheres, Davis's Table I at St_n = 3.7253, 45 deg: pair 1-2 has three contacts, is held
@@ -1725,6 +1811,7 @@ int main(void)
         cmocka_unit_test(test_pairwise_long_spinning_cluster),
         cmocka_unit_test(test_pairwise_scales_of_the_reference_pair),
         cmocka_unit_test(test_pairwise_two_sphere_mechanisms),
+        cmocka_unit_test(test_pairwise_thin_films),
         cmocka_unit_test(test_pairwise_released_pair_is_not_a_bounce),
         cmocka_unit_test(test_pairwise_knocked_apart_is_a_bounce),
         cmocka_unit_test(test_pairwise_receding_in_films_is_recede),
