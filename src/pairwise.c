@@ -1260,9 +1260,10 @@ static void classify(struct wetdem_pairwise* pw)
 
 /* ------------------------------------------------------------------------------ run ---- */
 
-#ifndef HOLD_RATE_FACTOR
+/* Rate of the hold of an untracked pair at h_min (struct wetdem_pairwise_system, hold_rate) in
+ * units of rtol v_scale / h_min: fast enough to keep its drift near h_min / 100, slow beside
+ * the integration step (docs/derivations/pairwise.md Sec. 7). */
 #define HOLD_RATE_FACTOR 100.0
-#endif
 /* Reference quantities, initial modes, tree and state from the configuration. */
 static void initial_state(struct wetdem_pairwise* pw)
 {
