@@ -91,14 +91,19 @@ size_t cli_result_fields(const struct cli_setup* su, const struct wetdem_collisi
                    r->rotation_angle * RAD2DEG);
     out[n++] = num("rotation_close", "deg",
                    "part of rotation_angle turned below close_gap after the approach was "
-                   "arrested (> 5 deg and separated: stick-rotate-separate)",
+                   "arrested",
                    r->rotation_close * RAD2DEG);
+    out[n++] = num("rotation_doublet", "deg",
+                   "part of rotation_close the relative velocity turned with (> 5 deg and "
+                   "separated: stick-rotate-separate)",
+                   r->rotation_doublet * RAD2DEG);
     out[n++] = num("close_gap", "m", "doublet gap of the outcome rule", r->close_gap);
-    out[n] = (struct cli_field){.name = "outcome",
-                                .unit = "",
-                                .kind = CLI_FIELD_TEXT,
-                                .doc = "stick, stick-rotate-separate or bounce",
-                                .text = wetdem_outcome_name(r->outcome)};
+    out[n] = (struct cli_field){
+        .name = "outcome",
+        .unit = "",
+        .kind = CLI_FIELD_TEXT,
+        .doc = "stick, stick-rotate-separate, bounce or none (never reached the target)",
+        .text = wetdem_outcome_name(r->outcome)};
     n++;
     out[n++] = count("steps", "accepted integrator steps", r->stats.steps);
     out[n++] = count("rejected_steps", "rejected step attempts", r->stats.rejected_steps);

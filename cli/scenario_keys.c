@@ -60,10 +60,10 @@ static const struct cli_key_desc collision_keys[] = {
     NUM("rebound_gap_factor", "-", "1", 1, 1e3, false, false,
         "Separation is declared when the gap exceeds this multiple of the interaction range."),
     NUM("close_gap", "m", "0 (auto)", 0, 1, false, false,
-        "Outcome rule: a pair that separates after its line of centres turned by more than 5 "
-        "deg with the gap below close_gap (after the approach was first arrested) is "
-        "stick-rotate-separate. 0: the film thickness delta_ij when the pair has films (the "
-        "overlapping films hold the doublet), else 0.01 R*."),
+        "Outcome rule: a pair that separates after its line of centres turned, together with "
+        "its relative velocity, by more than 5 deg with the gap below close_gap (after the "
+        "approach was first arrested) is stick-rotate-separate. 0: the film thickness delta_ij "
+        "when the pair has films (the overlapping films hold the doublet), else 0.01 R*."),
     {0},
 };
 

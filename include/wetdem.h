@@ -541,9 +541,11 @@ WETDEM_API const struct wetdem_particle* wetdem_sim_particles_const(const struct
 /* ---- two-body collision analysis (SPEC §4) ---- */
 
 enum wetdem_outcome {
-    WETDEM_OUTCOME_NONE = -1,                 /* pairwise pair that never interacted: its films
-                                                 never met and it never touched */
-    WETDEM_OUTCOME_STICK = 0,                 /* no separation by t_end */
+    WETDEM_OUTCOME_NONE = -1,                 /* never interacted: a pairwise pair whose films
+                                                 never met and that never touched, or a
+                                                 collision whose striker had not reached the
+                                                 interaction range by t_end */
+    WETDEM_OUTCOME_STICK = 0,                 /* interacted, no separation by t_end */
     WETDEM_OUTCOME_STICK_ROTATE_SEPARATE = 1, /* separated after rotating as a doublet */
     WETDEM_OUTCOME_BOUNCE = 2,                /* separated promptly (contact-bounce) */
     WETDEM_OUTCOME_RECEDE = 3,                /* pairwise pair that separated without having
@@ -618,7 +620,11 @@ struct wetdem_collision_result {
     double rotation_angle;      /* angle the line of centres turned during interaction [rad] */
     double rotation_close;      /* the part of rotation_angle turned after the approach was
                                    first arrested (first minimum of the gap) while the gap was
-                                   below close_gap (stick-rotate-separate criterion) [rad] */
+                                   below close_gap [rad] */
+    double rotation_doublet;    /* the part of rotation_close that the relative velocity turned
+                                   with, the same way (the doublet's orbit; free flight past the
+                                   target and the impact turn only one of the two) [rad]: above
+                                   5 deg a separated pair is stick-rotate-separate */
     double close_gap;           /* the doublet gap used (spec close_gap or automatic) [m] */
     double t_first_interaction; /* time the gap first reached the interaction range [s]
                                    (0 when starting inside it) */

@@ -46,12 +46,16 @@
  *     passive models of the catalogue, so a value above it measures the integration's error
  *     (NAN with gravity). Without U a pair held by a capillary bridge, its well's energy
  *     turned into motion, ended with up to 6 times its initial kinetic energy.
- * Outcome: stick if not separated by t_end; stick-rotate-separate if separated after the
- * line of centres turned by more than 5 degrees, after the approach was first arrested (the
- * first minimum of the gap), in steps with the gap below h_close (a doublet rotating in near contact: a prompt bounce turns it by a few
- * degrees at most); else bounce. h_close = spec close_gap when > 0, else the pair's film
- * thickness delta_ij when it has films (overlapping films are the bridge that holds the
- * doublet, Punch; Davis), else 0.01 R* (immersed pairs).
+ * Outcome (docs/engines.md "Outcome"; Punch's definitions): none if the striker had not
+ * reached the interaction range by t_end; stick if not separated by t_end; stick-rotate-
+ * separate if separated after the pair orbited as a doublet by more than 5 degrees: the turn
+ * that the line of centres and the relative velocity shared (per step the smaller, about the
+ * line's axis), after the approach was first arrested (the first minimum of the gap), in steps
+ * with the gap below h_close; else bounce. The line's turn alone is no measure: a bounce that
+ * leaves a grazing contact turns it, in free flight, by up to sqrt(2 h_close / (R_i + R_j))
+ * (8.4 degrees for Punch's films), while its velocity stays. h_close = spec close_gap when > 0,
+ * else the pair's film thickness delta_ij when it has films (overlapping films are the bridge
+ * that holds the doublet, Punch; Davis), else 0.01 R* (immersed pairs).
  */
 #include <float.h>
 #include <gsl/gsl_integration.h>
@@ -63,7 +67,7 @@
 #include "integrator.h"
 #include "vec3.h"
 
-#define SRS_ANGLE (5.0 * M_PI / 180.0) /* rotation that marks stick-rotate-separate [rad] */
+#define SRS_ANGLE (5.0 * M_PI / 180.0) /* doublet turn that marks stick-rotate-separate [rad] */
 #define CLOSE_GAP_RATIO 0.01           /* h_close / R* without films [-] */
 #define START_MARGIN_RATIO 0.01        /* start gap beyond the range, / R* [-] */
 
@@ -89,7 +93,8 @@ struct tracker {
     bool interacting; /* after the first interaction */
     double t_first;   /* time of the first interaction [s] */
     double rotation, rotation_close;
-    bool arrested; /* the approach has been arrested once (first minimum of
+    double rotation_doublet; /* the part of rotation_close the relative velocity shared */
+    bool arrested;           /* the approach has been arrested once (first minimum of
                                       the gap): rotation_close counts from there */
     size_t events_seen;
     double t_observe;    /* absolute observation time [s], INFINITY if none yet */
@@ -113,7 +118,7 @@ static struct wetdem_vec3 rebound_normal(const struct tracker* tr, struct wetdem
 {
     if (tr->film > 0)
         return tr->left_film ? tr->n_film : now;
-    if (tr->rotation_close > SRS_ANGLE)
+    if (tr->rotation_doublet > SRS_ANGLE)
         return tr->left_close ? tr->n_leave : now;
     return tr->turned ? tr->n_turn : now;
 }
@@ -123,6 +128,24 @@ static struct wetdem_vec3 unit_between(struct wetdem_vec3 a, struct wetdem_vec3 
 {
     struct wetdem_vec3 n = vec3_add(vec3_scale(a, 1 - s), vec3_scale(b, s));
     return vec3_scale(n, 1.0 / vec3_norm(n));
+}
+
+/* The part of a step's turn of the line of centres, from n0 to n1 (turn [rad], > 0), that the
+ * relative velocity shared, dv0 to dv1 turning about the same axis and the same way [rad]: a
+ * doublet held in near contact orbits, its velocity turning with its line of centres; a pair
+ * in free flight past the target turns its line while its velocity stays; an impact turns
+ * the velocity while the line stays. */
+static double shared_turn(struct wetdem_vec3 n0, struct wetdem_vec3 n1, double turn,
+                          struct wetdem_vec3 dv0, struct wetdem_vec3 dv1)
+{
+    struct wetdem_vec3 axis = vec3_cross(n0, n1);
+    double len = vec3_norm(axis);
+    if (!(len > 0))
+        return 0.0;
+    axis = vec3_scale(axis, 1.0 / len);
+    struct wetdem_vec3 p0 = vec3_reject(dv0, axis), p1 = vec3_reject(dv1, axis);
+    double dv_turn = atan2(vec3_dot(axis, vec3_cross(p0, p1)), vec3_dot(p0, p1));
+    return fmax(0.0, fmin(turn, dv_turn));
 }
 
 static struct wetdem_vec3 relative_velocity(const struct wetdem_sim* sim)
@@ -225,8 +248,10 @@ static int monitor(struct wetdem_sim* sim, void* ctx)
         double turn =
             atan2(vec3_norm(vec3_cross(tr->n_prev, c.normal)), vec3_dot(tr->n_prev, c.normal));
         tr->rotation += turn;
-        if (tr->arrested && tr->gap_prev < tr->h_close && c.gap < tr->h_close)
+        if (tr->arrested && tr->gap_prev < tr->h_close && c.gap < tr->h_close) {
             tr->rotation_close += turn;
+            tr->rotation_doublet += shared_turn(tr->n_prev, c.normal, turn, tr->dv_prev, dv);
+        }
         tr->arrested = tr->arrested || turned_back;
     }
     observe_in_step(tr, t, c.normal, dv);
@@ -603,10 +628,13 @@ static int analyse(struct wetdem_sim* sim, const struct setup* su, const struct 
     r->energy_ratio = e0 > 0 && g == 0 ? (collision_energy(sim) + stored) / e0 : NAN;
     r->rotation_angle = tr->rotation;
     r->rotation_close = tr->rotation_close;
+    r->rotation_doublet = tr->rotation_doublet;
     r->close_gap = su->h_close;
-    if (!separated)
+    if (!tr->interacting)
+        r->outcome = WETDEM_OUTCOME_NONE;
+    else if (!separated)
         r->outcome = WETDEM_OUTCOME_STICK;
-    else if (tr->rotation_close > SRS_ANGLE)
+    else if (tr->rotation_doublet > SRS_ANGLE)
         r->outcome = WETDEM_OUTCOME_STICK_ROTATE_SEPARATE;
     else
         r->outcome = WETDEM_OUTCOME_BOUNCE;

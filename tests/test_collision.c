@@ -560,6 +560,8 @@ static void test_collision_outcomes(void** state)
         /* measured: ~176 degrees in all, 99 (verlet) and 116 (cvode) after the first arrest
          * with the gap within h_close = 0.01 R* (steel has no film) */
         assert_true(r.rotation_close > 20 * M_PI / 180 && r.rotation_close <= r.rotation_angle);
+        /* a held doublet orbits: its relative velocity turns with its line of centres */
+        assert_true(r.rotation_doublet > 0.9 * r.rotation_close);
         /* held near G_REST, pushed out by the centrifugal load 0.057 N / k = 5.7 um */
         assert_true(r.min_gap > G_REST && r.min_gap < 0.01 * R / 2);
         CHECK_REL(r.close_gap, 0.01 * R / 2, 1e-12);
@@ -575,11 +577,12 @@ static void test_collision_outcomes(void** state)
         assert_int_equal(r.outcome, WETDEM_OUTCOME_STICK);
         CHECK_REL(r.t_final, 0.05, 1e-12);
         /* no rebound: e = e_n = 0, also for a run too short to reach the target, whose
-           velocities at t_end are those of the approach (e = 1, e_n = -1 as ratios) */
+           velocities at t_end are those of the approach (e = 1, e_n = -1 as ratios); that
+           run never interacted: none, not stick */
         assert_true(r.e == 0.0 && r.e_n == 0.0);
         s.t_end = 1e-6;
         CHECK_OK(wetdem_collision_run(sim, &s, &r));
-        assert_true(!r.separated && r.outcome == WETDEM_OUTCOME_STICK);
+        assert_true(!r.separated && r.outcome == WETDEM_OUTCOME_NONE);
         assert_true(r.e == 0.0 && r.e_n == 0.0);
         wetdem_sim_free(sim);
     }
@@ -795,13 +798,13 @@ static void test_collision_outcome_with_films(void** state)
     CHECK_STATUS(wetdem_collision_run(sim, &s, &r), WETDEM_ERR_INVALID);
     CHECK_CONTAINS(wetdem_sim_errmsg(sim), "close_gap");
     /* one rebound normal, where the films part, for both outcomes: across the Stokes number
-       where the outcome turns from stick-rotate-separate (St_n 1.55) to bounce (1.6) e_n rises
-       smoothly (0.159, 0.191, 0.228 at 1.55, 1.595, 1.64); with the closest approach for the
-       bounce it dropped to 0.060 there. The steps between neighbours are 0.03-0.04: a fall
-       of any size fails. */
+       where the outcome turns from stick-rotate-separate (St_n 1.5: the doublet turned 5.4
+       deg, 8.5 below close_gap) to bounce (1.55: 3.7 of 5.8) e_n rises smoothly (0.136,
+       0.159, 0.191 at 1.5, 1.55, 1.595); with the closest approach for the bounce it dropped
+       by 0.1 there. The steps between neighbours are 0.02-0.03: a fall of any size fails. */
     s.close_gap = 0;
     s.t_end = 0.2;
-    const double st[] = {1.55, 1.595, 1.64};
+    const double st[] = {1.5, 1.55, 1.595};
     double e_n[3];
     enum wetdem_outcome outcome[3];
     for (int k = 0; k < 3; k++) {
@@ -817,11 +820,87 @@ static void test_collision_outcome_with_films(void** state)
     assert_int_equal(outcome[0], WETDEM_OUTCOME_STICK_ROTATE_SEPARATE);
     assert_int_equal(outcome[2], WETDEM_OUTCOME_BOUNCE);
     assert_true(e_n[1] > e_n[0] && e_n[2] > e_n[1]);
+    /* grazing, 85 deg at St_n = 2: a prompt bounce off the solid contact (0.1 ms, e = 0.99)
+       whose line of centres turns by 6.4 deg before the films part, as the striker leaves
+       almost tangentially (up to acos(25.4 / 25.67) = 8.4 deg in free flight): the old rule
+       labelled it stick-rotate-separate; the relative velocity shared under 1 deg of it */
+    s.angle = 85 * M_PI / 180;
+    s.stokes = 2;
+    CHECK_OK(wetdem_collision_run(sim, &s, &r));
+    assert_true(r.separated && r.solid_contact && r.contact_duration < 2e-4 && r.e > 0.98);
+    assert_true(r.rotation_close > 5 * M_PI / 180 && r.rotation_doublet < 1 * M_PI / 180);
+    assert_int_equal(r.outcome, WETDEM_OUTCOME_BOUNCE);
     /* head-on the line of centres does not turn: both normals are +x */
     s.angle = 0;
     s.stokes = 3;
     CHECK_OK(wetdem_collision_run(sim, &s, &r));
     CHECK_REL(r.e_n_contact, r.e_n, 1e-12);
+    wetdem_sim_free(sim);
+}
+
+/* A grazing bounce is not a doublet's rotation (Punch: contact-bounce separates "near-
+ * instantaneously and negligible rotation occurs about one another"). A dry Hertz impact of
+ * two steel spheres at 89 deg (v_n0 = 0.5 cos 89 deg = 8.7 mm/s), with a force-free model
+ * that keeps the run going out to R* after the contact, and close_gap = 0.04 R*: the contact
+ * is a single Hertz contact (its time the closed form 2.87 (m*^2 / (E*^2 R* v_n0))^(1/5) to
+ * 10 %), the approach is reversed by it (min_gap < 0, then separating), and the striker
+ * leaves nearly elastically (e > 0.99). Leaving almost tangentially, it turns the line of
+ * centres by up to acos((R_i + R_j) / (R_i + R_j + close_gap)) = 8.1 deg before the gap
+ * reaches close_gap, in free flight, with nothing holding it: the old rule counted that turn
+ * (rotation_close > 5 deg) and labelled the bounce stick-rotate-separate. The relative
+ * velocity does not turn with the line in free flight, so rotation_doublet, the turn both
+ * share, stays near the contact's own (< 0.5 deg): bounce. */
+static void test_collision_grazing_bounce_is_not_a_doublet(void** state)
+{
+    (void)state;
+    for (int q = 0; q < 2; q++) {
+        int mat;
+        struct wetdem_sim* sim = make_sim("steel1", 0, "hertz", NULL, integrators[q], &mat);
+        CHECK_OK(wetdem_sim_add_model(sim, &ghost_model, &(struct glue_params){0}));
+        CHECK_OK(wetdem_sim_set_param(sim, "verlet.dt", 2e-7));
+        struct wetdem_collision_spec s = head_on(mat, 0.5, 0.1);
+        s.angle = 89 * M_PI / 180;
+        s.close_gap = 0.04 * R / 2;
+        struct wetdem_collision_result r;
+        CHECK_OK(wetdem_collision_run(sim, &s, &r));
+        assert_true(r.separated && r.solid_contact && r.min_gap < 0);
+        double nu = 0.27, es = 190e9 / (2 * (1 - nu * nu)),
+               ms = 7780 * 4.0 / 3 * M_PI * R * R * R / 2;
+        double t_hertz = 2.87 * pow(ms * ms / (es * es * (R / 2) * r.speed_n0), 0.2);
+        CHECK_REL(r.contact_duration, t_hertz, 0.1);
+        assert_true(r.e > 0.99);
+        double bound = acos(2 * R / (2 * R + s.close_gap));
+        assert_true(bound > 5 * M_PI / 180);
+        assert_true(r.rotation_close > 5 * M_PI / 180 && r.rotation_close < bound + 0.01);
+        assert_true(r.rotation_doublet < 0.5 * M_PI / 180);
+        assert_int_equal(r.outcome, WETDEM_OUTCOME_BOUNCE);
+        wetdem_sim_free(sim);
+    }
+}
+
+/* A collision whose striker never reaches the interaction range by t_end has neither stuck
+ * nor bounced: outcome none, not stick (Punch: stick = the spheres remain together). The dry
+ * Hertz example at 89.99 deg with its t_end = 1 ms: the striker moves 0.5 mm along its
+ * grazing line, which brings the 100 um gap down to 47 um; no interaction, no contact. Given
+ * 10 ms it arrives (contact after 3.2 ms) and bounces. */
+static void test_collision_never_reached_is_none(void** state)
+{
+    (void)state;
+    int mat;
+    struct wetdem_sim* sim = make_sim("steel1", 0, "hertz", NULL, "verlet", &mat);
+    struct wetdem_collision_spec s = head_on(mat, 0.5, 1e-3);
+    s.angle = 89.99 * M_PI / 180;
+    s.initial_gap = 1e-4;
+    struct wetdem_collision_result r;
+    CHECK_OK(wetdem_collision_run(sim, &s, &r));
+    assert_false(r.separated || r.solid_contact);
+    assert_true(r.min_gap > 4e-5 && isnan(r.t_first_interaction));
+    assert_true(r.interaction_duration == 0 && r.e == 0 && r.e_n == 0);
+    assert_int_equal(r.outcome, WETDEM_OUTCOME_NONE);
+    s.t_end = 1e-2;
+    CHECK_OK(wetdem_collision_run(sim, &s, &r));
+    assert_true(r.separated && r.solid_contact);
+    assert_int_equal(r.outcome, WETDEM_OUTCOME_BOUNCE);
     wetdem_sim_free(sim);
 }
 
@@ -938,6 +1017,8 @@ int main(void)
         cmocka_unit_test(test_collision_free_flight_impact_parameter),
         cmocka_unit_test(test_collision_oblique_rebound_normal),
         cmocka_unit_test(test_collision_outcome_with_films),
+        cmocka_unit_test(test_collision_grazing_bounce_is_not_a_doublet),
+        cmocka_unit_test(test_collision_never_reached_is_none),
         cmocka_unit_test(test_collision_stokes_speed),
         cmocka_unit_test(test_collision_observe_window),
         cmocka_unit_test(test_collision_bad_spec),
