@@ -191,8 +191,10 @@ void cli_print_provenance(FILE* f, int argc, char** argv)
 int cli_make_dirs(const char* dir)
 {
     char path[1024];
-    if (snprintf(path, sizeof path, "%s", dir) >= (int)sizeof path)
+    if (snprintf(path, sizeof path, "%s", dir) >= (int)sizeof path) {
+        errno = ENAMETOOLONG;
         return -1;
+    }
     for (char* p = path + 1; *p; p++)
         if (*p == '/') {
             *p = '\0';
@@ -287,32 +289,46 @@ static FILE* output_std_stream(const char* path)
     return NULL;
 }
 
+/* snprintf into buf of what fits: false when it was cut (the name is then not used). */
+static bool format_path(char* buf, size_t size, const char* fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    int n = vsnprintf(buf, size, fmt, ap);
+    va_end(ap);
+    return n >= 0 && (size_t)n < size;
+}
+
 /* Where output to `path` goes: *direct when path names a standard stream's file (above) or
  * exists and is not a regular file (a device such as /dev/null, a FIFO, a process
  * substitution), which is written in place, never replaced; otherwise the regular file that
  * path names, with a symbolic link followed to its target (so the link stays a link), written
- * under a temporary name next to it and renamed over it when whole. */
-static void output_target(const char* path, char* final, size_t n, bool* direct)
+ * under a temporary name next to it and renamed over it when whole. false when the name does
+ * not fit in final (n characters). */
+static bool output_target(const char* path, char* final, size_t n, bool* direct)
 {
     struct stat st;
     *direct = false;
-    snprintf(final, n, "%s", path);
+    if (!format_path(final, n, "%s", path))
+        return false;
     if (lstat(path, &st) != 0)
-        return; /* a new file */
+        return true; /* a new file */
     if (output_std_stream(path)) {
         *direct = true;
-        return;
+        return true;
     }
     if (S_ISLNK(st.st_mode)) {
         char* target = realpath(path, NULL);
+        bool fits = true;
         if (target && stat(target, &st) == 0 && S_ISREG(st.st_mode))
-            snprintf(final, n, "%s", target);
+            fits = format_path(final, n, "%s", target);
         else
             *direct = true; /* (a link to a device, or a dangling one: written through) */
         free(target);
-        return;
+        return fits;
     }
     *direct = !S_ISREG(st.st_mode);
+    return true;
 }
 
 int cli_check_writable(const char* what, const char* option, const char* path)
@@ -367,17 +383,56 @@ int cli_check_writable(const char* what, const char* option, const char* path)
  * missing. So the directory holds either the earlier set or the new one, whole. */
 
 #define JOURNAL_PREFIX ".wetdem-set."
-#define SET_PATH 1500                /* a directory or file of a set, absolute */
+#define SET_PATH (PATH_MAX + 256)    /* a directory or file of a set, absolute */
 #define JOURNAL_PATH (SET_PATH + 40) /* a journal's path */
 
-/* snprintf into buf of what fits: false when it was cut (the name is then not used). */
-static bool format_path(char* buf, size_t size, const char* fmt, ...)
+/* Appends `path` to buf at *len with a backslash, tab and newline written as two characters
+ * each (backslash then itself, 't' or 'n'), so
+ * that any name keeps to its field of the journal's tab-separated line. false when full. */
+static bool journal_escape(char* buf, size_t size, size_t* len, const char* path)
 {
-    va_list ap;
-    va_start(ap, fmt);
-    int n = vsnprintf(buf, size, fmt, ap);
-    va_end(ap);
-    return n >= 0 && (size_t)n < size;
+    for (const char* p = path; *p; p++) {
+        const char* e = *p == '\\' ? "\\\\" : *p == '\t' ? "\\t" : *p == '\n' ? "\\n" : NULL;
+        size_t n = e ? 2 : 1;
+        if (*len + n >= size)
+            return false;
+        memcpy(buf + *len, e ? e : p, n);
+        *len += n;
+    }
+    buf[*len] = '\0';
+    return true;
+}
+
+/* Appends text to buf at *len. false when full. */
+static bool journal_put(char* buf, size_t size, size_t* len, const char* text)
+{
+    size_t n = strlen(text);
+    if (*len + n >= size)
+        return false;
+    memcpy(buf + *len, text, n + 1);
+    *len += n;
+    return true;
+}
+
+/* Decodes a field of a journal line (journal_escape) into out. false when it does not fit or
+ * holds an escape the journal does not write. */
+static bool journal_unescape(const char* field, char* out, size_t size)
+{
+    size_t n = 0;
+    for (const char* p = field; *p; p++) {
+        char c = *p;
+        if (c == '\\') {
+            p++;
+            c = *p == '\\' ? '\\' : *p == 't' ? '\t' : *p == 'n' ? '\n' : '\0';
+            if (!c)
+                return false;
+        }
+        if (n + 1 >= size)
+            return false;
+        out[n++] = c;
+    }
+    out[n] = '\0';
+    return n > 0;
 }
 
 /* Whether process pid is alive (or its liveness cannot be known: then it is left alone). */
@@ -405,61 +460,135 @@ static long name_pid(const char* name, const char* prefix, const char* suffix)
     return strcmp(end, suffix) == 0 ? pid : -1;
 }
 
-/* Completes (committed) or takes back the set of a dead process from its journal at `path`. */
-static void recover_journal(const char* path, long pid)
+/* The sets of a journal (recover_journal). */
+struct journal {
+    char dirs[CLI_MAX_OUTPUTS][SET_PATH], tmp[CLI_MAX_OUTPUTS][SET_PATH],
+        final[CLI_MAX_OUTPUTS][SET_PATH];
+    size_t n_dirs, n;
+    bool whole;
+};
+
+/* Whether entry k of journal j (process pid) names what a set of wetdem's files holds: a
+ * temporary file of its target, BASE.tmpPID or .BASE.tmpPID, beside it in one of the set's
+ * directories. Anything else (a corrupt journal, or one that is not wetdem's) names files
+ * that are not its to move. */
+static bool journal_entry_valid(const struct journal* j, size_t k, long pid)
+{
+    char dir_tmp[SET_PATH], dir_final[SET_PATH], visible[SET_PATH], hidden[SET_PATH];
+    parent_dir(j->tmp[k], dir_tmp, sizeof dir_tmp);
+    parent_dir(j->final[k], dir_final, sizeof dir_final);
+    if (j->tmp[k][0] != '/' || strcmp(dir_tmp, dir_final) != 0)
+        return false;
+    bool listed = false;
+    for (size_t d = 0; d < j->n_dirs; d++)
+        listed = listed || strcmp(j->dirs[d], dir_tmp) == 0;
+    const char* base = strrchr(j->final[k], '/') + 1;
+    const char* tmp_base = strrchr(j->tmp[k], '/') + 1;
+    return listed && base[0] && format_path(visible, sizeof visible, "%s.tmp%ld", base, pid) &&
+           format_path(hidden, sizeof hidden, ".%s.tmp%ld", base, pid) &&
+           (strcmp(tmp_base, visible) == 0 || strcmp(tmp_base, hidden) == 0);
+}
+
+/* Reads the journal at `path` of process pid into j: false when it is not this user's, cannot
+ * be read, or holds a line or an entry that a journal of wetdem does not (it is then left, and
+ * its files with it). */
+static bool read_journal(const char* path, long pid, struct journal* j)
 {
     FILE* f = fopen(path, "r");
     if (!f)
-        return;
-    char line[2 * SET_PATH + 16], dirs[CLI_MAX_OUTPUTS][SET_PATH], tmp[CLI_MAX_OUTPUTS][SET_PATH],
-        final[CLI_MAX_OUTPUTS][SET_PATH];
-    size_t n_dirs = 0, n = 0;
-    bool whole = false;
-    while (fgets(line, sizeof line, f)) {
-        line[strcspn(line, "\n")] = '\0';
+        return false;
+    struct stat st;
+    bool ok = fstat(fileno(f), &st) == 0 && S_ISREG(st.st_mode) && st.st_uid == geteuid();
+    char* line = NULL;
+    size_t cap = 0;
+    ssize_t len;
+    j->n_dirs = j->n = 0;
+    j->whole = false;
+    for (bool first = true; ok && (len = getline(&line, &cap, f)) > 0; first = false) {
+        if (line[len - 1] != '\n' || j->whole) {
+            ok = false; /* (a line cut short, or one after "end") */
+            break;
+        }
+        line[len - 1] = '\0';
         char* tab = strchr(line, '\t');
-        if (strncmp(line, "dir\t", 4) == 0 && n_dirs < CLI_MAX_OUTPUTS)
-            format_path(dirs[n_dirs++], sizeof dirs[0], "%s", line + 4);
-        else if (strncmp(line, "file\t", 5) == 0 && n < CLI_MAX_OUTPUTS &&
-                 (tab = strchr(line + 5, '\t')) != NULL) {
+        if (first)
+            ok = strcmp(line, "wetdem output set") == 0;
+        else if (strncmp(line, "dir\t", 4) == 0 && j->n_dirs < CLI_MAX_OUTPUTS)
+            ok = journal_unescape(line + 4, j->dirs[j->n_dirs++], SET_PATH) &&
+                 strchr(line + 4, '\t') == NULL;
+        else if (strncmp(line, "file\t", 5) == 0 && j->n < CLI_MAX_OUTPUTS &&
+                 (tab = strchr(line + 5, '\t')) != NULL && strchr(tab + 1, '\t') == NULL) {
             *tab = '\0';
-            format_path(tmp[n], sizeof tmp[0], "%s", line + 5);
-            format_path(final[n++], sizeof final[0], "%s", tab + 1);
+            ok = journal_unescape(line + 5, j->tmp[j->n], SET_PATH) &&
+                 journal_unescape(tab + 1, j->final[j->n], SET_PATH);
+            j->n++;
         } else if (strcmp(line, "end") == 0)
-            whole = true;
+            j->whole = true;
+        else
+            ok = false;
     }
+    free(line);
+    ok = ok && !ferror(f);
     fclose(f);
-    char journal[JOURNAL_PATH];
-    bool committed = whole;
-    for (size_t d = 0; d < n_dirs && committed; d++) {
-        format_path(journal, sizeof journal, "%s/" JOURNAL_PREFIX "%ld", dirs[d], pid);
-        committed = path_exists(journal);
+    for (size_t k = 0; ok && k < j->n; k++)
+        ok = journal_entry_valid(j, k, pid);
+    /* the journal lies in one of the set's directories */
+    char dir[SET_PATH], real[PATH_MAX];
+    parent_dir(path, dir, sizeof dir);
+    bool here = false;
+    if (ok && realpath(dir[0] ? dir : ".", real))
+        for (size_t d = 0; d < j->n_dirs; d++)
+            here = here || strcmp(j->dirs[d], real) == 0;
+    return ok && here;
+}
+
+/* Completes (committed) or takes back the set of a dead process from its journal at `path`.
+ * A journal that is not a whole one of this user's (read_journal) is left as it is, and the
+ * files of that process with it: they are not known to be a set of wetdem's. */
+static void recover_journal(const char* path, long pid)
+{
+    struct journal* j = malloc(sizeof *j);
+    if (!j)
+        return;
+    if (!read_journal(path, pid, j)) {
+        cli_error("%s: not a journal of a set of files that wetdem can put in order (another "
+                  "user's, or damaged); it and the files of process %ld are left as they are",
+                  path, pid);
+        free(j);
+        return;
     }
-    for (size_t k = 0; k < n; k++) {
+    char journal[JOURNAL_PATH];
+    bool committed = j->whole;
+    for (size_t d = 0; d < j->n_dirs && committed; d++)
+        committed =
+            format_path(journal, sizeof journal, "%s/" JOURNAL_PREFIX "%ld", j->dirs[d], pid) &&
+            path_exists(journal);
+    for (size_t k = 0; k < j->n; k++) {
         char old[SET_PATH + 8];
-        format_path(old, sizeof old, "%s.old", tmp[k]);
-        bool has_tmp = path_exists(tmp[k]), has_old = path_exists(old);
-        if (committed && has_tmp && rename(tmp[k], final[k]) == 0)
+        if (!format_path(old, sizeof old, "%s.old", j->tmp[k]))
+            continue;
+        bool has_tmp = path_exists(j->tmp[k]), has_old = path_exists(old);
+        if (committed && has_tmp && rename(j->tmp[k], j->final[k]) == 0)
             cli_error("%s: completed from a set of files that process %ld, now gone, was "
                       "replacing",
-                      final[k], pid);
+                      j->final[k], pid);
         else if (!committed && has_tmp)
-            remove(tmp[k]);
-        if (has_old && !committed && !path_exists(final[k]) && rename(old, final[k]) == 0)
+            remove(j->tmp[k]);
+        if (has_old && !committed && !path_exists(j->final[k]) && rename(old, j->final[k]) == 0)
             cli_error("%s: put back: process %ld, now gone, had moved it aside to replace it",
-                      final[k], pid);
+                      j->final[k], pid);
         else if (has_old)
             remove(old);
     }
-    if (!committed && n > 0)
+    if (!committed && j->n > 0)
         cli_error("%s: the files that process %ld, now gone, was writing there were not all "
                   "written; the earlier ones stay",
-                  final[0], pid);
-    for (size_t d = 0; d < n_dirs; d++) {
-        format_path(journal, sizeof journal, "%s/" JOURNAL_PREFIX "%ld", dirs[d], pid);
-        remove(journal);
-    }
+                  j->final[0], pid);
+    for (size_t d = 0; d < j->n_dirs; d++)
+        if (format_path(journal, sizeof journal, "%s/" JOURNAL_PREFIX "%ld", j->dirs[d], pid))
+            remove(journal);
     remove(path);
+    free(j);
 }
 
 /* Puts in order what dead processes left in the directory of `final` (see above): their
@@ -514,6 +643,14 @@ static void recover_stale(const char* final)
         format_path(path, sizeof path, "%s/%s", dir[0] ? dir : ".", name);
         if (pid_alive(pid) || !path_exists(path)) /* (a journal may have dealt with it) */
             continue;
+        /* a file of a set whose journal is still there (left as not wetdem's, or one whose
+           process died after the journals above were passed over) is the journal's to put
+           in order: on its own it might be taken back while the rest of the set is not */
+        char journal[1500];
+        if (!format_path(journal, sizeof journal, "%s/" JOURNAL_PREFIX "%ld", dir[0] ? dir : ".",
+                         pid) ||
+            path_exists(journal))
+            continue;
         if (old && !path_exists(final) && rename(path, final) == 0) {
             cli_error("%s: put back from %s, where process %ld, now gone, had moved it aside "
                       "to replace it",
@@ -535,8 +672,10 @@ static int absolute_path(const char* path, char* buf, size_t size)
     base = base ? base + 1 : path;
     if (!realpath(dir[0] ? dir : ".", real))
         return -1;
-    int n = format_path(buf, size, "%s/%s", strcmp(real, "/") == 0 ? "" : real, base);
-    return n > 0 && (size_t)n < size ? 0 : -1;
+    if (format_path(buf, size, "%s/%s", strcmp(real, "/") == 0 ? "" : real, base))
+        return 0;
+    errno = ENAMETOOLONG;
+    return -1;
 }
 
 /* Writes the journal of the set (files to be renamed: rename[k]) into each of its
@@ -544,10 +683,13 @@ static int absolute_path(const char* path, char* buf, size_t size)
 static int write_journals(struct cli_out_file* const* files, size_t n, const bool* renamed,
                           char dirs[][SET_PATH], size_t* n_dirs)
 {
-    char text[CLI_MAX_OUTPUTS * 3000 + 200];
-    size_t len = strlen(strcpy(text, "wetdem output set\n"));
+    /* the journal's text: at most CLI_MAX_OUTPUTS directories and files, each name escaped
+       (journal_escape: at most two characters for one) */
+    char text[CLI_MAX_OUTPUTS * 3 * 2 * SET_PATH + 64];
+    size_t size = sizeof text, len = 0;
+    bool ok = journal_put(text, size, &len, "wetdem output set\n");
     *n_dirs = 0;
-    for (size_t k = 0; k < n; k++) {
+    for (size_t k = 0; k < n && ok; k++) {
         char tmp[SET_PATH], final[SET_PATH], dir[SET_PATH];
         if (!renamed[k])
             continue;
@@ -560,30 +702,33 @@ static int write_journals(struct cli_out_file* const* files, size_t n, const boo
             seen = seen || strcmp(dirs[d], dir) == 0;
         if (!seen) {
             format_path(dirs[(*n_dirs)++], SET_PATH, "%s", dir);
-            if (!format_path(text + len, sizeof text - len, "dir\t%s\n", dir))
-                return -1;
-            len += strlen(text + len);
+            ok = journal_put(text, size, &len, "dir\t") && journal_escape(text, size, &len, dir) &&
+                 journal_put(text, size, &len, "\n");
         }
-        if (!format_path(text + len, sizeof text - len, "file\t%s\t%s\n", tmp, final))
-            return -1;
-        len += strlen(text + len);
+        ok = ok && journal_put(text, size, &len, "file\t") &&
+             journal_escape(text, size, &len, tmp) && journal_put(text, size, &len, "\t") &&
+             journal_escape(text, size, &len, final) && journal_put(text, size, &len, "\n");
     }
-    if (!format_path(text + len, sizeof text - len, "end\n"))
+    if (!(ok && journal_put(text, size, &len, "end\n"))) {
+        errno = ENAMETOOLONG;
         return -1;
-    len += strlen(text + len);
+    }
     for (size_t d = 0; d < *n_dirs; d++) {
         char path[JOURNAL_PATH], part[JOURNAL_PATH + 8];
         format_path(path, sizeof path, "%s/" JOURNAL_PREFIX "%ld", dirs[d], (long)getpid());
         format_path(part, sizeof part, "%s.part", path);
+        errno = 0;
         FILE* f = fopen(part, "w");
-        bool ok = f && fwrite(text, 1, len, f) == len;
-        ok = f && fclose(f) == 0 && ok;
-        if (!ok || rename(part, path) != 0) {
+        bool written = f && fwrite(text, 1, len, f) == len;
+        written = f && fclose(f) == 0 && written;
+        if (!written || rename(part, path) != 0) {
+            int err = errno ? errno : EIO;
             remove(part);
             for (size_t e = 0; e < d; e++) {
                 format_path(path, sizeof path, "%s/" JOURNAL_PREFIX "%ld", dirs[e], (long)getpid());
                 remove(path);
             }
+            errno = err;
             return -1;
         }
     }
@@ -615,7 +760,12 @@ static void maybe_killed(size_t renamed)
  * (recover_stale). 0, or -1 with errno set. */
 static int open_output(struct cli_out_file* o, const char* path, const char* tmp_format)
 {
-    output_target(path, o->final, sizeof o->final, &o->direct);
+    o->f = NULL;
+    if (!output_target(path, o->final, sizeof o->final, &o->direct)) {
+        o->final[0] = o->tmp[0] = '\0';
+        errno = ENAMETOOLONG; /* (a name cut short would be another file) */
+        return -1;
+    }
     o->std = o->direct ? output_std_stream(o->final) : NULL;
     if (o->direct) {
         format_path(o->tmp, sizeof o->tmp, "%s", o->final);
@@ -626,7 +776,12 @@ static int open_output(struct cli_out_file* o, const char* path, const char* tmp
         parent_dir(o->final, dir, sizeof dir);
         const char* base = strrchr(o->final, '/');
         base = base ? base + 1 : o->final;
-        format_path(o->tmp, sizeof o->tmp, tmp_format, dir[0] ? dir : ".", base, (long)getpid());
+        if (!format_path(o->tmp, sizeof o->tmp, tmp_format, dir[0] ? dir : ".", base,
+                         (long)getpid())) {
+            o->tmp[0] = '\0'; /* (one cut short would not hold this process's whole PID) */
+            errno = ENAMETOOLONG;
+            return -1;
+        }
         recover_stale(o->final);
         o->f = fopen(o->tmp, "w");
     }
@@ -696,8 +851,10 @@ int cli_out_open(struct cli_out_file* o, const char* what, const char* dir, cons
     if (!dir || !name[0])
         return 0;
     char path[1400];
-    format_path(path, sizeof path, "%s/%s", dir, name);
-    if (open_output(o, path, "%s/.%s.tmp%ld") != 0) {
+    bool fits = format_path(path, sizeof path, "%s/%s", dir, name);
+    if (!fits)
+        errno = ENAMETOOLONG;
+    if (!fits || open_output(o, path, "%s/.%s.tmp%ld") != 0) {
         cli_error("%s: cannot write %s: %s", what, path, strerror(errno));
         return -1;
     }

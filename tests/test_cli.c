@@ -734,6 +734,123 @@ static void test_cli_run_outputs_recovered_after_a_kill(void** state)
     assert_int_equal(system(args), 0);
 }
 
+/* The journal of a set holds any name: a directory whose name has a tab in it, written by a
+ * run killed after its first rename, is completed by the next run from its journal, and a
+ * user's files whose names are the parts of that name before the tab ("a", "a.old") are left
+ * as they are (a journal split at the tab named them). */
+static void test_cli_run_outputs_journal_names_with_tabs(void** state)
+{
+    (void)state;
+    char dir[] = "/tmp/wetdem_test_cli_tab_XXXXXX";
+    assert_non_null(mkdtemp(dir));
+    char args[600], b_args[600], path[600];
+    snprintf(args, sizeof args, "run examples/scenarios/dry_hertz.ini --out '%s/a\tb'", dir);
+    snprintf(b_args, sizeof b_args,
+             "run examples/scenarios/dry_hertz.ini --set collision.speed=0.2 --out '%s/a\tb'", dir);
+    snprintf(path, sizeof path, "%s/a", dir);
+    test_write_file(path, "the user's a\n");
+    snprintf(path, sizeof path, "%s/a.old", dir);
+    test_write_file(path, "the user's a.old\n");
+    struct test_run r = run_cli(args, true);
+    assert_int_equal(r.code, 0);
+    free(r.out);
+    r = test_run_cli("WETDEM_TEST_KILL_AT_RENAME=1", b_args, true);
+    if (r.code != 137 && r.code != -1)
+        fail_msg("a run with WETDEM_TEST_KILL_AT_RENAME=1: exit %d, expected a kill\n%s", r.code,
+                 r.out);
+    free(r.out);
+    r = run_cli(args, true);
+    assert_int_equal(r.code, 0);
+    CHECK_CONTAINS(r.out, "events.csv: completed from a set of files that process");
+    CHECK_CONTAINS(r.out, "summary.json: completed from a set of files that process");
+    free(r.out);
+    char* listing = test_list_dir(dir);
+    assert_string_equal(listing, "a\na\tb\na.old\n");
+    free(listing);
+    snprintf(path, sizeof path, "%s/a.old", dir);
+    char* text = test_read_file(path, NULL);
+    assert_non_null(text);
+    assert_string_equal(text, "the user's a.old\n");
+    free(text);
+    snprintf(path, sizeof path, "%s/a\tb", dir);
+    listing = test_list_dir(path);
+    assert_string_equal(listing, "events.csv\nsummary.json\ntrajectory.csv\n");
+    free(listing);
+    snprintf(args, sizeof args, "rm -rf '%s'", dir);
+    assert_int_equal(system(args), 0);
+}
+
+/* A journal of a dead process that names files which are not a set's temporary files and
+ * targets (another user's in a shared directory, or one damaged) moves nothing: the user's
+ * notes.txt is neither renamed over other.txt nor its notes.txt.old removed. */
+static void test_cli_run_outputs_foreign_journal_left_alone(void** state)
+{
+    (void)state;
+    char dir[] = "/tmp/wetdem_test_cli_foreign_XXXXXX";
+    assert_non_null(mkdtemp(dir));
+    char real[PATH_MAX], args[600], path[600], text[3 * PATH_MAX + 100];
+    assert_non_null(realpath(dir, real));
+    pid_t child = fork();
+    assert_true(child >= 0);
+    if (child == 0)
+        _exit(0);
+    assert_int_equal(waitpid(child, NULL, 0), child);
+    snprintf(path, sizeof path, "%s/notes.txt", dir);
+    test_write_file(path, "notes\n");
+    snprintf(path, sizeof path, "%s/notes.txt.old", dir);
+    test_write_file(path, "older notes\n");
+    snprintf(text, sizeof text,
+             "wetdem output set\ndir\t%s\nfile\t%s/notes.txt\t%s/other.txt\nend\n", real, real,
+             real);
+    snprintf(path, sizeof path, "%s/.wetdem-set.%ld", dir, (long)child);
+    test_write_file(path, text);
+    snprintf(args, sizeof args, "run examples/scenarios/dry_hertz.ini --out %s", dir);
+    struct test_run r = run_cli(args, true);
+    assert_int_equal(r.code, 0);
+    CHECK_CONTAINS(r.out, "not a journal of a set of files that wetdem can put in order");
+    free(r.out);
+    char* listing = test_list_dir(dir);
+    snprintf(text, sizeof text,
+             ".wetdem-set.%ld\nevents.csv\nnotes.txt\nnotes.txt.old\nsummary.json\n"
+             "trajectory.csv\n",
+             (long)child);
+    assert_string_equal(listing, text);
+    free(listing);
+    snprintf(args, sizeof args, "rm -rf '%s'", dir);
+    assert_int_equal(system(args), 0);
+}
+
+/* A set written through a short name of a directory whose real path is long (a symbolic
+ * link to it; or a relative --out from a deep working directory) is written: its journal
+ * holds real paths of up to PATH_MAX characters. */
+static void test_cli_run_outputs_into_a_deep_directory(void** state)
+{
+    (void)state;
+    char dir[] = "/tmp/wetdem_test_cli_deep_XXXXXX";
+    assert_non_null(mkdtemp(dir));
+    char deep[2000], args[800], link[200];
+    size_t len = (size_t)snprintf(deep, sizeof deep, "%s", dir);
+    while (len < 1480) {
+        len += (size_t)snprintf(deep + len, sizeof deep - len, "/%.*s", 100,
+                                "dddddddddddddddddddddddddddddddddddddddddddddddddd"
+                                "dddddddddddddddddddddddddddddddddddddddddddddddddd");
+        assert_int_equal(mkdir(deep, 0777), 0);
+    }
+    snprintf(link, sizeof link, "%s/short", dir);
+    assert_int_equal(symlink(deep, link), 0);
+    snprintf(args, sizeof args, "run examples/scenarios/dry_hertz.ini --out %s/d", link);
+    struct test_run r = run_cli(args, true);
+    if (r.code != 0)
+        fail_msg("a run into %s/d: exit %d\n%s", link, r.code, r.out);
+    free(r.out);
+    snprintf(args, sizeof args, "%s/d", link);
+    char* listing = test_list_dir(args);
+    assert_string_equal(listing, "events.csv\nsummary.json\ntrajectory.csv\n");
+    free(listing);
+    snprintf(args, sizeof args, "rm -rf '%s'", dir);
+    assert_int_equal(system(args), 0);
+}
+
 /* A [model.NAME] section of the file for a model that a --set of [models] switched away from
  * is ignored, so one file serves both choices (the files below hold [model.fixed] and
  * [model.glass], for the models they choose); a --set of such a parameter, a section the
@@ -823,6 +940,9 @@ int main(void)
         cmocka_unit_test(test_cli_stdout_write_failures),
         cmocka_unit_test(test_cli_run_outputs_replaced_whole_or_not_at_all),
         cmocka_unit_test(test_cli_run_outputs_recovered_after_a_kill),
+        cmocka_unit_test(test_cli_run_outputs_journal_names_with_tabs),
+        cmocka_unit_test(test_cli_run_outputs_foreign_journal_left_alone),
+        cmocka_unit_test(test_cli_run_outputs_into_a_deep_directory),
         cmocka_unit_test(test_cli_dev_stdout_output_to_a_redirected_file),
         cmocka_unit_test(test_cli_numbers_out_of_range_and_cr_lines),
     };
