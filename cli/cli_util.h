@@ -158,6 +158,13 @@ int cli_write_outputs(const struct cli_output* outs, size_t n, const char* what)
  * --out directory: under the temporary name DIR/.NAME.tmpPID, renamed to DIR/NAME by
  * cli_out_close only when the run and every write succeeded, so an interrupted or failed run
  * leaves nothing half-written under the final name. */
+/* snprintf into buf of what fits: false when it was cut (the name is then not to be used). */
+bool cli_format_path(char* buf, size_t size, const char* fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+
+/* The parent directory of path into dir (empty when it has none; "/" for "/x"). */
+void cli_parent_dir(const char* path, char* dir, size_t n);
+
 struct cli_out_file {
     char final[1400], tmp[1400];
     FILE* f;     /* NULL: not open (no directory, or the name is empty: the file is not wanted) */
