@@ -764,6 +764,14 @@ static int dry_start(const struct cli_scenario* sc, struct cli_many_setup* su, s
                            span, s.dt, WETDEM_MANY_MAX_STEPS);
         return CLI_EXIT_USAGE;
     }
+    double max_steps = 1e8;
+    wetdem_sim_param(su->sim, "verlet.max_steps", &max_steps);
+    if (span > max_steps) {
+        /* the library refuses such a call before its first step, saying what sets the step */
+        st = wetdem_sim_integrate(su->sim, pl->t_end);
+        if (st != WETDEM_OK)
+            return cli_many_report_start(sc, st, wetdem_sim_errmsg(su->sim));
+    }
     pl->total = su->steps ? su->steps : (unsigned long long)ceil(span - 1e-9);
     if (!su->vtk_every_given)
         su->vtk_every = pl->total / 50 > 0 ? pl->total / 50 : 1;

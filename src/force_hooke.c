@@ -63,6 +63,19 @@ static double hooke_contact_time(const void* params, const struct wetdem_contact
     return M_PI / sqrt(k / c->m_eff - decay * decay);
 }
 
+/* Relaxation time m* / gamma of the dashpot [s], the same at every overlap and speed. As
+ * e_dry -> 0, gamma -> 2 sqrt(m* k) (critical damping) and the contact time above grows
+ * without bound (the motion no longer oscillates), so this time, sqrt(m* / k) / 2 at the least,
+ * and not the contact time, bounds the many-particle step there (docs/many.md, Time step);
+ * INFINITY without damping (e_dry = 1). */
+static double hooke_relaxation_time(const void* params, const struct wetdem_contact* c)
+{
+    double k = ((const struct hooke_params*)params)->stiffness;
+    if (!(c->restitution > 0.0 && c->restitution <= 1.0))
+        return INFINITY;
+    return viscous_relaxation_time(c->m_eff, hooke_damping(k, c->m_eff, c->restitution));
+}
+
 /* Energy stored in the spring, k delta^2 / 2 [J] (the dashpot stores none). */
 static double hooke_elastic_energy(const void* params, const struct wetdem_contact* c,
                                    const double* history)
@@ -94,6 +107,7 @@ const struct wetdem_model wetdem_force_hooke = {
     .pair = hooke_pair,
     .thresholds = contact_only_thresholds,
     .contact_time = hooke_contact_time,
+    .relaxation_time = hooke_relaxation_time,
     .elastic_energy = hooke_elastic_energy,
     .is_in_contact = contact_only_is_in_contact,
 };

@@ -43,6 +43,7 @@
 #include <stdbool.h>
 #include <stddef.h>
 
+#include "mindlin.h"
 #include "minsep_ehd.h"
 #include "models.h"
 #include "vec3.h"
@@ -181,16 +182,39 @@ static size_t nijssen_thresholds(const void* params, const struct wetdem_contact
     return 3;
 }
 
-/* m* / c_d with c_d = 6 pi mu R*^2 / h_min, the lubrication at the model's own minimum
- * approach h_min = max(h_sigma, h_eps) for v0 = c->v_n (Eq. 8; the lever blend below h_min
- * damps less) [s]. */
+/* The shortest relaxation time m / c_d of the model's dampers at approach speed v0 = c->v_n
+ * [s]: a fresh pair, h_min = max(h_sigma, h_eps(v0)).
+ *   - lubrication (Eq. 8): c_d = 6 pi mu R*^2 / h_min, m = m*, largest at h_min (the lever
+ *     blend below h_min weights it down by h/h_min);
+ *   - the contact branch's Hertz dashpot (Eq. 7): c_d = c(e) sqrt(m* k) d^(1/4),
+ *     k = (4/3) E* sqrt(R*), m = m*;
+ *   - its Mindlin dashpot (Eq. 10): gamma_t = -2 sqrt(5/6) beta sqrt(m* k_t),
+ *     k_t = 8 G* sqrt(R* d), m = (2/7) m* (a tangential force also spins both spheres).
+ * Both contact dashpots grow with the shifted overlap d = h_min - h and act with the lever
+ * weight w_c <= 1, so they are taken at the largest d of an undamped approach at v0: from the
+ * stored energy of the header comment, (1/2) m* v0^2 = (2/7) k h_min^(5/2) +
+ * (2/5) k (d^(5/2) - h_min^(5/2)), d_max^(5/2) = (5/4) m* v0^2 / k + (2/7) h_min^(5/2), which
+ * also bounds d where the pair stops inside the blend. The exact c(e) grows as sqrt(5/(4 e)),
+ * so for a small e_dry the Hertz dashpot, not the lubrication, sets this time (docs/many.md,
+ * Time step), as in the hertz model. */
 static double nijssen_relaxation_time(const void* params, const struct wetdem_contact* c)
 {
-    (void)params;
-    double h_eps = minsep_ehd_gap(c->viscosity, fmax(c->v_n, 0.0), c->e_star, c->r_eff);
+    const struct nijssen_params* p = params;
+    double v0 = fmax(c->v_n, 0.0), m = c->m_eff;
+    double h_eps = minsep_ehd_gap(c->viscosity, v0, c->e_star, c->r_eff);
     double h_min = fmax(c->roughness, h_eps);
-    return viscous_relaxation_time(c->m_eff,
-                                   lubrication_force(c->viscosity, c->r_eff, 1.0, h_min, h_min));
+    double tau =
+        viscous_relaxation_time(m, lubrication_force(c->viscosity, c->r_eff, 1.0, h_min, h_min));
+    double k = hertz_stiffness(c->e_star, c->r_eff);
+    if (!(v0 > 0.0 && k > 0.0 && m > 0.0 && c->restitution > 0.0 && c->restitution < 1.0))
+        return tau;
+    double d = pow(1.25 * m * v0 * v0 / k + 2.0 / 7.0 * h_min * h_min * sqrt(h_min), 0.4);
+    double coef = wetdem_force_hertz_damping_coefficient(c->restitution, (int)p->damping);
+    double c_n = coef * sqrt(m * k) * sqrt(sqrt(d));
+    double c_t = tangential_damping(tangential_stiffness(c->g_star, c->r_eff, d), m,
+                                    wetdem_force_mindlin_damping_factor(c->restitution));
+    tau = fmin(tau, viscous_relaxation_time(m, c_n));
+    return fmin(tau, viscous_relaxation_time(2.0 / 7.0 * m, c_t));
 }
 
 const struct wetdem_model wetdem_force_nijssen = {

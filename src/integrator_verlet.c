@@ -34,6 +34,7 @@
  * the gap, relative to h_min.
  */
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 
 #include "integrator.h"
@@ -108,12 +109,20 @@ static int choose_step(struct wetdem_sim* sim, const struct verlet_params* p, do
                                "(check the materials' youngs_modulus and density, and the radii)",
                                *dt, p->dt_fraction, t_contact);
     }
-    if (span / *dt > p->max_steps)
+    if (span / *dt > p->max_steps) {
+        char why[256] = "";
+        if (held)
+            snprintf(why, sizeof why, " (the step is held at hmin_fraction x h_min / v)");
+        else if (!(p->dt > 0))
+            snprintf(why, sizeof why,
+                     " (the step is dt_fraction = %g x the contact time %.3g s at %.3g m/s: "
+                     "check the materials' youngs_modulus and density, and the radii)",
+                     p->dt_fraction, t_contact, v);
         return wetdem_sim_fail(sim, WETDEM_ERR_MAX_STEPS,
                                "verlet: %.3g steps of %.3g s to reach t = %.9g s exceed "
                                "verlet.max_steps = %.3g%s",
-                               span / *dt, *dt, t_end, p->max_steps,
-                               held ? " (the step is held at hmin_fraction x h_min / v)" : "");
+                               span / *dt, *dt, t_end, p->max_steps, why);
+    }
     return WETDEM_OK;
 }
 

@@ -208,6 +208,7 @@ struct wetdem_many {
     bool record_partial;
     double wall_reach;
     double dt;              /* time step [s], fixed once the many run starts */
+    char dt_origin[384];    /* what sets dt, for messages (choose_dt; "" after a restore) */
     double relaxation_time; /* shortest viscous relaxation time at the start [s] (choose_dt),
                                or when the run was restored from a checkpoint */
     double contact_time;    /* shortest contact time, normal or tangential, then [s] */

@@ -421,6 +421,35 @@ int wetdem_sim_many_time_scales(struct wetdem_sim* sim)
     return sim->n_particles > 0 ? time_scales(sim, &sp, &s) : WETDEM_OK;
 }
 
+/* Says in m->dt_origin which bound of choose_dt sets the derived step dt, and which
+ * parameters set that bound, for a message that refuses the step or the run's length. */
+static void describe_dt(struct wetdem_sim* sim, const struct step_spheres* sp,
+                        const struct step_scales* s, double dt, double fraction,
+                        double many_hmin_fraction)
+{
+    struct wetdem_many* m = sim->many;
+    if (dt == 0.25 * s->tau)
+        snprintf(m->dt_origin, sizeof m->dt_origin,
+                 "the step is a quarter of the viscous relaxation time %g s that '%s' sets "
+                 "(m/c_d of its damping, which grows as the materials' restitution e_dry falls "
+                 "and with the fluid's viscosity)",
+                 s->tau, s->damper->name);
+    else if (dt == many_hmin_fraction * m->crossing_time)
+        snprintf(m->dt_origin, sizeof m->dt_origin,
+                 "the step is verlet.many_hmin_fraction = %g x the time %g s in which a pair "
+                 "closing at the speed scale %g m/s crosses the smallest gap where the force "
+                 "laws jump, %g m",
+                 many_hmin_fraction, m->crossing_time, sp->speed, s->gap);
+    else
+        snprintf(m->dt_origin, sizeof m->dt_origin,
+                 "the step is verlet.dt_fraction = %g x the contact time %g s of %s (the "
+                 "smallest free one R = %g m, mass %g kg) at the speed scale %g m/s, which "
+                 "scales as (m*^2/(E*^2 R* v))^(1/5): check the materials' youngs_modulus and "
+                 "density, and the radii",
+                 fraction, s->t_contact, probe_names[s->contact_probe], sp->small.radius,
+                 sp->small.mass, sp->speed);
+}
+
 /* Step [s]: many.dt, else verlet.dt, else the shortest of verlet.dt_fraction x the shortest
  * contact time (normal or tangential) at the speed scale, a quarter of the shortest viscous
  * relaxation time tau, and verlet.many_hmin_fraction x the time a pair closing at the speed
@@ -477,10 +506,12 @@ static int choose_dt(struct wetdem_sim* sim, double* dt)
                                    given, tau, s.damper->name, where, 0.25 * tau);
         }
         *dt = given;
+        snprintf(m->dt_origin, sizeof m->dt_origin, "the step is given (many.dt or verlet.dt)");
         return WETDEM_OK;
     }
     double by_gap = many_hmin_fraction > 0 ? many_hmin_fraction * m->crossing_time : INFINITY;
     *dt = fmin(fmin(fraction * s.t_contact, 0.25 * tau), by_gap);
+    describe_dt(sim, &sp, &s, *dt, fraction, many_hmin_fraction);
     /* a contact time of 0 or inf (a density or modulus near the ends of the double range)
      * resolves no contact, even where the other bounds give a finite step */
     if (!(isfinite(*dt) && *dt > 0 && isfinite(s.t_contact) && s.t_contact > 0))
@@ -1475,6 +1506,15 @@ int wetdem_sim_many_integrate(struct wetdem_sim* sim, double t_end)
                                "reaching t_end = %g s from t = %g s takes %.3g steps of dt = %g s, "
                                "more than %g: raise dt or lower t_end",
                                t_end, sim->engine.time, span, m->dt, WETDEM_MANY_MAX_STEPS);
+    double max_steps = 1e8;
+    wetdem_sim_param(sim, "verlet.max_steps", &max_steps);
+    if (span > max_steps)
+        return wetdem_sim_fail(sim, WETDEM_ERR_MAX_STEPS,
+                               "many: reaching t_end = %g s from t = %g s takes %.3g steps of "
+                               "dt = %g s, more than verlet.max_steps = %.3g%s%s: raise "
+                               "max_steps, lower t_end or integrate in shorter calls",
+                               t_end, sim->engine.time, span, m->dt, max_steps,
+                               m->dt_origin[0] ? "; " : "", m->dt_origin);
     if (sim->engine.observer && !(sim->engine.last_observed == sim->engine.time))
         st = wetdem_sim_observe(sim);
     unsigned long long total = span > 1e-9 ? (unsigned long long)ceil(span - 1e-9) : 0;

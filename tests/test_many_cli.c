@@ -1568,6 +1568,36 @@ static size_t count_rows_finite(const char* name, bool* finite)
     return rows;
 }
 
+/* A run whose derived step is absurdly short for its length (a Young's modulus of 1e30 Pa,
+ * inside the material's range: 4e4 steps became 5e13; e_dry = 1e-12: the hertz dashpot's
+ * relaxation time holds the step at 5e-12 s) is refused at once, exit 2, with the number of
+ * steps, the step, what sets it and the parameters to check, and no --out directory. Before,
+ * [integrator] max_steps did not apply to the many-particle mode: the run started and ground
+ * at some 300 steps a second (interrupted, it resumed from its checkpoint). A given step is
+ * held to max_steps the same way. */
+static void test_many_cli_refuses_a_run_with_too_many_steps(void** state)
+{
+    (void)state;
+    scenario("long.ini", "t_end = 0.05\n");
+    char* err = expect_exit("run long.ini --set run.dt=0 --set material.wet.youngs_modulus=1e30 "
+                            "--out long.out",
+                            2, "long.ini:");
+    CHECK_CONTAINS(err, "steps of dt = ");
+    CHECK_CONTAINS(err, "more than verlet.max_steps = 1e+08; the step is verlet.dt_fraction = "
+                        "0.02 x the contact time ");
+    CHECK_CONTAINS(err, "check the materials' youngs_modulus and density, and the radii");
+    assert_false(exists("long.out"));
+    free(err);
+    err = expect_exit("run long.ini --set run.dt=0 --set material.wet.restitution=1e-12 --check", 2,
+                      "the step is a quarter of the viscous relaxation time ");
+    CHECK_CONTAINS(err, "that 'hertz' sets");
+    free(err);
+    err = expect_exit("run long.ini --set integrator.max_steps=1000 --check", 2,
+                      "takes 2.5e+04 steps of dt = 2e-06 s, more than verlet.max_steps = 1e+03; "
+                      "the step is given");
+    free(err);
+}
+
 /* A step that does not resolve what the run meets is warned about on stderr (the library
  * gives the time scales in wetdem_many_stats): the base scenario's given 2 us lets a pair at
  * its speed scale (2 m/s) travel several times h_min = 1 um in a step; many_hmin_fraction = 0 turns
@@ -1659,6 +1689,7 @@ int main(void)
         cmocka_unit_test(test_many_cli_read_spheres_from_a_file),
         cmocka_unit_test(test_many_cli_examples_and_budget),
         cmocka_unit_test(test_many_cli_warns_about_the_step),
+        cmocka_unit_test(test_many_cli_refuses_a_run_with_too_many_steps),
     };
     return cmocka_run_group_tests(tests, setup, getenv("WETDEM_KEEP_TMP") ? NULL : teardown);
 }
