@@ -601,6 +601,16 @@ static struct wetdem_material pair_material(double film)
                                     .film = film};
 }
 
+/* Two spheres of R = 1 mm, 5 um apart on the x axis, meeting head-on at u each. */
+static void add_head_on_pair(struct wetdem_sim* sim, double u)
+{
+    double x = 1e-3 + 2.5e-6;
+    CHECK_OK(wetdem_sim_add_particle(
+        sim, (struct wetdem_particle){.pos = {-x, 0, 0}, .vel = {u, 0, 0}, .radius = 1e-3}));
+    CHECK_OK(wetdem_sim_add_particle(
+        sim, (struct wetdem_particle){.pos = {x, 0, 0}, .vel = {-u, 0, 0}, .radius = 1e-3}));
+}
+
 static struct wetdem_sim* damped_pair(const char* model, double viscosity, double u, int dir)
 {
     struct wetdem_sim* sim = wetdem_sim_create();
@@ -880,11 +890,8 @@ static void test_many_step_resolves_strong_contact_damping(void** state)
     m.restitution = 1e-6;
     assert_int_equal(wetdem_sim_add_material(sim, &m), 0);
     CHECK_OK(wetdem_sim_enable_model(sim, "hertz"));
-    double x = 1e-3 + 2.5e-6, u = 0.05;
-    CHECK_OK(wetdem_sim_add_particle(
-        sim, (struct wetdem_particle){.pos = {-x, 0, 0}, .vel = {u, 0, 0}, .radius = 1e-3}));
-    CHECK_OK(wetdem_sim_add_particle(
-        sim, (struct wetdem_particle){.pos = {x, 0, 0}, .vel = {-u, 0, 0}, .radius = 1e-3}));
+    double u = 0.05;
+    add_head_on_pair(sim, u);
     CHECK_OK(wetdem_sim_set_many(
         sim, &(struct wetdem_many_settings){.skin = 1e-4, .energy_budget = true}));
     CHECK_OK(wetdem_sim_integrate(sim, 100e-6));
@@ -917,11 +924,8 @@ static void dashpot_pair_comes_to_rest(const char* model, double e_dry, double v
     assert_int_equal(wetdem_sim_add_material(sim, &m), 0);
     CHECK_OK(wetdem_sim_set_param(sim, "fluid.viscosity", viscosity));
     CHECK_OK(wetdem_sim_enable_model(sim, model));
-    double x = 1e-3 + 2.5e-6, u = 0.05;
-    CHECK_OK(wetdem_sim_add_particle(
-        sim, (struct wetdem_particle){.pos = {-x, 0, 0}, .vel = {u, 0, 0}, .radius = 1e-3}));
-    CHECK_OK(wetdem_sim_add_particle(
-        sim, (struct wetdem_particle){.pos = {x, 0, 0}, .vel = {-u, 0, 0}, .radius = 1e-3}));
+    double u = 0.05;
+    add_head_on_pair(sim, u);
     CHECK_OK(wetdem_sim_set_many(
         sim, &(struct wetdem_many_settings){.skin = 1e-4, .energy_budget = true}));
     CHECK_OK(wetdem_sim_integrate(sim, t_end));
@@ -983,11 +987,8 @@ static void test_many_max_steps_refuses_the_call_up_front(void** state)
     m.youngs_modulus = 1e30;
     assert_int_equal(wetdem_sim_add_material(sim, &m), 0);
     CHECK_OK(wetdem_sim_enable_model(sim, "hertz"));
-    double x = 1e-3 + 2.5e-6, u = 0.05;
-    CHECK_OK(wetdem_sim_add_particle(
-        sim, (struct wetdem_particle){.pos = {-x, 0, 0}, .vel = {u, 0, 0}, .radius = 1e-3}));
-    CHECK_OK(wetdem_sim_add_particle(
-        sim, (struct wetdem_particle){.pos = {x, 0, 0}, .vel = {-u, 0, 0}, .radius = 1e-3}));
+    double u = 0.05;
+    add_head_on_pair(sim, u);
     CHECK_OK(wetdem_sim_set_many(sim, &(struct wetdem_many_settings){.skin = 1e-4}));
     CHECK_STATUS(wetdem_sim_integrate(sim, 1e-3), WETDEM_ERR_MAX_STEPS);
     CHECK_CONTAINS(wetdem_sim_errmsg(sim), "more than verlet.max_steps = 1e+08; the step is "
