@@ -210,7 +210,7 @@ static double nijssen_relaxation_time(const void* params, const struct wetdem_co
         return tau;
     double d = pow(1.25 * m * v0 * v0 / k + 2.0 / 7.0 * h_min * h_min * sqrt(h_min), 0.4);
     double coef = wetdem_force_hertz_damping_coefficient(c->restitution, (int)p->damping);
-    double c_n = coef * sqrt(m * k) * sqrt(sqrt(d));
+    double c_n = hertz_damping_k(coef, k, m, d, 1.0); /* (the force at unit speed) */
     double c_t = tangential_damping(tangential_stiffness(c->g_star, c->r_eff, d), m,
                                     wetdem_force_mindlin_damping_factor(c->restitution));
     tau = fmin(tau, viscous_relaxation_time(m, c_n));

@@ -61,6 +61,15 @@ find_event(struct wetdem_pairwise* pw, enum wetdem_pairwise_event_kind kind, siz
     return NULL;
 }
 
+/* The configuration of Davis's groups d (which must be valid). */
+static struct wetdem_pairwise_config davis_config(const struct wetdem_pairwise_davis* d)
+{
+    struct wetdem_pairwise_config c;
+    char msg[256];
+    CHECK_OK(wetdem_pairwise_davis_config(d, &c, msg, sizeof msg));
+    return c;
+}
+
 static struct wetdem_pairwise_config davis(double st, double ca, double angle_deg, double t_star)
 {
     struct wetdem_pairwise_davis d;
@@ -69,10 +78,7 @@ static struct wetdem_pairwise_config davis(double st, double ca, double angle_de
     d.capillary = ca;
     d.angle_deg = angle_deg;
     d.t_star_end = t_star;
-    struct wetdem_pairwise_config c;
-    char msg[256];
-    CHECK_OK(wetdem_pairwise_davis_config(&d, &c, msg, sizeof msg));
-    return c;
+    return davis_config(&d);
 }
 
 static int run(const struct wetdem_pairwise_config* c, struct wetdem_pairwise_result* r,
@@ -1244,9 +1250,7 @@ static int run_film(double h_a, double st, double angle_deg, struct wetdem_pairw
     d.film_ratio = h_a;
     d.stokes = st;
     d.angle_deg = angle_deg;
-    struct wetdem_pairwise_config c;
-    char msg[256];
-    CHECK_OK(wetdem_pairwise_davis_config(&d, &c, msg, sizeof msg));
+    struct wetdem_pairwise_config c = davis_config(&d);
     return run(&c, r, NULL);
 }
 
