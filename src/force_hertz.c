@@ -385,10 +385,10 @@ static int hertz_pair(const void* params, const struct wetdem_contact* c, double
 /* Relaxation time m* / c_d [s] of the damping at the largest overlap of an undamped collision
  * at c->v_n, delta_max = (5 m* v_n^2 / (4 k))^(2/5) (energy (1/2) m* v^2 = (2/5) k delta^(5/2)),
  * where c_d = c(e) sqrt(m* k) delta^(1/4) (hertz_damping_k at unit speed) is largest (the
- * damped overlap is smaller). The exact coefficient grows as sqrt(5/(4 e))
- * for small e_dry (header comment), so tau falls below the contact time as e_dry -> 0 and
- * bounds the explicit many-particle step there (docs/many.md, Time step); INFINITY without
- * damping (e_dry = 1) or approach speed. */
+ * damped overlap is smaller): tau = sqrt(m* / k) / (c(e) delta_max^(1/4)). The exact
+ * coefficient grows as sqrt(5/(4 e)) for small e_dry (header comment), so tau falls below the
+ * contact time as e_dry -> 0 and bounds the explicit many-particle step there (docs/many.md,
+ * Time step); INFINITY without damping (e_dry = 1) or approach speed. */
 static double hertz_relaxation_time(const void* params, const struct wetdem_contact* c)
 {
     const struct hertz_params* p = params;
@@ -397,7 +397,9 @@ static double hertz_relaxation_time(const void* params, const struct wetdem_cont
     if (!(coef > 0.0 && v > 0.0 && k > 0.0 && c->m_eff > 0.0))
         return INFINITY;
     double delta_max = pow(1.25 * c->m_eff * v * v / k, 0.4);
-    return viscous_relaxation_time(c->m_eff, hertz_damping_k(coef, k, c->m_eff, delta_max, 1.0));
+    /* = m* / hertz_damping_k(coef, k, m*, delta_max, 1), written so that m* k cannot overflow
+       (a density near the end of its range) */
+    return sqrt(c->m_eff / k) / (coef * sqrt(sqrt(delta_max)));
 }
 
 /* Energy stored in the elastic part of the law, (8/15) E* sqrt(R*) delta^(5/2) [J]: the
