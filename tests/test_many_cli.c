@@ -7,8 +7,9 @@
  *     checkpoint) exit 2 with "FILE:LINE:" at the right line
  *     and write nothing, not even the --out directory;
  *   - a run split by --restart (at a step on the output grid and off it), and a run resumed
- *     from an older checkpoint after its outputs went further, give byte-identical VTK frames,
- *     series index, CSV and summary to the uninterrupted run;
+ *     from an older checkpoint after its outputs went further (listed in the index or, after
+ *     a kill, not yet), give byte-identical VTK frames, series index, CSV and summary to the
+ *     uninterrupted run;
  *   - SIGINT sent to a running CLI, once or twice back to back, writes a checkpoint, exits 130
  *     and prints the command that resumes it; resuming gives the uninterrupted run's files
  *     byte for byte; a third stops it at once, the earlier checkpoint intact;
@@ -402,6 +403,38 @@ static void test_many_cli_restart_is_bit_identical(void** state)
     assert_int_equal(run_cli("run box.ini --set run.steps=600 --out crash"), 0);
     assert_int_equal(run_cli("run box.ini --set run.steps=600 --out crash --restart old.ckpt"), 0);
     check_same_outputs("whole", "crash", 7);
+    /* a run killed (SIGKILL) after writing frames past the checkpoint but before listing them:
+       between a frame and its index, or while a resume from an older checkpoint wrote its
+       frames again over a longer series. The index lists the frames up to step 300, the
+       directory holds those up to 600; the frames after the checkpoint are written again */
+    assert_int_equal(run_cli("run box.ini --set run.steps=300 --out killed"), 0);
+    snprintf(cmd, sizeof cmd,
+             "cd '%s/killed' && cp checkpoint.ckpt ../killed.ckpt && "
+             "cp particles.vtk.series ../killed.series",
+             tmpdir);
+    assert_int_equal(system(cmd), 0);
+    assert_int_equal(run_cli("run box.ini --set run.steps=600 --out killed"), 0);
+    assert_int_equal(rename(tpath("killed.series"), tpath("killed/particles.vtk.series")), 0);
+    code = run_cli("run box.ini --set run.steps=600 --out killed --restart killed.ckpt");
+    if (code != 0)
+        fail_msg("restart after a kill before the index: exit %d\n%s", code, stderr_text());
+    check_same_outputs("whole", "killed", 7);
+    /* killed between the frame of a periodic checkpoint's step and its index: the frame at
+       the checkpoint's time is not listed; it is written again */
+    assert_int_equal(run_cli("run box.ini --set run.steps=300 --out killed300"), 0);
+    char* index = test_read_file(tpath("killed300/particles.vtk.series"), NULL);
+    assert_non_null(index);
+    char* last = strstr(index, ",\n    { \"name\" : \"particles_000003.vtk\"");
+    assert_non_null(last);
+    snprintf(last, 10, "\n  ]\n}\n");
+    write_text("killed300/particles.vtk.series", index);
+    free(index);
+    code = run_cli("run box.ini --set run.steps=600 --out killed300 --restart "
+                   "killed300/checkpoint.ckpt");
+    if (code != 0)
+        fail_msg("restart after a kill at the checkpoint's frame: exit %d\n%s", code,
+                 stderr_text());
+    check_same_outputs("whole", "killed300", 7);
     /* a crash in the middle of a CSV row: the cut row (no newline) is dropped, not joined to
        the first row the resumed run appends */
     assert_int_equal(run_cli("run box.ini --set run.steps=300 --out cut"), 0);
