@@ -217,6 +217,21 @@ static unsigned long long frame_step(const struct series* s, size_t k, double t,
     return step - (unsigned long long)llround((t - s->times[k]) / dt);
 }
 
+/* Whether `time`, of a row or frame at `row` steps (or, row NULL, at some step), lies on the
+ * time grid t0 + k dt of the checkpoint (at step `step`, time t) to within `rel` of it: the
+ * outputs of another run (another scenario's step, given --out by mistake) do not. */
+static bool on_time_grid(double time, const unsigned long long* row, double t,
+                         unsigned long long step, double dt, double rel)
+{
+    double t0 = t - (double)step * dt;
+    if (row) {
+        double want = t0 + (double)*row * dt;
+        return fabs(time - want) <= rel * fabs(want) + 1e-3 * dt;
+    }
+    double k = (time - t0) / dt;
+    return fabs(k - nearbyint(k)) <= 1e-6 + rel * fabs(k);
+}
+
 /* The time in the title line of the frame at `path` ("wetdem particles t = T s", as the
  * library writes it, ASCII or binary), into *t; false when the file cannot be read or has no
  * such line. */
@@ -246,7 +261,8 @@ static bool frame_file_time(const char* path, double* t)
  * older checkpoint wrote its frames again over a longer series): they are dropped as the
  * listed ones after t are. One before t, or one whose time cannot be read, means the index is
  * missing or cut short: numbering from its end would overwrite frames the resumed run does
- * not write again, so the restart is refused (CLI exit code; nothing is touched). */
+ * not write again, so the restart is refused (CLI exit code; nothing is touched); so is an
+ * entry up to t off the checkpoint's time grid: another run's frames. */
 static int series_resume(struct series* s, double t, unsigned long long step, double dt,
                          unsigned long long every)
 {
@@ -266,6 +282,15 @@ static int series_resume(struct series* s, double t, unsigned long long step, do
             break;
         listed++;
         later = later || !(time <= t);
+        if (!later && !on_time_grid(time, NULL, t, step, dt, 1e-12)) {
+            fclose(f);
+            cli_error("--restart: %s lists %s at t = %.17g s, off the time grid of the "
+                      "checkpoint (dt = %.9g s, step %llu at t = %.9g s): the directory holds "
+                      "the outputs of another run; give --out the directory of the run that "
+                      "wrote the checkpoint",
+                      path, name, time, dt, step, t);
+            return CLI_EXIT_USAGE;
+        }
         if (!later && push_time(s, time) != 0) {
             fclose(f);
             cli_error("--restart: out of memory reading %s", path);
@@ -391,9 +416,10 @@ static int many_stats(const struct cli_scenario* sc, struct wetdem_sim* sim,
  * (the resumed run would append to it). *at_step says whether a row at `step` is kept. CLI
  * exit code; a missing file, one without its header line, and one whose rows end before those
  * the run that wrote the checkpoint had written (a file cut short or replaced) are input
- * errors, and leave the file as it was (the resumed run would append its rows after a gap). */
-static int csv_resume(const char* path, unsigned long long step, const struct writer* w,
-                      const char* out_dir, bool* at_step)
+ * errors, and leave the file as it was (the resumed run would append its rows after a gap);
+ * so is a row up to `step` at a time off the checkpoint's grid (t, dt): another run's CSV. */
+static int csv_resume(const char* path, double t, unsigned long long step, double dt,
+                      const struct writer* w, const char* out_dir, bool* at_step)
 {
     *at_step = false;
     FILE* f = fopen(path, "r");
@@ -409,6 +435,7 @@ static int csv_resume(const char* path, unsigned long long step, const struct wr
     char line[4096];
     bool dropped = false, header = false, rows = false;
     unsigned long long every = w->csv_every, last = 0; /* the last whole row's step */
+    unsigned long long off_grid = 0; /* 1 + the step of a row off the checkpoint's time grid */
     while (g && fgets(line, sizeof line, f)) {
         const char* comma = strchr(line, ',');
         bool data = line[0] >= '0' && line[0] <= '9' && comma;
@@ -419,6 +446,9 @@ static int csv_resume(const char* path, unsigned long long step, const struct wr
             last = rows && last > row ? last : row;
             rows = true;
         }
+        if (data && whole && row <= step && !off_grid &&
+            !on_time_grid(strtod(line, NULL), &row, t, step, dt, 1e-8))
+            off_grid = row + 1; /* (+1: step 0 too) */
         if (!whole || (data && (row > step || (row == step && !(every && step % every == 0))))) {
             dropped = true;
             continue;
@@ -432,9 +462,15 @@ static int csv_resume(const char* path, unsigned long long step, const struct wr
     /* the rows the run that wrote the checkpoint had written by then: one at the step it
        ended at, else those of its grid (this run's, as far as is known) */
     unsigned long long due = w->ended_here ? step : every ? step / every * every : 0;
-    if (ok && (!header || !rows || last < due)) {
+    if (ok && (!header || !rows || last < due || off_grid)) {
         remove(tmp);
-        if (!header)
+        if (off_grid)
+            cli_error("--restart: %s has a row of step %llu at a time off the time grid of the "
+                      "checkpoint (dt = %.9g s, step %llu at t = %.9g s): it holds the rows of "
+                      "another run; give --out the directory of the run that wrote the "
+                      "checkpoint (now %s)",
+                      path, off_grid - 1, dt, step, t, out_dir);
+        else if (!header)
             cli_error("--restart: %s has no header line (time_s,step,...): it was emptied or "
                       "cut at its start, and the rows up to the checkpoint are lost; restore "
                       "it, or start the run afresh without --restart",
@@ -1005,7 +1041,7 @@ static int resume(const struct cli_scenario* sc, const struct cli_many_setup* su
     char path[PATH_CHARS + 8];
     snprintf(path, sizeof path, "%s.csv", pl->csv_prefix);
     if (rc == CLI_EXIT_OK && pl->csv_prefix[0])
-        rc = csv_resume(path, s.step, &w, opt->out_dir, &at_step);
+        rc = csv_resume(path, wetdem_sim_time(su->sim), s.step, pl->dt, &w, opt->out_dir, &at_step);
     /* a row at the checkpoint's step on this run's grid that the CSV lacks (that run's grid
        was another): the uninterrupted run with this run's settings has it */
     if (rc == CLI_EXIT_OK && pl->csv_prefix[0] && !at_step && s.step % su->csv_every == 0 &&

@@ -481,6 +481,35 @@ static void test_many_cli_restart_is_bit_identical(void** state)
     CHECK_CONTAINS(err, "different materials");
     free(err);
     check_same_outputs("whole", "split", 7);
+    /* --out naming the directory of another run, as long but with a step of 1.23456 us, not
+       2 us: its frames and rows are not the checkpoint's run's, and the resumed run appended
+       to them (exit 0); refused, exit 2, by the index or, without frames, by the CSV, nothing
+       touched */
+    assert_int_equal(run_cli("run box.ini --set run.steps=900 --set run.dt=1.23456e-6 --out other"),
+                     0);
+    before = test_read_file(tpath("other/global.csv"), NULL);
+    char* index_before = test_read_file(tpath("other/particles.vtk.series"), NULL);
+    free(expect_exit("run box.ini --set run.steps=1000 --out other --restart split/checkpoint.ckpt",
+                     2,
+                     "other/particles.vtk.series lists particles_000001.vtk at t = "
+                     "0.000123456"));
+    err = stderr_text();
+    CHECK_CONTAINS(err, "off the time grid of the checkpoint (dt = 2e-06 s, step 600");
+    CHECK_CONTAINS(err, "the directory holds the outputs of another run");
+    free(err);
+    free(expect_exit("run box.ini --set run.steps=1000 --set dump.vtk=none --out other --restart "
+                     "split/checkpoint.ckpt",
+                     2,
+                     "other/global.csv has a row of step 20 at a time off the time grid of the "
+                     "checkpoint"));
+    after = test_read_file(tpath("other/global.csv"), NULL);
+    assert_string_equal(before, after);
+    free(before);
+    free(after);
+    after = test_read_file(tpath("other/particles.vtk.series"), NULL);
+    assert_string_equal(index_before, after);
+    free(index_before);
+    free(after);
     /* so is one written without the energy budget when the budget is on (it would count the
        work since the restart against the energies since the start), with the key to set */
     code = run_cli("run box.ini --set run.steps=600 --set run.energy_budget=no --out split "
