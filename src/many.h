@@ -208,6 +208,9 @@ struct wetdem_many {
     bool record_partial;
     double wall_reach;
     double dt;              /* time step [s], fixed once the many run starts */
+    double advance;         /* the time the tangential springs advance in a force pass [s]: dt,
+                               but 0 in the first pass of a run, the forces at t0, which no
+                               motion has moved yet (as the two-body engine's c.dt = 0) */
     char dt_origin[384];    /* what sets dt, for messages (choose_dt; "" after a restore) */
     double relaxation_time; /* shortest viscous relaxation time at the start [s] (choose_dt),
                                or when the run was restored from a checkpoint */

@@ -428,7 +428,7 @@ lean_force(const struct wetdem_many* m, const struct lean_geometry* g,
                 hertz_total(f_el, hertz_damping_from(g->damping, overlap, v_n), L->hertz_form);
         if (L->mindlin) { /* wetdem_pair_force_add_tangential onto a zero record */
             struct wetdem_vec3 ft =
-                mindlin_spring(n, g->v_t, m->dt, x->g_star, r_eff, m_eff, overlap, f_el,
+                mindlin_spring(n, g->v_t, m->advance, x->g_star, r_eff, m_eff, overlap, f_el,
                                L->mindlin_lub ? x->friction_lub : x->friction_dry,
                                x->mindlin_damping, hist + L->mindlin_off);
             f_tan = vec3_add(zero, ft);
@@ -780,7 +780,7 @@ static int eval_pair(const struct wetdem_sim* sim, struct wetdem_contact* c,
             wetdem_sim_history_init(sim, hist);
         return WETDEM_OK;
     }
-    c->dt = m->dt;
+    c->dt = m->advance;
     struct wetdem_pair_force f, per_model[WETDEM_MAX_MODELS];
     struct wetdem_pair_force* pm = m->set.energy_budget ? per_model : NULL;
     int st = m->fused ? wetdem_sim_many_eval_fused(sim, c, x, hist, &f, pm)
@@ -2282,6 +2282,7 @@ int wetdem_sim_many_forces(struct wetdem_sim* sim, enum wetdem_many_end end)
     if (st != WETDEM_OK)
         return st;
     st = pair_constants(sim);
+    m->advance = m->started ? m->dt : 0.0; /* (the first pass gives the forces at t0) */
     if (st == WETDEM_OK && m->set.energy_budget)
         st = reserve_work(sim);
     if (st != WETDEM_OK)
@@ -2354,7 +2355,7 @@ int wetdem_sim_many_forces(struct wetdem_sim* sim, enum wetdem_many_end end)
             .history = m->history,
             .len = sim->history_len,
             .spring_off = L->mindlin_off,
-            .dt = m->dt,
+            .dt = m->advance,
             .g_star = x->g_star,
             .mu = L->mindlin_lub ? x->friction_lub : x->friction_dry,
             .tangential_factor = x->mindlin_damping};
