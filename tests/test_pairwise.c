@@ -1326,6 +1326,49 @@ static void test_pairwise_thin_films(void** state)
     CHECK_CONTAINS(msg, "film_ratio x hmin_ratio >= 5e-11");
 }
 
+/* Small Stokes numbers (found by fuzzing): a held pair's capillary pull 8 pi a sigma, which
+ * the contact force cancels, grows as 1 / (Ca St_n) beside the masses, and added to the contact
+ * force it left a rounding of DBL_EPSILON 8 pi a sigma / m* in the accelerations (~2e-3 m/s^2
+ * here, against CVODE's velocity tolerance of 1e-9 m/s): the held triangle took 50 514 steps
+ * and its untracked pair drifted from h_min, its capillary energy missing from the budget
+ * (residual 6.5e-4 of the largest term); at Ca = 1000, St_n = 1e-11, 30 000 steps. The contact
+ * problem now yields the net normal force of a held pair: 5 365 and 5 857 steps, residuals
+ * 2.6e-12 and 5.8e-8. Bounds: the steps with a margin of ~3 over the fixed runs and ~3 below the
+ * former ones; the residual at 1e-6 of the largest term, the bound of an rtol = 1e-9 run whose
+ * local errors add up (1e-7 to 6e-7 in the Table-I range, test_pairwise_energy_budget_closes). */
+static void test_pairwise_small_stokes_held_cluster(void** state)
+{
+    (void)state;
+    const double st[2] = {1e-6, 1e-11}, ca[2] = {0.01, 1000.0};
+    for (int k = 0; k < 2; k++) {
+        struct wetdem_pairwise_config c = davis(st[k], ca[k], 30.0, 20.0);
+        struct wetdem_pairwise_result r;
+        CHECK_OK(run(&c, &r, NULL));
+        assert_int_equal(r.outcome, WETDEM_PAIRWISE_FA);
+        double rel = fabs(r.energy.residual) / wetdem_pairwise_energy_scale(&r.energy);
+        if (r.steps > 15000 || !(rel <= 1e-6))
+            fail_msg("St_n %g, Ca %g: %llu steps, residual %.3g of the largest term", st[k], ca[k],
+                     r.steps, rel);
+    }
+}
+
+/* Far smaller masses make the films' relaxation, 6 pi mu a^2 / (m* h), so fast beside the
+ * motion that CVODE's Newton iteration fails on every step and its steps shrink to 1e-13 s of a
+ * 0.07 s run (St_n = 1e-25, Ca = 0.01: some 3e11 steps to go). The run stops within one window
+ * of 20 000 steps (< 1 s) with a message that says why, instead of running for days. */
+static void test_pairwise_inertia_free_limit_stops(void** state)
+{
+    (void)state;
+    struct wetdem_pairwise_config c = davis(1e-25, 0.01, 30.0, 20.0);
+    struct wetdem_pairwise_result r;
+    struct wetdem_pairwise* pw = wetdem_pairwise_create();
+    assert_non_null(pw);
+    CHECK_STATUS(wetdem_pairwise_run(pw, &c, &r), WETDEM_ERR_STEP);
+    CHECK_CONTAINS(wetdem_pairwise_errmsg(pw), "the integration stalls at t = ");
+    CHECK_CONTAINS(wetdem_pairwise_errmsg(pw), "the inertia-free limit");
+    wetdem_pairwise_free(pw);
+}
+
 /* A pair held at h_min (resting contact, v_n = 0) and then let go separates through the film
  * and centrifugal forces with no impulse after the release: stick-rotate-separate, not bounce.
  * Three spheres, Davis's Table I at St_n = 3.7253, 45 deg: pair 1-2 has three contacts, is held
@@ -1816,6 +1859,8 @@ int main(void)
         cmocka_unit_test(test_pairwise_scales_of_the_reference_pair),
         cmocka_unit_test(test_pairwise_two_sphere_mechanisms),
         cmocka_unit_test(test_pairwise_thin_films),
+        cmocka_unit_test(test_pairwise_small_stokes_held_cluster),
+        cmocka_unit_test(test_pairwise_inertia_free_limit_stops),
         cmocka_unit_test(test_pairwise_released_pair_is_not_a_bounce),
         cmocka_unit_test(test_pairwise_knocked_apart_is_a_bounce),
         cmocka_unit_test(test_pairwise_receding_in_films_is_recede),
