@@ -7,6 +7,7 @@
  * at -R_i n from i's centre and at +R_j n from j's. The impulse on i is J = J_n n + J_t
  * (j receives -J). The relative velocity of i's surface with respect to j's there is
  *   u = (v_i + w_i x (-R_i n)) - (v_j + w_j x (R_j n)),   v_n = -u.n (> 0 approaching),
+ *   computed as -(v_i - v_j).n since w x n is normal to n,
  *   u_t = u - (u.n) n                                       (the slip velocity).
  * The impulse changes u by  du = J/m* + (R_i^2/I_i + R_j^2/I_j) J_t,  so
  *   normal (A1-A3):     J_n = m* (1 + e) v_n,               after: v_n' = -e v_n
@@ -127,7 +128,9 @@ int wetdem_hard_impulse(struct wetdem_impulse_body* bi, struct wetdem_impulse_bo
         return WETDEM_ERR_INVALID;
     struct wetdem_vec3 n = normal, n_i = vec3_neg(normal);
     struct wetdem_vec3 u = vec3_sub(surface_velocity(bi, n_i), surface_velocity(bj, n));
-    double v_n = -vec3_dot(u, n);
+    /* -u.n without the spin terms, which are normal to n: their rounding (eps |w R|) would
+     * make spinning spheres at rest approach, and a slow approach under fast spin inexact */
+    double v_n = -vec3_dot(vec3_sub(bi->vel, bj->vel), n);
     if (!(v_n > 0.0))
         return WETDEM_OK;
     double inv_m = inverse_mass(bi) + inverse_mass(bj);

@@ -327,6 +327,39 @@ static void test_hard_separating_pair_unchanged(void** state)
     }
 }
 
+/* Spin has no normal component at the contact point (omega x n is perpendicular to n), so the
+ * approach speed is that of the centres alone: spheres whose centres do not approach get no
+ * impulse however fast they spin, and the normal impulse of a slow approach under fast spin
+ * carries no rounding from the spin. */
+static void test_hard_spin_does_not_enter_normal_approach(void** state)
+{
+    (void)state;
+    const struct wetdem_vec3 normals[] = {{0.28, 0.96, 0.0}, {0.36, 0.48, 0.8}};
+    const double spins[] = {1e3, 12345.0};
+    for (int a = 0; a < 2; a++) {
+        struct wetdem_vec3 n = normals[a];
+        for (int b = 0; b < 2; b++) {
+            double w = spins[b];
+            struct wetdem_impulse_body bi = sphere(1.0, 0.1, v3(0.2, -0.1, 0.3), v3(0, 0, w));
+            struct wetdem_impulse_body bj =
+                sphere(2.0, 0.3, v3(0.2, -0.1, 0.3), v3(w / 3.0, 0, -w));
+            struct wetdem_impulse_body ci = bi, cj = bj;
+            struct wetdem_impulse_result r;
+            CHECK_OK(wetdem_hard_impulse(&bi, &bj, n, 0.9, 0.5, &r));
+            assert_memory_equal(&bi, &ci, sizeof bi);
+            assert_memory_equal(&bj, &cj, sizeof bj);
+            CHECK_ABS(r.impulse_normal, 0.0, 0.0);
+            /* approaching at 1 mm/s under a surface speed of 10^2-10^3 m/s, sliding */
+            bi.vel = sub(bi.vel, scale(n, 1e-3));
+            double v_n = -dot(sub(bi.vel, bj.vel), n), m_red = 2.0 / 3.0;
+            CHECK_OK(wetdem_hard_impulse(&bi, &bj, n, 0.9, 0.5, &r));
+            assert_false(r.is_sticking);
+            CHECK_REL(r.impulse_normal, m_red * 1.9 * v_n, 1e-14);
+            CHECK_REL(norm(r.impulse_tan), 0.5 * m_red * 1.9 * v_n, 1e-14);
+        }
+    }
+}
+
 static void test_hard_model_object(void** state)
 {
     (void)state;
@@ -352,6 +385,7 @@ int main(void)
         cmocka_unit_test(test_hard_sphere_on_wall),
         cmocka_unit_test(test_hard_rejects_invalid_input),
         cmocka_unit_test(test_hard_separating_pair_unchanged),
+        cmocka_unit_test(test_hard_spin_does_not_enter_normal_approach),
         cmocka_unit_test(test_hard_model_object),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
