@@ -97,7 +97,11 @@ const struct wetdem_model wetdem_force_hooke = {
            "clipped, so it pulls slightly at the end of unloading (clipping would break both "
            "closed forms), and the dashpot makes it jump by gamma v_n where the overlap "
            "begins and ends. Cheaper and stiffer-to-tune than hertz; k does not follow from the "
-           "material moduli. Keep the overlap v sqrt(m* / k) small compared with R*.",
+           "material moduli. Keep the overlap v sqrt(m* / k) small compared with R*. mindlin "
+           "beside it keeps its Hertzian tangential stiffness 8 G* sqrt(R* delta) and Coulomb "
+           "limit mu (4/3) E* sqrt(R*) delta^(3/2), not mu k delta: with a soft k its friction "
+           "can exceed mu times this normal force (about 5 x for steel spheres of R = 2 mm, "
+           "k = 1e6 N/m, delta = 1 um).",
     .equations = "linear spring-dashpot (Cundall & Strack 1979; LIGGGHTS model hooke); "
                  "docs/derivations/contact.md",
     .params = hooke_params_desc,
