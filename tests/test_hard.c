@@ -349,7 +349,9 @@ static void test_hard_spin_does_not_enter_normal_approach(void** state)
             assert_memory_equal(&bi, &ci, sizeof bi);
             assert_memory_equal(&bj, &cj, sizeof bj);
             CHECK_ABS(r.impulse_normal, 0.0, 0.0);
-            /* approaching at 1 mm/s under a surface speed of 10^2-10^3 m/s, sliding */
+            /* approaching at 1 mm/s under a surface speed of 10^2-10^3 m/s, sliding; 1e-14:
+               some ten roundings of products of eps = 2.2e-16 each, where the spin terms'
+               rounding (eps |w R| / v_n ~ 1e-11) showed before */
             bi.vel = sub(bi.vel, scale(n, 1e-3));
             double v_n = -dot(sub(bi.vel, bj.vel), n), m_red = 2.0 / 3.0;
             CHECK_OK(wetdem_hard_impulse(&bi, &bj, n, 0.9, 0.5, &r));
