@@ -1270,28 +1270,6 @@ static void classify(struct wetdem_pairwise* pw)
  * the integration step (docs/derivations/pairwise.md Sec. 7). */
 #define HOLD_RATE_FACTOR 100.0
 
-/* Whether held pairs take their net normal force from the contact problem (sys->hold_net,
- * pairwise_rhs.c constraint_forces): when the rounding of the capillary pull the contact force
- * cancels, DBL_EPSILON 8 pi a sigma / m* as an acceleration, could build up to CVODE's velocity
- * tolerance rtol v_scale within the run, i.e. when
- *     R = DBL_EPSILON max_p (8 pi a_p sigma / m*_p) t_end / (rtol v_scale) > HOLD_NET_RATIO.
- * For Davis's groups R = 4 DBL_EPSILON t*_end cos^2(beta) / (h_a Ca St_n rtol): at most
- * 4.4e-3 over Table I (St_n >= 0.1, Ca >= 20, h_a >= 0.002, t* = 20, rtol = 1e-9) and 0.067 in
- * the deep-well validation run (Ca = 0.01, St_n = 2, 30 deg). The rounding showed at Ca = 0.01
- * in the energy residual from R ~ 100 (8.8e-6 of the largest term at St_n = 1e-3, R = 130;
- * 6.6e-5 at R = 1.3e4) and in the steps from R ~ 1e5 (St_n = 1e-6: 50 000 instead of 5 400).
- * Below the ratio the former arithmetic, which agrees with the net form to that rounding, is
- * kept, and with it those results to the bit (the validation's outputs are unchanged). */
-#define HOLD_NET_RATIO 1.0
-static bool hold_net(const struct wetdem_pairwise_config* cfg,
-                     const struct wetdem_pairwise_system* sys, double v_scale)
-{
-    double pull = 0.0; /* [m/s^2] */
-    for (size_t p = 0; p < sys->n_pairs; p++)
-        if (sys->delta[p] > sys->h_min)
-            pull = fmax(pull, 8.0 * M_PI * sys->a_eff[p] * sys->sigma / sys->m_eff[p]);
-    return DBL_EPSILON * pull * cfg->t_end > HOLD_NET_RATIO * cfg->rtol * v_scale;
-}
 /* Reference quantities, initial modes, tree and state from the configuration. */
 static void initial_state(struct wetdem_pairwise* pw)
 {
@@ -1321,7 +1299,6 @@ static void initial_state(struct wetdem_pairwise* pw)
         v = fmax(v, fmax(hypot(k.ux[i], k.uy[i]), hypot(k.vx[i], k.vy[i])));
     pw->v_scale = v > 0.0 ? v : 1e-6;
     sys->hold_rate = HOLD_RATE_FACTOR * cfg->rtol * pw->v_scale / sys->h_min;
-    sys->hold_net = hold_net(cfg, sys, pw->v_scale);
     /* (without an approach of the reference pair, the largest initial speed: Sec. 7) */
     pw->rest_speed = cfg->rest_speed_ratio * (res->v_n0 > 0.0 ? res->v_n0 : pw->v_scale);
     if (cfg->rest_speed_ratio > 0.0) /* (0: no resting contact at all) */

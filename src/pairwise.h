@@ -39,8 +39,6 @@ struct wetdem_pairwise_system {
     double gx, gy;                                   /* [m/s^2] */
     double hold_rate; /* alpha [1/s]: a held pair that is not tracked is kept at h_min by
                          dv_n/dt = alpha^2 (h - h_min) - 2 alpha v_n (pairwise_rhs.c) */
-    bool hold_net;    /* solve a held pair's net normal force, not the contact force added to
-                         its capillary pull (pairwise_rhs.c, constraint_forces) */
 };
 
 /* Discrete mode of a run: tracked tree and the per-pair switches. */

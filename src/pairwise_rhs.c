@@ -182,22 +182,20 @@ bool wetdem_pairwise_rhs_solve(size_t n, double A[PW_PMAX][PW_PMAX], double* b)
     return true;
 }
 
-/* Constraint forces of the resting pairs: dv_n/dt = 0 for each (added to f_n).
+/* Constraint forces of the resting pairs: dv_n/dt = 0 for each; the solve yields each held
+ * pair's net normal force N = F_n + lambda (docs/derivations/pairwise.md Sec. 7).
  * The film force of a held pair is its capillary pull -8 pi a sigma (v_n = 0), and the contact
- * force lambda cancels it but for what the pair's net normal force F_n + lambda needs
- * (centripetal, the neighbours'). Added in that order the net force carries a rounding of
- * DBL_EPSILON 8 pi a sigma, an acceleration of DBL_EPSILON 8 pi a sigma / m*, which grows as
- * 1 / (Ca St_n): at Ca = 0.01 and St_n = 1e-6 it was ~2e-3 m/s^2 against a net ~0 and CVODE's
- * velocity tolerance of 1e-9 m/s, so that the rounding alone limited the steps of a held
- * cluster to ~1e-6 s (50 000 steps a run, 880 000 at St_n = 1e-7) and the Newton iteration
- * failed every tenth step on a Jacobian whose difference quotients were that rounding; and the
- * pair that is not tracked, whose v_n = 0 the constraint only holds at the acceleration level,
- * drifted from h_min by a random walk of it (the capillary energy 8 pi a sigma (h - h_min) came
- * out of the budget: residuals of 6.5e-4 to 1.7e-2 of the largest term). With sys->hold_net
- * the held pairs' normal forces are left out of the right-hand side b and the solve yields the
- * net force F_n + lambda itself, free of the pull; lambda (the release guard) is its
- * difference from F_n. Where the pull is weak the two agree to rounding, and the first form is
- * kept (pairwise.c, initial_state) so that results there do not change. */
+ * force lambda cancels it but for what the net force needs (centripetal, the neighbours').
+ * Formed as F_n + lambda, N would carry a rounding of DBL_EPSILON 8 pi a sigma, an
+ * acceleration of DBL_EPSILON 8 pi a sigma / m* that grows as 1 / (Ca St_n): at Ca = 0.01 and
+ * St_n = 1e-6 ~2e-3 m/s^2 against a net ~0 and CVODE's velocity tolerance of 1e-9 m/s, which
+ * limited the steps of a held cluster to ~1e-6 s (50 000 steps a run, 880 000 at
+ * St_n = 1e-7), failed the Newton iteration every tenth step on a Jacobian whose difference
+ * quotients were that rounding, and let the pair that is not tracked (its v_n = 0 held only at
+ * the acceleration level) drift from h_min by a random walk of it (the capillary energy
+ * 8 pi a sigma (h - h_min) came out of the budget: residuals of 6.5e-4 to 1.7e-2 of the
+ * largest term). So the held pairs' normal forces are left out of the right-hand side b, the
+ * solve yields N itself, free of the pull, and lambda (the release guard) is N - F_n. */
 static bool constraint_forces(const struct wetdem_pairwise_system* sys,
                               const struct wetdem_pairwise_mode* md,
                               const struct wetdem_pairwise_kin* k, struct wetdem_pairwise_forces* f)
@@ -211,8 +209,7 @@ static bool constraint_forces(const struct wetdem_pairwise_system* sys,
     double A[PW_PMAX][PW_PMAX], b[PW_PMAX], film_n[PW_PMAX];
     for (size_t a = 0; a < n; a++) {
         film_n[a] = f->f_n[rest[a]];
-        if (sys->hold_net)
-            f->f_n[rest[a]] = 0.0;
+        f->f_n[rest[a]] = 0.0;
     }
     for (size_t a = 0; a < n; a++) {
         double dvn, rdom;
@@ -228,8 +225,8 @@ static bool constraint_forces(const struct wetdem_pairwise_system* sys,
     if (!wetdem_pairwise_rhs_solve(n, A, b))
         return false;
     for (size_t a = 0; a < n; a++) {
-        f->lambda[rest[a]] = sys->hold_net ? b[a] - film_n[a] : b[a];
-        f->f_n[rest[a]] = sys->hold_net ? b[a] : film_n[a] + b[a];
+        f->lambda[rest[a]] = b[a] - film_n[a];
+        f->f_n[rest[a]] = b[a];
     }
     return true;
 }
