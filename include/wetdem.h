@@ -794,6 +794,13 @@ WETDEM_API int wetdem_sim_write_vtk(struct wetdem_sim* sim, const char* path, bo
  * force of the enabled models at this state, with the pairs' histories as the latest step
  * left them (docs/many.md, Outputs). WETDEM_ERR_INVALID before a run, WETDEM_ERR_IO. */
 WETDEM_API int wetdem_sim_write_vtk_links(struct wetdem_sim* sim, const char* path, bool binary);
+/* The simulated time [s] of a particle file that wetdem_sim_write_vtk or a many-particle run
+ * wrote (ASCII or binary), into *t, read from its title line "wetdem particles t = T s": the
+ * time written, bit for bit. *t is set only on success. Returns WETDEM_OK, WETDEM_ERR_INVALID
+ * (path or t NULL), WETDEM_ERR_IO (the file cannot be opened or read), WETDEM_ERR_PARSE (no
+ * such title: another file, a links file, a title cut short, altered or with anything after
+ * " s", a time that is not finite) or WETDEM_ERR_NOMEM (no C locale could be made). */
+WETDEM_API int wetdem_output_vtk_frame_time(const char* path, double* t);
 /* Writes a checkpoint of a many-particle run (atomic: temporary file, then rename).
  * Returns WETDEM_OK, WETDEM_ERR_INVALID (not in many mode) or WETDEM_ERR_IO. */
 WETDEM_API int wetdem_sim_write_checkpoint(struct wetdem_sim* sim, const char* path);

@@ -1,10 +1,12 @@
 /*
  * output_vtk.c — legacy VTK (version 3.0) POLYDATA files of the particles and of their links
  * (contacts and liquid bridges as lines), ASCII or binary, and ParaView ".vtk.series"
- * time-series files. Prefix: wetdem_output_vtk.
+ * time-series files; and the time of a particle file, read back from its title (the one
+ * definition of the title's format, TITLE_FORMAT, serves both). Prefix: wetdem_output_vtk.
  *
  * Layout (VTK User's Guide, "VTK File Formats", legacy format):
  *   # vtk DataFile Version 3.0 / title / ASCII|BINARY / DATASET POLYDATA
+ *   (title: "wetdem particles t = T s" or "wetdem links t = T s", T the time [s] in %.17g)
  *   FIELD FieldData 1, TIME 1 1 double      simulated time [s] (ParaView shows it)
  *   POINTS n double                         centres [m]
  *   VERTICES n 2n                           one vertex cell per sphere ("1 i")
@@ -22,12 +24,22 @@
  * Files are written to "<path>.tmp" and renamed into place (atomic on POSIX file systems).
  */
 #include <errno.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "locale_guard.h"
 #include "output_vtk.h"
 #include "status.h"
+
+/* The first two lines of every file: the legacy format's version, and the title, which names
+ * the content ("particles" or "links") and gives the time [s] with 17 significant digits (an
+ * exact round trip). write_head writes them; wetdem_output_vtk_frame_time reads them back. */
+#define VERSION_LINE "# vtk DataFile Version 3.0\n"
+#define TITLE_HEAD "wetdem %s t = "
+#define TITLE_FORMAT TITLE_HEAD "%.17g s\n"
+#define PARTICLES "particles"
 
 static bool host_is_little_endian(void)
 {
@@ -116,10 +128,9 @@ static void write_ints(FILE* f, const char* name, const struct wetdem_particle* 
 /* The title, format and TIME field data of a file. */
 static void write_head(FILE* f, const char* what, double time, bool binary)
 {
-    fprintf(f,
-            "# vtk DataFile Version 3.0\nwetdem %s t = %.17g s\n%s\n"
-            "DATASET POLYDATA\nFIELD FieldData 1\nTIME 1 1 double\n",
-            what, time, binary ? "BINARY" : "ASCII");
+    fprintf(f, VERSION_LINE TITLE_FORMAT, what, time);
+    fprintf(f, "%s\nDATASET POLYDATA\nFIELD FieldData 1\nTIME 1 1 double\n",
+            binary ? "BINARY" : "ASCII");
     put_double(f, time, binary);
     if (binary)
         fputc('\n', f);
@@ -128,7 +139,7 @@ static void write_head(FILE* f, const char* what, double time, bool binary)
 static void write_body(FILE* f, const struct wetdem_particle* p, size_t n,
                        const struct wetdem_output_vtk_counts* counts, double time, bool binary)
 {
-    write_head(f, "particles", time, binary);
+    write_head(f, PARTICLES, time, binary);
     write_vectors(f, "POINTS %zu double\n", p, n, 0, binary);
     fprintf(f, "VERTICES %zu %zu\n", n, 2 * n);
     for (size_t k = 0; k < n; k++) {
@@ -276,6 +287,50 @@ int wetdem_output_vtk_links_write(const char* path, const struct wetdem_output_v
     const struct vtk_content c = {
         .is_links = true, .l = links, .n = n, .time = time, .binary = binary};
     return write_vtk_file(path, &c, msg, msg_size);
+}
+
+/* The time in `title` if it is the title write_head gives a particle file: after the head, a
+ * finite number that TITLE_FORMAT prints as the line has it (nothing else after " s", no other
+ * spelling of the number). */
+static int title_time(const char* title, double* t)
+{
+    char head[64], want[128];
+    int n = snprintf(head, sizeof head, TITLE_HEAD, PARTICLES);
+    if (strncmp(title, head, (size_t)n) != 0)
+        return WETDEM_ERR_PARSE;
+    double x = strtod(title + n, NULL);
+    snprintf(want, sizeof want, TITLE_FORMAT, PARTICLES, x);
+    if (!isfinite(x) || strcmp(title, want) != 0)
+        return WETDEM_ERR_PARSE;
+    *t = x;
+    return WETDEM_OK;
+}
+
+/* The time of a particle file from its first two lines, the version and the title. */
+static int read_frame_time(FILE* f, double* t)
+{
+    char version[64], title[128]; /* (a longer line is cut, and so not a title) */
+    bool got = fgets(version, sizeof version, f) && fgets(title, sizeof title, f);
+    if (ferror(f))
+        return WETDEM_ERR_IO;
+    if (!got || strcmp(version, VERSION_LINE) != 0)
+        return WETDEM_ERR_PARSE;
+    return title_time(title, t);
+}
+
+int wetdem_output_vtk_frame_time(const char* path, double* t)
+{
+    if (!path || !t)
+        return WETDEM_ERR_INVALID;
+    struct wetdem_locale_guard g; /* (strtod reads a decimal point in the C locale only) */
+    if (wetdem_locale_guard_enter(&g) != WETDEM_OK)
+        return WETDEM_ERR_NOMEM;
+    FILE* f = fopen(path, "rb");
+    int st = f ? read_frame_time(f, t) : WETDEM_ERR_IO;
+    if (f)
+        fclose(f);
+    wetdem_locale_guard_leave(&g);
+    return st;
 }
 
 int wetdem_output_vtk_path(char* buf, size_t size, const char* prefix, uint64_t index)

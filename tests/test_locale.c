@@ -4,7 +4,8 @@
  * the same bytes in its VTK files (particles, links), .vtk.series indexes, global CSV and
  * checkpoints as in the C locale, restarts from a .vtk.series file with the same times, and
  * has "0.5" read as 0.5 in parameter strings and track files, and written as 0.5 by the
- * parameter formatters; and the host's locale is left as it was.
+ * parameter formatters, and a frame's time read back from its title; and the host's locale is
+ * left as it was.
  *
  * The German locale is built at run time into a temporary directory (localedef, from the
  * sources of Debian's `locales` package; LOCPATH points glibc there), and the test first
@@ -57,6 +58,9 @@ struct outcome {
     size_t n_samples;
     struct wetdem_track_sample samples[N_TRACK_FRAMES];
     char formatted[64], range[64];
+    int frame_status;  /* of reading the time of a frame (wetdem_output_vtk_frame_time) */
+    double frame_time; /* what it read */
+    double sim_time;   /* the time the frame was written at */
 };
 
 /* A wet granular gas of 20 spheres in a box periodic in x and y with a floor, and the
@@ -105,6 +109,9 @@ static void exercise(const char* dir, struct outcome* out)
     CHECK_OK(wetdem_sim_integrate(sim, 2e-4));
     snprintf(path, sizeof path, "%s/extra.vtk", dir);
     CHECK_OK(wetdem_sim_write_vtk(sim, path, false));
+    out->frame_time = NAN;
+    out->frame_status = wetdem_output_vtk_frame_time(path, &out->frame_time);
+    out->sim_time = wetdem_sim_time(sim);
     snprintf(path, sizeof path, "%s/extra_links.vtk", dir);
     CHECK_OK(wetdem_sim_write_vtk_links(sim, path, false));
     CHECK_OK(wetdem_sim_many_write_csv_row(sim));
@@ -196,6 +203,8 @@ static void test_locale_text_io_ignores_the_hosts_decimal_comma(void** state)
     CHECK_OK(c.track_status);
     assert_string_equal(c.formatted, "0.5");
     assert_string_equal(c.range, "[0.25, 1.5]");
+    CHECK_OK(c.frame_status);
+    assert_memory_equal(&c.frame_time, &c.sim_time, sizeof c.sim_time);
 
     /* the host's locale, as after setlocale(LC_ALL, "") with LANG=de_DE.UTF-8 */
     if (!setlocale(LC_ALL, "de_DE.UTF-8"))
@@ -220,6 +229,10 @@ static void test_locale_text_io_ignores_the_hosts_decimal_comma(void** state)
     assert_memory_equal(de.samples, c.samples, c.n_samples * sizeof c.samples[0]);
     assert_string_equal(de.formatted, c.formatted);
     assert_string_equal(de.range, c.range);
+    if (de.frame_status != WETDEM_OK)
+        fail_msg("output_vtk_frame_time gave %s in the German locale",
+                 wetdem_status_name(de.frame_status));
+    assert_memory_equal(&de.frame_time, &de.sim_time, sizeof de.sim_time);
 }
 
 int main(void)

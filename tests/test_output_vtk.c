@@ -3,8 +3,10 @@
  * back here, keyword by keyword, and must equal the input bit for bit (ASCII with 17 digits
  * and big-endian binary are both exact); when the VTK Python module is installed the files
  * are also read with VTK's own legacy reader. Also: the links file (lines and cell data), atomic
- * write, series file, bad path.
+ * write, series file, bad path; the time of a particle file read back from its title
+ * (wetdem_output_vtk_frame_time), bit for bit, and every other file refused.
  */
+#include <float.h>
 #include <stdlib.h>
 #include <unistd.h>
 
@@ -409,6 +411,143 @@ static void test_output_vtk_series_and_names(void** state)
     remove(path);
 }
 
+/* A temporary file holding the `len` bytes of text. */
+static void temp_file_with(char* path, const char* text, size_t len)
+{
+    int fd = mkstemp(path);
+    assert_true(fd >= 0);
+    assert_int_equal(write(fd, text, len), (ssize_t)len);
+    close(fd);
+}
+
+/* Writes N particles at `time` and reads the time back from the file's title. */
+static double time_written_and_read(double time, bool binary)
+{
+    struct wetdem_particle p[N];
+    struct counts_data links;
+    make_particles(p, &links);
+    char path[] = "/tmp/wetdem_test_vtk_time_XXXXXX";
+    temp_file_with(path, "", 0);
+    char msg[256] = "";
+    CHECK_OK(wetdem_output_vtk_write(path, p, N, NULL, time, binary, msg, sizeof msg));
+    double got = NAN;
+    CHECK_OK(wetdem_output_vtk_frame_time(path, &got));
+    remove(path);
+    return got;
+}
+
+/* Times whose text is awkward: zero of both signs, the smallest subnormal and normal numbers,
+ * sums and quotients that 15 digits do not round-trip, the largest double. */
+static void test_output_vtk_frame_time_reads_back_every_bit(void** state)
+{
+    (void)state;
+    const double times[] = {0.0,        -0.0,      5e-324,  DBL_MIN,    1e-300,
+                            1.0 / 3.0,  0.1 + 0.2, 0.1,     2.5e-3,     1.0 + DBL_EPSILON,
+                            123456.789, 1e300,     DBL_MAX, -1.0 / 3.0, 4503599627370497.0,
+                            -DBL_MAX};
+    for (size_t k = 0; k < sizeof times / sizeof times[0]; k++)
+        for (int binary = 0; binary < 2; binary++) {
+            double got = time_written_and_read(times[k], binary);
+            if (memcmp(&got, &times[k], sizeof got) != 0)
+                fail_msg("time %.17g (%s) read back as %.17g", times[k],
+                         binary ? "binary" : "ASCII", got);
+        }
+}
+
+/* The status of reading the time of a file holding `text`; *t must be left as it was unless
+ * the read succeeds. */
+static int frame_time_of_text(const char* text, size_t len)
+{
+    char path[] = "/tmp/wetdem_test_vtk_title_XXXXXX";
+    temp_file_with(path, text, len);
+    double t = 42;
+    int st = wetdem_output_vtk_frame_time(path, &t);
+    remove(path);
+    if (st != WETDEM_OK && t != 42)
+        fail_msg("a failed read (%s) changed *t to %.17g: '%s'", wetdem_status_name(st), t, text);
+    return st;
+}
+
+/* A title that is not exactly the one the writer gives a particle file is refused as
+ * WETDEM_ERR_PARSE: missing, altered, cut short, with anything after " s", or with a time that
+ * is not a finite number; so is a links file. */
+static void test_output_vtk_frame_time_refuses_other_titles(void** state)
+{
+    (void)state;
+    static const char* const bad[] = {
+        "",
+        "# vtk DataFile Version 3.0\n",
+        "# vtk DataFile Version 3.0\nASCII\nDATASET POLYDATA\n",
+        "# vtk DataFile Version 2.0\nwetdem particles t = 0.5 s\nASCII\n",
+        "wetdem particles t = 0.5 s\nASCII\n",
+        "# vtk DataFile Version 3.0\nwetdem links t = 0.5 s\nASCII\n",
+        "# vtk DataFile Version 3.0\nwetdem particle t = 0.5 s\nASCII\n",
+        "# vtk DataFile Version 3.0\nWetdem particles t = 0.5 s\nASCII\n",
+        "# vtk DataFile Version 3.0\n wetdem particles t = 0.5 s\nASCII\n",
+        "# vtk DataFile Version 3.0\nwetdem particles t= 0.5 s\nASCII\n",
+        "# vtk DataFile Version 3.0\nwetdem particles t = 0.5 ms\nASCII\n",
+        "# vtk DataFile Version 3.0\nwetdem particles t = 0.50 s\nASCII\n",
+        "# vtk DataFile Version 3.0\nwetdem particles t = +0.5 s\nASCII\n",
+        "# vtk DataFile Version 3.0\nwetdem particles t = 0x1p-1 s\nASCII\n",
+        "# vtk DataFile Version 3.0\nwetdem particles t =  0.5 s\nASCII\n",
+        "# vtk DataFile Version 3.0\nwetdem particles t = s\nASCII\n",
+        "# vtk DataFile Version 3.0\nwetdem particles t = ",
+        "# vtk DataFile Version 3.0\nwetdem particles t = 0.5",
+        "# vtk DataFile Version 3.0\nwetdem particles t = 0.5 s",
+        "# vtk DataFile Version 3.0\nwetdem particles t = 0.5 s \nASCII\n",
+        "# vtk DataFile Version 3.0\nwetdem particles t = 0.5 s\r\nASCII\n",
+        "# vtk DataFile Version 3.0\nwetdem particles t = 0.5 s extra\nASCII\n",
+        "# vtk DataFile Version 3.0\nwetdem particles t = 0.5abc s\nASCII\n",
+        "# vtk DataFile Version 3.0\nwetdem particles t = 0.5 s0.5 s\nASCII\n",
+        "# vtk DataFile Version 3.0\nwetdem particles t = nan s\nASCII\n",
+        "# vtk DataFile Version 3.0\nwetdem particles t = -nan s\nASCII\n",
+        "# vtk DataFile Version 3.0\nwetdem particles t = inf s\nASCII\n",
+        "# vtk DataFile Version 3.0\nwetdem particles t = -inf s\nASCII\n",
+        "# vtk DataFile Version 3.0\nwetdem particles t = infinity s\nASCII\n",
+        "# vtk DataFile Version 3.0\nwetdem particles t = 1e999 s\nASCII\n",
+    };
+    for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {
+        int st = frame_time_of_text(bad[k], strlen(bad[k]));
+        if (st != WETDEM_ERR_PARSE)
+            fail_msg("'%s' gave %s, expected WETDEM_ERR_PARSE", bad[k], wetdem_status_name(st));
+    }
+    /* the good title itself, as the control of the cases above */
+    static const char good[] = "# vtk DataFile Version 3.0\nwetdem particles t = 0.5 s\nASCII\n";
+    CHECK_OK(frame_time_of_text(good, strlen(good)));
+    /* a NUL inside the title */
+    static const char nul[] = "# vtk DataFile Version 3.0\nwetdem particles t = 0.5 s\0\nASCII\n";
+    CHECK_STATUS(frame_time_of_text(nul, sizeof nul - 1), WETDEM_ERR_PARSE);
+    /* a title line longer than any the writer gives */
+    char long_title[400];
+    snprintf(long_title, sizeof long_title,
+             "# vtk DataFile Version 3.0\nwetdem particles t = 0.5 s%*s\n", 300, "");
+    CHECK_STATUS(frame_time_of_text(long_title, strlen(long_title)), WETDEM_ERR_PARSE);
+    /* a links file, as the links writer gives it */
+    char path[] = "/tmp/wetdem_test_vtk_title_XXXXXX";
+    temp_file_with(path, "", 0);
+    char msg[256] = "";
+    double t = 42;
+    CHECK_OK(wetdem_output_vtk_links_write(path, NULL, 0, 0.5, false, msg, sizeof msg));
+    CHECK_STATUS(wetdem_output_vtk_frame_time(path, &t), WETDEM_ERR_PARSE);
+    assert_true(t == 42);
+    remove(path);
+}
+
+/* A file that cannot be read is WETDEM_ERR_IO, a NULL argument WETDEM_ERR_INVALID. */
+static void test_output_vtk_frame_time_refuses_what_it_cannot_read(void** state)
+{
+    (void)state;
+    double t = 42;
+    CHECK_STATUS(wetdem_output_vtk_frame_time("/nonexistent-dir/x.vtk", &t), WETDEM_ERR_IO);
+    CHECK_STATUS(wetdem_output_vtk_frame_time("/tmp", &t), WETDEM_ERR_IO); /* a directory */
+    CHECK_STATUS(wetdem_output_vtk_frame_time(NULL, &t), WETDEM_ERR_INVALID);
+    assert_true(t == 42);
+    char path[] = "/tmp/wetdem_test_vtk_title_XXXXXX";
+    temp_file_with(path, "", 0);
+    CHECK_STATUS(wetdem_output_vtk_frame_time(path, NULL), WETDEM_ERR_INVALID);
+    remove(path);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -417,6 +556,9 @@ int main(void)
         cmocka_unit_test(test_output_vtk_links_round_trip),
         cmocka_unit_test(test_output_vtk_bad_path_is_an_io_error),
         cmocka_unit_test(test_output_vtk_series_and_names),
+        cmocka_unit_test(test_output_vtk_frame_time_reads_back_every_bit),
+        cmocka_unit_test(test_output_vtk_frame_time_refuses_other_titles),
+        cmocka_unit_test(test_output_vtk_frame_time_refuses_what_it_cannot_read),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
