@@ -232,37 +232,20 @@ static bool on_time_grid(double time, const unsigned long long* row, double t,
     return fabs(k - nearbyint(k)) <= 1e-6 + rel * fabs(k);
 }
 
-/* The time in the title line of the frame at `path` ("wetdem particles t = T s", as the
- * library writes it, ASCII or binary), into *t; false when the file cannot be read or has no
- * such line. */
-static bool frame_file_time(const char* path, double* t)
-{
-    FILE* f = fopen(path, "rb");
-    char line[256] = "";
-    bool ok = f && fgets(line, sizeof line, f) && fgets(line, sizeof line, f);
-    if (f)
-        fclose(f);
-    const char* at = ok ? strstr(line, " t = ") : NULL;
-    char* end;
-    if (!at || strncmp(line, "wetdem particles t = ", 21) != 0)
-        return false;
-    *t = strtod(at + 5, &end);
-    return end != at + 5 && strcmp(end, " s\n") == 0;
-}
-
 /* On restart: the frames of the existing index up to time t, the checkpoint's (entries in
  * order, named as this run names them); the rest are dropped and will be written again. A
  * frame at t itself is kept only on the grid of `every`, the vtk_every of the run that wrote
  * the checkpoint (struct writer): off it, it is the last frame that run added at its end,
  * which the uninterrupted run does not have (the resumed run writes a frame there when t is
- * on its own grid). Frames on disk beyond those the index lists, at t or after it, were
- * written from the checkpoint on by a run killed before it listed them (between a frame and
- * its index, the frame of a periodic checkpoint's step included, or while a resume from an
- * older checkpoint wrote its frames again over a longer series): they are dropped as the
- * listed ones after t are. One before t, or one whose time cannot be read, means the index is
- * missing or cut short: numbering from its end would overwrite frames the resumed run does
- * not write again, so the restart is refused (CLI exit code; nothing is touched); so is an
- * entry up to t off the checkpoint's time grid: another run's frames. */
+ * on its own grid). Frames on disk beyond those the index lists, at t or after it (the time
+ * of their title, wetdem_output_vtk_frame_time), were written from the checkpoint on by a
+ * run killed before it listed them (between a frame and its index, the frame of a periodic
+ * checkpoint's step included, or while a resume from an older checkpoint wrote its frames
+ * again over a longer series): they are dropped as the listed ones after t are. One before
+ * t, or one whose time cannot be read, means the index is missing or cut short: numbering
+ * from its end would overwrite frames the resumed run does not write again, so the restart
+ * is refused (CLI exit code; nothing is touched); so is an entry up to t off the
+ * checkpoint's time grid: another run's frames. */
 static int series_resume(struct series* s, double t, unsigned long long step, double dt,
                          unsigned long long every)
 {
@@ -305,8 +288,8 @@ static int series_resume(struct series* s, double t, unsigned long long step, do
     for (;; listed++) { /* (frames a killed run wrote past the checkpoint, not yet listed) */
         frame_name(s, listed, false, name, sizeof name);
         snprintf(frame, sizeof frame, "%s/%s", s->dir, name);
-        if (!(indexed && access(frame, F_OK) == 0 && frame_file_time(frame, &later_time) &&
-              later_time >= t))
+        if (!(indexed && access(frame, F_OK) == 0 &&
+              wetdem_output_vtk_frame_time(frame, &later_time) == WETDEM_OK && later_time >= t))
             break;
     }
     if (access(frame, F_OK) == 0) {
