@@ -763,6 +763,16 @@ static int initial_values(const struct fit_args* a, const struct fit_ctx* c, dou
     return CLI_EXIT_OK;
 }
 
+/* The descriptor of a fitted key's valid range into *d ("material.striker.restitution": key
+ * restitution of [material.striker]); false for a key of unknown range. */
+static bool key_desc(const char* full, struct wetdem_param_desc* d)
+{
+    const char* dot = strrchr(full, '.');
+    char section[CLI_NAME_MAX];
+    snprintf(section, sizeof section, "%.*s", (int)(dot - full), full);
+    return cli_scenario_key_range(section, dot + 1, d) == 0;
+}
+
 /* The fit's bounds of every key, its valid range [min, max] (the library varies the distance to
  * a bound on a log scale, so every evaluation stays inside; docs/calibration.md "Method").
  * Keys of an unknown range are unbounded, fitted in log form when their initial value is > 0.
@@ -772,12 +782,9 @@ static int key_bounds(const struct fit_ctx* c, const double* init, double* lower
 {
     for (size_t j = 0; j < c->n_keys; j++) {
         const char* full = c->keys[j];
-        const char* dot = strrchr(full, '.');
-        char section[CLI_NAME_MAX];
-        snprintf(section, sizeof section, "%.*s", (int)(dot - full), full);
         struct wetdem_param_desc d;
         lower[j] = -INFINITY, upper[j] = INFINITY, is_log[j] = false;
-        if (cli_scenario_key_range(section, dot + 1, &d) != 0) {
+        if (!key_desc(full, &d)) {
             is_log[j] = init[j] > 0;
             continue;
         }
@@ -853,6 +860,22 @@ static void residual_stats(const struct fit_ctx* c, const double* pred, size_t p
 
 static const char* const transform_words[] = {"linear", "log", "log-upper", "logistic"};
 
+/* What key j ending at a bound (side -1 lower, +1 upper) of [lower, upper] means, with its
+ * range open or closed at each end as its descriptor has it: "(0, 1]" for a restitution. */
+static void print_at_bound(const struct fit_ctx* c, size_t j, int side, double lower, double upper)
+{
+    char range[128];
+    struct wetdem_param_desc d;
+    if (key_desc(c->keys[j], &d))
+        wetdem_param_range_text(&d, range, sizeof range);
+    else /* (not reached: a key of unknown range is fitted unbounded) */
+        snprintf(range, sizeof range, "[%g, %g]", lower, upper);
+    printf(": at the %s bound %g of its range %s: the data would take it further, or do not tell "
+           "it from the bound (no standard error there%s)",
+           side < 0 ? "lower" : "upper", side < 0 ? lower : upper, range,
+           c->n_keys > 1 ? "; the others' are with it held there" : "");
+}
+
 /* "KEY = value +- error UNIT (relative %)" lines, and what an infinite or NAN error means. */
 static void print_values(const struct fit_ctx* c, const struct wetdem_fit_result* r,
                          const double* lower, const double* upper)
@@ -864,10 +887,7 @@ static void print_values(const struct fit_ctx* c, const struct wetdem_fit_result
         if (r->undetermined[j])
             printf(": not determined by the data");
         else if (r->at_bound[j])
-            printf(": at the %s bound %g of its range [%g, %g]: the data would take it further, "
-                   "or do not tell it from the bound (no standard error there%s)",
-                   r->at_bound[j] < 0 ? "lower" : "upper", r->at_bound[j] < 0 ? lower[j] : upper[j],
-                   lower[j], upper[j], c->n_keys > 1 ? "; the others' are with it held there" : "");
+            print_at_bound(c, j, r->at_bound[j], lower[j], upper[j]);
         else if (r->std_errors[j] > fabs(r->values[j]))
             printf(": hardly determined by the data here (a standard error above the value); a "
                    "start nearer the value you expect may find a better minimum");

@@ -986,6 +986,28 @@ static void test_fit_cli_keeps_keys_in_range(void** state)
     remove(csv);
 }
 
+/* A key fitted to a bound is reported with its valid range as its descriptor has it, open or
+ * closed at each end: a restitution in (0, 1] was printed as [0, 1]. The data are the e_n of
+ * e_dry = 0.995 of test_fit_cli_keeps_keys_in_range raised by 3 %: more than e_dry = 1 gives,
+ * so the fit runs into the upper bound. */
+static void test_fit_cli_reports_a_bound_with_its_range_ends(void** state)
+{
+    (void)state;
+    if (!getenv("WETDEM_CLI"))
+        skip();
+    char csv[96], args[1024];
+    temp_csv(csv, "e103",
+             "stokes_n,e_n\n1.6,0.111592\n1.9,0.405472\n2.2,0.563459\n2.5,0.663377\n"
+             "2.8,0.731686\n3.1,0.780767\n3.4,0.817310\n3.7,0.845268\n4,0.867118\n");
+    snprintf(args, sizeof args,
+             "fit examples/fit/punch_db_c.ini --data %s --fit material.striker.restitution "
+             "--init 0.9",
+             csv);
+    expect_cli(args, 0,
+               ": at the upper bound 1 of its range (0, 1]: the data would take it further");
+    remove(csv);
+}
+
 static void test_fit_cli_reports_units_on_example(void** state)
 {
     (void)state;
@@ -1139,6 +1161,7 @@ int main(void)
         cmocka_unit_test(test_fit_cli_reports_undetermined_keys),
         cmocka_unit_test(test_fit_cli_flat_start_is_not_a_result),
         cmocka_unit_test(test_fit_cli_keeps_keys_in_range),
+        cmocka_unit_test(test_fit_cli_reports_a_bound_with_its_range_ends),
         cmocka_unit_test(test_fit_cli_reports_units_on_example),
         cmocka_unit_test(test_fit_cli_curve_covers_every_angle),
         cmocka_unit_test(test_fit_cli_writes_files_whole_or_not_at_all),
