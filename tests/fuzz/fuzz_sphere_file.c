@@ -5,6 +5,8 @@
  * spheres accepted with a value outside the ranges the reader promises (finite everywhere, a
  * radius in (0, 1] m, centres and speeds within 1000, spins within 1e6, a fixed sphere at
  * rest, a material index in [0, 1000] or -1 for none), or an error without a message.
+ * The same bytes also go to wetdem_output_vtk_frame_time, which must give a finite time or an
+ * error that leaves the time as it was.
  */
 #include <math.h>
 #include <stdint.h>
@@ -34,7 +36,11 @@ int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size)
     size_t n = 0;
     char err[512] = "";
     int rc = cli_read_sphere_file(path, true, &p, &n, err, sizeof err);
+    double t = NAN;
+    int st = wetdem_output_vtk_frame_time(path, &t);
     remove(path);
+    if (st == WETDEM_OK ? !isfinite(t) : (st != WETDEM_ERR_PARSE || !isnan(t)))
+        abort();
     if (rc != 0 && (!err[0] || p || n))
         abort();
     for (size_t k = 0; rc == 0 && k < n; k++)
