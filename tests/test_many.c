@@ -585,6 +585,65 @@ static void test_many_matches_few_body_engine(void** state)
     wetdem_sim_free(sims[1]);
 }
 
+/* A pair of spheres of test_soft_glass (R = 0.5 mm, friction_dry mu) overlapping by 2 um, or
+ * with `wall` one pressed 1 um into a floor (at x = -2 x, facing +x), approaching at vn and
+ * sliding at vt along y, each sphere (the floor still); models hertz and mindlin, or with
+ * `hooke` hooke (stiffness 1e4 N/m) and mindlin; verlet.dt = 0.2 us; in the many mode when
+ * `many`. hertz + mindlin runs through the lean kernel, hooke + mindlin through the generic
+ * one. */
+static struct wetdem_sim* contact_at_the_start(bool hooke, bool wall, double vn, double vt,
+                                               double mu, bool many)
+{
+    struct wetdem_sim* s = wetdem_sim_create();
+    struct wetdem_material m = test_soft_glass(0);
+    m.friction_dry = mu;
+    assert_int_equal(wetdem_sim_add_material(s, &m), 0);
+    CHECK_OK(wetdem_sim_enable_model(s, hooke ? "hooke" : "hertz"));
+    CHECK_OK(wetdem_sim_enable_model(s, "mindlin"));
+    if (hooke)
+        CHECK_OK(wetdem_sim_set_param(s, "hooke.stiffness", 1e4));
+    CHECK_OK(wetdem_sim_set_param(s, "verlet.dt", 2e-7));
+    double r = 0.5e-3, x = r - 1e-6; /* an overlap of 2 um, or 1 um on the floor */
+    CHECK_OK(wetdem_sim_add_particle(
+        s,
+        (struct wetdem_particle){.pos = {-x, 0, 0}, .vel = {wall ? -vn : vn, vt, 0}, .radius = r}));
+    if (wall)
+        CHECK_OK(wetdem_sim_add_wall(s, (struct wetdem_vec3){-2 * x, 0, 0},
+                                     (struct wetdem_vec3){1, 0, 0}, 0));
+    else
+        CHECK_OK(wetdem_sim_add_particle(
+            s, (struct wetdem_particle){.pos = {x, 0, 0}, .vel = {-vn, -vt, 0}, .radius = r}));
+    if (many)
+        CHECK_OK(wetdem_sim_set_many(s, &(struct wetdem_many_settings){.skin = 1e-4}));
+    return s;
+}
+
+/* contact_at_the_start with (vn, vt), run for `steps` steps by the two-body engine and by the
+ * many mode, for both kernels, pair and floor: sphere 0 rebounds, spun by the spring and its
+ * slip slowed, with the same velocity, spin and position in both to tol relative. */
+static void contacts_at_the_start_match(double vn, double vt, int steps, double tol)
+{
+    for (int hooke = 0; hooke < 2; hooke++)
+        for (int wall = 0; wall < 2; wall++) {
+            struct wetdem_sim* sims[2];
+            for (int k = 0; k < 2; k++) {
+                sims[k] = contact_at_the_start(hooke, wall, vn, vt, 0.4, k == 1);
+                CHECK_OK(wetdem_sim_integrate(sims[k], steps * 2e-7));
+            }
+            const struct wetdem_particle* p0 = wetdem_sim_particles_const(sims[0], NULL);
+            const struct wetdem_particle* p1 = wetdem_sim_particles_const(sims[1], NULL);
+            assert_true(wall ? p0[0].vel.x > 0 : p0[0].vel.x < 0); /* it rebounded */
+            assert_true(fabs(p0[0].omega.z) > 1);                  /* the spring spun it */
+            assert_true(fabs(p0[0].vel.y - vt) > 1e-2 * vt);       /* and slowed its slip */
+            CHECK_REL(p1[0].vel.x, p0[0].vel.x, tol);
+            CHECK_REL(p1[0].vel.y, p0[0].vel.y, tol);
+            CHECK_REL(p1[0].omega.z, p0[0].omega.z, tol);
+            CHECK_REL(p1[0].pos.y, p0[0].pos.y, tol);
+            wetdem_sim_free(sims[0]);
+            wetdem_sim_free(sims[1]);
+        }
+}
+
 /* A pair already in contact when the run starts, and a sphere pressed into a floor, both with
  * a tangential velocity small enough for the Mindlin spring to stick: the forces at t0 are
  * those of fresh springs, which no motion has moved yet, in both engines. The many mode gave
@@ -592,54 +651,11 @@ static void test_many_matches_few_body_engine(void** state)
  * after 400 steps of 0.2 us, past the rebound, the tangential velocities were off by 2e-4 to
  * 1.3e-3 relative, the spins by 1.3e-3 to 6.8e-3. The same scheme and the same forces
  * otherwise agree to rounding, as in test_many_matches_few_body_engine: 1e-12 relative
- * (measured 0 to 8e-15). hertz + mindlin runs through the lean kernel, hooke + mindlin through
- * the generic one. */
+ * (measured 0 to 8e-15). */
 static void test_many_contacts_at_the_start_match_few_body_engine(void** state)
 {
     (void)state;
-    const char* sets[] = {"hertz mindlin", "hooke mindlin"};
-    for (int set = 0; set < 2; set++)
-        for (int wall = 0; wall < 2; wall++) {
-            struct wetdem_sim* sims[2];
-            for (int k = 0; k < 2; k++) {
-                struct wetdem_sim* s = wetdem_sim_create();
-                struct wetdem_material m = test_soft_glass(0);
-                assert_int_equal(wetdem_sim_add_material(s, &m), 0);
-                char names[32];
-                snprintf(names, sizeof names, "%s", sets[set]);
-                for (char* name = strtok(names, " "); name; name = strtok(NULL, " "))
-                    CHECK_OK(wetdem_sim_enable_model(s, name));
-                if (set == 1)
-                    CHECK_OK(wetdem_sim_set_param(s, "hooke.stiffness", 1e4));
-                CHECK_OK(wetdem_sim_set_param(s, "verlet.dt", 2e-7));
-                double r = 0.5e-3, x = r - 1e-6; /* an overlap of 2 um, or 1 um on the floor */
-                CHECK_OK(wetdem_sim_add_particle(
-                    s, (struct wetdem_particle){
-                           .pos = {-x, 0, 0}, .vel = {wall ? -0.01 : 0.01, 0.01, 0}, .radius = r}));
-                if (wall) /* at x = -2 x, facing +x */
-                    CHECK_OK(wetdem_sim_add_wall(s, (struct wetdem_vec3){-2 * x, 0, 0},
-                                                 (struct wetdem_vec3){1, 0, 0}, 0));
-                else
-                    CHECK_OK(wetdem_sim_add_particle(
-                        s, (struct wetdem_particle){
-                               .pos = {x, 0, 0}, .vel = {-0.01, -0.01, 0}, .radius = r}));
-                if (k == 1)
-                    CHECK_OK(wetdem_sim_set_many(s, &(struct wetdem_many_settings){.skin = 1e-4}));
-                CHECK_OK(wetdem_sim_integrate(s, 400 * 2e-7));
-                sims[k] = s;
-            }
-            const struct wetdem_particle* p0 = wetdem_sim_particles_const(sims[0], NULL);
-            const struct wetdem_particle* p1 = wetdem_sim_particles_const(sims[1], NULL);
-            assert_true(wall ? p0[0].vel.x > 0 : p0[0].vel.x < 0); /* it rebounded */
-            assert_true(fabs(p0[0].omega.z) > 1);                  /* the spring spun it */
-            assert_true(fabs(p0[0].vel.y - 0.01) > 1e-4);          /* and slowed its slip */
-            CHECK_REL(p1[0].vel.x, p0[0].vel.x, 1e-12);
-            CHECK_REL(p1[0].vel.y, p0[0].vel.y, 1e-12);
-            CHECK_REL(p1[0].omega.z, p0[0].omega.z, 1e-12);
-            CHECK_REL(p1[0].pos.y, p0[0].pos.y, 1e-12);
-            wetdem_sim_free(sims[0]);
-            wetdem_sim_free(sims[1]);
-        }
+    contacts_at_the_start_match(0.01, 0.01, 400, 1e-12);
 }
 
 /* Two spheres of radius 1 mm (glass-like, 2500 kg/m^3) at gap h0 = 5 um inside h_min =
