@@ -210,7 +210,8 @@ struct wetdem_many {
     double dt;              /* time step [s], fixed once the many run starts */
     double advance;         /* the time the tangential springs advance in a force pass [s]: dt,
                                but 0 in the first pass of a run, the forces at t0, which no
-                               motion has moved yet (as the two-body engine's c.dt = 0) */
+                               motion has moved yet (as the two-body engine's c.dt = 0); that
+                               pass keeps none of the histories it writes (sim_many_force.c) */
     char dt_origin[384];    /* what sets dt, for messages (choose_dt; "" after a restore) */
     double relaxation_time; /* shortest viscous relaxation time at the start [s] (choose_dt),
                                or when the run was restored from a checkpoint */
@@ -237,7 +238,8 @@ struct wetdem_many {
        walls may be added between calls, which widens every particle's row */
     size_t wall_history_n, wall_history_walls;
     struct wetdem_celllist_pair* old_pairs; /* previous list, for history remapping */
-    double* old_history;
+    double* old_history; /* their histories; in the first pass of a run, the histories (pairs,
+                            then walls) as given, put back after it (sim_many_force.c) */
     size_t old_cap, old_history_cap;
     unsigned char* flags; /* per candidate pair: MANY_ACTIVE | _CONTACT | _DIRTY | _SPRING
                                     (a separate byte array: the gather scans it densely) */

@@ -29,6 +29,12 @@
  * number of threads and, because pairs out of range add nothing, for any time at which the
  * list was rebuilt (checkpoint + restart).
  *
+ * The first pass of a run gives the forces at t0 of the state as given, as the two-body engine
+ * evaluates its start (sim_integrate.c begin_run, nothing committed): the tangential springs
+ * not advanced (many.h advance = 0) and the histories it writes put back after it, so that a
+ * contact sliding at t0 starts its first step from its spring, not from the one mindlin.h
+ * sets at the Coulomb limit (docs/derivations/contact.md Sec. 2, step 4).
+ *
  * Mixed properties (contact.c, SPEC §2): 1/E* = (1-nu_a^2)/E_a + (1-nu_b^2)/E_b, 1/G* =
  * (2-nu_a)/G_a + (2-nu_b)/G_b, means of e, mu, sigma, sum of films; computed once per
  * material pair with the same code (wetdem_contact_from_particles on probe particles) so the
@@ -2267,6 +2273,40 @@ static void collect_pass_work(struct wetdem_sim* sim, bool parallel)
     }
 }
 
+/* The histories of the pairs and particle-wall pairs as the state gives them, kept in
+ * m->old_history (unused between list builds, whose remap needs that room anyway) for
+ * put_given_histories; *n gets the number of doubles kept. For the first pass of a run. */
+static int keep_given_histories(struct wetdem_sim* sim, size_t* n)
+{
+    struct wetdem_many* m = sim->many;
+    size_t len = sim->history_len, pairs = m->cl.n_pairs * len;
+    *n = pairs + sim->n_particles * sim->n_walls * len;
+    if (*n == 0)
+        return WETDEM_OK;
+    if (!reserve((void**)&m->old_history, &m->old_history_cap, *n, sizeof(double)))
+        return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory for %zu pair histories",
+                               *n / len);
+    if (pairs) /* (no memcpy from a NULL array, even of nothing) */
+        memcpy(m->old_history, m->history, pairs * sizeof(double));
+    if (*n > pairs)
+        memcpy(m->old_history + pairs, m->wall_history, (*n - pairs) * sizeof(double));
+    return WETDEM_OK;
+}
+
+/* Puts the n doubles of histories kept by keep_given_histories back (n = 0: none kept, a pass
+ * after the first or no histories). */
+static void put_given_histories(struct wetdem_sim* sim, size_t n)
+{
+    struct wetdem_many* m = sim->many;
+    size_t pairs = m->cl.n_pairs * sim->history_len;
+    if (n == 0)
+        return;
+    if (pairs)
+        memcpy(m->history, m->old_history, pairs * sizeof(double));
+    if (n > pairs)
+        memcpy(m->wall_history, m->old_history + pairs, (n - pairs) * sizeof(double));
+}
+
 int wetdem_sim_many_forces(struct wetdem_sim* sim, enum wetdem_many_end end)
 {
     bool kick = end == WETDEM_MANY_END_KICK, drift = end == WETDEM_MANY_END_STEP;
@@ -2282,7 +2322,13 @@ int wetdem_sim_many_forces(struct wetdem_sim* sim, enum wetdem_many_end end)
     if (st != WETDEM_OK)
         return st;
     st = pair_constants(sim);
-    m->advance = m->started ? m->dt : 0.0; /* (the first pass gives the forces at t0) */
+    /* the first pass of a run gives the forces at t0 of the state as given (the top of this
+       file): springs not advanced, and nothing it writes into the histories kept (a spring set
+       to the Coulomb limit, a min-separation record); a test per pass, none per pair */
+    m->advance = m->started ? m->dt : 0.0;
+    size_t given = 0;
+    if (st == WETDEM_OK && !m->started)
+        st = keep_given_histories(sim, &given);
     if (st == WETDEM_OK && m->set.energy_budget)
         st = reserve_work(sim);
     if (st != WETDEM_OK)
@@ -2395,6 +2441,7 @@ int wetdem_sim_many_forces(struct wetdem_sim* sim, enum wetdem_many_end end)
             m->block_time[b] += omp_get_wtime() - t0;
         }
     }
+    put_given_histories(sim, given); /* (also after a failure: the next call starts again) */
     if (m->set.energy_budget)
         collect_pass_work(sim, parallel);
     m->drift_passes += drift;
