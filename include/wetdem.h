@@ -1130,9 +1130,14 @@ struct wetdem_track_sample {
     double vx_raw, vy_raw, omega_raw; /* from the unsmoothed dots [m/s], [rad/s] */
     double vx, vy, omega;             /* from the Savitzky-Golay smoothed dots */
     double residual;                  /* rms residual of Eq. 23 on the smoothed dots [m] */
+    /* standard uncertainties (1 sigma) of the six velocities above from the tracking noise
+     * (docs/tracking.md "Uncertainties"), in their units */
+    double u_vx_raw, u_vy_raw, u_omega_raw;
+    double u_vx, u_vy, u_omega;
 };
 
-/* Velocities and dot-1 position of one sphere at one frame (straight-line fit values). */
+/* Velocities and dot-1 position of one sphere at one frame (straight-line fit values); also
+ * their standard uncertainties (the u_ fields of struct wetdem_track_summary). */
 struct wetdem_track_state {
     double vx, vy; /* [m/s] */
     double omega;  /* spin about the camera axis, counter-clockwise in (x, y) [rad/s] */
@@ -1156,6 +1161,18 @@ struct wetdem_track_summary {
                                         (separation > 0) [m/s] */
     double e_n;                /* Eq. 3: speed_nf / speed_n0 [-] */
     double stokes_n;           /* Eq. 2 with m* = m/2, R* = R/2; NAN without options */
+    /* Tracking noise per pixel coordinate estimated from the residuals of Eq. 23 on the raw
+     * dots, per sphere in the order of wetdem_track_sphere_id() [pixel]; also with one
+     * sphere (noise_px[1] then NAN). */
+    double noise_px[2];
+    /* Standard uncertainties (1 sigma) of the values above from that noise, propagated to
+     * first order with their correlations (docs/tracking.md "Uncertainties"); in the same
+     * units; NAN where the value is NAN. Systematic biases are not included. */
+    struct wetdem_track_state u_striker_before, u_striker_after;
+    struct wetdem_track_state u_target_before, u_target_after;
+    double u_angle_centres, u_impact_angle; /* [rad] */
+    double u_speed_n0, u_speed_nf;          /* [m/s] */
+    double u_e_n, u_stokes_n;               /* [-] */
 };
 
 /* Allocates an empty track. NULL only if out of memory. */

@@ -28,6 +28,18 @@
  *  5. Impact angle of the centres (Eq. 16), normal relative speeds with the line of centres at
  *     the collision frame (n_0) and at `offset` frames after (n_f), e_n (Eq. 3) and
  *     St_n = m* v_n0 / (6 pi mu R*^2) (Eq. 2) for two equal spheres (m* = m/2, R* = R/2).
+ *  6. Standard uncertainties (derivation in docs/tracking.md "Uncertainties"). The noise sigma
+ *     of every pixel coordinate of a sphere, independent between coordinates and frames, is
+ *     estimated from the residuals of Eq. 23 on the raw dots, less the small-angle part that
+ *     the solution determines: E|r|^2 = 2 sigma^2 (6 - 3) per interval. With the collision
+ *     frame fixed every value is, to first order, a linear function of the raw dots:
+ *     smoothing s = S x, Eq. 23 per interval v_i = A_i+ (s_{i+1} - s_i)/dt (the closed form
+ *     of its normal equations; A_i moves with s_i as dv = A+ (db - omega dt J dD)/dt), the
+ *     straight lines sum_i w_i v_i. So the before/after values and the dot-1 positions have
+ *     gradients g with respect to the raw dots and covariances sigma^2 g_a . g_b, which hold
+ *     the correlations of values that share frames; the spheres, and the before and after
+ *     fits, share none. The derived values (normal speeds, e_n, St_n, angles) follow by
+ *     first-order propagation with those covariances.
  *
  * Validity: dot 1 on the spin axis (the painted centre dot), rotation about the camera axis,
  * orthographic imaging; at most two spheres; frames consecutive without gaps.
@@ -60,6 +72,7 @@ struct sphere_track {
     double* xy;                          /* 6 per frame: dots in pixels as given */
     double* raw;                         /* 6 per frame [m], y negated when y_down */
     double* smooth;                      /* 6 per frame [m], Savitzky-Golay smoothed */
+    double noise;                        /* tracking noise per coordinate [m], after analysis */
     struct wetdem_track_sample* samples; /* n - 1 intervals, after analysis */
 };
 
@@ -398,14 +411,20 @@ int wetdem_track_savgol_hat(int window, int order, double* hat)
     return WETDEM_OK;
 }
 
+/* First raw frame of the smoothing window of frame j: centred inside, the first/last
+ * `window` frames at the ends. */
+static size_t window_start(size_t j, size_t w, size_t n)
+{
+    size_t h = w / 2, start = j < h ? 0 : j - h;
+    return start + w > n ? n - w : start;
+}
+
 void wetdem_track_savgol_apply(const double* hat, int window, const double* x, size_t n,
                                double* out)
 {
-    size_t w = (size_t)window, h = w / 2;
+    size_t w = (size_t)window;
     for (size_t j = 0; j < n; j++) {
-        size_t start = j < h ? 0 : j - h;
-        if (start + w > n)
-            start = n - w;
+        size_t start = window_start(j, w, n);
         const double* row = hat + (j - start) * w;
         double sum = 0;
         for (size_t m = 0; m < w; m++)
@@ -447,6 +466,72 @@ int wetdem_track_solve_interval(const double p0[6], const double p1[6], double d
         *rms = sqrt(s / 6.0);
     }
     return isfinite(out[0] + out[1] + out[2]) ? WETDEM_OK : WETDEM_ERR_NUMERIC;
+}
+
+/* Eq. 23 in closed form (docs/tracking.md "Uncertainties"): with the dots' offsets
+ * Dk = pk - p1 at the first frame (D1 = 0), their centroid c = (D2 + D3)/3, ek = Dk - c and
+ * M = sum_k |ek|^2, the normal equations give
+ *     omega dt = sum_k ek x bk / M,    v dt = mean_k(bk) - omega dt J c
+ * (a x b = ax by - ay bx, J(a, b) = (-b, a)): the rotation about the dots' centroid and the
+ * centroid's displacement. Fills e[6] = (e1, e2, e3), c[2] and *m; false when M is not > 0
+ * (the outer dots on the centre dot, the QR's R[2][2] = 0). */
+static bool interval_centroid(const double p0[6], double e[6], double c[2], double* m)
+{
+    c[0] = (p0[2] + p0[4] - 2 * p0[0]) / 3;
+    c[1] = (p0[3] + p0[5] - 2 * p0[1]) / 3;
+    *m = 0;
+    for (int k = 0; k < 3; k++) {
+        e[2 * k] = p0[2 * k] - p0[0] - c[0];
+        e[2 * k + 1] = p0[2 * k + 1] - p0[1] - c[1];
+        *m += e[2 * k] * e[2 * k] + e[2 * k + 1] * e[2 * k + 1];
+    }
+    return *m > 0 && isfinite(*m);
+}
+
+/* The residual used for the noise: with the solution's sin(a) = omega dt, the rigid step
+ * about the centroid, bk - mean(b) = (R(a) - I) ek, leaves
+ *     rk = bk - mean(b) - (cos a - 1) ek - sin a J ek,
+ * the residual of Eq. 23 less its small-angle part (cos a - 1) ek (header, step 2):
+ * cos a - 1 = -sin^2 a / (1 + cos a). */
+int wetdem_track_rigid_residual(const double p0[6], const double p1[6], double* ss)
+{
+    double e[6], c[2], m, b[6], mean[2] = {0, 0}, w = 0;
+    if (!interval_centroid(p0, e, c, &m))
+        return WETDEM_ERR_NUMERIC;
+    for (int j = 0; j < 6; j++) {
+        b[j] = p1[j] - p0[j];
+        mean[j % 2] += b[j] / 3;
+    }
+    for (int k = 0; k < 3; k++)
+        w += (e[2 * k] * b[2 * k + 1] - e[2 * k + 1] * b[2 * k]) / m;
+    double s2 = fmin(w * w, 1.0), cm1 = -s2 / (1 + sqrt(1 - s2)), sum = 0;
+    for (int k = 0; k < 3; k++) {
+        double rx = b[2 * k] - mean[0] - cm1 * e[2 * k] + w * e[2 * k + 1];
+        double ry = b[2 * k + 1] - mean[1] - cm1 * e[2 * k + 1] - w * e[2 * k];
+        sum += rx * rx + ry * ry;
+    }
+    *ss = sum;
+    return isfinite(sum) ? WETDEM_OK : WETDEM_ERR_NUMERIC;
+}
+
+/* The derivatives of the closed form above with respect to bk = (bx, by):
+ * d(omega dt) = (-eky, ekx)/M, d(vx dt) = (1/3, 0) + cy d(omega dt),
+ * d(vy dt) = (0, 1/3) - cx d(omega dt). */
+int wetdem_track_interval_gain(const double p0[6], double dt, double gain[18])
+{
+    double e[6], c[2], m;
+    if (!interval_centroid(p0, e, c, &m))
+        return WETDEM_ERR_NUMERIC;
+    for (int k = 0; k < 3; k++) {
+        double wx = -e[2 * k + 1] / m, wy = e[2 * k] / m;
+        gain[2 * k] = (1.0 / 3 + c[1] * wx) / dt;
+        gain[2 * k + 1] = c[1] * wy / dt;
+        gain[6 + 2 * k] = -c[0] * wx / dt;
+        gain[6 + 2 * k + 1] = (1.0 / 3 - c[0] * wy) / dt;
+        gain[12 + 2 * k] = wx / dt;
+        gain[12 + 2 * k + 1] = wy / dt;
+    }
+    return WETDEM_OK;
 }
 
 /* ---- analysis --------------------------------------------------------------------------- */
@@ -514,6 +599,96 @@ static int check_options(struct wetdem_track* t, const struct wetdem_track_optio
     return WETDEM_OK;
 }
 
+/* ---- uncertainties (docs/tracking.md "Uncertainties") ------------------------------------ */
+
+/* Adds the gradient of weight * v[c], v = (vx, vy, omega) of Eq. 23 for one interval, with
+ * respect to the dots of its first frame (to g0[6]) and of its last frame (to g1[6]); gain
+ * from wetdem_track_interval_gain, x2 = omega dt of the solution. To first order
+ * v dt = A+ (db - dA x): the matrix A holds the first frame's Dk = pk - p1, and dA x =
+ * x2 J dDk in the rows of dot k (J(a, b) = (-b, a)). */
+static void add_interval_gradient(const double gain[18], double x2, int c, double weight,
+                                  double g0[6], double g1[6])
+{
+    const double* u = gain + 6 * c;
+    const double rot[6] = {-(u[3] + u[5]), u[2] + u[4], u[3], -u[2], u[5], -u[4]};
+    for (int j = 0; j < 6; j++) {
+        g1[j] += weight * u[j];
+        g0[j] -= weight * (u[j] + x2 * rot[j]);
+    }
+}
+
+/* Adds the gradient gs[6] of a value with respect to the smoothed dots of frame j to its
+ * gradient g with respect to the raw dots of frames lo, lo + 1, ...: the transpose of the
+ * smoothing (wetdem_track_savgol_apply). */
+static void unsmooth_gradient(const double* hat, size_t w, size_t n, size_t j, const double gs[6],
+                              size_t lo, double* g)
+{
+    size_t start = window_start(j, w, n);
+    const double* row = hat + (j - start) * w;
+    for (size_t m = 0; m < w; m++)
+        for (size_t c = 0; c < 6; c++)
+            g[6 * (start + m - lo) + c] += row[m] * gs[c];
+}
+
+static double sum_squares(const double* g, size_t n)
+{
+    double sum = 0;
+    for (size_t i = 0; i < n; i++)
+        sum += g[i] * g[i];
+    return sum;
+}
+
+/* The gain of Eq. 23 for the dots p0 (wetdem_track_interval_gain), NAN where it is not
+ * defined (dots whose offsets overflow), so that the uncertainties are NAN there. */
+static void interval_gain(const double p0[6], double dt, double gain[18])
+{
+    if (wetdem_track_interval_gain(p0, dt, gain) != WETDEM_OK)
+        for (int j = 0; j < 18; j++)
+            gain[j] = NAN;
+}
+
+/* Standard uncertainties of the velocities of interval i from the raw dots (u_raw[3]) and from
+ * the smoothed dots (u[3]); g: room for 6 (window + 1) doubles. */
+static void interval_uncertainties(const struct sphere_track* s, const double* hat, size_t w,
+                                   double dt, size_t i, double* g, double u_raw[3], double u[3])
+{
+    double gain[18], gain_s[18];
+    const struct wetdem_track_sample* q = &s->samples[i];
+    interval_gain(s->raw + 6 * i, dt, gain);
+    interval_gain(s->smooth + 6 * i, dt, gain_s);
+    size_t lo = window_start(i, w, s->n), hi = window_start(i + 1, w, s->n) + w;
+    for (int c = 0; c < 3; c++) {
+        double g0[6] = {0}, g1[6] = {0};
+        add_interval_gradient(gain, q->omega_raw * dt, c, 1.0, g0, g1);
+        u_raw[c] = s->noise * sqrt(sum_squares(g0, 6) + sum_squares(g1, 6));
+        memset(g0, 0, sizeof g0);
+        memset(g1, 0, sizeof g1);
+        add_interval_gradient(gain_s, q->omega * dt, c, 1.0, g0, g1);
+        memset(g, 0, 6 * (hi - lo) * sizeof *g);
+        unsmooth_gradient(hat, w, s->n, i, g0, lo, g);
+        unsmooth_gradient(hat, w, s->n, i + 1, g1, lo, g);
+        u[c] = s->noise * sqrt(sum_squares(g, 6 * (hi - lo)));
+    }
+}
+
+static int sample_uncertainties(struct wetdem_track* t, struct sphere_track* s,
+                                const struct wetdem_track_options* o, const double* hat)
+{
+    size_t w = (size_t)o->window;
+    double* g = malloc(6 * (w + 1) * sizeof *g);
+    if (!g)
+        return fail(t, WETDEM_ERR_NOMEM, "out of memory analysing sphere %d", s->id);
+    for (size_t i = 0; i + 1 < s->n; i++) {
+        struct wetdem_track_sample* q = &s->samples[i];
+        double u_raw[3], u[3];
+        interval_uncertainties(s, hat, w, 1.0 / o->fps, i, g, u_raw, u);
+        q->u_vx_raw = u_raw[0], q->u_vy_raw = u_raw[1], q->u_omega_raw = u_raw[2];
+        q->u_vx = u[0], q->u_vy = u[1], q->u_omega = u[2];
+    }
+    free(g);
+    return WETDEM_OK;
+}
+
 /* Positions in m (raw and smoothed) and the per-interval velocities of one sphere. */
 static int sphere_velocities(struct wetdem_track* t, struct sphere_track* s,
                              const struct wetdem_track_options* o, const double* hat)
@@ -539,13 +714,15 @@ static int sphere_velocities(struct wetdem_track* t, struct sphere_track* s,
             s->smooth[6 * i + (size_t)c] = col[n + i];
     }
     free(col);
-    double dt = 1.0 / o->fps, v[3];
+    double dt = 1.0 / o->fps, v[3], ss_sum = 0, ss;
     for (size_t i = 0; i + 1 < n; i++) {
         struct wetdem_track_sample* q = &s->samples[i];
         q->frame = s->first_frame + (long)i;
         q->time = ((double)q->frame + 0.5) * dt;
         int st = wetdem_track_solve_interval(s->raw + 6 * i, s->raw + 6 * (i + 1), dt, v, NULL);
         q->vx_raw = v[0], q->vy_raw = v[1], q->omega_raw = v[2];
+        if (wetdem_track_rigid_residual(s->raw + 6 * i, s->raw + 6 * (i + 1), &ss) != WETDEM_OK)
+            ss = NAN; /* (offsets that overflow: the uncertainties are NAN) */
         if (st == WETDEM_OK)
             st = wetdem_track_solve_interval(s->smooth + 6 * i, s->smooth + 6 * (i + 1), dt, v,
                                              &q->residual);
@@ -555,8 +732,11 @@ static int sphere_velocities(struct wetdem_track* t, struct sphere_track* s,
                         "sphere %d frame %ld: dots 2 and 3 coincide with dot 1 (or are not "
                         "finite); spin cannot be resolved",
                         s->id, q->frame);
+        ss_sum += ss;
     }
-    return WETDEM_OK;
+    /* E[ss] = 6 sigma^2 per interval (docs/tracking.md "Uncertainties") */
+    s->noise = sqrt(ss_sum / (6.0 * (double)(n - 1)));
+    return sample_uncertainties(t, s, o, hat);
 }
 
 static double sample_component(const struct wetdem_track_sample* q, int c)
@@ -732,6 +912,211 @@ static int restitution(struct wetdem_track* t, const struct wetdem_track_options
     return WETDEM_OK;
 }
 
+/* ---- uncertainties of the summary (docs/tracking.md "Uncertainties") -------------------- */
+
+/* The values of a sphere that the summary is made of, each a linear function of its raw dots
+ * to first order: the before line's vx, vy, omega at k - offset, the after line's at
+ * k + offset, and the smoothed dot 1 (x, y) at k - offset, k and k + offset. */
+enum { L_BEFORE = 0, L_AFTER = 3, L_POS_BEFORE = 6, L_POS_K = 8, L_POS_AFTER = 10, N_LIN = 12 };
+
+/* Gradient of one such value with respect to the raw dots of frames [lo, hi), 6 per frame. */
+struct lin_fn {
+    size_t lo, hi;
+    double* g;
+};
+
+static int lin_alloc(struct lin_fn* f, size_t lo, size_t hi)
+{
+    f->lo = lo;
+    f->hi = hi;
+    f->g = calloc(6 * (hi - lo), sizeof *f->g);
+    return f->g ? WETDEM_OK : WETDEM_ERR_NOMEM;
+}
+
+/* The gradients of a straight-line fit over intervals [first, first + count) evaluated at
+ * t_eval, for vx, vy and omega (f[0..3)): the fit is sum_i w_i v_i with
+ * w_i = 1/count + (t_i - t_mean)(t_eval - t_mean)/S_tt (line_value), each v_i is Eq. 23 on
+ * the smoothed dots of frames i and i + 1 (add_interval_gradient), and those are the
+ * smoothing of the raw dots (unsmooth_gradient). */
+static int line_gradients(const struct sphere_track* s, const double* hat, size_t w, double dt,
+                          size_t first, size_t count, double t_eval, struct lin_fn f[3])
+{
+    const struct wetdem_track_sample* q = s->samples;
+    double tm = 0, stt = 0, gain[18];
+    for (size_t i = first; i < first + count; i++)
+        tm += q[i].time;
+    tm /= (double)count;
+    for (size_t i = first; i < first + count; i++)
+        stt += (q[i].time - tm) * (q[i].time - tm);
+    size_t m = count + 1; /* smoothed frames first .. first + count */
+    double* gs = calloc(3 * 6 * m, sizeof *gs);
+    if (!gs)
+        return WETDEM_ERR_NOMEM;
+    for (size_t i = first; i < first + count; i++) {
+        double wi = 1.0 / (double)count + (q[i].time - tm) * (t_eval - tm) / stt;
+        interval_gain(s->smooth + 6 * i, dt, gain);
+        for (int c = 0; c < 3; c++)
+            add_interval_gradient(gain, q[i].omega * dt, c, wi, gs + 6 * (c * m + i - first),
+                                  gs + 6 * (c * m + i + 1 - first));
+    }
+    int st = WETDEM_OK;
+    size_t lo = window_start(first, w, s->n), hi = window_start(first + count, w, s->n) + w;
+    for (int c = 0; c < 3 && st == WETDEM_OK; c++) {
+        st = lin_alloc(&f[c], lo, hi);
+        for (size_t j = 0; j < m && st == WETDEM_OK; j++)
+            unsmooth_gradient(hat, w, s->n, first + j, gs + 6 * (c * m + j), lo, f[c].g);
+    }
+    free(gs);
+    return st;
+}
+
+/* The gradients of the smoothed dot 1 (x, y) of frame j (f[0..2)). */
+static int position_gradients(const struct sphere_track* s, const double* hat, size_t w, size_t j,
+                              struct lin_fn f[2])
+{
+    size_t lo = window_start(j, w, s->n);
+    for (int c = 0; c < 2; c++) {
+        if (lin_alloc(&f[c], lo, lo + w) != WETDEM_OK)
+            return WETDEM_ERR_NOMEM;
+        double gs[6] = {0};
+        gs[c] = 1.0;
+        unsmooth_gradient(hat, w, s->n, j, gs, lo, f[c].g);
+    }
+    return WETDEM_OK;
+}
+
+static double lin_dot(const struct lin_fn* a, const struct lin_fn* b)
+{
+    size_t lo = a->lo > b->lo ? a->lo : b->lo, hi = a->hi < b->hi ? a->hi : b->hi;
+    double sum = 0;
+    for (size_t i = 6 * lo; i < 6 * hi; i++)
+        sum += a->g[i - 6 * a->lo] * b->g[i - 6 * b->lo];
+    return sum;
+}
+
+/* Covariance matrix of the N_LIN values of one sphere: noise^2 times the dot products of their
+ * gradients (the noise of different coordinates and frames independent, of equal variance). */
+static int sphere_covariance(const struct sphere_track* s, const struct wetdem_track_options* o,
+                             const double* hat, const struct fit_windows* fw, size_t k, double* cov)
+{
+    struct lin_fn f[N_LIN] = {{0}};
+    size_t w = (size_t)o->window, off = (size_t)o->offset;
+    double dt = 1.0 / o->fps;
+    double t_before = (double)(s->first_frame + (long)(k - off)) * dt;
+    double t_after = (double)(s->first_frame + (long)(k + off)) * dt;
+    int st =
+        line_gradients(s, hat, w, dt, fw->before_first, fw->before_count, t_before, f + L_BEFORE);
+    if (st == WETDEM_OK)
+        st = line_gradients(s, hat, w, dt, fw->after_first, fw->after_count, t_after, f + L_AFTER);
+    if (st == WETDEM_OK)
+        st = position_gradients(s, hat, w, k - off, f + L_POS_BEFORE);
+    if (st == WETDEM_OK)
+        st = position_gradients(s, hat, w, k, f + L_POS_K);
+    if (st == WETDEM_OK)
+        st = position_gradients(s, hat, w, k + off, f + L_POS_AFTER);
+    for (int a = 0; a < N_LIN && st == WETDEM_OK; a++)
+        for (int b = 0; b <= a; b++)
+            cov[N_LIN * a + b] = cov[N_LIN * b + a] = s->noise * s->noise * lin_dot(&f[a], &f[b]);
+    for (int a = 0; a < N_LIN; a++)
+        free(f[a].g);
+    return st;
+}
+
+/* Standard uncertainty of a function of the striker-minus-target differences of the N_LIN
+ * values with gradient a: sqrt(a^T cov a), cov the sum of both spheres' covariances (the
+ * spheres' dots are independent). */
+static double propagate(const double* cov, const double a[N_LIN])
+{
+    double sum = 0;
+    for (int i = 0; i < N_LIN; i++)
+        for (int j = 0; j < N_LIN; j++)
+            sum += a[i] * cov[N_LIN * i + j] * a[j];
+    return sqrt(fmax(sum, 0.0));
+}
+
+static struct wetdem_track_state state_uncertainty(const double* cov, int line, int pos)
+{
+    struct wetdem_track_state u = {
+        .vx = sqrt(cov[N_LIN * line + line]),
+        .vy = sqrt(cov[N_LIN * (line + 1) + line + 1]),
+        .omega = sqrt(cov[N_LIN * (line + 2) + line + 2]),
+        .x = sqrt(cov[N_LIN * pos + pos]),
+        .y = sqrt(cov[N_LIN * (pos + 1) + pos + 1]),
+    };
+    return u;
+}
+
+/* First-order propagation to the derived values (docs/tracking.md "Uncertainties"), with
+ * v0, vf the relative velocities before and after, D0, Df the centres' differences at k and
+ * k + offset, n = D/|D|, p = v - (v.n) n:
+ *   speed_n0 = -v0.n0:        d = -n0 . dv0 - p0 . dD0/|D0|
+ *   speed_nf = vf.nf:         d = nf . dvf + pf . dDf/|Df|
+ *   e_n = speed_nf/speed_n0:  d = (d speed_nf - e_n d speed_n0)/speed_n0
+ *   St_n = c speed_n0:        d = St_n d speed_n0/speed_n0
+ *   angle_centres, the direction of D0:       d = (D0 x dD0)/|D0|^2
+ *   impact_angle = |direction(D0) - direction(-v0)|: d = (D0 x dD0)/|D0|^2 - (v0 x dv0)/|v0|^2
+ * with a x b = ax by - ay bx. */
+static void summary_uncertainties(const double* cov, const double v0[2], const double vf[2],
+                                  const double d0[2], const double df[2],
+                                  struct wetdem_track_summary* sum)
+{
+    double l0 = hypot(d0[0], d0[1]), lf = hypot(df[0], df[1]), s0 = v0[0] * v0[0] + v0[1] * v0[1];
+    double n0[2] = {d0[0] / l0, d0[1] / l0}, nf[2] = {df[0] / lf, df[1] / lf};
+    double vn0 = v0[0] * n0[0] + v0[1] * n0[1], vnf = vf[0] * nf[0] + vf[1] * nf[1];
+    double a_n0[N_LIN] = {0}, a_nf[N_LIN] = {0}, a_en[N_LIN], a_centres[N_LIN] = {0};
+    double a_impact[N_LIN] = {0};
+    for (int c = 0; c < 2; c++) {
+        a_n0[L_BEFORE + c] = -n0[c];
+        a_n0[L_POS_K + c] = -(v0[c] - vn0 * n0[c]) / l0;
+        a_nf[L_AFTER + c] = nf[c];
+        a_nf[L_POS_AFTER + c] = (vf[c] - vnf * nf[c]) / lf;
+    }
+    a_centres[L_POS_K] = -d0[1] / (l0 * l0);
+    a_centres[L_POS_K + 1] = d0[0] / (l0 * l0);
+    memcpy(a_impact, a_centres, sizeof a_impact);
+    a_impact[L_BEFORE] = v0[1] / s0;
+    a_impact[L_BEFORE + 1] = -v0[0] / s0;
+    for (int i = 0; i < N_LIN; i++)
+        a_en[i] = (a_nf[i] - sum->e_n * a_n0[i]) / sum->speed_n0;
+    sum->u_speed_n0 = propagate(cov, a_n0);
+    sum->u_speed_nf = propagate(cov, a_nf);
+    sum->u_e_n = propagate(cov, a_en);
+    sum->u_stokes_n = sum->stokes_n * sum->u_speed_n0 / sum->speed_n0; /* (NAN with it) */
+    sum->u_angle_centres = propagate(cov, a_centres);
+    sum->u_impact_angle = propagate(cov, a_impact);
+}
+
+/* The uncertainties of the summary of striker s and target g with the collision at k. */
+static int collision_uncertainties(struct wetdem_track* t, const struct wetdem_track_options* o,
+                                   const double* hat, const struct sphere_track* s,
+                                   const struct sphere_track* g, const struct fit_windows* fw,
+                                   size_t k, struct wetdem_track_summary* sum)
+{
+    double cs[N_LIN * N_LIN], cg[N_LIN * N_LIN], cov[N_LIN * N_LIN];
+    int st = sphere_covariance(s, o, hat, fw, k, cs);
+    if (st == WETDEM_OK)
+        st = sphere_covariance(g, o, hat, fw, k, cg);
+    if (st != WETDEM_OK)
+        return fail(t, st, "out of memory for the uncertainties");
+    sum->u_striker_before = state_uncertainty(cs, L_BEFORE, L_POS_BEFORE);
+    sum->u_striker_after = state_uncertainty(cs, L_AFTER, L_POS_AFTER);
+    sum->u_target_before = state_uncertainty(cg, L_BEFORE, L_POS_BEFORE);
+    sum->u_target_after = state_uncertainty(cg, L_AFTER, L_POS_AFTER);
+    for (int a = 0; a < N_LIN * N_LIN; a++)
+        cov[a] = cs[a] + cg[a];
+    size_t kf = k + (size_t)o->offset;
+    double v0[2] = {sum->striker_before.vx - sum->target_before.vx,
+                    sum->striker_before.vy - sum->target_before.vy};
+    double vf[2] = {sum->striker_after.vx - sum->target_after.vx,
+                    sum->striker_after.vy - sum->target_after.vy};
+    double d0[2] = {s->smooth[6 * k] - g->smooth[6 * k],
+                    s->smooth[6 * k + 1] - g->smooth[6 * k + 1]};
+    double df[2] = {s->smooth[6 * kf] - g->smooth[6 * kf],
+                    s->smooth[6 * kf + 1] - g->smooth[6 * kf + 1]};
+    summary_uncertainties(cov, v0, vf, d0, df, sum);
+    return WETDEM_OK;
+}
+
 /* Largest velocity change of the striker from its initial mean, for error messages. */
 static double largest_change(const struct sphere_track* s, size_t n_ref)
 {
@@ -744,7 +1129,7 @@ static double largest_change(const struct sphere_track* s, size_t n_ref)
 }
 
 static int collision_summary(struct wetdem_track* t, const struct wetdem_track_options* o,
-                             struct wetdem_track_summary* sum)
+                             const double* hat, struct wetdem_track_summary* sum)
 {
     size_t n_int = t->s[0].n - 1, h = (size_t)o->window / 2;
     size_t n_ref = o->window > TRACK_MIN_FIT ? (size_t)o->window : TRACK_MIN_FIT, si = 0;
@@ -786,7 +1171,9 @@ static int collision_summary(struct wetdem_track* t, const struct wetdem_track_o
     sum->striker_after = fitted_state(s, w.after_first, w.after_count, k + off, dt);
     sum->target_before = fitted_state(g, w.before_first, w.before_count, k - off, dt);
     sum->target_after = fitted_state(g, w.after_first, w.after_count, k + off, dt);
-    return restitution(t, o, s, g, k, sum);
+    if ((st = restitution(t, o, s, g, k, sum)) != WETDEM_OK)
+        return st;
+    return collision_uncertainties(t, o, hat, s, g, &w, k, sum);
 }
 
 int wetdem_track_analyse(struct wetdem_track* track, const struct wetdem_track_options* opt,
@@ -795,7 +1182,8 @@ int wetdem_track_analyse(struct wetdem_track* track, const struct wetdem_track_o
     if (!opt || !summary)
         return fail(track, WETDEM_ERR_INVALID, "analyse: NULL %s", opt ? "summary" : "options");
     memset(summary, 0, sizeof *summary);
-    summary->e_n = summary->stokes_n = NAN;
+    summary->e_n = summary->stokes_n = summary->u_e_n = summary->u_stokes_n = NAN;
+    summary->noise_px[0] = summary->noise_px[1] = NAN;
     int st = check_options(track, opt);
     if (st != WETDEM_OK)
         return st;
@@ -820,11 +1208,16 @@ int wetdem_track_analyse(struct wetdem_track* track, const struct wetdem_track_o
     st = wetdem_track_savgol_hat(opt->window, opt->order, hat);
     if (st != WETDEM_OK) /* (the window and order were checked) */
         st = fail(track, st, "out of memory for the Savitzky-Golay weights");
-    for (size_t k = 0; st == WETDEM_OK && k < track->n_spheres; k++)
+    for (size_t k = 0; st == WETDEM_OK && k < track->n_spheres; k++) {
         st = sphere_velocities(track, &track->s[k], opt, hat);
+        if (st == WETDEM_OK)
+            summary->noise_px[k] = track->s[k].noise / opt->pixel_size;
+    }
+    if (st == WETDEM_OK) {
+        summary->n_spheres = track->n_spheres;
+        if (track->n_spheres == 2)
+            st = collision_summary(track, opt, hat, summary);
+    }
     free(hat);
-    if (st != WETDEM_OK)
-        return st;
-    summary->n_spheres = track->n_spheres;
-    return track->n_spheres == 2 ? collision_summary(track, opt, summary) : WETDEM_OK;
+    return st;
 }

@@ -1,7 +1,8 @@
 /*
  * track.h — internal kernels of the experiment tracking (src/track.c), shared with its tests:
- * the Savitzky-Golay hat matrix derived by least squares and the per-interval solution of
- * Punch (2023) Eq. 23.
+ * the Savitzky-Golay hat matrix derived by least squares, the per-interval solution of
+ * Punch (2023) Eq. 23, and the residual and linear map of that solution that the
+ * uncertainties use.
  */
 #ifndef WETDEM_TRACK_H
 #define WETDEM_TRACK_H
@@ -29,5 +30,17 @@ void wetdem_track_savgol_apply(const double* hat, int window, const double* x, s
  * WETDEM_ERR_NUMERIC when the dots are degenerate. */
 int wetdem_track_solve_interval(const double p0[6], const double p1[6], double dt, double out[3],
                                 double* rms);
+
+/* Sum of squares [m^2] of the residuals of Eq. 23 for dots p0 -> p1 [m] less their part due to
+ * the small-angle approximation, which follows from the solution (track.c): zero up to
+ * round-off for an exact rigid step of any rotation below pi/2 per frame, 6 sigma^2 on
+ * average for independent noise sigma on every coordinate (docs/tracking.md "Uncertainties").
+ * Returns WETDEM_OK or WETDEM_ERR_NUMERIC as wetdem_track_solve_interval. */
+int wetdem_track_rigid_residual(const double p0[6], const double p1[6], double* ss);
+
+/* The least-squares solution of Eq. 23 as a linear map of its right-hand side: gain[6 c + j]
+ * = d (vx, vy, omega)[c] / d b[j] for b = p1 - p0 [1/s, 1/(m s)], the matrix (A^T A)^-1 A^T / dt
+ * for the dots p0 [m]. Returns WETDEM_OK or WETDEM_ERR_NUMERIC when the dots are degenerate. */
+int wetdem_track_interval_gain(const double p0[6], double dt, double gain[18]);
 
 #endif

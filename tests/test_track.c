@@ -681,6 +681,399 @@ static void test_track_recovers_simulated_punch_collision(void** state)
     check_simulated_recovery(3.0, 30 * M_PI / 180, 22);
 }
 
+/* ---- uncertainties ------------------------------------------------------------------------- */
+
+/* Every value of the summary that carries an uncertainty: per state (striker before, striker
+ * after, target before, target after) vx, vy, omega, x, y; then angle_centres, impact_angle,
+ * speed_n0, speed_nf, e_n, stokes_n. */
+#define N_ALL 26
+static const char* const all_names[N_ALL] = {"striker_before_vx",
+                                             "striker_before_vy",
+                                             "striker_before_omega",
+                                             "striker_before_x",
+                                             "striker_before_y",
+                                             "striker_after_vx",
+                                             "striker_after_vy",
+                                             "striker_after_omega",
+                                             "striker_after_x",
+                                             "striker_after_y",
+                                             "target_before_vx",
+                                             "target_before_vy",
+                                             "target_before_omega",
+                                             "target_before_x",
+                                             "target_before_y",
+                                             "target_after_vx",
+                                             "target_after_vy",
+                                             "target_after_omega",
+                                             "target_after_x",
+                                             "target_after_y",
+                                             "angle_centres",
+                                             "impact_angle",
+                                             "speed_n0",
+                                             "speed_nf",
+                                             "e_n",
+                                             "stokes_n"};
+
+static void summary_values(const struct wetdem_track_summary* s, double v[N_ALL], double u[N_ALL])
+{
+    const struct wetdem_track_state* st[4] = {&s->striker_before, &s->striker_after,
+                                              &s->target_before, &s->target_after};
+    const struct wetdem_track_state* us[4] = {&s->u_striker_before, &s->u_striker_after,
+                                              &s->u_target_before, &s->u_target_after};
+    for (int k = 0; k < 4; k++) {
+        const double a[5] = {st[k]->vx, st[k]->vy, st[k]->omega, st[k]->x, st[k]->y};
+        const double b[5] = {us[k]->vx, us[k]->vy, us[k]->omega, us[k]->x, us[k]->y};
+        memcpy(v + 5 * k, a, sizeof a);
+        memcpy(u + 5 * k, b, sizeof b);
+    }
+    const double a[6] = {s->angle_centres, s->impact_angle, s->speed_n0,
+                         s->speed_nf,      s->e_n,          s->stokes_n};
+    const double b[6] = {s->u_angle_centres, s->u_impact_angle, s->u_speed_n0,
+                         s->u_speed_nf,      s->u_e_n,          s->u_stokes_n};
+    memcpy(v + 20, a, sizeof a);
+    memcpy(u + 20, b, sizeof b);
+}
+
+static int analyse_all(const double* dots, const struct wetdem_track_options* o, double v[N_ALL],
+                       double u[N_ALL], struct wetdem_track_summary* sum)
+{
+    double out[N_OUT];
+    int st = analyse_dots(dots, o, out, sum);
+    summary_values(sum, v, u);
+    return st;
+}
+
+/* The true values of the synthetic collision by the tracker's definitions at its collision
+ * frame c (true_outputs), with dot 1's position in the tracker's frame (pixel offsets). */
+static void true_values(const struct synth* y, const struct wetdem_track_options* o, long c,
+                        double v[N_ALL])
+{
+    double pos[4][2], vel[4][2], om[4], yaw, p0[2][2], pf[2][2], tmp[2];
+    const double t[4] = {(double)(c - o->offset) / y->fps, (double)(c + o->offset) / y->fps,
+                         (double)(c - o->offset) / y->fps, (double)(c + o->offset) / y->fps};
+    for (int k = 0; k < 4; k++) {
+        synth_state(y, k / 2, t[k], pos[k], vel[k], &yaw, &om[k]);
+        const double a[5] = {vel[k][0], vel[k][1], om[k], pos[k][0] + 600 * y->pixel,
+                             pos[k][1] + 400 * y->pixel};
+        memcpy(v + 5 * k, a, sizeof a);
+    }
+    for (int k = 0; k < 2; k++) {
+        synth_state(y, k, (double)c / y->fps, p0[k], tmp, &yaw, tmp);
+        synth_state(y, k, t[1], pf[k], tmp, &yaw, tmp);
+    }
+    double d0[2] = {p0[0][0] - p0[1][0], p0[0][1] - p0[1][1]};
+    double df[2] = {pf[0][0] - pf[1][0], pf[0][1] - pf[1][1]};
+    double v0[2] = {vel[0][0] - vel[2][0], vel[0][1] - vel[2][1]};
+    double vf[2] = {vel[1][0] - vel[3][0], vel[1][1] - vel[3][1]};
+    double vn0 = -(v0[0] * d0[0] + v0[1] * d0[1]) / hypot(d0[0], d0[1]);
+    double vnf = (vf[0] * df[0] + vf[1] * df[1]) / hypot(df[0], df[1]);
+    double m = 7960 * 4.0 / 3.0 * M_PI * pow(y->radius, 3), r_eff = y->radius / 2;
+    v[20] = atan(d0[1] / d0[0]);
+    v[21] = acos(vn0 / hypot(v0[0], v0[1]));
+    v[22] = vn0;
+    v[23] = vnf;
+    v[24] = vnf / vn0;
+    v[25] = (m / 2) * vn0 / (6 * M_PI * 10.0 * r_eff * r_eff);
+}
+
+/* Standard deviation of every value for independent noise sigma_px[k] on each coordinate of
+ * sphere k (the library's order: sphere id k + 1), from the gains by finite differences
+ * (noise_sigma, per sphere). */
+static void fd_sigma(double* dots, const struct wetdem_track_options* o, const double sigma_px[2],
+                     const double base[N_ALL], double sigma[N_ALL])
+{
+    const double eps = 1e-3; /* [pixel] */
+    double sum2[N_ALL] = {0}, v[N_ALL], u[N_ALL];
+    struct wetdem_track_summary s;
+    for (int j = 0; j < 12 * N_FRAMES; j++) {
+        dots[j] += eps;
+        CHECK_OK(analyse_all(dots, o, v, u, &s));
+        dots[j] -= eps;
+        double sp = sigma_px[(j % 12) / 6];
+        for (int q = 0; q < N_ALL; q++)
+            sum2[q] += pow(sp * (v[q] - base[q]) / eps, 2);
+    }
+    for (int q = 0; q < N_ALL; q++)
+        sigma[q] = sqrt(sum2[q]);
+}
+
+/* The closed form of Eq. 23 that the uncertainties differentiate agrees with the QR solution,
+ * and the residual they estimate the noise from vanishes for an exact rigid step however
+ * large its rotation (the small-angle part removed) and averages 6 sigma^2 with noise sigma
+ * on every coordinate (3 degrees of freedom of differences of variance 2 sigma^2). */
+static void test_track_interval_gain_and_rigid_residual(void** state)
+{
+    (void)state;
+    double dt = 2e-4, a = 0.3, v[2] = {0.4, -0.1};
+    double d2[2] = {3e-3, 1e-3}, d3[2] = {-0.5e-3, 2.5e-3}, p0[6] = {0.01, 0.02}, p1[6];
+    for (int k = 0; k < 2; k++) {
+        const double* d = k == 0 ? d2 : d3;
+        p0[2 + 2 * k] = p0[0] + d[0];
+        p0[3 + 2 * k] = p0[1] + d[1];
+        p1[2 + 2 * k] = p0[0] + v[0] * dt + cos(a) * d[0] - sin(a) * d[1];
+        p1[3 + 2 * k] = p0[1] + v[1] * dt + sin(a) * d[0] + cos(a) * d[1];
+    }
+    p1[0] = p0[0] + v[0] * dt;
+    p1[1] = p0[1] + v[1] * dt;
+    double gain[18], out[3], rms, ss;
+    CHECK_OK(wetdem_track_interval_gain(p0, dt, gain));
+    CHECK_OK(wetdem_track_solve_interval(p0, p1, dt, out, &rms));
+    /* the same least squares solved two ways: differences of positions ~0.01 m carry steps of
+       1e-4 m, ~100 ulp of their digits each (2e-14 relative): 1e-12 */
+    for (int c = 0; c < 3; c++) {
+        double sum = 0;
+        for (int j = 0; j < 6; j++)
+            sum += gain[6 * c + j] * (p1[j] - p0[j]);
+        CHECK_REL(sum, out[c], 1e-12);
+    }
+    /* Eq. 23's residual at a = 0.3 is (1 - cos a) |e| ~ 1e-4 m; less its small-angle part
+       only round-off of the 0.02 m positions remains: 1e-16 m, 30 ulp (measured 1.5e-18) */
+    CHECK_OK(wetdem_track_rigid_residual(p0, p1, &ss));
+    assert_true(rms > 1e-5);
+    assert_true(sqrt(ss) < 1e-16);
+    /* 3000 noisy steps, sigma = 1e-5 m (1/300 of the dot offsets, so that the noise of the
+       matrix, O(sigma/|D|) relative, is negligible): ss / (6 sigma^2) is chi^2_3/3, of variance
+       2/3, so its mean has a standard error sqrt(2/(3 * 3000)) = 0.015; 4 of them: 0.06. */
+    gsl_rng* rng = gsl_rng_alloc(gsl_rng_mt19937);
+    gsl_rng_set(rng, 7);
+    const double sigma = 1e-5;
+    const int n = 3000;
+    double mean = 0, q0[6], q1[6];
+    for (int i = 0; i < n; i++) {
+        for (int j = 0; j < 6; j++) {
+            q0[j] = p0[j] + gsl_ran_gaussian(rng, sigma);
+            q1[j] = p1[j] + gsl_ran_gaussian(rng, sigma);
+        }
+        CHECK_OK(wetdem_track_rigid_residual(q0, q1, &ss));
+        mean += ss / (6 * sigma * sigma) / n;
+    }
+    gsl_rng_free(rng);
+    CHECK_ABS(mean, 1.0, 0.06);
+    double z[6] = {1, 1, 1, 1, 1, 1};
+    CHECK_STATUS(wetdem_track_interval_gain(z, dt, gain), WETDEM_ERR_NUMERIC);
+    CHECK_STATUS(wetdem_track_rigid_residual(z, z, &ss), WETDEM_ERR_NUMERIC);
+}
+
+/* The velocities of interval i of sphere k (raw, then smoothed) and their uncertainties. */
+static void interval_values(const double* dots, const struct wetdem_track_options* o, size_t k,
+                            size_t i, double v[6], double u[6], double* noise_px)
+{
+    struct wetdem_track* t = wetdem_track_create();
+    for (int f = 0; f < N_FRAMES; f++)
+        for (int s = 0; s < 2; s++)
+            CHECK_OK(wetdem_track_add_frame(t, s + 1, f, dots + 12 * f + 6 * s));
+    struct wetdem_track_summary sum;
+    CHECK_OK(wetdem_track_analyse(t, o, &sum));
+    size_t n;
+    const struct wetdem_track_sample* q = wetdem_track_samples(t, k, &n);
+    assert_true(i < n);
+    const double a[6] = {q[i].vx_raw, q[i].vy_raw, q[i].omega_raw, q[i].vx, q[i].vy, q[i].omega};
+    const double b[6] = {q[i].u_vx_raw, q[i].u_vy_raw, q[i].u_omega_raw,
+                         q[i].u_vx,     q[i].u_vy,     q[i].u_omega};
+    memcpy(v, a, sizeof a);
+    memcpy(u, b, sizeof b);
+    *noise_px = sum.noise_px[k];
+    wetdem_track_free(t);
+}
+
+/* The per-interval uncertainties of sphere k, interval i against finite differences over the
+ * frames that the interval's smoothing reaches. */
+static void check_interval_uncertainty(double* dots, const struct wetdem_track_options* o, size_t k,
+                                       size_t i)
+{
+    const double eps = 1e-3; /* [pixel] */
+    double v[6], u[6], vp[6], up[6], noise, sum2[6] = {0};
+    interval_values(dots, o, k, i, v, u, &noise);
+    size_t lo = i >= 7 ? i - 7 : 0, hi = i + 9 < N_FRAMES ? i + 9 : N_FRAMES;
+    for (size_t f = lo; f < hi; f++)
+        for (size_t c = 0; c < 6; c++) {
+            double* x = dots + 12 * f + 6 * k + c;
+            *x += eps;
+            interval_values(dots, o, k, i, vp, up, &noise);
+            *x -= eps;
+            for (int q = 0; q < 6; q++)
+                sum2[q] += pow(noise * (vp[q] - v[q]) / eps, 2);
+        }
+    /* (tolerance as in test_track_uncertainties_are_the_propagated_noise; measured 2e-3 for
+       the raw spin of the interval of the collision) */
+    for (int q = 0; q < 6; q++)
+        CHECK_REL(u[q], sqrt(sum2[q]), 5e-3);
+}
+
+/* The reported uncertainties are the estimated noise propagated through the whole analysis:
+ * against the gains by finite differences (every pixel coordinate moved in turn) times each
+ * sphere's reported noise, for every value of the summary and for per-interval velocities.
+ * They agree to first order; the second-order terms left out (the noise of the matrix of
+ * Eq. 23 times its residual) are O(noise / dot offset) = 0.05/31 px = 1.6e-3 relative:
+ * 5e-3 (measured 8e-4). */
+static void test_track_uncertainties_are_the_propagated_noise(void** state)
+{
+    (void)state;
+    struct synth y;
+    synth_init(&y, 45 * M_PI / 180);
+    struct wetdem_track_options o;
+    track_options(&o, &y);
+    static double dots[12 * N_FRAMES];
+    gsl_rng* rng = gsl_rng_alloc(gsl_rng_mt19937);
+    gsl_rng_set(rng, 5);
+    render(&y, rng, 0.05, dots);
+    gsl_rng_free(rng);
+    double v[N_ALL], u[N_ALL], fd[N_ALL];
+    struct wetdem_track_summary s;
+    CHECK_OK(analyse_all(dots, &o, v, u, &s));
+    /* the rendered noise is 0.05 px; each sphere's estimate from its 119 intervals scatters
+       by 4.6 % (measured over 1000 seeds: mean 0.0501): 4 of that, 0.18 */
+    for (int k = 0; k < 2; k++)
+        CHECK_REL(s.noise_px[k], 0.05, 0.18);
+    fd_sigma(dots, &o, s.noise_px, v, fd);
+    for (int q = 0; q < N_ALL; q++)
+        if (!(fabs(u[q] / fd[q] - 1) <= 5e-3))
+            fail_msg("%s: reported %.6g, propagated by finite differences %.6g", all_names[q], u[q],
+                     fd[q]);
+    /* intervals in the free flights and across the collision, both spheres */
+    check_interval_uncertainty(dots, &o, 0, 20);
+    check_interval_uncertainty(dots, &o, 1, 49);
+    check_interval_uncertainty(dots, &o, 1, 118); /* (the end window) */
+}
+
+/* Monte Carlo: 1000 noise seeds of the 45-degree collision at 0.05 px. For every value, the
+ * root mean square of the reported sigma must match the scatter of the estimates about the
+ * truth (by the tracker's definitions at the collision frame it found): the relative
+ * standard error of a standard deviation from N samples is 1/sqrt(2 (N - 1)) = 0.022, and 4
+ * of them (two-sided 6e-5 per value) give 0.09. The coverage of |estimate - truth| <= k sigma,
+ * k = 1 and 2, must be the Gaussian rate P_k (0.6827, 0.9545) within 4 binomial standard
+ * errors sqrt(P_k (1 - P_k)/N) (0.059 and 0.026); from below, the truth may be off by the
+ * method's bias bound (method_bias: the small-angle velocity and spin biases, e_n); the
+ * biases of the smoothing across the contact (positions, angles) are below 0.15 sigma
+ * (measured), which moves the coverage by less than 0.01. */
+static void test_track_uncertainties_match_monte_carlo(void** state)
+{
+    (void)state;
+    enum { N_SEEDS = 1000 };
+    struct synth y;
+    synth_init(&y, 45 * M_PI / 180);
+    struct wetdem_track_options o;
+    track_options(&o, &y);
+    /* bias bounds per value (index as N_ALL) from method_bias: before (spins 3 and 0 rad/s)
+       and after (-18 and 25 rad/s) velocities and spins, speed_nf from two after velocities,
+       e_n; 0 where the bias is second order in the coverage (above) */
+    static const double bias[N_ALL] = {1e-5, 1e-5, 2e-4, 0,    0,    2.5e-4, 2.5e-4, 2e-4,   0,
+                                       0,    1e-5, 1e-5, 2e-4, 0,    0,      2.5e-4, 2.5e-4, 2e-4,
+                                       0,    0,    0,    1e-4, 1e-5, 5e-4,   3e-3,   1e-4};
+    static double dots[12 * N_FRAMES], err[N_SEEDS][N_ALL], us[N_SEEDS][N_ALL];
+    gsl_rng* rng = gsl_rng_alloc(gsl_rng_mt19937);
+    for (int k = 0; k < N_SEEDS; k++) {
+        double v[N_ALL], want[N_ALL];
+        struct wetdem_track_summary s;
+        gsl_rng_set(rng, 1000 + (unsigned long)k);
+        render(&y, rng, 0.05, dots);
+        CHECK_OK(analyse_all(dots, &o, v, us[k], &s));
+        true_values(&y, &o, s.collision_frame, want);
+        for (int q = 0; q < N_ALL; q++)
+            err[k][q] = v[q] - want[q];
+    }
+    gsl_rng_free(rng);
+    const double n = N_SEEDS, tol_sd = 4 / sqrt(2 * (n - 1));
+    const double p_k[2] = {0.682689, 0.954500};
+    for (int q = 0; q < N_ALL; q++) {
+        double mean = 0, var = 0, u2 = 0;
+        int inside[2] = {0, 0}, inside_biased[2] = {0, 0};
+        for (int k = 0; k < N_SEEDS; k++)
+            mean += err[k][q] / n, u2 += us[k][q] * us[k][q] / n;
+        for (int k = 0; k < N_SEEDS; k++) {
+            var += pow(err[k][q] - mean, 2) / (n - 1);
+            for (int m = 0; m < 2; m++) {
+                inside[m] += fabs(err[k][q]) <= (m + 1) * us[k][q];
+                inside_biased[m] += fabs(err[k][q]) <= (m + 1) * us[k][q] + bias[q];
+            }
+        }
+        double ratio = sqrt(u2 / var);
+        if (!(fabs(ratio - 1) <= tol_sd))
+            fail_msg("%s: rms reported sigma %.4g, scatter %.4g (ratio %.3f, tolerance %.3f)",
+                     all_names[q], sqrt(u2), sqrt(var), ratio, tol_sd);
+        for (int m = 0; m < 2; m++) {
+            double tol = 4 * sqrt(p_k[m] * (1 - p_k[m]) / n);
+            if (!(inside_biased[m] / n >= p_k[m] - tol && inside[m] / n <= p_k[m] + tol))
+                fail_msg("%s: |error| <= %d sigma in %d of %d seeds (%d with the bias bound); "
+                         "Gaussian %.4f +- %.4f",
+                         all_names[q], m + 1, inside[m], N_SEEDS, inside_biased[m], p_k[m], tol);
+        }
+    }
+}
+
+/* Noise-free dots give uncertainties at round-off: the residuals of the rigid steps are the
+ * rounding of the pixel coordinates (up to 800 px, ulp 1.1e-13 px), so the noise estimate must
+ * be below 1e-12 px (measured 3e-14) and every uncertainty below 1e-10 of its value at 0.05 px
+ * (they scale with the noise: measured 6e-13). */
+static void test_track_noise_free_uncertainties_vanish(void** state)
+{
+    (void)state;
+    struct synth y;
+    synth_init(&y, 45 * M_PI / 180);
+    struct wetdem_track_options o;
+    track_options(&o, &y);
+    static double dots[12 * N_FRAMES];
+    double v[N_ALL], u[N_ALL], u_noisy[N_ALL];
+    struct wetdem_track_summary s;
+    gsl_rng* rng = gsl_rng_alloc(gsl_rng_mt19937);
+    gsl_rng_set(rng, 5);
+    render(&y, rng, 0.05, dots);
+    gsl_rng_free(rng);
+    CHECK_OK(analyse_all(dots, &o, v, u_noisy, &s));
+    render(&y, NULL, 0, dots);
+    CHECK_OK(analyse_all(dots, &o, v, u, &s));
+    assert_true(s.noise_px[0] < 1e-12 && s.noise_px[1] < 1e-12);
+    for (int q = 0; q < N_ALL; q++)
+        if (!(u[q] >= 0 && u[q] < 1e-10 * u_noisy[q]))
+            fail_msg("%s: noise-free uncertainty %.3g (%.3g at 0.05 px)", all_names[q], u[q],
+                     u_noisy[q]);
+    size_t n;
+    struct wetdem_track* t = wetdem_track_create();
+    for (int f = 0; f < N_FRAMES; f++)
+        for (int k = 0; k < 2; k++)
+            CHECK_OK(wetdem_track_add_frame(t, k + 1, f, dots + 12 * f + 6 * k));
+    CHECK_OK(wetdem_track_analyse(t, &o, &s));
+    const struct wetdem_track_sample* q = wetdem_track_samples(t, 0, &n);
+    for (size_t i = 0; i < n; i++) /* (0.05 px gives ~0.012 m/s and ~3 rad/s) */
+        assert_true(q[i].u_vx < 1e-12 && q[i].u_vy_raw < 1e-12 && q[i].u_omega < 1e-9);
+    wetdem_track_free(t);
+}
+
+/* Doubling the noise doubles the uncertainties: the same seed at 0.01 and 0.02 px (the
+ * collision found at the same frame). The noise estimate and the states' uncertainties are
+ * the noise times gains that depend on the noisy dots only through the dot offsets and the
+ * spin, O(noise/offset) = 0.02/31 px = 7e-4 relative: 1e-3 (measured 3e-4). The derived
+ * values' coefficients are evaluated at the estimates, which move by their own relative
+ * uncertainty: 1e-3 plus twice the largest u/|value| among them, 0.018 (measured 4.6e-3, e_n).
+ */
+static void test_track_uncertainties_scale_with_noise(void** state)
+{
+    (void)state;
+    struct synth y;
+    synth_init(&y, 45 * M_PI / 180);
+    struct wetdem_track_options o;
+    track_options(&o, &y);
+    static double dots[12 * N_FRAMES];
+    double v[2][N_ALL], u[2][N_ALL];
+    struct wetdem_track_summary s[2];
+    gsl_rng* rng = gsl_rng_alloc(gsl_rng_mt19937);
+    for (int m = 0; m < 2; m++) {
+        gsl_rng_set(rng, 4);
+        render(&y, rng, 0.01 * (m + 1), dots);
+        CHECK_OK(analyse_all(dots, &o, v[m], u[m], &s[m]));
+    }
+    gsl_rng_free(rng);
+    assert_int_equal(s[0].collision_frame, s[1].collision_frame);
+    for (int k = 0; k < 2; k++)
+        CHECK_REL(s[1].noise_px[k], 2 * s[0].noise_px[k], 1e-3);
+    double rel = 0;
+    for (int q = 20; q < N_ALL; q++)
+        rel = fmax(rel, u[1][q] / fabs(v[1][q]));
+    for (int q = 0; q < N_ALL; q++)
+        if (!(fabs(u[1][q] / (2 * u[0][q]) - 1) <= (q < 20 ? 1e-3 : 1e-3 + 2 * rel)))
+            fail_msg("%s: %.6g at 0.01 px, %.6g at 0.02 px", all_names[q], u[0][q], u[1][q]);
+}
+
 /* ---- malformed tracks ---------------------------------------------------------------------- */
 
 static const char* write_temp(const char* text)
@@ -1023,6 +1416,11 @@ int main(void)
         cmocka_unit_test(test_track_noise_free_recovery_is_tight),
         cmocka_unit_test(test_track_sticking_pair_is_reported),
         cmocka_unit_test(test_track_recovers_simulated_punch_collision),
+        cmocka_unit_test(test_track_interval_gain_and_rigid_residual),
+        cmocka_unit_test(test_track_uncertainties_are_the_propagated_noise),
+        cmocka_unit_test(test_track_uncertainties_match_monte_carlo),
+        cmocka_unit_test(test_track_noise_free_uncertainties_vanish),
+        cmocka_unit_test(test_track_uncertainties_scale_with_noise),
         cmocka_unit_test(test_track_rejects_malformed_files),
         cmocka_unit_test(test_track_rejects_short_or_mismatched_tracks),
         cmocka_unit_test(test_track_cli_exits_2_with_line_number),
