@@ -4,7 +4,8 @@
  * from the tracked positions of three painted dots per sphere (Punch 2023 Sec. 3.2, Eq. 23;
  * library: wetdem_track_*). The summary goes to stdout as "key = value" lines (or JSON with
  * --json); --frames FILE writes the per-frame velocities as CSV, whole or not at all (under a
- * temporary name, renamed when written; cli_write_output). docs/tracking.md.
+ * temporary name, renamed when written; cli_write_output). Standard uncertainties (u_ keys and
+ * columns) and the estimated noise are appended after the values. docs/tracking.md.
  * Exit codes: 0 ok, 1 out of memory or unwritable output, 2 bad options or malformed track.
  */
 #include <errno.h>
@@ -21,7 +22,9 @@ static const char usage[] =
     "                    [--y-down] [--radius R --mass M --viscosity MU] [--frames FILE]\n"
     "                    [--json]\n"
     "Velocities, spin, collision time, impact angle, St_n and e_n of a Stokes-cradle\n"
-    "collision from tracked dots, as Punch Sec. 3.2 (docs/tracking.md).\n"
+    "collision from tracked dots, as Punch Sec. 3.2 (docs/tracking.md). Every value\n"
+    "has a standard uncertainty (u_ keys and --frames columns, 1 sigma) from the\n"
+    "tracking noise, which the dots give (striker_noise_px, target_noise_px).\n"
     "  DOTS.csv      rows frame,sphere,x1,y1,x2,y2,x3,y3 (pixels); dot 1 = centre dot\n"
     "  --fps         frame rate [1/s];  --pixel-size  image resolution [m/pixel]\n"
     "  --window/--order  Savitzky-Golay smoothing (odd frames > order; 1 = none)\n"
@@ -144,14 +147,19 @@ static void frames_table(FILE* f, const void* ctx)
     const struct frames_ctx* c = ctx;
     cli_print_provenance(f, c->argc, c->argv);
     fprintf(f, "sphere,frame,time_s,vx_raw_m_s,vy_raw_m_s,omega_raw_rad_s,vx_m_s,vy_m_s,"
-               "omega_rad_s,residual_m\n");
+               "omega_rad_s,residual_m,u_vx_raw_m_s,u_vy_raw_m_s,u_omega_raw_rad_s,u_vx_m_s,"
+               "u_vy_m_s,u_omega_rad_s\n");
     for (size_t k = 0; k < wetdem_track_n_spheres(c->t); k++) {
         size_t n;
         const struct wetdem_track_sample* q = wetdem_track_samples(c->t, k, &n);
         for (size_t i = 0; i < n; i++)
-            fprintf(f, "%d,%ld,%.15g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.6g\n",
+            fprintf(f,
+                    "%d,%ld,%.15g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,"
+                    "%.6g\n",
                     wetdem_track_sphere_id(c->t, k), q[i].frame, q[i].time, q[i].vx_raw,
-                    q[i].vy_raw, q[i].omega_raw, q[i].vx, q[i].vy, q[i].omega, q[i].residual);
+                    q[i].vy_raw, q[i].omega_raw, q[i].vx, q[i].vy, q[i].omega, q[i].residual,
+                    q[i].u_vx_raw, q[i].u_vy_raw, q[i].u_omega_raw, q[i].u_vx, q[i].u_vy,
+                    q[i].u_omega);
     }
 }
 
@@ -160,9 +168,11 @@ struct kv {
     double value;
 };
 
-static void print_summary(const struct wetdem_track_summary* s, bool json)
+static void print_summary(const struct wetdem_track* t, const struct wetdem_track_summary* s,
+                          bool json)
 {
     const double deg = 180.0 / M_PI;
+    size_t si = wetdem_track_sphere_id(t, 0) == s->striker_id ? 0 : 1; /* noise_px's order */
     const struct kv rows[] = {
         {"collision_time_s", s->collision_time},
         {"striker", s->striker_id},
@@ -185,6 +195,27 @@ static void print_summary(const struct wetdem_track_summary* s, bool json)
         {"speed_nf_m_s", s->speed_nf},
         {"e_n", s->e_n},
         {"stokes_n", s->stokes_n},
+        /* appended: the estimated noise and the standard uncertainties (1 sigma) */
+        {"striker_noise_px", s->noise_px[si]},
+        {"target_noise_px", s->noise_px[1 - si]},
+        {"u_striker_before_vx_m_s", s->u_striker_before.vx},
+        {"u_striker_before_vy_m_s", s->u_striker_before.vy},
+        {"u_striker_before_omega_rad_s", s->u_striker_before.omega},
+        {"u_target_before_vx_m_s", s->u_target_before.vx},
+        {"u_target_before_vy_m_s", s->u_target_before.vy},
+        {"u_target_before_omega_rad_s", s->u_target_before.omega},
+        {"u_striker_after_vx_m_s", s->u_striker_after.vx},
+        {"u_striker_after_vy_m_s", s->u_striker_after.vy},
+        {"u_striker_after_omega_rad_s", s->u_striker_after.omega},
+        {"u_target_after_vx_m_s", s->u_target_after.vx},
+        {"u_target_after_vy_m_s", s->u_target_after.vy},
+        {"u_target_after_omega_rad_s", s->u_target_after.omega},
+        {"u_angle_centres_deg", s->u_angle_centres * deg},
+        {"u_impact_angle_deg", s->u_impact_angle * deg},
+        {"u_speed_n0_m_s", s->u_speed_n0},
+        {"u_speed_nf_m_s", s->u_speed_nf},
+        {"u_e_n", s->u_e_n},
+        {"u_stokes_n", s->u_stokes_n},
     };
     size_t n = s->has_collision ? sizeof rows / sizeof rows[0] : 0;
     if (json)
@@ -204,8 +235,8 @@ static void print_summary(const struct wetdem_track_summary* s, bool json)
             printf("  \"%s\": %.*g%s\n", rows[k].key, k == 0 ? 15 : 9, rows[k].value, sep);
         else if (!isfinite(rows[k].value)) /* (a comment, not "nan", for key = value readers) */
             printf("# %s not computed: %s\n", rows[k].key,
-                   !strcmp(rows[k].key, "stokes_n") ? "give --radius, --mass and --viscosity"
-                                                    : "not defined for this track");
+                   strstr(rows[k].key, "stokes_n") ? "give --radius, --mass and --viscosity"
+                                                   : "not defined for this track");
         else
             printf("%s = %.*g\n", rows[k].key, k == 0 ? 15 : 9, rows[k].value);
     }
@@ -243,7 +274,7 @@ int cmd_track(int argc, char** argv)
     if (rc == CLI_EXIT_OK) {
         if (!c.json)
             cli_print_provenance(stdout, argc, argv);
-        print_summary(&s, c.json);
+        print_summary(t, &s, c.json);
     }
     wetdem_track_free(t);
     return rc;

@@ -1302,10 +1302,12 @@ static void test_track_cli_summary_has_no_nan(void** state)
     assert_int_equal(test_run_cli_into(track, out, sizeof out), 0);
     assert_null(strstr(out, "nan"));
     CHECK_CONTAINS(out, "# stokes_n not computed: give --radius, --mass and --viscosity\n");
+    CHECK_CONTAINS(out, "# u_stokes_n not computed: give --radius, --mass and --viscosity\n");
     snprintf(args, sizeof args, "%s --json", track);
     assert_int_equal(test_run_cli_into(args, out, sizeof out), 0);
     assert_null(strstr(out, "nan"));
-    CHECK_CONTAINS(out, "\"stokes_n\": null\n");
+    CHECK_CONTAINS(out, "\"stokes_n\": null,\n"); /* (uncertainties follow) */
+    CHECK_CONTAINS(out, "\"u_stokes_n\": null\n");
     const double radius = 6.35e-3, mass = 8.4e-3, viscosity = 0.02;
     snprintf(args, sizeof args, "%s --radius %g --mass %g --viscosity %g", track, radius, mass,
              viscosity);
@@ -1319,6 +1321,88 @@ static void test_track_cli_summary_has_no_nan(void** state)
     /* (both printed to 9 digits: 1e-8 covers their rounding) */
     CHECK_REL(stokes, (mass / 2) * speed / (6 * M_PI * viscosity * (radius / 2) * (radius / 2)),
               1e-8);
+}
+
+/* The value after "KEY = " in key = value text, or NAN when the key is missing. */
+static double text_value(const char* out, const char* key)
+{
+    char needle[96];
+    snprintf(needle, sizeof needle, "\n%s = ", key);
+    const char* at = strstr(out, needle);
+    return at ? strtod(at + strlen(needle), NULL) : NAN;
+}
+
+/* The summary appends the noise estimate and an uncertainty per value after the keys it had
+ * (text and JSON), equal to the library's (printed to 9 digits), the striker's and target's
+ * noise in their roles; the same command prints the same bytes; --frames appends the
+ * per-interval uncertainties to its columns. */
+static void test_track_cli_reports_uncertainties(void** state)
+{
+    (void)state;
+    if (!getenv("WETDEM_CLI"))
+        skip();
+    const char* file = "examples/tracks/punch_45deg.csv";
+    char args[512], out[8192], again[8192];
+    snprintf(args, sizeof args,
+             "track %s --fps 5000 --pixel-size 175e-6 --radius 12.7e-3 --mass 0.06830 "
+             "--viscosity 10",
+             file);
+    assert_int_equal(test_run_cli_into(args, out, sizeof out), 0);
+    assert_int_equal(test_run_cli_into(args, again, sizeof again), 0);
+    assert_string_equal(out, again);
+    struct wetdem_track* t = wetdem_track_create();
+    CHECK_OK(wetdem_track_read_csv(t, file));
+    struct wetdem_track_options o;
+    wetdem_track_options_init(&o);
+    o.fps = 5000;
+    o.pixel_size = 175e-6;
+    o.radius = 12.7e-3;
+    o.mass = 0.06830;
+    o.viscosity = 10;
+    struct wetdem_track_summary s;
+    CHECK_OK(wetdem_track_analyse(t, &o, &s));
+    size_t si = wetdem_track_sphere_id(t, 0) == s.striker_id ? 0 : 1;
+    wetdem_track_free(t);
+    const double deg = 180 / M_PI;
+    const struct {
+        const char* key;
+        double value;
+    } want[] = {{"striker_noise_px", s.noise_px[si]},
+                {"target_noise_px", s.noise_px[1 - si]},
+                {"u_striker_before_vx_m_s", s.u_striker_before.vx},
+                {"u_target_before_omega_rad_s", s.u_target_before.omega},
+                {"u_striker_after_vy_m_s", s.u_striker_after.vy},
+                {"u_target_after_omega_rad_s", s.u_target_after.omega},
+                {"u_angle_centres_deg", s.u_angle_centres * deg},
+                {"u_impact_angle_deg", s.u_impact_angle * deg},
+                {"u_speed_n0_m_s", s.u_speed_n0},
+                {"u_speed_nf_m_s", s.u_speed_nf},
+                {"u_e_n", s.u_e_n},
+                {"u_stokes_n", s.u_stokes_n}};
+    for (size_t k = 0; k < sizeof want / sizeof want[0]; k++)
+        CHECK_REL(text_value(out, want[k].key), want[k].value, 1e-8);
+    /* 0.05 px rendered; e_n 0.704 +- 0.004 */
+    assert_true(s.noise_px[0] > 0.04 && s.noise_px[0] < 0.06 && s.u_e_n < 0.01);
+    /* appended: every earlier key comes before the first new one */
+    assert_true(strstr(out, "\nstokes_n = ") < strstr(out, "\nstriker_noise_px = "));
+    snprintf(args + strlen(args), sizeof args - strlen(args), " --json");
+    assert_int_equal(test_run_cli_into(args, out, sizeof out), 0);
+    CHECK_CONTAINS(out, "\"stokes_n\": 3.02");
+    CHECK_CONTAINS(out, "\"u_e_n\": 0.00");
+    assert_true(strstr(out, "\"stokes_n\"") < strstr(out, "\"striker_noise_px\""));
+    assert_true(strstr(out, "\"u_stokes_n\": 0.0") && strstr(out, "}\n"));
+    char frames[96];
+    snprintf(frames, sizeof frames, "/tmp/wetdem_track_u_%d.csv", (int)getpid());
+    snprintf(args, sizeof args, "track %s --fps 5000 --pixel-size 175e-6 --frames %s", file,
+             frames);
+    assert_int_equal(test_run_cli_into(args, out, sizeof out), 0);
+    char* text = test_read_file(frames, NULL);
+    assert_non_null(text);
+    CHECK_CONTAINS(text, "\nsphere,frame,time_s,vx_raw_m_s,vy_raw_m_s,omega_raw_rad_s,vx_m_s,"
+                         "vy_m_s,omega_rad_s,residual_m,u_vx_raw_m_s,u_vy_raw_m_s,"
+                         "u_omega_raw_rad_s,u_vx_m_s,u_vy_m_s,u_omega_rad_s\n");
+    free(text);
+    remove(frames);
 }
 
 /* --frames is written whole or not at all: it was written under its final name, so a write
@@ -1426,6 +1510,7 @@ int main(void)
         cmocka_unit_test(test_track_cli_exits_2_with_line_number),
         cmocka_unit_test(test_track_cli_refuses_a_change_that_is_no_collision),
         cmocka_unit_test(test_track_cli_summary_has_no_nan),
+        cmocka_unit_test(test_track_cli_reports_uncertainties),
         cmocka_unit_test(test_track_cli_writes_frames_whole_or_not_at_all),
         cmocka_unit_test(test_track_cli_frames_through_links_and_devices),
     };
