@@ -718,23 +718,6 @@ bool cli_is_frame_name(const char* prefix, const char* name)
     return true;
 }
 
-bool cli_series_entry(const char* line, char* name, size_t n, double* time)
-{
-    const char* p = strstr(line, "\"name\" : \"");
-    const char* q = p ? strstr(line, "\"time\" : ") : NULL;
-    if (!q)
-        return false;
-    p += strlen("\"name\" : \"");
-    size_t len = strcspn(p, "\"");
-    char* end;
-    *time = strtod(q + strlen("\"time\" : "), &end);
-    if (len == 0 || len >= n || p[len] != '"' || end == q + strlen("\"time\" : "))
-        return false;
-    memcpy(name, p, len);
-    name[len] = '\0';
-    return true;
-}
-
 const char* cli_option_hint(const char* arg, const char* const* options, char* buf, size_t n)
 {
     const char* hint = arg[0] == '-' ? wetdem_param_suggest(arg, options) : NULL;

@@ -102,10 +102,6 @@ int cli_csv_columns(char** f, int n, const char* const* names, const char* const
  * `prefix`: PREFIX_, six or more digits, .vtk. */
 bool cli_is_frame_name(const char* prefix, const char* name);
 
-/* Whether `line` is an entry of a .vtk.series index as wetdem writes them,
- * { "name" : "NAME", "time" : T }: then its name (if shorter than n) and time. */
-bool cli_series_entry(const char* line, char* name, size_t n, double* time);
-
 /* Writes the '#' provenance lines that start every CSV the CLI prints:
  *     # wetdem <version> (git <hash>)
  *     # command: wetdem <argv[0]> <argv[1]> ...

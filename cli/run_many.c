@@ -258,7 +258,7 @@ static int series_resume(struct series* s, double t, unsigned long long step, do
     while (f && fgets(line, sizeof line, f)) {
         char name[CLI_VALUE_MAX + 40], want[CLI_VALUE_MAX + 40];
         double time;
-        if (!cli_series_entry(line, name, sizeof name, &time))
+        if (wetdem_output_vtk_series_entry(line, name, sizeof name, &time) != WETDEM_OK)
             continue;
         frame_name(s, listed, false, want, sizeof want);
         if (strcmp(name, want) != 0)

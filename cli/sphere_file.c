@@ -564,7 +564,7 @@ static int last_frame(const char* index, char* text, char* path, size_t n, char*
     double time;
     for (char *line = text, *next; line; line = next) {
         next = cut_line(line);
-        if (cli_series_entry(line, entry, sizeof entry, &time))
+        if (wetdem_output_vtk_series_entry(line, entry, sizeof entry, &time) == WETDEM_OK)
             memcpy(name, entry, sizeof name);
     }
     if (!name[0])

@@ -801,6 +801,13 @@ WETDEM_API int wetdem_sim_write_vtk_links(struct wetdem_sim* sim, const char* pa
  * such title: another file, a links file, a title cut short, altered or with anything after
  * " s", a time that is not finite) or WETDEM_ERR_NOMEM (no C locale could be made). */
 WETDEM_API int wetdem_output_vtk_frame_time(const char* path, double* t);
+/* One entry of a ".vtk.series" index as wetdem writes them, the line
+ * { "name" : "NAME", "time" : T } (comma after it or not): NAME, its JSON escapes \" and \\
+ * undone, into name (n bytes) and T [s] into *time, both set only on success. Returns
+ * WETDEM_OK, WETDEM_ERR_PARSE (no such entry: the index's other lines, an empty or
+ * unterminated name, one of n bytes or more, a time missing or not finite), WETDEM_ERR_INVALID
+ * (a NULL argument or n = 0) or WETDEM_ERR_NOMEM. */
+WETDEM_API int wetdem_output_vtk_series_entry(const char* line, char* name, size_t n, double* time);
 /* Writes a checkpoint of a many-particle run (atomic: temporary file, then rename).
  * Returns WETDEM_OK, WETDEM_ERR_INVALID (not in many mode) or WETDEM_ERR_IO. */
 WETDEM_API int wetdem_sim_write_checkpoint(struct wetdem_sim* sim, const char* path);

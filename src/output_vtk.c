@@ -1,8 +1,10 @@
 /*
  * output_vtk.c — legacy VTK (version 3.0) POLYDATA files of the particles and of their links
  * (contacts and liquid bridges as lines), ASCII or binary, and ParaView ".vtk.series"
- * time-series files; and the time of a particle file, read back from its title (the one
- * definition of the title's format, TITLE_FORMAT, serves both). Prefix: wetdem_output_vtk.
+ * time-series files; and what the readers of those files need back: the time of a particle
+ * file from its title, an entry of a series index (the one definition of each format,
+ * TITLE_FORMAT and SERIES_NAME / SERIES_TIME, serves writer and reader). Prefix:
+ * wetdem_output_vtk.
  *
  * Layout (VTK User's Guide, "VTK File Formats", legacy format):
  *   # vtk DataFile Version 3.0 / title / ASCII|BINARY / DATASET POLYDATA
@@ -40,6 +42,10 @@
 #define TITLE_HEAD "wetdem %s t = "
 #define TITLE_FORMAT TITLE_HEAD "%.17g s\n"
 #define PARTICLES "particles"
+/* The keys of an entry of a ".vtk.series" index, one line each ({ "name" : "F", "time" : T }):
+ * wetdem_output_vtk_series_write writes them, wetdem_output_vtk_series_entry reads them. */
+#define SERIES_NAME "\"name\" : "
+#define SERIES_TIME "\"time\" : "
 
 static bool host_is_little_endian(void)
 {
@@ -359,10 +365,55 @@ int wetdem_output_vtk_series_write(const char* path, const char* const* files, c
         return WETDEM_ERR_IO;
     fputs("{\n  \"file-series-version\" : \"1.0\",\n  \"files\" : [\n", f);
     for (size_t k = 0; k < n; k++) {
-        fputs("    { \"name\" : ", f);
+        fputs("    { " SERIES_NAME, f);
         put_json_string(f, files[k]);
-        fprintf(f, ", \"time\" : %.17g }%s\n", times[k], k + 1 < n ? "," : "");
+        fprintf(f, ", " SERIES_TIME "%.17g }%s\n", times[k], k + 1 < n ? "," : "");
     }
     fputs("  ]\n}\n", f);
     return finish_atomic(f, tmp, path, msg, msg_size);
+}
+
+/* The JSON string at s (after its opening quote) with the escapes put_json_string writes
+ * (\" and \\) undone, into name unless it is NULL (n bytes); its length, or n when it is
+ * unterminated or does not fit in n bytes. *end: after the closing quote. */
+static size_t json_string(const char* s, char* name, size_t n, const char** end)
+{
+    size_t len = 0;
+    for (; *s && *s != '"'; s++, len++) {
+        if (*s == '\\' && (s[1] == '"' || s[1] == '\\'))
+            s++;
+        if (len + 1 >= n)
+            return n;
+        if (name)
+            name[len] = *s;
+    }
+    if (*s != '"')
+        return n;
+    if (name)
+        name[len] = '\0';
+    *end = s + 1;
+    return len;
+}
+
+int wetdem_output_vtk_series_entry(const char* line, char* name, size_t n, double* time)
+{
+    if (!line || !name || n == 0 || !time)
+        return WETDEM_ERR_INVALID;
+    const char *p = strstr(line, SERIES_NAME "\""), *end = NULL;
+    p = p ? p + strlen(SERIES_NAME "\"") : NULL;
+    size_t len = p ? json_string(p, NULL, n, &end) : 0;
+    const char* q = len > 0 && len < n ? strstr(end, SERIES_TIME) : NULL;
+    if (!q)
+        return WETDEM_ERR_PARSE;
+    struct wetdem_locale_guard g; /* (strtod reads a decimal point in the C locale only) */
+    if (wetdem_locale_guard_enter(&g) != WETDEM_OK)
+        return WETDEM_ERR_NOMEM;
+    char* after;
+    double t = strtod(q + strlen(SERIES_TIME), &after);
+    wetdem_locale_guard_leave(&g);
+    if (after == q + strlen(SERIES_TIME) || !isfinite(t))
+        return WETDEM_ERR_PARSE;
+    json_string(p, name, n, &end);
+    *time = t;
+    return WETDEM_OK;
 }

@@ -4,7 +4,8 @@
  * and big-endian binary are both exact); when the VTK Python module is installed the files
  * are also read with VTK's own legacy reader. Also: the links file (lines and cell data), atomic
  * write, series file, bad path; the time of a particle file read back from its title
- * (wetdem_output_vtk_frame_time), bit for bit, and every other file refused.
+ * (wetdem_output_vtk_frame_time) and the entries of a series index
+ * (wetdem_output_vtk_series_entry), bit for bit, and everything else refused.
  */
 #include <float.h>
 #include <stdlib.h>
@@ -411,6 +412,66 @@ static void test_output_vtk_series_and_names(void** state)
     remove(path);
 }
 
+/* The entries of a series index read back as written, line by line: names (with the JSON
+ * escapes the writer adds) and times bit for bit; the index's other lines and broken entries
+ * refused, the outputs untouched. */
+static void test_output_vtk_series_entries_read_back(void** state)
+{
+    (void)state;
+    const char* files[] = {"run_000000.vtk", "a \"quoted\" \\ name.vtk", "run_000002.vtk"};
+    double times[] = {-0.0, 0.1 + 0.2, DBL_MAX};
+    char path[] = "/tmp/wetdem_test_series_read_XXXXXX";
+    int fd = mkstemp(path);
+    close(fd);
+    CHECK_OK(wetdem_output_vtk_series_write(path, files, times, 3, NULL, 0));
+    FILE* f = fopen(path, "r");
+    char line[256], name[64];
+    size_t k = 0;
+    while (fgets(line, sizeof line, f)) {
+        double t = 42;
+        int st = wetdem_output_vtk_series_entry(line, name, sizeof name, &t);
+        if (st != WETDEM_OK) {
+            CHECK_STATUS(st, WETDEM_ERR_PARSE);
+            assert_true(t == 42);
+            continue;
+        }
+        assert_true(k < 3);
+        assert_string_equal(name, files[k]);
+        assert_memory_equal(&t, &times[k], sizeof t); /* (-0 too) */
+        k++;
+    }
+    fclose(f);
+    remove(path);
+    assert_int_equal(k, 3);
+    const char* bad[] = {
+        "{ \"name\" : \"\", \"time\" : 1 }",        /* empty name */
+        "{ \"name\" : \"x.vtk, \"time\" : 1 }",     /* unterminated */
+        "{ \"name\" : \"x.vtk\" }",                 /* no time */
+        "{ \"name\" : \"x.vtk\", \"time\" : }",     /* no number */
+        "{ \"name\" : \"x.vtk\", \"time\" : nan }", /* not finite */
+        "{ \"name\" : \"x.vtk\", \"time\" : 1e999 }",
+        "{ \"time\" : 1, \"name\" : \"x.vtk\" }", /* not as the writer orders it */
+        "  \"files\" : [",
+    };
+    for (size_t b = 0; b < sizeof bad / sizeof *bad; b++) {
+        double t = 42;
+        strcpy(name, "untouched");
+        CHECK_STATUS(wetdem_output_vtk_series_entry(bad[b], name, sizeof name, &t),
+                     WETDEM_ERR_PARSE);
+        assert_true(t == 42);
+        assert_string_equal(name, "untouched");
+    }
+    double t = 0;
+    const char* fits = "{ \"name\" : \"abcd\", \"time\" : 1 }";
+    CHECK_STATUS(wetdem_output_vtk_series_entry(fits, name, 4, &t), WETDEM_ERR_PARSE);
+    CHECK_OK(wetdem_output_vtk_series_entry(fits, name, 5, &t));
+    assert_string_equal(name, "abcd");
+    CHECK_STATUS(wetdem_output_vtk_series_entry(fits, name, 0, &t), WETDEM_ERR_INVALID);
+    CHECK_STATUS(wetdem_output_vtk_series_entry(NULL, name, 5, &t), WETDEM_ERR_INVALID);
+    CHECK_STATUS(wetdem_output_vtk_series_entry(fits, NULL, 5, &t), WETDEM_ERR_INVALID);
+    CHECK_STATUS(wetdem_output_vtk_series_entry(fits, name, 5, NULL), WETDEM_ERR_INVALID);
+}
+
 /* A temporary file holding the `len` bytes of text. */
 static void temp_file_with(char* path, const char* text, size_t len)
 {
@@ -556,6 +617,7 @@ int main(void)
         cmocka_unit_test(test_output_vtk_links_round_trip),
         cmocka_unit_test(test_output_vtk_bad_path_is_an_io_error),
         cmocka_unit_test(test_output_vtk_series_and_names),
+        cmocka_unit_test(test_output_vtk_series_entries_read_back),
         cmocka_unit_test(test_output_vtk_frame_time_reads_back_every_bit),
         cmocka_unit_test(test_output_vtk_frame_time_refuses_other_titles),
         cmocka_unit_test(test_output_vtk_frame_time_refuses_what_it_cannot_read),
