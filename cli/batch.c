@@ -58,16 +58,22 @@ static int build_point(const struct cli_scenario* base, const struct cli_batch* 
 }
 
 /* The values of point p into buf: for messages, "KEY = VALUE[, KEY2 = VALUE2]"; else as the
- * first fields of its row, "VALUE,[VALUE2,]" (12 digits both). */
+ * first fields of its row, "VALUE,[VALUE2,]". Each value is the one the point ran with: 12
+ * digits, or up to 17 where 12 would read back as another number (0:0.4:5 gives
+ * 0.30000000000000004, a log sweep most of its values), so that `wetdem run FILE --set
+ * KEY=VALUE` with the text of a row runs that row's collision. */
 static void format_values(const struct cli_batch* b, const struct cli_batch_point* p,
                           bool for_message, char* buf, size_t n)
 {
     size_t used = 0;
     buf[0] = '\0';
-    for (int d = 0; d < b->n_keys && used < n; d++)
-        used += (size_t)(for_message ? snprintf(buf + used, n - used, "%s%s = %.12g", d ? ", " : "",
-                                                b->key[d], p->value[d])
-                                     : snprintf(buf + used, n - used, "%.12g,", p->value[d]));
+    for (int d = 0; d < b->n_keys && used < n; d++) {
+        char value[40];
+        wetdem_param_format_value(p->value[d], 12, value, sizeof value);
+        used += (size_t)(for_message ? snprintf(buf + used, n - used, "%s%s = %s", d ? ", " : "",
+                                                b->key[d], value)
+                                     : snprintf(buf + used, n - used, "%s,", value));
+    }
 }
 
 /* "KEY = VALUE[, KEY2 = VALUE2]" of point p into buf. */

@@ -273,14 +273,16 @@ static void sweep_row(FILE* f, int status, const struct wetdem_pairwise_config* 
     size_t n_events = 0;
     wetdem_pairwise_events(pw, &n_events);
     if (status != WETDEM_OK) {
-        fprintf(f, "%s,none,0,nan,nan,%zu,%llu", wetdem_status_name(status), n_events, r->steps);
+        fprintf(f, "%s,none,nan,nan,nan,%zu,%llu", wetdem_status_name(status), n_events, r->steps);
         for (size_t i = 0; i < cfg->n_spheres; i++)
             for (size_t j = i + 1; j < cfg->n_spheres; j++)
                 fputs(",nan,nan,0,none,nan", f);
         return;
     }
+    /* separated_sphere: 1-based, -1 for none, as in the JSON summary */
     fprintf(f, "%s,%s,%d,%.12g,%.12g,%zu,%llu", wetdem_status_name(status),
-            wetdem_pairwise_outcome_name(r->outcome), r->separated_sphere + 1, r->time,
+            wetdem_pairwise_outcome_name(r->outcome),
+            r->separated_sphere >= 0 ? r->separated_sphere + 1 : -1, r->time,
             wetdem_pairwise_t_star(r, r->time), r->n_events, r->steps);
     for (size_t p = 0; p < r->n_pairs; p++) {
         const struct wetdem_pairwise_pair_result* q = &r->pairs[p];

@@ -944,7 +944,7 @@ static void test_scenario_resumed_map_equals_the_whole(void** state)
     cut_table(whole, gone, 4, false, "cut.csv");
     snprintf(path, sizeof path, "%s/cut.csv", tmpdir);
     char* cut = test_read_file(path, NULL);
-    CHECK_CONTAINS(cut, "\n0.5,26.6666666667,NOT_RUN,none,none,nan,");
+    CHECK_CONTAINS(cut, "\n0.5,26.666666666666664,NOT_RUN,none,none,nan,");
     free(cut);
     snprintf(args, sizeof args, "%s --resume %s/cut.csv --out %s/cut.csv", map, tmpdir, tmpdir);
     expect_run(args, 0, NULL);
@@ -1345,6 +1345,97 @@ static double json_value(const char* out, const char* key)
     return strtod(p + strlen(want), NULL);
 }
 
+/* A row's swept value, as printed, is the value its collision ran with: `run --set KEY=TEXT`
+ * with that text gives the row's numbers exactly (the same 12-digit text). Printed with 12
+ * digits, the interior values of a log sweep (14.422495703074084 as 14.4224957031) and 0.3 of
+ * 0:0.4:5 (0.30000000000000004) named another number: run at the label, e differed by 2e-7
+ * (St_n = 54.77), min_gap in the 12th digit. */
+static void test_scenario_sweep_row_label_reruns_the_row(void** state)
+{
+    (void)state;
+    const char* args = "sweep examples/scenarios/nijssen_head_on.ini --param collision.stokes "
+                       "--values 1:3000:7 --log";
+    struct test_run sw = test_run_cli("OMP_NUM_THREADS=2", args, false);
+    assert_int_equal(sw.code, 0);
+    char* rows = data_lines(sw.out);
+    const char* line = strchr(rows, '\n') + 1; /* after the header */
+    /* e, energy_ratio, striker_speed_out, min_gap: columns of the soft row */
+    static const struct {
+        const char* key;
+        int col;
+    } fields[] = {{"e", 5}, {"energy_ratio", 10}, {"striker_speed_out", 14}, {"min_gap", 23}};
+    for (int k = 0; k < 7; k++) {
+        char label[64], cmd[256];
+        csv_field(line, 0, label, sizeof label);
+        double want = 1.0 * pow(3000.0, k / 6.0);
+        CHECK_REL(strtod(label, NULL), want, 1e-14);
+        snprintf(cmd, sizeof cmd,
+                 "run examples/scenarios/nijssen_head_on.ini --json --set collision.stokes=%s",
+                 label);
+        struct test_run r = test_run_cli("", cmd, false);
+        assert_int_equal(r.code, 0);
+        for (size_t f = 0; f < sizeof fields / sizeof fields[0]; f++) {
+            char in_row[64], in_run[64];
+            csv_field(line, fields[f].col, in_row, sizeof in_row);
+            snprintf(in_run, sizeof in_run, "%.12g", json_value(r.out, fields[f].key));
+            if (strcmp(in_row, in_run) != 0)
+                fail_msg("collision.stokes = %s: %s is %s in the sweep, %s in run", label,
+                         fields[f].key, in_row, in_run);
+        }
+        free(r.out);
+        line = strchr(line, '\n') + 1;
+    }
+    assert_int_equal(*line, '\0');
+    free(rows);
+    free(sw.out);
+    /* linear: 0.1 + 2 x 0.1 is not 0.3 */
+    struct test_run lin = test_run_cli("",
+                                       "sweep examples/scenarios/dry_hertz.ini --param "
+                                       "collision.speed --values 0.1:0.5:5",
+                                       false);
+    assert_int_equal(lin.code, 0);
+    CHECK_CONTAINS(lin.out, "\n0.2,WETDEM_OK,");
+    CHECK_CONTAINS(lin.out, "\n0.30000000000000004,WETDEM_OK,");
+    free(lin.out);
+}
+
+/* A pairwise row's separated_sphere is the JSON summary's: the sphere that left alone
+ * (numbered from 1) or -1; the row wrote 0 for none. */
+static void test_scenario_pairwise_row_separated_sphere_as_json(void** state)
+{
+    (void)state;
+    /* davis_three: all three agglomerate (FA) up to St_n = 5, sphere 1 leaves (PA) from 6 */
+    struct test_run sw = test_run_cli("",
+                                      "sweep examples/scenarios/davis_three.ini --param "
+                                      "davis.stokes --values 4:6:2",
+                                      false);
+    assert_int_equal(sw.code, 0);
+    char* rows = data_lines(sw.out);
+    CHECK_CONTAINS(rows, "outcome [word],separated_sphere [-],");
+    const char* line = strchr(rows, '\n') + 1;
+    static const char* const outcome_want[] = {"FA", "PA"};
+    for (int k = 0; k < 2; k++) {
+        char label[32], outcome[16], in_row[16], cmd[256];
+        csv_field(line, 0, label, sizeof label);
+        csv_field(line, 3, outcome, sizeof outcome);
+        csv_field(line, 4, in_row, sizeof in_row);
+        assert_string_equal(outcome, outcome_want[k]);
+        snprintf(cmd, sizeof cmd,
+                 "run examples/scenarios/davis_three.ini --json --set davis.stokes=%s", label);
+        struct test_run r = test_run_cli("", cmd, false);
+        assert_int_equal(r.code, 0);
+        char in_run[16];
+        snprintf(in_run, sizeof in_run, "%.0f", json_value(r.out, "separated_sphere"));
+        if (strcmp(in_row, in_run) != 0)
+            fail_msg("davis.stokes = %s (%s): separated_sphere is %s in the sweep, %s in run",
+                     label, outcome, in_row, in_run);
+        free(r.out);
+        line = strchr(line, '\n') + 1;
+    }
+    free(rows);
+    free(sw.out);
+}
+
 static void test_scenario_map_and_check_of_other_engines(void** state)
 {
     (void)state;
@@ -1470,6 +1561,8 @@ int main(void)
         cmocka_unit_test(test_scenario_sweep_order_and_threads),
         cmocka_unit_test(test_scenario_sweep_point_equals_run),
         cmocka_unit_test(test_scenario_sweep_pairwise_threads_and_status),
+        cmocka_unit_test(test_scenario_sweep_row_label_reruns_the_row),
+        cmocka_unit_test(test_scenario_pairwise_row_separated_sphere_as_json),
         cmocka_unit_test(test_scenario_map_and_check_of_other_engines),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
