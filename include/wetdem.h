@@ -630,7 +630,8 @@ struct wetdem_collision_result {
                                    (0 when starting inside it) */
     double t_final;             /* time of the final state: separation or t_end [s] */
     enum wetdem_outcome outcome;
-    struct wetdem_stats stats;
+    struct wetdem_stats stats; /* the integrator's counts; also when the run failed (those up
+                                  to the failure; every other field is then 0) */
 };
 
 /* Sets up and runs one binary collision on `sim` (its particles are replaced; its materials,

@@ -679,7 +679,9 @@ int wetdem_collision_run(struct wetdem_sim* sim, const struct wetdem_collision_s
         return st;
     bool in_contact = tr.gap_prev < 0;
     st = run(sim, spec, &tr);
-    if (st < 0)
+    if (st < 0) {
+        result->stats = wetdem_sim_stats(sim); /* (the work done up to the failure) */
         return st;
+    }
     return analyse(sim, &su, &in, &tr, st == WETDEM_EVENT, in_contact, result);
 }

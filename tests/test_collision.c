@@ -400,6 +400,25 @@ static void test_collision_nijssen_refuses_hmin_beyond_cutoff(void** state)
     wetdem_sim_free(sim);
 }
 
+/* A run that fails still reports the integrator's counts up to the failure (what a sweep's
+ * totals add up): with cvode.max_steps = 300 the run stops after that many steps, which the
+ * result's stats give (0 before), and every other field is 0. */
+static void test_collision_failed_run_reports_its_counts(void** state)
+{
+    (void)state;
+    int mat;
+    struct wetdem_sim* sim = make_sim("delrin", 0, "nijssen", NULL, "cvode", &mat);
+    CHECK_OK(wetdem_sim_set_param(sim, "cvode.max_steps", 300));
+    struct wetdem_collision_spec s = head_on(mat, 0, 1.0);
+    s.stokes = 100;
+    struct wetdem_collision_result r;
+    CHECK_STATUS(wetdem_collision_run(sim, &s, &r), WETDEM_ERR_MAX_STEPS);
+    assert_int_equal(r.stats.steps, 300);
+    assert_true(r.stats.force_evals >= r.stats.steps);
+    assert_true(r.e == 0 && !r.separated);
+    wetdem_sim_free(sim);
+}
+
 /* Verlet at a small step (0.5 % of the Hertz time) and CVODE (rtol 1e-10) agree on e of a
  * Nijssen collision (Delrin, St = 200): the difference is Verlet's error, measured 2.0e-5;
  * 2e-4 asserted. */
@@ -1022,6 +1041,7 @@ int main(void)
         cmocka_unit_test(test_collision_stokes_speed),
         cmocka_unit_test(test_collision_observe_window),
         cmocka_unit_test(test_collision_bad_spec),
+        cmocka_unit_test(test_collision_failed_run_reports_its_counts),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
