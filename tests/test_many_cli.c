@@ -22,7 +22,9 @@
  *     CSV at its values; bad files exit 2 with the scenario's line and the file's line;
  *   - the example scenarios check, and the summary's energy budget adds up; a run whose budget
  *     does not close (a step too long for the contacts) says so and exits 1, and a restart
- *     from an edited checkpoint whose budget does not close is refused with exit 2.
+ *     from an edited checkpoint whose budget does not close is refused with exit 2; a run
+ *     whose models' works cancel (wet spheres at rest pulled together by their bridge) is
+ *     judged against the size of each model's work, and closes.
  *
  * The runs use one OpenMP thread (results are bit-identical for a given thread count, and one
  * thread is the fastest for 150 spheres on a shared machine) and the passive wait policy.
@@ -1609,6 +1611,57 @@ static void test_many_cli_examples_and_budget(void** state)
     free(off_json);
 }
 
+/* The budget of a run whose models' works cancel: two wet spheres at rest, 10 um apart within
+ * their 20 um films. The bridge pulls them together (capillary work > 0) and the films and the
+ * contact bring them to rest (< 0); the run starts with no input and ends with a net work the
+ * size of its own closure error. That error is the integration's, 2e-13 J against 2.8e-9 J
+ * of the models' work at 2 us (9e-13 J at 4 us, 5e-14 J at 1 us: second order); judged
+ * against the net work the run failed at any step with "error 1" and advice to halve it, and
+ * --restart refused its checkpoint. */
+static void test_many_cli_budget_of_works_that_cancel(void** state)
+{
+    (void)state;
+    write_text("rest.ini",
+               "[box]\nsize_x = 4e-3\nsize_y = 4e-3\nsize_z = 4e-3\n[walls]\nfaces = none\n"
+               "[material.wet]\ndensity = 2500\nyoungs_modulus = 1e7\npoisson_ratio = 0.3\n"
+               "restitution = 0.6\nfriction_dry = 0.4\nfriction_lub = 0.1\nfilm = 20e-6\n"
+               "[fluid]\nviscosity = 0.01\nsurface_tension = 0.02\n"
+               "[models]\nforce = hertz mindlin sb capillary\nmin_separation = fixed\n"
+               "[particle.a]\nmaterial = wet\nradius = 0.5e-3\nx = 1.5e-3\ny = 2e-3\nz = 2e-3\n"
+               "[particle.b]\nmaterial = wet\nradius = 0.5e-3\nx = 2.51e-3\ny = 2e-3\nz = 2e-3\n"
+               "[run]\ndt = 2e-6\nsteps = 2000\n");
+    int code = run_cli("run rest.ini --out rest");
+    char* err = stderr_text();
+    if (code != 0)
+        fail_msg("exit %d, expected 0\n%s", code, err);
+    assert_null(strstr(err, "does not close"));
+    free(err);
+    char* js = test_read_file(tpath("rest/summary.json"), NULL);
+    assert_non_null(js);
+    const char* keys[] = {"\"input\": ", "\"work_total\": ", "\"balance_error\": ",
+                          "\"balance_error_ratio\": ", "\"capillary\", \"pairs\": "};
+    double v[5];
+    for (int k = 0; k < 5; k++) {
+        const char* p = strstr(js, keys[k]);
+        if (!p)
+            fail_msg("%s missing in %s", keys[k], js);
+        v[k] = strtod(p + strlen(keys[k]), NULL);
+    }
+    free(js);
+    assert_true(v[0] == 0);                /* at rest: no input */
+    assert_true(v[4] > 1e-9);              /* the bridge's work, 1.4e-9 J */
+    assert_true(fabs(v[1]) < 1e-2 * v[4]); /* the works cancel (net 2e-13 J) */
+    /* the error, second order (2e-13 J), against the models' work: 7.5e-5 */
+    assert_true(fabs(v[2]) < 1e-3 * v[4]);
+    assert_true(v[3] > 0 && v[3] < 1e-3);
+    /* and the run goes on from its checkpoint */
+    code = run_cli("run rest.ini --set run.steps=2500 --out rest --restart rest/checkpoint.ckpt");
+    err = stderr_text();
+    if (code != 0)
+        fail_msg("restart: exit %d, expected 0\n%s", code, err);
+    free(err);
+}
+
 /* Counts the lines of a file that start with a digit (the rows of a CSV); *finite: whether
  * every field of those rows is a finite number. */
 static size_t count_rows_finite(const char* name, bool* finite)
@@ -1750,6 +1803,7 @@ int main(void)
         cmocka_unit_test(test_many_cli_random_groups_share_the_box),
         cmocka_unit_test(test_many_cli_read_spheres_from_a_file),
         cmocka_unit_test(test_many_cli_examples_and_budget),
+        cmocka_unit_test(test_many_cli_budget_of_works_that_cancel),
         cmocka_unit_test(test_many_cli_warns_about_the_step),
         cmocka_unit_test(test_many_cli_refuses_a_run_with_too_many_steps),
     };
