@@ -205,6 +205,11 @@ struct wetdem_contact {
     struct wetdem_vec3 v_t;    /* tangential velocity of i's surface relative to j's at the
                                   contact point [m/s] */
     double dt;                 /* time since the pair's history was last committed [s] */
+    /* Added to v_t in the tangential spring's increment over dt [m/s]: 0 (the spring advances
+     * by v_t dt) except in the two-body CVODE engine, where it is half the change of v_t since
+     * the commit, in the tangent plane, so that the spring advances with the mean of v_t at
+     * both ends of dt (trapezoidal rule, docs/engines.md). */
+    struct wetdem_vec3 dv_t_spring;
     /* mixed pair properties */
     double e_star;          /* 1/E* = (1-nu_i^2)/E_i + (1-nu_j^2)/E_j [Pa] */
     double g_star;          /* 1/G* = (2-nu_i)/G_i + (2-nu_j)/G_j [Pa] */

@@ -37,6 +37,7 @@ static void mix_properties(struct wetdem_contact* c, const struct wetdem_materia
     c->surface_tension = fluid ? fluid->surface_tension : 0.0;
     c->h_min = 0.0;
     c->dt = 0.0;
+    c->dv_t_spring = vec3(0, 0, 0);
 }
 
 void wetdem_contact_from_particles(struct wetdem_contact* c, const struct wetdem_particle* a,
@@ -65,6 +66,7 @@ struct wetdem_contact wetdem_contact_swapped(const struct wetdem_contact* c)
     s.j = c->i;
     s.normal = vec3_neg(c->normal);
     s.v_t = vec3_neg(c->v_t);
+    s.dv_t_spring = vec3_neg(c->dv_t_spring);
     s.radius_i = c->radius_j;
     s.radius_j = c->radius_i;
     return s;

@@ -26,6 +26,11 @@ struct wetdem_integrator {
      * list, the event slots and the forces at the start state are ready. Returns WETDEM_OK,
      * WETDEM_EVENT (stop condition) or a negative status with the message in sim. */
     int (*integrate)(struct wetdem_sim* sim, const void* params, double t_end);
+    /* Whether force evaluations between commits are trials at any time in the step (cvode):
+     * the tangential spring then advances over c->dt with the mean of v_t at the commit and
+     * at the evaluation (trapezoidal rule, second order) rather than with v_t at the
+     * evaluation (first order; what a fixed step that commits every evaluation uses). */
+    bool trapezoid_spring;
 };
 
 extern const struct wetdem_integrator wetdem_integrator_verlet;

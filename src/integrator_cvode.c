@@ -526,4 +526,5 @@ const struct wetdem_integrator wetdem_integrator_cvode = {
     .params = cvode_params_desc,
     .params_size = sizeof(struct cvode_params),
     .integrate = cvode_integrate,
+    .trapezoid_spring = true,
 };

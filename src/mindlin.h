@@ -43,20 +43,22 @@ static inline void store_spring(double* spring, struct wetdem_vec3 s)
 }
 
 /* The spring update and tangential force on i [N] (wetdem_force_mindlin_update_with) from the
- * contact quantities it reads: unit normal n, tangential velocity v_t [m/s], dt [s], G* [Pa],
- * R* [m], m* [kg], overlap [m], f_limit [N], mu [-], the damping factor [-]; spring: the 3
- * doubles of history [m]. */
+ * contact quantities it reads: unit normal n, tangential velocity v_t [m/s] (the dashpot's),
+ * the velocity v_s the spring advances with over dt [m/s] (v_t, or the trapezoidal mean of the
+ * two-body CVODE engine: struct wetdem_contact dv_t_spring), dt [s], G* [Pa], R* [m], m* [kg],
+ * overlap [m], f_limit [N], mu [-], the damping factor [-]; spring: the 3 doubles of history
+ * [m]. */
 static inline __attribute__((always_inline)) struct wetdem_vec3
-mindlin_spring(struct wetdem_vec3 n, struct wetdem_vec3 v_t, double dt, double g_star, double r_eff,
-               double m_eff, double overlap, double f_limit, double mu, double damping_factor,
-               double* spring)
+mindlin_spring(struct wetdem_vec3 n, struct wetdem_vec3 v_t, struct wetdem_vec3 v_s, double dt,
+               double g_star, double r_eff, double m_eff, double overlap, double f_limit, double mu,
+               double damping_factor, double* spring)
 {
     if (!(overlap > 0.0)) {
         store_spring(spring, vec3(0, 0, 0));
         return vec3(0, 0, 0);
     }
     struct wetdem_vec3 s = rotate_into_plane(vec3(spring[0], spring[1], spring[2]), n);
-    s = vec3_axpy(s, dt, v_t);
+    s = vec3_axpy(s, dt, v_s);
     double k_t = tangential_stiffness(g_star, r_eff, overlap);
     double gamma_t = tangential_damping(k_t, m_eff, damping_factor);
     struct wetdem_vec3 ft = vec3_axpy(vec3_scale(s, -k_t), -gamma_t, v_t);

@@ -15,6 +15,8 @@
 #include <stdbool.h>
 #include <stddef.h>
 
+#include "wetdem.h"
+
 struct wetdem_sim;
 struct wetdem_model;
 
@@ -28,6 +30,10 @@ struct wetdem_pair {
     size_t j;            /* particle index (> i), or wall index when is_wall */
     bool is_wall;        /* j is a plane wall */
     bool has_interacted; /* came within the interaction range since the last separation stop */
+    /* v_t of the pair at engine.t_committed [m/s], kept for the integrators with trial
+     * evaluations (engine.trapezoid_spring): set at the start of every run and on every
+     * commit (sim_integrate.c) */
+    struct wetdem_vec3 v_t_committed;
 };
 
 struct wetdem_pairs {

@@ -47,7 +47,10 @@ struct wetdem_sim;
 struct wetdem_engine {
     double time;        /* simulated time [s] */
     double t_committed; /* time at which the pair histories hold the committed state [s] */
-    size_t integrator;  /* index into the integrator registry (integrator.c) */
+    /* the tangential spring advances with the mean of v_t at t_committed and at the
+     * evaluation (struct wetdem_contact dv_t_spring); set from the integrator at each run */
+    bool trapezoid_spring;
+    size_t integrator; /* index into the integrator registry (integrator.c) */
     /* parameter blocks of every registered integrator, addressed as "<name>.<param>" */
     double integrator_params[WETDEM_MAX_INTEGRATORS][WETDEM_INTEGRATOR_PARAMS_MAX];
 

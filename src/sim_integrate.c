@@ -13,7 +13,11 @@
  * engine.t_committed; a force evaluation at time t hands the models a scratch copy with
  * c->dt = t - t_committed and keeps the advanced copy only on commit. Pairs beyond their
  * interaction range are not evaluated, and their history is reset on commit, so each
- * encounter starts afresh.
+ * encounter starts afresh. With engine.trapezoid_spring (cvode, whose evaluations are trials
+ * anywhere in the step) the tangential spring advances with the trapezoidal mean
+ *     v_s = (v_t(t_committed) + v_t(t))/2,   projected into the current tangent plane,
+ * (c->dv_t_spring = v_s - v_t(t)), so s(t) = s_c + v_s (t - t_c) is second order in the step
+ * (docs/engines.md); v_t(t_committed) is kept per pair (struct wetdem_pair v_t_committed).
  */
 #include <math.h>
 #include <stdlib.h>
@@ -164,19 +168,24 @@ static void apply_pair(struct wetdem_engine* e, const struct wetdem_contact* c,
 static int eval_pair(struct wetdem_sim* sim, size_t k, double t, bool commit, bool accumulate)
 {
     struct wetdem_engine* e = &sim->engine;
-    const struct wetdem_pair* p = &e->pairs.items[k];
+    struct wetdem_pair* p = &e->pairs.items[k];
     double* history = wetdem_pairs_history(&e->pairs, k);
     struct wetdem_contact c;
     wetdem_sim_build_contact(sim, p->i, p->j, p->is_wall, &c);
+    struct wetdem_vec3 v_t = c.v_t;
     if (c.gap > wetdem_sim_contact_range(sim, &c)) {
         if (commit && history) /* (a min-separation record may outlive the force range) */
             wetdem_sim_history_beyond_range(sim, &c, wetdem_sim_record_range(sim, &c), history);
+        if (commit)
+            p->v_t_committed = v_t;
         return WETDEM_OK;
     }
     double scratch[WETDEM_HISTORY_SCRATCH];
     if (history)
         memcpy(scratch, history, sim->history_len * sizeof *scratch);
     c.dt = t - e->t_committed;
+    if (e->trapezoid_spring) /* v_t_committed lay in the old tangent plane */
+        c.dv_t_spring = vec3_reject(vec3_scale(vec3_sub(p->v_t_committed, v_t), 0.5), c.normal);
     struct wetdem_pair_force f;
     int st = wetdem_sim_eval_contact(sim, &c, scratch, &f, NULL);
     e->stats.pair_evals++;
@@ -191,6 +200,8 @@ static int eval_pair(struct wetdem_sim* sim, size_t k, double t, bool commit, bo
                                p->i, p->is_wall ? "wall " : "", p->j, t, c.gap);
     if (commit && history)
         memcpy(history, scratch, sim->history_len * sizeof *scratch);
+    if (commit)
+        p->v_t_committed = v_t;
     if (accumulate)
         apply_pair(e, &c, &f);
     return WETDEM_OK;
@@ -363,11 +374,27 @@ static int check_run(struct wetdem_sim* sim, double t_end)
     return WETDEM_OK;
 }
 
+/* v_t of every pair at the start state as the committed one (engine.trapezoid_spring): the
+ * histories hold the state at engine.time (t_committed), the particles may have been set
+ * since the last run. */
+static void note_start_velocities(struct wetdem_sim* sim)
+{
+    struct wetdem_engine* e = &sim->engine;
+    for (size_t k = 0; k < e->pairs.n; k++) {
+        struct wetdem_pair* p = &e->pairs.items[k];
+        struct wetdem_contact c;
+        wetdem_sim_build_contact(sim, p->i, p->j, p->is_wall, &c);
+        p->v_t_committed = c.v_t;
+    }
+}
+
 /* Pair list, event functions, per-particle arrays and the forces at the start state. */
 static int begin_run(struct wetdem_sim* sim)
 {
     struct wetdem_engine* e = &sim->engine;
     int st = wetdem_pairs_update(&e->pairs, sim);
+    if (st == WETDEM_OK && e->trapezoid_spring)
+        note_start_velocities(sim);
     if (st == WETDEM_OK)
         st = wetdem_event_slots_build(sim);
     if (st == WETDEM_OK && sim->n_particles > e->force_cap) {
@@ -395,6 +422,7 @@ int wetdem_sim_integrate(struct wetdem_sim* sim, double t_end)
     int st = check_run(sim, t_end);
     if (st == WETDEM_OK && sim->many) /* many-particle mode: cell lists, no events */
         return wetdem_sim_many_integrate(sim, t_end);
+    e->trapezoid_spring = wetdem_integrator_registry()[e->integrator]->trapezoid_spring;
     if (st == WETDEM_OK)
         st = begin_run(sim);
     bool due = e->observer_interval > 0 ? e->time >= e->next_observe : true;

@@ -434,8 +434,8 @@ lean_force(const struct wetdem_many* m, const struct lean_geometry* g,
                 hertz_total(f_el, hertz_damping_from(g->damping, overlap, v_n), L->hertz_form);
         if (L->mindlin) { /* wetdem_pair_force_add_tangential onto a zero record */
             struct wetdem_vec3 ft =
-                mindlin_spring(n, g->v_t, m->advance, x->g_star, r_eff, m_eff, overlap, f_el,
-                               L->mindlin_lub ? x->friction_lub : x->friction_dry,
+                mindlin_spring(n, g->v_t, g->v_t, m->advance, x->g_star, r_eff, m_eff, overlap,
+                               f_el, L->mindlin_lub ? x->friction_lub : x->friction_dry,
                                x->mindlin_damping, hist + L->mindlin_off);
             f_tan = vec3_add(zero, ft);
             struct wetdem_vec3 nxf = vec3_cross(n, ft);

@@ -626,7 +626,7 @@ double wetdem_sim_force_at_rest(const struct wetdem_sim* sim, struct wetdem_cont
         return NAN;
     struct wetdem_pair_force f;
     c.v_n = 0.0;
-    c.v_t = vec3(0, 0, 0);
+    c.v_t = c.dv_t_spring = vec3(0, 0, 0);
     return force_at_gap(sim, c, history, gap, &f) == WETDEM_OK && isfinite(f.f_normal) ? f.f_normal
                                                                                        : NAN;
 }
@@ -640,6 +640,7 @@ static double tangential_after(const struct wetdem_sim* sim, struct wetdem_conta
     c.gap = -overlap;
     c.v_n = 0.0;
     c.v_t = vec3_scale(t, u);
+    c.dv_t_spring = vec3(0, 0, 0);
     c.dt = dt;
     return wetdem_sim_eval_contact(sim, &c, NULL, &f, NULL) == WETDEM_OK ? vec3_dot(f.f_tan, t)
                                                                          : NAN;
