@@ -244,6 +244,48 @@ static void test_collision_cvode_sees_a_grazing_contact(void** state)
     CHECK_ABS(r[1].omega_i.z, r[0].omega_i.z, 1e-3 * fabs(r[0].omega_i.z));
 }
 
+/* e_t of a dry Hertz + Mindlin impact (steel spheres, 0.5 m/s, at `degrees` from the line of
+ * centres) with CVODE at its default tolerances and the largest step max_step (0: default). */
+static double mindlin_e_t(double degrees, double max_step)
+{
+    int mat;
+    struct wetdem_sim* sim = make_sim("steel1", 0, "hertz", "mindlin", "cvode", &mat);
+    CHECK_OK(wetdem_sim_set_param(sim, "cvode.max_step", max_step));
+    struct wetdem_collision_spec s = head_on(mat, 0.5, 1e-3);
+    s.initial_gap = 1e-4;
+    s.angle = degrees * M_PI / 180;
+    struct wetdem_collision_result r;
+    CHECK_OK(wetdem_collision_run(sim, &s, &r));
+    assert_true(r.separated && r.solid_contact);
+    wetdem_sim_free(sim);
+    return r.e_t;
+}
+
+/* CVODE's trial evaluations advance the committed Mindlin spring with the mean of v_t at the
+ * commit and at the trial (trapezoidal rule, docs/engines.md): second order in the step. With
+ * v_t at the end of the step (the first-order increment it replaced) e_t of this impact
+ * (Hertz contact time 48 us) was 4.9e-3 (10 deg) and 3.4e-3 (25 deg) from its converged value
+ * at default tolerances and moved by up to 6e-3 between max_step values; now 6.5e-4 and
+ * 1.1e-4 (1e-3 asserted), and at 10 deg halving max_step from 5e-7 s to 2.5e-7 and to
+ * 1.25e-7 s divides the error by 4.2 and 4.0 (first order: 2; 3 asserted). The reference,
+ * max_step 1e-8 s, is then 2e-7 from the limit. */
+static void test_collision_cvode_mindlin_second_order(void** state)
+{
+    (void)state;
+    const double degrees[] = {10, 25};
+    for (int k = 0; k < 2; k++) {
+        double ref = mindlin_e_t(degrees[k], 1e-8);
+        CHECK_ABS(mindlin_e_t(degrees[k], 0), ref, 1e-3);
+        if (k > 0)
+            continue;
+        double e1 = fabs(mindlin_e_t(degrees[k], 2.5e-7) - ref);
+        double e2 = fabs(mindlin_e_t(degrees[k], 1.25e-7) - ref);
+        print_message("mindlin e_t %g deg: ref %.9g, errors %.3g %.3g, ratio %.3g\n", degrees[k],
+                      ref, e1, e2, e1 / e2);
+        assert_true(e1 > 3 * e2);
+    }
+}
+
 /* CVODE's step bound near a contact applies to the very next step: a new largest step
  * (CVodeSetMaxStep) applies only from the step after next, and here (1 mm steel spheres at
  * 1 mm/s, 2 um apart, 0.3 rad, rtol 1e-8, atol 1e-11) the step before contact ended 1e-12 m
@@ -1024,6 +1066,7 @@ int main(void)
         cmocka_unit_test(test_collision_momentum),
         cmocka_unit_test(test_collision_energy_ratio_counts_the_capillary_well),
         cmocka_unit_test(test_collision_cvode_sees_a_grazing_contact),
+        cmocka_unit_test(test_collision_cvode_mindlin_second_order),
         cmocka_unit_test(test_collision_cvode_step_bound_applies_at_once),
         cmocka_unit_test(test_collision_cvode_sees_a_grazing_pass),
         cmocka_unit_test(test_collision_e_falls_with_viscosity),
