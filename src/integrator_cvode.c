@@ -31,9 +31,10 @@
  * placed exactly touching), interpolated between the step ends. On a root the integrator is
  * restarted with CVodeReInit there, at order 1, so that it never steps across the
  * discontinuity.
- * History-carrying models (tangential spring, largest approach speed) are therefore coupled to
- * first order in the step: their state advances once per accepted step with the end-of-step
- * kinematics and is not part of CVODE's error control (docs/engines.md).
+ * History-carrying models are not part of CVODE's error control (docs/engines.md): the largest
+ * approach speed is sampled once per accepted step, at its end (first order); the tangential
+ * spring advances from its committed value with the trapezoidal mean of v_t at the commit and
+ * at the trial (.trapezoid_spring, sim_integrate.c), second order in the step.
  */
 #include <float.h>
 #include <math.h>

@@ -267,7 +267,7 @@ static double mindlin_e_t(double degrees, double max_step)
  * (Hertz contact time 48 us) was 4.9e-3 (10 deg) and 3.4e-3 (25 deg) from its converged value
  * at default tolerances and moved by up to 6e-3 between max_step values; now 6.5e-4 and
  * 1.1e-4 (1e-3 asserted), and at 10 deg halving max_step from 5e-7 s to 2.5e-7 and to
- * 1.25e-7 s divides the error by 4.2 and 4.0 (first order: 2; 3 asserted). The reference,
+ * 1.25e-7 s divides the error by 4.1 and 4.0 (first order: 2; 3 asserted). The reference,
  * max_step 1e-8 s, is then 2e-7 from the limit. */
 static void test_collision_cvode_mindlin_second_order(void** state)
 {
