@@ -37,7 +37,6 @@ static void mix_properties(struct wetdem_contact* c, const struct wetdem_materia
     c->surface_tension = fluid ? fluid->surface_tension : 0.0;
     c->h_min = 0.0;
     c->dt = 0.0;
-    c->dv_t_spring = vec3(0, 0, 0);
 }
 
 void wetdem_contact_from_particles(struct wetdem_contact* c, const struct wetdem_particle* a,

@@ -39,7 +39,7 @@ static inline double contact_effective_mass(const struct wetdem_particle* p)
 
 /* The geometry and kinematics of the contact of a with b, d = x_a - x_b (minimum image where
  * the caller needs it): normal (b to a), gap, radii, R*, m*, v_n, v_t; the mixed properties
- * are the caller's. */
+ * are the caller's; dv_t_spring = 0. */
 static inline void contact_pair_geometry(struct wetdem_contact* c, const struct wetdem_particle* a,
                                          const struct wetdem_particle* b, struct wetdem_vec3 d)
 {
@@ -56,6 +56,7 @@ static inline void contact_pair_geometry(struct wetdem_contact* c, const struct 
     struct wetdem_vec3 vb = vec3_add(b->vel, vec3_cross(b->omega, vec3_scale(n, b->radius)));
     c->v_n = -vec3_dot(vec3_sub(a->vel, b->vel), n);
     c->v_t = vec3_reject(vec3_sub(va, vb), n);
+    c->dv_t_spring = vec3(0, 0, 0);
 }
 
 /* The same for particle a and the plane through `point` with unit `normal` (into the side of
@@ -74,6 +75,7 @@ static inline void contact_wall_geometry(struct wetdem_contact* c, const struct 
     struct wetdem_vec3 va = vec3_add(a->vel, vec3_cross(a->omega, vec3_scale(normal, -a->radius)));
     c->v_n = -vec3_dot(a->vel, normal);
     c->v_t = vec3_reject(va, normal);
+    c->dv_t_spring = vec3(0, 0, 0);
 }
 
 #endif
