@@ -2273,38 +2273,65 @@ static void collect_pass_work(struct wetdem_sim* sim, bool parallel)
     }
 }
 
+/* Whether a history of len doubles is all +0.0 bits (a fresh one, wetdem_sim_history_init). */
+static bool history_is_fresh(const double* h, size_t len)
+{
+    static const double zero[64]; /* (history_len <= 64, sim_many.c HISTORY_MAX) */
+    return memcmp(h, zero, len * sizeof *h) == 0;
+}
+
 /* The histories of the pairs and particle-wall pairs as the state gives them, kept in
- * m->old_history (unused between list builds, whose remap needs that room anyway) for
- * put_given_histories; *n gets the number of doubles kept. For the first pass of a run. */
-static int keep_given_histories(struct wetdem_sim* sim, size_t* n)
+ * m->old_history (unused between list builds, whose remap needs room for the pairs anyway)
+ * for put_given_histories: the pairs' whole, then of the n_particles x n_walls wall histories
+ * only those that are not fresh, each after its index (a double, exact below 2^53), so that
+ * the buffer grows by no more than the pairs need (all wall histories would add ~160 bytes a
+ * particle in a closed box). *kept: whether anything was kept. For the first pass of a run. */
+static int keep_given_histories(struct wetdem_sim* sim, bool* kept)
 {
     struct wetdem_many* m = sim->many;
-    size_t len = sim->history_len, pairs = m->cl.n_pairs * len;
-    *n = pairs + sim->n_particles * sim->n_walls * len;
-    if (*n == 0)
+    size_t len = sim->history_len, pairs = m->cl.n_pairs * len, rows = 0;
+    size_t n_rows = sim->n_particles * sim->n_walls;
+    *kept = false;
+    if (len == 0)
         return WETDEM_OK;
-    if (!reserve((void**)&m->old_history, &m->old_history_cap, *n, sizeof(double)))
+    for (size_t r = 0; r < n_rows; r++)
+        rows += !history_is_fresh(m->wall_history + r * len, len);
+    size_t n = pairs + rows * (len + 1) + 1;
+    if (!reserve((void**)&m->old_history, &m->old_history_cap, n, sizeof(double)))
         return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory for %zu pair histories",
-                               *n / len);
+                               m->cl.n_pairs + rows);
+    double* o = m->old_history;
     if (pairs) /* (no memcpy from a NULL array, even of nothing) */
-        memcpy(m->old_history, m->history, pairs * sizeof(double));
-    if (*n > pairs)
-        memcpy(m->old_history + pairs, m->wall_history, (*n - pairs) * sizeof(double));
+        memcpy(o, m->history, pairs * sizeof(double));
+    o += pairs;
+    *o++ = (double)rows;
+    for (size_t r = 0; r < n_rows; r++)
+        if (!history_is_fresh(m->wall_history + r * len, len)) {
+            *o++ = (double)r;
+            memcpy(o, m->wall_history + r * len, len * sizeof(double));
+            o += len;
+        }
+    *kept = true;
     return WETDEM_OK;
 }
 
-/* Puts the n doubles of histories kept by keep_given_histories back (n = 0: none kept, a pass
- * after the first or no histories). */
-static void put_given_histories(struct wetdem_sim* sim, size_t n)
+/* Puts the histories kept by keep_given_histories back (kept = false: none kept, a pass after
+ * the first or no histories): the pairs', and the wall histories fresh but for those kept. */
+static void put_given_histories(struct wetdem_sim* sim, bool kept)
 {
     struct wetdem_many* m = sim->many;
-    size_t pairs = m->cl.n_pairs * sim->history_len;
-    if (n == 0)
+    size_t len = sim->history_len, pairs = m->cl.n_pairs * len;
+    if (!kept)
         return;
+    const double* o = m->old_history;
     if (pairs)
-        memcpy(m->history, m->old_history, pairs * sizeof(double));
-    if (n > pairs)
-        memcpy(m->wall_history, m->old_history + pairs, (n - pairs) * sizeof(double));
+        memcpy(m->history, o, pairs * sizeof(double));
+    o += pairs;
+    size_t rows = (size_t)*o++;
+    for (size_t r = 0; r < sim->n_particles * sim->n_walls; r++)
+        wetdem_sim_history_init(sim, m->wall_history + r * len);
+    for (size_t q = 0; q < rows; q++, o += len + 1)
+        memcpy(m->wall_history + (size_t)o[0] * len, o + 1, len * sizeof(double));
 }
 
 int wetdem_sim_many_forces(struct wetdem_sim* sim, enum wetdem_many_end end)
@@ -2326,7 +2353,7 @@ int wetdem_sim_many_forces(struct wetdem_sim* sim, enum wetdem_many_end end)
        file): springs not advanced, and nothing it writes into the histories kept (a spring set
        to the Coulomb limit, a min-separation record); a test per pass, none per pair */
     m->advance = m->started ? m->dt : 0.0;
-    size_t given = 0;
+    bool given = false;
     if (st == WETDEM_OK && !m->started)
         st = keep_given_histories(sim, &given);
     if (st == WETDEM_OK && m->set.energy_budget)
