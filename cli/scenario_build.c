@@ -318,8 +318,8 @@ static int build_kinematics(const struct cli_scenario* sc, struct cli_setup* su,
     s->target_is_fixed = strcmp(target, "fixed") == 0;
     s->radius_i = cli_scenario_number(sc, "collision", "striker_radius", 6.35e-3);
     s->radius_j = cli_scenario_number(sc, "collision", "target_radius", s->radius_i);
-    double m_i = mi->density * 4.0 / 3.0 * PI * pow(s->radius_i, 3);
-    double m_j = mj->density * 4.0 / 3.0 * PI * pow(s->radius_j, 3);
+    double m_i = wetdem_material_sphere_mass(mi, s->radius_i);
+    double m_j = wetdem_material_sphere_mass(mj, s->radius_j);
     bool free_target = !s->target_is_wall && !s->target_is_fixed;
     bool striker_ok = isfinite(m_i) && m_i > 0, target_ok = isfinite(m_j) && m_j > 0;
     /* a radius or density near the ends of the double range */

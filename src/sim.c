@@ -168,7 +168,7 @@ int wetdem_sim_add_particle(struct wetdem_sim* sim, struct wetdem_particle p)
                                p.material, sim->n_materials - 1);
     double density = sim->materials[p.material].density;
     if (p.mass == 0) {
-        p.mass = density * 4.0 / 3.0 * M_PI * p.radius * p.radius * p.radius;
+        p.mass = wetdem_material_sphere_mass(&sim->materials[p.material], p.radius);
         if (isfinite(p.radius) && p.radius > 0 && !(isfinite(p.mass) && p.mass > 0))
             return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
                                    "particle %zu: its mass density x 4/3 pi R^3 = %g kg (density "

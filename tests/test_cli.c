@@ -533,6 +533,52 @@ static void test_cli_stdout_write_failures(void** state)
     }
 }
 
+/* The text after `"key": ` in a JSON line, up to the next comma or brace. */
+static void json_token(const char* json, const char* key, char* out, size_t n)
+{
+    char pattern[64];
+    snprintf(pattern, sizeof pattern, "\"%s\": ", key);
+    const char* at = strstr(json, pattern);
+    assert_non_null(at);
+    at += strlen(pattern);
+    size_t len = strcspn(at, ",}");
+    assert_true(len < n);
+    memcpy(out, at, len);
+    out[len] = '\0';
+}
+
+/* `run --check` reports the St_n the run then uses, bit for bit: both take the spheres'
+ * masses from wetdem_material_sphere_mass. Before, the check computed them with pow(R, 3) and the run
+ * with R R R, and a scenario asking for stokes = 100 was checked as 99.999999999999986 and run
+ * as 99.999999999999972. */
+static void test_cli_check_reports_the_stokes_number_run(void** state)
+{
+    (void)state;
+    char dir[] = "/tmp/wetdem_test_cli_check_st_XXXXXX";
+    assert_non_null(mkdtemp(dir));
+    static const char* const scenarios[] = {"nijssen_head_on.ini", "nijssen_oblique.ini",
+                                            "punch_oblique.ini", "wall_collision.ini"};
+    for (size_t k = 0; k < sizeof scenarios / sizeof scenarios[0]; k++) {
+        char args[400], checked[64], run[64];
+        snprintf(args, sizeof args, "run examples/scenarios/%s --check --json", scenarios[k]);
+        struct test_run r = run_cli(args, false);
+        assert_int_equal(r.code, 0);
+        json_token(r.out, "stokes_n", checked, sizeof checked);
+        free(r.out);
+        snprintf(args, sizeof args, "run examples/scenarios/%s --json --out %s/%zu", scenarios[k],
+                 dir, k);
+        r = run_cli(args, false);
+        assert_int_equal(r.code, 0);
+        json_token(r.out, "stokes_n", run, sizeof run);
+        free(r.out);
+        if (strcmp(checked, run) != 0)
+            fail_msg("%s: --check St_n %s, the run's %s", scenarios[k], checked, run);
+        snprintf(args, sizeof args, "rm -r %s/%zu", dir, k);
+        assert_int_equal(system(args), 0);
+    }
+    assert_int_equal(rmdir(dir), 0);
+}
+
 /* Output named /dev/stdout goes through standard output in place, also when that is a
  * regular file (`> FILE`): the CSV of fit --out and track --frames and the summary printed
  * beside it all reach the file. Before, /dev/stdout led to that file, which was replaced by a
@@ -943,6 +989,7 @@ int main(void)
         cmocka_unit_test(test_cli_run_outputs_journal_names_with_tabs),
         cmocka_unit_test(test_cli_run_outputs_foreign_journal_left_alone),
         cmocka_unit_test(test_cli_run_outputs_into_a_deep_directory),
+        cmocka_unit_test(test_cli_check_reports_the_stokes_number_run),
         cmocka_unit_test(test_cli_dev_stdout_output_to_a_redirected_file),
         cmocka_unit_test(test_cli_numbers_out_of_range_and_cr_lines),
     };
