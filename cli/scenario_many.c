@@ -18,7 +18,7 @@
  * overlaps by construction (src/insert.c; a random group also keeps clear of the spheres
  * added before it) and the groups are checked against each other here
  * (|x_i - x_j| >= R_i + R_j with the minimum image on periodic axes), as is every centre being
- * inside the box and every sphere inside the walls.
+ * inside the box and every free sphere of [insert] or [particle] inside the walls.
  *
  * Every check runs before anything is written; each failure names the file, the line and the
  * key (scenario.h error convention).
@@ -98,7 +98,9 @@ static const struct cli_key_desc insert_keys[] = {
 
 static const struct cli_key_desc particle_keys[] = {
     NUM("radius", "m", "required", 0, 1, true, false, "Radius."),
-    NUM("x", "m", "required", -1e3, 1e3, false, false, "Centre, x (inside the box)."),
+    NUM("x", "m", "required", -1e3, 1e3, false, false,
+        "Centre, x (inside the box; a free sphere wholly inside the walls, a fixed one may cut "
+        "them)."),
     NUM("y", "m", "required", -1e3, 1e3, false, false, "Centre, y."),
     NUM("z", "m", "required", -1e3, 1e3, false, false, "Centre, z."),
     NUM("vx", "m/s", "0", -1e3, 1e3, false, false, "Velocity, x."),
@@ -741,7 +743,8 @@ struct group {
 
 /* Spheres [from, n) of the latest of groups[0 .. n_groups) against the spheres of the groups
  * before it, and each inside the box: its centre in [0, size], and the whole sphere inside on
- * an axis with walls. */
+ * an axis with walls unless it was read from a file or is fixed (fixed spheres meet no wall:
+ * a base sunk into the floor). */
 static int check_group(const struct cli_scenario* sc, const struct cli_many_setup* su,
                        const struct group* groups, size_t n_groups, unsigned faces)
 {
@@ -753,8 +756,9 @@ static int check_group(const struct cli_scenario* sc, const struct cli_many_setu
     for (size_t i = from; i < n; i++) {
         double x[3] = {p[i].pos.x, p[i].pos.y, p[i].pos.z};
         for (int k = 0; k < 3; k++) {
-            double lo = inside_walls && (faces >> (2 * k)) & 1u ? p[i].radius : 0.0;
-            double hi = inside_walls && (faces >> (2 * k + 1)) & 1u ? p[i].radius : 0.0;
+            bool walls = inside_walls && !p[i].is_fixed;
+            double lo = walls && (faces >> (2 * k)) & 1u ? p[i].radius : 0.0;
+            double hi = walls && (faces >> (2 * k + 1)) & 1u ? p[i].radius : 0.0;
             if (!(x[k] >= lo && x[k] <= su->box[k] - hi)) {
                 cli_scenario_section_error(sc, section,
                                            "sphere %zu of [%s] (centre %c = %g m, "

@@ -1391,6 +1391,18 @@ static void test_many_cli_read_spheres_from_a_file(void** state)
     assert_non_null(frame);
     CHECK_CONTAINS(frame, "fixed 1 4 int\n0\n0\n0\n0\n");
     free(frame);
+    /* a fixed [particle] may cut a wall, as a fixed sphere read from a file may: it meets
+       none (it was refused as "outside the box ... or cuts a wall"); a free one may not */
+    const char* sunk = WET_BOX "[particle.base]\nradius = 4e-4\nx = 3e-3\ny = 3e-3\nz = 1e-4\n"
+                               "material = wet\nfixed = %s\n[run]\ndt = 2e-6\nsteps = 1\n";
+    snprintf(ini, sizeof ini, sunk, "yes");
+    write_text("sunk.ini", ini);
+    expect_output("run sunk.ini --check", "out.txt", "  particles     1  (1 fixed)\n");
+    snprintf(ini, sizeof ini, sunk, "no");
+    write_text("sunk.ini", ini);
+    free(expect_exit("run sunk.ini --check", 2,
+                     "sphere 1 of [particle.base] (centre z = 0.0001 m, radius 0.0004 m) is "
+                     "outside the box [0, 0.008] m or cuts a wall"));
     /* a CSV's fixed column */
     write_text("fixed.csv", "x,y,z,radius,vx,fixed\n1e-3,3e-3,1e-3,4e-4,0,1\n"
                             "3e-3,3e-3,3e-3,4e-4,0.1,0\n");
