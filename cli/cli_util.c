@@ -185,6 +185,20 @@ void cli_print_provenance(FILE* f, int argc, char** argv)
     fputc('\n', f);
 }
 
+char* cli_provenance_text(int argc, char** argv)
+{
+    size_t n = strlen("git ") + strlen(WETDEM_GIT_HASH) + strlen("\ncommand: wetdem") + 1;
+    for (int k = 0; k < argc; k++)
+        n += 1 + strlen(argv[k]);
+    char* text = malloc(n);
+    if (!text)
+        return NULL;
+    size_t at = (size_t)snprintf(text, n, "git %s\ncommand: wetdem", WETDEM_GIT_HASH);
+    for (int k = 0; k < argc; k++)
+        at += (size_t)snprintf(text + at, n - at, " %s", argv[k]);
+    return text;
+}
+
 /* Creates dir and its parents (mkdir -p). */
 int cli_make_dirs(const char* dir)
 {

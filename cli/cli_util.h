@@ -107,6 +107,10 @@ bool cli_is_frame_name(const char* prefix, const char* name);
  *     # command: wetdem <argv[0]> <argv[1]> ...
  * argv is the subcommand's argument vector (argv[0] = subcommand name). */
 void cli_print_provenance(FILE* f, int argc, char** argv);
+/* The lines "git HASH" and "command: wetdem ARGS" (no '#', no final newline) in a new string
+ * for the caller to free, or NULL when out of memory: the provenance of a file the library
+ * writes (the many-particle CSV's csv_comment). */
+char* cli_provenance_text(int argc, char** argv);
 
 /* mkdir -p: creates dir and its parents. 0, or -1 with errno set. */
 int cli_make_dirs(const char* dir);

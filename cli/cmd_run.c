@@ -168,7 +168,7 @@ static int run_soft(const struct cli_scenario* sc, struct cli_setup* su, const s
     if (events.f)
         cli_events_csv(events.f, su->sim, argc, argv);
     if (summary.f)
-        cli_summary_json(summary.f, sc, su, &res);
+        cli_summary_json(summary.f, sc, su, &res, argc, argv);
     /* the three files as a set: all kept whole, or none (a signal until now keeps none) */
     sigset_t mask;
     cli_signals_block(&mask);
@@ -179,7 +179,7 @@ static int run_soft(const struct cli_scenario* sc, struct cli_setup* su, const s
     if (stopped)
         return stopped;
     if (a->json)
-        cli_summary_json(stdout, sc, su, &res);
+        cli_summary_json(stdout, sc, su, &res, argc, argv);
     else
         cli_summary_text(stdout, sc, su, &res);
     if (a->out_dir && rc == CLI_EXIT_OK && !a->json)

@@ -279,6 +279,16 @@ void cli_json_string(FILE* f, const char* s)
     fputc('"', f);
 }
 
+void cli_json_command(FILE* f, int argc, char** argv)
+{
+    fputs("[\"wetdem\"", f);
+    for (int k = 0; k < argc; k++) {
+        fputs(", ", f);
+        cli_json_string(f, argv[k]);
+    }
+    fputc(']', f);
+}
+
 static void json_fields(FILE* f, const struct cli_field* fields, size_t n, bool units)
 {
     for (size_t k = 0; k < n; k++) {
@@ -297,11 +307,13 @@ static void json_fields(FILE* f, const struct cli_field* fields, size_t n, bool 
 }
 
 void cli_summary_json(FILE* f, const struct cli_scenario* sc, const struct cli_setup* su,
-                      const struct wetdem_collision_result* r)
+                      const struct wetdem_collision_result* r, int argc, char** argv)
 {
     fprintf(f, "{\n  \"wetdem\": \"%s\",\n  \"git\": \"%s\",\n  \"scenario\": ", WETDEM_VERSION,
             WETDEM_GIT_HASH);
     cli_json_string(f, sc->file);
+    fputs(",\n  \"command\": ", f);
+    cli_json_command(f, argc, argv);
     fputs(",\n  \"integrator\": ", f);
     cli_json_string(f, wetdem_sim_integrator_name(su->sim));
     fputs(",\n  \"setup\": {\n    \"m_eff\": ", f);

@@ -72,9 +72,9 @@ void cli_csv_failed_row(FILE* f, const struct cli_setup* su);
 /* The result as aligned "name  value  unit  meaning" lines. */
 void cli_summary_text(FILE* f, const struct cli_scenario* sc, const struct cli_setup* su,
                       const struct wetdem_collision_result* r);
-/* The result as one JSON object (version, scenario, integrator, result, units). */
+/* The result as one JSON object (version, scenario, command, integrator, result, units). */
 void cli_summary_json(FILE* f, const struct cli_scenario* sc, const struct cli_setup* su,
-                      const struct wetdem_collision_result* r);
+                      const struct wetdem_collision_result* r, int argc, char** argv);
 /* The event log of sim as CSV, with provenance lines. */
 void cli_events_csv(FILE* f, const struct wetdem_sim* sim, int argc, char** argv);
 
@@ -96,5 +96,8 @@ int cli_trajectory_observe(const struct wetdem_sim* sim, void* ctx);
 void cli_json_number(FILE* f, double v);
 /* A string as JSON (quotes and backslashes escaped). */
 void cli_json_string(FILE* f, const char* s);
+/* The command line as a JSON array of strings, "wetdem" and then the subcommand's arguments
+ * (argc, argv from "run" on), as the CSV files' "# command:" line gives it. */
+void cli_json_command(FILE* f, int argc, char** argv);
 
 #endif

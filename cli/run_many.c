@@ -416,10 +416,16 @@ static int csv_resume(const char* path, double t, unsigned long long step, doubl
     snprintf(tmp, sizeof tmp, "%s.tmp", path);
     FILE* g = fopen(tmp, "w");
     char line[4096];
-    bool dropped = false, header = false, rows = false;
+    bool dropped = false, header = false, rows = false, in_comment = false;
     unsigned long long every = w->csv_every, last = 0; /* the last whole row's step */
     unsigned long long off_grid = 0; /* 1 + the step of a row off the checkpoint's time grid */
     while (g && fgets(line, sizeof line, f)) {
+        bool comment = in_comment || line[0] == '#'; /* (kept whole, however long) */
+        in_comment = comment && !strchr(line, '\n');
+        if (comment) {
+            fputs(line, g);
+            continue;
+        }
         const char* comma = strchr(line, ',');
         bool data = line[0] >= '0' && line[0] <= '9' && comma;
         unsigned long long row = data ? strtoull(comma + 1, NULL, 10) : 0;
@@ -688,12 +694,14 @@ static void json_num(FILE* f, const char* key, double v, bool comma)
 }
 
 static void summary_json(FILE* f, const struct cli_scenario* sc, const struct cli_many_setup* su,
-                         const struct outcome* o)
+                         const struct cli_run_options* opt, const struct outcome* o)
 {
     const struct wetdem_many_stats* s = &o->stats;
     fprintf(f, "{\"engine\": \"many\", \"version\": \"%s\", \"git\": \"%s\", \"scenario\": ",
             WETDEM_VERSION, WETDEM_GIT_HASH);
     cli_json_string(f, sc->file);
+    fputs(", \"command\": ", f);
+    cli_json_command(f, opt->argc, opt->argv);
     fprintf(f,
             ", \"interrupted\": %s, \"particles\": %zu, \"fixed\": %zu, \"walls\": %zu, "
             "\"step\": %llu, \"vtk_every\": %llu, \"csv_every\": %llu, ",
@@ -730,7 +738,8 @@ static void summary_json(FILE* f, const struct cli_scenario* sc, const struct cl
 
 /* Writes DIR/summary.json atomically. CLI exit code. */
 static int write_summary(const char* dir, const struct cli_scenario* sc,
-                         const struct cli_many_setup* su, const struct outcome* o)
+                         const struct cli_many_setup* su, const struct cli_run_options* opt,
+                         const struct outcome* o)
 {
     if (!dir || !su->summary_name[0])
         return CLI_EXIT_OK;
@@ -739,7 +748,7 @@ static int write_summary(const char* dir, const struct cli_scenario* sc,
     snprintf(tmp, sizeof tmp, "%s.tmp", path);
     FILE* f = fopen(tmp, "w");
     if (f)
-        summary_json(f, sc, su, o);
+        summary_json(f, sc, su, opt, o);
     bool ok = f && !ferror(f);
     ok = f && fclose(f) == 0 && ok;
     if (ok && rename(tmp, path) == 0)
@@ -943,7 +952,15 @@ static int set_outputs(struct cli_many_setup* su, const struct cli_run_options* 
     m.progress = on_progress;
     m.progress_ctx = prog;
     m.progress_every = 1;
-    if (wetdem_sim_set_many(su->sim, &m) == WETDEM_OK)
+    char* comment = cli_provenance_text(opt->argc, opt->argv);
+    if (!comment) {
+        cli_error("run: out of memory");
+        return CLI_EXIT_RUNTIME;
+    }
+    m.csv_comment = comment;
+    int st = wetdem_sim_set_many(su->sim, &m);
+    free(comment); /* (copied) */
+    if (st == WETDEM_OK)
         return CLI_EXIT_OK;
     cli_error("run: %s", wetdem_sim_errmsg(su->sim));
     return CLI_EXIT_RUNTIME;
@@ -1077,9 +1094,9 @@ static int finish(const struct cli_scenario* sc, struct cli_many_setup* su,
                                  : "run with --out DIR to keep one");
         else
             fprintf(stderr, "; checkpoint %s written\n", pl->checkpoint);
-        write_summary(opt->out_dir, sc, su, &o); /* ("interrupted": true) */
+        write_summary(opt->out_dir, sc, su, opt, &o); /* ("interrupted": true) */
         if (opt->json)
-            summary_json(stdout, sc, su, &o);
+            summary_json(stdout, sc, su, opt, &o);
         if (pl->checkpoint[0])
             print_resume(opt, pl->checkpoint);
         return 128 + sig;
@@ -1093,9 +1110,9 @@ static int finish(const struct cli_scenario* sc, struct cli_many_setup* su,
         cli_error("run %s: %s", sc->file, wetdem_sim_errmsg(su->sim));
         return CLI_EXIT_RUNTIME;
     }
-    int rc = write_summary(opt->out_dir, sc, su, &o);
+    int rc = write_summary(opt->out_dir, sc, su, opt, &o);
     if (opt->json)
-        summary_json(stdout, sc, su, &o);
+        summary_json(stdout, sc, su, opt, &o);
     else
         summary_text(stdout, su, &o);
     if (opt->out_dir && !opt->json && rc == CLI_EXIT_OK)

@@ -350,12 +350,16 @@ static void json_number(FILE* f, double v)
         fputs("null", f);
 }
 
-static void summary_json(FILE* f, const struct wetdem_pairwise_result* r)
+static void summary_json(FILE* f, const struct cli_scenario* sc, const struct cli_run_options* opt,
+                         const struct wetdem_pairwise_result* r)
 {
-    fprintf(f,
-            "{\"engine\": \"pairwise\", \"version\": \"%s\", \"outcome\": \"%s\", "
-            "\"separated_sphere\": %d, \"time_s\": ",
-            WETDEM_VERSION, wetdem_pairwise_outcome_name(r->outcome),
+    fprintf(f, "{\"engine\": \"pairwise\", \"version\": \"%s\", \"git\": \"%s\", \"scenario\": ",
+            WETDEM_VERSION, WETDEM_GIT_HASH);
+    cli_json_string(f, sc->file);
+    fputs(", \"command\": ", f);
+    cli_json_command(f, opt->argc, opt->argv);
+    fprintf(f, ", \"outcome\": \"%s\", \"separated_sphere\": %d, \"time_s\": ",
+            wetdem_pairwise_outcome_name(r->outcome),
             r->separated_sphere >= 0 ? r->separated_sphere + 1 : -1);
     json_number(f, r->time);
     fputs(", \"v_n0_m_s\": ", f);
@@ -549,7 +553,7 @@ static int run_with_files(const struct cli_scenario* sc, const struct cli_run_op
         events_csv(fe.f, pw);
     }
     if (fs.f)
-        summary_json(fs.f, r);
+        summary_json(fs.f, sc, opt, r);
     /* the three files as a set: all kept whole, or none (a signal until now keeps none) */
     sigset_t mask;
     cli_signals_block(&mask);
@@ -607,7 +611,7 @@ int cli_run_pairwise(const struct cli_scenario* sc, const struct cli_run_options
                   wetdem_status_name(status));
         rc = CLI_EXIT_RUNTIME;
     } else if (opt->json) {
-        summary_json(stdout, &r);
+        summary_json(stdout, sc, opt, &r);
     } else {
         summary_text(stdout, &r);
     }

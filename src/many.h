@@ -193,6 +193,7 @@ struct wetdem_many {
     struct wetdem_many_settings set; /* copy; the strings below are owned copies */
     char* output_prefix;
     char* checkpoint_path;
+    char* csv_comment;
     struct wetdem_celllist cl;
     double reach; /* largest interaction gap of any pair [m] (start-up bound) */
     /* With a min-separation model that keeps a record beyond the force range (its record_range

@@ -88,6 +88,7 @@ void wetdem_sim_many_free(struct wetdem_sim* sim)
     wetdem_celllist_clear(&m->cl);
     free(m->output_prefix);
     free(m->checkpoint_path);
+    free(m->csv_comment);
     free(m->history);
     free(m->wall_history);
     free(m->old_pairs);
@@ -149,10 +150,13 @@ int wetdem_sim_set_many(struct wetdem_sim* sim, const struct wetdem_many_setting
     m->set = *s;
     m->output_prefix = dup_string(s->output_prefix);
     m->checkpoint_path = dup_string(s->checkpoint_path);
+    m->csv_comment = dup_string(s->csv_comment);
     m->set.output_prefix = m->output_prefix;
     m->set.checkpoint_path = m->checkpoint_path;
+    m->set.csv_comment = m->csv_comment;
     sim->many = m;
-    if ((s->output_prefix && !m->output_prefix) || (s->checkpoint_path && !m->checkpoint_path))
+    if ((s->output_prefix && !m->output_prefix) || (s->checkpoint_path && !m->checkpoint_path) ||
+        (s->csv_comment && !m->csv_comment))
         return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory");
     return WETDEM_OK;
 }
@@ -165,13 +169,16 @@ void wetdem_sim_many_reset(struct wetdem_sim* sim)
     struct wetdem_many_settings s = sim->many->set;
     char* prefix = dup_string(s.output_prefix);
     char* checkpoint = dup_string(s.checkpoint_path);
+    char* comment = dup_string(s.csv_comment);
     s.output_prefix = prefix;
     s.checkpoint_path = checkpoint;
+    s.csv_comment = comment;
     if ((s.output_prefix && !prefix) || (s.checkpoint_path && !checkpoint) ||
-        wetdem_sim_set_many(sim, &s) != WETDEM_OK)
+        (s.csv_comment && !comment) || wetdem_sim_set_many(sim, &s) != WETDEM_OK)
         wetdem_sim_many_free(sim); /* (out of memory: back to the two-body mode) */
     free(prefix);
     free(checkpoint);
+    free(comment);
 }
 
 struct wetdem_vec3 wetdem_sim_many_nearest_image(const struct wetdem_sim* sim, struct wetdem_vec3 a,

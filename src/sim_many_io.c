@@ -498,6 +498,11 @@ static int reload_series(struct wetdem_sim* sim)
 static void csv_header(const struct wetdem_sim* sim, FILE* f)
 {
     fprintf(f, "# wetdem %s many-particle run: global quantities\n", WETDEM_VERSION);
+    for (const char* line = sim->many->set.csv_comment; line && *line;) {
+        size_t n = strcspn(line, "\n");
+        fprintf(f, "# %.*s\n", (int)n, line);
+        line += n + (line[n] == '\n');
+    }
     fputs("time_s,step,kinetic_J,potential_J,elastic_J,contacts,bridges,agglomerates,"
           "mean_agglomerate_size,candidate_pairs",
           f);

@@ -579,6 +579,66 @@ static void test_cli_check_reports_the_stokes_number_run(void** state)
     assert_int_equal(rmdir(dir), 0);
 }
 
+/* Every engine's summary.json (and --json) names the command that made it, --set included,
+ * as the CSV files' "# command:" line does: the overrides were in no file of a many-particle
+ * or pairwise run, and a pairwise summary named neither the scenario nor the git version. */
+static void test_cli_summary_names_its_command(void** state)
+{
+    (void)state;
+    char dir[] = "/tmp/wetdem_test_cli_command_XXXXXX";
+    assert_non_null(mkdtemp(dir));
+    static const struct {
+        const char* scenario;
+        const char* set;
+    } cases[] = {
+        {"dry_hertz.ini", "collision.speed=0.2"},
+        {"davis_three.ini", "davis.stokes=3"},
+        {"many_stokes_cradle.ini", "run.steps=2"},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        char args[400], want[600], path[300];
+        snprintf(args, sizeof args, "run examples/scenarios/%s --set '%s' --out %s/%zu",
+                 cases[k].scenario, cases[k].set, dir, k);
+        struct test_run r = run_cli(args, false);
+        assert_int_equal(r.code, 0);
+        free(r.out);
+        snprintf(path, sizeof path, "%s/%zu/summary.json", dir, k);
+        char* json = test_read_file(path, NULL);
+        assert_non_null(json);
+        snprintf(want, sizeof want,
+                 "\"scenario\": \"examples/scenarios/%s\", \"command\": [\"wetdem\", \"run\", "
+                 "\"examples/scenarios/%s\", \"--set\", \"%s\", \"--out\", \"%s/%zu\"]",
+                 cases[k].scenario, cases[k].scenario, cases[k].set, dir, k);
+        if (k == 0) /* the two-body summary puts a field on each line */
+            snprintf(want, sizeof want,
+                     "\"scenario\": \"examples/scenarios/%s\",\n  \"command\": [\"wetdem\", "
+                     "\"run\", \"examples/scenarios/%s\", \"--set\", \"%s\", \"--out\", "
+                     "\"%s/%zu\"]",
+                     cases[k].scenario, cases[k].scenario, cases[k].set, dir, k);
+        CHECK_CONTAINS(json, want);
+        CHECK_CONTAINS(json, "\"git\": \"");
+        free(json);
+    }
+    /* and the many-particle run's global.csv, which the library writes, under its first line */
+    char path[300], want[600];
+    snprintf(path, sizeof path, "%s/2/global.csv", dir);
+    char* csv = test_read_file(path, NULL);
+    assert_non_null(csv);
+    const char* git = strstr(csv, "\n# git ");
+    assert_non_null(git);
+    const char* command = strstr(git + 1, "\n# command: ");
+    assert_non_null(command);
+    snprintf(want, sizeof want,
+             "\n# command: wetdem run examples/scenarios/many_stokes_cradle.ini --set run.steps=2 "
+             "--out %s/2\ntime_s,",
+             dir);
+    assert_memory_equal(command, want, strlen(want));
+    free(csv);
+    char cmd[200];
+    snprintf(cmd, sizeof cmd, "rm -r %s", dir);
+    assert_int_equal(system(cmd), 0);
+}
+
 /* Output named /dev/stdout goes through standard output in place, also when that is a
  * regular file (`> FILE`): the CSV of fit --out and track --frames and the summary printed
  * beside it all reach the file. Before, /dev/stdout led to that file, which was replaced by a
@@ -990,6 +1050,7 @@ int main(void)
         cmocka_unit_test(test_cli_run_outputs_foreign_journal_left_alone),
         cmocka_unit_test(test_cli_run_outputs_into_a_deep_directory),
         cmocka_unit_test(test_cli_check_reports_the_stokes_number_run),
+        cmocka_unit_test(test_cli_summary_names_its_command),
         cmocka_unit_test(test_cli_dev_stdout_output_to_a_redirected_file),
         cmocka_unit_test(test_cli_numbers_out_of_range_and_cr_lines),
     };
