@@ -288,6 +288,23 @@ static inline int test_run_cli_into(const char* args, char* out, size_t n)
  * EFBIG instead of killing the program. Pipes (the output tests read) have no such limit. */
 #define TEST_FILE_SIZE_LIMIT "trap '' XFSZ; ulimit -f 2;"
 
+/* Takes the field "command": [...] (the command line, which differs between runs that are
+ * otherwise the same) out of a summary's JSON text in place, with the separator before it;
+ * true if there was one. The arguments must hold no ']'. */
+static inline bool test_drop_json_command(char* json)
+{
+    char* at = strstr(json, "\"command\": [\"wetdem\"");
+    char* end = at ? strchr(at, ']') : NULL;
+    if (!end)
+        return false;
+    while (at > json && (at[-1] == ' ' || at[-1] == '\n'))
+        at--;
+    if (at > json && at[-1] == ',')
+        at--;
+    memmove(at, end + 1, strlen(end + 1) + 1);
+    return true;
+}
+
 /* The names in directory dir, hidden ones included (not "." and ".."), each followed by a
  * newline, sorted, in a heap buffer (the caller frees it); "" for an empty directory and NULL
  * when dir cannot be opened (e.g. it does not exist). */
