@@ -181,10 +181,11 @@ WETDEM_API const char* const* wetdem_material_preset_names(void);
 /* Descriptors of struct wetdem_material and struct wetdem_fluid, for docs and validation. */
 WETDEM_API const struct wetdem_param_desc* wetdem_material_params(void);
 WETDEM_API const struct wetdem_param_desc* wetdem_fluid_params(void);
-/* Checks every field of a material; message into msg. WETDEM_OK or WETDEM_ERR_INVALID. */
 /* The mass density (4/3) pi R^3 [kg] of a solid sphere of material m and radius R [m], as the
- * library fills in a particle's mass of 0: callers deriving m* or St_n get the library's bits. */
+ * library fills in a particle's mass of 0: callers deriving m* or St_n get the library's bits.
+ * NaN for a NULL m. */
 WETDEM_API double wetdem_material_sphere_mass(const struct wetdem_material* m, double radius);
+/* Checks every field of a material; message into msg. WETDEM_OK or WETDEM_ERR_INVALID. */
 WETDEM_API int wetdem_material_validate(const struct wetdem_material* m, char* msg, size_t n);
 /* Checks every field of a fluid; message into msg. WETDEM_OK or WETDEM_ERR_INVALID. */
 WETDEM_API int wetdem_fluid_validate(const struct wetdem_fluid* f, char* msg, size_t n);

@@ -185,7 +185,7 @@ static int validate_struct(const struct wetdem_param_desc* table, const void* ob
 
 double wetdem_material_sphere_mass(const struct wetdem_material* m, double radius)
 {
-    return m->density * 4.0 / 3.0 * M_PI * radius * radius * radius;
+    return m ? m->density * 4.0 / 3.0 * M_PI * radius * radius * radius : NAN;
 }
 
 int wetdem_material_validate(const struct wetdem_material* m, char* msg, size_t n)

@@ -36,6 +36,12 @@ static void test_api_null_names_materials_fluids_and_paths_are_refused(void** st
     CHECK_CONTAINS(msg, "NULL");
     assert_int_equal(wetdem_fluid_validate(NULL, msg, sizeof msg), WETDEM_ERR_INVALID);
     CHECK_CONTAINS(msg, "NULL");
+    assert_true(isnan(wetdem_material_sphere_mass(NULL, 1e-3)));
+    /* and the mass the library fills in is this function's, bit for bit */
+    struct wetdem_material glass;
+    assert_int_equal(wetdem_material_preset("glass", &glass), WETDEM_OK);
+    assert_true(wetdem_material_sphere_mass(&glass, 1.1e-3) ==
+                glass.density * 4.0 / 3.0 * M_PI * 1.1e-3 * 1.1e-3 * 1.1e-3);
     /* lookups answer as for a name they do not know */
     const struct wetdem_param_desc* settings = wetdem_sim_settings_params();
     assert_null(wetdem_param_find(settings, NULL));
