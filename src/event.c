@@ -6,7 +6,12 @@
  *     as h_min when it equals the min-separation model's h_min or is the only such threshold
  *     of its model (nijssen's own h_min), otherwise as "branch",
  *   - 0 (solid contact),
- *   - separation_factor x range when the stop on separation needs it (not logged).
+ *   - separation_factor x range when the stop on separation needs it (not logged),
+ *   - the record range of the min-separation model (record_range(): ehd and max, reset_ratio
+ *     R*; glass, the films) when it is > 0 and differs from the range (not logged): the
+ *     record of the largest approach speed starts there, so the adaptive integrator commits
+ *     at the located crossing and the record begins with v_n at that gap, not at the first
+ *     step end past it (an error of first order in the step where v_n falls).
  * g falling through 0 starts a phase (interaction, h_min, contact), rising ends it.
  * The adaptive integrator hands these functions to its root finder; fixed-step integrators
  * compare them between steps and interpolate the crossing linearly (wetdem_event_advance).
@@ -114,7 +119,8 @@ static size_t interior_thresholds(const struct wetdem_sim* sim, size_t k,
 }
 
 /* Appends the event functions of pair k in decreasing threshold order: range, interior
- * thresholds, 0, then separation. Marks the pair as interacting when it starts within range. */
+ * thresholds, 0, then separation, and last the record range where it is another gap. Marks the
+ * pair as interacting when it starts within range. */
 static int build_pair_slots(struct wetdem_sim* sim, size_t k)
 {
     struct wetdem_engine* e = &sim->engine;
@@ -133,6 +139,9 @@ static int build_pair_slots(struct wetdem_sim* sim, size_t k)
     if (st == WETDEM_OK && sim->settings.stop_on_separation != 0 &&
         sim->settings.separation_factor > 1)
         st = append_slot(e, (struct wetdem_event_slot){k, WETDEM_EVENT_SOURCE_SEPARATION, 0, 0, 0});
+    double record = wetdem_sim_record_range(sim, &c);
+    if (st == WETDEM_OK && record > 0.0 && record != range)
+        st = append_slot(e, (struct wetdem_event_slot){k, WETDEM_EVENT_SOURCE_RECORD, 0, 0, 0});
     return st;
 }
 
@@ -179,6 +188,7 @@ static double slot_threshold(const struct wetdem_sim* sim, const struct wetdem_e
     case WETDEM_EVENT_SOURCE_RANGE: return range;
     case WETDEM_EVENT_SOURCE_ZERO: return 0.0;
     case WETDEM_EVENT_SOURCE_SEPARATION: return sim->settings.separation_factor * range;
+    case WETDEM_EVENT_SOURCE_RECORD: return wetdem_sim_record_range(sim, c);
     case WETDEM_EVENT_SOURCE_MODEL: break;
     }
     const struct wetdem_model_slot* m = &sim->models[s->model];
@@ -219,7 +229,8 @@ static int kind_of(const struct wetdem_event_slot* s, int dir)
         if (!s->as_hmin)
             return WETDEM_EVENT_BRANCH;
         return dir < 0 ? WETDEM_EVENT_HMIN_REACHED : WETDEM_EVENT_HMIN_LEFT;
-    case WETDEM_EVENT_SOURCE_SEPARATION: break;
+    case WETDEM_EVENT_SOURCE_SEPARATION:
+    case WETDEM_EVENT_SOURCE_RECORD: break;
     }
     return 0;
 }

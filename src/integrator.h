@@ -51,6 +51,9 @@ enum wetdem_event_source {
     WETDEM_EVENT_SOURCE_MODEL = 1,      /* a threshold a model lists inside its range */
     WETDEM_EVENT_SOURCE_ZERO = 2,       /* gap 0: solid contact start/end */
     WETDEM_EVENT_SOURCE_SEPARATION = 3, /* separation_factor x range: stop check only */
+    WETDEM_EVENT_SOURCE_RECORD = 4,     /* record range of the min-separation model where it
+                                           differs from the range: the record's start (not
+                                           logged) */
 };
 
 /* One event function g = gap - threshold of one pair. */
