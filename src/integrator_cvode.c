@@ -32,9 +32,12 @@
  * restarted with CVodeReInit there, at order 1, so that it never steps across the
  * discontinuity.
  * History-carrying models are not part of CVODE's error control (docs/engines.md): the largest
- * approach speed is sampled once per accepted step, at its end (first order); the tangential
- * spring advances from its committed value with the trapezoidal mean of v_t at the commit and
- * at the trial (.trapezoid_spring, sim_integrate.c), second order in the step.
+ * approach speed is committed at step ends and starts at a located crossing (the range, or the
+ * record range of the min-separation model, event.c), so where v_n falls from there on it is
+ * v_n at the crossing; a peak of v_n between two step ends is missed by its flat top's fall to
+ * the nearer end. The tangential spring advances from its committed value with the
+ * trapezoidal mean of v_t at the commit and at the trial (.trapezoid_spring,
+ * sim_integrate.c), second order in the step.
  */
 #include <float.h>
 #include <math.h>
