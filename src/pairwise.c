@@ -988,23 +988,27 @@ static bool set_does_not_slip(const struct wetdem_pairwise* pw, const bool* set,
     return true;
 }
 
-/* Contacts met at one instant at the rest speed or faster (`set`, two or more): their normal
- * impulses together (wetdem_pairwise_jump_simultaneous), so that the result does not depend
- * on the pairs' numbering, as one impulse after the other did (a sphere meeting two touching
- * ones symmetrically left off the symmetry line). With friction this holds when no pair of
- * the set slips before or after the normal impulses (spheres in a line): no friction impulse
- * is then called for, and the frictionless result is the frictional one (one after the other,
- * a sphere squeezed between two at 1 m/s, e_dry = 0.8, mu_f = 0.3, left at 0.009 m/s instead
- * of at rest). Returns WETDEM_EVENT, the velocities untouched, when the joint solution would
- * pull a pair or friction would act (the caller then resolves them one by one). */
+/* Contacts met at one instant at the rest speed or faster (`set`, two or more): their
+ * impulses together, so that the result does not depend on the pairs' numbering, as one
+ * impulse after the other did (a sphere meeting two touching ones symmetrically left off the
+ * symmetry line). Without friction, or with friction when no pair of the set slips before or
+ * after them (spheres in a line), the normal impulses of Newton's rule for each contact
+ * (wetdem_pairwise_jump_simultaneous): no friction impulse is then called for, and the
+ * frictionless result is the frictional one (one after the other, a sphere squeezed between two
+ * at 1 m/s, e_dry = 0.8, mu_f = 0.3, left at 0.009 m/s instead of at rest). Otherwise, with
+ * friction, compression and restitution with Coulomb friction at every contact of the set
+ * (wetdem_pairwise_jump_simultaneous_friction). Returns WETDEM_EVENT, the velocities untouched,
+ * when the joint solution would pull a pair (or could not be found: more than six frictional
+ * contacts, energy that would grow); the caller then resolves them one by one. */
 static int simultaneous_contacts(struct wetdem_pairwise* pw, const bool* set)
 {
     struct wetdem_pairwise_kin k, after;
     bool friction = pw->sys.mu_f > 0.0;
     if (!current_kin(pw, &k))
         return WETDEM_ERR_NUMERIC;
-    if (friction && !set_does_not_slip(pw, set, &k))
-        return WETDEM_EVENT;
+    bool frictionless = !friction || set_does_not_slip(pw, set, &k);
+    double y_met[PW_YMAX]; /* (a set resolved one by one starts from the state it was met at) */
+    memcpy(y_met, pw->y, sizeof y_met);
     for (size_t q = 0; q < pw->sys.n_pairs; q++)
         if (set[q] && pw->md.edge_of_pair[q] >= 0)
             gap_to_hmin(pw, q);
@@ -1012,12 +1016,18 @@ static int simultaneous_contacts(struct wetdem_pairwise* pw, const bool* set)
         return WETDEM_ERR_NUMERIC;
     double y_before[PW_YMAX];
     memcpy(y_before, pw->y, sizeof y_before);
-    if (!wetdem_pairwise_jump_simultaneous(&pw->sys, &pw->md, &k, set, pw->y))
-        return WETDEM_EVENT;
-    if (friction && (!current_kin(pw, &after) || !set_does_not_slip(pw, set, &after))) {
+    bool done =
+        frictionless && wetdem_pairwise_jump_simultaneous(&pw->sys, &pw->md, &k, set, pw->y);
+    if (done && friction && (!current_kin(pw, &after) || !set_does_not_slip(pw, set, &after))) {
         memcpy(pw->y, y_before, sizeof y_before);
-        return WETDEM_EVENT;
+        done = false;
     }
+    if (!done && friction)
+        done = wetdem_pairwise_jump_simultaneous_friction(&pw->sys, &pw->md, &k, set, pw->y);
+    if (!done && !frictionless)
+        memcpy(pw->y, y_met, sizeof y_met);
+    if (!done)
+        return WETDEM_EVENT;
     for (size_t q = 0; q < pw->sys.n_pairs; q++) {
         int st = set[q] ? note_impulse(pw, q, k.v_n[q]) : WETDEM_OK;
         if (st != WETDEM_OK)

@@ -167,6 +167,18 @@ bool wetdem_pairwise_jump_simultaneous(const struct wetdem_pairwise_system* sys,
                                        const struct wetdem_pairwise_kin* k, const bool* set,
                                        double* y);
 
+/* Frictional impulses of the pairs in `set` (at most 6), met at one instant while approaching
+ * with mu_f > 0 (docs/derivations/pairwise.md Sec. 6): compression, the impulses that bring
+ * every v_n of the set to zero with the least kinetic energy after within the friction cone
+ * |J_t| <= mu_f J_n (each slip arrested, or slid against at mu_f J_n); restitution, normal
+ * impulses e_dry J_n more (Poisson) with friction by the same rule within mu_f e_dry J_n.
+ * Updates y and returns true; false (y untouched) if a J_n would pull, the set is larger, or
+ * the kinetic energy would grow. */
+bool wetdem_pairwise_jump_simultaneous_friction(const struct wetdem_pairwise_system* sys,
+                                                const struct wetdem_pairwise_mode* md,
+                                                const struct wetdem_pairwise_kin* k,
+                                                const bool* set, double* y);
+
 /* Plastic impulses of the pairs in `set` (a contact slower than the rest speed and the pairs
  * touching at h_min that move slower than it): normal impulses J_q that bring every v_n of the
  * set to zero at once, sum_q coupling(p, q) J_q = -v_n,p. A J_q < 0 (a pull of at most

@@ -31,6 +31,14 @@
  * -(1 + e_dry) v_n,p, so that every v_n of the set is reversed to -e_dry v_n at once (Newton's
  * rule for each contact of a multiple collision); applied only when every J_q > 0 (else the
  * engine resolves them one by one).
+ * Simultaneous contacts with friction that slip (docs/derivations/pairwise.md Sec. 6): with the
+ * impulses P = (J_n,q, J_t,q) of the set, the kinetic energy after is T0 + g.P + P.H.P / 2
+ * (g: the contact velocities -v_n and v_s; H: mass-weighted products of the velocity and spin
+ * changes of unit impulses, the vector-form application above). Compression: every v_n to
+ * zero, P of least T in the friction cone |J_t| <= mu_f J_n (Coulomb friction as maximal
+ * dissipation); restitution: J_n,q grows by e_dry J_n,q (Poisson), the J_t,q by d_q of least T
+ * with |d_q| <= mu_f e_dry J_n,q. For one contact this is Davis's A1-A3, A8 and A30-A36: stick
+ * with I_t = m_t v_s (A33) if that is at most mu_f I_n, else slide at mu_f I_n.
  */
 #include <math.h>
 
@@ -210,5 +218,259 @@ bool wetdem_pairwise_jump_plastic(const struct wetdem_pairwise_system* sys,
         if (e >= 0)
             y[PW_ANCHOR_LEN + PW_EDGE_LEN * (size_t)e + PW_VN] = 0.0;
     }
+    return true;
+}
+
+/* ---------------------------------------- simultaneous contacts with friction (Sec. 6) ---- */
+
+/* Largest frictional set solved jointly: 3^6 = 729 faces of the friction cone per phase. */
+#define FR_MAX 6
+#define FR_DIM (2 * FR_MAX)
+#define FR_KKT (3 * FR_MAX)
+
+/* Impulse space of a frictional set of n contacts: component a < n is the normal impulse J_n
+ * of contact list[a] on its sphere i along n = -e_ij (J_n > 0 pushes the pair apart), component
+ * n + a its tangential impulse J_t on i along t_ij = (-sin theta, cos theta); j receives the
+ * opposite. H is the kinetic energy's Hessian and g its gradient at P = 0, so that the kinetic
+ * energy after the impulses P is T0 + g.P + P.H.P / 2. */
+struct fr_problem {
+    size_t n, list[FR_MAX];
+    double H[FR_DIM][FR_DIM], g[FR_DIM];
+    double mu, e;
+};
+
+/* Sphere velocity and spin changes (dvx, dvy, dw per sphere) of unit impulse component c. */
+static void fr_unit(const struct wetdem_pairwise_system* sys, const struct wetdem_pairwise_kin* k,
+                    const struct fr_problem* fp, size_t c, double dv[PW_NMAX][3])
+{
+    for (size_t s = 0; s < sys->n; s++)
+        dv[s][0] = dv[s][1] = dv[s][2] = 0.0;
+    size_t q = fp->list[c % fp->n], i = sys->pi[q], j = sys->pj[q];
+    bool normal = c < fp->n;
+    /* impulse on i: n = (-c, -s) for J_n, t = (-s, c) for J_t */
+    double px = normal ? -k->c[q] : -k->s[q], py = normal ? -k->s[q] : k->c[q];
+    dv[i][0] = px / sys->m[i];
+    dv[i][1] = py / sys->m[i];
+    dv[j][0] = -px / sys->m[j];
+    dv[j][1] = -py / sys->m[j];
+    if (!normal) { /* (-a_i n) x t and (a_j n) x (-t) both have z component +a (n = -e) */
+        dv[i][2] = sys->a[i] / sys->inertia[i];
+        dv[j][2] = sys->a[j] / sys->inertia[j];
+    }
+}
+
+/* H from the unit impulses' velocity changes (mass-weighted inner products); g from the contact
+ * velocities: dT/dJ_n = -v_n, dT/dJ_t = v_s = -r Omega + v_omega (the slip along t_ij). */
+static void fr_setup(const struct wetdem_pairwise_system* sys, const struct wetdem_pairwise_kin* k,
+                     struct fr_problem* fp)
+{
+    size_t m = 2 * fp->n;
+    double u[FR_DIM][PW_NMAX][3];
+    for (size_t c = 0; c < m; c++)
+        fr_unit(sys, k, fp, c, u[c]);
+    for (size_t r = 0; r < m; r++)
+        for (size_t c = 0; c < m; c++) {
+            double h = 0.0;
+            for (size_t s = 0; s < sys->n; s++)
+                h += sys->m[s] * (u[r][s][0] * u[c][s][0] + u[r][s][1] * u[c][s][1]) +
+                     sys->inertia[s] * u[r][s][2] * u[c][s][2];
+            fp->H[r][c] = h;
+        }
+    for (size_t a = 0; a < fp->n; a++) {
+        size_t q = fp->list[a];
+        fp->g[a] = -k->v_n[q];
+        fp->g[fp->n + a] = -k->r[q] * k->omega_lc[q] + k->v_w[q];
+    }
+}
+
+/* Kinetic energy change g.P + P.H.P / 2 of impulses P [J]. */
+static double fr_energy(const struct fr_problem* fp, const double* P)
+{
+    size_t m = 2 * fp->n;
+    double d = 0.0;
+    for (size_t r = 0; r < m; r++) {
+        double hp = 0.0;
+        for (size_t c = 0; c < m; c++)
+            hp += fp->H[r][c] * P[c];
+        d += P[r] * (fp->g[r] + 0.5 * hp);
+    }
+    return d;
+}
+
+/* Gaussian elimination with partial pivoting of A x = b (n <= FR_KKT); false if singular. */
+static bool fr_solve(size_t n, double A[FR_KKT][FR_KKT], double* b)
+{
+    for (size_t c = 0; c < n; c++) {
+        size_t piv = c;
+        for (size_t r = c + 1; r < n; r++)
+            if (fabs(A[r][c]) > fabs(A[piv][c]))
+                piv = r;
+        if (!(fabs(A[piv][c]) > 0.0))
+            return false;
+        for (size_t cc = 0; cc < n; cc++) {
+            double t = A[c][cc];
+            A[c][cc] = A[piv][cc];
+            A[piv][cc] = t;
+        }
+        double t = b[c];
+        b[c] = b[piv];
+        b[piv] = t;
+        for (size_t r = c + 1; r < n; r++) {
+            double f = A[r][c] / A[c][c];
+            for (size_t cc = c; cc < n; cc++)
+                A[r][cc] -= f * A[c][cc];
+            b[r] -= f * b[c];
+        }
+    }
+    for (size_t c = n; c-- > 0;) {
+        for (size_t cc = c + 1; cc < n; cc++)
+            b[c] -= A[c][cc] * b[cc];
+        b[c] /= A[c][c];
+    }
+    return true;
+}
+
+/* Minimiser of the kinetic energy over P = P0 + B z (B: m x nz, its columns in B[.][col]),
+ * with every v_n after brought to zero if plastic: dT/dJ_n = -v_n' = (g + H P)_a = 0 for
+ * a < n. Lagrange's conditions, multipliers l:
+ *     (B^T H B) z + (H_N B)^T l = -B^T (g + H P0),   (H_N B) z = -(g + H P0)_N.
+ * Writes P; false if singular. */
+static bool fr_minimise(const struct fr_problem* fp, const double* P0, double B[FR_DIM][FR_DIM],
+                        size_t nz, bool plastic, double* P)
+{
+    size_t m = 2 * fp->n, nc = plastic ? fp->n : 0;
+    double grad[FR_DIM], HB[FR_DIM][FR_DIM], A[FR_KKT][FR_KKT], z[FR_KKT];
+    for (size_t r = 0; r < m; r++) {
+        grad[r] = fp->g[r];
+        for (size_t c = 0; c < m; c++)
+            grad[r] += fp->H[r][c] * P0[c];
+        for (size_t b = 0; b < nz; b++) {
+            HB[r][b] = 0.0;
+            for (size_t c = 0; c < m; c++)
+                HB[r][b] += fp->H[r][c] * B[c][b];
+        }
+    }
+    for (size_t a = 0; a < nz; a++) {
+        z[a] = 0.0;
+        for (size_t r = 0; r < m; r++)
+            z[a] -= B[r][a] * grad[r];
+        for (size_t b = 0; b < nz; b++) {
+            A[a][b] = 0.0;
+            for (size_t r = 0; r < m; r++)
+                A[a][b] += B[r][a] * HB[r][b];
+        }
+    }
+    for (size_t l = 0; l < nc; l++) { /* H_N B = (B^T H)_N, H symmetric */
+        z[nz + l] = -grad[l];
+        for (size_t b = 0; b < nz; b++)
+            A[nz + l][b] = A[b][nz + l] = HB[l][b];
+        for (size_t l2 = 0; l2 < nc; l2++)
+            A[nz + l][nz + l2] = 0.0;
+    }
+    if (nz + nc > 0 && !fr_solve(nz + nc, A, z))
+        return false;
+    for (size_t r = 0; r < m; r++) {
+        P[r] = P0[r];
+        for (size_t b = 0; b < nz; b++)
+            P[r] += B[r][b] * z[b];
+    }
+    return true;
+}
+
+/* Relative slack of the friction cone |dJ_t| <= mu J_n accepted as rounding: a face's minimiser
+ * comes from at most 18 linear equations in impulses of one scale, whose rounding is some
+ * 1e-16 times their condition number; 1e-9 lies far above that for contacts that are not
+ * nearly parallel, and changes a velocity by 1e-9 of mu_f v_n, what the integration resolves
+ * at the default rtol. A face minimiser let in by the slack lies on the cone's boundary but
+ * for rounding, where the neighbouring face's minimiser gives the same point. */
+#define FR_CONE_SLACK 1e-9
+
+/* The minimiser of the kinetic energy over the faces of the friction cone: phase 1
+ * (compression, restitution == false) over all P that bring every v_n to zero with
+ * |J_t| <= mu J_n and J_n > 0; phase 2 (restitution) over J_t = J_t1 + d with
+ * J_n = (1 + e) J_n1 and |d| <= mu e J_n1. A face fixes each contact's mode: free (its
+ * components vary), or sliding with J_t (phase 1) or d (phase 2) at -s mu times its normal
+ * impulse, s = +-1. The least energy among the faces' minimisers that lie in the cone is the
+ * minimum over the cone (the energy is strictly convex, the conditions linear). False if no
+ * face has one (a J_n1 <= 0: a contact of the set would pull). */
+static bool fr_phase(const struct fr_problem* fp, const double* P1, bool restitution, double* P)
+{
+    size_t n = fp->n, m = 2 * n, faces = 1;
+    for (size_t a = 0; a < n; a++)
+        faces *= 3;
+    double best = INFINITY;
+    for (size_t f = 0; f < faces; f++) {
+        double B[FR_DIM][FR_DIM] = {{0}}, P0[FR_DIM] = {0}, Pf[FR_DIM];
+        size_t nz = 0, code = f;
+        int mode[FR_MAX];
+        for (size_t a = 0; a < n; a++, code /= 3) {
+            mode[a] = (int)(code % 3); /* 0 free, 1 slide with s = +1, 2 with s = -1 */
+            double s = mode[a] == 1 ? 1.0 : -1.0;
+            if (restitution) {
+                P0[a] = (1.0 + fp->e) * P1[a];
+                P0[n + a] = P1[n + a] - (mode[a] ? s * fp->mu * fp->e * P1[a] : 0.0);
+                if (!mode[a])
+                    B[n + a][nz++] = 1.0;
+            } else {
+                B[a][nz] = 1.0; /* J_n */
+                if (mode[a]) {
+                    B[n + a][nz++] = -s * fp->mu; /* J_t = -s mu J_n */
+                } else {
+                    nz++;
+                    B[n + a][nz++] = 1.0; /* J_t */
+                }
+            }
+        }
+        if (!fr_minimise(fp, P0, B, nz, !restitution, Pf))
+            continue;
+        bool inside = true;
+        for (size_t a = 0; a < n && inside; a++) {
+            double jn = restitution ? fp->e * P1[a] : Pf[a];
+            double jt = restitution ? Pf[n + a] - P1[n + a] : Pf[n + a];
+            inside = jn > 0.0 && fabs(jt) <= fp->mu * jn * (1.0 + FR_CONE_SLACK);
+        }
+        double dT = inside ? fr_energy(fp, Pf) : INFINITY;
+        if (dT < best) {
+            best = dT;
+            for (size_t r = 0; r < m; r++)
+                P[r] = Pf[r];
+        }
+    }
+    return best < INFINITY;
+}
+
+bool wetdem_pairwise_jump_simultaneous_friction(const struct wetdem_pairwise_system* sys,
+                                                const struct wetdem_pairwise_mode* md,
+                                                const struct wetdem_pairwise_kin* k,
+                                                const bool* set, double* y)
+{
+    struct fr_problem fp = {.mu = sys->mu_f, .e = sys->e_dry};
+    size_t list[PW_PMAX] = {0}; /* (filled by set_list; zeroed for the compiler's flow analysis) */
+    fp.n = set_list(sys, set, list);
+    if (fp.n < 1 || fp.n > FR_MAX || !(fp.mu > 0.0))
+        return false;
+    for (size_t a = 0; a < fp.n; a++)
+        fp.list[a] = list[a];
+    fr_setup(sys, k, &fp);
+    double P1[FR_DIM], P[FR_DIM];
+    if (!fr_phase(&fp, NULL, false, P1) || !fr_phase(&fp, P1, true, P))
+        return false;
+    /* energy not increased (e_dry <= 1), to the rounding of the impulses' work */
+    double work = 0.0;
+    for (size_t r = 0; r < 2 * fp.n; r++)
+        work += fabs(fp.g[r] * P[r]);
+    if (!(fr_energy(&fp, P) <= 1e-12 * work))
+        return false;
+    double gvx[PW_NMAX] = {0}, gvy[PW_NMAX] = {0}, gw[PW_NMAX] = {0};
+    for (size_t c = 0; c < 2 * fp.n; c++) {
+        double u[PW_NMAX][3];
+        fr_unit(sys, k, &fp, c, u);
+        for (size_t s = 0; s < sys->n; s++) {
+            gvx[s] += P[c] * u[s][0];
+            gvy[s] += P[c] * u[s][1];
+            gw[s] += P[c] * u[s][2];
+        }
+    }
+    add_jumps(sys, md, k, gvx, gvy, gw, y);
     return true;
 }

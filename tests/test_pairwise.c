@@ -823,6 +823,262 @@ static void test_pairwise_simultaneous_line_with_friction(void** state)
     }
 }
 
+/* Runs c with its spheres relabelled (input slot perm[i] holds sphere i, the reference pair
+ * follows) and writes the final (vx, vy, a omega) of each sphere i of c into out[i]. */
+static void run_relabelled(const struct wetdem_pairwise_config* c, const size_t* perm,
+                           double out[][3])
+{
+    struct wetdem_pairwise_config d = *c;
+    for (size_t i = 0; i < c->n_spheres; i++)
+        d.spheres[perm[i]] = c->spheres[i];
+    d.ref_i = perm[c->ref_i];
+    d.ref_j = perm[c->ref_j];
+    struct wetdem_pairwise_result r;
+    CHECK_OK(run(&d, &r, NULL));
+    for (size_t i = 0; i < c->n_spheres; i++) {
+        const struct wetdem_pairwise_sphere* f = &r.final[perm[i]];
+        out[i][0] = f->vx;
+        out[i][1] = f->vy;
+        out[i][2] = f->omega * f->radius;
+    }
+}
+
+static const size_t perms3[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2},
+                                    {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
+
+/* Linear momentum conserved and kinetic energy not increased (e_dry <= 1) by the impulses of
+ * a dry run of c that ended with velocities v (vx, vy, a omega per sphere); returns
+ * T_after / T_before. Momentum to 1e-12 of the largest sphere momentum (rounding of the
+ * impulses); energy to 1e-12 relative. */
+static double check_conserved(const struct wetdem_pairwise_config* c, double v[][3])
+{
+    double p0[2] = {0}, p1[2] = {0}, t0 = 0.0, t1 = 0.0, pmax = 0.0;
+    for (size_t i = 0; i < c->n_spheres; i++) {
+        const struct wetdem_pairwise_sphere* s = &c->spheres[i];
+        double m = s->mass, wa = s->omega * s->radius;
+        p0[0] += m * s->vx;
+        p0[1] += m * s->vy;
+        p1[0] += m * v[i][0];
+        p1[1] += m * v[i][1];
+        pmax = fmax(pmax, m * fmax(hypot(s->vx, s->vy), hypot(v[i][0], v[i][1])));
+        t0 += 0.5 * m * (s->vx * s->vx + s->vy * s->vy) + 0.2 * m * wa * wa;
+        t1 += 0.5 * m * (v[i][0] * v[i][0] + v[i][1] * v[i][1]) + 0.2 * m * v[i][2] * v[i][2];
+    }
+    CHECK_ABS(p1[0], p0[0], 1e-12 * pmax);
+    CHECK_ABS(p1[1], p0[1], 1e-12 * pmax);
+    assert_true(t1 <= t0 * (1.0 + 1e-12));
+    return t1 / t0;
+}
+
+/* Slip of the contact between spheres i and j, n the unit normal from j to i: the tangential
+ * velocity of i's surface relative to j's, (v_i - v_j) . t + a_i w_i + a_j w_j, t = z x (-n). */
+static double contact_slip(double v[][3], size_t i, size_t j, double nx, double ny)
+{
+    double tx = ny, ty = -nx;
+    return (v[i][0] - v[j][0]) * tx + (v[i][1] - v[j][1]) * ty + v[i][2] + v[j][2];
+}
+
+/* The frictional multiple collision off a line (dry, mu_f = 0.3, equal spheres; sphere 1 at
+ * 1 m/s along +x meeting two touching spheres at +-30 degrees at t = 0), resolved jointly
+ * (docs/derivations/pairwise.md Sec. 6: compression with the impulses of least kinetic energy
+ * in the friction cone, restitution e_dry J_n1 with friction again): the same whatever the
+ * numbering of the spheres (all six) and mirror-symmetric (the set-up and its mirror image
+ * give mirrored results), momentum conserved, energy not increased. Reference values from an
+ * independent computation, tools/simultaneous_friction.py (plain Python: the impulses applied
+ * to the spheres in 2-D vector form, the energy's gradient and Hessian by differences, the
+ * cone's faces enumerated): for e_dry = 1 sphere 1 leaves at (-0.118243, 0), the two at
+ * (0.559122, +-0.342314) m/s with a omega = -+0.042230 m/s, T / T0 = 7/8; both contacts leave
+ * sticking (slip zero). One impulse after the other (the rule until this version) left
+ * sphere 1 at (-0.105, -+0.181) m/s, by the numbering. Start in contact, impulses only:
+ * rounding, 1e-12 m/s. */
+static void test_pairwise_simultaneous_friction_is_symmetric(void** state)
+{
+    (void)state;
+    const double a = 1e-3, m = 1e-5, h_min = 1e-6, d = 2 * a + h_min;
+    const double want[2][3][3] = {
+        {{-0.118243243243243, 0.0, 0.0},
+         {0.559121621621621, 0.342314095414795, -0.042229729729730},
+         {0.559121621621621, -0.342314095414795, 0.042229729729730}},
+        {{-0.018918918918919, 0.0, 0.0},
+         {0.509459459459459, 0.297257368326010, -0.006756756756757},
+         {0.509459459459459, -0.297257368326010, 0.006756756756757}},
+    };
+    for (int k = 0; k < 2; k++)
+        for (int mirror = 0; mirror < 2; mirror++) {
+            double sg = mirror ? -1.0 : 1.0;
+            struct wetdem_pairwise_config c = three_dry(h_min, k ? 0.8 : 1.0, 0.3, 1e-3);
+            c.spheres[0] = (struct wetdem_pairwise_sphere){
+                .radius = a, .mass = m, .x = -sqrt(d * d - d * d / 4), .vx = 1.0};
+            c.spheres[1] = (struct wetdem_pairwise_sphere){.radius = a, .mass = m, .y = sg * d / 2};
+            c.spheres[2] =
+                (struct wetdem_pairwise_sphere){.radius = a, .mass = m, .y = -sg * d / 2};
+            for (size_t p = 0; p < 6; p++) {
+                double v[3][3];
+                run_relabelled(&c, perms3[p], v);
+                for (size_t i = 0; i < 3; i++) {
+                    CHECK_ABS(v[i][0], want[k][i][0], 1e-12);
+                    CHECK_ABS(sg * v[i][1], want[k][i][1], 1e-12);
+                    CHECK_ABS(sg * v[i][2], want[k][i][2], 1e-12);
+                }
+                double ratio = check_conserved(&c, v);
+                if (k == 0)
+                    CHECK_ABS(ratio, 0.875, 1e-12);
+                for (size_t j = 1; j < 3; j++) { /* n from sphere j to sphere 1 */
+                    double nx = c.spheres[0].x - c.spheres[j].x, ny = -c.spheres[j].y;
+                    double len = hypot(nx, ny);
+                    CHECK_ABS(contact_slip(v, 0, j, nx / len, ny / len), 0.0, 1e-12);
+                }
+            }
+        }
+}
+
+/* A frictional multiple collision without any symmetry: unequal spheres (radii 1, 1.3 and
+ * 0.8 mm, masses 1e-5, 2.2e-5, 0.7e-5 kg), sphere 1 at (1, 0.1) m/s spinning at 200 rad/s
+ * meeting spheres 2 and 3 at 40 and -25 degrees at t = 0 (e_dry = 1). Every numbering of the
+ * spheres gives the same result, that of tools/simultaneous_friction.py (mu_f = 0.3: both
+ * contacts stick in each phase; mu_f = 0.02: both slide in each, and the restitution's
+ * friction takes back the compression's), momentum is conserved and energy is lost.
+ * Rounding: 1e-12 m/s. */
+static void test_pairwise_simultaneous_friction_unequal(void** state)
+{
+    (void)state;
+    const double h_min = 1e-6, a[3] = {1.0e-3, 1.3e-3, 0.8e-3}, m[3] = {1e-5, 2.2e-5, 0.7e-5};
+    const double theta[3] = {0.0, 40.0, -25.0}, mu[2] = {0.3, 0.02};
+    const double want[2][3][3] = {
+        {{-0.140370048353378, -0.285251818861388, 0.177135871681666},
+         {0.313632780488771, 0.281388320443445, -0.034891734861407},
+         {0.643397044682973, -0.334003551591702, 0.076996697681089}},
+        {{-0.234415323878459, -0.304353893070196, 0.2},
+         {0.341227955146427, 0.286324251310744, 0.0},
+         {0.691019746509030, -0.322227799733486, 0.0}},
+    };
+    for (int k = 0; k < 2; k++) {
+        struct wetdem_pairwise_config c = three_dry(h_min, 1.0, mu[k], 1e-3);
+        for (size_t i = 0; i < 3; i++) {
+            double r = i ? a[0] + a[i] + h_min : 0.0, t = theta[i] * M_PI / 180.0;
+            c.spheres[i] = (struct wetdem_pairwise_sphere){
+                .radius = a[i], .mass = m[i], .x = r * cos(t), .y = r * sin(t)};
+        }
+        c.spheres[0].vx = 1.0;
+        c.spheres[0].vy = 0.1;
+        c.spheres[0].omega = 200.0;
+        for (size_t p = 0; p < 6; p++) {
+            double v[3][3];
+            run_relabelled(&c, perms3[p], v);
+            for (size_t i = 0; i < 3; i++)
+                for (size_t q = 0; q < 3; q++)
+                    CHECK_ABS(v[i][q], want[k][i][q], 1e-12);
+            assert_true(check_conserved(&c, v) < 1.0);
+        }
+    }
+}
+
+/* Three simultaneous contacts on one sphere: three equal spheres at 120 degrees around a
+ * fourth at rest, touching it at t = 0, each moving at 1 m/s towards its centre and 0.4 m/s
+ * counter-clockwise about it (e_dry = 1). The three contacts are coupled through the middle
+ * sphere's spin. By symmetry the middle sphere stays at rest and each contact takes
+ * J_n = (1 + e) m v_n = 2 m x 1 m/s; with the same J_t on each (on the outer sphere, against
+ * its tangential motion) the outer one keeps 0.4 - J_t/m along its tangent and spins at
+ * a omega = 2.5 J_t/m, the middle one at 3 x 2.5 J_t/m. Sticking (mu_f = 0.3) stops the slip
+ * 0.4 - 11 J_t/m: J_t/m = 0.4/11, middle a omega = 3/11 m/s; sliding (mu_f = 0.01, both
+ * phases) J_t = mu_f J_n: J_t/m = 0.02, tangent 0.38, a omega 0.05 and 0.15 m/s. The result
+ * keeps the three-fold symmetry (the outer spheres leave turned by 120 degrees from each
+ * other) and is the same for cyclic and other numberings; tools/simultaneous_friction.py
+ * gives the same values. Rounding: 1e-12 m/s. */
+static void test_pairwise_simultaneous_friction_three_contacts(void** state)
+{
+    (void)state;
+    const double a = 1e-3, m = 1e-5, h_min = 1e-6, d = 2 * a + h_min, mu[2] = {0.3, 0.01};
+    const double want[2][4][3] = {
+        {{0.0, 0.0, 0.272727272727273},
+         {1.0, 0.363636363636364, 0.090909090909091},
+         {-0.814918328648886, 0.684207221966256, 0.090909090909091},
+         {-0.185081671351113, -1.047843585602620, 0.090909090909091}},
+        {{0.0, 0.0, 0.15},
+         {1.0, 0.38, 0.05},
+         {-0.829089653438086, 0.676025403784438, 0.05},
+         {-0.170910346561914, -1.056025403784439, 0.05}},
+    };
+    const size_t perms[4][4] = {{0, 1, 2, 3}, {1, 2, 3, 0}, {3, 2, 1, 0}, {2, 0, 3, 1}};
+    for (int k = 0; k < 2; k++) {
+        struct wetdem_pairwise_config c = three_dry(h_min, 1.0, mu[k], 1e-3);
+        c.n_spheres = 4;
+        c.spheres[0] = (struct wetdem_pairwise_sphere){.radius = a, .mass = m};
+        for (size_t i = 1; i < 4; i++) {
+            double t = 2.0 * M_PI * (double)(i - 1) / 3.0;
+            c.spheres[i] = (struct wetdem_pairwise_sphere){.radius = a,
+                                                           .mass = m,
+                                                           .x = d * cos(t),
+                                                           .y = d * sin(t),
+                                                           .vx = -cos(t) - 0.4 * sin(t),
+                                                           .vy = -sin(t) + 0.4 * cos(t)};
+        }
+        for (size_t p = 0; p < 4; p++) {
+            double v[4][3];
+            run_relabelled(&c, perms[p], v);
+            for (size_t i = 0; i < 4; i++)
+                for (size_t q = 0; q < 3; q++)
+                    CHECK_ABS(v[i][q], want[k][i][q], 1e-12);
+            for (size_t i = 2; i < 4; i++) { /* sphere i is sphere i - 1 turned by 120 deg */
+                double cs = cos(2.0 * M_PI / 3.0), sn = sin(2.0 * M_PI / 3.0);
+                CHECK_ABS(v[i][0], cs * v[i - 1][0] - sn * v[i - 1][1], 1e-12);
+                CHECK_ABS(v[i][1], sn * v[i - 1][0] + cs * v[i - 1][1], 1e-12);
+                CHECK_ABS(v[i][2], v[i - 1][2], 1e-12);
+            }
+            assert_true(check_conserved(&c, v) < 1.0);
+        }
+    }
+}
+
+/* Two frictional contacts met at the same instant but sharing no sphere (two pairs 4 mm
+ * apart, each touching at t = 0) are resolved jointly too, and the joint rule then reduces to
+ * the single-contact one of Davis's Appendix A: each pair leaves as wetdem_hard_impulse()
+ * leaves it alone, one sticking (slip 0.5 m/s against J_n = m* 1.8 m/s: m_t |u_t| <=
+ * mu_f J_n) and one sliding (slip 3.4 m/s with the spin, unequal spheres). The far pair's
+ * velocities come out of the engine's relative variables, integrated over the flight after
+ * the impulses (rtol 1e-9: 2e-10 m/s after 1 us, 2e-8 after 100 us); at rtol 1e-12 over 1 us,
+ * 1e-13 m/s: tolerance 1e-12 m/s. */
+static void test_pairwise_simultaneous_friction_apart_is_single(void** state)
+{
+    (void)state;
+    const double h_min = 1e-6, e = 0.8, mu = 0.3;
+    struct wetdem_pairwise_config c = three_dry(h_min, e, mu, 1e-6);
+    c.n_spheres = 4;
+    c.rtol = 1e-12;
+    c.spheres[0] = (struct wetdem_pairwise_sphere){
+        .radius = 1e-3, .mass = 1e-5, .x = -(2e-3 + h_min), .vx = 1.0, .vy = 0.5};
+    c.spheres[1] = (struct wetdem_pairwise_sphere){.radius = 1e-3, .mass = 1e-5};
+    c.spheres[2] = (struct wetdem_pairwise_sphere){
+        .radius = 0.7e-3, .mass = 0.4e-5, .x = -(1.7e-3 + h_min), .y = 0.004, .vx = 1.0, .vy = 3.0};
+    c.spheres[3] =
+        (struct wetdem_pairwise_sphere){.radius = 1e-3, .mass = 1.5e-5, .y = 0.004, .omega = 400.0};
+    double v[4][3];
+    run_relabelled(&c, (const size_t[]){0, 1, 2, 3}, v);
+    bool sticking[2];
+    for (size_t p = 0; p < 2; p++) {
+        struct wetdem_impulse_body b[2];
+        for (size_t s = 0; s < 2; s++) {
+            const struct wetdem_pairwise_sphere* sp = &c.spheres[2 * p + s];
+            b[s] =
+                (struct wetdem_impulse_body){.vel = {sp->vx, sp->vy, 0.0},
+                                             .omega = {0.0, 0.0, sp->omega},
+                                             .mass = sp->mass,
+                                             .radius = sp->radius,
+                                             .inertia = 0.4 * sp->mass * sp->radius * sp->radius};
+        }
+        struct wetdem_impulse_result res;
+        CHECK_OK(
+            wetdem_hard_impulse(&b[0], &b[1], (struct wetdem_vec3){-1.0, 0.0, 0.0}, e, mu, &res));
+        sticking[p] = res.is_sticking;
+        for (size_t s = 0; s < 2; s++) {
+            CHECK_ABS(v[2 * p + s][0], b[s].vel.x, 1e-12);
+            CHECK_ABS(v[2 * p + s][1], b[s].vel.y, 1e-12);
+            CHECK_ABS(v[2 * p + s][2], b[s].omega.z * b[s].radius, 1e-12);
+        }
+    }
+    assert_true(sticking[0] && !sticking[1]);
+}
+
 /* A Newton's cradle of four equal dry elastic spheres touching at h_min, placed as a user
  * writes it (centres at k (2a + h_min) in decimal): the computed gaps come out a few ulps of
  * the centres' size short of h_min, which must not be refused; the striker's velocity passes
@@ -1846,6 +2102,10 @@ int main(void)
         cmocka_unit_test(test_pairwise_relabelling_symmetry),
         cmocka_unit_test(test_pairwise_simultaneous_contacts_are_symmetric),
         cmocka_unit_test(test_pairwise_simultaneous_line_with_friction),
+        cmocka_unit_test(test_pairwise_simultaneous_friction_is_symmetric),
+        cmocka_unit_test(test_pairwise_simultaneous_friction_unequal),
+        cmocka_unit_test(test_pairwise_simultaneous_friction_three_contacts),
+        cmocka_unit_test(test_pairwise_simultaneous_friction_apart_is_single),
         cmocka_unit_test(test_pairwise_cradle_placed_at_h_min),
         cmocka_unit_test(test_pairwise_deterministic),
         cmocka_unit_test(test_pairwise_positions_match_cartesian),
