@@ -932,6 +932,39 @@ static void test_pairwise_simultaneous_friction_is_symmetric(void** state)
         }
 }
 
+/* The +-30 degree set-up with films and viscosity (as in
+ * test_pairwise_simultaneous_contacts_are_symmetric) and friction mu_f = 0.3: the two contacts,
+ * met 4e-13 s apart, are one collision, resolved jointly, and sphere 1 stays on the symmetry
+ * line with the two struck spheres mirrored, for either numbering of them (one impulse after
+ * the other left sphere 1 at vy = +-0.142 m/s, by the numbering). The films' forces before and
+ * after, integrated at rtol 1e-9: 1e-6 m/s. */
+static void test_pairwise_simultaneous_friction_wet_is_symmetric(void** state)
+{
+    (void)state;
+    const double a = 1e-3, m = 1e-5, h_min = 1e-6, d = 2 * a + h_min, film = 50e-6;
+    for (int swap = 0; swap < 2; swap++) {
+        struct wetdem_pairwise_config c = three_dry(h_min, 1.0, 0.3, 0.01);
+        double y = swap ? -d / 2 : d / 2;
+        c.viscosity = 0.05;
+        c.spheres[0] = (struct wetdem_pairwise_sphere){.radius = a,
+                                                       .mass = m,
+                                                       .film = film,
+                                                       .x = -sqrt(d * d - d * d / 4) - 2 * film,
+                                                       .vx = 1.0};
+        c.spheres[1] =
+            (struct wetdem_pairwise_sphere){.radius = a, .mass = m, .film = film, .y = y};
+        c.spheres[2] =
+            (struct wetdem_pairwise_sphere){.radius = a, .mass = m, .film = film, .y = -y};
+        struct wetdem_pairwise_result r;
+        CHECK_OK(run(&c, &r, NULL));
+        CHECK_ABS(r.final[0].vy, 0.0, 1e-6);
+        CHECK_ABS(r.final[0].omega * a, 0.0, 1e-6);
+        CHECK_ABS(r.final[1].vx, r.final[2].vx, 1e-6);
+        CHECK_ABS(r.final[1].vy, -r.final[2].vy, 1e-6);
+        CHECK_ABS(r.final[1].omega * a, -r.final[2].omega * a, 1e-6);
+    }
+}
+
 /* A frictional multiple collision without any symmetry: unequal spheres (radii 1, 1.3 and
  * 0.8 mm, masses 1e-5, 2.2e-5, 0.7e-5 kg), sphere 1 at (1, 0.1) m/s spinning at 200 rad/s
  * meeting spheres 2 and 3 at 40 and -25 degrees at t = 0 (e_dry = 1). Every numbering of the
@@ -2103,6 +2136,7 @@ int main(void)
         cmocka_unit_test(test_pairwise_simultaneous_contacts_are_symmetric),
         cmocka_unit_test(test_pairwise_simultaneous_line_with_friction),
         cmocka_unit_test(test_pairwise_simultaneous_friction_is_symmetric),
+        cmocka_unit_test(test_pairwise_simultaneous_friction_wet_is_symmetric),
         cmocka_unit_test(test_pairwise_simultaneous_friction_unequal),
         cmocka_unit_test(test_pairwise_simultaneous_friction_three_contacts),
         cmocka_unit_test(test_pairwise_simultaneous_friction_apart_is_single),
