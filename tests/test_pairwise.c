@@ -1063,6 +1063,56 @@ static void test_pairwise_simultaneous_friction_three_contacts(void** state)
     }
 }
 
+/* Where the joint rule would raise the kinetic energy, the contacts are resolved one after the
+ * other (the documented fall-back), which loses it. Unequal spinning spheres touching sphere 1
+ * at 7.565 and -84.21 degrees, e_dry = 0.9, mu_f = 1: the compression's friction impulses
+ * enlarge its normal impulses through the coupling, and Poisson's restitution returns more than
+ * was taken, T / T0 = 1.074 (tools/simultaneous_friction.py with this set-up). One after the
+ * other, the 1-3 impulse leaves the 1-2 pair separating: T / T0 = 0.887. Momentum and energy
+ * as check_conserved. */
+static void test_pairwise_simultaneous_friction_energy_fallback(void** state)
+{
+    (void)state;
+    const double h_min = 1e-6, a[3] = {0.9e-3, 1.4e-3, 0.7e-3}, m[3] = {1.0e-5, 1.35e-5, 2.3e-5};
+    const double theta[3] = {0.0, 7.565, -84.21}, w[3] = {210.0, 480.0, 130.0};
+    const double v[3][2] = {{0.0, -0.85}, {-0.35, 0.57}, {-1.0, 0.23}};
+    struct wetdem_pairwise_config c = three_dry(h_min, 0.9, 1.0, 1e-4);
+    for (size_t i = 0; i < 3; i++) {
+        double r = i ? a[0] + a[i] + h_min : 0.0, t = theta[i] * M_PI / 180.0;
+        c.spheres[i] = (struct wetdem_pairwise_sphere){.radius = a[i],
+                                                       .mass = m[i],
+                                                       .x = r * cos(t),
+                                                       .y = r * sin(t),
+                                                       .vx = v[i][0],
+                                                       .vy = v[i][1],
+                                                       .omega = w[i]};
+    }
+    double out[3][3];
+    run_relabelled(&c, perms3[0], out);
+    CHECK_ABS(check_conserved(&c, out), 0.886980160183, 1e-11); /* (printed to 12 digits) */
+    /* the 1-3 impulse alone, sphere 2 untouched: rounding, 1e-12 m/s */
+    struct wetdem_impulse_body b[2];
+    for (size_t s = 0; s < 2; s++) {
+        const struct wetdem_pairwise_sphere* sp = &c.spheres[2 * s];
+        b[s] = (struct wetdem_impulse_body){.vel = {sp->vx, sp->vy, 0.0},
+                                            .omega = {0.0, 0.0, sp->omega},
+                                            .mass = sp->mass,
+                                            .radius = sp->radius,
+                                            .inertia = 0.4 * sp->mass * sp->radius * sp->radius};
+    }
+    double nx = -c.spheres[2].x, ny = -c.spheres[2].y, len = hypot(nx, ny);
+    CHECK_OK(wetdem_hard_impulse(&b[0], &b[1], (struct wetdem_vec3){nx / len, ny / len, 0.0}, 0.9,
+                                 1.0, NULL));
+    for (size_t s = 0; s < 2; s++) {
+        CHECK_ABS(out[2 * s][0], b[s].vel.x, 1e-12);
+        CHECK_ABS(out[2 * s][1], b[s].vel.y, 1e-12);
+        CHECK_ABS(out[2 * s][2], b[s].omega.z * b[s].radius, 1e-12);
+    }
+    CHECK_ABS(out[1][0], -0.35, 1e-12);
+    CHECK_ABS(out[1][1], 0.57, 1e-12);
+    CHECK_ABS(out[1][2], 480.0 * 1.4e-3, 1e-12);
+}
+
 /* Two frictional contacts met at the same instant but sharing no sphere (two pairs 4 mm
  * apart, each touching at t = 0) are resolved jointly too, and the joint rule then reduces to
  * the single-contact one of Davis's Appendix A: each pair leaves as wetdem_hard_impulse()
@@ -2139,6 +2189,7 @@ int main(void)
         cmocka_unit_test(test_pairwise_simultaneous_friction_wet_is_symmetric),
         cmocka_unit_test(test_pairwise_simultaneous_friction_unequal),
         cmocka_unit_test(test_pairwise_simultaneous_friction_three_contacts),
+        cmocka_unit_test(test_pairwise_simultaneous_friction_energy_fallback),
         cmocka_unit_test(test_pairwise_simultaneous_friction_apart_is_single),
         cmocka_unit_test(test_pairwise_cradle_placed_at_h_min),
         cmocka_unit_test(test_pairwise_deterministic),
