@@ -11,9 +11,13 @@ free, or sliding at -+mu times its normal impulse) and keeping the least energy 
 faces' constrained minimisers (Lagrange multipliers) that lie in the cone.
 
 Usage: python3 tools/simultaneous_friction.py   (prints the set-ups of the tests)
+       python3 tools/simultaneous_friction.py --random 2000 --seed 7
+           (random sets of two and three contacts on one sphere: how many would gain energy)
 """
+import argparse
 import itertools
 import math
+import random
 
 
 def solve(A, b):
@@ -137,6 +141,8 @@ def joint(cs, e, mu):
         if all(P[q] > 0 and abs(P[n + q]) <= mu * P[q] * (1 + 1e-9) for q in range(n)):
             if best is None or cs.energy(P) < cs.energy(best):
                 best = P
+    if best is None:  # a contact would pull: no joint solution
+        return None
     P1, best = best, None
     for modes in itertools.product((0, 1, -1), repeat=n):  # restitution
         P0 = P1[:]
@@ -166,7 +172,51 @@ def report(name, cs, e, mu):
               f"a omega = {W[k] * cs.a[k]:.15f}")
 
 
+def random_sets(trials, seed):
+    """Random sets of two or three contacts on sphere 1 (radii 0.5-1.5 mm, masses
+    0.3-3e-5 kg, spins up to 500 rad/s, e_dry 0.5-1, mu_f 0.05-1, contacts at least 1.2 rad
+    apart, all approaching): the sets solved and those whose kinetic energy would grow."""
+    rng = random.Random(seed)
+    solved, gains = 0, []
+    for _ in range(trials):
+        n = rng.choice([2, 2, 3])
+        a = [rng.uniform(0.5e-3, 1.5e-3) for _ in range(n + 1)]
+        m = [rng.uniform(0.3e-5, 3e-5) for _ in range(n + 1)]
+        X, V, W = [[0.0, 0.0]], [[rng.uniform(-1, 1), rng.uniform(-1, 1)]], [rng.uniform(-500, 500)]
+        angs = sorted(rng.uniform(0, 2 * math.pi) for _ in range(n))
+        gaps = [angs[i] - angs[i - 1] for i in range(1, n)] + [2 * math.pi - angs[-1] + angs[0]]
+        if min(gaps) <= 1.2:
+            continue
+        for k in range(n):
+            r, c, s = a[0] + a[k + 1] + 1e-6, math.cos(angs[k]), math.sin(angs[k])
+            X.append([r * c, r * s])
+            inward, across = rng.uniform(0.2, 1), rng.uniform(-1, 1)
+            V.append([-c * inward - s * across, -s * inward + c * across])
+            W.append(rng.uniform(-500, 500))
+        cs = Contacts(X, V, W, m, a, [(0, k + 1) for k in range(n)])
+        if any(v <= 0 for v in cs.approach([0.0] * (2 * n))):
+            continue
+        e, mu = rng.choice([1.0, 0.9, 0.5]), rng.choice([0.05, 0.1, 0.3, 0.6, 1.0])
+        P = joint(cs, e, mu)
+        if P is None:
+            continue
+        solved += 1
+        ratio = cs.energy(P) / cs.energy([0.0] * (2 * n))
+        if ratio > 1 + 1e-12:
+            gains.append((n, e, mu, ratio))
+    print(f"{solved} sets solved, {len(gains)} would gain energy")
+    for n, e, mu, ratio in gains:
+        print(f"  {n} contacts, e_dry = {e}, mu_f = {mu}: T/T0 = {ratio:.4f}")
+
+
 if __name__ == "__main__":
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--random", type=int, default=0)
+    ap.add_argument("--seed", type=int, default=7)
+    args = ap.parse_args()
+    if args.random:
+        random_sets(args.random, args.seed)
+        raise SystemExit(0)
     h = 1e-6
     a, m, d = 1e-3, 1e-5, 2e-3 + h
     for e in (1.0, 0.8):  # +-30 degrees
