@@ -1067,7 +1067,7 @@ static void test_pairwise_simultaneous_friction_three_contacts(void** state)
  * other (the documented fall-back), which loses it. Unequal spinning spheres touching sphere 1
  * at 7.565 and -84.21 degrees, e_dry = 0.9, mu_f = 1: the compression's friction impulses
  * enlarge its normal impulses through the coupling, and Poisson's restitution returns more than
- * was taken, T / T0 = 1.074 (tools/simultaneous_friction.py with this set-up). One after the
+ * was taken, T / T0 = 1.074 (the last set-up of tools/simultaneous_friction.py). One after the
  * other, the 1-3 impulse leaves the 1-2 pair separating: T / T0 = 0.887. Momentum and energy
  * as check_conserved. */
 static void test_pairwise_simultaneous_friction_energy_fallback(void** state)

@@ -240,3 +240,10 @@ if __name__ == "__main__":
     for mu in (0.3, 0.01):
         cs = Contacts(X, V, [0.0] * 4, [m] * 4, [a] * 4, [(0, 1), (0, 2), (0, 3)])
         report("three contacts", cs, 1.0, mu)
+    A, Ms = [0.9e-3, 1.4e-3, 0.7e-3], [1.0e-5, 1.35e-5, 2.3e-5]  # energy would grow
+    X = [[0.0, 0.0]] + [[(A[0] + A[k] + h) * math.cos(math.radians(t)),
+                         (A[0] + A[k] + h) * math.sin(math.radians(t))]
+                        for k, t in ((1, 7.565), (2, -84.21))]
+    cs = Contacts(X, [[0.0, -0.85], [-0.35, 0.57], [-1.0, 0.23]], [210.0, 480.0, 130.0], Ms, A,
+                  [(0, 1), (0, 2)])
+    report("energy would grow (the engine falls back)", cs, 0.9, 1.0)
