@@ -76,10 +76,140 @@ const char* cli_number_problem(const char* text)
     }
 }
 
+/* The length of the longest prefix of text in cli_number's syntax (0: none), its value in *v. */
+static size_t number_prefix(const char* text, double* v)
+{
+    const char* p = text;
+    size_t mantissa = 0;
+    p += *p == '+' || *p == '-';
+    for (; isdigit((unsigned char)*p); p++)
+        mantissa++;
+    if (*p == '.')
+        for (p++; isdigit((unsigned char)*p); p++)
+            mantissa++;
+    if (!mantissa)
+        return 0;
+    if (*p == 'e' || *p == 'E') {
+        const char* q = p + 1;
+        q += *q == '+' || *q == '-';
+        if (isdigit((unsigned char)*q)) {
+            while (isdigit((unsigned char)*q))
+                q++;
+            p = q;
+        }
+    }
+    char buf[64];
+    size_t len = (size_t)(p - text);
+    if (len >= sizeof buf)
+        return 0;
+    memcpy(buf, text, len);
+    buf[len] = '\0';
+    *v = strtod(buf, NULL);
+    return isfinite(*v) ? len : 0;
+}
+
+/* Copies s to out without blanks. */
+static void squeeze(const char* s, char* out, size_t n)
+{
+    size_t k = 0;
+    for (; *s && k + 1 < n; s++)
+        if (!isspace((unsigned char)*s))
+            out[k++] = *s;
+    out[k] = '\0';
+}
+
+/* The factor of an SI prefix at the start of s ("m", "u", "µ", "k", ...), its length in *len;
+ * 0 when there is none. */
+static double si_prefix(const char* s, size_t* len)
+{
+    static const struct {
+        const char* p;
+        double f;
+    } prefixes[] = {{"G", 1e9},  {"M", 1e6},  {"k", 1e3},         {"c", 1e-2},       {"m", 1e-3},
+                    {"u", 1e-6}, {"n", 1e-9}, {"\xc2\xb5", 1e-6}, {"\xce\xbc", 1e-6}};
+    for (size_t k = 0; k < sizeof prefixes / sizeof prefixes[0]; k++) {
+        size_t n = strlen(prefixes[k].p);
+        if (strncmp(s, prefixes[k].p, n) == 0) {
+            *len = n;
+            return prefixes[k].f;
+        }
+    }
+    return 0;
+}
+
+const char* cli_number_hint(const char* text, const char* unit, char* buf, size_t n)
+{
+    buf[0] = '\0';
+    double v;
+    size_t len = strlen(text);
+    if (len >= 2 && (text[0] == '"' || text[0] == '\'') && text[len - 1] == text[0]) {
+        char inner[128];
+        if (len - 2 < sizeof inner) {
+            memcpy(inner, text + 1, len - 2);
+            inner[len - 2] = '\0';
+            if (cli_number(inner, &v) == 0)
+                snprintf(buf, n, ": write it without quotes, %s", inner);
+        }
+        return buf;
+    }
+    size_t k = number_prefix(text, &v);
+    if (k == 0 || cli_number(text, &v) == 0)
+        return buf;
+    const char* rest = text + k;
+    if (strchr("eExX", *rest)) /* a broken exponent (5e), hexadecimal (0x10): no unit */
+        return buf;
+    while (isspace((unsigned char)*rest))
+        rest++;
+    bool dimensionless = !unit || !unit[0] || strcmp(unit, "-") == 0;
+    if (*rest == ';' || *rest == '#') {
+        snprintf(buf, n, ": an inline comment needs a blank before its '%c' (%.*s %s)", *rest,
+                 (int)(rest - text), text, rest);
+    } else if (*rest == ',' && rest == text + k && isdigit((unsigned char)rest[1])) {
+        /* a decimal comma ("0,5"), or a thousands separator ("1,000") */
+        const char* d = rest + 1;
+        while (isdigit((unsigned char)*d))
+            d++;
+        if (*d == '\0' && d - rest - 1 != 3)
+            snprintf(buf, n, ": write a decimal point, not a comma: %.*s.%s", (int)k, text,
+                     rest + 1);
+        else
+            snprintf(buf, n, ": write a decimal point, not a comma, and no thousands separator");
+    } else if (strcmp(rest, "%") == 0 && dimensionless) {
+        snprintf(buf, n, ": write a fraction, not a percentage: %s = %.6g", text, v / 100);
+    } else if (isalpha((unsigned char)*rest) || (unsigned char)*rest >= 0x80 || *rest == '%') {
+        /* a unit: the key's own (written out), one with an SI prefix (converted), or another */
+        char given[64], want[64];
+        squeeze(rest, given, sizeof given);
+        squeeze(unit && !dimensionless ? unit : "", want, sizeof want);
+        size_t plen = 0;
+        double f = want[0] ? si_prefix(given, &plen) : 0;
+        if (want[0] && strcmp(given, want) == 0)
+            snprintf(buf, n, ": write the number alone, %.*s (the unit is %s)", (int)k, text, unit);
+        else if (f != 0 && strcmp(given + plen, want) == 0)
+            snprintf(buf, n, ": write the number alone, in %s: %s = %.6g %s", unit, text, v * f,
+                     unit);
+        else if (want[0] && strcmp(want, "Pas") == 0 && strcmp(given, "cP") == 0)
+            snprintf(buf, n, ": write the number alone, in %s: %s = %.6g %s", unit, text, v * 1e-3,
+                     unit);
+        else if (want[0] && strcmp(want, "deg") == 0 && strcmp(given, "rad") == 0)
+            snprintf(buf, n, ": write the number alone, in deg: %s = %.6g deg", text,
+                     v * 57.295779513082321);
+        else if (want[0] && strcmp(want, "deg") == 0)
+            snprintf(buf, n, ": write the number alone, in degrees");
+        else if (want[0])
+            snprintf(buf, n, ": write the number alone, in %s (SI units throughout)", unit);
+        else
+            snprintf(buf, n, ": write the number alone, without a unit");
+    }
+    return buf;
+}
+
 int cli_parse_double(const char* text, const char* what, double* out)
 {
     if (cli_number(text, out) != 0) {
-        cli_error("%s: '%s' is %s", what, text, cli_number_problem(text));
+        char hint[160];
+        cli_error("%s: '%s' is %s%s", what, text, cli_number_problem(text),
+                  cli_number_hint(text, NULL, hint, sizeof hint));
         return CLI_EXIT_USAGE;
     }
     return CLI_EXIT_OK;

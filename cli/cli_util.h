@@ -40,6 +40,13 @@ int cli_number(const char* text, double* out);
  * ...", "below the smallest normal double ..."); NULL when cli_number takes it. */
 const char* cli_number_problem(const char* text);
 
+/* The likely slip behind a `text` that cli_number refuses, as ": <what to write>" (for
+ * "%s" after the error) into buf, or "" when none is recognised: a unit after the number
+ * ("2 mm": the value in `unit`, 0.002, converted for an SI prefix of it; `unit` NULL or "-"
+ * when the value has none), a decimal comma ("0,5"), a percentage of a dimensionless value,
+ * an inline comment without its blank ("0.1;x"), quotes. Returns buf. */
+const char* cli_number_hint(const char* text, const char* unit, char* buf, size_t n);
+
 /* Parses `text` as one finite number (cli_number). `what`
  * names the option in the error message, e.g. "--speed". Returns CLI_EXIT_OK and sets *out,
  * or prints an error and returns CLI_EXIT_USAGE. */

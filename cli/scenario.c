@@ -270,8 +270,11 @@ static int check_number(const struct cli_scenario* sc, const struct cli_entry* e
     double v;
     if (cli_number(e->value, &v) != 0) {
         const char* why = cli_number_problem(e->value);
-        cli_scenario_error(sc, e, "%s%s%s%s (decimal or exponent notation, e.g. 6.35e-3)", why,
-                           d->unit[0] ? " [" : "", d->unit, d->unit[0] ? "]" : "");
+        char hint[160];
+        cli_number_hint(e->value, d->unit, hint, sizeof hint);
+        cli_scenario_error(sc, e, "%s%s%s%s%s", why, d->unit[0] ? " [" : "", d->unit,
+                           d->unit[0] ? "]" : "",
+                           hint[0] ? hint : " (decimal or exponent notation, e.g. 6.35e-3)");
         return CLI_EXIT_USAGE;
     }
     char msg[512];

@@ -248,6 +248,8 @@ static void test_cli_forces_bad_input(void** state)
         {"forces --model reynolds --set fluid.viscosty=1", "did you mean 'fluid.viscosity'"},
         {"forces --model reynolds --set reynolds.cutoff_ratio=-1", "valid (0, 100]"},
         {"forces --model reynolds --speed nan", "--speed: 'nan' is not a finite number"},
+        {"forces --model reynolds --speed 1m/s",
+         "--speed: '1m/s' is not a finite number: write the number alone, without a unit"},
         {"forces --model reynolds --radius 0", "--radius = 0 m is out of range"},
         {"forces --model reynolds --radius 1e300",
          "--radius = 1e+300 m is out of range: valid (0, 1]"},
