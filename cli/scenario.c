@@ -499,6 +499,8 @@ struct reader {
     int read_errno; /* a read error (e.g. EISDIR: the path is a directory), else 0 */
     char* buf;      /* the physical line (getline) */
     size_t cap;
+    int shape_line;   /* the last line check_shape reported (inih would report it again) */
+    bool header_lost; /* a header was malformed: keys up to the next one have no section */
 };
 
 /* Records a "[name]" header line (inih reports malformed ones itself). */
@@ -555,6 +557,53 @@ static size_t without_comment(const char* s, size_t len)
 /* inih reader: one line per call, counted, given to inih without its comment (inih's lines
  * hold num - 1 characters, which long comments would exceed); a line longer than that
  * without its comment is reported and skipped. */
+/* Reports a line that inih will refuse, at once and in the words of its fault (a header
+ * without its ']', a line without '='), so that its message comes in line order before those
+ * of the lines after it: the keys under a header without its ']' are reported by it alone,
+ * not each as a key before any [section]. Indented lines are left to inih, which reads them
+ * as continuations of a value. */
+static void check_shape(struct reader* r, const char* str, size_t len)
+{
+    const char* p = str;
+    const char* end = str + len;
+    if (len == 0 || isspace((unsigned char)*p))
+        return;
+    if (*p == '[') {
+        if (memchr(p, ']', len)) {
+            r->header_lost = false;
+            return;
+        }
+        fprintf(
+            stderr,
+            "%s:%d: malformed line '%.*s': a section header needs its closing ']', e.g. '%.*s]'\n",
+            r->sc->file, r->line, (int)len, p, (int)len, p);
+        r->header_lost = true;
+    } else if (!memchr(p, '=', len) && !memchr(p, ':', len)) {
+        const char* blank = p;
+        while (blank < end && !isspace((unsigned char)*blank))
+            blank++;
+        const char* word = blank;
+        while (word < end && isspace((unsigned char)*word))
+            word++;
+        if (word < end)
+            fprintf(stderr,
+                    "%s:%d: malformed line '%.*s': no '=': write 'key = value' (%.*s = %.*s?), a "
+                    "[section] "
+                    "header or a comment\n",
+                    r->sc->file, r->line, (int)len, p, (int)(blank - p), p, (int)(end - word),
+                    word);
+        else
+            fprintf(stderr,
+                    "%s:%d: malformed line '%.*s': no '=': write 'key = value', a [section] header "
+                    "or a "
+                    "comment\n",
+                    r->sc->file, r->line, (int)len, p);
+    } else
+        return;
+    r->n_errors++;
+    r->shape_line = r->line;
+}
+
 static char* read_line(char* str, int num, void* stream)
 {
     struct reader* r = stream;
@@ -597,6 +646,7 @@ static char* read_line(char* str, int num, void* stream)
     memcpy(str, text, len);
     str[len] = '\n';
     str[len + 1] = '\0';
+    check_shape(r, str, len);
     note_section(r, str);
     return str;
 }
@@ -609,6 +659,8 @@ static int on_pair(void* user, const char* section_as_read, const char* key, con
     strip_hash_comment(v);
     /* "[ fluid ]" is [fluid], as the section marks have it (note_section); inih keeps the
        spaces (its lines hold fewer than 256 characters) */
+    if (r->header_lost) /* under a header without its ']': reported there */
+        return 1;
     char section[256];
     copy_text(section, sizeof section, section_as_read);
     trim(section);
@@ -661,7 +713,7 @@ int cli_scenario_load(const char* path, struct cli_scenario* sc)
         return CLI_EXIT_USAGE;
     }
     int rc = r.n_errors ? CLI_EXIT_USAGE : CLI_EXIT_OK;
-    if (bad_line > 0) {
+    if (bad_line > 0 && bad_line > r.shape_line) { /* (those up to shape_line are reported) */
         fprintf(stderr,
                 "%s:%d: malformed line: expected '[section]', 'key = value' or a "
                 "comment\n",

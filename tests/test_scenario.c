@@ -206,11 +206,43 @@ struct bad_case {
     const char* message; /* expected part of the message */
 };
 
+/* A header without its ']' is the one error reported for it, first: the keys under it were
+ * each "before any [section]" (a consequence, printed before the cause), and those under a
+ * later broken header were taken as keys of the section before it ("unknown key 'viscosity'
+ * in [collision]"). */
+static void test_scenario_broken_header_is_the_first_and_only_error(void** state)
+{
+    (void)state;
+    const char* path = write_file("broken_header.ini", "[collision\nstriker = delrin\nspeed = 1\n");
+    char args[700], want[700];
+    snprintf(args, sizeof args, "run '%s' --check", path);
+    struct test_run r = run_cli(args);
+    assert_int_equal(r.code, 2);
+    snprintf(want, sizeof want,
+             "%s:1: malformed line '[collision': a section header needs its closing ']', e.g. "
+             "'[collision]'\n",
+             path);
+    assert_string_equal(r.out, want);
+    free(r.out);
+    path = write_file("broken_header2.ini",
+                      "[collision]\nspeed = 1\n[fluid\nviscosity = 1\n[models]\nforce = hertz\n");
+    snprintf(args, sizeof args, "run '%s' --check", path);
+    r = run_cli(args);
+    assert_int_equal(r.code, 2);
+    snprintf(want, sizeof want, "%s:3: malformed line '[fluid'", path);
+    CHECK_CONTAINS(r.out, want);
+    assert_null(strstr(r.out, "viscosity"));
+    assert_null(strchr(strchr(r.out, '\n') + 1, '\n')); /* (that line only) */
+    free(r.out);
+}
+
 static void test_scenario_bad_files_exit_2_with_line(void** state)
 {
     (void)state;
     static const struct bad_case cases[] = {
         {"malformed", "[collision]\nstokes = 5\nstriker delrin\n", ":3:", "malformed line"},
+        {"no equals", "[collision]\nstokes = 5\nstriker delrin\n",
+         ":3:", "malformed line 'striker delrin': no '=': write 'key = value' (striker = delrin?)"},
         /* inih reads "[fluid] viscosity = 0.1" as the header alone: the key was lost */
         {"header", "[collision]\nstokes = 5\n[fluid] viscosity = 0.1\n",
          ":3:", "text after the section header [fluid]: 'viscosity = 0.1'"},
@@ -1565,6 +1597,7 @@ int main(void)
         cmocka_unit_test(test_scenario_stokes_gives_speed),
         cmocka_unit_test(test_scenario_set_overrides),
         cmocka_unit_test(test_scenario_bad_files_exit_2_with_line),
+        cmocka_unit_test(test_scenario_broken_header_is_the_first_and_only_error),
         cmocka_unit_test(test_scenario_boms_crlf_and_long_comments),
         cmocka_unit_test(test_scenario_large_overlap_is_reported),
         cmocka_unit_test(test_scenario_energy_gain_is_an_error),
