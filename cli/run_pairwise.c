@@ -124,8 +124,61 @@ static int report(const struct cli_scenario* sc, const char* section, const char
     return CLI_EXIT_USAGE;
 }
 
+/* With [davis] the spheres, their films, h_min and the contact come from its groups: a
+ * [sphere.NAME] section, a [pairwise] key of [sphere.NAME] runs, and with n_spheres = 2 a key
+ * that places sphere 3 would be ignored, so each is an error (all are reported). A key of
+ * sphere 3 in the file is ignored when a --set makes n_spheres 2, as the file's [model.NAME]
+ * sections are when a --set chooses the models. */
+static int check_davis_keys(const struct cli_scenario* sc)
+{
+    static const char* const sphere_run_keys[][2] = {
+        {"viscosity", "[davis] viscosity (a unit only; the film's effect is [davis] stokes)"},
+        {"surface_tension", "[davis] capillary (Ca)"},
+        {"h_min", "[davis] hmin_ratio"},
+        {"restitution", "[davis] restitution"},
+        {"friction", "[davis] friction"},
+    };
+    static const char* const third_sphere_keys[] = {"d23", "d13", "h23", "theta23_deg"};
+    int rc = CLI_EXIT_OK;
+    for (size_t s = 0; s < sc->n_sections; s++)
+        if (strncmp(sc->sections[s].name, "sphere.", 7) == 0) {
+            fprintf(stderr,
+                    "%s:%d: [%s]: a scenario with [davis] takes its spheres from the [davis] "
+                    "groups, so this section would be ignored: remove it, or remove [davis] "
+                    "and give every sphere a [sphere.NAME] section\n",
+                    sc->file, sc->sections[s].line, sc->sections[s].name);
+            rc = CLI_EXIT_USAGE;
+        }
+    const struct cli_entry* n = cli_scenario_find(sc, "davis", "n_spheres");
+    bool two = n && strtod(n->value, NULL) == 2;
+    for (size_t m = 0; m < sc->n_entries; m++) { /* (in file order) */
+        const struct cli_entry* e = &sc->entries[m];
+        for (size_t k = 0; k < sizeof sphere_run_keys / sizeof sphere_run_keys[0]; k++)
+            if (strcmp(e->section, "pairwise") == 0 && strcmp(e->key, sphere_run_keys[k][0]) == 0) {
+                cli_scenario_error(sc, e,
+                                   "[pairwise] %s is read only without [davis] (runs of "
+                                   "[sphere.NAME] sections); with [davis] it would be ignored: "
+                                   "set %s instead",
+                                   e->key, sphere_run_keys[k][1]);
+                rc = CLI_EXIT_USAGE;
+            }
+        for (size_t k = 0; two && k < sizeof third_sphere_keys / sizeof third_sphere_keys[0]; k++)
+            if (strcmp(e->section, "davis") == 0 && strcmp(e->key, third_sphere_keys[k]) == 0 &&
+                !(n->line == 0 && e->line > 0)) {
+                cli_scenario_error(sc, e,
+                                   "%s places sphere 3, which n_spheres = 2 leaves out, so it "
+                                   "would be ignored: remove it, or set n_spheres = 3",
+                                   e->key);
+                rc = CLI_EXIT_USAGE;
+            }
+    }
+    return rc;
+}
+
 static int from_davis(const struct cli_scenario* sc, struct wetdem_pairwise_config* cfg)
 {
+    if (check_davis_keys(sc) != CLI_EXIT_OK)
+        return CLI_EXIT_USAGE;
     struct wetdem_pairwise_davis d;
     wetdem_pairwise_davis_init(&d);
     for (const struct wetdem_param_desc* p = wetdem_pairwise_davis_params(); p->name; p++) {

@@ -332,6 +332,17 @@ static void test_scenario_bad_files_exit_2_with_line(void** state)
          "[engine]\ntype = pairwise\n[davis]\nstokes = 2\n[integrator]\nrtol = 1e-6\n", ":5:",
          "[integrator]: not read by the pairwise engine, which reads [engine], [davis], "
          "[pairwise], [sphere.NAME] and [output]"},
+        /* with [davis], what only a run of [sphere.NAME] sections reads was ignored */
+        {"davis_sphere",
+         "[engine]\ntype = pairwise\n[davis]\nstokes = 2\n[sphere.a]\nradius = 1e-3\n",
+         ":5:", "[sphere.a]: a scenario with [davis] takes its spheres from the [davis] groups"},
+        {"davis_pairwise_key",
+         "[engine]\ntype = pairwise\n[davis]\nstokes = 2\n[pairwise]\nrestitution = 0.5\n", ":6:",
+         "[pairwise] restitution is read only without [davis] (runs of [sphere.NAME] "
+         "sections); with [davis] it would be ignored: set [davis] restitution instead"},
+        {"davis_two_d23",
+         "[engine]\ntype = pairwise\n[davis]\nn_spheres = 2\nstokes = 2\nh23 = 3\n",
+         ":6:", "h23 places sphere 3, which n_spheres = 2 leaves out"},
         {"unread_binary", "[collision]\nstokes = 5\n\n[davis]\nstokes = 2\n",
          ":4:", "[davis]: not read by a binary collision"},
         {"unread_many", "[box]\nsize_x = 1e-2\n[output]\ntrajectory = none\n",
