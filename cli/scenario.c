@@ -405,19 +405,36 @@ static void unknown_key(const struct cli_scenario* sc, const struct cli_entry* e
                         const struct cli_section_info* info)
 {
     const char* names[128];
-    section_key_names(info, names, 128);
+    size_t n = section_key_names(info, names, 128);
     const char* hint = wetdem_param_suggest(e->key, names);
+    /* a word of a key's name, angle for angle_deg: its one key */
+    size_t len = strlen(e->key), starts = 0;
+    for (size_t k = 0; !hint && k < n; k++)
+        if (strncmp(names[k], e->key, len) == 0 && names[k][len] == '_' && ++starts == 1)
+            hint = names[k];
+    if (starts > 1)
+        hint = NULL;
+    char home[400];
+    int where = cli_key_home(sc, e, home, sizeof home);
+    if (where == 1) { /* a key of another section of this engine: not a misspelling */
+        cli_scenario_error(sc, e, "unknown key '%s' in [%s]: %s", e->key, e->section, home);
+        return;
+    }
+    char aside[420] = ""; /* another engine's key: said beside the hint or list */
+    if (where == 2)
+        snprintf(aside, sizeof aside, " (%s)", home);
     if (hint) {
-        cli_scenario_error(sc, e, "unknown key '%s' in [%s] (did you mean '%s'?)", e->key,
-                           e->section, hint);
+        cli_scenario_error(sc, e, "unknown key '%s' in [%s] (did you mean '%s'?)%s", e->key,
+                           e->section, hint, aside);
         return;
     }
     char list[512] = "";
     for (size_t k = 0; names[k]; k++) {
-        size_t len = strlen(list);
-        snprintf(list + len, sizeof list - len, "%s%s", k ? ", " : "", names[k]);
+        size_t used = strlen(list);
+        snprintf(list + used, sizeof list - used, "%s%s", k ? ", " : "", names[k]);
     }
-    cli_scenario_error(sc, e, "unknown key '%s' in [%s]; valid keys: %s", e->key, e->section, list);
+    cli_scenario_error(sc, e, "unknown key '%s' in [%s]; valid keys: %s%s", e->key, e->section,
+                       list, aside);
 }
 
 /* Checks one entry against its section. Returns an exit code; prints the error. */

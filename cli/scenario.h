@@ -249,6 +249,12 @@ int cli_section_lookup(const char* name, struct cli_section_info* info);
 const char* cli_model_suggestion(const char* word);
 /* Writes " (did you mean [x]?)" or a list of valid sections for an unknown name into msg. */
 void cli_section_suggestion(const char* name, char* msg, size_t n);
+/* Where the key of entry e, which its section lacks, belongs, taking e's value as its kind
+ * there (a number, or a word of its choices): writes "it is a key of [collision]: move it
+ * there" into buf and returns 1 when sections (or [model.NAME] sections) the scenario's
+ * engine reads have it; "'count' is a key of [insert] ... of a many-particle run, which this
+ * scenario is not" and 2 when only another engine's have it; "" and 0 otherwise. */
+int cli_key_home(const struct cli_scenario* sc, const struct cli_entry* e, char* buf, size_t n);
 /* Whether s is a non-empty name of letters, digits, '_' and '-'. */
 bool cli_is_name(const char* s);
 /* A numeric or choice key descriptor as a library parameter descriptor (for range text). */

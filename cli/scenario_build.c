@@ -32,7 +32,12 @@ double cli_stokes_speed(double stokes_n, double viscosity, double m_eff, double 
 int cli_scenario_lib_error(const struct cli_scenario* sc, const struct cli_entry* e,
                            const char* section, const struct wetdem_sim* sim, int status)
 {
-    if (e)
+    char home[400];
+    if (e && status == WETDEM_ERR_NOT_FOUND &&
+        (strcmp(e->section, "sim") == 0 || strcmp(e->section, "integrator") == 0) &&
+        cli_key_home(sc, e, home, sizeof home) == 1)
+        cli_scenario_error(sc, e, "unknown key '%s' in [%s]: %s", e->key, e->section, home);
+    else if (e)
         cli_scenario_error(sc, e, "%s", wetdem_sim_errmsg(sim));
     else
         cli_scenario_section_error(sc, section, "%s", wetdem_sim_errmsg(sim));

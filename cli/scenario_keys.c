@@ -497,3 +497,146 @@ int cmd_docs_scenarios(int argc, char** argv)
     }
     return cli_scenario_print_docs(stdout) == 0 ? CLI_EXIT_OK : CLI_EXIT_RUNTIME;
 }
+
+/* ------------------------------------------------------------ a key in another section -- */
+
+enum { ENGINE_BINARY = 1, ENGINE_MANY = 2, ENGINE_PAIRWISE = 4 };
+
+/* The engines that read section (table entry) d of table t (0 the common table, 1 the
+ * pairwise engine's, 2 the many-particle run's). */
+static unsigned section_engines(int t, const struct cli_section_desc* d)
+{
+    if (t == 1)
+        return ENGINE_PAIRWISE;
+    if (t == 2)
+        return ENGINE_MANY;
+    if (strcmp(d->name, "collision") == 0)
+        return ENGINE_BINARY;
+    if (strcmp(d->name, "output") == 0)
+        return ENGINE_BINARY | ENGINE_PAIRWISE;
+    if (strcmp(d->name, "engine") == 0)
+        return ENGINE_BINARY | ENGINE_MANY | ENGINE_PAIRWISE;
+    return ENGINE_BINARY | ENGINE_MANY;
+}
+
+static unsigned scenario_engine(const struct cli_scenario* sc)
+{
+    if (strcmp(cli_scenario_text(sc, "engine", "type", "soft"), "pairwise") == 0)
+        return ENGINE_PAIRWISE;
+    if (cli_scenario_is_many && cli_scenario_is_many(sc))
+        return ENGINE_MANY;
+    return ENGINE_BINARY;
+}
+
+/* Whether value is of the kind a library parameter takes (a number, or one of its words). */
+static bool lib_takes(const struct wetdem_param_desc* d, const char* value)
+{
+    double v;
+    if (!d)
+        return false;
+    if (!d->choices)
+        return cli_number(value, &v) == 0;
+    for (size_t k = 0; d->choices[k]; k++)
+        if (strcmp(d->choices[k], value) == 0)
+            return true;
+    return false;
+}
+
+/* Whether section d of the table has key and takes value there as its kind (a number for a
+ * number, one of the words of a choice): its own table, or the library's for materials, the
+ * fluid and the simulation settings. A key whose value is of another kind (a particle's
+ * speed = 1 and the glass model's speed = max) belongs elsewhere only in name. */
+static bool desc_has_key(const struct cli_section_desc* d, const char* key, const char* value)
+{
+    double v;
+    for (size_t k = 0; d->keys && d->keys[k].key; k++)
+        if (strcmp(d->keys[k].key, key) == 0) {
+            if (d->keys[k].kind == CLI_VALUE_NUMBER)
+                return cli_number(value, &v) == 0;
+            if (d->keys[k].kind == CLI_VALUE_CHOICE) {
+                for (size_t c = 0; d->keys[k].choices[c]; c++)
+                    if (strcmp(d->keys[k].choices[c], value) == 0)
+                        return true;
+                return false;
+            }
+            return true;
+        }
+    if (strcmp(d->name, "material.*") == 0)
+        return lib_takes(wetdem_param_find(wetdem_material_params(), key), value);
+    if (strcmp(d->name, "fluid") == 0)
+        return lib_takes(wetdem_param_find(wetdem_fluid_params(), key), value);
+    if (strcmp(d->name, "sim") == 0)
+        return lib_takes(wetdem_param_find(wetdem_sim_settings_params(), key), value);
+    return false;
+}
+
+/* Appends "[name]" (a family as [family.NAME]) to a list of at most 4 in buf. */
+static void add_home(char* buf, size_t n, int* count, const char* name)
+{
+    if (*count == 4)
+        return;
+    size_t used = strlen(buf);
+    const char* star = strstr(name, ".*");
+    snprintf(buf + used, n - used, "%s[%.*s%s]", *count ? ", " : "",
+             star ? (int)(star - name) : (int)strlen(name), name, star ? ".NAME" : "");
+    (*count)++;
+}
+
+/* Lists into buf the sections other than `section` that have `key` and that the engines in
+ * `engines` read, with the models whose parameter it is as [model.NAME]. Returns how many. */
+static int key_homes(const char* section, const char* key, const char* value, unsigned engines,
+                     char* buf, size_t n)
+{
+    buf[0] = '\0';
+    int count = 0;
+    const struct cli_section_desc* tables[3] = {sections, cli_pairwise_sections, cli_many_sections};
+    for (int t = 0; t < 3; t++)
+        for (size_t k = 0; tables[t] && tables[t][k].name; k++) {
+            const struct cli_section_desc* d = &tables[t][k];
+            if ((section_engines(t, d) & engines) && !cli_section_matches(section, d->name) &&
+                desc_has_key(d, key, value))
+                add_home(buf, n, &count, d->name);
+        }
+    if (engines & (ENGINE_BINARY | ENGINE_MANY)) {
+        const struct wetdem_model* const* reg = wetdem_model_registry();
+        for (size_t k = 0; reg[k]; k++) {
+            char name[CLI_NAME_MAX];
+            snprintf(name, sizeof name, "model.%s", reg[k]->name);
+            if (strcmp(name, section) != 0 &&
+                lib_takes(wetdem_param_find(reg[k]->params, key), value))
+                add_home(buf, n, &count, name);
+        }
+    }
+    char* last = strrchr(buf, ',');
+    if (count > 1 && last) { /* "[a], [b], [c]" -> "[a], [b] and [c]" */
+        char tail[256];
+        snprintf(tail, sizeof tail, " and%s", last + 1);
+        snprintf(last, n - (size_t)(last - buf), "%s", tail);
+    }
+    return count;
+}
+
+int cli_key_home(const struct cli_scenario* sc, const struct cli_entry* e, char* buf, size_t n)
+{
+    unsigned engine = scenario_engine(sc);
+    char homes[320];
+    if (key_homes(e->section, e->key, e->value, engine, homes, sizeof homes) > 0) {
+        snprintf(buf, n, "it is a key of %s: move it there", homes);
+        return 1;
+    }
+    static const struct {
+        unsigned engine;
+        const char* what;
+    } others[] = {{ENGINE_BINARY, "a binary collision"},
+                  {ENGINE_MANY, "a many-particle run"},
+                  {ENGINE_PAIRWISE, "the pairwise engine"}};
+    for (size_t k = 0; k < 3; k++)
+        if (others[k].engine != engine &&
+            key_homes(e->section, e->key, e->value, others[k].engine, homes, sizeof homes) > 0) {
+            snprintf(buf, n, "'%s' is a key of %s of %s, which this scenario is not", e->key, homes,
+                     others[k].what);
+            return 2;
+        }
+    buf[0] = '\0';
+    return 0;
+}

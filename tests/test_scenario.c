@@ -258,6 +258,18 @@ static void test_scenario_bad_files_exit_2_with_line(void** state)
          "[material.NAME] [model.NAME] [sphere.NAME] "
          "[insert.NAME] [particle.NAME] [read.NAME]"},
         {"key", "[collision]\nstokse = 5\n", ":2:", "did you mean 'stokes'"},
+        /* a key in the wrong section is named with its section, not refused as unknown alone */
+        {"sim key", "[collision]\nspeed = 1\n[sim]\nangle_deg = 30\n",
+         ":4:", "unknown key 'angle_deg' in [sim]: it is a key of [collision]: move it there"},
+        {"walls key", "[box]\nsize_x = 1e-2\n[walls]\nperiodic = x\n",
+         ":4:", "unknown key 'periodic' in [walls]: it is a key of [box]: move it there"},
+        {"model key", "[collision]\nspeed = 1\ncutoff_ratio = 2\n",
+         ":3:", "it is a key of [model.nijssen] and [model.reynolds]: move it there"},
+        {"engine key", "[collision]\nspeed = 1\ncount = 3\n", ":3:",
+         "('count' is a key of [insert] and [insert.NAME] of a many-particle run, which this "
+         "scenario is not)"},
+        {"key word", "[collision]\nspeed = 1\nangle = 30\n",
+         ":3:", "unknown key 'angle' in [collision] (did you mean 'angle_deg'?)"},
         {"nan", "[collision]\n\nstokes = nan\n", ":3:", "not a finite number"},
         {"inf", "[collision]\nspeed = inf\n", ":2:", "not a finite number"},
         /* only decimal or exponent notation (docs/scenarios.md): strtod alone would read 16
