@@ -275,7 +275,9 @@ static int check_keys(const struct cli_batch* b)
     char full[CLI_BATCH_MAX_KEYS][2 * CLI_NAME_MAX + 2];
     for (int d = 0; d < b->n_keys; d++) {
         char section[CLI_NAME_MAX], key[CLI_NAME_MAX];
-        if (cli_key_split(options[d], b->key[d], section, key) != 0)
+        if (cli_key_split(options[d], b->key[d], section, key) != 0 ||
+            cli_check_numeric_key(b->cmd, options[d], b->key[d], section, key, "varied") !=
+                CLI_EXIT_OK)
             return CLI_EXIT_USAGE;
         snprintf(full[d], sizeof full[d], "%s.%s", section, key);
     }

@@ -473,61 +473,6 @@ static int fit_model(const double* params, double* predicted, char* msg, size_t 
 
 /* ---- parameters --------------------------------------------------------------------------- */
 
-/* The numeric key `key` of section `section` as named in --fit (tok): the section must exist,
- * the key must be one of its keys (with a suggestion otherwise) and take a number. Sections
- * whose keys are only known when built ([integrator], [sim]) pass here and are checked when
- * the first point is built. */
-static int check_key(const char* tok, const char* section, const char* key)
-{
-    struct cli_section_info info;
-    char msg[512] = "";
-    if (cli_section_lookup(section, &info) != 0) {
-        const char* hint = strchr(section, '.') ? NULL : cli_model_suggestion(section);
-        if (hint)
-            snprintf(msg, sizeof msg, " (did you mean '%s.%s'?)", hint, key);
-        else
-            cli_section_suggestion(section, msg, sizeof msg);
-        cli_error("fit: --fit %s: unknown section [%s]%s", tok, section, msg);
-        return CLI_EXIT_USAGE;
-    }
-    const char* names[128];
-    size_t n = 0;
-    for (size_t k = 0; info.desc->keys && info.desc->keys[k].key && n + 1 < 128; k++) {
-        const struct cli_key_desc* d = &info.desc->keys[k];
-        if (strcmp(d->key, key) == 0 && d->kind != CLI_VALUE_NUMBER) {
-            cli_error("fit: --fit %s: [%s] %s takes a word, not a number; only numeric keys "
-                      "can be fitted",
-                      tok, section, key);
-            return CLI_EXIT_USAGE;
-        }
-        if (strcmp(d->key, key) == 0)
-            return CLI_EXIT_OK;
-        names[n++] = d->key;
-    }
-    for (size_t k = 0; info.lib_keys && info.lib_keys[k].name && n + 1 < 128; k++) {
-        const struct wetdem_param_desc* d = &info.lib_keys[k];
-        if (strcmp(d->name, key) == 0 && d->choices) {
-            cli_error("fit: --fit %s: [%s] %s is a choice, not a number; only numeric "
-                      "parameters can be fitted",
-                      tok, section, key);
-            return CLI_EXIT_USAGE;
-        }
-        if (strcmp(d->name, key) == 0)
-            return CLI_EXIT_OK;
-        names[n++] = d->name;
-    }
-    if (info.open_keys)
-        return CLI_EXIT_OK;
-    names[n] = NULL;
-    const char* hint = wetdem_param_suggest(key, names);
-    if (hint)
-        snprintf(msg, sizeof msg, " (did you mean '%s'?)", hint);
-    cli_error("fit: --fit %s: unknown key '%s' in [%s]%s; 'wetdem describe' lists a model's "
-              "parameters, docs/scenarios.md the scenario keys",
-              tok, key, section, msg);
-    return CLI_EXIT_USAGE;
-}
-
 /* Whether `key=value` is accepted as an override of the base scenario (the checker prints
  * why not). Returns its exit code. */
 static int probe_override(const struct fit_ctx* c, const char* key, const char* value)
@@ -601,7 +546,7 @@ static int parse_keys(const char* list, struct fit_ctx* c)
         }
         char section[CLI_NAME_MAX], key[CLI_NAME_MAX];
         if (cli_key_split("--fit", tok, section, key) != 0 ||
-            check_key(tok, section, key) != CLI_EXIT_OK)
+            cli_check_numeric_key("fit", "--fit", tok, section, key, "fitted") != CLI_EXIT_OK)
             return CLI_EXIT_USAGE;
         char* full = c->keys[c->n_keys];
         snprintf(full, sizeof c->keys[0], "%s.%s", section, key);

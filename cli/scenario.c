@@ -963,3 +963,55 @@ int cli_load_with_overrides(const char* file, const char* const* sets, int n_set
         warn_shadowed_presets(sc);
     return rc;
 }
+
+int cli_check_numeric_key(const char* cmd, const char* option, const char* tok, const char* section,
+                          const char* key, const char* verb)
+{
+    struct cli_section_info info;
+    char msg[512] = "";
+    if (cli_section_lookup(section, &info) != 0) {
+        const char* hint = strchr(section, '.') ? NULL : cli_model_suggestion(section);
+        if (hint)
+            snprintf(msg, sizeof msg, " (did you mean '%s.%s'?)", hint, key);
+        else
+            cli_section_suggestion(section, msg, sizeof msg);
+        cli_error("%s: %s %s: unknown section [%s]%s", cmd, option, tok, section, msg);
+        return CLI_EXIT_USAGE;
+    }
+    const char* names[128];
+    size_t n = 0;
+    for (size_t k = 0; info.desc->keys && info.desc->keys[k].key && n + 1 < 128; k++) {
+        const struct cli_key_desc* d = &info.desc->keys[k];
+        if (strcmp(d->key, key) == 0 && d->kind != CLI_VALUE_NUMBER) {
+            cli_error("%s: %s %s: [%s] %s takes a word, not a number; only numeric keys "
+                      "can be %s",
+                      cmd, option, tok, section, key, verb);
+            return CLI_EXIT_USAGE;
+        }
+        if (strcmp(d->key, key) == 0)
+            return CLI_EXIT_OK;
+        names[n++] = d->key;
+    }
+    for (size_t k = 0; info.lib_keys && info.lib_keys[k].name && n + 1 < 128; k++) {
+        const struct wetdem_param_desc* d = &info.lib_keys[k];
+        if (strcmp(d->name, key) == 0 && d->choices) {
+            cli_error("%s: %s %s: [%s] %s is a choice, not a number; only numeric "
+                      "parameters can be %s",
+                      cmd, option, tok, section, key, verb);
+            return CLI_EXIT_USAGE;
+        }
+        if (strcmp(d->name, key) == 0)
+            return CLI_EXIT_OK;
+        names[n++] = d->name;
+    }
+    if (info.open_keys)
+        return CLI_EXIT_OK;
+    names[n] = NULL;
+    const char* hint = wetdem_param_suggest(key, names);
+    if (hint)
+        snprintf(msg, sizeof msg, " (did you mean '%s'?)", hint);
+    cli_error("%s: %s %s: unknown key '%s' in [%s]%s; 'wetdem describe' lists a model's "
+              "parameters, docs/scenarios.md the scenario keys",
+              cmd, option, tok, key, section, msg);
+    return CLI_EXIT_USAGE;
+}

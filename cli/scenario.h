@@ -272,6 +272,13 @@ int cli_override_split(const char* text, char* section, char* key, char* value);
 /* The same for a key given alone by `option` ("--param", "--fit"): "a.b.c" into section and
  * key; the message names the option. Returns 0 or -1 (message printed). */
 int cli_key_split(const char* option, const char* name, char* section, char* key);
+/* Checks that key `key` of section `section`, named `tok` by `option` of command `cmd` (fit
+ * --fit, sweep --param), is a numeric key: the section must exist, the key must be one of
+ * its keys (with a suggestion otherwise) and take a number ("only numeric keys can be
+ * <verb>"). Sections whose keys are only known when built ([integrator], [sim]) pass here.
+ * CLI_EXIT_OK, or the message printed and CLI_EXIT_USAGE. */
+int cli_check_numeric_key(const char* cmd, const char* option, const char* tok, const char* section,
+                          const char* key, const char* verb);
 /* Whether two keys "section.key" (as those splits resolve them) set one thing: 1 the same
  * key, 2 collision.speed and collision.stokes (the impact: setting one replaces the other),
  * else 0. */

@@ -1304,6 +1304,18 @@ static void test_scenario_sweep_order_and_threads(void** state)
     CHECK_CONTAINS(r.out, "sweep: at point 3 of 3 of the values: collision.angle_deg = 120");
     free(r.out);
     assert_false(exists(tmpdir, "sweep.csv"));
+    /* a --param that is no numeric key is named as the option gave it: it was reported as a
+     * "--set collision.stoke=1" the user never wrote, at "point 1" */
+    expect_run("sweep examples/scenarios/nijssen_head_on.ini --param collision.stoke --values "
+               "1:10:3",
+               2,
+               "wetdem: sweep: --param collision.stoke: unknown key 'stoke' in [collision] (did "
+               "you mean 'stokes'?)");
+    expect_run("map examples/scenarios/nijssen_head_on.ini --param collision.stokes --values "
+               "1:10:2 --param2 collision.striker --values2 1:2:2",
+               2,
+               "wetdem: map: --param2 collision.striker: [collision] striker takes a word, not a "
+               "number; only numeric keys can be varied");
     /* --out into a directory that does not exist yet: it is created, the table written whole */
     snprintf(cmd, sizeof cmd,
              "sweep examples/scenarios/nijssen_head_on.ini --param collision.stokes "
