@@ -137,9 +137,17 @@ static double si_prefix(const char* s, size_t* len)
     return 0;
 }
 
+/* v with the fewest digits that read back as v (a converted value to paste), into num[32]. */
+static const char* shortest(double v, char* num)
+{
+    wetdem_param_format_value(v, 1, num, 32);
+    return num;
+}
+
 const char* cli_number_hint(const char* text, const char* unit, char* buf, size_t n)
 {
     buf[0] = '\0';
+    char num[32]; /* a converted value */
     double v;
     size_t len = strlen(text);
     if (len >= 2 && (text[0] == '"' || text[0] == '\'') && text[len - 1] == text[0]) {
@@ -175,7 +183,8 @@ const char* cli_number_hint(const char* text, const char* unit, char* buf, size_
         else
             snprintf(buf, n, ": write a decimal point, not a comma, and no thousands separator");
     } else if (strcmp(rest, "%") == 0 && dimensionless) {
-        snprintf(buf, n, ": write a fraction, not a percentage: %s = %.6g", text, v / 100);
+        snprintf(buf, n, ": write a fraction, not a percentage: %s = %s", text,
+                 shortest(v / 100, num));
     } else if (isalpha((unsigned char)*rest) || (unsigned char)*rest >= 0x80 || *rest == '%') {
         /* a unit: the key's own (written out), one with an SI prefix (converted), or another */
         char given[64], want[64];
@@ -186,14 +195,14 @@ const char* cli_number_hint(const char* text, const char* unit, char* buf, size_
         if (want[0] && strcmp(given, want) == 0)
             snprintf(buf, n, ": write the number alone, %.*s (the unit is %s)", (int)k, text, unit);
         else if (f != 0 && strcmp(given + plen, want) == 0)
-            snprintf(buf, n, ": write the number alone, in %s: %s = %.6g %s", unit, text, v * f,
-                     unit);
+            snprintf(buf, n, ": write the number alone, in %s: %s = %s %s", unit, text,
+                     shortest(v * f, num), unit);
         else if (want[0] && strcmp(want, "Pas") == 0 && strcmp(given, "cP") == 0)
-            snprintf(buf, n, ": write the number alone, in %s: %s = %.6g %s", unit, text, v * 1e-3,
-                     unit);
+            snprintf(buf, n, ": write the number alone, in %s: %s = %s %s", unit, text,
+                     shortest(v * 1e-3, num), unit);
         else if (want[0] && strcmp(want, "deg") == 0 && strcmp(given, "rad") == 0)
-            snprintf(buf, n, ": write the number alone, in deg: %s = %.6g deg", text,
-                     v * 57.295779513082321);
+            snprintf(buf, n, ": write the number alone, in deg: %s = %s deg", text,
+                     shortest(v * 57.295779513082321, num));
         else if (want[0] && strcmp(want, "deg") == 0)
             snprintf(buf, n, ": write the number alone, in degrees");
         else if (want[0])

@@ -288,7 +288,7 @@ static void test_scenario_bad_files_exit_2_with_line(void** state)
         {"GPa", "[collision]\nspeed = 1\n[material.m]\nyoungs_modulus = 190 GPa\n",
          ":4:", "190 GPa = 1.9e+11 Pa"},
         {"cP", "[collision]\nspeed = 1\n[fluid]\nviscosity = 1 cP\n", ":4:", "1 cP = 0.001 Pa s"},
-        {"rad", "[collision]\nspeed = 1\nangle_deg = 0.5 rad\n", ":3:", "0.5 rad = 28.6479 deg"},
+        {"rad", "[collision]\nspeed = 1\nangle_deg = 0.5 rad\n", ":3:", "0.5 rad = 28.64788975654116 deg"},
         {"other unit", "[collision]\nspeed = 1\n[material.m]\ndensity = 7.8 g/cm^3\n",
          ":4:", "write the number alone, in kg/m^3 (SI units throughout)"},
         {"percent", "[collision]\nspeed = 1\n[material.m]\nrestitution = 90%\n",
