@@ -42,16 +42,16 @@ static inline void store_spring(double* spring, struct wetdem_vec3 s)
     spring[2] = s.z;
 }
 
-/* The spring update and tangential force on i [N] (wetdem_force_mindlin_update_with) from the
- * contact quantities it reads: unit normal n, tangential velocity v_t [m/s] (the dashpot's),
- * the velocity v_s the spring advances with over dt [m/s] (v_t, or the trapezoidal mean of the
- * two-body CVODE engine: struct wetdem_contact dv_t_spring), dt [s], G* [Pa], R* [m], m* [kg],
+/* The spring update and tangential force on i [N] with the tangential stiffness k_t [N/m]
+ * given (mindlin_spring: the Hertzian one), from the contact quantities it reads: unit normal
+ * n, tangential velocity v_t [m/s] (the dashpot's), the velocity v_s the spring advances with over dt [m/s] (v_t, or the trapezoidal
+ * mean of the two-body CVODE engine: struct wetdem_contact dv_t_spring), dt [s], m* [kg],
  * overlap [m], f_limit [N], mu [-], the damping factor [-]; spring: the 3 doubles of history
- * [m]. */
+ * [m]. k_t is read only when overlap > 0. */
 static inline __attribute__((always_inline)) struct wetdem_vec3
-mindlin_spring(struct wetdem_vec3 n, struct wetdem_vec3 v_t, struct wetdem_vec3 v_s, double dt,
-               double g_star, double r_eff, double m_eff, double overlap, double f_limit, double mu,
-               double damping_factor, double* spring)
+mindlin_spring_k(struct wetdem_vec3 n, struct wetdem_vec3 v_t, struct wetdem_vec3 v_s, double dt,
+                 double k_t, double m_eff, double overlap, double f_limit, double mu,
+                 double damping_factor, double* spring)
 {
     if (!(overlap > 0.0)) {
         store_spring(spring, vec3(0, 0, 0));
@@ -59,7 +59,6 @@ mindlin_spring(struct wetdem_vec3 n, struct wetdem_vec3 v_t, struct wetdem_vec3 
     }
     struct wetdem_vec3 s = rotate_into_plane(vec3(spring[0], spring[1], spring[2]), n);
     s = vec3_axpy(s, dt, v_s);
-    double k_t = tangential_stiffness(g_star, r_eff, overlap);
     double gamma_t = tangential_damping(k_t, m_eff, damping_factor);
     struct wetdem_vec3 ft = vec3_axpy(vec3_scale(s, -k_t), -gamma_t, v_t);
     double f_total = vec3_norm(ft), f_max = mu * fabs(f_limit);
@@ -69,6 +68,18 @@ mindlin_spring(struct wetdem_vec3 n, struct wetdem_vec3 v_t, struct wetdem_vec3 
     }
     store_spring(spring, s);
     return ft;
+}
+
+/* The spring update and tangential force on i [N] (wetdem_force_mindlin_update_with) with the
+ * Hertzian k_t = 8 G* sqrt(R* delta) from G* [Pa] and R* [m]; the rest as mindlin_spring_k. */
+static inline __attribute__((always_inline)) struct wetdem_vec3
+mindlin_spring(struct wetdem_vec3 n, struct wetdem_vec3 v_t, struct wetdem_vec3 v_s, double dt,
+               double g_star, double r_eff, double m_eff, double overlap, double f_limit, double mu,
+               double damping_factor, double* spring)
+{
+    double k_t = overlap > 0.0 ? tangential_stiffness(g_star, r_eff, overlap) : 0.0;
+    return mindlin_spring_k(n, v_t, v_s, dt, k_t, m_eff, overlap, f_limit, mu, damping_factor,
+                            spring);
 }
 
 #endif
