@@ -226,6 +226,11 @@ struct wetdem_contact {
     double viscosity;       /* fluid mu [Pa s] */
     double surface_tension; /* fluid sigma [N/m] */
     double h_min;           /* minimum separation from the min-separation model [m] */
+    /* Normal stiffness k [N/m] of the enabled linear solid-contact law (its linear_stiffness
+     * hook: hooke's k), filled in by the engines as h_min is, so that the tangential spring
+     * (mindlin) follows the normal law beside it without reading that model's force; 0 when
+     * the normal law is Hertzian or absent (wetdem_contact_from_particles sets 0). */
+    double linear_stiffness;
 };
 
 /* What one model adds for one pair. Forces act on i; j receives the opposite. */
@@ -271,6 +276,10 @@ struct wetdem_model {
     /* Duration of an impact [s] at approach speed c->v_n > 0 (models with a solid contact;
      * optional). The explicit engines derive their step from the shortest. */
     double (*contact_time)(const void* params, const struct wetdem_contact* c);
+    /* Constant normal stiffness dF_n/d(delta) [N/m] of a linear solid-contact law (hooke's k),
+     * which the engines pass to every model as c->linear_stiffness. Optional: NULL for a law
+     * that is not linear (hertz). */
+    double (*linear_stiffness)(const void* params, const struct wetdem_contact* c);
     /* Shortest relaxation time m / c_d [s] of the motion the model damps viscously, at the
      * smallest gap it acts at (c->h_min filled in, c->v_n the approach speed): c_d = dF/dv,
      * m = m* for normal and (2/7) m* for tangential motion (the spins take part); INFINITY
@@ -306,8 +315,8 @@ WETDEM_API const struct wetdem_model* wetdem_model_find(const char* name);
 WETDEM_API const char* wetdem_model_kind_name(enum wetdem_model_kind kind);
 
 /* Builds the contact of particles a (as i) and b (as j) with their materials and the fluid
- * (NULL: none, viscosity and surface tension 0). h_min and dt are left 0 for the caller to
- * fill. */
+ * (NULL: none, viscosity and surface tension 0). h_min, linear_stiffness and dt are left 0
+ * for the caller to fill. */
 WETDEM_API void
 wetdem_contact_from_particles(struct wetdem_contact* c, const struct wetdem_particle* a,
                               const struct wetdem_material* ma, const struct wetdem_particle* b,

@@ -13,6 +13,7 @@
  * means of the two materials (Nijssen Eq. 3 for sigma); delta_ij = delta_i + delta_j.
  * A plane wall is a sphere of infinite radius and mass: R* = R_i, m* = m_i.
  * A fixed particle has infinite mass: m* = m of the other.
+ * h_min, linear_stiffness and dt are left 0: the engines fill them in.
  */
 #include <math.h>
 
@@ -36,6 +37,7 @@ static void mix_properties(struct wetdem_contact* c, const struct wetdem_materia
     c->viscosity = fluid ? fluid->viscosity : 0.0;
     c->surface_tension = fluid ? fluid->surface_tension : 0.0;
     c->h_min = 0.0;
+    c->linear_stiffness = 0.0;
     c->dt = 0.0;
 }
 

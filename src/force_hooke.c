@@ -12,7 +12,10 @@
  * e_dry is reproduced exactly at every impact speed. The force is NOT clipped at zero: near
  * the end of unloading it pulls by up to gamma v; clipping would raise the rebound speed and
  * break both closed forms. At delta = 0 the force jumps by gamma v_n (the dashpot acts from
- * the first overlap), the one discontinuity of the law; thresholds() reports that gap. k is a model parameter, independent of the material moduli.
+ * the first overlap), the one discontinuity of the law; thresholds() reports that gap. k is a
+ * model parameter, independent of the material moduli; the engines pass it to the other models
+ * as c->linear_stiffness (linear_stiffness hook), from which mindlin beside hooke takes its
+ * linear form, k_t = 4 (G* / E*) k and the Coulomb limit mu k delta (contact.md Sec. 3.1).
  * Validity: e in (0, 1]; choose k so that the overlap stays small, delta_max = v sqrt(m* / k)
  * (undamped) << R*.
  */
@@ -76,6 +79,14 @@ static double hooke_relaxation_time(const void* params, const struct wetdem_cont
     return viscous_relaxation_time(c->m_eff, hooke_damping(k, c->m_eff, c->restitution));
 }
 
+/* The spring constant k [N/m]: the engines pass it to every model as c->linear_stiffness, and
+ * mindlin beside hooke takes its linear form from it (force_mindlin.c). */
+static double hooke_linear_stiffness(const void* params, const struct wetdem_contact* c)
+{
+    (void)c;
+    return ((const struct hooke_params*)params)->stiffness;
+}
+
 /* Energy stored in the spring, k delta^2 / 2 [J] (the dashpot stores none). */
 static double hooke_elastic_energy(const void* params, const struct wetdem_contact* c,
                                    const double* history)
@@ -98,10 +109,10 @@ const struct wetdem_model wetdem_force_hooke = {
            "closed forms), and the dashpot makes it jump by gamma v_n where the overlap "
            "begins and ends. Cheaper and stiffer-to-tune than hertz; k does not follow from the "
            "material moduli. Keep the overlap v sqrt(m* / k) small compared with R*. mindlin "
-           "beside it keeps its Hertzian tangential stiffness 8 G* sqrt(R* delta) and Coulomb "
-           "limit mu (4/3) E* sqrt(R*) delta^(3/2), not mu k delta: with a soft k its friction "
-           "can exceed mu times this normal force (about 5 x for steel spheres of R = 2 mm, "
-           "k = 1e6 N/m, delta = 1 um).",
+           "beside it becomes the linear history spring: tangential stiffness (4 G*/E*) k (the "
+           "Hertz-Mindlin ratio of tangential to normal stiffness) and Coulomb limit mu k delta, "
+           "so friction stays within mu times this model's elastic force; it reads the current "
+           "k (the engines pass it as the contact's linear_stiffness).",
     .equations = "linear spring-dashpot (Cundall & Strack 1979; LIGGGHTS model hooke); "
                  "docs/derivations/contact.md",
     .params = hooke_params_desc,
@@ -111,6 +122,7 @@ const struct wetdem_model wetdem_force_hooke = {
     .pair = hooke_pair,
     .thresholds = contact_only_thresholds,
     .contact_time = hooke_contact_time,
+    .linear_stiffness = hooke_linear_stiffness,
     .relaxation_time = hooke_relaxation_time,
     .elastic_energy = hooke_elastic_energy,
     .is_in_contact = contact_only_is_in_contact,

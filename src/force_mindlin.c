@@ -22,7 +22,14 @@
  * violations (up to 3.7 mu F_lim in oblique collisions at 5-20 deg) and why the cap is kept.
  * F_lim is the Hertz elastic normal force (4/3) E* sqrt(R*) delta^(3/2) for this model
  * (LIGGGHTS takes the total normal force, damping included; models do not read each other's
- * force here, and the elastic part stays positive while unloading). LIGGGHTS projects s into
+ * force here, and the elastic part stays positive while unloading).
+ * Beside a linear normal law (c->linear_stiffness = k > 0, which the engines fill in from the
+ * enabled contact model's linear_stiffness hook: hooke) the spring is its linear counterpart
+ * (contact.md Sec. 3.1): F_lim = k delta, hooke's elastic force, and in step 3
+ *      k_t = (4 G* / E*) k                                      [N/m]
+ * the ratio k_t / k_n = 8 G* a / (2 E* a) of Hertz-Mindlin (a the contact radius), with the
+ * same gamma_t formula; so friction is bounded by mu times hooke's elastic force, not by a
+ * Hertz force of the same overlap (many times larger for a soft k). LIGGGHTS projects s into
  * the plane without restoring its length; here the length is kept (rigid rotation).
  * delta <= 0 resets s to zero and gives no force. The damping is the normal Tsuji form with
  * k_t in place of S_n = 2 E* sqrt(R* delta) (as LIGGGHTS): the tangential restitution of a
@@ -82,8 +89,17 @@ static int mindlin_pair(const void* params, const struct wetdem_contact* c, doub
         return WETDEM_ERR_INVALID;
     double overlap = -c->gap;
     double mu = p->friction == 0 ? c->friction_dry : c->friction_lub;
-    double f_limit = wetdem_force_hertz_elastic(c->e_star, c->r_eff, overlap);
-    struct wetdem_vec3 ft = wetdem_force_mindlin_update(c, overlap, f_limit, mu, history);
+    double k = c->linear_stiffness;
+    struct wetdem_vec3 ft;
+    if (k > 0.0) { /* beside a linear normal law: its linear counterpart */
+        double factor = overlap > 0.0 ? wetdem_force_mindlin_damping_factor(c->restitution) : 0.0;
+        ft = mindlin_spring_k(c->normal, c->v_t, vec3_add(c->v_t, c->dv_t_spring), c->dt,
+                              linear_tangential_stiffness(c->g_star, c->e_star, k), c->m_eff,
+                              overlap, k * overlap, mu, factor, history);
+    } else {
+        double f_limit = wetdem_force_hertz_elastic(c->e_star, c->r_eff, overlap);
+        ft = wetdem_force_mindlin_update(c, overlap, f_limit, mu, history);
+    }
     if (overlap > 0.0)
         wetdem_pair_force_add_tangential(out, c, ft);
     return WETDEM_OK;
@@ -107,12 +123,17 @@ const struct wetdem_model wetdem_force_mindlin = {
            "evaluation; LIGGGHTS compares only the spring, which lets a sticking dashpot exceed "
            "the limit many times at small overlaps. Separation (delta <= 0) resets s. The force "
            "acts at the contact point "
-           "and gives torques on both spheres. Use with hertz. mu is the pair's dry or "
+           "and gives torques on both spheres. Beside hooke (a linear normal spring k) it is the "
+           "linear counterpart: k_t = (4 G*/E*) k, the Hertz-Mindlin ratio of tangential to "
+           "normal stiffness, the same gamma_t formula, and the limit mu k delta (hooke's "
+           "elastic force), so Coulomb's law holds against hooke's normal force; the engines "
+           "pass hooke's current k to it. mu is the pair's dry or "
            "lubricated coefficient (parameter friction). Valid for small overlaps; no "
            "micro-slip hysteresis inside the contact area.",
     .equations = "tangential part of Punch 2023 Eq. 6 (Hertz-Mindlin as in LIGGGHTS); the "
                  "friction switch of Nijssen 2023 Eq. 10 selects mu; Mindlin 1949; Di Renzo "
-                 "& Di Maio 2004; docs/derivations/contact.md",
+                 "& Di Maio 2004; beside hooke the linear history model (LIGGGHTS hooke/"
+                 "history) with k_t/k_n of Hertz-Mindlin; docs/derivations/contact.md",
     .params = mindlin_params_desc,
     .params_size = sizeof(struct mindlin_params),
     .history_len = 3,

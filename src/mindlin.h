@@ -17,6 +17,13 @@ static inline double tangential_stiffness(double g_star, double r_eff, double ov
     return 8.0 * g_star * sqrt(r_eff * overlap);
 }
 
+/* Tangential stiffness beside a linear normal spring k [N/m]: (4 G* / E*) k [N/m], the ratio
+ * k_t / k_n = 8 G* a / (2 E* a) of Hertz-Mindlin (a the contact radius) applied to k. */
+static inline double linear_tangential_stiffness(double g_star, double e_star, double k)
+{
+    return 4.0 * g_star / e_star * k;
+}
+
 /* Tsuji-form tangential damping coefficient -2 sqrt(5/6) beta sqrt(m* k_t) [kg/s], from the
  * factor -2 sqrt(5/6) beta (the product is formed in that order either way). */
 static inline double tangential_damping(double k_t, double m_eff, double factor)
@@ -43,8 +50,9 @@ static inline void store_spring(double* spring, struct wetdem_vec3 s)
 }
 
 /* The spring update and tangential force on i [N] with the tangential stiffness k_t [N/m]
- * given (mindlin_spring: the Hertzian one), from the contact quantities it reads: unit normal
- * n, tangential velocity v_t [m/s] (the dashpot's), the velocity v_s the spring advances with over dt [m/s] (v_t, or the trapezoidal
+ * given (mindlin_spring: the Hertzian one; force_mindlin.c: the linear one beside hooke), from
+ * the contact quantities it reads: unit normal n, tangential velocity v_t [m/s] (the
+ * dashpot's), the velocity v_s the spring advances with over dt [m/s] (v_t, or the trapezoidal
  * mean of the two-body CVODE engine: struct wetdem_contact dv_t_spring), dt [s], m* [kg],
  * overlap [m], f_limit [N], mu [-], the damping factor [-]; spring: the 3 doubles of history
  * [m]. k_t is read only when overlap > 0. */

@@ -127,7 +127,11 @@ bool wetdem_sim_particle_valid(const struct wetdem_sim* sim, const struct wetdem
  * model fails or the force is not finite. */
 double wetdem_sim_force_at_rest(const struct wetdem_sim* sim, struct wetdem_contact c,
                                 const double* history, double gap);
-/* Fills c->h_min from the min-separation model, then sums every enabled force model into
+/* The normal stiffness of the enabled linear solid-contact law, from the models'
+ * linear_stiffness hooks (hooke's k) [N/m]; 0 when none is linear (struct wetdem_contact). */
+double wetdem_sim_linear_stiffness(const struct wetdem_sim* sim, const struct wetdem_contact* c);
+/* Fills c->h_min from the min-separation model and c->linear_stiffness
+ * (wetdem_sim_linear_stiffness), then sums every enabled force model into
  * *out (zeroed first). history: sim->history_len doubles (committed state in, advanced state
  * out), or NULL for a fresh pair with nothing kept. per_model (optional, n_models entries)
  * receives each model's own contribution. */

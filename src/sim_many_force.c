@@ -56,7 +56,10 @@
  * the same bits, because the sum starts at +0 and so is never -0 (x + (+0) = x and
  * x + (0 + y) = x + y for every x other than -0), so the skipped additions of zero fields
  * and the dropped 0 + y change nothing. The range of these models is the film thickness delta_ab
- * (0 for the contact models), a property of the material pair.
+ * (0 for the contact models), a property of the material pair. hooke is not among them: with
+ * hooke (a linear normal law, whose k mindlin beside it reads as c->linear_stiffness) every
+ * pair takes the generic path, wetdem_sim_eval_contact, which fills that field in; the fused,
+ * lean and four-at-a-time kernels compute mindlin's Hertzian form only.
  *
  * Lean kernel: for the same model sets (with sb, only with a constant h_min), the force is
  * computed straight from the two particles (or particle and wall), without a contact record
@@ -241,6 +244,7 @@ static void copy_mix(struct wetdem_contact* c, const struct wetdem_many_mix* x)
     c->viscosity = x->viscosity;
     c->surface_tension = x->surface_tension;
     c->h_min = 0.0;
+    c->linear_stiffness = 0.0;
     c->dt = 0.0;
 }
 
@@ -348,6 +352,7 @@ int wetdem_sim_many_eval_fused(const struct wetdem_sim* sim, struct wetdem_conta
         history = scratch;
     *out = (struct wetdem_pair_force){0};
     c->h_min = sim->minsep.model->min_separation(sim->minsep.params, c, history);
+    c->linear_stiffness = 0.0; /* (no fused model is a linear law) */
     double f_el = wetdem_force_hertz_elastic(c->e_star, c->r_eff, -c->gap);
     if (!per_model) { /* each model adds into *out at once: see the file header */
         for (size_t k = 0; k < sim->n_models; k++) {

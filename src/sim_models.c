@@ -685,6 +685,17 @@ double wetdem_sim_tangential_time(const struct wetdem_sim* sim, const struct wet
     return M_PI * sqrt(ratio * c->m_eff); /* no normal spring: the tangential half period */
 }
 
+double wetdem_sim_linear_stiffness(const struct wetdem_sim* sim, const struct wetdem_contact* c)
+{
+    double k = 0.0; /* (at most one normal contact law is enabled: contact_twice) */
+    for (size_t m = 0; m < sim->n_models; m++) {
+        const struct wetdem_model_slot* s = &sim->models[m];
+        if (s->model->linear_stiffness)
+            k += s->model->linear_stiffness(s->params, c);
+    }
+    return k;
+}
+
 int wetdem_sim_eval_contact(const struct wetdem_sim* sim, struct wetdem_contact* c, double* history,
                             struct wetdem_pair_force* out, struct wetdem_pair_force* per_model)
 {
@@ -697,6 +708,7 @@ int wetdem_sim_eval_contact(const struct wetdem_sim* sim, struct wetdem_contact*
     }
     *out = (struct wetdem_pair_force){0};
     c->h_min = sim->minsep.model->min_separation(sim->minsep.params, c, history);
+    c->linear_stiffness = wetdem_sim_linear_stiffness(sim, c);
     for (size_t k = 0; k < sim->n_models; k++) {
         const struct wetdem_model_slot* s = &sim->models[k];
         struct wetdem_pair_force f = {0};

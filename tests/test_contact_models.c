@@ -807,6 +807,320 @@ static void test_mindlin_resets_when_separated(void** state)
     CHECK_REL(ft.y, -0.1, 1e-15);
 }
 
+/* mindlin beside a linear normal spring (c->linear_stiffness = k > 0, as the engines fill it in
+ * beside hooke) is the linear counterpart (contact.md Sec. 3.1). Hand values, harness steel pair
+ * (E* = 100 GPa, G* = 40 GPa, m* = 1e-4 kg, mu = 0.1) at delta = 1 um, k = 1e6 N/m:
+ *   k_t = (4 G* / E*) k = 1.6 x 1e6 = 1.6e6 N/m (Hertzian 8 G* sqrt(R* delta) = 1.01e7 N/m);
+ *   one step from s = 0 at v_t = 0.01 m/s, dt = 1e-7 s, e = 1: s = 1e-9 m, F_t = -1.6e-3 N,
+ *   below mu k delta = 0.1 N: sticking;
+ *   e = 0.9: gamma_t = -2 sqrt(5/6) beta sqrt(m* k_t) = 0.06119603555922603 sqrt(160)
+ *   = 0.7740754245592409 kg/s, F_t = -1.6e-3 - 7.740754245592409e-3 = -9.34075424559241e-3 N;
+ *   sliding from s = 1 um at v_t = 0.5 m/s (spring 1.6 N): |F_t| = mu k delta = 0.1 N, and the
+ *   spring set so that -k_t s - gamma_t v_t = F_t.
+ * Tolerances: a few roundings of the same products (1e-14), the spring term a difference of
+ * forces of similar size (1e-13). Random states then never exceed mu k delta. */
+static void test_mindlin_beside_a_linear_spring_closed_forms(void** state)
+{
+    (void)state;
+    double p[1] = {0.0}, k = 1e6;
+    double hooke_p[1] = {k};
+    struct wetdem_contact c = steel_pair(-1e-6, 0.0);
+    assert_true(wetdem_force_hooke.linear_stiffness != NULL);
+    assert_true(wetdem_force_hertz.linear_stiffness == NULL); /* Hertz: not a linear law */
+    CHECK_REL(wetdem_force_hooke.linear_stiffness(hooke_p, &c), k, 0);
+    c.linear_stiffness = k;
+    c.restitution = 1.0;
+    c.v_t = (struct wetdem_vec3){0, 0.01, 0};
+    double hist[3] = {0, 0, 0};
+    struct wetdem_pair_force f = {0};
+    CHECK_OK(wetdem_force_mindlin.pair(p, &c, hist, &f));
+    CHECK_REL(f.f_tan.y, -1.6e-3, 1e-14);
+    CHECK_ABS(f.f_tan.x, 0.0, 0.0);
+    CHECK_ABS(f.f_tan.z, 0.0, 0.0);
+    CHECK_REL(hist[1], 1e-9, 1e-15);
+    CHECK_ABS(f.f_normal, 0.0, 0.0);
+    c.restitution = 0.9;
+    hist[1] = 0.0;
+    f = (struct wetdem_pair_force){0};
+    CHECK_OK(wetdem_force_mindlin.pair(p, &c, hist, &f));
+    CHECK_REL(f.f_tan.y, -9.34075424559241e-3, 1e-14);
+    c.v_t = (struct wetdem_vec3){0, 0.5, 0};
+    hist[1] = 1e-6;
+    f = (struct wetdem_pair_force){0};
+    CHECK_OK(wetdem_force_mindlin.pair(p, &c, hist, &f));
+    CHECK_REL(f.f_tan.y, -0.1, 1e-14);
+    CHECK_REL(-1.6e6 * hist[1] - 0.7740754245592409 * 0.5, f.f_tan.y, 1e-13);
+    /* the same state without a linear law: the Hertzian spring, whose limit mu F_el = 0.42 N */
+    c.linear_stiffness = 0.0;
+    hist[1] = 1e-6;
+    f = (struct wetdem_pair_force){0};
+    CHECK_OK(wetdem_force_mindlin.pair(p, &c, hist, &f));
+    CHECK_REL(f.f_tan.y, -0.1 * 4.216370213557839, 1e-14);
+    /* random states: spring, slip, overlap, k, e, mu and dt */
+    unsigned long long seed = 2024;
+    for (int n = 0; n < 20000; n++) {
+        double u[9];
+        for (int q = 0; q < 9; q++) {
+            seed = seed * 6364136223846793005ULL + 1442695040888963407ULL;
+            u[q] = (double)(seed >> 11) / 9007199254740992.0;
+        }
+        struct wetdem_contact r = steel_pair(-pow(10.0, -10.0 + 5.0 * u[0]), 0.0);
+        r.linear_stiffness = pow(10.0, 2.0 + 6.0 * u[8]);
+        r.restitution = 0.05 + 0.95 * u[1];
+        r.friction_dry = 0.5 * u[2];
+        r.dt = u[3] < 0.3 ? 0.0 : 1e-6 * u[3];
+        r.v_t = (struct wetdem_vec3){0, 2.0 * u[4] - 1.0, 0.5 * u[5] - 0.25};
+        double h[3] = {0, 1e-6 * (2.0 * u[6] - 1.0), 1e-7 * u[7]};
+        double s_y = h[1] + r.dt * r.v_t.y, s_z = h[2] + r.dt * r.v_t.z;
+        struct wetdem_pair_force q = {0};
+        CHECK_OK(wetdem_force_mindlin.pair(p, &r, h, &q));
+        double limit = r.friction_dry * r.linear_stiffness * -r.gap;
+        double ft = vec3_norm_test(q.f_tan);
+        if (!(ft <= limit * (1 + 1e-14))) /* the capped total is the limit to rounding */
+            fail_msg("state %d: |F_t| = %.17g N above mu k delta = %.17g N", n, ft, limit);
+        if (ft < limit * (1 - 1e-12)) /* sticking: the spring was not touched */
+            assert_true(h[1] == s_y && h[2] == s_z);
+    }
+}
+
+/* The stiffness the user last gave hooke [N/m], which every evaluation of the probe below must
+ * see as c->linear_stiffness. */
+static double probe_hooke_k;
+
+/* mindlin beside hooke, recording |F_t| / (mu k delta) of each evaluation in contact and
+ * checking that the engine passed hooke's current k. */
+static int mindlin_linear_probe_pair(const void* params, const struct wetdem_contact* c,
+                                     double* history, struct wetdem_pair_force* out)
+{
+    if (c->linear_stiffness != probe_hooke_k)
+        fail_msg("the engine passed k = %g N/m, hooke's is %g N/m", c->linear_stiffness,
+                 probe_hooke_k);
+    struct wetdem_pair_force f = {0};
+    int st = wetdem_force_mindlin.pair(params, c, history, &f);
+    double f_el = c->linear_stiffness * -c->gap;
+    if (f_el > 0.0) {
+        probe_worst_ratio =
+            fmax(probe_worst_ratio, vec3_norm_test(f.f_tan) / (c->friction_dry * f_el));
+        probe_evaluations++;
+    }
+    out->f_tan = f.f_tan;
+    out->torque_i = f.torque_i;
+    out->torque_j = f.torque_j;
+    return st;
+}
+
+/* A glass-like sphere (R = 1 mm, 2500 kg/m^3, E = 60 GPa, nu = 0.23, e_dry, mu) at rest in its
+ * equilibrium overlap m g / k on the floor z = 0 under gravity g = 9.81 m/s^2, models hooke
+ * (k = 1e3 N/m, set after enabling it) and mindlin (or the probe above when `probe`), sliding
+ * along x at v0 without spin; engine 0: two-body Verlet, 1: two-body CVODE (rtol 1e-10), 2:
+ * the many-particle mode; verlet.dt = dt when > 0. */
+static struct wetdem_sim* sphere_on_floor(int engine, bool probe, double v0, double dt,
+                                          double e_dry, double mu)
+{
+    static struct wetdem_model probe_model;
+    probe_model = wetdem_force_mindlin;
+    probe_model.name = "mindlin_linear_probe";
+    probe_model.pair = mindlin_linear_probe_pair;
+    struct wetdem_sim* sim = wetdem_sim_create();
+    struct wetdem_material m = {.density = 2500,
+                                .youngs_modulus = 60e9,
+                                .poisson_ratio = 0.23,
+                                .restitution = e_dry,
+                                .friction_dry = mu,
+                                .friction_lub = 0.1};
+    int mat = wetdem_sim_add_material(sim, &m);
+    CHECK_OK(wetdem_sim_enable_model(sim, "hooke"));
+    double p[1] = {0.0};
+    if (probe)
+        CHECK_OK(wetdem_sim_add_model(sim, &probe_model, p));
+    else
+        CHECK_OK(wetdem_sim_enable_model(sim, "mindlin"));
+    double k = 1e3;
+    probe_hooke_k = k;
+    CHECK_OK(wetdem_sim_set_param(sim, "hooke.stiffness", k));
+    CHECK_OK(wetdem_sim_set_param(sim, "sim.gravity_z", -9.81));
+    if (dt > 0)
+        CHECK_OK(wetdem_sim_set_param(sim, "verlet.dt", dt));
+    CHECK_OK(wetdem_sim_add_wall(sim, (struct wetdem_vec3){0, 0, 0}, (struct wetdem_vec3){0, 0, 1},
+                                 mat));
+    double r = 1e-3, mass = wetdem_material_sphere_mass(&m, r);
+    CHECK_OK(wetdem_sim_add_particle(
+        sim,
+        (struct wetdem_particle){
+            .pos = {0, 0, r - mass * 9.81 / k}, .vel = {v0, 0, 0}, .radius = r, .material = mat}));
+    if (engine == 1) {
+        CHECK_OK(wetdem_sim_set_integrator(sim, "cvode"));
+        CHECK_OK(wetdem_sim_set_param(sim, "cvode.rtol", 1e-10));
+        CHECK_OK(wetdem_sim_set_param(sim, "cvode.atol", 1e-12));
+    }
+    if (engine == 2)
+        CHECK_OK(wetdem_sim_set_many(sim, &(struct wetdem_many_settings){.skin = 1e-4}));
+    return sim;
+}
+
+/* sphere_on_floor with e_dry = 0.5, mu = 0.3. */
+static struct wetdem_sim* sliding_sphere(int engine, bool probe, double v0, double dt)
+{
+    return sphere_on_floor(engine, probe, v0, dt, 0.5, 0.3);
+}
+
+/* Coulomb's law against hooke's normal force: the sphere of sliding_sphere, pressed on the
+ * floor by its weight (hooke's k delta = m g), slides with the friction mu k delta = mu m g,
+ * so its centre decelerates at mu g and its spin grows at (mu m g R) / I = (5/2) mu g / R:
+ *   v(t) = v0 - mu g t,   w_y(t) R = (5/2) mu g t,   until they meet at t* = 2 v0 / (7 mu g),
+ * from where it rolls at v = w_y R = (5/7) v0 (angular momentum about the contact point,
+ * m v R + I w, is kept by every force through that point, whatever the friction law). Here
+ * v0 = 0.1 m/s, mu g = 2.943 m/s^2, t* = 9.71 ms. The mindlin this sphere had (Hertzian limit
+ * mu (4/3) E* sqrt(R*) delta^(3/2) at delta = 1.03e-7 m: 430 x mu m g) stopped it within a
+ * step. The dashpot alone exceeds the limit at the first evaluation (gamma_t v0 = 3.4e-3 N
+ * against mu m g = 3.1e-5 N), so the contact slides from t0 with exactly that force:
+ * - Verlet and the many mode integrate a constant force exactly; at t* / 2 the sums of 760
+ *   and 1300 steps carry rounding only: 1e-10 relative (measured 5.4e-13);
+ * - CVODE at rtol 1e-10 follows a piecewise constant force: 1e-7 (measured 1.5e-12);
+ * - after 4 t* (three more t*) the spring's stick oscillation (period 0.37 ms, tangential
+ *   damping from e_dry = 0.5) has decayed: v and w R are (5/7) v0, and rolling w R = v, to
+ *   1e-9 relative (measured 9.4e-12 with CVODE, 1.4e-13 otherwise).
+ * The many mode with the two-body engine's step matches that engine to rounding (the same
+ * scheme and forces, test_many_matches_few_body_engine): 1e-12 (measured 9.8e-14). */
+static void test_mindlin_beside_hooke_sliding_sphere_obeys_coulomb(void** state)
+{
+    (void)state;
+    double v0 = 0.1, mu_g = 0.3 * 9.81, r = 1e-3, t_star = 2 * v0 / (7 * mu_g);
+    struct wetdem_particle at[2][3];
+    for (int engine = 0; engine < 3; engine++) {
+        struct wetdem_sim* sim = sliding_sphere(engine, false, v0, 0);
+        double tol = engine == 1 ? 1e-7 : 1e-10;
+        CHECK_OK(wetdem_sim_integrate(sim, 0.5 * t_star));
+        struct wetdem_particle p = wetdem_sim_particles_const(sim, NULL)[0];
+        double t = wetdem_sim_time(sim); /* (the many mode ends on whole steps) */
+        CHECK_REL(p.vel.x, v0 - mu_g * t, tol);
+        CHECK_REL(p.omega.y * r, 2.5 * mu_g * t, tol);
+        CHECK_OK(wetdem_sim_integrate(sim, 4 * t_star));
+        p = wetdem_sim_particles_const(sim, NULL)[0];
+        CHECK_REL(p.vel.x, 5.0 / 7 * v0, 1e-9);
+        CHECK_REL(p.omega.y * r, p.vel.x, 1e-9);
+        wetdem_sim_free(sim);
+    }
+    /* the many mode against the two-body engine, at one step (5 us; 970 and 7800 steps) */
+    for (int k = 0; k < 2; k++) {
+        struct wetdem_sim* sim = sliding_sphere(k ? 2 : 0, false, v0, 5e-6);
+        CHECK_OK(wetdem_sim_integrate(sim, 970 * 5e-6));
+        at[k][0] = wetdem_sim_particles_const(sim, NULL)[0];
+        CHECK_OK(wetdem_sim_integrate(sim, 7800 * 5e-6));
+        at[k][1] = wetdem_sim_particles_const(sim, NULL)[0];
+        wetdem_sim_free(sim);
+    }
+    for (int q = 0; q < 2; q++) {
+        CHECK_REL(at[1][q].vel.x, at[0][q].vel.x, 1e-12);
+        CHECK_REL(at[1][q].omega.y, at[0][q].omega.y, 1e-12);
+        CHECK_REL(at[1][q].pos.x, at[0][q].pos.x, 1e-12);
+    }
+}
+
+/* The sticking contact oscillates with the period of k_t = (4 G* / E*) k and the tangential
+ * mass m_t = (2/7) m (the sphere spins too: dv_t/dt = F (1/m + R^2/I) = (7/2) F/m):
+ * sphere_on_floor without damping (e_dry = 1), mu = 1, slipping at u = 1e-4 m/s, whose spring
+ * force u sqrt(k_t m_t) = 5.1e-6 N stays below mu m g = 1.0e-4 N. With s(0) = 0, v_t(0) = u,
+ *   v_t = u cos(w_t t),  w_t = sqrt(k_t / m_t),  and (angular momentum about the contact point)
+ *   v = (5/7) u + (2/7) u cos(w_t t),
+ * 4 G* / E* = 2 (1 - nu) / (2 - nu) = 0.870 for one material: period T = 0.368 ms (the
+ * Hertzian k_t this spring had beside hooke, 5.6e5 N/m at this overlap, gave T / 25). v is
+ * compared at eighths of T over three periods; the worst error, in units of u, per engine:
+ * - CVODE (rtol 1e-10, trapezoidal spring): 2e-4 (measured 4.7e-5);
+ * - the spring's quadrature in Verlet and the many mode is first order (docs/engines.md):
+ *   measured 0.072 at T/100 and 0.039 at T/200 in both, so 0.05 at T/200;
+ * - at the steps they derive: the two-body one, 0.02 of hooke's half period, is w_t dt =
+ *   0.02 pi sqrt(3.5 x 0.870) = 0.109 (for any k: k_t/k is a material constant, where the
+ *   Hertzian k_t made it 2.7 here), measured 0.114, so 0.15; the many mode's, which also
+ *   resolves the tangential time (docs/many.md), w_t dt = 0.063, measured 0.073, so 0.1. */
+static void test_mindlin_beside_hooke_sticks_with_the_linear_period(void** state)
+{
+    (void)state;
+    double u = 1e-4, nu = 0.23, k = 1e3;
+    const struct {
+        int engine;
+        double steps_per_period, tol; /* 0: the derived step */
+    } runs[] = {{1, 0, 2e-4}, {0, 200, 0.05}, {2, 200, 0.05}, {0, 0, 0.15}, {2, 0, 0.1}};
+    for (size_t q = 0; q < sizeof runs / sizeof runs[0]; q++) {
+        struct wetdem_sim* probe = sphere_on_floor(0, false, u, 0, 1.0, 1.0);
+        double m = wetdem_sim_particles_const(probe, NULL)[0].mass;
+        wetdem_sim_free(probe);
+        double w_t = sqrt(2 * (1 - nu) / (2 - nu) * k / (2.0 / 7 * m));
+        double dt = runs[q].steps_per_period > 0 ? 2 * M_PI / w_t / runs[q].steps_per_period : 0;
+        struct wetdem_sim* sim = sphere_on_floor(runs[q].engine, false, u, dt, 1.0, 1.0);
+        double worst = 0;
+        for (int n = 1; n <= 24; n++) {
+            CHECK_OK(wetdem_sim_integrate(sim, n * M_PI / 4 / w_t));
+            double t = wetdem_sim_time(sim); /* (the many mode ends on whole steps) */
+            double v = wetdem_sim_particles_const(sim, NULL)[0].vel.x;
+            worst = fmax(worst, fabs(v - (5.0 / 7 * u + 2.0 / 7 * u * cos(w_t * t))) / u);
+        }
+        if (!(worst < runs[q].tol))
+            fail_msg("engine %d, %g steps per period: v off by %g u", runs[q].engine,
+                     runs[q].steps_per_period, worst);
+        wetdem_sim_free(sim);
+    }
+}
+
+/* |F_t| <= mu k delta at every evaluation of every engine, with k the stiffness the user gave
+ * hooke after enabling it (the probe checks the engines pass that k): the sliding sphere
+ * above through its slide and the stick-slip of its onset of rolling, and oblique dry
+ * collisions of two steel spheres (R = 6.35 mm, 0.5 m/s, e_dry = 0.5, mu = 0.1, hooke
+ * k = 2e5 N/m) at 5, 10 and 20 deg, which stick and slide in turn. 1e-14: the capped total
+ * is the limit up to the rescaling roundings; the limit is reached (1e-12), so the check is
+ * not vacuous. */
+static void test_mindlin_beside_hooke_obeys_coulomb_at_every_evaluation(void** state)
+{
+    (void)state;
+    for (int engine = 0; engine < 3; engine++) {
+        struct wetdem_sim* sim = sliding_sphere(engine, true, 0.1, 0);
+        probe_worst_ratio = 0.0;
+        probe_evaluations = 0;
+        CHECK_OK(wetdem_sim_integrate(sim, 0.03));
+        assert_true(probe_evaluations > 100);
+        if (!(probe_worst_ratio <= 1.0 + 1e-14))
+            fail_msg("engine %d: |F_t| reached %.17g mu k delta", engine, probe_worst_ratio);
+        CHECK_REL(probe_worst_ratio, 1.0, 1e-12);
+        wetdem_sim_free(sim);
+    }
+    struct wetdem_model probe = wetdem_force_mindlin;
+    probe.name = "mindlin_linear_probe";
+    probe.pair = mindlin_linear_probe_pair;
+    const double angles[] = {5, 10, 20};
+    for (int cvode = 0; cvode < 2; cvode++)
+        for (int a = 0; a < 3; a++) {
+            struct wetdem_sim* sim = wetdem_sim_create();
+            struct wetdem_material m;
+            CHECK_OK(wetdem_material_preset("steel1", &m));
+            m.restitution = 0.5;
+            m.friction_dry = 0.1;
+            int mat = wetdem_sim_add_material(sim, &m);
+            double p[1] = {0.0};
+            CHECK_OK(wetdem_sim_enable_model(sim, "hooke"));
+            CHECK_OK(wetdem_sim_add_model(sim, &probe, p));
+            probe_hooke_k = 2e5;
+            CHECK_OK(wetdem_sim_set_param(sim, "hooke.stiffness", probe_hooke_k));
+            if (cvode)
+                CHECK_OK(wetdem_sim_set_integrator(sim, "cvode"));
+            struct wetdem_collision_spec spec = {.material_i = mat,
+                                                 .material_j = mat,
+                                                 .radius_i = 6.35e-3,
+                                                 .radius_j = 6.35e-3,
+                                                 .speed = 0.5,
+                                                 .angle = angles[a] * M_PI / 180,
+                                                 .t_end = 1e-2};
+            struct wetdem_collision_result r;
+            probe_worst_ratio = 0.0;
+            probe_evaluations = 0;
+            CHECK_OK(wetdem_collision_run(sim, &spec, &r));
+            assert_true(r.separated && probe_evaluations > 40); /* (Verlet: 50 steps) */
+            if (!(probe_worst_ratio <= 1.0 + 1e-14))
+                fail_msg("%g deg: |F_t| reached %.17g mu k delta", angles[a], probe_worst_ratio);
+            CHECK_REL(probe_worst_ratio, 1.0, 1e-12);
+            wetdem_sim_free(sim);
+        }
+}
+
 /* ======================================================================================== */
 /* hooke                                                                                     */
 /* ======================================================================================== */
@@ -971,6 +1285,10 @@ int main(int argc, char** argv)
         cmocka_unit_test(test_mindlin_sliding_caps_at_coulomb_limit),
         cmocka_unit_test(test_mindlin_total_never_exceeds_coulomb_limit),
         cmocka_unit_test(test_mindlin_collisions_obey_coulomb_at_every_evaluation),
+        cmocka_unit_test(test_mindlin_beside_a_linear_spring_closed_forms),
+        cmocka_unit_test(test_mindlin_beside_hooke_sliding_sphere_obeys_coulomb),
+        cmocka_unit_test(test_mindlin_beside_hooke_obeys_coulomb_at_every_evaluation),
+        cmocka_unit_test(test_mindlin_beside_hooke_sticks_with_the_linear_period),
         cmocka_unit_test(test_mindlin_spring_rotates_into_tangent_plane),
         cmocka_unit_test(test_mindlin_swap_symmetry_and_torques),
         cmocka_unit_test(test_mindlin_resets_when_separated),
