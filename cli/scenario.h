@@ -233,6 +233,12 @@ int cli_scenario_enable_min_separation(const struct cli_scenario* sc, struct wet
  * the file when [models] force or min_separation came from --set: the file may hold the
  * parameters of the model the --set switched away from. Returns an exit code. */
 int cli_scenario_set_model_params(const struct cli_scenario* sc, struct wetdem_sim* sim);
+/* Warns (once a process) when sim's thin-film models (sb, db, davis, nase, capillary) can do
+ * nothing: the pair has no film (delta = 0), or [model.fixed] h_min >= delta, where they take
+ * h_min capped at delta. delta: the pair's film thickness (the largest a pair can have);
+ * films: where it comes from, for the message. */
+void cli_scenario_warn_films(const struct cli_scenario* sc, const struct wetdem_sim* sim,
+                             double delta, const char* films);
 
 /* ---- internal: section lookup (scenario_keys.c), shared by scenario*.c ---- */
 

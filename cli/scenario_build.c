@@ -16,6 +16,9 @@
  */
 #include <float.h>
 #include <math.h>
+#include <stdarg.h>
+#include <stdatomic.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -471,6 +474,85 @@ int cli_scenario_check_trajectory(const struct cli_scenario* sc, const char* run
     return CLI_EXIT_USAGE;
 }
 
+/* The thin-film models: they act only where the pair's films overlap (h <= delta); all but
+ * capillary read h_min, capped at delta (docs/models.md). */
+static bool is_thin_film_model(const char* name, bool* reads_h_min)
+{
+    static const char* const names[] = {"sb", "db", "davis", "nase", "capillary", NULL};
+    for (size_t k = 0; names[k]; k++)
+        if (strcmp(name, names[k]) == 0) {
+            *reads_h_min = strcmp(name, "capillary") != 0;
+            return true;
+        }
+    return false;
+}
+
+/* "wetdem: warning: FILE:LINE: [section] key = value: ..." (FILE: --set section.key=value for
+ * an entry of --set), as cli_scenario_error places an error. */
+static void warn_at(const struct cli_scenario* sc, const struct cli_entry* e, const char* fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    if (e->line > 0)
+        fprintf(stderr, "wetdem: warning: %s:%d: [%s] %s = %s: ", sc->file, e->line, e->section,
+                e->key, e->value);
+    else
+        fprintf(stderr, "wetdem: warning: %s: --set %s.%s=%s: ", sc->file, e->section, e->key,
+                e->value);
+    vfprintf(stderr, fmt, ap);
+    fputc('\n', stderr);
+    va_end(ap);
+}
+
+void cli_scenario_warn_films(const struct cli_scenario* sc, const struct wetdem_sim* sim,
+                             double delta, const char* films)
+{
+    static atomic_flag warned = ATOMIC_FLAG_INIT;
+    char all[256] = "", reading[256] = "";
+    size_t n_all = 0, n_reading = 0;
+    for (size_t k = 0; k < wetdem_sim_n_models(sim); k++) {
+        const char* name = wetdem_sim_model(sim, k)->name;
+        bool reads_h_min = false;
+        if (!is_thin_film_model(name, &reads_h_min))
+            continue;
+        n_all += (size_t)snprintf(all + n_all, sizeof all - n_all, "%s%s", n_all ? ", " : "", name);
+        if (reads_h_min)
+            n_reading += (size_t)snprintf(reading + n_reading, sizeof reading - n_reading, "%s%s",
+                                          n_reading ? ", " : "", name);
+        if (n_all >= sizeof all || n_reading >= sizeof reading)
+            break;
+    }
+    const struct wetdem_model* ms = wetdem_sim_min_separation_model(sim);
+    double h_min = 0;
+    bool fixed = ms && strcmp(ms->name, "fixed") == 0 &&
+                 wetdem_sim_param(sim, "fixed.h_min", &h_min) == WETDEM_OK;
+    bool dry = n_all > 0 && !(delta > 0);
+    bool capped = !dry && n_reading > 0 && fixed && h_min >= delta;
+    if ((!dry && !capped) || atomic_flag_test_and_set(&warned))
+        return;
+    const struct cli_entry* force = cli_scenario_find(sc, "models", "force");
+    if (dry) {
+        bool plural = strchr(all, ',') != NULL;
+        if (force)
+            warn_at(sc, force,
+                    "the thin-film model%s %s act%s only within the pair's liquid film, but "
+                    "the film thickness delta = 0 m (%s): the run is dry for %s; give the "
+                    "materials a film > 0 [m] ([material.NAME] film = ...) or leave %s out",
+                    plural ? "s" : "", all, plural ? "" : "s", films, plural ? "them" : "it",
+                    plural ? "them" : "it");
+        return;
+    }
+    const struct cli_entry* e = cli_scenario_find(sc, "model.fixed", "h_min");
+    const char* whose = e ? "" : " (fixed's default)";
+    if (!e && !(e = cli_scenario_find(sc, "models", "min_separation")) && !(e = force))
+        return;
+    warn_at(sc, e,
+            "h_min = %g m%s is at or above the pair's film thickness delta = %g m (%s): %s "
+            "take%s h_min capped at delta, so the film has no range left above h_min; set "
+            "[model.fixed] h_min below %g m or give the materials thicker films",
+            h_min, whose, delta, films, reading, strchr(reading, ',') ? "" : "s", delta);
+}
+
 int cli_scenario_engine(const struct cli_scenario* sc, enum cli_engine* engine)
 {
     const char* t = cli_scenario_text(sc, "engine", "type", "soft");
@@ -503,6 +585,11 @@ int cli_scenario_build(const struct cli_scenario* sc, struct cli_setup* su)
         cli_setup_free(su);
         return rc;
     }
+    const char* si = cli_scenario_text(sc, "collision", "striker", "steel1");
+    char films[2 * CLI_VALUE_MAX + 64];
+    snprintf(films, sizeof films, "film of striker %s %g m + target %s %g m", si, mi.film,
+             cli_scenario_text(sc, "collision", "target_material", si), mj.film);
+    cli_scenario_warn_films(sc, su->sim, mi.film + mj.film, films);
     /* (checked by cli_scenario_check_outputs above) */
     cli_scenario_out_name(sc, "output", "trajectory", "trajectory.csv", su->trajectory_file);
     cli_scenario_out_name(sc, "output", "events", "events.csv", su->events_file);

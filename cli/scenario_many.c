@@ -1016,7 +1016,13 @@ int cli_many_build(const struct cli_scenario* sc, struct cli_many_setup* su)
     if (st != WETDEM_OK) {
         rc = cli_many_report_start(sc, st, wetdem_sim_errmsg(su->sim));
         cli_many_setup_free(su);
+        return rc;
     }
+    double film = 0;
+    for (int k = 0; k < wetdem_sim_n_materials(su->sim); k++)
+        film = fmax(film, wetdem_sim_material(su->sim, k)->film);
+    cli_scenario_warn_films(sc, su->sim, 2 * film,
+                            "at most: twice the thickest film of the materials");
     return rc;
 }
 

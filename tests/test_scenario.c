@@ -481,6 +481,61 @@ static void test_scenario_unresolved_hmin_is_reported(void** state)
                "moved the gap by 0.935 h_min");
 }
 
+/* Runs args and returns how often needle occurs in the output (stderr included); checks the
+ * exit code. */
+static int count_in_run(const char* args, int code, const char* needle)
+{
+    struct test_run r = run_cli(args);
+    if (r.code != code)
+        fail_msg("%s: exit %d, expected %d\n%s", args, r.code, code, r.out);
+    int n = 0;
+    for (const char* p = r.out; (p = strstr(p, needle)) != NULL; p++)
+        n++;
+    free(r.out);
+    return n;
+}
+
+/* A thin-film model with no film on the pair, or [model.fixed] h_min at or above the pair's
+ * film thickness (where it is capped at delta), runs dry or at the cap: a warning says so
+ * (once, for a sweep too), and the run exits 0. Films thicker than h_min say nothing. */
+static void test_scenario_idle_film_models_are_reported(void** state)
+{
+    (void)state;
+    const char* file = write_file("film.ini", "[material.m]\npreset = steel1\nfilm = 2e-5\n"
+                                              "[collision]\nstriker = m\nstokes = 10\n"
+                                              "[models]\nforce = hertz sb capillary\n"
+                                              "min_separation = fixed\n"
+                                              "[model.fixed]\nh_min = 5e-5\n");
+    char args[800];
+    snprintf(args, sizeof args, "run --check '%s' --set material.m.film=0", file);
+    expect_run(args, 0, "wetdem: warning: ");
+    expect_run(args, 0,
+               "film.ini:8: [models] force = hertz sb capillary: the thin-film models sb, "
+               "capillary act only within the pair's liquid film, but the film thickness delta "
+               "= 0 m (film of striker m 0 m + target m 0 m): the run is dry for them; give the "
+               "materials a film > 0 [m] ([material.NAME] film = ...) or leave them out");
+    snprintf(args, sizeof args, "run --check '%s'", file);
+    expect_run(args, 0,
+               "film.ini:11: [model.fixed] h_min = 5e-5: h_min = 5e-05 m is at or above the "
+               "pair's film thickness delta = 4e-05 m (film of striker m 2e-05 m + target m "
+               "2e-05 m): sb takes h_min capped at delta, so the film has no range left above "
+               "h_min; set [model.fixed] h_min below 4e-05 m or give the materials thicker "
+               "films");
+    snprintf(args, sizeof args, "sweep '%s' --param collision.speed --values 0.1:0.2:3", file);
+    assert_int_equal(count_in_run(args, 0, "warning"), 1);
+    snprintf(args, sizeof args, "run --check '%s' --set model.fixed.h_min=1e-5", file);
+    assert_int_equal(count_in_run(args, 0, "warning"), 0);
+    /* the many-particle set-up: no material with a film */
+    snprintf(args, sizeof args,
+             "run --check examples/scenarios/many_settling.ini --set material.wetglass.film=0");
+    expect_run(args, 0,
+               "sb, capillary act only within the pair's liquid film, but the film "
+               "thickness delta = 0 m (at most: twice the thickest film of the "
+               "materials)");
+    snprintf(args, sizeof args, "run --check examples/scenarios/many_settling.ini");
+    assert_int_equal(count_in_run(args, 0, "warning"), 0);
+}
+
 /* An overlap beyond what the contact laws hold for (above 0.1 R*) is reported, not an error:
  * two soft undamped spheres (R = 1 mm, rho = 1000 kg/m^3, E = 1 MPa, nu = 0, e_dry = 1) at
  * 1 m/s overlap by Hertz's delta_max = (15 m* v^2 / (16 E* sqrt(R*)))^(2/5) = 0.25 R*. run
@@ -1638,6 +1693,7 @@ int main(void)
         cmocka_unit_test(test_scenario_large_overlap_is_reported),
         cmocka_unit_test(test_scenario_energy_gain_is_an_error),
         cmocka_unit_test(test_scenario_unresolved_hmin_is_reported),
+        cmocka_unit_test(test_scenario_idle_film_models_are_reported),
         cmocka_unit_test(test_scenario_docs_list_every_key),
         cmocka_unit_test(test_scenario_run_writes_files_or_nothing),
         cmocka_unit_test(test_scenario_run_leaves_no_partial_files),
