@@ -237,6 +237,10 @@ int cli_scenario_set_model_params(const struct cli_scenario* sc, struct wetdem_s
  * nothing: the pair has no film (delta = 0), or [model.fixed] h_min >= delta, where they take
  * h_min capped at delta. delta: the pair's film thickness (the largest a pair can have);
  * films: where it comes from, for the message. */
+/* Warns (once a process) about each [material.NAME] section that none of used[0 .. n_used)
+ * names (it would be read by no sphere): "FILE:LINE: [material.NAME] is not used: <how>". */
+void cli_scenario_warn_unused_materials(const struct cli_scenario* sc, const char* const* used,
+                                        size_t n_used, const char* how);
 void cli_scenario_warn_films(const struct cli_scenario* sc, const struct wetdem_sim* sim,
                              double delta, const char* films);
 

@@ -553,6 +553,34 @@ void cli_scenario_warn_films(const struct cli_scenario* sc, const struct wetdem_
             h_min, whose, delta, films, reading, strchr(reading, ',') ? "" : "s", delta);
 }
 
+/* Whether section k of sc is a [material.NAME] that none of used[0 .. n_used) names. */
+static bool unused_material(const struct cli_scenario* sc, size_t k, const char* const* used,
+                            size_t n_used)
+{
+    const char* name = sc->sections[k].name;
+    if (strncmp(name, "material.", 9) != 0)
+        return false;
+    for (size_t j = 0; j < n_used; j++)
+        if (strcmp(used[j], name + 9) == 0)
+            return false;
+    return true;
+}
+
+void cli_scenario_warn_unused_materials(const struct cli_scenario* sc, const char* const* used,
+                                        size_t n_used, const char* how)
+{
+    static atomic_flag warned = ATOMIC_FLAG_INIT;
+    bool any = false;
+    for (size_t k = 0; k < sc->n_sections && !any; k++)
+        any = unused_material(sc, k, used, n_used);
+    if (!any || atomic_flag_test_and_set(&warned))
+        return;
+    for (size_t k = 0; k < sc->n_sections; k++)
+        if (unused_material(sc, k, used, n_used))
+            cli_error("warning: %s:%d: [%s] is not used: %s", sc->file, sc->sections[k].line,
+                      sc->sections[k].name, how);
+}
+
 int cli_scenario_engine(const struct cli_scenario* sc, enum cli_engine* engine)
 {
     const char* t = cli_scenario_text(sc, "engine", "type", "soft");
@@ -590,6 +618,17 @@ int cli_scenario_build(const struct cli_scenario* sc, struct cli_setup* su)
     snprintf(films, sizeof films, "film of striker %s %g m + target %s %g m", si, mi.film,
              cli_scenario_text(sc, "collision", "target_material", si), mj.film);
     cli_scenario_warn_films(sc, su->sim, mi.film + mj.film, films);
+    const struct cli_entry* ei = cli_scenario_find(sc, "collision", "striker");
+    const struct cli_entry* ej = cli_scenario_find(sc, "collision", "target_material");
+    if (!(ei && ei->line == 0) && !(ej && ej->line == 0)) { /* (not switched by --set) */
+        const char* used[2] = {si, cli_scenario_text(sc, "collision", "target_material", si)};
+        char how[2 * CLI_VALUE_MAX + 160];
+        snprintf(how, sizeof how,
+                 "neither [collision] striker (%s) nor target_material (%s) names it; name it "
+                 "there (striker = NAME), or leave it out",
+                 used[0], used[1]);
+        cli_scenario_warn_unused_materials(sc, used, 2, how);
+    }
     /* (checked by cli_scenario_check_outputs above) */
     cli_scenario_out_name(sc, "output", "trajectory", "trajectory.csv", su->trajectory_file);
     cli_scenario_out_name(sc, "output", "events", "events.csv", su->events_file);

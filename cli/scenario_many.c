@@ -1021,6 +1021,14 @@ int cli_many_build(const struct cli_scenario* sc, struct cli_many_setup* su)
     double film = 0;
     for (int k = 0; k < wetdem_sim_n_materials(su->sim); k++)
         film = fmax(film, wetdem_sim_material(su->sim, k)->film);
+    const char* used[MAX_MATERIALS];
+    int n_used = wetdem_sim_n_materials(su->sim);
+    for (int k = 0; k < n_used; k++)
+        used[k] = su->material_names[k];
+    cli_scenario_warn_unused_materials(sc, used, (size_t)n_used,
+                                       "no material or materials key of [insert], [particle.*], "
+                                       "[read.*] or [walls] names it; name it there, or leave "
+                                       "it out");
     cli_scenario_warn_films(sc, su->sim, 2 * film,
                             "at most: twice the thickest film of the materials");
     return rc;

@@ -536,6 +536,38 @@ static void test_scenario_idle_film_models_are_reported(void** state)
     assert_int_equal(count_in_run(args, 0, "warning"), 0);
 }
 
+/* A [material.NAME] that the scenario never uses (a forgotten striker = NAME runs steel1) is
+ * warned about, exit 0; one a --set collision.striker switched to or from is not. */
+static void test_scenario_unused_material_is_reported(void** state)
+{
+    (void)state;
+    const char* file = write_file("unused.ini", "[collision]\nstokes = 10\n[material.soft]\n"
+                                                "preset = delrin\n[material.wet]\n"
+                                                "preset = glass\nfilm = 1e-5\n");
+    char args[800];
+    snprintf(args, sizeof args, "run --check '%s'", file);
+    expect_run(args, 0,
+               "unused.ini:3: [material.soft] is not used: neither [collision] striker (steel1) "
+               "nor target_material (steel1) names it; name it there (striker = NAME), or leave "
+               "it out");
+    expect_run(args, 0, "unused.ini:5: [material.wet] is not used");
+    snprintf(args, sizeof args, "run --check '%s' --set collision.striker=soft", file);
+    assert_int_equal(count_in_run(args, 0, "warning"), 0);
+    snprintf(args, sizeof args, "sweep '%s' --param collision.speed --values 0.1:0.2:3", file);
+    assert_int_equal(count_in_run(args, 0, "[material.soft] is not used"), 1);
+    file = write_file("used.ini", "[collision]\nstokes = 10\nstriker = soft\n"
+                                  "target_material = wet\n[material.soft]\npreset = delrin\n"
+                                  "[material.wet]\npreset = glass\n");
+    snprintf(args, sizeof args, "run --check '%s'", file);
+    assert_int_equal(count_in_run(args, 0, "warning"), 0);
+    /* many-particle: no [insert] material names it */
+    snprintf(args, sizeof args,
+             "run --check examples/scenarios/many_settling.ini --set insert.material=glass");
+    expect_run(args, 0,
+               "[material.wetglass] is not used: no material or materials key of "
+               "[insert], [particle.*], [read.*] or [walls] names it");
+}
+
 /* An overlap beyond what the contact laws hold for (above 0.1 R*) is reported, not an error:
  * two soft undamped spheres (R = 1 mm, rho = 1000 kg/m^3, E = 1 MPa, nu = 0, e_dry = 1) at
  * 1 m/s overlap by Hertz's delta_max = (15 m* v^2 / (16 E* sqrt(R*)))^(2/5) = 0.25 R*. run
@@ -1694,6 +1726,7 @@ int main(void)
         cmocka_unit_test(test_scenario_energy_gain_is_an_error),
         cmocka_unit_test(test_scenario_unresolved_hmin_is_reported),
         cmocka_unit_test(test_scenario_idle_film_models_are_reported),
+        cmocka_unit_test(test_scenario_unused_material_is_reported),
         cmocka_unit_test(test_scenario_docs_list_every_key),
         cmocka_unit_test(test_scenario_run_writes_files_or_nothing),
         cmocka_unit_test(test_scenario_run_leaves_no_partial_files),
