@@ -871,14 +871,25 @@ bool cli_is_frame_name(const char* prefix, const char* name)
     return true;
 }
 
+bool cli_needs_value(const char* cmd, const char* arg, const char* const* what)
+{
+    for (size_t k = 0; what[k]; k += 2)
+        if (strcmp(arg, what[k]) == 0) {
+            if (what[k + 1])
+                cli_error("%s: %s needs a value (%s)", cmd, arg, what[k + 1]);
+            else
+                cli_error("%s: %s needs a value", cmd, arg);
+            return true;
+        }
+    return false;
+}
+
 const char* cli_option_hint(const char* arg, const char* const* options, char* buf, size_t n)
 {
     const char* hint = arg[0] == '-' ? wetdem_param_suggest(arg, options) : NULL;
-    if (hint && strcmp(hint, arg) == 0) /* a known option that reached here: its value is missing */
-        snprintf(buf, n, " (needs a value)");
-    else
-        snprintf(buf, n, "%s%s%s", hint ? " (did you mean '" : "", hint ? hint : "",
-                 hint ? "'?)" : "");
+    if (hint && strcmp(hint, arg) == 0) /* (cli_needs_value said what its value is) */
+        hint = NULL;
+    snprintf(buf, n, "%s%s%s", hint ? " (did you mean '" : "", hint ? hint : "", hint ? "'?)" : "");
     return buf;
 }
 

@@ -74,10 +74,14 @@ int cli_apply_set(struct wetdem_sim* sim, const char* key_value);
  * prints its usage to stdout and exits 0, whatever else is on the line. */
 bool cli_wants_help(int argc, char** argv);
 
+/* When arg is one of the options of what ({OPTION, WHAT it takes or NULL, ..., NULL}), which
+ * take a value: prints "CMD: OPTION needs a value (WHAT)" and returns true (a parser that
+ * found no value after it); else false. */
+bool cli_needs_value(const char* cmd, const char* arg, const char* const* what);
 /* " (did you mean 'NAME'?)" for the name among `options` (NULL-terminated) closest to a
- * misspelt option `arg` (wetdem_param_suggest), written into buf; " (needs a value)" when arg
- * is one of them (a command's parser rejects a known option only when its value is missing);
- * "" when arg does not start with '-' or nothing is close. Returns buf, for "%s". */
+ * misspelt option `arg` (wetdem_param_suggest), written into buf; "" when arg is one of them
+ * (cli_needs_value reports a known option whose value is missing), does not start with '-' or
+ * nothing is close. Returns buf, for "%s". */
 const char* cli_option_hint(const char* arg, const char* const* options, char* buf, size_t n);
 
 /* Refuses an option given a second time that takes one value: `once` lists such options of

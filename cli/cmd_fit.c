@@ -114,7 +114,11 @@ static int parse_args(int argc, char** argv, struct fit_args* a)
             continue;
         }
         if (!v) {
-            cli_error("fit: option '%s' needs a value", s);
+            static const char* const takes[] = {
+                "--data", "a CSV file", "--fit",  "KEYS",  "--init",    "VALUES", "--out",
+                "a file", "--curve",    "a file", "--set", "KEY=VALUE", NULL};
+            if (!cli_needs_value("fit", s, takes))
+                cli_error("fit: option '%s' needs a value", s);
             usage(stderr);
             return CLI_EXIT_USAGE;
         }

@@ -99,9 +99,27 @@ static int parse_args(int argc, char** argv, struct map_args* a)
             static const char* const options[] = {
                 "--param",      "--values", "--param2", "--values2", "--out", "--resume",
                 "--save-every", "--set",    "--log",    "--log2",    NULL};
+            static const char* const takes[] = {"--param",
+                                                "a scenario key or model parameter",
+                                                "--values",
+                                                "A:B:N",
+                                                "--param2",
+                                                "a scenario key or model parameter",
+                                                "--values2",
+                                                "A:B:N",
+                                                "--out",
+                                                "a file, FILE.csv",
+                                                "--resume",
+                                                "a grid, T.csv",
+                                                "--set",
+                                                "KEY=VALUE",
+                                                "--save-every",
+                                                "S seconds",
+                                                NULL};
             char hint[64];
-            cli_error("map: unexpected argument '%s'%s", s,
-                      cli_option_hint(s, options, hint, sizeof hint));
+            if (next || !cli_needs_value("map", s, takes))
+                cli_error("map: unexpected argument '%s'%s", s,
+                          cli_option_hint(s, options, hint, sizeof hint));
             usage(stderr);
             return CLI_EXIT_USAGE;
         }

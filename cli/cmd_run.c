@@ -74,9 +74,14 @@ static int parse_args(int argc, char** argv, struct run_args* a)
         else {
             static const char* const options[] = {"--set",  "--out",   "--restart",
                                                   "--json", "--check", NULL};
+            static const char* const takes[] = {"--set",       "KEY=VALUE", "--out",
+                                                "a directory", "--restart", "a checkpoint file",
+                                                NULL};
             char hint[64];
             if (strcmp(s, "--set") == 0 && has_next) /* the only option refused with a value */
                 cli_error("run: more than %d --set options", MAX_SETS);
+            else if (!has_next && cli_needs_value("run", s, takes))
+                ;
             else
                 cli_error("run: unexpected argument '%s'%s", s,
                           cli_option_hint(s, options, hint, sizeof hint));

@@ -95,9 +95,23 @@ static int parse_args(int argc, char** argv, struct sweep_args* a)
         else {
             static const char* const options[] = {"--param",      "--values", "--out", "--resume",
                                                   "--save-every", "--set",    "--log", NULL};
+            static const char* const takes[] = {"--param",
+                                                "a scenario key or model parameter",
+                                                "--values",
+                                                "A:B:N",
+                                                "--out",
+                                                "a file, FILE.csv",
+                                                "--resume",
+                                                "a table, T.csv",
+                                                "--set",
+                                                "KEY=VALUE",
+                                                "--save-every",
+                                                "S seconds",
+                                                NULL};
             char hint[64];
-            cli_error("sweep: unexpected argument '%s'%s", s,
-                      cli_option_hint(s, options, hint, sizeof hint));
+            if (next || !cli_needs_value("sweep", s, takes))
+                cli_error("sweep: unexpected argument '%s'%s", s,
+                          cli_option_hint(s, options, hint, sizeof hint));
             usage(stderr);
             return CLI_EXIT_USAGE;
         }

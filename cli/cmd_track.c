@@ -107,7 +107,9 @@ static int parse_args(int argc, char** argv, struct track_cli* c)
             c->opt.y_down = true;
         } else if (strncmp(a, "--", 2) == 0) {
             if (k + 1 >= argc) {
-                cli_error("track: option %s needs a value", a);
+                static const char* const takes[] = {"--frames", "a file, FILE.csv", NULL};
+                if (!cli_needs_value("track", a, takes))
+                    cli_error("track: option %s needs a value", a);
                 return CLI_EXIT_USAGE;
             }
             int rc = parse_option(c, a, argv[++k]);
