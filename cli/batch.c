@@ -283,6 +283,9 @@ static int check_keys(const struct cli_batch* b)
     }
     for (int k = 0; k < b->n_sets; k++) { /* each point's value would replace the --set */
         char section[CLI_NAME_MAX], key[CLI_NAME_MAX], set[2 * CLI_NAME_MAX + 2];
+        const char* eq = strchr(b->sets[k], '=');
+        if (eq && eq > b->sets[k] && !memchr(b->sets[k], '.', (size_t)(eq - b->sets[k])))
+            continue; /* a key without its section: loading the file names its section */
         if (cli_override_split(b->sets[k], section, key, NULL) != 0)
             return CLI_EXIT_USAGE;
         snprintf(set, sizeof set, "%s.%s", section, key);

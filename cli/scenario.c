@@ -852,9 +852,31 @@ static int new_named_section(const struct cli_scenario* sc, const char* key_valu
     return CLI_EXIT_USAGE;
 }
 
+/* A --set KEY=VALUE without a section, where exactly one section of the scenario's engine has
+ * KEY: "did you mean 'SECTION.KEY=VALUE'?". Returns whether it said so. */
+static bool bare_key_suggestion(const struct cli_scenario* sc, const char* key_value)
+{
+    const char* eq = strchr(key_value, '=');
+    size_t klen = eq ? (size_t)(eq - key_value) : 0;
+    char key[CLI_NAME_MAX], value[CLI_VALUE_MAX], home[CLI_NAME_MAX];
+    if (!eq || klen == 0 || klen >= sizeof key || memchr(key_value, '.', klen))
+        return false;
+    memcpy(key, key_value, klen);
+    key[klen] = '\0';
+    copy_text(value, sizeof value, eq + 1);
+    trim(value);
+    if (!cli_is_name(key) || cli_key_only_home(sc, key, value, home, sizeof home) != 1)
+        return false;
+    cli_error("--set '%s': expected section.key=value (did you mean '%s.%s=%s'?)", key_value, home,
+              key, value);
+    return true;
+}
+
 int cli_scenario_override(struct cli_scenario* sc, const char* key_value)
 {
     char section[CLI_NAME_MAX], key[CLI_NAME_MAX], value[CLI_VALUE_MAX];
+    if (bare_key_suggestion(sc, key_value))
+        return CLI_EXIT_USAGE;
     if (cli_override_split(key_value, section, key, value) != 0)
         return CLI_EXIT_USAGE;
     struct cli_section_info info;

@@ -265,6 +265,11 @@ void cli_section_suggestion(const char* name, char* msg, size_t n);
  * engine reads have it; "'count' is a key of [insert] ... of a many-particle run, which this
  * scenario is not" and 2 when only another engine's have it; "" and 0 otherwise. */
 int cli_key_home(const struct cli_scenario* sc, const struct cli_entry* e, char* buf, size_t n);
+/* The one section that the scenario's engine reads and that has `key` (taking value as its
+ * kind there), a named family ([material.NAME]) excepted: written into section (e.g.
+ * "collision", "model.nijssen"), returns 1; 0 when none or several have it. */
+int cli_key_only_home(const struct cli_scenario* sc, const char* key, const char* value,
+                      char* section, size_t n);
 /* Whether s is a non-empty name of letters, digits, '_' and '-'. */
 bool cli_is_name(const char* s);
 /* A numeric or choice key descriptor as a library parameter descriptor (for range text). */

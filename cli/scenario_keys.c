@@ -583,10 +583,13 @@ static void add_home(char* buf, size_t n, int* count, const char* name)
 }
 
 /* Lists into buf the sections other than `section` that have `key` and that the engines in
- * `engines` read, with the models whose parameter it is as [model.NAME]. Returns how many. */
-static int key_homes(const char* section, const char* key, const char* value, unsigned engines,
-                     char* buf, size_t n)
+ * `engines` read, with the models whose parameter it is as [model.NAME]. Returns how many;
+ * *first (when not NULL) is the name of the first, as its table has it ("collision",
+ * "material.*", "model.nijssen" in a static buffer). */
+static int key_homes_first(const char* section, const char* key, const char* value,
+                           unsigned engines, char* buf, size_t n, const char** first)
 {
+    static _Thread_local char model_section[CLI_NAME_MAX];
     buf[0] = '\0';
     int count = 0;
     const struct cli_section_desc* tables[3] = {sections, cli_pairwise_sections, cli_many_sections};
@@ -594,8 +597,11 @@ static int key_homes(const char* section, const char* key, const char* value, un
         for (size_t k = 0; tables[t] && tables[t][k].name; k++) {
             const struct cli_section_desc* d = &tables[t][k];
             if ((section_engines(t, d) & engines) && !cli_section_matches(section, d->name) &&
-                desc_has_key(d, key, value))
+                desc_has_key(d, key, value)) {
+                if (first && count == 0)
+                    *first = d->name;
                 add_home(buf, n, &count, d->name);
+            }
         }
     if (engines & (ENGINE_BINARY | ENGINE_MANY)) {
         const struct wetdem_model* const* reg = wetdem_model_registry();
@@ -603,8 +609,13 @@ static int key_homes(const char* section, const char* key, const char* value, un
             char name[CLI_NAME_MAX];
             snprintf(name, sizeof name, "model.%s", reg[k]->name);
             if (strcmp(name, section) != 0 &&
-                lib_takes(wetdem_param_find(reg[k]->params, key), value))
+                lib_takes(wetdem_param_find(reg[k]->params, key), value)) {
+                if (first && count == 0) {
+                    snprintf(model_section, sizeof model_section, "%s", name);
+                    *first = model_section;
+                }
                 add_home(buf, n, &count, name);
+            }
         }
     }
     char* last = strrchr(buf, ',');
@@ -614,6 +625,24 @@ static int key_homes(const char* section, const char* key, const char* value, un
         snprintf(last, n - (size_t)(last - buf), "%s", tail);
     }
     return count;
+}
+
+static int key_homes(const char* section, const char* key, const char* value, unsigned engines,
+                     char* buf, size_t n)
+{
+    return key_homes_first(section, key, value, engines, buf, n, NULL);
+}
+
+int cli_key_only_home(const struct cli_scenario* sc, const char* key, const char* value,
+                      char* section, size_t n)
+{
+    char homes[320];
+    const char* first = NULL;
+    if (key_homes_first("", key, value, scenario_engine(sc), homes, sizeof homes, &first) != 1 ||
+        !first || strchr(first, '*'))
+        return 0;
+    snprintf(section, n, "%s", first);
+    return 1;
 }
 
 int cli_key_home(const struct cli_scenario* sc, const struct cli_entry* e, char* buf, size_t n)

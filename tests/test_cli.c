@@ -397,6 +397,28 @@ static void test_cli_set_overrides_never_used(void** state)
     check_cli_cases(cases, sizeof cases / sizeof cases[0]);
 }
 
+/* A --set KEY=VALUE without its section suggests the one section of the scenario's engine
+ * that has KEY ([collision] stokes of a binary collision, [davis] stokes of the pairwise
+ * engine); with none or several (film: every [material.NAME]) the example stays. */
+static void test_cli_set_without_section_suggests_it(void** state)
+{
+    (void)state;
+    static const struct cli_case cases[] = {
+        {"run examples/scenarios/nijssen_head_on.ini --check --set stokes=3",
+         "wetdem: --set 'stokes=3': expected section.key=value (did you mean "
+         "'collision.stokes=3'?)\n",
+         2},
+        {"sweep examples/scenarios/nijssen_head_on.ini --param collision.speed --values 1:2:2 "
+         "--set angle_deg=30",
+         "(did you mean 'collision.angle_deg=30'?)", 2},
+        {"run examples/scenarios/davis_three.ini --check --set stokes=5",
+         "(did you mean 'davis.stokes=5'?)", 2},
+        {"run examples/scenarios/nijssen_head_on.ini --check --set film=1e-5",
+         "--set 'film=1e-5': expected section.key=value, e.g. --set collision.stokes=50", 2},
+    };
+    check_cli_cases(cases, sizeof cases / sizeof cases[0]);
+}
+
 /* Messages that named the wrong thing: a --param without its section called "--set 'stokes=0'"
  * (an option the user never typed, a value from nowhere), --log2 called --log, a NAME with a
  * dot was suggested as itself, an upper-case model got no hint, --fd-step 0 came back as the
@@ -1051,6 +1073,7 @@ int main(void)
         cmocka_unit_test(test_cli_set_overrides_never_used),
         cmocka_unit_test(test_cli_model_of_the_wrong_kind),
         cmocka_unit_test(test_cli_messages_name_what_is_wrong),
+        cmocka_unit_test(test_cli_set_without_section_suggests_it),
         cmocka_unit_test(test_cli_unused_model_sections),
         cmocka_unit_test(test_cli_integrator_names_in_set),
         cmocka_unit_test(test_cli_fuzz_regressions),
