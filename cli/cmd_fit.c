@@ -193,9 +193,26 @@ static const char* const col_names[N_COLS + 1] = {"stokes_n", "e_n", "angle_deg"
                                                   NULL};
 static const char* const col_units[N_COLS] = {"-", "-", "deg", "rad/s"};
 
+/* A hint for a line whose columns do not fit (text as read, before the split): "; ;-separated?
+ * use commas" for a ';' in it, "; decimal comma? use a point (0.5, not 0,5)" for more columns
+ * than the header's where a ',' stands between digits and no '.' is seen; else "". */
+static const char* separator_hint(const char* text, int n, int n_header)
+{
+    if (strchr(text, ';'))
+        return "; ;-separated? use commas";
+    bool digit_comma_digit = false;
+    for (const char* p = text; *p && !digit_comma_digit; p++)
+        digit_comma_digit =
+            p > text && *p == ',' && isdigit((unsigned char)p[-1]) && isdigit((unsigned char)p[1]);
+    if (n > n_header && digit_comma_digit && !strchr(text, '.'))
+        return "; decimal comma? use a point (0.5, not 0,5)";
+    return "";
+}
+
 /* Maps the header's fields to the columns: each known column at most once, no other (a column
  * the fit would not read, e.g. per-point uncertainties, is refused rather than ignored). */
-static int read_header(const char* path, long line, char** f, int n, int col[N_COLS])
+static int read_header(const char* path, long line, const char* text, char** f, int n,
+                       int col[N_COLS])
 {
     char why[300];
     int bad = 0, rc = cli_csv_columns(f, n, col_names, col_units, col, &bad, why, sizeof why);
@@ -203,10 +220,10 @@ static int read_header(const char* path, long line, char** f, int n, int col[N_C
         if (rc == CLI_CSV_TWICE)
             cli_error("%s:%ld: %s", path, line, why);
         else
-            cli_error("%s:%ld: column %d: %s; the columns are stokes_n and e_n (required), "
+            cli_error("%s:%ld: column %d: %s%s; the columns are stokes_n and e_n (required), "
                       "angle_deg and omega_rad_s (per-point uncertainties are not read: the "
                       "scatter of the data about the fit sets the standard errors)",
-                      path, line, bad + 1, why);
+                      path, line, bad + 1, why, separator_hint(text, n, n));
         return CLI_EXIT_USAGE;
     }
     if (col[COL_STOKES] < 0 || col[COL_EN] < 0) {
@@ -220,8 +237,8 @@ static int read_header(const char* path, long line, char** f, int n, int col[N_C
 
 /* Reads column c of a row (with the header's number of columns) into *v with its range
  * check. */
-static int read_value(const char* path, long line, char** f, const int col[N_COLS], int c,
-                      double* v)
+static int read_value(const char* path, long line, const char* hint, char** f,
+                      const int col[N_COLS], int c, double* v)
 {
     const char* t = f[col[c]];
     while (isspace((unsigned char)*t)) /* (a space after the comma) */
@@ -243,29 +260,31 @@ static int read_value(const char* path, long line, char** f, const int col[N_COL
     if (ok && c == COL_OMEGA && !(*v >= 0))
         ok = false, why = "a spin magnitude >= 0 rad/s";
     if (!ok) {
-        cli_error("%s:%ld: column %s: '%s' is not %s", path, line, col_names[c], t, why);
+        cli_error("%s:%ld: column %s: '%s' is not %s%s", path, line, col_names[c], t, why, hint);
         return CLI_EXIT_USAGE;
     }
     return CLI_EXIT_OK;
 }
 
-static int read_row(const char* path, long line, char** f, int n, int n_header,
+static int read_row(const char* path, long line, const char* text, char** f, int n, int n_header,
                     const int col[N_COLS], struct point* p)
 {
     if (n != n_header) { /* (a value too many or too few: the columns would shift) */
-        cli_error("%s:%ld: %d columns, but the header has %d", path, line, n, n_header);
+        cli_error("%s:%ld: %d columns, but the header has %d%s", path, line, n, n_header,
+                  separator_hint(text, n, n_header));
         return CLI_EXIT_USAGE;
     }
-    int rc = read_value(path, line, f, col, COL_STOKES, &p->stokes);
+    const char* hint = separator_hint(text, n, n_header);
+    int rc = read_value(path, line, hint, f, col, COL_STOKES, &p->stokes);
     if (rc == CLI_EXIT_OK)
-        rc = read_value(path, line, f, col, COL_EN, &p->e_n);
+        rc = read_value(path, line, hint, f, col, COL_EN, &p->e_n);
     p->has_angle = col[COL_ANGLE] >= 0;
     p->omega = NAN;
     p->line = line;
     if (rc == CLI_EXIT_OK && p->has_angle)
-        rc = read_value(path, line, f, col, COL_ANGLE, &p->angle_deg);
+        rc = read_value(path, line, hint, f, col, COL_ANGLE, &p->angle_deg);
     if (rc == CLI_EXIT_OK && col[COL_OMEGA] >= 0)
-        rc = read_value(path, line, f, col, COL_OMEGA, &p->omega);
+        rc = read_value(path, line, hint, f, col, COL_OMEGA, &p->omega);
     return rc;
 }
 
@@ -296,16 +315,18 @@ static int read_data(const char* path, struct point** out, size_t* n_out)
         s += strspn(s, " \t");
         if (*s == '#' || *s == '\n' || *s == '\r' || *s == '\0')
             continue;
+        char text[sizeof buf];
+        snprintf(text, sizeof text, "%s", s);
         int nf = cli_csv_split(s, f, 64);
         if (!have_header) {
-            rc = read_header(path, line, f, nf, col);
+            rc = read_header(path, line, text, f, nf, col);
             have_header = true;
             n_header = nf;
         } else if (n == MAX_POINTS) {
             cli_error("%s:%ld: more than %d data rows", path, line, MAX_POINTS);
             rc = CLI_EXIT_USAGE;
         } else {
-            rc = read_row(path, line, f, nf, n_header, col, &pts[n++]);
+            rc = read_row(path, line, text, f, nf, n_header, col, &pts[n++]);
         }
     }
     if (rc == CLI_EXIT_OK && ferror(fp)) { /* (e.g. a directory: it opens, but does not read) */

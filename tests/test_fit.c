@@ -750,7 +750,22 @@ static void test_fit_cli_rejects_bad_input(void** state)
     temp_csv(bad, "bad", "stokes_n,e_n\n2\n");
     expect_cli(args, 2, ":2: 1 columns, but the header has 2");
     temp_csv(bad, "bad", "stokes_n,e_n\n2,0.5,7\n"); /* a value too many would shift nothing */
-    expect_cli(args, 2, ":2: 3 columns, but the header has 2");
+    expect_cli(args, 2, ":2: 3 columns, but the header has 2\n");
+    /* a spreadsheet's export in a locale with decimal commas: ';' between the values, or ',' in
+     * them */
+    temp_csv(bad, "bad", "stokes_n,e_n\n2;0,5\n");
+    expect_cli(args, 2,
+               ":2: column stokes_n: '2;0' is not a finite number; ;-separated? use commas");
+    temp_csv(bad, "bad", "stokes_n,e_n\n2;0.5\n");
+    expect_cli(args, 2, ":2: 1 columns, but the header has 2; ;-separated? use commas");
+    temp_csv(bad, "bad", "stokes_n;e_n\n2;0,5\n");
+    expect_cli(args, 2,
+               ":1: column 1: unknown column 'stokes_n;e_n' (did you mean 'stokes_n'?); "
+               ";-separated? use commas;");
+    temp_csv(bad, "bad", "stokes_n,e_n\n2,0,5\n");
+    expect_cli(args, 2,
+               ":2: 3 columns, but the header has 2; decimal comma? use a point (0.5, "
+               "not 0,5)");
     temp_csv(bad, "bad", "stokes_n,e_n\n2,99999999999\n");
     expect_cli(args, 2,
                ":2: column e_n: '99999999999' is not a restitution coefficient in [0, 1.5)");
