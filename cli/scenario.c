@@ -153,15 +153,18 @@ void cli_scenario_error(const struct cli_scenario* sc, const struct cli_entry* e
     va_end(ap);
 }
 
+/* The line of section's header (or of its first key in the file); 0 when the file has none
+ * (-1 when --set gave its keys). */
 static int section_line(const struct cli_scenario* sc, const char* section)
 {
     for (size_t k = 0; k < sc->n_sections; k++)
         if (strcmp(sc->sections[k].name, section) == 0)
             return sc->sections[k].line;
-    for (size_t k = 0; k < sc->n_entries; k++)
-        if (strcmp(sc->entries[k].section, section) == 0 && sc->entries[k].line > 0)
-            return sc->entries[k].line;
-    return 1;
+    int line = 0;
+    for (size_t k = 0; k < sc->n_entries && line <= 0; k++)
+        if (strcmp(sc->entries[k].section, section) == 0)
+            line = sc->entries[k].line > 0 ? sc->entries[k].line : -1;
+    return line;
 }
 
 void cli_scenario_section_error(const struct cli_scenario* sc, const char* section, const char* fmt,
@@ -169,7 +172,13 @@ void cli_scenario_section_error(const struct cli_scenario* sc, const char* secti
 {
     va_list ap;
     va_start(ap, fmt);
-    fprintf(stderr, "%s:%d: [%s]: ", sc->file, section_line(sc, section), section);
+    int line = section_line(sc, section);
+    if (line > 0)
+        fprintf(stderr, "%s:%d: [%s]: ", sc->file, line, section);
+    else if (line < 0) /* (keys of --set only) */
+        fprintf(stderr, "%s: [%s] of --set: ", sc->file, section);
+    else /* (a line of the file would point at something else) */
+        fprintf(stderr, "%s: no [%s] section: ", sc->file, section);
     vfprintf(stderr, fmt, ap);
     fputc('\n', stderr);
     va_end(ap);

@@ -495,6 +495,26 @@ static int count_in_run(const char* args, int code, const char* needle)
     return n;
 }
 
+/* A required section that the file lacks is said to be missing, with no line (line 1 pointed
+ * at whatever the file has there); keys of it given by --set only are named as such. */
+static void test_scenario_missing_section_is_named(void** state)
+{
+    (void)state;
+    const char* many = write_file("no_run.ini", "[box]\nsize_x = 1e-2\nsize_y = 1e-2\n"
+                                                "size_z = 1e-2\n[insert]\ncount = 5\n"
+                                                "radius_min = 1e-3\nradius_max = 1e-3\n");
+    const char* binary = write_file("no_collision.ini", "[models]\nforce = hertz\n");
+    char args[800];
+    snprintf(args, sizeof args, "run --check '%s'", many);
+    expect_run(args, 2, "no_run.ini: no [run] section: [run] needs t_end [s] or steps\n");
+    snprintf(args, sizeof args, "run --check '%s'", binary);
+    expect_run(args, 2,
+               "no_collision.ini: no [collision] section: needs speed > 0 [m/s] or "
+               "stokes > 0 [-]\n");
+    snprintf(args, sizeof args, "run --check '%s' --set collision.angle_deg=10", binary);
+    expect_run(args, 2, "no_collision.ini: [collision] of --set: needs speed > 0 [m/s]");
+}
+
 /* A thin-film model with no film on the pair, or [model.fixed] h_min at or above the pair's
  * film thickness (where it is capped at delta), runs dry or at the cap: a warning says so
  * (once, for a sweep too), and the run exits 0. Films thicker than h_min say nothing. */
@@ -1727,6 +1747,7 @@ int main(void)
         cmocka_unit_test(test_scenario_unresolved_hmin_is_reported),
         cmocka_unit_test(test_scenario_idle_film_models_are_reported),
         cmocka_unit_test(test_scenario_unused_material_is_reported),
+        cmocka_unit_test(test_scenario_missing_section_is_named),
         cmocka_unit_test(test_scenario_docs_list_every_key),
         cmocka_unit_test(test_scenario_run_writes_files_or_nothing),
         cmocka_unit_test(test_scenario_run_leaves_no_partial_files),
