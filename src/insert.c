@@ -145,6 +145,23 @@ static size_t lattice_axis(const struct wetdem_insert_spec* s, int k, double r_m
     return m < (double)s->n ? (size_t)m : s->n;
 }
 
+/* The first axis along which the region is narrower than one sphere of radius r with its gaps
+ * (2 r + 2 gap; 2 r + gap across a periodic axis, which a lattice fills with whole spacings,
+ * when `lattice`; a periodic axis has room for any sphere at random), or -1; *need is that
+ * width [m]. */
+static int narrow_axis(const struct wetdem_insert_spec* s, double r, bool lattice, double* need)
+{
+    for (int k = 0; k < 3; k++) {
+        double len = axis(s->hi, k) - axis(s->lo, k);
+        if (s->periodic[k] && !lattice)
+            continue;
+        *need = s->periodic[k] ? 2 * r + s->gap : 2 * r + 2 * s->gap;
+        if (len < *need)
+            return k;
+    }
+    return -1;
+}
+
 /* WETDEM_OK if the lattice for spheres of largest radius r has at least n sites; `what` says
  * what r is. */
 static int lattice_capacity(const struct wetdem_insert_spec* s, double r, const char* what,
@@ -157,6 +174,15 @@ static int lattice_capacity(const struct wetdem_insert_spec* s, double r, const 
     double sites = (double)m[0] * (double)m[1] * (double)m[2];
     if (sites >= (double)s->n)
         return WETDEM_OK;
+    double need;
+    int k = narrow_axis(s, r, true, &need);
+    if (k >= 0)
+        return wetdem_status_fail(
+            msg, n, WETDEM_ERR_INVALID,
+            "insert: the region is %g m across in %c, narrower than one sphere: 2 r + %s = %g m "
+            "(r = %g m, %s; gap = %g m); enlarge the region in %c or reduce radius_max or gap",
+            axis(s->hi, k) - axis(s->lo, k), "xyz"[k], s -> periodic[k] ? "gap" : "2 gap", need, r,
+            what, s->gap, "xyz"[k]);
     return wetdem_status_fail(
         msg, n, WETDEM_ERR_INVALID,
         "insert: the region holds at most %.0f spheres (%zu x %zu x %zu) on a lattice of "
@@ -373,12 +399,22 @@ static int place_one(const struct wetdem_insert_spec* s, gsl_rng* rng, struct gr
     size_t attempts = s->max_attempts ? s->max_attempts : DEFAULT_ATTEMPTS;
     for (size_t t = 0; t < attempts; t++) {
         struct wetdem_vec3 x;
-        if (!random_position(s, rng, out[i].radius, &x))
+        if (!random_position(s, rng, out[i].radius, &x)) {
+            double need = 0;
+            int k = narrow_axis(s, out[i].radius, false, &need);
+            if (k < 0) /* (rounding: the two tests may differ in the last bit) */
+                return wetdem_status_fail(msg, n, WETDEM_ERR_INVALID,
+                                          "insert: sphere %zu of radius %g m plus gap %g m does "
+                                          "not fit in the region",
+                                          i, out[i].radius, s->gap);
             return wetdem_status_fail(
                 msg, n, WETDEM_ERR_INVALID,
-                "insert: sphere %zu of radius %g m plus gap %g m does not fit in the "
-                "region",
-                i, out[i].radius, s->gap);
+                "insert: sphere %zu of radius %g m plus gap %g m does not fit in the region: it "
+                "is %g m across in %c, narrower than 2 r + 2 gap = %g m; enlarge the region in "
+                "%c or reduce the radius or gap",
+                i, out[i].radius, s->gap, axis(s->hi, k) - axis(s->lo, k), "xyz"[k], need,
+                "xyz"[k]);
+        }
         if (!is_free(g, x, out[i].radius, s->gap))
             continue;
         out[i].pos = x;

@@ -432,7 +432,20 @@ static void test_insert_rejects_bad_spec(void** state)
     s = base_spec(WETDEM_INSERT_RANDOM, 4);
     s.hi.x = 1.5e-3; /* thinner than one sphere */
     CHECK_STATUS(wetdem_insert_particles(&s, p, msg, sizeof msg), WETDEM_ERR_INVALID);
-    CHECK_CONTAINS(msg, "does not fit");
+    CHECK_CONTAINS(msg, "does not fit in the region: it is 0.0015 m across in x, narrower than "
+                        "2 r + 2 gap = ");
+    /* the lattice names the axis too, not "holds at most 0 spheres"; across a periodic axis
+     * a sphere needs one spacing, 2 r + gap */
+    s = base_spec(WETDEM_INSERT_LATTICE, 4);
+    s.radius_min = s.radius_max = 1e-3;
+    s.hi.y = 2e-3;
+    CHECK_STATUS(wetdem_insert_particles(&s, p, msg, sizeof msg), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(msg, "insert: the region is 0.002 m across in y, narrower than one sphere: "
+                        "2 r + 2 gap = 0.0021 m (r = 0.001 m, the largest radius drawn; gap = "
+                        "5e-05 m); enlarge the region in y or reduce radius_max or gap");
+    s.periodic[1] = true;
+    CHECK_STATUS(wetdem_insert_particles(&s, p, msg, sizeof msg), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(msg, "across in y, narrower than one sphere: 2 r + gap = 0.00205 m");
 
     /* 10^8 spheres of R >= 0.5 mm in a 20 mm cube: at least 10^8 x 4/3 pi (0.5 mm)^3 =
      * 0.0524 m^3, 6545 times the 8e-6 m^3 region. Refused before the 10^8 particles are

@@ -160,6 +160,11 @@ static void test_many_cli_bad_inputs_exit_2_with_file_and_line(void** state)
                "[insert]\ncount = 150\nradius = 0.5e-3\nlayout = lattice\n[box]\nsize_x = 2e-3\n"
                "size_y = 2e-3\nsize_z = 2e-3\n[run]\nsteps = 10\n",
                2, "holds at most 8 spheres");
+    /* a box thinner than one sphere names its size against the diameter, not "0 spheres" */
+    expect_bad("thin.ini",
+               "[insert]\ncount = 5\nradius = 1e-3\nlayout = lattice\n[box]\nsize_x = 1e-3\n"
+               "size_y = 1e-2\nsize_z = 1e-2\n[run]\nsteps = 10\n",
+               2, "the region is 0.001 m across in x, narrower than one sphere: 2 r + 2 gap = ");
     expect_bad("negative.ini",
                "[box]\nsize_x = 1e-2\nsize_y = 1e-2\nsize_z = 1e-2\n[insert]\ncount = 5\n"
                "radius = -1e-3\n[run]\nsteps = 10\n",
