@@ -144,7 +144,9 @@ const char* cli_scenario_text(const struct cli_scenario* sc, const char* section
 /* Prints "FILE:LINE: [section] key = value: <message>" (or the --set form) to stderr. */
 void cli_scenario_error(const struct cli_scenario* sc, const struct cli_entry* e, const char* fmt,
                         ...) __attribute__((format(printf, 3, 4)));
-/* Prints "FILE:LINE: <message>" for a whole section (its header line, or line 1 if absent). */
+/* Prints "FILE:LINE: [section]: <message>" for a whole section (its header line, or that of its
+ * first key); "FILE: no [section] section: " when the file lacks it, "FILE: [section] of
+ * --set: " when only --set gave its keys. */
 void cli_scenario_section_error(const struct cli_scenario* sc, const char* section, const char* fmt,
                                 ...) __attribute__((format(printf, 3, 4)));
 
