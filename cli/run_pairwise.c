@@ -17,6 +17,7 @@
  */
 #include <errno.h>
 #include <math.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -191,6 +192,37 @@ static int from_davis(const struct cli_scenario* sc, struct wetdem_pairwise_conf
     return CLI_EXIT_OK;
 }
 
+/* The film forces of [sphere.*] spheres act while a pair's films overlap above its contact at
+ * h_min: with no film on any two spheres, or h_min at or above the thickest pair's films
+ * delta, they never act. Warned once a process (a sweep checks each point). */
+static void warn_films(const struct cli_scenario* sc, const struct wetdem_pairwise_config* cfg)
+{
+    static atomic_flag warned = ATOMIC_FLAG_INIT;
+    double first = 0, second = 0; /* the two thickest films */
+    for (size_t k = 0; k < cfg->n_spheres; k++) {
+        double f = cfg->spheres[k].film;
+        second = f > first ? first : fmax(second, f);
+        first = fmax(first, f);
+    }
+    double delta = first + second;
+    if (delta > 0 && cfg->h_min < delta)
+        return;
+    if (atomic_flag_test_and_set(&warned))
+        return;
+    if (!(delta > 0))
+        cli_error("warning: %s: no two [sphere.NAME] have a film (film = 0 m): the film forces "
+                  "(viscous and capillary) never act and the spheres collide dry at h_min; give "
+                  "the spheres a film > 0 [m]",
+                  sc->file);
+    else
+        cli_scenario_warning(sc, cli_scenario_find(sc, "pairwise", "h_min"),
+                             "h_min is at or above the film thickness delta = %g m of the "
+                             "thickest pair of spheres: they touch before their films overlap, "
+                             "so the film forces never act; set h_min below %g m or give the "
+                             "spheres thicker films",
+                             delta, delta);
+}
+
 static int from_spheres(const struct cli_scenario* sc, struct wetdem_pairwise_config* cfg)
 {
     wetdem_pairwise_config_init(cfg);
@@ -233,6 +265,7 @@ static int from_spheres(const struct cli_scenario* sc, struct wetdem_pairwise_co
     cfg->h_min = cli_scenario_number(sc, "pairwise", "h_min", 0.0);
     cfg->restitution = cli_scenario_number(sc, "pairwise", "restitution", 1.0);
     cfg->friction = cli_scenario_number(sc, "pairwise", "friction", 0.0);
+    warn_films(sc, cfg);
     return CLI_EXIT_OK;
 }
 

@@ -144,6 +144,10 @@ const char* cli_scenario_text(const struct cli_scenario* sc, const char* section
 /* Prints "FILE:LINE: [section] key = value: <message>" (or the --set form) to stderr. */
 void cli_scenario_error(const struct cli_scenario* sc, const struct cli_entry* e, const char* fmt,
                         ...) __attribute__((format(printf, 3, 4)));
+/* "wetdem: warning: FILE:LINE: [section] key = value: ..." ("FILE: --set section.key=value:"
+ * for an entry of --set), placed as cli_scenario_error places an error. */
+void cli_scenario_warning(const struct cli_scenario* sc, const struct cli_entry* e, const char* fmt,
+                          ...) __attribute__((format(printf, 3, 4)));
 /* Prints "FILE:LINE: [section]: <message>" for a whole section (its header line, or that of its
  * first key); "FILE: no [section] section: " when the file lacks it, "FILE: [section] of
  * --set: " when only --set gave its keys. */

@@ -487,9 +487,8 @@ static bool is_thin_film_model(const char* name, bool* reads_h_min)
     return false;
 }
 
-/* "wetdem: warning: FILE:LINE: [section] key = value: ..." (FILE: --set section.key=value for
- * an entry of --set), as cli_scenario_error places an error. */
-static void warn_at(const struct cli_scenario* sc, const struct cli_entry* e, const char* fmt, ...)
+void cli_scenario_warning(const struct cli_scenario* sc, const struct cli_entry* e, const char* fmt,
+                          ...)
 {
     va_list ap;
     va_start(ap, fmt);
@@ -534,23 +533,25 @@ void cli_scenario_warn_films(const struct cli_scenario* sc, const struct wetdem_
     if (dry) {
         bool plural = strchr(all, ',') != NULL;
         if (force)
-            warn_at(sc, force,
-                    "the thin-film model%s %s act%s only within the pair's liquid film, but "
-                    "the film thickness delta = 0 m (%s): the run is dry for %s; give the "
-                    "materials a film > 0 [m] ([material.NAME] film = ...) or leave %s out",
-                    plural ? "s" : "", all, plural ? "" : "s", films, plural ? "them" : "it",
-                    plural ? "them" : "it");
+            cli_scenario_warning(
+                sc, force,
+                "the thin-film model%s %s act%s only within the pair's liquid film, but "
+                "the film thickness delta = 0 m (%s): the run is dry for %s; give the "
+                "materials a film > 0 [m] ([material.NAME] film = ...) or leave %s out",
+                plural ? "s" : "", all, plural ? "" : "s", films, plural ? "them" : "it",
+                plural ? "them" : "it");
         return;
     }
     const struct cli_entry* e = cli_scenario_find(sc, "model.fixed", "h_min");
     const char* whose = e ? "" : " (fixed's default)";
     if (!e && !(e = cli_scenario_find(sc, "models", "min_separation")) && !(e = force))
         return;
-    warn_at(sc, e,
-            "h_min = %g m%s is at or above the pair's film thickness delta = %g m (%s): %s "
-            "take%s h_min capped at delta, so the film has no range left above h_min; set "
-            "[model.fixed] h_min below %g m or give the materials thicker films",
-            h_min, whose, delta, films, reading, strchr(reading, ',') ? "" : "s", delta);
+    cli_scenario_warning(
+        sc, e,
+        "h_min = %g m%s is at or above the pair's film thickness delta = %g m (%s): %s "
+        "take%s h_min capped at delta, so the film has no range left above h_min; set "
+        "[model.fixed] h_min below %g m or give the materials thicker films",
+        h_min, whose, delta, films, reading, strchr(reading, ',') ? "" : "s", delta);
 }
 
 /* Whether section k of sc is a [material.NAME] that none of used[0 .. n_used) names. */

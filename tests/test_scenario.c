@@ -554,6 +554,19 @@ static void test_scenario_idle_film_models_are_reported(void** state)
                "materials)");
     snprintf(args, sizeof args, "run --check examples/scenarios/many_settling.ini");
     assert_int_equal(count_in_run(args, 0, "warning"), 0);
+    /* the pairwise engine's [sphere.NAME] spheres: no film, or h_min above the films */
+    const char* pw = "run --check examples/scenarios/davis_unequal.ini --set sphere.striker.film=0 "
+                     "--set sphere.target.film=0";
+    snprintf(args, sizeof args, "%s --set sphere.third.film=0", pw);
+    expect_run(args, 0,
+               "wetdem: warning: examples/scenarios/davis_unequal.ini: no two [sphere.NAME] have "
+               "a film (film = 0 m): the film forces (viscous and capillary) never act");
+    snprintf(args, sizeof args, "%s --set sphere.third.film=1e-7", pw);
+    expect_run(args, 0,
+               "davis_unequal.ini:11: [pairwise] h_min = 1e-6: h_min is at or above the film "
+               "thickness delta = 1e-07 m of the thickest pair of spheres");
+    snprintf(args, sizeof args, "run --check examples/scenarios/davis_unequal.ini");
+    assert_int_equal(count_in_run(args, 0, "warning"), 0);
 }
 
 /* A [material.NAME] that the scenario never uses (a forgotten striker = NAME runs steel1) is
