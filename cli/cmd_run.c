@@ -80,9 +80,7 @@ static int parse_args(int argc, char** argv, struct run_args* a)
             char hint[64];
             if (strcmp(s, "--set") == 0 && has_next) /* the only option refused with a value */
                 cli_error("run: more than %d --set options", MAX_SETS);
-            else if (!has_next && cli_needs_value("run", s, takes))
-                ;
-            else
+            else if (has_next || !cli_needs_value("run", s, takes))
                 cli_error("run: unexpected argument '%s'%s", s,
                           cli_option_hint(s, options, hint, sizeof hint));
             usage(stderr);
