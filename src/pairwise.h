@@ -120,9 +120,12 @@ bool wetdem_pairwise_rhs_forces(const struct wetdem_pairwise_system* sys,
  * a shared sphere otherwise, 0 for pairs without a common sphere. */
 double wetdem_pairwise_rhs_coupling(const struct wetdem_pairwise_system* sys,
                                     const struct wetdem_pairwise_kin* k, size_t p, size_t q);
-/* Solves A x = b in place (n <= PW_PMAX) by Gaussian elimination with partial pivoting;
- * false if A is singular. */
-bool wetdem_pairwise_rhs_solve(size_t n, double A[PW_PMAX][PW_PMAX], double* b);
+/* Solves A x = b in place for the n x n matrix whose rows start tda doubles apart at a
+ * (overwritten by its LU factors), by GSL's LU decomposition with partial pivoting; false if
+ * A is singular (a zero or NaN pivot). n <= PW_SOLVE_MAX. */
+#define PW_SOLVE_MAX 32
+_Static_assert(PW_PMAX <= PW_SOLVE_MAX, "every pair fits the solver");
+bool wetdem_pairwise_rhs_solve(size_t n, double* a, size_t tda, double* b);
 /* Which of the candidate pairs (touching at h_min with v_n = 0) must be held: the solution of
  * the contact problem lambda >= 0, dv_n/dt = 0 where held, dv_n/dt <= 0 elsewhere, found by
  * enumerating the subsets (<= 16 candidates). False if none is consistent. */

@@ -165,7 +165,7 @@ static bool normal_solve(const struct wetdem_pairwise_system* sys,
         for (size_t c = 0; c < n; c++)
             A[a][c] = wetdem_pairwise_rhs_coupling(sys, k, list[a], list[c]);
     }
-    return wetdem_pairwise_rhs_solve(n, A, J);
+    return wetdem_pairwise_rhs_solve(n, &A[0][0], PW_PMAX, J);
 }
 
 /* Adds to y the velocity jumps of the normal impulses J of the pairs in list[0..n): on i
@@ -227,6 +227,7 @@ bool wetdem_pairwise_jump_plastic(const struct wetdem_pairwise_system* sys,
 #define FR_MAX 6
 #define FR_DIM (2 * FR_MAX)
 #define FR_KKT (3 * FR_MAX)
+_Static_assert(FR_KKT <= PW_SOLVE_MAX, "the KKT system fits the solver");
 
 /* Impulse space of a frictional set of n contacts: component a < n is the normal impulse J_n
  * of contact list[a] on its sphere i along n = -e_ij (J_n > 0 pushes the pair apart), component
@@ -297,39 +298,6 @@ static double fr_energy(const struct fr_problem* fp, const double* P)
     return d;
 }
 
-/* Gaussian elimination with partial pivoting of A x = b (n <= FR_KKT); false if singular. */
-static bool fr_solve(size_t n, double A[FR_KKT][FR_KKT], double* b)
-{
-    for (size_t c = 0; c < n; c++) {
-        size_t piv = c;
-        for (size_t r = c + 1; r < n; r++)
-            if (fabs(A[r][c]) > fabs(A[piv][c]))
-                piv = r;
-        if (!(fabs(A[piv][c]) > 0.0))
-            return false;
-        for (size_t cc = 0; cc < n; cc++) {
-            double t = A[c][cc];
-            A[c][cc] = A[piv][cc];
-            A[piv][cc] = t;
-        }
-        double t = b[c];
-        b[c] = b[piv];
-        b[piv] = t;
-        for (size_t r = c + 1; r < n; r++) {
-            double f = A[r][c] / A[c][c];
-            for (size_t cc = c; cc < n; cc++)
-                A[r][cc] -= f * A[c][cc];
-            b[r] -= f * b[c];
-        }
-    }
-    for (size_t c = n; c-- > 0;) {
-        for (size_t cc = c + 1; cc < n; cc++)
-            b[c] -= A[c][cc] * b[cc];
-        b[c] /= A[c][c];
-    }
-    return true;
-}
-
 /* Minimiser of the kinetic energy over P = P0 + B z (B: m x nz, its columns in B[.][col]),
  * with every v_n after brought to zero if plastic: dT/dJ_n = -v_n' = (g + H P)_a = 0 for
  * a < n. Lagrange's conditions, multipliers l:
@@ -367,7 +335,7 @@ static bool fr_minimise(const struct fr_problem* fp, const double* P0, double B[
         for (size_t l2 = 0; l2 < nc; l2++)
             A[nz + l][nz + l2] = 0.0;
     }
-    if (nz + nc > 0 && !fr_solve(nz + nc, A, z))
+    if (nz + nc > 0 && !wetdem_pairwise_rhs_solve(nz + nc, &A[0][0], FR_KKT, z))
         return false;
     for (size_t r = 0; r < m; r++) {
         P[r] = P0[r];

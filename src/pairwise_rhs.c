@@ -25,7 +25,7 @@
  *
  * Resting contact (an extension, docs/derivations/pairwise.md): a pair held at h = h_min
  * carries an extra normal force lambda (> 0 compressive) chosen so that dv_n/dt = 0 for every
- * held pair; the small linear system A lambda = -b is solved by Gaussian elimination.
+ * held pair; the small linear system A lambda = -b is solved by GSL's LU decomposition.
  * Energy (docs/derivations/pairwise.md Sec. 11): the film forces of pair p do work at the rate
  * -(F_n v_n + F_t v_s) on the two spheres (translation and spin), so with the capillary
  * potential U = 8 pi a sigma (h - delta) <= 0 of each film pair and gravity's -sum m g . x,
@@ -35,6 +35,7 @@
  * the constraint force of a held pair does no work (v_n = 0).
  * Validity: thin films delta << a, low Reynolds number, motion in a plane.
  */
+#include <gsl/gsl_linalg.h>
 #include <math.h>
 #include <string.h>
 
@@ -150,35 +151,24 @@ double wetdem_pairwise_rhs_coupling(const struct wetdem_pairwise_system* sys,
     return 0.0;
 }
 
-bool wetdem_pairwise_rhs_solve(size_t n, double A[PW_PMAX][PW_PMAX], double* b)
+bool wetdem_pairwise_rhs_solve(size_t n, double* a, size_t tda, double* b)
 {
-    for (size_t c = 0; c < n; c++) {
-        size_t piv = c;
-        for (size_t r = c + 1; r < n; r++)
-            if (fabs(A[r][c]) > fabs(A[piv][c]))
-                piv = r;
-        if (!(fabs(A[piv][c]) > 0.0))
+    if (n == 0)
+        return true;
+    if (n > PW_SOLVE_MAX)
+        return false;
+    gsl_matrix_view m = gsl_matrix_view_array_with_tda(a, n, n, tda);
+    size_t perm[PW_SOLVE_MAX];
+    gsl_permutation p = {n, perm};
+    int sign;
+    /* no GSL error path is reached: the sizes agree, and a singular matrix is caught here
+       before gsl_linalg_LU_svx would report it */
+    gsl_linalg_LU_decomp(&m.matrix, &p, &sign);
+    for (size_t c = 0; c < n; c++)
+        if (!(fabs(a[c * tda + c]) > 0.0))
             return false;
-        for (size_t cc = 0; cc < n; cc++) {
-            double t = A[c][cc];
-            A[c][cc] = A[piv][cc];
-            A[piv][cc] = t;
-        }
-        double t = b[c];
-        b[c] = b[piv];
-        b[piv] = t;
-        for (size_t r = c + 1; r < n; r++) {
-            double fct = A[r][c] / A[c][c];
-            for (size_t cc = c; cc < n; cc++)
-                A[r][cc] -= fct * A[c][cc];
-            b[r] -= fct * b[c];
-        }
-    }
-    for (size_t c = n; c-- > 0;) {
-        for (size_t cc = c + 1; cc < n; cc++)
-            b[c] -= A[c][cc] * b[cc];
-        b[c] /= A[c][c];
-    }
+    gsl_vector_view x = gsl_vector_view_array(b, n);
+    gsl_linalg_LU_svx(&m.matrix, &p, &x.vector);
     return true;
 }
 
@@ -222,7 +212,7 @@ static bool constraint_forces(const struct wetdem_pairwise_system* sys,
         for (size_t c = 0; c < n; c++)
             A[a][c] = wetdem_pairwise_rhs_coupling(sys, k, rest[a], rest[c]);
     }
-    if (!wetdem_pairwise_rhs_solve(n, A, b))
+    if (!wetdem_pairwise_rhs_solve(n, &A[0][0], PW_PMAX, b))
         return false;
     for (size_t a = 0; a < n; a++) {
         f->lambda[rest[a]] = b[a] - film_n[a];
@@ -254,7 +244,7 @@ static bool hold_valid(size_t m, double A[PW_PMAX][PW_PMAX], const double* b, un
         for (size_t c = 0; c < n; c++)
             M[a][c] = A[idx[a]][idx[c]];
     }
-    if (n > 0 && !wetdem_pairwise_rhs_solve(n, M, x))
+    if (n > 0 && !wetdem_pairwise_rhs_solve(n, &M[0][0], PW_PMAX, x))
         return false;
     for (size_t a = 0; a < m; a++)
         lam[a] = 0.0;
