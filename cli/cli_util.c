@@ -29,9 +29,11 @@ void cli_error(const char* fmt, ...)
     va_end(ap);
 }
 
-int cli_number(const char* text, double* out)
+/* The length of the longest prefix of text in the number syntax
+ * [+-] digits [. digits] [(e|E) [+-] digits], with at least one digit before the exponent
+ * (an exponent without digits is not part of it); 0 when text does not start with one. */
+static size_t number_syntax(const char* text)
 {
-    /* [+-] digits [. digits] [(e|E) [+-] digits], with at least one digit before the exponent */
     const char* p = text;
     size_t mantissa = 0;
     p += *p == '+' || *p == '-';
@@ -40,15 +42,25 @@ int cli_number(const char* text, double* out)
     if (*p == '.')
         for (p++; isdigit((unsigned char)*p); p++)
             mantissa++;
-    if (mantissa && (*p == 'e' || *p == 'E')) {
-        p++;
-        p += *p == '+' || *p == '-';
-        if (!isdigit((unsigned char)*p))
-            return -1;
-        while (isdigit((unsigned char)*p))
-            p++;
+    if (!mantissa)
+        return 0;
+    if (*p == 'e' || *p == 'E') {
+        const char* q = p + 1;
+        q += *q == '+' || *q == '-';
+        if (isdigit((unsigned char)*q)) {
+            while (isdigit((unsigned char)*q))
+                q++;
+            p = q;
+        }
     }
-    if (!mantissa || *p != '\0')
+    return (size_t)(p - text);
+}
+
+int cli_number(const char* text, double* out)
+{
+    size_t n = number_syntax(text);
+    const char* p = text + n;
+    if (n == 0 || *p != '\0')
         return -1;
     char* end = NULL;
     errno = 0;
@@ -79,28 +91,9 @@ const char* cli_number_problem(const char* text)
 /* The length of the longest prefix of text in cli_number's syntax (0: none), its value in *v. */
 static size_t number_prefix(const char* text, double* v)
 {
-    const char* p = text;
-    size_t mantissa = 0;
-    p += *p == '+' || *p == '-';
-    for (; isdigit((unsigned char)*p); p++)
-        mantissa++;
-    if (*p == '.')
-        for (p++; isdigit((unsigned char)*p); p++)
-            mantissa++;
-    if (!mantissa)
-        return 0;
-    if (*p == 'e' || *p == 'E') {
-        const char* q = p + 1;
-        q += *q == '+' || *q == '-';
-        if (isdigit((unsigned char)*q)) {
-            while (isdigit((unsigned char)*q))
-                q++;
-            p = q;
-        }
-    }
     char buf[64];
-    size_t len = (size_t)(p - text);
-    if (len >= sizeof buf)
+    size_t len = number_syntax(text);
+    if (len == 0 || len >= sizeof buf)
         return 0;
     memcpy(buf, text, len);
     buf[len] = '\0';
