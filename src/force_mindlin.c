@@ -89,17 +89,18 @@ static int mindlin_pair(const void* params, const struct wetdem_contact* c, doub
         return WETDEM_ERR_INVALID;
     double overlap = -c->gap;
     double mu = p->friction == 0 ? c->friction_dry : c->friction_lub;
+    /* beside a linear normal law its linear counterpart, else Hertz-Mindlin (the operations of
+       wetdem_force_mindlin_update, bit for bit) */
     double k = c->linear_stiffness;
-    struct wetdem_vec3 ft;
-    if (k > 0.0) { /* beside a linear normal law: its linear counterpart */
-        double factor = overlap > 0.0 ? wetdem_force_mindlin_damping_factor(c->restitution) : 0.0;
-        ft = mindlin_spring_k(c->normal, c->v_t, vec3_add(c->v_t, c->dv_t_spring), c->dt,
-                              linear_tangential_stiffness(c->g_star, c->e_star, k), c->m_eff,
-                              overlap, k * overlap, mu, factor, history);
-    } else {
-        double f_limit = wetdem_force_hertz_elastic(c->e_star, c->r_eff, overlap);
-        ft = wetdem_force_mindlin_update(c, overlap, f_limit, mu, history);
-    }
+    double k_t = !(overlap > 0.0) ? 0.0
+                 : k > 0.0        ? linear_tangential_stiffness(c->g_star, c->e_star, k)
+                                  : tangential_stiffness(c->g_star, c->r_eff, overlap);
+    double f_limit =
+        k > 0.0 ? k * overlap : wetdem_force_hertz_elastic(c->e_star, c->r_eff, overlap);
+    double factor = overlap > 0.0 ? wetdem_force_mindlin_damping_factor(c->restitution) : 0.0;
+    struct wetdem_vec3 ft =
+        mindlin_spring_k(c->normal, c->v_t, vec3_add(c->v_t, c->dv_t_spring), c->dt, k_t, c->m_eff,
+                         overlap, f_limit, mu, factor, history);
     if (overlap > 0.0)
         wetdem_pair_force_add_tangential(out, c, ft);
     return WETDEM_OK;

@@ -370,18 +370,17 @@ static bool fr_phase(const struct fr_problem* fp, const double* P1, bool restitu
     for (size_t f = 0; f < faces; f++) {
         double B[FR_DIM][FR_DIM] = {{0}}, P0[FR_DIM] = {0}, Pf[FR_DIM];
         size_t nz = 0, code = f;
-        int mode[FR_MAX];
         for (size_t a = 0; a < n; a++, code /= 3) {
-            mode[a] = (int)(code % 3); /* 0 free, 1 slide with s = +1, 2 with s = -1 */
-            double s = mode[a] == 1 ? 1.0 : -1.0;
+            size_t mode = code % 3; /* 0 free, 1 slide with s = +1, 2 with s = -1 */
+            double s = mode == 1 ? 1.0 : -1.0;
             if (restitution) {
                 P0[a] = (1.0 + fp->e) * P1[a];
-                P0[n + a] = P1[n + a] - (mode[a] ? s * fp->mu * fp->e * P1[a] : 0.0);
-                if (!mode[a])
+                P0[n + a] = P1[n + a] - (mode ? s * fp->mu * fp->e * P1[a] : 0.0);
+                if (!mode)
                     B[n + a][nz++] = 1.0;
             } else {
                 B[a][nz] = 1.0; /* J_n */
-                if (mode[a]) {
+                if (mode) {
                     B[n + a][nz++] = -s * fp->mu; /* J_t = -s mu J_n */
                 } else {
                     nz++;
