@@ -281,10 +281,11 @@ struct wetdem_model {
      * that is not linear (hertz). */
     double (*linear_stiffness)(const void* params, const struct wetdem_contact* c);
     /* Shortest relaxation time m / c_d [s] of the motion the model damps viscously, at the
-     * smallest gap it acts at (c->h_min filled in, c->v_n the approach speed): c_d = dF/dv,
-     * m = m* for normal and (2/7) m* for tangential motion (the spins take part); INFINITY
-     * where the model damps nothing, 0 where c_d has no bound. Optional. The many-particle
-     * engine keeps its step below a quarter of the shortest (docs/many.md, Time step). */
+     * smallest gap it acts at (c->h_min and c->linear_stiffness filled in, c->v_n the approach
+     * speed): c_d = dF/dv, m = m* for normal and (2/7) m* for tangential motion (the spins
+     * take part); INFINITY where the model damps nothing, 0 where c_d has no bound. Optional.
+     * The many-particle engine keeps its step below a quarter of the shortest (docs/many.md,
+     * Time step). */
     double (*relaxation_time)(const void* params, const struct wetdem_contact* c);
     /* The next three read the pair's state at its latest evaluation: c as pair() received it
      * (c->h_min and c->dt not filled in), history (history_len doubles, read only) as pair()

@@ -106,6 +106,35 @@ static int mindlin_pair(const void* params, const struct wetdem_contact* c, doub
     return WETDEM_OK;
 }
 
+/* Relaxation time (2/7) m* / gamma_t of the tangential dashpot [s]: a tangential force also
+ * spins both spheres, so the slip velocity relaxes with the mass (2/7) m* (docs/many.md, Viscous
+ * relaxation time), gamma_t = -2 sqrt(5/6) beta sqrt(m* k_t). Beside a linear normal law k_t =
+ * 4 G* k / E* at every overlap; for Hertz-Mindlin k_t = 8 G* sqrt(R* delta) is taken at the
+ * largest overlap of an undamped head-on impact at c->v_n, delta_max = (5 m* v_n^2 / (4 k))^(2/5)
+ * with k = (4/3) E* sqrt(R*), where it is largest (as the hertz model's own time). Written as
+ * (2/7) sqrt(m* / k_t) / factor so that m* k_t cannot overflow. INFINITY without damping
+ * (e_dry = 1) and, for Hertz-Mindlin, without approach speed. */
+static double mindlin_relaxation_time(const void* params, const struct wetdem_contact* c)
+{
+    (void)params;
+    if (!(c->restitution > 0.0 && c->restitution < 1.0 && c->m_eff > 0.0))
+        return INFINITY;
+    double k = c->linear_stiffness, k_t;
+    if (k > 0.0) {
+        k_t = linear_tangential_stiffness(c->g_star, c->e_star, k);
+    } else {
+        double k_hertz = hertz_stiffness(c->e_star, c->r_eff), v = c->v_n;
+        if (!(v > 0.0 && k_hertz > 0.0))
+            return INFINITY;
+        double delta_max = pow(1.25 * c->m_eff * v * v / k_hertz, 0.4);
+        k_t = tangential_stiffness(c->g_star, c->r_eff, delta_max);
+    }
+    double factor = wetdem_force_mindlin_damping_factor(c->restitution);
+    if (!(k_t > 0.0 && factor > 0.0))
+        return INFINITY;
+    return 2.0 / 7.0 * sqrt(c->m_eff / k_t) / factor;
+}
+
 const struct wetdem_model wetdem_force_mindlin = {
     .name = "mindlin",
     .kind = WETDEM_MODEL_CONTACT,
@@ -141,6 +170,7 @@ const struct wetdem_model wetdem_force_mindlin = {
     .range = contact_only_range,
     .pair = mindlin_pair,
     .thresholds = contact_only_thresholds,
+    .relaxation_time = mindlin_relaxation_time,
     /* no elastic_energy: the spring's k_t |s|^2 / 2 is no potential (k_t follows the overlap,
        so its work depends on the path, and sliding resets s) */
     .is_in_contact = contact_only_is_in_contact,

@@ -479,6 +479,7 @@ double wetdem_sim_relaxation_time(const struct wetdem_sim* sim, struct wetdem_co
     c->h_min = sim->minsep.model->history_len <= WETDEM_HISTORY_SCRATCH
                    ? sim->minsep.model->min_separation(sim->minsep.params, c, history)
                    : 0.0;
+    c->linear_stiffness = wetdem_sim_linear_stiffness(sim, c); /* (mindlin beside hooke) */
     double t = INFINITY;
     if (which)
         *which = NULL;

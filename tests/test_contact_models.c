@@ -285,6 +285,48 @@ static void test_hertz_relaxation_time_is_the_dashpot_at_the_largest_overlap(voi
     assert_true(isinf(wetdem_force_hertz.relaxation_time(p, &c)));
 }
 
+/* mindlin's relaxation time (2/7) m* / gamma_t (the step bound; the spins take part): gamma_t
+ * taken here from the model's own force, |F_t| at |v_t| = 1 m/s on a fresh spring with dt = 0
+ * and a Coulomb limit far above it (the dashpot alone). Beside a linear law (linear_stiffness
+ * k) at any overlap; for Hertz-Mindlin at the largest overlap of an undamped impact at v_n,
+ * delta_max = (5 m* v^2 / (4 k))^(2/5), k = (4/3) E* sqrt(R*). It falls with e_dry (beta ->
+ * -1), and without damping (e = 1) or, Hertzian, approach it is infinite. 1e-12: the same
+ * products in another order. */
+static void test_mindlin_relaxation_time_is_the_tangential_dashpot(void** state)
+{
+    (void)state;
+    double p[1] = {0}; /* friction = dry */
+    for (int linear = 0; linear < 2; linear++) {
+        double prev = INFINITY;
+        for (double e = 0.9; e > 1e-9; e /= 100) {
+            struct wetdem_contact c = steel_pair(0, 0.5);
+            c.restitution = e;
+            c.friction_dry = 1e12;
+            c.linear_stiffness = linear ? 2e5 : 0.0;
+            double k = (4.0 / 3.0) * c.e_star * sqrt(c.r_eff);
+            double tau = wetdem_force_mindlin.relaxation_time(p, &c);
+            c.gap = linear ? -1e-6 : -pow(1.25 * c.m_eff * 0.25 / k, 0.4);
+            c.v_t = (struct wetdem_vec3){0, 1, 0};
+            c.dt = 0;
+            double spring[3] = {0};
+            struct wetdem_pair_force f = {0};
+            CHECK_OK(wetdem_force_mindlin.pair(p, &c, spring, &f));
+            double gamma_t =
+                sqrt(f.f_tan.x * f.f_tan.x + f.f_tan.y * f.f_tan.y + f.f_tan.z * f.f_tan.z);
+            CHECK_REL(tau, 2.0 / 7.0 * c.m_eff / gamma_t, 1e-12);
+            assert_true(tau < prev);
+            prev = tau;
+        }
+        struct wetdem_contact c = steel_pair(0, 0.5);
+        c.linear_stiffness = linear ? 2e5 : 0.0;
+        c.restitution = 1.0;
+        assert_true(isinf(wetdem_force_mindlin.relaxation_time(p, &c)));
+        c.restitution = 0.5;
+        c.v_n = 0;
+        assert_true(isinf(wetdem_force_mindlin.relaxation_time(p, &c)) == !linear);
+    }
+}
+
 static void test_hertz_elastic_force_at_hand_point(void** state)
 {
     (void)state;
@@ -1293,6 +1335,7 @@ int main(int argc, char** argv)
         cmocka_unit_test(test_mindlin_swap_symmetry_and_torques),
         cmocka_unit_test(test_mindlin_resets_when_separated),
         cmocka_unit_test(test_hertz_relaxation_time_is_the_dashpot_at_the_largest_overlap),
+        cmocka_unit_test(test_mindlin_relaxation_time_is_the_tangential_dashpot),
         cmocka_unit_test(test_hooke_force_closed_form),
         cmocka_unit_test(test_hooke_collision_recovers_e_and_contact_time),
         cmocka_unit_test(test_contact_model_objects_are_documented),

@@ -1704,17 +1704,20 @@ static void test_many_cli_examples_and_budget(void** state)
     assert_true(v[4] > 0);                              /* damping and films took energy */
     CHECK_CONTAINS(js, ", \"energy_J\": {\"input\": "); /* fields separated as JSON wants */
     free(js);
-    /* a step too long for the contacts (20 us, about a sixth of the contact time): the budget
-       closes to only 0.09 (2e-4 at 2 us), the run says so and exits 1, its files written */
-    assert_int_equal(run_cli("run budget.ini --set run.steps=300 --set run.dt=2e-5 --out long"), 1);
+    /* a step too long for the contacts (19 us, 0.45 of the contact time, tangential, and just
+       below mindlin's relaxation time of 19.1 us, at or above which a step is refused): the
+       budget closes to only 0.078 (2e-4 at 2 us), the run says so and exits 1, its files
+       written */
+    assert_int_equal(run_cli("run budget.ini --set run.steps=300 --set run.dt=1.9e-5 --out long"),
+                     1);
     char* err = stderr_text();
-    CHECK_CONTAINS(err, "the energy budget does not close (error 0.09");
-    CHECK_CONTAINS(err, "the step dt = 2e-05 s is too long for these contacts; halve it");
+    CHECK_CONTAINS(err, "the energy budget does not close (error 0.078");
+    CHECK_CONTAINS(err, "the step dt = 1.9e-05 s is too long for these contacts; halve it");
     free(err);
     assert_true(exists("long/summary.json") && exists("long/global.csv"));
     /* without the budget no work is summed: the same run prints no budget and does not judge
        one (it gave every model's work as 0 and failed on the change of kinetic energy) */
-    assert_int_equal(run_cli("run budget.ini --set run.steps=300 --set run.dt=2e-5 "
+    assert_int_equal(run_cli("run budget.ini --set run.steps=300 --set run.dt=1.9e-5 "
                              "--set run.energy_budget=no --out off"),
                      0);
     char* off = test_read_file(tpath("out.txt"), NULL);
@@ -1834,7 +1837,7 @@ static void test_many_cli_refuses_a_run_with_too_many_steps(void** state)
  * its speed scale (2 m/s) travel several times h_min = 1 um in a step; many_hmin_fraction = 0 turns
  * that bound and its warning off, and the derived step keeps to the bound. A step of 0.3 ms,
  * some 8 x the contact time of the dry spheres, is refused up front (exit 2) where it is not
- * below the relaxation time of the damped hertz contact, with the step to use; with undamped
+ * below the relaxation time of the damped contact (mindlin's dashpot), with the step to use; with undamped
  * contacts (e_dry = 1) it is warned about and diverges: the run stops
  * at the first step whose motion is not finite with exit 1, naming the step, the time and
  * the particle, and every CSV row and VTK frame written before is of a finite state (one of
@@ -1860,7 +1863,7 @@ static void test_many_cli_warns_about_the_step(void** state)
 
     err = expect_exit("run warn.ini --set 'models.force=hertz mindlin' --set run.dt=3e-4", 2,
                       "many: the step dt = 0.0003 s is not below the viscous relaxation time ");
-    CHECK_CONTAINS(err, "that 'hertz' sets in contact");
+    CHECK_CONTAINS(err, "that 'mindlin' sets in contact"); /* (its dashpot: 0.3 of hertz's) */
     free(err);
     err = expect_exit("run warn.ini --set 'models.force=hertz mindlin' --set run.dt=3e-4 "
                       "--set material.wet.restitution=1 "
