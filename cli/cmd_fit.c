@@ -691,6 +691,16 @@ static int initial_value(const struct fit_ctx* c, size_t j, double* v)
     return CLI_EXIT_USAGE;
 }
 
+/* The descriptor of a fitted key's valid range into *d ("material.striker.restitution": key
+ * restitution of [material.striker]); false for a key of unknown range. */
+static bool key_desc(const char* full, struct wetdem_param_desc* d)
+{
+    const char* dot = strrchr(full, '.');
+    char section[CLI_NAME_MAX];
+    snprintf(section, sizeof section, "%.*s", (int)(dot - full), full);
+    return cli_scenario_key_range(section, dot + 1, d) == 0;
+}
+
 static int initial_values(const struct fit_args* a, const struct fit_ctx* c, double* init)
 {
     if (!a->init) {
@@ -717,7 +727,16 @@ static int initial_values(const struct fit_args* a, const struct fit_ctx* c, dou
         if (cli_parse_double(tok, "--init", &init[n]) != CLI_EXIT_OK)
             return CLI_EXIT_USAGE;
         /* the value as given, against its key's range, before the fit (which works on its
-           logarithm and would report exp(log(v)) at the first collision instead) */
+           logarithm and would report exp(log(v)) at the first collision instead): the range
+           in the --init message, else the scenario checker's message of the override */
+        struct wetdem_param_desc d;
+        char why[256];
+        if (key_desc(c->keys[n], &d) &&
+            wetdem_param_validate(&d, init[n], why, sizeof why) != WETDEM_OK) {
+            cli_error("fit: --init: %s is not a valid initial value of %s: %s", tok, c->keys[n],
+                      why);
+            return CLI_EXIT_USAGE;
+        }
         int rc = probe_override(c, c->keys[n], tok);
         if (rc != CLI_EXIT_OK) {
             cli_error("fit: --init: %s is not a valid initial value of %s (the message above)", tok,
@@ -731,16 +750,6 @@ static int initial_values(const struct fit_args* a, const struct fit_ctx* c, dou
         return CLI_EXIT_USAGE;
     }
     return CLI_EXIT_OK;
-}
-
-/* The descriptor of a fitted key's valid range into *d ("material.striker.restitution": key
- * restitution of [material.striker]); false for a key of unknown range. */
-static bool key_desc(const char* full, struct wetdem_param_desc* d)
-{
-    const char* dot = strrchr(full, '.');
-    char section[CLI_NAME_MAX];
-    snprintf(section, sizeof section, "%.*s", (int)(dot - full), full);
-    return cli_scenario_key_range(section, dot + 1, d) == 0;
 }
 
 /* The fit's bounds of every key, its valid range [min, max] (the library varies the distance to
