@@ -52,7 +52,10 @@ static void usage(FILE* f)
             "  --slip V        tangential slip speed of the surfaces [m/s] (default 0)\n"
             "  --gaps A:B:N    gaps [m] (default 1e-7:1e-3:9 with --log)\n"
             "  --log           geometric spacing of the gaps\n"
-            "  --set K=V       set a parameter by dotted name, e.g. fluid.viscosity=0.05\n");
+            "  --set K=V       set a parameter by dotted name, e.g. fluid.viscosity=0.05\n"
+            "A minimum-separation model (fixed, roughness, ehd, max, glass) gives only the\n"
+            "h_min_m column: list a force model that reads h_min with it (reynolds, sb, db,\n"
+            "davis, nase); alone, its force columns are 0 (with a warning).\n");
 }
 
 /* Takes the value of option argv[*k]; error if missing. */
@@ -165,6 +168,21 @@ static int check_opts(const struct forces_opts* o)
     return CLI_EXIT_OK;
 }
 
+/* Only min-separation models given (each replaces the default fixed): they give the h_min_m
+ * column and no force, so both force columns are 0 at every gap. Said, not refused (h_min
+ * against the gap is a use of its own). */
+static void warn_no_force(const struct wetdem_sim* sim)
+{
+    if (wetdem_sim_n_models(sim) > 0)
+        return;
+    const char* ms = wetdem_sim_min_separation_model(sim)->name;
+    cli_error("warning: forces: no force model given ('%s' is a minimum-separation model: it "
+              "gives only the h_min_m column), so f_normal_N and f_tangential_N are 0 at every "
+              "gap; add a force model that reads h_min, e.g. 'wetdem forces reynolds %s' "
+              "(reynolds, sb, db, davis, nase; 'wetdem models' lists them)",
+              ms, ms);
+}
+
 /* Materials, fluid, two particles, models and parameters; CLI_EXIT_OK or an exit code. */
 static int build_sim(struct wetdem_sim* sim, const struct forces_opts* o)
 {
@@ -205,6 +223,7 @@ static int build_sim(struct wetdem_sim* sim, const struct forces_opts* o)
         if (rc != CLI_EXIT_OK)
             return rc;
     }
+    warn_no_force(sim);
     return CLI_EXIT_OK;
 }
 

@@ -214,6 +214,24 @@ static void test_cli_forces_matches_reynolds_closed_form(void** state)
     CHECK_REL(c[3], 1e-6, 0.0); /* h_min of the default "fixed" model */
 }
 
+/* Only a min-separation model: no force, so both force columns are 0 at every gap; a warning
+ * says so and names the force models that read h_min, and with one of them none is given. */
+static void test_cli_forces_min_separation_only_is_explained(void** state)
+{
+    (void)state;
+    struct test_run r = run_cli("forces roughness --gaps 1e-6:1e-5:2", true);
+    assert_int_equal(r.code, 0);
+    CHECK_CONTAINS(r.out, "wetdem: warning: forces: no force model given ('roughness' is a "
+                          "minimum-separation model: it gives only the h_min_m column), so "
+                          "f_normal_N and f_tangential_N are 0 at every gap; add a force model "
+                          "that reads h_min, e.g. 'wetdem forces reynolds roughness'");
+    free(r.out);
+    r = run_cli("forces reynolds roughness --gaps 1e-6:1e-5:2", true);
+    assert_int_equal(r.code, 0);
+    assert_null(strstr(r.out, "warning"));
+    free(r.out);
+}
+
 static void test_cli_forces_log_gaps_are_decades(void** state)
 {
     (void)state;
@@ -1066,6 +1084,7 @@ int main(void)
         cmocka_unit_test(test_cli_describe_lists_parameters_with_units),
         cmocka_unit_test(test_cli_describe_unknown_name),
         cmocka_unit_test(test_cli_forces_matches_reynolds_closed_form),
+        cmocka_unit_test(test_cli_forces_min_separation_only_is_explained),
         cmocka_unit_test(test_cli_forces_log_gaps_are_decades),
         cmocka_unit_test(test_cli_forces_bad_input),
         cmocka_unit_test(test_cli_bad_options_get_hints),
