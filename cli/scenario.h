@@ -240,15 +240,32 @@ int cli_scenario_enable_min_separation(const struct cli_scenario* sc, struct wet
  * parameters of the model the --set switched away from. Returns an exit code. */
 int cli_scenario_set_model_params(const struct cli_scenario* sc, struct wetdem_sim* sim);
 /* Warns (once a process) when sim's thin-film models (sb, db, davis, nase, capillary) can do
- * nothing: the pair has no film (delta = 0), or [model.fixed] h_min >= delta, where they take
- * h_min capped at delta. delta: the pair's film thickness (the largest a pair can have);
- * films: where it comes from, for the message. */
+ * nothing: the pair has no film (delta = 0), or [model.fixed] h_min >= delta, or the
+ * roughness (min_separation roughness or max, whose h_min is at least the mean roughness)
+ * >= delta, where they take h_min capped at delta. delta: the pair's film thickness (the
+ * largest a pair can have); films: where it comes from, for the message; roughness: the
+ * pair's mean roughness (sigma_i + sigma_j)/2 (the smallest a pair can have) [m]; roughs:
+ * where it comes from. */
+void cli_scenario_warn_films(const struct cli_scenario* sc, const struct wetdem_sim* sim,
+                             double delta, const char* films, double roughness, const char* roughs);
 /* Warns (once a process) about each [material.NAME] section that none of used[0 .. n_used)
  * names (it would be read by no sphere): "FILE:LINE: [material.NAME] is not used: <how>". */
 void cli_scenario_warn_unused_materials(const struct cli_scenario* sc, const char* const* used,
                                         size_t n_used, const char* how);
-void cli_scenario_warn_films(const struct cli_scenario* sc, const struct wetdem_sim* sim,
-                             double delta, const char* films);
+/* Warns (once a process) about each key given that the run does not read, at its line with
+ * why: [integrator] parameters of the integrator not chosen, the other engine's step bound
+ * (hmin_fraction of binary collisions, many_hmin_fraction of many-particle runs), dt_fraction
+ * (and [integrator] dt, in a many-particle run with [run] dt) when the step is given;
+ * [collision] target_radius with target = wall; [model.NAME] parameters of the
+ * min-separation model when no force model reads h_min. A key of the file that a --set of the
+ * key making it unread (integrator.name, say) set aside is not warned about. many: a
+ * many-particle run. */
+void cli_scenario_warn_ignored(const struct cli_scenario* sc, const struct wetdem_sim* sim,
+                               bool many);
+/* Warns (once a process), at [models] force, when none of sim's force models holds the
+ * surfaces apart at contact (a solid contact, with a contact time: hertz, hooke, nijssen),
+ * naming those that do. */
+void cli_scenario_warn_no_contact(const struct cli_scenario* sc, const struct wetdem_sim* sim);
 
 /* ---- internal: section lookup (scenario_keys.c), shared by scenario*.c ---- */
 

@@ -504,7 +504,7 @@ void cli_scenario_warning(const struct cli_scenario* sc, const struct cli_entry*
 }
 
 void cli_scenario_warn_films(const struct cli_scenario* sc, const struct wetdem_sim* sim,
-                             double delta, const char* films)
+                             double delta, const char* films, double roughness, const char* roughs)
 {
     static atomic_flag warned = ATOMIC_FLAG_INIT;
     char all[256] = "", reading[256] = "";
@@ -525,8 +525,11 @@ void cli_scenario_warn_films(const struct cli_scenario* sc, const struct wetdem_
     double h_min = 0;
     bool fixed = ms && strcmp(ms->name, "fixed") == 0 &&
                  wetdem_sim_param(sim, "fixed.h_min", &h_min) == WETDEM_OK;
+    /* roughness: h_min = (sigma_i + sigma_j)/2; max: at least that */
+    bool rough = ms && (strcmp(ms->name, "roughness") == 0 || strcmp(ms->name, "max") == 0);
     bool dry = n_all > 0 && !(delta > 0);
-    bool capped = !dry && n_reading > 0 && fixed && h_min >= delta;
+    bool capped =
+        !dry && n_reading > 0 && ((fixed && h_min >= delta) || (rough && roughness >= delta));
     if ((!dry && !capped) || atomic_flag_test_and_set(&warned))
         return;
     const struct cli_entry* force = cli_scenario_find(sc, "models", "force");
@@ -542,6 +545,21 @@ void cli_scenario_warn_films(const struct cli_scenario* sc, const struct wetdem_
                 plural ? "them" : "it");
         return;
     }
+    const char* takes = strchr(reading, ',') ? "" : "s";
+    if (rough) {
+        const struct cli_entry* e = cli_scenario_find(sc, "models", "min_separation");
+        bool is_max = strcmp(ms->name, "max") == 0;
+        if (e)
+            cli_scenario_warning(
+                sc, e,
+                "h_min %s the mean roughness (sigma_i + sigma_j)/2 = %g m (%s), which is at "
+                "or above the pair's film thickness delta = %g m (%s): %s take%s h_min "
+                "capped at delta, so the film has no range left above h_min; give the "
+                "materials a roughness below %g m or thicker films",
+                is_max ? "is at least" : "is", roughness, roughs, delta, films, reading, takes,
+                delta);
+        return;
+    }
     const struct cli_entry* e = cli_scenario_find(sc, "model.fixed", "h_min");
     const char* whose = e ? "" : " (fixed's default)";
     if (!e && !(e = cli_scenario_find(sc, "models", "min_separation")) && !(e = force))
@@ -551,7 +569,7 @@ void cli_scenario_warn_films(const struct cli_scenario* sc, const struct wetdem_
         "h_min = %g m%s is at or above the pair's film thickness delta = %g m (%s): %s "
         "take%s h_min capped at delta, so the film has no range left above h_min; set "
         "[model.fixed] h_min below %g m or give the materials thicker films",
-        h_min, whose, delta, films, reading, strchr(reading, ',') ? "" : "s", delta);
+        h_min, whose, delta, films, reading, takes, delta);
 }
 
 /* Whether section k of sc is a [material.NAME] that none of used[0 .. n_used) names. */
@@ -580,6 +598,178 @@ void cli_scenario_warn_unused_materials(const struct cli_scenario* sc, const cha
         if (unused_material(sc, k, used, n_used))
             cli_error("warning: %s:%d: [%s] is not used: %s", sc->file, sc->sections[k].line,
                       sc->sections[k].name, how);
+}
+
+/* The force models that read the min-separation model's h_min (docs/models.md); nijssen
+ * takes its own h_min = max(h_sigma, h_eps), the others none. */
+static bool reads_min_separation(const char* name)
+{
+    static const char* const names[] = {"reynolds", "sb", "db", "davis", "nase", NULL};
+    for (size_t k = 0; names[k]; k++)
+        if (strcmp(name, names[k]) == 0)
+            return true;
+    return false;
+}
+
+/* Whether entry e of the file is one that a --set of `by`, the key that leaves it unread,
+ * set aside (a file tuned for cvode run with --set integrator.name=verlet, say). */
+static bool set_aside(const struct cli_entry* e, const struct cli_entry* by)
+{
+    return e->line > 0 && by && by->line == 0;
+}
+
+/* A key the run does not read, and why (for cli_scenario_warn_ignored). */
+struct ignored_key {
+    const struct cli_entry* e;
+    char why[480];
+};
+
+#define MAX_IGNORED 32
+
+/* [integrator] keys that the engine's step does not read: the other integrator's parameters,
+ * the other engine's step bound, and the step's derivation when a step is given. */
+static size_t ignored_integrator_keys(const struct cli_scenario* sc, const struct wetdem_sim* sim,
+                                      bool many, struct ignored_key* out)
+{
+    const char* name = many ? "verlet" : wetdem_sim_integrator_name(sim);
+    const struct cli_entry* ne = cli_scenario_find(sc, "integrator", "name");
+    const struct cli_entry* run_dt = many ? cli_scenario_find(sc, "run", "dt") : NULL;
+    const struct cli_entry* dt = cli_scenario_find(sc, "integrator", "dt");
+    if (run_dt && !(strtod(run_dt->value, NULL) > 0))
+        run_dt = NULL;
+    if (dt && !(strtod(dt->value, NULL) > 0))
+        dt = NULL;
+    size_t n = 0;
+    for (size_t k = 0; k < sc->n_entries && n < MAX_IGNORED; k++) {
+        const struct cli_entry* e = &sc->entries[k];
+        if (strcmp(e->section, "integrator") != 0 || strcmp(e->key, "name") == 0)
+            continue;
+        char full[2 * CLI_NAME_MAX];
+        snprintf(full, sizeof full, "%s.%s", name, e->key);
+        double v;
+        char* why = out[n].why;
+        size_t size = sizeof out[n].why;
+        /* (many_hmin_fraction is read with a step given: 0 turns off the warning about a
+           step that crosses h_min, cli/run_many.c) */
+        bool derives = strcmp(e->key, "dt_fraction") == 0;
+        const struct cli_entry* given = run_dt ? run_dt : dt;
+        if (!many && strcmp(e->key, "many_hmin_fraction") == 0)
+            snprintf(why, size,
+                     "only many-particle runs hold their step with it; a binary collision's "
+                     "verlet step reads hmin_fraction (0, off, by default), so it has no "
+                     "effect here: use hmin_fraction");
+        else if (many && strcmp(e->key, "hmin_fraction") == 0)
+            snprintf(why, size,
+                     "only a binary collision's verlet step reads it; a many-particle run "
+                     "holds its step with many_hmin_fraction (0.5 by default), so it has no "
+                     "effect here: use many_hmin_fraction");
+        else if (!many && wetdem_sim_param(sim, full, &v) != WETDEM_OK) {
+            if (set_aside(e, ne))
+                continue;
+            const char* other = strcmp(name, "verlet") == 0 ? "cvode" : "verlet";
+            snprintf(why, size,
+                     "a parameter of the %s integrator, and [integrator] name = %s%s does not "
+                     "read it, so it has no effect: remove it, or set name = %s",
+                     other, name, ne ? "" : " (the default)", other);
+        } else if ((derives && given && !set_aside(e, given)) ||
+                   (many && run_dt && strcmp(e->key, "dt") == 0 && !set_aside(e, run_dt)))
+            snprintf(why, size,
+                     "the step is given ([%s] dt = %s s), so %s has no effect: remove one of "
+                     "them",
+                     given->section, given->value, e->key);
+        else
+            continue;
+        out[n++].e = e;
+    }
+    return n;
+}
+
+/* [model.NAME] parameters of the min-separation model when no force model reads its h_min:
+ * they move only the run's h_min events (hmin_reached, hmin_left), not the spheres. */
+static size_t ignored_min_separation_keys(const struct cli_scenario* sc,
+                                          const struct wetdem_sim* sim, struct ignored_key* out)
+{
+    char forces[256] = "";
+    size_t used = 0;
+    for (size_t k = 0; k < wetdem_sim_n_models(sim); k++) {
+        const char* name = wetdem_sim_model(sim, k)->name;
+        if (reads_min_separation(name))
+            return 0;
+        if (used < sizeof forces)
+            used +=
+                (size_t)snprintf(forces + used, sizeof forces - used, "%s%s", k ? ", " : "", name);
+    }
+    const char* ms = wetdem_sim_min_separation_model(sim)->name;
+    char section[CLI_NAME_MAX];
+    snprintf(section, sizeof section, "model.%s", ms);
+    const struct cli_entry* force = cli_scenario_find(sc, "models", "force");
+    size_t n = 0;
+    for (size_t k = 0; k < sc->n_entries && n < MAX_IGNORED; k++) {
+        const struct cli_entry* e = &sc->entries[k];
+        if (strcmp(e->section, section) != 0 || set_aside(e, force))
+            continue;
+        snprintf(out[n].why, sizeof out[n].why,
+                 "none of the force models (%s) reads the h_min of '%s', so this parameter "
+                 "moves only the run's h_min events, not the spheres: reynolds, sb, db, davis "
+                 "and nase read h_min (nijssen takes its own)",
+                 used ? forces : "none", ms);
+        out[n++].e = e;
+    }
+    return n;
+}
+
+void cli_scenario_warn_ignored(const struct cli_scenario* sc, const struct wetdem_sim* sim,
+                               bool many)
+{
+    static atomic_flag warned = ATOMIC_FLAG_INIT;
+    struct ignored_key keys[2 * MAX_IGNORED + 1];
+    size_t n = ignored_integrator_keys(sc, sim, many, keys);
+    n += ignored_min_separation_keys(sc, sim, keys + n);
+    const struct cli_entry* target = cli_scenario_find(sc, "collision", "target");
+    const struct cli_entry* radius = cli_scenario_find(sc, "collision", "target_radius");
+    if (!many && target && strcmp(target->value, "wall") == 0 && radius &&
+        !set_aside(radius, target)) {
+        snprintf(keys[n].why, sizeof keys[n].why,
+                 "a wall has no radius (with target = wall, R* = striker_radius and m* the "
+                 "striker's mass), so it has no effect: remove it, or set target = sphere or "
+                 "fixed");
+        keys[n++].e = radius;
+    }
+    if (n == 0 || atomic_flag_test_and_set(&warned))
+        return;
+    for (size_t k = 0; k < n; k++)
+        cli_scenario_warning(sc, keys[k].e, "%s", keys[k].why);
+}
+
+void cli_scenario_warn_no_contact(const struct cli_scenario* sc, const struct wetdem_sim* sim)
+{
+    static atomic_flag warned = ATOMIC_FLAG_INIT;
+    char forces[256] = "", contact[256] = "";
+    size_t n_forces = 0, n_contact = 0;
+    for (size_t k = 0; k < wetdem_sim_n_models(sim); k++) {
+        const struct wetdem_model* m = wetdem_sim_model(sim, k);
+        if (m->contact_time)
+            return;
+        if (n_forces < sizeof forces)
+            n_forces += (size_t)snprintf(forces + n_forces, sizeof forces - n_forces, "%s%s",
+                                         k ? ", " : "", m->name);
+    }
+    const struct cli_entry* force = cli_scenario_find(sc, "models", "force");
+    if (!force || atomic_flag_test_and_set(&warned))
+        return;
+    /* the models with a solid contact (a contact time); the impulse model hard is the
+       pairwise engine's */
+    for (const struct wetdem_model* const* r = wetdem_model_registry(); *r; r++)
+        if ((*r)->contact_time && n_contact < sizeof contact)
+            n_contact += (size_t)snprintf(contact + n_contact, sizeof contact - n_contact, "%s%s",
+                                          n_contact ? ", " : "", (*r)->name);
+    cli_scenario_warning(sc, force,
+                         "%s%s%s no contact model, so nothing holds the surfaces apart where "
+                         "they touch: only the fluid forces slow the approach, and the spheres "
+                         "overlap as far as those let them; add a contact model: %s (nijssen "
+                         "includes its Hertz-Mindlin contact)",
+                         n_forces ? "the force models (" : "", n_forces ? forces : "it enables",
+                         n_forces ? ") include" : "", contact);
 }
 
 int cli_scenario_engine(const struct cli_scenario* sc, enum cli_engine* engine)
@@ -618,7 +808,13 @@ int cli_scenario_build(const struct cli_scenario* sc, struct cli_setup* su)
     char films[2 * CLI_VALUE_MAX + 64];
     snprintf(films, sizeof films, "film of striker %s %g m + target %s %g m", si, mi.film,
              cli_scenario_text(sc, "collision", "target_material", si), mj.film);
-    cli_scenario_warn_films(sc, su->sim, mi.film + mj.film, films);
+    char roughs[2 * CLI_VALUE_MAX + 64];
+    snprintf(roughs, sizeof roughs, "roughness of striker %s %g m, target %s %g m", si,
+             mi.roughness, cli_scenario_text(sc, "collision", "target_material", si), mj.roughness);
+    cli_scenario_warn_films(sc, su->sim, mi.film + mj.film, films,
+                            0.5 * (mi.roughness + mj.roughness), roughs);
+    cli_scenario_warn_ignored(sc, su->sim, false);
+    cli_scenario_warn_no_contact(sc, su->sim);
     const struct cli_entry* ei = cli_scenario_find(sc, "collision", "striker");
     const struct cli_entry* ej = cli_scenario_find(sc, "collision", "target_material");
     if (!(ei && ei->line == 0) && !(ej && ej->line == 0)) { /* (not switched by --set) */

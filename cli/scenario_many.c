@@ -227,10 +227,15 @@ static bool is_many_section(const char* name)
 
 bool cli_scenario_is_many(const struct cli_scenario* sc)
 {
-    for (size_t k = 0; k < sc->n_sections; k++)
+    bool collision = false;
+    for (size_t k = 0; k < sc->n_sections; k++) {
         if (is_many_section(sc->sections[k].name))
             return true;
-    for (size_t k = 0; k < sc->n_entries; k++)
+        collision = collision || strcmp(sc->sections[k].name, "collision") == 0;
+    }
+    /* a file of a binary collision stays one: a --set of a many-particle section ([box]) is
+       refused at that --set as a section it does not read, not at the file's [collision] */
+    for (size_t k = 0; k < sc->n_entries && !collision; k++)
         if (is_many_section(sc->entries[k].section))
             return true;
     return false;
@@ -1018,9 +1023,11 @@ int cli_many_build(const struct cli_scenario* sc, struct cli_many_setup* su)
         cli_many_setup_free(su);
         return rc;
     }
-    double film = 0;
-    for (int k = 0; k < wetdem_sim_n_materials(su->sim); k++)
+    double film = 0, roughness = INFINITY;
+    for (int k = 0; k < wetdem_sim_n_materials(su->sim); k++) {
         film = fmax(film, wetdem_sim_material(su->sim, k)->film);
+        roughness = fmin(roughness, wetdem_sim_material(su->sim, k)->roughness);
+    }
     const char* used[MAX_MATERIALS];
     int n_used = wetdem_sim_n_materials(su->sim);
     for (int k = 0; k < n_used; k++)
@@ -1030,7 +1037,10 @@ int cli_many_build(const struct cli_scenario* sc, struct cli_many_setup* su)
                                        "[read.*] or [walls] names it; name it there, or leave "
                                        "it out");
     cli_scenario_warn_films(sc, su->sim, 2 * film,
-                            "at most: twice the thickest film of the materials");
+                            "at most: twice the thickest film of the materials", roughness,
+                            "at least: the least roughness of the materials");
+    cli_scenario_warn_ignored(sc, su->sim, true);
+    cli_scenario_warn_no_contact(sc, su->sim);
     return rc;
 }
 

@@ -406,6 +406,17 @@ static void test_scenario_bad_files_exit_2_with_line(void** state)
     /* the same for a --set of such a section, and for a sweep of the pairwise engine */
     expect_run("run examples/scenarios/davis_three.ini --set integrator.rtol=1e-6 --check", 2,
                "--set integrator.rtol=1e-6: [integrator] is not read by the pairwise engine");
+    /* a binary collision's file: at the --set, not at the file's [collision] (which said
+       "a scenario is a binary collision or a many-particle run, not both") */
+    struct test_run rb = run_cli("run examples/scenarios/dry_hertz.ini --check --set box.size_x=1");
+    assert_int_equal(rb.code, 2);
+    CHECK_CONTAINS(rb.out, "examples/scenarios/dry_hertz.ini: --set box.size_x=1: [box] is not "
+                           "read by a binary collision, which reads [engine], [collision]");
+    assert_null(strstr(rb.out, "dry_hertz.ini:5"));
+    free(rb.out);
+    expect_run("sweep examples/scenarios/dry_hertz.ini --set run.t_end=1 --param "
+               "collision.speed --values 1:2:2",
+               2, "dry_hertz.ini: --set run.t_end=1: [run] is not read by a binary");
     expect_run("sweep examples/scenarios/davis_three.ini --set box.size_x=1 --param davis.stokes "
                "--values 1:2:2 --out /dev/null",
                2, "[box] is not read by the pairwise engine");
@@ -545,6 +556,27 @@ static void test_scenario_idle_film_models_are_reported(void** state)
     assert_int_equal(count_in_run(args, 0, "warning"), 1);
     snprintf(args, sizeof args, "run --check '%s' --set model.fixed.h_min=1e-5", file);
     assert_int_equal(count_in_run(args, 0, "warning"), 0);
+    /* h_min of roughness (the mean roughness), and of max (at least that), at or above delta */
+    snprintf(args, sizeof args,
+             "run --check '%s' --set models.min_separation=roughness --set "
+             "material.m.roughness=4e-5",
+             file);
+    expect_run(args, 0,
+               "film.ini: --set models.min_separation=roughness: h_min is the mean roughness "
+               "(sigma_i + sigma_j)/2 = 4e-05 m (roughness of striker m 4e-05 m, target m "
+               "4e-05 m), which is at or above the pair's film thickness delta = 4e-05 m (film "
+               "of striker m 2e-05 m + target m 2e-05 m): sb takes h_min capped at delta, so "
+               "the film has no range left above h_min; give the materials a roughness below "
+               "4e-05 m or thicker films");
+    snprintf(args, sizeof args,
+             "run --check '%s' --set models.min_separation=max --set material.m.roughness=5e-5",
+             file);
+    expect_run(args, 0, "h_min is at least the mean roughness (sigma_i + sigma_j)/2 = 5e-05 m");
+    snprintf(args, sizeof args,
+             "run --check '%s' --set models.min_separation=roughness --set "
+             "material.m.roughness=3.9e-5",
+             file);
+    assert_int_equal(count_in_run(args, 0, "warning"), 0);
     /* the many-particle set-up: no material with a film */
     snprintf(args, sizeof args,
              "run --check examples/scenarios/many_settling.ini --set material.wetglass.film=0");
@@ -552,6 +584,13 @@ static void test_scenario_idle_film_models_are_reported(void** state)
                "sb, capillary act only within the pair's liquid film, but the film "
                "thickness delta = 0 m (at most: twice the thickest film of the "
                "materials)");
+    snprintf(args, sizeof args,
+             "run --check examples/scenarios/many_settling.ini --set "
+             "models.min_separation=roughness --set material.wetglass.roughness=4e-5");
+    expect_run(args, 0,
+               "h_min is the mean roughness (sigma_i + sigma_j)/2 = 4e-05 m (at least: the "
+               "least roughness of the materials), which is at or above the pair's film "
+               "thickness delta = 4e-05 m (at most: twice the thickest film of the materials)");
     snprintf(args, sizeof args, "run --check examples/scenarios/many_settling.ini");
     assert_int_equal(count_in_run(args, 0, "warning"), 0);
     /* the pairwise engine's [sphere.NAME] spheres: no film, or h_min above the films */
@@ -567,6 +606,126 @@ static void test_scenario_idle_film_models_are_reported(void** state)
                "thickness delta = 1e-07 m of the thickest pair of spheres");
     snprintf(args, sizeof args, "run --check examples/scenarios/davis_unequal.ini");
     assert_int_equal(count_in_run(args, 0, "warning"), 0);
+}
+
+/* A key given that the run does not read is warned about at its line, with why (exit 0, once
+ * for a sweep): in a binary collision an [integrator] parameter of the integrator not chosen
+ * and many_hmin_fraction (many-particle runs only), target_radius of a wall, a parameter of
+ * the min-separation model when no force model reads h_min (hertz alone); in a many-particle
+ * run hmin_fraction (binary collisions only) and dt_fraction when [run] dt gives the step. A
+ * file's key that a --set of integrator.name (or of dt) set aside is not; nor is a key read. */
+static void test_scenario_ignored_keys_are_reported(void** state)
+{
+    (void)state;
+    const char* file = write_file("ignored.ini", "[collision]\nstokes = 10\ntarget = wall\n"
+                                                 "target_radius = 1e-3\n[models]\n"
+                                                 "force = hertz\nmin_separation = glass\n"
+                                                 "[model.glass]\np_gt = 1e6\n[integrator]\n"
+                                                 "name = cvode\nrtol = 1e-8\n"
+                                                 "dt_fraction = 0.01\n"
+                                                 "many_hmin_fraction = 0.2\n");
+    char args[800];
+    snprintf(args, sizeof args, "run --check '%s'", file);
+    expect_run(args, 0, "wetdem: warning: ");
+    expect_run(args, 0,
+               "ignored.ini:13: [integrator] dt_fraction = 0.01: a parameter of the verlet "
+               "integrator, and [integrator] name = cvode does not read it, so it has no "
+               "effect: remove it, or set name = verlet");
+    expect_run(args, 0,
+               "ignored.ini:14: [integrator] many_hmin_fraction = 0.2: only many-particle runs "
+               "hold their step with it; a binary collision's verlet step reads hmin_fraction");
+    expect_run(args, 0,
+               "ignored.ini:4: [collision] target_radius = 1e-3: a wall has no radius (with "
+               "target = wall, R* = striker_radius and m* the striker's mass), so it has no "
+               "effect");
+    expect_run(args, 0,
+               "ignored.ini:9: [model.glass] p_gt = 1e6: none of the force models (hertz) reads "
+               "the h_min of 'glass', so this parameter moves only the run's h_min events, not "
+               "the spheres");
+    assert_int_equal(count_in_run(args, 0, "warning"), 4); /* (rtol is cvode's) */
+    /* the file's rtol, set aside by a --set of the integrator, is not; the others stay */
+    snprintf(args, sizeof args, "run --check '%s' --set integrator.name=verlet", file);
+    assert_int_equal(count_in_run(args, 0, "rtol"), 0);
+    assert_int_equal(count_in_run(args, 0, "warning"), 3);
+    /* verlet with a step given: dt_fraction of a --set is not read, the file's is set aside */
+    snprintf(args, sizeof args,
+             "run --check '%s' --set integrator.name=verlet --set integrator.dt=1e-7", file);
+    assert_int_equal(count_in_run(args, 0, "dt_fraction"), 0);
+    snprintf(args, sizeof args,
+             "run --check examples/scenarios/dry_hertz.ini --set integrator.dt=1e-7 --set "
+             "integrator.dt_fraction=0.01");
+    expect_run(args, 0,
+               "--set integrator.dt_fraction=0.01: the step is given ([integrator] dt = 1e-7 "
+               "s), so dt_fraction has no effect");
+    /* once for a sweep's points */
+    snprintf(args, sizeof args, "sweep '%s' --param collision.stokes --values 10:20:3", file);
+    assert_int_equal(count_in_run(args, 0, "target_radius"), 1);
+    /* keys that are read say nothing */
+    snprintf(args, sizeof args,
+             "run --check examples/scenarios/dry_hertz.ini --set integrator.dt_fraction=0.01 "
+             "--set collision.target_radius=1e-3 --set integrator.hmin_fraction=0.1");
+    assert_int_equal(count_in_run(args, 0, "warning"), 0);
+    /* many-particle: the binary collision's step bound, the step's derivation when given */
+    snprintf(args, sizeof args,
+             "run --check examples/scenarios/many_settling.ini --set integrator.hmin_fraction=0.1 "
+             "--set run.dt=1e-6 --set integrator.dt_fraction=0.01");
+    expect_run(args, 0,
+               "many_settling.ini: --set integrator.hmin_fraction=0.1: only a binary "
+               "collision's verlet step reads it; a many-particle run holds its step with "
+               "many_hmin_fraction");
+    expect_run(args, 0,
+               "many_settling.ini: --set integrator.dt_fraction=0.01: the step is given ([run] "
+               "dt = 1e-6 s), so dt_fraction has no effect");
+    snprintf(args, sizeof args,
+             "run --check examples/scenarios/many_settling.ini --set run.dt=1e-6 --set "
+             "integrator.dt=2e-6");
+    expect_run(args, 0,
+               "many_settling.ini: --set integrator.dt=2e-6: the step is given ([run] dt = "
+               "1e-6 s), so dt has no effect");
+    /* read: dt_fraction of a derived step; many_hmin_fraction also with a step given (0 turns
+       off the warning about a step that crosses h_min: test_many_cli_warns_about_the_step) */
+    snprintf(args, sizeof args,
+             "run --check examples/scenarios/many_settling.ini --set "
+             "integrator.many_hmin_fraction=0.2 --set integrator.dt_fraction=0.01");
+    assert_int_equal(count_in_run(args, 0, "warning"), 0);
+    snprintf(args, sizeof args,
+             "run --check examples/scenarios/many_settling.ini --set run.dt=1e-6 --set "
+             "integrator.many_hmin_fraction=0");
+    assert_int_equal(count_in_run(args, 0, "warning"), 0);
+}
+
+/* A scenario with no contact model (fluid forces only) lets the spheres pass into each other
+ * where the fluid does not stop them: warned up front at [models] force, once, naming the
+ * contact models, in both engines; nothing with one of them. */
+static void test_scenario_no_contact_model_is_reported(void** state)
+{
+    (void)state;
+    const char* file = write_file("fluid_only.ini", "[collision]\nstokes = 10\n[models]\n"
+                                                    "force = reynolds mindlin\n");
+    char args[800];
+    snprintf(args, sizeof args, "run --check '%s'", file);
+    expect_run(args, 0, "wetdem: warning: ");
+    expect_run(args, 0,
+               "fluid_only.ini:4: [models] force = reynolds mindlin: the force models "
+               "(reynolds, mindlin) include no contact model, so nothing holds the surfaces "
+               "apart where they touch: only the fluid forces slow the approach, and the "
+               "spheres overlap as far as those let them; add a contact model: hertz, hooke, "
+               "nijssen (nijssen includes its Hertz-Mindlin contact)");
+    snprintf(args, sizeof args,
+             "sweep '%s' --param collision.stokes --values 10:20:3 "
+             "--set integrator.name=cvode --set collision.t_end=1e-4",
+             file);
+    assert_int_equal(count_in_run(args, 0, "no contact model"), 1);
+    const char* with[] = {"hertz", "hooke reynolds", "nijssen"};
+    for (int k = 0; k < 3; k++) {
+        snprintf(args, sizeof args, "run --check '%s' --set 'models.force=%s'", file, with[k]);
+        assert_int_equal(count_in_run(args, 0, "warning"), 0);
+    }
+    expect_run("run --check examples/scenarios/many_settling.ini --set models.force=sb", 0,
+               "many_settling.ini: --set models.force=sb: the force models (sb) include no "
+               "contact model, so nothing holds the surfaces apart where they touch: only the "
+               "fluid forces slow the approach, and the spheres overlap as far as those let "
+               "them; add a contact model: hertz, hooke, nijssen (nijssen includes");
 }
 
 /* A [material.NAME] that the scenario never uses (a forgotten striker = NAME runs steel1) is
@@ -1761,6 +1920,8 @@ int main(void)
         cmocka_unit_test(test_scenario_unresolved_hmin_is_reported),
         cmocka_unit_test(test_scenario_idle_film_models_are_reported),
         cmocka_unit_test(test_scenario_unused_material_is_reported),
+        cmocka_unit_test(test_scenario_ignored_keys_are_reported),
+        cmocka_unit_test(test_scenario_no_contact_model_is_reported),
         cmocka_unit_test(test_scenario_missing_section_is_named),
         cmocka_unit_test(test_scenario_docs_list_every_key),
         cmocka_unit_test(test_scenario_run_writes_files_or_nothing),
