@@ -3,7 +3,8 @@
 
 `setup DIR` writes one initial state of isolated pairs of equal spheres, as a CSV for wetdem
 (`[read.NAME]`) and a data file for LIGGGHTS (bench/liggghts/friction.in), both with 17
-digits, and DIR/runs.txt, the runs the piece makes (name, material set, dt, steps). In each
+digits, wetdem's scenario of each set, and DIR/runs.txt, the runs the piece makes (name, set,
+dt, steps, e, E, nu, mu, and which codes: the controls run LIGGGHTS alone). In each
 pair a striker meets a sphere at rest with normal speed V_N along the line of centres at first
 touch (x) and tangential speed V_N tan(theta) (y), over ANGLES, without and with a spin of the
 striker (SPIN); it touches after 0.2 t_c, and each run ends after the contact. `check DIR` reads the
@@ -30,8 +31,8 @@ as the one difference left at dt -> 0; the damped runs (e = 0.5) show the Coulom
 Checks, each printed and failing the script (differences: the largest of a velocity or R
 times a spin component of either sphere, over V_N):
   reference  each code's final velocities and spins equal its scheme's (step_map), from the
-             same state, for every pair and step size, e = 1 and e = 0.5, to 1e-9 (the
-             reference sums in another order; measured 1.4e-15, rounding);
+             same state, for every pair and run (stiff, soft, damped), to 1e-9 (the reference
+             sums in another order; measured 1.4e-15, rounding);
   decomposition  e = 1: the reference with wetdem's scheme but the half-step velocity and
              with LIGGGHTS' scheme but the lever arm R differ by 7e-13 at 25 and half that at
              50 steps per contact time (1.6-2.5: first order), at most 1e-9 of the codes'
@@ -80,6 +81,7 @@ SPIN = (1.0, 0.4, 0.3)  # the striker's spin in V_N / R: twist, out-of-plane sli
 N_STIFF = [25, 50, 100, 200, 400, 800, 1600]  # steps per head-on contact time
 N_SOFT = [400, 800]
 N_CONTROL = [800, 1600]
+NU_CONTROL, MU_CONTROL = 0.31, 1.01 * MU  # LIGGGHTS' parameters in the controls
 N_DAMPED = [800, 1600]
 E_DAMPED = 0.5
 SPACING = 10e-3  # between pairs [m]: far beyond the neighbour lists' reach
@@ -170,15 +172,45 @@ def setup(d):
                 for v, w in ((p[1], p[2]), (p[4], p[5])):
                     f.write(f"{i} " + " ".join(f"{q:.17g}" for q in (*v, *w)) + "\n")
                     i += 1
-        with open(os.path.join(d, f"{name}.box"), "w") as f:
-            f.write(" ".join(f"{q:.17g}" for q in hi) + "\n")
+        with open(os.path.join(d, f"wetdem_{name}.ini"), "w") as f:
+            f.write(f"""# set {name} of the friction cross-check (liggghts_friction.py setup)
+[box]
+size_x = {hi[0]:.17g}
+size_y = {hi[1]:.17g}
+size_z = {hi[2]:.17g}
+[walls]
+faces = none
+[material.m]
+density = {RHO:.17g}
+youngs_modulus = {SETS[name]['E']:.17g}
+poisson_ratio = {NU:.17g}
+restitution = 1      ; each run sets material.m.restitution
+friction_dry = {MU:.17g}
+[models]
+force = hertz mindlin
+[model.hertz]
+damping = tsuji      ; LIGGGHTS' model hertz
+[read.pairs]
+file = {name}.csv
+material = m
+[run]
+steps = 1            ; each run sets run.dt and run.steps
+energy_budget = no
+[dump]
+csv = none
+checkpoint = none
+summary = none
+""")
         for n, e in ([(n, 1.0) for n in N_STIFF] + [(n, E_DAMPED) for n in N_DAMPED]
                      if name == "stiff" else [(n, 1.0) for n in N_SOFT]):
             dt, steps = run_steps(name, n)
-            runs.append(f"{name} {run_name(name, n, e)} {dt:.6g} {steps} "
-                        f"{SETS[name]['E']:.6g} {e:g}")
+            base = f"{name} {dt:.6g} {steps} {e:g} {SETS[name]['E']:.17g}"
+            runs.append(f"{run_name(name, n, e)} {base} {NU:g} {MU:g} both")
+            if name == "stiff" and e == 1.0 and n in N_CONTROL:  # the controls: LIGGGHTS
+                runs.append(f"{run_name(name, n, e)}_nu {base} {NU_CONTROL:g} {MU:g} liggghts")
+                runs.append(f"{run_name(name, n, e)}_mu {base} {NU:g} {MU_CONTROL:g} liggghts")
     with open(os.path.join(d, "runs.txt"), "w") as f:
-        f.write("\n".join(runs) + "\n")
+        f.write("# name set dt steps e E nu mu codes\n" + "\n".join(runs) + "\n")
 
 
 # ---- the reference: both schemes, step for step ----
@@ -390,7 +422,7 @@ def main_check(d):
         ref = {"wetdem": reference_all("stiff", n, WETDEM, p1),
                "LIGGGHTS": reference_all("stiff", n, LIGGGHTS, p1)}
         for code, got in (("wetdem", wd[n]), ("LIGGGHTS", lg[n])):
-            ref_err.append((largest(got, ref[code], vn).max(), code, n, "e = 1"))
+            ref_err.append((largest(got, ref[code], vn).max(), code, n, "stiff"))
         # LIGGGHTS as it would be with wetdem's lever arm R (its scheme, one switch changed)
         lever = reference_all("stiff", n, dict(LIGGGHTS, lever="R"), p1) - ref["LIGGGHTS"]
         corr[n] = scaled(wd[n], vn) - scaled(lg[n] + lever, vn)
@@ -401,14 +433,24 @@ def main_check(d):
         rl = reference_all("stiff", n, LIGGGHTS, pd)
         for code, got, sch in (("wetdem", w, WETDEM), ("LIGGGHTS", g, LIGGGHTS)):
             ref = rl if code == "LIGGGHTS" else reference_all("stiff", n, sch, pd)
-            ref_err.append((largest(got, ref, vn).max(), code, n, f"e = {E_DAMPED}"))
+            ref_err.append((largest(got, ref, vn).max(), code, n, "damped"))
         conv = reference_all("stiff", n, dict(LIGGGHTS, lever="R", limit="wetdem"), pd) - rl
         dmp[n] = dict(w=w, g=g, diff=scaled(w, vn) - scaled(g, vn), conv=scaled(conv, vn))
+    vs, ps = SETS["soft"]["vn"], params("soft")
+    soft, soft_ref = {}, {}
+    for n in N_SOFT:
+        w = read_wetdem(d, run_name("soft", n))
+        g = read_liggghts(os.path.join(d, f"liggghts_{run_name('soft', n)}.dump"))
+        soft_ref[n] = reference_all("soft", n, LIGGGHTS, ps)
+        ref_err.append((largest(g, soft_ref[n], vs).max(), "LIGGGHTS", n, "soft"))
+        ref_err.append((largest(w, reference_all("soft", n, WETDEM, ps), vs).max(), "wetdem", n,
+                        "soft"))
+        soft[n] = scaled(w, vs) - scaled(g, vs)
     worst = max(ref_err)
     check(worst[0] <= 1e-9,
           f"reference: each code equals its scheme written out, for every pair and step, to "
           f"{worst[0]:.2g} V_N at most ({worst[1]}, {worst[3]}, {worst[2]} steps per contact "
-          "time; <= 1e-9)")
+          "time; <= 1e-9), in the stiff, damped and soft runs")
 
     # e = 1: the spring's velocity and the lever arm are the whole difference but for the
     # spring's rotation or projection (the Coulomb limits are one rule at e = 1)
@@ -451,7 +493,7 @@ def main_check(d):
           + " V_N at " + ", ".join(str(n) for n in N_STIFF) + " steps per t_c")
 
     controls = {}
-    for tag, label in (("nu", "nu = 0.31"), ("mu", "mu x 1.01")):
+    for tag, label in (("nu", f"nu = {NU_CONTROL:g}"), ("mu", f"mu x {MU_CONTROL / MU:g}")):
         # wetdem against the perturbed LIGGGHTS, with the same lever correction
         c = {n: corr[n] + scaled(lg[n], vn) - scaled(read_liggghts(os.path.join(
             d, f"liggghts_{run_name('stiff', n)}_{tag}.dump")), vn) for n in N_CONTROL}
@@ -484,14 +526,9 @@ def main_check(d):
           f"{err_touch:.2g} in e_t with the normal of the first touch)")
 
     # soft: the lever arm is what is left at dt = 0
-    vs = SETS["soft"]["vn"]
-    ps = params("soft")
-    soft = {n: scaled(read_wetdem(d, run_name("soft", n)), vs) - scaled(
-        read_liggghts(os.path.join(d, f"liggghts_{run_name('soft', n)}.dump")), vs)
-        for n in N_SOFT}
     soft_lim = 2 * soft[N_SOFT[1]] - soft[N_SOFT[0]]
     lever_soft = scaled(reference_all("soft", N_SOFT[1], dict(LIGGGHTS, lever="R"), ps)
-                        - reference_all("soft", N_SOFT[1], LIGGGHTS, ps), vs)
+                        - soft_ref[N_SOFT[1]], vs)
     mis = np.abs(soft_lim - lever_soft).max() / np.abs(lever_soft).max()
     check(mis <= 0.05 and np.abs(soft_lim).max() > 30 * LIMIT_BOUND,
           f"lever: soft set, the codes differ at dt = 0 by up to {np.abs(soft_lim).max():.2g} "
