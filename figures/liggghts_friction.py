@@ -638,7 +638,8 @@ def figure(r):
     ax[2].set_xlabel("impact angle [deg] (left: no spin, right: spin)")
     ax[2].set_ylabel("largest difference of v, R w at dt = 0 [V_N]")
     ax[2].set_title("At dt = 0: the documented differences, and nothing else", fontsize=10)
-    ax[2].legend(fontsize=7, loc=(0.38, 0.1))  # below the spin pairs, above 1e-14
+    ax[2].set_ylim(1e-18, 1)  # room below the points for the legend
+    ax[2].legend(fontsize=6.5, loc="lower right")
     fig.suptitle("Binary oblique collisions with friction (Hertz-Mindlin): wetdem against "
                  "LIGGGHTS 3.8", fontsize=11)
     save_and_finish(fig, "liggghts_friction.png")
