@@ -209,11 +209,13 @@ struct wetdem_contact {
     struct wetdem_vec3 v_t;    /* tangential velocity of i's surface relative to j's at the
                                   contact point [m/s] */
     double dt;                 /* time since the pair's history was last committed [s] */
-    /* Added to v_t in the tangential spring's increment over dt [m/s]: 0 (the spring advances
-     * by v_t dt) except in the two-body CVODE engine, where it is half the change of v_t since
-     * the commit, in the tangent plane, so that the spring advances with the mean of v_t at
-     * both ends of dt (trapezoidal rule, docs/engines.md). wetdem_contact_from_particles sets
-     * it to 0; a contact filled in by hand must too. */
+    /* Added to v_t in the tangential spring's increment over dt [m/s], so that the spring
+     * advances with a second-order mean of the slip over dt (docs/engines.md): in the two-body
+     * CVODE engine half the change of v_t since the commit, in the tangent plane (the mean of
+     * v_t at both ends of dt, trapezoidal rule); in the fixed-step engines (verlet, the
+     * many-particle mode) the slip at the half-step velocities less v_t (midpoint rule).
+     * wetdem_contact_from_particles sets it to 0 (the spring advances by v_t dt); a contact
+     * filled in by hand must too. */
     struct wetdem_vec3 dv_t_spring;
     /* mixed pair properties */
     double e_star;          /* 1/E* = (1-nu_i^2)/E_i + (1-nu_j^2)/E_j [Pa] */

@@ -40,6 +40,26 @@ static inline double contact_effective_mass(const struct wetdem_particle* p)
 /* The geometry and kinematics of the contact of a with b, d = x_a - x_b (minimum image where
  * the caller needs it): normal (b to a), gap, radii, R*, m*, v_n, v_t; the mixed properties
  * are the caller's; dv_t_spring = 0. */
+/* Tangential part of the surface velocity of sphere a (radius r_a, velocity v_a, spin w_a)
+ * relative to sphere b at their contact, n the unit normal from b to a [m/s]:
+ * (v_a + w_a x (-r_a n)) - (v_b + w_b x (r_b n)), less its part along n. */
+static inline struct wetdem_vec3 contact_pair_slip(struct wetdem_vec3 n, double r_a,
+                                                   struct wetdem_vec3 v_a, struct wetdem_vec3 w_a,
+                                                   double r_b, struct wetdem_vec3 v_b,
+                                                   struct wetdem_vec3 w_b)
+{
+    struct wetdem_vec3 va = vec3_add(v_a, vec3_cross(w_a, vec3_scale(n, -r_a)));
+    struct wetdem_vec3 vb = vec3_add(v_b, vec3_cross(w_b, vec3_scale(n, r_b)));
+    return vec3_reject(vec3_sub(va, vb), n);
+}
+
+/* The same against a wall that does not move (normal n into the side of a). */
+static inline struct wetdem_vec3 contact_wall_slip(struct wetdem_vec3 n, double r_a,
+                                                   struct wetdem_vec3 v_a, struct wetdem_vec3 w_a)
+{
+    return vec3_reject(vec3_add(v_a, vec3_cross(w_a, vec3_scale(n, -r_a))), n);
+}
+
 static inline void contact_pair_geometry(struct wetdem_contact* c, const struct wetdem_particle* a,
                                          const struct wetdem_particle* b, struct wetdem_vec3 d)
 {
@@ -52,10 +72,8 @@ static inline void contact_pair_geometry(struct wetdem_contact* c, const struct 
     c->r_eff = contact_reduced(a->radius, b->radius);
     c->m_eff = contact_reduced(contact_effective_mass(a), contact_effective_mass(b));
     struct wetdem_vec3 n = c->normal;
-    struct wetdem_vec3 va = vec3_add(a->vel, vec3_cross(a->omega, vec3_scale(n, -a->radius)));
-    struct wetdem_vec3 vb = vec3_add(b->vel, vec3_cross(b->omega, vec3_scale(n, b->radius)));
     c->v_n = -vec3_dot(vec3_sub(a->vel, b->vel), n);
-    c->v_t = vec3_reject(vec3_sub(va, vb), n);
+    c->v_t = contact_pair_slip(n, a->radius, a->vel, a->omega, b->radius, b->vel, b->omega);
     c->dv_t_spring = vec3(0, 0, 0);
 }
 
@@ -72,9 +90,8 @@ static inline void contact_wall_geometry(struct wetdem_contact* c, const struct 
     c->radius_j = INFINITY;
     c->r_eff = a->radius;
     c->m_eff = contact_effective_mass(a);
-    struct wetdem_vec3 va = vec3_add(a->vel, vec3_cross(a->omega, vec3_scale(normal, -a->radius)));
     c->v_n = -vec3_dot(a->vel, normal);
-    c->v_t = vec3_reject(va, normal);
+    c->v_t = contact_wall_slip(normal, a->radius, a->vel, a->omega);
     c->dv_t_spring = vec3(0, 0, 0);
 }
 

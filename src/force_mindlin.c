@@ -8,8 +8,8 @@
  * evaluation, with overlap delta > 0, unit normal n (j to i) and tangential surface velocity
  * v_t of i relative to j (struct wetdem_contact):
  *   1. s is rotated into the current tangent plane: s <- |s| (s - (s.n) n)/|s - (s.n) n|;
- *   2. s <- s + v_s dt          (dt = c->dt; v_s = v_t + c->dv_t_spring: v_t, or in the
- *                                 two-body CVODE engine the mean of v_t over dt, docs/engines.md)
+ *   2. s <- s + v_s dt          (dt = c->dt; v_s = v_t + c->dv_t_spring, the engines'
+ *                                 second-order mean of the slip over dt: docs/engines.md)
  *   3. k_t = 8 G* sqrt(R* delta)                            [N/m]
  *      gamma_t = -2 sqrt(5/6) beta sqrt(m* k_t),  beta = ln e / sqrt(ln^2 e + pi^2)   [kg/s]
  *   4. F_t = -k_t s - gamma_t v_t (spring and dashpot); if |F_t| > mu F_lim (sliding), the

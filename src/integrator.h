@@ -28,8 +28,9 @@ struct wetdem_integrator {
     int (*integrate)(struct wetdem_sim* sim, const void* params, double t_end);
     /* Whether force evaluations between commits are trials at any time in the step (cvode):
      * the tangential spring then advances over c->dt with the mean of v_t at the commit and
-     * at the evaluation (trapezoidal rule, second order) rather than with v_t at the
-     * evaluation (first order; what a fixed step that commits every evaluation uses). */
+     * at the evaluation (trapezoidal rule, second order). A fixed step that commits every
+     * evaluation (verlet) advances it with v_t at the half step instead (midpoint rule,
+     * engine.half_vel). */
     bool trapezoid_spring;
 };
 

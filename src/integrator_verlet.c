@@ -127,14 +127,18 @@ static int choose_step(struct wetdem_sim* sim, const struct verlet_params* p, do
 }
 
 /* Half kick with the current forces and drift; velocities become the predicted ones
- * (v + a dt), the half-step ones are kept in vh/wh. */
+ * (v + a dt), the half-step ones are kept in vh/wh (a fixed particle's own velocity and
+ * spin). */
 static void kick_drift(struct wetdem_sim* sim, double h, struct wetdem_vec3* vh,
                        struct wetdem_vec3* wh)
 {
     for (size_t k = 0; k < sim->n_particles; k++) {
         struct wetdem_particle* p = &sim->particles[k];
-        if (p->is_fixed)
+        if (p->is_fixed) { /* (the springs read vh and wh of every particle) */
+            vh[k] = p->vel;
+            wh[k] = p->omega;
             continue;
+        }
         struct wetdem_vec3 a = wetdem_sim_acceleration(sim, k);
         struct wetdem_vec3 alpha = wetdem_sim_angular_acceleration(sim, k);
         vh[k] = vec3_axpy(p->vel, 0.5 * h, a);
@@ -165,7 +169,10 @@ static int step(struct wetdem_sim* sim, double t0, double h, struct wetdem_vec3*
     struct wetdem_engine* e = &sim->engine;
     kick_drift(sim, h, vh, wh);
     double t1 = t0 + h;
+    e->half_vel = vh; /* the springs advance with the half-step slip (midpoint rule) */
+    e->half_omega = wh;
     int st = wetdem_sim_compute_forces(sim, t1, true);
+    e->half_vel = e->half_omega = NULL;
     if (st != WETDEM_OK)
         return st;
     kick(sim, h, vh, wh);

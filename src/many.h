@@ -89,6 +89,7 @@ static const unsigned char wetdem_many_mask_count[16] = {0, 1, 1, 2, 1, 2, 2, 3,
 struct wetdem_many_bulk_in {
     const struct wetdem_celllist_item* xr;
     const struct wetdem_vec3 (*vw)[2];
+    const struct wetdem_vec3 (*vwh)[2]; /* the half-step ones (struct wetdem_many vwh) */
     const struct wetdem_celllist_pair* pairs;
     const double* lim2;             /* pair_lim2 */
     double film, film_h_min, range; /* of the material pair [m] */
@@ -393,7 +394,11 @@ struct wetdem_many {
     bool periodic_any;     /* some axis is periodic */
     unsigned char kind[WETDEM_MAX_MODELS]; /* fused kernel of model k */
     double kind_opt[WETDEM_MAX_MODELS];    /* its switch parameter (hertz damping form, ...) */
-    struct wetdem_vec3 *force, *torque, *vh, *wh; /* per particle */
+    struct wetdem_vec3 *force, *torque;    /* per particle */
+    /* per particle: velocity and spin at the half step, v' and w' of the latest drift (a fixed
+       particle's own); the tangential springs advance with the slip they give (midpoint rule:
+       sim_many_force.c, many_bulk.h) */
+    struct wetdem_vec3 (*vwh)[2];
     /* The engine state of a run: per particle, position and radius (xr, also what the gap
        tests read) and velocity and spin (vw; the predicted v' + a dt/2 during a force pass).
        Loaded from the particle records when a call starts (wetdem_sim_many_prepare), and
@@ -478,8 +483,8 @@ static inline void wetdem_many_close_kick(struct wetdem_many* m, size_t k, struc
     if (m->fixed[k])
         return;
     double h = m->dt;
-    m->vw[k][0] = vec3_axpy(m->vh[k], 0.5 * h, vec3_axpy(g, m->inv[k][0], m->force[k]));
-    m->vw[k][1] = vec3_axpy(m->wh[k], 0.5 * h, vec3_scale(m->torque[k], m->inv[k][1]));
+    m->vw[k][0] = vec3_axpy(m->vwh[k][0], 0.5 * h, vec3_axpy(g, m->inv[k][0], m->force[k]));
+    m->vw[k][1] = vec3_axpy(m->vwh[k][1], 0.5 * h, vec3_scale(m->torque[k], m->inv[k][1]));
 }
 
 /* sim_many.c */

@@ -23,7 +23,9 @@
  *   v_t = (v_i + w_i x (-R_i n)) - (v_j + w_j x (R_j n)), less its normal part,
  *   delta = -gap,  F_el = k delta sqrt(delta),  F_d = c sqrt(sqrt(delta)) v_n,
  *   F_hertz = F_el + F_d (tsuji) or max(F_el + F_d, 0) (exact),
- *   s = the spring rotated into the tangent plane (its length kept) + dt v_t,
+ *   s = the spring rotated into the tangent plane (its length kept) + dt v_s, with v_s =
+ *   v_t + (v_t' - v_t), v_t' the same slip from the half-step velocities and spins (vwh),
+ *   or v_s = v_t where dt = 0 (sim_many_force.c spring_velocity),
  *   k_t = 8 G* sqrt(R* delta),  gamma_t = factor sqrt(m* k_t),  F_t = -k_t s - gamma_t v_t,
  *   where |F_t| > mu |F_el|: F_t scaled to mu |F_el|, s = -(F_t + gamma_t v_t) / k_t,
  *   torques -R_i n x F_t and -R_j n x F_t,  F = F_t + (the normal terms in model order) n.
@@ -320,6 +322,7 @@ struct bulk_lanes {
     wetdem_v4d r_eff, m_eff;   /* R* [m], m* [kg] */
     wetdem_v4d k, damping;     /* Hertz stiffness factor, damping factor (models.h) */
     wetdem_v4d v_t[3];         /* tangential velocity [m/s] (with mindlin) */
+    wetdem_v4d v_s[3];         /* what the spring advances with [m/s] (spring_velocity) */
     wetdem_v4d s[3];           /* the Mindlin spring [m] (with mindlin): in, then out */
     wetdem_v4d term[3];        /* sb and capillary terms in term[1], term[2] [N] */
     /* out: the force on i [N], the torques on i and j [N m], all ones where all are finite;
@@ -327,6 +330,48 @@ struct bulk_lanes {
     wetdem_v4d force[3], ti[3], tj[3], f_tan[3];
     wetdem_v4i finite;
 };
+
+/* The tangential part of the contact points' relative velocity, contact.h contact_pair_slip
+ * (or contact_wall_slip, `wall`: b0 and b1 unused) lane by lane, from the columns of the
+ * velocity-and-spin records of i (a0: v_x v_y v_z w_x, a1: v_z w_x w_y w_z) and j (b0, b1). */
+static inline __attribute__((always_inline)) void
+bulk_slip(const wetdem_v4d a0[4], const wetdem_v4d a1[4], const wetdem_v4d b0[4],
+          const wetdem_v4d b1[4], const wetdem_v4d n[3], const wetdem_v4d* r_i,
+          const wetdem_v4d* r_j, bool wall, wetdem_v4d out[3])
+{
+    wetdem_v4d mra = -*r_i, a[3] = {n[0] * mra, n[1] * mra, n[2] * mra}; /* n (-R_i) */
+    wetdem_v4d rel[3] = {a0[0] + (a1[2] * a[2] - a1[3] * a[1]),
+                         a0[1] + (a1[3] * a[0] - a1[1] * a[2]),
+                         a0[2] + (a1[1] * a[1] - a1[2] * a[0])};
+    if (!wall) {
+        wetdem_v4d b[3] = {n[0] * *r_j, n[1] * *r_j, n[2] * *r_j}; /* n R_j */
+        rel[0] = rel[0] - (b0[0] + (b1[2] * b[2] - b1[3] * b[1]));
+        rel[1] = rel[1] - (b0[1] + (b1[3] * b[0] - b1[1] * b[2]));
+        rel[2] = rel[2] - (b0[2] + (b1[1] * b[1] - b1[2] * b[0]));
+    }
+    wetdem_v4d rn = -(rel[0] * n[0] + rel[1] * n[1] + rel[2] * n[2]);
+    for (int c = 0; c < 3; c++)
+        out[c] = rel[c] + rn * n[c];
+}
+
+/* The spring's velocity L->v_s from L->v_t and the slip at the half-step velocities (the
+ * columns of struct wetdem_many vwh: a0, a1 of i, b0, b1 of j): sim_many_force.c
+ * spring_velocity, v_t + (half - v_t), or v_t where the pass advances nothing (dt = 0). */
+static inline __attribute__((always_inline)) void
+bulk_spring_velocity(const struct wetdem_many_bulk_in* in, const wetdem_v4d a0[4],
+                     const wetdem_v4d a1[4], const wetdem_v4d b0[4], const wetdem_v4d b1[4],
+                     bool wall, struct bulk_lanes* L)
+{
+    if (!(in->dt > 0.0)) {
+        for (int c = 0; c < 3; c++)
+            L->v_s[c] = L->v_t[c];
+        return;
+    }
+    wetdem_v4d half[3];
+    bulk_slip(a0, a1, b0, b1, L->n, &L->r_i, &L->r_j, wall, half);
+    for (int c = 0; c < 3; c++)
+        L->v_s[c] = L->v_t[c] + (half[c] - L->v_t[c]);
+}
 
 /* The normal terms of L in model order into *f_n (chosen by value, not indexed: an indexed
  * member would keep all of L in memory). */
@@ -375,7 +420,7 @@ bulk_lean_force(const struct wetdem_many_bulk_in* in, const struct bulk_constant
         wetdem_v4d ratio = len / BULK_SELECT(some, plen, C->one);
         const wetdem_v4d dt = BULK_SPLAT(in->dt);
         for (int c = 0; c < 3; c++)
-            s[c] = BULK_SELECT(some, p[c] * ratio, zero) + dt * v_t[c];
+            s[c] = BULK_SELECT(some, p[c] * ratio, zero) + dt * L->v_s[c];
         wetdem_v4d k_t = L->r_eff * overlap;
         bulk_sqrt(&k_t);
         k_t = BULK_SPLAT(8.0 * in->g_star) * k_t; /* tangential_stiffness */
@@ -466,16 +511,16 @@ bulk_contacts(const struct wetdem_many_bulk_in* in, const struct bulk_constants*
         bulk_columns(&vw[i[0]][0].z, &vw[i[1]][0].z, &vw[i[2]][0].z, &vw[i[3]][0].z, a1);
         bulk_columns(&vw[j[0]][0].x, &vw[j[1]][0].x, &vw[j[2]][0].x, &vw[j[3]][0].x, b0);
         bulk_columns(&vw[j[0]][0].z, &vw[j[1]][0].z, &vw[j[2]][0].z, &vw[j[3]][0].z, b1);
-        const wetdem_v4d* n = L.n;
-        wetdem_v4d mra = -L.r_i, a[3] = {n[0] * mra, n[1] * mra, n[2] * mra}; /* n (-R_i) */
-        wetdem_v4d b[3] = {n[0] * L.r_j, n[1] * L.r_j, n[2] * L.r_j};         /* n R_j */
-        wetdem_v4d rel[3] = {
-            (a0[0] + (a1[2] * a[2] - a1[3] * a[1])) - (b0[0] + (b1[2] * b[2] - b1[3] * b[1])),
-            (a0[1] + (a1[3] * a[0] - a1[1] * a[2])) - (b0[1] + (b1[3] * b[0] - b1[1] * b[2])),
-            (a0[2] + (a1[1] * a[1] - a1[2] * a[0])) - (b0[2] + (b1[1] * b[1] - b1[2] * b[0]))};
-        wetdem_v4d rn = -(rel[0] * n[0] + rel[1] * n[1] + rel[2] * n[2]);
+        bulk_slip(a0, a1, b0, b1, L.n, &L.r_i, &L.r_j, false, L.v_t);
+        if (in->dt > 0.0) { /* the half-step records (struct wetdem_many vwh) */
+            const struct wetdem_vec3(*h)[2] = in->vwh;
+            bulk_columns(&h[i[0]][0].x, &h[i[1]][0].x, &h[i[2]][0].x, &h[i[3]][0].x, a0);
+            bulk_columns(&h[i[0]][0].z, &h[i[1]][0].z, &h[i[2]][0].z, &h[i[3]][0].z, a1);
+            bulk_columns(&h[j[0]][0].x, &h[j[1]][0].x, &h[j[2]][0].x, &h[j[3]][0].x, b0);
+            bulk_columns(&h[j[0]][0].z, &h[j[1]][0].z, &h[j[2]][0].z, &h[j[3]][0].z, b1);
+        }
+        bulk_spring_velocity(in, a0, a1, b0, b1, false, &L);
         for (int c = 0; c < 3; c++) {
-            L.v_t[c] = rel[c] + rn * n[c];
             L.s[c] = (wetdem_v4d){in->history[q[0] * in->len + in->spring_off + c],
                                   in->history[q[1] * in->len + in->spring_off + c],
                                   in->history[q[2] * in->len + in->spring_off + c],
@@ -637,13 +682,14 @@ bulk_walls_four(const struct wetdem_many_bulk_in* in, const struct bulk_constant
         }
         if (in->mindlin) {
             bulk_columns(&vw[i[0]][0].z, &vw[i[1]][0].z, &vw[i[2]][0].z, &vw[i[3]][0].z, a1);
-            wetdem_v4d mr = -radius, a[3] = {nv[0] * mr, nv[1] * mr, nv[2] * mr}; /* n (-R) */
-            wetdem_v4d va[3] = {a0[0] + (a1[2] * a[2] - a1[3] * a[1]),
-                                a0[1] + (a1[3] * a[0] - a1[1] * a[2]),
-                                a0[2] + (a1[1] * a[1] - a1[2] * a[0])};
-            wetdem_v4d vn = -(va[0] * nv[0] + va[1] * nv[1] + va[2] * nv[2]);
+            bulk_slip(a0, a1, a0, a1, nv, &radius, &radius, true, L.v_t);
+            if (in->dt > 0.0) { /* the half-step records (struct wetdem_many vwh) */
+                const struct wetdem_vec3(*h)[2] = in->vwh;
+                bulk_columns(&h[i[0]][0].x, &h[i[1]][0].x, &h[i[2]][0].x, &h[i[3]][0].x, a0);
+                bulk_columns(&h[i[0]][0].z, &h[i[1]][0].z, &h[i[2]][0].z, &h[i[3]][0].z, a1);
+            }
+            bulk_spring_velocity(in, a0, a1, a0, a1, true, &L);
             for (int c = 0; c < 3; c++) {
-                L.v_t[c] = va[c] + vn * nv[c];
                 L.s[c] =
                     (wetdem_v4d){in->wall_history[spring[0] + c], in->wall_history[spring[1] + c],
                                  in->wall_history[spring[2] + c], in->wall_history[spring[3] + c]};

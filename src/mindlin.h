@@ -52,8 +52,8 @@ static inline void store_spring(double* spring, struct wetdem_vec3 s)
 /* The spring update and tangential force on i [N] with the tangential stiffness k_t [N/m]
  * given (mindlin_spring: the Hertzian one; force_mindlin.c: the linear one beside hooke), from
  * the contact quantities it reads: unit normal n, tangential velocity v_t [m/s] (the
- * dashpot's), the velocity v_s the spring advances with over dt [m/s] (v_t, or the trapezoidal
- * mean of the two-body CVODE engine: struct wetdem_contact dv_t_spring), dt [s], m* [kg],
+ * dashpot's), the velocity v_s the spring advances with over dt [m/s] (the engines' mean of
+ * the slip over dt: struct wetdem_contact dv_t_spring), dt [s], m* [kg],
  * overlap [m], f_limit [N], mu [-], the damping factor [-]; spring: the 3 doubles of history
  * [m]. k_t is read only when overlap > 0. */
 static inline __attribute__((always_inline)) struct wetdem_vec3

@@ -50,6 +50,10 @@ struct wetdem_engine {
     /* the tangential spring advances with the mean of v_t at t_committed and at the
      * evaluation (struct wetdem_contact dv_t_spring); set from the integrator at each run */
     bool trapezoid_spring;
+    /* velocity and spin of every particle at the half step (verlet, during a step's force
+     * evaluation; else NULL): the tangential spring advances with the slip they give
+     * (midpoint rule, struct wetdem_contact dv_t_spring) */
+    const struct wetdem_vec3 *half_vel, *half_omega;
     size_t integrator; /* index into the integrator registry (integrator.c) */
     /* parameter blocks of every registered integrator, addressed as "<name>.<param>" */
     double integrator_params[WETDEM_MAX_INTEGRATORS][WETDEM_INTEGRATOR_PARAMS_MAX];

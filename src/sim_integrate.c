@@ -18,6 +18,9 @@
  *     v_s = (v_t(t_committed) + v_t(t))/2,   projected into the current tangent plane,
  * (c->dv_t_spring = v_s - v_t(t)), so s(t) = s_c + v_s (t - t_c) is second order in the step
  * (docs/engines.md); v_t(t_committed) is kept per pair (struct wetdem_pair v_t_committed).
+ * verlet, whose forces see the velocities predicted for the step's end, sets engine.half_vel
+ * and half_omega during its evaluation instead, and the spring advances with the slip of the
+ * half-step velocities at the current normal (midpoint rule, also second order).
  */
 #include <math.h>
 #include <stdlib.h>
@@ -186,6 +189,13 @@ static int eval_pair(struct wetdem_sim* sim, size_t k, double t, bool commit, bo
     c.dt = t - e->t_committed;
     if (e->trapezoid_spring) /* v_t_committed lay in the old tangent plane */
         c.dv_t_spring = vec3_reject(vec3_scale(vec3_sub(p->v_t_committed, v_t), 0.5), c.normal);
+    if (e->half_vel) /* verlet: the slip at the half step, at the current contact normal */
+        c.dv_t_spring = vec3_sub(
+            p->is_wall
+                ? contact_wall_slip(c.normal, c.radius_i, e->half_vel[p->i], e->half_omega[p->i])
+                : contact_pair_slip(c.normal, c.radius_i, e->half_vel[p->i], e->half_omega[p->i],
+                                    c.radius_j, e->half_vel[p->j], e->half_omega[p->j]),
+            v_t);
     struct wetdem_pair_force f;
     int st = wetdem_sim_eval_contact(sim, &c, scratch, &f, NULL);
     e->stats.pair_evals++;

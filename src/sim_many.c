@@ -103,8 +103,7 @@ void wetdem_sim_many_free(struct wetdem_sim* sim)
     free(m->wall_entry_wall);
     free(m->force);
     free(m->torque);
-    free(m->vh);
-    free(m->wh);
+    free(m->vwh);
     free(m->xr);
     free(m->inv);
     free(m->m_eff);
@@ -557,13 +556,16 @@ static int size_particle_arrays(struct wetdem_sim* sim)
     struct {
         void** a;
         size_t size;
-    } arrays[] = {
-        {(void**)&m->force, sizeof *m->force}, {(void**)&m->torque, sizeof *m->torque},
-        {(void**)&m->vh, sizeof *m->vh},       {(void**)&m->wh, sizeof *m->wh},
-        {(void**)&m->xr, sizeof *m->xr},       {(void**)&m->inv, sizeof *m->inv},
-        {(void**)&m->m_eff, sizeof *m->m_eff}, {(void**)&m->vw, sizeof *m->vw},
-        {(void**)&m->fixed, sizeof *m->fixed}, {(void**)&m->wall_dirty, sizeof *m->wall_dirty},
-        {(void**)&m->image, sizeof *m->image}};
+    } arrays[] = {{(void**)&m->force, sizeof *m->force},
+                  {(void**)&m->torque, sizeof *m->torque},
+                  {(void**)&m->vwh, sizeof *m->vwh},
+                  {(void**)&m->xr, sizeof *m->xr},
+                  {(void**)&m->inv, sizeof *m->inv},
+                  {(void**)&m->m_eff, sizeof *m->m_eff},
+                  {(void**)&m->vw, sizeof *m->vw},
+                  {(void**)&m->fixed, sizeof *m->fixed},
+                  {(void**)&m->wall_dirty, sizeof *m->wall_dirty},
+                  {(void**)&m->image, sizeof *m->image}};
     size_t c = cap;
     for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++) {
         c = cap;
@@ -896,8 +898,8 @@ int wetdem_sim_many_prepare(struct wetdem_sim* sim)
     for (size_t k = 0; refresh && k < sim->n_particles; k++) { /* the user may move particles */
         const struct wetdem_particle* p = &sim->particles[k];
         m->xr[k] = (struct wetdem_celllist_item){p->pos.x, p->pos.y, p->pos.z, p->radius};
-        m->vw[k][0] = p->vel;
-        m->vw[k][1] = p->omega;
+        m->vw[k][0] = m->vwh[k][0] = p->vel; /* (a fixed particle's half-step velocity too) */
+        m->vw[k][1] = m->vwh[k][1] = p->omega;
         refixed = refixed || (built && m->fixed[k] != p->is_fixed);
         m->fixed[k] = p->is_fixed;
         m->inv[k][0] = 1.0 / p->mass;
@@ -950,8 +952,7 @@ static struct wetdem_vec3 wrap(const struct wetdem_celllist_box* b, struct wetde
 struct kick_arrays {
     struct wetdem_vec3* restrict force;
     struct wetdem_vec3* restrict torque;
-    struct wetdem_vec3* restrict vh;
-    struct wetdem_vec3* restrict wh;
+    struct wetdem_vec3 (*restrict vwh)[2];
     const double (*restrict inv)[2];
     struct wetdem_celllist_item* restrict xr;
     struct wetdem_vec3 (*restrict vw)[2];
@@ -971,8 +972,8 @@ kick_drift_one(const struct kick_arrays* A, const struct wetdem_celllist_box* bo
     struct wetdem_vec3 alpha = vec3_scale(A->torque[k], A->inv[k][1]);
     struct wetdem_vec3 v = A->vw[k][0], w = A->vw[k][1];
     if (pending) { /* the previous step's closing half kick, with the same a and alpha */
-        v = vec3_axpy(A->vh[k], half, a);
-        w = vec3_axpy(A->wh[k], half, alpha);
+        v = vec3_axpy(A->vwh[k][0], half, a);
+        w = vec3_axpy(A->vwh[k][1], half, alpha);
     }
     struct wetdem_vec3 vh = vec3_axpy(v, half, a), wh = vec3_axpy(w, half, alpha);
     struct wetdem_vec3 x = vec3_axpy(vec3(A->xr[k].x, A->xr[k].y, A->xr[k].z), h, vh);
@@ -980,8 +981,8 @@ kick_drift_one(const struct kick_arrays* A, const struct wetdem_celllist_box* bo
     v2 = v2 == v2 ? v2 : INFINITY; /* a NaN wins no max: count it as infinite */
     *v2_max = v2 > *v2_max ? v2 : *v2_max;
     x = periodic ? wrap(box, x, A->image[k]) : x;
-    A->vh[k] = vh;
-    A->wh[k] = wh;
+    A->vwh[k][0] = vh;
+    A->vwh[k][1] = wh;
     A->xr[k].x = x.x;
     A->xr[k].y = x.y;
     A->xr[k].z = x.z;
@@ -999,8 +1000,7 @@ static inline __attribute__((always_inline)) void kick_drift_range(struct wetdem
 {
     const struct kick_arrays arrays = {.force = m->force,
                                        .torque = m->torque,
-                                       .vh = m->vh,
-                                       .wh = m->wh,
+                                       .vwh = m->vwh,
                                        .inv = (const double(*)[2])m->inv,
                                        .xr = m->xr,
                                        .vw = m->vw,
@@ -1340,7 +1340,7 @@ static size_t first_diverged_drift(const struct wetdem_sim* sim)
 {
     const struct wetdem_many* m = sim->many;
     for (size_t k = 0; k < sim->n_particles; k++)
-        if (!m->fixed[k] && !(vec3_dot(m->vh[k], m->vh[k]) <= DBL_MAX))
+        if (!m->fixed[k] && !(vec3_dot(m->vwh[k][0], m->vwh[k][0]) <= DBL_MAX))
             return k;
     return 0;
 }
@@ -1353,7 +1353,7 @@ static size_t first_diverged_drift(const struct wetdem_sim* sim)
 static int diverged(struct wetdem_sim* sim, size_t k, bool drift)
 {
     const struct wetdem_many* m = sim->many;
-    struct wetdem_vec3 v = drift ? m->vh[k] : m->vw[k][0], w = m->vw[k][1];
+    struct wetdem_vec3 v = drift ? m->vwh[k][0] : m->vw[k][0], w = m->vw[k][1];
     double ratio = m->dt / m->contact_time;
     char hint[200];
     if (ratio > WETDEM_MANY_CONTACT_FRACTION_MAX)

@@ -386,8 +386,20 @@ struct lean_geometry {
     double k, damping;      /* hertz_stiffness and hertz_damping_factor of the pair */
     double v_n;             /* [m/s] */
     struct wetdem_vec3 v_t; /* [m/s], set only when mindlin is enabled */
+    struct wetdem_vec3 v_s; /* what the spring advances with (spring_velocity), the same */
     bool wall;
 };
+
+/* What a tangential spring advances with over a step, from the slip v_t at the predicted
+ * velocities and the slip `half` at the half-step ones (struct wetdem_many vwh): v_t +
+ * (half - v_t), the operations of c->v_t + c->dv_t_spring in the models (mindlin.h), so the
+ * generic and fused paths agree bit for bit; v_t where the pass advances nothing (its start,
+ * whose half-step velocities are not yet those of a step). Midpoint rule: docs/many.md. */
+static inline struct wetdem_vec3 spring_velocity(const struct wetdem_many* m,
+                                                 struct wetdem_vec3 v_t, struct wetdem_vec3 half)
+{
+    return m->advance > 0.0 ? vec3_add(v_t, vec3_sub(half, v_t)) : v_t;
+}
 
 /* Each model's part of a lean result, for the energy budget: the normal terms of hertz, sb
  * and capillary (+0 where a model does not act), mindlin's tangential force and torques, and
@@ -439,7 +451,7 @@ lean_force(const struct wetdem_many* m, const struct lean_geometry* g,
                 hertz_total(f_el, hertz_damping_from(g->damping, overlap, v_n), L->hertz_form);
         if (L->mindlin) { /* wetdem_pair_force_add_tangential onto a zero record */
             struct wetdem_vec3 ft =
-                mindlin_spring(n, g->v_t, g->v_t, m->advance, x->g_star, r_eff, m_eff, overlap,
+                mindlin_spring(n, g->v_t, g->v_s, m->advance, x->g_star, r_eff, m_eff, overlap,
                                f_el, L->mindlin_lub ? x->friction_lub : x->friction_dry,
                                x->mindlin_damping, hist + L->mindlin_off);
             f_tan = vec3_add(zero, ft);
@@ -553,9 +565,10 @@ lean_contact(const struct wetdem_many* m, size_t ia, size_t ib, struct wetdem_ve
                               .v_t = vec3(0, 0, 0), /* read in solid contact only */
                               .wall = false};
     if (m->lean.mindlin) {
-        struct wetdem_vec3 va = vec3_add(vw_a[0], vec3_cross(vw_a[1], vec3_scale(n, -r_a)));
-        struct wetdem_vec3 vb = vec3_add(vw_b[0], vec3_cross(vw_b[1], vec3_scale(n, r_b)));
-        g.v_t = vec3_reject(vec3_sub(va, vb), n);
+        g.v_t = contact_pair_slip(n, r_a, vw_a[0], vw_a[1], r_b, vw_b[0], vw_b[1]);
+        const struct wetdem_vec3 *h_a = m->vwh[ia], *h_b = m->vwh[ib];
+        g.v_s = spring_velocity(m, g.v_t,
+                                contact_pair_slip(n, r_a, h_a[0], h_a[1], r_b, h_b[0], h_b[1]));
     }
     return lean_force(m, &g, x, hist, flags, o, film, terms);
 }
@@ -600,11 +613,11 @@ lean_pair(const struct wetdem_many* m, size_t ia, size_t ib, struct wetdem_vec3 
 
 /* Particle a and plane wall w: the geometry of wall_contact_from, then lean_force (walls
  * apart are too few for a path of their own to pay); *flags = 0 beyond the range. */
-static int lean_wall(const struct wetdem_many* m, const struct wetdem_particle* a,
+static int lean_wall(const struct wetdem_many* m, size_t ia, const struct wetdem_particle* a,
                      const struct wetdem_wall* w, const struct wetdem_many_mix* x, double* hist,
                      unsigned char* flags, struct wetdem_many_pair_out* o, struct lean_terms* terms)
     __attribute__((noinline));
-static int lean_wall(const struct wetdem_many* m, const struct wetdem_particle* a,
+static int lean_wall(const struct wetdem_many* m, size_t ia, const struct wetdem_particle* a,
                      const struct wetdem_wall* w, const struct wetdem_many_mix* x, double* hist,
                      unsigned char* flags, struct wetdem_many_pair_out* o, struct lean_terms* terms)
 {
@@ -626,9 +639,9 @@ static int lean_wall(const struct wetdem_many* m, const struct wetdem_particle* 
                         : 0.0;
     }
     if (g.gap < 0.0 && m->lean.mindlin) {
-        struct wetdem_vec3 va =
-            vec3_add(a->vel, vec3_cross(a->omega, vec3_scale(w->normal, -a->radius)));
-        g.v_t = vec3_reject(va, g.n);
+        g.v_t = contact_wall_slip(g.n, a->radius, a->vel, a->omega);
+        g.v_s = spring_velocity(m, g.v_t,
+                                contact_wall_slip(g.n, a->radius, m->vwh[ia][0], m->vwh[ia][1]));
     }
     return lean_force(m, &g, x, hist, flags, o, NULL, terms);
 }
@@ -792,6 +805,14 @@ static int eval_pair(const struct wetdem_sim* sim, struct wetdem_contact* c,
         return WETDEM_OK;
     }
     c->dt = m->advance;
+    if (m->advance > 0.0) { /* the spring's slip at the half step (spring_velocity) */
+        const struct wetdem_vec3* h_i = m->vwh[c->i];
+        struct wetdem_vec3 half =
+            c->is_wall ? contact_wall_slip(c->normal, c->radius_i, h_i[0], h_i[1])
+                       : contact_pair_slip(c->normal, c->radius_i, h_i[0], h_i[1], c->radius_j,
+                                           m->vwh[c->j][0], m->vwh[c->j][1]);
+        c->dv_t_spring = vec3_sub(half, c->v_t);
+    }
     struct wetdem_pair_force f, per_model[WETDEM_MAX_MODELS];
     struct wetdem_pair_force* pm = m->set.energy_budget ? per_model : NULL;
     int st = m->fused ? wetdem_sim_many_eval_fused(sim, c, x, hist, &f, pm)
@@ -1125,7 +1146,7 @@ static unsigned char eval_wall(const struct wetdem_sim* sim, size_t i, size_t w,
     unsigned char flags;
     if (m->lean.on) {
         struct lean_terms terms, *budget = work ? &terms : NULL;
-        int st = lean_wall(m, a, wall, x, hist, &flags, o, budget);
+        int st = lean_wall(m, i, a, wall, x, hist, &flags, o, budget);
         if (!flags && hist && dirty) /* reset beyond the range, as eval_pair does */
             wetdem_sim_history_init(sim, hist);
         if (budget && flags && st == WETDEM_OK)
@@ -2411,6 +2432,7 @@ int wetdem_sim_many_forces(struct wetdem_sim* sim, enum wetdem_many_end end)
         P.bulk_in = (struct wetdem_many_bulk_in){
             .xr = m->xr,
             .vw = (const struct wetdem_vec3(*)[2])m->vw,
+            .vwh = (const struct wetdem_vec3(*)[2])m->vwh,
             .pairs = m->cl.pairs,
             .lim2 = m->pair_lim2,
             .film = x->film,
