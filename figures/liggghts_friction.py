@@ -13,56 +13,78 @@ scheme written out, with switches for each of their differences), checks and dra
 docs/figures/liggghts_friction.png.
 
 The two schemes (docs/validation.md, "LIGGGHTS: friction"):
-  wetdem    spring rotated into the tangent plane keeping its length, then advanced by v_t dt
-            with the velocity predicted for the step's end (v' + a dt/2); force and v_t with the
-            lever arm R (contact point at -R n); Coulomb: spring + dashpot against mu F_el;
-  LIGGGHTS  spring advanced by v_t dt with the half-step velocity v', then projected into the
-            plane (length not kept); lever arm R - delta/2; Coulomb: spring alone against
-            mu |F_n| (F_n with damping), the dashpot added only while it sticks.
-With e = 1 the dashpots vanish and F_n = F_el, so the Coulomb limits coincide. What remains:
-the spring's velocity (first order in dt: the difference halves with dt), its projection
-(first order, but 1e-9 of the rest here: the normal turns by 4.2e-4 rad at most) and the lever arm
-(R against R - delta/2: an O(delta/R) difference that does not vanish with dt). The stiff set
-(E = 70 GPa, V_N = 0.01 m/s, delta/R = 5e-5) makes the last small (1e-5 V_N), so the codes
-tend to nearly one answer, and to one answer once the reference sets LIGGGHTS' lever arm to R;
-the soft set (the benchmark's E = 10 MPa, V_N = 0.1 m/s, delta/R ~ 1e-2) shows the lever arm
-as the one difference left at dt -> 0; the damped runs (e = 0.5) show the Coulomb limits'.
+  wetdem    spring rotated into the tangent plane keeping its length, then advanced by v_s dt
+            with v_s the slip of the half-step velocities and spins v', w' at the current
+            normal (midpoint rule; docs/engines.md); the dashpots (tangential and normal) take
+            the velocities predicted for the step's end, v' + a dt/2; force, v_t and v_s with
+            the lever arm R (contact point at -R n); Coulomb: spring + dashpot against mu F_el;
+  LIGGGHTS  spring advanced by v_t dt with the half-step velocities v', w', then projected
+            into the plane (length not kept); the dashpots take v' too; lever arm R - delta/2;
+            Coulomb: spring alone against mu |F_n| (F_n with damping), the dashpot added only
+            while it sticks.
+`step_map`'s switches: lever, spring (rotate or project), limit, and velocity ('midpoint':
+wetdem's; 'half': LIGGGHTS'; 'predicted': the spring at the predicted slip too, wetdem's
+scheme before the midpoint rule, first order, kept to show the order check can fail).
+With e = 1 the dashpots vanish and F_n = F_el, so the Coulomb limits coincide and the
+velocities the dashpots see do not matter: the spring advances with the same slip in both.
+What remains: the spring's rotation against its projection (first order, but 7e-13 V_N at the
+coarsest step: the normal turns by 4.2e-4 rad at most, and a step's projection shortens the
+spring by |s| theta^2 / 2) and the lever arm (R against R - delta/2: an O(delta/R) difference
+that does not vanish with dt). The stiff set (E = 70 GPa, V_N = 0.01 m/s, delta/R = 5e-5)
+makes the last small (1e-5 V_N): the codes differ by it at every dt, and by the projection
+and rounding once the reference sets LIGGGHTS' lever arm to R; the soft set (the
+benchmark's E = 10 MPa, V_N = 0.1 m/s, delta/R ~ 1e-2) shows the lever arm larger; the damped
+runs (e = 0.5) add the Coulomb limits' conventions, which stay at dt = 0, and the dashpots'
+velocity (first order: LIGGGHTS' half-step one is a first-order estimate of the velocity at
+the step's end, wetdem's predicted one second order).
 
 Checks, each printed and failing the script (differences: the largest of a velocity or R
 times a spin component of either sphere, over V_N):
   reference  each code's final velocities and spins equal its scheme's (step_map), from the
              same state, for every pair and run (stiff, soft, damped), to 1e-9 (the reference
-             sums in another order; measured 1.4e-15, rounding);
-  decomposition  e = 1: the reference with wetdem's scheme but the half-step velocity and
-             with LIGGGHTS' scheme but the lever arm R differ by 7e-13 at 25 and half that at
-             50 steps per contact time (1.6-2.5: first order), at most 1e-9 of the codes'
-             difference: what is left is the spring's rotation against its projection, whose
-             share is that small because the line of centres turns by 4.2e-4 rad at most in
-             a contact (a step's projection shortens the spring by |s| theta^2 / 2); the
-             Coulomb limits are one rule at e = 1. So the velocity and the lever arm are
-             the whole difference;
-  order      stiff, e = 1: the codes' largest difference shrinks by 1.6-2.5 per halving of
-             dt (first order: 2) from 25 to 1600 steps per contact time;
-  limit      stiff, e = 1: extrapolated to dt = 0 (Richardson, first order, from 800 and
-             1600 steps) the codes differ by the lever arm's effect (~1e-5); with LIGGGHTS'
-             lever arm set to R by the reference, by at most 5e-6 (the extrapolation's
-             second-order remainder: measured 7.5e-6 from 400 and 800 steps, 2.1e-6 from 800
-             and 1600, a quarter per halving);
+             sums in another order; measured 8.9e-16, rounding);
+  decomposition  e = 1: the reference with wetdem's scheme and with LIGGGHTS' but the lever
+             arm R differ by 7.0e-13 V_N at 25 steps per contact time, 1.1e-14 at 1600, the
+             spring's rotation against projection: first order (factors 1.6-2.5 per halving
+             from 25 to 400 steps, where it is 30 times rounding or more; measured 1.97-2.32),
+             at most 1e-6 of the codes' difference (measured 6.8e-8): at e = 1 the two codes
+             follow one scheme but for the lever arm;
+  agreement  stiff, e = 1, at each of 25 ... 1600 steps per contact time: the codes differ by
+             the lever arm's effect (1.03e-5, by the reference); less it, by at most 1e-11
+             (the projection above, 7.0e-13 at the coarsest step, and rounding, 1e-15; a
+             margin of 14; measured 7.0e-13 ... 1.1e-14);
+  order      stiff, e = 1, each code against itself: its results at n and 2n steps per
+             contact time differ by D(n), which falls by a factor 4 per halving of dt for a
+             second-order scheme and 2 for a first-order one. Required: 3-5 from 100 steps on
+             (measured 3.53-4.23 for both codes) and a fitted order of 1.8-2.2 over 25 ... 1600
+             (1.92). The band allows for the stick-slip transitions and the contact's start
+             and end, which fall anywhere within a step: per pair the differences change sign
+             and their factors scatter (0.1-350), and the largest over the pairs is set by
+             other pairs at other steps (2.57 from 25 to 50 steps, where a sticking phase lasts
+             a few steps). The former scheme (velocity 'predicted', by the reference) must
+             fail it (measured factors 2.00-2.07, order 1.03);
   control    stiff, e = 1, LIGGGHTS with nu = 0.31 (G* 0.2 % lower, E* 0.7 % higher) or
-             mu x 1.01, compared in the same way: more than 100 times the limit's bound
-             (measured 250 and 1000), so the check above can fail;
+             mu x 1.01 at 800 and 1600 steps per contact time, compared in the same way: more
+             than 100 times the agreement's bound (measured 1.2e-3 and 5.0e-3 V_N), so that
+             check can fail;
   sliding    stiff, e = 1, the pairs that slide throughout (|u_t0| > 1.15 x 3.5 mu (1 + e)
              v_n): wetdem's e_t = -(1 - 3.5 mu (1 + e) v_n / |u_t0|) and spin change
              R dw = (5/2) mu (1 + e)/2 v_n n x u_hat of the rigid-body impact (Maw, Barber &
              Fawcett 1976; Walton 1993) to 5e-5, in the frame of the line of centres at
              mid-contact (with the normal of the first touch e_t is off by up to 4e-4: the
              line of centres turns by up to 4.2e-4 rad during the contact);
-  lever      soft, e = 1: the codes' extrapolated difference equals the reference's effect
-             of the lever arm alone (LIGGGHTS' scheme with R against R - delta/2) to 5 % of
-             it (measured 0.4 %: the extrapolation's remainder);
-  damped     stiff, e = 0.5: the codes' extrapolated difference equals the reference's
-             effect of LIGGGHTS' Coulomb limit and lever arm together (its scheme with
-             wetdem's, both extrapolated) to 1 % of it (measured 0.09 %).
+  lever      soft, e = 1, at 400 and 800 steps per contact time: the codes' difference
+             (2.2e-3 V_N) equals the reference's effect of the lever arm alone (LIGGGHTS'
+             scheme with R against R - delta/2) to 1e-8 V_N (the projection, 1.7e-9 at 400
+             steps by the reference, first order, and rounding; measured 1.7e-9 and 8.7e-10);
+  damped dashpots  stiff, e = 0.5: the codes' difference less the conventions' effect
+             (LIGGGHTS' scheme with wetdem's Coulomb limit and lever arm, by the reference) is
+             the dashpots' velocity, predicted against half-step: it halves with dt (factor
+             1.8-2.2 from 800 to 1600 steps; measured 2.00, and 1.99-2.01 by the reference
+             from 200 to 3200);
+  damped     stiff, e = 0.5: so the codes' difference extrapolated to dt = 0 (Richardson,
+             first order, from 800 and 1600 steps) equals the conventions' effect, extrapolated
+             in the same way, to 1 % of it (measured 0.09 %: the extrapolation's remainder).
 Usage: /usr/bin/python3 figures/liggghts_friction.py [setup|check] [DIR]
   (check by default; DIR: out/validate/liggghts_friction)
 """
@@ -231,12 +253,14 @@ def _sc(a, x):
     return (a * x[0], a * x[1], a * x[2])
 
 
-def pair_force(x1, v1, w1, x2, v2, w2, s, adv, p, scheme):
+def pair_force(x1, v1, w1, x2, v2, w2, s, adv, p, scheme, spring_vel=None):
     """Force on the striker (1; the target gets its opposite), the torque on either sphere
     (the same for equal spheres), the new spring, and whether the contact slides (the limit
     caps the force), of one evaluation with the spring advanced over adv [s]. p: E, nu, mu,
     e; scheme: lever ('R' or 'R-d/2'), spring ('rotate' or 'project'), limit ('wetdem' or
-    'liggghts')."""
+    'liggghts'). The spring advances with the slip of spring_vel (v1, w1, v2, w2; at the
+    current normal and lever arm) when given, else with that of v1, w1, v2, w2, which the
+    dashpots and the normal damping take."""
     d = (x1[0] - x2[0], x1[1] - x2[1], x1[2] - x2[2])
     r = math.sqrt(_dot(d, d))
     n = _sc(1.0 / r, d)
@@ -252,6 +276,13 @@ def pair_force(x1, v1, w1, x2, v2, w2, s, adv, p, scheme):
     vt = _axpy(-vn, n, vr)
     rot = _cross(_axpy(c, w1, _sc(c, w2)), n)  # (c w1 + c w2) x n
     vt = (vt[0] - rot[0], vt[1] - rot[1], vt[2] - rot[2])
+    vs = vt
+    if spring_vel is not None:
+        sv1, sw1, sv2, sw2 = spring_vel
+        vr = (sv1[0] - sv2[0], sv1[1] - sv2[1], sv1[2] - sv2[2])
+        vs = _axpy(-_dot(vr, n), n, vr)
+        rot = _cross(_axpy(c, sw1, _sc(c, sw2)), n)
+        vs = (vs[0] - rot[0], vs[1] - rot[1], vs[2] - rot[2])
     sq = math.sqrt(rs * delta)
     kt = 8 * gs * sq
     f_el = 4.0 / 3.0 * es * sq * delta
@@ -265,9 +296,9 @@ def pair_force(x1, v1, w1, x2, v2, w2, s, adv, p, scheme):
         q = _axpy(-_dot(s, n), n, s)
         ql = math.sqrt(_dot(q, q))
         s = _sc(length / ql, q) if ql > 0 else zero
-        s = _axpy(adv, vt, s)
+        s = _axpy(adv, vs, s)
     else:
-        s = _axpy(adv, vt, s)
+        s = _axpy(adv, vs, s)
         s = _axpy(-_dot(s, n), n, s)
     if scheme["limit"] == "wetdem":
         ft = _axpy(-gamma_t, vt, _sc(-kt, s))
@@ -290,7 +321,7 @@ def pair_force(x1, v1, w1, x2, v2, w2, s, adv, p, scheme):
     return force, torque, s, slides
 
 
-WETDEM = dict(lever="R", spring="rotate", limit="wetdem", velocity="predicted")
+WETDEM = dict(lever="R", spring="rotate", limit="wetdem", velocity="midpoint")
 LIGGGHTS = dict(lever="R-d/2", spring="project", limit="liggghts", velocity="half")
 
 
@@ -307,12 +338,12 @@ def step_map(state, p, dt, steps, scheme, stats=None):
         v1, v2 = _axpy(dt / 2 / m, f, v1), _axpy(-dt / 2 / m, f, v2)
         w1, w2 = _axpy(dt / 2 / inertia, t, w1), _axpy(dt / 2 / inertia, t, w2)
         x1, x2 = _axpy(dt, v1, x1), _axpy(dt, v2, x2)
-        if scheme["velocity"] == "predicted":
-            u = (_axpy(dt / 2 / m, f, v1), _axpy(dt / 2 / inertia, t, w1),
-                 _axpy(-dt / 2 / m, f, v2), _axpy(dt / 2 / inertia, t, w2))
-        else:
-            u = (v1, w1, v2, w2)
-        f, t, s, slides = pair_force(x1, u[0], u[1], x2, u[2], u[3], s, dt, p, scheme)
+        half = (v1, w1, v2, w2)
+        u = half if scheme["velocity"] == "half" else (
+            _axpy(dt / 2 / m, f, v1), _axpy(dt / 2 / inertia, t, w1),
+            _axpy(-dt / 2 / m, f, v2), _axpy(dt / 2 / inertia, t, w2))
+        f, t, s, slides = pair_force(x1, u[0], u[1], x2, u[2], u[3], s, dt, p, scheme,
+                                     half if scheme["velocity"] == "midpoint" else None)
         touching += f != (0.0, 0.0, 0.0)  # (the last step's stays in f: apart at the end?)
         sliding += slides
         v1, v2 = _axpy(dt / 2 / m, f, v1), _axpy(-dt / 2 / m, f, v2)
@@ -408,13 +439,31 @@ def reference_all(name, n, scheme, p):
     return np.array([step_map(s, p, dt, steps, scheme) for s in initial_state(name)])
 
 
-LIMIT_BOUND = 5e-6  # [V_N]: see the docstring, check "limit"
+AGREE_BOUND = 1e-11  # [V_N]: stiff, e = 1, codes less the lever arm; docstring, "agreement"
+SOFT_BOUND = 1e-8  # [V_N]: the same in the soft set; docstring, "lever"
+ORDER_FROM, ORDER_BAND, FIT_BAND = 100, (3.0, 5.0), (1.8, 2.2)  # docstring, "order"
+FORMER = dict(WETDEM, velocity="predicted")  # wetdem's spring before: the predicted slip
+
+
+def order(a, ns):
+    """Successive differences D(n) = largest |a[n] - a[2n]| (scaled), their factors per
+    halving of dt, and the order fitted to all of them (slope of log D against log dt)."""
+    big = [np.abs(a[n] - a[2 * n]).max() for n in ns[:-1]]
+    factors = [x / y for x, y in zip(big, big[1:])]
+    fit = np.polyfit(np.log(1.0 / np.array(ns[:-1], float)), np.log(big), 1)[0]
+    return big, factors, fit
+
+
+def second_order(factors, fit):
+    lo, hi = ORDER_BAND
+    tail = factors[N_STIFF.index(ORDER_FROM):]
+    return all(lo <= f <= hi for f in tail) and FIT_BAND[0] <= fit <= FIT_BAND[1]
 
 
 def main_check(d):
     vn = SETS["stiff"]["vn"]
     p1, pd = params("stiff"), params("stiff", e=E_DAMPED)
-    wd, lg, diff, corr, ref_err = {}, {}, {}, {}, []
+    wd, lg, diff, lever, corr, proj, former, ref_err = {}, {}, {}, {}, {}, {}, {}, []
     for n in N_STIFF:
         wd[n] = read_wetdem(d, run_name("stiff", n))
         lg[n] = read_liggghts(os.path.join(d, f"liggghts_{run_name('stiff', n)}.dump"))
@@ -424,8 +473,11 @@ def main_check(d):
         for code, got in (("wetdem", wd[n]), ("LIGGGHTS", lg[n])):
             ref_err.append((largest(got, ref[code], vn).max(), code, n, "stiff"))
         # LIGGGHTS as it would be with wetdem's lever arm R (its scheme, one switch changed)
-        lever = reference_all("stiff", n, dict(LIGGGHTS, lever="R"), p1) - ref["LIGGGHTS"]
-        corr[n] = scaled(wd[n], vn) - scaled(lg[n] + lever, vn)
+        lever_r = reference_all("stiff", n, dict(LIGGGHTS, lever="R"), p1)
+        lever[n] = scaled(lever_r - ref["LIGGGHTS"], vn)
+        corr[n] = diff[n] - lever[n]
+        proj[n] = largest(ref["wetdem"], lever_r, vn).max()  # rotation against projection
+        former[n] = scaled(reference_all("stiff", n, FORMER, p1), vn)
     dmp = {}
     for n in N_DAMPED:
         w = read_wetdem(d, run_name("stiff", n, E_DAMPED))
@@ -437,71 +489,87 @@ def main_check(d):
         conv = reference_all("stiff", n, dict(LIGGGHTS, lever="R", limit="wetdem"), pd) - rl
         dmp[n] = dict(w=w, g=g, diff=scaled(w, vn) - scaled(g, vn), conv=scaled(conv, vn))
     vs, ps = SETS["soft"]["vn"], params("soft")
-    soft, soft_ref = {}, {}
+    soft, lever_soft, proj_soft = {}, {}, {}
     for n in N_SOFT:
         w = read_wetdem(d, run_name("soft", n))
         g = read_liggghts(os.path.join(d, f"liggghts_{run_name('soft', n)}.dump"))
-        soft_ref[n] = reference_all("soft", n, LIGGGHTS, ps)
-        ref_err.append((largest(g, soft_ref[n], vs).max(), "LIGGGHTS", n, "soft"))
-        ref_err.append((largest(w, reference_all("soft", n, WETDEM, ps), vs).max(), "wetdem", n,
-                        "soft"))
+        rl, rw = reference_all("soft", n, LIGGGHTS, ps), reference_all("soft", n, WETDEM, ps)
+        ref_err.append((largest(g, rl, vs).max(), "LIGGGHTS", n, "soft"))
+        ref_err.append((largest(w, rw, vs).max(), "wetdem", n, "soft"))
+        lever_r = reference_all("soft", n, dict(LIGGGHTS, lever="R"), ps)
         soft[n] = scaled(w, vs) - scaled(g, vs)
+        lever_soft[n] = scaled(lever_r - rl, vs)
+        proj_soft[n] = largest(rw, lever_r, vs).max()
     worst = max(ref_err)
     check(worst[0] <= 1e-9,
           f"reference: each code equals its scheme written out, for every pair and step, to "
           f"{worst[0]:.2g} V_N at most ({worst[1]}, {worst[3]}, {worst[2]} steps per contact "
           "time; <= 1e-9), in the stiff, damped and soft runs")
 
-    # e = 1: the spring's velocity and the lever arm are the whole difference but for the
-    # spring's rotation or projection (the Coulomb limits are one rule at e = 1)
-    dec = [largest(reference_all("stiff", n, dict(WETDEM, velocity="half"), p1),
-                   reference_all("stiff", n, dict(LIGGGHTS, lever="R"), p1), vn).max()
-           for n in (N_STIFF[0], N_STIFF[1])]
-    dec_rel = dec[0] / np.abs(diff[N_STIFF[0]]).max()
-    check(dec_rel <= 1e-9 and 1.6 <= dec[0] / dec[1] <= 2.5,
-          f"decomposition: e = 1, wetdem's scheme with the half-step velocity and LIGGGHTS' "
-          f"with the lever arm R differ by {dec[0]:.2g} and {dec[1]:.2g} at {N_STIFF[0]} and "
-          f"{N_STIFF[1]} steps per contact time, the spring's rotation against projection "
-          f"(first order), {dec_rel:.2g} of the codes' difference (<= 1e-9)")
+    # e = 1: no dashpots, one Coulomb rule, one spring velocity (the half step's slip): the
+    # schemes differ by the lever arm and the spring's rotation against its projection
+    pf = [proj[a] / proj[b] for a, b in zip(N_STIFF, N_STIFF[1:]) if b <= 400]
+    dec_rel = max(proj[n] / np.abs(diff[n]).max() for n in N_STIFF)
+    check(dec_rel <= 1e-6 and all(1.6 <= f <= 2.5 for f in pf),
+          "decomposition: e = 1, wetdem's scheme and LIGGGHTS' with the lever arm R differ by "
+          + ", ".join(f"{proj[n]:.2g}" for n in N_STIFF) + " V_N at "
+          + ", ".join(str(n) for n in N_STIFF) + " steps per contact time, the spring's "
+          "rotation against projection (first order: factors "
+          + ", ".join(f"{f:.2f}" for f in pf) + " to 400, 1.6-2.5), at most "
+          f"{dec_rel:.2g} of the codes' difference (<= 1e-6)")
 
     big = [np.abs(diff[n]).max() for n in N_STIFF]
-    factors = [a / b for a, b in zip(big, big[1:])]
-    check(all(1.6 <= f <= 2.5 for f in factors),
-          "order: the codes' largest difference " + ", ".join(f"{b:.2g}" for b in big)
-          + " V_N at " + ", ".join(str(n) for n in N_STIFF) + " steps per contact time, "
-          + "factors " + ", ".join(f"{f:.2f}" for f in factors) + " per halving (1.6-2.5)")
-    n1, n0 = N_STIFF[-1], N_STIFF[-2]
-    raw_lim = np.abs(2 * diff[n1] - diff[n0]).max(axis=1)
-    lever_lim = np.abs(scaled(reference_all("stiff", n1, dict(LIGGGHTS, lever="R"), p1)
-                              - reference_all("stiff", n1, LIGGGHTS, p1), vn)).max(axis=1)
-    lim = np.abs(2 * corr[n1] - corr[n0]).max(axis=1)
-    check(lim.max() <= LIMIT_BOUND,
-          f"limit: extrapolated to dt = 0 the codes differ by up to {raw_lim.max():.2g} V_N, "
-          f"the lever arm's effect ({lever_lim.max():.2g}); with LIGGGHTS' lever arm set to R "
-          f"by the reference, by {lim.max():.2g} (<= {LIMIT_BOUND:g}; "
-          f"{lim.max() / big[0]:.1g} of the difference at the coarsest step)")
+    lev = [np.abs(lever[n]).max() for n in N_STIFF]
+    agree = [np.abs(corr[n]).max() for n in N_STIFF]
+    check(max(agree) <= AGREE_BOUND,
+          "agreement: stiff, e = 1, the codes differ by " + ", ".join(f"{b:.4g}" for b in big)
+          + " V_N at " + ", ".join(str(n) for n in N_STIFF) + " steps per contact time, the "
+          f"lever arm's effect by the reference ({min(lev):.4g}-{max(lev):.4g}); less it, by "
+          + ", ".join(f"{a:.2g}" for a in agree) + f" (<= {AGREE_BOUND:g}: the projection "
+          "above and rounding)")
 
-    # each code against its own dt = 0 limit (Richardson: first order for wetdem, whose spring
-    # advances with the predicted velocity; second order for LIGGGHTS' half-step velocity)
-    w_inf = 2 * scaled(wd[n1], vn) - scaled(wd[n0], vn)
-    g_inf = (4 * scaled(lg[n1], vn) - scaled(lg[n0], vn)) / 3
-    own = {"wetdem": [np.abs(scaled(wd[n], vn) - w_inf).max() for n in N_STIFF],
-           "LIGGGHTS": [np.abs(scaled(lg[n], vn) - g_inf).max() for n in N_STIFF]}
-    print("  accuracy (not checked): largest error against the code's own dt = 0 limit, "
-          "wetdem / LIGGGHTS: " + ", ".join(f"{a:.2g} / {b:.2g}" for a, b in
-                                             zip(own["wetdem"], own["LIGGGHTS"]))
+    # each code against itself: second order (the spring at the half step's slip); the
+    # former wetdem scheme (the predicted slip, by the reference) is first order
+    own, orders = {}, {}
+    sw = {n: scaled(wd[n], vn) for n in N_STIFF}
+    sg = {n: scaled(lg[n], vn) for n in N_STIFF}
+    n1, n0 = N_STIFF[-1], N_STIFF[-2]
+    for code, a, richardson in (("wetdem", sw, 3), ("LIGGGHTS", sg, 3), ("former", former, 1)):
+        big_c, factors, fit = order(a, N_STIFF)
+        orders[code] = (big_c, factors, fit)
+        lim = a[n1] + (a[n1] - a[n0]) / richardson  # 2nd order: /3; 1st: /1
+        own[code] = [np.abs(a[n] - lim).max() for n in N_STIFF]
+    for code in ("wetdem", "LIGGGHTS"):
+        big_c, factors, fit = orders[code]
+        check(second_order(factors, fit),
+              f"order: {code}, e = 1, its own results at successive halvings of dt differ by "
+              + ", ".join(f"{b:.2g}" for b in big_c) + " V_N (25 ... 800 against twice the "
+              "steps): factors " + ", ".join(f"{f:.2f}" for f in factors)
+              + f" (from {ORDER_FROM}: {ORDER_BAND[0]:g}-{ORDER_BAND[1]:g}), fitted order "
+              f"{fit:.2f} ({FIT_BAND[0]:g}-{FIT_BAND[1]:g}): second order")
+    big_c, factors, fit = orders["former"]
+    check(not second_order(factors, fit),
+          "order control: wetdem's former scheme (the spring at the predicted slip; "
+          "reference): factors " + ", ".join(f"{f:.2f}" for f in factors)
+          + f", fitted order {fit:.2f}: first order, which the check above refuses")
+    print("  accuracy: largest error against the code's own dt = 0 limit (Richardson from "
+          f"{n0} and {n1}), wetdem / LIGGGHTS / former wetdem: "
+          + ", ".join(f"{a:.2g} / {b:.2g} / {c:.2g}" for a, b, c in
+                      zip(own["wetdem"], own["LIGGGHTS"], own["former"]))
           + " V_N at " + ", ".join(str(n) for n in N_STIFF) + " steps per t_c")
 
     controls = {}
     for tag, label in (("nu", f"nu = {NU_CONTROL:g}"), ("mu", f"mu x {MU_CONTROL / MU:g}")):
         # wetdem against the perturbed LIGGGHTS, with the same lever correction
-        c = {n: corr[n] + scaled(lg[n], vn) - scaled(read_liggghts(os.path.join(
-            d, f"liggghts_{run_name('stiff', n)}_{tag}.dump")), vn) for n in N_CONTROL}
-        controls[tag] = np.abs(2 * c[N_CONTROL[1]] - c[N_CONTROL[0]]).max(axis=1)
-        check(controls[tag].max() > 100 * LIMIT_BOUND,
-              f"control: LIGGGHTS with {label} differs at dt = 0 by up to "
-              f"{controls[tag].max():.2g} V_N, {controls[tag].max() / LIMIT_BOUND:.3g} x the "
-              "limit's bound (> 100)")
+        controls[tag] = {n: np.abs(corr[n] + sg[n] - scaled(read_liggghts(os.path.join(
+            d, f"liggghts_{run_name('stiff', n)}_{tag}.dump")), vn)).max()
+            for n in N_CONTROL}
+        worst_c = min(controls[tag].values())
+        check(worst_c > 100 * AGREE_BOUND,
+              f"control: LIGGGHTS with {label} differs, less the lever arm, by "
+              + ", ".join(f"{controls[tag][n]:.2g}" for n in N_CONTROL) + " V_N at "
+              + ", ".join(str(n) for n in N_CONTROL) + f" steps per t_c, "
+              f"{worst_c / AGREE_BOUND:.2g} x the agreement's bound (> 100)")
 
     # gross sliding: the rigid-body closed form (e = 1), in the frame of the mid-contact normal
     tc = contact_time(SETS["stiff"]["E"], vn)
@@ -525,26 +593,39 @@ def main_check(d):
           f"differ from the closed form by at most {err_et:.2g} and {err_w:.2g} (<= 5e-5; "
           f"{err_touch:.2g} in e_t with the normal of the first touch)")
 
-    # soft: the lever arm is what is left at dt = 0
-    soft_lim = 2 * soft[N_SOFT[1]] - soft[N_SOFT[0]]
-    lever_soft = scaled(reference_all("soft", N_SOFT[1], dict(LIGGGHTS, lever="R"), ps)
-                        - soft_ref[N_SOFT[1]], vs)
-    mis = np.abs(soft_lim - lever_soft).max() / np.abs(lever_soft).max()
-    check(mis <= 0.05 and np.abs(soft_lim).max() > 30 * LIMIT_BOUND,
-          f"lever: soft set, the codes differ at dt = 0 by up to {np.abs(soft_lim).max():.2g} "
-          f"V_N; the lever arm alone gives that to {mis:.2g} of its size (<= 0.05)")
+    # soft: the lever arm is the difference, at every step
+    soft_mis = {n: np.abs(soft[n] - lever_soft[n]).max() for n in N_SOFT}
+    soft_big = min(np.abs(soft[n]).max() for n in N_SOFT)
+    check(max(soft_mis.values()) <= SOFT_BOUND and soft_big > 1e4 * SOFT_BOUND,
+          f"lever: soft set, the codes differ by up to {soft_big:.2g} V_N at "
+          + " and ".join(str(n) for n in N_SOFT) + " steps per t_c; the lever arm alone "
+          "(reference) gives that to " + " and ".join(f"{soft_mis[n]:.2g}" for n in N_SOFT)
+          + f" (<= {SOFT_BOUND:g}: the projection, "
+          + " and ".join(f"{proj_soft[n]:.2g}" for n in N_SOFT) + " by the reference)")
 
-    # damped: the Coulomb-limit conventions (and the lever arm) are what is left at dt = 0
-    dmp_lim = 2 * dmp[N_DAMPED[1]]["diff"] - dmp[N_DAMPED[0]]["diff"]
-    conv = 2 * dmp[N_DAMPED[1]]["conv"] - dmp[N_DAMPED[0]]["conv"]
+    # damped: the codes differ by the conventions (Coulomb limit, lever arm), which stay at
+    # dt = 0, and by the dashpots' velocity (wetdem's predicted, LIGGGHTS' half-step), first
+    # order: what is left once the reference takes the conventions out
+    na, nb_ = N_DAMPED
+    rest = {n: dmp[n]["diff"] - dmp[n]["conv"] for n in N_DAMPED}
+    rest_big = [np.abs(rest[n]).max() for n in N_DAMPED]
+    rest_factor = rest_big[0] / rest_big[1]
+    dmp_lim = 2 * dmp[nb_]["diff"] - dmp[na]["diff"]
+    conv = 2 * dmp[nb_]["conv"] - dmp[na]["conv"]
     mis_d = np.abs(dmp_lim - conv).max() / np.abs(conv).max()
-    check(mis_d <= 0.01 and np.abs(dmp_lim).max() > 30 * LIMIT_BOUND,
+    check(1.8 <= rest_factor <= 2.2,
+          f"damped dashpots: e = {E_DAMPED}, the codes' difference less the conventions' "
+          "(LIGGGHTS' scheme with wetdem's Coulomb limit and lever arm) is "
+          + " and ".join(f"{b:.2g}" for b in rest_big) + " V_N at "
+          + " and ".join(str(n) for n in N_DAMPED) + f" steps per t_c, factor "
+          f"{rest_factor:.2f} (1.8-2.2: first order, the dashpots' velocity)")
+    check(mis_d <= 0.01 and np.abs(dmp_lim).max() > 1e3 * AGREE_BOUND,
           f"damped: e = {E_DAMPED}, the codes differ at dt = 0 by up to "
           f"{np.abs(dmp_lim).max():.2g} V_N; LIGGGHTS' scheme with wetdem's Coulomb limit "
           f"and lever arm gives that to {mis_d:.2g} of its size (<= 0.01)")
     e_t_lg = tangential_restitution(a0, lg[n1], nb, vn)
-    e_t_dw = tangential_restitution(a0, dmp[N_DAMPED[1]]["w"], nb, vn)
-    e_t_dl = tangential_restitution(a0, dmp[N_DAMPED[1]]["g"], nb, vn)
+    e_t_dw = tangential_restitution(a0, dmp[nb_]["w"], nb, vn)
+    e_t_dl = tangential_restitution(a0, dmp[nb_]["g"], nb, vn)
     share, apart = [], True
     for state in initial_state("stiff"):  # wetdem's steps that slide, at 400 steps per t_c
         stats = {}
@@ -553,28 +634,36 @@ def main_check(d):
         apart = apart and stats["apart"]
     check(apart, "the runs end after the contacts: every pair is apart at the last step "
           "(reference, 400 steps per t_c)")
+    n25 = N_STIFF[0]
     print(f"  per pair ({n1} steps per t_c; differences: largest of v, R w over V_N; slides: "
           "wetdem's share of sliding steps in contact)")
-    print("  angle spin  |u_t0|/v_n slides  e_t wetdem  LIGGGHTS  closed   diff@25  diff@1600  "
-          "dt=0 (lever R)  e_t(e=0.5) wetdem  LIGGGHTS")
+    print(f"  angle spin  |u_t0|/v_n slides  e_t wetdem  LIGGGHTS  closed  diff@{n25}  "
+          f"diff@{n1}  less lever@{n25}  err@{n25} wetdem  former  e_t(e=0.5) wetdem  "
+          "LIGGGHTS")
+    lim_w = sw[n1] + (sw[n1] - sw[n0]) / 3
+    lim_f = 2 * former[n1] - former[n0]
     for k in range(len(a0)):
         print(f"  {ANGLES[k % len(ANGLES)]:5d} {'yes' if k >= len(ANGLES) else 'no':4s} "
               f"{u0n[k]:9.3f} {share[k]:6.0%}  {e_t[k]:10.5f}  {e_t_lg[k]:8.5f}  "
               + (f"{e_t_closed[k]:7.4f}" if sliding[k] else "      -")
-              + f"  {np.abs(diff[N_STIFF[0]][k]).max():8.2g}  {np.abs(diff[n1][k]).max():8.2g}"
-              f"  {lim[k]:14.2g}  {e_t_dw[k]:17.4f}  {e_t_dl[k]:8.4f}")
+              + f"  {np.abs(diff[n25][k]).max():8.3g}  {np.abs(diff[n1][k]).max():8.3g}"
+              f"  {np.abs(corr[n25][k]).max():13.2g}"
+              f"  {np.abs(sw[n25][k] - lim_w[k]).max():13.2g}"
+              f"  {np.abs(former[n25][k] - lim_f[k]).max():6.2g}"
+              f"  {e_t_dw[k]:17.4f}  {e_t_dl[k]:8.4f}")
     # the striker's tangential over normal impulse in the pairs that slide throughout
     ratio = {}
-    for code, got in (("wetdem", dmp[N_DAMPED[1]]["w"]), ("LIGGGHTS", dmp[N_DAMPED[1]]["g"])):
+    for code, got in (("wetdem", dmp[nb_]["w"]), ("LIGGGHTS", dmp[nb_]["g"])):
         dv = got[:, 0:3] - a0[:, 0:3]
         jn = np.einsum("ij,ij->i", dv, nb)  # the target pushes the striker back along nb
         jt = np.linalg.norm(dv - jn[:, None] * nb, axis=1)
         ratio[code] = (jt / (MU * jn))[sliding]
     print(f"  e = {E_DAMPED}, the {sliding.sum()} sliding pairs: J_t / (mu J_n) "
           + ", ".join(f"{c} {r.min():.3f}-{r.max():.3f}" for c, r in ratio.items()))
-    return dict(wd=wd, lg=lg, big=big, lim=lim, raw_lim=raw_lim, own=own, controls=controls,
-                e_t=e_t, e_t_closed=e_t_closed, sliding=sliding, soft_lim=soft_lim,
-                lever_soft=lever_soft, nb=nb, dmp_lim=dmp_lim, conv=conv, dmp=dmp)
+    return dict(wd=wd, lg=lg, big=big, agree=agree, own=own, orders=orders,
+                controls=controls, e_t=e_t, e_t_closed=e_t_closed, sliding=sliding,
+                soft=soft, lever_soft=lever_soft, corr=corr, nb=nb, dmp_lim=dmp_lim,
+                conv=conv, dmp=dmp)
 
 
 def figure(r):
@@ -605,41 +694,46 @@ def figure(r):
                     fontsize=10)
     ax[0].legend(fontsize=6.5, loc=(0.24, 0.02))  # the empty corner below 20-50 deg
     dts = 1.0 / np.array(N_STIFF)
-    ax[1].loglog(dts, r["big"], "o-", label="wetdem - LIGGGHTS (largest over pairs)")
-    ax[1].loglog(dts, r["big"][0] * dts / dts[0], "k--", lw=0.8, label="first order")
-    ax[1].loglog(dts, r["own"]["wetdem"], "s:", ms=3, color="C0", lw=0.8,
-                 label="wetdem against its dt = 0 limit")
-    ax[1].loglog(dts, r["own"]["LIGGGHTS"], "x:", ms=5, color="k", lw=0.8,
-                 label="LIGGGHTS against its dt = 0 limit")
-    ax[1].axhline(r["raw_lim"].max(), color="C1", ls="-.",
-                  label="extrapolated to dt = 0: the lever arm")
-    ax[1].axhline(r["lim"].max(), color="C2", ls="-.",
-                  label="same, LIGGGHTS' lever arm set to R")
-    ax[1].axhline(r["controls"]["nu"].max(), color="C3", ls=":",
-                  label="LIGGGHTS with nu = 0.31, at dt = 0")
-    ax[1].axhline(r["controls"]["mu"].max(), color="C4", ls=":",
-                  label="LIGGGHTS with mu x 1.01, at dt = 0")
+    ax[1].loglog(dts, r["big"], "o-", color="C1", label="wetdem - LIGGGHTS: lever arm")
+    ax[1].loglog(dts, r["agree"], "s-", color="C2", ms=4,
+                 label="less the lever arm: projection")
+    ax[1].loglog(dts, r["own"]["wetdem"], "o:", ms=4, color="C0", lw=1,
+                 label="wetdem vs its dt = 0 limit")
+    ax[1].loglog(dts, r["own"]["LIGGGHTS"], "x", ms=7, color="k",
+                 label="LIGGGHTS vs its dt = 0 limit")
+    ax[1].loglog(dts, r["own"]["wetdem"][2] * (dts / dts[2]) ** 2, "k--", lw=0.8,
+                 label="second order")
+    ax[1].loglog(dts, r["own"]["former"], "v-.", ms=4, color="0.5", lw=0.8,
+                 label="former wetdem (predicted slip)")
+    for tag, col, lab in (("nu", "C3", f"nu = {NU_CONTROL:g}"),
+                          ("mu", "C4", f"mu x {MU_CONTROL / MU:g}")):
+        c = r["controls"][tag]
+        ax[1].loglog([1.0 / n for n in N_CONTROL], [c[n] for n in N_CONTROL], "*", ms=9,
+                     color=col, label=f"control: LIGGGHTS, {lab}")
     ax[1].set_xlabel("dt / head-on contact time t_c")
     ax[1].set_ylabel("largest difference of v, R w [V_N]")
-    ax[1].set_title("Stiff, e = 1 (delta/R = 5e-5): first order to one limit", fontsize=10)
-    ax[1].legend(fontsize=6.5, loc="lower right")
+    ax[1].set_ylim(1e-16, 1)
+    ax[1].set_title("Stiff, e = 1 (delta/R = 5e-5): the lever arm at every dt,\n"
+                    "each code second order to its limit", fontsize=10)
+    ax[1].legend(fontsize=6, loc="center", bbox_to_anchor=(0.5, 0.44), ncol=2)  # the gap
     x = np.arange(2 * na)
     ax[2].semilogy(x, np.abs(r["dmp_lim"]).max(axis=1), "^", color="C1",
-                   label=f"stiff, e = {E_DAMPED}: wetdem - LIGGGHTS")
+                   label=f"stiff, e = {E_DAMPED}, at dt = 0: wetdem - LIGGGHTS")
     ax[2].semilogy(x, np.abs(r["conv"]).max(axis=1), "+", ms=11, color="C1",
                    label="  reference: Coulomb limit and lever arm")
-    ax[2].semilogy(x, np.abs(r["soft_lim"]).max(axis=1), "o", color="C0",
-                   label="soft, e = 1: wetdem - LIGGGHTS")
-    ax[2].semilogy(x, np.abs(r["lever_soft"]).max(axis=1), "x", ms=9, color="C0",
+    ns = N_SOFT[-1]
+    ax[2].semilogy(x, np.abs(r["soft"][ns]).max(axis=1), "o", color="C0",
+                   label=f"soft, e = 1, {ns} steps per t_c: wetdem - LIGGGHTS")
+    ax[2].semilogy(x, np.abs(r["lever_soft"][ns]).max(axis=1), "x", ms=9, color="C0",
                    label="  reference: lever arm R vs R - delta/2")
-    ax[2].semilogy(x, np.maximum(r["lim"], 1e-16), "s", color="C2", ms=4,
-                   label="stiff, e = 1, lever arm set to R")
+    ax[2].semilogy(x, np.maximum(np.abs(r["corr"][n1]).max(axis=1), 1e-17), "s", color="C2",
+                   ms=4, label=f"stiff, e = 1, {n1} steps per t_c, less the lever arm")
     ax[2].set_xticks(x, [f"{a}" for a in ANGLES] * 2, fontsize=7)
     ax[2].set_xlabel("impact angle [deg] (left: no spin, right: spin)")
-    ax[2].set_ylabel("largest difference of v, R w at dt = 0 [V_N]")
-    ax[2].set_title("At dt = 0: the documented differences, and nothing else", fontsize=10)
-    ax[2].set_ylim(1e-18, 1)  # room below the points for the legend
-    ax[2].legend(fontsize=6.5, loc="lower right")
+    ax[2].set_ylabel("largest difference of v, R w [V_N]")
+    ax[2].set_title("What the codes differ by: the documented differences only", fontsize=10)
+    ax[2].set_ylim(1e-18, 1)
+    ax[2].legend(fontsize=6.5, loc="center", bbox_to_anchor=(0.5, 0.5))  # the gap
     fig.suptitle("Binary oblique collisions with friction (Hertz-Mindlin): wetdem against "
                  "LIGGGHTS 3.8", fontsize=11)
     save_and_finish(fig, "liggghts_friction.png")

@@ -5,14 +5,15 @@
 # `model hertz tangential history`), from one state written for both codes by
 # figures/liggghts_friction.py (`setup`, with wetdem's scenarios and the list of runs):
 #   stiff, e = 1 (E = 70 GPa, delta/R = 5e-5; no dashpots, and both codes' Coulomb limits are
-#     mu times the Hertz force) at 25 ... 1600 steps per contact time: the codes differ at
-#     first order in dt (the velocity the spring advances with) and tend to one answer but
-#     for the lever arm of the tangential force (R in wetdem, R - delta/2 in LIGGGHTS);
-#     LIGGGHTS with nu or mu perturbed does not (the controls); the sliding pairs give the
+#     mu times the Hertz force) at 25 ... 1600 steps per contact time: both springs advance
+#     with the slip of the half-step velocities, so the codes differ at every dt by the lever
+#     arm of the tangential force alone (R in wetdem, R - delta/2 in LIGGGHTS; 1e-5 V_N) but
+#     for the spring's rotation against projection (<= 7e-13 V_N); each code is second order;
+#     LIGGGHTS with nu or mu perturbed is far off (the controls); the sliding pairs give the
 #     rigid-body closed form;
-#   soft, e = 1 (the benchmark's E = 10 MPa, delta/R ~ 1e-2): the lever arm is what is left
-#     at dt = 0;
-#   stiff, e = 0.5: the Coulomb limits' conventions are what is left at dt = 0.
+#   soft, e = 1 (the benchmark's E = 10 MPa, delta/R ~ 1e-2): the lever arm, larger;
+#   stiff, e = 0.5: the dashpots' velocity (first order) and the Coulomb limits' conventions,
+#     which are what is left at dt = 0.
 # Checks and figure: figures/liggghts_friction.py check -> docs/figures/liggghts_friction.png.
 # Usage: scripts/validate.d/48-liggghts-friction.sh PATH_TO_WETDEM_CLI   (from the repository root)
 set -euo pipefail
