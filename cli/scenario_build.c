@@ -718,13 +718,50 @@ static size_t ignored_min_separation_keys(const struct cli_scenario* sc,
     return n;
 }
 
+/* [material.NAME] roughness when no model reads it: the min-separation models roughness and
+ * max (h_min from it) and the force model nijssen (h_sigma) do, and nothing else. */
+static size_t ignored_roughness_keys(const struct cli_scenario* sc, const struct wetdem_sim* sim,
+                                     struct ignored_key* out)
+{
+    const char* ms = wetdem_sim_min_separation_model(sim)->name;
+    if (strcmp(ms, "roughness") == 0 || strcmp(ms, "max") == 0)
+        return 0;
+    char forces[256] = "";
+    size_t used = 0;
+    for (size_t k = 0; k < wetdem_sim_n_models(sim); k++) {
+        const char* name = wetdem_sim_model(sim, k)->name;
+        if (strcmp(name, "nijssen") == 0)
+            return 0;
+        if (used < sizeof forces)
+            used +=
+                (size_t)snprintf(forces + used, sizeof forces - used, "%s%s", k ? ", " : "", name);
+    }
+    const struct cli_entry* by[] = {cli_scenario_find(sc, "models", "min_separation"),
+                                    cli_scenario_find(sc, "models", "force")};
+    size_t n = 0;
+    for (size_t k = 0; k < sc->n_entries && n < MAX_IGNORED; k++) {
+        const struct cli_entry* e = &sc->entries[k];
+        if (strncmp(e->section, "material.", 9) != 0 || strcmp(e->key, "roughness") != 0 ||
+            set_aside(e, by[0]) || set_aside(e, by[1]))
+            continue;
+        snprintf(out[n].why, sizeof out[n].why,
+                 "no model of this run reads a roughness (min_separation = %s, force models: "
+                 "%s), so it has no effect: min_separation = roughness or max takes h_min from "
+                 "it, and the force model nijssen its h_sigma",
+                 ms, used ? forces : "none");
+        out[n++].e = e;
+    }
+    return n;
+}
+
 void cli_scenario_warn_ignored(const struct cli_scenario* sc, const struct wetdem_sim* sim,
                                bool many)
 {
     static atomic_flag warned = ATOMIC_FLAG_INIT;
-    struct ignored_key keys[2 * MAX_IGNORED + 1];
+    struct ignored_key keys[3 * MAX_IGNORED + 1];
     size_t n = ignored_integrator_keys(sc, sim, many, keys);
     n += ignored_min_separation_keys(sc, sim, keys + n);
+    n += ignored_roughness_keys(sc, sim, keys + n);
     const struct cli_entry* target = cli_scenario_find(sc, "collision", "target");
     const struct cli_entry* radius = cli_scenario_find(sc, "collision", "target_radius");
     if (!many && target && strcmp(target->value, "wall") == 0 && radius &&

@@ -245,12 +245,13 @@ static void test_collision_cvode_sees_a_grazing_contact(void** state)
 }
 
 /* e_t of a dry Hertz + Mindlin impact (steel spheres, 0.5 m/s, at `degrees` from the line of
- * centres) with CVODE at its default tolerances and the largest step max_step (0: default). */
-static double mindlin_e_t(double degrees, double max_step)
+ * centres) with `integrator` and its parameter `key` set to `value`. */
+static double mindlin_e_t_with(double degrees, const char* integrator, const char* key,
+                               double value)
 {
     int mat;
-    struct wetdem_sim* sim = make_sim("steel1", 0, "hertz", "mindlin", "cvode", &mat);
-    CHECK_OK(wetdem_sim_set_param(sim, "cvode.max_step", max_step));
+    struct wetdem_sim* sim = make_sim("steel1", 0, "hertz", "mindlin", integrator, &mat);
+    CHECK_OK(wetdem_sim_set_param(sim, key, value));
     struct wetdem_collision_spec s = head_on(mat, 0.5, 1e-3);
     s.initial_gap = 1e-4;
     s.angle = degrees * M_PI / 180;
@@ -259,6 +260,12 @@ static double mindlin_e_t(double degrees, double max_step)
     assert_true(r.separated && r.solid_contact);
     wetdem_sim_free(sim);
     return r.e_t;
+}
+
+/* The same with CVODE at its default tolerances and the largest step max_step (0: default). */
+static double mindlin_e_t(double degrees, double max_step)
+{
+    return mindlin_e_t_with(degrees, "cvode", "cvode.max_step", max_step);
 }
 
 /* CVODE's trial evaluations advance the committed Mindlin spring with the mean of v_t at the
@@ -286,21 +293,10 @@ static void test_collision_cvode_mindlin_second_order(void** state)
     }
 }
 
-/* e_t of the same impact with the verlet integrator at dt_fraction `fraction` of the contact
- * time. */
+/* The same with the verlet integrator at dt_fraction `fraction` of the contact time. */
 static double mindlin_e_t_verlet(double degrees, double fraction)
 {
-    int mat;
-    struct wetdem_sim* sim = make_sim("steel1", 0, "hertz", "mindlin", "verlet", &mat);
-    CHECK_OK(wetdem_sim_set_param(sim, "verlet.dt_fraction", fraction));
-    struct wetdem_collision_spec s = head_on(mat, 0.5, 1e-3);
-    s.initial_gap = 1e-4;
-    s.angle = degrees * M_PI / 180;
-    struct wetdem_collision_result r;
-    CHECK_OK(wetdem_collision_run(sim, &s, &r));
-    assert_true(r.separated && r.solid_contact);
-    wetdem_sim_free(sim);
-    return r.e_t;
+    return mindlin_e_t_with(degrees, "verlet", "verlet.dt_fraction", fraction);
 }
 
 /* verlet advances the Mindlin spring with the slip at the half-step velocities (midpoint rule,

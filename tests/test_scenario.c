@@ -692,6 +692,26 @@ static void test_scenario_ignored_keys_are_reported(void** state)
              "run --check examples/scenarios/many_settling.ini --set run.dt=1e-6 --set "
              "integrator.many_hmin_fraction=0");
     assert_int_equal(count_in_run(args, 0, "warning"), 0);
+    /* a material's roughness where neither the min-separation model (roughness, max) nor
+       nijssen reads it; not where one does, nor when a --set of either set it aside */
+    const char* rough = write_file("rough.ini", "[collision]\nstriker = mat\ntarget = wall\n"
+                                                "speed = 0.1\n[material.mat]\npreset = glass\n"
+                                                "roughness = 1e-6\n[models]\nforce = hertz\n"
+                                                "min_separation = fixed\n");
+    snprintf(args, sizeof args, "run --check '%s'", rough);
+    expect_run(args, 0,
+               "rough.ini:7: [material.mat] roughness = 1e-6: no model of this run reads a "
+               "roughness (min_separation = fixed, force models: hertz), so it has no effect");
+    const char* reading[] = {"--set models.min_separation=roughness",
+                             "--set models.min_separation=max", "--set models.force=nijssen"};
+    for (int k = 0; k < 3; k++) {
+        snprintf(args, sizeof args, "run --check '%s' %s", rough, reading[k]);
+        assert_int_equal(count_in_run(args, 0, "roughness = 1e-6"), 0);
+    }
+    snprintf(args, sizeof args,
+             "run --check examples/scenarios/many_settling.ini --set "
+             "material.wetglass.roughness=1e-7");
+    assert_int_equal(count_in_run(args, 0, "no model of this run reads a roughness"), 1);
 }
 
 /* A scenario with no contact model (fluid forces only) lets the spheres pass into each other
