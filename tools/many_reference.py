@@ -1,0 +1,1259 @@
+"""An independent reference of the many-particle engine (docs/many.md) in plain Python/numpy,
+written from the documented step and force laws, not from the C code: velocity Verlet with the
+forces at the predicted velocities (docs/many.md, "Time step"), the pair and wall geometry and
+signs of docs/concepts.md, the laws of docs/models.md and docs/derivations/ (hertz with
+damping = tsuji or exact, hooke, mindlin beside either, sb, db, davis, nase, capillary,
+reynolds with a fixed h_min, nijssen with its own h_min record and blended contact), walls,
+periodic axes by the minimum image, gravity, and the energy budget (work per model by the
+trapezoid rule over the force passes, the stored energy of hertz and hooke).
+
+Each scenario below is written as a scenario file, run with `build/wetdem run` (binary VTK
+at every step, exact), and followed by the reference; positions, velocities and spins are
+compared at every step, and the budget of summary.json at the end.
+
+    /usr/bin/python3 tools/many_reference.py [--wetdem build/wetdem] [--only NAME]
+        [--every N] [--coverage] [-v] [--mutants]
+
+prints one line per case with the largest difference over the run of the positions (over
+the largest radius), velocities and spins (R w, over the largest speed of the run) and of
+the budget's terms (over the larger of the input and the models' work), and exits with 1
+when a case is off by more than its tolerance: 1e-9, rounding grown over some thousand
+steps (the cases agree to 1e-16..1e-13); 1e-8 with the exact damping of hertz or nijssen,
+whose coefficient the engine tabulates to about 4e-9 relative (docs/derivations/contact.md
+Sec. 1.3) where this reference bisects Eq. 1.7 (a shift of c by 4e-9 moves these cases by
+up to 2e-9). --every N compares a frame every N steps, between which the engine takes its
+fused paths; --coverage prints what each case exercised; --mutants checks instead that
+deliberate errors of the reference are detected. Needs numpy (Debian python3-numpy);
+about 1.5 min.
+"""
+import argparse
+import functools
+import json
+import math
+import os
+import subprocess
+import sys
+import tempfile
+
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from wetdem_vtk import read_series, read_vtk  # noqa: E402
+
+PI = math.pi
+
+
+def cross(a, b):
+    """a x b of two 3-vectors (numpy's cross is slow on single vectors)."""
+    return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2],
+                     a[0] * b[1] - a[1] * b[0]])
+
+
+# ------------------------------------------------------------------ materials and pairs ---
+class Material:
+    def __init__(self, density=7780.0, youngs_modulus=1.9e11, poisson_ratio=0.27,
+                 restitution=0.97, friction_dry=0.11, friction_lub=0.02, roughness=0.0,
+                 film=0.0):
+        self.density, self.E, self.nu = density, youngs_modulus, poisson_ratio
+        self.e, self.mu_dry, self.mu_lub = restitution, friction_dry, friction_lub
+        self.rough, self.film = roughness, film
+
+    def ini(self):
+        return {"density": self.density, "youngs_modulus": self.E,
+                "poisson_ratio": self.nu, "restitution": self.e,
+                "friction_dry": self.mu_dry, "friction_lub": self.mu_lub,
+                "roughness": self.rough, "film": self.film}
+
+
+@functools.lru_cache(maxsize=None)
+def mixed(a, b):
+    """Mixed properties of a pair (docs/concepts.md)."""
+    e_star = 1.0 / ((1 - a.nu ** 2) / a.E + (1 - b.nu ** 2) / b.E)
+    ga, gb = a.E / (2 * (1 + a.nu)), b.E / (2 * (1 + b.nu))
+    g_star = 1.0 / ((2 - a.nu) / ga + (2 - b.nu) / gb)
+    return dict(E=e_star, G=g_star, e=(a.e + b.e) / 2, mu_dry=(a.mu_dry + b.mu_dry) / 2,
+                mu_lub=(a.mu_lub + b.mu_lub) / 2, rough=(a.rough + b.rough) / 2,
+                film=a.film + b.film)
+
+
+def beta_of(e):
+    le = math.log(e)
+    return le / math.sqrt(le * le + PI * PI)
+
+
+@functools.lru_cache(maxsize=None)
+def hertz_c_exact(e):
+    """c of damping = exact: the root of ln e = -(c/2) J(c) (docs/derivations/contact.md,
+    Eq. 1.7), by bisection on ln e(c), which falls monotonically."""
+    if e >= 1.0:
+        return 0.0
+
+    def ln_e(c):
+        if c * c < 5:
+            s = math.sqrt(5 - c * c)
+            j = 2 / s * math.atan2(c * s, c * c - 2.5)
+        elif c * c == 5:
+            j = 4 / math.sqrt(5)
+        else:
+            s = math.sqrt(c * c - 5)
+            j = 2 / s * math.log((c * c + c * s - 2.5) / 2.5)
+        return -c / 2 * j
+
+    lo, hi, target = 0.0, 1.0, math.log(e)
+    while ln_e(hi) > target:
+        hi *= 2
+    for _ in range(200):
+        mid = (lo + hi) / 2
+        if ln_e(mid) > target:
+            lo = mid
+        else:
+            hi = mid
+    return (lo + hi) / 2
+
+
+# --------------------------------------------------------------------------- reference ---
+class Reference:
+    """The state and the step of docs/many.md. models: list of names in the order enabled
+    (the budget's per-model work follows it)."""
+
+    def __init__(self, sc):
+        self.sc = sc
+        self.mats = sc["materials"]
+        ps = sc["particles"]
+        self.n = len(ps)
+        self.x = np.array([p["x"] for p in ps], float)
+        self.v = np.array([p.get("v", (0, 0, 0)) for p in ps], float)
+        self.w = np.array([p.get("w", (0, 0, 0)) for p in ps], float)
+        self.R = np.array([p["R"] for p in ps], float)
+        self.mat = [p["mat"] for p in ps]
+        self.fixed = np.array([p.get("fixed", False) for p in ps])
+        self.m = np.array([4 / 3 * PI * r ** 3 * self.mats[k].density
+                           for r, k in zip(self.R, self.mat)])
+        self.I = 0.4 * self.m * self.R ** 2
+        self.g = np.array(sc.get("gravity", (0, 0, 0)), float)
+        self.lo = np.zeros(3)
+        self.hi = np.array(sc["box"], float)
+        self.periodic = [ax in sc.get("periodic", "") for ax in "xyz"]
+        self.walls = []  # (point, inward normal, material)
+        for face in sc.get("walls", []):
+            ax = "xyz".index(face[0])
+            nrm = np.zeros(3)
+            pt = np.zeros(3)
+            if face.endswith("min"):
+                nrm[ax] = 1.0
+            else:
+                nrm[ax] = -1.0
+                pt[ax] = self.hi[ax]
+            self.walls.append((pt, nrm, sc.get("wall_material", self.mat[0])))
+        self.models = sc["models"].split()
+        self.params = sc.get("params", {})
+        # the largest range and record range of the models, as a multiple of R*
+        self.reach_ratio = 0.0
+        if {"nijssen", "reynolds"} & set(self.models) or \
+                sc.get("min_separation") in ("ehd", "max"):
+            self.reach_ratio = max([1.0] + [float(v) for k, v in self.params.items()
+                                            if k.endswith("cutoff_ratio") or
+                                            k.endswith("reset_ratio")])
+        self.mu_f = sc.get("viscosity", 1e-3)
+        self.sigma = sc.get("surface_tension", 0.072)
+        self.dt = sc["dt"]
+        self.hist = {}  # key -> dict of per-model history
+        self.unwrap = np.zeros((self.n, 3))  # box lengths taken off by wraps
+        self.work = {m: [0.0, 0.0] for m in self.models}  # [pairs, walls], trapezoid sums
+        self.last_power = None
+        # what the run exercised: evaluations with a non-zero force per model and kind,
+        # Coulomb slides, pairs acting across a periodic face, the most partners acting on
+        # one sphere at once, wraps
+        self.cover = {"across_face": 0, "max_partners": 0,
+                      "wraps": 0, "blend": 0, "below_hmin": 0}
+        self.cover_model = {}
+
+    # -------------------------------------------------------------- one pair's forces ---
+    def pair_force(self, key, ri, rj, mi, mj, mp, d, vi, vj, wi, wj, dt, wall):
+        """Forces of every model on i: list of (model, F_i (3), T_i, T_j) and the new history.
+        d = x_i - x_j (minimum image) for a sphere, or for a wall the normal times the
+        centre's distance from it. rj, mj = inf for a wall or fixed sphere (mj)."""
+        dist = math.sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
+        n = d / dist
+        if wall:
+            h = dist - ri
+            rstar = ri
+        else:
+            h = dist - ri - rj
+            rstar = ri * rj / (ri + rj)
+        if h > max(mp["film"], self.reach_ratio * rstar):  # beyond every model's range
+            return [], {}, h
+        mstar = mi if math.isinf(mj) else (mj if math.isinf(mi) else mi * mj / (mi + mj))
+        vn = -np.dot(vi - vj, n)
+        vs = (vi + cross(wi, -ri * n)) - (vj + (np.zeros(3) if wall else
+                                                   cross(wj, rj * n)))
+        vt = vs - np.dot(vs, n) * n
+        old = self.hist.get(key, {})
+        new = {}
+        out = []
+        film = mp["film"]
+        hmin = self.min_separation(old, new, h, vn, rstar, mp)
+
+        def tangential(name, ft):
+            ti = cross(-ri * n, ft)
+            tj = np.zeros(3) if wall else cross(rj * n, -ft)
+            out.append((name, ft, ti, tj))
+
+        def normal(name, fn):
+            out.append((name, fn * n, np.zeros(3), np.zeros(3)))
+
+        hooke_k = self.params.get("hooke.stiffness", 1e6) if "hooke" in self.models else 0.0
+        for name in self.models:
+            if name == "hertz":
+                if h < 0:
+                    delta = -h
+                    k = 4 / 3 * mp["E"] * math.sqrt(rstar)
+                    fel = k * delta ** 1.5
+                    if self.params.get("hertz.damping", "exact") == "tsuji":
+                        c = -math.sqrt(5) * beta_of(mp["e"])
+                        f = fel + c * math.sqrt(mstar * k) * delta ** 0.25 * vn
+                    else:
+                        c = hertz_c_exact(mp["e"])
+                        f = max(0.0, fel + c * math.sqrt(mstar * k) * delta ** 0.25 * vn)
+                    normal(name, f)
+                else:
+                    normal(name, 0.0)
+            elif name == "hooke":
+                if h < 0:
+                    le = math.log(mp["e"])
+                    gam = -2 * le * math.sqrt(mstar * hooke_k) / math.sqrt(le * le + PI * PI)
+                    normal(name, hooke_k * (-h) + gam * vn)
+                else:
+                    normal(name, 0.0)
+            elif name == "mindlin":
+                s = old.get("s", np.zeros(3))
+                if h < 0:
+                    delta = -h
+                    mu = mp["mu_dry"] if self.params.get("mindlin.friction", "dry") == "dry" \
+                        else mp["mu_lub"]
+                    if hooke_k > 0:
+                        kt = 4 * mp["G"] / mp["E"] * hooke_k
+                        flim = mu * hooke_k * delta
+                    else:
+                        kt = 8 * mp["G"] * math.sqrt(rstar * delta)
+                        flim = mu * 4 / 3 * mp["E"] * math.sqrt(rstar) * delta ** 1.5
+                    ft, s = mindlin_update(s, n, vt, dt, kt, mstar, mp["e"], flim)
+                    new["s"] = s
+                    tangential(name, ft)
+                else:
+                    tangential(name, np.zeros(3))
+            elif name in ("sb", "db"):
+                f = 0.0
+                if film > 0:
+                    hm = min(hmin, film)
+                    below = self.params.get(name + ".below_hmin", "c")
+                    he = None
+                    if hm <= h <= film:
+                        he = h
+                    elif h < hm and below == "nc" and hm > 0:
+                        he = hm
+                    if he is not None and he > 0:
+                        self.cover["below_hmin"] += he != h and dt > 0
+                        self.cover["below_hmin"] += he != h
+                        if name == "sb":
+                            br = (1 - he / film) ** 2
+                        else:
+                            br = (1 - he / (2 * film - he)) ** 2
+                        f = 6 * PI * self.mu_f * rstar ** 2 * vn / he * br
+                normal(name, f)
+            elif name in ("davis", "nase"):
+                ft = np.zeros(3)
+                if film > 0:
+                    hm = min(hmin, film)
+                    below = self.params.get(name + ".below_hmin", "c")
+                    he = None
+                    if hm <= h <= film:
+                        he = h
+                    elif h < hm and below == "nc" and hm > 0:
+                        he = hm
+                    if he is not None and he > 0:
+                        self.cover["below_hmin"] += he != h and dt > 0
+                        if name == "davis":
+                            ft = -2 * PI * self.mu_f * rstar * math.log((2 * film - he) / he) * vt
+                        else:
+                            fac = max(0.0, 8 / 15 * math.log(rstar / he) + 0.9588)
+                            ft = -6 * PI * self.mu_f * rstar * fac * vt
+                tangential(name, ft)
+            elif name == "capillary":
+                f = -8 * PI * rstar * self.sigma if (film > 0 and h <= film) else 0.0
+                normal(name, f)
+            elif name == "reynolds":
+                hco = self.params.get("reynolds.cutoff_ratio", 1.0) * rstar
+                f = 0.0
+                if 0 < h <= hco:
+                    f = 6 * PI * self.mu_f * rstar ** 2 * vn / max(h, hmin)
+                normal(name, f)
+            elif name == "nijssen":
+                fn, ft, st = self.nijssen(old, h, vn, vt, n, rstar, mstar, mp, dt)
+                new.update(st)
+                out.append((name, fn * n + ft, cross(-ri * n, ft),
+                            np.zeros(3) if wall else cross(rj * n, -ft)))
+            else:
+                raise ValueError(name)
+        return out, new, h
+
+    def min_separation(self, old, new, h, vn, rstar, mp):
+        """h_min of the min-separation model (docs/models.md; docs/derivations/fluid.md
+        Sec. 6), with its record kept in the pair's history."""
+        model = self.sc.get("min_separation", "fixed")
+        if model == "fixed":
+            return self.params.get("fixed.h_min", 1e-6)
+        if model == "roughness":
+            return mp["rough"]
+        if model in ("ehd", "max"):
+            reset = self.params.get(model + ".reset_ratio", 1.0) * rstar
+            v0 = max(vn, 0.0)
+            if h <= reset:
+                v0 = max(old.get("v0_ms", 0.0), v0)
+                new["v0_ms"] = v0
+            heps = 0.37 * rstar * (self.mu_f * v0 / (mp["E"] * rstar)) ** 0.4
+            return heps if model == "ehd" else max(heps, mp["rough"])
+        if model == "glass":
+            film = mp["film"]
+            mode = self.params.get("glass.speed", "max")
+            if mode == "current":
+                v = abs(vn)
+            elif h > film:
+                v = max(vn, 0.0)
+            else:
+                first = old.get("glass_first")
+                if first is None:
+                    first = max(vn, 0.0)
+                largest = max(old.get("glass_max", 0.0), vn)
+                new["glass_first"], new["glass_max"] = first, largest
+                v = first if mode == "initial" else largest
+            return min(math.sqrt(3 * self.mu_f * rstar * v /
+                                 self.params.get("glass.p_gt", 1.16e7)), film)
+        raise ValueError(model)
+
+    def nijssen(self, old, h, vn, vt, n, rstar, mstar, mp, dt):
+        """Nijssen Eqs. 1, 3-10 as docs/derivations/fluid.md Sec. 5 states them."""
+        hco = self.params.get("nijssen.cutoff_ratio", 1.0) * rstar
+        if h > hco:
+            return 0.0, np.zeros(3), {}
+        v0 = max(old.get("v0", 0.0), vn)
+        h_sig = mp["rough"]
+        h_eps = 0.37 * rstar * (self.mu_f * max(v0, 0.0) / (mp["E"] * rstar)) ** 0.4
+        hmin = max(h_sig, h_eps)
+        st = {"v0": v0, "hmin": hmin}
+        fl = 6 * PI * self.mu_f * rstar ** 2 * vn / max(h, hmin)
+        dn = max(0.0, hmin - h)
+        k = 4 / 3 * mp["E"] * math.sqrt(rstar)
+        fel = k * dn ** 1.5
+        if self.params.get("nijssen.damping", "exact") == "tsuji":
+            c = -math.sqrt(5) * beta_of(mp["e"])
+        else:
+            c = hertz_c_exact(mp["e"])
+        fc = max(0.0, fel + c * math.sqrt(mstar * k) * dn ** 0.25 * vn) if dn > 0 else 0.0
+        if h > hmin:
+            fn, wc = fl, 0.0
+        elif h > 0:
+            self.cover["blend"] += dt > 0
+            wc = (hmin - h) / hmin
+            fn = (h / hmin) * fl + wc * fc
+        else:
+            fn, wc = fc, 1.0
+        ft = np.zeros(3)
+        if dn > 0:
+            mu = mp["mu_dry"] if h_sig >= h_eps else mp["mu_lub"]
+            kt = 8 * mp["G"] * math.sqrt(rstar * dn)
+            ft, s = mindlin_update(old.get("s", np.zeros(3)), n, vt, dt, kt, mstar, mp["e"],
+                                   mu * wc * fel)
+            st["s"] = s
+        return fn, ft, st
+
+    # --------------------------------------------------------------------- force pass ---
+    def near_pairs(self):
+        """The pairs (i < j, in order) that any model may act on: a gap below the largest
+        film sum plus reach_ratio R_max (with a margin); the others are out of range and get a
+        fresh history, as pair_force gives them."""
+        x = self.x
+        d = x[:, None, :] - x[None, :, :]
+        L = self.hi - self.lo
+        for a in range(3):
+            if self.periodic[a]:
+                d[:, :, a] -= L[a] * np.round(d[:, :, a] / L[a])
+        h = np.sqrt(np.sum(d * d, axis=2)) - self.R[:, None] - self.R[None, :]
+        film = max(m.film for m in self.mats) * 2
+        far = film + self.reach_ratio * self.R.max() + 1e-9
+        near = (h <= 1.01 * far) & ~(self.fixed[:, None] & self.fixed[None, :])
+        ii, jj = np.nonzero(np.triu(near, 1))
+        return zip(ii.tolist(), jj.tolist())
+
+    def forces(self, v, w, dt, keep):
+        F = np.zeros((self.n, 3))
+        T = np.zeros((self.n, 3))
+        power = {m: [0.0, 0.0] for m in self.models}
+        newhist = {}
+        L = self.hi - self.lo
+        partners = np.zeros(self.n, int)
+        for i, j in self.near_pairs():
+            if True:
+                d = self.x[i] - self.x[j]
+                for a in range(3):
+                    if self.periodic[a]:
+                        d[a] -= L[a] * round(d[a] / L[a])
+                mi = math.inf if self.fixed[i] else self.m[i]
+                mj = math.inf if self.fixed[j] else self.m[j]
+                mp = mixed(self.mats[self.mat[i]], self.mats[self.mat[j]])
+                out, new, h = self.pair_force((i, j), self.R[i], self.R[j], mi, mj, mp, d,
+                                              v[i], v[j], w[i], w[j], dt, False)
+                newhist[(i, j)] = new
+                crossed = any(self.periodic[a] and abs(self.x[i][a] - self.x[j][a]) > L[a] / 2
+                              for a in range(3))
+                if keep and any(np.any(f != 0) for _, f, _, _ in out):
+                    partners[i] += 1
+                    partners[j] += 1
+                    self.cover["across_face"] += crossed
+                self.count(out, "pairs", keep)
+                for name, f, ti, tj in out:
+                    F[i] += f
+                    F[j] -= f
+                    T[i] += ti
+                    T[j] += tj
+                    power[name][0] += (np.dot(f, v[i] - v[j]) + np.dot(ti, w[i]) +
+                                       np.dot(tj, w[j]))
+        for i in range(self.n):
+            if self.fixed[i]:
+                continue
+            for k, (pt, nrm, wm) in enumerate(self.walls):
+                dist = np.dot(self.x[i] - pt, nrm)
+                mp = mixed(self.mats[self.mat[i]], self.mats[wm])
+                out, new, h = self.pair_force((i, "w", k), self.R[i], math.inf, self.m[i],
+                                              math.inf, mp, dist * nrm, v[i], np.zeros(3),
+                                              w[i], np.zeros(3), dt, True)
+                newhist[(i, "w", k)] = new
+                if keep and any(np.any(f != 0) for _, f, _, _ in out):
+                    partners[i] += 1
+                self.count(out, "walls", keep)
+                for name, f, ti, tj in out:
+                    F[i] += f
+                    T[i] += ti
+                    power[name][1] += np.dot(f, v[i]) + np.dot(ti, w[i])
+        if keep:
+            self.hist = newhist
+            self.cover["max_partners"] = max(self.cover["max_partners"], int(partners.max()))
+        return F, T, power
+
+    def count(self, out, kind, keep):
+        if not keep:
+            return
+        for name, f, ti, tj in out:
+            if np.any(f != 0):
+                key = f"{name}.{kind}"
+                self.cover_model[key] = self.cover_model.get(key, 0) + 1
+
+    # ------------------------------------------------------------------ energies ---
+    def kinetic(self):
+        free = ~self.fixed
+        return float(np.sum(0.5 * self.m[free] * np.sum(self.v[free] ** 2, axis=1)) +
+                     np.sum(0.5 * self.I[free] * np.sum(self.w[free] ** 2, axis=1)))
+
+    def potential(self):
+        free = ~self.fixed
+        xu = self.x + self.unwrap
+        return float(-np.sum(self.m[free] * (xu[free] @ self.g)))
+
+    # --------------------------------------------------------------------------- run ---
+    def start(self):
+        self.F, self.T, p = self.forces(self.v, self.w, 0.0, keep=False)
+        self.last_power = p
+        self.E0 = self.kinetic() + self.potential()
+        self.input = self.E0 + self.elastic()
+
+    def step(self):
+        dt = self.dt
+        free = ~self.fixed
+        a = np.where(free[:, None], self.F / self.m[:, None] + self.g, 0.0)
+        al = np.where(free[:, None], self.T / self.I[:, None], 0.0)
+        vh = self.v + a * dt / 2
+        wh = self.w + al * dt / 2
+        self.x = self.x + vh * dt
+        for ax in range(3):
+            if self.periodic[ax]:
+                L = self.hi[ax] - self.lo[ax]
+                under = self.x[:, ax] < self.lo[ax]
+                over = self.x[:, ax] >= self.hi[ax]
+                self.x[under, ax] += L
+                self.unwrap[under, ax] -= L
+                self.x[over, ax] -= L
+                self.unwrap[over, ax] += L
+                self.cover["wraps"] += int(under.sum() + over.sum())
+        vp = vh + a * dt / 2
+        wp = wh + al * dt / 2
+        self.F, self.T, p = self.forces(vp, wp, dt, keep=True)
+        a = np.where(free[:, None], self.F / self.m[:, None] + self.g, 0.0)
+        al = np.where(free[:, None], self.T / self.I[:, None], 0.0)
+        self.v = vh + a * dt / 2
+        self.w = wh + al * dt / 2
+        # trapezoid: the previous pass's half was counted; add its other half and this half
+        for m in self.models:
+            for k in (0, 1):
+                self.work[m][k] += 0.5 * dt * (self.last_power[m][k] + p[m][k])
+        self.last_power = p
+
+    def elastic(self):
+        """Stored energy of hertz and hooke over the pairs and walls (docs/many.md)."""
+        tot = 0.0
+        hooke_k = self.params.get("hooke.stiffness", 1e6)
+        L = self.hi - self.lo
+
+        def store(h, rstar, mp, key):
+            s = 0.0
+            hm = self.hist.get(key, {}).get("hmin")
+            if "nijssen" in self.models and hm is not None and h < hm:
+                # the potential of the lever-blended elastic force (docs/many.md)
+                k = 4 / 3 * mp["E"] * math.sqrt(rstar)
+                d = hm - h
+                if h > 0:
+                    s += 2 / 7 * k * d ** 3.5 / hm
+                else:
+                    s += 2 / 7 * k * hm ** 2.5 + 2 / 5 * k * (d ** 2.5 - hm ** 2.5)
+            if h >= 0:
+                return s
+            if "hertz" in self.models:
+                s += 8 / 15 * mp["E"] * math.sqrt(rstar) * (-h) ** 2.5
+            if "hooke" in self.models:
+                s += hooke_k * h * h / 2
+            return s
+        for i in range(self.n):
+            for j in range(i + 1, self.n):
+                if self.fixed[i] and self.fixed[j]:
+                    continue
+                d = self.x[i] - self.x[j]
+                for a in range(3):
+                    if self.periodic[a]:
+                        d[a] -= L[a] * round(d[a] / L[a])
+                h = np.linalg.norm(d) - self.R[i] - self.R[j]
+                mp = mixed(self.mats[self.mat[i]], self.mats[self.mat[j]])
+                tot += store(h, self.R[i] * self.R[j] / (self.R[i] + self.R[j]), mp, (i, j))
+            if not self.fixed[i]:
+                for k, (pt, nrm, wm) in enumerate(self.walls):
+                    h = np.dot(self.x[i] - pt, nrm) - self.R[i]
+                    tot += store(h, self.R[i], mixed(self.mats[self.mat[i]], self.mats[wm]),
+                                 (i, "w", k))
+        return tot
+
+
+def mindlin_update(s, n, vt, dt, kt, mstar, e, flim):
+    """docs/derivations/contact.md Sec. 2: rotate s into the tangent plane keeping its
+    length, advance by v_t dt, trial force spring + dashpot, cap at flim with the spring set
+    to match."""
+    sp = s - np.dot(s, n) * n
+    ns, nsp = np.linalg.norm(s), np.linalg.norm(sp)
+    s = sp * (ns / nsp) if nsp > 0 else np.zeros(3)
+    s = s + vt * dt
+    gam = -2 * math.sqrt(5 / 6) * beta_of(e) * math.sqrt(mstar * kt)
+    f = -kt * s - gam * vt
+    nf = np.linalg.norm(f)
+    if nf > flim:
+        f = f * (flim / nf)
+        s = -(f + gam * vt) / kt
+        SLIDES[0] += 1
+    else:
+        SLIDES[1] += 1
+    return f, s
+
+
+SLIDES = [0, 0]
+
+
+# ------------------------------------------------------------------ scenario files ---
+def write_ini(sc, path, steps, every=1):
+    lines = ["[box]"]
+    for ax, size in zip("xyz", sc["box"]):
+        lines.append(f"size_{ax} = {size!r}")
+    lines.append("periodic = " + (" ".join(sc.get("periodic", "")) or "none"))
+    lines += ["[walls]", "faces = " + (" ".join(sc.get("walls", [])) or "none")]
+    if sc.get("walls"):
+        lines.append(f"material = m{sc.get('wall_material', sc['particles'][0]['mat'])}")
+    for k, m in enumerate(sc["materials"]):
+        lines.append(f"[material.m{k}]")
+        lines += [f"{key} = {val!r}" for key, val in m.ini().items()]
+    lines += ["[fluid]", f"viscosity = {sc.get('viscosity', 1e-3)!r}",
+              f"surface_tension = {sc.get('surface_tension', 0.072)!r}"]
+    lines += ["[models]", "force = " + sc["models"],
+              "min_separation = " + sc.get("min_separation", "fixed")]
+    sections = {}
+    for key, val in sc.get("params", {}).items():
+        model, name = key.split(".")
+        sections.setdefault(model, []).append(f"{name} = {val}")
+    for model, keys in sections.items():
+        lines += [f"[model.{model}]"] + keys
+    g = sc.get("gravity", (0, 0, 0))
+    lines += ["[sim]"] + [f"gravity_{ax} = {gv!r}" for ax, gv in zip("xyz", g)]
+    for k, p in enumerate(sc["particles"]):
+        lines += [f"[particle.p{k}]", f"material = m{p['mat']}", f"radius = {p['R']!r}"]
+        lines += [f"{ax} = {val!r}" for ax, val in zip("xyz", p["x"])]
+        lines += [f"v{ax} = {val!r}" for ax, val in zip("xyz", p.get("v", (0, 0, 0)))]
+        lines += [f"spin_{ax} = {val!r}" for ax, val in zip("xyz", p.get("w", (0, 0, 0)))]
+        if p.get("fixed"):
+            lines.append("fixed = yes")
+    lines += ["[integrator]", "many_hmin_fraction = 0",
+              "[run]", f"steps = {steps}", f"dt = {sc['dt']!r}", "energy_budget = yes"]
+    # a skin of 0.5 um rebuilds the lists every few steps, so that the histories are carried
+    # across many rebuilds
+    lines.append(f"skin = {sc.get('skin', 5e-7)!r}")
+    lines += ["[dump]", f"vtk_every = {every}", "vtk_binary = yes", f"csv_every = {every}",
+              "checkpoint = none"]
+    with open(path, "w") as f:
+        f.write("\n".join(lines) + "\n")
+
+
+def run_case(sc, wetdem, steps, verbose=False, every=1):
+    """Runs the case through wetdem with a frame every `every` steps (and at the last) and
+    follows it with the reference. With every > 1 the engine steps between frames without
+    handing the state out, taking its fused paths (the closing half kick left to the next
+    step, the next step begun in the force pass: docs/many.md)."""
+    with tempfile.TemporaryDirectory() as tmp:
+        ini = os.path.join(tmp, "case.ini")
+        write_ini(sc, ini, steps, every)
+        r = subprocess.run([wetdem, "run", ini, "--out", tmp], capture_output=True, text=True,
+                           env=dict(os.environ, OMP_NUM_THREADS=str(sc.get("threads", 1)),
+                                    OMP_WAIT_POLICY="passive"))
+        if r.returncode not in (0,):
+            raise RuntimeError(f"{sc['name']}: wetdem exit {r.returncode}: {r.stderr}")
+        series = read_series(os.path.join(tmp, "particles.vtk.series"))
+        frames = [(round(t / sc["dt"]), read_vtk(p)) for t, p in series]
+        summary = json.load(open(os.path.join(tmp, "summary.json")))
+    ref = Reference(sc)
+    ref.start()
+    scale_x = max(ref.R)
+    scale_v = max(1e-300, max(np.abs(ref.v).max(), (np.abs(ref.w) * ref.R[:, None]).max()))
+    worst = {"x": 0.0, "v": 0.0, "w": 0.0}
+    vmax = scale_v
+    at = 0
+    for k, fr in frames:
+        while at < k:
+            ref.step()
+            at += 1
+        vmax = max(vmax, np.abs(ref.v).max(), (np.abs(ref.w) * ref.R[:, None]).max())
+        dx = fr["POINTS"] - ref.x
+        L = ref.hi - ref.lo
+        for a in range(3):
+            if ref.periodic[a]:
+                dx[:, a] -= L[a] * np.round(dx[:, a] / L[a])
+        worst["x"] = max(worst["x"], np.abs(dx).max() / scale_x)
+        worst["v"] = max(worst["v"], np.abs(fr["velocity"] - ref.v).max() / vmax)
+        worst["w"] = max(worst["w"], (np.abs(fr["spin"] - ref.w) * ref.R[:, None]).max() / vmax)
+        if verbose and (k % 50 == 0 or k == len(frames) - 1):
+            print(f"  step {k}: x {np.abs(dx).max():.3g} v "
+                  f"{np.abs(fr['velocity'] - ref.v).max():.3g} "
+                  f"w {np.abs(fr['spin'] - ref.w).max():.3g}")
+    e = summary["energy_J"]
+    kin, pot, ela = ref.kinetic(), ref.potential(), ref.elastic()
+    # the budget counts the latest pass's power by half (trapezoid), as ref.work holds it
+    wscale = max(abs(e["input"]), sum(abs(m["pairs"]) + abs(m["walls"])
+                                      for m in e["work_by_model"]), 1e-300)
+    total_work = sum(a + b for a, b in ref.work.values())
+    bud = {"kinetic": abs(e["kinetic"] - kin), "potential": abs(e["potential"] - pot),
+           "elastic": abs(e["elastic"] - ela), "input": abs(e["input"] - ref.input),
+           "dissipated": abs(e["dissipated"] - (ref.input - kin - pot - ela)),
+           "work_total": abs(e["work_total"] - total_work),
+           "balance_error": abs(e["balance_error"] - ((kin + pot - ref.E0) - total_work))}
+    for m in e["work_by_model"]:
+        bud[m["model"] + ".pairs"] = abs(m["pairs"] - ref.work[m["model"]][0])
+        bud[m["model"] + ".walls"] = abs(m["walls"] - ref.work[m["model"]][1])
+    bal_ref = (kin + pot - ref.E0) - total_work
+    if verbose:
+        for key, val in bud.items():
+            print(f"  budget {key}: {val / wscale:.3g}")
+        print(f"  balance error engine {e['balance_error']:.6g} reference {bal_ref:.6g}, "
+              f"work scale {wscale:.6g}")
+        for m in e["work_by_model"]:
+            print(f"  work {m['model']}: engine {m['pairs']:.17g} {m['walls']:.17g}, "
+                  f"reference {ref.work[m['model']][0]:.17g} {ref.work[m['model']][1]:.17g}")
+    worst["budget"] = max(bud.values()) / wscale
+    return worst, frames[-1][0], ref
+
+
+# ----------------------------------------------------------------------------- cases ---
+def glass(**kw):
+    base = dict(density=2500.0, youngs_modulus=1e8, poisson_ratio=0.3, restitution=0.6,
+                friction_dry=0.3, friction_lub=0.1)
+    base.update(kw)
+    return Material(**base)
+
+
+CASES = []
+
+
+def case(fn):
+    CASES.append(fn)
+    return fn
+
+
+@case
+def friction_spin_unequal():
+    """Two spheres of radii 1 and 0.5 mm meeting obliquely with spins: hertz (tsuji) +
+    mindlin, sticking and sliding; the torques' lever arms R_i and R_j differ."""
+    return dict(name="friction_spin_unequal", box=(0.01, 0.01, 0.01),
+                materials=[glass(), glass(youngs_modulus=2e8, poisson_ratio=0.25,
+                                          restitution=0.8, friction_dry=0.5)],
+                models="hertz mindlin", params={"hertz.damping": "tsuji"},
+                particles=[dict(R=1e-3, x=(0.004, 0.005, 0.005), v=(0.2, 0.05, -0.03),
+                                w=(10, -20, 30), mat=0),
+                           dict(R=0.5e-3, x=(0.00549, 0.0052, 0.005), v=(-0.1, 0, 0.02),
+                                w=(-40, 5, 0), mat=1)],
+                dt=2e-7, steps=600)
+
+
+@case
+def friction_spin_exact():
+    """The same pair with hertz's exact damping (clipped; coefficient from the engine's table,
+    about 4e-9 relative, against a bisection of Eq. 1.7 here)."""
+    sc = friction_spin_unequal()
+    sc.update(name="friction_spin_exact", params={}, tol=1e-8)
+    return sc
+
+
+def beside(centre, r0, r1, direction, gap):
+    """The centre of a sphere of radius r1 at surface gap `gap` from a sphere of radius r0 at
+    `centre`, along `direction`."""
+    u = np.asarray(direction, float)
+    u = u / np.linalg.norm(u)
+    return tuple(float(c) for c in np.asarray(centre) + (r0 + r1 + gap) * u)
+
+
+@case
+def three_and_wall():
+    """A sphere (R 1 mm) falling onto a floor under gravity while two smaller ones (0.6 and
+    0.8 mm, another material) strike it from two sides, all spinning: hertz + mindlin, up to
+    three contacts on the large sphere at once, each with its own lever arms."""
+    big = (0.005, 0.005, 0.001 + 1e-6)
+    return dict(name="three_and_wall", box=(0.01, 0.01, 0.01), walls=["z_min"],
+                materials=[glass(), glass(youngs_modulus=3e8, restitution=0.9,
+                                          friction_dry=0.2)],
+                models="hertz mindlin", gravity=(0, 0, -9.81), wall_material=1,
+                particles=[dict(R=1e-3, x=big, v=(0.01, 0.02, -0.05), w=(0, 30, 5), mat=0),
+                           dict(R=0.6e-3, x=beside(big, 1e-3, 0.6e-3, (1, 0, -0.2), 1e-6),
+                                v=(-0.05, 0.01, -0.05), w=(3, 0, -10), mat=1),
+                           dict(R=0.8e-3, x=beside(big, 1e-3, 0.8e-3, (0, 1, 0.2), 1e-6),
+                                v=(0, -0.05, 0.01), w=(20, 0, 0), mat=0)],
+                dt=2e-7, steps=1500, tol=1e-8)
+
+
+@case
+def periodic_straddle():
+    """A wet polydisperse pair meeting across the periodic x face (radii 0.9 and 0.4 mm, the
+    larger sphere wrapping through the face during the run), a third sphere striking the
+    larger one, periodic x and y, a floor and gravity along x and z (so that the unwrapped
+    potential counts the wrap): hertz + mindlin + sb + capillary with 20 and 30 um films."""
+    p0 = (0.005995, 0.003, 0.0011)
+    p1 = beside(p0, 0.9e-3, 0.4e-3, (1, 0.05, -0.15), 6e-6)
+    p1 = (p1[0] - 0.006,) + p1[1:]
+    return dict(name="periodic_straddle", box=(0.006, 0.006, 0.006), periodic="xy",
+                walls=["z_min"],
+                materials=[glass(film=20e-6), glass(film=30e-6, youngs_modulus=2e8)],
+                viscosity=0.01, surface_tension=0.05,
+                models="hertz mindlin sb capillary", params={"fixed.h_min": 2e-6},
+                gravity=(3.0, 0, -9.81),
+                particles=[dict(R=0.9e-3, x=p0, v=(0.1, 0.02, 0), w=(0, 0, 40), mat=0),
+                           dict(R=0.4e-3, x=p1, v=(-0.1, 0, 0.01), w=(10, 0, 0), mat=1),
+                           dict(R=0.5e-3, x=beside(p0, 0.9e-3, 0.5e-3, (-0.1, 1, -0.3), 5e-6),
+                                v=(0.1, -0.1, 0), mat=1)],
+                dt=1e-7, steps=2000, tol=1e-8)
+
+
+@case
+def slide_wall_hooke():
+    """A sphere set down on a floor under gravity, sliding at 0.1 m/s without spin: hooke +
+    mindlin (linear history spring, limit mu k delta), sliding at every step."""
+    return dict(name="slide_wall_hooke", box=(0.02, 0.01, 0.01), walls=["z_min"],
+                materials=[glass(restitution=0.3, friction_dry=0.4)],
+                models="hooke mindlin", params={"hooke.stiffness": 200.0},
+                gravity=(0, 0, -9.81),
+                particles=[dict(R=1e-3, x=(0.003, 0.005, 1e-3), v=(0.1, 0, 0),
+                                mat=0)],
+                dt=2e-6, steps=600, skin=2e-6)
+
+
+@case
+def slide_wall_hertz():
+    """A sphere sliding and spinning on a floor and a second sphere rolling along it in
+    contact: hertz + mindlin with a small skin, so that the lists are rebuilt many times
+    while the tangential springs persist."""
+    return dict(name="slide_wall_hertz", box=(0.02, 0.01, 0.01), walls=["z_min"],
+                materials=[glass(friction_dry=0.15)],
+                models="hertz mindlin", params={"hertz.damping": "tsuji"},
+                gravity=(0, 0, -9.81),
+                particles=[dict(R=1e-3, x=(0.003, 0.005, 1e-3), v=(0.3, 0.05, 0),
+                                w=(0, -100, 20), mat=0),
+                           dict(R=0.7e-3, x=(0.003, 0.005 + 1.67383e-3, 0.7e-3),
+                                v=(0.29, 0.04, 0), w=(0, 0, 0), mat=0)],
+                dt=2e-7, steps=800, skin=1e-6)
+
+
+def wet_pair(name, models, params=None, **kw):
+    """Three wet spheres (0.8, 0.5, 0.6 mm) and a wet floor: the smaller two strike the
+    larger one from 5 and 4 um (films of 40 and 50 um), which falls onto the floor from
+    8 um, all spinning, so that the films act apart, below h_min and in contact."""
+    p0 = (0.005, 0.005, 0.0008 + 8e-6)
+    sc = dict(name=name, box=(0.01, 0.01, 0.01), walls=["z_min"],
+              materials=[glass(film=25e-6), glass(film=15e-6, youngs_modulus=3e8)],
+              viscosity=0.01, surface_tension=0.06, models=models,
+              params=params or {"fixed.h_min": 3e-6},
+              particles=[dict(R=0.8e-3, x=p0, v=(0.03, 0.01, -0.1), w=(5, -10, 30), mat=0),
+                         dict(R=0.5e-3, x=beside(p0, 0.8e-3, 0.5e-3, (1, 0.02, 0.05), 5e-6),
+                              v=(-0.2, 0.005, 0), w=(0, 20, -5), mat=1),
+                         dict(R=0.6e-3, x=beside(p0, 0.8e-3, 0.6e-3, (0, 1, 0.1), 4e-6),
+                              v=(0.0, -0.15, 0.0), w=(-15, 0, 0), mat=0)],
+              dt=1e-7, steps=1500)
+    sc.update(kw)
+    return sc
+
+
+@case
+def wet_sb_davis():
+    return wet_pair("wet_sb_davis", "hertz mindlin sb davis capillary",
+                    {"fixed.h_min": 3e-6, "hertz.damping": "tsuji"})
+
+
+@case
+def wet_db_nase_nc():
+    return wet_pair("wet_db_nase_nc", "hertz mindlin db nase capillary",
+                    {"fixed.h_min": 3e-6, "hertz.damping": "tsuji", "db.below_hmin": "nc",
+                     "nase.below_hmin": "nc"})
+
+
+@case
+def wet_films_only():
+    """Film forces alone (no contact model): sb, db, davis, nase, capillary together."""
+    return wet_pair("wet_films_only", "sb db davis nase capillary",
+                    {"fixed.h_min": 1e-6, "sb.below_hmin": "nc"}, steps=500)
+
+
+@case
+def reynolds_hooke():
+    return wet_pair("reynolds_hooke", "hooke mindlin reynolds",
+                    {"fixed.h_min": 2e-6, "hooke.stiffness": 300.0,
+                     "reynolds.cutoff_ratio": 0.5}, viscosity=0.05)
+
+
+@case
+def nijssen_three():
+    return wet_pair("nijssen_three", "nijssen", {"nijssen.damping": "tsuji"},
+                    viscosity=0.05,
+                    materials=[glass(roughness=0.5e-6), glass(roughness=2e-6,
+                                                              youngs_modulus=3e8)])
+
+
+
+@case
+def fixed_sphere_ehd():
+    """Two wet spheres striking a fixed one (infinite mass: m* the other's mass, no motion
+    of its own) from either side, with ehd's h_min set by each pair's largest approach
+    speed: hertz + mindlin + sb + davis + capillary."""
+    base = (0.005, 0.005, 0.005)
+    return dict(name="fixed_sphere_ehd", box=(0.01, 0.01, 0.01),
+                materials=[glass(film=20e-6), glass(film=10e-6, youngs_modulus=5e8)],
+                viscosity=0.01, surface_tension=0.03, min_separation="ehd",
+                models="hertz mindlin sb davis capillary",
+                params={"hertz.damping": "tsuji"},
+                particles=[dict(R=0.7e-3, x=base, fixed=True, mat=1),
+                           dict(R=0.5e-3, x=beside(base, 0.7e-3, 0.5e-3, (1, 0.2, 0), 4e-6),
+                                v=(-0.2, 0.03, 0.01), w=(0, 10, 50), mat=0),
+                           dict(R=0.4e-3, x=beside(base, 0.7e-3, 0.4e-3, (-1, 0, 0.5), 3e-6),
+                                v=(0.1, 0.0, -0.08), w=(-30, 0, 0), mat=0)],
+                dt=1e-7, steps=1500)
+
+
+@case
+def glass_films():
+    """Wet spheres with glass's h_min (largest approach speed since the films overlapped,
+    p_gt lowered so that h_min is some um), db and nase below it held (nc), capillary."""
+    return wet_pair("glass_films", "hertz mindlin db nase capillary",
+                    {"glass.p_gt": 1e5, "hertz.damping": "tsuji", "db.below_hmin": "nc",
+                     "nase.below_hmin": "nc"}, min_separation="glass")
+
+
+@case
+def max_roughness_films():
+    """max(roughness, ehd) as h_min of sb and davis beside hooke + mindlin."""
+    return wet_pair("max_roughness_films", "hooke mindlin sb davis capillary",
+                    {"hooke.stiffness": 500.0}, min_separation="max",
+                    materials=[glass(film=25e-6, roughness=1e-6),
+                               glass(film=15e-6, roughness=3e-6, youngs_modulus=3e8)])
+
+
+@case
+def nijssen_tsuji_wall():
+    """nijssen (its own blended Hertz-Mindlin, tsuji damping) with a sphere falling onto a
+    floor into full contact under gravity."""
+    sc = wet_pair("nijssen_tsuji_wall", "nijssen", {"nijssen.damping": "tsuji"},
+                  viscosity=0.002, gravity=(0, 0, -9.81),
+                  materials=[glass(roughness=0.2e-6), glass(roughness=0.5e-6,
+                                                            youngs_modulus=3e8)])
+    sc["particles"][0]["v"] = (0.03, 0.01, -0.3)
+    return sc
+
+
+def cluster_eight():
+    """Eight wet polydisperse spheres (0.3-0.5 mm) grown as a cluster, each placed 1-8 um
+    from one before it, around the periodic x face of a box periodic in x and y with a
+    floor and gravity, and thrown about: several neighbours per sphere at once, contacts,
+    bridges and periodic images, hertz + mindlin + sb + davis + capillary."""
+    rng = np.random.default_rng(5)
+    L = np.array([2.6e-3, 2.6e-3, 0.005])
+    radii = [0.5e-3, 0.45e-3, 0.4e-3, 0.5e-3, 0.3e-3, 0.35e-3, 0.45e-3, 0.3e-3]
+    xs = [np.array([0.1e-3, 1.3e-3, 0.6e-3])]
+    while len(xs) < len(radii):
+        r = radii[len(xs)]
+        k = rng.integers(len(xs))
+        u = rng.normal(size=3)
+        c = np.array(beside(xs[k], radii[k], r, u, rng.uniform(1e-6, 8e-6)))
+        c[:2] %= L[:2]
+        ok = c[2] - r > 2e-6 and c[2] + r < L[2]
+        for x, rr in zip(xs, radii):
+            d = c - x
+            d[:2] -= L[:2] * np.round(d[:2] / L[:2])
+            ok = ok and np.linalg.norm(d) > r + rr + 0.5e-6
+        if ok:
+            xs.append(c)
+    parts = [dict(R=r, x=tuple(float(v) for v in x), v=tuple(rng.normal(0, 0.1, 3)),
+                  w=tuple(rng.normal(0, 100, 3)), mat=k % 2)
+             for k, (r, x) in enumerate(zip(radii, xs))]
+    return dict(name="cluster_eight", box=tuple(L), periodic="xy", walls=["z_min"],
+                materials=[glass(film=30e-6, friction_dry=0.4),
+                           glass(film=20e-6, youngs_modulus=2e8, restitution=0.4)],
+                viscosity=0.02, surface_tension=0.05,
+                models="hertz mindlin sb davis capillary",
+                params={"fixed.h_min": 2e-6, "hertz.damping": "tsuji"},
+                gravity=(0, 0, -9.81), particles=parts, dt=1e-7, steps=2000, skin=2e-6)
+
+
+CASES.append(cluster_eight)
+
+
+def cluster_variant(name, models, one_material, params, **kw):
+    sc = cluster_eight()
+    sc.update(name=name, models=models, params=params, **kw)
+    if one_material:  # one material pair: the lean kernel four pairs at a time
+        for p in sc["particles"]:
+            p["mat"] = 0
+    return sc
+
+
+@case
+def cluster_lean_wet():
+    """cluster_eight with one material and hertz mindlin sb capillary: the lean kernel, four
+    pairs and four walls at a time (docs/many.md, Fast path)."""
+    return cluster_variant("cluster_lean_wet", "hertz mindlin sb capillary", True,
+                           {"fixed.h_min": 2e-6, "hertz.damping": "tsuji"})
+
+
+@case
+def cluster_lean_dry():
+    """Dry, each sphere also thrown at 0.3 m/s towards the cluster's centre."""
+    sc = cluster_variant("cluster_lean_dry", "hertz mindlin", True, {"hertz.damping": "tsuji"})
+    L = np.array(sc["box"])
+    x0 = np.array(sc["particles"][0]["x"])
+    rel = []
+    for p in sc["particles"]:
+        d = np.array(p["x"]) - x0
+        d[:2] -= L[:2] * np.round(d[:2] / L[:2])
+        rel.append(d)
+    centre = np.mean(rel, axis=0)
+    for p, d in zip(sc["particles"], rel):
+        u = (centre - d) / np.linalg.norm(centre - d)
+        p["v"] = tuple(float(c) for c in np.array(p["v"]) + 0.3 * u)
+    return sc
+
+
+@case
+def cluster_lean_exact_order():
+    """Another model order, exact damping and sb held below h_min (nc)."""
+    return cluster_variant("cluster_lean_exact_order", "capillary sb mindlin hertz", True,
+                           {"fixed.h_min": 2e-6, "sb.below_hmin": "nc"}, tol=1e-8)
+
+
+@case
+def cluster_mindlin_no_hertz():
+    """mindlin and the films without a normal contact law (the spring still acts on
+    overlaps)."""
+    return cluster_variant("cluster_mindlin_no_hertz", "mindlin sb capillary", True,
+                           {"fixed.h_min": 2e-6})
+
+
+@case
+def bounce_ehd_record():
+    """A wet sphere (film 10 um on it and on the floor) bouncing on a floor under strong
+    gravity with spin: it leaves the films (and the wall's list) and comes back, with ehd's
+    record kept within reset_ratio R and the spring reset at each lift-off."""
+    return dict(name="bounce_ehd_record", box=(0.01, 0.01, 0.01), walls=["z_min"],
+                materials=[glass(film=10e-6, restitution=0.9, friction_dry=0.3)],
+                viscosity=1e-4, surface_tension=0.02, min_separation="ehd",
+                models="hertz mindlin sb davis capillary",
+                params={"hertz.damping": "tsuji", "sb.below_hmin": "nc",
+                        "davis.below_hmin": "nc"}, gravity=(0, 0, -1000.0),
+                particles=[dict(R=0.5e-3, x=(0.005, 0.005, 0.5e-3 + 19e-6),
+                                v=(0.05, 0.02, -0.4), w=(100, -50, 20), mat=0)],
+                dt=2e-7, steps=5000)
+
+
+@case
+def bounce_fixed_hmin():
+    """The same bounce with a fixed h_min and a second sphere bouncing beside it."""
+    sc = bounce_ehd_record()
+    sc.update(name="bounce_fixed_hmin", min_separation="fixed",
+              params={"hertz.damping": "tsuji", "fixed.h_min": 1e-6})
+    sc["particles"].append(dict(R=0.3e-3, x=(0.005, 0.005 + 0.8e-3 + 3e-6, 0.3e-3 + 30e-6),
+                                v=(0.0, -0.1, -0.5), w=(0, 0, -300), mat=0))
+    return sc
+
+
+@case
+def hooke_fixed():
+    """hooke + mindlin against a fixed sphere and a wall, with davis and capillary films."""
+    base = (0.005, 0.005, 0.0009)
+    return dict(name="hooke_fixed", box=(0.01, 0.01, 0.01), walls=["z_min"],
+                materials=[glass(film=20e-6), glass(film=10e-6, youngs_modulus=5e8)],
+                viscosity=0.01, surface_tension=0.03,
+                models="hooke mindlin davis capillary",
+                params={"hooke.stiffness": 400.0, "fixed.h_min": 1e-6},
+                gravity=(0, 0, -9.81),
+                particles=[dict(R=0.7e-3, x=base, fixed=True, mat=1),
+                           dict(R=0.5e-3, x=beside(base, 0.7e-3, 0.5e-3, (1, 0.2, 0), 4e-6),
+                                v=(-0.2, 0.03, 0.01), w=(0, 10, 50), mat=0),
+                           dict(R=0.4e-3, x=beside(base, 0.7e-3, 0.4e-3, (-1, 0, 0.3), 3e-6),
+                                v=(0.1, 0.0, -0.08), w=(-30, 0, 0), mat=0)],
+                dt=1e-7, steps=1500)
+
+
+
+@case
+def roll_off_fixed():
+    """A sphere (0.4 mm) rolling off the top of a fixed one (1 mm) under strong gravity with
+    a high friction: the contact sticks while its normal turns by tens of degrees, so the
+    spring is rotated into each new tangent plane (kept at its length) at every step."""
+    base = (0.005, 0.005, 0.004)
+    return dict(name="roll_off_fixed", box=(0.01, 0.01, 0.01),
+                materials=[glass(friction_dry=1.0, restitution=0.5)], models="hertz mindlin",
+                params={"hertz.damping": "tsuji"}, gravity=(0, 0, -5000.0),
+                particles=[dict(R=1e-3, x=base, fixed=True, mat=0),
+                           dict(R=0.4e-3, x=beside(base, 1e-3, 0.4e-3, (0.15, 0.05, 1), 1e-8),
+                                mat=0)],
+                dt=2e-7, steps=3000)
+
+
+
+@case
+def channel_walls():
+    """A wet sphere squeezed across a channel one diameter wide (walls at x_min and x_max,
+    of another material with a film of its own) and a second one striking it along the
+    channel, under gravity along y: both walls act on the first sphere at once."""
+    return dict(name="channel_walls", box=(2.004e-3, 0.01, 0.01), walls=["x_min", "x_max"],
+                materials=[glass(film=10e-6), glass(film=5e-6, youngs_modulus=4e8,
+                                                     friction_dry=0.5)],
+                wall_material=1, viscosity=0.005, surface_tension=0.04,
+                models="hertz mindlin sb nase capillary",
+                params={"fixed.h_min": 1e-6, "hertz.damping": "tsuji",
+                        "nase.below_hmin": "nc"}, gravity=(0, -2000.0, 0),
+                particles=[dict(R=1e-3, x=(1.002e-3, 0.005, 0.005), v=(0.1, 0, 0.02),
+                                w=(0, 100, -50), mat=0),
+                           dict(R=0.6e-3, x=(1.2e-3, 0.005 + 1.6e-3 + 5e-6, 0.005),
+                                v=(-0.05, -0.2, 0), w=(30, 0, 0), mat=0)],
+                dt=1e-7, steps=1500)
+
+
+@case
+def nijssen_exact():
+    """nijssen with its exact damping (tabulated coefficient, as hertz's)."""
+    sc = wet_pair("nijssen_exact", "nijssen", {}, viscosity=0.002, gravity=(0, 0, -9.81),
+                  materials=[glass(roughness=0.2e-6), glass(roughness=0.5e-6,
+                                                            youngs_modulus=3e8)], tol=1e-8)
+    sc["particles"][0]["v"] = (0.03, 0.01, -0.3)
+    return sc
+
+
+@case
+def glass_initial():
+    return wet_pair("glass_initial", "hertz mindlin sb davis capillary",
+                    {"glass.p_gt": 1e5, "glass.speed": "initial", "hertz.damping": "tsuji",
+                     "sb.below_hmin": "nc", "davis.below_hmin": "nc"},
+                    min_separation="glass")
+
+
+@case
+def glass_current():
+    return wet_pair("glass_current", "hertz mindlin sb davis capillary",
+                    {"glass.p_gt": 1e5, "glass.speed": "current", "hertz.damping": "tsuji",
+                     "sb.below_hmin": "nc", "davis.below_hmin": "nc"},
+                    min_separation="glass")
+
+
+
+@case
+def periodic_fixed_straddle():
+    """periodic_straddle with its small sphere fixed across the face from the large one."""
+    sc = periodic_straddle()
+    sc["name"] = "periodic_fixed_straddle"
+    sc["particles"][1].update(fixed=True, v=(0, 0, 0), w=(0, 0, 0))
+    return sc
+
+
+
+@case
+def pack_512_threads():
+    """512 wet spheres (R 0.47-0.5 mm, two materials) on a simple cubic lattice 3 um apart at
+    the closest, periodic in x and y over a floor, with random velocities and spins and
+    gravity, run on two threads: the blocks, the pairs crossing them and the summation
+    order of the parallel force pass (docs/many.md), with hertz + mindlin + sb + davis +
+    capillary."""
+    rng = np.random.default_rng(11)
+    nx, nz, a = 8, 8, 1.003e-3
+    parts = []
+    for k in range(nz):
+        for j in range(nx):
+            for i in range(nx):
+                r = rng.uniform(0.47e-3, 0.5e-3)
+                parts.append(dict(R=r, x=(a * (i + 0.5), a * (j + 0.5), 0.502e-3 + a * k),
+                                  v=tuple(rng.normal(0, 0.3, 3)),
+                                  w=tuple(rng.normal(0, 300, 3)), mat=(i + j + k) % 2))
+    return dict(name="pack_512_threads", box=(nx * a, nx * a, 0.012), periodic="xy",
+                walls=["z_min"],
+                materials=[glass(film=20e-6, friction_dry=0.4),
+                           glass(film=10e-6, youngs_modulus=2e8, restitution=0.4)],
+                viscosity=0.01, surface_tension=0.05,
+                models="hertz mindlin sb davis capillary",
+                params={"fixed.h_min": 1e-6, "hertz.damping": "tsuji"},
+                gravity=(0, 0, -9.81), particles=parts, dt=1e-7, steps=150, threads=2,
+                skin=2e-6)
+
+
+@case
+def pack_512_lean():
+    """The same packing with one material and hertz mindlin sb capillary: the lean kernel
+    four pairs at a time, on two threads."""
+    sc = pack_512_threads()
+    sc.update(name="pack_512_lean", models="hertz mindlin sb capillary")
+    for p in sc["particles"]:
+        p["mat"] = 0
+    return sc
+
+
+
+# ----------------------------------------------------------------------------- mutants ---
+# Deliberate errors in the reference, each of which the comparison must detect in the case
+# named: they show that the agreement above is not reached by cases that miss the point.
+def _mutant_lever(ctx):
+    orig = Reference.pair_force
+
+    def pf(self, key, ri, rj, *a):
+        out, new, h = orig(self, key, ri, rj, *a)
+        if not a[-1]:  # spheres: j's torque with i's lever arm
+            out = [(nm, f, ti, tj * (ri / rj)) for nm, f, ti, tj in out]
+        return out, new, h
+    ctx.append((Reference, "pair_force", orig))
+    Reference.pair_force = pf
+
+
+def _mutant_record(ctx):
+    orig = Reference.min_separation
+
+    def ms(self, old, new, h, vn, rstar, mp):
+        return orig(self, {} if h > mp["film"] else old, new, h, vn, rstar, mp)
+    ctx.append((Reference, "min_separation", orig))
+    Reference.min_separation = ms
+
+
+def _mutant_coulomb(ctx):
+    orig = globals()["mindlin_update"]
+    ctx.append((sys.modules[__name__], "mindlin_update", orig))
+    globals()["mindlin_update"] = lambda s, n, vt, dt, kt, m, e, fl: \
+        orig(s, n, vt, dt, kt, m, e, fl * 0.999)
+
+
+def _mutant_image(ctx):
+    orig = Reference.near_pairs
+
+    def near(self):  # the pairs across a periodic face are lost
+        return [(i, j) for i, j in orig(self)
+                if not any(self.periodic[a] and abs(self.x[i][a] - self.x[j][a]) >
+                           (self.hi[a] - self.lo[a]) / 2 for a in range(3))]
+    ctx.append((Reference, "near_pairs", orig))
+    Reference.near_pairs = near
+
+
+def _mutant_power(ctx):
+    orig = Reference.forces
+
+    def forces(self, v, w, dt, keep):  # the power at the velocities before the step
+        F, T, p = orig(self, v, w, dt, keep)
+        if keep:
+            self.hist, saved = dict(self.hist), self.hist
+            _, _, p = orig(self, self.v, self.w, dt, False)
+            self.hist = saved
+        return F, T, p
+    ctx.append((Reference, "forces", orig))
+    Reference.forces = forces
+
+
+MUTANTS = [("torque on j with i's lever arm", _mutant_lever, "friction_spin_unequal"),
+           ("ehd record forgotten at the film edge", _mutant_record, "bounce_ehd_record"),
+           ("Coulomb limit 0.1 % low", _mutant_coulomb, "slide_wall_hertz"),
+           ("pairs across a periodic face lost", _mutant_image, "periodic_straddle"),
+           ("work at the velocities of the step's start", _mutant_power, "wet_films_only")]
+
+
+def run_mutants(wetdem, every):
+    """1 when a mutant of the reference still agrees with the engine."""
+    by_name = {fn.__name__: fn for fn in CASES}
+    bad = 0
+    for what, patch, name in MUTANTS:
+        sc = by_name[name]()
+        ctx = []
+        patch(ctx)
+        try:
+            worst, _, _ = run_case(sc, wetdem, sc["steps"], False, every)
+        finally:
+            for owner, attr, orig in ctx:
+                setattr(owner, attr, orig)
+        caught = max(worst.values()) > 100 * sc.get("tol", 1e-9)
+        bad += not caught
+        print(f"{'ok ' if caught else 'BAD'} mutant '{what}' on {name}: off by "
+              f"{max(worst.values()):.2g}{'' if caught else ' (not detected)'}")
+    return 1 if bad else 0
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--wetdem", default="build/wetdem")
+    ap.add_argument("--only")
+    ap.add_argument("-v", action="store_true")
+    ap.add_argument("--every", type=int, default=1,
+                    help="steps between the frames compared (default 1)")
+    ap.add_argument("--coverage", action="store_true",
+                    help="print what each case exercised (contacts, slides, films, ...)")
+    ap.add_argument("--mutants", action="store_true",
+                    help="instead, check that deliberate errors of the reference are detected")
+    args = ap.parse_args()
+    if args.mutants:
+        return run_mutants(args.wetdem, args.every)
+    bad = 0
+    for fn in CASES:
+        sc = fn()
+        if args.only and sc["name"] != args.only:
+            continue
+        tol = sc.get("tol", 1e-9)
+        SLIDES[:] = [0, 0]
+        worst, steps, ref = run_case(sc, args.wetdem, sc["steps"], args.v, args.every)
+        ok = max(worst.values()) <= tol
+        bad += not ok
+        print(f"{'ok ' if ok else 'BAD'} {sc['name']:<28} {steps} steps: x {worst['x']:.2g} "
+              f"v {worst['v']:.2g} w {worst['w']:.2g} budget {worst['budget']:.2g} "
+              f"(tol {tol:g})")
+        if args.v or args.coverage:
+            print("    exercised:", ", ".join(f"{k} {v}" for k, v in ref.cover.items()),
+                  f"slides {SLIDES[0]} sticks {SLIDES[1]};",
+                  ", ".join(f"{k} {v}" for k, v in sorted(ref.cover_model.items())))
+    return 1 if bad else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
