@@ -1,6 +1,7 @@
 """An independent reference of the many-particle engine (docs/many.md) in plain Python/numpy,
 written from the documented step and force laws, not from the C code: velocity Verlet with the
-forces at the predicted velocities (docs/many.md, "Time step"), the pair and wall geometry and
+forces at the predicted velocities and the tangential springs advanced with the slip of the
+half-step velocities (docs/many.md, "Time step"), the pair and wall geometry and
 signs of docs/concepts.md, the laws of docs/models.md and docs/derivations/ (hertz with
 damping = tsuji or exact, hooke, mindlin beside either, sb, db, davis, nase, capillary,
 reynolds with a fixed h_min, nijssen with its own h_min record and blended contact), walls,
@@ -169,10 +170,12 @@ class Reference:
         self.cover_model = {}
 
     # -------------------------------------------------------------- one pair's forces ---
-    def pair_force(self, key, ri, rj, mi, mj, mp, d, vi, vj, wi, wj, dt, wall):
+    def pair_force(self, key, ri, rj, mi, mj, mp, d, vi, vj, wi, wj, dt, wall, half=None):
         """Forces of every model on i: list of (model, F_i (3), T_i, T_j) and the new history.
         d = x_i - x_j (minimum image) for a sphere, or for a wall the normal times the
-        centre's distance from it. rj, mj = inf for a wall or fixed sphere (mj)."""
+        centre's distance from it. rj, mj = inf for a wall or fixed sphere (mj). half: the
+        half-step (vi, vj, wi, wj), whose slip the springs advance with (None: the slip of
+        the velocities given, as at the start, where dt = 0)."""
         dist = math.sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
         n = d / dist
         if wall:
@@ -188,6 +191,12 @@ class Reference:
         vs = (vi + cross(wi, -ri * n)) - (vj + (np.zeros(3) if wall else
                                                    cross(wj, rj * n)))
         vt = vs - np.dot(vs, n) * n
+        vts = vt
+        if half is not None:
+            hvi, hvj, hwi, hwj = half
+            us = (hvi + cross(hwi, -ri * n)) - (hvj + (np.zeros(3) if wall else
+                                                       cross(hwj, rj * n)))
+            vts = us - np.dot(us, n) * n
         old = self.hist.get(key, {})
         new = {}
         out = []
@@ -237,7 +246,7 @@ class Reference:
                     else:
                         kt = 8 * mp["G"] * math.sqrt(rstar * delta)
                         flim = mu * 4 / 3 * mp["E"] * math.sqrt(rstar) * delta ** 1.5
-                    ft, s = mindlin_update(s, n, vt, dt, kt, mstar, mp["e"], flim)
+                    ft, s = mindlin_update(s, n, vt, dt, kt, mstar, mp["e"], flim, vts)
                     new["s"] = s
                     tangential(name, ft)
                 else:
@@ -289,7 +298,7 @@ class Reference:
                     f = 6 * PI * self.mu_f * rstar ** 2 * vn / max(h, hmin)
                 normal(name, f)
             elif name == "nijssen":
-                fn, ft, st = self.nijssen(old, h, vn, vt, n, rstar, mstar, mp, dt)
+                fn, ft, st = self.nijssen(old, h, vn, vt, vts, n, rstar, mstar, mp, dt)
                 new.update(st)
                 out.append((name, fn * n + ft, cross(-ri * n, ft),
                             np.zeros(3) if wall else cross(rj * n, -ft)))
@@ -331,7 +340,7 @@ class Reference:
                                  self.params.get("glass.p_gt", 1.16e7)), film)
         raise ValueError(model)
 
-    def nijssen(self, old, h, vn, vt, n, rstar, mstar, mp, dt):
+    def nijssen(self, old, h, vn, vt, vts, n, rstar, mstar, mp, dt):
         """Nijssen Eqs. 1, 3-10 as docs/derivations/fluid.md Sec. 5 states them."""
         hco = self.params.get("nijssen.cutoff_ratio", 1.0) * rstar
         if h > hco:
@@ -363,7 +372,7 @@ class Reference:
             mu = mp["mu_dry"] if h_sig >= h_eps else mp["mu_lub"]
             kt = 8 * mp["G"] * math.sqrt(rstar * dn)
             ft, s = mindlin_update(old.get("s", np.zeros(3)), n, vt, dt, kt, mstar, mp["e"],
-                                   mu * wc * fel)
+                                   mu * wc * fel, vts)
             st["s"] = s
         return fn, ft, st
 
@@ -385,7 +394,9 @@ class Reference:
         ii, jj = np.nonzero(np.triu(near, 1))
         return zip(ii.tolist(), jj.tolist())
 
-    def forces(self, v, w, dt, keep):
+    def forces(self, v, w, dt, keep, vh=None, wh=None):
+        """The force pass at velocities v and spins w; the springs advance over dt with the
+        slip of the half-step ones vh, wh (None: of v, w)."""
         F = np.zeros((self.n, 3))
         T = np.zeros((self.n, 3))
         power = {m: [0.0, 0.0] for m in self.models}
@@ -401,8 +412,9 @@ class Reference:
                 mi = math.inf if self.fixed[i] else self.m[i]
                 mj = math.inf if self.fixed[j] else self.m[j]
                 mp = mixed(self.mats[self.mat[i]], self.mats[self.mat[j]])
+                half = None if vh is None else (vh[i], vh[j], wh[i], wh[j])
                 out, new, h = self.pair_force((i, j), self.R[i], self.R[j], mi, mj, mp, d,
-                                              v[i], v[j], w[i], w[j], dt, False)
+                                              v[i], v[j], w[i], w[j], dt, False, half)
                 newhist[(i, j)] = new
                 crossed = any(self.periodic[a] and abs(self.x[i][a] - self.x[j][a]) > L[a] / 2
                               for a in range(3))
@@ -424,9 +436,10 @@ class Reference:
             for k, (pt, nrm, wm) in enumerate(self.walls):
                 dist = np.dot(self.x[i] - pt, nrm)
                 mp = mixed(self.mats[self.mat[i]], self.mats[wm])
+                half = None if vh is None else (vh[i], np.zeros(3), wh[i], np.zeros(3))
                 out, new, h = self.pair_force((i, "w", k), self.R[i], math.inf, self.m[i],
                                               math.inf, mp, dist * nrm, v[i], np.zeros(3),
-                                              w[i], np.zeros(3), dt, True)
+                                              w[i], np.zeros(3), dt, True, half)
                 newhist[(i, "w", k)] = new
                 if keep and any(np.any(f != 0) for _, f, _, _ in out):
                     partners[i] += 1
@@ -486,7 +499,7 @@ class Reference:
                 self.cover["wraps"] += int(under.sum() + over.sum())
         vp = vh + a * dt / 2
         wp = wh + al * dt / 2
-        self.F, self.T, p = self.forces(vp, wp, dt, keep=True)
+        self.F, self.T, p = self.forces(vp, wp, dt, keep=True, vh=vh, wh=wh)
         a = np.where(free[:, None], self.F / self.m[:, None] + self.g, 0.0)
         al = np.where(free[:, None], self.T / self.I[:, None], 0.0)
         self.v = vh + a * dt / 2
@@ -540,14 +553,14 @@ class Reference:
         return tot
 
 
-def mindlin_update(s, n, vt, dt, kt, mstar, e, flim):
+def mindlin_update(s, n, vt, dt, kt, mstar, e, flim, vs):
     """docs/derivations/contact.md Sec. 2: rotate s into the tangent plane keeping its
-    length, advance by v_t dt, trial force spring + dashpot, cap at flim with the spring set
-    to match."""
+    length, advance by v_s dt (the slip of the half-step velocities), trial force spring +
+    dashpot (at v_t), cap at flim with the spring set to match."""
     sp = s - np.dot(s, n) * n
     ns, nsp = np.linalg.norm(s), np.linalg.norm(sp)
     s = sp * (ns / nsp) if nsp > 0 else np.zeros(3)
-    s = s + vt * dt
+    s = s + vs * dt
     gam = -2 * math.sqrt(5 / 6) * beta_of(e) * math.sqrt(mstar * kt)
     f = -kt * s - gam * vt
     nf = np.linalg.norm(f)
@@ -1146,7 +1159,7 @@ def _mutant_lever(ctx):
 
     def pf(self, key, ri, rj, *a):
         out, new, h = orig(self, key, ri, rj, *a)
-        if not a[-1]:  # spheres: j's torque with i's lever arm
+        if not a[9]:  # (wall) spheres: j's torque with i's lever arm
             out = [(nm, f, ti, tj * (ri / rj)) for nm, f, ti, tj in out]
         return out, new, h
     ctx.append((Reference, "pair_force", orig))
@@ -1165,8 +1178,8 @@ def _mutant_record(ctx):
 def _mutant_coulomb(ctx):
     orig = globals()["mindlin_update"]
     ctx.append((sys.modules[__name__], "mindlin_update", orig))
-    globals()["mindlin_update"] = lambda s, n, vt, dt, kt, m, e, fl: \
-        orig(s, n, vt, dt, kt, m, e, fl * 0.999)
+    globals()["mindlin_update"] = lambda s, n, vt, dt, kt, m, e, fl, vs: \
+        orig(s, n, vt, dt, kt, m, e, fl * 0.999, vs)
 
 
 def _mutant_image(ctx):
@@ -1183,8 +1196,8 @@ def _mutant_image(ctx):
 def _mutant_power(ctx):
     orig = Reference.forces
 
-    def forces(self, v, w, dt, keep):  # the power at the velocities before the step
-        F, T, p = orig(self, v, w, dt, keep)
+    def forces(self, v, w, dt, keep, vh=None, wh=None):  # the power at the step's start
+        F, T, p = orig(self, v, w, dt, keep, vh, wh)
         if keep:
             self.hist, saved = dict(self.hist), self.hist
             _, _, p = orig(self, self.v, self.w, dt, False)
@@ -1194,7 +1207,18 @@ def _mutant_power(ctx):
     Reference.forces = forces
 
 
+def _mutant_spring(ctx):
+    orig = Reference.forces
+
+    def forces(self, v, w, dt, keep, vh=None, wh=None):  # the springs with the predicted slip
+        return orig(self, v, w, dt, keep)
+    ctx.append((Reference, "forces", orig))
+    Reference.forces = forces
+
+
 MUTANTS = [("torque on j with i's lever arm", _mutant_lever, "friction_spin_unequal"),
+           ("springs advanced with the predicted slip (first order)", _mutant_spring,
+            "friction_spin_unequal"),
            ("ehd record forgotten at the film edge", _mutant_record, "bounce_ehd_record"),
            ("Coulomb limit 0.1 % low", _mutant_coulomb, "slide_wall_hertz"),
            ("pairs across a periodic face lost", _mutant_image, "periodic_straddle"),
