@@ -170,6 +170,23 @@ class Reference:
         self.cover_model = {}
 
     # -------------------------------------------------------------- one pair's forces ---
+    def film_gap(self, name, h, hmin, film, dt):
+        """The gap a thin-film law of model `name` takes at gap h (docs/models.md): h within
+        [h_min', delta] with h_min' = min(h_min, delta), h_min' below it with below_hmin = nc,
+        else None (the law does not act)."""
+        if not film > 0:
+            return None
+        hm = min(hmin, film)
+        he = None
+        if hm <= h <= film:
+            he = h
+        elif h < hm and self.params.get(name + ".below_hmin", "c") == "nc" and hm > 0:
+            he = hm
+        if he is None or not he > 0:
+            return None
+        self.cover["below_hmin"] += he != h and dt > 0
+        return he
+
     def pair_force(self, key, ri, rj, mi, mj, mp, d, vi, vj, wi, wj, dt, wall, half=None):
         """Forces of every model on i: list of (model, F_i (3), T_i, T_j) and the new history.
         d = x_i - x_j (minimum image) for a sphere, or for a wall the normal times the
@@ -253,40 +270,23 @@ class Reference:
                     tangential(name, np.zeros(3))
             elif name in ("sb", "db"):
                 f = 0.0
-                if film > 0:
-                    hm = min(hmin, film)
-                    below = self.params.get(name + ".below_hmin", "c")
-                    he = None
-                    if hm <= h <= film:
-                        he = h
-                    elif h < hm and below == "nc" and hm > 0:
-                        he = hm
-                    if he is not None and he > 0:
-                        self.cover["below_hmin"] += he != h and dt > 0
-                        self.cover["below_hmin"] += he != h
-                        if name == "sb":
-                            br = (1 - he / film) ** 2
-                        else:
-                            br = (1 - he / (2 * film - he)) ** 2
-                        f = 6 * PI * self.mu_f * rstar ** 2 * vn / he * br
+                he = self.film_gap(name, h, hmin, film, dt)
+                if he is not None:
+                    if name == "sb":
+                        br = (1 - he / film) ** 2
+                    else:
+                        br = (1 - he / (2 * film - he)) ** 2
+                    f = 6 * PI * self.mu_f * rstar ** 2 * vn / he * br
                 normal(name, f)
             elif name in ("davis", "nase"):
                 ft = np.zeros(3)
-                if film > 0:
-                    hm = min(hmin, film)
-                    below = self.params.get(name + ".below_hmin", "c")
-                    he = None
-                    if hm <= h <= film:
-                        he = h
-                    elif h < hm and below == "nc" and hm > 0:
-                        he = hm
-                    if he is not None and he > 0:
-                        self.cover["below_hmin"] += he != h and dt > 0
-                        if name == "davis":
-                            ft = -2 * PI * self.mu_f * rstar * math.log((2 * film - he) / he) * vt
-                        else:
-                            fac = max(0.0, 8 / 15 * math.log(rstar / he) + 0.9588)
-                            ft = -6 * PI * self.mu_f * rstar * fac * vt
+                he = self.film_gap(name, h, hmin, film, dt)
+                if he is not None:
+                    if name == "davis":
+                        ft = -2 * PI * self.mu_f * rstar * math.log((2 * film - he) / he) * vt
+                    else:
+                        fac = max(0.0, 8 / 15 * math.log(rstar / he) + 0.9588)
+                        ft = -6 * PI * self.mu_f * rstar * fac * vt
                 tangential(name, ft)
             elif name == "capillary":
                 f = -8 * PI * rstar * self.sigma if (film > 0 and h <= film) else 0.0
