@@ -386,7 +386,7 @@ struct lean_geometry {
     double k, damping;      /* hertz_stiffness and hertz_damping_factor of the pair */
     double v_n;             /* [m/s] */
     struct wetdem_vec3 v_t; /* [m/s], set only when mindlin is enabled */
-    struct wetdem_vec3 v_s; /* what the spring advances with (spring_velocity), the same */
+    struct wetdem_vec3 v_s; /* [m/s], what the spring advances with (spring_velocity); as v_t */
     bool wall;
 };
 
