@@ -715,14 +715,16 @@ static void test_mindlin_total_never_exceeds_coulomb_limit(void** state)
 /* Largest |F_t| / (mu F_el) over every evaluation of the probe model below. */
 static double probe_worst_ratio;
 static long probe_evaluations;
+/* The stiffness the user last gave hooke [N/m], which every evaluation of the linear probe
+ * (mindlin_linear_probe_pair) must see as c->linear_stiffness. */
+static double probe_hooke_k;
 
-/* mindlin, recording |F_t| / (mu F_el) of each evaluation in contact. */
-static int mindlin_probe_pair(const void* params, const struct wetdem_contact* c, double* history,
-                              struct wetdem_pair_force* out)
+/* mindlin's pair(), recording |F_t| / (mu f_el) where the elastic normal force f_el > 0. */
+static int mindlin_recorded(const void* params, const struct wetdem_contact* c, double* history,
+                            struct wetdem_pair_force* out, double f_el)
 {
     struct wetdem_pair_force f = {0};
     int st = wetdem_force_mindlin.pair(params, c, history, &f);
-    double f_el = wetdem_force_hertz_elastic(c->e_star, c->r_eff, -c->gap);
     if (f_el > 0.0) {
         probe_worst_ratio =
             fmax(probe_worst_ratio, vec3_norm_test(f.f_tan) / (c->friction_dry * f_el));
@@ -732,6 +734,59 @@ static int mindlin_probe_pair(const void* params, const struct wetdem_contact* c
     out->torque_i = f.torque_i;
     out->torque_j = f.torque_j;
     return st;
+}
+
+/* mindlin, recording |F_t| / (mu F_el) of each evaluation in contact. */
+static int mindlin_probe_pair(const void* params, const struct wetdem_contact* c, double* history,
+                              struct wetdem_pair_force* out)
+{
+    return mindlin_recorded(params, c, history, out,
+                            wetdem_force_hertz_elastic(c->e_star, c->r_eff, -c->gap));
+}
+
+/* Oblique dry collisions of two steel spheres (R = 6.35 mm, 0.5 m/s, e_dry = 0.5, mu = 0.1)
+ * at 5, 10 and 20 deg, where the contact sticks and slides in turn, with `integrator` up to
+ * t_end, the Coulomb probe `probe` (probe_worst_ratio: the largest |F_t| over its limit) beside
+ * hertz, or beside hooke of stiffness hooke_k when it is > 0; more than min_evals evaluations
+ * in contact. 1e-14: the capped total equals the limit up to the rescaling roundings; the
+ * limit is reached (sliding phases, 1e-12), so the check is not vacuous. */
+static void oblique_collisions_obey_coulomb(const struct wetdem_model* probe, double hooke_k,
+                                            const char* integrator, double t_end, long min_evals)
+{
+    const double angles[] = {5, 10, 20};
+    for (int a = 0; a < 3; a++) {
+        struct wetdem_sim* sim = wetdem_sim_create();
+        struct wetdem_material m;
+        CHECK_OK(wetdem_material_preset("steel1", &m));
+        m.restitution = 0.5;
+        m.friction_dry = 0.1;
+        int mat = wetdem_sim_add_material(sim, &m);
+        double p[1] = {0.0}; /* friction = dry */
+        CHECK_OK(wetdem_sim_enable_model(sim, hooke_k > 0 ? "hooke" : "hertz"));
+        CHECK_OK(wetdem_sim_add_model(sim, probe, p));
+        if (hooke_k > 0) {
+            probe_hooke_k = hooke_k;
+            CHECK_OK(wetdem_sim_set_param(sim, "hooke.stiffness", hooke_k));
+        }
+        CHECK_OK(wetdem_sim_set_integrator(sim, integrator));
+        struct wetdem_collision_spec spec = {.material_i = mat,
+                                             .material_j = mat,
+                                             .radius_i = 6.35e-3,
+                                             .radius_j = 6.35e-3,
+                                             .speed = 0.5,
+                                             .angle = angles[a] * M_PI / 180,
+                                             .t_end = t_end};
+        struct wetdem_collision_result r;
+        probe_worst_ratio = 0.0;
+        probe_evaluations = 0;
+        CHECK_OK(wetdem_collision_run(sim, &spec, &r));
+        assert_true(r.separated && probe_evaluations > min_evals);
+        if (!(probe_worst_ratio <= 1.0 + 1e-14))
+            fail_msg("%s, %g deg: |F_t| reached %.17g times its limit", integrator, angles[a],
+                     probe_worst_ratio);
+        CHECK_REL(probe_worst_ratio, 1.0, 1e-12);
+        wetdem_sim_free(sim);
+    }
 }
 
 /* Oblique dry collisions of two steel spheres (R = 6.35 mm, 0.5 m/s, e_dry = 0.5, mu = 0.1)
@@ -744,37 +799,7 @@ static void test_mindlin_collisions_obey_coulomb_at_every_evaluation(void** stat
     struct wetdem_model probe = wetdem_force_mindlin;
     probe.name = "mindlin_probe";
     probe.pair = mindlin_probe_pair;
-    const double angles[] = {5, 10, 20};
-    for (int a = 0; a < 3; a++) {
-        struct wetdem_sim* sim = wetdem_sim_create();
-        struct wetdem_material m;
-        CHECK_OK(wetdem_material_preset("steel1", &m));
-        m.restitution = 0.5;
-        m.friction_dry = 0.1;
-        int mat = wetdem_sim_add_material(sim, &m);
-        double p[1] = {0.0}; /* friction = dry */
-        CHECK_OK(wetdem_sim_enable_model(sim, "hertz"));
-        CHECK_OK(wetdem_sim_add_model(sim, &probe, p));
-        CHECK_OK(wetdem_sim_set_integrator(sim, "cvode"));
-        struct wetdem_collision_spec spec = {.material_i = mat,
-                                             .material_j = mat,
-                                             .radius_i = 6.35e-3,
-                                             .radius_j = 6.35e-3,
-                                             .speed = 0.5,
-                                             .angle = angles[a] * M_PI / 180,
-                                             .t_end = 1e-3};
-        struct wetdem_collision_result r;
-        probe_worst_ratio = 0.0;
-        probe_evaluations = 0;
-        CHECK_OK(wetdem_collision_run(sim, &spec, &r));
-        assert_true(r.separated && probe_evaluations > 100);
-        /* 1e-14: the capped total equals the limit up to the rescaling roundings */
-        if (!(probe_worst_ratio <= 1.0 + 1e-14))
-            fail_msg("%g deg: |F_t| reached %.17g mu F_el", angles[a], probe_worst_ratio);
-        /* the limit is reached (sliding phases), so the check is not vacuous */
-        CHECK_REL(probe_worst_ratio, 1.0, 1e-12);
-        wetdem_sim_free(sim);
-    }
+    oblique_collisions_obey_coulomb(&probe, 0.0, "cvode", 1e-3, 100);
 }
 
 static void test_mindlin_spring_rotates_into_tangent_plane(void** state)
@@ -925,10 +950,6 @@ static void test_mindlin_beside_a_linear_spring_closed_forms(void** state)
     }
 }
 
-/* The stiffness the user last gave hooke [N/m], which every evaluation of the probe below must
- * see as c->linear_stiffness. */
-static double probe_hooke_k;
-
 /* mindlin beside hooke, recording |F_t| / (mu k delta) of each evaluation in contact and
  * checking that the engine passed hooke's current k. */
 static int mindlin_linear_probe_pair(const void* params, const struct wetdem_contact* c,
@@ -937,18 +958,7 @@ static int mindlin_linear_probe_pair(const void* params, const struct wetdem_con
     if (c->linear_stiffness != probe_hooke_k)
         fail_msg("the engine passed k = %g N/m, hooke's is %g N/m", c->linear_stiffness,
                  probe_hooke_k);
-    struct wetdem_pair_force f = {0};
-    int st = wetdem_force_mindlin.pair(params, c, history, &f);
-    double f_el = c->linear_stiffness * -c->gap;
-    if (f_el > 0.0) {
-        probe_worst_ratio =
-            fmax(probe_worst_ratio, vec3_norm_test(f.f_tan) / (c->friction_dry * f_el));
-        probe_evaluations++;
-    }
-    out->f_tan = f.f_tan;
-    out->torque_i = f.torque_i;
-    out->torque_j = f.torque_j;
-    return st;
+    return mindlin_recorded(params, c, history, out, c->linear_stiffness * -c->gap);
 }
 
 /* A glass-like sphere (R = 1 mm, 2500 kg/m^3, E = 60 GPa, nu = 0.23, e_dry, mu) at rest in its
@@ -1128,39 +1138,8 @@ static void test_mindlin_beside_hooke_obeys_coulomb_at_every_evaluation(void** s
     struct wetdem_model probe = wetdem_force_mindlin;
     probe.name = "mindlin_linear_probe";
     probe.pair = mindlin_linear_probe_pair;
-    const double angles[] = {5, 10, 20};
-    for (int cvode = 0; cvode < 2; cvode++)
-        for (int a = 0; a < 3; a++) {
-            struct wetdem_sim* sim = wetdem_sim_create();
-            struct wetdem_material m;
-            CHECK_OK(wetdem_material_preset("steel1", &m));
-            m.restitution = 0.5;
-            m.friction_dry = 0.1;
-            int mat = wetdem_sim_add_material(sim, &m);
-            double p[1] = {0.0};
-            CHECK_OK(wetdem_sim_enable_model(sim, "hooke"));
-            CHECK_OK(wetdem_sim_add_model(sim, &probe, p));
-            probe_hooke_k = 2e5;
-            CHECK_OK(wetdem_sim_set_param(sim, "hooke.stiffness", probe_hooke_k));
-            if (cvode)
-                CHECK_OK(wetdem_sim_set_integrator(sim, "cvode"));
-            struct wetdem_collision_spec spec = {.material_i = mat,
-                                                 .material_j = mat,
-                                                 .radius_i = 6.35e-3,
-                                                 .radius_j = 6.35e-3,
-                                                 .speed = 0.5,
-                                                 .angle = angles[a] * M_PI / 180,
-                                                 .t_end = 1e-2};
-            struct wetdem_collision_result r;
-            probe_worst_ratio = 0.0;
-            probe_evaluations = 0;
-            CHECK_OK(wetdem_collision_run(sim, &spec, &r));
-            assert_true(r.separated && probe_evaluations > 40); /* (Verlet: 50 steps) */
-            if (!(probe_worst_ratio <= 1.0 + 1e-14))
-                fail_msg("%g deg: |F_t| reached %.17g mu k delta", angles[a], probe_worst_ratio);
-            CHECK_REL(probe_worst_ratio, 1.0, 1e-12);
-            wetdem_sim_free(sim);
-        }
+    oblique_collisions_obey_coulomb(&probe, 2e5, "verlet", 1e-2, 40); /* (Verlet: 50 steps) */
+    oblique_collisions_obey_coulomb(&probe, 2e5, "cvode", 1e-2, 40);
 }
 
 /* ======================================================================================== */
