@@ -396,7 +396,7 @@ static double hertz_relaxation_time(const void* params, const struct wetdem_cont
     double k = hertz_stiffness(c->e_star, c->r_eff), v = c->v_n;
     if (!(coef > 0.0 && v > 0.0 && k > 0.0 && c->m_eff > 0.0))
         return INFINITY;
-    double delta_max = pow(1.25 * c->m_eff * v * v / k, 0.4);
+    double delta_max = hertz_impact_overlap(c->m_eff, v, k);
     /* = m* / hertz_damping_k(coef, k, m*, delta_max, 1), written so that m* k cannot overflow
        (a density near the end of its range) */
     return sqrt(c->m_eff / k) / (coef * sqrt(sqrt(delta_max)));

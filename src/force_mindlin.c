@@ -126,8 +126,7 @@ static double mindlin_relaxation_time(const void* params, const struct wetdem_co
         double k_hertz = hertz_stiffness(c->e_star, c->r_eff), v = c->v_n;
         if (!(v > 0.0 && k_hertz > 0.0))
             return INFINITY;
-        double delta_max = pow(1.25 * c->m_eff * v * v / k_hertz, 0.4);
-        k_t = tangential_stiffness(c->g_star, c->r_eff, delta_max);
+        k_t = tangential_stiffness(c->g_star, c->r_eff, hertz_impact_overlap(c->m_eff, v, k_hertz));
     }
     double factor = wetdem_force_mindlin_damping_factor(c->restitution);
     if (!(k_t > 0.0 && factor > 0.0))

@@ -101,6 +101,14 @@ static inline double hertz_stiffness(double e_star, double r_eff)
 {
     return (4.0 / 3.0) * e_star * sqrt(r_eff);
 }
+/* Largest overlap [m] of an undamped Hertz impact of reduced mass m* [kg] at approach speed v
+ * [m/s], stiffness factor k (hertz_stiffness): (1/2) m* v^2 = (2/5) k delta^(5/2), so
+ * delta_max = (5 m* v^2 / (4 k))^(2/5); where the dampers that grow with the overlap are
+ * largest (the hertz and mindlin relaxation times). */
+static inline double hertz_impact_overlap(double m_eff, double v, double k)
+{
+    return pow(1.25 * m_eff * v * v / k, 0.4);
+}
 static inline double hertz_elastic_k(double k, double overlap)
 {
     return k * overlap * sqrt(overlap);
