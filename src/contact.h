@@ -60,6 +60,19 @@ static inline struct wetdem_vec3 contact_wall_slip(struct wetdem_vec3 n, double 
     return vec3_reject(vec3_add(v_a, vec3_cross(w_a, vec3_scale(n, -r_a))), n);
 }
 
+/* c->dv_t_spring of the fixed-step engines (midpoint rule, docs/engines.md): the slip of the
+ * half-step velocities and spins v_i, w_i (and v_j, w_j of a sphere j) at c's normal, less
+ * c->v_t [m/s]. */
+static inline struct wetdem_vec3
+contact_half_step_dv(const struct wetdem_contact* c, struct wetdem_vec3 v_i, struct wetdem_vec3 w_i,
+                     struct wetdem_vec3 v_j, struct wetdem_vec3 w_j)
+{
+    struct wetdem_vec3 half =
+        c->is_wall ? contact_wall_slip(c->normal, c->radius_i, v_i, w_i)
+                   : contact_pair_slip(c->normal, c->radius_i, v_i, w_i, c->radius_j, v_j, w_j);
+    return vec3_sub(half, c->v_t);
+}
+
 static inline void contact_pair_geometry(struct wetdem_contact* c, const struct wetdem_particle* a,
                                          const struct wetdem_particle* b, struct wetdem_vec3 d)
 {

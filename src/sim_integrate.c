@@ -189,13 +189,11 @@ static int eval_pair(struct wetdem_sim* sim, size_t k, double t, bool commit, bo
     c.dt = t - e->t_committed;
     if (e->trapezoid_spring) /* v_t_committed lay in the old tangent plane */
         c.dv_t_spring = vec3_reject(vec3_scale(vec3_sub(p->v_t_committed, v_t), 0.5), c.normal);
-    if (e->half_vel) /* verlet: the slip at the half step, at the current contact normal */
-        c.dv_t_spring = vec3_sub(
-            p->is_wall
-                ? contact_wall_slip(c.normal, c.radius_i, e->half_vel[p->i], e->half_omega[p->i])
-                : contact_pair_slip(c.normal, c.radius_i, e->half_vel[p->i], e->half_omega[p->i],
-                                    c.radius_j, e->half_vel[p->j], e->half_omega[p->j]),
-            v_t);
+    if (e->half_vel) { /* verlet: the slip at the half step, at the current contact normal */
+        size_t j = p->is_wall ? p->i : p->j; /* (a wall's unused) */
+        c.dv_t_spring = contact_half_step_dv(&c, e->half_vel[p->i], e->half_omega[p->i],
+                                             e->half_vel[j], e->half_omega[j]);
+    }
     struct wetdem_pair_force f;
     int st = wetdem_sim_eval_contact(sim, &c, scratch, &f, NULL);
     e->stats.pair_evals++;

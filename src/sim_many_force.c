@@ -806,12 +806,8 @@ static int eval_pair(const struct wetdem_sim* sim, struct wetdem_contact* c,
     }
     c->dt = m->advance;
     if (m->advance > 0.0) { /* the spring's slip at the half step (spring_velocity) */
-        const struct wetdem_vec3* h_i = m->vwh[c->i];
-        struct wetdem_vec3 half =
-            c->is_wall ? contact_wall_slip(c->normal, c->radius_i, h_i[0], h_i[1])
-                       : contact_pair_slip(c->normal, c->radius_i, h_i[0], h_i[1], c->radius_j,
-                                           m->vwh[c->j][0], m->vwh[c->j][1]);
-        c->dv_t_spring = vec3_sub(half, c->v_t);
+        const struct wetdem_vec3 *h_i = m->vwh[c->i], *h_j = m->vwh[c->is_wall ? c->i : c->j];
+        c->dv_t_spring = contact_half_step_dv(c, h_i[0], h_i[1], h_j[0], h_j[1]);
     }
     struct wetdem_pair_force f, per_model[WETDEM_MAX_MODELS];
     struct wetdem_pair_force* pm = m->set.energy_budget ? per_model : NULL;
