@@ -241,6 +241,16 @@ static double collide(const struct collision* col, double v0, double dt, double*
     return NAN;
 }
 
+/* n numbers uniform in [0, 1) into u from the 64-bit linear congruential generator *seed
+ * (Knuth's MMIX constants; the top 53 bits): reproducible random states for the tests. */
+static void uniforms(unsigned long long* seed, double* u, int n)
+{
+    for (int q = 0; q < n; q++) {
+        *seed = *seed * 6364136223846793005ULL + 1442695040888963407ULL;
+        u[q] = (double)(*seed >> 11) / 9007199254740992.0;
+    }
+}
+
 /* Two steel-like spheres of radius 2 mm and mass 2e-4 kg: R* = 1 mm, m* = 1e-4 kg,
  * E* = 100 GPa, G* = 40 GPa (harness defaults). */
 static struct wetdem_contact steel_pair(double gap, double v_n)
@@ -690,10 +700,7 @@ static void test_mindlin_total_never_exceeds_coulomb_limit(void** state)
     unsigned long long seed = 12345;
     for (int k = 0; k < 20000; k++) {
         double u[8];
-        for (int q = 0; q < 8; q++) {
-            seed = seed * 6364136223846793005ULL + 1442695040888963407ULL;
-            u[q] = (double)(seed >> 11) / 9007199254740992.0;
-        }
+        uniforms(&seed, u, 8);
         struct wetdem_contact r = steel_pair(-pow(10.0, -10.0 + 5.0 * u[0]), 0.0);
         r.restitution = 0.05 + 0.95 * u[1];
         r.friction_dry = 0.5 * u[2];
@@ -927,10 +934,7 @@ static void test_mindlin_beside_a_linear_spring_closed_forms(void** state)
     unsigned long long seed = 2024;
     for (int n = 0; n < 20000; n++) {
         double u[9];
-        for (int q = 0; q < 9; q++) {
-            seed = seed * 6364136223846793005ULL + 1442695040888963407ULL;
-            u[q] = (double)(seed >> 11) / 9007199254740992.0;
-        }
+        uniforms(&seed, u, 9);
         struct wetdem_contact r = steel_pair(-pow(10.0, -10.0 + 5.0 * u[0]), 0.0);
         r.linear_stiffness = pow(10.0, 2.0 + 6.0 * u[8]);
         r.restitution = 0.05 + 0.95 * u[1];
