@@ -179,7 +179,7 @@ static int eval_pair(struct wetdem_sim* sim, size_t k, double t, bool commit, bo
     if (c.gap > wetdem_sim_contact_range(sim, &c)) {
         if (commit && history) /* (a min-separation record may outlive the force range) */
             wetdem_sim_history_beyond_range(sim, &c, wetdem_sim_record_range(sim, &c), history);
-        if (commit)
+        if (commit && e->trapezoid_spring)
             p->v_t_committed = v_t;
         return WETDEM_OK;
     }
@@ -208,7 +208,7 @@ static int eval_pair(struct wetdem_sim* sim, size_t k, double t, bool commit, bo
                                p->i, p->is_wall ? "wall " : "", p->j, t, c.gap);
     if (commit && history)
         memcpy(history, scratch, sim->history_len * sizeof *scratch);
-    if (commit)
+    if (commit && e->trapezoid_spring) /* (only the trapezoid reads it) */
         p->v_t_committed = v_t;
     if (accumulate)
         apply_pair(e, &c, &f);
