@@ -309,26 +309,36 @@ int cli_apply_set(struct wetdem_sim* sim, const char* key_value)
     return CLI_EXIT_OK;
 }
 
-void cli_print_provenance(FILE* f, int argc, char** argv)
+/* The provenance lines "wetdem VERSION (git HASH)" and "command: wetdem ARGS", each begun with
+ * `mark`, the first ended by a newline (the last's end is the caller's): the one text of
+ * cli_print_provenance and cli_provenance_text. */
+static void write_provenance(FILE* f, const char* mark, int argc, char** argv)
 {
-    fprintf(f, "# wetdem %s (git %s)\n# command: wetdem", WETDEM_VERSION, WETDEM_GIT_HASH);
+    fprintf(f, "%swetdem %s (git %s)\n%scommand: wetdem", mark, WETDEM_VERSION, WETDEM_GIT_HASH,
+            mark);
     for (int k = 0; k < argc; k++)
         fprintf(f, " %s", argv[k]);
+}
+
+void cli_print_provenance(FILE* f, int argc, char** argv)
+{
+    write_provenance(f, "# ", argc, argv); /* (written as it goes: printing allocates nothing) */
     fputc('\n', f);
 }
 
 char* cli_provenance_text(int argc, char** argv)
 {
-    size_t n = strlen("git ") + strlen(WETDEM_GIT_HASH) + strlen("\ncommand: wetdem") + 1;
-    for (int k = 0; k < argc; k++)
-        n += 1 + strlen(argv[k]);
-    char* text = malloc(n);
-    if (!text)
+    char* text = NULL;
+    size_t len = 0;
+    FILE* f = open_memstream(&text, &len);
+    if (!f)
         return NULL;
-    size_t at = (size_t)snprintf(text, n, "git %s\ncommand: wetdem", WETDEM_GIT_HASH);
-    for (int k = 0; k < argc; k++)
-        at += (size_t)snprintf(text + at, n - at, " %s", argv[k]);
-    return text;
+    write_provenance(f, "", argc, argv);
+    bool ok = !ferror(f);
+    if (fclose(f) == 0 && ok)
+        return text;
+    free(text);
+    return NULL;
 }
 
 /* Creates dir and its parents (mkdir -p). */

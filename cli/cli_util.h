@@ -113,14 +113,16 @@ int cli_csv_columns(char** f, int n, const char* const* names, const char* const
  * `prefix`: PREFIX_, six or more digits, .vtk. */
 bool cli_is_frame_name(const char* prefix, const char* name);
 
-/* Writes the '#' provenance lines that start every CSV the CLI prints:
+/* Writes the '#' provenance lines that start every CSV wetdem writes:
  *     # wetdem <version> (git <hash>)
  *     # command: wetdem <argv[0]> <argv[1]> ...
- * argv is the subcommand's argument vector (argv[0] = subcommand name). */
+ * argv is the subcommand's argument vector (argv[0] = subcommand name). Any lines that
+ * describe the file follow them, then the header of "name [unit]" columns. */
 void cli_print_provenance(FILE* f, int argc, char** argv);
-/* The lines "git HASH" and "command: wetdem ARGS" (no '#', no final newline) in a new string
- * for the caller to free, or NULL when out of memory: the provenance of a file the library
- * writes (the many-particle CSV's csv_comment). */
+/* The same two lines without their '#' ("wetdem VERSION (git HASH)\ncommand: wetdem ARGS",
+ * no final newline) in a new string for the caller to free, or NULL when out of memory: the
+ * provenance of a file the library writes (the many-particle CSV's csv_comment, which the
+ * library writes as '#' lines). */
 char* cli_provenance_text(int argc, char** argv);
 
 /* mkdir -p: creates dir and its parents. 0, or -1 with errno set. */

@@ -879,7 +879,9 @@ static void print_result(const struct fit_ctx* c, const double* init, const doub
                          const double* pred, double omega_scale, int argc, char** argv)
 {
     cli_print_provenance(stdout, argc, argv);
-    printf("parameter,unit,value,std_error,initial,fitted_as\n");
+    /* value, std_error and initial are in the unit the row's unit column names */
+    printf("parameter [word],unit [word],value [unit],std_error [unit],initial [unit],"
+           "fitted_as [word]\n");
     for (size_t j = 0; j < c->n_keys; j++) {
         int t = r->transform[j] >= 0 && r->transform[j] <= 3 ? r->transform[j] : 0;
         printf("%s,%s,%.9g,%.3g,%.9g,%s\n", c->keys[j], key_unit(c->keys[j]), r->values[j],

@@ -9,9 +9,9 @@
  * is v_n = speed (> 0 approaching) and i's surface slides past j's at `slip` along +y. Each
  * row is a fresh pair (no history), so history-dependent models see their initial state.
  *
- * Columns: gap_m (h [m]; < 0 overlap), f_normal_N (on i along the normal, > 0 repulsive),
- * f_tangential_N (on i along +y, the slip direction), h_min_m (from the min-separation model;
- * composite models with their own minimum approach, e.g. nijssen, do not read it).
+ * Columns: gap [m] (h; < 0 overlap), f_normal [N] (on i along the normal, > 0 repulsive),
+ * f_tangential [N] (on i along +y, the slip direction), h_min [m] (from the min-separation
+ * model; composite models with their own minimum approach, e.g. nijssen, do not read it).
  */
 #include <math.h>
 #include <stdio.h>
@@ -54,7 +54,7 @@ static void usage(FILE* f)
             "  --log           geometric spacing of the gaps\n"
             "  --set K=V       set a parameter by dotted name, e.g. fluid.viscosity=0.05\n"
             "A minimum-separation model (fixed, roughness, ehd, max, glass) gives only the\n"
-            "h_min_m column: list a force model that reads h_min with it (reynolds, sb, db,\n"
+            "h_min column: list a force model that reads h_min with it (reynolds, sb, db,\n"
             "davis, nase); alone, its force columns are 0 (with a warning).\n");
 }
 
@@ -168,7 +168,7 @@ static int check_opts(const struct forces_opts* o)
     return CLI_EXIT_OK;
 }
 
-/* Only min-separation models given (each replaces the default fixed): they give the h_min_m
+/* Only min-separation models given (each replaces the default fixed): they give the h_min
  * column and no force, so both force columns are 0 at every gap. Said, not refused (h_min
  * against the gap is a use of its own). */
 static void warn_no_force(const struct wetdem_sim* sim)
@@ -177,7 +177,7 @@ static void warn_no_force(const struct wetdem_sim* sim)
         return;
     const char* ms = wetdem_sim_min_separation_model(sim)->name;
     cli_error("warning: forces: no force model given ('%s' is a minimum-separation model: it "
-              "gives only the h_min_m column), so f_normal_N and f_tangential_N are 0 at every "
+              "gives only the h_min column), so f_normal and f_tangential are 0 at every "
               "gap; add a force model that reads h_min, e.g. 'wetdem forces reynolds %s' "
               "(reynolds, sb, db, davis, nase; 'wetdem models' lists them)",
               ms, ms);
@@ -238,10 +238,10 @@ static void print_header(struct wetdem_sim* sim, const struct forces_opts* o, in
     for (size_t k = 0; k < wetdem_sim_n_models(sim); k++)
         printf(" %s", wetdem_sim_model(sim, k)->name);
     printf("; min-separation: %s\n", wetdem_sim_min_separation_model(sim)->name);
-    printf("# f_normal_N: on i along the normal from j to i, > 0 repulsive; f_tangential_N: on i "
-           "along the slip direction; h_min_m: from the min-separation model (models with their "
+    printf("# f_normal: on i along the normal from j to i, > 0 repulsive; f_tangential: on i "
+           "along the slip direction; h_min: from the min-separation model (models with their "
            "own h_min, e.g. nijssen, do not read it)\n");
-    printf("gap_m,f_normal_N,f_tangential_N,h_min_m\n");
+    printf("gap [m],f_normal [N],f_tangential [N],h_min [m]\n");
 }
 
 int cmd_forces(int argc, char** argv)

@@ -148,9 +148,10 @@ static void frames_table(FILE* f, const void* ctx)
 {
     const struct frames_ctx* c = ctx;
     cli_print_provenance(f, c->argc, c->argv);
-    fprintf(f, "sphere,frame,time_s,vx_raw_m_s,vy_raw_m_s,omega_raw_rad_s,vx_m_s,vy_m_s,"
-               "omega_rad_s,residual_m,u_vx_raw_m_s,u_vy_raw_m_s,u_omega_raw_rad_s,u_vx_m_s,"
-               "u_vy_m_s,u_omega_rad_s\n");
+    fputs("sphere [index],frame [index],time [s],vx_raw [m/s],vy_raw [m/s],omega_raw [rad/s],"
+          "vx [m/s],vy [m/s],omega [rad/s],residual [m],u_vx_raw [m/s],u_vy_raw [m/s],"
+          "u_omega_raw [rad/s],u_vx [m/s],u_vy [m/s],u_omega [rad/s]\n",
+          f);
     for (size_t k = 0; k < wetdem_track_n_spheres(c->t); k++) {
         size_t n;
         const struct wetdem_track_sample* q = wetdem_track_samples(c->t, k, &n);

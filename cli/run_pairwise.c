@@ -340,13 +340,13 @@ static const char* mechanism_name(int m)
 
 static void sweep_header(FILE* f, const struct wetdem_pairwise_config* cfg)
 {
-    fputs("pairwise_status [word],outcome [word],separated_sphere [-],time [s],t_star_end [-],"
-          "events [-],steps [-]",
+    fputs("pairwise_status [word],outcome [word],separated_sphere [index],time [s],"
+          "t_star_end [-],events [count],steps [count]",
           f);
     for (size_t i = 0; i < cfg->n_spheres; i++)
         for (size_t j = i + 1; j < cfg->n_spheres; j++)
             fprintf(f,
-                    ",e_w_%zu%zu [-],e_own_%zu%zu [-],contacts_%zu%zu [-],"
+                    ",e_w_%zu%zu [-],e_own_%zu%zu [-],contacts_%zu%zu [count],"
                     "mechanism_%zu%zu [word],t_sep_star_%zu%zu [-]",
                     i + 1, j + 1, i + 1, j + 1, i + 1, j + 1, i + 1, j + 1, i + 1, j + 1);
 }
@@ -564,8 +564,8 @@ static void events_csv(FILE* f, const struct wetdem_pairwise* pw)
 {
     size_t n;
     const struct wetdem_pairwise_event* ev = wetdem_pairwise_events(pw, &n);
-    fputs("time [s],t_hat [-],t_star [-],event [word],i [-],j [-],k [-],l [-],gap [m],"
-          "v_n [m/s]\n",
+    fputs("time [s],t_hat [-],t_star [-],event [word],i [index],j [index],k [index],l [index],"
+          "gap [m],v_n [m/s]\n",
           f);
     for (size_t e = 0; e < n; e++)
         fprintf(f, "%.12g,%.12g,%.12g,%s,%zu,%zu,%zu,%zu,%.12g,%.12g\n", ev[e].time, ev[e].t_hat,

@@ -23,8 +23,7 @@ import numpy as np  # noqa: E402
 def fitted_values(path):
     """Lines "KEY = value +- std_error unit" from the standard output of `wetdem fit`."""
     rows = [ln.strip().split(",") for ln in open(path) if ln.strip() and not ln.startswith("#")]
-    head = rows[0]
-    col = {name: k for k, name in enumerate(head)}
+    col = {name.split(" [")[0]: k for k, name in enumerate(rows[0])}  # "value [unit]": value
     out = []
     for r in rows[1:]:
         unit = r[col["unit"]] if "unit" in col else ""

@@ -60,10 +60,11 @@ def save_and_finish(fig, name):
 
 
 def read_global(path):
-    """global.csv as {column: array}."""
+    """global.csv as {column: array}, the columns by name without their unit ("time [s]":
+    "time")."""
     with open(path) as f:
         lines = [ln.strip() for ln in f if not ln.startswith("#") and ln.strip()]
-    names = lines[0].split(",")
+    names = [h.split(" [")[0] for h in lines[0].split(",")]
     rows = np.array([[float(x) for x in ln.split(",")] for ln in lines[1:]])
     return {n: rows[:, k] for k, n in enumerate(names)}
 
@@ -71,10 +72,10 @@ def read_global(path):
 def energy_panel(ax, g):
     """Kinetic, dissipated and released potential energy against time (global.csv columns),
     on a log scale (values below 1e-14 J drawn at it)."""
-    t = g["time_s"] * 1e3
-    ax.semilogy(t, np.maximum(g["kinetic_J"], 1e-14), label="kinetic")
-    ax.semilogy(t, g["dissipated_J"].clip(1e-14), label="dissipated")
-    ax.semilogy(t, (g["potential_J"][0] - g["potential_J"]).clip(1e-14), label="potential released")
+    t = g["time"] * 1e3
+    ax.semilogy(t, np.maximum(g["kinetic"], 1e-14), label="kinetic")
+    ax.semilogy(t, g["dissipated"].clip(1e-14), label="dissipated")
+    ax.semilogy(t, (g["potential"][0] - g["potential"]).clip(1e-14), label="potential released")
     ax.set_xlabel("time [ms]")
     ax.set_ylabel("energy [J]")
     ax.legend(fontsize=8)
@@ -115,7 +116,7 @@ def settling(run_dir):
     g = read_global(os.path.join(run_dir, "global.csv"))
     s = json.load(open(os.path.join(run_dir, "summary.json")))
     e = s["energy_J"]
-    released = g["potential_J"][0] - e["potential"]
+    released = g["potential"][0] - e["potential"]
     check(abs(e["balance_error"]) < 2e-3 * abs(e["work_total"]),
           f"energy closure {abs(e['balance_error']) / abs(e['work_total']):.2e} of the work")
     check(e["kinetic"] < 1e-4 * released,
@@ -139,11 +140,11 @@ def settling(run_dir):
     check(abs(np.mean(ratios) - 1) < 0.03,
           f"the floor carries {np.mean(ratios):.3f} of the weight (last eight frames: "
           f"{min(ratios):.3f} to {max(ratios):.3f})")
-    t = g["time_s"] * 1e3
+    t = g["time"] * 1e3
     fig, (a, b, c) = plt.subplots(1, 3, figsize=(13, 3.8))
     energy_panel(a, g)
     for name in [c for c in g if c.startswith("work_")]:
-        b.plot(t, -g[name] * 1e6, label=name[5:-2])
+        b.plot(t, -g[name] * 1e6, label=name[5:])
     b.set_xlabel("time [ms]")
     b.set_ylabel("energy taken by the model [uJ]")
     b.legend(fontsize=8)
@@ -189,7 +190,7 @@ def agglomeration(run_dir):
     matched = 0
     for entry in series["files"]:
         f = read_vtk(os.path.join(run_dir, entry["name"]))
-        row = np.flatnonzero(np.abs(g["time_s"] - f["TIME"][0]) <= 1e-8 * f["TIME"][0])
+        row = np.flatnonzero(np.abs(g["time"] - f["TIME"][0]) <= 1e-8 * f["TIME"][0])
         if len(row) == 0:
             continue
         matched += 1
@@ -210,9 +211,9 @@ def agglomeration(run_dir):
     # a frame while the agglomerates merge (about 15 of them; at the end one spans the box)
     snaps = [read_vtk(os.path.join(run_dir, e["name"])) for e in series["files"]]
     snap = min(snaps, key=lambda f: abs(int(f["agglomerate"].max()) - 15))
-    t = g["time_s"] * 1e3
+    t = g["time"] * 1e3
     fig, (a, b, s) = plt.subplots(1, 3, figsize=(13, 3.8))
-    a.semilogy(t, g["kinetic_J"])
+    a.semilogy(t, g["kinetic"])
     a.set_xlabel("time [ms]")
     a.set_ylabel("kinetic energy [J]")
     b.plot(t, n, label="agglomerates")
@@ -265,7 +266,7 @@ def rough_base(run_dir):
           f"no free sphere reaches the floor (lowest bottom {bottom * 1e3:.3f} mm; floor's work "
           f"{floor:g} J)")
     g = read_global(os.path.join(run_dir, "global.csv"))
-    released = g["potential_J"][0] - e["potential"]
+    released = g["potential"][0] - e["potential"]
     check(abs(e["balance_error"]) < 2e-3 * abs(e["work_total"]),
           f"energy closure {abs(e['balance_error']) / abs(e['work_total']):.2e} of the work")
     check(e["kinetic"] < 1e-4 * released,

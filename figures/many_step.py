@@ -52,14 +52,14 @@ def main():
     for lam, d in runs:
         g = read_global(os.path.join(d, "global.csv"))
         steps = int(g["step"][-1])
-        ratio = math.sqrt(g["kinetic_J"][-1] / g["kinetic_J"][0])
+        ratio = math.sqrt(g["kinetic"][-1] / g["kinetic"][0])
         expected = map_speed(lam, steps)
         worst = max(worst, abs(ratio / expected - 1))
-        t = g["time_s"][-1] / tau
+        t = g["time"][-1] / tau
         lams.append(lam)
         rates.append(-math.log(ratio) / t)
         map_rates.append(-math.log(expected) / t)
-        closures.append(abs(g["balance_error_J"][-1]) / abs(g["work_reynolds_J"][-1]))
+        closures.append(abs(g["balance_error"][-1]) / abs(g["work_reynolds"][-1]))
     lams, rates, closures = np.array(lams), np.array(rates), np.array(closures)
     check(worst < 1e-6, f"the decay follows the scheme's map at every step (worst {worst:.1e})")
     quarter = int(np.argmin(abs(lams - 0.25)))

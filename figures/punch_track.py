@@ -78,10 +78,13 @@ def main():
     ax.set_ylabel("dot 1 position [mm]")
     ax.set_title("(a) raw dot-1 positions (0.05 px noise)", fontsize=10)
     ax.legend(fontsize=7, ncol=2)
-    panels = [("vx", "vx_raw_m_s", "vx_m_s", "v_x [m/s]", "(b)"),
-              ("vy", "vy_raw_m_s", "vy_m_s", "v_y [m/s]", "(c)"),
-              ("omega", "omega_raw_rad_s", "omega_rad_s", "omega [rad/s]", "(d)")]
-    for (key, raw, comp, label, tag), ax in zip(panels, [axes[0, 1], axes[1, 0], axes[1, 1]]):
+    # (frames columns raw and smoothed, the summary's key suffix: the summary keeps its units in
+    # the key, striker_after_vx_m_s)
+    panels = [("vx", "vx_raw", "vx", "vx_m_s", "v_x [m/s]", "(b)"),
+              ("vy", "vy_raw", "vy", "vy_m_s", "v_y [m/s]", "(c)"),
+              ("omega", "omega_raw", "omega", "omega_rad_s", "omega [rad/s]", "(d)")]
+    for (key, raw, comp, suffix, label, tag), ax in zip(panels,
+                                                         [axes[0, 1], axes[1, 0], axes[1, 1]]):
         for n, s in enumerate(sorted(dots)):
             fr = {c: v[frames["sphere"] == s] for c, v in frames.items()}
             who = "striker" if s == striker else "target"
@@ -95,10 +98,11 @@ def main():
             for (x, y, v_at), when in zip(fitted_lines(fr, k, comp), ("before", "after")):
                 ax.plot(x, y, "-", color=col, lw=1.5,
                         label=f"{who}: fitted lines" if when == "before" else None)
-                want = tr[f"{who}_{when}_{comp}"]
+                want = tr[f"{who}_{when}_{suffix}"]
                 tol = 1e-4 if key == "omega" else 1e-6
                 if abs(v_at - want) > tol:
-                    fails.append(f"{who} {when} {comp}: refit {v_at:.9g} vs summary {want:.9g}")
+                    fails.append(f"{who} {when} {suffix}: refit {v_at:.9g} vs summary "
+                                 f"{want:.9g}")
                 ax.plot(k + (OFFSET if when == "after" else -OFFSET), want, "*", color=col,
                         ms=9)
         ax.axvline(k, color="k", ls="--", lw=0.8)

@@ -711,9 +711,10 @@ struct wetdem_many_settings {
     wetdem_progress_fn progress;         /* optional progress callback */
     void* progress_ctx;
     unsigned long long progress_every; /* steps between progress calls; 0: 1000 */
-    const char* csv_comment;           /* written into <prefix>.csv under its first line, each
-                                          of its lines as a "# " comment (the CLI's git hash
-                                          and command); NULL: none (copied) */
+    const char* csv_comment;           /* the first lines of <prefix>.csv, each written as a
+                                          "# " comment: its provenance (the CLI's "wetdem
+                                          VERSION (git HASH)" and "command: ..."); NULL or
+                                          "": "wetdem VERSION" (copied) */
 };
 
 /* Most steps one wetdem_sim_integrate() call of a many-particle run takes: a longer call is

@@ -495,21 +495,27 @@ static int reload_series(struct wetdem_sim* sim)
     return m->set.vtk_links ? find_links_from(sim) : WETDEM_OK;
 }
 
+/* The CSV's '#' lines, its provenance (csv_comment, else the version) and what it holds, then
+ * its columns, "name [unit]" as every CSV of wetdem's CLI (docs/concepts.md). */
 static void csv_header(const struct wetdem_sim* sim, FILE* f)
 {
-    fprintf(f, "# wetdem %s many-particle run: global quantities\n", WETDEM_VERSION);
-    for (const char* line = sim->many->set.csv_comment; line && *line;) {
+    const char* comment = sim->many->set.csv_comment;
+    if (!comment || !*comment)
+        fprintf(f, "# wetdem %s\n", WETDEM_VERSION);
+    for (const char* line = comment; line && *line;) {
         size_t n = strcspn(line, "\n");
         fprintf(f, "# %.*s\n", (int)n, line);
         line += n + (line[n] == '\n');
     }
-    fputs("time_s,step,kinetic_J,potential_J,elastic_J,contacts,bridges,agglomerates,"
-          "mean_agglomerate_size,candidate_pairs",
+    fputs("# many-particle run: global quantities\n"
+          "time [s],step [count],kinetic [J],potential [J],elastic [J],contacts [count],"
+          "bridges [count],agglomerates [count],mean_agglomerate_size [-],"
+          "candidate_pairs [count]",
           f);
     for (size_t k = 0; sim->many->set.energy_budget && k < sim->n_models; k++)
-        fprintf(f, ",work_%s_J", sim->models[k].model->name);
+        fprintf(f, ",work_%s [J]", sim->models[k].model->name);
     if (sim->many->set.energy_budget)
-        fputs(",dissipated_J,balance_error_J", f);
+        fputs(",dissipated [J],balance_error [J]", f);
     fputc('\n', f);
 }
 

@@ -183,7 +183,7 @@ static void parse_forces_csv(const char* csv, double cols[4])
 {
     CHECK_CONTAINS(csv, "# wetdem " WETDEM_VERSION " (git ");
     CHECK_CONTAINS(csv, "# command: wetdem forces");
-    const char* header = strstr(csv, "\ngap_m,f_normal_N,f_tangential_N,h_min_m\n");
+    const char* header = strstr(csv, "\ngap [m],f_normal [N],f_tangential [N],h_min [m]\n");
     if (!header)
         fail_msg("no column header line in:\n%s", csv);
     const char* row = strchr(header + 1, '\n') + 1;
@@ -222,8 +222,8 @@ static void test_cli_forces_min_separation_only_is_explained(void** state)
     struct test_run r = run_cli("forces roughness --gaps 1e-6:1e-5:2", true);
     assert_int_equal(r.code, 0);
     CHECK_CONTAINS(r.out, "wetdem: warning: forces: no force model given ('roughness' is a "
-                          "minimum-separation model: it gives only the h_min_m column), so "
-                          "f_normal_N and f_tangential_N are 0 at every gap; add a force model "
+                          "minimum-separation model: it gives only the h_min column), so "
+                          "f_normal and f_tangential are 0 at every gap; add a force model "
                           "that reads h_min, e.g. 'wetdem forces reynolds roughness'");
     free(r.out);
     r = run_cli("forces reynolds roughness --gaps 1e-6:1e-5:2", true);
@@ -237,7 +237,7 @@ static void test_cli_forces_log_gaps_are_decades(void** state)
     (void)state;
     struct test_run r = run_cli("forces --model reynolds --gaps 1e-7:1e-3:5 --log", false);
     assert_int_equal(r.code, 0);
-    const char* row = strstr(r.out, "h_min_m\n");
+    const char* row = strstr(r.out, "h_min [m]\n");
     assert_non_null(row);
     /* Five geometric points from 1e-7 to 1e-3 m are the decades 1e-7 ... 1e-3, printed as
      * such (the text must read back as the double nearest the decimal). */
@@ -370,7 +370,7 @@ static void test_cli_single_options_given_twice(void** state)
          "track: --frames is given twice", 2},
         {"forces --model reynolds --model hertz --set fluid.viscosity=0.1 --set sim.gravity_z=0 "
          "--log --log",
-         "gap_m,f_normal_N", 0},
+         "gap [m],f_normal [N]", 0},
     };
     check_cli_cases(cases, sizeof cases / sizeof cases[0]);
 }
@@ -670,18 +670,18 @@ static void test_cli_summary_names_its_command(void** state)
         CHECK_CONTAINS(json, "\"git\": \"");
         free(json);
     }
-    /* and the many-particle run's global.csv, which the library writes, under its first line */
+    /* and the many-particle run's global.csv, which the library writes, as its first lines */
     char path[300], want[600];
     snprintf(path, sizeof path, "%s/2/global.csv", dir);
     char* csv = test_read_file(path, NULL);
     assert_non_null(csv);
-    const char* git = strstr(csv, "\n# git ");
-    assert_non_null(git);
-    const char* command = strstr(git + 1, "\n# command: ");
+    const char* git = "# wetdem " WETDEM_VERSION " (git ";
+    assert_memory_equal(csv, git, strlen(git));
+    const char* command = strstr(csv, "\n# command: ");
     assert_non_null(command);
     snprintf(want, sizeof want,
              "\n# command: wetdem run examples/scenarios/many_stokes_cradle.ini --set run.steps=2 "
-             "--out %s/2\ntime_s,",
+             "--out %s/2\n# many-particle run: global quantities\ntime [s],step [count],",
              dir);
     assert_memory_equal(command, want, strlen(want));
     free(csv);
@@ -706,11 +706,12 @@ static void test_cli_dev_stdout_output_to_a_redirected_file(void** state)
     } cases[] = {
         {"fit examples/fit/punch_db_c.ini --data examples/fit/punch_0deg.csv --fit glass.p_gt "
          "--init 4e6 --out /dev/stdout",
-         "parameter,unit,value,std_error,initial,fitted_as\nmodel.glass.p_gt,Pa,",
+         "parameter [word],unit [word],value [unit],std_error [unit],initial [unit],fitted_as "
+         "[word]\nmodel.glass.p_gt,Pa,",
          "\nstokes_n [-],angle_deg [deg],e_n_data [-],e_n_fit [-],e_n_residual [-]\n1.6,0,"},
         {"track examples/tracks/punch_45deg.csv --fps 5000 --pixel-size 175e-6 --frames "
          "/dev/stdout",
-         "\ne_n = 0.70", "\nsphere,frame,time_s,vx_raw_m_s,"},
+         "\ne_n = 0.70", "\nsphere [index],frame [index],time [s],vx_raw [m/s],"},
     };
     for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
         char args[600], path[300];
@@ -866,7 +867,7 @@ static void test_cli_run_outputs_recovered_after_a_kill(void** state)
     snprintf(path2, sizeof path2, "%s/d/.summary.json.tmp%ld.old", dir, (long)child);
     assert_int_equal(rename(path, path2), 0);
     snprintf(path, sizeof path, "%s/d/events.csv.tmp%ld", dir, (long)child);
-    test_write_file(path, "time_s,");
+    test_write_file(path, "time [s],");
     snprintf(path, sizeof path, "%s/d/.trajectory.csv.tmp%ld", dir, (long)getpid());
     test_write_file(path, "a live process's\n");
     r = test_run_cli(TEST_FILE_SIZE_LIMIT, args, true); /* (trajectory.csv: too large) */

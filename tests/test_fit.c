@@ -1046,7 +1046,8 @@ static void test_fit_cli_reports_units_on_example(void** state)
                                out, sizeof out);
     if (rc != 0)
         fail_msg("exit %d:\n%s", rc, out);
-    CHECK_CONTAINS(out, "parameter,unit,value,std_error,initial,fitted_as\nmodel.glass.p_gt,Pa,");
+    CHECK_CONTAINS(out, "parameter [word],unit [word],value [unit],std_error [unit],initial [unit],"
+                        "fitted_as [word]\nmodel.glass.p_gt,Pa,");
     CHECK_CONTAINS(out, "# residuals e_n (fit - data): rms ");
     CHECK_CONTAINS(out, "residual std s = ");
     const char* row = strstr(out, "model.glass.p_gt,Pa,");

@@ -375,7 +375,7 @@ static void check_same_outputs(const char* a, const char* b, size_t frames)
         if (!ta || !tb)
             fail_msg("%s missing in %s", names[k], ta ? b : a);
         if (k == 0) { /* global.csv: column 9 is candidate_pairs */
-            CHECK_CONTAINS(ta, ",mean_agglomerate_size,candidate_pairs,");
+            CHECK_CONTAINS(ta, ",mean_agglomerate_size [-],candidate_pairs [count],");
             drop_line(ta, "# command: wetdem run ");
             drop_line(tb, "# command: wetdem run ");
             drop_column(ta, 9);
@@ -1050,10 +1050,10 @@ static void test_many_cli_third_signal_stops_at_once(void** state)
 
 /* The CSV ends with the state of the last step, also off its grid of csv_every steps, and that
  * row agrees with summary.json; it is the row the library writes on its grid, byte for byte. */
-/* global.csv names the git version and the command under its first line, as the other CSVs
- * do (it named the version alone), and a restart keeps that line whole however long: the
- * resume read the file in pieces of 4096 bytes and dropped a piece without a newline as a row
- * cut by a crash. Here the command is over 5000 characters (19 keys set to values padded with
+/* global.csv starts with the git version and the command, as the other CSVs do (it named the
+ * version alone), then says what it holds, and a restart keeps those lines whole however long:
+ * the resume read the file in pieces of 4096 bytes and dropped a piece without a newline as a
+ * row cut by a crash. Here the command is over 5000 characters (19 keys set to values padded with
  * zeros to 250 characters), and the resumed file is the uninterrupted run's. */
 static void test_many_cli_csv_names_its_command(void** state)
 {
@@ -1106,15 +1106,18 @@ static void test_many_cli_csv_names_its_command(void** state)
     }
     char* csv = test_read_file(tpath("cmd_b/global.csv"), NULL);
     assert_non_null(csv);
-    const char* head = "# wetdem " WETDEM_VERSION " many-particle run: global quantities\n# git ";
+    const char* head = "# wetdem " WETDEM_VERSION " (git ";
     assert_memory_equal(csv, head, strlen(head));
     const char* command = strchr(csv + strlen(head), '\n');
     assert_non_null(command);
     command++;
     char* want = malloc(at + 400);
     assert_non_null(want);
-    snprintf(want, at + 400,
-             "# command: wetdem run cmd.ini%s --set run.steps=100 --out cmd_b\ntime_s,step,", sets);
+    snprintf(
+        want, at + 400,
+        "# command: wetdem run cmd.ini%s --set run.steps=100 --out cmd_b\n# many-particle run: "
+        "global quantities\ntime [s],step [count],",
+        sets);
     assert_memory_equal(command, want, strlen(want));
     free(csv);
     free(want);

@@ -1823,7 +1823,7 @@ static void test_scenario_pairwise_row_separated_sphere_as_json(void** state)
                                       false);
     assert_int_equal(sw.code, 0);
     char* rows = data_lines(sw.out);
-    CHECK_CONTAINS(rows, "outcome [word],separated_sphere [-],");
+    CHECK_CONTAINS(rows, "outcome [word],separated_sphere [index],");
     const char* line = strchr(rows, '\n') + 1;
     static const char* const outcome_want[] = {"FA", "PA"};
     for (int k = 0; k < 2; k++) {

@@ -1398,9 +1398,10 @@ static void test_track_cli_reports_uncertainties(void** state)
     assert_int_equal(test_run_cli_into(args, out, sizeof out), 0);
     char* text = test_read_file(frames, NULL);
     assert_non_null(text);
-    CHECK_CONTAINS(text, "\nsphere,frame,time_s,vx_raw_m_s,vy_raw_m_s,omega_raw_rad_s,vx_m_s,"
-                         "vy_m_s,omega_rad_s,residual_m,u_vx_raw_m_s,u_vy_raw_m_s,"
-                         "u_omega_raw_rad_s,u_vx_m_s,u_vy_m_s,u_omega_rad_s\n");
+    CHECK_CONTAINS(text, "\nsphere [index],frame [index],time [s],vx_raw [m/s],vy_raw [m/s],"
+                         "omega_raw [rad/s],vx [m/s],vy [m/s],omega [rad/s],residual [m],"
+                         "u_vx_raw [m/s],u_vy_raw [m/s],u_omega_raw [rad/s],u_vx [m/s],"
+                         "u_vy [m/s],u_omega [rad/s]\n");
     free(text);
     remove(frames);
 }
@@ -1472,7 +1473,7 @@ static void test_track_cli_frames_through_links_and_devices(void** state)
     assert_true(S_ISLNK(st.st_mode));
     char* text = test_read_file(target, NULL);
     assert_non_null(text);
-    CHECK_CONTAINS(text, "sphere,frame,time_s,");
+    CHECK_CONTAINS(text, "sphere [index],frame [index],time [s],");
     free(text);
     snprintf(args, sizeof args, "%s --frames %s", track, null_link);
     r = test_run_cli("", args, true);

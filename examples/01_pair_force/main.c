@@ -45,7 +45,7 @@ int main(void)
     if (wetdem_sim_enable_model(sim, "nijssen") != WETDEM_OK)
         return report(sim, "model");
 
-    printf("gap_m,f_normal_N\n");
+    printf("gap [m],f_normal [N]\n");
     for (size_t k = 0; k < sizeof gaps / sizeof gaps[0]; k++) {
         wetdem_sim_particles(sim, NULL)[0].pos.x = 2 * radius + gaps[k];
         struct wetdem_pair_force f;
