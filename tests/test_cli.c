@@ -6,7 +6,8 @@
  * `--help`/`-h` of every subcommand listed by `wetdem --help` (usage on stdout, exit 0), and
  * the choice of models: a model of the wrong kind named with its kind, and [model.NAME]
  * sections of models that a --set of [models] left out; the inputs `make fuzz` found
- * (tests/fuzz/regressions/), each answered as any other file.
+ * (tests/fuzz/regressions/), each answered as any other file; the shape of every CSV the tool
+ * writes (provenance lines, then columns "name [unit]" whose rows fit their units).
  *
  * The CLI path comes from the environment variable WETDEM_CLI (set by `make test`), falling
  * back to build/wetdem relative to the working directory (the repository root).
@@ -690,6 +691,167 @@ static void test_cli_summary_names_its_command(void** state)
     assert_int_equal(system(cmd), 0);
 }
 
+/* Whether text[0..n) is one number as the CSVs write them (nan and inf included). */
+static bool csv_number(const char* text, size_t n)
+{
+    char buf[64], *end;
+    if (n == 0 || n >= sizeof buf)
+        return false;
+    memcpy(buf, text, n);
+    buf[n] = '\0';
+    strtod(buf, &end);
+    return *end == '\0';
+}
+
+/* Whether text[0..n) is a whole number (a leading '-' allowed: separated_sphere -1 for none). */
+static bool csv_integer(const char* text, size_t n)
+{
+    size_t k = n > 1 && text[0] == '-';
+    if (k == n)
+        return false;
+    for (; k < n; k++)
+        if (text[k] < '0' || text[k] > '9')
+            return false;
+    return true;
+}
+
+/* The shape every CSV wetdem writes has (docs/concepts.md, "CSV files"): the provenance lines
+ * "# wetdem VERSION (git HASH)" and "# command: wetdem ...", any '#' lines, then a header
+ * whose every column is "name [unit]" (a name of letters, digits, '_' and '.'; a unit with no
+ * bracket, comma or outer blank), then at least one row of as many fields, '#' lines allowed
+ * between and after the rows. A row's field must fit its column's unit: a number but in a
+ * [word] column, a whole number in a [count] or [index] column, 0 or 1 in a [0/1] column.
+ * `what` names the file in a failure. */
+static void check_csv_shape(const char* what, const char* text)
+{
+    const char* first = "# wetdem " WETDEM_VERSION " (git ";
+    if (strncmp(text, first, strlen(first)) != 0)
+        fail_msg("%s: the first line is not '%s...)': '%.80s'", what, first, text);
+    const char* line = strchr(text, '\n');
+    if (!line || strncmp(line + 1, "# command: wetdem ", 18) != 0)
+        fail_msg("%s: the second line is not '# command: wetdem ...'", what);
+    while (line && line[1] == '#')
+        line = strchr(line + 1, '\n');
+    if (!line || !line[1])
+        fail_msg("%s: no header line after the '#' lines", what);
+    line++;
+    enum { MAX_COLS = 128 };
+    char units[MAX_COLS][32];
+    size_t n_cols = 0, len = strcspn(line, "\n");
+    for (const char* f = line; f < line + len; n_cols++) {
+        const char* end = memchr(f, ',', (size_t)(line + len - f));
+        end = end ? end : line + len;
+        size_t n = (size_t)(end - f);
+        const char* open = memchr(f, '[', n);
+        size_t name = open ? (size_t)(open - f) : 0;
+        bool ok = open && name >= 2 && open[-1] == ' ' && end[-1] == ']' && n_cols < MAX_COLS;
+        for (size_t k = 0; ok && k + 1 < name; k++)
+            ok = (f[k] >= 'a' && f[k] <= 'z') || (f[k] >= 'A' && f[k] <= 'Z') ||
+                 (f[k] >= '0' && f[k] <= '9') || f[k] == '_' || f[k] == '.';
+        size_t unit = ok ? n - name - 2 : 0; /* between the brackets */
+        ok = ok && unit > 0 && unit < sizeof units[0] && open[1] != ' ' && end[-2] != ' ' &&
+             !memchr(open + 1, '[', unit) && !memchr(open + 1, ']', unit);
+        if (!ok)
+            fail_msg("%s: column %zu '%.*s' is not 'name [unit]' in the header '%.*s'", what,
+                     n_cols + 1, (int)n, f, (int)len, line);
+        snprintf(units[n_cols], sizeof units[0], "%.*s", (int)unit, open + 1);
+        f = end + (end < line + len);
+    }
+    size_t rows = 0;
+    for (const char* row = line + len; *row && row[1]; row += len) {
+        row++;
+        len = strcspn(row, "\n");
+        if (row[0] == '#')
+            continue;
+        rows++;
+        size_t c = 0;
+        for (const char* f = row; c < MAX_COLS; c++) {
+            const char* end = memchr(f, ',', (size_t)(row + len - f));
+            end = end ? end : row + len;
+            size_t n = (size_t)(end - f);
+            const char* u = c < n_cols ? units[c] : "";
+            bool ok = c < n_cols &&
+                      (strcmp(u, "word") == 0 ||
+                       (strcmp(u, "0/1") == 0 ? n == 1 && (*f == '0' || *f == '1')
+                        : strcmp(u, "count") == 0 || strcmp(u, "index") == 0 ? csv_integer(f, n)
+                                                                             : csv_number(f, n)));
+            if (!ok)
+                fail_msg("%s: row %zu, column %zu: '%.*s' %s", what, rows, c + 1, (int)n, f,
+                         c < n_cols ? "does not fit its unit" : "is beyond the header's columns");
+            if (end == row + len)
+                break;
+            f = end + 1;
+        }
+        if (c + 1 != n_cols)
+            fail_msg("%s: row %zu has %zu fields, the header %zu columns", what, rows, c + 1,
+                     n_cols);
+    }
+    if (rows == 0)
+        fail_msg("%s: no rows", what);
+}
+
+/* Every CSV wetdem writes has the shape of check_csv_shape: forces, the trajectory and events
+ * of a run of each engine, the tables of sweep (both engines) and map, the three of fit (its
+ * standard output, --out, --curve), track --frames and the library's global CSV of a
+ * many-particle run. Three of them had columns "name_unit" (gap_m, time_s, kinetic_J) and no
+ * brackets, and global.csv put its version line before the provenance. */
+static void test_cli_every_csv_has_provenance_and_name_unit_columns(void** state)
+{
+    (void)state;
+    char dir[] = "/tmp/wetdem_test_cli_csv_XXXXXX";
+    assert_non_null(mkdtemp(dir));
+    static const struct {
+        const char* args;     /* %s: the directory */
+        const char* files[3]; /* in the directory; none: standard output */
+    } cases[] = {
+        {"forces --model reynolds mindlin --slip 0.01 --gaps 1e-6:1e-5:3", {NULL}},
+        {"run examples/scenarios/nijssen_oblique.ini --out %s/soft",
+         {"soft/trajectory.csv", "soft/events.csv"}},
+        {"run examples/scenarios/davis_three.ini --out %s/pairwise",
+         {"pairwise/trajectory.csv", "pairwise/events.csv"}},
+        {"sweep examples/scenarios/nijssen_head_on.ini --param collision.stokes --values 10:30:2",
+         {NULL}},
+        {"sweep examples/scenarios/davis_three.ini --param davis.stokes --values 4:6:2", {NULL}},
+        {"map examples/scenarios/dry_hertz.ini --param collision.speed --values 0.1:0.2:2 "
+         "--param2 collision.angle_deg --values2 0:30:2",
+         {NULL}},
+        {"fit examples/fit/punch_db_c.ini --data examples/fit/punch_0deg.csv --fit glass.p_gt "
+         "--init 4e6 --out %s/fit.csv --curve %s/curve.csv --curve-points 3",
+         {NULL, "fit.csv", "curve.csv"}},
+        {"track examples/tracks/punch_45deg.csv --fps 5000 --pixel-size 175e-6 --frames "
+         "%s/frames.csv",
+         {"frames.csv"}},
+        {"run examples/scenarios/many_stokes_cradle.ini --set run.steps=2 --out %s/many",
+         {"many/global.csv"}},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        char args[600];
+        snprintf(args, sizeof args, cases[k].args, dir, dir);
+        struct test_run r = run_cli(args, false);
+        if (r.code != 0)
+            fail_msg("wetdem %s: exit %d", args, r.code);
+        for (size_t f = 0; f == 0 || (f < 3 && cases[k].files[f]); f++) {
+            char what[800], path[400];
+            if (!cases[k].files[f]) {
+                snprintf(what, sizeof what, "the output of wetdem %s", args);
+                check_csv_shape(what, r.out);
+                continue;
+            }
+            snprintf(path, sizeof path, "%s/%s", dir, cases[k].files[f]);
+            snprintf(what, sizeof what, "%s of wetdem %s", cases[k].files[f], args);
+            char* text = test_read_file(path, NULL);
+            if (!text)
+                fail_msg("%s is missing", what);
+            check_csv_shape(what, text);
+            free(text);
+        }
+        free(r.out);
+    }
+    char cmd[200];
+    snprintf(cmd, sizeof cmd, "rm -r %s", dir);
+    assert_int_equal(system(cmd), 0);
+}
+
 /* Output named /dev/stdout goes through standard output in place, also when that is a
  * regular file (`> FILE`): the CSV of fit --out and track --frames and the summary printed
  * beside it all reach the file. Before, /dev/stdout led to that file, which was replaced by a
@@ -1105,6 +1267,7 @@ int main(void)
         cmocka_unit_test(test_cli_run_outputs_into_a_deep_directory),
         cmocka_unit_test(test_cli_check_reports_the_stokes_number_run),
         cmocka_unit_test(test_cli_summary_names_its_command),
+        cmocka_unit_test(test_cli_every_csv_has_provenance_and_name_unit_columns),
         cmocka_unit_test(test_cli_dev_stdout_output_to_a_redirected_file),
         cmocka_unit_test(test_cli_numbers_out_of_range_and_cr_lines),
     };
