@@ -311,13 +311,21 @@ int cli_apply_set(struct wetdem_sim* sim, const char* key_value)
 
 /* The provenance lines "wetdem VERSION (git HASH)" and "command: wetdem ARGS", each begun with
  * `mark`, the first ended by a newline (the last's end is the caller's): the one text of
- * cli_print_provenance and cli_provenance_text. */
+ * cli_print_provenance and cli_provenance_text. A line break within an argument (a file name
+ * may hold one) continues the command on a line begun with `mark` again, so that it cannot end
+ * the comment and pass for the header or a row. */
 static void write_provenance(FILE* f, const char* mark, int argc, char** argv)
 {
     fprintf(f, "%swetdem %s (git %s)\n%scommand: wetdem", mark, WETDEM_VERSION, WETDEM_GIT_HASH,
             mark);
-    for (int k = 0; k < argc; k++)
-        fprintf(f, " %s", argv[k]);
+    for (int k = 0; k < argc; k++) {
+        fputc(' ', f);
+        for (const char* c = argv[k]; *c; c++)
+            if (*c == '\n' || *c == '\r')
+                fprintf(f, "\n%s", mark);
+            else
+                fputc(*c, f);
+    }
 }
 
 void cli_print_provenance(FILE* f, int argc, char** argv)

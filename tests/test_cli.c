@@ -794,7 +794,8 @@ static void check_csv_shape(const char* what, const char* text)
  * of a run of each engine, the tables of sweep (both engines) and map, the three of fit (its
  * standard output, --out, --curve), track --frames and the library's global CSV of a
  * many-particle run. Three of them had columns "name_unit" (gap_m, time_s, kinetic_J) and no
- * brackets, and global.csv put its version line before the provenance. */
+ * brackets, global.csv put its version line before the provenance, and a line break in an
+ * argument ended the command's comment line. */
 static void test_cli_every_csv_has_provenance_and_name_unit_columns(void** state)
 {
     (void)state;
@@ -821,6 +822,10 @@ static void test_cli_every_csv_has_provenance_and_name_unit_columns(void** state
         {"track examples/tracks/punch_45deg.csv --fps 5000 --pixel-size 175e-6 --frames "
          "%s/frames.csv",
          {"frames.csv"}},
+        /* a line break in an argument (here the file name) continues the command's comment */
+        {"track examples/tracks/punch_45deg.csv --fps 5000 --pixel-size 175e-6 --frames "
+         "\"%s/two\nlines.csv\"",
+         {"two\nlines.csv"}},
         {"run examples/scenarios/many_stokes_cradle.ini --set run.steps=2 --out %s/many",
          {"many/global.csv"}},
     };

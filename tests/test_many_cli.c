@@ -1048,8 +1048,6 @@ static void test_many_cli_third_signal_stops_at_once(void** state)
     wetdem_checkpoint_clear(&ck);
 }
 
-/* The CSV ends with the state of the last step, also off its grid of csv_every steps, and that
- * row agrees with summary.json; it is the row the library writes on its grid, byte for byte. */
 /* global.csv starts with the git version and the command, as the other CSVs do (it named the
  * version alone), then says what it holds, and a restart keeps those lines whole however long:
  * the resume read the file in pieces of 4096 bytes and dropped a piece without a newline as a
@@ -1126,6 +1124,8 @@ static void test_many_cli_csv_names_its_command(void** state)
     check_same_outputs("cmd_a", "cmd_b", 3);
 }
 
+/* The CSV ends with the state of the last step, also off its grid of csv_every steps, and that
+ * row agrees with summary.json; it is the row the library writes on its grid, byte for byte. */
 static void test_many_cli_csv_ends_at_the_last_step(void** state)
 {
     (void)state;
