@@ -8,6 +8,7 @@ Usage: nijssen_fig3.py [--dir DIR] [--png PATH] [--merged CSV] [--no-checks]
 """
 import argparse
 import os
+import sys
 
 import numpy as np
 
@@ -23,11 +24,19 @@ def load(directory):
 
 def merge(data, directory, path):
     """One CSV with a material column (the demo's fig3.csv)."""
-    first = os.path.join(directory, f"fig3_{ORDER[0]}.csv")
-    with open(first) as f:
-        prov = [ln for ln in f if ln.startswith("# wetdem")]
+    # provenance as every CSV of wetdem (docs/concepts.md, "CSV files"): the version of the
+    # sweeps, this command, then each sweep's own command
+    prov, commands = None, []
+    for m in ORDER:
+        with open(os.path.join(directory, f"fig3_{m}.csv")) as f:
+            head = [ln for ln in f if ln.startswith("# ")][:2]
+        prov = prov or head[0]
+        if len(head) == 2 and head[1].startswith("# command: "):
+            commands.append(f"# {m}: " + head[1][len("# command: "):])
     with open(path, "w") as out:
-        out.writelines(prov)
+        out.write(prov)
+        out.write("# command: " + " ".join(sys.argv) + " (the rows of the four sweeps)\n")
+        out.writelines(commands)
         header = None
         for m in ORDER:
             with open(os.path.join(directory, f"fig3_{m}.csv")) as f:
