@@ -129,7 +129,8 @@ static const struct cli_key_desc integrator_keys[] = {
           "cvode, method auto: Adams steps without an event after which BDF takes over."),
     COUNT("max_order", NULL, 1, 12, "cvode: largest order of the method (BDF uses at most 5)."),
     NUM("max_step", "s", NULL, 0, 1e6, false, false,
-        "cvode: largest step; 0 uses 0.1 x smallest radius / speed scale."),
+        "cvode: largest step; 0 uses 0.1 x smallest radius / the pairs' largest relative speed "
+        "(gravity's addition included, no floor)."),
     {0},
 };
 

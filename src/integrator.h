@@ -122,6 +122,9 @@ struct wetdem_vec3 wetdem_sim_angular_acceleration(const struct wetdem_sim* sim,
  * duration of any pair at its speed (wetdem_sim_contact_time: the enabled models' contact
  * times, else Hertz's) [s] (INFINITY without pairs). */
 double wetdem_sim_speed_scale(const struct wetdem_sim* sim, double* t_contact);
+/* The same largest relative speed without the floor [m/s]: 0 when every pair rests (no gravity
+ * to close a gap) or there is none. */
+double wetdem_sim_motion_speed(const struct wetdem_sim* sim);
 /* Smallest radius of a free particle [m] (1 if none). */
 double wetdem_sim_length_scale(const struct wetdem_sim* sim);
 /* Checks sim.stop_on_separation at the current state (engine.pair_gap/pair_vn must be

@@ -18,8 +18,10 @@
  * Tolerances: rtol = cvode.rtol; absolute tolerances per component, scaled so that one
  * dimensionless cvode.atol serves all: positions atol L, velocities atol V, spins atol V/L,
  * with L the smallest free radius [m] and V the speed scale of wetdem_sim_speed_scale() [m/s]
- * at the start of the run. Largest step: cvode.max_step, or 0.1 L/V when 0, so that no step
- * can carry a pair through its interaction range unseen, and for a pair closing in the larger
+ * at the start of the run. Largest step: cvode.max_step, or 0.1 L/V' when 0, V' the speed
+ * scale without its floor (the pairs' own largest relative speed, gravity's addition included;
+ * no bound when nothing moves), so that no step can carry a pair through its interaction range
+ * unseen, and for a pair closing in the larger
  * of half the time to close its gap and 0.1 of its contact time (contact_step_bound), so that
  * no step carries it through a whole solid contact.
  *
@@ -88,8 +90,10 @@ static const struct wetdem_param_desc cvode_params_desc[] = {
      "adams (non-stiff, functional iteration), bdf (stiff, dense Newton) or auto (adams, "
      "switching to bdf when a stretch without events takes stiff_steps steps).",
      P(method), 0, 0, 2, false, false, method_choices, false},
-    {"max_step", "s", "Largest step; 0 uses 0.1 x smallest radius / speed scale.", P(max_step), 0,
-     0, 1e6, false, false, NULL, false},
+    {"max_step", "s",
+     "Largest step; 0 uses 0.1 x smallest radius / the pairs' largest relative speed (gravity's "
+     "addition included, no floor).",
+     P(max_step), 0, 0, 1e6, false, false, NULL, false},
     {"stiff_steps", "-",
      "auto: Adams steps without an event after which the problem counts as stiff (e.g. a "
      "resting lubricated contact) and BDF takes over for the rest of the run.",
@@ -345,7 +349,10 @@ static int solver_create(struct wetdem_sim* sim, struct run* r, const struct cvo
 {
     sunindextype n = (sunindextype)(9 * r->n_free);
     double len = wetdem_sim_length_scale(sim), speed = wetdem_sim_speed_scale(sim, NULL);
-    double h_max = p->max_step > 0 ? p->max_step : 0.1 * len / speed;
+    /* (the pairs' own speed, not the floored scale: beneath sim.speed_floor the floor held a
+     * slow approach to steps floor / v times too short, and t_end grows as 1 / v) */
+    double motion = wetdem_sim_motion_speed(sim);
+    double h_max = p->max_step > 0 ? p->max_step : motion > 0 ? 0.1 * len / motion : INFINITY;
     s->h_max = h_max;
     s->h_cur = fmin(h_max, contact_step_bound(sim));
     s->t_end = s->t_stop = t_end;

@@ -264,13 +264,15 @@ struct wetdem_vec3 wetdem_sim_angular_acceleration(const struct wetdem_sim* sim,
 
 /* ---- scales ---- */
 
-double wetdem_sim_speed_scale(const struct wetdem_sim* sim, double* t_contact)
+/* The largest relative speed of any pair, gravity's addition over its gap included, each
+ * floored by `floor` [m/s]; *t_contact as wetdem_sim_speed_scale's. */
+static double pair_speed_scale(const struct wetdem_sim* sim, double floor, double* t_contact)
 {
     const struct wetdem_engine* e = &sim->engine;
     double g = sqrt(sim->settings.gravity_x * sim->settings.gravity_x +
                     sim->settings.gravity_y * sim->settings.gravity_y +
                     sim->settings.gravity_z * sim->settings.gravity_z);
-    double floor = sim->settings.speed_floor, v_max = floor, t_min = INFINITY;
+    double v_max = floor, t_min = INFINITY;
     for (size_t k = 0; k < e->pairs.n; k++) {
         const struct wetdem_pair* p = &e->pairs.items[k];
         struct wetdem_contact c;
@@ -290,6 +292,16 @@ double wetdem_sim_speed_scale(const struct wetdem_sim* sim, double* t_contact)
     if (t_contact)
         *t_contact = t_min;
     return v_max;
+}
+
+double wetdem_sim_speed_scale(const struct wetdem_sim* sim, double* t_contact)
+{
+    return pair_speed_scale(sim, sim->settings.speed_floor, t_contact);
+}
+
+double wetdem_sim_motion_speed(const struct wetdem_sim* sim)
+{
+    return pair_speed_scale(sim, 0.0, NULL);
 }
 
 double wetdem_sim_length_scale(const struct wetdem_sim* sim)

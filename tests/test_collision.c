@@ -491,6 +491,44 @@ static void test_collision_failed_run_reports_its_counts(void** state)
     wetdem_sim_free(sim);
 }
 
+/* A slow approach costs CVODE no more steps than a faster one: two Delrin spheres in water
+ * (nijssen, as examples/scenarios/nijssen_head_on.ini) at St_n = 1e-2 and 1e-5 (v_n = 2.6e-6
+ * and 2.6e-9 m/s, far beneath sim.speed_floor = 1e-3 m/s), each over 20 crossing times
+ * 20 R* / v_n as the CLI's automatic t_end. Both are overdamped (viscous relaxation time over
+ * crossing time ~ St_n): the spheres stop within 1e-3 R* of their start and stick (e = 0), and
+ * in time scaled by R* / v_n the two runs are alike (measured 533 and 534 steps). Asserted: the
+ * slower run takes at most 1.5 times the steps of the faster. The largest step was 0.1 R / V
+ * with V the speed scale floored at 1e-3 m/s, so the runs took ~20 x 20 x 10 x floor / v_n
+ * steps: 3.9e4 and 3.9e7, the second past cvode.max_steps = 1e7 (WETDEM_ERR_MAX_STEPS). */
+static void test_collision_cvode_slow_approach_steps_do_not_grow(void** state)
+{
+    (void)state;
+    double stokes[2] = {1e-2, 1e-5};
+    unsigned long long steps[2];
+    struct wetdem_material delrin;
+    struct wetdem_fluid water;
+    CHECK_OK(wetdem_material_preset("delrin", &delrin));
+    CHECK_OK(wetdem_fluid_preset("water", &water));
+    double m_eff = 0.5 * delrin.density * 4.0 / 3.0 * M_PI * R * R * R, r_eff = R / 2;
+    for (int k = 0; k < 2; k++) {
+        int mat;
+        struct wetdem_sim* sim = make_sim("delrin", 0, "nijssen", NULL, "cvode", &mat);
+        CHECK_OK(wetdem_sim_set_fluid(sim, &water));
+        CHECK_OK(wetdem_sim_set_param(sim, "nijssen.cutoff_ratio", 1.0));
+        double v_n = stokes[k] * 6.0 * M_PI * water.viscosity * r_eff * r_eff / m_eff;
+        struct wetdem_collision_spec s = head_on(mat, 0, 20.0 * r_eff / v_n);
+        s.stokes = stokes[k];
+        struct wetdem_collision_result r;
+        CHECK_OK(wetdem_collision_run(sim, &s, &r));
+        CHECK_REL(r.speed_n0, v_n, 1e-12);
+        assert_true(r.e == 0 && !r.separated && !r.solid_contact);
+        steps[k] = r.stats.steps;
+        wetdem_sim_free(sim);
+    }
+    if (!(steps[1] <= 1.5 * (double)steps[0]))
+        fail_msg("St_n = 1e-5 took %llu steps, St_n = 1e-2 %llu", steps[1], steps[0]);
+}
+
 /* Verlet at a small step (0.5 % of the Hertz time) and CVODE (rtol 1e-10) agree on e of a
  * Nijssen collision (Delrin, St = 200): the difference is Verlet's error, measured 2.0e-5;
  * 2e-4 asserted. */
@@ -1103,6 +1141,7 @@ int main(void)
         cmocka_unit_test(test_collision_e_falls_with_viscosity),
         cmocka_unit_test(test_collision_wall_lubrication),
         cmocka_unit_test(test_collision_nijssen_refuses_hmin_beyond_cutoff),
+        cmocka_unit_test(test_collision_cvode_slow_approach_steps_do_not_grow),
         cmocka_unit_test(test_collision_integrators_agree),
         cmocka_unit_test(test_collision_swap_roles),
         cmocka_unit_test(test_collision_deterministic_and_clone),
