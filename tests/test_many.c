@@ -1405,6 +1405,36 @@ static void test_many_step_resolves_hmin(void** state)
     }
 }
 
+/* The tangential thin-film laws jump at h_min too (`davis`, `nase` with below_hmin = c: from
+ * their largest force to zero), so the derived step holds the travel per step against their
+ * h_min as against sb's, however the spheres move at the start (docs/many.md, Travel per
+ * step). wall_impact's sphere with roughness h_min = 1 um (its films 100 um together): at
+ * rest, as a packing released from rest, the speed scale is sim.speed_floor, 1e-3 m/s;
+ * moving obliquely with spin, twice its speed, 0.1 m/s. hmin_crossing_time is h_min / v
+ * (1e-14: the same formula, a rounding apart), and the step at most half of it. The pairs the
+ * step is derived from took the spheres' own velocities, so a sphere at rest (or moving along
+ * z only) gave them no slip and these laws no jump: the bound was left out. */
+static void test_many_step_hmin_of_tangential_laws(void** state)
+{
+    (void)state;
+    const char* models[] = {"hertz davis", "hertz mindlin nase"};
+    for (int k = 0; k < 4; k++) {
+        bool rest = k % 2 == 0;
+        struct wetdem_sim* sim = wall_impact(models[k / 2], "roughness", rest ? 0.0 : 3.0);
+        if (rest)
+            wetdem_sim_particles(sim, NULL)[0].vel = (struct wetdem_vec3){0, 0, 0};
+        CHECK_OK(wetdem_sim_integrate(sim, 1e-6));
+        struct wetdem_many_stats st;
+        CHECK_OK(wetdem_sim_many_stats(sim, &st));
+        double expect = 1e-6 / (rest ? 1e-3 : 0.1);
+        if (!(fabs(st.hmin_crossing_time / expect - 1) < 1e-14))
+            fail_msg("%s, %s: hmin_crossing_time %g s, h_min / v = %g s", models[k / 2],
+                     rest ? "at rest" : "oblique with spin", st.hmin_crossing_time, expect);
+        assert_true(st.dt <= 0.5 * st.hmin_crossing_time);
+        wetdem_sim_free(sim);
+    }
+}
+
 /* The derived step also resolves the tangential spring (docs/many.md, Time step). Mindlin's
  * k_t = 8 G* sqrt(R* delta) against the Hertz tangent stiffness k_n = 2 E* sqrt(R* delta), and
  * a tangential mass of (2/7) m* (both spheres spin): omega_t/omega_n = sqrt(4 G* / E* x 7/2)
@@ -2440,6 +2470,7 @@ int main(void)
         cmocka_unit_test(test_many_fixed_spheres_meet_neither_each_other_nor_walls),
         cmocka_unit_test(test_many_freeing_a_fixed_sphere_between_calls),
         cmocka_unit_test(test_many_step_resolves_hmin),
+        cmocka_unit_test(test_many_step_hmin_of_tangential_laws),
         cmocka_unit_test(test_many_api_misuse_is_refused),
         cmocka_unit_test(test_many_gravity_along_a_periodic_axis_keeps_the_budget),
         cmocka_unit_test(test_many_walls_must_be_parallel_to_periodic_axes),
