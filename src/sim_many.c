@@ -371,15 +371,70 @@ static int step_scales(struct wetdem_sim* sim, const struct step_spheres* sp, st
     return WETDEM_OK;
 }
 
+/* How far gravity can make a free sphere fall before something that does not fall with it stops
+ * it [m] (docs/many.md, Time step, "What a fall adds"), along the unit direction gh of gravity,
+ * with heights h = -gh.x: the largest of
+ *   - over the walls that face up (a = -n.gh > 0), the fall of a free sphere p to the wall's
+ *     plane along gh, (n.(x_p - q) - R_p) / a, bounded over the spheres in one pass: with t =
+ *     n + a gh the part of n across gravity, it is (h_p - R_p) - R_p (1 - a)/a + (t.x_p -
+ *     n.q)/a <= U - R_min (1 - a)/a + (max of t.x over the box of the free centres - n.q)/a,
+ *     U the largest h_p - R_p (exact for a wall normal to gravity, and for one sphere);
+ *   - the fall of the highest free centre to the lowest point a free centre can touch a fixed
+ *     sphere at, min over fixed f of (h_f - R_f) less the largest free radius;
+ *   - the extent of the free centres along gravity.
+ * 0 without free spheres. O(particles + walls). */
+static double fall_height(const struct wetdem_sim* sim, struct wetdem_vec3 gh)
+{
+    double top = -INFINITY, bot = INFINITY, u = -INFINITY, r_min = INFINITY, r_max = 0;
+    double fixed_low = INFINITY;
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (size_t k = 0; k < sim->n_particles; k++) {
+        const struct wetdem_particle* p = &sim->particles[k];
+        double h = -vec3_dot(gh, p->pos);
+        if (p->is_fixed) {
+            fixed_low = fmin(fixed_low, h - p->radius);
+            continue;
+        }
+        top = fmax(top, h);
+        bot = fmin(bot, h);
+        u = fmax(u, h - p->radius);
+        r_min = fmin(r_min, p->radius);
+        r_max = fmax(r_max, p->radius);
+        const double x[3] = {p->pos.x, p->pos.y, p->pos.z};
+        for (int a = 0; a < 3; a++) {
+            lo[a] = fmin(lo[a], x[a]);
+            hi[a] = fmax(hi[a], x[a]);
+        }
+    }
+    if (!(top > -INFINITY))
+        return 0; /* no free sphere */
+    double fall = top - bot;
+    if (fixed_low < INFINITY)
+        fall = fmax(fall, top - (fixed_low - r_max));
+    for (size_t w = 0; w < sim->n_walls; w++) {
+        const struct wetdem_wall* W = &sim->walls[w];
+        double a = -vec3_dot(W->normal, gh);
+        if (!(a > 0))
+            continue; /* a wall that does not face up stops no fall */
+        const struct wetdem_vec3 t = vec3_add(W->normal, vec3_scale(gh, a));
+        const double tc[3] = {t.x, t.y, t.z};
+        double across = 0; /* the largest t.x over the box of the free centres */
+        for (int c = 0; c < 3; c++)
+            across += fmax(tc[c] * lo[c], tc[c] * hi[c]);
+        fall = fmax(fall, u - r_min * (1 - a) / a + (across - vec3_dot(W->normal, W->point)) / a);
+    }
+    return fmax(fall, 0.0);
+}
+
 /* The spheres of struct step_spheres and the speed scale of the step [m/s]: twice the largest
- * particle speed plus what gravity adds over the height of the packing, floored by
+ * particle speed plus what gravity adds over the fall of fall_height, floored by
  * sim.speed_floor. Without free spheres, small and big are copies of the smallest sphere,
  * taken as free. Needs at least one particle. */
 static void start_speed(const struct wetdem_sim* sim, struct step_spheres* sp)
 {
     const struct wetdem_particle *small = NULL, *big = NULL, *fs = NULL, *fb = NULL;
     const struct wetdem_particle* smallest = &sim->particles[0];
-    double v = 0, lo = INFINITY, hi = -INFINITY;
+    double v = 0;
     sp->n_free = sp->n_fixed = 0;
     for (size_t k = 0; k < sim->n_particles; k++) {
         const struct wetdem_particle* p = &sim->particles[k];
@@ -394,8 +449,6 @@ static void start_speed(const struct wetdem_sim* sim, struct step_spheres* sp)
             sp->n_free++;
         }
         v = fmax(v, 2 * vec3_norm(p->vel));
-        lo = fmin(lo, fmin(p->pos.z, fmin(p->pos.x, p->pos.y)));
-        hi = fmax(hi, fmax(p->pos.z, fmax(p->pos.x, p->pos.y)));
     }
     sp->small = small ? *small : *smallest;
     sp->big = big ? *big : *smallest;
@@ -403,9 +456,10 @@ static void start_speed(const struct wetdem_sim* sim, struct step_spheres* sp)
     sp->fixed_small = fs ? *fs : sp->small;
     sp->fixed_big = fb ? *fb : sp->small;
     const struct wetdem_sim_settings* s = &sim->settings;
-    double g = sqrt(s->gravity_x * s->gravity_x + s->gravity_y * s->gravity_y +
-                    s->gravity_z * s->gravity_z);
-    sp->speed = fmax(s->speed_floor, v + sqrt(2 * g * fmax(hi - lo, 0.0)));
+    const struct wetdem_vec3 gv = vec3(s->gravity_x, s->gravity_y, s->gravity_z);
+    double g = vec3_norm(gv);
+    double fall = g > 0 ? fall_height(sim, vec3(gv.x / g, gv.y / g, gv.z / g)) : 0;
+    sp->speed = fmax(s->speed_floor, v + sqrt(2 * g * fall));
 }
 
 /* The spheres and time scales of the step for the current particles, into the engine's

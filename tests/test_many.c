@@ -1173,13 +1173,16 @@ static void test_many_max_steps_refuses_the_call_up_front(void** state)
  * sphere with another free one, with a fixed one, with a wall. A fixed sphere has infinite
  * mass, so two copies of it (what "the two smallest spheres" were when a fixed sphere was the
  * smallest) had an infinite contact time, and no step could be derived. Steel, hertz alone, a
- * free sphere of R = 1 mm at rest with its centre 4 mm above the floor z = 0, under gravity:
- * the speed scale is sqrt(2 g 4 mm) (the fall over the packing's height) and the step 0.02 x
- * the Hertz contact time of the shortest pair:
+ * free sphere of R = 1 mm at rest with its centre 4 mm above the floor z = 0, under gravity,
+ * and the step 0.02 x the Hertz contact time of the shortest pair:
  *   - with a fixed sphere of R = 0.5 mm on the floor, and the floor: the floor's (m* = m,
  *     R* = R; the fixed sphere's R* = R/3 gives a longer time);
  *   - with the fixed sphere alone: that pair (m* = m, R* = 1/3 mm);
  *   - alone (no partner at all): two copies of it (m* = m/2, R* = R/2), as if another came.
+ * With the fixed sphere the speed scale is sqrt(2 g 5 mm): the deepest a free centre can touch
+ * it is R = 1 mm below its lowest point, z = 0, 5 mm below the free centre (docs/many.md, What
+ * a fall adds; the floor alone gives 3 mm). Alone, nothing stops its fall: gravity gives no
+ * relative speed, and the speed scale is sim.speed_floor (1e-3 m/s).
  * 1e-14: the same formula, evaluated in the same order, from m* and R* that may each be an
  * ulp apart (measured 0). */
 static void test_many_step_comes_from_the_pairs_that_occur(void** state)
@@ -1204,7 +1207,7 @@ static void test_many_step_comes_from_the_pairs_that_occur(void** state)
         struct wetdem_contact c;
         wetdem_contact_from_particles(&c, &p[0], &sim->materials[0], &p[0], &sim->materials[0],
                                       &sim->fluid);
-        double m = p[0].mass, v = sqrt(2 * 9.81 * 4e-3);
+        double m = p[0].mass, v = k < 2 ? sqrt(2 * 9.81 * 5e-3) : 1e-3;
         double m_eff = k == 2 ? m / 2 : m, r_eff = k == 0 ? 1e-3 : k == 1 ? 1e-3 / 3 : 0.5e-3;
         double t_c = wetdem_force_hertz_contact_time(c.e_star, r_eff, m_eff, v);
         struct wetdem_many_stats st;
@@ -1213,6 +1216,71 @@ static void test_many_step_comes_from_the_pairs_that_occur(void** state)
         CHECK_REL(st.dt, 0.02 * t_c, 1e-14);
         assert_true(isinf(st.hmin_crossing_time)); /* nothing viscous */
         assert_true(p[0].pos.z < 4e-3);            /* the free sphere falls */
+        wetdem_sim_free(sim);
+    }
+}
+
+/* The speed scale bounds what gravity can add before something stops a sphere (docs/many.md,
+ * What a fall adds): a soft glass sphere (R = 1 mm, hertz alone) released at rest, its centre at
+ * (a, a, h) with h = 5 mm, falls onto the plane wall it meets at the distance L along gravity
+ * that its surface has to the plane over -n.g_hat; the speed scale is sqrt(2 g L) and the step
+ * 0.02 x the Hertz contact time of the sphere against the wall (m* = m, R* = R) at it:
+ *   - a floor z = 0 (L = h - R) with a = 0 and a = 0.3 m: the horizontal position does not
+ *     count (the rule before took the largest coordinate less the smallest over the three axes
+ *     together: 0.295 m at a = 0.3, a speed scale 8.6 times too high);
+ *   - a wall through the origin inclined at 30 deg, n = (sin, 0, cos) (L = (x sin + h cos - R) /
+ *     cos), with a = 2 mm: the sphere is then followed step by step to the wall, and its speed
+ *     where it first touches is sqrt(2 g L), the speed scale: the bound is reached.
+ * 1e-14 on the step: the engine's L and this one are the same sums in another order, a few
+ * ulps, and the contact time goes as L^(-1/10). On the speed at the wall: Verlet under a
+ * constant force alone is exact, so before the touch v = g t at the steps t = k dt, and the
+ * last one before the touch lies within one step of the exact time: at most g dt below
+ * sqrt(2 g L) (1.9e-4 of it; measured 1.9e-5), never above it (1e-12 for the rounding of the
+ * 5400 steps' kicks). */
+static void test_many_speed_scale_bounds_the_fall(void** state)
+{
+    (void)state;
+    const double R = 1e-3, h = 5e-3, g = 9.81, th = M_PI / 6;
+    for (int k = 0; k < 3; k++) {
+        struct wetdem_sim* sim = wetdem_sim_create();
+        struct wetdem_material mat = test_soft_glass(0);
+        assert_int_equal(wetdem_sim_add_material(sim, &mat), 0);
+        CHECK_OK(wetdem_sim_enable_model(sim, "hertz"));
+        CHECK_OK(wetdem_sim_set_param(sim, "sim.gravity_z", -g));
+        double a = k == 0 ? 0 : k == 1 ? 0.3 : 2e-3, L = h - R;
+        struct wetdem_vec3 n = vec3(0, 0, 1);
+        if (k == 2) {
+            n = vec3(sin(th), 0, cos(th));
+            L = (a * sin(th) + h * cos(th) - R) / cos(th);
+        }
+        CHECK_OK(
+            wetdem_sim_add_particle(sim, (struct wetdem_particle){.pos = {a, a, h}, .radius = R}));
+        CHECK_OK(wetdem_sim_add_wall(sim, vec3(0, 0, 0), n, 0));
+        CHECK_OK(wetdem_sim_set_many(sim, &(struct wetdem_many_settings){.skin = 1e-4}));
+        CHECK_OK(wetdem_sim_integrate(sim, 1e-9)); /* one step: the step is derived */
+        const struct wetdem_particle* p = wetdem_sim_particles_const(sim, NULL);
+        struct wetdem_contact c;
+        wetdem_contact_from_particles(&c, &p[0], &sim->materials[0], &p[0], &sim->materials[0],
+                                      &sim->fluid);
+        double v = sqrt(2 * g * L);
+        double t_c = wetdem_force_hertz_contact_time(c.e_star, R, p[0].mass, v);
+        struct wetdem_many_stats st;
+        CHECK_OK(wetdem_sim_many_stats(sim, &st));
+        CHECK_REL(st.contact_time, t_c, 1e-14);
+        CHECK_REL(st.dt, 0.02 * t_c, 1e-14);
+        if (k == 2) {
+            /* to a few steps before the touch at t = sqrt(2 L / g), then a step at a time */
+            CHECK_OK(wetdem_sim_integrate(sim, sqrt(2 * L / g) - 5 * st.dt));
+            double gap = 1, speed = 0;
+            for (int s = 0; s < 100 && gap > 0; s++) {
+                speed = vec3_norm(p[0].vel);
+                CHECK_OK(wetdem_sim_integrate(sim, wetdem_sim_time(sim) + st.dt));
+                gap = vec3_dot(n, p[0].pos) - R;
+            }
+            assert_true(gap <= 0); /* it reached the wall */
+            assert_true(speed <= v * (1 + 1e-12));
+            assert_true(speed >= v - g * st.dt);
+        }
         wetdem_sim_free(sim);
     }
 }
@@ -1236,12 +1304,14 @@ static struct wetdem_sim* wet_glass(void)
  * spheres meet neither each other nor a wall (infinite masses would give the contact damping
  * no finite value), so the run goes on, the bed stays where it was bit for bit, the only
  * contact is the free sphere's, and it lands on the bed. With 69 more walls far away (the
- * path for more than 64 walls, which scans every wall of every particle) the free sphere
- * moves bit for bit the same: those walls are beyond reach. */
+ * path for more than 64 walls, which scans every wall of every particle) and the step the run
+ * with one wall derived, the free sphere moves bit for bit the same: those walls are beyond
+ * reach. (Not at its own derived step: the speed scale counts the fall to every wall that faces
+ * up, and the far ones give 1 m, docs/many.md, What a fall adds.) */
 static void test_many_fixed_spheres_meet_neither_each_other_nor_walls(void** state)
 {
     (void)state;
-    double z_end[2];
+    double z_end[2], dt = 0;
     for (int many_walls = 0; many_walls < 2; many_walls++) {
         struct wetdem_sim* sim = wet_glass();
         const char* models[] = {"hertz", "mindlin", "sb", "capillary", "fixed"};
@@ -1261,7 +1331,7 @@ static void test_many_fixed_spheres_meet_neither_each_other_nor_walls(void** sta
         /* the floor last: with 70 walls it is beyond the 64 of the walls' bit masks */
         CHECK_OK(wetdem_sim_add_wall(sim, vec3(0, 0, 0), vec3(0, 0, 1), 0));
         assert_int_equal(wetdem_sim_n_walls(sim), many_walls ? 70 : 1);
-        CHECK_OK(wetdem_sim_set_many(sim, &(struct wetdem_many_settings){.skin = 5e-5}));
+        CHECK_OK(wetdem_sim_set_many(sim, &(struct wetdem_many_settings){.skin = 5e-5, .dt = dt}));
         CHECK_OK(wetdem_sim_integrate(sim, 20e-3));
         const struct wetdem_particle* p = wetdem_sim_particles_const(sim, NULL);
         for (int k = 0; k < 2; k++)
@@ -1272,6 +1342,7 @@ static void test_many_fixed_spheres_meet_neither_each_other_nor_walls(void** sta
            contact: neither the bed's own overlap nor its cut into the floor counts */
         struct wetdem_many_stats st;
         CHECK_OK(wetdem_sim_many_stats(sim, &st));
+        dt = st.dt;
         assert_int_equal(st.contacts, 0);
         assert_int_equal(st.bridges, 1);
         double gap = p[2].pos.z - bed[0].pos.z - 2 * 0.5e-3;
@@ -2467,6 +2538,7 @@ int main(void)
         cmocka_unit_test(test_many_step_resolves_hooke_damping),
         cmocka_unit_test(test_many_max_steps_refuses_the_call_up_front),
         cmocka_unit_test(test_many_step_comes_from_the_pairs_that_occur),
+        cmocka_unit_test(test_many_speed_scale_bounds_the_fall),
         cmocka_unit_test(test_many_fixed_spheres_meet_neither_each_other_nor_walls),
         cmocka_unit_test(test_many_freeing_a_fixed_sphere_between_calls),
         cmocka_unit_test(test_many_step_resolves_hmin),
