@@ -2,7 +2,8 @@
 written from the documented step and force laws, not from the C code: velocity Verlet with the
 forces at the predicted velocities and the tangential springs advanced with the slip of the
 half-step velocities (docs/many.md, "Time step"), the step derived when none is given (the
-speed scale, the contact, relaxation and h_min crossing times of the pairs that can occur),
+speed scale with gravity's term over the fall of "What a fall adds", the contact, relaxation
+and h_min crossing times of the pairs that can occur),
 the pair and wall geometry and signs of docs/concepts.md, the laws of docs/models.md and
 docs/derivations/ (hertz with damping = tsuji or exact, hooke, mindlin beside either, sb, db,
 davis, nase, capillary, reynolds with a fixed h_min, nijssen with its own h_min record and
@@ -595,6 +596,50 @@ HERTZ_TC = 0.8 * (15 / 16) ** 0.4 * math.gamma(0.4) * math.gamma(0.5) / math.gam
 JUMPING_LAWS = ("sb", "db", "davis", "nase")
 
 
+def face_walls(sc):
+    """The walls of [walls] faces: (a point, the unit normal into the box)."""
+    out = []
+    for face in sc.get("walls", []):
+        ax = "xyz".index(face[0])
+        nrm, pt = np.zeros(3), np.zeros(3)
+        nrm[ax] = 1.0 if face.endswith("min") else -1.0
+        if face.endswith("max"):
+            pt[ax] = sc["box"][ax]
+        out.append((pt, nrm))
+    return out
+
+
+def fall_height(sc):
+    """H of docs/many.md, *What a fall adds*: with g^ the unit gravity and heights h = -g^.x,
+    the largest over the free spheres of (1) for each wall that faces up, a = -n.g^ > 0,
+    U - R_min (1 - a)/a + (max over the box B of the free centres of t.x - n.q)/a, with t =
+    n + a g^, U the largest h - R, R_min the smallest free radius; (2) the highest free
+    centre's fall to min over fixed spheres of (h - R) less the largest free radius; (3) the
+    extent of the free centres' heights. 0 without gravity or free spheres."""
+    gv = np.array(sc.get("gravity", (0, 0, 0)), float)
+    g = math.sqrt(float(gv @ gv))
+    free = [p for p in sc["particles"] if not p.get("fixed")]
+    if g == 0 or not free:
+        return 0.0
+    gh = gv / g
+    xs = np.array([p["x"] for p in free], float)
+    rs = np.array([p["R"] for p in free], float)
+    h = -(xs @ gh)
+    terms = [h.max() - h.min()]
+    fixed = [p for p in sc["particles"] if p.get("fixed")]
+    if fixed:
+        low = min(-float(np.array(p["x"], float) @ gh) - p["R"] for p in fixed)
+        terms.append(h.max() - low + rs.max())
+    u, lo, hi = (h - rs).max(), xs.min(axis=0), xs.max(axis=0)
+    for q, n in face_walls(sc):
+        a = -float(n @ gh)
+        if a > 0:
+            t = n + a * gh
+            across = sum(max(t[k] * lo[k], t[k] * hi[k]) for k in range(3))
+            terms.append(u - rs.min() * (1 - a) / a + (across - float(n @ q)) / a)
+    return max(max(terms), 0.0)
+
+
 def step_scales(sc):
     """The derived step of docs/many.md, *Time step*, from the scenario alone: the speed
     scale, and over the pairs that can occur the shortest contact time (normal or
@@ -613,12 +658,11 @@ def step_scales(sc):
     free = [p for p in ps if not p.get("fixed")]
     fixed = [p for p in ps if p.get("fixed")]
     walls = bool(sc.get("walls"))
-    # twice the largest speed, plus what gravity adds over the packing's extent: the largest
-    # coordinate of a centre less the smallest, over the three axes; at least sim.speed_floor
-    xs = [c for p in ps for c in p["x"]]
+    # twice the largest speed, plus what gravity adds over the fall H of *What a fall adds*;
+    # at least sim.speed_floor
     g = math.sqrt(sum(c * c for c in sc.get("gravity", (0, 0, 0))))
     v = max(2 * math.sqrt(sum(c * c for c in p.get("v", (0, 0, 0)))) for p in ps)
-    speed = max(1e-3, v + math.sqrt(2 * g * max(max(xs) - min(xs), 0.0)))
+    speed = max(1e-3, v + math.sqrt(2 * g * fall_height(sc)))
     first_min = functools.partial(min, key=lambda p: p["R"])  # the first of equal radii
     first_max = functools.partial(max, key=lambda p: p["R"])
     small = first_min(free) if free else first_min(ps)
@@ -1438,9 +1482,10 @@ def derived_from_rest():
     bridges, with the tangential films davis and nase cut off below a fixed h_min of 0.1 um
     (c) and no normal thin-film law: the step derived at the speed scale that gravity alone
     sets, many_hmin_fraction x the time to cross h_min, a jump of the tangential laws, binds
-    (a pair at rest slides at the speed scale as it closes at it)."""
+    (a pair at rest slides at the speed scale as it closes at it). Gravity is inclined to the
+    floor, so that the fall to it takes the part of the normal across gravity."""
     sc = wet_pair("derived_from_rest", "hertz mindlin davis nase capillary",
-                  {"fixed.h_min": 1e-7, "hertz.damping": "tsuji"}, gravity=(0, 0, -9.81),
+                  {"fixed.h_min": 1e-7, "hertz.damping": "tsuji"}, gravity=(1.5, -1.0, -9.7),
                   dt=None)
     for p in sc["particles"]:
         p.update(v=(0, 0, 0), w=(0, 0, 0))
@@ -1525,6 +1570,13 @@ def _mutant_speed(ctx, sc):  # the speed scale without what gravity adds
     globals()["step_scales"] = lambda sc: orig(dict(sc, gravity=(0, 0, 0)))
 
 
+def _mutant_mixed_axes(ctx, sc):  # the rule before: the largest coordinate less the smallest
+    ctx.append((sys.modules[__name__], "fall_height", fall_height))
+    globals()["fall_height"] = lambda sc: max(
+        max(c for p in sc["particles"] for c in p["x"]) -
+        min(c for p in sc["particles"] for c in p["x"]), 0.0)
+
+
 def _mutant_jumps(ctx, sc):  # the step bound by the normal laws' jumps alone
     ctx.append((sys.modules[__name__], "JUMPING_LAWS", JUMPING_LAWS))
     globals()["JUMPING_LAWS"] = ("sb", "db")
@@ -1575,6 +1627,8 @@ MUTANTS = [("torque on j with i's lever arm", _mutant_lever, "friction_spin_uneq
            ("derived step without the tangential contact time", _mutant_tangential,
             "derived_contact", "", None),
            ("speed scale without gravity", _mutant_speed, "derived_roughness", "", None),
+           ("fall over the three axes together (the rule before)", _mutant_mixed_axes,
+            "derived_roughness", "", None),
            ("the tangential laws' jump at h_min left out", _mutant_jumps,
             "derived_from_rest", "", None),
            ("roughness h_min the sum, not the mean", _mutant_roughness, "derived_roughness",

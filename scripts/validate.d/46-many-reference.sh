@@ -8,8 +8,9 @@
 # resumed from their checkpoint) run through `wetdem run` with a binary frame every 25 steps,
 # and the state compared at each frame, the energy budget per model at the end. Then
 # deliberate errors of the reference (a lever arm, a record, the Coulomb limit, the periodic
-# image, the power, the derived step, roughness, the histories at a restart, the pairs across
-# thread blocks) must be detected.
+# image, the power, the derived step and its fall (the rule before, over the three axes
+# together), roughness, the histories at a restart, the pairs across thread blocks) must be
+# detected.
 # Usage: scripts/validate.d/46-many-reference.sh PATH_TO_WETDEM_CLI   (from the repository root)
 set -euo pipefail
 . scripts/piece-start.sh
