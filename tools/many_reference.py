@@ -29,7 +29,8 @@ steps (the cases agree to 1e-16..1e-13); 1e-8 with the exact damping of hertz or
 whose coefficient the engine tabulates to about 4e-9 relative (docs/derivations/contact.md
 Sec. 1.3) where this reference bisects Eq. 1.7 (a shift of c by 4e-9 moves these cases by
 up to 2e-9). A derived step agrees to 1e-12 where a closed form binds, 1e-9 where mindlin's
-contact time does (the engine's central differences, derived_contact), and the printed time
+contact time does (the engine's central differences, derived_contact), 1e-8 where nijssen's
+exact dashpot does (the tabulated coefficient, derived_nijssen), and the printed time
 scales to 1e-5 (6 digits). --every N compares a frame every N steps, between which the
 engine takes its fused paths; --coverage prints what each case exercised; --mutants checks
 instead that deliberate errors of the reference are detected. Needs numpy (Debian
@@ -586,6 +587,11 @@ SLIDES = [0, 0]
 
 
 # ------------------------------------------------------------------ the derived step ---
+def glass_hmin(mu_f, rstar, v, p_gt, film):
+    """glass's h_min = min((3 mu a v / P_gt)^(1/2), delta), a = R* (docs/models.md)."""
+    return min(math.sqrt(3 * mu_f * rstar * v / p_gt), film)
+
+
 # t_c = (4/5)(15/16)^(2/5) B(2/5, 1/2) (m*^2/(E*^2 R* v))^(1/5), docs/derivations/contact.md
 # Eq. 1.8
 HERTZ_TC = 0.8 * (15 / 16) ** 0.4 * math.gamma(0.4) * math.gamma(0.5) / math.gamma(0.9)
@@ -645,8 +651,8 @@ def step_scales(sc):
     scale, and over the pairs that can occur the shortest contact time (normal or
     tangential), viscous relaxation time and time to cross the smallest gap where the laws
     jump; dt the shortest of dt_fraction (0.02) of the first, a quarter of the second and
-    many_hmin_fraction (0.5) of the third. Only the models and min-separation models the
-    derived cases use are written out (no nijssen, no glass)."""
+    many_hmin_fraction (0.5) of the third. Only the models the derived cases use are written
+    out (not hertz and hooke together)."""
     mats = sc["materials"]
     ps = sc["particles"]
     models = sc["models"].split()
@@ -696,14 +702,16 @@ def step_scales(sc):
                 # damped half period; the tangential one beside mindlin
                 t_hertz = HERTZ_TC * (mstar ** 2 / (mp["E"] ** 2 * rstar * speed)) ** 0.2
                 t_n = math.inf
-                if "hertz" in models:
+                if "hertz" in models or "nijssen" in models:
                     t_n = t_hertz
                 if "hooke" in models:
                     t_n = min(t_n, PI / math.sqrt(hooke_k / mstar - (gam / (2 * mstar)) ** 2))
                 if math.isinf(t_n):
                     t_n = t_hertz
                 t = t_n
-                if "mindlin" in models:
+                if "mindlin" in models or "nijssen" in models:
+                    # nijssen's spring on the shifted overlap d: k_t / k_n = 8 G* sqrt(R* d) /
+                    # (2 E* sqrt(R* d)), mindlin's ratio at every overlap (docs/many.md)
                     t = min(t, t_n * math.sqrt(mp["E"] / (14 * mp["G"])))
                 t_contact = min(t_contact, t)
                 if not (a in used and (b == wall_mat if wall else b in used)):
@@ -718,6 +726,9 @@ def step_scales(sc):
                     if ms == "max":
                         hmin = max(hmin, mp["rough"])
                 film = mp["film"]
+                if ms == "glass":  # docs/models.md, glass: at the speed scale, capped at delta
+                    hmin = glass_hmin(mu_f, rstar, speed, params.get("glass.p_gt", 1.16e7),
+                                      film)
                 hf = min(hmin, film)
                 dmax = (5 * mstar * speed ** 2 / (4 * k)) ** 0.4
                 for name in models:
@@ -745,6 +756,22 @@ def step_scales(sc):
                         tau = min(tau, 2 / 7 * mstar / (6 * PI * mu_f * rstar * fac))
                     elif name == "reynolds":
                         tau = min(tau, mstar / (6 * PI * mu_f * rstar ** 2 / hmin))
+                    elif name == "nijssen":
+                        # its own h_min at the speed scale (docs/models.md), its lubrication
+                        # there, and its hertz and mindlin dashpots at the largest shifted
+                        # overlap of an undamped approach (docs/many.md, Viscous relaxation)
+                        hn = max(mp["rough"], 0.37 * rstar * (mu_f * speed / (mp["E"] * rstar))
+                                 ** 0.4)
+                        tau = min(tau, mstar / (6 * PI * mu_f * rstar ** 2 / hn))
+                        if mp["e"] < 1:
+                            dn = (1.25 * mstar * speed ** 2 / k + 2 / 7 * hn ** 2.5) ** 0.4
+                            c = (-math.sqrt(5) * beta_of(mp["e"])
+                                 if params.get("nijssen.damping", "exact") == "tsuji"
+                                 else hertz_c_exact(mp["e"]))
+                            tau = min(tau, mstar / (c * math.sqrt(mstar * k) * dn ** 0.25))
+                            kt = 8 * mp["G"] * math.sqrt(rstar * dn)
+                            gt = -2 * math.sqrt(5 / 6) * beta_of(mp["e"]) * math.sqrt(mstar * kt)
+                            tau = min(tau, 2 / 7 * mstar / gt)
                     elif name not in ("hertz", "hooke", "mindlin", "capillary"):
                         raise ValueError(f"no derived step for {name} here")
                 # the jump at h_min' of the thin-film laws cut off below it (c), inside
@@ -1492,6 +1519,70 @@ def derived_from_rest():
     return sc
 
 
+@case
+def derived_fixed():
+    """Two wet spheres striking a fixed one (0.7 mm) under gravity, a larger fixed sphere
+    (1 mm) lower down and no wall, the step derived: the probe pairs with the smallest and
+    the largest fixed sphere (infinite mass, m* the free sphere's), the largest giving the
+    shortest (tangential) contact time, which binds, at the speed scale raised by the fixed
+    spheres' term of the fall (docs/many.md, What a fall adds, 2: to the lowest point of the
+    lower fixed sphere, 4.5 mm, against 0.04 mm of the free centres' extent). mindlin's
+    stiffness by the engine's central differences: 1e-9, and the engine's step followed, as
+    in derived_contact."""
+    base = (0.005, 0.005, 0.005)
+    return dict(name="derived_fixed", box=(0.01, 0.01, 0.01),
+                materials=[glass(film=20e-6), glass(film=10e-6, youngs_modulus=5e8)],
+                viscosity=0.01, surface_tension=0.03,
+                models="hertz mindlin sb davis capillary",
+                params={"fixed.h_min": 1e-6, "hertz.damping": "tsuji"},
+                gravity=(0, 0, -9.81),
+                particles=[dict(R=0.7e-3, x=base, fixed=True, mat=1),
+                           dict(R=0.5e-3, x=beside(base, 0.7e-3, 0.5e-3, (1, 0.2, 0.5), 4e-6),
+                                v=(-0.2, 0.03, 0.01), w=(0, 10, 50), mat=0),
+                           dict(R=0.4e-3, x=beside(base, 0.7e-3, 0.4e-3, (-1, 0, 0.5), 3e-6),
+                                v=(0.1, 0.0, -0.08), w=(-30, 0, 0), mat=0),
+                           dict(R=1e-3, x=(0.005, 0.005, 0.0025), fixed=True, mat=0)],
+                dt=None, dt_tol=1e-9, follow_dt=True, steps=1500)
+
+
+@case
+def derived_reynolds():
+    """reynolds beside hooke + mindlin in a 0.2 Pa s liquid, the step derived: a quarter of
+    reynolds' relaxation time m* h_min / (6 pi mu R*^2) at the fixed h_min binds, a closed
+    form; reynolds is held at h_min and sets no bound on the travel per step."""
+    return wet_pair("derived_reynolds", "hooke mindlin reynolds",
+                    {"fixed.h_min": 2e-6, "hooke.stiffness": 300.0,
+                     "reynolds.cutoff_ratio": 0.5}, viscosity=0.2, dt=None)
+
+
+@case
+def derived_nijssen():
+    """nijssen (exact damping, e_dry 0.01 and 0.02) under gravity, the step derived: its
+    h_min at the speed scale (max of the mean roughness and the ehd gap), its lubrication
+    there and its hertz and mindlin dashpots at the largest shifted overlap of an undamped
+    approach (docs/many.md, Viscous relaxation time); a quarter of the hertz dashpot's time
+    binds (0.87 of the step from the contact time). The engine tabulates the exact
+    coefficient to about 4e-9 relative, this reference bisects Eq. 1.7: the relaxation time
+    moves by as much, so the steps agree to 1e-8, and the run to 1e-8 (nijssen_exact)."""
+    sc = wet_pair("derived_nijssen", "nijssen", {}, viscosity=0.002, gravity=(0, 0, -9.81),
+                  materials=[glass(roughness=0.2e-6, restitution=0.01),
+                             glass(roughness=0.5e-6, youngs_modulus=3e8, restitution=0.02)],
+                  dt=None, dt_tol=1e-8, tol=1e-8)
+    sc["particles"][0]["v"] = (0.03, 0.01, -0.3)
+    return sc
+
+
+@case
+def derived_glass():
+    """glass's h_min (p_gt 1e8 Pa) with sb and davis cut off below it (c), the step derived:
+    many_hmin_fraction x the time to cross the smallest h_min at the speed scale,
+    (3 mu R* v / P_gt)^(1/2) = 0.19 um (docs/models.md), binds (0.55 of the step from the
+    contact time), a closed form."""
+    return wet_pair("derived_glass", "hertz mindlin sb davis capillary",
+                    {"glass.p_gt": 1e8, "hertz.damping": "tsuji"}, min_separation="glass",
+                    gravity=(0, 0, -9.81), dt=None)
+
+
 # ----------------------------------------------------------------------------- mutants ---
 # Deliberate errors in the reference, each of which the comparison must detect in the case
 # named: they show that the agreement above is not reached by cases that miss the point.
@@ -1613,6 +1704,34 @@ def _mutant_blocks(ctx, sc):  # the pairs between quarters of the index range lo
     Reference.near_pairs = near
 
 
+def _mutant_fixed_fall(ctx, sc):  # the fall to the fixed spheres left out
+    orig = globals()["fall_height"]
+    ctx.append((sys.modules[__name__], "fall_height", orig))
+    globals()["fall_height"] = lambda sc: orig(dict(sc, particles=[
+        p for p in sc["particles"] if not p.get("fixed")]))
+
+
+def _mutant_reynolds_jump(ctx, sc):  # reynolds taken for a law that jumps at h_min
+    ctx.append((sys.modules[__name__], "JUMPING_LAWS", JUMPING_LAWS))
+    globals()["JUMPING_LAWS"] = JUMPING_LAWS + ("reynolds",)
+
+
+def _mutant_nijssen_lub(ctx, sc):  # nijssen's lubrication alone (the rule before)
+    orig = globals()["step_scales"]
+    ctx.append((sys.modules[__name__], "step_scales", orig))
+
+    def scales(sc):  # e_dry = 1 for the step alone: no dashpot counts
+        return orig(dict(sc, materials=[Material(**dict(m.ini(), restitution=1.0))
+                                        for m in sc["materials"]]))
+    globals()["step_scales"] = scales
+
+
+def _mutant_glass_factor(ctx, sc):  # glass's h_min without the 3 of the Reynolds pressure
+    orig = globals()["glass_hmin"]
+    ctx.append((sys.modules[__name__], "glass_hmin", orig))
+    globals()["glass_hmin"] = lambda mu, r, v, p, film: orig(mu / 3, r, v, p, film)
+
+
 # (what, the mutant, the case, the run of it that must detect it, steps: None for the case's)
 MUTANTS = [("torque on j with i's lever arm", _mutant_lever, "friction_spin_unequal", "",
             None),
@@ -1633,6 +1752,14 @@ MUTANTS = [("torque on j with i's lever arm", _mutant_lever, "friction_spin_uneq
             "derived_from_rest", "", None),
            ("roughness h_min the sum, not the mean", _mutant_roughness, "derived_roughness",
             "", None),
+           ("fall to the fixed spheres left out", _mutant_fixed_fall, "derived_fixed", "",
+            None),
+           ("reynolds taken for a law that jumps at h_min", _mutant_reynolds_jump,
+            "derived_reynolds", "", None),
+           ("nijssen's lubrication alone in the relaxation time (the rule before)",
+            _mutant_nijssen_lub, "derived_nijssen", "", None),
+           ("glass's h_min without the 3 of the Reynolds pressure", _mutant_glass_factor,
+            "derived_glass", "", None),
            ("histories lost at the checkpoint", _mutant_restart, "cluster_eight",
             "resumed at 1513, frames every 10", None),
            ("pairs between index quarters lost", _mutant_blocks, "pack_512_lean", "4 threads",
