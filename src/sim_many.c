@@ -341,8 +341,7 @@ static int step_scales(struct wetdem_sim* sim, const struct step_spheres* sp, st
                 /* sliding at the speed scale too, whatever the spheres' own velocities, so
                  * that a tangential law's jump at h_min (davis, nase with below_hmin = c)
                  * bounds the step as a normal law's does */
-                struct wetdem_vec3 slide =
-                    vec3_reject(fabs(c.normal.x) < 0.9 ? vec3(1, 0, 0) : vec3(0, 1, 0), c.normal);
+                struct wetdem_vec3 slide = vec3_some_perpendicular(c.normal);
                 c.v_t = vec3_scale(slide, c.v_n / vec3_norm(slide));
                 double t_n = wetdem_sim_contact_time(sim, &c);
                 double t = fmin(t_n, wetdem_sim_tangential_time(sim, &c, t_n));

@@ -669,7 +669,7 @@ double wetdem_sim_tangential_time(const struct wetdem_sim* sim, const struct wet
      * below the Coulomb limit mu F_n ~ mu k_n delta for any mu above 1e-5 (below it the
      * tangential force is negligible, and so is this bound). */
     struct wetdem_vec3 n = c->normal;
-    struct wetdem_vec3 t = vec3_reject(fabs(n.x) < 0.9 ? vec3(1, 0, 0) : vec3(0, 1, 0), n);
+    struct wetdem_vec3 t = vec3_some_perpendicular(n);
     t = vec3_scale(t, 1.0 / vec3_norm(t));
     double u = 1e-6 * overlap;
     double k_t = (tangential_after(sim, *c, overlap, t, u, 1.0) -

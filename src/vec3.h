@@ -51,6 +51,12 @@ static inline struct wetdem_vec3 vec3_reject(struct wetdem_vec3 a, struct wetdem
 {
     return vec3_axpy(a, -vec3_dot(a, n), n);
 }
+/* A vector perpendicular to the unit vector n, of length at least 0.43 (x or, where n lies
+ * near x, y with n's part taken out): a tangent direction for probing a contact. */
+static inline struct wetdem_vec3 vec3_some_perpendicular(struct wetdem_vec3 n)
+{
+    return vec3_reject(fabs(n.x) < 0.9 ? vec3(1, 0, 0) : vec3(0, 1, 0), n);
+}
 static inline int vec3_is_finite(struct wetdem_vec3 a)
 {
     return isfinite(a.x) && isfinite(a.y) && isfinite(a.z);
