@@ -1155,6 +1155,17 @@ def nijssen_three():
 
 
 
+def struck_fixed_sphere(base, tilt):
+    """A fixed sphere (0.7 mm, material 1) at base and two free ones (0.5 and 0.4 mm, material
+    0) a few um from it, closing in from either side with spin; the second's direction is
+    (-1, 0, tilt)."""
+    return [dict(R=0.7e-3, x=base, fixed=True, mat=1),
+            dict(R=0.5e-3, x=beside(base, 0.7e-3, 0.5e-3, (1, 0.2, 0), 4e-6),
+                 v=(-0.2, 0.03, 0.01), w=(0, 10, 50), mat=0),
+            dict(R=0.4e-3, x=beside(base, 0.7e-3, 0.4e-3, (-1, 0, tilt), 3e-6),
+                 v=(0.1, 0.0, -0.08), w=(-30, 0, 0), mat=0)]
+
+
 @case
 def fixed_sphere_ehd():
     """Two wet spheres striking a fixed one (infinite mass: m* the other's mass, no motion
@@ -1166,11 +1177,7 @@ def fixed_sphere_ehd():
                 viscosity=0.01, surface_tension=0.03, min_separation="ehd",
                 models="hertz mindlin sb davis capillary",
                 params={"hertz.damping": "tsuji"},
-                particles=[dict(R=0.7e-3, x=base, fixed=True, mat=1),
-                           dict(R=0.5e-3, x=beside(base, 0.7e-3, 0.5e-3, (1, 0.2, 0), 4e-6),
-                                v=(-0.2, 0.03, 0.01), w=(0, 10, 50), mat=0),
-                           dict(R=0.4e-3, x=beside(base, 0.7e-3, 0.4e-3, (-1, 0, 0.5), 3e-6),
-                                v=(0.1, 0.0, -0.08), w=(-30, 0, 0), mat=0)],
+                particles=struck_fixed_sphere(base, 0.5),
                 dt=1e-7, steps=1500)
 
 
@@ -1336,11 +1343,7 @@ def hooke_fixed():
                 models="hooke mindlin davis capillary",
                 params={"hooke.stiffness": 400.0, "fixed.h_min": 1e-6},
                 gravity=(0, 0, -9.81),
-                particles=[dict(R=0.7e-3, x=base, fixed=True, mat=1),
-                           dict(R=0.5e-3, x=beside(base, 0.7e-3, 0.5e-3, (1, 0.2, 0), 4e-6),
-                                v=(-0.2, 0.03, 0.01), w=(0, 10, 50), mat=0),
-                           dict(R=0.4e-3, x=beside(base, 0.7e-3, 0.4e-3, (-1, 0, 0.3), 3e-6),
-                                v=(0.1, 0.0, -0.08), w=(-30, 0, 0), mat=0)],
+                particles=struck_fixed_sphere(base, 0.3),
                 dt=1e-7, steps=1500)
 
 
