@@ -1393,21 +1393,22 @@ def nijssen_exact():
     return sc
 
 
-@case
-def glass_initial():
-    return wet_pair("glass_initial", "hertz mindlin sb davis capillary",
-                    {"glass.p_gt": 1e5, "glass.speed": "initial", "hertz.damping": "tsuji",
+def glass_speed(speed):
+    """A wet pair with glass's h_min set by the approach speed `speed` reads (glass.speed)."""
+    return wet_pair(f"glass_{speed}", "hertz mindlin sb davis capillary",
+                    {"glass.p_gt": 1e5, "glass.speed": speed, "hertz.damping": "tsuji",
                      "sb.below_hmin": "nc", "davis.below_hmin": "nc"},
                     min_separation="glass")
+
+
+@case
+def glass_initial():
+    return glass_speed("initial")
 
 
 @case
 def glass_current():
-    return wet_pair("glass_current", "hertz mindlin sb davis capillary",
-                    {"glass.p_gt": 1e5, "glass.speed": "current", "hertz.damping": "tsuji",
-                     "sb.below_hmin": "nc", "davis.below_hmin": "nc"},
-                    min_separation="glass")
-
+    return glass_speed("current")
 
 
 @case
