@@ -619,6 +619,58 @@ static void warn_step(const struct cli_scenario* sc, const struct cli_many_setup
                   sc->file, s->dt, s->dt / s->hmin_crossing_time, s->hmin_crossing_time);
 }
 
+/* Warns on stderr when a particle has moved faster than the speed scale of the step allows
+ * (largest_speed above speed_bound: an incline, a chute, capillary attraction; docs/many.md,
+ * "Speeds beyond the step's") and the step does not resolve, at the speed scale with that
+ * speed in place of the bound, what warn_step checks at the start, or is not below the
+ * viscous relaxation time there. */
+static void warn_speed(const struct cli_scenario* sc, struct cli_many_setup* su,
+                       const struct wetdem_many_stats* s)
+{
+    if (!(s->largest_speed > s->speed_bound))
+        return;
+    double v = s->speed_scale + (s->largest_speed - s->speed_bound), t_c, tau, t_x;
+    char what[600] = "";
+    int ok = wetdem_sim_many_time_scales_at(su->sim, v, &t_c, &tau, &t_x) == WETDEM_OK;
+    size_t n =
+        ok ? (size_t)snprintf(what, sizeof what, "and there the step dt = %.4g s is ", s->dt) : 0;
+    size_t head = n;
+    if (!ok)
+        snprintf(what, sizeof what, "where the time scales cannot be evaluated: %s",
+                 wetdem_sim_errmsg(su->sim));
+    else {
+        double fraction = 0.02, gap_fraction = many_hmin_fraction(su->sim);
+        wetdem_sim_param(su->sim, "verlet.dt_fraction", &fraction);
+        if (s->dt / t_c > WETDEM_MANY_CONTACT_FRACTION_MAX)
+            n += (size_t)snprintf(what + n, sizeof what - n,
+                                  "%.3g x the contact time %.4g s (above %g x: the contacts are "
+                                  "not resolved)",
+                                  s->dt / t_c, t_c, WETDEM_MANY_CONTACT_FRACTION_MAX);
+        if (s->dt > t_x && gap_fraction != 0 && n < sizeof what)
+            n += (size_t)snprintf(what + n, sizeof what - n,
+                                  "%slonger than the time %.4g s a pair takes to cross the "
+                                  "smallest h_min where the force laws jump",
+                                  n > head ? "; " : "", t_x);
+        if (s->dt >= tau && n < sizeof what)
+            n += (size_t)snprintf(what + n, sizeof what - n,
+                                  "%snot below the viscous relaxation time %.4g s (velocity "
+                                  "Verlet is unstable there)",
+                                  n > head ? "; " : "", tau);
+        if (n == head)
+            return;
+        /* the step the start would have derived at that speed scale (sim_many.c choose_dt) */
+        double dt = fmin(fraction * t_c, 0.25 * tau);
+        dt = gap_fraction > 0 ? fmin(dt, gap_fraction * t_x) : dt;
+        if (n < sizeof what)
+            snprintf(what + n, sizeof what - n, ": [run] dt = %.4g s would resolve it", dt);
+    }
+    cli_error("warning: %s: a particle reached %.4g m/s, above the %.4g m/s the step's time "
+              "scales allow a particle (an incline, a chute or capillary attraction: "
+              "docs/many.md, Speeds beyond the step's); with it the speed scale, %.4g m/s at "
+              "the start, becomes %.4g m/s, %s",
+              sc->file, s->largest_speed, s->speed_bound, s->speed_scale, v, what);
+}
+
 /* How many of the run's spheres are fixed (held in place). */
 static size_t n_fixed(const struct cli_many_setup* su)
 {
@@ -713,6 +765,9 @@ static void summary_json(FILE* f, const struct cli_scenario* sc, const struct cl
             su->csv_name[0] ? su->csv_every : 0);
     json_num(f, "time_s", wetdem_sim_time(su->sim), true);
     json_num(f, "dt_s", s->dt, true);
+    json_num(f, "speed_scale_m_s", s->speed_scale, true);
+    json_num(f, "speed_bound_m_s", s->speed_bound, true);
+    json_num(f, "largest_speed_m_s", s->largest_speed, true);
     fprintf(f, "\"contacts\": %zu, \"bridges\": %zu, \"agglomerates\": %zu, ", s->contacts,
             s->bridges, s->agglomerates);
     json_num(f, "mean_agglomerate_size", s->mean_agglomerate, o->has_budget);
@@ -874,13 +929,16 @@ static void print_check_json(const struct cli_scenario* sc, const struct cli_man
         cli_json_string(stdout, su->material_names[k]);
     }
     printf("], ");
-    const char* key[3] = {"relaxation_time_s", "contact_time_s", "hmin_crossing_time_s"};
-    double value[3] = {s->relaxation_time, s->contact_time, s->hmin_crossing_time};
-    for (int k = 0; k < 3; k++) /* (INFINITY: nothing damps, touches or crosses an h_min) */
+    const char* key[5] = {"relaxation_time_s", "contact_time_s", "hmin_crossing_time_s",
+                          "speed_scale_m_s", "speed_bound_m_s"};
+    double value[5] = {s->relaxation_time, s->contact_time, s->hmin_crossing_time, s->speed_scale,
+                       s->speed_bound};
+    /* (INFINITY: nothing damps, touches or crosses an h_min; no bound: all falls together) */
+    for (int k = 0; k < 5; k++)
         if (isfinite(value[k]))
-            printf("\"%s\": %.17g%s", key[k], value[k], k < 2 ? ", " : "}\n");
+            printf("\"%s\": %.17g%s", key[k], value[k], k < 4 ? ", " : "}\n");
         else
-            printf("\"%s\": null%s", key[k], k < 2 ? ", " : "}\n");
+            printf("\"%s\": null%s", key[k], k < 4 ? ", " : "}\n");
 }
 
 /* The resolved set-up of `run --check`. CLI exit code. */
@@ -906,6 +964,12 @@ static int print_check(const struct cli_scenario* sc, const struct cli_many_setu
            su->many.periodic[2] ? "z" : "",
            su->many.periodic[0] || su->many.periodic[1] || su->many.periodic[2] ? "" : "none");
     printf("  dt            %.6g s\n", pl->dt);
+    printf("  speed scale   %.6g m/s  (", s.speed_scale);
+    if (isfinite(s.speed_bound))
+        printf("of the time scales below, which hold while no particle exceeds %.6g m/s)\n",
+               s.speed_bound);
+    else
+        printf("of the time scales below; nothing stops a fall: no particle speed bound)\n");
     if (isfinite(s.contact_time))
         printf("  contact time  %.6g s  (shortest, normal or tangential, at the speed scale; "
                "dt is %.3g of it)\n",
@@ -1081,6 +1145,7 @@ static int finish(const struct cli_scenario* sc, struct cli_many_setup* su,
     if (many_stats(sc, su->sim, &o.stats) != CLI_EXIT_OK)
         return CLI_EXIT_RUNTIME;
     o.has_budget = wetdem_sim_energy_budget(su->sim, &o.budget) == WETDEM_OK;
+    warn_speed(sc, su, &o.stats);
     if (csv_final_row(pl->csv_prefix, su->csv_every, su->sim, o.stats.step) != WETDEM_OK) {
         cli_error("run %s: cannot append the last row to %s.csv: %s", sc->file, pl->csv_prefix,
                   wetdem_sim_errmsg(su->sim));

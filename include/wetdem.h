@@ -791,6 +791,17 @@ struct wetdem_many_stats {
        enabled force laws jump (h_min, below_hmin = c), then [s]: verlet.many_hmin_fraction
        multiplies it; a longer dt crosses the jump within one step (INFINITY: none jumps) */
     double hmin_crossing_time;
+    /* The speeds behind those time scales (docs/many.md, "Speeds beyond the step's"): the speed
+       scale V they were evaluated at when the run started, 2 v0 + sqrt(2 |g| H) floored at
+       sim.speed_floor, v0 the largest particle speed then and H the fall of "What a fall
+       adds" [m/s]; the speed B = V - v0 no particle exceeds where H bounds the fall and the
+       contacts and films take energy rather than give it (INFINITY with gravity but no walls
+       or fixed spheres: all falls together) [m/s]; and the largest speed u a free particle has
+       had since the start, over the half-step velocities of every step [m/s]. Where u > B the
+       time scales above do not hold: wetdem_sim_many_time_scales_at gives them at V + u - B,
+       the speed scale with u in place of B. A checkpoint keeps all three, so a resumed run
+       reports those of the whole run. */
+    double speed_scale, speed_bound, largest_speed;
 };
 /* The largest step, as a fraction of wetdem_many_stats.contact_time, that resolves the
  * contacts: velocity Verlet is unstable for a Hertz contact from about 0.5 of it, and a dry
@@ -798,6 +809,17 @@ struct wetdem_many_stats {
  * step). `wetdem run` warns above it, and above hmin_crossing_time. */
 #define WETDEM_MANY_CONTACT_FRACTION_MAX 0.1
 WETDEM_API int wetdem_sim_many_stats(const struct wetdem_sim* sim, struct wetdem_many_stats* s);
+/* The time scales of a started many-particle run that wetdem_many_stats reports
+ * (contact_time, relaxation_time, hmin_crossing_time), evaluated as when the run started but
+ * with the pairs closing and sliding at `speed` [m/s] instead of the speed scale, for the
+ * particles and walls as they are now: e.g. at 2 largest_speed, to see whether the step
+ * resolves what the run has met. The run is not changed. Returns WETDEM_OK,
+ * WETDEM_ERR_INVALID (not a started many run, a NULL output, a speed not finite and > 0, or
+ * a model that meets the edge of its range at that speed: nijssen, whose h_min grows with the
+ * approach speed; message names it), WETDEM_ERR_NOMEM. */
+WETDEM_API int wetdem_sim_many_time_scales_at(struct wetdem_sim* sim, double speed,
+                                              double* contact_time, double* relaxation_time,
+                                              double* hmin_crossing_time);
 
 /* Appends a row of the global quantities at the current state to the run's CSV
  * (output_prefix.csv), with the columns and format of the rows written every csv_every steps:

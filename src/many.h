@@ -221,8 +221,12 @@ struct wetdem_many {
     double crossing_time;   /* time to close the smallest h_min where the force laws jump at
                                the speed scale, then [s] (INFINITY: none jumps) */
     double v2_drift;        /* largest |v'|^2 of the latest drift [m^2/s^2] (after_drift) */
-    double t0;              /* time of step 0 [s] */
-    uint64_t step;          /* steps since t0 */
+    /* the speed scale of the time scales above and the speed no particle exceeds under it
+       (wetdem_many_stats speed_scale, speed_bound) [m/s], and the largest |v'|^2 of the drifts
+       since the start [m^2/s^2]: set when the run starts, kept by a checkpoint */
+    double speed_scale, speed_bound, v2_seen;
+    double t0;     /* time of step 0 [s] */
+    uint64_t step; /* steps since t0 */
     bool started;
     /* the force models of the run and its min-separation model, in order, as it started (or
        was restored): its pair histories are laid out and its work summed by them, so a call
@@ -503,8 +507,9 @@ void wetdem_sim_many_energies(const struct wetdem_sim* sim, double* kinetic, dou
 int wetdem_sim_many_prepare(struct wetdem_sim* sim);
 /* The time scales of the step for the current particles, as at the start of a run: sets
  * m->relaxation_time (what the step is held below; INFINITY when nothing damps),
- * m->contact_time and m->crossing_time (wetdem_many_stats). Returns WETDEM_OK or
- * WETDEM_ERR_NOMEM (message in sim). */
+ * m->contact_time and m->crossing_time (wetdem_many_stats), and m->speed_scale and
+ * m->speed_bound at this state, with m->v2_seen = 0. Returns WETDEM_OK or WETDEM_ERR_NOMEM
+ * (message in sim). */
 int wetdem_sim_many_time_scales(struct wetdem_sim* sim);
 
 /* Records the enabled models as those of the run (run_models), when it starts or is restored. */

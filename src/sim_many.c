@@ -254,6 +254,7 @@ struct step_spheres {
     struct wetdem_particle small, big, fixed_small, fixed_big;
     size_t n_free, n_fixed;
     double speed; /* [m/s] */
+    double bound; /* the speed no particle exceeds under it (wetdem_many_stats) [m/s] */
 };
 
 /* The pairs that can occur, each probed with a smallest free sphere: with a smallest and with
@@ -459,6 +460,10 @@ static void start_speed(const struct wetdem_sim* sim, struct step_spheres* sp)
     double g = vec3_norm(gv);
     double fall = g > 0 ? fall_height(sim, vec3(gv.x / g, gv.y / g, gv.z / g)) : 0;
     sp->speed = fmax(s->speed_floor, v + sqrt(2 * g * fall));
+    /* without walls or fixed spheres everything falls together: the speeds grow without
+       bound, the relative speeds as little as without gravity */
+    bool stops = sim->n_walls > 0 || sp->n_fixed > 0;
+    sp->bound = g > 0 && !stops ? INFINITY : sp->speed - 0.5 * v;
 }
 
 /* The spheres and time scales of the step for the current particles, into the engine's
@@ -474,6 +479,9 @@ static int time_scales(struct wetdem_sim* sim, struct step_spheres* sp, struct s
     m->relaxation_time = s->tau;
     m->contact_time = s->t_contact;
     m->crossing_time = s->gap / sp->speed;
+    m->speed_scale = sp->speed;
+    m->speed_bound = sp->bound;
+    m->v2_seen = 0;
     return WETDEM_OK;
 }
 
@@ -481,9 +489,38 @@ int wetdem_sim_many_time_scales(struct wetdem_sim* sim)
 {
     struct wetdem_many* m = sim->many;
     m->relaxation_time = m->contact_time = m->crossing_time = INFINITY;
+    m->speed_scale = m->speed_bound = m->v2_seen = 0;
     struct step_spheres sp;
     struct step_scales s;
     return sim->n_particles > 0 ? time_scales(sim, &sp, &s) : WETDEM_OK;
+}
+
+int wetdem_sim_many_time_scales_at(struct wetdem_sim* sim, double speed, double* contact_time,
+                                   double* relaxation_time, double* hmin_crossing_time)
+{
+    if (!sim->many || !sim->many->started)
+        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID, "many_time_scales_at: %s",
+                               !sim->many ? "the simulation is not in the many-particle mode"
+                                          : "the many-particle run has not started");
+    if (!contact_time || !relaxation_time || !hmin_crossing_time)
+        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID, "many_time_scales_at: NULL output");
+    if (!(isfinite(speed) && speed > 0))
+        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
+                               "many_time_scales_at: speed = %g m/s must be finite and > 0", speed);
+    *contact_time = *relaxation_time = *hmin_crossing_time = INFINITY;
+    if (sim->n_particles == 0)
+        return WETDEM_OK;
+    struct step_spheres sp;
+    struct step_scales s;
+    start_speed(sim, &sp);
+    sp.speed = speed;
+    int st = step_scales(sim, &sp, &s);
+    if (st != WETDEM_OK)
+        return st;
+    *contact_time = s.t_contact;
+    *relaxation_time = s.tau;
+    *hmin_crossing_time = s.gap / speed;
+    return WETDEM_OK;
 }
 
 /* Says in m->dt_origin which bound of choose_dt sets the derived step dt, and which
@@ -531,6 +568,7 @@ static int choose_dt(struct wetdem_sim* sim, double* dt)
     wetdem_sim_param(sim, "verlet.many_hmin_fraction", &many_hmin_fraction);
     double given = m->set.dt > 0 ? m->set.dt : fixed;
     m->relaxation_time = m->contact_time = m->crossing_time = INFINITY;
+    m->speed_scale = m->speed_bound = m->v2_seen = 0;
     if (sim->n_particles == 0) {
         *dt = given;
         return given > 0 ? WETDEM_OK
@@ -1510,6 +1548,7 @@ static int one_step(struct wetdem_sim* sim, bool defer)
     sim->engine.t_committed = sim->engine.time;
     if (!(m->v2_drift <= DBL_MAX)) /* the largest |v'|^2 of the drift: one test a step */
         return diverged(sim, first_diverged_drift(sim), true);
+    m->v2_seen = m->v2_drift > m->v2_seen ? m->v2_drift : m->v2_seen;
     bool step = defer && !m->no_drift_in_pass && !(m->set.stop_flag && *m->set.stop_flag);
     int st = forces_and_work(sim, !defer ? WETDEM_MANY_END_KICK
                                   : step ? WETDEM_MANY_END_STEP

@@ -160,6 +160,9 @@ static void fill_run_stats(const struct wetdem_sim* sim, struct wetdem_many_stat
     s->relaxation_time = m->relaxation_time;
     s->contact_time = m->contact_time;
     s->hmin_crossing_time = m->crossing_time;
+    s->speed_scale = m->speed_scale;
+    s->speed_bound = m->speed_bound;
+    s->largest_speed = sqrt(m->v2_seen);
     s->step = m->step;
     s->seconds_kick = m->seconds_kick;
     s->seconds_forces = m->seconds_forces;
@@ -675,13 +678,32 @@ static size_t blob_size(size_t n)
     return 2 * sizeof(double) + n * 6 * sizeof(double);
 }
 
-/* The blob as written now: blob_size(n), then each particle's periodic images (3 doubles). */
+/* blob_size(n), then each particle's periodic images (3 doubles). */
 static size_t blob_size_images(size_t n)
 {
     return blob_size(n) + n * 3 * sizeof(double);
 }
 
-/* Whether a USER blob of `size` bytes fits n particles: blob_size_images(n); blob_size(n),
+/* The speeds kept after the images: the start's speed scale and speed bound and the largest
+ * |v'|^2 since the start (struct wetdem_many speed_scale, speed_bound, v2_seen). */
+#define BLOB_SPEEDS (3 * sizeof(double))
+
+/* The blob as written now: blob_size_images(n), then BLOB_SPEEDS. */
+static size_t blob_size_speeds(size_t n)
+{
+    return blob_size_images(n) + BLOB_SPEEDS;
+}
+
+/* Whether a USER blob of `size` bytes for n particles holds their periodic images. */
+static bool blob_has_images(size_t size, size_t n)
+{
+    return size == blob_size_images(n) || size == blob_size_speeds(n);
+}
+
+/* Whether a USER blob of `size` bytes fits n particles: blob_size_speeds(n);
+ * blob_size_images(n), written before the speeds were kept (a run resumed from it reports the
+ * speeds since the resumption, its speed scale and bound those of the restored state);
+ * blob_size(n),
  * written before the images were kept (read as no wraps: such a run's budget had the jumps
  * of its wraps, if gravity acted along a periodic axis); or blob_size(n) and a uint32 per
  * particle, each one's count of solid overlaps at the latest pass, which checkpoints held while
@@ -691,7 +713,7 @@ static size_t blob_size_images(size_t n)
  * another. */
 static bool blob_size_fits(size_t size, size_t n)
 {
-    return size == blob_size_images(n) || size == blob_size(n) ||
+    return size == blob_size_speeds(n) || size == blob_size_images(n) || size == blob_size(n) ||
            size == blob_size(n) + n * sizeof(uint32_t);
 }
 
@@ -703,7 +725,7 @@ static int fill_checkpoint(struct wetdem_sim* sim, struct wetdem_checkpoint* ck)
     ck->pairs = malloc((total ? total : 1) * sizeof *ck->pairs);
     ck->history = malloc((total * len > 0 ? total * len : 1) * sizeof(double));
     ck->walls = malloc((nw ? nw : 1) * sizeof *ck->walls);
-    ck->extra = malloc(blob_size_images(n));
+    ck->extra = malloc(blob_size_speeds(n));
     ck->energy = malloc(N_ENERGY * sizeof(double));
     if (!ck->pairs || !ck->history || !ck->walls || !ck->extra || !ck->energy)
         return WETDEM_ERR_NOMEM;
@@ -728,6 +750,8 @@ static int fill_checkpoint(struct wetdem_sim* sim, struct wetdem_checkpoint* ck)
     }
     if (n)
         memcpy(b + blob_size(n), m->image, n * sizeof *m->image);
+    const double speeds[3] = {m->speed_scale, m->speed_bound, m->v2_seen};
+    memcpy(b + blob_size_images(n), speeds, BLOB_SPEEDS);
     double* e = ck->energy;
     e[0] = m->energy.k0;
     e[1] = m->energy.u0;
@@ -752,7 +776,7 @@ static int fill_checkpoint(struct wetdem_sim* sim, struct wetdem_checkpoint* ck)
         .energy = ck->energy,
         .n_energy = N_ENERGY,
         .extra = ck->extra,
-        .extra_size = blob_size_images(n),
+        .extra_size = blob_size_speeds(n),
         .output = {m->vtk_files, m->csv_rows, m->next_vtk_step, m->next_csv_step}};
     return WETDEM_OK;
 }
@@ -808,13 +832,19 @@ static int check_restorable_values(struct wetdem_sim* sim, const struct wetdem_c
         if (!all_finite(ft, 6))
             bad = "a non-finite force or torque";
     }
-    for (size_t k = 0; !bad && ck->extra_size == blob_size_images(n) && k < n; k++) {
+    for (size_t k = 0; !bad && blob_has_images(ck->extra_size, n) && k < n; k++) {
         double im[3];
         memcpy(im, ck->extra + blob_size(n) + k * sizeof im, sizeof im);
         for (int a = 0; a < 3; a++)
             if (!(isfinite(im[a]) && im[a] == floor(im[a])))
                 bad = "a periodic image count that is not a whole number";
     }
+    double speeds[3] = {0, 0, 0};
+    if (ck->extra_size == blob_size_speeds(n))
+        memcpy(speeds, ck->extra + blob_size_images(n), BLOB_SPEEDS);
+    if (!bad && !(isfinite(speeds[0]) && speeds[0] >= 0 && speeds[1] >= 0 && isfinite(speeds[2]) &&
+                  speeds[2] >= 0)) /* (the bound may be infinite) */
+        bad = "a speed scale, speed bound or largest speed that is not finite and >= 0";
     if (!bad && !all_finite(ck->energy, ck->n_energy))
         bad = "a non-finite energy-budget term";
     if (!bad && !all_finite(ck->history, ck->n_pairs * ck->history_len))
@@ -960,8 +990,15 @@ static int restore_pairs(struct wetdem_sim* sim, const struct wetdem_checkpoint*
         m->force[k] = vec3(ft[0], ft[1], ft[2]);
         m->torque[k] = vec3(ft[3], ft[4], ft[5]);
     }
-    if (n && ck->extra_size == blob_size_images(n)) /* (prepare zeroed them: older layouts) */
+    if (n && blob_has_images(ck->extra_size, n)) /* (prepare zeroed them: older layouts) */
         memcpy(m->image, ck->extra + blob_size(n), n * sizeof *m->image);
+    if (ck->extra_size == blob_size_speeds(n)) { /* (older layouts: time_scales' at this state) */
+        double speeds[3];
+        memcpy(speeds, ck->extra + blob_size_images(n), BLOB_SPEEDS);
+        m->speed_scale = speeds[0];
+        m->speed_bound = speeds[1];
+        m->v2_seen = speeds[2];
+    }
     for (size_t q = 0; q < m->cl.n_pairs; q++) /* histories may be stale: check on next use */
         m->flags[q] = WETDEM_MANY_DIRTY | WETDEM_MANY_SPRING;
     m->started = true;

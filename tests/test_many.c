@@ -184,6 +184,12 @@ static void test_many_restart_is_bit_identical(void** state)
     assert_true(isfinite(s_whole.relaxation_time) && s_whole.relaxation_time > s_whole.dt);
     assert_true(isfinite(s_resumed.relaxation_time) && s_resumed.relaxation_time > s_whole.dt);
     CHECK_ABS(s_resumed.dt, s_whole.dt, 0);
+    /* the speeds are the whole run's: the checkpoint keeps the start's speed scale and bound
+       and the largest speed before it (docs/many.md, Speeds beyond the step's) */
+    assert_true(s_whole.largest_speed > 0 && s_whole.speed_bound > 0);
+    CHECK_ABS(s_resumed.speed_scale, s_whole.speed_scale, 0);
+    CHECK_ABS(s_resumed.speed_bound, s_whole.speed_bound, 0);
+    CHECK_ABS(s_resumed.largest_speed, s_whole.largest_speed, 0);
     /* a sim set up differently refuses the checkpoint */
     struct wetdem_sim* dry = wet_box(150, false);
     CHECK_STATUS(wetdem_sim_read_checkpoint(dry, path), WETDEM_ERR_INVALID);
@@ -213,8 +219,9 @@ static void test_many_restart_refuses_impossible_states(void** state)
                           "a non-finite energy-budget term",
                           "a non-finite pair history",
                           "pair keys out of (i, j) order",
-                          "a particle-wall key out of order"};
-    for (int c = 0; c < 9; c++) {
+                          "a particle-wall key out of order",
+                          "a speed scale, speed bound or largest speed that is not finite"};
+    for (int c = 0; c < 10; c++) {
         struct wetdem_checkpoint ck;
         char msg[256];
         CHECK_OK(wetdem_checkpoint_read(good, &ck, msg, sizeof msg));
@@ -236,6 +243,7 @@ static void test_many_restart_refuses_impossible_states(void** state)
             break;
         }
         case 8: ck.pairs[np + 1].j = 0; break;
+        case 9: memcpy(ck.extra + 16 + 72 * n + 16, &nan, 8); break; /* the largest |v'|^2 */
         }
         CHECK_OK(wetdem_checkpoint_write(bad, &ck, msg, sizeof msg));
         wetdem_checkpoint_clear(&ck);
@@ -294,18 +302,19 @@ static void test_many_restart_reads_checkpoints_with_contact_counts(void** state
     struct wetdem_sim* whole = wet_box(150, true);
     CHECK_OK(wetdem_sim_integrate(whole, 1.2e-3));
     wetdem_sim_free(wet_box_checkpointed(150, 0.5e-3, good));
-    for (int variant = 0; variant < 3; variant++) { /* no images; the counts; one byte more */
+    /* no images; the counts; one byte more; the images without the speeds */
+    for (int variant = 0; variant < 4; variant++) {
         int extra = variant == 2;
         struct wetdem_checkpoint ck;
         char msg[256];
         CHECK_OK(wetdem_checkpoint_read(good, &ck, msg, sizeof msg));
-        size_t n = ck.n_particles, base = 16 + 48 * n;  /* dt, t0, force and torque */
-        assert_int_equal(ck.extra_size, base + 24 * n); /* and the images */
-        size_t size = base + (variant ? n * sizeof(uint32_t) + (size_t)extra : 0);
-        unsigned char* blob = realloc(ck.extra, size > base + 24 * n ? size : base + 24 * n);
-        assert_non_null(blob);
-        memset(blob + base, 0x5a, size - base); /* counts no run has */
-        ck.extra = blob;
+        size_t n = ck.n_particles, base = 16 + 48 * n; /* dt, t0, force and torque */
+        /* and the images, then the speed scale, the speed bound and the largest |v'|^2 */
+        assert_int_equal(ck.extra_size, base + 24 * n + 24);
+        size_t size = variant == 3 ? base + 24 * n
+                                   : base + (variant ? n * sizeof(uint32_t) + (size_t)extra : 0);
+        if (variant != 3)
+            memset(ck.extra + base, 0x5a, size - base); /* counts no run has */
         ck.extra_size = size;
         CHECK_OK(wetdem_checkpoint_write(old, &ck, msg, sizeof msg));
         wetdem_checkpoint_clear(&ck);
@@ -324,6 +333,9 @@ static void test_many_restart_reads_checkpoints_with_contact_counts(void** state
             assert_int_equal(b.contacts, a.contacts);
             assert_int_equal(b.bridges, a.bridges);
             assert_int_equal(b.agglomerates, a.agglomerates);
+            /* without the speeds: those since the resumption, the largest no faster than the
+               whole run's */
+            assert_true(b.largest_speed > 0 && b.largest_speed <= a.largest_speed);
         }
         wetdem_sim_free(resumed);
     }
@@ -1236,7 +1248,9 @@ static void test_many_step_comes_from_the_pairs_that_occur(void** state)
  * constant force alone is exact, so before the touch v = g t at the steps t = k dt, and the
  * last one before the touch lies within one step of the exact time: at most g dt below
  * sqrt(2 g L) (1.9e-4 of it; measured 1.9e-5), never above it (1e-12 for the rounding of the
- * 5400 steps' kicks). */
+ * 5400 steps' kicks). The speed bound is the speed scale (released at rest: v0 = 0), and the
+ * largest speed until the touch, over the half-step velocities v' = g (k + 1/2) dt, lies within
+ * g dt / 2 of it (the drift that reaches the wall starts within one step before the touch). */
 static void test_many_speed_scale_bounds_the_fall(void** state)
 {
     (void)state;
@@ -1268,6 +1282,8 @@ static void test_many_speed_scale_bounds_the_fall(void** state)
         CHECK_OK(wetdem_sim_many_stats(sim, &st));
         CHECK_REL(st.contact_time, t_c, 1e-14);
         CHECK_REL(st.dt, 0.02 * t_c, 1e-14);
+        CHECK_REL(st.speed_scale, v, 1e-14); /* (the same sums as L, above) */
+        CHECK_ABS(st.speed_bound, st.speed_scale, 0);
         if (k == 2) {
             /* to a few steps before the touch at t = sqrt(2 L / g), then a step at a time */
             CHECK_OK(wetdem_sim_integrate(sim, sqrt(2 * L / g) - 5 * st.dt));
@@ -1280,9 +1296,100 @@ static void test_many_speed_scale_bounds_the_fall(void** state)
             assert_true(gap <= 0); /* it reached the wall */
             assert_true(speed <= v * (1 + 1e-12));
             assert_true(speed >= v - g * st.dt);
+            CHECK_OK(wetdem_sim_many_stats(sim, &st));
+            CHECK_ABS(st.largest_speed, v, 0.5 * g * st.dt * (1 + 1e-9));
         }
         wetdem_sim_free(sim);
     }
+}
+
+/* Speeds beyond the step's (docs/many.md): a soft glass sphere (R = 1 mm, hertz + mindlin,
+ * mu = 0.4) at rest on a floor, under gravity tilted by 30 deg (a chute periodic along x).
+ * Nothing falls (H = 0), so the speed scale and the bound are sim.speed_floor, 1e-3 m/s; with
+ * mu above (2/7) tan 30 deg = 0.165 the sphere rolls without slipping, its centre speeding up
+ * at (5/7) g sin 30 deg, so after T = 0.2 s the largest speed is (5/7) g sin(30 deg) T, 0.70
+ * m/s, 700 times the bound. To 1e-4: the soft contact is not the rigid one (the sphere settles
+ * into the floor from zero overlap, bouncing at the contact frequency, and the Mindlin spring's
+ * compliance lets the contact point creep); measured 8e-6. At the speed scale V + u - B the
+ * contact and relaxation times are those at V times (V / (V + u - B))^(1/5): Hertz's and
+ * Mindlin's times and the dashpots' go as v^(-1/5) (docs/many.md, Time step), to rounding.
+ * A checkpoint at T/2 resumes to the same largest speed, bit for bit. Without walls the bound
+ * is infinite (all falls together). Bad speeds are refused with their value named. */
+static void test_many_largest_speed_down_a_chute(void** state)
+{
+    (void)state;
+    char path[] = "/tmp/wetdem_test_many_chute_XXXXXX";
+    close(mkstemp(path));
+    const double R = 1e-3, g = 9.81, th = M_PI / 6, T = 0.2;
+    struct wetdem_many_stats st[2];
+    for (int resumed = 0; resumed < 2; resumed++) {
+        struct wetdem_sim* sim = wetdem_sim_create();
+        struct wetdem_material mat = test_soft_glass(0);
+        mat.friction_dry = 0.4;
+        assert_int_equal(wetdem_sim_add_material(sim, &mat), 0);
+        CHECK_OK(wetdem_sim_enable_model(sim, "hertz"));
+        CHECK_OK(wetdem_sim_enable_model(sim, "mindlin"));
+        CHECK_OK(wetdem_sim_set_param(sim, "sim.gravity_x", g * sin(th)));
+        CHECK_OK(wetdem_sim_set_param(sim, "sim.gravity_z", -g * cos(th)));
+        CHECK_OK(wetdem_sim_add_particle(
+            sim, (struct wetdem_particle){.pos = {2e-3, 2e-3, R}, .radius = R}));
+        CHECK_OK(wetdem_sim_add_wall(sim, vec3(0, 0, 0), vec3(0, 0, 1), 0));
+        struct wetdem_many_settings set = {.periodic = {true, true, false},
+                                           .box_lo = {0, 0, 0},
+                                           .box_hi = {6e-3, 6e-3, 6e-3},
+                                           .skin = 1e-4};
+        CHECK_OK(wetdem_sim_set_many(sim, &set));
+        if (resumed) {
+            CHECK_OK(wetdem_sim_read_checkpoint(sim, path));
+        } else {
+            CHECK_OK(wetdem_sim_integrate(sim, 0.5 * T));
+            CHECK_OK(wetdem_sim_write_checkpoint(sim, path));
+        }
+        CHECK_OK(wetdem_sim_integrate(sim, T));
+        CHECK_OK(wetdem_sim_many_stats(sim, &st[resumed]));
+        if (!resumed) {
+            const struct wetdem_many_stats* s = &st[0];
+            CHECK_ABS(s->speed_scale, 1e-3, 0);
+            CHECK_ABS(s->speed_bound, 1e-3, 0);
+            CHECK_REL(s->largest_speed, 5.0 / 7.0 * g * sin(th) * T, 1e-4);
+            double V = s->speed_scale + s->largest_speed - s->speed_bound, t_c, tau, t_x;
+            CHECK_OK(wetdem_sim_many_time_scales_at(sim, V, &t_c, &tau, &t_x));
+            double shrink = pow(s->speed_scale / V, 0.2);
+            CHECK_REL(t_c, s->contact_time * shrink, 1e-12);
+            CHECK_REL(tau, s->relaxation_time * shrink, 1e-12);
+            assert_true(isinf(t_x) && isinf(s->hmin_crossing_time)); /* no law jumps */
+            /* at the start's speed scale, the start's time scales */
+            CHECK_OK(wetdem_sim_many_time_scales_at(sim, s->speed_scale, &t_c, &tau, &t_x));
+            CHECK_REL(t_c, s->contact_time, 1e-14);
+            CHECK_STATUS(wetdem_sim_many_time_scales_at(sim, NAN, &t_c, &tau, &t_x),
+                         WETDEM_ERR_INVALID);
+            CHECK_CONTAINS(wetdem_sim_errmsg(sim), "speed = nan m/s must be finite and > 0");
+            CHECK_STATUS(wetdem_sim_many_time_scales_at(sim, 0, &t_c, &tau, &t_x),
+                         WETDEM_ERR_INVALID);
+        }
+        wetdem_sim_free(sim);
+    }
+    CHECK_ABS(st[1].largest_speed, st[0].largest_speed, 0);
+    CHECK_ABS(st[1].speed_scale, st[0].speed_scale, 0);
+    remove(path);
+    /* no walls: a falling cloud's speeds grow, its relative speeds do not */
+    struct wetdem_sim* sim = wetdem_sim_create();
+    struct wetdem_material mat = test_soft_glass(0);
+    assert_int_equal(wetdem_sim_add_material(sim, &mat), 0);
+    CHECK_OK(wetdem_sim_enable_model(sim, "hertz"));
+    CHECK_OK(wetdem_sim_set_param(sim, "sim.gravity_z", -g));
+    CHECK_OK(wetdem_sim_add_particle(sim, (struct wetdem_particle){.pos = {0, 0, 0}, .radius = R}));
+    CHECK_OK(
+        wetdem_sim_add_particle(sim, (struct wetdem_particle){.pos = {3e-3, 0, 0}, .radius = R}));
+    CHECK_OK(wetdem_sim_set_many(sim, &(struct wetdem_many_settings){.skin = 1e-4}));
+    double t_c, tau, t_x;
+    CHECK_STATUS(wetdem_sim_many_time_scales_at(sim, 1, &t_c, &tau, &t_x), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(wetdem_sim_errmsg(sim), "has not started");
+    CHECK_OK(wetdem_sim_integrate(sim, 1e-3));
+    struct wetdem_many_stats s;
+    CHECK_OK(wetdem_sim_many_stats(sim, &s));
+    assert_true(isinf(s.speed_bound) && s.largest_speed > 0);
+    wetdem_sim_free(sim);
 }
 
 /* A simulation of material 0, the glass preset with 20 um films, in a liquid of 0.01 Pa s and
@@ -2539,6 +2646,7 @@ int main(void)
         cmocka_unit_test(test_many_max_steps_refuses_the_call_up_front),
         cmocka_unit_test(test_many_step_comes_from_the_pairs_that_occur),
         cmocka_unit_test(test_many_speed_scale_bounds_the_fall),
+        cmocka_unit_test(test_many_largest_speed_down_a_chute),
         cmocka_unit_test(test_many_fixed_spheres_meet_neither_each_other_nor_walls),
         cmocka_unit_test(test_many_freeing_a_fixed_sphere_between_calls),
         cmocka_unit_test(test_many_step_resolves_hmin),

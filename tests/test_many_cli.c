@@ -1895,6 +1895,51 @@ static void test_many_cli_warns_about_the_step(void** state)
     assert_false(exists("div/summary.json"));
 }
 
+/* A sphere rolling down a chute (a floor under gravity tilted by 30 deg, periodic along x)
+ * outgrows the speed scale its step was derived at (docs/many.md, Speeds beyond the step's):
+ * at rest on the floor it has nothing to fall, so the speed scale and the bound are the
+ * floor's 1e-3 m/s; after 0.05 s it rolls at (5/7) g sin(30 deg) t = 0.175 m/s, and at that
+ * speed scale the step, 0.05 of the contact time at 1e-3 m/s, is 0.05 x 175^(1/5) = 0.14 of
+ * the contact time, above 0.1: the end of the run warns (exit 0) with the step that would
+ * resolve it, and summary.json holds the three speeds. Run again at that step, the same
+ * speed is reached (the motion does not depend on the step to 1e-4) and nothing is warned. */
+static void test_many_cli_warns_when_speeds_outgrow_the_step(void** state)
+{
+    (void)state;
+    write_text("chute.ini", "[box]\nsize_x = 4e-3\nsize_y = 4e-3\nsize_z = 4e-3\nperiodic = x y\n"
+                            "[walls]\nfaces = z_min\n"
+                            "[material.soft]\ndensity = 2500\nyoungs_modulus = 1e7\n"
+                            "poisson_ratio = 0.3\nrestitution = 0.6\nfriction_dry = 0.4\n"
+                            "[models]\nforce = hertz mindlin\n"
+                            "[sim]\ngravity_x = 4.905\ngravity_z = -8.49571\n"
+                            "[particle.a]\nx = 2e-3\ny = 2e-3\nz = 0.5e-3\nradius = 0.5e-3\n"
+                            "material = soft\n"
+                            "[integrator]\ndt_fraction = 0.05\n[run]\nt_end = 0.05\n");
+    expect_output("run chute.ini --check", "out.txt",
+                  "  speed scale   0.001 m/s  (of the time scales below, which hold while no "
+                  "particle exceeds 0.001 m/s)\n");
+    char* err = expect_exit("run chute.ini --out o", 0,
+                            "wetdem: warning: chute.ini: a particle reached 0.175");
+    CHECK_CONTAINS(err, "above the 0.001 m/s the step's time scales allow a particle");
+    CHECK_CONTAINS(err, "x the contact time");
+    const char* at = strstr(err, "[run] dt = ");
+    assert_non_null(at);
+    double dt = strtod(at + strlen("[run] dt = "), NULL);
+    assert_true(dt > 0 && dt < 1.373e-5 / 2);
+    free(err);
+    char* js = test_read_file(tpath("o/summary.json"), NULL);
+    assert_non_null(js);
+    CHECK_CONTAINS(js, "\"speed_scale_m_s\": 0.001, \"speed_bound_m_s\": 0.001, "
+                       "\"largest_speed_m_s\": 0.175");
+    free(js);
+    char args[200];
+    snprintf(args, sizeof args, "run chute.ini --set run.dt=%.4g", dt);
+    assert_int_equal(run_cli(args), 0);
+    err = stderr_text();
+    assert_string_equal(err, "");
+    free(err);
+}
+
 static int setup(void** state)
 {
     (void)state;
@@ -1928,6 +1973,7 @@ int main(void)
         cmocka_unit_test(test_many_cli_random_groups_share_the_box),
         cmocka_unit_test(test_many_cli_read_spheres_from_a_file),
         cmocka_unit_test(test_many_cli_examples_and_budget),
+        cmocka_unit_test(test_many_cli_warns_when_speeds_outgrow_the_step),
         cmocka_unit_test(test_many_cli_budget_of_works_that_cancel),
         cmocka_unit_test(test_many_cli_warns_about_the_step),
         cmocka_unit_test(test_many_cli_refuses_a_run_with_too_many_steps),
