@@ -628,12 +628,13 @@ static void warn_step(const struct cli_scenario* sc, const struct cli_many_setup
  * (largest_speed above speed_bound: an incline, a chute, capillary attraction; docs/many.md,
  * "Speeds beyond the step's") and the step does not resolve, at the speed scale with that
  * speed in place of the bound, what warn_step checks at the start, or is not below the
- * viscous relaxation time there. */
-static void warn_speed(const struct cli_scenario* sc, struct cli_many_setup* su,
-                       const struct wetdem_many_stats* s)
+ * viscous relaxation time there; `tty`: after a newline, off the progress line. Whether it
+ * warned. */
+static bool warn_speed(const struct cli_scenario* sc, struct cli_many_setup* su,
+                       const struct wetdem_many_stats* s, bool tty)
 {
     if (!(s->largest_speed > s->speed_bound))
-        return;
+        return false;
     double v = s->speed_scale + (s->largest_speed - s->speed_bound), t_c, tau, t_x;
     char what[600] = "";
     int ok = wetdem_sim_many_time_scales_at(su->sim, v, &t_c, &tau, &t_x) == WETDEM_OK;
@@ -662,18 +663,22 @@ static void warn_speed(const struct cli_scenario* sc, struct cli_many_setup* su,
                                   "Verlet is unstable there)",
                                   n > head ? "; " : "", tau);
         if (n == head)
-            return;
+            return false;
         /* the step the start would have derived at that speed scale (sim_many.c choose_dt) */
         double dt = fmin(fraction * t_c, 0.25 * tau);
         dt = gap_fraction > 0 ? fmin(dt, gap_fraction * t_x) : dt;
         if (n < sizeof what)
             snprintf(what + n, sizeof what - n, ": [run] dt = %.4g s would resolve it", dt);
     }
-    cli_error("warning: %s: a particle reached %.4g m/s, above the %.4g m/s the step's time "
-              "scales allow a particle (an incline, a chute or capillary attraction: "
-              "docs/many.md, Speeds beyond the step's); with it the speed scale, %.4g m/s at "
-              "the start, becomes %.4g m/s, %s",
-              sc->file, s->largest_speed, s->speed_bound, s->speed_scale, v, what);
+    if (tty) /* (off the progress line) */
+        fputc('\n', stderr);
+    cli_error("warning: %s: by t = %.6g s a particle reached %.4g m/s, above the %.4g m/s the "
+              "step's time scales allow a particle (an incline, a chute or capillary "
+              "attraction: docs/many.md, Speeds beyond the step's); with it the speed scale, "
+              "%.4g m/s at the start, becomes %.4g m/s, %s",
+              sc->file, wetdem_sim_time(su->sim), s->largest_speed, s->speed_bound, s->speed_scale,
+              v, what);
+    return true;
 }
 
 /* How many of the run's spheres are fixed (held in place). */
@@ -1150,7 +1155,7 @@ static int finish(const struct cli_scenario* sc, struct cli_many_setup* su,
     if (many_stats(sc, su->sim, &o.stats) != CLI_EXIT_OK)
         return CLI_EXIT_RUNTIME;
     o.has_budget = wetdem_sim_energy_budget(su->sim, &o.budget) == WETDEM_OK;
-    warn_speed(sc, su, &o.stats);
+    warn_speed(sc, su, &o.stats, prog->tty);
     if (csv_final_row(pl->csv_prefix, su->csv_every, su->sim, o.stats.step) != WETDEM_OK) {
         cli_error("run %s: cannot append the last row to %s.csv: %s", sc->file, pl->csv_prefix,
                   wetdem_sim_errmsg(su->sim));
@@ -1239,14 +1244,17 @@ static int check_output_volume(const struct cli_scenario* sc, const struct cli_m
 }
 
 /* The stepping from `step` to the run's end at pl->t_end (pl->total steps): an integrate call
- * up to each frame of the grid of vtk_every, the frame written when it returns, as it would
+ * up to each frame of the grid of vtk_every, the frame written when it returns (and the
+ * speeds checked, warn_speed, until that warns once; the end checks them again), as it would
  * be at that step of one call (the library's outputs and checkpoints follow their own grid
  * of steps, and the motion is the same bit for bit over any calls: tests/test_many.c). A
  * call ends half a step before the frame's time, t + (n - 1/2) dt, which the library rounds
  * up to n steps. WETDEM status of the library; prog->status a frame's failure. */
-static int run_steps(struct cli_many_setup* su, const struct plan* pl, struct series* vtk,
-                     struct progress* prog, unsigned long long step)
+static int run_steps(const struct cli_scenario* sc, struct cli_many_setup* su,
+                     const struct plan* pl, struct series* vtk, struct progress* prog,
+                     unsigned long long step)
 {
+    bool warned = false; /* about the speeds (warn_speed): at the first frame that shows it */
     prog->first_step = step;
     prog->start = omp_get_wtime();
     int st = WETDEM_OK;
@@ -1267,6 +1275,10 @@ static int run_steps(struct cli_many_setup* su, const struct plan* pl, struct se
             if (pl->checkpoint[0])
                 st = wetdem_sim_write_checkpoint(su->sim, pl->checkpoint);
         }
+        struct wetdem_many_stats s;
+        if (!warned && next < pl->total && prog->status == WETDEM_OK &&
+            wetdem_sim_many_stats(su->sim, &s) == WETDEM_OK)
+            warned = warn_speed(sc, su, &s, prog->tty);
     }
     return st;
 }
@@ -1321,7 +1333,7 @@ static int run(const struct cli_scenario* sc, struct cli_many_setup* su,
     if (st == WETDEM_OK && frame_due && series_add(vtk, su->sim, s.step) != WETDEM_OK)
         prog.status = WETDEM_ERR_IO;
     if (st == WETDEM_OK && prog.status == WETDEM_OK)
-        st = run_steps(su, pl, vtk, &prog, s.step);
+        st = run_steps(sc, su, pl, vtk, &prog, s.step);
     rc = finish(sc, su, opt, pl, &prog, st, omp_get_wtime() - t0);
     /* after a signal the handlers stay until the process exits: a duplicate arriving after the
        files are written would otherwise kill it, and turn exit 130 into death by signal */

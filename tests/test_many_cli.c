@@ -1900,8 +1900,8 @@ static void test_many_cli_warns_about_the_step(void** state)
  * at rest on the floor it has nothing to fall, so the speed scale and the bound are the
  * floor's 1e-3 m/s; after 0.05 s it rolls at (5/7) g sin(30 deg) t = 0.175 m/s, and at that
  * speed scale the step, 0.05 of the contact time at 1e-3 m/s, is 0.05 x 175^(1/5) = 0.14 of
- * the contact time, above 0.1: the end of the run warns (exit 0) with the step that would
- * resolve it, and summary.json holds the three speeds. Run again at that step, the same
+ * the contact time, above 0.1: the run warns (exit 0) at the first frame that shows it and
+ * at its end, with the step that would resolve it, and summary.json holds the three speeds. Run again at that step, the same
  * speed is reached (the motion does not depend on the step to 1e-4) and nothing is warned. */
 static void test_many_cli_warns_when_speeds_outgrow_the_step(void** state)
 {
@@ -1918,9 +1918,16 @@ static void test_many_cli_warns_when_speeds_outgrow_the_step(void** state)
     expect_output("run chute.ini --check", "out.txt",
                   "  speed scale   0.001 m/s  (of the time scales below, which hold while no "
                   "particle exceeds 0.001 m/s)\n");
-    char* err = expect_exit("run chute.ini --out o", 0,
-                            "wetdem: warning: chute.ini: a particle reached 0.175");
+    char* err = expect_exit("run chute.ini --out o", 0, "s a particle reached 0.175");
     CHECK_CONTAINS(err, "above the 0.001 m/s the step's time scales allow a particle");
+    /* and once before, at the first frame where the step no longer resolves the contacts: at
+       0.1 = 0.05 x (V'/V)^(1/5), V' = 32 x 1e-3 m/s, reached at t = 0.032 / ((5/7) g sin 30
+       deg) = 9.1 ms; frames every 72 steps of 13.7 us, 0.99 ms */
+    const char* first = strstr(err, "warning: chute.ini: by t = ");
+    assert_non_null(first);
+    double t_first = strtod(first + strlen("warning: chute.ini: by t = "), NULL);
+    assert_true(t_first > 9.1e-3 && t_first < 9.1e-3 + 1e-3);
+    CHECK_CONTAINS(first + 1, "warning: chute.ini: by t = 0.050011 s"); /* the last step */
     CHECK_CONTAINS(err, "x the contact time");
     const char* at = strstr(err, "[run] dt = ");
     assert_non_null(at);
