@@ -712,6 +712,11 @@ static void summary_text(FILE* f, const struct cli_many_setup* su, const struct 
                 "                   (dt held at %g of the time %.4g s a pair at the speed "
                 "scale takes to cross h_min: docs/many.md, Time step)\n",
                 many_hmin_fraction(su->sim), s->hmin_crossing_time);
+    fprintf(f, "largest speed      %.4g m/s  (the step's time scales allow ", s->largest_speed);
+    if (isfinite(s->speed_bound))
+        fprintf(f, "%.4g m/s: docs/many.md, Speeds beyond the step's)\n", s->speed_bound);
+    else
+        fprintf(f, "any: all falls together)\n");
     fprintf(f, "contacts           %zu\nliquid bridges     %zu\n", s->contacts, s->bridges);
     /* a mean of whole sizes: "2000", not %g's "2e+03"; below 1000 four digits at most */
     fprintf(f,

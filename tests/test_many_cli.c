@@ -1939,6 +1939,11 @@ static void test_many_cli_warns_when_speeds_outgrow_the_step(void** state)
     CHECK_CONTAINS(js, "\"speed_scale_m_s\": 0.001, \"speed_bound_m_s\": 0.001, "
                        "\"largest_speed_m_s\": 0.175");
     free(js);
+    char* out = test_read_file(tpath("out.txt"), NULL);
+    assert_non_null(out);
+    CHECK_CONTAINS(out, "largest speed      0.175"); /* (the text summary) */
+    CHECK_CONTAINS(out, " m/s  (the step's time scales allow 0.001 m/s: docs/many.md");
+    free(out);
     char args[200];
     snprintf(args, sizeof args, "run chute.ini --set run.dt=%.4g", dt);
     assert_int_equal(run_cli(args), 0);
