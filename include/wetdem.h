@@ -812,8 +812,8 @@ WETDEM_API int wetdem_sim_many_stats(const struct wetdem_sim* sim, struct wetdem
 /* The time scales of a started many-particle run that wetdem_many_stats reports
  * (contact_time, relaxation_time, hmin_crossing_time), evaluated as when the run started but
  * with the pairs closing and sliding at `speed` [m/s] instead of the speed scale, for the
- * particles and walls as they are now: e.g. at 2 largest_speed, to see whether the step
- * resolves what the run has met. The run is not changed. Returns WETDEM_OK,
+ * particles and walls as they are now: e.g. at speed_scale + largest_speed - speed_bound, to
+ * see whether the step resolves what the run has met. The run is not changed. Returns WETDEM_OK,
  * WETDEM_ERR_INVALID (not a started many run, a NULL output, a speed not finite and > 0, or
  * a model that meets the edge of its range at that speed: nijssen, whose h_min grows with the
  * approach speed; message names it), WETDEM_ERR_NOMEM. */
