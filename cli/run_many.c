@@ -14,9 +14,10 @@
  * budget. The VTK frames are written here, between integrate calls that each end at a frame
  * (run_steps), rather than by the library, so that the frame numbering and the series index
  * continue across restarts; between frames nothing reads the state, so the library lets each
- * force pass begin the next step (1.06x faster on one thread, 1.17x on two, the settling
- * example; before, the frames were written from a progress callback called at every step,
- * which made the library write the state back at every step). On --restart the existing index
+ * force pass begin the next step (the settling example 1.06x faster on one and two threads,
+ * 1.44x on two with OMP_WAIT_POLICY=passive: docs/performance.md; before, the frames were
+ * written from a progress callback called at every step, which made the library write the
+ * state back at every step). On --restart the existing index
  * is read back and the entries after the checkpoint time are dropped, as are CSV rows after
  * the checkpoint step (a run resumed from an older periodic checkpoint then rewrites them
  * identically), and the last frame and row of the run that wrote the checkpoint when they lie
