@@ -1,8 +1,9 @@
 """Figures and checks of the many-particle validation piece (scripts/validate.d/40-many.sh).
 
-Reads the --out directories of the four shipped scenarios (global.csv, summary.json and the
-VTK frames, ASCII or binary) and writes docs/figures/many_cradle.png, many_settling.png,
-many_agglomeration.png and many_rough_base.png. Checks, each printed and failing the script:
+Reads the --out directories of the five shipped scenarios, the chute's wet and dry
+(global.csv, summary.json and the VTK frames, ASCII or binary), and writes
+docs/figures/many_cradle.png, many_settling.png, many_agglomeration.png, many_rough_base.png
+and many_chute.png. Checks, each printed and failing the script:
   cradle        x momentum conserved (no walls, no gravity: only pair forces, equal and
                 opposite) to 1e-9 of the striker's; the last sphere leaves with more than
                 half the striker's speed and faster than every other sphere;
@@ -23,6 +24,11 @@ many_agglomeration.png and many_rough_base.png. Checks, each printed and failing
                 no free sphere reaches the floor (the floor does no work: the base holds the
                 grains); closure < 2e-3 of the work; at rest at the end (kinetic < 1e-4 of
                 the potential energy released).
+  chute         wet grains on the rough base under gravity tilted by 30 deg come to rest
+                (mean downslope speed < 1e-3 m/s from 0.1 s on), dry ones keep flowing
+                (mean > 3 cm/s, every frame from 0.1 s on within 25 % of it); closure
+                < 2e-3 of the work in both; the largest speed within the speed bound of the
+                step in both. Writes many_chute.png too.
 Usage: /usr/bin/python3 figures/many_figs.py --dir out/validate/many
 """
 import argparse
@@ -301,6 +307,64 @@ def rough_base(run_dir):
     fig.savefig(os.path.join(FIGURES, "many_rough_base.png"), dpi=120)
 
 
+def chute(wet_dir, dry_dir):
+    print("wet and dry grains on a rough incline of 30 deg (the chute example)")
+    runs = {}
+    for name, d in (("wet", wet_dir), ("dry", dry_dir)):
+        series = json.load(open(os.path.join(d, "particles.vtk.series")))
+        fr = [read_vtk(os.path.join(d, e["name"])) for e in series["files"]]
+        free = fr[0]["fixed"] == 0
+        t = np.array([f["TIME"][0] for f in fr])
+        vx = np.array([f["velocity"][free, 0].mean() for f in fr])
+        runs[name] = (t, vx, fr, free, json.load(open(os.path.join(d, "summary.json"))))
+    t, vx, fr, free, s = runs["wet"]
+    late = t >= 0.1
+    check(np.abs(vx[late]).max() < 1e-3,
+          f"wet: at rest from 0.1 s on (mean downslope speed at most "
+          f"{np.abs(vx[late]).max():.1e} m/s): the bridges hold the layer")
+    t, vx, fr, free, s_dry = runs["dry"]
+    late = t >= 0.1
+    mean = vx[late].mean()
+    check(mean > 0.03 and np.abs(vx[late] - mean).max() < 0.25 * mean,
+          f"dry: keeps flowing from 0.1 s on (mean downslope speed {mean:.3f} m/s, frames "
+          f"within {np.abs(vx[late] - mean).max() / mean:.0%} of it)")
+    for name, run in runs.items():
+        e = run[4]["energy_J"]
+        check(abs(e["balance_error"]) < 2e-3 * abs(e["work_total"]),
+              f"{name}: energy closure {abs(e['balance_error']) / abs(e['work_total']):.2e} of "
+              "the work (gravity along the periodic x axis: the images' drops counted)")
+        sp = run[4]
+        check(sp["largest_speed_m_s"] <= sp["speed_bound_m_s"],
+              f"{name}: largest speed {sp['largest_speed_m_s']:.3f} m/s within the "
+              f"{sp['speed_bound_m_s']:.3f} m/s the step allows (docs/many.md, Speeds beyond "
+              "the step's)")
+    fig, (a, b) = plt.subplots(1, 2, figsize=(11, 4.2))
+    for name, (t, vx, fr, free, s) in runs.items():
+        a.plot(t * 1e3, vx * 1e2, label=name)
+    a.axhline(0, color="k", linewidth=0.5)
+    a.set_xlabel("time [ms]")
+    a.set_ylabel("mean downslope speed of the grains [cm/s]")
+    a.legend()
+    # the profiles: downslope speed against height above the floor, the grains of the frames
+    # from 0.1 s on in bins of 0.25 mm (bins of at least 20 grain-frames)
+    for name, mark in (("dry", "o-"), ("wet", "s-")):
+        t, vx, fr, free, s = runs[name]
+        z = np.concatenate([f["POINTS"][free, 2] for f, tt in zip(fr, t) if tt >= 0.1]) * 1e3
+        v = np.concatenate([f["velocity"][free, 0] for f, tt in zip(fr, t) if tt >= 0.1]) * 1e2
+        edges = np.arange(0, z.max() + 0.25, 0.25)
+        k = np.digitize(z, edges)
+        bins = [j for j in range(1, len(edges)) if (k == j).sum() >= 20]
+        b.plot([v[k == j].mean() for j in bins], [0.5 * (edges[j - 1] + edges[j]) for j in bins],
+               mark, label=f"{name}, from 0.1 s on")
+    b.axvline(0, color="k", linewidth=0.5)
+    b.set_xlabel("downslope speed [cm/s]")
+    b.set_ylabel("height of the centre above the floor [mm]")
+    b.legend()
+    fig.suptitle("300 grains on a rough incline of 30 deg: the dry layer flows, the wet one "
+                 "is held by its liquid bridges")
+    save_and_finish(fig, "many_chute.png")
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--dir", default=os.path.join(ROOT, "out", "validate", "many"))
@@ -310,6 +374,7 @@ def main():
     settling(os.path.join(d, "settling"))
     agglomeration(os.path.join(d, "agglomeration"))
     rough_base(os.path.join(d, "rough_base"))
+    chute(os.path.join(d, "chute"), os.path.join(d, "chute_dry"))
     if failures:
         print(f"{len(failures)} check(s) failed")
         sys.exit(1)

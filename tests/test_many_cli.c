@@ -1670,8 +1670,8 @@ static void test_many_cli_examples_and_budget(void** state)
 {
     (void)state;
     const char* files[] = {"many_stokes_cradle", "many_settling", "many_agglomeration",
-                           "many_rough_base"};
-    for (size_t k = 0; k < 4; k++) {
+                           "many_rough_base", "many_chute"};
+    for (size_t k = 0; k < 5; k++) {
         char args[1400], cwd[1024];
         assert_non_null(getcwd(cwd, sizeof cwd)); /* the repository root */
         snprintf(args, sizeof args, "run '%s/examples/scenarios/%s.ini' --check", cwd, files[k]);
