@@ -3,9 +3,11 @@ written from the documented step and force laws, not from the C code: velocity V
 forces at the predicted velocities and the tangential springs advanced with the slip of the
 half-step velocities (docs/many.md, "Time step"), the step derived when none is given (the
 speed scale with gravity's term over the fall of "What a fall adds", the contact, relaxation
-and h_min crossing times of the pairs that can occur),
-the pair and wall geometry and signs of docs/concepts.md, the laws of docs/models.md and
-docs/derivations/ (hertz with damping = tsuji or exact, hooke, mindlin beside either, sb, db,
+and h_min crossing times of the pairs that can occur), the speeds behind it ("Speeds beyond
+the step's": the speed scale V, the bound B = V - v0, infinite where nothing stops a fall,
+and the largest half-step speed u of a free particle over the run), the pair and wall
+geometry and signs of docs/concepts.md, the laws of docs/models.md and docs/derivations/
+(hertz with damping = tsuji or exact, hooke, mindlin beside either, sb, db,
 davis, nase, capillary, reynolds with a fixed h_min, nijssen with its own h_min record and
 blended contact; h_min fixed, roughness, ehd, max, glass), walls, periodic axes by the minimum
 image, gravity, and the energy budget (work per model by the trapezoid rule over the force
@@ -13,28 +15,30 @@ passes, the stored energy of hertz and hooke).
 
 Each scenario below is written as a scenario file, run with `build/wetdem run` (binary VTK,
 exact), and followed by the reference; positions, velocities and spins are compared at every
-frame, and the budget of summary.json at the end. A scenario without a step compares the
-engine's derived step (summary.json) and the time scales `wetdem run --check` prints with the
-reference's. Variants of a scenario run the engine again (3 and 4 threads; stopped at a step
-and resumed with --restart) against the same reference run.
+frame, and the budget and the speeds V, B and u of summary.json at the end, whatever the
+step. A scenario without a step compares the engine's derived step (summary.json) and the
+time scales `wetdem run --check` prints with the reference's. Variants of a scenario run
+the engine again (3 and 4 threads; stopped at a step and resumed with --restart) against the
+same reference run.
 
     /usr/bin/python3 tools/many_reference.py [--wetdem build/wetdem] [--only NAME]
         [--every N] [--coverage] [-v] [--mutants]
 
-prints one line per run with the largest difference over the run of the positions (over
-the largest radius), velocities and spins (R w, over the largest speed of the run) and of
-the budget's terms (over the larger of the input and the models' work), and exits with 1
-when a run is off by more than its tolerance: 1e-9, rounding grown over some thousand
-steps (the cases agree to 1e-16..1e-13); 1e-8 with the exact damping of hertz or nijssen,
-whose coefficient the engine tabulates to about 4e-9 relative (docs/derivations/contact.md
-Sec. 1.3) where this reference bisects Eq. 1.7 (a shift of c by 4e-9 moves these cases by
-up to 2e-9). A derived step agrees to 1e-12 where a closed form binds, 1e-9 where mindlin's
-contact time does (the engine's central differences, derived_contact), 1e-8 where nijssen's
-exact dashpot does (the tabulated coefficient, derived_nijssen), and the printed time
-scales to 1e-5 (6 digits). --every N compares a frame every N steps, between which the
+prints one line per run with the largest difference over the run of the positions (over the
+largest radius), velocities and spins (R w, over the largest speed of the run), of the largest
+speed u (relative) and of the budget's terms (over the larger of the input and the models'
+work), and exits with 1 when a run is off by more than its tolerance: 1e-9, rounding grown
+over some thousand steps (the cases agree to 1e-16..1e-13); 1e-8 with the exact damping of
+hertz or nijssen, whose coefficient the engine tabulates to about 4e-9 relative
+(docs/derivations/contact.md Sec. 1.3) where this reference bisects Eq. 1.7 (a shift of c by
+4e-9 moves these cases by up to 2e-9). V and B agree to 1e-12 relative (a closed form of the
+start; SPEED_TOL). A derived step agrees to 1e-12 where a closed form binds, 1e-9 where
+mindlin's contact time does (the engine's central differences, derived_contact), 1e-8 where
+nijssen's exact dashpot does (the tabulated coefficient, derived_nijssen), and the printed
+time scales to 1e-5 (6 digits). --every N compares a frame every N steps, between which the
 engine takes its fused paths; --coverage prints what each case exercised; --mutants checks
 instead that deliberate errors of the reference are detected. Needs numpy (Debian
-python3-numpy); about 2 min.
+python3-numpy); about 2 min (frames every 25 steps: 1.5 min, and 0.5 min for --mutants).
 """
 import argparse
 import functools
@@ -172,6 +176,9 @@ class Reference:
         self.unwrap = np.zeros((self.n, 3))  # box lengths taken off by wraps
         self.work = {m: [0.0, 0.0] for m in self.models}  # [pairs, walls], trapezoid sums
         self.last_power = None
+        # the largest |v'|^2 of a free particle over the steps so far, v' the half-step
+        # velocity of the drift (docs/many.md, Speeds beyond the step's)
+        self.u2 = 0.0
         # what the run exercised: evaluations with a non-zero force per model and kind,
         # Coulomb slides, pairs acting across a periodic face, the most partners acting on
         # one sphere at once, wraps
@@ -496,6 +503,8 @@ class Reference:
         al = np.where(free[:, None], self.T / self.I[:, None], 0.0)
         vh = self.v + a * dt / 2
         wh = self.w + al * dt / 2
+        if free.any():
+            self.u2 = max(self.u2, float(np.max(np.sum(vh[free] ** 2, axis=1))))
         self.x = self.x + vh * dt
         for ax in range(3):
             if self.periodic[ax]:
@@ -646,6 +655,20 @@ def fall_height(sc):
     return max(max(terms), 0.0)
 
 
+def speed_scale(sc):
+    """The speed scale V and the speed bound B of docs/many.md (*Time step*, *Speeds beyond
+    the step's*) from the scenario alone: V = 2 v0 + sqrt(2 |g| H), at least sim.speed_floor
+    (1e-3 m/s), v0 the largest particle speed at the start (spins not counted) and H the fall
+    of *What a fall adds*; B = V - v0, infinite where gravity acts and neither a wall nor a
+    fixed sphere stops a fall (everything falls together)."""
+    ps = sc["particles"]
+    g = math.sqrt(sum(c * c for c in sc.get("gravity", (0, 0, 0))))
+    v0 = max(math.sqrt(sum(c * c for c in p.get("v", (0, 0, 0)))) for p in ps)
+    speed = max(1e-3, 2 * v0 + math.sqrt(2 * g * fall_height(sc)))
+    stops = bool(sc.get("walls")) or any(p.get("fixed") for p in ps)
+    return speed, (math.inf if g > 0 and not stops else speed - v0)
+
+
 def step_scales(sc):
     """The derived step of docs/many.md, *Time step*, from the scenario alone: the speed
     scale, and over the pairs that can occur the shortest contact time (normal or
@@ -664,11 +687,7 @@ def step_scales(sc):
     free = [p for p in ps if not p.get("fixed")]
     fixed = [p for p in ps if p.get("fixed")]
     walls = bool(sc.get("walls"))
-    # twice the largest speed, plus what gravity adds over the fall H of *What a fall adds*;
-    # at least sim.speed_floor
-    g = math.sqrt(sum(c * c for c in sc.get("gravity", (0, 0, 0))))
-    v = max(2 * math.sqrt(sum(c * c for c in p.get("v", (0, 0, 0)))) for p in ps)
-    speed = max(1e-3, v + math.sqrt(2 * g * fall_height(sc)))
+    speed = speed_scale(sc)[0]
     first_min = functools.partial(min, key=lambda p: p["R"])  # the first of equal radii
     first_max = functools.partial(max, key=lambda p: p["R"])
     small = first_min(free) if free else first_min(ps)
@@ -978,9 +997,34 @@ def run_case(sc, wetdem, steps, verbose=False, every=1):
                 print(f"  step {k}: x {np.abs(dx).max():.3g} v "
                       f"{np.abs(fr['velocity'] - ref.v).max():.3g} "
                       f"w {np.abs(fr['spin'] - ref.w).max():.3g}")
+    # the speeds behind the step (docs/many.md, Speeds beyond the step's): V and B of the
+    # start, whatever the step, and the largest half-step speed of the whole run, which a
+    # resumed run reports too (its checkpoint keeps them)
+    speed, bound = speed_scale(sc)
+    largest = math.sqrt(ref.u2)
     for label, _, summary, _ in runs:
         results[label]["budget"] = budget_diff(ref, summary, verbose and not label)
+        results[label].update(speeds_diff(speed, bound, largest, summary))
+        if verbose:
+            print(f"  speeds{' ' + label if label else ''}: engine V "
+                  f"{summary['speed_scale_m_s']!r} B {summary['speed_bound_m_s']!r} u "
+                  f"{summary['largest_speed_m_s']!r}, reference V {speed!r} B {bound!r} u "
+                  f"{largest!r}")
     return results, grid[-1], ref
+
+
+def speeds_diff(speed, bound, largest, summary):
+    """The relative differences of summary.json's speed scale ("V"), speed bound ("B"; null
+    for infinite) and largest half-step speed ("u") from the reference's: 0 where both are
+    infinite or zero, infinite where only one is."""
+    def rel(engine, ref):
+        engine = math.inf if engine is None else engine
+        if engine == ref:
+            return 0.0
+        return abs(engine / ref - 1) if 0 < ref < math.inf else math.inf
+    return {"V": rel(summary["speed_scale_m_s"], speed),
+            "B": rel(summary["speed_bound_m_s"], bound),
+            "u": rel(summary["largest_speed_m_s"], largest)}
 
 
 # ----------------------------------------------------------------------------- cases ---
@@ -1736,6 +1780,37 @@ def _mutant_glass_factor(ctx, sc):  # glass's h_min without the 3 of the Reynold
     globals()["glass_hmin"] = lambda mu, r, v, p, film: orig(mu / 3, r, v, p, film)
 
 
+def _mutant_full_step_speed(ctx, sc):  # the largest speed over the full-step velocities
+    orig = Reference.step
+
+    def step(self):
+        u2 = self.u2
+        orig(self)
+        free = ~self.fixed
+        self.u2 = max(u2, float(np.max(np.sum(self.v[free] ** 2, axis=1))))
+    ctx.append((Reference, "step", orig))
+    Reference.step = step
+
+
+def _mutant_resumed_speed(ctx, sc):  # the largest speed of the resumed part of a run alone
+    at = sc["variants"][0]["restart_at"]
+    orig = Reference.step
+
+    def step(self):
+        self.steps_done = getattr(self, "steps_done", 0) + 1
+        if self.steps_done == at + 1:
+            self.u2 = 0.0
+        orig(self)
+    ctx.append((Reference, "step", orig))
+    Reference.step = step
+
+
+def _mutant_bound_as_scale(ctx, sc):  # B taken as V
+    orig = globals()["speed_scale"]
+    ctx.append((sys.modules[__name__], "speed_scale", orig))
+    globals()["speed_scale"] = lambda sc: (orig(sc)[0],) * 2
+
+
 # (what, the mutant, the case, the run of it that must detect it, steps: None for the case's)
 MUTANTS = [("torque on j with i's lever arm", _mutant_lever, "friction_spin_unequal", "",
             None),
@@ -1764,34 +1839,55 @@ MUTANTS = [("torque on j with i's lever arm", _mutant_lever, "friction_spin_uneq
             _mutant_nijssen_lub, "derived_nijssen", "", None),
            ("glass's h_min without the 3 of the Reynolds pressure", _mutant_glass_factor,
             "derived_glass", "", None),
+           ("largest speed over the full-step velocities", _mutant_full_step_speed,
+            "derived_contact", "", 200),
+           ("speed bound taken as the speed scale", _mutant_bound_as_scale, "slide_wall_hooke",
+            "", 100),
+           ("largest speed of the resumed part alone", _mutant_resumed_speed,
+            "derived_contact", "resumed at 437", 600),
            ("histories lost at the checkpoint", _mutant_restart, "cluster_eight",
             "resumed at 1513, frames every 10", None),
            ("pairs between index quarters lost", _mutant_blocks, "pack_512_lean", "4 threads",
             25)]
 
 
+# V and B of summary.json against speed_scale(), relative: the same closed form evaluated in
+# another order, a few roundings of 1e-16 each (a norm, sums of coordinates, a square root),
+# so 1e-12 leaves a margin of 1e3 and still catches any change of a term. The fall H is a
+# difference of coordinates (rounded to some 1e-18 m) that the square root turns into
+# sqrt(2 |g| dH) = 4e-9 m/s at H = 0; but the cases' H is either 19 um or more, or exactly 0
+# on both sides (no gravity; a sphere set on a floor square to g, its height less its
+# radius), and they agree bit for bit. The largest speed u is
+# compared to the velocities' tolerance (sc["tol"]): it is the largest norm of the half-step
+# velocities, which carry the rounding, or the tabulated damping's shift, of the velocities.
+SPEED_TOL = 1e-12
+
+
 def judge(sc, worst):
-    """The largest of a run's differences over its tolerance: the state and budget's
-    (sc["tol"], 1e-9 unless set); a derived step's (sc["dt_tol"], 1e-12: a closed form
+    """The largest of a run's differences over its tolerance: the state's, the largest
+    speed's and the budget's (sc["tol"], 1e-9 unless set); the speed scale's and bound's
+    (SPEED_TOL); a derived step's (sc["dt_tol"], 1e-12: a closed form
     evaluated in another order, unless set); the time scales `--check` prints to 6 digits
     (1e-5)."""
     tol = sc.get("tol", 1e-9)
-    ratio = max(v for k, v in worst.items() if k not in ("dt", "check")) / tol
+    ratio = max(v for k, v in worst.items() if k not in ("dt", "check", "V", "B")) / tol
+    ratio = max(ratio, worst["V"] / SPEED_TOL, worst["B"] / SPEED_TOL)
     if "dt" in worst:
         ratio = max(ratio, worst["dt"] / sc.get("dt_tol", 1e-12), worst["check"] / 1e-5)
     return ratio
 
 
 def describe(sc, label, steps, worst):
-    extra = ""
+    extra = f" V {worst['V']:.2g} B {worst['B']:.2g} (tol {SPEED_TOL:g})"
     if "dt" in worst:
-        extra = (f" dt {worst['dt']:.2g} (tol {sc.get('dt_tol', 1e-12):g})"
+        extra += (f" dt {worst['dt']:.2g} (tol {sc.get('dt_tol', 1e-12):g})"
                  f" --check {worst['check']:.2g} (tol 1e-05)")
     if "frames" in worst:
         extra += " frames not those of the uninterrupted run"
     name = sc["name"] + (f" {label}" if label else "")
     return (f"{name:<28} {steps} steps: x {worst['x']:.2g} v {worst['v']:.2g} "
-            f"w {worst['w']:.2g} budget {worst['budget']:.2g} (tol {sc.get('tol', 1e-9):g})"
+            f"w {worst['w']:.2g} u {worst['u']:.2g} budget {worst['budget']:.2g} "
+            f"(tol {sc.get('tol', 1e-9):g})"
             + extra)
 
 
