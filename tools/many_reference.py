@@ -34,11 +34,12 @@ hertz or nijssen, whose coefficient the engine tabulates to about 4e-9 relative
 4e-9 moves these cases by up to 2e-9). V and B agree to 1e-12 relative (a closed form of the
 start; SPEED_TOL). A derived step agrees to 1e-12 where a closed form binds, 1e-9 where
 mindlin's contact time does (the engine's central differences, derived_contact), 1e-8 where
-nijssen's exact dashpot does (the tabulated coefficient, derived_nijssen), and the printed
-time scales to 1e-5 (6 digits). --every N compares a frame every N steps, between which the
-engine takes its fused paths; --coverage prints what each case exercised; --mutants checks
-instead that deliberate errors of the reference are detected. Needs numpy (Debian
-python3-numpy); about 2 min (frames every 25 steps: 1.5 min, and 0.5 min for --mutants).
+the exact dashpot of hertz or nijssen does (the tabulated coefficient, derived_hertz_exact,
+derived_nijssen), and the printed time scales to 1e-5 (6 digits). --every N compares a frame
+every N steps, between which the engine takes its fused paths; --coverage prints what each
+case exercised; --mutants checks instead that deliberate errors of the reference are detected.
+Needs numpy (Debian python3-numpy); about 2 min (frames every 25 steps: 1.5 min, and 0.5 min
+for --mutants).
 """
 import argparse
 import functools
@@ -674,8 +675,9 @@ def step_scales(sc):
     scale, and over the pairs that can occur the shortest contact time (normal or
     tangential), viscous relaxation time and time to cross the smallest gap where the laws
     jump; dt the shortest of dt_fraction (0.02) of the first, a quarter of the second and
-    many_hmin_fraction (0.5) of the third. Only the models the derived cases use are written
-    out (not hertz and hooke together)."""
+    many_hmin_fraction (0.5) of the third. Every force model is written out, for the
+    combinations the engine accepts (it refuses hertz with hooke, both a normal contact, and
+    nijssen beside either or mindlin)."""
     mats = sc["materials"]
     ps = sc["particles"]
     models = sc["models"].split()
@@ -823,9 +825,13 @@ def write_ini(sc, path, steps, every=1, checkpoint=False):
     lines += ["[models]", "force = " + sc["models"],
               "min_separation = " + sc.get("min_separation", "fixed")]
     sections = {}
+    integrator = []  # verlet's parameters: [integrator]
     for key, val in sc.get("params", {}).items():
         model, name = key.split(".")
-        sections.setdefault(model, []).append(f"{name} = {val}")
+        if model == "verlet":
+            integrator.append(f"{name} = {val}")
+        else:
+            sections.setdefault(model, []).append(f"{name} = {val}")
     for model, keys in sections.items():
         lines += [f"[model.{model}]"] + keys
     g = sc.get("gravity", (0, 0, 0))
@@ -840,10 +846,11 @@ def write_ini(sc, path, steps, every=1, checkpoint=False):
     # a given step, without the bound on the travel per step; or the step derived by the
     # engine, with that bound at its default (docs/many.md, Time step)
     if sc["dt"] is None:
-        lines += ["[run]", f"steps = {steps}", "energy_budget = yes"]
+        lines += (["[integrator]"] + integrator if integrator else []) + \
+            ["[run]", f"steps = {steps}", "energy_budget = yes"]
     else:
-        lines += ["[integrator]", "many_hmin_fraction = 0",
-                  "[run]", f"steps = {steps}", f"dt = {sc['dt']!r}", "energy_budget = yes"]
+        lines += ["[integrator]", "many_hmin_fraction = 0"] + integrator + \
+            ["[run]", f"steps = {steps}", f"dt = {sc['dt']!r}", "energy_budget = yes"]
     # a skin of 0.5 um rebuilds the lists every few steps, so that the histories are carried
     # across many rebuilds
     lines.append(f"skin = {sc.get('skin', 5e-7)!r}")
@@ -1621,6 +1628,42 @@ def derived_nijssen():
 
 
 @case
+def derived_hertz_exact():
+    """The three wet spheres falling freely under gravity (no wall, no fixed sphere) with
+    hertz's exact damping at e_dry 0.01 and 0.02, mindlin, and sb and davis cut off below
+    ehd's h_min (c) in a 0.1 Pa s liquid, the step derived: a quarter of the hertz dashpot's
+    relaxation time at the largest overlap of an undamped impact at the speed scale binds
+    (0.87 of the step from the tangential contact time; docs/many.md, Viscous relaxation
+    time); many_hmin_fraction x the time to cross ehd's h_min at the speed scale (0.38 um)
+    is 1.34 times it.
+    Nothing stops a fall: the fall is the extent of the free centres along g (What a fall
+    adds, 3), and the speed bound is infinite (null in summary.json). The exact coefficient
+    is tabulated by the engine (derived_nijssen): the steps and the run agree to 1e-8."""
+    return wet_pair("derived_hertz_exact", "hertz mindlin sb davis capillary",
+                    {"hertz.damping": "exact"},
+                    min_separation="ehd", viscosity=0.1, walls=[], gravity=(0, 0, -9.81),
+                    materials=[glass(film=25e-6, restitution=0.01),
+                               glass(film=15e-6, youngs_modulus=3e8, restitution=0.02)],
+                    dt=None, dt_tol=1e-8, tol=1e-8)
+
+
+@case
+def derived_nijssen_tsuji():
+    """derived_nijssen with nijssen's tsuji damping and verlet.dt_fraction 0.03, the step
+    derived: the normal dashpot takes c = -sqrt(5) beta(e_dry) = 1.85 and 1.74 for e_dry 0.01
+    and 0.02 (the exact coefficient is 10.7 and 7.4), so its relaxation time at the largest
+    shifted overlap, 4.9 us, is 3.2 times that of nijssen's Mindlin dashpot (Eq. 10), a
+    quarter of which binds (0.78 of the step from the contact time; at the default
+    dt_fraction 0.02 the contact time would bind); with the exact coefficient the normal
+    dashpot's would (derived_nijssen). A closed form: the steps agree to rounding."""
+    sc = derived_nijssen()
+    sc.update(name="derived_nijssen_tsuji", params={"nijssen.damping": "tsuji",
+                                                    "verlet.dt_fraction": 0.03},
+              dt_tol=1e-12, tol=1e-9)
+    return sc
+
+
+@case
 def derived_glass():
     """glass's h_min (p_gt 1e8 Pa) with sb and davis cut off below it (c), the step derived:
     many_hmin_fraction x the time to cross the smallest h_min at the speed scale,
@@ -1811,6 +1854,29 @@ def _mutant_bound_as_scale(ctx, sc):  # B taken as V
     globals()["speed_scale"] = lambda sc: (orig(sc)[0],) * 2
 
 
+def _mutant_bound_finite(ctx, sc):  # B = V - v0 also where nothing stops a fall
+    orig = globals()["speed_scale"]
+    ctx.append((sys.modules[__name__], "speed_scale", orig))
+
+    def scale(sc):
+        speed, _ = orig(sc)
+        return speed, speed - max(math.sqrt(sum(c * c for c in p.get("v", (0, 0, 0))))
+                                  for p in sc["particles"])
+    globals()["speed_scale"] = scale
+
+
+def _mutant_damping_swapped(ctx, sc):  # the step from the other damping's coefficient
+    orig = globals()["step_scales"]
+    ctx.append((sys.modules[__name__], "step_scales", orig))
+
+    def scales(sc):
+        params = dict(sc.get("params", {}))
+        for key in ("hertz.damping", "nijssen.damping"):
+            params[key] = "exact" if params.get(key, "exact") == "tsuji" else "tsuji"
+        return orig(dict(sc, params=params))
+    globals()["step_scales"] = scales
+
+
 # (what, the mutant, the case, the run of it that must detect it, steps: None for the case's)
 MUTANTS = [("torque on j with i's lever arm", _mutant_lever, "friction_spin_unequal", "",
             None),
@@ -1839,10 +1905,16 @@ MUTANTS = [("torque on j with i's lever arm", _mutant_lever, "friction_spin_uneq
             _mutant_nijssen_lub, "derived_nijssen", "", None),
            ("glass's h_min without the 3 of the Reynolds pressure", _mutant_glass_factor,
             "derived_glass", "", None),
+           ("hertz's exact dashpot with tsuji's coefficient in the step",
+            _mutant_damping_swapped, "derived_hertz_exact", "", 100),
+           ("nijssen's tsuji dashpot with the exact coefficient in the step",
+            _mutant_damping_swapped, "derived_nijssen_tsuji", "", 100),
            ("largest speed over the full-step velocities", _mutant_full_step_speed,
             "derived_contact", "", 200),
            ("speed bound taken as the speed scale", _mutant_bound_as_scale, "slide_wall_hooke",
             "", 100),
+           ("speed bound finite where nothing stops a fall", _mutant_bound_finite,
+            "derived_hertz_exact", "", 100),
            ("largest speed of the resumed part alone", _mutant_resumed_speed,
             "derived_contact", "resumed at 437", 600),
            ("histories lost at the checkpoint", _mutant_restart, "cluster_eight",
