@@ -1773,7 +1773,9 @@ def _mutant_roughness(ctx, sc):  # h_min the sum of the roughnesses, not their m
     Reference.min_separation = ms
 
 
-def _mutant_restart(ctx, sc):  # the histories lost at the step the run was resumed from
+def _after_restart_step(ctx, sc, forget):
+    """Reference.step patched to call forget(ref) after the step the case's first variant is
+    resumed from (what a checkpoint that lost something would do)."""
     at = sc["variants"][0]["restart_at"]
     orig = Reference.step
 
@@ -1781,9 +1783,13 @@ def _mutant_restart(ctx, sc):  # the histories lost at the step the run was resu
         orig(self)
         self.steps_done = getattr(self, "steps_done", 0) + 1
         if self.steps_done == at:
-            self.hist = {}
+            forget(self)
     ctx.append((Reference, "step", orig))
     Reference.step = step
+
+
+def _mutant_restart(ctx, sc):  # the histories lost at the step the run was resumed from
+    _after_restart_step(ctx, sc, lambda ref: setattr(ref, "hist", {}))
 
 
 def _mutant_blocks(ctx, sc):  # the pairs between quarters of the index range lost
@@ -1836,16 +1842,7 @@ def _mutant_full_step_speed(ctx, sc):  # the largest speed over the full-step ve
 
 
 def _mutant_resumed_speed(ctx, sc):  # the largest speed of the resumed part of a run alone
-    at = sc["variants"][0]["restart_at"]
-    orig = Reference.step
-
-    def step(self):
-        self.steps_done = getattr(self, "steps_done", 0) + 1
-        if self.steps_done == at + 1:
-            self.u2 = 0.0
-        orig(self)
-    ctx.append((Reference, "step", orig))
-    Reference.step = step
+    _after_restart_step(ctx, sc, lambda ref: setattr(ref, "u2", 0.0))
 
 
 def _mutant_bound_as_scale(ctx, sc):  # B taken as V
