@@ -640,9 +640,9 @@ static bool warn_speed(const struct cli_scenario* sc, struct cli_many_setup* su,
 {
     if (!(s->largest_speed > s->speed_bound))
         return false;
-    double v = s->speed_scale + (s->largest_speed - s->speed_bound), t_c, tau, t_x;
+    double v = s->speed_scale + (s->largest_speed - s->speed_bound), t_c, tau, t_x, dt;
     char what[600] = "";
-    int ok = wetdem_sim_many_time_scales_at(su->sim, v, &t_c, &tau, &t_x) == WETDEM_OK;
+    bool ok = wetdem_sim_many_time_scales_at(su->sim, v, &t_c, &tau, &t_x, &dt) == WETDEM_OK;
     size_t n =
         ok ? (size_t)snprintf(what, sizeof what, "and there the step dt = %.4g s is ", s->dt) : 0;
     size_t head = n;
@@ -650,8 +650,7 @@ static bool warn_speed(const struct cli_scenario* sc, struct cli_many_setup* su,
         snprintf(what, sizeof what, "where the time scales cannot be evaluated: %s",
                  wetdem_sim_errmsg(su->sim));
     else {
-        double fraction = 0.02, gap_fraction = many_hmin_fraction(su->sim);
-        wetdem_sim_param(su->sim, "verlet.dt_fraction", &fraction);
+        double gap_fraction = many_hmin_fraction(su->sim);
         if (s->dt / t_c > WETDEM_MANY_CONTACT_FRACTION_MAX)
             n += (size_t)snprintf(what + n, sizeof what - n,
                                   "%.3g x the contact time %.4g s (above %g x: the contacts are "
@@ -669,10 +668,7 @@ static bool warn_speed(const struct cli_scenario* sc, struct cli_many_setup* su,
                                   n > head ? "; " : "", tau);
         if (n == head)
             return false;
-        /* the step the start would have derived at that speed scale (sim_many.c choose_dt) */
-        double dt = fmin(fraction * t_c, 0.25 * tau);
-        dt = gap_fraction > 0 ? fmin(dt, gap_fraction * t_x) : dt;
-        if (n < sizeof what)
+        if (n < sizeof what) /* the step a start at that speed scale would derive */
             snprintf(what + n, sizeof what - n, ": [run] dt = %.4g s would resolve it", dt);
     }
     if (tty) /* (off the progress line) */

@@ -813,13 +813,16 @@ WETDEM_API int wetdem_sim_many_stats(const struct wetdem_sim* sim, struct wetdem
  * (contact_time, relaxation_time, hmin_crossing_time), evaluated as when the run started but
  * with the pairs closing and sliding at `speed` [m/s] instead of the speed scale, for the
  * particles and walls as they are now: e.g. at speed_scale + largest_speed - speed_bound, to
- * see whether the step resolves what the run has met. The run is not changed. Returns WETDEM_OK,
+ * see whether the step resolves what the run has met; and the step a run starting at that
+ * speed would derive (*step: verlet.dt_fraction x contact_time, relaxation_time / 4 and
+ * verlet.many_hmin_fraction x hmin_crossing_time, the shortest). The run is not changed.
+ * Returns WETDEM_OK,
  * WETDEM_ERR_INVALID (not a started many run, a NULL output, a speed not finite and > 0, or
  * a model that meets the edge of its range at that speed: nijssen, whose h_min grows with the
  * approach speed; message names it), WETDEM_ERR_NOMEM. */
 WETDEM_API int wetdem_sim_many_time_scales_at(struct wetdem_sim* sim, double speed,
                                               double* contact_time, double* relaxation_time,
-                                              double* hmin_crossing_time);
+                                              double* hmin_crossing_time, double* step);
 
 /* Appends a row of the global quantities at the current state to the run's CSV
  * (output_prefix.csv), with the columns and format of the rows written every csv_every steps:

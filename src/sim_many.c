@@ -485,29 +485,49 @@ static int time_scales(struct wetdem_sim* sim, struct step_spheres* sp, struct s
     return WETDEM_OK;
 }
 
-int wetdem_sim_many_time_scales(struct wetdem_sim* sim)
+/* The time scales and speeds of a run without particles: nothing touches, damps or moves. */
+static void clear_time_scales(struct wetdem_many* m)
 {
-    struct wetdem_many* m = sim->many;
     m->relaxation_time = m->contact_time = m->crossing_time = INFINITY;
     m->speed_scale = m->speed_bound = m->v2_seen = 0;
+}
+
+int wetdem_sim_many_time_scales(struct wetdem_sim* sim)
+{
+    clear_time_scales(sim->many);
     struct step_spheres sp;
     struct step_scales s;
     return sim->n_particles > 0 ? time_scales(sim, &sp, &s) : WETDEM_OK;
 }
 
+/* The derived step [s] (docs/many.md, Time step) from the shortest contact time t_contact,
+ * relaxation time tau and h_min crossing time crossing [s]: the shortest of
+ * verlet.dt_fraction x t_contact, tau / 4 and verlet.many_hmin_fraction x crossing (that bound
+ * off at 0). */
+static double derived_step(const struct wetdem_sim* sim, double t_contact, double tau,
+                           double crossing)
+{
+    double fraction = 0.02, many_hmin_fraction = 0.5;
+    wetdem_sim_param(sim, "verlet.dt_fraction", &fraction);
+    wetdem_sim_param(sim, "verlet.many_hmin_fraction", &many_hmin_fraction);
+    double by_gap = many_hmin_fraction > 0 ? many_hmin_fraction * crossing : INFINITY;
+    return fmin(fmin(fraction * t_contact, 0.25 * tau), by_gap);
+}
+
 int wetdem_sim_many_time_scales_at(struct wetdem_sim* sim, double speed, double* contact_time,
-                                   double* relaxation_time, double* hmin_crossing_time)
+                                   double* relaxation_time, double* hmin_crossing_time,
+                                   double* step)
 {
     if (!sim->many || !sim->many->started)
         return wetdem_sim_fail(sim, WETDEM_ERR_INVALID, "many_time_scales_at: %s",
                                !sim->many ? "the simulation is not in the many-particle mode"
                                           : "the many-particle run has not started");
-    if (!contact_time || !relaxation_time || !hmin_crossing_time)
+    if (!contact_time || !relaxation_time || !hmin_crossing_time || !step)
         return wetdem_sim_fail(sim, WETDEM_ERR_INVALID, "many_time_scales_at: NULL output");
     if (!(isfinite(speed) && speed > 0))
         return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
                                "many_time_scales_at: speed = %g m/s must be finite and > 0", speed);
-    *contact_time = *relaxation_time = *hmin_crossing_time = INFINITY;
+    *contact_time = *relaxation_time = *hmin_crossing_time = *step = INFINITY;
     if (sim->n_particles == 0)
         return WETDEM_OK;
     struct step_spheres sp;
@@ -520,6 +540,7 @@ int wetdem_sim_many_time_scales_at(struct wetdem_sim* sim, double speed, double*
     *contact_time = s.t_contact;
     *relaxation_time = s.tau;
     *hmin_crossing_time = s.gap / speed;
+    *step = derived_step(sim, s.t_contact, s.tau, *hmin_crossing_time);
     return WETDEM_OK;
 }
 
@@ -567,8 +588,7 @@ static int choose_dt(struct wetdem_sim* sim, double* dt)
     wetdem_sim_param(sim, "verlet.dt_fraction", &fraction);
     wetdem_sim_param(sim, "verlet.many_hmin_fraction", &many_hmin_fraction);
     double given = m->set.dt > 0 ? m->set.dt : fixed;
-    m->relaxation_time = m->contact_time = m->crossing_time = INFINITY;
-    m->speed_scale = m->speed_bound = m->v2_seen = 0;
+    clear_time_scales(m);
     if (sim->n_particles == 0) {
         *dt = given;
         return given > 0 ? WETDEM_OK
@@ -612,8 +632,7 @@ static int choose_dt(struct wetdem_sim* sim, double* dt)
         snprintf(m->dt_origin, sizeof m->dt_origin, "the step is given (many.dt or verlet.dt)");
         return WETDEM_OK;
     }
-    double by_gap = many_hmin_fraction > 0 ? many_hmin_fraction * m->crossing_time : INFINITY;
-    *dt = fmin(fmin(fraction * s.t_contact, 0.25 * tau), by_gap);
+    *dt = derived_step(sim, s.t_contact, tau, m->crossing_time);
     describe_dt(sim, &sp, &s, *dt, fraction, many_hmin_fraction);
     /* a contact time of 0 or inf (a density or modulus near the ends of the double range)
      * resolves no contact, even where the other bounds give a finite step */

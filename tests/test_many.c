@@ -1312,7 +1312,8 @@ static void test_many_speed_scale_bounds_the_fall(void** state)
  * into the floor from zero overlap, bouncing at the contact frequency, and the Mindlin spring's
  * compliance lets the contact point creep); measured 8e-6. At the speed scale V + u - B the
  * contact and relaxation times are those at V times (V / (V + u - B))^(1/5): Hertz's and
- * Mindlin's times and the dashpots' go as v^(-1/5) (docs/many.md, Time step), to rounding.
+ * Mindlin's times and the dashpots' go as v^(-1/5) (docs/many.md, Time step), to rounding;
+ * the step it gives is the derived step's rule there, and at V the run's own step, bit for bit.
  * A checkpoint at T/2 resumes to the same largest speed, bit for bit. Without walls the bound
  * is infinite (all falls together). Bad speeds are refused with their value named. */
 static void test_many_largest_speed_down_a_chute(void** state)
@@ -1352,19 +1353,21 @@ static void test_many_largest_speed_down_a_chute(void** state)
             CHECK_ABS(s->speed_scale, 1e-3, 0);
             CHECK_ABS(s->speed_bound, 1e-3, 0);
             CHECK_REL(s->largest_speed, 5.0 / 7.0 * g * sin(th) * T, 1e-4);
-            double V = s->speed_scale + s->largest_speed - s->speed_bound, t_c, tau, t_x;
-            CHECK_OK(wetdem_sim_many_time_scales_at(sim, V, &t_c, &tau, &t_x));
+            double V = s->speed_scale + s->largest_speed - s->speed_bound, t_c, tau, t_x, step;
+            CHECK_OK(wetdem_sim_many_time_scales_at(sim, V, &t_c, &tau, &t_x, &step));
             double shrink = pow(s->speed_scale / V, 0.2);
             CHECK_REL(t_c, s->contact_time * shrink, 1e-12);
             CHECK_REL(tau, s->relaxation_time * shrink, 1e-12);
             assert_true(isinf(t_x) && isinf(s->hmin_crossing_time)); /* no law jumps */
-            /* at the start's speed scale, the start's time scales */
-            CHECK_OK(wetdem_sim_many_time_scales_at(sim, s->speed_scale, &t_c, &tau, &t_x));
+            CHECK_ABS(step, fmin(0.02 * t_c, 0.25 * tau), 0);        /* the derived step's rule */
+            /* at the start's speed scale, the start's time scales and derived step */
+            CHECK_OK(wetdem_sim_many_time_scales_at(sim, s->speed_scale, &t_c, &tau, &t_x, &step));
             CHECK_REL(t_c, s->contact_time, 1e-14);
-            CHECK_STATUS(wetdem_sim_many_time_scales_at(sim, NAN, &t_c, &tau, &t_x),
+            CHECK_ABS(step, s->dt, 0);
+            CHECK_STATUS(wetdem_sim_many_time_scales_at(sim, NAN, &t_c, &tau, &t_x, &step),
                          WETDEM_ERR_INVALID);
             CHECK_CONTAINS(wetdem_sim_errmsg(sim), "speed = nan m/s must be finite and > 0");
-            CHECK_STATUS(wetdem_sim_many_time_scales_at(sim, 0, &t_c, &tau, &t_x),
+            CHECK_STATUS(wetdem_sim_many_time_scales_at(sim, 0, &t_c, &tau, &t_x, &step),
                          WETDEM_ERR_INVALID);
         }
         wetdem_sim_free(sim);
@@ -1382,8 +1385,9 @@ static void test_many_largest_speed_down_a_chute(void** state)
     CHECK_OK(
         wetdem_sim_add_particle(sim, (struct wetdem_particle){.pos = {3e-3, 0, 0}, .radius = R}));
     CHECK_OK(wetdem_sim_set_many(sim, &(struct wetdem_many_settings){.skin = 1e-4}));
-    double t_c, tau, t_x;
-    CHECK_STATUS(wetdem_sim_many_time_scales_at(sim, 1, &t_c, &tau, &t_x), WETDEM_ERR_INVALID);
+    double t_c, tau, t_x, step;
+    CHECK_STATUS(wetdem_sim_many_time_scales_at(sim, 1, &t_c, &tau, &t_x, &step),
+                 WETDEM_ERR_INVALID);
     CHECK_CONTAINS(wetdem_sim_errmsg(sim), "has not started");
     CHECK_OK(wetdem_sim_integrate(sim, 1e-3));
     struct wetdem_many_stats s;
