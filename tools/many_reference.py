@@ -1648,6 +1648,23 @@ def derived_hertz_exact():
 
 
 @case
+def derived_hertz_tsuji():
+    """The three spheres of derived_hertz_exact with hertz's tsuji damping, no tangential
+    contact and no film law (capillary alone: nothing jumps at h_min) and verlet.dt_fraction
+    0.05, the step derived: the dashpot takes c = -sqrt(5) beta(e_dry) = 1.85 and 1.74 for
+    e_dry 0.01 and 0.02, and a quarter of its relaxation time at the largest overlap of an
+    undamped impact at the speed scale, 1.34 us, binds (0.87 of the step from the contact
+    time; at the default dt_fraction 0.02 the contact time would bind). Tsuji's coefficient
+    itself sets the step here, where beside mindlin (derived_glass, derived_nijssen_tsuji)
+    another time binds. A closed form: the steps agree to rounding."""
+    sc = derived_hertz_exact()
+    sc.update(name="derived_hertz_tsuji", models="hertz capillary",
+              params={"hertz.damping": "tsuji", "verlet.dt_fraction": 0.05},
+              viscosity=0.001, dt_tol=1e-12, tol=1e-9)
+    return sc
+
+
+@case
 def derived_nijssen_tsuji():
     """derived_nijssen with nijssen's tsuji damping and verlet.dt_fraction 0.03, the step
     derived: the normal dashpot takes c = -sqrt(5) beta(e_dry) = 1.85 and 1.74 for e_dry 0.01
@@ -1904,6 +1921,8 @@ MUTANTS = [("torque on j with i's lever arm", _mutant_lever, "friction_spin_uneq
             "derived_glass", "", None),
            ("hertz's exact dashpot with tsuji's coefficient in the step",
             _mutant_damping_swapped, "derived_hertz_exact", "", 100),
+           ("hertz's tsuji dashpot with the exact coefficient in the step",
+            _mutant_damping_swapped, "derived_hertz_tsuji", "", 100),
            ("nijssen's tsuji dashpot with the exact coefficient in the step",
             _mutant_damping_swapped, "derived_nijssen_tsuji", "", 100),
            ("largest speed over the full-step velocities", _mutant_full_step_speed,
