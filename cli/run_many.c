@@ -395,9 +395,6 @@ static int many_stats(const struct cli_scenario* sc, struct wetdem_sim* sim,
     return CLI_EXIT_RUNTIME;
 }
 
-/* How the header line of the library's CSV begins (src/sim_many_io.c). */
-#define CSV_HEAD "time [s],step [count],"
-
 /* Keeps the comment and header lines of the CSV and the rows up to `step` (second column),
  * rewriting the file atomically when rows are dropped. A row at `step` itself is kept only on
  * the grid of w->csv_every, that of the run which wrote the checkpoint: off it, it is the last
@@ -437,7 +434,7 @@ static int csv_resume(const char* path, double t, unsigned long long step, doubl
         bool data = line[0] >= '0' && line[0] <= '9' && comma;
         unsigned long long row = data ? strtoull(comma + 1, NULL, 10) : 0;
         bool whole = strchr(line, '\n') != NULL; /* (a row cut by a crash ends without) */
-        header = header || strncmp(line, CSV_HEAD, strlen(CSV_HEAD)) == 0;
+        header = header || strncmp(line, WETDEM_MANY_CSV_HEAD, strlen(WETDEM_MANY_CSV_HEAD)) == 0;
         if (data && whole) {
             last = rows && last > row ? last : row;
             rows = true;
@@ -467,9 +464,9 @@ static int csv_resume(const char* path, double t, unsigned long long step, doubl
                       "checkpoint (now %s)",
                       path, off_grid - 1, dt, step, t, out_dir);
         else if (!header)
-            cli_error("--restart: %s has no header line (" CSV_HEAD "...): it was emptied or "
-                      "cut at its start, and the rows up to the checkpoint are lost; restore "
-                      "it, or start the run afresh without --restart",
+            cli_error("--restart: %s has no header line (" WETDEM_MANY_CSV_HEAD "...): it was "
+                      "emptied or cut at its start, and the rows up to the checkpoint are lost; "
+                      "restore it, or start the run afresh without --restart",
                       path);
         else
             cli_error("--restart: %s %s%llu, before the checkpoint's step %llu: it was cut short "

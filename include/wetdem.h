@@ -824,6 +824,10 @@ WETDEM_API int wetdem_sim_many_time_scales_at(struct wetdem_sim* sim, double spe
                                               double* contact_time, double* relaxation_time,
                                               double* hmin_crossing_time, double* step);
 
+/* How the header line of a many-particle run's CSV (output_prefix.csv) begins, after its '#'
+ * lines: the time and step columns; the columns after them depend on the models and the energy
+ * budget (docs/many.md, Outputs). A reader of the file finds its header by it. */
+#define WETDEM_MANY_CSV_HEAD "time [s],step [count],"
 /* Appends a row of the global quantities at the current state to the run's CSV
  * (output_prefix.csv), with the columns and format of the rows written every csv_every steps:
  * e.g. the state a run ends or is interrupted at, off that grid. WETDEM_ERR_INVALID before a

@@ -510,10 +510,9 @@ static void csv_header(const struct wetdem_sim* sim, FILE* f)
         fprintf(f, "# %.*s\n", (int)n, line);
         line += n + (line[n] == '\n');
     }
-    fputs("# many-particle run: global quantities\n"
-          "time [s],step [count],kinetic [J],potential [J],elastic [J],contacts [count],"
-          "bridges [count],agglomerates [count],mean_agglomerate_size [-],"
-          "candidate_pairs [count]",
+    fputs("# many-particle run: global quantities\n" WETDEM_MANY_CSV_HEAD
+          "kinetic [J],potential [J],elastic [J],contacts [count],bridges [count],"
+          "agglomerates [count],mean_agglomerate_size [-],candidate_pairs [count]",
           f);
     for (size_t k = 0; sim->many->set.energy_budget && k < sim->n_models; k++)
         fprintf(f, ",work_%s [J]", sim->models[k].model->name);

@@ -2282,6 +2282,8 @@ static void test_many_writes_vtk_and_csv(void** state)
     assert_string_equal(line, "# many-particle run: global quantities\n");
     assert_non_null(fgets(line, sizeof line, f)); /* columns */
     CHECK_CONTAINS(line, "time [s],step [count],kinetic [J],");
+    /* the start by which the CLI finds the header of a CSV it resumes */
+    assert_int_equal(strncmp(line, WETDEM_MANY_CSV_HEAD, strlen(WETDEM_MANY_CSV_HEAD)), 0);
     CHECK_CONTAINS(line, ",work_capillary [J],");
     while (fgets(line, sizeof line, f))
         rows++;
