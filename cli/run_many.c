@@ -626,6 +626,18 @@ static void warn_step(const struct cli_scenario* sc, const struct cli_many_setup
                   sc->file, s->dt, s->dt / s->hmin_crossing_time, s->hmin_crossing_time);
 }
 
+/* What warn_speed judges: the run's step dt [s] and its speeds (wetdem_many_stats:
+ * speed_scale, speed_bound, largest_speed [m/s]), from the stats where the run has them, else
+ * from wetdem_sim_many_speeds, which counts no links. */
+struct run_speeds {
+    double dt, scale, bound, largest;
+};
+
+static struct run_speeds speeds_of(const struct wetdem_many_stats* s)
+{
+    return (struct run_speeds){s->dt, s->speed_scale, s->speed_bound, s->largest_speed};
+}
+
 /* Warns on stderr when a particle has moved faster than the speed scale of the step allows
  * (largest_speed above speed_bound: an incline, a chute, capillary attraction; docs/many.md,
  * "Speeds beyond the step's") and the step does not resolve, at the speed scale with that
@@ -633,11 +645,11 @@ static void warn_step(const struct cli_scenario* sc, const struct cli_many_setup
  * viscous relaxation time there; `tty`: after a newline, off the progress line. Whether it
  * warned. */
 static bool warn_speed(const struct cli_scenario* sc, struct cli_many_setup* su,
-                       const struct wetdem_many_stats* s, bool tty)
+                       const struct run_speeds* s, bool tty)
 {
-    if (!(s->largest_speed > s->speed_bound))
+    if (!(s->largest > s->bound))
         return false;
-    double v = s->speed_scale + (s->largest_speed - s->speed_bound), t_c, tau, t_x, dt;
+    double v = s->scale + (s->largest - s->bound), t_c, tau, t_x, dt;
     char what[600] = "";
     bool ok = wetdem_sim_many_time_scales_at(su->sim, v, &t_c, &tau, &t_x, &dt) == WETDEM_OK;
     size_t n =
@@ -674,8 +686,7 @@ static bool warn_speed(const struct cli_scenario* sc, struct cli_many_setup* su,
               "step's time scales allow a particle (an incline, a chute or capillary "
               "attraction: docs/many.md, Speeds beyond the step's); with it the speed scale, "
               "%.4g m/s at the start, becomes %.4g m/s, %s",
-              sc->file, wetdem_sim_time(su->sim), s->largest_speed, s->speed_bound, s->speed_scale,
-              v, what);
+              sc->file, wetdem_sim_time(su->sim), s->largest, s->bound, s->scale, v, what);
     return true;
 }
 
@@ -1161,7 +1172,8 @@ static int finish(const struct cli_scenario* sc, struct cli_many_setup* su,
     if (many_stats(sc, su->sim, &o.stats) != CLI_EXIT_OK)
         return CLI_EXIT_RUNTIME;
     o.has_budget = wetdem_sim_energy_budget(su->sim, &o.budget) == WETDEM_OK;
-    warn_speed(sc, su, &o.stats, prog->tty);
+    struct run_speeds v = speeds_of(&o.stats);
+    warn_speed(sc, su, &v, prog->tty);
     if (csv_final_row(pl->csv_prefix, su->csv_every, su->sim, o.stats.step) != WETDEM_OK) {
         cli_error("run %s: cannot append the last row to %s.csv: %s", sc->file, pl->csv_prefix,
                   wetdem_sim_errmsg(su->sim));
@@ -1281,10 +1293,12 @@ static int run_steps(const struct cli_scenario* sc, struct cli_many_setup* su,
             if (pl->checkpoint[0])
                 st = wetdem_sim_write_checkpoint(su->sim, pl->checkpoint);
         }
-        struct wetdem_many_stats s;
+        /* (pl->dt is the run's step, on whose grid these calls end: the start derives it
+           again as the dry start did, and a restart refuses a checkpoint of another) */
+        struct run_speeds v = {.dt = pl->dt};
         if (!warned && next < pl->total && prog->status == WETDEM_OK &&
-            wetdem_sim_many_stats(su->sim, &s) == WETDEM_OK)
-            warned = warn_speed(sc, su, &s, prog->tty);
+            wetdem_sim_many_speeds(su->sim, &v.scale, &v.bound, &v.largest) == WETDEM_OK)
+            warned = warn_speed(sc, su, &v, prog->tty);
     }
     return st;
 }

@@ -809,6 +809,14 @@ struct wetdem_many_stats {
  * step). `wetdem run` warns above it, and above hmin_crossing_time. */
 #define WETDEM_MANY_CONTACT_FRACTION_MAX 0.1
 WETDEM_API int wetdem_sim_many_stats(const struct wetdem_sim* sim, struct wetdem_many_stats* s);
+/* The speeds of wetdem_many_stats alone (speed_scale, speed_bound, largest_speed [m/s]), bit
+ * for bit those it reports, without its pass over the pairs for the contacts, bridges and
+ * agglomerates (which allocates): cheap enough to check the speeds between any two integrate
+ * calls. Returns WETDEM_OK, or WETDEM_ERR_INVALID (not a started many run, a NULL output, or
+ * models enabled or cleared since the run started, as wetdem_sim_many_stats refuses), the
+ * outputs then unchanged. */
+WETDEM_API int wetdem_sim_many_speeds(const struct wetdem_sim* sim, double* speed_scale,
+                                      double* speed_bound, double* largest_speed);
 /* The time scales of a started many-particle run that wetdem_many_stats reports
  * (contact_time, relaxation_time, hmin_crossing_time), evaluated as when the run started but
  * with the pairs closing and sliding at `speed` [m/s] instead of the speed scale, for the

@@ -150,6 +150,16 @@ int wetdem_sim_many_links(const struct wetdem_sim* sim, const struct wetdem_many
     return WETDEM_OK;
 }
 
+/* The speeds of the statistics, from the state of the run m (one source for
+ * wetdem_sim_many_stats and wetdem_sim_many_speeds). */
+static void run_speeds(const struct wetdem_many* m, double* speed_scale, double* speed_bound,
+                       double* largest_speed)
+{
+    *speed_scale = m->speed_scale;
+    *speed_bound = m->speed_bound;
+    *largest_speed = sqrt(m->v2_seen);
+}
+
 /* The fields of the statistics other than the links (counts, step, timers). */
 static void fill_run_stats(const struct wetdem_sim* sim, struct wetdem_many_stats* s)
 {
@@ -160,9 +170,7 @@ static void fill_run_stats(const struct wetdem_sim* sim, struct wetdem_many_stat
     s->relaxation_time = m->relaxation_time;
     s->contact_time = m->contact_time;
     s->hmin_crossing_time = m->crossing_time;
-    s->speed_scale = m->speed_scale;
-    s->speed_bound = m->speed_bound;
-    s->largest_speed = sqrt(m->v2_seen);
+    run_speeds(m, &s->speed_scale, &s->speed_bound, &s->largest_speed);
     s->step = m->step;
     s->seconds_kick = m->seconds_kick;
     s->seconds_forces = m->seconds_forces;
@@ -188,6 +196,24 @@ int wetdem_sim_many_stats(const struct wetdem_sim* sim, struct wetdem_many_stats
                                "many_stats: out of memory for the agglomerates of %zu particles",
                                sim->n_particles);
     fill_run_stats(sim, s);
+    return WETDEM_OK;
+}
+
+int wetdem_sim_many_speeds(const struct wetdem_sim* sim, double* speed_scale, double* speed_bound,
+                           double* largest_speed)
+{
+    const struct wetdem_many* m = sim->many;
+    if (!m || !m->started) /* (the message buffer: as wetdem_sim_many_stats) */
+        return wetdem_sim_fail((struct wetdem_sim*)sim, WETDEM_ERR_INVALID, "many_speeds: %s",
+                               !m ? "the simulation is not in the many-particle mode"
+                                  : "the many-particle run has not started");
+    if (!speed_scale || !speed_bound || !largest_speed)
+        return wetdem_sim_fail((struct wetdem_sim*)sim, WETDEM_ERR_INVALID,
+                               "many_speeds: NULL output");
+    int st = wetdem_sim_many_check_models(sim, "many_speeds");
+    if (st != WETDEM_OK)
+        return st;
+    run_speeds(m, speed_scale, speed_bound, largest_speed);
     return WETDEM_OK;
 }
 

@@ -1303,6 +1303,18 @@ static void test_many_speed_scale_bounds_the_fall(void** state)
     }
 }
 
+/* wetdem_sim_many_speeds gives the speeds of the stats of sim, bit for bit (memcmp: an
+ * infinite bound too), and its outputs only on success. */
+static void check_speeds_are_the_stats(struct wetdem_sim* sim)
+{
+    struct wetdem_many_stats s;
+    CHECK_OK(wetdem_sim_many_stats(sim, &s));
+    const double stats[3] = {s.speed_scale, s.speed_bound, s.largest_speed};
+    double v[3] = {NAN, NAN, NAN};
+    CHECK_OK(wetdem_sim_many_speeds(sim, &v[0], &v[1], &v[2]));
+    assert_memory_equal(v, stats, sizeof v);
+}
+
 /* Speeds beyond the step's (docs/many.md): a soft glass sphere (R = 1 mm, hertz + mindlin,
  * mu = 0.4) at rest on a floor, under gravity tilted by 30 deg (a chute periodic along x).
  * Nothing falls (H = 0), so the speed scale and the bound are sim.speed_floor, 1e-3 m/s; with
@@ -1315,7 +1327,10 @@ static void test_many_speed_scale_bounds_the_fall(void** state)
  * Mindlin's times and the dashpots' go as v^(-1/5) (docs/many.md, Time step), to rounding;
  * the step it gives is the derived step's rule there, and at V the run's own step, bit for bit.
  * A checkpoint at T/2 resumes to the same largest speed, bit for bit. Without walls the bound
- * is infinite (all falls together). Bad speeds are refused with their value named. */
+ * is infinite (all falls together). Bad speeds are refused with their value named.
+ * wetdem_sim_many_speeds gives the three speeds of the stats bit for bit, and refuses as they
+ * do: a simulation not in the many-particle mode, a run not started, models changed since
+ * the start; and a NULL output, as wetdem_sim_many_time_scales_at. */
 static void test_many_largest_speed_down_a_chute(void** state)
 {
     (void)state;
@@ -1348,6 +1363,7 @@ static void test_many_largest_speed_down_a_chute(void** state)
         }
         CHECK_OK(wetdem_sim_integrate(sim, T));
         CHECK_OK(wetdem_sim_many_stats(sim, &st[resumed]));
+        check_speeds_are_the_stats(sim);
         if (!resumed) {
             const struct wetdem_many_stats* s = &st[0];
             CHECK_ABS(s->speed_scale, 1e-3, 0);
@@ -1369,6 +1385,21 @@ static void test_many_largest_speed_down_a_chute(void** state)
             CHECK_CONTAINS(wetdem_sim_errmsg(sim), "speed = nan m/s must be finite and > 0");
             CHECK_STATUS(wetdem_sim_many_time_scales_at(sim, 0, &t_c, &tau, &t_x, &step),
                          WETDEM_ERR_INVALID);
+            double v[3] = {-1, -1, -1};
+            CHECK_STATUS(wetdem_sim_many_speeds(sim, &v[0], NULL, &v[2]), WETDEM_ERR_INVALID);
+            CHECK_CONTAINS(wetdem_sim_errmsg(sim), "many_speeds: NULL output");
+            assert_true(v[0] == -1 && v[2] == -1); /* (untouched) */
+            /* a model enabled after the start: the reports refuse until the run's models are
+               enabled again as they were */
+            CHECK_OK(wetdem_sim_enable_model(sim, "reynolds"));
+            CHECK_STATUS(wetdem_sim_many_speeds(sim, &v[0], &v[1], &v[2]), WETDEM_ERR_INVALID);
+            CHECK_CONTAINS(wetdem_sim_errmsg(sim), "many_speeds: the models of the many-particle "
+                                                   "run changed since it started");
+            assert_true(v[0] == -1 && v[1] == -1 && v[2] == -1);
+            wetdem_sim_clear_models(sim);
+            CHECK_OK(wetdem_sim_enable_model(sim, "hertz"));
+            CHECK_OK(wetdem_sim_enable_model(sim, "mindlin"));
+            check_speeds_are_the_stats(sim);
         }
         wetdem_sim_free(sim);
     }
@@ -1389,11 +1420,20 @@ static void test_many_largest_speed_down_a_chute(void** state)
     CHECK_STATUS(wetdem_sim_many_time_scales_at(sim, 1, &t_c, &tau, &t_x, &step),
                  WETDEM_ERR_INVALID);
     CHECK_CONTAINS(wetdem_sim_errmsg(sim), "has not started");
+    double v[3];
+    CHECK_STATUS(wetdem_sim_many_speeds(sim, &v[0], &v[1], &v[2]), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(wetdem_sim_errmsg(sim), "many_speeds: the many-particle run has not started");
     CHECK_OK(wetdem_sim_integrate(sim, 1e-3));
     struct wetdem_many_stats s;
     CHECK_OK(wetdem_sim_many_stats(sim, &s));
     assert_true(isinf(s.speed_bound) && s.largest_speed > 0);
+    check_speeds_are_the_stats(sim);
     wetdem_sim_free(sim);
+    struct wetdem_sim* two_body = wetdem_sim_create();
+    CHECK_STATUS(wetdem_sim_many_speeds(two_body, &v[0], &v[1], &v[2]), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(wetdem_sim_errmsg(two_body), "many_speeds: the simulation is not in the "
+                                                "many-particle mode");
+    wetdem_sim_free(two_body);
 }
 
 /* A simulation of material 0, the glass preset with 20 um films, in a liquid of 0.01 Pa s and
