@@ -602,22 +602,45 @@ static bool dt_held_by_gap(const struct wetdem_sim* sim, const struct wetdem_man
     return s->dt == many_hmin_fraction(sim) * s->hmin_crossing_time;
 }
 
-/* Warns on stderr when the step does not resolve what the run meets (docs/many.md, Time
- * step): above WETDEM_MANY_CONTACT_FRACTION_MAX of the contact time, where velocity Verlet
- * loses the contacts' restitution and then diverges; or longer than the time a pair at the
- * speed scale takes to cross the h_min where the force laws jump, so that the jump falls
- * within one step (unless many_hmin_fraction = 0 turned that bound off). */
+/* What a step does not resolve of the time scales at a speed scale (docs/many.md, Time step):
+ * the two tests that warn_step makes at the start's speed scale and warn_speed at the one a
+ * run reaches beyond it, each with its own message. */
+struct unresolved {
+    /* dt above WETDEM_MANY_CONTACT_FRACTION_MAX of the contact time, where velocity Verlet
+       loses the contacts' restitution and then diverges */
+    bool contacts;
+    /* dt longer than the time a pair closing at the speed scale takes to cross the h_min where
+       the force laws jump, so that the jump falls within one step (unless
+       many_hmin_fraction = 0 turned that bound off) */
+    bool h_min;
+};
+
+/* The tests of struct unresolved for step dt, contact time t_contact and h_min crossing time
+ * t_cross [s] (INFINITY: nothing touches, nothing jumps) of sim. */
+static struct unresolved step_unresolved(const struct wetdem_sim* sim, double dt, double t_contact,
+                                         double t_cross)
+{
+    return (struct unresolved){
+        .contacts = dt / t_contact > WETDEM_MANY_CONTACT_FRACTION_MAX,
+        .h_min = dt > t_cross && many_hmin_fraction(sim) != 0,
+    };
+}
+
+/* Warns on stderr when the step does not resolve what the run meets at the speed scale it
+ * starts with (struct unresolved). (A step not below the viscous relaxation time is derived
+ * below it, or refused by the library when given.) */
 static void warn_step(const struct cli_scenario* sc, const struct cli_many_setup* su,
                       const struct wetdem_many_stats* s)
 {
+    struct unresolved u = step_unresolved(su->sim, s->dt, s->contact_time, s->hmin_crossing_time);
     double ratio = s->dt / s->contact_time;
-    if (ratio > WETDEM_MANY_CONTACT_FRACTION_MAX)
+    if (u.contacts)
         cli_error("warning: %s: the step dt = %.4g s is %.3g x the contact time %.4g s (the "
                   "shortest, normal or tangential, at the speed scale), above %g x: the "
                   "contacts are not resolved, and from about 0.5 x the motion diverges; lower "
                   "dt or dt_fraction (docs/many.md, Time step)",
                   sc->file, s->dt, ratio, s->contact_time, WETDEM_MANY_CONTACT_FRACTION_MAX);
-    if (s->dt > s->hmin_crossing_time && many_hmin_fraction(su->sim) != 0)
+    if (u.h_min)
         cli_error("warning: %s: in one step dt = %.4g s a pair closing at the speed scale "
                   "travels %.3g x the smallest h_min where the force laws jump (crossed in "
                   "%.4g s): the jump falls within a step, which can shift a collision's "
@@ -641,9 +664,9 @@ static struct run_speeds speeds_of(const struct wetdem_many_stats* s)
 /* Warns on stderr when a particle has moved faster than the speed scale of the step allows
  * (largest_speed above speed_bound: an incline, a chute, capillary attraction; docs/many.md,
  * "Speeds beyond the step's") and the step does not resolve, at the speed scale with that
- * speed in place of the bound, what warn_step checks at the start, or is not below the
- * viscous relaxation time there; `tty`: after a newline, off the progress line. Whether it
- * warned. */
+ * speed in place of the bound, what warn_step checks at the start (struct unresolved), or is
+ * not below the viscous relaxation time there; `tty`: after a newline, off the progress line.
+ * Whether it warned. */
 static bool warn_speed(const struct cli_scenario* sc, struct cli_many_setup* su,
                        const struct run_speeds* s, bool tty)
 {
@@ -659,13 +682,13 @@ static bool warn_speed(const struct cli_scenario* sc, struct cli_many_setup* su,
         snprintf(what, sizeof what, "where the time scales cannot be evaluated: %s",
                  wetdem_sim_errmsg(su->sim));
     else {
-        double gap_fraction = many_hmin_fraction(su->sim);
-        if (s->dt / t_c > WETDEM_MANY_CONTACT_FRACTION_MAX)
+        struct unresolved u = step_unresolved(su->sim, s->dt, t_c, t_x);
+        if (u.contacts)
             n += (size_t)snprintf(what + n, sizeof what - n,
                                   "%.3g x the contact time %.4g s (above %g x: the contacts are "
                                   "not resolved)",
                                   s->dt / t_c, t_c, WETDEM_MANY_CONTACT_FRACTION_MAX);
-        if (s->dt > t_x && gap_fraction != 0 && n < sizeof what)
+        if (u.h_min && n < sizeof what)
             n += (size_t)snprintf(what + n, sizeof what - n,
                                   "%slonger than the time %.4g s a pair takes to cross the "
                                   "smallest h_min where the force laws jump",
