@@ -1950,6 +1950,27 @@ static void test_many_cli_warns_when_speeds_outgrow_the_step(void** state)
     err = stderr_text();
     assert_string_equal(err, "");
     free(err);
+    /* wet, sb cut off below h_min = 1 um: the step (0.05 of the contact time at 1e-3 m/s,
+       13.7 us) is far below the 0.5 ms to cross h_min at the start's speed scale, but a pair
+       closing at V' = 0.176 m/s crosses it in 5.7 us, so the end's warning names the h_min
+       crossing beside the contact time (it outgrows it from V' = 1 um / 13.7 us = 0.073 m/s,
+       reached at 21 ms, after the contacts' first warning at 9.1 ms) */
+    assert_int_equal(run_cli("run chute.ini --out w --set models.force=\"hertz mindlin sb\" "
+                             "--set material.soft.film=20e-6 --set model.fixed.h_min=1e-6"),
+                     0);
+    err = stderr_text();
+    const char* last = strstr(err, "by t = 0.050011 s");
+    assert_non_null(last);
+    CHECK_CONTAINS(last, "x the contact time");
+    CHECK_CONTAINS(last, "; longer than the time 5.7");
+    CHECK_CONTAINS(last, " s a pair takes to cross the smallest h_min where the force laws jump");
+    /* the first warning, at the contacts' frame, does not name the h_min crossing yet */
+    const char* early = strstr(err, "warning: chute.ini: by t = ");
+    assert_true(early != NULL && early < last);
+    assert_true(strtod(early + strlen("warning: chute.ini: by t = "), NULL) < 0.021);
+    const char* h_min = strstr(early, "cross the smallest h_min");
+    assert_true(h_min > last);
+    free(err);
 }
 
 static int setup(void** state)
