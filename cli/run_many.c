@@ -76,22 +76,26 @@ static void frame_name(const struct series* s, size_t k, bool links, char* buf, 
 
 /* A fresh run replaces the run in its directory: removes the frames and links an earlier run
  * left there (the files named as this series names its frames and their links, and no other
- * file), which the new index would not list and a shorter run would not overwrite; and the
- * links' index, which a run without links would leave behind. 0, or -1 with errno set. */
+ * file), which the new index would not list and a shorter run would not overwrite; and both
+ * indexes, which a run without links, or without frames, would leave behind describing the
+ * earlier run. 0, or -1 with errno set. */
 static int series_clear(const struct series* s)
 {
     DIR* d = opendir(s->dir);
     if (!d)
         return -1;
     char links_prefix[CLI_VALUE_MAX + 8], links_index[CLI_VALUE_MAX + 24];
+    char index[CLI_VALUE_MAX + 16];
     snprintf(links_prefix, sizeof links_prefix, "%s" WETDEM_LINKS_SUFFIX, s->prefix);
     snprintf(links_index, sizeof links_index, "%s.vtk.series", links_prefix);
+    snprintf(index, sizeof index, "%s.vtk.series", s->prefix);
     int rc = 0;
     for (struct dirent* e = readdir(d); e && rc == 0; e = readdir(d)) {
         char path[PATH_CHARS + 300];
         snprintf(path, sizeof path, "%s/%s", s->dir, e->d_name);
         if ((cli_is_frame_name(s->prefix, e->d_name) ||
-             cli_is_frame_name(links_prefix, e->d_name) || strcmp(e->d_name, links_index) == 0) &&
+             cli_is_frame_name(links_prefix, e->d_name) || strcmp(e->d_name, links_index) == 0 ||
+             strcmp(e->d_name, index) == 0) &&
             unlink(path) != 0 && errno != ENOENT)
             rc = -1;
     }
@@ -1326,9 +1330,12 @@ static int run_steps(const struct cli_scenario* sc, struct cli_many_setup* su,
     return st;
 }
 
-/* Fresh start or restart, first frame, the stepping and the end. */
+/* Fresh start or restart, first frame, the stepping and the end. vtk: the frames this run
+ * writes (NULL: none); named: the series named as its frames, or by the default name when it
+ * writes none, whose files of an earlier run a fresh run removes (NULL without --out). */
 static int run(const struct cli_scenario* sc, struct cli_many_setup* su,
-               const struct cli_run_options* opt, struct plan* pl, struct series* vtk)
+               const struct cli_run_options* opt, struct plan* pl, struct series* vtk,
+               const struct series* named)
 {
     struct progress prog = {
         .sim = su->sim, .vtk = vtk, .run_total = pl->total, .tty = isatty(STDERR_FILENO) == 1};
@@ -1341,9 +1348,9 @@ static int run(const struct cli_scenario* sc, struct cli_many_setup* su,
         cli_error("run: cannot create directory %s: %s", opt->out_dir, strerror(errno));
         return CLI_EXIT_RUNTIME;
     }
-    if (vtk && !opt->restart && series_clear(vtk) != 0) {
+    if (named && !opt->restart && series_clear(named) != 0) {
         cli_error("run: cannot remove the frames %s_NNNNNN.vtk of an earlier run in %s: %s",
-                  vtk->prefix, vtk->dir, strerror(errno));
+                  named->prefix, named->dir, strerror(errno));
         return CLI_EXIT_RUNTIME;
     }
     if (opt->out_dir && !opt->restart && outputs_clear(opt->out_dir, su) != 0) {
@@ -1409,8 +1416,11 @@ int cli_run_many(const struct cli_scenario* sc, const struct cli_run_options* op
         struct series vtk = {.binary = su.vtk_binary, .links = su.vtk_links};
         bool has_vtk = opt->out_dir && su.vtk_prefix[0] && su.vtk_every;
         snprintf(vtk.dir, sizeof vtk.dir, "%s", opt->out_dir ? opt->out_dir : "");
-        snprintf(vtk.prefix, sizeof vtk.prefix, "%s", su.vtk_prefix);
-        rc = run(sc, &su, opt, &pl, has_vtk ? &vtk : NULL);
+        /* (without frames, those of an earlier run under the default name go too, as the
+           summary, CSV and checkpoint do: outputs_clear) */
+        snprintf(vtk.prefix, sizeof vtk.prefix, "%s",
+                 su.vtk_prefix[0] ? su.vtk_prefix : "particles");
+        rc = run(sc, &su, opt, &pl, has_vtk ? &vtk : NULL, opt->out_dir ? &vtk : NULL);
         free(vtk.times);
     }
     cli_many_setup_free(&su);

@@ -168,7 +168,8 @@ static const struct cli_key_desc dump_keys[] = {
     WORD("vtk", CLI_VALUE_TEXT, "particles", NULL,
          "Prefix of the VTK files PREFIX_NNNNNN.vtk and of the ParaView index PREFIX.vtk.series "
          "in --out DIR; none disables them. A fresh run (no --restart) first removes the "
-         "PREFIX_NNNNNN.vtk files of an earlier run from DIR."),
+         "PREFIX_NNNNNN.vtk files and index of an earlier run from DIR (with none, or "
+         "vtk_every = 0, those named particles)."),
     COUNT("vtk_every", "run steps / 50", 0, 1e15,
           "Steps between VTK frames (the last step is always written); 0: none. At most 1e5 "
           "files a run."),

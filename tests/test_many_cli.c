@@ -1235,6 +1235,31 @@ static void test_many_cli_fresh_run_replaces_earlier_frames(void** state)
     assert_true(exists("reuse/summary.json"));
     assert_false(exists("reuse/global.csv"));
     assert_false(exists("reuse/checkpoint.ckpt"));
+    /* nor the earlier run's frames and index when it writes no frames (vtk_every = 0, or vtk =
+       none: those under the default name): the index described the earlier run beside this
+       run's summary */
+    const char* no_frames[] = {"--set dump.vtk_every=0", "--set dump.vtk=none"};
+    for (int k = 0; k < 2; k++) {
+        assert_int_equal(run_cli("run frames.ini --set run.steps=200 --out reuse"), 0);
+        assert_true(exists("reuse/particles.vtk.series"));
+        assert_true(exists("reuse/particles_links_000002.vtk"));
+        char cmd[200];
+        snprintf(cmd, sizeof cmd, "run frames.ini --set run.steps=200 %s --out reuse",
+                 no_frames[k]);
+        assert_int_equal(run_cli(cmd), 0);
+        assert_true(exists("reuse/summary.json"));
+        assert_false(exists("reuse/particles.vtk.series"));
+        assert_false(exists("reuse/particles_links.vtk.series"));
+        for (int f = 0; f <= 2; f++) {
+            char name[64];
+            snprintf(name, sizeof name, "reuse/particles_%06d.vtk", f);
+            if (exists(name))
+                fail_msg("%s of the earlier run is left by a run with %s", name, no_frames[k]);
+            snprintf(name, sizeof name, "reuse/particles_links_%06d.vtk", f);
+            if (exists(name))
+                fail_msg("%s of the earlier run is left by a run with %s", name, no_frames[k]);
+        }
+    }
 }
 
 /* A restart whose scenario derives another step (here [integrator] dt_fraction, which the
