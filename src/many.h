@@ -511,6 +511,11 @@ int wetdem_sim_many_prepare(struct wetdem_sim* sim);
  * m->speed_bound at this state, with m->v2_seen = 0. Returns WETDEM_OK or WETDEM_ERR_NOMEM
  * (message in sim). */
 int wetdem_sim_many_time_scales(struct wetdem_sim* sim);
+/* The same time scales at the speed scale m->speed_scale rather than at this state's (a
+ * restored run's, whose checkpoint keeps the start's speed scale: the time scales of the
+ * run that wrote it, for the same spheres and materials); m->speed_scale, m->speed_bound and
+ * m->v2_seen are left as they are. Returns WETDEM_OK or the error of the probes. */
+int wetdem_sim_many_time_scales_at_scale(struct wetdem_sim* sim);
 
 /* Records the enabled models as those of the run (run_models), when it starts or is restored. */
 void wetdem_sim_many_keep_models(struct wetdem_sim* sim);

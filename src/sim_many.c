@@ -492,6 +492,24 @@ static void clear_time_scales(struct wetdem_many* m)
     m->speed_scale = m->speed_bound = m->v2_seen = 0;
 }
 
+int wetdem_sim_many_time_scales_at_scale(struct wetdem_sim* sim)
+{
+    struct wetdem_many* m = sim->many;
+    if (sim->n_particles == 0 || !(m->speed_scale > 0))
+        return WETDEM_OK;
+    struct step_spheres sp;
+    struct step_scales s;
+    start_speed(sim, &sp);
+    sp.speed = m->speed_scale;
+    int st = step_scales(sim, &sp, &s);
+    if (st != WETDEM_OK)
+        return st;
+    m->relaxation_time = s.tau;
+    m->contact_time = s.t_contact;
+    m->crossing_time = s.gap / sp.speed;
+    return WETDEM_OK;
+}
+
 int wetdem_sim_many_time_scales(struct wetdem_sim* sim)
 {
     clear_time_scales(sim->many);

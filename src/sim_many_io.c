@@ -1023,6 +1023,11 @@ static int restore_pairs(struct wetdem_sim* sim, const struct wetdem_checkpoint*
         m->speed_scale = speeds[0];
         m->speed_bound = speeds[1];
         m->v2_seen = speeds[2];
+        /* the time scales at that speed scale, as the run that wrote it reported them (and
+           its summary and warnings judged its step by), not at this state's */
+        st = wetdem_sim_many_time_scales_at_scale(sim);
+        if (st != WETDEM_OK)
+            return st;
     }
     for (size_t q = 0; q < m->cl.n_pairs; q++) /* histories may be stale: check on next use */
         m->flags[q] = WETDEM_MANY_DIRTY | WETDEM_MANY_SPRING;
