@@ -754,14 +754,47 @@ static size_t ignored_roughness_keys(const struct cli_scenario* sc, const struct
     return n;
 }
 
+/* [sim] stop_on_separation and separation_factor where the run does not read them: a
+ * many-particle run does not stop on separation, and a binary collision sets both itself
+ * (src/collision.c: it always stops, beyond [collision] rebound_gap_factor x the range). */
+static size_t ignored_sim_keys(const struct cli_scenario* sc, bool many, struct ignored_key* out)
+{
+    bool collision = !many && cli_scenario_has_section(sc, "collision");
+    if (!many && !collision)
+        return 0;
+    const char* const names[] = {"stop_on_separation", "separation_factor"};
+    size_t n = 0;
+    for (int k = 0; k < 2; k++) {
+        const struct cli_entry* e = cli_scenario_find(sc, "sim", names[k]);
+        if (!e)
+            continue;
+        if (many)
+            snprintf(out[n].why, sizeof out[n].why,
+                     "a many-particle run does not stop on separation: it runs to [run] t_end "
+                     "or steps, so it has no effect here: remove it");
+        else if (k == 0)
+            snprintf(out[n].why, sizeof out[n].why,
+                     "a binary collision always stops once its spheres have separated, so it "
+                     "has no effect here: remove it");
+        else
+            snprintf(out[n].why, sizeof out[n].why,
+                     "a binary collision counts its spheres as separated beyond [collision] "
+                     "rebound_gap_factor x their range, so it has no effect here: use "
+                     "rebound_gap_factor");
+        out[n++].e = e;
+    }
+    return n;
+}
+
 void cli_scenario_warn_ignored(const struct cli_scenario* sc, const struct wetdem_sim* sim,
                                bool many)
 {
     static atomic_flag warned = ATOMIC_FLAG_INIT;
-    struct ignored_key keys[3 * MAX_IGNORED + 1];
+    struct ignored_key keys[3 * MAX_IGNORED + 3];
     size_t n = ignored_integrator_keys(sc, sim, many, keys);
     n += ignored_min_separation_keys(sc, sim, keys + n);
     n += ignored_roughness_keys(sc, sim, keys + n);
+    n += ignored_sim_keys(sc, many, keys + n);
     const struct cli_entry* target = cli_scenario_find(sc, "collision", "target");
     const struct cli_entry* radius = cli_scenario_find(sc, "collision", "target_radius");
     if (!many && target && strcmp(target->value, "wall") == 0 && radius &&

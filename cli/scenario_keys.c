@@ -140,9 +140,12 @@ static const struct cli_key_desc sim_keys[] = {
     NUM("gravity_z", "m/s^2", NULL, -1e4, 1e4, false, false, "Gravity, z component."),
     WORD("stop_on_separation", CLI_VALUE_CHOICE, NULL, cli_yes_no,
          "Stop once every pair that interacted has left its range and recedes (a collision "
-         "run sets this itself)."),
+         "run sets this itself; a many-particle run does not stop on separation: both warn "
+         "that it has no effect)."),
     NUM("separation_factor", "-", NULL, 1, 1e3, false, false,
-        "A pair counts as separated beyond this multiple of its interaction range."),
+        "A pair counts as separated beyond this multiple of its interaction range (a "
+        "collision run takes [collision] rebound_gap_factor; a many-particle run does not "
+        "read it: both warn)."),
     NUM("speed_floor", "m/s", NULL, 0, 1e3, true, false,
         "Smallest relative speed used for the Verlet step and the CVODE tolerance scales."),
     {0},

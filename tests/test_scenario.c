@@ -635,7 +635,8 @@ static void test_scenario_idle_film_models_are_reported(void** state)
  * for a sweep): in a binary collision an [integrator] parameter of the integrator not chosen
  * and many_hmin_fraction (many-particle runs only), target_radius of a wall, a parameter of
  * the min-separation model when no force model reads h_min (hertz alone); in a many-particle
- * run hmin_fraction (binary collisions only) and dt_fraction when [run] dt gives the step. A
+ * run hmin_fraction (binary collisions only) and dt_fraction when [run] dt gives the step; in
+ * both, [sim] stop_on_separation and separation_factor (neither engine reads them). A
  * file's key that a --set of integrator.name (or of dt) set aside is not; nor is a key read. */
 static void test_scenario_ignored_keys_are_reported(void** state)
 {
@@ -715,6 +716,26 @@ static void test_scenario_ignored_keys_are_reported(void** state)
              "run --check examples/scenarios/many_settling.ini --set run.dt=1e-6 --set "
              "integrator.many_hmin_fraction=0");
     assert_int_equal(count_in_run(args, 0, "warning"), 0);
+    /* [sim] stop_on_separation and separation_factor: a many-particle run does not stop on
+       separation, a binary collision sets both itself (it stopped and took rebound_gap_factor
+       whatever they said) */
+    snprintf(args, sizeof args,
+             "run --check examples/scenarios/many_settling.ini --set sim.stop_on_separation=yes "
+             "--set sim.separation_factor=2");
+    expect_run(args, 0,
+               "many_settling.ini: --set sim.stop_on_separation=yes: a many-particle run does "
+               "not stop on separation: it runs to [run] t_end or steps, so it has no effect");
+    assert_int_equal(count_in_run(args, 0, "warning"), 2);
+    snprintf(args, sizeof args,
+             "run --check examples/scenarios/dry_hertz.ini --set sim.stop_on_separation=no "
+             "--set sim.separation_factor=2");
+    expect_run(args, 0,
+               "dry_hertz.ini: --set sim.stop_on_separation=no: a binary collision always stops "
+               "once its spheres have separated, so it has no effect");
+    expect_run(args, 0,
+               "dry_hertz.ini: --set sim.separation_factor=2: a binary collision counts its "
+               "spheres as separated beyond [collision] rebound_gap_factor x their range, so it "
+               "has no effect here: use rebound_gap_factor");
     /* a material's roughness where neither the min-separation model (roughness, max) nor
        nijssen reads it; not where one does, nor when a --set of either set it aside */
     const char* rough = write_file("rough.ini", "[collision]\nstriker = mat\ntarget = wall\n"
