@@ -128,7 +128,8 @@ static const struct cli_key_desc read_keys[] = {
          "spin_y, spin_z [rad/s], fixed (0 or 1), material (an index: see materials) (a name "
          "may carry its unit, 'x [m]'; '#' lines are skipped). "
          "Values are checked as the keys of [particle.NAME]. The spheres may overlap each other "
-         "and the walls (a settled packing does), but no two share a centre; their centres must "
+         "and the walls (a settled packing does), but no two share a centre (0 and the length of a "
+         "periodic axis are one place); their centres must "
          "lie in the box."),
     WORD("material", CLI_VALUE_NAME, "steel1", NULL, "Material of every sphere, as in [insert]."),
     WORD("materials", CLI_VALUE_TEXT, "none (material)", NULL,
@@ -709,7 +710,11 @@ static int build_sphere_file(const struct cli_scenario* sc, struct cli_many_setu
     struct wetdem_particle* p = NULL;
     size_t n = 0;
     const char* fixed = cli_scenario_text(sc, section, "fixed", "file");
-    int rc = cli_read_sphere_file(path, strcmp(fixed, "file") == 0, &p, &n, why, sizeof why);
+    double period[3];
+    for (int k = 0; k < 3; k++)
+        period[k] = su->many.periodic[k] ? su->box[k] : 0;
+    int rc =
+        cli_read_sphere_file(path, strcmp(fixed, "file") == 0, period, &p, &n, why, sizeof why);
     if (rc != CLI_EXIT_OK) {
         /* "PATH:LINE: why" for a CSV (why starts with its line), "PATH: why" otherwise */
         cli_scenario_error(sc, e, "%s:%s%s", path, isdigit((unsigned char)why[0]) ? "" : " ", why);

@@ -145,31 +145,42 @@ static int by_centre(const void* a, const void* b)
 
 /* Two of the n spheres at one centre (a row given twice) cannot be a packing: every pair
  * force acts along the line of centres, which they do not have, so the pair was pushed apart
- * along an arbitrary axis from an overlap of a whole diameter. The first such pair, by its CSV
- * lines (lines[i] of sphere i) or, without lines, by its place in the frame, into err:
- * CLI_EXIT_USAGE; CLI_EXIT_OK when every centre is distinct. Sorting: O(n log n). */
+ * along an arbitrary axis from an overlap of a whole diameter. On a periodic axis of length
+ * period[k] > 0 (period may be NULL) the centre at period[k] is the one at 0. The first such
+ * pair, by its CSV lines (lines[i] of sphere i) or, without lines, by its place in the frame,
+ * into err: CLI_EXIT_USAGE; CLI_EXIT_OK when every centre is distinct. Sorting: O(n log n). */
 static int check_distinct_centres(const struct wetdem_particle* p, size_t n, const size_t* lines,
-                                  char* err, size_t err_len)
+                                  const double* period, char* err, size_t err_len)
 {
     struct centre* c = malloc((n ? n : 1) * sizeof *c);
     if (!c)
         return no_memory(err, err_len);
-    for (size_t i = 0; i < n; i++)
-        c[i] = (struct centre){p[i].pos.x, p[i].pos.y, p[i].pos.z, i};
+    for (size_t i = 0; i < n; i++) {
+        double x[3] = {p[i].pos.x, p[i].pos.y, p[i].pos.z};
+        for (int k = 0; k < 3 && period; k++)
+            if (period[k] > 0 && x[k] == period[k])
+                x[k] = 0;
+        c[i] = (struct centre){x[0], x[1], x[2], i};
+    }
     qsort(c, n, sizeof *c, by_centre);
     int rc = CLI_EXIT_OK;
     for (size_t k = 1; k < n && rc == CLI_EXIT_OK; k++) {
         if (c[k].x != c[k - 1].x || c[k].y != c[k - 1].y || c[k].z != c[k - 1].z)
             continue;
         size_t i = c[k - 1].index, j = c[k].index; /* i < j: the earlier in the file first */
-        const char* why = "two spheres at one centre have no line of centres for their "
-                          "contact; give each sphere once";
+        const struct wetdem_vec3 a = p[i].pos, b = p[j].pos;
+        const char* why = a.x == b.x && a.y == b.y && a.z == b.z
+                              ? "two spheres at one centre have no line of centres for their "
+                                "contact; give each sphere once"
+                              : "two spheres at one centre (on a periodic axis, 0 and the box "
+                                "length are one place) have no line of centres for their "
+                                "contact; give each sphere once";
         if (lines)
             rc = fail(err, err_len, "%zu: centre (%g, %g, %g) m, that of line %zu: %s", lines[j],
-                      c[k].x, c[k].y, c[k].z, lines[i], why);
+                      b.x, b.y, b.z, lines[i], why);
         else
             rc = fail(err, err_len, "sphere %zu: centre (%g, %g, %g) m, that of sphere %zu: %s",
-                      j + 1, c[k].x, c[k].y, c[k].z, i + 1, why);
+                      j + 1, b.x, b.y, b.z, i + 1, why);
     }
     free(c);
     return rc;
@@ -579,8 +590,8 @@ static int last_frame(const char* index, char* text, char* path, size_t n, char*
     return CLI_EXIT_OK;
 }
 
-int cli_read_sphere_file(const char* path, bool marks_fixed, struct wetdem_particle** out,
-                         size_t* n, char* err, size_t err_len)
+int cli_read_sphere_file(const char* path, bool marks_fixed, const double* period,
+                         struct wetdem_particle** out, size_t* n, char* err, size_t err_len)
 {
     *out = NULL;
     *n = 0;
@@ -599,7 +610,7 @@ int cli_read_sphere_file(const char* path, bool marks_fixed, struct wetdem_parti
         free(text);
         char why[400];
         if (rc == CLI_EXIT_OK &&
-            (rc = cli_read_sphere_file(frame, marks_fixed, out, n, why, sizeof why)) != 0)
+            (rc = cli_read_sphere_file(frame, marks_fixed, period, out, n, why, sizeof why)) != 0)
             snprintf(err, err_len, "its last frame %s: %s", frame, why);
         return rc;
     }
@@ -611,7 +622,7 @@ int cli_read_sphere_file(const char* path, bool marks_fixed, struct wetdem_parti
                                        : read_csv(text, marks_fixed, out, n, &lines, err, err_len));
     free(text);
     if (rc == 0)
-        rc = check_distinct_centres(*out, *n, lines, err, err_len);
+        rc = check_distinct_centres(*out, *n, lines, period, err, err_len);
     free(lines);
     if (rc != 0) {
         free(*out);

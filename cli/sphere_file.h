@@ -22,11 +22,12 @@
  * spheres are fixed; otherwise every sphere is read as free), material a whole number in
  * [0, 1000] (the
  * file's index, left in .material for the caller to map; -1 when the file has none); no two
- * spheres at one centre (a row given twice). Film
+ * spheres at one centre (a row given twice; with period, NULL or the box lengths of the
+ * periodic axes and 0 for the others, a centre at 0 and one at the length are one centre). Film
  * and mass are left at zero for the caller. Returns CLI_EXIT_OK, or CLI_EXIT_USAGE (bad input) or
  * CLI_EXIT_RUNTIME (out of memory) with a one-line reason in err ("LINE: ..." for a CSV,
  * naming the array for a frame). */
-int cli_read_sphere_file(const char* path, bool marks_fixed, struct wetdem_particle** out,
-                         size_t* n, char* err, size_t err_len);
+int cli_read_sphere_file(const char* path, bool marks_fixed, const double* period,
+                         struct wetdem_particle** out, size_t* n, char* err, size_t err_len);
 
 #endif

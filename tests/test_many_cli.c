@@ -1646,6 +1646,10 @@ static void test_many_cli_read_spheres_from_a_file(void** state)
         /* a row given twice: two spheres at one centre, pushed apart along an arbitrary axis */
         {"x,y,z,radius\n1e-3,1e-3,1e-3,1e-4\n2e-3,1e-3,1e-3,1e-4\n1e-3,1e-3,1e-3,1e-4\n",
          "bad.csv:4: centre (0.001, 0.001, 0.001) m, that of line 2: two spheres at one centre"},
+        /* and one centre through the periodic face x (WET_BOX: x and y periodic, 6 mm) */
+        {"x,y,z,radius\n0,1e-3,1e-3,1e-4\n6e-3,1e-3,1e-3,1e-4\n",
+         "bad.csv:3: centre (0.006, 0.001, 0.001) m, that of line 2: two spheres at one centre "
+         "(on a periodic axis, 0 and the box length are one place)"},
         {"x,y,z,radius\n1e-3,1e-3,9e-3,1e-4\n", "sphere 1 of [read.bed] (centre z = 0.009 m"},
     };
     for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {

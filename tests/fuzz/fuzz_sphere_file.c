@@ -35,7 +35,7 @@ int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size)
     struct wetdem_particle* p = NULL;
     size_t n = 0;
     char err[512] = "";
-    int rc = cli_read_sphere_file(path, true, &p, &n, err, sizeof err);
+    int rc = cli_read_sphere_file(path, true, NULL, &p, &n, err, sizeof err);
     double t = NAN;
     int st = wetdem_output_vtk_frame_time(path, &t);
     remove(path);
