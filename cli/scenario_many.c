@@ -897,8 +897,8 @@ static int check_group(const struct cli_scenario* sc, const struct cli_many_setu
             double hi = walls && (faces >> (2 * k + 1)) & 1u ? p[i].radius : 0.0;
             if (!(x[k] >= lo && x[k] <= su->box[k] - hi)) {
                 cli_scenario_section_error(sc, section,
-                                           "sphere %zu of [%s] (centre %c = %g m, "
-                                           "radius %g m) is outside the box [0, %g] m%s",
+                                           "sphere %zu of [%s] (centre %c = %.15g m, "
+                                           "radius %g m) is outside the box [0, %.15g] m%s",
                                            i - from + 1, section, "xyz"[k], x[k], p[i].radius,
                                            su->box[k], (lo > 0 || hi > 0) ? " or cuts a wall" : "");
                 rc = CLI_EXIT_USAGE;

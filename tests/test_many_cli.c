@@ -1667,14 +1667,19 @@ static void test_many_cli_read_spheres_from_a_file(void** state)
          "bad.csv:3: centre (0.006, 0.001, 0.001) m, that of line 2: two spheres at one centre "
          "(on a periodic axis, 0 and the box length are one place)"},
         {"x,y,z,radius\n1e-3,1e-3,9e-3,1e-4\n", "sphere 1 of [read.bed] (centre z = 0.009 m"},
+        /* just outside: the centre with the digits that tell it from the box's edge (it read
+           "centre z = 0.008 m ... outside the box [0, 0.008] m") */
+        {"x,y,z,radius\n1e-3,1e-3,8.000000001e-3,1e-4\n",
+         "sphere 1 of [read.bed] (centre z = 0.008000000001 m, radius 0.0001 m) is outside the "
+         "box [0, 0.008] m"},
     };
     for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {
         write_text("bad.csv", bad[k].csv);
         char text[2048];
         snprintf(text, sizeof text, "%s%s%s", head, "bad.csv", tail);
-        /* the sphere outside the box (the last case) is a fault of the group: its section's
-           line, 22 */
-        expect_bad("badread.ini", text, 22 + (k + 1 < sizeof bad / sizeof bad[0]), bad[k].what);
+        /* the spheres outside the box (the last two cases) are a fault of the group: its
+           section's line, 22 */
+        expect_bad("badread.ini", text, 22 + (k + 2 < sizeof bad / sizeof bad[0]), bad[k].what);
     }
     char text[2048];
     snprintf(text, sizeof text, "%s%s%s", head, "missing.csv", tail);
