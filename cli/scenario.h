@@ -196,6 +196,10 @@ double cli_stokes_speed(double stokes_n, double viscosity, double m_eff, double 
  * reported with that hint and CLI_EXIT_USAGE returned; else CLI_EXIT_OK (nothing printed). */
 int cli_scenario_integrator_name_typo(const struct cli_scenario* sc, const struct cli_entry* p);
 
+/* Whether an integrator other than `chosen` has the parameter `key` (cvode's rtol, say, where
+ * verlet is chosen). */
+bool cli_scenario_other_integrator_has(const char* chosen, const char* key);
+
 /* Most rows a trajectory file may get: about 2 GB of CSV. */
 #define CLI_MAX_TRAJECTORY_ROWS 1e7
 

@@ -256,8 +256,7 @@ static int build_models(const struct cli_scenario* sc, struct wetdem_sim* sim)
     return rc == CLI_EXIT_OK ? cli_scenario_set_model_params(sc, sim) : rc;
 }
 
-/* Whether an integrator other than `chosen` has the parameter `key`. */
-static bool other_integrator_has(const char* chosen, const char* key)
+bool cli_scenario_other_integrator_has(const char* chosen, const char* key)
 {
     struct wetdem_sim* probe = wetdem_sim_create();
     const char* const* names = wetdem_integrator_names();
@@ -305,7 +304,7 @@ static int build_integrator(const struct cli_scenario* sc, struct wetdem_sim* si
         snprintf(full, sizeof full, "%s.%s", is_integrator ? name : "sim", p->key);
         double current;
         if (is_integrator && wetdem_sim_param(sim, full, &current) == WETDEM_ERR_NOT_FOUND &&
-            other_integrator_has(name, p->key))
+            cli_scenario_other_integrator_has(name, p->key))
             continue; /* a parameter of the integrator not chosen (e.g. --set name=verlet) */
         int st = wetdem_sim_set_param_str(sim, full, p->value);
         if (st != WETDEM_OK)
@@ -663,6 +662,10 @@ static size_t ignored_integrator_keys(const struct cli_scenario* sc, const struc
                      "only a binary collision's verlet step reads it; a many-particle run "
                      "holds its step with many_hmin_fraction (0.5 by default), so it has no "
                      "effect here: use many_hmin_fraction");
+        else if (many && wetdem_sim_param(sim, full, &v) != WETDEM_OK)
+            snprintf(why, size,
+                     "a parameter of the cvode integrator, which a many-particle run does not "
+                     "use (it steps with velocity Verlet), so it has no effect: remove it");
         else if (!many && wetdem_sim_param(sim, full, &v) != WETDEM_OK) {
             if (set_aside(e, ne))
                 continue;

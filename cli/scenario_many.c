@@ -288,6 +288,10 @@ static int build_settings(const struct cli_scenario* sc, struct wetdem_sim* sim)
             continue;
         char full[2 * CLI_NAME_MAX];
         snprintf(full, sizeof full, "%s.%s", integ ? "verlet" : "sim", p->key);
+        double current;
+        if (integ && wetdem_sim_param(sim, full, &current) == WETDEM_ERR_NOT_FOUND &&
+            cli_scenario_other_integrator_has("verlet", p->key))
+            continue; /* cvode's (rtol, say): not read, warned about (warn_ignored) */
         int st = wetdem_sim_set_param_str(sim, full, p->value);
         if (st != WETDEM_OK)
             return cli_scenario_integrator_name_typo(sc, p) != CLI_EXIT_OK

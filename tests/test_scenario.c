@@ -716,6 +716,15 @@ static void test_scenario_ignored_keys_are_reported(void** state)
              "run --check examples/scenarios/many_settling.ini --set run.dt=1e-6 --set "
              "integrator.many_hmin_fraction=0");
     assert_int_equal(count_in_run(args, 0, "warning"), 0);
+    /* cvode's parameters: a many-particle run steps with verlet (it refused them as "unknown
+       parameter 'verlet.rtol' (did you mean 'verlet.dt'?)", where a binary collision warns) */
+    snprintf(args, sizeof args,
+             "run --check examples/scenarios/many_settling.ini --set integrator.rtol=1e-8");
+    expect_run(args, 0,
+               "many_settling.ini: --set integrator.rtol=1e-8: a parameter of the cvode "
+               "integrator, which a many-particle run does not use (it steps with velocity "
+               "Verlet), so it has no effect: remove it");
+    assert_int_equal(count_in_run(args, 0, "warning"), 1);
     /* [sim] stop_on_separation and separation_factor: a many-particle run does not stop on
        separation, a binary collision sets both itself (it stopped and took rebound_gap_factor
        whatever they said) */
