@@ -492,22 +492,31 @@ static void clear_time_scales(struct wetdem_many* m)
     m->speed_scale = m->speed_bound = m->v2_seen = 0;
 }
 
+/* The shortest contact, relaxation and h_min crossing times [s] over the pairs that can occur
+ * in sim (n_particles > 0), at the speed scale speed [m/s] in place of the start's. */
+static int scales_at_speed(struct wetdem_sim* sim, double speed, double* t_contact, double* tau,
+                           double* crossing)
+{
+    struct step_spheres sp;
+    struct step_scales s;
+    start_speed(sim, &sp);
+    sp.speed = speed;
+    int st = step_scales(sim, &sp, &s);
+    if (st != WETDEM_OK)
+        return st;
+    *t_contact = s.t_contact;
+    *tau = s.tau;
+    *crossing = s.gap / speed;
+    return WETDEM_OK;
+}
+
 int wetdem_sim_many_time_scales_at_scale(struct wetdem_sim* sim)
 {
     struct wetdem_many* m = sim->many;
     if (sim->n_particles == 0 || !(m->speed_scale > 0))
         return WETDEM_OK;
-    struct step_spheres sp;
-    struct step_scales s;
-    start_speed(sim, &sp);
-    sp.speed = m->speed_scale;
-    int st = step_scales(sim, &sp, &s);
-    if (st != WETDEM_OK)
-        return st;
-    m->relaxation_time = s.tau;
-    m->contact_time = s.t_contact;
-    m->crossing_time = s.gap / sp.speed;
-    return WETDEM_OK;
+    return scales_at_speed(sim, m->speed_scale, &m->contact_time, &m->relaxation_time,
+                           &m->crossing_time);
 }
 
 int wetdem_sim_many_time_scales(struct wetdem_sim* sim)
@@ -548,18 +557,10 @@ int wetdem_sim_many_time_scales_at(struct wetdem_sim* sim, double speed, double*
     *contact_time = *relaxation_time = *hmin_crossing_time = *step = INFINITY;
     if (sim->n_particles == 0)
         return WETDEM_OK;
-    struct step_spheres sp;
-    struct step_scales s;
-    start_speed(sim, &sp);
-    sp.speed = speed;
-    int st = step_scales(sim, &sp, &s);
-    if (st != WETDEM_OK)
-        return st;
-    *contact_time = s.t_contact;
-    *relaxation_time = s.tau;
-    *hmin_crossing_time = s.gap / speed;
-    *step = derived_step(sim, s.t_contact, s.tau, *hmin_crossing_time);
-    return WETDEM_OK;
+    int st = scales_at_speed(sim, speed, contact_time, relaxation_time, hmin_crossing_time);
+    if (st == WETDEM_OK)
+        *step = derived_step(sim, *contact_time, *relaxation_time, *hmin_crossing_time);
+    return st;
 }
 
 /* Says in m->dt_origin which bound of choose_dt sets the derived step dt, and which
