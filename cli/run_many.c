@@ -21,7 +21,8 @@
  * is read back and the entries after the checkpoint time are dropped, as are CSV rows after
  * the checkpoint step (a run resumed from an older periodic checkpoint then rewrites them
  * identically), and the last frame and row of the run that wrote the checkpoint when they lie
- * off the output grid. A fresh run first removes the frames an earlier run left in DIR.
+ * off the output grid. A fresh run first removes the frames an earlier run left in DIR. Before
+ * either, a directory (or a FIFO) under the name of an output is refused (outputs_usable).
  *
  * Interruption: the first SIGINT or SIGTERM sets a volatile flag that the library reads every
  * step as its stop flag; it writes the checkpoint and returns, and the run exits with 128 +
@@ -44,6 +45,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "cli_util.h"
@@ -105,23 +107,97 @@ static int series_clear(const struct series* s)
     return rc;
 }
 
+/* The summary, the global CSV and the checkpoint, in this order (outputs_clear removes the
+ * summary first), as output_what names them. */
+static const char* const output_files[3] = {"the summary", "the CSV", "the checkpoint"};
+
+/* The names in --out of the summary, global CSV and checkpoint (output_files) that a fresh
+ * run replaces: this run's names or, for an output it does not write, the default names. */
+static void earlier_names(const struct cli_many_setup* su, const char* names[3])
+{
+    names[0] = su->summary_name[0] ? su->summary_name : "summary.json";
+    names[1] = su->csv_name[0] ? su->csv_name : "global.csv";
+    names[2] = su->checkpoint_name[0] ? su->checkpoint_name : "checkpoint.ckpt";
+}
+
 /* A fresh run replaces the run in its directory (as series_clear its frames): removes the
- * summary, global CSV and checkpoint an earlier run left there under this run's names, or,
- * for an output this run does not write, under the default names; the summary first, so a
- * run that fails or is killed before its end leaves no summary beside its files that
- * describes the earlier run. 0, or -1 with errno set. */
+ * summary, global CSV and checkpoint an earlier run left there (earlier_names); the summary
+ * first, so a run that fails or is killed before its end leaves no summary beside its files
+ * that describes the earlier run. 0, or -1 with errno set. */
 static int outputs_clear(const char* dir, const struct cli_many_setup* su)
 {
-    const char* names[][2] = {{su->summary_name, "summary.json"},
-                              {su->csv_name, "global.csv"},
-                              {su->checkpoint_name, "checkpoint.ckpt"}};
-    for (size_t k = 0; k < sizeof names / sizeof names[0]; k++) {
+    const char* names[3];
+    earlier_names(su, names);
+    for (size_t k = 0; k < 3; k++) {
         char path[PATH_CHARS + CLI_VALUE_MAX];
-        snprintf(path, sizeof path, "%s/%s", dir, names[k][0][0] ? names[k][0] : names[k][1]);
+        snprintf(path, sizeof path, "%s/%s", dir, names[k]);
         if (unlink(path) != 0 && errno != ENOENT)
             return -1;
     }
     return 0;
+}
+
+/* Which of the run's outputs the file `name` in --out is, or NULL: a frame or links frame of
+ * s (NULL: none) or one of their indexes (series_clear), or names[k] (NULL: none), which is
+ * output_files[k]. */
+static const char* output_what(const char* name, const struct series* s, const char* const names[3])
+{
+    char links_prefix[CLI_VALUE_MAX + 8], links_index[CLI_VALUE_MAX + 24];
+    char index[CLI_VALUE_MAX + 16];
+    if (s) {
+        snprintf(links_prefix, sizeof links_prefix, "%s" WETDEM_LINKS_SUFFIX, s->prefix);
+        snprintf(links_index, sizeof links_index, "%s.vtk.series", links_prefix);
+        snprintf(index, sizeof index, "%s.vtk.series", s->prefix);
+        if (cli_is_frame_name(s->prefix, name))
+            return "a VTK frame";
+        if (cli_is_frame_name(links_prefix, name))
+            return "a frame of the links";
+        if (strcmp(name, index) == 0)
+            return "the frames' index";
+        if (strcmp(name, links_index) == 0)
+            return "the links' index";
+    }
+    for (int k = 0; k < 3; k++)
+        if (names[k] && strcmp(name, names[k]) == 0)
+            return output_files[k];
+    return NULL;
+}
+
+/* Refuses an --out DIR that holds, under the name of one of the run's outputs (output_what,
+ * with the frames s and the files `names`) or of its temporary NAME.tmp (every output is
+ * written under it and renamed), a directory or a file that is not a regular one or a link
+ * (a FIFO, a device): a fresh run failed to remove it, or the run to write there, after the
+ * earlier run's frames and outputs were gone (or, resumed, after it had trimmed the CSV). The
+ * message names the path. CLI exit code; nothing is touched. */
+static int outputs_usable(const char* dir, const struct series* s, const char* const names[3])
+{
+    DIR* d = opendir(dir);
+    if (!d) /* (none yet, which the run creates: a file there is refused with --out) */
+        return CLI_EXIT_OK;
+    int rc = CLI_EXIT_OK;
+    for (struct dirent* e = readdir(d); e && rc == CLI_EXIT_OK; e = readdir(d)) {
+        char name[sizeof e->d_name];
+        snprintf(name, sizeof name, "%s", e->d_name);
+        size_t n = strlen(name);
+        const char* what = output_what(name, s, names);
+        bool tmp = !what && n > 4 && strcmp(name + n - 4, ".tmp") == 0;
+        if (tmp) {
+            name[n - 4] = '\0';
+            what = output_what(name, s, names);
+        }
+        char path[PATH_CHARS + 300];
+        snprintf(path, sizeof path, "%s/%s", dir, e->d_name);
+        struct stat st;
+        if (!what || lstat(path, &st) != 0 || S_ISREG(st.st_mode) || S_ISLNK(st.st_mode))
+            continue;
+        cli_error("run: %s is %s, named as %s%s, which the run replaces: move it elsewhere, or "
+                  "give another --out (nothing was changed)",
+                  path, S_ISDIR(st.st_mode) ? "a directory" : "not a regular file",
+                  tmp ? "the temporary file of " : "", what);
+        rc = CLI_EXIT_USAGE;
+    }
+    closedir(d);
+    return rc;
 }
 
 /* Writes the .vtk.series index of the frames (links: of their links; temporary file, then
@@ -1340,6 +1416,18 @@ static int run(const struct cli_scenario* sc, struct cli_many_setup* su,
     struct progress prog = {
         .sim = su->sim, .vtk = vtk, .run_total = pl->total, .tty = isatty(STDERR_FILENO) == 1};
     int rc = set_outputs(su, opt, pl, &prog);
+    if (rc == CLI_EXIT_OK && opt->out_dir) {
+        /* what a fresh run removes and writes (earlier_names, the frames as named), or what a
+           restart writes: before any of it is touched, and before the restart trims the CSV */
+        const char* names[3];
+        earlier_names(su, names);
+        if (opt->restart) {
+            names[0] = su->summary_name[0] ? names[0] : NULL;
+            names[1] = pl->csv_prefix[0] ? names[1] : NULL;
+            names[2] = pl->checkpoint[0] ? names[2] : NULL;
+        }
+        rc = outputs_usable(opt->out_dir, opt->restart ? vtk : named, names);
+    }
     if (rc == CLI_EXIT_OK && opt->restart)
         rc = resume(sc, su, opt, pl, vtk);
     if (rc != CLI_EXIT_OK)

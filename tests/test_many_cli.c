@@ -16,6 +16,8 @@
  *   - the CSV ends with a row of the last step, in the library's format;
  *   - a fresh run into a used --out removes the earlier run's frames and links (vtk_links),
  *     and no other file; a restart continues both, bit-identical to an uninterrupted run;
+ *   - a directory named as one of the run's outputs (or their temporary files) in --out is
+ *     refused, exit 2, naming it, with every file as it was;
  *   - the summary prints a large mean agglomerate size as a whole number;
  *   - progress goes to stderr only when it is a terminal, with an estimate of the time left;
  *   - [read.NAME] starts a run from a frame of another (ASCII or binary) bit for bit, or from a
@@ -1236,13 +1238,25 @@ static void test_many_cli_fresh_run_replaces_earlier_frames(void** state)
     free(index);
     assert_true(exists("reuse/particles_links_000004.vtk"));
     assert_false(exists("reuse/particles_links_000002.vtk"));
-    /* a fresh run that fails leaves no summary of the earlier run beside its own files (the
-       final checkpoint cannot be written: its temporary name is a directory) */
+    /* a fresh run killed before its end leaves no summary of the earlier run beside its own
+       files (killed once its CSV, which names its command, is there: past the removal) */
     assert_true(exists("reuse/summary.json"));
-    assert_int_equal(mkdir(tpath("reuse/checkpoint.ckpt.tmp"), 0755), 0);
-    free(expect_exit("run frames.ini --set run.steps=200 --out reuse", 1, "checkpoint"));
+    pid_t pid = spawn_cli("run frames.ini --set run.steps=1000000 --out reuse");
+    struct timespec nap = {0, 1000000};
+    for (int k = 0; k < 60000; k++) {
+        char* csv = test_read_file(tpath("reuse/global.csv"), NULL);
+        bool started = csv && strstr(csv, "run.steps=1000000");
+        free(csv);
+        if (started)
+            break;
+        nanosleep(&nap, NULL);
+    }
+    kill(pid, SIGKILL);
+    int status;
+    assert_int_equal(waitpid(pid, &status, 0), pid);
+    if (!WIFSIGNALED(status) || WTERMSIG(status) != SIGKILL)
+        fail_msg("the long run was not killed: status %d\n%s", status, stderr_text());
     assert_false(exists("reuse/summary.json"));
-    assert_int_equal(rmdir(tpath("reuse/checkpoint.ckpt.tmp")), 0);
     /* nor, when it writes neither, the earlier run's CSV and checkpoint */
     assert_int_equal(run_cli("run frames.ini --set run.steps=200 --out reuse"), 0);
     assert_int_equal(run_cli("run frames.ini --set run.steps=200 --set dump.csv=none "
@@ -1276,6 +1290,57 @@ static void test_many_cli_fresh_run_replaces_earlier_frames(void** state)
                 fail_msg("%s of the earlier run is left by a run with %s", name, no_frames[k]);
         }
     }
+}
+
+/* A directory in --out named as one of the run's outputs, or as the temporary file one is
+ * written to, is refused (exit 2, the path named) before any file is touched: a fresh run
+ * removed the earlier run's frames, CSV and checkpoint, then failed on it with exit 1, and a
+ * restart trimmed the CSV and ran to its end before it failed to write its summary there. */
+static void test_many_cli_refuses_a_directory_named_as_an_output(void** state)
+{
+    (void)state;
+    scenario("named.ini", "[dump]\nvtk_every = 100\ncsv_every = 20\nvtk_links = yes\n");
+    assert_int_equal(run_cli("run named.ini --set run.steps=300 --out named"), 0);
+    copy_dir("named", "named_before");
+    const char* taken[] = {"global.csv",           "summary.json",
+                           "checkpoint.ckpt",      "checkpoint.ckpt.tmp",
+                           "particles_000002.vtk", "particles_links_000007.vtk.tmp",
+                           "particles.vtk.series", "particles_links.vtk.series.tmp"};
+    char cmd[1400], name[128], args[256];
+    for (size_t k = 0; k < sizeof taken / sizeof taken[0]; k++)
+        for (int restart = 0; restart < 2; restart++) {
+            snprintf(name, sizeof name, "named/%s", taken[k]);
+            bool was = exists(name);
+            if (was)
+                assert_int_equal(rename(tpath(name), tpath("taken.keep")), 0);
+            assert_int_equal(mkdir(tpath(name), 0755), 0);
+            snprintf(args, sizeof args, "run named.ini --set run.steps=500 --out named%s",
+                     restart ? " --restart named/checkpoint.ckpt" : "");
+            char needle[200];
+            snprintf(needle, sizeof needle, "run: %s is a directory, named as ", name);
+            free(expect_exit(args, 2, needle));
+            assert_int_equal(rmdir(tpath(name)), 0);
+            if (was)
+                assert_int_equal(rename(tpath("taken.keep"), tpath(name)), 0);
+            snprintf(cmd, sizeof cmd, "diff -r '%s/named_before' '%s/named' > /dev/null", tmpdir,
+                     tmpdir);
+            if (system(cmd) != 0)
+                fail_msg("a %s with %s as a directory changed the files of --out",
+                         restart ? "restart" : "fresh run", taken[k]);
+        }
+    /* a FIFO where the CSV is trimmed (the restart opened it and waited for a writer) */
+    assert_int_equal(mkfifo(tpath("named/global.csv.tmp"), 0644), 0);
+    free(expect_exit("run named.ini --set run.steps=500 --out named --restart "
+                     "named/checkpoint.ckpt",
+                     2, "run: named/global.csv.tmp is not a regular file"));
+    assert_int_equal(unlink(tpath("named/global.csv.tmp")), 0);
+    /* a fresh run that writes no CSV still removes the earlier one's: a directory there too */
+    assert_int_equal(rename(tpath("named/global.csv"), tpath("taken.keep")), 0);
+    assert_int_equal(mkdir(tpath("named/global.csv"), 0755), 0);
+    free(expect_exit("run named.ini --set run.steps=500 --set dump.csv=none --out named", 2,
+                     "run: named/global.csv is a directory, named as the CSV"));
+    assert_true(exists("named/particles_000003.vtk"));
+    assert_true(exists("named/summary.json"));
 }
 
 /* A restart whose scenario derives another step (here [integrator] dt_fraction, which the
@@ -2078,6 +2143,7 @@ int main(void)
         cmocka_unit_test(test_many_cli_csv_names_its_command),
         cmocka_unit_test(test_many_cli_csv_ends_at_the_last_step),
         cmocka_unit_test(test_many_cli_fresh_run_replaces_earlier_frames),
+        cmocka_unit_test(test_many_cli_refuses_a_directory_named_as_an_output),
         cmocka_unit_test(test_many_cli_restart_refuses_another_step),
         cmocka_unit_test(test_many_cli_summary_mean_size_readable),
         cmocka_unit_test(test_many_cli_progress_only_on_a_terminal),
