@@ -329,7 +329,8 @@ static bool on_time_grid(double time, const unsigned long long* row, double t,
  * t, or one whose time cannot be read, means the index is missing or cut short: numbering
  * from its end would overwrite frames the resumed run does not write again, so the restart
  * is refused (CLI exit code; nothing is touched); so is an entry up to t off the
- * checkpoint's time grid: another run's frames. */
+ * checkpoint's time grid: another run's frames, and a frame the index keeps that is missing
+ * (deleted since). */
 static int series_resume(struct series* s, double t, unsigned long long step, double dt,
                          unsigned long long every)
 {
@@ -386,6 +387,19 @@ static int series_resume(struct series* s, double t, unsigned long long step, do
     }
     if (s->n && frame_step(s, s->n - 1, t, step, dt) == step && !(every && step % every == 0))
         s->n--;
+    /* the frames kept stay listed: one deleted since the run that wrote them would leave the
+       resumed run's index naming a file that is not there */
+    for (size_t k = 0; k < s->n; k++) {
+        frame_name(s, k, false, name, sizeof name);
+        snprintf(frame, sizeof frame, "%s/%s", s->dir, name);
+        if (access(frame, F_OK) != 0) {
+            cli_error("--restart: %s lists %s at t = %.9g s, but %s is missing: the resumed run "
+                      "would keep it in its index, naming a file that is not there; restore "
+                      "the frame, or start the run afresh without --restart",
+                      path, name, s->times[k], frame);
+            return CLI_EXIT_USAGE;
+        }
+    }
     /* the links index lists the frames from the first after which each has its links file:
        a run written without links, resumed with them, has links from the restart on */
     for (s->links_from = s->n; s->links && s->links_from > 0; s->links_from--) {

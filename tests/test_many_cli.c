@@ -842,7 +842,8 @@ static void copy_dir(const char* a, const char* b)
 
 /* Restarts as a demanding user tries them: a t_end before the checkpoint's time (exit 2, said
  * so, nothing touched); a CSV deleted, emptied or cut short at a row's end (exit 2, the file
- * as it was: the resumed run appended its rows after a gap); two restarts in a row, and one
+ * as it was: the resumed run appended its rows after a gap); a frame the index lists deleted
+ * (exit 2, nothing touched: the resumed index named it); two restarts in a row, and one
  * with another number of threads (bit-identical frames, index and summary), and one from a
  * checkpoint written at a signal in the first step. */
 static void test_many_cli_restart_probes(void** state)
@@ -882,6 +883,26 @@ static void test_many_cli_restart_probes(void** state)
     assert_non_null(strstr(kept, ",240,"));
     assert_null(strstr(kept, ",260,"));
     free(kept);
+    /* a frame the index lists deleted (it stayed listed, the index naming a missing file),
+       also the one at the checkpoint's step: refused, every file as it was */
+    const char* gone[2] = {"particles_000001.vtk", "particles_000003.vtk"};
+    for (int k = 0; k < 2; k++) {
+        copy_dir("p300", "pframe");
+        char name[64], needle[200], cmd[1400];
+        snprintf(name, sizeof name, "pframe/%s", gone[k]);
+        assert_int_equal(unlink(tpath(name)), 0);
+        snprintf(needle, sizeof needle, "pframe/particles.vtk.series lists %s at t = ", gone[k]);
+        err = expect_exit("run probe.ini --set run.steps=600 --out pframe --restart "
+                          "pframe/checkpoint.ckpt",
+                          2, needle);
+        snprintf(needle, sizeof needle, "but pframe/%s is missing", gone[k]);
+        CHECK_CONTAINS(err, needle);
+        free(err);
+        snprintf(cmd, sizeof cmd, "cd '%s' && cp p300/%s pframe/ && diff -r p300 pframe", tmpdir,
+                 gone[k]);
+        if (system(cmd) != 0)
+            fail_msg("a restart refused for a missing %s changed the files of --out", gone[k]);
+    }
     /* two restarts in a row */
     copy_dir("p300", "ptwice");
     assert_int_equal(run_cli("run probe.ini --set run.steps=450 --out ptwice --restart "
