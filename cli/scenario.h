@@ -192,9 +192,15 @@ double cli_stokes_speed(double stokes_n, double viscosity, double m_eff, double 
 /* ---- internal: building blocks of the soft-engine and many-particle builders
  * (scenario_build.c, used by scenario_many.c) ---- */
 
-/* An [integrator] key p that no parameter matches, if it is close to `name` (as "nam"):
- * reported with that hint and CLI_EXIT_USAGE returned; else CLI_EXIT_OK (nothing printed). */
-int cli_scenario_integrator_name_typo(const struct cli_scenario* sc, const struct cli_entry* p);
+/* Reports an [integrator] or [sim] key p that the library refused with `status` when set as a
+ * parameter of the integrator `chosen` (many: of a many-particle run, which steps with it) or
+ * a setting: an [integrator] key close to `name` (as "nam") with that hint; one closer to a
+ * parameter of another integrator than to any of the chosen one's (rtoll, where verlet steps:
+ * cvode's rtol) with that parameter and its integrator; else as cli_scenario_lib_error.
+ * Returns the exit code. */
+int cli_scenario_integrator_error(const struct cli_scenario* sc, const struct cli_entry* p,
+                                  const char* chosen, bool many, const struct wetdem_sim* sim,
+                                  int status);
 
 /* Whether an integrator other than `chosen` has the parameter `key` (cvode's rtol, say, where
  * verlet is chosen). */

@@ -273,12 +273,62 @@ bool cli_scenario_other_integrator_has(const char* chosen, const char* key)
     return found;
 }
 
-int cli_scenario_integrator_name_typo(const struct cli_scenario* sc, const struct cli_entry* p)
+/* The parameter of any integrator closest to `key` (wetdem_param_suggest), those of `chosen`
+ * first, so that it has a tie; *owner is the integrator it belongs to. NULL: none is close. */
+static const char* integrator_key_suggest(const char* chosen, const char* key, const char** owner)
+{
+    const char* const* names = wetdem_integrator_names();
+    const char* keys[128];
+    const char* of[128];
+    size_t n = 0;
+    for (int pass = 0; pass < 2; pass++) /* (the chosen integrator's first) */
+        for (size_t k = 0; names[k]; k++) {
+            const struct wetdem_param_desc* d = wetdem_integrator_params(names[k]);
+            if ((strcmp(names[k], chosen) == 0) != (pass == 0) || !d)
+                continue;
+            for (size_t j = 0; d[j].name && n + 1 < sizeof keys / sizeof keys[0]; j++) {
+                of[n] = names[k];
+                keys[n++] = d[j].name;
+            }
+        }
+    keys[n] = NULL;
+    const char* hint = wetdem_param_suggest(key, keys);
+    for (size_t k = 0; hint && k < n; k++)
+        if (keys[k] == hint)
+            *owner = of[k];
+    return hint;
+}
+
+int cli_scenario_integrator_error(const struct cli_scenario* sc, const struct cli_entry* p,
+                                  const char* chosen, bool many, const struct wetdem_sim* sim,
+                                  int status)
 {
     static const char* const name_key[] = {"name", NULL};
-    if (strcmp(p->section, "integrator") != 0 || !wetdem_param_suggest(p->key, name_key))
-        return CLI_EXIT_OK;
-    cli_scenario_error(sc, p, "unknown key '%s' in [integrator] (did you mean 'name'?)", p->key);
+    bool integrator = strcmp(p->section, "integrator") == 0;
+    if (integrator && wetdem_param_suggest(p->key, name_key)) {
+        cli_scenario_error(sc, p, "unknown key '%s' in [integrator] (did you mean 'name'?)",
+                           p->key);
+        return CLI_EXIT_USAGE;
+    }
+    /* the library suggests among the chosen integrator's parameters (and the other dotted
+       names): a typo of the other's (rtoll, where verlet steps) is named with its owner */
+    const char* owner = NULL;
+    const char* hint = integrator && status == WETDEM_ERR_NOT_FOUND
+                           ? integrator_key_suggest(chosen, p->key, &owner)
+                           : NULL;
+    char home[400];
+    if (!hint || strcmp(owner, chosen) == 0 || cli_key_home(sc, p, home, sizeof home) == 1)
+        return cli_scenario_lib_error(sc, p, p->section, sim, status);
+    if (many)
+        cli_scenario_error(sc, p,
+                           "unknown parameter '%s.%s' (did you mean '%s', a parameter of the %s "
+                           "integrator? a many-particle run steps with %s)",
+                           chosen, p->key, hint, owner, chosen);
+    else
+        cli_scenario_error(sc, p,
+                           "unknown parameter '%s.%s' (did you mean '%s', a parameter of the %s "
+                           "integrator? the scenario uses %s: [integrator] name)",
+                           chosen, p->key, hint, owner, chosen);
     return CLI_EXIT_USAGE;
 }
 
@@ -308,9 +358,7 @@ static int build_integrator(const struct cli_scenario* sc, struct wetdem_sim* si
             continue; /* a parameter of the integrator not chosen (e.g. --set name=verlet) */
         int st = wetdem_sim_set_param_str(sim, full, p->value);
         if (st != WETDEM_OK)
-            return cli_scenario_integrator_name_typo(sc, p) != CLI_EXIT_OK
-                       ? CLI_EXIT_USAGE
-                       : cli_scenario_lib_error(sc, p, p->section, sim, st);
+            return cli_scenario_integrator_error(sc, p, name, false, sim, st);
     }
     return CLI_EXIT_OK;
 }

@@ -294,9 +294,7 @@ static int build_settings(const struct cli_scenario* sc, struct wetdem_sim* sim)
             continue; /* cvode's (rtol, say): not read, warned about (warn_ignored) */
         int st = wetdem_sim_set_param_str(sim, full, p->value);
         if (st != WETDEM_OK)
-            return cli_scenario_integrator_name_typo(sc, p) != CLI_EXIT_OK
-                       ? CLI_EXIT_USAGE
-                       : cli_scenario_lib_error(sc, p, p->section, sim, st);
+            return cli_scenario_integrator_error(sc, p, "verlet", true, sim, st);
     }
     return CLI_EXIT_OK;
 }

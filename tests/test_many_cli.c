@@ -180,6 +180,13 @@ static void test_many_cli_bad_inputs_exit_2_with_file_and_line(void** state)
                "[box]\nsize_x = 1e-2\nsize_y = 1e-2\nsize_z = 1e-2\n[insert]\ncuont = 5\n"
                "radius = 1e-3\n[run]\nsteps = 10\n",
                6, "did you mean 'count'");
+    /* a typo of cvode's rtol: named as cvode's, not 'verlet.dt', the closest of verlet's */
+    expect_bad("rtoll.ini",
+               "[box]\nsize_x = 1e-2\nsize_y = 1e-2\nsize_z = 1e-2\n[insert]\ncount = 5\n"
+               "radius = 1e-3\n[run]\nsteps = 10\n[integrator]\nrtoll = 1e-8\n",
+               11,
+               "unknown parameter 'verlet.rtoll' (did you mean 'rtol', a parameter of the cvode "
+               "integrator? a many-particle run steps with verlet)");
     expect_bad("periodic_wall.ini",
                "[box]\nsize_x = 1e-2\nsize_y = 1e-2\nsize_z = 1e-2\nperiodic = x\n[walls]\n"
                "faces = x_min z_min\n[insert]\ncount = 5\nradius = 1e-3\n[run]\nsteps = 10\n",

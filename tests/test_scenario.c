@@ -207,8 +207,22 @@ static void test_scenario_set_overrides(void** state)
     free(r.out);
     r = run_cli("run examples/scenarios/nijssen_head_on.ini --check --set integrator.rtoll=1");
     assert_int_equal(r.code, 2);
-    CHECK_CONTAINS(r.out, "rtol");
+    CHECK_CONTAINS(r.out, "unknown parameter 'cvode.rtoll' (did you mean 'cvode.rtol'?)");
     free(r.out);
+    /* a typo of the other integrator's parameter is named with its integrator (the hint was
+       the closest of the chosen one's: 'verlet.dt' for rtoll), the chosen one's keeps the
+       library's wording, ties going to it */
+    expect_run("run examples/scenarios/dry_hertz.ini --check --set integrator.rtoll=1", 2,
+               "--set integrator.rtoll=1: unknown parameter 'verlet.rtoll' (did you mean 'rtol', "
+               "a parameter of the cvode integrator? the scenario uses verlet: [integrator] "
+               "name)");
+    expect_run("run examples/scenarios/nijssen_head_on.ini --check --set "
+               "integrator.dt_fractoin=0.1",
+               2,
+               "unknown parameter 'cvode.dt_fractoin' (did you mean 'dt_fraction', a parameter "
+               "of the verlet integrator? the scenario uses cvode: [integrator] name)");
+    expect_run("run examples/scenarios/dry_hertz.ini --check --set integrator.dtt=1", 2,
+               "unknown parameter 'verlet.dtt' (did you mean 'verlet.dt'?)");
     /* a --set of a material the file does not define added one no sphere used (a typo), or
        one named after a preset that started from the field defaults, not from the preset */
     expect_run("run examples/fit/punch_db_c.ini --check --set material.strikr.roughness=1e-7", 2,
