@@ -316,6 +316,41 @@ static bool on_time_grid(double time, const unsigned long long* row, double t,
     return fabs(k - nearbyint(k)) <= 1e-6 + rel * fabs(k);
 }
 
+/* On a restart with links: a links frame of the kept frames (number below s->n) that the
+ * links index lists must still be there, as series_resume requires of the frames; one deleted
+ * since would be dropped from the resumed run's links index without a word (the links start
+ * after the last missing file), and the earlier ones still on disk with it. 0, or -1 after
+ * the message. (A links index left by a run resumed without links lists frames that all
+ * exist: the links then start again at the restart.) */
+static int links_listed_missing(const struct series* s)
+{
+    char index[PATH_CHARS + CLI_VALUE_MAX + 48], prefix[CLI_VALUE_MAX + 8];
+    snprintf(prefix, sizeof prefix, "%s" WETDEM_LINKS_SUFFIX, s->prefix);
+    snprintf(index, sizeof index, "%s/%s.vtk.series", s->dir, prefix);
+    FILE* f = fopen(index, "r");
+    char line[1024];
+    int missing = 0;
+    while (f && !missing && fgets(line, sizeof line, f)) {
+        char name[CLI_VALUE_MAX + 40], frame[PATH_CHARS + CLI_VALUE_MAX + 48];
+        double time;
+        if (wetdem_output_vtk_series_entry(line, name, sizeof name, &time) != WETDEM_OK ||
+            !cli_is_frame_name(prefix, name))
+            continue;
+        unsigned long long k = strtoull(name + strlen(prefix) + 1, NULL, 10);
+        snprintf(frame, sizeof frame, "%s/%s", s->dir, name);
+        if (k < s->n && access(frame, F_OK) != 0) {
+            cli_error("--restart: %s lists %s at t = %.9g s, but %s is missing: the resumed "
+                      "run's links index would leave out the links before it; restore the "
+                      "file, or start the run afresh without --restart",
+                      index, name, time, frame);
+            missing = -1;
+        }
+    }
+    if (f)
+        fclose(f);
+    return missing;
+}
+
 /* On restart: the frames of the existing index up to time t, the checkpoint's (entries in
  * order, named as this run names them); the rest are dropped and will be written again. A
  * frame at t itself is kept only on the grid of `every`, the vtk_every of the run that wrote
@@ -408,6 +443,8 @@ static int series_resume(struct series* s, double t, unsigned long long step, do
         if (access(path, F_OK) != 0)
             break;
     }
+    if (s->links && links_listed_missing(s) != 0)
+        return CLI_EXIT_USAGE;
     s->last_step = s->n ? frame_step(s, s->n - 1, t, step, dt) : 0;
     return CLI_EXIT_OK;
 }

@@ -1242,6 +1242,24 @@ static void test_many_cli_fresh_run_replaces_earlier_frames(void** state)
     for (size_t k = 0; k < 4; k++)
         if (!exists(keep[k]))
             fail_msg("%s, not a frame, was removed", keep[k]);
+    /* a links frame the links index lists, deleted: refused, every file as it was (the
+       resumed links index started after it, leaving out the links before it) */
+    copy_dir("reuse", "links_gone");
+    assert_int_equal(unlink(tpath("links_gone/particles_links_000001.vtk")), 0);
+    char* err = expect_exit("run frames.ini --set run.steps=400 --out links_gone --restart "
+                            "links_gone/checkpoint.ckpt",
+                            2,
+                            "links_gone/particles_links.vtk.series lists "
+                            "particles_links_000001.vtk at t = ");
+    CHECK_CONTAINS(err, "but links_gone/particles_links_000001.vtk is missing");
+    free(err);
+    char diff[600];
+    snprintf(diff, sizeof diff,
+             "cd '%s' && cp reuse/particles_links_000001.vtk links_gone/ && "
+             "diff -r reuse links_gone",
+             tmpdir);
+    if (system(diff) != 0)
+        fail_msg("a restart refused for a missing links frame changed the files of --out");
     assert_int_equal(run_cli("run frames.ini --set run.steps=400 --out reuse --restart "
                              "reuse/checkpoint.ckpt"),
                      0);
