@@ -895,6 +895,14 @@ bool cli_needs_value(const char* cmd, const char* arg, const char* const* what)
     return false;
 }
 
+bool cli_name_in(const char* arg, const char* const* names)
+{
+    for (size_t k = 0; names[k]; k++)
+        if (strcmp(arg, names[k]) == 0)
+            return true;
+    return false;
+}
+
 const char* cli_option_hint(const char* arg, const char* const* options, char* buf, size_t n)
 {
     const char* hint = arg[0] == '-' ? wetdem_param_suggest(arg, options) : NULL;

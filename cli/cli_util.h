@@ -78,6 +78,8 @@ bool cli_wants_help(int argc, char** argv);
  * take a value: prints "CMD: OPTION needs a value (WHAT)" and returns true (a parser that
  * found no value after it); else false. */
 bool cli_needs_value(const char* cmd, const char* arg, const char* const* what);
+/* Whether arg is one of `names` (NULL-terminated). */
+bool cli_name_in(const char* arg, const char* const* names);
 /* " (did you mean 'NAME'?)" for the name among `options` (NULL-terminated) closest to a
  * misspelt option `arg` (wetdem_param_suggest), written into buf; "" when arg is one of them
  * (cli_needs_value reports a known option whose value is missing), does not start with '-' or

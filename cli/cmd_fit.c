@@ -113,12 +113,21 @@ static int parse_args(int argc, char** argv, struct fit_args* a)
             a->file = s;
             continue;
         }
+        static const char* const options[] = {
+            "--data",        "--fit",     "--init",     "--out",          "--curve", "--set",
+            "--omega-scale", "--fd-step", "--max-iter", "--curve-points", NULL};
         if (!v) {
             static const char* const takes[] = {
                 "--data", "a CSV file", "--fit",  "KEYS",  "--init",    "VALUES", "--out",
                 "a file", "--curve",    "a file", "--set", "KEY=VALUE", NULL};
-            if (!cli_needs_value("fit", s, takes))
+            char hint[64];
+            if (cli_needs_value("fit", s, takes))
+                ;
+            else if (cli_name_in(s, options))
                 cli_error("fit: option '%s' needs a value", s);
+            else /* (every option of fit takes a value: this one is none of them) */
+                cli_error("fit: unknown option '%s'%s", s,
+                          cli_option_hint(s, options, hint, sizeof hint));
             usage(stderr);
             return CLI_EXIT_USAGE;
         }
@@ -156,9 +165,6 @@ static int parse_args(int argc, char** argv, struct fit_args* a)
             if (rc == CLI_EXIT_OK)
                 *(s[2] == 'm' ? &a->max_iter : &a->curve_points) = (int)x;
         } else {
-            static const char* const options[] = {
-                "--data",        "--fit",     "--init",     "--out",          "--curve", "--set",
-                "--omega-scale", "--fd-step", "--max-iter", "--curve-points", NULL};
             char hint[64];
             cli_error("fit: unknown option '%s'%s", s,
                       cli_option_hint(s, options, hint, sizeof hint));

@@ -108,8 +108,12 @@ static int parse_args(int argc, char** argv, struct track_cli* c)
         } else if (strncmp(a, "--", 2) == 0) {
             if (k + 1 >= argc) {
                 static const char* const takes[] = {"--frames", "a file, FILE.csv", NULL};
-                if (!cli_needs_value("track", a, takes))
+                if (cli_needs_value("track", a, takes))
+                    return CLI_EXIT_USAGE;
+                if (cli_name_in(a, once)) /* (the options that take a value) */
                     cli_error("track: option %s needs a value", a);
+                else /* unknown: parse_option names it, with a hint */
+                    parse_option(c, a, "");
                 return CLI_EXIT_USAGE;
             }
             int rc = parse_option(c, a, argv[++k]);

@@ -311,7 +311,7 @@ static void check_cli_cases(const struct cli_case* cases, size_t n)
 /* Every command rejects a bad option before it reads a file: exit code 2, the option named,
  * a hint for a near-miss spelling (one or two letters off, as wetdem_param_suggest measures
  * it), none for a word far from every option, and a note for an option left without its
- * value. */
+ * value (an unknown option given last is unknown: fit and track said it "needs a value"). */
 static void test_cli_bad_options_get_hints(void** state)
 {
     (void)state;
@@ -341,6 +341,14 @@ static void test_cli_bad_options_get_hints(void** state)
         {"forces --model reynolds --radus 1", "unknown option '--radus' (did you mean '--radius'?)",
          2},
         {"track dots.csv --fsp 30", "track: unknown option '--fsp' (did you mean '--fps'?)", 2},
+        /* an unknown option given last is unknown, not one whose value is missing */
+        {"fit none.ini --jsno", "fit: unknown option '--jsno'\n", 2},
+        {"fit none.ini --outt", "fit: unknown option '--outt' (did you mean '--out'?)", 2},
+        {"fit none.ini --max-iter", "fit: option '--max-iter' needs a value", 2},
+        {"track dots.csv --fps=5000", "track: unknown option '--fps=5000'\n", 2},
+        {"track dots.csv --framse", "track: unknown option '--framse' (did you mean '--frames'?)",
+         2},
+        {"track dots.csv --window", "track: option --window needs a value", 2},
     };
     check_cli_cases(cases, sizeof cases / sizeof cases[0]);
 }
