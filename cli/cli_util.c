@@ -493,37 +493,68 @@ static bool output_target(const char* path, char* final, size_t n, bool* direct)
     return true;
 }
 
+/* 0 when a file can be written at path, whose directory exists: the temporary file that output
+ * to it writes is created, then removed (a device or a FIFO, written in place, is asked with
+ * access(): opening it could block); else the errno of the failure. */
+static int probe_writable(const char* path)
+{
+    char final[1400], dir[1400], tmp[2900];
+    bool direct;
+    if (!output_target(path, final, sizeof final, &direct))
+        return ENAMETOOLONG;
+    if (direct) /* (a directory in a file's place fails at its rename: the set is not kept) */
+        return access(final, W_OK) == 0 ? 0 : errno;
+    cli_parent_dir(final, dir, sizeof dir);
+    snprintf(tmp, sizeof tmp, "%s/%s.tmp%ld", dir[0] ? dir : ".",
+             strrchr(final, '/') ? strrchr(final, '/') + 1 : final,
+             (long)getpid()); /* (the name written later) */
+    FILE* f = fopen(tmp, "w");
+    if (!f)
+        return errno;
+    fclose(f);
+    remove(tmp);
+    return 0;
+}
+
 int cli_check_writable(const char* what, const char* option, const char* path)
 {
     if (!path)
         return CLI_EXIT_OK;
-    char dir[1400], tmp[2900];
+    char dir[1400];
     cli_parent_dir(path, dir, sizeof dir);
     if (dir[0] && cli_make_dirs(dir) != 0) {
         cli_error("%s: %s %s: cannot create directory %s: %s", what, option, path, dir,
                   strerror(errno));
         return CLI_EXIT_USAGE;
     }
-    char final[1400];
-    bool direct;
-    output_target(path, final, sizeof final, &direct);
-    if (direct) { /* written in place (a device, a FIFO: not opened here, it could block) */
-        if (access(final, W_OK) == 0)
-            return CLI_EXIT_OK;
-        cli_error("%s: %s %s cannot be written: %s", what, option, path, strerror(errno));
+    int err = probe_writable(path);
+    if (err) {
+        cli_error("%s: %s %s cannot be written: %s", what, option, path, strerror(err));
         return CLI_EXIT_USAGE;
     }
-    cli_parent_dir(final, dir, sizeof dir);
-    snprintf(tmp, sizeof tmp, "%s/%s.tmp%ld", dir[0] ? dir : ".",
-             strrchr(final, '/') ? strrchr(final, '/') + 1 : final,
-             (long)getpid()); /* (the name written later) */
-    FILE* f = fopen(tmp, "w");
-    if (!f) {
-        cli_error("%s: %s %s cannot be written: %s", what, option, path, strerror(errno));
+    return CLI_EXIT_OK;
+}
+
+int cli_check_out_dir(const char* what, const char* dir, const char* const* names, size_t n)
+{
+    if (!dir)
+        return CLI_EXIT_OK;
+    if (cli_make_dirs(dir) != 0) {
+        cli_error("%s: --out %s: cannot create the directory: %s", what, dir, strerror(errno));
         return CLI_EXIT_USAGE;
     }
-    fclose(f);
-    remove(tmp);
+    for (size_t k = 0; k < n; k++) {
+        char path[2048];
+        if (!names[k] || !names[k][0])
+            continue;
+        int err = cli_format_path(path, sizeof path, "%s/%s", dir, names[k]) ? probe_writable(path)
+                                                                             : ENAMETOOLONG;
+        if (err) {
+            cli_error("%s: --out %s: %s cannot be written there: %s", what, dir, names[k],
+                      strerror(err));
+            return CLI_EXIT_USAGE;
+        }
+    }
     return CLI_EXIT_OK;
 }
 

@@ -147,6 +147,11 @@ int cli_check_not_input(const char* what, const char* option, const char* out,
  * cli_write_output would write. Returns CLI_EXIT_OK, or prints "wetdem: <what>: <option>
  * <path> cannot be written: <why>" and returns CLI_EXIT_USAGE. */
 int cli_check_writable(const char* what, const char* option, const char* path);
+/* The same for the files names[0..n) (an empty name or NULL: not written) of --out dir (NULL
+ * passes), before the run that writes them: makes dir when missing and checks that each can
+ * be written there. Returns CLI_EXIT_OK, or prints "wetdem: <what>: --out <dir>: ..." and
+ * returns CLI_EXIT_USAGE. */
+int cli_check_out_dir(const char* what, const char* dir, const char* const* names, size_t n);
 
 /* Writes a table with write(f, ctx): to stdout when path is NULL, otherwise to path (its
  * directory is created when missing) under a temporary name renamed only when everything was

@@ -131,10 +131,9 @@ static int run_soft(const struct cli_scenario* sc, struct cli_setup* su, const s
         (rc = cli_scenario_check_trajectory(sc, "collision", su->spec.t_end,
                                             su->trajectory_interval)) != CLI_EXIT_OK)
         return rc; /* before the directory is made */
-    if (a->out_dir && cli_make_dirs(a->out_dir) != 0) {
-        cli_error("run: cannot create directory %s: %s", a->out_dir, strerror(errno));
-        return CLI_EXIT_RUNTIME;
-    }
+    const char* names[3] = {su->trajectory_file, su->events_file, su->summary_file};
+    if ((rc = cli_check_out_dir("run", a->out_dir, names, 3)) != CLI_EXIT_OK)
+        return rc; /* (before the run: an unwritable place is bad input) */
     if (cli_out_open(&traj, "run", a->out_dir, su->trajectory_file) != 0)
         return CLI_EXIT_RUNTIME;
     struct cli_trajectory t = {

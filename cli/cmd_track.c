@@ -6,7 +6,8 @@
  * --json); --frames FILE writes the per-frame velocities as CSV, whole or not at all (under a
  * temporary name, renamed when written; cli_write_output). Standard uncertainties (u_ keys and
  * columns) and the estimated noise are appended after the values. docs/tracking.md.
- * Exit codes: 0 ok, 1 out of memory or unwritable output, 2 bad options or malformed track.
+ * Exit codes: 0 ok, 1 out of memory or a failed write (a full disk), 2 bad options, a --frames
+ * that cannot be written there, or a malformed track.
  */
 #include <errno.h>
 #include <limits.h>
@@ -137,7 +138,10 @@ static int parse_args(int argc, char** argv, struct track_cli* c)
     }
     const char* in[1] = {c->input};
     const char* names[1] = {"DOTS.csv"};
-    return cli_check_not_input("track", "--frames", c->frames_path, in, names, 1);
+    int rc = cli_check_output_path("track", "--frames", c->frames_path, false);
+    return rc != CLI_EXIT_OK
+               ? rc
+               : cli_check_not_input("track", "--frames", c->frames_path, in, names, 1);
 }
 
 /* What frames_table prints. */
@@ -277,7 +281,9 @@ int cmd_track(int argc, char** argv)
         return st == WETDEM_ERR_NOMEM ? CLI_EXIT_RUNTIME : CLI_EXIT_USAGE;
     }
     struct frames_ctx fc = {t, argc, argv};
-    rc = c.frames_path ? cli_write_output(c.frames_path, "track", frames_table, &fc) : CLI_EXIT_OK;
+    rc = cli_check_writable("track", "--frames", c.frames_path); /* (a place it cannot write) */
+    if (rc == CLI_EXIT_OK && c.frames_path)
+        rc = cli_write_output(c.frames_path, "track", frames_table, &fc);
     if (rc == CLI_EXIT_OK) {
         if (!c.json)
             cli_print_provenance(stdout, argc, argv);

@@ -595,10 +595,9 @@ static int run_with_files(const struct cli_scenario* sc, const struct cli_run_op
                           : CLI_EXIT_OK;
     if (rc != CLI_EXIT_OK)
         return rc; /* before the directory is made */
-    if (cli_make_dirs(opt->out_dir) != 0) {
-        cli_error("run: cannot create directory %s: %s", opt->out_dir, strerror(errno));
-        return CLI_EXIT_RUNTIME;
-    }
+    const char* names[3] = {traj_name, events_name, summary_name};
+    if ((rc = cli_check_out_dir("run", opt->out_dir, names, 3)) != CLI_EXIT_OK)
+        return rc; /* (before the run: an unwritable place is bad input) */
     if (cli_out_open(&ft, "run", opt->out_dir, traj_name) != 0)
         return CLI_EXIT_RUNTIME;
     struct traj t = {ft.f, 0};

@@ -1126,11 +1126,24 @@ static void test_scenario_bad_output_paths_exit_2(void** state)
              tmpdir);
     expect_run(args, 2, "a file name in the --out directory (no '/', not starting with '.')");
     /* a directory that cannot be made: the pairwise engine reported a result it never
-     * computed (a crash) */
-    expect_run("run examples/scenarios/davis_three.ini --out /proc/wetdem_no/out", 1,
-               "cannot create directory /proc/wetdem_no/out");
-    expect_run("run examples/scenarios/dry_hertz.ini --out /proc/wetdem_no/out", 1,
-               "cannot create directory /proc/wetdem_no/out");
+     * computed (a crash), then both exited 1 as for a failed run; exit 2 before the run, as
+     * sweep, map and fit refuse an --out they cannot write */
+    expect_run("run examples/scenarios/davis_three.ini --out /proc/wetdem_no/out", 2,
+               "run: --out /proc/wetdem_no/out: cannot create the directory");
+    expect_run("run examples/scenarios/dry_hertz.ini --out /proc/wetdem_no/out", 2,
+               "run: --out /proc/wetdem_no/out: cannot create the directory");
+    /* a directory where the files of the set cannot be written: refused before the run, which
+     * ran to its end and then failed (exit 1) when there was no trajectory to write first */
+    const char* engines[2] = {"dry_hertz.ini", "davis_three.ini"};
+    for (int k = 0; k < 2; k++) {
+        snprintf(args, sizeof args,
+                 "run examples/scenarios/%s --set output.trajectory=none --out /proc/1",
+                 engines[k]);
+        expect_run(args, 2, "run: --out /proc/1: events.csv cannot be written there");
+    }
+    expect_run("track examples/tracks/punch_45deg.csv --fps 5000 --pixel-size 1.75e-4 --frames "
+               "/proc/wetdem_no/frames.csv",
+               2, "track: --frames /proc/wetdem_no/frames.csv: cannot create directory");
     /* a trajectory row every 1e-12 s: 6.9e10 rows (some 14 TB) for Davis's three spheres,
      * 1e9 for the dry impact, refused before the directory is made */
     snprintf(args, sizeof args,
