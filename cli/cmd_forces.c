@@ -48,7 +48,7 @@ static void usage(FILE* f)
             "presets')\n"
             "  --fluid NAME    fluid preset: water, glycerol80, silicone10 (default water)\n"
             "  --radius R      sphere radius [m] (default 0.00635)\n"
-            "  --speed V       normal approach speed [m/s] (default 0.1)\n"
+            "  --speed V       normal approach speed [m/s] (default 0.1; < 0: separating)\n"
             "  --slip V        tangential slip speed of the surfaces [m/s] (default 0)\n"
             "  --gaps A:B:N    gaps [m] (default 1e-7:1e-3:9 with --log)\n"
             "  --log           geometric spacing of the gaps\n"
@@ -231,9 +231,12 @@ static void print_header(struct wetdem_sim* sim, const struct forces_opts* o, in
 {
     struct wetdem_fluid fl = wetdem_sim_fluid(sim);
     cli_print_provenance(stdout, argc, argv);
-    printf("# pair: two '%s' spheres of radius %g m; v_n = %g m/s (approaching), slip %g m/s; "
+    const char* motion = o->speed > 0   ? "approaching"
+                         : o->speed < 0 ? "separating"
+                                        : "no normal motion";
+    printf("# pair: two '%s' spheres of radius %g m; v_n = %g m/s (%s), slip %g m/s; "
            "fluid viscosity %g Pa s, surface tension %g N/m\n",
-           o->preset, o->radius, o->speed, o->slip, fl.viscosity, fl.surface_tension);
+           o->preset, o->radius, o->speed, motion, o->slip, fl.viscosity, fl.surface_tension);
     printf("# models:");
     for (size_t k = 0; k < wetdem_sim_n_models(sim); k++)
         printf(" %s", wetdem_sim_model(sim, k)->name);

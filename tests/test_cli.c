@@ -213,6 +213,16 @@ static void test_cli_forces_matches_reynolds_closed_form(void** state)
     CHECK_REL(c[1], want, 1e-12);
     CHECK_REL(c[2], 0.0, 0.0);  /* reynolds has no tangential part */
     CHECK_REL(c[3], 1e-6, 0.0); /* h_min of the default "fixed" model */
+    /* separating at the same speed: the same force, as suction (F is odd in v_n), and the
+       header says so (it said "approaching" for every speed) */
+    r = run_cli("forces --model reynolds --preset steel1 --radius 6.35e-3 --speed -0.1 "
+                "--gaps 1e-5:1e-5:1 --set fluid.viscosity=0.5",
+                false);
+    assert_int_equal(r.code, 0);
+    CHECK_CONTAINS(r.out, "v_n = -0.1 m/s (separating)");
+    parse_forces_csv(r.out, c);
+    free(r.out);
+    CHECK_REL(c[1], -want, 1e-12); /* (the same rounding of h as above) */
 }
 
 /* Only a min-separation model: no force, so both force columns are 0 at every gap; a warning
