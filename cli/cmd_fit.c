@@ -294,6 +294,27 @@ static int read_row(const char* path, long line, const char* text, char** f, int
     return rc;
 }
 
+/* Reads one line of fp into buf (n bytes: at most n - 1 characters, the '\n' kept, NUL-terminated)
+ * as fgets does, but tells a NUL byte, which fgets would take for the end of the line (a binary
+ * file was read as lines cut short, or as one too long): 1 a line, 0 the end of the file, -1 a
+ * line longer than n - 2 characters, -2 a NUL byte in the line. */
+static int read_text_line(FILE* fp, char* buf, size_t n)
+{
+    size_t len = 0;
+    int c;
+    while ((c = getc(fp)) != EOF) {
+        if (c == '\0')
+            return -2;
+        if (len + 1 >= n)
+            return -1;
+        buf[len++] = (char)c;
+        if (c == '\n')
+            break;
+    }
+    buf[len] = '\0';
+    return len > 0 ? 1 : 0;
+}
+
 static int read_data(const char* path, struct point** out, size_t* n_out)
 {
     FILE* fp = fopen(path, "r");
@@ -309,9 +330,14 @@ static int read_data(const char* path, struct point** out, size_t* n_out)
     bool have_header = false;
     int n_header = 0;
     size_t n = 0;
-    for (long line = 1; rc == CLI_EXIT_OK && fgets(buf, sizeof buf, fp); line++) {
-        if (!strchr(buf, '\n') && !feof(fp)) { /* (its rest would be read as another line) */
-            cli_error("%s:%ld: line longer than %zu characters", path, line, sizeof buf - 2);
+    int got;
+    for (long line = 1; rc == CLI_EXIT_OK && (got = read_text_line(fp, buf, sizeof buf)) != 0;
+         line++) {
+        if (got < 0) { /* (the rest of a long line would be read as another line) */
+            if (got == -2)
+                cli_error("%s:%ld: a NUL byte in the line: not a text (CSV) file", path, line);
+            else
+                cli_error("%s:%ld: line longer than %zu characters", path, line, sizeof buf - 2);
             rc = CLI_EXIT_USAGE;
             break;
         }

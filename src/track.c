@@ -326,6 +326,27 @@ static int read_line(struct wetdem_track* t, char* text, bool* seen_data)
     return parse_row(t, f);
 }
 
+/* Reads one line of fp into buf (n bytes: at most n - 1 characters, the '\n' kept, NUL-terminated)
+ * as fgets does, but tells a NUL byte, which fgets would take for the end of the line (a binary
+ * file was read as lines cut short, or as one too long): 1 a line, 0 the end of the file, -1 a
+ * line longer than n - 2 characters, -2 a NUL byte in the line. */
+static int read_text_line(FILE* fp, char* buf, size_t n)
+{
+    size_t len = 0;
+    int c;
+    while ((c = getc(fp)) != EOF) {
+        if (c == '\0')
+            return -2;
+        if (len + 1 >= n)
+            return -1;
+        buf[len++] = (char)c;
+        if (c == '\n')
+            break;
+    }
+    buf[len] = '\0';
+    return len > 0 ? 1 : 0;
+}
+
 static int read_csv(struct wetdem_track* track, const char* path)
 {
     if (!path)
@@ -337,13 +358,16 @@ static int read_csv(struct wetdem_track* track, const char* path)
     long line = 0;
     bool seen_data = false;
     int st = WETDEM_OK;
-    while (st == WETDEM_OK && fgets(buf, sizeof buf, fp)) {
+    int got;
+    while (st == WETDEM_OK && (got = read_text_line(fp, buf, sizeof buf)) != 0) {
         line++;
-        if (!strchr(buf, '\n') && !feof(fp)) {
-            st = located(
-                track,
-                fail(track, WETDEM_ERR_PARSE, "line longer than %d characters", TRACK_LINE_MAX - 2),
-                path, line);
+        if (got < 0) {
+            st = located(track,
+                         got == -2 ? fail(track, WETDEM_ERR_PARSE,
+                                          "a NUL byte in the line: not a text (CSV) file")
+                                   : fail(track, WETDEM_ERR_PARSE, "line longer than %d characters",
+                                          TRACK_LINE_MAX - 2),
+                         path, line);
             break;
         }
         char* text = buf;

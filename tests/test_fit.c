@@ -787,6 +787,13 @@ static void test_fit_cli_rejects_bad_input(void** state)
              "\nstokes_n,e_n\n2,0.5\n3,0.6\n");
     temp_csv(bad, "bad", long_line);
     expect_cli(args, 2, ":1: line longer than 4094 characters");
+    /* a NUL byte is named, not taken for a line too long */
+    static const char bin[] = "stokes_n,e_n\n2,0.5\n3,0.6\0junk\n4,0.7\n";
+    FILE* fb = fopen(bad, "wb");
+    assert_non_null(fb);
+    assert_int_equal(fwrite(bin, 1, sizeof bin - 1, fb), sizeof bin - 1);
+    assert_int_equal(fclose(fb), 0);
+    expect_cli(args, 2, ":3: a NUL byte in the line: not a text (CSV) file");
     /* collisions whose step is too long for the contact gain energy: the fit stops there */
     snprintf(args, sizeof args,
              "fit %s --data %s --fit glass.p_gt --init 4e6 --set integrator.name=verlet "

@@ -1104,6 +1104,21 @@ static void test_track_rejects_malformed_files(void** state)
         CHECK_CONTAINS(wetdem_track_errmsg(t), "/tmp: cannot read: Is a directory");
         wetdem_track_free(t);
     }
+    { /* a NUL byte (a binary file) is named: the row before it at the end of the file was
+         read as the whole row, and one inside a line was "longer than 4094 characters" */
+        static const char bin[] = "frame,sphere,x1,y1,x2,y2,x3,y3\n0,1,1,1,2,2,3,3\n"
+                                  "1,1,1,1,2,2,3,3\0\x01\x02";
+        const char* path = write_temp("");
+        FILE* f = fopen(path, "wb");
+        assert_non_null(f);
+        assert_int_equal(fwrite(bin, 1, sizeof bin - 1, f), sizeof bin - 1);
+        assert_int_equal(fclose(f), 0);
+        struct wetdem_track* t = wetdem_track_create();
+        CHECK_STATUS(wetdem_track_read_csv(t, path), WETDEM_ERR_PARSE);
+        CHECK_CONTAINS(wetdem_track_errmsg(t), ":3: a NUL byte in the line: not a text (CSV) file");
+        wetdem_track_free(t);
+        remove(path);
+    }
     const char* head = "frame,sphere,x1,y1,x2,y2,x3,y3\n";
     char buf[512];
     snprintf(buf, sizeof buf, "%s0,1,1,1,2,2,3,3\n1,1,1,1,2,2,3\n", head);
