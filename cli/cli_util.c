@@ -411,6 +411,28 @@ int cli_check_output_path(const char* what, const char* option, const char* path
     return CLI_EXIT_OK;
 }
 
+/* Whether paths a and b, of which one at least does not exist (yet), name one file: the same
+ * name in the same directory (its real path; as written when it does not exist either: then
+ * the same text), so that "./x.csv" and "x.csv" are one. */
+static bool same_new_file(const char* a, const char* b)
+{
+    if (strcmp(a, b) == 0)
+        return true;
+    const char* base_a = strrchr(a, '/') ? strrchr(a, '/') + 1 : a;
+    const char* base_b = strrchr(b, '/') ? strrchr(b, '/') + 1 : b;
+    if (strcmp(base_a, base_b) != 0 || !base_a[0])
+        return false;
+    char dir_a[1024], dir_b[1024];
+    cli_parent_dir(a, dir_a, sizeof dir_a);
+    cli_parent_dir(b, dir_b, sizeof dir_b);
+    char* real_a = realpath(dir_a[0] ? dir_a : ".", NULL);
+    char* real_b = realpath(dir_b[0] ? dir_b : ".", NULL);
+    bool same = real_a && real_b && strcmp(real_a, real_b) == 0;
+    free(real_a);
+    free(real_b);
+    return same;
+}
+
 int cli_check_not_input(const char* what, const char* option, const char* out,
                         const char* const* in, const char* const* in_names, int n)
 {
@@ -421,7 +443,7 @@ int cli_check_not_input(const char* what, const char* option, const char* out,
             continue;
         bool same = out_exists && stat(in[k], &si) == 0
                         ? so.st_dev == si.st_dev && so.st_ino == si.st_ino && S_ISREG(so.st_mode)
-                        : strcmp(out, in[k]) == 0;
+                        : same_new_file(out, in[k]);
         if (same) {
             cli_error("%s: %s %s is also %s: the command would write over it; give another "
                       "name",

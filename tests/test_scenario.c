@@ -1108,6 +1108,12 @@ static void test_scenario_bad_output_paths_exit_2(void** state)
              "--curve '%s/a.csv'",
              data, tmpdir, tmpdir);
     expect_run(args, 2, "a.csv is also --out");
+    /* one new file under two spellings: the fit ran, then wrote neither (exit 1) */
+    snprintf(args, sizeof args,
+             "fit examples/fit/punch_db_c.ini --data '%s' --fit glass.p_gt --out '%s/./b.csv' "
+             "--curve '%s/b.csv'",
+             data, tmpdir, tmpdir);
+    expect_run(args, 2, "b.csv is also --out");
     expect_run("sweep examples/scenarios/dry_hertz.ini --param collision.speed --values 0.5:1:2 "
                "--out ./examples/scenarios/dry_hertz.ini",
                2, "sweep: --out ./examples/scenarios/dry_hertz.ini is also FILE");
