@@ -176,6 +176,10 @@ int cmd_map(int argc, char** argv)
         rc = cli_parse_range(a.values[d], a.is_log[d], d ? "--values2" : "--values", &b.range[d]);
     if (rc == CLI_EXIT_OK && a.save_every)
         rc = cli_batch_parse_save_every("map", a.save_every, &b.save_every);
+    if (rc == CLI_EXIT_OK && a.save_every && !a.out && b.save_every > 0)
+        cli_error("warning: map: --save-every %s has no effect without --out: a table on "
+                  "standard output is written once, at the end",
+                  a.save_every);
     if (rc != CLI_EXIT_OK)
         return rc;
     double points = (double)b.range[0].n * (double)b.range[1].n;

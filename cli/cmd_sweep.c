@@ -183,6 +183,10 @@ int cmd_sweep(int argc, char** argv)
         rc = cli_parse_range(a.values, a.is_log, "--values", &b.range[0]);
     if (rc == CLI_EXIT_OK && a.save_every)
         rc = cli_batch_parse_save_every("sweep", a.save_every, &b.save_every);
+    if (rc == CLI_EXIT_OK && a.save_every && !a.out && b.save_every > 0)
+        cli_error("warning: sweep: --save-every %s has no effect without --out: a table on "
+                  "standard output is written once, at the end",
+                  a.save_every);
     if (rc != CLI_EXIT_OK)
         return rc;
     rc = cli_batch_run(&b);

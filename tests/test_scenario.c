@@ -1589,6 +1589,18 @@ static void test_scenario_killed_map_resumes_from_its_saved_table(void** state)
         snprintf(args, sizeof args, "%s --save-every %s", map, bad[k]);
         expect_run(args, 2, "--save-every");
     }
+    /* without --out there is nothing to save to (the table on stdout is written once): said,
+     * not ignored without a word; nothing with 0 (never) */
+    expect_run("sweep examples/scenarios/dry_hertz.ini --param collision.speed --values 0.5:1:2 "
+               "--save-every 5",
+               0, "warning: sweep: --save-every 5 has no effect without --out");
+    expect_run("map examples/scenarios/dry_hertz.ini --param collision.speed --values 0.5:1:2 "
+               "--param2 collision.angle_deg --values2 0:30:2 --save-every 5",
+               0, "warning: map: --save-every 5 has no effect without --out");
+    assert_int_equal(count_in_run("sweep examples/scenarios/dry_hertz.ini --param "
+                                  "collision.speed --values 0.5:1:2 --save-every 0",
+                                  0, "warning"),
+                     0);
 }
 
 /* Runs `wetdem run FILE --set SET1 --set SET2 --set SET3 --out tmpdir/NAME` (a collision of
