@@ -33,6 +33,7 @@
 #include <omp.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "cli_util.h"
 #include "output_csv.h"
@@ -509,6 +510,49 @@ static int simulate(const struct fit_ctx* c, const double* params, const struct 
     return st;
 }
 
+/* Progress of the fit on stderr when it is a terminal (as sweep and map show theirs): the model
+ * evaluations so far, each a collision per data point, at most every 0.2 s. One fit a process:
+ * the solver calls fit_model serially. */
+static struct {
+    bool show, shown;
+    size_t evals;
+    double t0, last;
+} progress;
+
+static void progress_start(void)
+{
+    progress.show = isatty(STDERR_FILENO);
+    progress.shown = false;
+    progress.evals = 0;
+    progress.t0 = progress.last = omp_get_wtime();
+}
+
+static void progress_show(const struct fit_ctx* c, double now)
+{
+    fprintf(stderr, "\rfit: %zu model evaluations (x %zu collisions), %.1f s elapsed   ",
+            progress.evals, c->n_pts, now - progress.t0);
+    progress.shown = true;
+    progress.last = now;
+}
+
+static void progress_step(const struct fit_ctx* c)
+{
+    progress.evals++;
+    double now = omp_get_wtime();
+    if (progress.show && (!progress.shown || now - progress.last >= 0.2))
+        progress_show(c, now);
+}
+
+/* The last count, and the line ended (the messages and the table start on their own). */
+static void progress_end(const struct fit_ctx* c)
+{
+    if (progress.shown) {
+        progress_show(c, omp_get_wtime());
+        fputc('\n', stderr);
+    }
+    progress.shown = false;
+}
+
 /* wetdem_fit_model_fn: e_n of every point, then (with omega) |omega_i| of every point. A
  * point the scenario rejects is not bad input here: the data and the initial values were
  * checked before the fit (check_points), so the fit tried values the scenario does not accept
@@ -522,6 +566,7 @@ static int fit_model(const double* params, double* predicted, char* msg, size_t 
         return WETDEM_ERR_NOMEM;
     }
     int st = simulate(c, params, c->pts, c->n_pts, predicted, omega, msg, msg_size);
+    progress_step(c);
     if (st == WETDEM_OK && c->use_omega)
         memcpy(predicted + c->n_pts, omega, c->n_pts * sizeof *omega);
     free(omega);
@@ -1093,7 +1138,9 @@ static int run_fit(const struct fit_args* a, struct fit_ctx* c, const double* in
     o.fd_step = a->fd_step;
     struct wetdem_fit_result r;
     char msg[512] = "";
+    progress_start();
     int st = wetdem_fit_run(&pb, &o, &r, pred, msg, sizeof msg);
+    progress_end(c);
     int rc = CLI_EXIT_OK;
     /* a result to show: converged, not converged, or not determining every parameter (dof 0:
        the fit stopped before it had one, e.g. at a zero column of the Jacobian) */
