@@ -1221,6 +1221,12 @@ int wetdem_track_analyse(struct wetdem_track* track, const struct wetdem_track_o
                     "spheres must be tracked over the same frames",
                     a->id, a->first_frame, a->first_frame + (long)a->n - 1, track->s[1].id,
                     track->s[1].first_frame, track->s[1].first_frame + (long)track->s[1].n - 1);
+    if (track->n_spheres == 1 && opt->striker >= 0 &&
+        a->id != opt->striker) /* (two: pick_striker) */
+        return fail(track, WETDEM_ERR_INVALID,
+                    "striker = %d: no sphere with that id (found %d only: one sphere, no "
+                    "collision)",
+                    opt->striker, a->id);
     size_t need = (size_t)(opt->window > 2 ? opt->window : 2);
     if (a->n < need)
         return fail(track, WETDEM_ERR_INVALID,

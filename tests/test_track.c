@@ -1185,6 +1185,19 @@ static void test_track_rejects_short_or_mismatched_tracks(void** state)
     CHECK_STATUS(wetdem_track_analyse(t, &o, &s), WETDEM_ERR_INVALID);
     CHECK_CONTAINS(wetdem_track_errmsg(t), "striker = -5: must be a sphere id in [0, 1000000]");
     wetdem_track_free(t);
+    /* a striker id that no sphere has: refused with one sphere too, where it was taken without
+       a word (the per-frame velocities, has_collision = false) */
+    t = wetdem_track_create();
+    for (int f = 0; f < 10; f++)
+        CHECK_OK(wetdem_track_add_frame(t, 1, f, xy));
+    o.striker = 2;
+    CHECK_STATUS(wetdem_track_analyse(t, &o, &s), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(wetdem_track_errmsg(t), "striker = 2: no sphere with that id (found 1 only");
+    o.striker = 1;
+    CHECK_OK(wetdem_track_analyse(t, &o, &s));
+    assert_int_equal(s.n_spheres, 1);
+    o.striker = -1;
+    wetdem_track_free(t);
     /* Two resting spheres: no collision, and the message says why. */
     t = wetdem_track_create();
     wetdem_track_options_init(&o);
