@@ -165,6 +165,10 @@ static int parse_args(int argc, char** argv, struct fit_args* a)
             }
             if (rc == CLI_EXIT_OK)
                 *(s[2] == 'm' ? &a->max_iter : &a->curve_points) = (int)x;
+        } else if (strcmp(s, "--set") == 0) { /* (the only option refused with a value) */
+            cli_error("fit: more than %d --set options", MAX_SETS);
+            usage(stderr);
+            return CLI_EXIT_USAGE;
         } else {
             char hint[64];
             cli_error("fit: unknown option '%s'%s", s,

@@ -117,7 +117,9 @@ static int parse_args(int argc, char** argv, struct map_args* a)
                                                 "S seconds",
                                                 NULL};
             char hint[64];
-            if (next || !cli_needs_value("map", s, takes))
+            if (strcmp(s, "--set") == 0 && next) /* (the only option refused with a value) */
+                cli_error("map: more than %d --set options", MAP_MAX_SETS);
+            else if (next || !cli_needs_value("map", s, takes))
                 cli_error("map: unexpected argument '%s'%s", s,
                           cli_option_hint(s, options, hint, sizeof hint));
             usage(stderr);

@@ -109,7 +109,9 @@ static int parse_args(int argc, char** argv, struct sweep_args* a)
                                                 "S seconds",
                                                 NULL};
             char hint[64];
-            if (next || !cli_needs_value("sweep", s, takes))
+            if (strcmp(s, "--set") == 0 && next) /* (the only option refused with a value) */
+                cli_error("sweep: more than %d --set options", MAX_SETS);
+            else if (next || !cli_needs_value("sweep", s, takes))
                 cli_error("sweep: unexpected argument '%s'%s", s,
                           cli_option_hint(s, options, hint, sizeof hint));
             usage(stderr);

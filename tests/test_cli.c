@@ -363,6 +363,25 @@ static void test_cli_bad_options_get_hints(void** state)
     check_cli_cases(cases, sizeof cases / sizeof cases[0]);
 }
 
+/* More --set options than a command keeps (256) are refused as such by run, sweep, map and fit;
+ * sweep, map and fit called the 257th "unexpected argument '--set'" (or unknown option). */
+static void test_cli_too_many_set_options(void** state)
+{
+    (void)state;
+    static const char* const cmds[] = {"run none.ini", "sweep none.ini", "map none.ini",
+                                       "fit none.ini"};
+    static char args[257 * 12 + 64]; /* (within test_run_cli's command of 4 kB) */
+    for (size_t c = 0; c < sizeof cmds / sizeof cmds[0]; c++) {
+        size_t used = (size_t)snprintf(args, sizeof args, "%s", cmds[c]);
+        for (int k = 0; k < 257; k++)
+            used += (size_t)snprintf(args + used, sizeof args - used, " --set x.y=1");
+        struct test_run r = run_cli(args, true);
+        assert_int_equal(r.code, 2);
+        CHECK_CONTAINS(r.out, "more than 256 --set options");
+        free(r.out);
+    }
+}
+
 /* An option that takes one value, given twice, is refused by every command: the later value
  * replaced the earlier unseen (`fit --fit A --fit B` fitted B alone, `sweep --param A --param
  * B` swept B, `track --fps 5000 --fps 4000` ran at 4000). Repeatable options (--set, --model)
@@ -1275,6 +1294,7 @@ int main(void)
         cmocka_unit_test(test_cli_forces_bad_input),
         cmocka_unit_test(test_cli_bad_options_get_hints),
         cmocka_unit_test(test_cli_single_options_given_twice),
+        cmocka_unit_test(test_cli_too_many_set_options),
         cmocka_unit_test(test_cli_set_overrides_never_used),
         cmocka_unit_test(test_cli_model_of_the_wrong_kind),
         cmocka_unit_test(test_cli_messages_name_what_is_wrong),
