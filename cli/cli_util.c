@@ -287,6 +287,11 @@ int cli_setup_exit(int status)
     return status == WETDEM_ERR_NOMEM ? CLI_EXIT_RUNTIME : CLI_EXIT_USAGE;
 }
 
+int cli_run_exit(int status)
+{
+    return status == WETDEM_ERR_INVALID ? CLI_EXIT_USAGE : CLI_EXIT_RUNTIME;
+}
+
 int cli_apply_set(struct wetdem_sim* sim, const char* key_value)
 {
     const char* eq = strchr(key_value, '=');

@@ -65,6 +65,11 @@ double cli_range_value(const struct cli_range* r, size_t k);
  * of the input, CLI_EXIT_USAGE for every other failure. */
 int cli_setup_exit(int status);
 
+/* The exit code of a run that the library stopped with `status` < 0: CLI_EXIT_USAGE when it
+ * refused the input before the first step (WETDEM_ERR_INVALID: a parameter or state the run
+ * cannot start from, e.g. nijssen's h_min reaching its cut-off), CLI_EXIT_RUNTIME otherwise. */
+int cli_run_exit(int status);
+
 /* Applies "KEY=VALUE" to sim through wetdem_sim_set_param_str (so enumerated parameters may
  * be given by word). Returns CLI_EXIT_OK, or prints "wetdem: --set KEY=VALUE: <library
  * message>" and returns CLI_EXIT_USAGE. */

@@ -157,7 +157,7 @@ static int run_soft(const struct cli_scenario* sc, struct cli_setup* su, const s
         else
             cli_error("run %s: %s (%s)", sc->file, wetdem_sim_errmsg(su->sim),
                       wetdem_status_name(st));
-        return CLI_EXIT_RUNTIME;
+        return t.err ? CLI_EXIT_RUNTIME : cli_run_exit(st);
     }
     cli_setup_capture(su, &res);
     struct cli_out_file* files[3] = {&traj, &events, &summary};

@@ -499,6 +499,10 @@ static void test_cli_messages_name_what_is_wrong(void** state)
              "fit examples/scenarios/many_settling.ini --data examples/fit/punch_0deg.csv --fit "
              "glass.p_gt");
     snprintf(args[5], 400, "run %s --check --set 'models.force=nijssen hertz'", head);
+    /* refused by the library when the run starts (WETDEM_ERR_INVALID: nijssen's h_min at
+       its cut-off): input, exit 2 */
+    snprintf(args[6], 400,
+             "run examples/scenarios/nijssen_roughness.ini --set material.rough.roughness=0.01");
     const struct cli_case cases[] = {
         {args[0], "--param 'stokes': expected section.key, e.g. --param collision.stokes", 2},
         {args[1], "'0:80:2' with --log2 needs A > 0", 2},
@@ -507,6 +511,7 @@ static void test_cli_messages_name_what_is_wrong(void** state)
         {args[4], "is a many-particle scenario; fit calibrates binary collisions", 2},
         {args[5], "model 'hertz' and model 'nijssen' both give the normal contact force", 2},
         {"describe NIJSSEN", "(did you mean 'nijssen'?)", 2},
+        {args[6], "is in solid contact already at the edge of its range", 2},
     };
     check_cli_cases(cases, sizeof cases / sizeof cases[0]);
     const char* dir = getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp";
