@@ -13,6 +13,7 @@
  * f_tangential [N] (on i along +y, the slip direction), h_min [m] (from the min-separation
  * model; composite models with their own minimum approach, e.g. nijssen, do not read it).
  */
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
@@ -160,6 +161,20 @@ static int check_opts(const struct forces_opts* o)
                   "radius, valid (%g, inf)",
                   lo, -o->radius);
         return CLI_EXIT_USAGE;
+    }
+    /* the gap the library sees is |x_i - x_j| - 2 R, of centres 2 R + h apart: a gap below
+       about R DBL_EPSILON x 1e6 (1.4e-12 m for R = 6.35 mm) loses more than 1e-6 of itself to
+       the rounding of 2 R + h, and one below R DBL_EPSILON vanishes (its row would give the
+       force at another gap, or at contact) */
+    for (size_t k = 0; k < o->gaps.n; k++) {
+        double h = cli_range_value(&o->gaps, k), seen = (2 * o->radius + h) - 2 * o->radius;
+        if (fabs(seen - h) > 1e-6 * fabs(h)) {
+            cli_error("forces: --gaps: gap %g m is not resolved beside centres %g m apart (the "
+                      "pair would be evaluated at a gap of %g m): valid 0 or |gap| above about "
+                      "%.2g m for --radius %g m (1e-6 of the gap; or a smaller --radius)",
+                      h, 2 * o->radius + h, seen, 1e6 * o->radius * DBL_EPSILON, o->radius);
+            return CLI_EXIT_USAGE;
+        }
     }
     if (o->n_models == 0) {
         cli_error("forces: no model given: add --model NAME (see 'wetdem models')");
