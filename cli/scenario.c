@@ -248,11 +248,19 @@ int cli_scenario_check_read(const struct cli_scenario* sc, const char* reader,
                                                 : " and ",
                                  len, reads[k], star ? ".NAME" : "");
     }
+    /* in a binary collision, a section of the pairwise engine, which only [engine] type =
+       pairwise chooses (the many-particle mode is chosen by its own sections) */
+    static const char* const pairwise[] = {"davis", "pairwise", "sphere.*", NULL};
+    const char* fix = section_read(name, pairwise) && section_read("collision", reads)
+                          ? " (a section of the pairwise engine: to run several spheres with it, "
+                            "add [engine] type = pairwise)"
+                          : "";
     if (set)
-        cli_scenario_error(sc, set, "[%s] is not read by %s, which reads %s", name, reader, list);
+        cli_scenario_error(sc, set, "[%s] is not read by %s, which reads %s%s", name, reader, list,
+                           fix);
     else
-        cli_scenario_section_error(sc, name, "not read by %s, which reads %s: remove it", reader,
-                                   list);
+        cli_scenario_section_error(sc, name, "not read by %s, which reads %s: remove it%s", reader,
+                                   list, fix);
     return CLI_EXIT_USAGE;
 }
 
@@ -779,6 +787,8 @@ static int split_key_value(const char* option, const char* text, char* section, 
     section[slen] = '\0';
     memcpy(key, dot + 1, klen);
     key[klen] = '\0';
+    trim(section); /* (as a file's "key = value" lines: --set "collision.stokes = 50") */
+    trim(key);
     if (value) {
         copy_text(value, CLI_VALUE_MAX, eq + 1);
         trim(value);

@@ -166,6 +166,12 @@ static void test_scenario_set_overrides(void** state)
     assert_int_equal(r.code, 0);
     CHECK_REL(check_value(r.out, "impact_speed"), 0.0253093363 / 2, 1e-8);
     free(r.out);
+    /* spaces around the key and the '=', as a file's lines may have them */
+    r = run_cli("run examples/scenarios/nijssen_head_on.ini --check "
+                "--set ' collision.stokes = 50'");
+    assert_int_equal(r.code, 0);
+    CHECK_REL(check_value(r.out, "impact_speed"), 0.0253093363 / 2, 1e-8);
+    free(r.out);
     /* a speed given on the command line replaces the file's Stokes number (it prints back as
        the input decimal: measured exactly 0.1; 1e-12 allows a different last printed digit) */
     r = run_cli("run examples/scenarios/nijssen_head_on.ini --check --set collision.speed=0.1");
@@ -395,8 +401,16 @@ static void test_scenario_bad_files_exit_2_with_line(void** state)
          ":6:", "h23 places sphere 3, which n_spheres = 2 leaves out"},
         {"unread_binary", "[collision]\nstokes = 5\n\n[davis]\nstokes = 2\n",
          ":4:", "[davis]: not read by a binary collision"},
+        /* a three-sphere scenario without its [engine] line: the line that chooses it named */
+        {"unread_pairwise", "[davis]\nn_spheres = 3\nstokes = 2\n", ":1:",
+         "remove it (a section of the pairwise engine: to run several spheres with it, add "
+         "[engine] type = pairwise)"},
         {"unread_many", "[box]\nsize_x = 1e-2\n[output]\ntrajectory = none\n",
          ":3:", "[output]: not read by a many-particle run"},
+        {"unread_many_sphere", "[box]\nsize_x = 1e-2\n[sphere.a]\nradius = 1e-3\n", ":3:",
+         "[sphere.a]: not read by a many-particle run, which reads [engine], [box], [walls], "
+         "[insert], [insert.NAME], [particle.NAME], [read.NAME], [run], [dump], "
+         "[material.NAME], [fluid], [models], [model.NAME], [integrator] and [sim]: remove it\n"},
         {"overlap",
          "[engine]\ntype = pairwise\n[pairwise]\nh_min = 1e-6\nt_end = 1\n[sphere.a]\nradius = "
          "1e-3\nmass = 1e-5\n"
