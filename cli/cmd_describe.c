@@ -100,8 +100,16 @@ static void describe_integrator(const char* name)
     print_table(wetdem_integrator_params(name));
 }
 
+/* What describe takes, for its messages. */
+static const char valid_names[] = "a model name (see 'wetdem models'), an integrator (verlet, "
+                                  "cvode), material, fluid, sim or presets";
+
 static int unknown_name(const char* name)
 {
+    if (!name[0]) { /* (every short name is "near" the empty one) */
+        cli_error("describe: an empty name; valid: %s", valid_names);
+        return CLI_EXIT_USAGE;
+    }
     const char* names[96];
     size_t n = 0;
     const struct wetdem_model* const* reg = wetdem_model_registry();
@@ -118,9 +126,8 @@ static int unknown_name(const char* name)
         lower[len] = (char)tolower((unsigned char)name[len]);
     lower[len] = '\0';
     const char* hint = wetdem_param_suggest(lower, names);
-    cli_error("describe: unknown name '%s'%s%s%s; valid: a model name (see 'wetdem models'), "
-              "an integrator (verlet, cvode), material, fluid, sim or presets",
-              name, hint ? " (did you mean '" : "", hint ? hint : "", hint ? "'?)" : "");
+    cli_error("describe: unknown name '%s'%s%s%s; valid: %s", name, hint ? " (did you mean '" : "",
+              hint ? hint : "", hint ? "'?)" : "", valid_names);
     return CLI_EXIT_USAGE;
 }
 

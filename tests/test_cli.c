@@ -176,6 +176,12 @@ static void test_cli_describe_unknown_name(void** state)
     assert_int_equal(r.code, 2);
     CHECK_CONTAINS(r.out, "usage: wetdem describe NAME");
     free(r.out);
+    /* an empty name is said to be one, with no hint (it was "did you mean 'sb'?") */
+    r = run_cli("describe ''", true);
+    assert_int_equal(r.code, 2);
+    CHECK_CONTAINS(r.out, "describe: an empty name; valid: a model name");
+    assert_null(strstr(r.out, "did you mean"));
+    free(r.out);
 }
 
 /* Parses the first data row of a forces CSV into cols[4]; checks the provenance lines and the
