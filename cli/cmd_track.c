@@ -9,7 +9,6 @@
  * Exit codes: 0 ok, 1 out of memory or a failed write (a full disk), 2 bad options, a --frames
  * that cannot be written there, or a malformed track.
  */
-#include <errno.h>
 #include <limits.h>
 #include <math.h>
 #include <stdlib.h>
@@ -45,12 +44,12 @@ struct track_cli {
     struct wetdem_track_options opt;
 };
 
+/* A whole number in decimal or exponent notation ("7", "7.0", "1e3"), as every count of the
+ * command line (sweep's N, fit's --max-iter) is read. */
 static int parse_int(const char* text, const char* what, int* out)
 {
-    char* end = NULL;
-    errno = 0;
-    long v = strtol(text, &end, 10);
-    if (end == text || *end != '\0' || errno == ERANGE || v < INT_MIN || v > INT_MAX) {
+    double v;
+    if (cli_number(text, &v) != 0 || v != floor(v) || v < INT_MIN || v > INT_MAX) {
         cli_error("%s: '%s' is not an integer", what, text);
         return CLI_EXIT_USAGE;
     }

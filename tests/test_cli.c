@@ -962,6 +962,28 @@ static void test_cli_numbers_out_of_range_and_cr_lines(void** state)
          2},
     };
     check_cli_cases(cases, sizeof cases / sizeof cases[0]);
+    /* track's counts are read as every count of the command line (sweep's N, fit's
+       --max-iter): a whole number, in exponent notation too; 7.5 is none */
+    const char* head =
+        "track examples/tracks/punch_45deg.csv --fps 5000 --pixel-size 175e-6 --json";
+    char cmd[200];
+    snprintf(cmd, sizeof cmd, "%s --window 7", head);
+    struct test_run seven = run_cli(cmd, false);
+    assert_int_equal(seven.code, 0);
+    const char* spellings[2] = {"7.0", "0.7e1"};
+    for (int k = 0; k < 2; k++) {
+        snprintf(cmd, sizeof cmd, "%s --window %s", head, spellings[k]);
+        struct test_run same = run_cli(cmd, false);
+        assert_int_equal(same.code, 0);
+        assert_string_equal(same.out, seven.out);
+        free(same.out);
+    }
+    free(seven.out);
+    snprintf(cmd, sizeof cmd, "%s --window 7.5", head);
+    struct test_run half = run_cli(cmd, true);
+    assert_int_equal(half.code, 2);
+    CHECK_CONTAINS(half.out, "--window: '7.5' is not an integer");
+    free(half.out);
     const char* path = temp_scenario("[collision]\rspeed = 0.1\r[models]\rforce = hertz\r");
     char args[128];
     snprintf(args, sizeof args, "run %s --check", path);
