@@ -523,6 +523,10 @@ void wetdem_sim_many_keep_models(struct wetdem_sim* sim);
  * run recorded (their parameters may change), else WETDEM_ERR_INVALID with a message naming
  * both sets, beginning with `what` (the call refused). */
 int wetdem_sim_many_check_models(const struct wetdem_sim* sim, const char* what);
+/* What a report of a started run requires (wetdem_sim_many_stats, wetdem_sim_many_speeds):
+ * the many-particle mode, a started run and its models unchanged
+ * (wetdem_sim_many_check_models). WETDEM_OK, or WETDEM_ERR_INVALID with "WHAT: why". */
+int wetdem_sim_many_check_run(const struct wetdem_sim* sim, const char* what);
 
 /* sim_many_force.c */
 /* Builds the material-pair table and chooses the kernel (fused or generic); needs m->reach

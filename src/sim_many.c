@@ -1440,6 +1440,16 @@ int wetdem_sim_many_check_models(const struct wetdem_sim* sim, const char* what)
                            what, was, is);
 }
 
+int wetdem_sim_many_check_run(const struct wetdem_sim* sim, const char* what)
+{
+    const struct wetdem_many* m = sim->many;
+    if (!m || !m->started) /* (the message buffer: as wetdem_sim_many_check_models) */
+        return wetdem_sim_fail((struct wetdem_sim*)sim, WETDEM_ERR_INVALID, "%s: %s", what,
+                               !m ? "the simulation is not in the many-particle mode"
+                                  : "the many-particle run has not started");
+    return wetdem_sim_many_check_models(sim, what);
+}
+
 /* First call of a many run: step size, pair list, forces and the energy at t0. */
 static int start(struct wetdem_sim* sim)
 {

@@ -182,12 +182,7 @@ static void fill_run_stats(const struct wetdem_sim* sim, struct wetdem_many_stat
 int wetdem_sim_many_stats(const struct wetdem_sim* sim, struct wetdem_many_stats* s)
 {
     memset(s, 0, sizeof *s);
-    const struct wetdem_many* m = sim->many;
-    if (!m || !m->started) /* (the message buffer: as wetdem_sim_energy_budget) */
-        return wetdem_sim_fail((struct wetdem_sim*)sim, WETDEM_ERR_INVALID, "many_stats: %s",
-                               !m ? "the simulation is not in the many-particle mode"
-                                  : "the many-particle run has not started");
-    int st = wetdem_sim_many_check_models(sim, "many_stats");
+    int st = wetdem_sim_many_check_run(sim, "many_stats");
     if (st != WETDEM_OK)
         return st;
     st = wetdem_sim_many_links(sim, NULL, s);
@@ -202,18 +197,13 @@ int wetdem_sim_many_stats(const struct wetdem_sim* sim, struct wetdem_many_stats
 int wetdem_sim_many_speeds(const struct wetdem_sim* sim, double* speed_scale, double* speed_bound,
                            double* largest_speed)
 {
-    const struct wetdem_many* m = sim->many;
-    if (!m || !m->started) /* (the message buffer: as wetdem_sim_many_stats) */
-        return wetdem_sim_fail((struct wetdem_sim*)sim, WETDEM_ERR_INVALID, "many_speeds: %s",
-                               !m ? "the simulation is not in the many-particle mode"
-                                  : "the many-particle run has not started");
+    int st = wetdem_sim_many_check_run(sim, "many_speeds");
+    if (st != WETDEM_OK)
+        return st;
     if (!speed_scale || !speed_bound || !largest_speed)
         return wetdem_sim_fail((struct wetdem_sim*)sim, WETDEM_ERR_INVALID,
                                "many_speeds: NULL output");
-    int st = wetdem_sim_many_check_models(sim, "many_speeds");
-    if (st != WETDEM_OK)
-        return st;
-    run_speeds(m, speed_scale, speed_bound, largest_speed);
+    run_speeds(sim->many, speed_scale, speed_bound, largest_speed);
     return WETDEM_OK;
 }
 
