@@ -319,16 +319,12 @@ int cli_scenario_integrator_error(const struct cli_scenario* sc, const struct cl
     char home[400];
     if (!hint || strcmp(owner, chosen) == 0 || cli_key_home(sc, p, home, sizeof home) == 1)
         return cli_scenario_lib_error(sc, p, p->section, sim, status);
-    if (many)
-        cli_scenario_error(sc, p,
-                           "unknown parameter '%s.%s' (did you mean '%s', a parameter of the %s "
-                           "integrator? a many-particle run steps with %s)",
-                           chosen, p->key, hint, owner, chosen);
-    else
-        cli_scenario_error(sc, p,
-                           "unknown parameter '%s.%s' (did you mean '%s', a parameter of the %s "
-                           "integrator? the scenario uses %s: [integrator] name)",
-                           chosen, p->key, hint, owner, chosen);
+    cli_scenario_error(sc, p,
+                       "unknown parameter '%s.%s' (did you mean '%s', a parameter of the %s "
+                       "integrator? %s %s%s)",
+                       chosen, p->key, hint, owner,
+                       many ? "a many-particle run steps with" : "the scenario uses", chosen,
+                       many ? "" : ": [integrator] name");
     return CLI_EXIT_USAGE;
 }
 
