@@ -192,19 +192,16 @@ double cli_stokes_speed(double stokes_n, double viscosity, double m_eff, double 
 /* ---- internal: building blocks of the soft-engine and many-particle builders
  * (scenario_build.c, used by scenario_many.c) ---- */
 
-/* Reports an [integrator] or [sim] key p that the library refused with `status` when set as a
- * parameter of the integrator `chosen` (many: of a many-particle run, which steps with it) or
- * a setting: an [integrator] key close to `name` (as "nam") with that hint; one closer to a
+/* Sets the [integrator] keys (but name) as parameters of the integrator `chosen`
+ * ("<chosen>.<key>") and the [sim] keys as settings ("sim.<key>"). A parameter of another
+ * integrator is skipped (a file tuned for cvode also runs with --set integrator.name=verlet;
+ * many: a many-particle run, which steps with verlet, warns about it elsewhere). A key the
+ * library refuses is reported: one close to `name` (as "nam") with that hint; one closer to a
  * parameter of another integrator than to any of the chosen one's (rtoll, where verlet steps:
  * cvode's rtol) with that parameter and its integrator; else as cli_scenario_lib_error.
  * Returns the exit code. */
-int cli_scenario_integrator_error(const struct cli_scenario* sc, const struct cli_entry* p,
-                                  const char* chosen, bool many, const struct wetdem_sim* sim,
-                                  int status);
-
-/* Whether an integrator other than `chosen` has the parameter `key` (cvode's rtol, say, where
- * verlet is chosen). */
-bool cli_scenario_other_integrator_has(const char* chosen, const char* key);
+int cli_scenario_set_integrator_keys(const struct cli_scenario* sc, struct wetdem_sim* sim,
+                                     const char* chosen, bool many);
 
 /* Most rows a trajectory file may get: about 2 GB of CSV. */
 #define CLI_MAX_TRAJECTORY_ROWS 1e7

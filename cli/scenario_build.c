@@ -256,7 +256,9 @@ static int build_models(const struct cli_scenario* sc, struct wetdem_sim* sim)
     return rc == CLI_EXIT_OK ? cli_scenario_set_model_params(sc, sim) : rc;
 }
 
-bool cli_scenario_other_integrator_has(const char* chosen, const char* key)
+/* Whether an integrator other than `chosen` has the parameter `key` (cvode's rtol, say, where
+ * verlet is chosen). */
+static bool other_integrator_has(const char* chosen, const char* key)
 {
     struct wetdem_sim* probe = wetdem_sim_create();
     const char* const* names = wetdem_integrator_names();
@@ -299,9 +301,10 @@ static const char* integrator_key_suggest(const char* chosen, const char* key, c
     return hint;
 }
 
-int cli_scenario_integrator_error(const struct cli_scenario* sc, const struct cli_entry* p,
-                                  const char* chosen, bool many, const struct wetdem_sim* sim,
-                                  int status)
+/* Reports the [integrator] or [sim] key p that the library refused with `status`
+ * (cli_scenario_set_integrator_keys). Returns the exit code. */
+static int integrator_error(const struct cli_scenario* sc, const struct cli_entry* p,
+                            const char* chosen, bool many, const struct wetdem_sim* sim, int status)
 {
     static const char* const name_key[] = {"name", NULL};
     bool integrator = strcmp(p->section, "integrator") == 0;
@@ -328,6 +331,27 @@ int cli_scenario_integrator_error(const struct cli_scenario* sc, const struct cl
     return CLI_EXIT_USAGE;
 }
 
+int cli_scenario_set_integrator_keys(const struct cli_scenario* sc, struct wetdem_sim* sim,
+                                     const char* chosen, bool many)
+{
+    for (size_t k = 0; k < sc->n_entries; k++) {
+        const struct cli_entry* p = &sc->entries[k];
+        bool is_integrator = strcmp(p->section, "integrator") == 0 && strcmp(p->key, "name");
+        if (!is_integrator && strcmp(p->section, "sim") != 0)
+            continue;
+        char full[CLI_VALUE_MAX + CLI_NAME_MAX + 2];
+        snprintf(full, sizeof full, "%s.%s", is_integrator ? chosen : "sim", p->key);
+        double current;
+        if (is_integrator && wetdem_sim_param(sim, full, &current) == WETDEM_ERR_NOT_FOUND &&
+            other_integrator_has(chosen, p->key))
+            continue; /* a parameter of the integrator not chosen (e.g. --set name=verlet) */
+        int st = wetdem_sim_set_param_str(sim, full, p->value);
+        if (st != WETDEM_OK)
+            return integrator_error(sc, p, chosen, many, sim, st);
+    }
+    return CLI_EXIT_OK;
+}
+
 /* [integrator] name and parameters ("<name>.<key>"), [sim] settings ("sim.<key>").
  * Parameters of an integrator other than the chosen one are skipped, so a file tuned for
  * cvode also runs with --set integrator.name=verlet; a key no integrator has is an error. */
@@ -341,22 +365,7 @@ static int build_integrator(const struct cli_scenario* sc, struct wetdem_sim* si
         cli_scenario_error(sc, e ? e : &d, "%s", wetdem_sim_errmsg(sim));
         return CLI_EXIT_USAGE;
     }
-    for (size_t k = 0; k < sc->n_entries; k++) {
-        const struct cli_entry* p = &sc->entries[k];
-        bool is_integrator = strcmp(p->section, "integrator") == 0 && strcmp(p->key, "name");
-        if (!is_integrator && strcmp(p->section, "sim") != 0)
-            continue;
-        char full[CLI_VALUE_MAX + CLI_NAME_MAX + 2];
-        snprintf(full, sizeof full, "%s.%s", is_integrator ? name : "sim", p->key);
-        double current;
-        if (is_integrator && wetdem_sim_param(sim, full, &current) == WETDEM_ERR_NOT_FOUND &&
-            cli_scenario_other_integrator_has(name, p->key))
-            continue; /* a parameter of the integrator not chosen (e.g. --set name=verlet) */
-        int st = wetdem_sim_set_param_str(sim, full, p->value);
-        if (st != WETDEM_OK)
-            return cli_scenario_integrator_error(sc, p, name, false, sim, st);
-    }
-    return CLI_EXIT_OK;
+    return cli_scenario_set_integrator_keys(sc, sim, name, false);
 }
 
 /* Radii, masses, R*, m*, the impact speed and the times of the collision. */

@@ -281,22 +281,8 @@ static int build_settings(const struct cli_scenario* sc, struct wetdem_sim* sim)
                            "name = verlet (or leave it out)");
         return CLI_EXIT_USAGE;
     }
-    for (size_t k = 0; k < sc->n_entries; k++) {
-        const struct cli_entry* p = &sc->entries[k];
-        bool integ = strcmp(p->section, "integrator") == 0 && strcmp(p->key, "name") != 0;
-        if (!integ && strcmp(p->section, "sim") != 0)
-            continue;
-        char full[2 * CLI_NAME_MAX];
-        snprintf(full, sizeof full, "%s.%s", integ ? "verlet" : "sim", p->key);
-        double current;
-        if (integ && wetdem_sim_param(sim, full, &current) == WETDEM_ERR_NOT_FOUND &&
-            cli_scenario_other_integrator_has("verlet", p->key))
-            continue; /* cvode's (rtol, say): not read, warned about (warn_ignored) */
-        int st = wetdem_sim_set_param_str(sim, full, p->value);
-        if (st != WETDEM_OK)
-            return cli_scenario_integrator_error(sc, p, "verlet", true, sim, st);
-    }
-    return CLI_EXIT_OK;
+    /* (cvode's keys, rtol say, are not read: warned about by warn_ignored) */
+    return cli_scenario_set_integrator_keys(sc, sim, "verlet", true);
 }
 
 /* ------------------------------------------------------------------------- materials --- */
