@@ -76,66 +76,9 @@ static void frame_name(const struct series* s, size_t k, bool links, char* buf, 
     snprintf(buf, n, "%s%s_%06zu.vtk", s->prefix, links ? WETDEM_LINKS_SUFFIX : "", k);
 }
 
-/* A fresh run replaces the run in its directory: removes the frames and links an earlier run
- * left there (the files named as this series names its frames and their links, and no other
- * file), which the new index would not list and a shorter run would not overwrite; and both
- * indexes, which a run without links, or without frames, would leave behind describing the
- * earlier run. 0, or -1 with errno set. */
-static int series_clear(const struct series* s)
-{
-    DIR* d = opendir(s->dir);
-    if (!d)
-        return -1;
-    char links_prefix[CLI_VALUE_MAX + 8], links_index[CLI_VALUE_MAX + 24];
-    char index[CLI_VALUE_MAX + 16];
-    snprintf(links_prefix, sizeof links_prefix, "%s" WETDEM_LINKS_SUFFIX, s->prefix);
-    snprintf(links_index, sizeof links_index, "%s.vtk.series", links_prefix);
-    snprintf(index, sizeof index, "%s.vtk.series", s->prefix);
-    int rc = 0;
-    for (struct dirent* e = readdir(d); e && rc == 0; e = readdir(d)) {
-        char path[PATH_CHARS + 300];
-        snprintf(path, sizeof path, "%s/%s", s->dir, e->d_name);
-        if ((cli_is_frame_name(s->prefix, e->d_name) ||
-             cli_is_frame_name(links_prefix, e->d_name) || strcmp(e->d_name, links_index) == 0 ||
-             strcmp(e->d_name, index) == 0) &&
-            unlink(path) != 0 && errno != ENOENT)
-            rc = -1;
-    }
-    int err = errno;
-    closedir(d);
-    errno = err;
-    return rc;
-}
-
 /* The summary, the global CSV and the checkpoint, in this order (outputs_clear removes the
  * summary first), as output_what names them. */
 static const char* const output_files[3] = {"the summary", "the CSV", "the checkpoint"};
-
-/* The names in --out of the summary, global CSV and checkpoint (output_files) that a fresh
- * run replaces: this run's names or, for an output it does not write, the default names. */
-static void earlier_names(const struct cli_many_setup* su, const char* names[3])
-{
-    names[0] = su->summary_name[0] ? su->summary_name : "summary.json";
-    names[1] = su->csv_name[0] ? su->csv_name : "global.csv";
-    names[2] = su->checkpoint_name[0] ? su->checkpoint_name : "checkpoint.ckpt";
-}
-
-/* A fresh run replaces the run in its directory (as series_clear its frames): removes the
- * summary, global CSV and checkpoint an earlier run left there (earlier_names); the summary
- * first, so a run that fails or is killed before its end leaves no summary beside its files
- * that describes the earlier run. 0, or -1 with errno set. */
-static int outputs_clear(const char* dir, const struct cli_many_setup* su)
-{
-    const char* names[3];
-    earlier_names(su, names);
-    for (size_t k = 0; k < 3; k++) {
-        char path[PATH_CHARS + CLI_VALUE_MAX];
-        snprintf(path, sizeof path, "%s/%s", dir, names[k]);
-        if (unlink(path) != 0 && errno != ENOENT)
-            return -1;
-    }
-    return 0;
-}
 
 /* Which of the run's outputs the file `name` in --out is, or NULL: a frame or links frame of
  * s (NULL: none) or one of their indexes (series_clear), or names[k] (NULL: none), which is
@@ -161,6 +104,56 @@ static const char* output_what(const char* name, const struct series* s, const c
         if (names[k] && strcmp(name, names[k]) == 0)
             return output_files[k];
     return NULL;
+}
+
+/* A fresh run replaces the run in its directory: removes the frames and links an earlier run
+ * left there (the files output_what names as this series's frames and links, and no other
+ * file), which the new index would not list and a shorter run would not overwrite; and both
+ * indexes, which a run without links, or without frames, would leave behind describing the
+ * earlier run. 0, or -1 with errno set. */
+static int series_clear(const struct series* s)
+{
+    DIR* d = opendir(s->dir);
+    if (!d)
+        return -1;
+    static const char* const none[3] = {NULL, NULL, NULL};
+    int rc = 0;
+    for (struct dirent* e = readdir(d); e && rc == 0; e = readdir(d)) {
+        char path[PATH_CHARS + 300];
+        snprintf(path, sizeof path, "%s/%s", s->dir, e->d_name);
+        if (output_what(e->d_name, s, none) && unlink(path) != 0 && errno != ENOENT)
+            rc = -1;
+    }
+    int err = errno;
+    closedir(d);
+    errno = err;
+    return rc;
+}
+
+/* The names in --out of the summary, global CSV and checkpoint (output_files) that a fresh
+ * run replaces: this run's names or, for an output it does not write, the default names. */
+static void earlier_names(const struct cli_many_setup* su, const char* names[3])
+{
+    names[0] = su->summary_name[0] ? su->summary_name : "summary.json";
+    names[1] = su->csv_name[0] ? su->csv_name : "global.csv";
+    names[2] = su->checkpoint_name[0] ? su->checkpoint_name : "checkpoint.ckpt";
+}
+
+/* A fresh run replaces the run in its directory (as series_clear its frames): removes the
+ * summary, global CSV and checkpoint an earlier run left there (earlier_names); the summary
+ * first, so a run that fails or is killed before its end leaves no summary beside its files
+ * that describes the earlier run. 0, or -1 with errno set. */
+static int outputs_clear(const char* dir, const struct cli_many_setup* su)
+{
+    const char* names[3];
+    earlier_names(su, names);
+    for (size_t k = 0; k < 3; k++) {
+        char path[PATH_CHARS + CLI_VALUE_MAX];
+        snprintf(path, sizeof path, "%s/%s", dir, names[k]);
+        if (unlink(path) != 0 && errno != ENOENT)
+            return -1;
+    }
+    return 0;
 }
 
 /* Refuses an --out DIR that holds, under the name of one of the run's outputs (output_what,
