@@ -560,6 +560,25 @@ WETDEM_API void wetdem_sim_set_observer(struct wetdem_sim* sim, double interval,
 WETDEM_API const struct wetdem_particle* wetdem_sim_particles_const(const struct wetdem_sim* sim,
                                                                     size_t* n);
 
+/* Progress of a long run, for a caller that shows it (e.g. with the time left): called with
+ * the simulated time t [s] the run has reached, the t_end [s] it runs to and the wall-clock
+ * time [s] since the run began, after every WETDEM_PROGRESS_STEPS accepted steps of the
+ * integrator and once more when the run ends without an error (at t_end, or where a stop
+ * condition ended it). Successive calls of one run have non-decreasing t. It only observes:
+ * it is given no state, it changes no step (not even CVODE's), and a run gives the same
+ * results bit for bit with or without it. A non-zero return stops the run at that step with
+ * WETDEM_ERR_CALLBACK (the state stays at the step; the return of the last call, when the run
+ * has ended, is ignored). Used by wetdem_sim_set_progress and wetdem_pairwise_set_progress;
+ * the many-particle mode has its own (wetdem_progress_fn). */
+typedef int (*wetdem_time_progress_fn)(double t, double t_end, double elapsed, void* ctx);
+#define WETDEM_PROGRESS_STEPS 64
+/* Sets the progress callback of the two-body engine (verlet and cvode): each
+ * wetdem_sim_integrate call, and so each wetdem_collision_run, is one run, from the call's
+ * start to its t_end. fn NULL removes it. Kept by wetdem_sim_reset, not copied by
+ * wetdem_sim_clone; not called in the many-particle mode (wetdem_many_settings.progress). */
+WETDEM_API void wetdem_sim_set_progress(struct wetdem_sim* sim, wetdem_time_progress_fn fn,
+                                        void* ctx);
+
 /* ---- two-body collision analysis (SPEC §4) ---- */
 
 enum wetdem_outcome {
@@ -1124,6 +1143,11 @@ WETDEM_API int wetdem_pairwise_config_validate(const struct wetdem_pairwise_conf
  * with an observer and an interval that is not finite and > 0 is refused (WETDEM_ERR_INVALID). */
 WETDEM_API void wetdem_pairwise_set_observer(struct wetdem_pairwise* pw, double interval,
                                              wetdem_pairwise_observer_fn fn, void* ctx);
+/* Sets the progress callback (wetdem_time_progress_fn) of the runs of pw: t from 0 to
+ * cfg.t_end, elapsed from the start of wetdem_pairwise_run; a non-zero return stops the run
+ * with WETDEM_ERR_CALLBACK, as a failed run (*res holds no result). fn NULL removes it. */
+WETDEM_API void wetdem_pairwise_set_progress(struct wetdem_pairwise* pw, wetdem_time_progress_fn fn,
+                                             void* ctx);
 /* Runs one collision from cfg (copied) and fills *res. Returns WETDEM_OK, or a negative
  * status with the message in wetdem_pairwise_errmsg(); *res then holds no result (zeroed, with
  * some fields filled up to the failure: time, final and n_events stay 0), and the event log

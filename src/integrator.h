@@ -131,7 +131,8 @@ double wetdem_sim_length_scale(const struct wetdem_sim* sim);
  * current): true when some pair has interacted and every such pair is at or beyond
  * separation_factor x range and receding (v_n < 0); their flags are then cleared. */
 bool wetdem_sim_separation_reached(struct wetdem_sim* sim);
-/* After an accepted step at engine.time: calls the monitor. Returns its status. */
+/* After an accepted step at engine.time: calls the monitor, and the progress callback every
+ * WETDEM_PROGRESS_STEPS steps of the integrate call. Returns the first failing status. */
 int wetdem_sim_step_done(struct wetdem_sim* sim);
 /* Calls the observer, if any, with the current state at engine.time; maps a non-zero return
  * to WETDEM_ERR_CALLBACK (message stored). */

@@ -14,11 +14,14 @@
  * on CVODE's dense output (CVodeGetDky) by the Illinois variant of regula falsi to a relative
  * time tolerance of ~1e-13, the earliest crossing is processed (mode switch, impulse,
  * partner change) and CVODE is restarted there. Guards that touch zero at a restart (films
- * just touching at t = 0, h = h_min right after an impulse) need no special rule.
+ * just touching at t = 0, h = h_min right after an impulse) need no special rule. The
+ * progress callback is called between steps (every WETDEM_PROGRESS_STEPS) and never changes
+ * CVODE's stops.
  * Validity: as pairwise_rhs.c; contact instantaneous (hard sphere), planar motion.
  */
 #include <float.h>
 #include <math.h>
+#include <omp.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -61,6 +64,9 @@ struct wetdem_pairwise {
     void* obs_ctx;
     double obs_interval;
     unsigned long long n_out;
+    wetdem_time_progress_fn progress;
+    void* progress_ctx;
+    double progress_start; /* omp_get_wtime() at the start of the run [s] */
     /* per run */
     struct wetdem_pairwise_result* res;
     bool approaching[PW_PMAX];
@@ -140,6 +146,24 @@ void wetdem_pairwise_set_observer(struct wetdem_pairwise* pw, double interval,
     pw->obs = fn; /* (an interval it cannot use is refused by the next run) */
     pw->obs_ctx = ctx;
     pw->obs_interval = interval;
+}
+
+void wetdem_pairwise_set_progress(struct wetdem_pairwise* pw, wetdem_time_progress_fn fn, void* ctx)
+{
+    pw->progress = fn;
+    pw->progress_ctx = ctx;
+}
+
+/* Calls the progress callback at pw->t; a non-zero return stops the run (can_stop) or, at its
+ * end, is ignored. */
+static int report_progress(struct wetdem_pairwise* pw, bool can_stop)
+{
+    int r =
+        pw->progress(pw->t, pw->cfg.t_end, omp_get_wtime() - pw->progress_start, pw->progress_ctx);
+    if (r != 0 && can_stop)
+        return fail(pw, WETDEM_ERR_CALLBACK, "the progress callback returned %d at t = %g s", r,
+                    pw->t);
+    return WETDEM_OK;
 }
 
 const struct wetdem_pairwise_event* wetdem_pairwise_events(const struct wetdem_pairwise* pw,
@@ -1525,6 +1549,7 @@ int wetdem_pairwise_run(struct wetdem_pairwise* pw, const struct wetdem_pairwise
     pw->stalled = 0;
     pw->conv_fails_seen = 0;
     pw->window_steps = pw->window_fails = 0;
+    pw->progress_start = pw->progress ? omp_get_wtime() : 0.0;
     initial_state(pw);
     double ke0, u_c0;
     if (!energy_parts(pw, pw->y, &ke0, &u_c0, &pw->gravity_ref))
@@ -1543,10 +1568,14 @@ int wetdem_pairwise_run(struct wetdem_pairwise* pw, const struct wetdem_pairwise
         return WETDEM_ERR_NUMERIC;
     pw->done = pw->cfg.stop_when_separated && all_apart(pw, &k);
     while (!pw->done)
-        if ((st = advance(pw)) != WETDEM_OK)
+        if ((st = advance(pw)) != WETDEM_OK ||
+            (pw->progress && res->steps % WETDEM_PROGRESS_STEPS == 0 &&
+             (st = report_progress(pw, true)) != WETDEM_OK))
             return st;
     if (pw->obs && (st = emit(pw, pw->t, pw->y)) != WETDEM_OK)
         return st;
     finish(pw);
+    if (pw->progress)
+        report_progress(pw, false); /* (the run is over: nothing left to stop) */
     return WETDEM_OK;
 }

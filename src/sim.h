@@ -81,6 +81,14 @@ struct wetdem_engine {
     double next_observe;      /* next observer time [s] */
     double last_observed;     /* time of the latest observer call [s], NAN if none */
 
+    /* progress callback (wetdem_sim_set_progress), called by wetdem_sim_step_done every
+     * WETDEM_PROGRESS_STEPS steps and at the end of wetdem_sim_integrate */
+    wetdem_time_progress_fn progress;
+    void* progress_ctx;
+    double progress_t_end;             /* t_end of the integrate call [s] */
+    double progress_start;             /* omp_get_wtime() at its start [s] */
+    unsigned long long progress_steps; /* its accepted steps */
+
     /* internal per-step hook (collision analysis): called after every accepted step with
      * the state at engine.time; a negative return stops the run with that status */
     int (*monitor)(struct wetdem_sim* sim, void* ctx);

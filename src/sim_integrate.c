@@ -1,7 +1,7 @@
 /*
  * sim_integrate.c — the run loop of the soft engine (docs/engines.md): pair forces summed
- * over the pair list, the start and end of a run, the stop on separation, the observer,
- * integrator choice, statistics and the event log. Prefix: wetdem_sim_.
+ * over the pair list, the start and end of a run, the stop on separation, the observer, the
+ * progress callback, integrator choice, statistics and the event log. Prefix: wetdem_sim_.
  *
  * Equations of motion of every free particle (fixed particles and walls do not move):
  *     dx/dt = v,   dv/dt = (sum of pair forces)/m + g,   dw/dt = (sum of pair torques)/I,
@@ -23,6 +23,7 @@
  * half-step velocities at the current normal (midpoint rule, also second order).
  */
 #include <math.h>
+#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -336,10 +337,32 @@ bool wetdem_sim_separation_reached(struct wetdem_sim* sim)
     return true;
 }
 
+void wetdem_sim_set_progress(struct wetdem_sim* sim, wetdem_time_progress_fn fn, void* ctx)
+{
+    sim->engine.progress = fn;
+    sim->engine.progress_ctx = ctx;
+}
+
+/* Calls the progress callback at engine.time; a non-zero return is WETDEM_ERR_CALLBACK when
+ * the run can still stop (can_stop), ignored at its end. */
+static int report_progress(struct wetdem_sim* sim, bool can_stop)
+{
+    struct wetdem_engine* e = &sim->engine;
+    int r = e->progress(e->time, e->progress_t_end, omp_get_wtime() - e->progress_start,
+                        e->progress_ctx);
+    if (r != 0 && can_stop)
+        return wetdem_sim_fail(sim, WETDEM_ERR_CALLBACK,
+                               "the progress callback returned %d at t = %.9g s", r, e->time);
+    return WETDEM_OK;
+}
+
 int wetdem_sim_step_done(struct wetdem_sim* sim)
 {
     struct wetdem_engine* e = &sim->engine;
-    return e->monitor ? e->monitor(sim, e->monitor_ctx) : WETDEM_OK;
+    int st = e->monitor ? e->monitor(sim, e->monitor_ctx) : WETDEM_OK;
+    if (st == WETDEM_OK && e->progress && ++e->progress_steps % WETDEM_PROGRESS_STEPS == 0)
+        st = report_progress(sim, true);
+    return st;
 }
 
 int wetdem_sim_observe(struct wetdem_sim* sim)
@@ -443,6 +466,9 @@ int wetdem_sim_integrate(struct wetdem_sim* sim, double t_end)
     if (st == WETDEM_OK && sim->many) /* many-particle mode: cell lists, no events */
         return wetdem_sim_many_integrate(sim, t_end);
     e->trapezoid_spring = wetdem_integrator_registry()[e->integrator]->trapezoid_spring;
+    e->progress_t_end = t_end;
+    e->progress_start = e->progress ? omp_get_wtime() : 0.0;
+    e->progress_steps = 0;
     if (st == WETDEM_OK)
         st = begin_run(sim);
     bool due = e->observer_interval > 0 ? e->time >= e->next_observe : true;
@@ -460,5 +486,7 @@ int wetdem_sim_integrate(struct wetdem_sim* sim, double t_end)
         if (so != WETDEM_OK)
             return so;
     }
+    if (st >= 0 && e->progress)
+        report_progress(sim, false); /* (the run is over: nothing left to stop) */
     return st;
 }

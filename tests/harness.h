@@ -110,6 +110,31 @@ static inline void test_check_same_particles(const struct wetdem_sim* a, const s
     }
 }
 
+/* ---- progress callbacks (wetdem_time_progress_fn) ---- */
+
+/* What the progress calls of a run gave: their count, whether t and elapsed never decreased
+ * (and elapsed was never negative), the t_end of every call (NAN when two differed) and the
+ * last t. Call number stop_at (> 0) returns 1, which stops the run. */
+struct test_progress_log {
+    unsigned long calls, stop_at;
+    bool monotone;
+    double t_end, last_t, last_elapsed;
+};
+
+static inline int test_log_progress(double t, double t_end, double elapsed, void* ctx)
+{
+    struct test_progress_log* log = ctx;
+    bool first = log->calls == 0;
+    log->monotone =
+        (first || (log->monotone && t >= log->last_t && elapsed >= log->last_elapsed)) &&
+        elapsed >= 0;
+    log->t_end = first || t_end == log->t_end ? t_end : NAN;
+    log->last_t = t;
+    log->last_elapsed = elapsed;
+    log->calls++;
+    return log->stop_at && log->calls == log->stop_at;
+}
+
 /* ---- the command-line tool ---- */
 
 /* The soft glass-like material of the many-particle tests: 2500 kg/m^3, E = 10 MPa (a step of

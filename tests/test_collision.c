@@ -2,8 +2,9 @@
  * test_collision.c — binary collisions on the soft engine (wetdem_collision_run) and their
  * analysis (STYLE §6.9.4): dry undamped Hertz (e = 1, Hertz contact time), damped Hertz
  * (e = e_dry), the Verlet step from hooke's own contact time, momentum conservation, e
- * falling with viscosity, lubrication acting on a wall, Verlet and CVODE agreeing, i <-> j symmetry, determinism, clones, outcome classes, the
- * Stokes-number speed, the observation window, and input validation.
+ * falling with viscosity, lubrication acting on a wall, Verlet and CVODE agreeing, i <-> j
+ * symmetry, determinism, clones, a progress callback that changes nothing, outcome classes,
+ * the Stokes-number speed, the observation window, and input validation.
  */
 #include "harness.h"
 
@@ -1095,6 +1096,70 @@ static void test_collision_observe_window(void** state)
 }
 
 /* Bad specs are refused with a message naming the field. */
+/* The progress callback only observes: a collision run with it gives the same bits as one
+ * without (both integrators; its results, work counters, event log and final state), and it
+ * is called every WETDEM_PROGRESS_STEPS steps (verlet counts them exactly) with the run's
+ * t_end and non-decreasing times, the last at the end of the run: the separation, or t_end
+ * when the run stops there first (a tenth of the first run's time). A non-zero return stops
+ * the run at that step with WETDEM_ERR_CALLBACK. */
+static void test_collision_progress_only_observes(void** state)
+{
+    (void)state;
+    for (int q = 0; q < 2; q++) {
+        struct wetdem_sim* sim[2];
+        struct wetdem_collision_result r[2];
+        struct test_progress_log log = {0};
+        struct wetdem_collision_spec s;
+        for (int with = 0; with < 2; with++) {
+            int mat;
+            sim[with] = make_sim("glass", 0, "nijssen", NULL, integrators[q], &mat);
+            s = head_on(mat, 0, 1.0);
+            s.stokes = 300;
+            s.angle = 0.3;
+            if (with)
+                wetdem_sim_set_progress(sim[with], test_log_progress, &log);
+            CHECK_OK(wetdem_collision_run(sim[with], &s, &r[with]));
+        }
+        assert_true(r[0].separated);
+        assert_true(r[1].e == r[0].e && r[1].e_n == r[0].e_n && r[1].e_t == r[0].e_t &&
+                    r[1].min_gap == r[0].min_gap && r[1].t_final == r[0].t_final &&
+                    r[1].contact_duration == r[0].contact_duration);
+        assert_memory_equal(&r[1].stats, &r[0].stats, sizeof r[0].stats);
+        test_check_same_particles(sim[0], sim[1]);
+        size_t n0, n1;
+        const struct wetdem_event_record* ev0 = wetdem_sim_events(sim[0], &n0);
+        const struct wetdem_event_record* ev1 = wetdem_sim_events(sim[1], &n1);
+        assert_int_equal(n0, n1);
+        for (size_t k = 0; k < n0; k++)
+            assert_true(ev0[k].time == ev1[k].time && ev0[k].kind == ev1[k].kind &&
+                        ev0[k].gap == ev1[k].gap);
+        assert_true(log.monotone && log.t_end == s.t_end && log.last_t == r[0].t_final);
+        if (q == 0)
+            assert_int_equal(log.calls, r[0].stats.steps / WETDEM_PROGRESS_STEPS + 1);
+        else /* (cvode: 532 steps, one a return of CV_ONE_STEP) */
+            assert_true(log.calls > 5);
+
+        /* a run that ends at t_end: the last call comes there */
+        s.t_end = 0.1 * r[0].t_final;
+        log = (struct test_progress_log){0};
+        CHECK_OK(wetdem_collision_run(sim[1], &s, &r[1]));
+        assert_false(r[1].separated);
+        assert_true(log.monotone && log.t_end == s.t_end && log.last_t == s.t_end);
+
+        /* the third call stops the run where it is */
+        s.t_end = 1.0;
+        log = (struct test_progress_log){.stop_at = 3};
+        CHECK_STATUS(wetdem_collision_run(sim[1], &s, &r[1]), WETDEM_ERR_CALLBACK);
+        CHECK_CONTAINS(wetdem_sim_errmsg(sim[1]), "progress callback returned 1");
+        assert_int_equal(log.calls, 3);
+        assert_true(wetdem_sim_time(sim[1]) == log.last_t);
+        if (q == 0)
+            assert_int_equal(r[1].stats.steps, 3 * WETDEM_PROGRESS_STEPS);
+        for (int with = 0; with < 2; with++)
+            wetdem_sim_free(sim[with]);
+    }
+}
+
 static void test_collision_bad_spec(void** state)
 {
     (void)state;
@@ -1145,6 +1210,7 @@ int main(void)
         cmocka_unit_test(test_collision_integrators_agree),
         cmocka_unit_test(test_collision_swap_roles),
         cmocka_unit_test(test_collision_deterministic_and_clone),
+        cmocka_unit_test(test_collision_progress_only_observes),
         cmocka_unit_test(test_collision_outcomes),
         cmocka_unit_test(test_collision_free_flight_impact_parameter),
         cmocka_unit_test(test_collision_oblique_rebound_normal),

@@ -3,8 +3,8 @@
  * deforming-bridge film, dry hard-sphere restitution, conservation through impulses, the
  * explicit jump formulas of Appendix A against the vector route, i<->j relabelling, positions
  * from relative variables against a Cartesian integration of the same forces, force kernels
- * against the soft engine's models, outcome classification, the Table-I builder and input
- * checks.
+ * against the soft engine's models, outcome classification, the Table-I builder, input
+ * checks and a progress callback that changes nothing.
  *
  * Closed form used below (docs/derivations/pairwise.md Sec. 5): head-on, no capillarity,
  * m* dv/dt = -6 pi mu a^2 v [1 - h/(2 delta - h)]^2 / h with v = -dh/dt gives
@@ -1200,6 +1200,42 @@ static void test_pairwise_deterministic(void** state)
     assert_memory_equal(&a, &b, sizeof a);
 }
 
+/* The progress callback only observes: a run with it gives the same result and event log,
+ * bit for bit, as one without (Davis's three spheres of Fig. 3, FA with a partner change,
+ * which runs to t_end); it is called every WETDEM_PROGRESS_STEPS steps with t_end and
+ * non-decreasing times, and once more at the end, at t_end. A non-zero return stops the run
+ * at that step with WETDEM_ERR_CALLBACK. */
+static void test_pairwise_progress_only_observes(void** state)
+{
+    (void)state;
+    struct wetdem_pairwise_config c = davis(2.0, 1000.0, 30.0, 20.0);
+    struct wetdem_pairwise_result a, b;
+    struct wetdem_pairwise* pa;
+    CHECK_OK(run(&c, &a, &pa));
+    struct wetdem_pairwise* pb = wetdem_pairwise_create();
+    struct test_progress_log log = {0};
+    wetdem_pairwise_set_progress(pb, test_log_progress, &log);
+    CHECK_OK(wetdem_pairwise_run(pb, &c, &b));
+    assert_memory_equal(&a, &b, sizeof a);
+    size_t na, nb;
+    const struct wetdem_pairwise_event* ea = wetdem_pairwise_events(pa, &na);
+    const struct wetdem_pairwise_event* eb = wetdem_pairwise_events(pb, &nb);
+    assert_int_equal(na, nb);
+    assert_memory_equal(ea, eb, na * sizeof *ea);
+    assert_int_equal(a.outcome, WETDEM_PAIRWISE_FA);
+    assert_true(log.monotone && log.t_end == c.t_end && log.last_t == c.t_end && a.time == c.t_end);
+    assert_int_equal(log.calls, a.steps / WETDEM_PROGRESS_STEPS + 1);
+    assert_true(log.calls > 5);
+
+    log = (struct test_progress_log){.stop_at = 2};
+    CHECK_STATUS(wetdem_pairwise_run(pb, &c, &b), WETDEM_ERR_CALLBACK);
+    CHECK_CONTAINS(wetdem_pairwise_errmsg(pb), "progress callback returned 1");
+    assert_int_equal(log.calls, 2);
+    assert_int_equal(b.steps, 2 * WETDEM_PROGRESS_STEPS);
+    wetdem_pairwise_free(pa);
+    wetdem_pairwise_free(pb);
+}
+
 /* ---------------------------------------------- Cartesian integration of the same forces */
 
 struct cart {
@@ -2193,6 +2229,7 @@ int main(void)
         cmocka_unit_test(test_pairwise_simultaneous_friction_apart_is_single),
         cmocka_unit_test(test_pairwise_cradle_placed_at_h_min),
         cmocka_unit_test(test_pairwise_deterministic),
+        cmocka_unit_test(test_pairwise_progress_only_observes),
         cmocka_unit_test(test_pairwise_positions_match_cartesian),
         cmocka_unit_test(test_pairwise_unequal_triangle_matches_cartesian),
         cmocka_unit_test(test_pairwise_forces_match_models),
