@@ -1,7 +1,8 @@
 /*
  * cli_util.c — helpers shared by the CLI subcommands (see cli_util.h): messages, strict
  * parsing of numbers and "A:B:N" ranges, "--set KEY=VALUE", CSV provenance lines, tables
- * and --out files written whole (temporary file, then rename) or not at all.
+ * and --out files written whole (temporary file, then rename) or not at all, the progress line
+ * of a long run.
  *
  * Range values: linear x_k = A + (B - A) k/(N - 1); geometric x_k = A (B/A)^(k/(N - 1)),
  * computed as 10^(log10 A + (log10 B - log10 A) k/(N - 1)) so that decades come out as the
@@ -10,6 +11,7 @@
 #include <ctype.h>
 #include <errno.h>
 #include <math.h>
+#include <omp.h>
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
@@ -997,4 +999,43 @@ void cli_param_default_text(const struct wetdem_param_desc* d, char* buf, size_t
         return;
     }
     snprintf(buf, n, "%g", d->default_value);
+}
+
+/* ---- progress of a long run ---- */
+
+void cli_progress_start(struct cli_progress* p, double done)
+{
+    *p = (struct cli_progress){
+        .tty = isatty(STDERR_FILENO) == 1, .start = omp_get_wtime(), .done0 = done};
+}
+
+void cli_progress_show(struct cli_progress* p, double done, const char* fmt, ...)
+{
+    if (!p->tty)
+        return;
+    double elapsed = omp_get_wtime() - p->start;
+    bool last = done >= 1;
+    if (!(elapsed - p->last >= CLI_PROGRESS_EVERY || last) || !(done > p->done0))
+        return;
+    p->last = elapsed;
+    char what[200];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(what, sizeof what, fmt, ap);
+    va_end(ap);
+    double left = ceil(elapsed * (1 - fmin(done, 1)) / (done - p->done0));
+    int n = fprintf(stderr, "\rwetdem: %s (%5.1f %%), %.0f s elapsed, about %.*g s left   ", what,
+                    100 * done, elapsed, left < 1e6 ? 6 : 2, left);
+    p->shown = n > 1 ? n - 1 : 0; /* (less the carriage return) */
+    if (last)
+        cli_progress_clear(p);
+    fflush(stderr);
+}
+
+void cli_progress_clear(struct cli_progress* p)
+{
+    if (p->shown)
+        fprintf(stderr, "\r%*s\r", p->shown, "");
+    p->shown = 0;
+    fflush(stderr);
 }

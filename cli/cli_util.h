@@ -230,4 +230,30 @@ const char* cli_article(const char* word);
  * the number in %g format. */
 void cli_param_default_text(const struct wetdem_param_desc* d, char* buf, size_t n);
 
+/* Progress of a long run (`run` of every engine) on stderr, only while stderr is a terminal:
+ * one line "wetdem: WHAT (P %), E s elapsed, about L s left", redrawn in place at most every
+ * CLI_PROGRESS_EVERY seconds of wall time and first after as long, so that a short run shows
+ * none; the line of a run done (fraction 1) is drawn, then cleared. L extrapolates the pace
+ * since the start: elapsed x fraction left / fraction done since the start. */
+#define CLI_PROGRESS_EVERY 0.5
+struct cli_progress {
+    bool tty;     /* stderr is a terminal (nothing is shown otherwise) */
+    int shown;    /* characters of the line on the terminal; 0: none */
+    double start; /* omp_get_wtime() at the start [s] */
+    double last;  /* wall time of the latest line, from the start [s] */
+    double done0; /* fraction done at the start */
+};
+
+/* Starts the clock of p with the fraction `done` already done (a run continued from a
+ * checkpoint), and looks whether stderr is a terminal. */
+void cli_progress_start(struct cli_progress* p, double done);
+
+/* Shows the line with WHAT from the printf-style fmt when it is due, `done` the fraction of
+ * the run done (in [0, 1]; 1 is the last line, then cleared). */
+void cli_progress_show(struct cli_progress* p, double done, const char* fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+
+/* Clears the line, if one is shown: at the end of a run that stopped before it was done. */
+void cli_progress_clear(struct cli_progress* p);
+
 #endif

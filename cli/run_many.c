@@ -616,14 +616,11 @@ static int csv_resume(const char* path, double t, unsigned long long step, doubl
  * library may let each force pass begin the next step between them (sim_many.c one_step). */
 struct progress {
     struct wetdem_sim* sim;
-    struct series* vtk;            /* NULL: no frames */
-    unsigned long long base_step;  /* step count when this integrate call began */
-    unsigned long long first_step; /* step count when the stepping began */
-    unsigned long long run_total;  /* steps of the whole run */
-    bool tty;
-    double start;      /* omp_get_wtime() when the stepping began [s] */
-    double last_print; /* [s] of wall time since start */
-    int status;        /* first failure writing a frame (its message: vtk->error) */
+    struct series* vtk;           /* NULL: no frames */
+    unsigned long long base_step; /* step count when this integrate call began */
+    unsigned long long run_total; /* steps of the whole run */
+    struct cli_progress line;     /* started when the stepping begins (line.tty before) */
+    int status;                   /* first failure writing a frame (its message: vtk->error) */
 };
 
 /* Calls of the progress callback: every PROGRESS_PARTICLE_STEPS / N steps for N particles
@@ -635,31 +632,16 @@ struct progress {
 #define PROGRESS_EVERY 64
 #define PROGRESS_PARTICLE_STEPS 2000000.0
 
-static void print_progress(struct progress* p, unsigned long long step)
-{
-    double elapsed = omp_get_wtime() - p->start;
-    if (!(elapsed - p->last_print >= 0.5 || step == p->run_total) || step == p->first_step)
-        return;
-    p->last_print = elapsed;
-    double left = elapsed * (double)(p->run_total - step) / (double)(step - p->first_step);
-    fprintf(stderr,
-            "\rwetdem: step %llu/%llu (%5.1f %%), t = %.4g s, %.0f s elapsed, about "
-            "%.0f s left   ",
-            step, p->run_total, 100.0 * (double)step / (double)p->run_total,
-            wetdem_sim_time(p->sim), elapsed, ceil(left));
-    if (step == p->run_total)
-        fprintf(stderr, "\r%110s\r", "");
-    fflush(stderr);
-}
-
 /* Library progress callback, every PROGRESS_EVERY steps or fewer and at the end of a call: the
- * progress text on a terminal. */
+ * progress line on a terminal. */
 static int on_progress(unsigned long long done, unsigned long long total, double elapsed, void* ctx)
 {
     (void)total;
     (void)elapsed;
     struct progress* p = ctx;
-    print_progress(p, p->base_step + done);
+    unsigned long long step = p->base_step + done;
+    cli_progress_show(&p->line, (double)step / (double)p->run_total, "t = %.4g s, step %llu/%llu",
+                      wetdem_sim_time(p->sim), step, p->run_total);
     return 0;
 }
 
@@ -1187,7 +1169,7 @@ static int set_outputs(struct cli_many_setup* su, const struct cli_run_options* 
     m.checkpoint_path = pl->checkpoint[0] ? pl->checkpoint : NULL;
     m.checkpoint_every = su->checkpoint_every;
     m.stop_flag = &cli_stop_signal;
-    m.progress = prog->tty ? on_progress : NULL;
+    m.progress = prog->line.tty ? on_progress : NULL;
     m.progress_ctx = prog;
     double every = PROGRESS_PARTICLE_STEPS / (double)(wetdem_sim_n_particles(su->sim) + 1);
     m.progress_every = every < 1                ? 1
@@ -1320,7 +1302,7 @@ static int finish(const struct cli_scenario* sc, struct cli_many_setup* su,
         return CLI_EXIT_RUNTIME;
     o.has_budget = wetdem_sim_energy_budget(su->sim, &o.budget) == WETDEM_OK;
     struct run_speeds v = speeds_of(&o.stats);
-    warn_speed(sc, su, &v, prog->tty);
+    warn_speed(sc, su, &v, prog->line.tty);
     if (csv_final_row(pl->csv_prefix, su->csv_every, su->sim, o.stats.step) != WETDEM_OK) {
         cli_error("run %s: cannot append the last row to %s.csv: %s", sc->file, pl->csv_prefix,
                   wetdem_sim_errmsg(su->sim));
@@ -1329,7 +1311,7 @@ static int finish(const struct cli_scenario* sc, struct cli_many_setup* su,
     if (st == WETDEM_EVENT) {
         int sig = cli_stop_signal ? (int)cli_stop_signal : SIGINT;
         fprintf(stderr, "%swetdem: interrupted by %s at t = %.9g s (step %llu of %llu)",
-                prog->tty ? "\n" : "", sig == SIGTERM ? "SIGTERM" : "SIGINT",
+                prog->line.tty ? "\n" : "", sig == SIGTERM ? "SIGTERM" : "SIGINT",
                 wetdem_sim_time(su->sim), o.stats.step, pl->total);
         if (!pl->checkpoint[0])
             fprintf(stderr, "; no checkpoint (%s)\n",
@@ -1420,8 +1402,7 @@ static int run_steps(const struct cli_scenario* sc, struct cli_many_setup* su,
                      unsigned long long step)
 {
     bool warned = false; /* about the speeds (warn_speed): at the first frame that shows it */
-    prog->first_step = step;
-    prog->start = omp_get_wtime();
+    cli_progress_start(&prog->line, (double)step / (double)pl->total);
     int st = WETDEM_OK;
     while (st == WETDEM_OK && prog->status == WETDEM_OK && step < pl->total) {
         unsigned long long next = pl->total;
@@ -1445,7 +1426,7 @@ static int run_steps(const struct cli_scenario* sc, struct cli_many_setup* su,
         struct run_speeds v = {.dt = pl->dt};
         if (!warned && next < pl->total && prog->status == WETDEM_OK &&
             wetdem_sim_many_speeds(su->sim, &v.scale, &v.bound, &v.largest) == WETDEM_OK)
-            warned = warn_speed(sc, su, &v, prog->tty);
+            warned = warn_speed(sc, su, &v, prog->line.tty);
     }
     return st;
 }
@@ -1457,8 +1438,8 @@ static int run(const struct cli_scenario* sc, struct cli_many_setup* su,
                const struct cli_run_options* opt, struct plan* pl, struct series* vtk,
                const struct series* named)
 {
-    struct progress prog = {
-        .sim = su->sim, .vtk = vtk, .run_total = pl->total, .tty = isatty(STDERR_FILENO) == 1};
+    struct progress prog = {.sim = su->sim, .vtk = vtk, .run_total = pl->total};
+    cli_progress_start(&prog.line, 0); /* (again when the stepping begins) */
     int rc = set_outputs(su, opt, pl, &prog);
     if (rc == CLI_EXIT_OK && opt->out_dir) {
         /* what a fresh run removes and writes (earlier_names, the frames as named), or what a
@@ -1497,7 +1478,7 @@ static int run(const struct cli_scenario* sc, struct cli_many_setup* su,
     snprintf(notice, sizeof notice,
              "%swetdem: stopping after this step%s; a second signal %g s or more after this "
              "one, or a third, stops at once%s\n",
-             prog.tty ? "\n" : "", pl->checkpoint[0] ? " to write the checkpoint" : "",
+             prog.line.tty ? "\n" : "", pl->checkpoint[0] ? " to write the checkpoint" : "",
              CLI_SIGNAL_GRACE_S, pl->checkpoint[0] ? " without it" : "");
     struct cli_saved_signals saved;
     cli_signals_install(notice,
