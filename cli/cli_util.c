@@ -1039,3 +1039,10 @@ void cli_progress_clear(struct cli_progress* p)
     p->shown = 0;
     fflush(stderr);
 }
+
+int cli_progress_time(double t, double t_end, double elapsed, void* ctx)
+{
+    (void)elapsed; /* (the line's own clock started with the command's run) */
+    cli_progress_show(ctx, t / t_end, "t = %.4g of %.4g s", t, t_end);
+    return 0;
+}

@@ -256,4 +256,8 @@ void cli_progress_show(struct cli_progress* p, double done, const char* fmt, ...
 /* Clears the line, if one is shown: at the end of a run that stopped before it was done. */
 void cli_progress_clear(struct cli_progress* p);
 
+/* wetdem_time_progress_fn of a binary collision or a pairwise run (ctx: its struct
+ * cli_progress): the line "t = T of T_END s", the fraction done t / t_end. Returns 0. */
+int cli_progress_time(double t, double t_end, double elapsed, void* ctx);
+
 #endif

@@ -7,6 +7,8 @@
  * Many-particle scenarios ([box], [insert], ...) go to cli_run_many (cli/run_many.c), which
  * also handles --restart CHECKPOINT.
  *
+ * A long run shows its progress with the time left on stderr when that is a terminal.
+ *
  * Nothing half-written: the scenario is checked and the simulation built (every input check)
  * before any file is opened; files are written under temporary names (cli_out_open) and
  * renamed only when the run succeeded and the file was written whole, removed otherwise.
@@ -46,7 +48,10 @@ static void usage(FILE* f)
                "  --check     check the scenario and print the resolved set-up; do not run\n"
                "  --restart C resume a many-particle run from checkpoint C (same scenario)\n"
                "The files of one collision are kept as a set, whole, or not at all. Ctrl-C or\n"
-               "SIGTERM: exit 128 + N (a many-particle run writes its checkpoint first).\n");
+               "SIGTERM: exit 128 + N (a many-particle run writes its checkpoint first).\n"
+               "A run longer than half a second shows its progress and the time left on\n"
+               "stderr when that is a terminal (the estimate runs to t_end: a collision\n"
+               "that separates, or a pairwise run that comes apart, ends sooner).\n");
 }
 
 static int parse_args(int argc, char** argv, struct run_args* a)
@@ -145,8 +150,13 @@ static int run_soft(const struct cli_scenario* sc, struct cli_setup* su, const s
         cli_signals_install_run(traj.tmp, &saved);
     }
     struct wetdem_collision_result res;
+    struct cli_progress line;
+    cli_progress_start(&line, 0);
+    if (line.tty)
+        wetdem_sim_set_progress(su->sim, cli_progress_time, &line);
     errno = 0;
     int st = wetdem_collision_run(su->sim, &su->spec, &res);
+    cli_progress_clear(&line); /* (before any message) */
     if ((guarded && cli_stop_signal) || st < 0) {
         cli_out_close(&traj, "run", false);
         int stopped = guarded ? cli_signals_finish_run("run", &saved) : 0;

@@ -3,7 +3,8 @@
  * (cli_pairwise_sections), building a struct wetdem_pairwise_config from them, running it
  * (wetdem_pairwise_run, Davis 2023) and reporting: a text or JSON summary, trajectory and
  * event CSVs in --out DIR, or one CSV row for `wetdem sweep` / `wetdem map`; with
- * `run --check`, the resolved configuration (text or JSON) without running.
+ * `run --check`, the resolved configuration (text or JSON) without running. A run (not a
+ * sweep's row) shows its progress on stderr when that is a terminal (cli_progress).
  *
  * Two ways to give the spheres:
  *   [davis]      Davis's Table I groups (St_n, Ca, h_a, h_m, beta, d_23, d_13, h_23,0,
@@ -577,6 +578,19 @@ static void events_csv(FILE* f, const struct wetdem_pairwise* pw)
  * summary after it, each under a temporary name renamed only when the run succeeded and the
  * file was written whole (a failed or interrupted run leaves nothing under the final names).
  * *ran: whether the run took place (not when the trajectory is refused or no directory). */
+/* wetdem_pairwise_run, with the progress line on a terminal when `show` (not for a sweep's
+ * rows), cleared when it returns. */
+static int run_shown(struct wetdem_pairwise* pw, const struct wetdem_pairwise_config* cfg,
+                     struct wetdem_pairwise_result* r, bool show)
+{
+    struct cli_progress line;
+    cli_progress_start(&line, 0);
+    wetdem_pairwise_set_progress(pw, show && line.tty ? cli_progress_time : NULL, &line);
+    int st = wetdem_pairwise_run(pw, cfg, r);
+    cli_progress_clear(&line);
+    return st;
+}
+
 static int run_with_files(const struct cli_scenario* sc, const struct cli_run_options* opt,
                           const struct wetdem_pairwise_config* cfg, struct wetdem_pairwise* pw,
                           struct wetdem_pairwise_result* r, int* status, bool* ran)
@@ -610,7 +624,7 @@ static int run_with_files(const struct cli_scenario* sc, const struct cli_run_op
         cli_signals_install_run(ft.tmp, &saved);
     }
     errno = 0;
-    *status = wetdem_pairwise_run(pw, cfg, r);
+    *status = run_shown(pw, cfg, r, !opt->sweep_row);
     *ran = true;
     if ((guarded && cli_stop_signal) || *status != WETDEM_OK) {
         cli_out_close(&ft, "run", false);
@@ -682,7 +696,7 @@ int cli_run_pairwise(const struct cli_scenario* sc, const struct cli_run_options
             return rc;
         }
     } else {
-        status = wetdem_pairwise_run(pw, &cfg, &r);
+        status = run_shown(pw, &cfg, &r, !opt->sweep_row);
     }
     if (opt->status_out)
         *opt->status_out = status;

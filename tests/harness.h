@@ -297,6 +297,23 @@ static inline struct test_run test_run_cli(const char* env, const char* args, bo
     return (struct test_run){out, WIFEXITED(status) ? WEXITSTATUS(status) : -1};
 }
 
+/* What the shell command line "'<CLI>' ARGS" writes to a terminal, which script(1) gives it
+ * (stdout and stderr both, unless ARGS redirects one: "... > /dev/null" leaves stderr alone).
+ * A heap buffer, the caller frees it. */
+static inline char* test_run_cli_on_terminal(const char* args)
+{
+    size_t n = strlen(test_cli_path()) + strlen(args) + 64;
+    char* cmd = malloc(n);
+    assert_non_null(cmd);
+    snprintf(cmd, n, "script -qec \"'%s' %s\" /dev/null", test_cli_path(), args);
+    FILE* p = popen(cmd, "r");
+    assert_non_null(p);
+    char* out = test_slurp(p, NULL);
+    pclose(p);
+    free(cmd);
+    return out;
+}
+
 /* test_run_cli("", args, true) with the output copied into out (n bytes, truncated). Returns
  * the exit code. */
 static inline int test_run_cli_into(const char* args, char* out, size_t n)

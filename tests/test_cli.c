@@ -601,6 +601,75 @@ static int run_cli_stderr(const char* args, char** err)
     return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
+/* The last percentage of a progress line in text ("( 24.5 %)"), -1 if there is none. */
+static double last_percent(const char* text)
+{
+    double pct = -1;
+    for (const char* at = strstr(text, " s ("); at; at = strstr(at + 1, " s ("))
+        pct = strtod(at + 4, NULL);
+    return pct;
+}
+
+/* Progress of a binary collision and of a pairwise run on a terminal: a line "wetdem: t = T
+ * of T_END s (P %), E s elapsed, about L s left" on stderr, redrawn at most twice a second and
+ * first after half a second, the last one, at t_end, drawn and then cleared; nothing on
+ * stdout, nothing when stderr is not a terminal, nothing for a short run that ends before
+ * t_end (a collision that separated). Such runs told nothing until they ended. */
+static void test_cli_run_progress_on_a_terminal(void** state)
+{
+    (void)state;
+    if (!getenv("WETDEM_CLI"))
+        skip();
+    /* dry_hertz.ini separates at 2.46e-4 s; with t_end = 2e-4 s both integrators run to t_end */
+    static const char* const runs[] = {
+        "run examples/scenarios/dry_hertz.ini --set collision.t_end=2e-4",
+        "run examples/scenarios/dry_hertz.ini --set collision.t_end=2e-4 --set "
+        "integrator.name=cvode",
+        "run examples/scenarios/davis_three.ini", /* (FA: runs to t_end) */
+    };
+    for (size_t k = 0; k < sizeof runs / sizeof runs[0]; k++) {
+        char args[512], *err;
+        snprintf(args, sizeof args, "%s 2>&1 > /dev/null", runs[k]);
+        assert_int_equal(run_cli_stderr(args, &err), 0);
+        assert_string_equal(err, ""); /* (not a terminal) */
+        free(err);
+        snprintf(args, sizeof args, "%s > /dev/null", runs[k]);
+        char* tty = test_run_cli_on_terminal(args);
+        CHECK_CONTAINS(tty, k < 2 ? "\rwetdem: t = 0.0002 of 0.0002 s (100.0 %), "
+                                  : "\rwetdem: t = 0.06928 of 0.06928 s (100.0 %), ");
+        CHECK_CONTAINS(tty, " s left   \r      "); /* (cleared) */
+        free(tty);
+    }
+    /* stdout to a file: the summary there, and no progress */
+    char out[64] = "/tmp/wetdem_test_progress_XXXXXX", args[512];
+    int fd = mkstemp(out);
+    assert_true(fd >= 0);
+    close(fd);
+    snprintf(args, sizeof args, "%s > %s", runs[0], out);
+    free(test_run_cli_on_terminal(args));
+    char* text = test_read_file(out, NULL);
+    assert_non_null(text);
+    CHECK_CONTAINS(text, "scenario examples/scenarios/dry_hertz.ini: verlet integrator");
+    assert_null(strstr(text, "wetdem: t = "));
+    free(text);
+    remove(out);
+    /* a short run that separates: nothing (its few ms are below the first half second) */
+    char* tty = test_run_cli_on_terminal("run examples/scenarios/dry_hertz.ini > /dev/null");
+    assert_string_equal(tty, "");
+    free(tty);
+    /* a long one (4e6 steps, some 2 s): lines before the last, whose estimate comes down */
+    tty =
+        test_run_cli_on_terminal("run examples/scenarios/dry_hertz.ini --set collision.t_end=2e-4 "
+                                 "--set integrator.dt=5e-11 > /dev/null");
+    const char* first = strstr(tty, "\rwetdem: t = ");
+    assert_non_null(first);
+    double pct = last_percent(first);
+    CHECK_CONTAINS(first, " s elapsed, about ");
+    if (!(strtod(first + strlen("\rwetdem: t = "), NULL) < 2e-4 && pct == 100))
+        fail_msg("expected lines before the last:\n%s", tty);
+    free(tty);
+}
+
 /* A table that cannot be written to standard output (a full disk, a closed descriptor) is an
  * error with the reason, exit 1: it was exit 0 with a truncated table, and a redirected
  * `wetdem docs-models > docs/models.md` on a full disk left half a file. A command that
@@ -1346,6 +1415,7 @@ int main(void)
         cmocka_unit_test(test_cli_every_csv_has_provenance_and_name_unit_columns),
         cmocka_unit_test(test_cli_dev_stdout_output_to_a_redirected_file),
         cmocka_unit_test(test_cli_numbers_out_of_range_and_cr_lines),
+        cmocka_unit_test(test_cli_run_progress_on_a_terminal),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

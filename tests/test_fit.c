@@ -1067,15 +1067,8 @@ static void test_fit_cli_reports_units_on_example(void** state)
     /* progress on stderr only when it is a terminal (as sweep and map): here it is not, and
        with one (script gives the command one) it ends with the count of the summary line */
     assert_null(strstr(out, "\rfit: "));
-    char args[512];
-    snprintf(args, sizeof args,
-             "script -qec \"'%s' fit examples/fit/punch_db_c.ini --data "
-             "examples/fit/punch_0deg.csv --fit glass.p_gt --init 4e6\" /dev/null",
-             cli);
-    FILE* p = popen(args, "r");
-    assert_non_null(p);
-    char* tty = test_slurp(p, NULL);
-    pclose(p);
+    char* tty = test_run_cli_on_terminal("fit examples/fit/punch_db_c.ini --data "
+                                         "examples/fit/punch_0deg.csv --fit glass.p_gt --init 4e6");
     CHECK_CONTAINS(tty, "\rfit: 19 model evaluations (x 9 collisions), ");
     CHECK_CONTAINS(tty, "19 model evaluations (x 9 collisions), converged");
     free(tty);
