@@ -156,7 +156,8 @@ static int run_soft(const struct cli_scenario* sc, struct cli_setup* su, const s
         wetdem_sim_set_progress(su->sim, cli_progress_time, &line);
     errno = 0;
     int st = wetdem_collision_run(su->sim, &su->spec, &res);
-    cli_progress_clear(&line); /* (before any message) */
+    wetdem_sim_set_progress(su->sim, NULL, NULL); /* (line ends with this call) */
+    cli_progress_clear(&line);                    /* (before any message) */
     if ((guarded && cli_stop_signal) || st < 0) {
         cli_out_close(&traj, "run", false);
         int stopped = guarded ? cli_signals_finish_run("run", &saved) : 0;

@@ -587,6 +587,7 @@ static int run_shown(struct wetdem_pairwise* pw, const struct wetdem_pairwise_co
     cli_progress_start(&line, 0);
     wetdem_pairwise_set_progress(pw, show && line.tty ? cli_progress_time : NULL, &line);
     int st = wetdem_pairwise_run(pw, cfg, r);
+    wetdem_pairwise_set_progress(pw, NULL, NULL); /* (line ends with this call) */
     cli_progress_clear(&line);
     return st;
 }
