@@ -65,6 +65,28 @@ bool cli_is_name(const char* s)
     return true;
 }
 
+const char* cli_list_empty_name(const char* list)
+{
+    bool name = false, comma = false; /* a name, a comma seen so far */
+    const char* first = NULL;         /* the first empty place */
+    for (const char* p = list;; p++) {
+        const char* start = p;
+        while (*p && *p != ',')
+            p++;
+        bool empty = strspn(start, " \t") >= (size_t)(p - start);
+        if (!empty)
+            name = true;
+        else if (!first && (comma || *p == ','))
+            first = !comma ? "a comma with no name before it"
+                    : *p   ? "two commas with no name between them"
+                           : "a comma with no name after it";
+        if (!*p)
+            break;
+        comma = true;
+    }
+    return !comma ? NULL : !name ? "only commas, no name" : first;
+}
+
 /* ---- growing arrays ---- */
 
 static int push_entry(struct cli_scenario* sc, const char* section, const char* key,
@@ -326,6 +348,16 @@ static int check_names(const struct cli_scenario* sc, const struct cli_entry* e,
     int count = 0;
     const char* names[CLI_VALUE_MAX / 2];
     const char* word = NULL; /* 'none' or 'all', which stand for the whole list */
+    const char* empty = cli_list_empty_name(e->value);
+    if (empty) { /* "hertz,,db": a name left out, or a slip; strtok would skip it unseen */
+        cli_scenario_error(sc, e, "%s%s", empty,
+                           !list                            ? ": expected one name"
+                           : strncmp(empty, "only", 4) == 0 ? ": expected one or more names"
+                                                            : ": separate the names by one comma "
+                                                              "or by blanks ('hertz, db' or "
+                                                              "'hertz db')");
+        return CLI_EXIT_USAGE;
+    }
     char* save = NULL;
     for (char* tok = strtok_r(buf, " ,\t", &save); tok; tok = strtok_r(NULL, " ,\t", &save)) {
         if (!cli_is_name(tok)) {

@@ -302,6 +302,11 @@ int cli_key_only_home(const struct cli_scenario* sc, const char* key, const char
                       char* section, size_t n);
 /* Whether s is a non-empty name of letters, digits, '_' and '-'. */
 bool cli_is_name(const char* s);
+/* What is wrong with the commas of a list of names (names separated by commas or blanks):
+ * "only commas, no name", "a comma with no name before it" (",hertz"), "two commas with no
+ * name between them" ("hertz,,db") or "a comma with no name after it" ("hertz,"), the first
+ * found; NULL when every comma stands between two names (or there is none). */
+const char* cli_list_empty_name(const char* list);
 /* A numeric or choice key descriptor as a library parameter descriptor (for range text). */
 struct wetdem_param_desc cli_key_as_param(const struct cli_key_desc* k);
 

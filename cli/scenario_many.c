@@ -614,6 +614,15 @@ static void sphere_file_path(const struct cli_scenario* sc, const char* value, c
 static int read_materials(const struct cli_scenario* sc, struct cli_many_setup* su,
                           const char* section, const struct cli_entry* list, int* index, size_t* n)
 {
+    const char* empty = cli_list_empty_name(list->value);
+    /* "glass,,steel1": an index left out, which strtok would skip unseen ("," alone: below) */
+    if (empty && strncmp(empty, "only", 4) != 0) {
+        cli_scenario_error(sc, list,
+                           "%s: separate the names by one comma or by blanks ('glass, steel1' "
+                           "or 'glass steel1')",
+                           empty);
+        return CLI_EXIT_USAGE;
+    }
     char buf[CLI_VALUE_MAX], *save = NULL;
     snprintf(buf, sizeof buf, "%s", list->value);
     *n = 0;

@@ -1737,6 +1737,9 @@ static void test_many_cli_read_spheres_from_a_file(void** state)
         {"two.csv", "materials = wet glass\nmaterial = wet",
          "give material (every sphere) or materials (by the file's material column), not both"},
         {"two.csv", "materials = ,", "materials names none"},
+        /* an empty name would be skipped: glass would take index 1, meant for another */
+        {"two.csv", "materials = wet,,glass",
+         "materials = wet,,glass: two commas with no name between them"},
     };
     for (size_t k = 0; k < sizeof refused / sizeof refused[0]; k++) {
         snprintf(ini, sizeof ini, two, refused[k].file, refused[k].keys);
