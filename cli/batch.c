@@ -39,7 +39,7 @@ static int build_point(const struct cli_scenario* base, const struct cli_batch* 
     int rc = cli_scenario_copy(base, sc);
     for (int d = 0; d < b->n_keys && rc == CLI_EXIT_OK; d++) {
         char set[512];
-        snprintf(set, sizeof set, "%s=%.17g", b->key[d], p->value[d]);
+        snprintf(set, sizeof set, "%s=%.17g", b->key[d], cli_plain_zero(p->value[d]));
         rc = cli_scenario_override(sc, set);
     }
     if (rc == CLI_EXIT_OK && b->engine == CLI_ENGINE_SOFT)
@@ -69,7 +69,7 @@ static void format_values(const struct cli_batch* b, const struct cli_batch_poin
     buf[0] = '\0';
     for (int d = 0; d < b->n_keys && used < n; d++) {
         char value[40];
-        wetdem_param_format_value(p->value[d], 12, value, sizeof value);
+        wetdem_param_format_value(cli_plain_zero(p->value[d]), 12, value, sizeof value);
         used += (size_t)(for_message ? snprintf(buf + used, n - used, "%s%s = %s", d ? ", " : "",
                                                 b->key[d], value)
                                      : snprintf(buf + used, n - used, "%s,", value));

@@ -817,10 +817,15 @@ const char* cli_article(const char* word)
     return word[0] && strchr("aeiouAEIOU", word[0]) ? "an" : "a";
 }
 
+double cli_plain_zero(double v)
+{
+    return v == 0.0 ? 0.0 : v; /* (-0 == 0: both zeros give +0) */
+}
+
 void cli_print_double(FILE* f, double v)
 {
     char buf[40];
-    wetdem_param_format_value(v, 15, buf, sizeof buf);
+    wetdem_param_format_value(cli_plain_zero(v), 15, buf, sizeof buf);
     fputs(buf, f);
 }
 

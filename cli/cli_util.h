@@ -218,6 +218,13 @@ int cli_out_close(struct cli_out_file* o, const char* what, bool keep);
  * after printing "wetdem: <what>: cannot write <final>: <why>" for the first that failed. */
 int cli_out_close_all(struct cli_out_file* const* files, size_t n, const char* what, bool keep);
 
+/* v, or 0 for -0: every number wetdem prints passes through it (cli_print_double does), so
+ * that a zero reads "0", never "-0". A -0 is the product or negation of a zero (the y velocity
+ * -U sin(0) of a head-on impact, a smoothed spin of a dot that did not turn) and has no sign
+ * a reader could use; every other value, NaN and the infinities included, is returned bit for
+ * bit. */
+double cli_plain_zero(double v);
+
 /* Writes v to f with the fewest significant digits (15, 16 or 17) that read back as exactly
  * v, so CSV output is both exact and readable ("1e-05", not "1.0000000000000001e-05"). */
 void cli_print_double(FILE* f, double v);

@@ -942,8 +942,8 @@ static void print_values(const struct fit_ctx* c, const struct wetdem_fit_result
 {
     for (size_t j = 0; j < c->n_keys; j++) {
         const char* unit = key_unit(c->keys[j]);
-        printf("# %s = %.6g +- %.3g %s (%.2g %%)", c->keys[j], r->values[j], r->std_errors[j], unit,
-               100 * r->std_errors[j] / fabs(r->values[j]));
+        printf("# %s = %.6g +- %.3g %s (%.2g %%)", c->keys[j], cli_plain_zero(r->values[j]),
+               r->std_errors[j], unit, 100 * r->std_errors[j] / fabs(r->values[j]));
         if (r->undetermined[j])
             printf(": not determined by the data");
         else if (r->at_bound[j])
@@ -965,8 +965,9 @@ static void print_result(const struct fit_ctx* c, const double* init, const doub
            "fitted_as [word]\n");
     for (size_t j = 0; j < c->n_keys; j++) {
         int t = r->transform[j] >= 0 && r->transform[j] <= 3 ? r->transform[j] : 0;
-        printf("%s,%s,%.9g,%.3g,%.9g,%s\n", c->keys[j], key_unit(c->keys[j]), r->values[j],
-               r->std_errors[j], init[j], transform_words[t]);
+        printf("%s,%s,%.9g,%.3g,%.9g,%s\n", c->keys[j], key_unit(c->keys[j]),
+               cli_plain_zero(r->values[j]), r->std_errors[j], cli_plain_zero(init[j]),
+               transform_words[t]);
     }
     print_values(c, r, lower, upper);
     int by = (r->converged_by >= 0 && r->converged_by <= 3) ? r->converged_by : 0;
@@ -985,7 +986,7 @@ static void print_result(const struct fit_ctx* c, const double* init, const doub
         if (c->pts[at].has_angle)
             snprintf(angle, sizeof angle, ", angle_deg = %g", c->pts[at].angle_deg);
         printf("# residuals %s (fit - data): rms %.3g [%s], largest %.3g [%s] at St_n = %g%s\n",
-               part ? "omega" : "e_n", rms, unit, residual(c, pred, part, at), unit,
+               part ? "omega" : "e_n", rms, unit, cli_plain_zero(residual(c, pred, part, at)), unit,
                c->pts[at].stokes, angle);
     }
     if (c->use_omega)
@@ -993,8 +994,11 @@ static void print_result(const struct fit_ctx* c, const double* init, const doub
                omega_scale);
     for (size_t j = 0; j < c->n_keys && c->n_keys > 1; j++) {
         printf("# correlation %s:", c->keys[j]);
-        for (size_t k = 0; k < c->n_keys; k++)
-            printf(" %.3f", r->correlation[j][k]);
+        for (size_t k = 0; k < c->n_keys; k++) { /* (-0.0004 is "0.000", not "-0.000") */
+            char text[32];
+            snprintf(text, sizeof text, "%.3f", cli_plain_zero(r->correlation[j][k]));
+            printf(" %s", strcmp(text, "-0.000") == 0 ? "0.000" : text);
+        }
         printf("\n");
     }
 }
@@ -1025,11 +1029,12 @@ static void fit_table(FILE* f, const void* ctx)
             c->use_omega ? ",omega_data [rad/s],omega_fit [rad/s],omega_residual [rad/s]" : "");
     for (size_t i = 0; i < c->n_pts; i++) {
         const struct point* p = &c->pts[i];
-        fprintf(f, "%.9g,%.9g,%.9g,%.9g,%.6g", p->stokes, point_angle(c, p), p->e_n, pred[i],
-                pred[i] - p->e_n);
+        fprintf(f, "%.9g,%.9g,%.9g,%.9g,%.6g", p->stokes, cli_plain_zero(point_angle(c, p)),
+                cli_plain_zero(p->e_n), cli_plain_zero(pred[i]), cli_plain_zero(pred[i] - p->e_n));
         if (c->use_omega)
-            fprintf(f, ",%.9g,%.9g,%.6g", p->omega, pred[c->n_pts + i],
-                    pred[c->n_pts + i] - p->omega);
+            fprintf(f, ",%.9g,%.9g,%.6g", cli_plain_zero(p->omega),
+                    cli_plain_zero(pred[c->n_pts + i]),
+                    cli_plain_zero(pred[c->n_pts + i] - p->omega));
         fputc('\n', f);
     }
 }
@@ -1041,8 +1046,8 @@ static void curve_table(FILE* f, const void* ctx)
     cli_print_provenance(f, t->argc, t->argv);
     fprintf(f, "angle_deg [deg],stokes_n [-],e_n_fit [-],omega_fit [rad/s]\n");
     for (size_t k = 0; k < t->n; k++)
-        fprintf(f, "%.9g,%.9g,%.9g,%.9g\n", t->pts[k].angle_deg, t->pts[k].stokes, t->pred[k],
-                t->pred[t->n + k]);
+        fprintf(f, "%.9g,%.9g,%.9g,%.9g\n", cli_plain_zero(t->pts[k].angle_deg), t->pts[k].stokes,
+                cli_plain_zero(t->pred[k]), cli_plain_zero(t->pred[t->n + k]));
 }
 
 /* The fitted model on `m` log-spaced Stokes numbers over the data range, per distinct angle

@@ -251,7 +251,8 @@ static void print_header(struct wetdem_sim* sim, const struct forces_opts* o, in
                                         : "no normal motion";
     printf("# pair: two '%s' spheres of radius %g m; v_n = %g m/s (%s), slip %g m/s; "
            "fluid viscosity %g Pa s, surface tension %g N/m\n",
-           o->preset, o->radius, o->speed, motion, o->slip, fl.viscosity, fl.surface_tension);
+           o->preset, o->radius, cli_plain_zero(o->speed), motion, cli_plain_zero(o->slip),
+           fl.viscosity, fl.surface_tension);
     printf("# models:");
     for (size_t k = 0; k < wetdem_sim_n_models(sim); k++)
         printf(" %s", wetdem_sim_model(sim, k)->name);

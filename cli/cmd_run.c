@@ -112,8 +112,9 @@ static void print_check(const struct cli_scenario* sc, const struct cli_setup* s
         cli_json_number(stdout, su->stokes_n);
         printf(", \"m_eff\": %.17g, \"r_eff\": %.17g, \"t_end\": %.17g, \"angle\": %.17g, "
                "\"trajectory_interval\": %.17g, \"n_models\": %zu}\n",
-               su->m_eff, su->r_eff, s->t_end, s->angle * 180.0 / 3.14159265358979323846,
-               su->trajectory_interval, wetdem_sim_n_models(su->sim));
+               su->m_eff, su->r_eff, s->t_end,
+               cli_plain_zero(s->angle * 180.0 / 3.14159265358979323846), su->trajectory_interval,
+               wetdem_sim_n_models(su->sim));
         return;
     }
     printf("scenario %s is valid\n", sc->file);

@@ -166,10 +166,14 @@ static void frames_table(FILE* f, const void* ctx)
             fprintf(f,
                     "%d,%ld,%.15g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,"
                     "%.6g\n",
-                    wetdem_track_sphere_id(c->t, k), q[i].frame, q[i].time, q[i].vx_raw,
-                    q[i].vy_raw, q[i].omega_raw, q[i].vx, q[i].vy, q[i].omega, q[i].residual,
-                    q[i].u_vx_raw, q[i].u_vy_raw, q[i].u_omega_raw, q[i].u_vx, q[i].u_vy,
-                    q[i].u_omega);
+                    wetdem_track_sphere_id(c->t, k), q[i].frame, cli_plain_zero(q[i].time),
+                    cli_plain_zero(q[i].vx_raw), cli_plain_zero(q[i].vy_raw),
+                    cli_plain_zero(q[i].omega_raw), cli_plain_zero(q[i].vx),
+                    cli_plain_zero(q[i].vy), cli_plain_zero(q[i].omega),
+                    cli_plain_zero(q[i].residual), cli_plain_zero(q[i].u_vx_raw),
+                    cli_plain_zero(q[i].u_vy_raw), cli_plain_zero(q[i].u_omega_raw),
+                    cli_plain_zero(q[i].u_vx), cli_plain_zero(q[i].u_vy),
+                    cli_plain_zero(q[i].u_omega));
     }
 }
 
@@ -242,13 +246,14 @@ static void print_summary(const struct wetdem_track* t, const struct wetdem_trac
         if (json && !isfinite(rows[k].value))
             printf("  \"%s\": null%s\n", rows[k].key, sep);
         else if (json)
-            printf("  \"%s\": %.*g%s\n", rows[k].key, k == 0 ? 15 : 9, rows[k].value, sep);
+            printf("  \"%s\": %.*g%s\n", rows[k].key, k == 0 ? 15 : 9,
+                   cli_plain_zero(rows[k].value), sep);
         else if (!isfinite(rows[k].value)) /* (a comment, not "nan", for key = value readers) */
             printf("# %s not computed: %s\n", rows[k].key,
                    strstr(rows[k].key, "stokes_n") ? "give --radius, --mass and --viscosity"
                                                    : "not defined for this track");
         else
-            printf("%s = %.*g\n", rows[k].key, k == 0 ? 15 : 9, rows[k].value);
+            printf("%s = %.*g\n", rows[k].key, k == 0 ? 15 : 9, cli_plain_zero(rows[k].value));
     }
     if (json)
         printf("}\n");

@@ -19,8 +19,11 @@
 
 static struct cli_field num(const char* name, const char* unit, const char* doc, double v)
 {
-    return (struct cli_field){
-        .name = name, .unit = unit, .doc = doc, .kind = CLI_FIELD_NUMBER, .number = v};
+    return (struct cli_field){.name = name,
+                              .unit = unit,
+                              .doc = doc,
+                              .kind = CLI_FIELD_NUMBER,
+                              .number = cli_plain_zero(v)};
 }
 
 static struct cli_field flag(const char* name, const char* doc, bool v)
@@ -240,7 +243,8 @@ void cli_summary_text(FILE* f, const struct cli_scenario* sc, const struct cli_s
                       const struct wetdem_collision_result* r)
 {
     fprintf(f, "scenario %s: %s integrator, St_n = %.6g, impact speed %.6g m/s\n", sc->file,
-            wetdem_sim_integrator_name(su->sim), su->stokes_n, su->impact_speed);
+            wetdem_sim_integrator_name(su->sim), cli_plain_zero(su->stokes_n),
+            cli_plain_zero(su->impact_speed));
     struct cli_field fields[CLI_MAX_FIELDS];
     size_t n = cli_result_fields(su, r, fields);
     for (size_t k = 0; k < n; k++) {
@@ -260,7 +264,7 @@ void cli_summary_text(FILE* f, const struct cli_scenario* sc, const struct cli_s
 void cli_json_number(FILE* f, double v)
 {
     if (isfinite(v))
-        fprintf(f, "%.17g", v);
+        fprintf(f, "%.17g", cli_plain_zero(v));
     else
         fputs("null", f);
 }
@@ -342,9 +346,9 @@ void cli_events_csv(FILE* f, const struct wetdem_sim* sim, int argc, char** argv
     size_t n = 0;
     const struct wetdem_event_record* ev = wetdem_sim_events(sim, &n);
     for (size_t k = 0; k < n; k++)
-        fprintf(f, "%.12g,%s,%zu,%zu,%d,%.12g,%.12g\n", ev[k].time,
+        fprintf(f, "%.12g,%s,%zu,%zu,%d,%.12g,%.12g\n", cli_plain_zero(ev[k].time),
                 wetdem_event_kind_name(ev[k].kind), ev[k].i, ev[k].j, ev[k].is_wall ? 1 : 0,
-                ev[k].gap, ev[k].v_n);
+                cli_plain_zero(ev[k].gap), cli_plain_zero(ev[k].v_n));
 }
 
 static void trajectory_header(struct cli_trajectory* t, size_t n)
@@ -399,16 +403,16 @@ int cli_trajectory_observe(const struct wetdem_sim* sim, void* ctx)
         n = 2;
     if (!t->header_done)
         trajectory_header(t, n);
-    fprintf(t->f, "%.12g", wetdem_sim_time(sim));
+    fprintf(t->f, "%.12g", cli_plain_zero(wetdem_sim_time(sim)));
     for (size_t k = 0; k < n; k++) {
         const double v[9] = {p[k].pos.x, p[k].pos.y,   p[k].pos.z,   p[k].vel.x,  p[k].vel.y,
                              p[k].vel.z, p[k].omega.x, p[k].omega.y, p[k].omega.z};
         for (size_t m = 0; m < 9; m++)
-            fprintf(t->f, ",%.12g", v[m]);
+            fprintf(t->f, ",%.12g", cli_plain_zero(v[m]));
     }
     double gap, v_n;
     pair_gap(sim, t, &gap, &v_n);
-    fprintf(t->f, ",%.12g,%.12g\n", gap, v_n);
+    fprintf(t->f, ",%.12g,%.12g\n", cli_plain_zero(gap), cli_plain_zero(v_n));
     if (ferror(t->f)) {
         t->err = errno ? errno : EIO;
         return 1;

@@ -873,28 +873,30 @@ static void summary_text(FILE* f, const struct cli_many_setup* su, const struct 
     const struct wetdem_energy_budget* b = &o->budget;
     fprintf(f, "energy budget [J]  input = kinetic + potential + elastic + dissipated\n");
     fprintf(f, "  input            %12.6g  (kinetic + potential + elastic at the start)\n",
-            b->input);
+            cli_plain_zero(b->input));
     fprintf(f,
             "  kinetic          %12.6g\n  potential        %12.6g\n  elastic          "
             "%12.6g\n  dissipated       %12.6g\n",
-            b->kinetic, b->potential, b->elastic, b->dissipated);
+            cli_plain_zero(b->kinetic), cli_plain_zero(b->potential), cli_plain_zero(b->elastic),
+            cli_plain_zero(b->dissipated));
     fprintf(f, "work by model [J]  %12s %12s %12s  (< 0: taken from the particles)\n", "pairs",
             "walls", "total");
     for (size_t k = 0; k < b->n_models && k < WETDEM_ENERGY_MAX_MODELS; k++)
         fprintf(f, "  %-16s %12.6g %12.6g %12.6g\n", wetdem_sim_model(su->sim, k)->name,
-                b->work_pair[k], b->work_wall[k], b->work_pair[k] + b->work_wall[k]);
-    fprintf(f, "  %-16s %12s %12s %12.6g\n", "all", "", "", b->work_total);
+                cli_plain_zero(b->work_pair[k]), cli_plain_zero(b->work_wall[k]),
+                cli_plain_zero(b->work_pair[k] + b->work_wall[k]));
+    fprintf(f, "  %-16s %12s %12s %12.6g\n", "all", "", "", cli_plain_zero(b->work_total));
     fprintf(f,
             "closure error      %12.6g  (change of kinetic + potential minus the work; "
             "%.2g of the larger of input and work)\n",
-            b->balance_error, closure_ratio(b));
+            cli_plain_zero(b->balance_error), cli_plain_zero(closure_ratio(b)));
 }
 
 static void json_num(FILE* f, const char* key, double v, bool comma)
 {
     fprintf(f, "\"%s\": ", key);
     if (isfinite(v))
-        fprintf(f, "%.17g", v);
+        fprintf(f, "%.17g", cli_plain_zero(v));
     else
         fputs("null", f);
     if (comma)

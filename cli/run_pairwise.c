@@ -369,12 +369,13 @@ static void sweep_row(FILE* f, int status, const struct wetdem_pairwise_config* 
     /* separated_sphere: 1-based, -1 for none, as in the JSON summary */
     fprintf(f, "%s,%s,%d,%.12g,%.12g,%zu,%llu", wetdem_status_name(status),
             wetdem_pairwise_outcome_name(r->outcome),
-            r->separated_sphere >= 0 ? r->separated_sphere + 1 : -1, r->time,
-            wetdem_pairwise_t_star(r, r->time), r->n_events, r->steps);
+            r->separated_sphere >= 0 ? r->separated_sphere + 1 : -1, cli_plain_zero(r->time),
+            cli_plain_zero(wetdem_pairwise_t_star(r, r->time)), r->n_events, r->steps);
     for (size_t p = 0; p < r->n_pairs; p++) {
         const struct wetdem_pairwise_pair_result* q = &r->pairs[p];
-        fprintf(f, ",%.12g,%.12g,%u,%s,%.12g", q->e_wet, q->e_wet_own, q->n_contacts,
-                mechanism_name(q->mechanism), wetdem_pairwise_t_star(r, q->t_end));
+        fprintf(f, ",%.12g,%.12g,%u,%s,%.12g", cli_plain_zero(q->e_wet),
+                cli_plain_zero(q->e_wet_own), q->n_contacts, mechanism_name(q->mechanism),
+                cli_plain_zero(wetdem_pairwise_t_star(r, q->t_end)));
     }
 }
 
@@ -382,7 +383,7 @@ static void sweep_row(FILE* f, int status, const struct wetdem_pairwise_config* 
 static void format_or_na(double v, char* buf, size_t n)
 {
     if (isfinite(v))
-        snprintf(buf, n, "%.6g", v);
+        snprintf(buf, n, "%.6g", cli_plain_zero(v));
     else
         snprintf(buf, n, "n/a");
 }
@@ -395,8 +396,10 @@ static void summary_text(FILE* f, const struct wetdem_pairwise_result* r)
     char t_star[32], t_hat[32];
     format_or_na(wetdem_pairwise_t_star(r, r->time), t_star, sizeof t_star);
     format_or_na(wetdem_pairwise_t_hat(r, r->time), t_hat, sizeof t_hat);
-    fprintf(f, "\ntime               %.6g s  (t* = %s, t-hat = %s)\n", r->time, t_star, t_hat);
-    fprintf(f, "v_n0               %.6g m/s  (delta_12 = %.6g m)%s\n", r->v_n0, r->delta_ref,
+    fprintf(f, "\ntime               %.6g s  (t* = %s, t-hat = %s)\n", cli_plain_zero(r->time),
+            t_star, t_hat);
+    fprintf(f, "v_n0               %.6g m/s  (delta_12 = %.6g m)%s\n", cli_plain_zero(r->v_n0),
+            cli_plain_zero(r->delta_ref),
             r->v_n0 > 0.0 ? ""
                           : "; the reference pair does not approach at t = 0, so t-hat and e_w "
                             "have no scale (n/a)");
@@ -418,21 +421,23 @@ static void summary_text(FILE* f, const struct wetdem_pairwise_result* r)
     const struct wetdem_pairwise_energy* e = &r->energy;
     if (!isfinite(e->residual))
         return; /* (not computed: energy_budget = false) */
-    fprintf(f, "energy [J]         initial %.6g\n", e->initial);
-    fprintf(f, "  kinetic          %-13.6g at the end\n", e->kinetic);
-    fprintf(f, "  capillary        %-13.6g potential at the end\n", e->capillary);
-    fprintf(f, "  gravity          %-13.6g potential at the end, from the start\n", e->gravity);
-    fprintf(f, "  viscous normal   %-13.6g dissipated\n", e->viscous_normal);
-    fprintf(f, "  viscous tangent  %-13.6g dissipated\n", e->viscous_tangential);
-    fprintf(f, "  contact          %-13.6g lost in impulses\n", e->contact);
+    fprintf(f, "energy [J]         initial %.6g\n", cli_plain_zero(e->initial));
+    fprintf(f, "  kinetic          %-13.6g at the end\n", cli_plain_zero(e->kinetic));
+    fprintf(f, "  capillary        %-13.6g potential at the end\n", cli_plain_zero(e->capillary));
+    fprintf(f, "  gravity          %-13.6g potential at the end, from the start\n",
+            cli_plain_zero(e->gravity));
+    fprintf(f, "  viscous normal   %-13.6g dissipated\n", cli_plain_zero(e->viscous_normal));
+    fprintf(f, "  viscous tangent  %-13.6g dissipated\n", cli_plain_zero(e->viscous_tangential));
+    fprintf(f, "  contact          %-13.6g lost in impulses\n", cli_plain_zero(e->contact));
     fprintf(f, "  residual         %-13.3g %.2g of the largest term (integration error)\n",
-            e->residual, e->residual / wetdem_pairwise_energy_scale(e));
+            cli_plain_zero(e->residual),
+            cli_plain_zero(e->residual / wetdem_pairwise_energy_scale(e)));
 }
 
 static void json_number(FILE* f, double v)
 {
     if (isfinite(v))
-        fprintf(f, "%.12g", v);
+        fprintf(f, "%.12g", cli_plain_zero(v));
     else
         fputs("null", f);
 }
@@ -494,13 +499,16 @@ static void print_check(const struct cli_scenario* sc, const struct wetdem_pairw
         printf(", \"engine\": \"pairwise\", \"viscosity\": %.17g, \"surface_tension\": %.17g, "
                "\"h_min\": %.17g, \"restitution\": %.17g, \"friction\": %.17g, "
                "\"t_end\": %.17g, \"rtol\": %.17g, \"spheres\": [",
-               c->viscosity, c->surface_tension, c->h_min, c->restitution, c->friction, c->t_end,
-               c->rtol);
+               cli_plain_zero(c->viscosity), cli_plain_zero(c->surface_tension),
+               cli_plain_zero(c->h_min), cli_plain_zero(c->restitution),
+               cli_plain_zero(c->friction), cli_plain_zero(c->t_end), cli_plain_zero(c->rtol));
         for (size_t i = 0; i < c->n_spheres; i++) {
             const struct wetdem_pairwise_sphere* s = &c->spheres[i];
             printf("%s{\"radius\": %.17g, \"mass\": %.17g, \"film\": %.17g, \"x\": %.17g, "
                    "\"y\": %.17g, \"vx\": %.17g, \"vy\": %.17g, \"omega\": %.17g}",
-                   i ? ", " : "", s->radius, s->mass, s->film, s->x, s->y, s->vx, s->vy, s->omega);
+                   i ? ", " : "", cli_plain_zero(s->radius), cli_plain_zero(s->mass),
+                   cli_plain_zero(s->film), cli_plain_zero(s->x), cli_plain_zero(s->y),
+                   cli_plain_zero(s->vx), cli_plain_zero(s->vy), cli_plain_zero(s->omega));
         }
         printf("]}\n");
         return;
@@ -509,14 +517,17 @@ static void print_check(const struct cli_scenario* sc, const struct wetdem_pairw
     printf("  viscosity        %.10g Pa s\n  surface_tension  %.10g N/m\n  h_min            "
            "%.10g m\n  restitution      %.10g -\n  friction         %.10g -\n  t_end            "
            "%.10g s\n  rtol             %.10g -\n",
-           c->viscosity, c->surface_tension, c->h_min, c->restitution, c->friction, c->t_end,
-           c->rtol);
+           cli_plain_zero(c->viscosity), cli_plain_zero(c->surface_tension),
+           cli_plain_zero(c->h_min), cli_plain_zero(c->restitution), cli_plain_zero(c->friction),
+           cli_plain_zero(c->t_end), cli_plain_zero(c->rtol));
     printf("  sphere  radius [m]    mass [kg]     film [m]      x [m]         y [m]         "
            "vx [m/s]      vy [m/s]      omega [rad/s]\n");
     for (size_t i = 0; i < c->n_spheres; i++) {
         const struct wetdem_pairwise_sphere* s = &c->spheres[i];
         printf("  %-6zu  %-12.6g  %-12.6g  %-12.6g  %-12.6g  %-12.6g  %-12.6g  %-12.6g  %.6g\n",
-               i + 1, s->radius, s->mass, s->film, s->x, s->y, s->vx, s->vy, s->omega);
+               i + 1, cli_plain_zero(s->radius), cli_plain_zero(s->mass), cli_plain_zero(s->film),
+               cli_plain_zero(s->x), cli_plain_zero(s->y), cli_plain_zero(s->vx),
+               cli_plain_zero(s->vy), cli_plain_zero(s->omega));
     }
 }
 
@@ -529,16 +540,20 @@ struct traj {
 static int write_frame(const struct wetdem_pairwise_frame* fr, void* ctx)
 {
     struct traj* t = ctx;
-    fprintf(t->f, "%.12g,%.12g,%.12g", fr->time, fr->t_hat, fr->t_star);
+    fprintf(t->f, "%.12g,%.12g,%.12g", cli_plain_zero(fr->time), cli_plain_zero(fr->t_hat),
+            cli_plain_zero(fr->t_star));
     for (size_t i = 0; i < fr->n_spheres; i++) {
         const struct wetdem_pairwise_sphere* s = &fr->spheres[i];
-        fprintf(t->f, ",%.12g,%.12g,%.12g,%.12g,%.12g", s->x, s->y, s->vx, s->vy, s->omega);
+        fprintf(t->f, ",%.12g,%.12g,%.12g,%.12g,%.12g", cli_plain_zero(s->x), cli_plain_zero(s->y),
+                cli_plain_zero(s->vx), cli_plain_zero(s->vy), cli_plain_zero(s->omega));
     }
     for (size_t p = 0; p < fr->n_pairs; p++)
-        fprintf(t->f, ",%.12g,%.12g", fr->gap[p], fr->v_n[p]);
+        fprintf(t->f, ",%.12g,%.12g", cli_plain_zero(fr->gap[p]), cli_plain_zero(fr->v_n[p]));
     const struct wetdem_pairwise_energy* e = &fr->energy;
-    fprintf(t->f, ",%.12g,%.12g,%.12g,%.12g,%.12g,%.12g,%.12g", e->kinetic, e->capillary,
-            e->gravity, e->viscous_normal, e->viscous_tangential, e->contact, e->residual);
+    fprintf(t->f, ",%.12g,%.12g,%.12g,%.12g,%.12g,%.12g,%.12g", cli_plain_zero(e->kinetic),
+            cli_plain_zero(e->capillary), cli_plain_zero(e->gravity),
+            cli_plain_zero(e->viscous_normal), cli_plain_zero(e->viscous_tangential),
+            cli_plain_zero(e->contact), cli_plain_zero(e->residual));
     fputc('\n', t->f);
     if (!ferror(t->f))
         return cli_stop_signal ? -1 : 0; /* (a signal asked the command to stop) */
@@ -569,9 +584,10 @@ static void events_csv(FILE* f, const struct wetdem_pairwise* pw)
           "gap [m],v_n [m/s]\n",
           f);
     for (size_t e = 0; e < n; e++)
-        fprintf(f, "%.12g,%.12g,%.12g,%s,%zu,%zu,%zu,%zu,%.12g,%.12g\n", ev[e].time, ev[e].t_hat,
-                ev[e].t_star, wetdem_pairwise_event_name(ev[e].kind), ev[e].i + 1, ev[e].j + 1,
-                ev[e].k + 1, ev[e].l + 1, ev[e].gap, ev[e].v_n);
+        fprintf(f, "%.12g,%.12g,%.12g,%s,%zu,%zu,%zu,%zu,%.12g,%.12g\n", cli_plain_zero(ev[e].time),
+                cli_plain_zero(ev[e].t_hat), cli_plain_zero(ev[e].t_star),
+                wetdem_pairwise_event_name(ev[e].kind), ev[e].i + 1, ev[e].j + 1, ev[e].k + 1,
+                ev[e].l + 1, cli_plain_zero(ev[e].gap), cli_plain_zero(ev[e].v_n));
 }
 
 /* The run with files in opt->out_dir: the trajectory written during the run, events and

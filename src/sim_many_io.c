@@ -537,6 +537,13 @@ static void csv_header(const struct wetdem_sim* sim, FILE* f)
     fputc('\n', f);
 }
 
+/* v, or 0 for -0, so that a zero reads "0", never "-0" (a potential of no height, -m g.0);
+ * every other value bit for bit. */
+static double plain_zero(double v)
+{
+    return v == 0.0 ? 0.0 : v;
+}
+
 /* The next row of the CSV; `links`, when not NULL, holds the run's links at this step (worked
  * out for the VTK frame of the same step), else they are worked out here. */
 static int write_csv_row(struct wetdem_sim* sim, const struct wetdem_many_stats* links)
@@ -567,13 +574,14 @@ static int write_csv_row(struct wetdem_sim* sim, const struct wetdem_many_stats*
     bool budget = m->set.energy_budget && wetdem_sim_energy_budget(sim, &b) == WETDEM_OK;
     if (!budget)
         wetdem_sim_many_energies(sim, &b.kinetic, &b.potential, &b.elastic);
-    fprintf(f, "%.9g,%llu,%.9g,%.9g,%.9g,%zu,%zu,%zu,%.6g,%zu", sim->engine.time,
-            (unsigned long long)m->step, b.kinetic, b.potential, b.elastic, s.contacts, s.bridges,
-            s.agglomerates, s.mean_agglomerate, s.candidate_pairs);
+    fprintf(f, "%.9g,%llu,%.9g,%.9g,%.9g,%zu,%zu,%zu,%.6g,%zu", plain_zero(sim->engine.time),
+            (unsigned long long)m->step, plain_zero(b.kinetic), plain_zero(b.potential),
+            plain_zero(b.elastic), s.contacts, s.bridges, s.agglomerates,
+            plain_zero(s.mean_agglomerate), s.candidate_pairs);
     if (budget) {
         for (size_t q = 0; q < sim->n_models && q < WETDEM_ENERGY_MAX_MODELS; q++)
-            fprintf(f, ",%.9g", b.work_pair[q] + b.work_wall[q]);
-        fprintf(f, ",%.9g,%.3g", b.dissipated, b.balance_error);
+            fprintf(f, ",%.9g", plain_zero(b.work_pair[q] + b.work_wall[q]));
+        fprintf(f, ",%.9g,%.3g", plain_zero(b.dissipated), plain_zero(b.balance_error));
     }
     fputc('\n', f);
     errno = 0;

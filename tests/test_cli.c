@@ -837,8 +837,8 @@ static bool csv_integer(const char* text, size_t n)
  * whose every column is "name [unit]" (a name of letters, digits, '_' and '.'; a unit with no
  * bracket, comma or outer blank), then at least one row of as many fields, '#' lines allowed
  * between and after the rows. A row's field must fit its column's unit: a number but in a
- * [word] column, a whole number in a [count] or [index] column, 0 or 1 in a [0/1] column.
- * `what` names the file in a failure. */
+ * [word] column, a whole number in a [count] or [index] column, 0 or 1 in a [0/1] column;
+ * a zero is "0", never "-0" (docs/concepts.md). `what` names the file in a failure. */
 static void check_csv_shape(const char* what, const char* text)
 {
     const char* first = "# wetdem " WETDEM_VERSION " (git ";
@@ -895,6 +895,9 @@ static void check_csv_shape(const char* what, const char* text)
             if (!ok)
                 fail_msg("%s: row %zu, column %zu: '%.*s' %s", what, rows, c + 1, (int)n, f,
                          c < n_cols ? "does not fit its unit" : "is beyond the header's columns");
+            if (strcmp(u, "word") != 0 && n > 1 && f[0] == '-' && strtod(f, NULL) == 0.0)
+                fail_msg("%s: row %zu, column %zu: '%.*s' is a zero with a sign", what, rows, c + 1,
+                         (int)n, f);
             if (end == row + len)
                 break;
             f = end + 1;
@@ -912,12 +915,29 @@ static void check_csv_shape(const char* what, const char* text)
  * standard output, --out, --curve), track --frames and the library's global CSV of a
  * many-particle run. Three of them had columns "name_unit" (gap_m, time_s, kinetic_J) and no
  * brackets, global.csv put its version line before the provenance, and a line break in an
- * argument ended the command's comment line. */
+ * argument ended the command's comment line. Zeros that came with a sign were written "-0":
+ * the y velocity -U sin 0 of a head-on run's first trajectory row, the smoothed vy and spin
+ * of track --frames for dots that move along x without turning, a sweep's value -0. */
 static void test_cli_every_csv_has_provenance_and_name_unit_columns(void** state)
 {
     (void)state;
     char dir[] = "/tmp/wetdem_test_cli_csv_XXXXXX";
     assert_non_null(mkdtemp(dir));
+    { /* dots of two spheres on the line y = 300 px that do not turn: the striker at 2 px a
+         frame strikes the resting target at frame 50 and goes on at 0.5, the target at 1.5 */
+        char path[400];
+        snprintf(path, sizeof path, "%s/still.csv", dir);
+        FILE* f = fopen(path, "w");
+        assert_non_null(f);
+        fputs("frame,sphere,x1,y1,x2,y2,x3,y3\n", f);
+        for (int k = 0; k < 100; k++)
+            for (int s = 1; s <= 2; s++) {
+                double x = s == 1 ? (k < 50 ? 400 + 2.0 * (k - 50) : 400 + 0.5 * (k - 50))
+                                  : (k < 50 ? 544 : 544 + 1.5 * (k - 50));
+                fprintf(f, "%d,%d,%.4f,300,%.4f,300,%.4f,330\n", k, s, x, x + 30, x);
+            }
+        assert_int_equal(fclose(f), 0);
+    }
     static const struct {
         const char* args;     /* %s: the directory */
         const char* files[3]; /* in the directory; none: standard output */
@@ -945,10 +965,15 @@ static void test_cli_every_csv_has_provenance_and_name_unit_columns(void** state
          {"two\nlines.csv"}},
         {"run examples/scenarios/many_stokes_cradle.ini --set run.steps=2 --out %s/many",
          {"many/global.csv"}},
+        {"run examples/scenarios/dry_hertz.ini --out %s/head_on", {"head_on/trajectory.csv"}},
+        {"track %s/still.csv --fps 5000 --pixel-size 1e-4 --frames %s/still_frames.csv",
+         {"still_frames.csv"}},
+        {"sweep examples/scenarios/nijssen_head_on.ini --param collision.spin_z --values -0:1:2",
+         {NULL}},
     };
     for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
         char args[600];
-        snprintf(args, sizeof args, cases[k].args, dir, dir);
+        snprintf(args, sizeof args, cases[k].args, dir, dir, dir);
         struct test_run r = run_cli(args, false);
         if (r.code != 0)
             fail_msg("wetdem %s: exit %d", args, r.code);
