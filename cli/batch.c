@@ -500,7 +500,9 @@ static unsigned long long scenario_hash(const struct cli_batch* b)
 /* Reads the table of b->resume, a table of this batch that an interruption left with rows
  * NOT_RUN: its column header and the values of every row must be this batch's; the rows that
  * ran are kept (verbatim: status word and fields), the others will run. '#' lines are passed
- * over. An exit code, the message printed (with the file and line that differs). */
+ * over; a NUL byte anywhere is refused (a text cut there would pass for a shorter line, a row
+ * ending in one for a whole row). An exit code, the message printed (with the file and line
+ * that differs). */
 static int read_resume(struct cli_batch* b)
 {
     FILE* f = fopen(b->resume, "r");
@@ -517,6 +519,12 @@ static int read_resume(struct cli_batch* b)
     bool seen_header = false;
     for (ssize_t len; rc == CLI_EXIT_OK && (len = getline(&text, &cap, f)) >= 0;) {
         line++;
+        if (memchr(text, '\0', (size_t)len)) { /* (the string functions would stop there) */
+            cli_error("%s: --resume %s:%zu: a NUL byte in the line: not a text (CSV) file", b->cmd,
+                      b->resume, line);
+            rc = CLI_EXIT_USAGE;
+            break;
+        }
         while (len > 0 && (text[len - 1] == '\n' || text[len - 1] == '\r'))
             text[--len] = '\0';
         if (line == 1 && strncmp(text, "\xEF\xBB\xBF", 3) == 0) /* a UTF-8 byte-order mark */

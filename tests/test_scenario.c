@@ -1535,6 +1535,48 @@ static void test_scenario_resume_refuses_a_damaged_kept_row(void** state)
         snprintf(path, sizeof path, "%s/completed.csv", tmpdir);
         assert_int_equal(access(path, F_OK), -1);
     }
+    /* a NUL byte is named with its line (the fit and track readers' words): the text was cut
+       there, a row of point 1 (line 5) "ended before" a column and a NUL after its last field
+       passed, the header (line 4) was "not this sweep's" and a map's row as the sweep's */
+    static const struct {
+        size_t at;       /* the NUL's place: bytes into the line ... */
+        int where;       /* ... of point 1's row (0), at that row's end (1), of the header (2) */
+        const char* cmd; /* "map": the map's table and command; NULL: the sweep's */
+    } nul[] = {{4, 0, NULL}, {0, 1, NULL}, {3, 2, NULL}, {0, 1, "map"}};
+    for (size_t k = 0; k < sizeof nul / sizeof nul[0]; k++) {
+        const char* map = "map examples/scenarios/dry_hertz.ini --param collision.speed "
+                          "--values 0.2:0.3:2 --param2 collision.angle_deg --values2 0:30:2";
+        const char* table = intact;
+        char* made = NULL;
+        if (nul[k].cmd) { /* the map's own table */
+            snprintf(args, sizeof args, "%s --out %s/nul_map.csv", map, tmpdir);
+            expect_run(args, 0, NULL);
+            snprintf(path, sizeof path, "%s/nul_map.csv", tmpdir);
+            table = made = test_read_file(path, NULL);
+            unlink(path);
+            assert_non_null(made);
+        }
+        const char* at = nul[k].where == 2 ? strstr(table, "\ncollision.speed [m/s],") + 1
+                                           : strstr(table, "\n0.2,") + 1;
+        at += nul[k].where == 1 ? strcspn(at, "\n") : nul[k].at;
+        snprintf(path, sizeof path, "%s/nul.csv", tmpdir);
+        FILE* f = fopen(path, "wb");
+        assert_non_null(f);
+        fwrite(table, 1, (size_t)(at - table), f);
+        fputc('\0', f);
+        fputs(at, f);
+        assert_int_equal(fclose(f), 0);
+        free(made);
+        snprintf(args, sizeof args, "%s --resume %s --out %s/completed.csv",
+                 nul[k].cmd ? map : sweep, path, tmpdir);
+        char want[700];
+        snprintf(want, sizeof want,
+                 "%s: --resume %s:%d: a NUL byte in the line: not a text (CSV) file\n",
+                 nul[k].cmd ? "map" : "sweep", path, nul[k].where == 2 ? 4 : 5);
+        expect_run(args, 2, want);
+        snprintf(path, sizeof path, "%s/completed.csv", tmpdir);
+        assert_int_equal(access(path, F_OK), -1);
+    }
     /* a table saved by an editor with a UTF-8 byte-order mark is this batch's all the same;
        a directory cannot be read (it was "0 rows, where this sweep has 2 points") */
     char* bom = malloc(strlen(intact) + 4);
