@@ -1154,6 +1154,57 @@ static int print_check(const struct cli_scenario* sc, const struct cli_many_setu
     return CLI_EXIT_OK;
 }
 
+/* What the checkpoints of a run record (checkpoint_note): the names its frames and CSV take
+ * from [dump], "none" for one it does not write, a "key = value" line each, into buf[n]. */
+static void output_note(const struct cli_many_setup* su, char* buf, size_t n)
+{
+    snprintf(buf, n, "vtk = %s\ncsv = %s",
+             su->vtk_prefix[0] && su->vtk_every ? su->vtk_prefix : "none",
+             su->csv_name[0] && su->csv_every ? su->csv_name : "none");
+}
+
+/* The value of `key` in a note of output_note into buf[n]; false when the note has none (a
+ * checkpoint written without it, by another program or an earlier version). */
+static bool note_value(const char* note, const char* key, char* buf, size_t n)
+{
+    size_t len = strlen(key);
+    for (const char* p = note; p && *p; p = strchr(p, '\n') ? strchr(p, '\n') + 1 : NULL)
+        if (strncmp(p, key, len) == 0 && strncmp(p + len, " = ", 3) == 0) {
+            snprintf(buf, n, "%.*s", (int)strcspn(p + len + 3, "\n"), p + len + 3);
+            return true;
+        }
+    return false;
+}
+
+/* Refuses a restart that names the frames or the CSV otherwise than the run that wrote the
+ * checkpoint (its checkpoint_note): another VTK prefix would start a second series beside the
+ * first, another CSV name find no rows before the checkpoint. Writing none of them, or
+ * starting frames that run did not write, continues it. CLI exit code; touches no file. */
+static int check_output_names(const struct cli_many_setup* su, const struct cli_run_options* opt)
+{
+    const char* note = wetdem_sim_checkpoint_note(su->sim);
+    char ours[2 * CLI_VALUE_MAX + 16];
+    output_note(su, ours, sizeof ours);
+    static const char* const keys[2] = {"vtk", "csv"};
+    for (int k = 0; k < 2; k++) {
+        char was[CLI_VALUE_MAX], now[CLI_VALUE_MAX];
+        note_value(ours, keys[k], now, sizeof now);
+        if (!note || !note_value(note, keys[k], was, sizeof was) || strcmp(was, "none") == 0 ||
+            strcmp(now, "none") == 0 || strcmp(was, now) == 0)
+            continue;
+        cli_error("--restart %s: [dump] %s = %s, but the run that wrote the checkpoint wrote %s "
+                  "%s%s: the resumed run would %s; resume with %s = %s (--set dump.%s=%s), or "
+                  "start afresh without --restart (nothing was changed)",
+                  opt->restart, keys[k], now, k ? "its CSV as" : "its frames as", was,
+                  k ? "" : "_NNNNNN.vtk",
+                  k ? "write a CSV that lacks the rows before the checkpoint"
+                    : "start another series of frames beside them",
+                  keys[k], was, keys[k], was);
+        return CLI_EXIT_USAGE;
+    }
+    return CLI_EXIT_OK;
+}
+
 /* Sets the mode again with the outputs of --out DIR and the stop flag. */
 static int set_outputs(struct cli_many_setup* su, const struct cli_run_options* opt,
                        struct plan* pl, struct progress* prog)
@@ -1183,6 +1234,9 @@ static int set_outputs(struct cli_many_setup* su, const struct cli_run_options* 
         return CLI_EXIT_RUNTIME;
     }
     m.csv_comment = comment;
+    char note[2 * CLI_VALUE_MAX + 16];
+    output_note(su, note, sizeof note);
+    m.checkpoint_note = note;
     int st = wetdem_sim_set_many(su->sim, &m);
     free(comment); /* (copied) */
     if (st == WETDEM_OK)
@@ -1211,6 +1265,8 @@ static int restore(const struct cli_scenario* sc, const struct cli_many_setup* s
                   opt->restart, wetdem_sim_n_particles(su->sim), n_scenario);
         return CLI_EXIT_USAGE;
     }
+    if (check_output_names(su, opt) != CLI_EXIT_OK)
+        return CLI_EXIT_USAGE;
     /* The budget restored closes at the checkpoint's step unless the state was edited or its
        run's step was too long for the contacts (which the end of that run judges too): either
        way the run is refused before any output is touched. */

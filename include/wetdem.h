@@ -734,6 +734,10 @@ struct wetdem_many_settings {
                                           "# " comment: its provenance (the CLI's "wetdem
                                           VERSION (git HASH)" and "command: ..."); NULL or
                                           "": "wetdem VERSION" (copied) */
+    const char* checkpoint_note;       /* text every checkpoint records, which
+                                          wetdem_sim_checkpoint_note gives back after a restore
+                                          (the CLI's: the names of its VTK frames and CSV, that
+                                          a restart must continue); NULL or "": none (copied) */
 };
 
 /* Most steps one wetdem_sim_integrate() call of a many-particle run takes: a longer call is
@@ -902,6 +906,11 @@ WETDEM_API int wetdem_sim_write_checkpoint(struct wetdem_sim* sim, const char* p
  * wrote the checkpoint. WETDEM_ERR_INVALID if the set-up differs, WETDEM_ERR_PARSE/IO if the
  * file is bad. */
 WETDEM_API int wetdem_sim_read_checkpoint(struct wetdem_sim* sim, const char* path);
+/* The checkpoint_note of the checkpoint that wetdem_sim_read_checkpoint last restored into
+ * sim: "" when it holds none (its run set none, or an earlier version wrote it); NULL when no
+ * checkpoint was restored since the many-particle mode was set (or sim is NULL). Valid until
+ * the next restore or wetdem_sim_set_many. */
+WETDEM_API const char* wetdem_sim_checkpoint_note(const struct wetdem_sim* sim);
 
 enum wetdem_insert_layout {
     WETDEM_INSERT_LATTICE = 0, /* simple cubic lattice of spacing 2 R_max + gap, x fastest */

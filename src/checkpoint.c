@@ -18,6 +18,7 @@
  *     RNG_   char name[32] | state bytes (gsl_rng_state, gsl_rng_size bytes)
  *     ENER   n_energy f64 energy-budget accumulators [J]
  *     USER   opaque bytes
+ *     NOTE   the run's checkpoint_note, text without its NUL (only when it has one)
  *   trailer  u32 CRC-32 of every byte before it
  *
  * Records are written field by field (never whole structs), so padding never reaches the file
@@ -204,6 +205,10 @@ static void put_rest(struct buf* b, const struct wetdem_checkpoint* ck, uint32_t
     put_section(b, "USER", ck->extra_size, ns);
     if (ck->extra_size)
         put(b, ck->extra, ck->extra_size);
+    if (ck->note && ck->note[0]) { /* (none: the file is as without notes) */
+        put_section(b, "NOTE", strlen(ck->note), ns);
+        put(b, ck->note, strlen(ck->note));
+    }
 }
 
 static int write_file(const char* path, const struct buf* b, char* msg, size_t n)
@@ -427,6 +432,16 @@ static int parse_section(struct cursor* c, const char tag[4], uint64_t bytes,
     }
     if (!memcmp(tag, "USER", 4))
         return parse_blob(c, &ck->extra, &ck->extra_size, bytes);
+    if (!memcmp(tag, "NOTE", 4)) { /* text without its NUL, which none of its bytes is */
+        int st = alloc_checked((void**)&ck->note, bytes + 1, 1, 1, bytes + 1);
+        if (st == WETDEM_OK) {
+            get(c, ck->note, (size_t)bytes);
+            ck->note[bytes] = '\0';
+            if (memchr(ck->note, '\0', (size_t)bytes))
+                st = WETDEM_ERR_PARSE;
+        }
+        return st;
+    }
     get(c, NULL, (size_t)bytes); /* unknown section of a later minor revision: skip */
     return WETDEM_OK;
 }
@@ -557,6 +572,7 @@ void wetdem_checkpoint_clear(struct wetdem_checkpoint* ck)
     free(ck->rng_state);
     free(ck->energy);
     free(ck->extra);
+    free(ck->note);
     memset(ck, 0, sizeof *ck);
 }
 

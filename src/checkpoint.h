@@ -58,6 +58,8 @@ struct wetdem_checkpoint {
     size_t n_energy;
     unsigned char* extra; /* opaque bytes for extensions */
     size_t extra_size;
+    char* note; /* the run's checkpoint_note (NOTE section, written when not empty); NULL:
+                   none */
 };
 
 /* Writes ck to path atomically (path.tmp, fsync, rename): a crash leaves the old file intact.

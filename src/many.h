@@ -195,6 +195,8 @@ struct wetdem_many {
     char* output_prefix;
     char* checkpoint_path;
     char* csv_comment;
+    char* checkpoint_note; /* written into every checkpoint (NOTE section) */
+    char* restored_note;   /* the note of the checkpoint restored last; NULL: none restored */
     struct wetdem_celllist cl;
     double reach; /* largest interaction gap of any pair [m] (start-up bound) */
     /* With a min-separation model that keeps a record beyond the force range (its record_range

@@ -89,6 +89,8 @@ void wetdem_sim_many_free(struct wetdem_sim* sim)
     free(m->output_prefix);
     free(m->checkpoint_path);
     free(m->csv_comment);
+    free(m->checkpoint_note);
+    free(m->restored_note);
     free(m->history);
     free(m->wall_history);
     free(m->old_pairs);
@@ -150,12 +152,14 @@ int wetdem_sim_set_many(struct wetdem_sim* sim, const struct wetdem_many_setting
     m->output_prefix = dup_string(s->output_prefix);
     m->checkpoint_path = dup_string(s->checkpoint_path);
     m->csv_comment = dup_string(s->csv_comment);
+    m->checkpoint_note = dup_string(s->checkpoint_note);
     m->set.output_prefix = m->output_prefix;
     m->set.checkpoint_path = m->checkpoint_path;
     m->set.csv_comment = m->csv_comment;
+    m->set.checkpoint_note = m->checkpoint_note;
     sim->many = m;
     if ((s->output_prefix && !m->output_prefix) || (s->checkpoint_path && !m->checkpoint_path) ||
-        (s->csv_comment && !m->csv_comment))
+        (s->csv_comment && !m->csv_comment) || (s->checkpoint_note && !m->checkpoint_note))
         return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory");
     return WETDEM_OK;
 }
@@ -169,15 +173,19 @@ void wetdem_sim_many_reset(struct wetdem_sim* sim)
     char* prefix = dup_string(s.output_prefix);
     char* checkpoint = dup_string(s.checkpoint_path);
     char* comment = dup_string(s.csv_comment);
+    char* note = dup_string(s.checkpoint_note);
     s.output_prefix = prefix;
     s.checkpoint_path = checkpoint;
     s.csv_comment = comment;
+    s.checkpoint_note = note;
     if ((s.output_prefix && !prefix) || (s.checkpoint_path && !checkpoint) ||
-        (s.csv_comment && !comment) || wetdem_sim_set_many(sim, &s) != WETDEM_OK)
+        (s.csv_comment && !comment) || (s.checkpoint_note && !note) ||
+        wetdem_sim_set_many(sim, &s) != WETDEM_OK)
         wetdem_sim_many_free(sim); /* (out of memory: back to the two-body mode) */
     free(prefix);
     free(checkpoint);
     free(comment);
+    free(note);
 }
 
 struct wetdem_vec3 wetdem_sim_many_nearest_image(const struct wetdem_sim* sim, struct wetdem_vec3 a,

@@ -800,7 +800,8 @@ static int fill_checkpoint(struct wetdem_sim* sim, struct wetdem_checkpoint* ck)
         .n_energy = N_ENERGY,
         .extra = ck->extra,
         .extra_size = blob_size_speeds(n),
-        .output = {m->vtk_files, m->csv_rows, m->next_vtk_step, m->next_csv_step}};
+        .output = {m->vtk_files, m->csv_rows, m->next_vtk_step, m->next_csv_step},
+        .note = m->checkpoint_note};
     return WETDEM_OK;
 }
 
@@ -1054,6 +1055,12 @@ static int read_checkpoint(struct wetdem_sim* sim, const char* path)
         st = restore_pairs(sim, &ck);
     if (st == WETDEM_OK)
         st = reload_series(sim);
+    if (st == WETDEM_OK) { /* (the note of an earlier restore goes, whatever this one's) */
+        free(sim->many->restored_note);
+        sim->many->restored_note = strdup(ck.note ? ck.note : "");
+        if (!sim->many->restored_note)
+            st = wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "out of memory");
+    }
     wetdem_checkpoint_clear(&ck);
     return st;
 }
@@ -1104,6 +1111,11 @@ int wetdem_sim_write_checkpoint(struct wetdem_sim* sim, const char* path)
 int wetdem_sim_read_checkpoint(struct wetdem_sim* sim, const char* path)
 {
     return file_call(sim, READ_CHECKPOINT, path, false);
+}
+
+const char* wetdem_sim_checkpoint_note(const struct wetdem_sim* sim)
+{
+    return sim && sim->many ? sim->many->restored_note : NULL;
 }
 
 /* ---- insertion ---- */

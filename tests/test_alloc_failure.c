@@ -402,7 +402,8 @@ static int many_box(struct wetdem_sim** out_sim, struct outcome* out)
                                      .vtk_links = true,
                                      .csv_every = 1,
                                      .checkpoint_path = ck,
-                                     .checkpoint_every = 3};
+                                     .checkpoint_every = 3,
+                                     .checkpoint_note = "csv = global.csv"};
     STEP(out, wetdem_sim_set_many(sim, &s), wetdem_sim_errmsg(sim));
     return WETDEM_OK;
 done:
@@ -428,6 +429,8 @@ static void path_many(struct outcome* out)
     if (many_box(&resumed, out) < 0)
         goto done;
     STEP(out, wetdem_sim_read_checkpoint(resumed, path), wetdem_sim_errmsg(resumed));
+    if (strcmp(wetdem_sim_checkpoint_note(resumed), "csv = global.csv") != 0)
+        fail_msg("the restored note is '%s'", wetdem_sim_checkpoint_note(resumed));
     STEP(out, wetdem_sim_integrate(resumed, 14e-6), wetdem_sim_errmsg(resumed));
     STEP(out, wetdem_sim_integrate(sim, 14e-6), wetdem_sim_errmsg(sim));
     test_check_same_particles(sim, resumed);

@@ -64,6 +64,8 @@ static void test_api_null_names_materials_fluids_and_paths_are_refused(void** st
     CHECK_CONTAINS(wetdem_sim_errmsg(sim), "NULL path");
     assert_int_equal(wetdem_sim_read_checkpoint(sim, NULL), WETDEM_ERR_INVALID);
     CHECK_CONTAINS(wetdem_sim_errmsg(sim), "NULL path");
+    assert_null(wetdem_sim_checkpoint_note(NULL));
+    assert_null(wetdem_sim_checkpoint_note(sim)); /* (none restored) */
     double t = 0;
     assert_int_equal(wetdem_output_vtk_frame_time(NULL, &t), WETDEM_ERR_INVALID);
     assert_int_equal(wetdem_output_vtk_frame_time("frame.vtk", NULL), WETDEM_ERR_INVALID);

@@ -301,6 +301,32 @@ static void test_checkpoint_empty_run_round_trips(void** state)
     wetdem_checkpoint_clear(&r);
 }
 
+/* A run's checkpoint_note (the names of the CLI's outputs) comes back as written, in a NOTE
+ * section of a 16-byte header and its text; none leaves the file as it was without notes
+ * (older readers skip the section: tag, flags, size). */
+static void test_checkpoint_note_round_trips(void** state)
+{
+    struct fixture* f = *state;
+    struct wetdem_checkpoint r;
+    struct stat plain, noted;
+    CHECK_OK(wetdem_checkpoint_write(f->path, &f->ck, NULL, 0));
+    assert_int_equal(stat(f->path, &plain), 0);
+    CHECK_OK(wetdem_checkpoint_read(f->path, &r, NULL, 0));
+    assert_null(r.note);
+    wetdem_checkpoint_clear(&r);
+    const char* note = "vtk = particles\ncsv = global.csv";
+    f->ck.note = (char*)note;
+    CHECK_OK(wetdem_checkpoint_write(f->path, &f->ck, NULL, 0));
+    f->ck.note = NULL;
+    assert_int_equal(stat(f->path, &noted), 0);
+    assert_int_equal(noted.st_size - plain.st_size, 16 + (off_t)strlen(note));
+    CHECK_OK(wetdem_checkpoint_read(f->path, &r, NULL, 0));
+    assert_non_null(r.note);
+    assert_string_equal(r.note, note);
+    wetdem_checkpoint_clear(&r);
+    assert_null(r.note);
+}
+
 /* Standard check values: CRC-32/ISO-HDLC of "123456789" is 0xCBF43926; FNV-1a 64 of "a" is
  * 0xaf63dc4c8601ec8c (Fowler-Noll-Vo reference test vectors). */
 static void test_checkpoint_checksums_match_reference_values(void** state)
@@ -326,6 +352,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_checkpoint_failed_write_keeps_the_old_file, setup,
                                         teardown),
         cmocka_unit_test_setup_teardown(test_checkpoint_empty_run_round_trips, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_checkpoint_note_round_trips, setup, teardown),
         cmocka_unit_test(test_checkpoint_checksums_match_reference_values),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

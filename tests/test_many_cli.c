@@ -572,6 +572,40 @@ static void test_many_cli_restart_is_bit_identical(void** state)
                         "(energy_budget = yes)");
     free(err);
     check_same_outputs("whole", "split", 7);
+    /* so are other names of the frames or the CSV than the checkpoint's run wrote, both
+       alike: another VTK prefix started a second series beside the first (exit 0), another
+       CSV name was "missing"; --check --restart says the same */
+    const struct {
+        const char *set, *what;
+    } renamed[] = {
+        {"dump.vtk=other",
+         "--restart split/checkpoint.ckpt: [dump] vtk = other, but the run that wrote the "
+         "checkpoint wrote its frames as particles_NNNNNN.vtk: the resumed run would start "
+         "another series of frames beside them; resume with vtk = particles (--set "
+         "dump.vtk=particles), or start afresh without --restart (nothing was changed)"},
+        {"dump.csv=other.csv",
+         "--restart split/checkpoint.ckpt: [dump] csv = other.csv, but the run that wrote the "
+         "checkpoint wrote its CSV as global.csv: the resumed run would write a CSV that lacks "
+         "the rows before the checkpoint; resume with csv = global.csv (--set "
+         "dump.csv=global.csv)"},
+    };
+    for (size_t k = 0; k < sizeof renamed / sizeof renamed[0]; k++) {
+        char args[300];
+        snprintf(args, sizeof args,
+                 "run box.ini --set run.steps=900 --set %s --out split --restart "
+                 "split/checkpoint.ckpt",
+                 renamed[k].set);
+        free(expect_exit(args, 2, renamed[k].what));
+        check_same_outputs("whole", "split", 7);
+        assert_int_equal(access(tpath("split/other.vtk.series"), F_OK), -1);
+        assert_int_equal(access(tpath("split/other_000000.vtk"), F_OK), -1);
+        assert_int_equal(access(tpath("split/other.csv"), F_OK), -1);
+        snprintf(args, sizeof args,
+                 "run box.ini --check --set run.steps=900 --set %s --restart "
+                 "split/checkpoint.ckpt",
+                 renamed[k].set);
+        free(expect_exit(args, 2, renamed[k].what));
+    }
     /* one holding another number of spheres than the scenario places (the checkpoint's would
        replace them unnoticed), and the final checkpoint of a run resumed with the same end
        (nothing to run: the message says how to extend it); both exit 2 before any output is
