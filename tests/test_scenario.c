@@ -1590,6 +1590,66 @@ static void test_scenario_resume_refuses_a_damaged_kept_row(void** state)
     free(intact);
 }
 
+/* Before a batch allocates its points, the memory they hold is estimated: a map of 10^7
+ * points of eight spheres (2.98 kB each: 147 columns of 16 bytes, and the point's 600) needs
+ * 29.8 GB, more than the machine's memory is refused (exit 2, no table), and a sweep of 10^6
+ * dry collisions above 1 GB gets a note. Both would fail at their first point (t_end = 0,
+ * speed = 0), so a batch that went on to allocate and build its points is told apart at once.
+ * WETDEM_TEST_MEMORY stands in for the machine's memory where it has more (or, for the note,
+ * so that 1.22 GB fits). */
+static void test_scenario_batch_memory_is_estimated(void** state)
+{
+    (void)state;
+    char text[2000] = "[engine]\ntype = pairwise\n[pairwise]\nh_min = 1e-6\nt_end = 1e-2\n"
+                      "viscosity = 1e-3\n";
+    for (int k = 1; k <= 8; k++) {
+        size_t used = strlen(text);
+        snprintf(text + used, sizeof text - used,
+                 "[sphere.s%d]\nradius = 1e-3\nmass = 1e-5\nfilm = 1e-5\nx = %g\nvx = %g\n", k,
+                 3e-3 * k, k == 1 ? 0.1 : 0.0);
+    }
+    const char* eight = write_file("eight.ini", text);
+    double have = (double)sysconf(_SC_PHYS_PAGES) * (double)sysconf(_SC_PAGESIZE);
+    bool more = have >= 29.8e9; /* (a machine that holds it: the hook's 25 GB stand in) */
+    char env[64] = "", args[1200], want[300];
+    if (more) {
+        have = 25e9;
+        snprintf(env, sizeof env, "WETDEM_TEST_MEMORY=%.17g", have);
+    }
+    snprintf(args, sizeof args,
+             "map %s --param pairwise.t_end --values 0:1e-2:3162 --param2 pairwise.viscosity "
+             "--values2 1e-3:1:3162 --out %s/huge.csv",
+             eight, tmpdir);
+    struct test_run r = test_run_cli(env, args, true);
+    snprintf(want, sizeof want,
+             "wetdem: map: 9998244 points need about 29.8 GB of memory for their results "
+             "(2.98 kB a point: values, result and CSV row), more than this machine has, %.3g "
+             "GB: run fewer points, or the range in parts\n",
+             have / 1e9);
+    if (r.code != 2)
+        fail_msg("exit %d, expected 2\n%s", r.code, r.out);
+    CHECK_CONTAINS(r.out, want);
+    free(r.out);
+    snprintf(want, sizeof want, "%s/huge.csv", tmpdir);
+    assert_int_equal(access(want, F_OK), -1);
+    /* the same estimate against a memory of 1 GB, and a note where it fits in 4 GB */
+    const char* sweep = "sweep examples/scenarios/dry_hertz.ini --param collision.speed --values "
+                        "0:1:1e6";
+    r = test_run_cli("WETDEM_TEST_MEMORY=1e9", sweep, true);
+    assert_int_equal(r.code, 2);
+    CHECK_CONTAINS(r.out, "wetdem: sweep: 1000000 points need about 1.22 GB of memory for their "
+                          "results (1.22 kB a point: values, result and CSV row), more than "
+                          "this machine has, 1 GB");
+    free(r.out);
+    r = test_run_cli("WETDEM_TEST_MEMORY=4e9", sweep, true);
+    assert_int_equal(r.code, 2);
+    CHECK_CONTAINS(r.out, "wetdem: sweep: note: 1000000 points hold about 1.22 GB of memory "
+                          "until the table is written (1.22 kB a point; the machine has 4 GB)\n");
+    CHECK_CONTAINS(r.out,
+                   "wetdem: sweep: at point 1 of 1000000 of the values: collision.speed = 0");
+    free(r.out);
+}
+
 /* A map killed outright (SIGKILL: no handler, no table at the end) leaves the table it saved
  * while running (--save-every): whole, under its name, every point there, those done with
  * their rows and the others NOT_RUN, and a line saying so; --resume with it runs the rest,
@@ -2118,6 +2178,7 @@ int main(void)
         cmocka_unit_test(test_scenario_resumed_map_equals_the_whole),
         cmocka_unit_test(test_scenario_resume_refuses_a_damaged_kept_row),
         cmocka_unit_test(test_scenario_killed_map_resumes_from_its_saved_table),
+        cmocka_unit_test(test_scenario_batch_memory_is_estimated),
         cmocka_unit_test(test_scenario_closed_loop_of_contacts_settles),
         cmocka_unit_test(test_scenario_interrupted_run_keeps_nothing),
         cmocka_unit_test(test_scenario_sweep_order_and_threads),
