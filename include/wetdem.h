@@ -401,7 +401,12 @@ WETDEM_API struct wetdem_fluid wetdem_sim_fluid(const struct wetdem_sim* sim);
 /* Appends a copy of p (validated: finite, radius > 0, known material). A mass of 0 is filled
  * from the material density. Returns WETDEM_OK or a negative status. */
 WETDEM_API int wetdem_sim_add_particle(struct wetdem_sim* sim, struct wetdem_particle p);
-/* Borrowed view of the particles, valid until the next add. *n receives the count. */
+/* Borrowed view of the particles, valid until the next add. *n receives the count. A program
+ * may edit them through it between calls (docs/many.md, Limits); the calls that read them then
+ * check them as wetdem_sim_add_particle does (a mass of 0 is not filled in here): a particle it
+ * would refuse makes wetdem_sim_integrate, wetdem_sim_pair_force and the reports of a started
+ * many-particle run (statistics, energy budget, CSV row, VTK frames and links, checkpoint)
+ * return WETDEM_ERR_INVALID with a message naming it. */
 WETDEM_API struct wetdem_particle* wetdem_sim_particles(struct wetdem_sim* sim, size_t* n);
 /* Number of particles. */
 WETDEM_API size_t wetdem_sim_n_particles(const struct wetdem_sim* sim);

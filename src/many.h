@@ -529,6 +529,11 @@ int wetdem_sim_many_check_models(const struct wetdem_sim* sim, const char* what)
  * the many-particle mode, a started run and its models unchanged
  * (wetdem_sim_many_check_models). WETDEM_OK, or WETDEM_ERR_INVALID with "WHAT: why". */
 int wetdem_sim_many_check_run(const struct wetdem_sim* sim, const char* what);
+/* What a report of a started run reads besides the histories: the particles as edited
+ * through wetdem_sim_particles() since the latest call. WETDEM_OK when each is one the next
+ * call accepts (wetdem_sim_particle_valid) or no run has started, else WETDEM_ERR_INVALID with
+ * "WHAT: particle K: why", so that no report reads past the materials or sums a NaN. */
+int wetdem_sim_many_check_particles(const struct wetdem_sim* sim, const char* what);
 
 /* sim_many_force.c */
 /* Builds the material-pair table and chooses the kernel (fused or generic); needs m->reach
@@ -537,8 +542,9 @@ int wetdem_sim_many_setup_kernel(struct wetdem_sim* sim);
 /* Mixed properties of materials a and b (setup_kernel must have run). */
 const struct wetdem_many_mix* wetdem_sim_many_mix(const struct wetdem_sim* sim, int a, int b);
 /* Contact of particle i with particle j (minimum image) or with wall j, properties from the
- * table: the same values as wetdem_sim_build_contact (up to the rounding of the image's
- * position across a periodic face). */
+ * table (a material added since it was made: mixed on the spot, with the table's fluid): the
+ * same values as wetdem_sim_build_contact (up to the rounding of the image's position across a
+ * periodic face). */
 void wetdem_sim_many_contact(const struct wetdem_sim* sim, size_t i, size_t j, bool is_wall,
                              struct wetdem_contact* c);
 /* The fused kernel: the same contract and results as wetdem_sim_eval_contact, for model sets

@@ -1458,6 +1458,19 @@ int wetdem_sim_many_check_run(const struct wetdem_sim* sim, const char* what)
     return wetdem_sim_many_check_models(sim, what);
 }
 
+int wetdem_sim_many_check_particles(const struct wetdem_sim* sim, const char* what)
+{
+    if (!sim->many || !sim->many->started)
+        return WETDEM_OK;
+    char why[256];
+    for (size_t k = 0; k < sim->n_particles; k++)
+        if (!wetdem_sim_particle_valid(sim, &sim->particles[k], why, sizeof why))
+            /* (the message buffer: as wetdem_sim_many_check_models) */
+            return wetdem_sim_fail((struct wetdem_sim*)sim, WETDEM_ERR_INVALID,
+                                   "%s: particle %zu: %s", what, k, why);
+    return WETDEM_OK;
+}
+
 /* First call of a many run: step size, pair list, forces and the energy at t0. */
 static int start(struct wetdem_sim* sim)
 {
@@ -1709,6 +1722,8 @@ int wetdem_sim_energy_budget(const struct wetdem_sim* sim, struct wetdem_energy_
                                : !m->started ? "the many-particle run has not started"
                                              : "the run's energy_budget setting is off");
     int st = wetdem_sim_many_check_models(sim, "energy_budget");
+    if (st == WETDEM_OK)
+        st = wetdem_sim_many_check_particles(sim, "energy_budget");
     if (st != WETDEM_OK)
         return st;
     wetdem_sim_many_energies(sim, &b->kinetic, &b->potential, &b->elastic);

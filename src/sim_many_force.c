@@ -272,17 +272,34 @@ const struct wetdem_many_mix* wetdem_sim_many_mix(const struct wetdem_sim* sim, 
     return &m->mix[(size_t)a * (size_t)m->n_mix_materials + (size_t)b];
 }
 
+/* The mixed properties of materials a and b: the table's, or for a material added since the
+ * table was made (at the latest call: a report between calls reads the particles as edited
+ * since, wetdem_sim_many_check_particles) mixed here as the next call will, with the fluid of
+ * the table. */
+static const struct wetdem_many_mix* mix_of(const struct wetdem_sim* sim, int a, int b,
+                                            struct wetdem_many_mix* scratch)
+{
+    const struct wetdem_many* m = sim->many;
+    if (a < m->n_mix_materials && b < m->n_mix_materials)
+        return wetdem_sim_many_mix(sim, a, b);
+    mix_pair(sim, a, b, scratch);
+    scratch->viscosity = m->mix[0].viscosity;
+    scratch->surface_tension = m->mix[0].surface_tension;
+    return scratch;
+}
+
 void wetdem_sim_many_contact(const struct wetdem_sim* sim, size_t i, size_t j, bool is_wall,
                              struct wetdem_contact* c)
 {
     const struct wetdem_particle* a = &sim->particles[i];
+    struct wetdem_many_mix scratch;
     if (is_wall) {
         const struct wetdem_wall* w = &sim->walls[j];
-        wall_contact_from(a, w, wetdem_sim_many_mix(sim, a->material, w->material), c);
+        wall_contact_from(a, w, mix_of(sim, a->material, w->material, &scratch), c);
     } else {
         const struct wetdem_particle* b = &sim->particles[j];
         struct wetdem_vec3 d = celllist_delta(&sim->many->cl.box, a->pos, b->pos);
-        pair_contact_from(a, b, d, wetdem_sim_many_mix(sim, a->material, b->material), c);
+        pair_contact_from(a, b, d, mix_of(sim, a->material, b->material, &scratch), c);
     }
     c->i = i;
     c->j = j;

@@ -183,6 +183,8 @@ int wetdem_sim_many_stats(const struct wetdem_sim* sim, struct wetdem_many_stats
 {
     memset(s, 0, sizeof *s);
     int st = wetdem_sim_many_check_run(sim, "many_stats");
+    if (st == WETDEM_OK)
+        st = wetdem_sim_many_check_particles(sim, "many_stats");
     if (st != WETDEM_OK)
         return st;
     st = wetdem_sim_many_links(sim, NULL, s);
@@ -600,6 +602,8 @@ int wetdem_sim_many_write_csv_row(struct wetdem_sim* sim)
         return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
                                "many: a CSV row needs a started many-particle run with outputs");
     int checked = wetdem_sim_many_check_models(sim, "many: a CSV row");
+    if (checked == WETDEM_OK)
+        checked = wetdem_sim_many_check_particles(sim, "many: a CSV row");
     if (checked != WETDEM_OK)
         return checked;
     struct wetdem_locale_guard g;
@@ -1076,6 +1080,8 @@ static int file_call(struct wetdem_sim* sim, enum file_call call, const char* pa
 {
     static const char* const what[] = {"write_vtk", "links", "write_checkpoint", NULL};
     int st = what[call] ? wetdem_sim_many_check_models(sim, what[call]) : WETDEM_OK;
+    if (st == WETDEM_OK && what[call])
+        st = wetdem_sim_many_check_particles(sim, what[call]);
     if (st != WETDEM_OK)
         return st;
     struct wetdem_locale_guard g;

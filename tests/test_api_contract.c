@@ -4,9 +4,12 @@
  * found" answer of a lookup), never dereferenced; an insertion is whole or nothing, also for
  * counts whose arrays no size_t can measure; a hard-sphere impulse that would give NaN or
  * infinite velocities is an error that leaves the bodies as they were; a fit refuses an
- * infinite scale or tolerance; a value is formatted whatever the digits asked for.
+ * infinite scale or tolerance; a value is formatted whatever the digits asked for; the
+ * reports of a many-particle run read particles edited since its latest call as that call
+ * would, and refuse those it would refuse.
  */
 #include <stdlib.h>
+#include <unistd.h>
 
 #include "harness.h"
 
@@ -211,6 +214,83 @@ static void test_api_pair_force_refuses_non_finite_force(void** state)
     wetdem_sim_free(sim);
 }
 
+/* The reports of a started many-particle run read the particles as they are now, edited
+ * through wetdem_sim_particles() since the latest call as the next call will read them: a
+ * material added since and given to a particle is mixed as that call mixes it (the table of
+ * material pairs was made for the materials of the latest call, and the reports read past its
+ * end), and a particle the next call would refuse (a material that does not exist, a NaN) is
+ * refused by every report, naming it, and not read. */
+static void test_api_many_reports_read_the_particles_edited_since_the_latest_call(void** state)
+{
+    (void)state;
+    const double radius = 1e-3, overlap = 1e-6;
+    struct wetdem_sim* sim = wetdem_sim_create();
+    assert_non_null(sim);
+    assert_int_equal(wetdem_sim_add_material_preset(sim, "glass"), 0);
+    CHECK_OK(wetdem_sim_add_particle(sim, (struct wetdem_particle){.radius = radius}));
+    CHECK_OK(wetdem_sim_add_particle(
+        sim, (struct wetdem_particle){.pos = {2 * radius - overlap, 0, 0}, .radius = radius}));
+    CHECK_OK(wetdem_sim_enable_model(sim, "hertz"));
+    char dir[] = "/tmp/wetdem_test_api_reports_XXXXXX";
+    assert_non_null(mkdtemp(dir));
+    char prefix[64], path[96];
+    snprintf(prefix, sizeof prefix, "%s/run", dir);
+    struct wetdem_many_settings ms = {.dt = 1e-9, .energy_budget = true, .output_prefix = prefix};
+    CHECK_OK(wetdem_sim_set_many(sim, &ms));
+    CHECK_OK(wetdem_sim_integrate(sim, 1e-9));
+    snprintf(path, sizeof path, "%s/run.csv", dir);
+    remove(path); /* (the header the run wrote) */
+
+    /* steel given to sphere 1 after the call, the spheres put back at the overlap: the Hertz
+     * energy (8/15) E* sqrt(R*) delta^(5/2) with the E* of glass on steel (closed form; the
+     * same arithmetic up to rounding: 1e-12) */
+    int steel = wetdem_sim_add_material_preset(sim, "steel1");
+    assert_int_equal(steel, 1);
+    struct wetdem_particle* p = wetdem_sim_particles(sim, NULL);
+    p[0].pos = (struct wetdem_vec3){0, 0, 0};
+    p[1].pos = (struct wetdem_vec3){2 * radius - overlap, 0, 0};
+    p[1].material = steel;
+    const struct wetdem_material *g = wetdem_sim_material(sim, 0), *s = wetdem_sim_material(sim, 1);
+    double e_star = 1.0 / ((1 - g->poisson_ratio * g->poisson_ratio) / g->youngs_modulus +
+                           (1 - s->poisson_ratio * s->poisson_ratio) / s->youngs_modulus);
+    struct wetdem_energy_budget b;
+    CHECK_OK(wetdem_sim_energy_budget(sim, &b));
+    CHECK_REL(b.elastic, 8.0 / 15.0 * e_star * sqrt(radius / 2) * pow(overlap, 2.5), 1e-12);
+    struct wetdem_many_stats st;
+    CHECK_OK(wetdem_sim_many_stats(sim, &st));
+    assert_int_equal(st.contacts, 1);
+
+    /* a particle the next call refuses: so do the reports, and they write nothing */
+    struct {
+        int material;
+        double mass;
+        const char* why;
+    } bad[] = {{7, p[1].mass, "material 7 does not exist"}, {steel, NAN, "mass must be"}};
+    for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {
+        p[1].material = bad[k].material;
+        double mass = p[1].mass;
+        p[1].mass = bad[k].mass;
+        assert_int_equal(wetdem_sim_energy_budget(sim, &b), WETDEM_ERR_INVALID);
+        CHECK_CONTAINS(wetdem_sim_errmsg(sim), "particle 1");
+        CHECK_CONTAINS(wetdem_sim_errmsg(sim), bad[k].why);
+        assert_int_equal(wetdem_sim_many_stats(sim, &st), WETDEM_ERR_INVALID);
+        CHECK_CONTAINS(wetdem_sim_errmsg(sim), bad[k].why);
+        assert_int_equal(wetdem_sim_many_write_csv_row(sim), WETDEM_ERR_INVALID);
+        snprintf(path, sizeof path, "%s/frame.vtk", dir);
+        assert_int_equal(wetdem_sim_write_vtk(sim, path, false), WETDEM_ERR_INVALID);
+        snprintf(path, sizeof path, "%s/links.vtk", dir);
+        assert_int_equal(wetdem_sim_write_vtk_links(sim, path, false), WETDEM_ERR_INVALID);
+        snprintf(path, sizeof path, "%s/run.ckpt", dir);
+        assert_int_equal(wetdem_sim_write_checkpoint(sim, path), WETDEM_ERR_INVALID);
+        CHECK_CONTAINS(wetdem_sim_errmsg(sim), "particle 1");
+        p[1].mass = mass;
+    }
+    assert_int_equal(rmdir(dir), 0); /* empty: no report wrote a file */
+    p[1].material = steel;
+    CHECK_OK(wetdem_sim_energy_budget(sim, &b));
+    wetdem_sim_free(sim);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -220,6 +300,7 @@ int main(void)
         cmocka_unit_test(test_api_fit_refuses_infinite_scale_and_tolerances),
         cmocka_unit_test(test_api_format_value_always_writes),
         cmocka_unit_test(test_api_pair_force_refuses_non_finite_force),
+        cmocka_unit_test(test_api_many_reports_read_the_particles_edited_since_the_latest_call),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
