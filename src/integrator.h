@@ -134,11 +134,14 @@ bool wetdem_sim_separation_reached(struct wetdem_sim* sim);
 /* After an accepted step at engine.time: calls the monitor, and the progress callback every
  * WETDEM_PROGRESS_STEPS steps of the integrate call. Returns the first failing status. */
 int wetdem_sim_step_done(struct wetdem_sim* sim);
-/* Calls the observer, if any, with the current state at engine.time; maps a non-zero return
- * to WETDEM_ERR_CALLBACK (message stored). */
+/* Calls the observer, if any, with the current state at engine.time, and with an interval
+ * sets the next observer time, the first multiple of it after engine.time (engine.time a few
+ * roundings below a multiple counting as at it); maps a non-zero return to
+ * WETDEM_ERR_CALLBACK (message stored). */
 int wetdem_sim_observe(struct wetdem_sim* sim);
 /* Calls the observer once at the current state if engine.time has reached the next observer
- * time, and advances that time past engine.time (fixed-step integrators). */
+ * time (or lies a few roundings below it), which advances that time past engine.time
+ * (fixed-step integrators). */
 int wetdem_sim_observe_due(struct wetdem_sim* sim);
 
 #endif

@@ -404,9 +404,7 @@ static int observe_between(struct wetdem_sim* sim, struct run* r, struct solver*
             return wetdem_sim_fail(sim, WETDEM_ERR_STEP, "cvode: no interpolant at t = %g s", t);
         unpack(r, N_VGetArrayPointer(s->ytmp));
         e->time = t;
-        double next = e->observer_interval * (floor(t / e->observer_interval) + 1.0);
-        e->next_observe = next > t ? next : next + e->observer_interval;
-        int st = wetdem_sim_observe(sim);
+        int st = wetdem_sim_observe(sim); /* (which sets the next observer time) */
         if (st != WETDEM_OK)
             return st;
     }

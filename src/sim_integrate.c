@@ -22,6 +22,7 @@
  * and half_omega during its evaluation instead, and the spring advances with the slip of the
  * half-step velocities at the current normal (midpoint rule, also second order).
  */
+#include <float.h>
 #include <math.h>
 #include <omp.h>
 #include <stdlib.h>
@@ -365,11 +366,28 @@ int wetdem_sim_step_done(struct wetdem_sim* sim)
     return st;
 }
 
+/* The observer time after t: the least multiple k x interval above t, where a multiple that t
+ * lies on, or a few roundings below, counts as t's own. Step ends summed from dt and multiples
+ * computed as products or sums land either side of one another by a rounding: taken as the
+ * multiple after them, it was observed a second time (1.3999999999999997e-06 s, then
+ * 1.3999999999999999e-06 s for an interval of 1e-7 s). Every multiple is computed here as the
+ * product of its index, so one multiple is one double. */
+static double next_observe_after(double t, double interval)
+{
+    double k = floor(t / interval);
+    if (interval * (k + 1.0) <= t + 4.0 * DBL_EPSILON * fabs(t))
+        k += 1.0;
+    double next = interval * (k + 1.0);
+    return next > t ? next : interval * (k + 2.0);
+}
+
 int wetdem_sim_observe(struct wetdem_sim* sim)
 {
     struct wetdem_engine* e = &sim->engine;
     if (!e->observer)
         return WETDEM_OK;
+    if (e->observer_interval > 0) /* (every call: at the start, the multiples and the end) */
+        e->next_observe = next_observe_after(e->time, e->observer_interval);
     e->last_observed = e->time;
     int r = e->observer(sim, e->observer_ctx);
     if (r != 0)
@@ -381,9 +399,10 @@ int wetdem_sim_observe(struct wetdem_sim* sim)
 int wetdem_sim_observe_due(struct wetdem_sim* sim)
 {
     struct wetdem_engine* e = &sim->engine;
-    if (!e->observer || !(e->observer_interval > 0) || e->time < e->next_observe)
+    /* (a step end a few roundings below the multiple is at it: next_observe_after) */
+    if (!e->observer || !(e->observer_interval > 0) ||
+        e->time + 4.0 * DBL_EPSILON * fabs(e->time) < e->next_observe)
         return WETDEM_OK;
-    e->next_observe = e->observer_interval * (floor(e->time / e->observer_interval) + 1.0);
     return wetdem_sim_observe(sim);
 }
 
@@ -472,11 +491,8 @@ int wetdem_sim_integrate(struct wetdem_sim* sim, double t_end)
     if (st == WETDEM_OK)
         st = begin_run(sim);
     bool due = e->observer_interval > 0 ? e->time >= e->next_observe : true;
-    if (st == WETDEM_OK && e->observer && due && !(e->last_observed == e->time)) {
-        if (e->observer_interval > 0)
-            e->next_observe = e->observer_interval * (floor(e->time / e->observer_interval) + 1);
+    if (st == WETDEM_OK && e->observer && due && !(e->last_observed == e->time))
         st = wetdem_sim_observe(sim);
-    }
     if (st != WETDEM_OK)
         return st;
     const struct wetdem_integrator* integ = wetdem_integrator_registry()[e->integrator];

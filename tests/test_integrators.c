@@ -408,6 +408,57 @@ static void test_integrators_observer(void** state)
     }
 }
 
+/* The observer sees each multiple k of its interval once: cvode on its interpolant at k x
+ * interval itself, the fixed-step engines (verlet, the many-particle mode) at the first step end
+ * at or after it; then once at the end of the run. The interval, 1e-7 s, is no binary fraction,
+ * so that the multiples computed as products and the step ends or the multiples computed as sums
+ * land either side of one another by a rounding: cvode observed one multiple in about 27 twice
+ * (1.3999999999999997e-06 s and 1.3999999999999999e-06 s), verlet with a step of 3e-8 s one in
+ * 50, and the many-particle mode the start twice (at t = 0 and after the first step). */
+struct grid_obs {
+    int calls;
+    double t[256];
+};
+
+static int grid_observer(const struct wetdem_sim* sim, void* ctx)
+{
+    struct grid_obs* o = ctx;
+    if (o->calls < 256)
+        o->t[o->calls] = wetdem_sim_time(sim);
+    o->calls++;
+    return 0;
+}
+
+static void test_integrators_observer_sees_each_multiple_once(void** state)
+{
+    (void)state;
+    const double interval = 1e-7, t_end = 200.5 * interval, dt = 3e-8;
+    const char* const engine[] = {"verlet", "cvode", "many"};
+    for (int q = 0; q < 3; q++) {
+        struct spring_params sp = {.k = 50.0};
+        struct wetdem_sim* sim = make_sim(q == 1 ? "cvode" : "verlet", 2e-4, -0.05, true, &sp);
+        CHECK_OK(wetdem_sim_set_param(sim, "verlet.dt", dt));
+        struct wetdem_many_settings ms = {.dt = dt};
+        if (q == 2)
+            CHECK_OK(wetdem_sim_set_many(sim, &ms));
+        struct grid_obs o = {0};
+        wetdem_sim_set_observer(sim, interval, grid_observer, &o);
+        CHECK_OK(wetdem_sim_integrate(sim, t_end));
+        /* the multiples 0 .. 200 and the end (at 200.5) */
+        if (o.calls != 202)
+            fail_msg("%s: %d observer calls, want 202", engine[q], o.calls);
+        for (int k = 0; k <= 200; k++) {
+            double lo = k * interval * (1 - 1e-12), hi = k * interval + (q == 1 ? 0.0 : dt);
+            if (!(o.t[k] >= lo && o.t[k] <= hi * (1 + 1e-12)))
+                fail_msg("%s: call %d at t = %.17g s, want the multiple %.17g s%s", engine[q], k,
+                         o.t[k], k * interval, q == 1 ? "" : " or the step end after it");
+        }
+        CHECK_REL(o.t[201], wetdem_sim_time(sim), 0); /* t_end; many: the step end after it */
+        CHECK_REL(wetdem_sim_time(sim), q == 2 ? ceil(t_end / dt) * dt : t_end, 1e-12);
+        wetdem_sim_free(sim);
+    }
+}
+
 /* ---- CVODE vector kernels (integrator_cvode_nvec.c) ---- */
 
 #define NV_N 19 /* odd length: no loop remainder left untested */
@@ -563,6 +614,7 @@ int main(void)
         cmocka_unit_test(test_integrators_params),
         cmocka_unit_test(test_integrators_cvode_bdf),
         cmocka_unit_test(test_integrators_observer),
+        cmocka_unit_test(test_integrators_observer_sees_each_multiple_once),
         cmocka_unit_test(test_integrators_cvode_vector_kernels),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
