@@ -9,11 +9,16 @@
 #include "models.h"
 #include "wetdem.h"
 
+/* One row a model, grouped by kind as in models.h (the comments keep clang-format from packing
+ * the rows into columns, which a new row would reflow). */
 static const struct wetdem_model* const registry[] = {
+    /* contact */
     &wetdem_force_hertz,
     &wetdem_force_mindlin,
     &wetdem_force_hooke,
+    /* impulse */
     &wetdem_hard_model,
+    /* fluid */
     &wetdem_force_nijssen,
     &wetdem_force_reynolds,
     &wetdem_force_sb,
@@ -21,6 +26,7 @@ static const struct wetdem_model* const registry[] = {
     &wetdem_force_davis,
     &wetdem_force_nase,
     &wetdem_force_capillary,
+    /* minimum separation */
     &wetdem_minsep_fixed,
     &wetdem_minsep_roughness,
     &wetdem_minsep_ehd,
