@@ -378,7 +378,10 @@ WETDEM_API int wetdem_hard_impulse(struct wetdem_impulse_body* bi, struct wetdem
 
 struct wetdem_sim;
 
-/* Allocates an empty simulation with default settings. NULL only if out of memory. */
+/* Allocates an empty simulation: no materials, particles, walls or force models; the fluid
+ * water (wetdem_fluid_preset "water"), the min-separation model "fixed", the integrator
+ * "verlet" and the settings of wetdem_sim_settings_params(), each with its defaults. NULL only
+ * if out of memory. */
 WETDEM_API struct wetdem_sim* wetdem_sim_create(void);
 /* Frees the simulation and everything it owns. NULL does nothing. */
 WETDEM_API void wetdem_sim_free(struct wetdem_sim* sim);
@@ -617,7 +620,8 @@ struct wetdem_collision_spec {
                                    the impact parameter b (wall: to its normal); 0 = head-on */
     struct wetdem_vec3 omega_i; /* initial spin of i [rad/s] */
     double initial_gap;         /* gap at t = 0 [m]; <= 0: just outside the interaction range */
-    double t_end;               /* longest simulated time [s] */
+    double t_end;               /* longest simulated time [s], finite and > 0 (no automatic
+                                   value here: the CLI derives one, docs/scenarios.md) */
     double observe_time;        /* > 0: also report e_n at this time (Punch Fig. 9 window) */
     double rebound_gap_factor;  /* separation is declared when the gap exceeds this multiple
                                    of the interaction range (>= 1; 0 means 1) */
