@@ -560,7 +560,9 @@ WETDEM_API const struct wetdem_event_record* wetdem_sim_events(const struct wetd
                                                                size_t* n);
 
 /* Called every `interval` seconds of simulated time (and at t = 0 and at the end) with the
- * current state; a non-zero return stops the integration with WETDEM_ERR_CALLBACK. */
+ * current state; a non-zero return stops the integration with WETDEM_ERR_CALLBACK, the
+ * simulation left at the state and time the observer saw (cvode: on its interpolant), from
+ * which a further wetdem_sim_integrate goes on. */
 typedef int (*wetdem_observer_fn)(const struct wetdem_sim* sim, void* ctx);
 WETDEM_API void wetdem_sim_set_observer(struct wetdem_sim* sim, double interval,
                                         wetdem_observer_fn fn, void* ctx);

@@ -418,6 +418,14 @@ static int after_return(struct wetdem_sim* sim, struct run* r, struct solver* s,
 {
     struct wetdem_engine* e = &sim->engine;
     int st = observe_between(sim, r, s, t);
+    if (st != WETDEM_OK) {
+        /* stopped by the observer (or without an interpolant): the run stays at the state and
+           time it last saw, engine.time <= t, committed there, and not at the step's end t, so
+           that a further call goes on from there; no root lies before t, so no event is lost
+           (the next call evaluates the event functions afresh) */
+        int committed = wetdem_sim_commit_histories(sim, e->time);
+        return committed != WETDEM_OK ? committed : st;
+    }
     unpack(r, N_VGetArrayPointer(s->y));
     double t_prev = e->time;
     e->time = t;

@@ -459,6 +459,56 @@ static void test_integrators_observer_sees_each_multiple_once(void** state)
     }
 }
 
+/* An observer that stops the run leaves it at the state it saw: cvode calls it on its
+ * interpolant within a step, and the run stayed at the end of that step, up to a step past
+ * the time the observer was told (3.07e-3 s for 3e-3 s here), so that the state it
+ * returned was not the one the observer saw and a further call skipped the multiples in
+ * between. Now the time, the positions and the observer's view agree (verlet stops at a step
+ * end, where it called the observer), and a further call goes on to see every multiple once,
+ * as the run that was not stopped, and to end where it ends (to the integrator's tolerance). */
+struct stop_obs {
+    int calls, stop_at;
+    double t, x;
+};
+
+static int stopping_observer(const struct wetdem_sim* sim, void* ctx)
+{
+    struct stop_obs* o = ctx;
+    o->calls++;
+    o->t = wetdem_sim_time(sim);
+    o->x = wetdem_sim_particles_const(sim, NULL)[0].pos.x;
+    return o->calls == o->stop_at;
+}
+
+static void test_integrators_observer_stop_leaves_the_state_it_saw(void** state)
+{
+    (void)state;
+    for (int q = 0; q < 2; q++) {
+        struct spring_params sp = {.k = 50.0};
+        double x_end[2], t_end = 0.1;
+        int calls[2];
+        for (int stop = 0; stop < 2; stop++) {
+            struct wetdem_sim* sim = make_sim(integrators[q], 2e-4, -0.05, true, &sp);
+            CHECK_OK(wetdem_sim_set_param(sim, "verlet.dt", 1e-5));
+            struct stop_obs o = {.stop_at = stop ? 4 : 0};
+            wetdem_sim_set_observer(sim, 0.001, stopping_observer, &o);
+            if (stop) {
+                CHECK_STATUS(wetdem_sim_integrate(sim, t_end), WETDEM_ERR_CALLBACK);
+                CHECK_REL(o.t, 0.003, q ? 1e-12 : 1e-5 / 0.003); /* verlet: a step end */
+                CHECK_REL(wetdem_sim_time(sim), o.t, 0);
+                CHECK_REL(particle0(sim).pos.x, o.x, 0);
+            }
+            CHECK_OK(wetdem_sim_integrate(sim, t_end));
+            x_end[stop] = particle0(sim).pos.x;
+            calls[stop] = o.calls;
+            wetdem_sim_free(sim);
+        }
+        assert_int_equal(calls[1], calls[0]); /* t = 0, 0.001, ..., 0.1 */
+        assert_int_equal(calls[0], 101);
+        CHECK_REL(x_end[1], x_end[0], 1e-6); /* cvode.rtol 1e-10, restarted once */
+    }
+}
+
 /* ---- CVODE vector kernels (integrator_cvode_nvec.c) ---- */
 
 #define NV_N 19 /* odd length: no loop remainder left untested */
@@ -615,6 +665,7 @@ int main(void)
         cmocka_unit_test(test_integrators_cvode_bdf),
         cmocka_unit_test(test_integrators_observer),
         cmocka_unit_test(test_integrators_observer_sees_each_multiple_once),
+        cmocka_unit_test(test_integrators_observer_stop_leaves_the_state_it_saw),
         cmocka_unit_test(test_integrators_cvode_vector_kernels),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
