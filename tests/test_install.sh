@@ -3,7 +3,8 @@
 # the stage with PREFIX written into wetdem.pc; the shared library's SONAME is the name of the
 # installed link to it; a program built against an install through pkg-config, linked to the
 # shared and to the static library, prints the same as the example built in the tree; the
-# installed CLI reports the version pkg-config does; `make uninstall` leaves no file of its
+# installed CLI reports the version pkg-config does; the README's C example builds the same way
+# and prints what the README says; `make uninstall` leaves no file of its
 # own behind, and removes none it did not install.
 # Run by `make test`: the nested make inherits the outer one's variables (BUILD, CC,
 # EXTRA_CFLAGS), so a sanitizer build installs its own objects; WETDEM_EXTRA_CFLAGS carries the
@@ -58,6 +59,17 @@ ldd "$work/static" | grep -q libwetdem && fail "static build linked to a shared 
 ex="$here/${WETDEM_BUILD:-build}/examples/01_pair_force"
 [ -x "$ex" ] && { "$ex" | cmp -s - "$work/out_shared" || fail "output differs from $ex"; }
 "$work/p/bin/wetdem" --version | grep -q "$version" || fail "installed wetdem --version"
+# The README's C example, built as the README says (pkg-config, shared library), prints what the
+# README says it prints.
+awk '/^## A tiny C example/ {f = 1} f && /^```c/ {g = 1; next} g && /^```/ {exit} g' \
+  "$here/README.md" >"$work/pair.c"
+# shellcheck disable=SC2016
+said=$(sed -n 's/^It prints `\([^`]*\)`.*/\1/p' "$here/README.md")
+# shellcheck disable=SC2046,SC2086
+$cc -std=c11 $extra "$work/pair.c" $(pkg-config --cflags --libs wetdem) -Wl,-rpath,"$work/p/lib" \
+  -o "$work/pair" || fail "the README's C example does not build"
+[ -n "$said" ] && [ "$("$work/pair")" = "$said" ] \
+  || fail "the README's C example prints '$("$work/pair" 2>&1)', the README says '$said'"
 
 # 3. Uninstall leaves nothing of its own, and what others put beside it.
 echo mine >"$work/p/share/wetdem/mine.txt"
