@@ -559,10 +559,12 @@ WETDEM_API const char* wetdem_event_kind_name(enum wetdem_event_kind kind);
 WETDEM_API const struct wetdem_event_record* wetdem_sim_events(const struct wetdem_sim* sim,
                                                                size_t* n);
 
-/* Called every `interval` seconds of simulated time (and at t = 0 and at the end) with the
- * current state; a non-zero return stops the integration with WETDEM_ERR_CALLBACK, the
- * simulation left at the state and time the observer saw (cvode: on its interpolant), from
- * which a further wetdem_sim_integrate goes on. */
+/* Called every `interval` seconds of simulated time (and at t = 0 and at the end; interval 0:
+ * only there) with the current state; fn NULL removes the observer, and a run with one and an
+ * interval that is not finite and >= 0 is refused (WETDEM_ERR_INVALID). A non-zero return
+ * stops the integration with WETDEM_ERR_CALLBACK, the simulation left at the state and time
+ * the observer saw (cvode: on its interpolant), from which a further wetdem_sim_integrate goes
+ * on. */
 typedef int (*wetdem_observer_fn)(const struct wetdem_sim* sim, void* ctx);
 WETDEM_API void wetdem_sim_set_observer(struct wetdem_sim* sim, double interval,
                                         wetdem_observer_fn fn, void* ctx);

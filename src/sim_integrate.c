@@ -421,7 +421,7 @@ static int check_run(struct wetdem_sim* sim, double t_end)
                                step > 0 ? " less the step it passed (the many-particle mode "
                                           "takes whole steps)"
                                         : "");
-    if (!(isfinite(e->observer_interval) && e->observer_interval >= 0))
+    if (e->observer && !(isfinite(e->observer_interval) && e->observer_interval >= 0))
         return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
                                "observer interval = %g s must be finite and >= 0",
                                e->observer_interval);

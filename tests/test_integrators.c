@@ -404,6 +404,15 @@ static void test_integrators_observer(void** state)
         CHECK_REL(o.last_t, 0.1, 1e-12);
         o = (struct obs){.stop_after = 3};
         CHECK_STATUS(wetdem_sim_integrate(sim, 0.2), WETDEM_ERR_CALLBACK);
+        /* an interval that is not finite and >= 0 is refused with an observer, and is nothing
+           without one (fn NULL removes it: the run was refused all the same) */
+        wetdem_sim_set_observer(sim, NAN, observer, &o);
+        double t = wetdem_sim_time(sim);
+        CHECK_STATUS(wetdem_sim_integrate(sim, 0.3), WETDEM_ERR_INVALID);
+        CHECK_CONTAINS(wetdem_sim_errmsg(sim), "observer interval = nan");
+        CHECK_REL(wetdem_sim_time(sim), t, 0);
+        wetdem_sim_set_observer(sim, NAN, NULL, NULL);
+        CHECK_OK(wetdem_sim_integrate(sim, 0.3));
         wetdem_sim_free(sim);
     }
 }
