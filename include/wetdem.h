@@ -210,9 +210,9 @@ struct wetdem_contact {
                                   contact point [m/s] */
     double dt;                 /* time since the pair's history was last committed [s] */
     /* Added to v_t in the tangential spring's increment over dt [m/s], so that the spring
-     * advances with a second-order mean of the slip over dt (docs/engines.md): in the two-body
-     * CVODE engine half the change of v_t since the commit, in the tangent plane (the mean of
-     * v_t at both ends of dt, trapezoidal rule); in the fixed-step engines (verlet, the
+     * advances with the slip over dt (docs/engines.md): in the two-body CVODE engine the
+     * increment of the integral of v_t that it carries as state, over dt and in the tangent
+     * plane, less v_t (under its error control); in the fixed-step engines (verlet, the
      * many-particle mode) the slip at the half-step velocities less v_t (midpoint rule).
      * wetdem_contact_from_particles sets it to 0 (the spring advances by v_t dt); a contact
      * filled in by hand must too. */
@@ -241,6 +241,10 @@ struct wetdem_pair_force {
     struct wetdem_vec3 f_tan;    /* tangential force on i [N] */
     struct wetdem_vec3 torque_i; /* torque on i about its centre [N m] */
     struct wetdem_vec3 torque_j; /* torque on j about its centre [N m] */
+    /* A tangential history spring in contact (mindlin, nijssen): |F_t| before the Coulomb cap
+     * minus the cap mu F_lim [N], > 0 sliding, <= 0 sticking; 0 where no spring acts. The
+     * adaptive integrator locates the stick-slip transitions with it (docs/engines.md). */
+    double slip;
 };
 
 enum wetdem_model_kind {

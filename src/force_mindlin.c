@@ -9,12 +9,14 @@
  * v_t of i relative to j (struct wetdem_contact):
  *   1. s is rotated into the current tangent plane: s <- |s| (s - (s.n) n)/|s - (s.n) n|;
  *   2. s <- s + v_s dt          (dt = c->dt; v_s = v_t + c->dv_t_spring, the engines'
- *                                 second-order mean of the slip over dt: docs/engines.md)
+ *                                 mean of the slip over dt: docs/engines.md)
  *   3. k_t = 8 G* sqrt(R* delta)                            [N/m]
  *      gamma_t = -2 sqrt(5/6) beta sqrt(m* k_t),  beta = ln e / sqrt(ln^2 e + pi^2)   [kg/s]
  *   4. F_t = -k_t s - gamma_t v_t (spring and dashpot); if |F_t| > mu F_lim (sliding), the
  *      total is capped, F_t <- F_t mu F_lim / |F_t|, and the spring is set to what gives
  *      the capped total with this dashpot, s <- -(F_t + gamma_t v_t) / k_t.
+ * The slip margin |F_t| - mu F_lim before the cap goes to struct wetdem_pair_force slip (the
+ * adaptive engine locates the stick-slip transitions with it).
  * So |F_t| <= mu F_lim at every evaluation (Coulomb), as LAMMPS pair granular does, and the
  * stored spring is consistent with the force (re-evaluating the same state with dt = 0 gives
  * the same F_t). LIGGGHTS compares only the spring with the limit, which lets a sticking
@@ -66,19 +68,21 @@ double wetdem_force_mindlin_damping_factor(double restitution)
 }
 
 struct wetdem_vec3 wetdem_force_mindlin_update(const struct wetdem_contact* c, double overlap,
-                                               double f_limit, double mu, double* spring)
+                                               double f_limit, double mu, double* spring,
+                                               double* slip)
 {
     double factor = overlap > 0.0 ? wetdem_force_mindlin_damping_factor(c->restitution) : 0.0;
-    return wetdem_force_mindlin_update_with(c, overlap, f_limit, mu, factor, spring);
+    return wetdem_force_mindlin_update_with(c, overlap, f_limit, mu, factor, spring, slip);
 }
 
 struct wetdem_vec3 wetdem_force_mindlin_update_with(const struct wetdem_contact* c, double overlap,
                                                     double f_limit, double mu,
-                                                    double damping_factor, double* spring)
+                                                    double damping_factor, double* spring,
+                                                    double* slip)
 {
     struct wetdem_vec3 v_s = vec3_add(c->v_t, c->dv_t_spring);
     return mindlin_spring(c->normal, c->v_t, v_s, c->dt, c->g_star, c->r_eff, c->m_eff, overlap,
-                          f_limit, mu, damping_factor, spring);
+                          f_limit, mu, damping_factor, spring, slip);
 }
 
 static int mindlin_pair(const void* params, const struct wetdem_contact* c, double* history,
@@ -100,7 +104,7 @@ static int mindlin_pair(const void* params, const struct wetdem_contact* c, doub
     double factor = overlap > 0.0 ? wetdem_force_mindlin_damping_factor(c->restitution) : 0.0;
     struct wetdem_vec3 ft =
         mindlin_spring_k(c->normal, c->v_t, vec3_add(c->v_t, c->dv_t_spring), c->dt, k_t, c->m_eff,
-                         overlap, f_limit, mu, factor, history);
+                         overlap, f_limit, mu, factor, history, &out->slip);
     if (overlap > 0.0)
         wetdem_pair_force_add_tangential(out, c, ft);
     return WETDEM_OK;
@@ -142,7 +146,9 @@ const struct wetdem_model wetdem_force_mindlin = {
            "history. Per pair the elastic tangential displacement s [m] is kept; each "
            "evaluation rotates it into the current tangent plane (length kept, where LIGGGHTS "
            "projects it), adds v_s dt with v_s the tangential slip over the step (its "
-           "midpoint in the fixed-step engines, the mean of its ends in CVODE: second order), "
+           "midpoint in the fixed-step engines, second order; in CVODE the increment of the "
+           "integral of v_t it integrates under its error control, with the stick-slip "
+           "transitions located), "
            "and gives F_t = -k_t s - gamma_t v_t with k_t = 8 G* sqrt(R* delta) and "
            "gamma_t = -2 sqrt(5/6) beta sqrt(m* k_t), beta = ln e / sqrt(ln^2 e + pi^2) (the "
            "normal Tsuji damping with k_t). If this total, spring and dashpot, exceeds "

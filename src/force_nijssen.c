@@ -137,7 +137,7 @@ static int nijssen_pair(const void* params, const struct wetdem_contact* c, doub
     double mu_f = c->roughness >= h_eps ? c->friction_dry : c->friction_lub;
     double f_limit = w_c * wetdem_force_hertz_elastic(c->e_star, c->r_eff, overlap);
     struct wetdem_vec3 ft =
-        wetdem_force_mindlin_update(c, overlap, f_limit, mu_f, &history[HIST_SPRING]);
+        wetdem_force_mindlin_update(c, overlap, f_limit, mu_f, &history[HIST_SPRING], &out->slip);
     wetdem_pair_force_add_tangential(out, c, ft);
     return WETDEM_OK;
 }

@@ -26,12 +26,13 @@ struct wetdem_integrator {
      * list, the event slots and the forces at the start state are ready. Returns WETDEM_OK,
      * WETDEM_EVENT (stop condition) or a negative status with the message in sim. */
     int (*integrate)(struct wetdem_sim* sim, const void* params, double t_end);
-    /* Whether force evaluations between commits are trials at any time in the step (cvode):
-     * the tangential spring then advances over c->dt with the mean of v_t at the commit and
-     * at the evaluation (trapezoidal rule, second order). A fixed step that commits every
-     * evaluation (verlet) advances it with v_t at the half step instead (midpoint rule,
-     * engine.half_vel). */
-    bool trapezoid_spring;
+    /* Whether the integrator carries q, the integral of every pair's v_t while its tangential
+     * spring acts, as part of its state (cvode, whose evaluations are trials at any time in
+     * the step): the spring then advances from its committed value by the increment of q
+     * since the commit, integrated under the integrator's error control (struct wetdem_pair
+     * q_trial). A fixed step that commits every evaluation (verlet) advances it with v_t at
+     * the half step instead (midpoint rule, engine.half_vel). */
+    bool spring_state;
 };
 
 extern const struct wetdem_integrator wetdem_integrator_verlet;
@@ -113,6 +114,10 @@ int wetdem_sim_compute_forces(struct wetdem_sim* sim, double t, bool commit);
 /* Commits the pair histories at the current state and time t without summing forces (for
  * integrators whose RHS evaluations are trials). */
 int wetdem_sim_commit_histories(struct wetdem_sim* sim, double t);
+/* Evaluates pair k at the current state as a trial at time t (nothing committed) and returns
+ * its slip margin (struct wetdem_pair_force slip; 0 where no tangential spring acts) [N];
+ * *f_t: the magnitude of its tangential force [N]; *status: WETDEM_OK or the failure. */
+double wetdem_sim_slip_margin(struct wetdem_sim* sim, size_t k, double t, double* f_t, int* status);
 /* Linear acceleration of free particle k from engine.force plus gravity [m/s^2]. */
 struct wetdem_vec3 wetdem_sim_acceleration(const struct wetdem_sim* sim, size_t k);
 /* Angular acceleration of free particle k from engine.torque [rad/s^2]. */

@@ -3,7 +3,12 @@
  * with SUNDIALS CVODE 6.4 (Hindmarsh et al. 2005), with every branch boundary of the force
  * laws located as a root (event.c) so that no step straddles a discontinuity.
  *
- * State: y = (x, v, w) of every free particle (9 doubles each). Method (cvode.method):
+ * State: y = (x, v, w) of every free particle (9 doubles each), then, while some pair is within
+ * its tangential spring's range (h < max(h_min, 0): entered and left at located events, where
+ * the solver is created anew with or without them), q of every pair (3 doubles each): the
+ * integral of the pair's v_t while its spring acts (sim_integrate.c), so that the spring,
+ * which advances from its committed value by the increment of q, is under the local error
+ * test (absolute tolerance atol L, as positions). Method (cvode.method):
  *   adams: Adams-Moulton orders 1-12 with fixed-point (functional) iteration, no Jacobian;
  *     fastest while the pair moves, since the Hertz contact time must be resolved anyway;
  *   bdf: BDF orders 1-5 with Newton iteration and a dense difference-quotient Jacobian (each
@@ -33,16 +38,24 @@
  * placed exactly touching), interpolated between the step ends. On a root the integrator is
  * restarted with CVodeReInit there, at order 1, so that it never steps across the
  * discontinuity.
- * History-carrying models are not part of CVODE's error control (docs/engines.md): the largest
- * approach speed is committed at step ends and starts at a located crossing (the range, or the
- * record range of the min-separation model, event.c), so where v_n falls from there on it is
- * v_n at the crossing; a peak of v_n between two step ends is missed by its flat top's fall to
- * the nearer end. The tangential spring advances from its committed value with the
- * trapezoidal mean of v_t at the commit and at the trial (.trapezoid_spring,
- * sim_integrate.c), second order in the step.
+ * Stick-slip transitions of the tangential springs (docs/engines.md): a trial from a sticking
+ * commit is the spring itself, so where it starts to slide inside a step the force has only a
+ * kink, under the error test; from a sliding commit (the spring capped there) the trial
+ * differs from the spring once the pair sticks again, and the slip margin of the trial (|F_t|
+ * before the cap minus the cap) peaks at the transition. So after every step each spring
+ * that slid at the commit and whose trial margin falls at the step end has its transition
+ * located at that peak on CVODE's interpolant, and each sticking spring whose margin turned
+ * positive has its start of sliding located at the margin's root; the run is restarted at the
+ * earliest such time inside the step (locate_transition), the rest of the step discarded (the
+ * commit at the step's end, whose evaluation gives the margins there, is taken back).
+ * The largest approach speed is not part of CVODE's error control: it is committed at step
+ * ends and starts at a located crossing (the range, or the record range of the
+ * min-separation model, event.c), so where v_n falls from there on it is v_n at the crossing;
+ * a peak of v_n between two step ends is missed by its flat top's fall to the nearer end.
  */
 #include <float.h>
 #include <math.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -112,6 +125,18 @@ struct run {
     size_t* free_index; /* particle index of each state block */
     size_t n_free;
     int status; /* first non-recoverable error raised in a callback */
+    /* the pairs and their histories as committed before the latest commit (after_return
+     * takes a commit back when a stick-slip transition fell inside the step), and the slip
+     * margin of every pair's trial just before the step's end [N]; room for the latest commit
+     * while the observer sees the one before (after_return) */
+    struct wetdem_pair *pairs_before, *pairs_after;
+    double *history_before, *history_after, *margin_before;
+    double* at_end; /* per pair: its trial margin and |F_t| at the step's end, or NAN NAN when
+                       no transition is possible there (may_transit) [N] */
+    double* ydot;   /* the latest right-hand side (n_state doubles), evaluated at t_rhs */
+    double t_rhs;
+    bool with_q;    /* the state holds q of every pair (some pair within its spring's range) */
+    size_t n_state; /* 9 n_free, and 3 per pair with_q */
 };
 
 static void unpack(struct run* r, const double* y)
@@ -123,6 +148,10 @@ static void unpack(struct run* r, const double* y)
         p->vel = vec3(s[3], s[4], s[5]);
         p->omega = vec3(s[6], s[7], s[8]);
     }
+    struct wetdem_pairs* pl = &r->sim->engine.pairs;
+    const double* q = y + 9 * r->n_free;
+    for (size_t k = 0; r->with_q && k < pl->n; k++)
+        pl->items[k].q_trial = vec3(q[3 * k], q[3 * k + 1], q[3 * k + 2]);
 }
 
 static void put3(double* d, struct wetdem_vec3 a)
@@ -140,6 +169,9 @@ static void pack(const struct run* r, double* y)
         put3(y + 9 * b + 3, p->vel);
         put3(y + 9 * b + 6, p->omega);
     }
+    const struct wetdem_pairs* pl = &r->sim->engine.pairs;
+    for (size_t k = 0; r->with_q && k < pl->n; k++)
+        put3(y + 9 * r->n_free + 3 * k, pl->items[k].q_committed);
 }
 
 static int rhs(sunrealtype t, N_Vector yv, N_Vector ydot, void* data)
@@ -160,6 +192,11 @@ static int rhs(sunrealtype t, N_Vector yv, N_Vector ydot, void* data)
         put3(d + 9 * b + 3, wetdem_sim_acceleration(r->sim, k));
         put3(d + 9 * b + 6, wetdem_sim_angular_acceleration(r->sim, k));
     }
+    const struct wetdem_pairs* pl = &r->sim->engine.pairs;
+    for (size_t k = 0; r->with_q && k < pl->n; k++)
+        put3(d + 9 * r->n_free + 3 * k, pl->items[k].q_rate);
+    memcpy(r->ydot, d, r->n_state * sizeof *d);
+    r->t_rhs = t;
     return 0;
 }
 
@@ -317,9 +354,12 @@ static void solver_free(struct solver* s)
         SUNContext_Free(&s->ctx);
 }
 
-/* Absolute tolerances: positions atol L, velocities atol V, spins atol V/L. */
+/* Absolute tolerances: positions and the q of the pairs atol L, velocities atol V, spins
+ * atol V/L. */
 static void fill_abstol(const struct run* r, double atol, double len, double speed, double* a)
 {
+    for (size_t k = 9 * r->n_free; k < r->n_state; k++)
+        a[k] = atol * len;
     for (size_t b = 0; b < r->n_free; b++)
         for (int q = 0; q < 3; q++) {
             a[9 * b + q] = atol * len;
@@ -347,7 +387,12 @@ static int attach_solvers(struct solver* s, bool bdf, sunindextype n)
 static int solver_create(struct wetdem_sim* sim, struct run* r, const struct cvode_params* p,
                          double t_end, bool bdf, struct solver* s)
 {
-    sunindextype n = (sunindextype)(9 * r->n_free);
+    r->with_q = false; /* q while some pair is within the range of its spring */
+    for (size_t k = 0; k < sim->engine.pairs.n; k++)
+        r->with_q = r->with_q || sim->engine.pairs.items[k].spring_zone;
+    r->n_state = 9 * r->n_free + (r->with_q ? 3 * sim->engine.pairs.n : 0);
+    r->t_rhs = NAN;
+    sunindextype n = (sunindextype)r->n_state;
     double len = wetdem_sim_length_scale(sim), speed = wetdem_sim_speed_scale(sim, NULL);
     /* (the pairs' own speed, not the floored scale: beneath sim.speed_floor the floor held a
      * slow approach to steps floor / v times too short, and t_end grows as 1 / v) */
@@ -411,13 +456,251 @@ static int observe_between(struct wetdem_sim* sim, struct run* r, struct solver*
     return WETDEM_OK;
 }
 
-/* Bookkeeping after CVode returned flag >= 0 at t: observer, commit, events, restart at a
- * root, stop check, monitor. *stop is set when the separation condition holds. */
-static int after_return(struct wetdem_sim* sim, struct run* r, struct solver* s, int flag, double t,
-                        bool* stop)
+/* The slip margin of pair k's spring (a trial from the commit) at time t of the last step,
+ * on CVODE's interpolant [N]. */
+static double margin_at(struct wetdem_sim* sim, struct run* r, struct solver* s, size_t k, double t,
+                        int* status)
+{
+    if (CVodeGetDky(s->mem, t, 0, s->ytmp) != CV_SUCCESS) {
+        *status = wetdem_sim_fail(sim, WETDEM_ERR_STEP, "cvode: no interpolant at t = %g s", t);
+        return 0.0;
+    }
+    unpack(r, N_VGetArrayPointer(s->ytmp));
+    double f_t = 0.0;
+    return wetdem_sim_slip_margin(sim, k, t, &f_t, status);
+}
+
+/* Time [s] at which pair k's spring changes between sticking and sliding inside the step
+ * (t_prev, t], or t (none), from the commit at t_prev (restored) and the trial margin e_hi
+ * at t. Sliding at the commit (the spring capped there), the trial margin e rises while the
+ * pair slides and, once it sticks at t*, falls from its peak at t* (e' = d|F_t|/dt of the
+ * sticking spring minus that of the cap, which changes sign there): when e falls at t
+ * (may_transit), t* is its maximum, found by golden section to 1e-6 of the step (near the
+ * peak e is flat: a spring capped that far from it is off by 1e-12 of the margin's change over
+ * the step). Sticking at the commit, the trial is the spring: the start of sliding is the
+ * root of e, found by regula falsi (Illinois) to 1e-12 of the step, at the end where e > 0,
+ * so that the commit there caps the spring. A transition counts only inside the step, more
+ * than 1e-6 of it (and 16 roundings of t) from its ends, and where the margin it corrects,
+ * the peak's height above e(t) or e(t) > 0, exceeds 1e-12 |F_t|: a spring capped at the
+ * wrong one of two times that close is off by less, and below it the margin is rounding
+ * (|F_t| minus the cap, two numbers of size |F_t|): without this floor the steps of a few
+ * 1e-11 s after the contact starts saw rounding as transitions and restarted at every one. */
+static double locate_transition(struct wetdem_sim* sim, struct run* r, struct solver* s, size_t k,
+                                double t_prev, double t, int* status)
+{
+    const double h = t - t_prev, g = 0.5 * (sqrt(5.0) - 1.0);
+    const double tol = fmax(1e-6 * h, 16 * DBL_EPSILON * fabs(t));
+    const struct wetdem_pair* before = &r->pairs_before[k];
+    double e_hi = r->at_end[2 * k], floor = 1e-12 * r->at_end[2 * k + 1];
+    double found = t;
+    if (before->sliding) { /* Brent: parabolic steps, golden sections where they fail */
+        double a = t_prev, b = t, x = a + (1 - g) * (b - a), w = x, v = x, d = 0, step = 0;
+        double fx = -margin_at(sim, r, s, k, x, status), fw = fx, fv = fx;
+        while (*status == WETDEM_OK) {
+            double m = 0.5 * (a + b), tol2 = 2 * tol;
+            if (fabs(x - m) <= tol2 - 0.5 * (b - a))
+                break;
+            bool golden = true;
+            if (fabs(step) > tol) {
+                double p1 = (x - w) * (fx - fv), q1 = (x - v) * (fx - fw);
+                double p = (x - v) * q1 - (x - w) * p1, q = 2 * (q1 - p1);
+                if (q > 0)
+                    p = -p;
+                q = fabs(q);
+                if (fabs(p) < fabs(0.5 * q * step) && p > q * (a - x) && p < q * (b - x)) {
+                    step = d, d = p / q, golden = false;
+                    if ((x + d) - a < tol2 || b - (x + d) < tol2)
+                        d = x < m ? tol : -tol;
+                }
+            }
+            if (golden) {
+                step = x >= m ? a - x : b - x;
+                d = (1 - g) * step;
+            }
+            double u = fabs(d) >= tol ? x + d : x + (d > 0 ? tol : -tol);
+            double fu = -margin_at(sim, r, s, k, u, status);
+            if (fu <= fx) {
+                if (u >= x)
+                    a = x;
+                else
+                    b = x;
+                v = w, fv = fw, w = x, fw = fx, x = u, fx = fu;
+            } else {
+                if (u < x)
+                    a = u;
+                else
+                    b = u;
+                if (fu <= fw || w == x)
+                    v = w, fv = fw, w = u, fw = fu;
+                else if (fu <= fv || v == x || v == w)
+                    v = u, fv = fu;
+            }
+        }
+        if (!(-fx - e_hi > floor))
+            return t;
+        found = x;
+    } else {
+        const double t_tol = fmax(1e-12 * h, 4 * DBL_EPSILON * fabs(t));
+        double a = t_prev, b = t, fa = fmin(before->slip, 0.0), fb = e_hi;
+        int side = 0; /* which end stayed last (Illinois: its value is halved) */
+        for (int it = 0; *status == WETDEM_OK && b - a > t_tol && it < 200; it++) {
+            double m = fb > fa ? (a * fb - b * fa) / (fb - fa) : 0.5 * (a + b);
+            if (!(m > a && m < b) || it % 8 == 7)
+                m = 0.5 * (a + b); /* (and now and then a bisection, which always shrinks) */
+            double fm = margin_at(sim, r, s, k, m, status);
+            if (fm > 0.0) {
+                b = m, fb = fm;
+                if (side == -1)
+                    fa *= 0.5;
+                side = -1;
+            } else {
+                a = m, fa = fm;
+                if (side == 1)
+                    fb *= 0.5;
+                side = 1;
+            }
+        }
+        found = b;
+    }
+    return found - t_prev > tol && t - found > tol ? found : t;
+}
+
+/* The offset before the step's end [s] at which a sliding spring's trial margin is compared
+ * with the end's, to see whether it falls there: 1e-6 of the step (and 16 roundings of t). */
+static double fall_offset(double t_prev, double t)
+{
+    return fmax(1e-6 * (t - t_prev), 16 * DBL_EPSILON * fabs(t));
+}
+
+/* Whether pair k (as committed before the step) may have changed between sticking and sliding
+ * inside the step: its spring acted at the commit and either slid, and its trial margin falls
+ * at the step's end (e_hi below the margin just before, r->margin_before), or stuck, and the
+ * margin at the end is above the rounding floor 1e-12 |F_t| (locate_transition). */
+static bool may_transit(const struct run* r, const struct wetdem_pairs* pl, size_t k)
+{
+    const struct wetdem_pair* before = &r->pairs_before[k];
+    double e_hi = pl->items[k].slip;
+    if (!before->acting || e_hi == 0.0) /* (a spring starts to act at a located event) */
+        return false;
+    return before->sliding ? e_hi < r->margin_before[k] : e_hi > 1e-12 * pl->items[k].f_t;
+}
+
+/* The trial margin of pair k at t - dt, just before the end t of the step [N]: at the state
+ * y(t) - dt y'(t) when the latest right-hand side was evaluated at t (the corrector's last
+ * iterate, within the tolerances of y(t): an error of order dt^2 and dt tol beside the
+ * change dt e' the comparison looks for), else on the interpolant. */
+static double margin_before_end(struct wetdem_sim* sim, struct run* r, struct solver* s, size_t k,
+                                double t, double dt, int* status)
+{
+    if (r->t_rhs != t)
+        return margin_at(sim, r, s, k, t - dt, status);
+    const double* y = N_VGetArrayPointer(s->y);
+    double* x = N_VGetArrayPointer(s->ytmp);
+    for (size_t q = 0; q < r->n_state; q++)
+        x[q] = y[q] - dt * r->ydot[q];
+    unpack(r, x);
+    double f_t = 0.0;
+    return wetdem_sim_slip_margin(sim, k, t - dt, &f_t, status);
+}
+
+/* Commits the pair histories at t, the end of the step from e->time, keeping what they were
+ * (r->pairs_before, r->history_before), after the trial margins of the springs that slid at
+ * the commit just before t (r->margin_before, on the interpolant, for may_transit). */
+static int commit_step(struct wetdem_sim* sim, struct run* r, struct solver* s, double t)
 {
     struct wetdem_engine* e = &sim->engine;
+    struct wetdem_pairs* pl = &e->pairs;
+    for (size_t k = 0; k < pl->n; k++) {
+        int st = WETDEM_OK;
+        r->margin_before[k] = pl->items[k].acting && pl->items[k].sliding
+                                  ? margin_before_end(sim, r, s, k, t, fall_offset(e->time, t), &st)
+                                  : 0.0;
+        if (st != WETDEM_OK)
+            return st;
+    }
+    unpack(r, N_VGetArrayPointer(s->y));
+    memcpy(r->pairs_before, pl->items, pl->n * sizeof *pl->items);
+    if (sim->history_len > 0)
+        memcpy(r->history_before, pl->history, pl->n * sim->history_len * sizeof(double));
+    return wetdem_sim_commit_histories(sim, t);
+}
+
+/* Takes the latest commit back (commit_step). */
+static void uncommit(struct wetdem_sim* sim, const struct run* r, double t_prev)
+{
+    struct wetdem_pairs* pl = &sim->engine.pairs;
+    memcpy(pl->items, r->pairs_before, pl->n * sizeof *pl->items);
+    if (sim->history_len > 0)
+        memcpy(pl->history, r->history_before, pl->n * sim->history_len * sizeof(double));
+    sim->engine.t_committed = t_prev;
+}
+
+/* observe_between up to t, the end of the step from t_prev whose commit at t stands: the
+ * observer sees the histories committed at t_prev, as the trials inside the step did. */
+static int observe_committed_step(struct wetdem_sim* sim, struct run* r, struct solver* s,
+                                  double t_prev, double t)
+{
+    struct wetdem_engine* e = &sim->engine;
+    struct wetdem_pairs* pl = &e->pairs;
+    if (!e->observer || !(e->observer_interval > 0) || e->next_observe > t)
+        return WETDEM_OK;
+    size_t len = pl->n * sim->history_len * sizeof(double);
+    memcpy(r->pairs_after, pl->items, pl->n * sizeof *pl->items);
+    if (len)
+        memcpy(r->history_after, pl->history, len);
+    uncommit(sim, r, t_prev);
     int st = observe_between(sim, r, s, t);
+    if (st != WETDEM_OK)
+        return st; /* (stopped: the histories stay those of t_prev, for after_return) */
+    memcpy(pl->items, r->pairs_after, pl->n * sizeof *pl->items);
+    if (len)
+        memcpy(pl->history, r->history_after, len);
+    e->t_committed = t;
+    return st;
+}
+
+/* Bookkeeping after CVode returned *flag >= 0 at t: commit, and where a stick-slip transition
+ * fell inside the step the commit taken back and made at the transition instead (the state
+ * moved back there, *flag CV_SUCCESS, the rest of the step discarded); observer, events,
+ * restart at a root or transition, stop check, monitor. *stop is set when the separation
+ * condition holds; *restarted when CVODE was restarted. */
+static int after_return(struct wetdem_sim* sim, struct run* r, struct solver* s, int* flag,
+                        double t, bool* stop, bool* restarted)
+{
+    struct wetdem_engine* e = &sim->engine;
+    double t_prev = e->time, t_step = t;
+    int st = commit_step(sim, r, s, t);
+    if (st != WETDEM_OK)
+        return st;
+    size_t stuck = SIZE_MAX; /* the pair whose slip ended at t, if any */
+    bool taken_back = false;
+    for (size_t k = 0; k < e->pairs.n; k++) {
+        bool may = may_transit(r, &e->pairs, k);
+        r->at_end[2 * k] = may ? e->pairs.items[k].slip : NAN;
+        r->at_end[2 * k + 1] = may ? e->pairs.items[k].f_t : NAN;
+    }
+    for (size_t k = 0; k < e->pairs.n; k++) {
+        if (isnan(r->at_end[2 * k]))
+            continue;
+        if (!taken_back) {
+            uncommit(sim, r, t_prev);
+            taken_back = true;
+        }
+        double t_k = locate_transition(sim, r, s, k, t_prev, t_step, &st);
+        if (st != WETDEM_OK)
+            return st;
+        if (t_k < t) {
+            t = t_k;
+            stuck = r->pairs_before[k].sliding ? k : SIZE_MAX;
+        }
+    }
+    if (t < t_step) { /* back to the transition */
+        if (CVodeGetDky(s->mem, t, 0, s->y) != CV_SUCCESS)
+            return wetdem_sim_fail(sim, WETDEM_ERR_STEP, "cvode: no interpolant at t = %g s", t);
+        *flag = CV_SUCCESS;
+    }
+    *restarted = t < t_step || *flag == CV_ROOT_RETURN;
+    st = taken_back ? observe_between(sim, r, s, t) : observe_committed_step(sim, r, s, t_prev, t);
     if (st != WETDEM_OK) {
         /* stopped by the observer (or without an interpolant): the run stays at the state and
            time it last saw, engine.time <= t, committed there, and not at the step's end t, so
@@ -427,18 +710,19 @@ static int after_return(struct wetdem_sim* sim, struct run* r, struct solver* s,
         return committed != WETDEM_OK ? committed : st;
     }
     unpack(r, N_VGetArrayPointer(s->y));
-    double t_prev = e->time;
     e->time = t;
-    if (st == WETDEM_OK)
+    if (st == WETDEM_OK && taken_back)
         st = wetdem_sim_commit_histories(sim, t);
     if (st != WETDEM_OK)
         return st;
-    if (flag == CV_ROOT_RETURN)
+    if (stuck != SIZE_MAX) /* capped at its peak margin, from where it sticks */
+        e->pairs.items[stuck].sliding = false;
+    if (*flag == CV_ROOT_RETURN)
         CVodeGetRootInfo(s->mem, s->rootsfound);
     else
         memset(s->rootsfound, 0, e->n_slots * sizeof *s->rootsfound);
     st = wetdem_event_advance(sim, t_prev, t, s->rootsfound);
-    if (flag == CV_ROOT_RETURN) {
+    if (*restarted) {
         add_counters(sim, s->mem);
         if (st == WETDEM_OK && CVodeReInit(s->mem, t, s->y) != CV_SUCCESS)
             st = WETDEM_ERR_STEP;
@@ -448,14 +732,27 @@ static int after_return(struct wetdem_sim* sim, struct run* r, struct solver* s,
     return st == WETDEM_OK ? wetdem_sim_step_done(sim) : st;
 }
 
-/* Restarts the integration with BDF at the current state (method auto, stiffness). */
-static int switch_to_bdf(struct wetdem_sim* sim, struct run* r, struct solver* s,
-                         const struct cvode_params* p, double t_end)
+/* Restarts the integration at the current state: with BDF (method auto, stiffness), or
+ * with or without the q of the pairs (whether some pair is within its spring's range:
+ * solver_create). */
+static int restart_solver(struct wetdem_sim* sim, struct run* r, struct solver* s,
+                          const struct cvode_params* p, double t_end, bool bdf)
 {
     add_counters(sim, s->mem);
     solver_free(s);
     *s = (struct solver){0};
-    return solver_create(sim, r, p, t_end, true, s);
+    return solver_create(sim, r, p, t_end, bdf, s);
+}
+
+/* Whether the state must change to hold q (some pair is now within its spring's range, e.g.
+ * past nijssen's h_min or in solid contact) or to drop it (none is): the range is entered and
+ * left at located events, where CVODE restarts anyway. */
+static bool q_change_due(const struct wetdem_sim* sim, const struct run* r)
+{
+    bool want = false;
+    for (size_t k = 0; k < sim->engine.pairs.n; k++)
+        want = want || sim->engine.pairs.items[k].spring_zone;
+    return want != r->with_q;
 }
 
 static int run_loop(struct wetdem_sim* sim, struct run* r, struct solver* s,
@@ -473,7 +770,7 @@ static int run_loop(struct wetdem_sim* sim, struct run* r, struct solver* s,
                                    p->max_steps, t_end, sim->engine.time,
                                    sim->settings.speed_floor);
         if (!bdf && p->method == METHOD_AUTO && quiet > p->stiff_steps) {
-            int st = switch_to_bdf(sim, r, s, p, t_end);
+            int st = restart_solver(sim, r, s, p, t_end, true);
             if (st != WETDEM_OK)
                 return st;
             bdf = true;
@@ -482,21 +779,40 @@ static int run_loop(struct wetdem_sim* sim, struct run* r, struct solver* s,
         int flag = CVode(s->mem, t_end, s->y, &t, CV_ONE_STEP);
         if (flag < 0)
             return map_flag(sim, r, flag, sim->engine.time);
-        int st = after_return(sim, r, s, flag, t, &stop);
+        bool restarted = false;
+        double h_last = 0;
+        CVodeGetLastStep(s->mem, &h_last);
+        int st = after_return(sim, r, s, &flag, t, &stop, &restarted);
         if (st != WETDEM_OK)
             return st;
         if (stop)
             return WETDEM_EVENT;
-        double h_last = 0;
-        CVodeGetLastStep(s->mem, &h_last);
-        if (flag == CV_ROOT_RETURN || h_last > 0.5 * s->h_cur)
+        if (restarted || h_last > 0.5 * s->h_cur)
             quiet = 0; /* an event, or a step limited by max_step rather than stability */
         if (flag == CV_TSTOP_RETURN && s->t_stop == t_end)
             sim->engine.time = t_end;
+        /* (after that test: a new solver's stop time is t_end) */
+        if (sim->engine.time < t_end && q_change_due(sim, r)) {
+            st = restart_solver(sim, r, s, p, t_end, bdf);
+            if (st != WETDEM_OK)
+                return st;
+        }
         if (limit_step(sim, s, sim->engine.time) != 0)
             return wetdem_sim_fail(sim, WETDEM_ERR_STEP, "cvode: cannot set the largest step");
     }
     return WETDEM_OK;
+}
+
+static void run_free(struct run* r)
+{
+    free(r->free_index);
+    free(r->pairs_before);
+    free(r->pairs_after);
+    free(r->history_before);
+    free(r->history_after);
+    free(r->margin_before);
+    free(r->ydot);
+    free(r->at_end);
 }
 
 static int cvode_integrate(struct wetdem_sim* sim, const void* params, double t_end)
@@ -515,9 +831,22 @@ static int cvode_integrate(struct wetdem_sim* sim, const void* params, double t_
                                "if more); give a longer t_end",
                                span, shortest, t);
     struct run r = {.sim = sim};
+    size_t n_pairs = sim->engine.pairs.n ? sim->engine.pairs.n : 1;
     r.free_index = malloc((sim->n_particles ? sim->n_particles : 1) * sizeof *r.free_index);
-    if (!r.free_index)
+    size_t n_history = n_pairs * (sim->history_len ? sim->history_len : 1);
+    r.pairs_before = malloc(n_pairs * sizeof *r.pairs_before);
+    r.pairs_after = malloc(n_pairs * sizeof *r.pairs_after);
+    r.history_before = malloc(n_history * sizeof(double));
+    r.history_after = malloc(n_history * sizeof(double));
+    r.margin_before = malloc(n_pairs * sizeof *r.margin_before);
+    r.at_end = malloc(2 * n_pairs * sizeof *r.at_end);
+    r.ydot = malloc((9 * sim->n_particles + 3 * n_pairs) * sizeof *r.ydot); /* (at most) */
+    r.t_rhs = NAN;
+    if (!r.free_index || !r.pairs_before || !r.pairs_after || !r.history_before ||
+        !r.history_after || !r.margin_before || !r.ydot || !r.at_end) {
+        run_free(&r);
         return wetdem_sim_fail(sim, WETDEM_ERR_NOMEM, "cvode: out of memory");
+    }
     for (size_t k = 0; k < sim->n_particles; k++)
         if (!sim->particles[k].is_fixed)
             r.free_index[r.n_free++] = k;
@@ -533,7 +862,7 @@ static int cvode_integrate(struct wetdem_sim* sim, const void* params, double t_
             add_counters(sim, s.mem);
         solver_free(&s);
     }
-    free(r.free_index);
+    run_free(&r);
     return st;
 }
 
@@ -543,5 +872,5 @@ const struct wetdem_integrator wetdem_integrator_cvode = {
     .params = cvode_params_desc,
     .params_size = sizeof(struct cvode_params),
     .integrate = cvode_integrate,
-    .trapezoid_spring = true,
+    .spring_state = true,
 };

@@ -55,11 +55,12 @@ static inline void store_spring(double* spring, struct wetdem_vec3 s)
  * dashpot's), the velocity v_s the spring advances with over dt [m/s] (the engines' mean of
  * the slip over dt: struct wetdem_contact dv_t_spring), dt [s], m* [kg],
  * overlap [m], f_limit [N], mu [-], the damping factor [-]; spring: the 3 doubles of history
- * [m]. k_t is read only when overlap > 0. */
+ * [m]; slip (NULL: not wanted): |F_t| before the cap minus the cap [N] when overlap > 0 (struct
+ * wetdem_pair_force slip), else left as it is. k_t is read only when overlap > 0. */
 static inline __attribute__((always_inline)) struct wetdem_vec3
 mindlin_spring_k(struct wetdem_vec3 n, struct wetdem_vec3 v_t, struct wetdem_vec3 v_s, double dt,
                  double k_t, double m_eff, double overlap, double f_limit, double mu,
-                 double damping_factor, double* spring)
+                 double damping_factor, double* spring, double* slip)
 {
     if (!(overlap > 0.0)) {
         store_spring(spring, vec3(0, 0, 0));
@@ -70,6 +71,8 @@ mindlin_spring_k(struct wetdem_vec3 n, struct wetdem_vec3 v_t, struct wetdem_vec
     double gamma_t = tangential_damping(k_t, m_eff, damping_factor);
     struct wetdem_vec3 ft = vec3_axpy(vec3_scale(s, -k_t), -gamma_t, v_t);
     double f_total = vec3_norm(ft), f_max = mu * fabs(f_limit);
+    if (slip)
+        *slip = f_total - f_max;
     if (f_total > f_max) { /* sliding: total capped, spring set so that it gives the cap */
         ft = vec3_scale(ft, f_max / f_total);
         s = k_t > 0.0 ? vec3_scale(vec3_axpy(ft, gamma_t, v_t), -1.0 / k_t) : vec3(0, 0, 0);
@@ -83,11 +86,11 @@ mindlin_spring_k(struct wetdem_vec3 n, struct wetdem_vec3 v_t, struct wetdem_vec
 static inline __attribute__((always_inline)) struct wetdem_vec3
 mindlin_spring(struct wetdem_vec3 n, struct wetdem_vec3 v_t, struct wetdem_vec3 v_s, double dt,
                double g_star, double r_eff, double m_eff, double overlap, double f_limit, double mu,
-               double damping_factor, double* spring)
+               double damping_factor, double* spring, double* slip)
 {
     double k_t = overlap > 0.0 ? tangential_stiffness(g_star, r_eff, overlap) : 0.0;
     return mindlin_spring_k(n, v_t, v_s, dt, k_t, m_eff, overlap, f_limit, mu, damping_factor,
-                            spring);
+                            spring, slip);
 }
 
 #endif

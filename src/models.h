@@ -175,9 +175,11 @@ static inline double hertz_contact_time_hook(const void* params, const struct we
  * with k_t; when the total spring + dashpot force exceeds mu |f_limit| it is capped at
  * |F_t| = mu |f_limit| and the spring set so that spring + dashpot give the capped force
  * (sliding, LAMMPS pair granular semantics), so |F_t| <= mu |f_limit| always. Returns the
- * tangential force on i [N]. overlap <= 0 resets the spring. */
+ * tangential force on i [N]. overlap <= 0 resets the spring. slip (NULL: not wanted): for
+ * overlap > 0, |F_t| before the cap minus the cap [N] (struct wetdem_pair_force slip). */
 struct wetdem_vec3 wetdem_force_mindlin_update(const struct wetdem_contact* c, double overlap,
-                                               double f_limit, double mu, double* spring);
+                                               double f_limit, double mu, double* spring,
+                                               double* slip);
 /* force_mindlin.c: the factor -2 sqrt(5/6) beta(e) of the Tsuji tangential damping [-],
  * beta = ln e / sqrt(ln^2 e + pi^2), to be computed once per material pair (e in (0, 1]). */
 double wetdem_force_mindlin_damping_factor(double restitution);
@@ -185,6 +187,7 @@ double wetdem_force_mindlin_damping_factor(double restitution);
  * (wetdem_force_mindlin_damping_factor(c->restitution)); bit-identical results. */
 struct wetdem_vec3 wetdem_force_mindlin_update_with(const struct wetdem_contact* c, double overlap,
                                                     double f_limit, double mu,
-                                                    double damping_factor, double* spring);
+                                                    double damping_factor, double* spring,
+                                                    double* slip);
 
 #endif

@@ -30,10 +30,16 @@ struct wetdem_pair {
     size_t j;            /* particle index (> i), or wall index when is_wall */
     bool is_wall;        /* j is a plane wall */
     bool has_interacted; /* came within the interaction range since the last separation stop */
-    /* v_t of the pair at engine.t_committed [m/s], kept for the integrators with trial
-     * evaluations (engine.trapezoid_spring): set at the start of every run and on every
-     * commit (sim_integrate.c) */
-    struct wetdem_vec3 v_t_committed;
+    /* engine.spring_state (sim_integrate.c, integrator_cvode.c): q = the integral of v_t
+     * while the pair's tangential spring acts [m], part of the integrator's state, at
+     * engine.t_committed and at the state of the latest evaluation; its rate at that
+     * evaluation [m/s] (v_t while a spring acts, else 0); the spring's slip margin there
+     * (struct wetdem_pair_force slip) and |F_t| [N]; whether the spring acted and whether it
+     * slid at the last commit. */
+    struct wetdem_vec3 q_committed, q_trial, q_rate;
+    double slip, f_t;
+    bool acting, sliding;
+    bool spring_zone; /* within its spring's range at that evaluation: h < max(h_min, 0) */
 };
 
 struct wetdem_pairs {

@@ -47,9 +47,10 @@ struct wetdem_sim;
 struct wetdem_engine {
     double time;        /* simulated time [s] */
     double t_committed; /* time at which the pair histories hold the committed state [s] */
-    /* the tangential spring advances with the mean of v_t at t_committed and at the
-     * evaluation (struct wetdem_contact dv_t_spring); set from the integrator at each run */
-    bool trapezoid_spring;
+    /* the tangential spring advances by the increment of the pair's q since t_committed
+     * (struct wetdem_pair q_trial, struct wetdem_contact dv_t_spring); set from the
+     * integrator at each run */
+    bool spring_state;
     /* velocity and spin of every particle at the half step (verlet, during a step's force
      * evaluation; else NULL): the tangential spring advances with the slip they give
      * (midpoint rule, struct wetdem_contact dv_t_spring) */

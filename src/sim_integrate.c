@@ -13,11 +13,14 @@
  * engine.t_committed; a force evaluation at time t hands the models a scratch copy with
  * c->dt = t - t_committed and keeps the advanced copy only on commit. Pairs beyond their
  * interaction range are not evaluated, and their history is reset on commit, so each
- * encounter starts afresh. With engine.trapezoid_spring (cvode, whose evaluations are trials
- * anywhere in the step) the tangential spring advances with the trapezoidal mean
- *     v_s = (v_t(t_committed) + v_t(t))/2,   projected into the current tangent plane,
- * (c->dv_t_spring = v_s - v_t(t)), so s(t) = s_c + v_s (t - t_c) is second order in the step
- * (docs/engines.md); v_t(t_committed) is kept per pair (struct wetdem_pair v_t_committed).
+ * encounter starts afresh. With engine.spring_state (cvode, whose evaluations are trials
+ * anywhere in the step) the integrator carries per pair q, the integral of v_t while the
+ * pair's tangential spring acts (dq/dt = q_rate, set here at every evaluation), and the
+ * spring advances from its committed value by the increment of q, projected into the current
+ * tangent plane,
+ *     v_s (t - t_c) = (q(t) - q(t_c)) - ((q(t) - q(t_c)) . n) n   (c->dv_t_spring = v_s - v_t),
+ * integrated under the integrator's error control (docs/engines.md); the pair's slip margin
+ * (struct wetdem_pair_force slip) is kept for the location of the stick-slip transitions.
  * verlet, whose forces see the velocities predicted for the step's end, sets engine.half_vel
  * and half_omega during its evaluation instead, and the spring advances with the slip of the
  * half-step velocities at the current normal (midpoint rule, also second order).
@@ -181,16 +184,23 @@ static int eval_pair(struct wetdem_sim* sim, size_t k, double t, bool commit, bo
     if (c.gap > wetdem_sim_contact_range(sim, &c)) {
         if (commit && history) /* (a min-separation record may outlive the force range) */
             wetdem_sim_history_beyond_range(sim, &c, wetdem_sim_record_range(sim, &c), history);
-        if (commit && e->trapezoid_spring)
-            p->v_t_committed = v_t;
+        p->q_rate = vec3(0, 0, 0);
+        p->slip = p->f_t = 0.0;
+        p->spring_zone = false;
+        if (commit) {
+            p->q_committed = p->q_trial;
+            p->acting = p->sliding = false;
+        }
         return WETDEM_OK;
     }
     double scratch[WETDEM_HISTORY_SCRATCH];
     if (history)
         memcpy(scratch, history, sim->history_len * sizeof *scratch);
     c.dt = t - e->t_committed;
-    if (e->trapezoid_spring) /* v_t_committed lay in the old tangent plane */
-        c.dv_t_spring = vec3_reject(vec3_scale(vec3_sub(p->v_t_committed, v_t), 0.5), c.normal);
+    if (e->spring_state && c.dt > 0) { /* the increment of q, in the current tangent plane */
+        struct wetdem_vec3 dq = vec3_sub(p->q_trial, p->q_committed);
+        c.dv_t_spring = vec3_sub(vec3_scale(vec3_reject(dq, c.normal), 1.0 / c.dt), v_t);
+    }
     if (e->half_vel) { /* verlet: the slip at the half step, at the current contact normal */
         size_t j = p->is_wall ? p->i : p->j; /* (a wall's unused) */
         c.dv_t_spring = contact_half_step_dv(&c, e->half_vel[p->i], e->half_omega[p->i],
@@ -210,8 +220,15 @@ static int eval_pair(struct wetdem_sim* sim, size_t k, double t, bool commit, bo
                                p->i, p->is_wall ? "wall " : "", p->j, t, c.gap);
     if (commit && history)
         memcpy(history, scratch, sim->history_len * sizeof *scratch);
-    if (commit && e->trapezoid_spring) /* (only the trapezoid reads it) */
-        p->v_t_committed = v_t;
+    p->slip = f.slip;
+    p->spring_zone = c.gap < fmax(c.h_min, 0.0); /* (mindlin: overlap; nijssen: below h_min) */
+    p->f_t = vec3_norm(f.f_tan);
+    p->q_rate = f.slip != 0.0 ? v_t : vec3(0, 0, 0); /* (0: no spring acts) */
+    if (commit) {
+        p->q_committed = p->q_trial;
+        p->acting = f.slip != 0.0;
+        p->sliding = f.slip > 0.0;
+    }
     if (accumulate)
         apply_pair(e, &c, &f);
     return WETDEM_OK;
@@ -231,6 +248,13 @@ int wetdem_sim_compute_forces(struct wetdem_sim* sim, double t, bool commit)
     if (commit)
         e->t_committed = t;
     return WETDEM_OK;
+}
+
+double wetdem_sim_slip_margin(struct wetdem_sim* sim, size_t k, double t, double* f_t, int* status)
+{
+    *status = eval_pair(sim, k, t, false, false);
+    *f_t = sim->engine.pairs.items[k].f_t;
+    return sim->engine.pairs.items[k].slip;
 }
 
 int wetdem_sim_commit_histories(struct wetdem_sim* sim, double t)
@@ -436,18 +460,22 @@ static int check_run(struct wetdem_sim* sim, double t_end)
     return WETDEM_OK;
 }
 
-/* v_t of every pair at the start state as the committed one (engine.trapezoid_spring): the
- * histories hold the state at engine.time (t_committed), the particles may have been set
- * since the last run. */
-static void note_start_velocities(struct wetdem_sim* sim)
+/* q of every pair zero at the start of a run (engine.spring_state: only its increments are
+ * read), and the slip state of the committed springs: the histories hold the state at
+ * engine.time (t_committed). */
+static int start_springs(struct wetdem_sim* sim)
 {
     struct wetdem_engine* e = &sim->engine;
     for (size_t k = 0; k < e->pairs.n; k++) {
         struct wetdem_pair* p = &e->pairs.items[k];
-        struct wetdem_contact c;
-        wetdem_sim_build_contact(sim, p->i, p->j, p->is_wall, &c);
-        p->v_t_committed = c.v_t;
+        p->q_committed = p->q_trial = vec3(0, 0, 0);
+        int st = eval_pair(sim, k, e->t_committed, false, false);
+        if (st < 0)
+            return st;
+        p->acting = p->slip != 0.0;
+        p->sliding = p->slip > 0.0;
     }
+    return WETDEM_OK;
 }
 
 /* Pair list, event functions, per-particle arrays and the forces at the start state. */
@@ -455,8 +483,8 @@ static int begin_run(struct wetdem_sim* sim)
 {
     struct wetdem_engine* e = &sim->engine;
     int st = wetdem_pairs_update(&e->pairs, sim);
-    if (st == WETDEM_OK && e->trapezoid_spring)
-        note_start_velocities(sim);
+    if (st == WETDEM_OK && e->spring_state)
+        st = start_springs(sim);
     if (st == WETDEM_OK)
         st = wetdem_event_slots_build(sim);
     if (st == WETDEM_OK && sim->n_particles > e->force_cap) {
@@ -484,7 +512,7 @@ int wetdem_sim_integrate(struct wetdem_sim* sim, double t_end)
     int st = check_run(sim, t_end);
     if (st == WETDEM_OK && sim->many) /* many-particle mode: cell lists, no events */
         return wetdem_sim_many_integrate(sim, t_end);
-    e->trapezoid_spring = wetdem_integrator_registry()[e->integrator]->trapezoid_spring;
+    e->spring_state = wetdem_integrator_registry()[e->integrator]->spring_state;
     e->progress_t_end = t_end;
     e->progress_start = e->progress ? omp_get_wtime() : 0.0;
     e->progress_steps = 0;

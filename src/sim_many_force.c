@@ -313,6 +313,7 @@ static void add_force(struct wetdem_pair_force* out, const struct wetdem_pair_fo
     out->f_tan = vec3_add(out->f_tan, f->f_tan);
     out->torque_i = vec3_add(out->torque_i, f->torque_i);
     out->torque_j = vec3_add(out->torque_j, f->torque_j);
+    out->slip += f->slip;
 }
 
 /* One model's force, as its pair() function computes it. f_el: the Hertz elastic force at
@@ -337,8 +338,9 @@ static int fused_model(int kind, double opt, const struct wetdem_contact* c,
         if (!(c->restitution > 0.0 && c->restitution <= 1.0))
             return WETDEM_ERR_INVALID;
         double mu = opt == 0 ? c->friction_dry : c->friction_lub;
-        struct wetdem_vec3 ft =
-            wetdem_force_mindlin_update_with(c, overlap, f_el, mu, x->mindlin_damping, history);
+        /* (the slip margin as the mindlin model gives it: the generic path's bits) */
+        struct wetdem_vec3 ft = wetdem_force_mindlin_update_with(
+            c, overlap, f_el, mu, x->mindlin_damping, history, &f->slip);
         if (overlap > 0.0)
             wetdem_pair_force_add_tangential(f, c, ft);
         return WETDEM_OK;
@@ -470,7 +472,7 @@ lean_force(const struct wetdem_many* m, const struct lean_geometry* g,
             struct wetdem_vec3 ft =
                 mindlin_spring(n, g->v_t, g->v_s, m->advance, x->g_star, r_eff, m_eff, overlap,
                                f_el, L->mindlin_lub ? x->friction_lub : x->friction_dry,
-                               x->mindlin_damping, hist + L->mindlin_off);
+                               x->mindlin_damping, hist + L->mindlin_off, NULL);
             f_tan = vec3_add(zero, ft);
             struct wetdem_vec3 nxf = vec3_cross(n, ft);
             t_i = vec3_axpy(zero, -g->r_i, nxf);

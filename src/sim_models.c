@@ -720,6 +720,7 @@ int wetdem_sim_eval_contact(const struct wetdem_sim* sim, struct wetdem_contact*
         out->f_tan = vec3_add(out->f_tan, f.f_tan);
         out->torque_i = vec3_add(out->torque_i, f.torque_i);
         out->torque_j = vec3_add(out->torque_j, f.torque_j);
+        out->slip += f.slip;
         if (per_model)
             per_model[k] = f;
     }

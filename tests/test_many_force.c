@@ -253,9 +253,9 @@ static void test_many_precomputed_damping_is_bit_identical(void** state)
             for (int slide = 0; slide < 2; slide++) {
                 double mu = slide ? 0.01 : 10.0; /* 0.01: capped; 10: sticking */
                 double s_ref[3] = {1e-7, -2e-8, 3e-8}, s_new[3] = {1e-7, -2e-8, 3e-8};
-                struct wetdem_vec3 want = wetdem_force_mindlin_update(&c, d, 0.2, mu, s_ref);
+                struct wetdem_vec3 want = wetdem_force_mindlin_update(&c, d, 0.2, mu, s_ref, NULL);
                 struct wetdem_vec3 got = wetdem_force_mindlin_update_with(
-                    &c, d, 0.2, mu, wetdem_force_mindlin_damping_factor(e), s_new);
+                    &c, d, 0.2, mu, wetdem_force_mindlin_damping_factor(e), s_new, NULL);
                 assert_memory_equal(&got, &want, sizeof got);
                 assert_memory_equal(s_new, s_ref, sizeof s_ref);
                 n_checked++;
