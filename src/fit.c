@@ -579,6 +579,16 @@ static void undetermined_names(const struct fit_ctx* c, const struct wetdem_fit_
         }
 }
 
+/* "A = a, B = b" of the parameters' initial values into buf. */
+static void initial_values(const struct fit_ctx* c, char* buf, size_t n)
+{
+    size_t used = 0;
+    buf[0] = '\0';
+    for (size_t j = 0; j < c->pb->n_params && used < n; j++)
+        used += (size_t)snprintf(buf + used, n - used, "%s%s = %g", j ? ", " : "",
+                                 param_name(c->pb, j), c->pb->initial[j]);
+}
+
 /* ---- solver ------------------------------------------------------------------------------- */
 
 /* Iterates the trust-region solver from x0; returns a wetdem status (WETDEM_OK: converged or
@@ -613,11 +623,16 @@ static int solve(struct fit_ctx* c, const struct wetdem_fit_options* o, const gs
     res->converged_by = info;
     if (c->status != WETDEM_OK)
         return c->status;
-    if (gst == GSL_ENOPROG)
+    if (gst == GSL_ENOPROG) {
+        char start[300];
+        initial_values(c, start, sizeof start);
         return wetdem_status_fail(c->msg, sizeof c->msg, WETDEM_ERR_STEP,
                                   "the trust-region solver found no step that lowers the cost "
-                                  "from the initial values (its predictions are flat or noisy "
-                                  "there: start nearer the value you expect)");
+                                  "from the initial values %s (the predictions are flat or "
+                                  "noisy there: start nearer the value you expect, or hold "
+                                  "the parameter fixed)",
+                                  start);
+    }
     if (gst != GSL_SUCCESS)
         return wetdem_status_fail(c->msg, sizeof c->msg, WETDEM_ERR_STEP,
                                   "the trust-region solver stopped: %s", gsl_strerror(gst));

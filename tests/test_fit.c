@@ -977,6 +977,19 @@ static void test_fit_cli_flat_start_is_not_a_result(void** state)
     CHECK_CONTAINS(r.out, "(not a fit: a key is not determined)");
     free(r.out);
     assert_null(test_read_file(out_csv, NULL));
+    /* from 0.35 the solver finds no step that lowers the cost at all (the other flat-start
+       verdict, which the integration noise chooses there): it names the key and its start
+       too, as the verdict above does */
+    snprintf(args, sizeof args,
+             "fit examples/fit/punch_db_c.ini --data examples/fit/punch_0deg.csv --fit "
+             "material.striker.poisson_ratio --init 0.35 --out %s",
+             out_csv);
+    r = test_run_cli("", args, true);
+    if (r.code != 1)
+        fail_msg("wetdem %s: exit %d, expected 1\n%s", args, r.code, r.out);
+    CHECK_CONTAINS(r.out, "material.striker.poisson_ratio = 0.35");
+    free(r.out);
+    assert_null(test_read_file(out_csv, NULL));
 }
 
 /* Parameter steps stay inside the key's range: from 1 MPa the unbounded log fit stepped P_gt
