@@ -147,15 +147,22 @@ WETDEM_API const struct wetdem_param_desc* wetdem_param_find(const struct wetdem
 /* Fills a parameter struct with the defaults of its table. */
 WETDEM_API void wetdem_param_init_defaults(const struct wetdem_param_desc* table, void* params);
 /* Checks `value` against a descriptor. Returns WETDEM_OK or WETDEM_ERR_INVALID and writes a
- * message naming the parameter, the value and the valid range into msg (may be NULL). */
+ * message naming the parameter, the value and the valid range into msg (may be NULL). A NULL
+ * d (what wetdem_param_find answers for an unknown name) is WETDEM_ERR_INVALID with a message
+ * saying so. */
 WETDEM_API int wetdem_param_validate(const struct wetdem_param_desc* d, double value, char* msg,
                                      size_t msg_size);
-/* Writes the valid range of d as text, e.g. "(0, 1]" or "one of: c, nc". */
-WETDEM_API void wetdem_param_range_text(const struct wetdem_param_desc* d, char* buf, size_t n);
+/* The two writers of text below follow snprintf: at most n bytes, NUL included, go to buf
+ * (the text cut short when it is longer; nothing when n is 0, and buf may then be NULL), and
+ * they return the length of the whole text without its NUL, so a return >= n means it was cut
+ * short and says how large a buffer it needs (plus 1). */
+/* Writes the valid range of d as text, e.g. "(0, 1]" or "one of: c, nc"; d NULL: "". */
+WETDEM_API size_t wetdem_param_range_text(const struct wetdem_param_desc* d, char* buf, size_t n);
 /* value with the fewest significant digits, at least min_digits (1..17; others are taken as
  * the nearer end), that read back as value (17 if none do, as for NaN); e.g. 1.000000000001
- * at 6, not 1; with a decimal point in any locale. */
-WETDEM_API void wetdem_param_format_value(double value, int min_digits, char* buf, size_t n);
+ * at 6, not 1; with a decimal point in any locale. The digits do not depend on n: a short buf
+ * receives the start of that text. */
+WETDEM_API size_t wetdem_param_format_value(double value, int min_digits, char* buf, size_t n);
 /* Index of `word` among d->choices, or -1. */
 WETDEM_API int wetdem_param_choice_index(const struct wetdem_param_desc* d, const char* word);
 /* The closest of `candidates` (NULL-terminated) to `word` by edit distance (insertions,
@@ -1422,9 +1429,10 @@ struct wetdem_fit_result {
 WETDEM_API void wetdem_fit_options_init(struct wetdem_fit_options* opt);
 /* Solves the problem with the GSL trust-region (Levenberg-Marquardt) solver and a
  * central-difference Jacobian. predicted (may be NULL) receives the predictions at the
- * solution [n_data]. Returns WETDEM_OK (a parameter at a bound is reported in *result, not as
- * an error), WETDEM_ERR_INVALID (bad problem or options, an initial value outside or on a
- * bound), WETDEM_ERR_CALLBACK or the model's status (the model failed), WETDEM_ERR_MAX_STEPS
+ * solution [n_data]; opt NULL takes the defaults of wetdem_fit_options_init(). Returns
+ * WETDEM_OK (a parameter at a bound is reported in *result, not as an error),
+ * WETDEM_ERR_INVALID (bad problem or options, problem or result NULL, an initial value not
+ * finite, or outside or on a bound), WETDEM_ERR_CALLBACK or the model's status (the model failed), WETDEM_ERR_MAX_STEPS
  * (not converged; *result holds the last iterate), WETDEM_ERR_UNDETERMINED (the data do not
  * depend on a parameter, exactly or beyond their scatter where the fit stopped, e.g. at a start
  * where its effect is cut off (see undetermined above), or do not determine some parameters

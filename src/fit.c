@@ -707,7 +707,15 @@ static int report(struct fit_ctx* c, int st, gsl_matrix* cov, const struct wetde
 int wetdem_fit_run(const struct wetdem_fit_problem* problem, const struct wetdem_fit_options* opt,
                    struct wetdem_fit_result* result, double* predicted, char* msg, size_t msg_size)
 {
+    if (!problem || !result)
+        return wetdem_status_fail(msg, msg_size, WETDEM_ERR_INVALID, "NULL %s",
+                                  problem ? "result" : "problem");
     memset(result, 0, sizeof *result);
+    struct wetdem_fit_options defaults;
+    if (!opt) { /* (the header's defaults, as wetdem_fit_options_init gives them) */
+        wetdem_fit_options_init(&defaults);
+        opt = &defaults;
+    }
     int st = check_problem(problem, opt, msg, msg_size);
     if (st != WETDEM_OK)
         return st;

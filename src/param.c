@@ -5,6 +5,7 @@
  * third of the word length, at least 2).
  */
 #include <math.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -43,42 +44,74 @@ static size_t count_choices(const char* const* choices)
     return n;
 }
 
-void wetdem_param_range_text(const struct wetdem_param_desc* d, char* buf, size_t n)
+/* snprintf into buf + used when there is room left, else only counts: the total length of
+ * the text so far, as snprintf returns it */
+static size_t append(char* buf, size_t n, size_t used, const char* fmt, ...)
 {
+    va_list ap;
+    va_start(ap, fmt);
+    int k = vsnprintf(used < n ? buf + used : NULL, used < n ? n - used : 0, fmt, ap);
+    va_end(ap);
+    return used + (k > 0 ? (size_t)k : 0);
+}
+
+size_t wetdem_param_range_text(const struct wetdem_param_desc* d, char* buf, size_t n)
+{
+    if (!buf)
+        n = 0; /* (snprintf's convention: NULL with 0 only counts; NULL with more is no room) */
+    if (n)
+        buf[0] = '\0';
+    if (!d)
+        return 0;
     if (d->choices) {
-        size_t used = (size_t)snprintf(buf, n, "one of:");
-        for (size_t k = 0; d->choices[k] && used < n; k++)
-            used += (size_t)snprintf(buf + used, n - used, "%s %s", k ? "," : "", d->choices[k]);
-        return;
+        size_t used = append(buf, n, 0, "one of:");
+        for (size_t k = 0; d->choices[k]; k++)
+            used = append(buf, n, used, "%s %s", k ? "," : "", d->choices[k]);
+        return used;
     }
     int digits = d->integer ? 10 : 6; /* counts in full: [0, 4294967295], not 4.29497e+09 */
     /* (in the C locale: "[0.5, 1]", not "[0,5, 1]"; without one, in the thread's) */
     struct wetdem_locale_guard g;
     (void)wetdem_locale_guard_enter(&g); /* (leave undoes only an enter that succeeded) */
-    snprintf(buf, n, "%s%c%.*g, %.*g%c", d->integer ? "integer in " : "", d->min_open ? '(' : '[',
-             digits, d->min, digits, d->max, d->max_open ? ')' : ']');
+    size_t used =
+        append(buf, n, 0, "%s%c%.*g, %.*g%c", d->integer ? "integer in " : "",
+               d->min_open ? '(' : '[', digits, d->min, digits, d->max, d->max_open ? ')' : ']');
     wetdem_locale_guard_leave(&g);
+    return used;
 }
 
-void wetdem_param_format_value(double value, int min_digits, char* buf, size_t n)
+size_t wetdem_param_format_value(double value, int min_digits, char* buf, size_t n)
 {
     /* (clamped to 1..17: above 17 the loop ran never and left buf as it was) */
     int first = min_digits < 1 ? 1 : (min_digits > 17 ? 17 : min_digits);
     /* the text of a number for files and command lines: in the C locale (without one, which
-     * does not happen with glibc or musl, in the thread's; it still reads back there) */
+     * does not happen with glibc or musl, in the thread's; it still reads back there). Found
+     * in a buffer of its own ("%.17g" of any double is at most 24 characters), so that a short
+     * or NULL buf neither stops the search early nor is read back */
+    char text[40];
     struct wetdem_locale_guard g;
     (void)wetdem_locale_guard_enter(&g); /* (leave undoes only an enter that succeeded) */
     for (int digits = first; digits <= 17; digits++) {
-        snprintf(buf, n, "%.*g", digits, value);
-        if (strtod(buf, NULL) == value)
+        snprintf(text, sizeof text, "%.*g", digits, value);
+        if (strtod(text, NULL) == value)
             break;
     }
     wetdem_locale_guard_leave(&g);
+    if (buf && n)
+        snprintf(buf, n, "%s", text);
+    return strlen(text);
 }
 
 int wetdem_param_validate(const struct wetdem_param_desc* d, double value, char* msg,
                           size_t msg_size)
 {
+    if (!d) { /* (what wetdem_param_find answers for a name it does not know) */
+        if (msg && msg_size)
+            snprintf(msg, msg_size,
+                     "no parameter to check the value against (NULL descriptor: a name that "
+                     "wetdem_param_find did not find?)");
+        return WETDEM_ERR_INVALID;
+    }
     bool ok = isfinite(value);
     if (ok && d->choices) {
         double idx = floor(value);

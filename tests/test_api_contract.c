@@ -4,7 +4,9 @@
  * found" answer of a lookup), never dereferenced; an insertion is whole or nothing, also for
  * counts whose arrays no size_t can measure; a hard-sphere impulse that would give NaN or
  * infinite velocities is an error that leaves the bodies as they were; a fit refuses an
- * infinite scale or tolerance; a value is formatted whatever the digits asked for; the
+ * infinite scale or tolerance, and takes the defaults for NULL options; a NULL descriptor is
+ * refused with a message; a value is formatted whatever the digits asked for, and the text
+ * writers follow snprintf (NULL with 0 only counts, the length needed returned); the
  * reports of a many-particle run read particles edited since its latest call as that call
  * would, and refuse those it would refuse.
  */
@@ -195,6 +197,75 @@ static void test_api_fit_refuses_infinite_scale_and_tolerances(void** state)
     }
 }
 
+/* The writers of text follow snprintf: buf NULL with n 0 only counts, a short buffer gets the
+ * start of the text, and the return is the whole text's length; a value's digits do not
+ * depend on the room given (a short buffer used to be read back and end the search at 17). */
+static void test_api_text_writers_follow_snprintf(void** state)
+{
+    (void)state;
+    char buf[64], small[4];
+    size_t len = wetdem_param_format_value(0.1, 6, NULL, 0);
+    assert_int_equal(len, 3); /* "0.1" */
+    assert_int_equal(wetdem_param_format_value(0.1, 6, buf, sizeof buf), len);
+    assert_string_equal(buf, "0.1");
+    assert_int_equal(wetdem_param_format_value(1.000000000001, 6, small, sizeof small), 14);
+    assert_string_equal(small, "1.0"); /* the start of 1.000000000001, cut to 3 + NUL */
+    strcpy(small, "abc");
+    assert_int_equal(wetdem_param_format_value(2.5, 1, small, 0), 3);
+    assert_string_equal(small, "abc"); /* n 0: nothing written */
+
+    const struct wetdem_param_desc* settings = wetdem_sim_settings_params();
+    const struct wetdem_param_desc* choice = wetdem_param_find(settings, "stop_on_separation");
+    assert_non_null(choice);
+    for (size_t k = 0; settings[k].name; k++) { /* numbers and enumerations alike */
+        size_t need = wetdem_param_range_text(&settings[k], NULL, 0);
+        assert_int_equal(wetdem_param_range_text(&settings[k], buf, sizeof buf), need);
+        assert_int_equal(strlen(buf), need);
+        char cut[6];
+        assert_int_equal(wetdem_param_range_text(&settings[k], cut, sizeof cut), need);
+        assert_int_equal(strncmp(cut, buf, sizeof cut - 1), 0);
+        assert_int_equal(strlen(cut), need < sizeof cut ? need : sizeof cut - 1);
+    }
+    assert_int_equal(wetdem_param_range_text(choice, NULL, 0), strlen("one of: no, yes"));
+    strcpy(buf, "stale");
+    assert_int_equal(wetdem_param_range_text(NULL, buf, sizeof buf), 0);
+    assert_string_equal(buf, "");
+}
+
+/* A name wetdem_param_find does not know, chained into wetdem_param_validate, is an error
+ * with a message, not a crash; a fit without options takes the defaults. */
+static void test_api_null_descriptor_and_fit_options(void** state)
+{
+    (void)state;
+    char msg[256] = "";
+    const struct wetdem_param_desc* d =
+        wetdem_param_find(wetdem_sim_settings_params(), "no_such_setting");
+    assert_null(d);
+    assert_int_equal(wetdem_param_validate(d, 1.0, msg, sizeof msg), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(msg, "NULL descriptor");
+    assert_int_equal(wetdem_param_validate(NULL, 1.0, NULL, 0), WETDEM_ERR_INVALID);
+
+    const double observed[5] = {1, 2, 3, 4, 5}, initial[2] = {1, 0.5};
+    struct wetdem_fit_problem pb = {.n_params = 2,
+                                    .initial = initial,
+                                    .n_data = 5,
+                                    .observed = observed,
+                                    .model = straight_line};
+    struct wetdem_fit_options opt;
+    struct wetdem_fit_result with_defaults, without;
+    wetdem_fit_options_init(&opt);
+    CHECK_OK(wetdem_fit_run(&pb, &opt, &with_defaults, NULL, msg, sizeof msg));
+    CHECK_OK(wetdem_fit_run(&pb, NULL, &without, NULL, msg, sizeof msg));
+    /* the same iterations: bit-identical values */
+    assert_memory_equal(without.values, with_defaults.values, sizeof without.values);
+    assert_int_equal(without.iterations, with_defaults.iterations);
+    assert_int_equal(wetdem_fit_run(NULL, NULL, &without, NULL, msg, sizeof msg),
+                     WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(msg, "NULL problem");
+    assert_int_equal(wetdem_fit_run(&pb, NULL, NULL, NULL, msg, sizeof msg), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(msg, "NULL result");
+}
+
 /* A force that overflows (a sphere 1e308 m behind a wall: Hertz's k delta^1.5) is reported as
  * a numerical failure, as the integrators report it, not returned as a result. */
 static void test_api_pair_force_refuses_non_finite_force(void** state)
@@ -299,6 +370,8 @@ int main(void)
         cmocka_unit_test(test_api_hard_impulse_never_returns_nan_velocities),
         cmocka_unit_test(test_api_fit_refuses_infinite_scale_and_tolerances),
         cmocka_unit_test(test_api_format_value_always_writes),
+        cmocka_unit_test(test_api_text_writers_follow_snprintf),
+        cmocka_unit_test(test_api_null_descriptor_and_fit_options),
         cmocka_unit_test(test_api_pair_force_refuses_non_finite_force),
         cmocka_unit_test(test_api_many_reports_read_the_particles_edited_since_the_latest_call),
     };
