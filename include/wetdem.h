@@ -1197,7 +1197,8 @@ wetdem_pairwise_events(const struct wetdem_pairwise* pw, size_t* n);
  * t* = v_10 t / 4a, NAN when their speed (res->v_n0, res->v_10) is not positive. */
 WETDEM_API double wetdem_pairwise_t_hat(const struct wetdem_pairwise_result* res, double t);
 WETDEM_API double wetdem_pairwise_t_star(const struct wetdem_pairwise_result* res, double t);
-/* Index of pair (i, j), i != j < n, in the per-pair arrays: (0,1), (0,2), ..., (1,2), ... */
+/* Index of pair (i, j), i != j < n, in the per-pair arrays: (0,1), (0,2), ..., (1,2), ...;
+ * (i, j) and (j, i) are the same pair. SIZE_MAX when i == j, i >= n or j >= n (no pair). */
 WETDEM_API size_t wetdem_pairwise_pair_index(size_t n, size_t i, size_t j);
 /* "film_start", "contact", "rest_start", "rest_end", "film_end", "partner_change". */
 WETDEM_API const char* wetdem_pairwise_event_name(enum wetdem_pairwise_event_kind kind);

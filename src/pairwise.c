@@ -23,6 +23,7 @@
 #include <math.h>
 #include <omp.h>
 #include <stdarg.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -175,6 +176,8 @@ const struct wetdem_pairwise_event* wetdem_pairwise_events(const struct wetdem_p
 
 size_t wetdem_pairwise_pair_index(size_t n, size_t i, size_t j)
 {
+    if (i == j || i >= n || j >= n) /* (no pair: the formula gave another pair's index) */
+        return SIZE_MAX;
     if (i > j) {
         size_t t = i;
         i = j;

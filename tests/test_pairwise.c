@@ -2010,6 +2010,30 @@ static void test_pairwise_partner_change_logged(void** state)
 /* ------------------------------------------------------------- builder and inputs ---- */
 
 /* The Table-I builder reproduces its groups: St_n, Ca, h_a, h_m, beta, h_23,0, theta_23,0. */
+/* Pair indices enumerate the pairs (0,1), (0,2), ..., (n-2,n-1) once each in order, in
+ * either argument order; what is no pair (i == j, or a sphere >= n) is SIZE_MAX, not the
+ * index of another pair ((1,1) of 3 spheres was 1, the pair (0,2)). */
+static void test_pairwise_pair_index(void** state)
+{
+    (void)state;
+    for (size_t n = 2; n <= WETDEM_PAIRWISE_MAX_SPHERES; n++) {
+        size_t next = 0;
+        for (size_t i = 0; i < n; i++)
+            for (size_t j = i + 1; j < n; j++) {
+                assert_int_equal(wetdem_pairwise_pair_index(n, i, j), next);
+                assert_int_equal(wetdem_pairwise_pair_index(n, j, i), next);
+                next++;
+            }
+        assert_int_equal(next, n * (n - 1) / 2);
+        for (size_t i = 0; i < n + 2; i++) {
+            assert_true(wetdem_pairwise_pair_index(n, i, i) == SIZE_MAX);
+            assert_true(wetdem_pairwise_pair_index(n, i, n) == SIZE_MAX);
+            assert_true(wetdem_pairwise_pair_index(n, n + 1, i) == SIZE_MAX);
+        }
+    }
+    assert_true(wetdem_pairwise_pair_index(0, 0, 1) == SIZE_MAX);
+}
+
 static void test_pairwise_davis_builder(void** state)
 {
     (void)state;
@@ -2203,6 +2227,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_pairwise_headon_matches_closed_form),
+        cmocka_unit_test(test_pairwise_pair_index),
         cmocka_unit_test(test_pairwise_run_object_reused),
         cmocka_unit_test(test_pairwise_headon_sticks_below_critical_stokes),
         cmocka_unit_test(test_pairwise_dry_restitution_and_friction),
