@@ -1205,7 +1205,8 @@ WETDEM_API const char* wetdem_pairwise_event_name(enum wetdem_pairwise_event_kin
 /* "FA", "PA", "FS". */
 WETDEM_API const char* wetdem_pairwise_outcome_name(enum wetdem_pairwise_outcome outcome);
 /* Largest magnitude among the terms of an energy budget [J] (DBL_MIN if all are zero): the
- * scale its residual is judged against. */
+ * scale its residual is judged against. NAN when a term (the residual aside) is NaN, as in a
+ * budget not computed (config.energy_budget false). */
 WETDEM_API double wetdem_pairwise_energy_scale(const struct wetdem_pairwise_energy* e);
 
 /* Fills *d with Davis's defaults (St_n 2, Ca 1000, h_a 0.01, h_m 0.01, beta 30 deg,

@@ -613,8 +613,11 @@ double wetdem_pairwise_energy_scale(const struct wetdem_pairwise_energy* e)
                       e->gravity, e->viscous_normal, e->viscous_tangential,
                       e->contact};
     double s = DBL_MIN;
-    for (size_t k = 0; k < sizeof terms / sizeof terms[0]; k++)
+    for (size_t k = 0; k < sizeof terms / sizeof terms[0]; k++) {
+        if (isnan(terms[k])) /* (fmax drops a NaN: a broken budget looked well scaled) */
+            return NAN;
         s = fmax(s, fabs(terms[k]));
+    }
     return s;
 }
 

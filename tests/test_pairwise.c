@@ -471,6 +471,18 @@ static void test_pairwise_energy_headon_closed_form(void** state)
     assert_true(wetdem_pairwise_energy_scale(e) == e->initial);
     struct wetdem_pairwise_energy none = {0};
     assert_true(wetdem_pairwise_energy_scale(&none) == DBL_MIN);
+    /* a NaN term makes the scale NaN (it was ignored: the rest's maximum, or DBL_MIN for a
+     * budget not computed, all NaN), whichever term it is */
+    for (size_t k = 0; k < 7; k++) {
+        struct wetdem_pairwise_energy broken = *e;
+        double* terms[] = {&broken.initial, &broken.kinetic,        &broken.capillary,
+                           &broken.gravity, &broken.viscous_normal, &broken.viscous_tangential,
+                           &broken.contact};
+        *terms[k] = NAN;
+        assert_true(isnan(wetdem_pairwise_energy_scale(&broken)));
+    }
+    struct wetdem_pairwise_energy off = {NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN};
+    assert_true(isnan(wetdem_pairwise_energy_scale(&off)));
 }
 
 /* The budget closes on Davis's three spheres, whatever dissipates: the Fig. 3 case (St 2,
