@@ -195,13 +195,22 @@ static int setup_map(const struct wetdem_fit_problem* pb, size_t j, struct param
               : has_lo         ? WETDEM_FIT_LOG_LOWER
               : has_hi         ? WETDEM_FIT_LOG_UPPER
                                : WETDEM_FIT_LINEAR;
-    if (!isfinite(p0) || (has_lo && !(p0 > m->lo)) || (has_hi && !(p0 < m->hi))) {
+    if (!isfinite(p0)) { /* (no bound to speak of: the start itself is no number) */
+        char who[48] = "";
+        if (!(pb->names && pb->names[j]))
+            snprintf(who, sizeof who, " %zu (initial[%zu])", j + 1, j);
+        return wetdem_status_fail(msg, n, WETDEM_ERR_INVALID,
+                                  "%s%s: initial value %g is not finite: the fit needs a finite "
+                                  "start",
+                                  param_name(pb, j), who, p0);
+    }
+    if ((has_lo && !(p0 > m->lo)) || (has_hi && !(p0 < m->hi))) {
         char range[96];
         snprintf(range, sizeof range, "%s%g, %g%s", has_lo ? "(" : "(-", has_lo ? m->lo : INFINITY,
                  m->hi, ")");
         return wetdem_status_fail(
             msg, n, WETDEM_ERR_INVALID,
-            "%s: initial value %g must be finite and inside %s%s: the fit varies %s, which "
+            "%s: initial value %g must be inside %s%s: the fit varies %s, which "
             "cannot start on or beyond a bound",
             param_name(pb, j), p0, range, lg && m->lo == 0 ? ", i.e. > 0 (log fit)" : "",
             m->kind == WETDEM_FIT_LOGISTIC    ? "ln((p - lower)/(upper - p))"

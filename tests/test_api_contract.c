@@ -266,6 +266,28 @@ static void test_api_null_descriptor_and_fit_options(void** state)
     CHECK_CONTAINS(msg, "NULL result");
 }
 
+/* A NaN start of an unbounded parameter is named as not finite; the message spoke of
+ * ln(upper - p) and bounds it does not have. */
+static void test_api_fit_names_a_start_that_is_not_finite(void** state)
+{
+    (void)state;
+    const double observed[5] = {1, 2, 3, 4, 5}, initial[2] = {1, NAN};
+    const char* names[2] = {"slope", "offset"};
+    struct wetdem_fit_problem pb = {.n_params = 2,
+                                    .initial = initial,
+                                    .n_data = 5,
+                                    .observed = observed,
+                                    .model = straight_line};
+    struct wetdem_fit_result res;
+    char msg[256] = "";
+    assert_int_equal(wetdem_fit_run(&pb, NULL, &res, NULL, msg, sizeof msg), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(msg, "parameter 2 (initial[1]): initial value nan is not finite");
+    assert_null(strstr(msg, "ln("));
+    pb.names = names;
+    assert_int_equal(wetdem_fit_run(&pb, NULL, &res, NULL, msg, sizeof msg), WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(msg, "offset: initial value nan is not finite");
+}
+
 /* A force that overflows (a sphere 1e308 m behind a wall: Hertz's k delta^1.5) is reported as
  * a numerical failure, as the integrators report it, not returned as a result. */
 static void test_api_pair_force_refuses_non_finite_force(void** state)
@@ -372,6 +394,7 @@ int main(void)
         cmocka_unit_test(test_api_format_value_always_writes),
         cmocka_unit_test(test_api_text_writers_follow_snprintf),
         cmocka_unit_test(test_api_null_descriptor_and_fit_options),
+        cmocka_unit_test(test_api_fit_names_a_start_that_is_not_finite),
         cmocka_unit_test(test_api_pair_force_refuses_non_finite_force),
         cmocka_unit_test(test_api_many_reports_read_the_particles_edited_since_the_latest_call),
     };
