@@ -424,7 +424,9 @@ WETDEM_API int wetdem_sim_add_particle(struct wetdem_sim* sim, struct wetdem_par
 WETDEM_API struct wetdem_particle* wetdem_sim_particles(struct wetdem_sim* sim, size_t* n);
 /* Number of particles. */
 WETDEM_API size_t wetdem_sim_n_particles(const struct wetdem_sim* sim);
-/* Adds a plane wall through `point` with unit `normal` into the domain, of material k. In the
+/* Adds a plane wall through `point` with `normal` into the domain, of material `material`.
+ * The normal is normalised: any finite, non-zero vector (of any length: 1e-200 or 1e200 as
+ * well) gives its direction; zero or non-finite ones are WETDEM_ERR_INVALID. In the
  * many-particle mode a wall must be parallel to every periodic axis (|normal| component along
  * it <= 1e-12): wetdem_sim_integrate refuses the run otherwise (WETDEM_ERR_INVALID). A wall
  * added between calls of a many-particle run acts from the next call on, with fresh histories

@@ -200,10 +200,26 @@ size_t wetdem_sim_n_particles(const struct wetdem_sim* sim)
 int wetdem_sim_add_wall(struct wetdem_sim* sim, struct wetdem_vec3 point, struct wetdem_vec3 normal,
                         int material)
 {
-    double len = vec3_norm(normal);
-    if (!vec3_is_finite(point) || !(isfinite(len) && len > 0))
+    if (!vec3_is_finite(point) || !vec3_is_finite(normal))
         return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
-                               "wall %zu: point must be finite and normal non-zero", sim->n_walls);
+                               "wall %zu: point (%g, %g, %g) m and normal (%g, %g, %g) must be "
+                               "finite",
+                               sim->n_walls, point.x, point.y, point.z, normal.x, normal.y,
+                               normal.z);
+    double big = fmax(fabs(normal.x), fmax(fabs(normal.y), fabs(normal.z)));
+    if (!(big > 0))
+        return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
+                               "wall %zu: normal (0, 0, 0) is zero: it gives no direction",
+                               sim->n_walls);
+    /* |normal| squares the components, which underflows to 0 (or loses digits) below 1e-150
+     * and overflows above 1.3e154: such a normal is first scaled by its largest component
+     * (others as they are: their unit normal unchanged to the last bit) */
+    double len = vec3_norm(normal);
+    if (!(len >= 1e-150 && len <= 1e150)) {
+        normal = (struct wetdem_vec3){normal.x / big, normal.y / big, normal.z / big};
+        /* (divided: 1 / big overflows for a subnormal big) */
+        len = vec3_norm(normal); /* in [1, sqrt(3)] */
+    }
     if (material < 0 || material >= sim->n_materials)
         return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
                                "wall %zu: material %d does not exist (valid 0..%d)", sim->n_walls,

@@ -288,6 +288,49 @@ static void test_api_fit_names_a_start_that_is_not_finite(void** state)
     CHECK_CONTAINS(msg, "offset: initial value nan is not finite");
 }
 
+/* A wall's normal gives only its direction: (1, 1, 0) scaled by 1e-200 or 1e200 (whose
+ * squared length under- or overflows) is the same wall, so a sphere pressed into it moves
+ * bit for bit as with (1, 1, 0), along that normal; these were refused as "normal
+ * non-zero". A zero normal is refused as zero. */
+static void test_api_wall_normal_of_any_length(void** state)
+{
+    (void)state;
+    const double scales[] = {1.0, 1e-200, 1e200, 5e-324};
+    struct wetdem_particle ref = {0};
+    for (size_t k = 0; k < sizeof scales / sizeof scales[0]; k++) {
+        struct wetdem_sim* sim = wetdem_sim_create();
+        assert_int_equal(wetdem_sim_add_material_preset(sim, "steel1"), 0);
+        CHECK_OK(wetdem_sim_enable_model(sim, "hertz"));
+        double c = scales[k];
+        CHECK_OK(wetdem_sim_add_wall(sim, (struct wetdem_vec3){0, 0, 0},
+                                     (struct wetdem_vec3){c, c, 0}, 0));
+        /* centre 0.99 mm from the plane x + y = 0: 10 um overlap with a 1 mm sphere */
+        double x = 0.99e-3 / sqrt(2.0);
+        CHECK_OK(wetdem_sim_add_particle(
+            sim, (struct wetdem_particle){.radius = 1e-3, .pos = {x, x, 0}, .material = 0}));
+        CHECK_OK(wetdem_sim_integrate(sim, 1e-7));
+        const struct wetdem_particle* p = wetdem_sim_particles(sim, NULL);
+        assert_true(p->vel.x > 0 && p->vel.x == p->vel.y && p->vel.z == 0);
+        if (k == 0)
+            ref = *p;
+        assert_memory_equal(&p->pos, &ref.pos, sizeof ref.pos);
+        assert_memory_equal(&p->vel, &ref.vel, sizeof ref.vel);
+        wetdem_sim_free(sim);
+    }
+    struct wetdem_sim* sim = wetdem_sim_create();
+    assert_int_equal(wetdem_sim_add_material_preset(sim, "steel1"), 0);
+    assert_int_equal(
+        wetdem_sim_add_wall(sim, (struct wetdem_vec3){0, 0, 0}, (struct wetdem_vec3){0, 0, 0}, 0),
+        WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(wetdem_sim_errmsg(sim), "wall 0: normal (0, 0, 0) is zero");
+    assert_int_equal(
+        wetdem_sim_add_wall(sim, (struct wetdem_vec3){0, 0, 0}, (struct wetdem_vec3){NAN, 0, 1}, 0),
+        WETDEM_ERR_INVALID);
+    CHECK_CONTAINS(wetdem_sim_errmsg(sim), "normal (nan, 0, 1) must be finite");
+    assert_int_equal(wetdem_sim_n_walls(sim), 0);
+    wetdem_sim_free(sim);
+}
+
 /* A force that overflows (a sphere 1e308 m behind a wall: Hertz's k delta^1.5) is reported as
  * a numerical failure, as the integrators report it, not returned as a result. */
 static void test_api_pair_force_refuses_non_finite_force(void** state)
@@ -395,6 +438,7 @@ int main(void)
         cmocka_unit_test(test_api_text_writers_follow_snprintf),
         cmocka_unit_test(test_api_null_descriptor_and_fit_options),
         cmocka_unit_test(test_api_fit_names_a_start_that_is_not_finite),
+        cmocka_unit_test(test_api_wall_normal_of_any_length),
         cmocka_unit_test(test_api_pair_force_refuses_non_finite_force),
         cmocka_unit_test(test_api_many_reports_read_the_particles_edited_since_the_latest_call),
     };
