@@ -636,7 +636,8 @@ struct wetdem_collision_spec {
                                    straight-line approach, sin(angle) = b / (R_i + R_j) with
                                    the impact parameter b (wall: to its normal); 0 = head-on */
     struct wetdem_vec3 omega_i; /* initial spin of i [rad/s] */
-    double initial_gap;         /* gap at t = 0 [m]; <= 0: just outside the interaction range */
+    double initial_gap;         /* gap at t = 0 [m], finite and <= 1e150 (the geometry squares
+                                   centre distances); <= 0: just outside the interaction range */
     double t_end;               /* longest simulated time [s], finite and > 0 (no automatic
                                    value here: the CLI derives one, docs/scenarios.md) */
     double observe_time;        /* > 0: also report e_n at this time (Punch Fig. 9 window) */

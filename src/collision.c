@@ -70,6 +70,10 @@
 #define SRS_ANGLE (5.0 * M_PI / 180.0) /* doublet turn that marks stick-rotate-separate [rad] */
 #define CLOSE_GAP_RATIO 0.01           /* h_close / R* without films [-] */
 #define START_MARGIN_RATIO 0.01        /* start gap beyond the range, / R* [-] */
+/* Largest initial gap [m]: the pair geometry squares centre distances (contact.c, and
+ * back_distance below), which overflows beyond sqrt(DBL_MAX) = 1.3e154 m; 1e150 leaves room
+ * for the radii and the three components, and lies far beyond any gap a run can cross. */
+#define INITIAL_GAP_MAX 1e150
 
 const char* wetdem_outcome_name(enum wetdem_outcome outcome)
 {
@@ -291,9 +295,17 @@ static int check_spec(struct wetdem_sim* sim, const struct wetdem_collision_spec
                                "which needs angle < pi/2 (%g rad) and fluid.viscosity > 0 "
                                "(%g Pa s)",
                                s->stokes, s->angle, sim->fluid.viscosity);
-    if (!vec3_is_finite(s->omega_i) || !isfinite(s->initial_gap))
+    if (!vec3_is_finite(s->omega_i))
         return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
-                               "collision: omega_i and initial_gap must be finite");
+                               "collision: omega_i = (%g, %g, %g) rad/s must be finite",
+                               s->omega_i.x, s->omega_i.y, s->omega_i.z);
+    if (!(isfinite(s->initial_gap) && s->initial_gap <= INITIAL_GAP_MAX))
+        return wetdem_sim_fail(
+            sim, WETDEM_ERR_INVALID,
+            "collision: initial_gap = %g m: valid finite and <= %g m (<= 0: just "
+            "outside the interaction range); the pair geometry squares "
+            "centre distances, which overflow beyond %.2g m",
+            s->initial_gap, INITIAL_GAP_MAX, sqrt(DBL_MAX));
     if (!(isfinite(s->t_end) && s->t_end > 0) ||
         !(isfinite(s->observe_time) && s->observe_time >= 0))
         return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,

@@ -331,6 +331,34 @@ static void test_api_wall_normal_of_any_length(void** state)
     wetdem_sim_free(sim);
 }
 
+/* A collision's initial gap beyond what the geometry can square is refused naming the gap
+ * and its range (it was "particle 0: position, velocity and spin must be finite"); the largest
+ * allowed gap runs: the striker, 1e150 m away at 0.1 m/s, never reaches the target. */
+static void test_api_collision_names_an_initial_gap_too_large(void** state)
+{
+    (void)state;
+    struct wetdem_sim* sim = wetdem_sim_create();
+    assert_int_equal(wetdem_sim_add_material_preset(sim, "steel1"), 0);
+    CHECK_OK(wetdem_sim_enable_model(sim, "hertz"));
+    struct wetdem_collision_spec s = {
+        .radius_i = 1e-3, .radius_j = 1e-3, .speed = 0.1, .t_end = 1e-3, .initial_gap = 1e150};
+    struct wetdem_collision_result r;
+    for (int wall = 0; wall < 2; wall++) {
+        s.target_is_wall = wall;
+        s.initial_gap = 1e150;
+        CHECK_OK(wetdem_collision_run(sim, &s, &r));
+        assert_int_equal(r.outcome, WETDEM_OUTCOME_NONE);
+        const double bad[] = {1e300, NAN, -INFINITY};
+        for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {
+            s.initial_gap = bad[k];
+            CHECK_STATUS(wetdem_collision_run(sim, &s, &r), WETDEM_ERR_INVALID);
+            CHECK_CONTAINS(wetdem_sim_errmsg(sim), "collision: initial_gap = ");
+            CHECK_CONTAINS(wetdem_sim_errmsg(sim), "valid finite and <= 1e+150 m");
+        }
+    }
+    wetdem_sim_free(sim);
+}
+
 /* A force that overflows (a sphere 1e308 m behind a wall: Hertz's k delta^1.5) is reported as
  * a numerical failure, as the integrators report it, not returned as a result. */
 static void test_api_pair_force_refuses_non_finite_force(void** state)
@@ -439,6 +467,7 @@ int main(void)
         cmocka_unit_test(test_api_null_descriptor_and_fit_options),
         cmocka_unit_test(test_api_fit_names_a_start_that_is_not_finite),
         cmocka_unit_test(test_api_wall_normal_of_any_length),
+        cmocka_unit_test(test_api_collision_names_an_initial_gap_too_large),
         cmocka_unit_test(test_api_pair_force_refuses_non_finite_force),
         cmocka_unit_test(test_api_many_reports_read_the_particles_edited_since_the_latest_call),
     };
