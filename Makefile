@@ -125,7 +125,8 @@ test: all $(TEST_BIN) $(EX_BIN) $(BUILD)/tests/wetdem_alloc_fail
 	@WETDEM_CLI='$(abspath $(BUILD)/wetdem)' CC='$(CC)' WETDEM_BUILD='$(BUILD)' \
 	  WETDEM_CLI_ALLOC_FAIL='$(abspath $(BUILD)/tests/wetdem_alloc_fail)' \
 	  WETDEM_EXTRA_CFLAGS='$(EXTRA_CFLAGS)' tests/run-tests $(TEST_BIN) $(EX_BIN) \
-	  tests/test_install_deps.sh tests/test_install.sh tests/test_cli_alloc_failure.sh
+	  tests/test_install_deps.sh tests/test_install.sh tests/test_cli_alloc_failure.sh \
+	  tests/test_build_without_openmp.sh
 
 # Tests again under AddressSanitizer + UndefinedBehaviorSanitizer, in a separate build tree,
 # built by GCC (test-san) and by clang (test-san-clang: its UBSan also reports pointer

@@ -1449,6 +1449,7 @@ static int index_blocks(struct wetdem_sim* sim, size_t nb)
        block, the blocks in parallel (each block's entries at its offset, in pair order) */
     size_t count[WETDEM_MANY_MAX_BLOCKS + 1] = {0};
     bool parallel = nb > 1 && wetdem_many_parallel(m, n);
+    (void)parallel; /* (read by the pragmas only: unused in a build without OpenMP) */
 #pragma omp parallel for schedule(static) if (parallel)
     for (size_t b = 0; b < (nb > 1 ? nb : 0); b++) {
         size_t c = 0; /* (stored once: neighbouring counts share a cache line) */
@@ -2276,6 +2277,7 @@ static int reserve_work(struct wetdem_sim* sim)
  * measured times). */
 static void collect_pass_work(struct wetdem_sim* sim, bool parallel)
 {
+    (void)parallel; /* (read by the pragma only: unused in a build without OpenMP) */
     struct wetdem_many* m = sim->many;
     size_t nm = sim->n_models, n = sim->n_particles, nc = m->cross_first[m->n_blocks];
     for (size_t e = 0; e < nc; e++) {
