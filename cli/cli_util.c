@@ -20,6 +20,7 @@
 
 #include "cli_util.h"
 #include "output_journal.h"
+#include "signals.h"
 
 void cli_error(const char* fmt, ...)
 {
@@ -1016,7 +1017,7 @@ void cli_progress_start(struct cli_progress* p, double done)
 
 void cli_progress_show(struct cli_progress* p, double done, const char* fmt, ...)
 {
-    if (!p->tty)
+    if (!p->tty || cli_stop_signal) /* (stopping: the signal's notice stays the last line) */
         return;
     double elapsed = omp_get_wtime() - p->start;
     bool last = done >= 1;
@@ -1029,6 +1030,7 @@ void cli_progress_show(struct cli_progress* p, double done, const char* fmt, ...
     vsnprintf(what, sizeof what, fmt, ap);
     va_end(ap);
     double left = ceil(elapsed * (1 - fmin(done, 1)) / (done - p->done0));
+    cli_progress_shown = 1; /* (before the line: a signal's notice then erases it) */
     int n = fprintf(stderr, "\rwetdem: %s (%5.1f %%), %.0f s elapsed, about %.*g s left   ", what,
                     100 * done, elapsed, left < 1e6 ? 6 : 2, left);
     p->shown = n > 1 ? n - 1 : 0; /* (less the carriage return) */
@@ -1042,6 +1044,7 @@ void cli_progress_clear(struct cli_progress* p)
     if (p->shown)
         fprintf(stderr, "\r%*s\r", p->shown, "");
     p->shown = 0;
+    cli_progress_shown = 0;
     fflush(stderr);
 }
 

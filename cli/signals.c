@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 volatile sig_atomic_t cli_stop_signal = 0;
+volatile sig_atomic_t cli_progress_shown = 0;
 
 static atomic_int signal_count;
 static atomic_llong first_signal_ns; /* CLOCK_MONOTONIC of the first signal; 0: not stored yet */
@@ -28,6 +29,20 @@ static void say(const char* text)
     (void)unused;
 }
 
+/* text on a line of its own: over a progress line, that line erased (carriage return, erase
+ * to the end of the line) and text's leading newline dropped, which would have left the
+ * progress line standing above it; write(2) only */
+static void say_on_clean_line(const char* text)
+{
+    if (!cli_progress_shown) {
+        say(text);
+        return;
+    }
+    cli_progress_shown = 0;
+    say("\r\033[K");
+    say(text[0] == '\n' ? text + 1 : text);
+}
+
 static long long monotonic_ns(void)
 {
     struct timespec now;
@@ -42,13 +57,13 @@ static void on_signal(int sig)
     if (before == 0) {
         atomic_store(&first_signal_ns, now > 0 ? now : 1);
         cli_stop_signal = sig;
-        say(notice_text);
+        say_on_clean_line(notice_text);
         return;
     }
     long long first = atomic_load(&first_signal_ns);
     if (before == 1 && (first == 0 || (double)(now - first) < 1e9 * CLI_SIGNAL_GRACE_S))
         return; /* the same request again (first == 0: both at once) */
-    say(stop_text);
+    say_on_clean_line(stop_text);
     if (remove_path[0])
         unlink(remove_path);
     /* die by the signal, as the caller asked: default action, raised again (delivered when

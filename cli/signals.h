@@ -26,6 +26,10 @@
 /* The first signal's number, 0 while none came; what a library stop flag points to. */
 extern volatile sig_atomic_t cli_stop_signal;
 
+/* 1 while a progress line (cli_progress_show, cli_util.c) may stand on the terminal: the
+ * handler then erases it ("\r\033[K") before its message, which starts on that clean line. */
+extern volatile sig_atomic_t cli_progress_shown;
+
 struct cli_saved_signals {
     struct sigaction sigint, sigterm;
 };

@@ -12,6 +12,8 @@
  * The CLI path comes from the environment variable WETDEM_CLI (set by `make test`), falling
  * back to build/wetdem relative to the working directory (the repository root).
  */
+#include <pty.h>
+#include <signal.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -668,6 +670,55 @@ static void test_cli_run_progress_on_a_terminal(void** state)
     if (!(strtod(first + strlen("\rwetdem: t = "), NULL) < 2e-4 && pct == 100))
         fail_msg("expected lines before the last:\n%s", tty);
     free(tty);
+}
+
+/* Ctrl-C over a run's progress line (a pairwise run with --out, on a terminal): the notice
+ * erases the line ("\r\033[K") and starts where it stood; it started on the next line, the
+ * progress line left above it. No progress line is drawn after it. */
+static void test_cli_signal_notice_starts_on_a_clean_line(void** state)
+{
+    (void)state;
+    char dir[] = "/tmp/wetdem_test_cli_signal_XXXXXX";
+    assert_non_null(mkdtemp(dir));
+    int master;
+    pid_t pid = forkpty(&master, NULL, NULL, NULL);
+    assert_true(pid >= 0);
+    if (pid == 0) {
+        char cmd[2048]; /* (some 4 s without the signal) */
+        snprintf(cmd, sizeof cmd,
+                 "exec env OMP_NUM_THREADS=1 '%s' run examples/scenarios/davis_three.ini --set "
+                 "davis.t_star_end=1e5 --out %s/out > /dev/null",
+                 test_cli_path(), dir);
+        execl("/bin/sh", "sh", "-c", cmd, (char*)NULL);
+        _exit(127);
+    }
+    char buf[16384];
+    size_t n = 0;
+    ssize_t got;
+    bool sent = false;
+    while (n + 1 < sizeof buf && (got = read(master, buf + n, sizeof buf - n - 1)) > 0) {
+        n += (size_t)got;
+        buf[n] = '\0';
+        if (!sent && strstr(buf, " s left") && test_signal_caught(pid, SIGINT)) {
+            kill(pid, SIGINT); /* (a progress line stands: the first comes after 0.5 s) */
+            sent = true;
+        }
+    }
+    buf[n] = '\0';
+    int status;
+    waitpid(pid, &status, 0);
+    close(master);
+    if (!sent)
+        fail_msg("no progress line to interrupt:\n%s", buf);
+    assert_true(WIFEXITED(status) && WEXITSTATUS(status) == 128 + SIGINT);
+    const char* notice = strstr(buf, "wetdem: run: stopping");
+    assert_non_null(notice);
+    assert_true(notice - buf >= 4 && memcmp(notice - 4, "\r\033[K", 4) == 0);
+    assert_null(strstr(notice, " s left")); /* nothing drawn after it */
+    CHECK_CONTAINS(notice, "wetdem: run: interrupted by signal 2");
+    char cmd[128];
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
+    assert_int_equal(system(cmd), 0);
 }
 
 /* A table that cannot be written to standard output (a full disk, a closed descriptor) is an
@@ -1441,6 +1492,7 @@ int main(void)
         cmocka_unit_test(test_cli_dev_stdout_output_to_a_redirected_file),
         cmocka_unit_test(test_cli_numbers_out_of_range_and_cr_lines),
         cmocka_unit_test(test_cli_run_progress_on_a_terminal),
+        cmocka_unit_test(test_cli_signal_notice_starts_on_a_clean_line),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
