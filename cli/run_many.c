@@ -1179,7 +1179,8 @@ static bool note_value(const char* note, const char* key, char* buf, size_t n)
 /* Refuses a restart that names the frames or the CSV otherwise than the run that wrote the
  * checkpoint (its checkpoint_note): another VTK prefix would start a second series beside the
  * first, another CSV name find no rows before the checkpoint. Writing none of them, or
- * starting frames that run did not write, continues it. CLI exit code; touches no file. */
+ * starting frames or a CSV that run did not write (from the checkpoint on), continues it. CLI
+ * exit code; touches no file. */
 static int check_output_names(const struct cli_many_setup* su, const struct cli_run_options* opt)
 {
     const char* note = wetdem_sim_checkpoint_note(su->sim);
@@ -1327,7 +1328,13 @@ static int resume(const struct cli_scenario* sc, const struct cli_many_setup* su
     bool at_step = false;
     char path[PATH_CHARS + 8];
     snprintf(path, sizeof path, "%s.csv", pl->csv_prefix);
-    if (rc == CLI_EXIT_OK && pl->csv_prefix[0])
+    /* a CSV the run that wrote the checkpoint did not write (csv = none there) starts here,
+       as frames that run did not write do: the library writes it anew, header first (the
+       checkpoint counts no rows), from the checkpoint's step on; there is nothing to trim */
+    char was[CLI_VALUE_MAX];
+    const char* note = wetdem_sim_checkpoint_note(su->sim);
+    bool csv_starts = note && note_value(note, "csv", was, sizeof was) && strcmp(was, "none") == 0;
+    if (rc == CLI_EXIT_OK && pl->csv_prefix[0] && !csv_starts)
         rc = csv_resume(path, wetdem_sim_time(su->sim), s.step, pl->dt, &w, opt->out_dir, &at_step);
     /* a row at the checkpoint's step on this run's grid that the CSV lacks (that run's grid
        was another): the uninterrupted run with this run's settings has it */

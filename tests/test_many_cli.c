@@ -606,6 +606,31 @@ static void test_many_cli_restart_is_bit_identical(void** state)
                  renamed[k].set);
         free(expect_exit(args, 2, renamed[k].what));
     }
+    /* a CSV the checkpoint's run did not write (csv = none) starts at the restart, as frames
+       do: its header and the rows from the checkpoint's step on, those of the uninterrupted
+       run (it was refused as a "missing" CSV) */
+    assert_int_equal(run_cli("run box.ini --set run.steps=300 --set dump.csv=none --out nocsv"), 0);
+    assert_int_equal(access(tpath("nocsv/global.csv"), F_OK), -1);
+    code = run_cli("run box.ini --set run.steps=600 --out nocsv --restart nocsv/checkpoint.ckpt");
+    if (code != 0)
+        fail_msg("restart starting a CSV: exit %d\n%s", code, stderr_text());
+    char* started = test_read_file(tpath("nocsv/global.csv"), NULL);
+    char* full = test_read_file(tpath("whole/global.csv"), NULL);
+    assert_non_null(started);
+    assert_non_null(full);
+    drop_column(started, 9); /* (candidate pairs: the restart builds its list afresh) */
+    drop_column(full, 9);
+    char* header = strstr(full, "\ntime [s],"); /* the header, then rows from step 300 on */
+    char* from300 = strstr(full, "\n0.0006,300,");
+    assert_non_null(header);
+    assert_non_null(from300);
+    size_t header_len = (size_t)(strchr(header + 1, '\n') - header);
+    char* own_header = strstr(started, "\ntime [s],");
+    assert_non_null(own_header);
+    assert_memory_equal(own_header, header, header_len + 1);
+    assert_string_equal(own_header + header_len, from300);
+    free(started);
+    free(full);
     /* one holding another number of spheres than the scenario places (the checkpoint's would
        replace them unnoticed), and the final checkpoint of a run resumed with the same end
        (nothing to run: the message says how to extend it); both exit 2 before any output is
