@@ -17,6 +17,7 @@
  * numbering: sphere 1 is the striker); the library counts from 0.
  */
 #include <errno.h>
+#include <float.h>
 #include <math.h>
 #include <stdatomic.h>
 #include <stdio.h>
@@ -308,6 +309,55 @@ static int report_gap(const struct cli_scenario* sc, const char* msg)
     return CLI_EXIT_USAGE;
 }
 
+/* Densities m / (4/3 pi a^3) a [sphere.NAME] may have [kg/m^3]: every solid sphere of matter
+ * lies inside, from aerogels (0.16) to osmium (22 590), with a margin of about 10 below and 4
+ * above. Outside, the scales of the run part beyond what double precision resolves long before
+ * anything physical is reached: a radius of 1e-150 m under a mass of 1e-4 kg (a spin equation
+ * with 1/I ~ 1e300), or a mass of 1e-300 kg pulled by a capillary force of 0.1 N (1e299 m/s^2
+ * when the films meet) failed at or soon after t = 0 with WETDEM_ERR_STEP. Davis's
+ * dimensionless runs, whose masses follow from St_n and carry no density, are [davis]'s. */
+#define SPHERE_DENSITY_MIN 1e-2
+#define SPHERE_DENSITY_MAX 1e5
+
+/* Checks of [sphere.NAME] runs beyond the library's (which also serves [davis] and programs):
+ * a density of matter (above), and a speed that moves its sphere by more than the rounding of
+ * its position within t_end (a slower one cannot be told from rest, and CVODE's weights on the
+ * speeds, 1 / (rtol v), overflow below ~1e-146 m/s: it failed at t = 0). The message is at the
+ * sphere's section. Exit code. */
+static int check_spheres(const struct cli_scenario* sc, const struct wetdem_pairwise_config* cfg)
+{
+    size_t i = 0;
+    for (size_t s = 0; s < sc->n_sections && i < cfg->n_spheres; s++) {
+        const char* name = sc->sections[s].name;
+        if (strncmp(name, "sphere.", 7) != 0)
+            continue;
+        const struct wetdem_pairwise_sphere* q = &cfg->spheres[i++];
+        double rho = q->mass / (4.0 / 3.0 * M_PI * q->radius * q->radius * q->radius);
+        if (!(rho >= SPHERE_DENSITY_MIN && rho <= SPHERE_DENSITY_MAX)) {
+            cli_scenario_section_error(
+                sc, name,
+                "mass = %g kg and radius = %g m give a density m / (4/3 pi a^3) = %g "
+                "kg/m^3: valid [%g, %g] (solids span 0.16 to 22 590 kg/m^3; beyond, the run's "
+                "time scales are not resolved in double precision); for dimensionless limits "
+                "use [davis]",
+                q->mass, q->radius, rho, SPHERE_DENSITY_MIN, SPHERE_DENSITY_MAX);
+            return CLI_EXIT_USAGE;
+        }
+        double v = hypot(q->vx, q->vy);
+        double rounding = DBL_EPSILON * (fabs(q->x) + fabs(q->y) + q->radius);
+        if (v > 0 && !(v * cfg->t_end >= rounding)) {
+            cli_scenario_section_error(
+                sc, name,
+                "speed |(vx, vy)| = %g m/s moves the sphere %g m in t_end = %g s, less than "
+                "the rounding of its position (%g m): it cannot be told from rest; give 0, or at "
+                "least %g m/s",
+                v, v * cfg->t_end, cfg->t_end, rounding, rounding / cfg->t_end);
+            return CLI_EXIT_USAGE;
+        }
+    }
+    return CLI_EXIT_OK;
+}
+
 /* Builds and checks the configuration; exit code. */
 static int build_config(const struct cli_scenario* sc, struct wetdem_pairwise_config* cfg)
 {
@@ -328,7 +378,7 @@ static int build_config(const struct cli_scenario* sc, struct wetdem_pairwise_co
             return report_gap(sc, msg);
         return report(sc, strncmp(msg, "spheres[", 8) == 0 && davis ? "davis" : "pairwise", msg);
     }
-    return CLI_EXIT_OK;
+    return davis ? CLI_EXIT_OK : check_spheres(sc, cfg);
 }
 
 /* ----------------------------------------------------------------------- reporting ---- */

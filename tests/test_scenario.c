@@ -427,6 +427,28 @@ static void test_scenario_bad_files_exit_2_with_line(void** state)
          "1e-3\nmass = 1e-5\n"
          "[sphere.b]\nradius = 1e-3\nmass = 1e-5\nx = 1.5e-3\n",
          ":9:", "initial gap of spheres 1 and 2"},
+        /* scales no run resolves, refused before it: densities beyond any solid's (a radius
+           of 1e-150 m, a mass of 1e-300 kg) and a speed that cannot be told from rest; in
+           runs that moved them they failed at or soon after t = 0, WETDEM_ERR_STEP (exit 1) */
+        {"tiny_radius",
+         "[engine]\ntype = pairwise\n[pairwise]\nh_min = 1e-6\nt_end = 1\n[sphere.a]\nradius = "
+         "1e-150\nmass = 1e-5\n[sphere.b]\nradius = 1e-3\nmass = 1e-5\nx = 3e-3\n",
+         ":6:",
+         "[sphere.a]: mass = 1e-05 kg and radius = 1e-150 m give a density m / (4/3 pi a^3) = "
+         "inf kg/m^3: valid [0.01, 100000]"},
+        {"tiny_mass",
+         "[engine]\ntype = pairwise\n[pairwise]\nh_min = 1e-6\nt_end = 1\nsurface_tension = "
+         "10\n[sphere.a]\nradius = 1e-3\nmass = 1e-5\n[sphere.b]\nradius = 1e-3\nmass = "
+         "1e-300\nx = 3e-3\n",
+         ":10:", "[sphere.b]: mass = 1e-300 kg and radius = 0.001 m give a density"},
+        {"tiny_speed",
+         "[engine]\ntype = pairwise\n[pairwise]\nh_min = 1e-6\nt_end = 1e-2\n[sphere.a]\n"
+         "radius = 1e-3\nmass = 1e-5\nvx = 1e-150\n[sphere.b]\nradius = 1e-3\nmass = "
+         "1e-5\nx = 3e-3\n",
+         ":6:",
+         "[sphere.a]: speed |(vx, vy)| = 1e-150 m/s moves the sphere 1e-152 m in t_end = 0.01 "
+         "s, less than the rounding of its position (2.22045e-19 m): it cannot be told from "
+         "rest; give 0, or at least 2.22045e-17 m/s"},
     };
     for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
         char name[64], args[700], where[600];
