@@ -166,16 +166,23 @@ static int straight_line(const double* p, double* predicted, char* msg, size_t m
     return WETDEM_OK;
 }
 
+/* The straight line's problem: the five points 1..5 from the start initial[2]. */
+static struct wetdem_fit_problem line_problem(const double* initial)
+{
+    static const double observed[5] = {1, 2, 3, 4, 5};
+    return (struct wetdem_fit_problem){.n_params = 2,
+                                       .initial = initial,
+                                       .n_data = 5,
+                                       .observed = observed,
+                                       .model = straight_line};
+}
+
 static void test_api_fit_refuses_infinite_scale_and_tolerances(void** state)
 {
     (void)state;
-    const double observed[5] = {1, 2, 3, 4, 5}, initial[2] = {1, 0.5};
+    const double initial[2] = {1, 0.5};
     const double scale[5] = {1, 1, INFINITY, 1, 1};
-    struct wetdem_fit_problem pb = {.n_params = 2,
-                                    .initial = initial,
-                                    .n_data = 5,
-                                    .observed = observed,
-                                    .model = straight_line};
+    struct wetdem_fit_problem pb = line_problem(initial);
     struct wetdem_fit_options opt;
     struct wetdem_fit_result res;
     char msg[256] = "";
@@ -245,12 +252,8 @@ static void test_api_null_descriptor_and_fit_options(void** state)
     CHECK_CONTAINS(msg, "NULL descriptor");
     assert_int_equal(wetdem_param_validate(NULL, 1.0, NULL, 0), WETDEM_ERR_INVALID);
 
-    const double observed[5] = {1, 2, 3, 4, 5}, initial[2] = {1, 0.5};
-    struct wetdem_fit_problem pb = {.n_params = 2,
-                                    .initial = initial,
-                                    .n_data = 5,
-                                    .observed = observed,
-                                    .model = straight_line};
+    const double initial[2] = {1, 0.5};
+    struct wetdem_fit_problem pb = line_problem(initial);
     struct wetdem_fit_options opt;
     struct wetdem_fit_result with_defaults, without;
     wetdem_fit_options_init(&opt);
@@ -271,13 +274,9 @@ static void test_api_null_descriptor_and_fit_options(void** state)
 static void test_api_fit_names_a_start_that_is_not_finite(void** state)
 {
     (void)state;
-    const double observed[5] = {1, 2, 3, 4, 5}, initial[2] = {1, NAN};
+    const double initial[2] = {1, NAN};
     const char* names[2] = {"slope", "offset"};
-    struct wetdem_fit_problem pb = {.n_params = 2,
-                                    .initial = initial,
-                                    .n_data = 5,
-                                    .observed = observed,
-                                    .model = straight_line};
+    struct wetdem_fit_problem pb = line_problem(initial);
     struct wetdem_fit_result res;
     char msg[256] = "";
     assert_int_equal(wetdem_fit_run(&pb, NULL, &res, NULL, msg, sizeof msg), WETDEM_ERR_INVALID);

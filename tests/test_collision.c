@@ -246,13 +246,9 @@ static void test_collision_cvode_sees_a_grazing_contact(void** state)
 }
 
 /* e_t of a dry Hertz + Mindlin impact (steel spheres, 0.5 m/s, at `degrees` from the line of
- * centres) with `integrator` and its parameter `key` set to `value`. */
-static double mindlin_e_t_with(double degrees, const char* integrator, const char* key,
-                               double value)
+ * centres) run on sim (material mat), which it frees. */
+static double oblique_e_t(struct wetdem_sim* sim, int mat, double degrees)
 {
-    int mat;
-    struct wetdem_sim* sim = make_sim("steel1", 0, "hertz", "mindlin", integrator, &mat);
-    CHECK_OK(wetdem_sim_set_param(sim, key, value));
     struct wetdem_collision_spec s = head_on(mat, 0.5, 1e-3);
     s.initial_gap = 1e-4;
     s.angle = degrees * M_PI / 180;
@@ -261,6 +257,16 @@ static double mindlin_e_t_with(double degrees, const char* integrator, const cha
     assert_true(r.separated && r.solid_contact);
     wetdem_sim_free(sim);
     return r.e_t;
+}
+
+/* The same with `integrator` and its parameter `key` set to `value`. */
+static double mindlin_e_t_with(double degrees, const char* integrator, const char* key,
+                               double value)
+{
+    int mat;
+    struct wetdem_sim* sim = make_sim("steel1", 0, "hertz", "mindlin", integrator, &mat);
+    CHECK_OK(wetdem_sim_set_param(sim, key, value));
+    return oblique_e_t(sim, mat, degrees);
 }
 
 /* The same with CVODE at its default tolerances and the largest step max_step (0: default). */
@@ -277,14 +283,7 @@ static double mindlin_e_t_rtol(double degrees, double rtol)
     struct wetdem_sim* sim = make_sim("steel1", 0, "hertz", "mindlin", "cvode", &mat);
     CHECK_OK(wetdem_sim_set_param(sim, "cvode.rtol", rtol));
     CHECK_OK(wetdem_sim_set_param(sim, "cvode.atol", 0.1 * rtol));
-    struct wetdem_collision_spec s = head_on(mat, 0.5, 1e-3);
-    s.initial_gap = 1e-4;
-    s.angle = degrees * M_PI / 180;
-    struct wetdem_collision_result r;
-    CHECK_OK(wetdem_collision_run(sim, &s, &r));
-    assert_true(r.separated && r.solid_contact);
-    wetdem_sim_free(sim);
-    return r.e_t;
+    return oblique_e_t(sim, mat, degrees);
 }
 
 static double mindlin_e_t_verlet(double degrees, double fraction);
