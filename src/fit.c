@@ -195,8 +195,8 @@ static int setup_map(const struct wetdem_fit_problem* pb, size_t j, struct param
               : has_lo         ? WETDEM_FIT_LOG_LOWER
               : has_hi         ? WETDEM_FIT_LOG_UPPER
                                : WETDEM_FIT_LINEAR;
-    if (!isfinite(p0)) { /* (no bound to speak of: the start itself is no number) */
-        char who[48] = "";
+    if (!isfinite(p0)) {   /* (no bound to speak of: the start itself is no number) */
+        char who[64] = ""; /* (room for two 20-digit counts) */
         if (!(pb->names && pb->names[j]))
             snprintf(who, sizeof who, " %zu (initial[%zu])", j + 1, j);
         return wetdem_status_fail(msg, n, WETDEM_ERR_INVALID,
