@@ -625,8 +625,8 @@ static void test_cli_run_progress_on_a_terminal(void** state)
     /* dry_hertz.ini separates at 2.46e-4 s; with t_end = 2e-4 s both integrators run to t_end */
     static const char* const runs[] = {
         "run examples/scenarios/dry_hertz.ini --set collision.t_end=2e-4",
-        "run examples/scenarios/dry_hertz.ini --set collision.t_end=2e-4 --set "
-        "integrator.name=cvode",
+        ("run examples/scenarios/dry_hertz.ini --set collision.t_end=2e-4 --set "
+         "integrator.name=cvode"),
         "run examples/scenarios/davis_three.ini", /* (FA: runs to t_end) */
     };
     for (size_t k = 0; k < sizeof runs / sizeof runs[0]; k++) {
