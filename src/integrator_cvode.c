@@ -384,12 +384,19 @@ static int attach_solvers(struct solver* s, bool bdf, sunindextype n)
     return flag == CVLS_MEM_FAIL ? CV_MEM_FAIL : flag;
 }
 
+/* Whether some pair is within the range of its tangential spring (the state then holds q). */
+static bool some_spring_acts(const struct wetdem_sim* sim)
+{
+    for (size_t k = 0; k < sim->engine.pairs.n; k++)
+        if (sim->engine.pairs.items[k].spring_zone)
+            return true;
+    return false;
+}
+
 static int solver_create(struct wetdem_sim* sim, struct run* r, const struct cvode_params* p,
                          double t_end, bool bdf, struct solver* s)
 {
-    r->with_q = false; /* q while some pair is within the range of its spring */
-    for (size_t k = 0; k < sim->engine.pairs.n; k++)
-        r->with_q = r->with_q || sim->engine.pairs.items[k].spring_zone;
+    r->with_q = some_spring_acts(sim); /* q while some pair is within its spring's range */
     r->n_state = 9 * r->n_free + (r->with_q ? 3 * sim->engine.pairs.n : 0);
     r->t_rhs = NAN;
     sunindextype n = (sunindextype)r->n_state;
@@ -749,10 +756,7 @@ static int restart_solver(struct wetdem_sim* sim, struct run* r, struct solver* 
  * left at located events, where CVODE restarts anyway. */
 static bool q_change_due(const struct wetdem_sim* sim, const struct run* r)
 {
-    bool want = false;
-    for (size_t k = 0; k < sim->engine.pairs.n; k++)
-        want = want || sim->engine.pairs.items[k].spring_zone;
-    return want != r->with_q;
+    return some_spring_acts(sim) != r->with_q;
 }
 
 static int run_loop(struct wetdem_sim* sim, struct run* r, struct solver* s,
