@@ -529,11 +529,13 @@ int wetdem_sim_many_check_models(const struct wetdem_sim* sim, const char* what)
  * the many-particle mode, a started run and its models unchanged
  * (wetdem_sim_many_check_models). WETDEM_OK, or WETDEM_ERR_INVALID with "WHAT: why". */
 int wetdem_sim_many_check_run(const struct wetdem_sim* sim, const char* what);
-/* What a report of a started run reads besides the histories: the particles as edited
- * through wetdem_sim_particles() since the latest call. WETDEM_OK when each is one the next
- * call accepts (wetdem_sim_particle_valid) or no run has started, else WETDEM_ERR_INVALID with
- * "WHAT: particle K: why", so that no report reads past the materials or sums a NaN. */
-int wetdem_sim_many_check_particles(const struct wetdem_sim* sim, const char* what);
+/* What a report of a started run reads besides the histories: its models unchanged
+ * (wetdem_sim_many_check_models) and the particles as edited through wetdem_sim_particles()
+ * since the latest call. WETDEM_OK when those hold and each particle is one the next call
+ * accepts (wetdem_sim_particle_valid), or no run has started, else WETDEM_ERR_INVALID with
+ * "WHAT: why" ("WHAT: particle K: why"), so that no report reads past the materials or sums a
+ * NaN. */
+int wetdem_sim_many_check_report(const struct wetdem_sim* sim, const char* what);
 
 /* sim_many_force.c */
 /* Builds the material-pair table and chooses the kernel (fused or generic); needs m->reach

@@ -1458,10 +1458,11 @@ int wetdem_sim_many_check_run(const struct wetdem_sim* sim, const char* what)
     return wetdem_sim_many_check_models(sim, what);
 }
 
-int wetdem_sim_many_check_particles(const struct wetdem_sim* sim, const char* what)
+int wetdem_sim_many_check_report(const struct wetdem_sim* sim, const char* what)
 {
-    if (!sim->many || !sim->many->started)
-        return WETDEM_OK;
+    int st = wetdem_sim_many_check_models(sim, what);
+    if (st != WETDEM_OK || !sim->many || !sim->many->started)
+        return st;
     char why[256];
     for (size_t k = 0; k < sim->n_particles; k++)
         if (!wetdem_sim_particle_valid(sim, &sim->particles[k], why, sizeof why))
@@ -1721,9 +1722,7 @@ int wetdem_sim_energy_budget(const struct wetdem_sim* sim, struct wetdem_energy_
                                !m            ? "the simulation is not in the many-particle mode"
                                : !m->started ? "the many-particle run has not started"
                                              : "the run's energy_budget setting is off");
-    int st = wetdem_sim_many_check_models(sim, "energy_budget");
-    if (st == WETDEM_OK)
-        st = wetdem_sim_many_check_particles(sim, "energy_budget");
+    int st = wetdem_sim_many_check_report(sim, "energy_budget");
     if (st != WETDEM_OK)
         return st;
     wetdem_sim_many_energies(sim, &b->kinetic, &b->potential, &b->elastic);

@@ -274,7 +274,7 @@ const struct wetdem_many_mix* wetdem_sim_many_mix(const struct wetdem_sim* sim, 
 
 /* The mixed properties of materials a and b: the table's, or for a material added since the
  * table was made (at the latest call: a report between calls reads the particles as edited
- * since, wetdem_sim_many_check_particles) mixed here as the next call will, with the fluid of
+ * since, wetdem_sim_many_check_report) mixed here as the next call will, with the fluid of
  * the table. */
 static const struct wetdem_many_mix* mix_of(const struct wetdem_sim* sim, int a, int b,
                                             struct wetdem_many_mix* scratch)

@@ -184,7 +184,7 @@ int wetdem_sim_many_stats(const struct wetdem_sim* sim, struct wetdem_many_stats
     memset(s, 0, sizeof *s);
     int st = wetdem_sim_many_check_run(sim, "many_stats");
     if (st == WETDEM_OK)
-        st = wetdem_sim_many_check_particles(sim, "many_stats");
+        st = wetdem_sim_many_check_report(sim, "many_stats");
     if (st != WETDEM_OK)
         return st;
     st = wetdem_sim_many_links(sim, NULL, s);
@@ -601,9 +601,7 @@ int wetdem_sim_many_write_csv_row(struct wetdem_sim* sim)
     if (!sim || !sim->many || !sim->many->started || !sim->many->output_prefix)
         return wetdem_sim_fail(sim, WETDEM_ERR_INVALID,
                                "many: a CSV row needs a started many-particle run with outputs");
-    int checked = wetdem_sim_many_check_models(sim, "many: a CSV row");
-    if (checked == WETDEM_OK)
-        checked = wetdem_sim_many_check_particles(sim, "many: a CSV row");
+    int checked = wetdem_sim_many_check_report(sim, "many: a CSV row");
     if (checked != WETDEM_OK)
         return checked;
     struct wetdem_locale_guard g;
@@ -1079,9 +1077,7 @@ enum file_call { WRITE_VTK, WRITE_VTK_LINKS, WRITE_CHECKPOINT, READ_CHECKPOINT }
 static int file_call(struct wetdem_sim* sim, enum file_call call, const char* path, bool binary)
 {
     static const char* const what[] = {"write_vtk", "links", "write_checkpoint", NULL};
-    int st = what[call] ? wetdem_sim_many_check_models(sim, what[call]) : WETDEM_OK;
-    if (st == WETDEM_OK && what[call])
-        st = wetdem_sim_many_check_particles(sim, what[call]);
+    int st = what[call] ? wetdem_sim_many_check_report(sim, what[call]) : WETDEM_OK;
     if (st != WETDEM_OK)
         return st;
     struct wetdem_locale_guard g;
